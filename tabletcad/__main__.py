@@ -1,0 +1,5 @@
+import sys
+
+from tabletcad.cli import main
+
+sys.exit(main())

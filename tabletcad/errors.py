@@ -1,0 +1,99 @@
+"""Errors raised by tabletcad.
+
+Bad input raises :class:`DesignError` (a :class:`ValueError`) whose message is
+one line naming the parameter, its value and the allowed range, e.g.
+``diameter = -1 mm is not allowed: must be > 0``.  Domain failures that are
+not the user's input (a fit that misses its tolerance, a sewing that leaves
+free edges) raise :class:`GeometryError`, which carries the object that failed.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+__all__ = [
+    "TabletcadError",
+    "DesignError",
+    "GeometryError",
+    "check_finite",
+    "check_positive",
+    "check_range",
+]
+
+
+class TabletcadError(Exception):
+    """Base class of every error tabletcad raises on purpose."""
+
+
+class DesignError(TabletcadError, ValueError):
+    """Invalid user input: the message names the parameter, value and allowed range."""
+
+    def __init__(self, parameter: str, value: Any, allowed: str, unit: str = "") -> None:
+        self.parameter = parameter
+        self.value = value
+        self.allowed = allowed
+        self.unit = unit
+        shown = _fmt(value)
+        if unit:
+            shown = f"{shown} {unit}"
+        super().__init__(f"{parameter} = {shown} is not allowed: {allowed}")
+
+
+class GeometryError(TabletcadError):
+    """A geometric construction failed; ``obj`` is what failed (patch, face, shell...)."""
+
+    def __init__(self, message: str, obj: Any = None) -> None:
+        self.obj = obj
+        super().__init__(message)
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return repr(value) if isinstance(value, str) else str(value)
+
+
+def check_finite(name: str, value: float, unit: str = "") -> float:
+    """Return ``float(value)`` or raise :class:`DesignError` if it is not a finite number."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise DesignError(name, value, "must be a finite number", unit) from None
+    if not math.isfinite(x):
+        raise DesignError(name, value, "must be a finite number", unit)
+    return x
+
+
+def check_positive(name: str, value: float, unit: str = "") -> float:
+    """Return ``float(value)`` or raise unless it is finite and > 0."""
+    x = check_finite(name, value, unit)
+    if x <= 0.0:
+        raise DesignError(name, value, "must be > 0", unit)
+    return x
+
+
+def check_range(
+    name: str,
+    value: float,
+    lo: float | None = None,
+    hi: float | None = None,
+    unit: str = "",
+    *,
+    lo_open: bool = False,
+    hi_open: bool = False,
+) -> float:
+    """Return ``float(value)`` or raise unless ``lo <=/< value <=/< hi``."""
+    x = check_finite(name, value, unit)
+    bad = (
+        (lo is not None and (x < lo or (lo_open and x == lo)))
+        or (hi is not None and (x > hi or (hi_open and x == hi)))
+    )
+    if bad:
+        parts = []
+        if lo is not None:
+            parts.append(f"{'>' if lo_open else '>='} {lo:g}")
+        if hi is not None:
+            parts.append(f"{'<' if hi_open else '<='} {hi:g}")
+        raise DesignError(name, value, "must be " + " and ".join(parts) + (f" {unit}" if unit else ""), unit)
+    return x

@@ -1,0 +1,65 @@
+"""The one tolerance object of tabletcad.
+
+Every numerical threshold the package uses lives here, documented, instead
+of being scattered as literals.  Lengths are in millimetres.  Change a value
+with :func:`dataclasses.replace` and pass the result where a function takes
+``tol=``; :data:`DEFAULT` is used otherwise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+__all__ = ["Tolerances", "DEFAULT"]
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Numerical tolerances (lengths in mm, angles in degrees).
+
+    Attributes
+    ----------
+    interpolation : float
+        Largest allowed distance (mm) between a PDE patch and its boundary
+        curves at the curve parameters; the remainder term guarantees it.
+    fourier : float
+        A curve is represented by ``N`` Fourier modes when the truncated series
+        is within this distance (mm) of the curve everywhere (sampled densely).
+    stray : float
+        Largest allowed distance (mm) that the modes a curve needs only below
+        ``fourier`` (plus the remainder term) may move the surface between the
+        curves.  A patch exceeding it is refused: its shape would be driven by
+        amplified high-frequency content instead of by the design.
+    max_modes : int
+        Upper bound on the number of Fourier modes ``N`` carried analytically;
+        content above it goes into the remainder term.
+    samples : int
+        Default number of samples per curve used for FFTs and checks.
+    quad_u : int
+        Gauss-Legendre points in ``u`` per patch for area/volume quadrature.
+    quad_v : int
+        Trapezoidal points in ``v`` (periodic, spectrally accurate).
+    seam_gap : float
+        Seam gap (mm) above which two patches are reported as not meeting.
+    seam_angle_deg : float
+        Normal angle (deg) below which a seam counts as tangent-continuous (G1).
+    fit : float
+        Largest deviation (mm) of a B-spline face from its PDE patch (CAD layer).
+    nominal : float
+        Largest deviation (mm) of a PDE surface from a family's exact nominal.
+    """
+
+    interpolation: float = 1e-9
+    fourier: float = 1e-9
+    stray: float = 1e-3
+    max_modes: int = 48
+    samples: int = 512
+    quad_u: int = 48
+    quad_v: int = 256
+    seam_gap: float = 1e-7
+    seam_angle_deg: float = 0.01
+    fit: float = 1e-4
+    nominal: float = 1e-3
+
+
+DEFAULT = Tolerances()
