@@ -1,0 +1,455 @@
+"""Closed boundary curves ``c(v)``, ``v ∈ [0, 2π)``, in millimetres.
+
+A curve is any object with ``evaluate(v, der=0)`` returning points (or
+``v``-derivatives) of shape ``(m, 3)``.  The PDE patch reads curves only
+through that method and through :meth:`Curve.fourier`, so analytic curves
+(circle, ellipse, outlines made of lines and arcs) are exact at every ``v``;
+curves given as points are interpolated by a periodic cubic spline.
+
+Plan outlines (stadium, rounded rectangle, any lines-and-arcs outline) are
+parametrised by arc length, starting on the +x axis and running
+counter-clockwise, so that scaled copies of one outline correspond point by
+point across a patch.  Circles and ellipses use the polar angle, which is the
+same thing for a circle.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from tabletcad.errors import DesignError, check_finite, check_positive, check_range
+from tabletcad.tolerance import DEFAULT, Tolerances
+
+__all__ = [
+    "Curve",
+    "CurveLike",
+    "Circle",
+    "Ellipse",
+    "Outline",
+    "Stadium",
+    "RoundedRectangle",
+    "PointCurve",
+    "Transformed",
+    "fourier_coefficients",
+    "modes_needed",
+    "sample_v",
+]
+
+TWO_PI = 2.0 * math.pi
+
+
+def sample_v(m: int) -> np.ndarray:
+    """``m`` equally spaced parameters on ``[0, 2π)``."""
+    return np.arange(m) * (TWO_PI / m)
+
+
+def _vec3(name: str, value) -> np.ndarray:
+    arr = np.asarray(value, dtype=float).reshape(-1)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise DesignError(name, value, "must be three finite numbers (x, y, z) in mm")
+    return arr
+
+
+@runtime_checkable
+class CurveLike(Protocol):
+    def evaluate(self, v: np.ndarray, der: int = 0) -> np.ndarray: ...
+
+
+class Curve:
+    """Base class: closed curve in 3-D parametrised over ``v ∈ [0, 2π)``."""
+
+    def evaluate(self, v, der: int = 0) -> np.ndarray:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def __call__(self, v) -> np.ndarray:
+        return self.evaluate(v)
+
+    # -- convenience ------------------------------------------------------------------
+    def fourier(self, modes: int, samples: int | None = None):
+        """Fourier coefficients ``(a0, a, b)`` up to ``modes``; see :func:`fourier_coefficients`."""
+        return fourier_coefficients(self, modes, samples)
+
+    def modes_needed(self, tol: float | None = None, max_modes: int = 256, samples: int | None = None) -> int:
+        """Fewest Fourier modes representing the curve within ``tol`` mm; see :func:`modes_needed`."""
+        return modes_needed(self, tol, max_modes, samples)
+
+    def centroid(self, samples: int = 256) -> np.ndarray:
+        """Mean of the curve over ``v`` (the ``n = 0`` Fourier term), shape (3,)."""
+        return self.evaluate(sample_v(samples)).mean(axis=0)
+
+    def moved(self, offset) -> "Transformed":
+        """This curve translated by ``offset`` (mm)."""
+        return Transformed(self, np.eye(3), _vec3("offset", offset))
+
+    def at_height(self, z: float) -> "Transformed":
+        """This curve translated by ``z`` mm along the z axis."""
+        return self.moved((0.0, 0.0, check_finite("z", z, "mm")))
+
+    def scaled_about_centroid(self, sxy: float = 1.0, sz: float = 1.0) -> "Transformed":
+        """Scale in the plane (``sxy``) and along z (``sz``) about the curve's centroid."""
+        c = self.centroid()
+        m = np.diag([sxy, sxy, sz])
+        return Transformed(self, m, c - m @ c)
+
+    @property
+    def is_point(self) -> bool:
+        """True when the curve is a single point (a pole of a patch)."""
+        pts = self.evaluate(sample_v(16))
+        return bool(np.max(np.ptp(pts, axis=0)) == 0.0)
+
+
+@dataclass(frozen=True)
+class Circle(Curve):
+    """Circle of ``radius`` (mm, >= 0; 0 gives a point) in the plane z = center[2].
+
+    ``c(v) = center + radius (cos v, sin v, 0)`` (thesis eq 4.2).
+    """
+
+    radius: float
+    center: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        check_range("radius", self.radius, 0.0, None, "mm")
+        object.__setattr__(self, "center", tuple(_vec3("center", self.center)))
+
+    def evaluate(self, v, der: int = 0) -> np.ndarray:
+        v = np.asarray(v, dtype=float).reshape(-1)
+        r = self.radius
+        c, s = np.cos(v), np.sin(v)
+        z = np.zeros_like(v)
+        if der == 0:
+            out = np.stack([r * c, r * s, z], axis=-1) + np.asarray(self.center)
+        elif der == 1:
+            out = np.stack([-r * s, r * c, z], axis=-1)
+        elif der == 2:
+            out = np.stack([-r * c, -r * s, z], axis=-1)
+        else:
+            raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
+        return out
+
+    @property
+    def is_point(self) -> bool:
+        return self.radius == 0.0
+
+
+@dataclass(frozen=True)
+class Ellipse(Curve):
+    """Ellipse with semi-axes ``rx`` and ``ry`` (mm) in the plane z = center[2].
+
+    ``c(v) = center + (rx cos v, ry sin v, 0)``.
+    """
+
+    rx: float
+    ry: float
+    center: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        check_range("rx", self.rx, 0.0, None, "mm")
+        check_range("ry", self.ry, 0.0, None, "mm")
+        object.__setattr__(self, "center", tuple(_vec3("center", self.center)))
+
+    def evaluate(self, v, der: int = 0) -> np.ndarray:
+        v = np.asarray(v, dtype=float).reshape(-1)
+        c, s = np.cos(v), np.sin(v)
+        z = np.zeros_like(v)
+        if der == 0:
+            return np.stack([self.rx * c, self.ry * s, z], axis=-1) + np.asarray(self.center)
+        if der == 1:
+            return np.stack([-self.rx * s, self.ry * c, z], axis=-1)
+        if der == 2:
+            return np.stack([-self.rx * c, -self.ry * s, z], axis=-1)
+        raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
+
+
+@dataclass(frozen=True)
+class _Seg:
+    kind: str  # "line" or "arc"
+    length: float
+    p0: tuple[float, float]
+    p1: tuple[float, float] = (0.0, 0.0)
+    center: tuple[float, float] = (0.0, 0.0)
+    radius: float = 0.0
+    theta0: float = 0.0
+    sweep: float = 0.0  # signed
+
+
+class Outline(Curve):
+    """Closed plan outline of straight lines and circular arcs, parametrised by arc length.
+
+    Build with :meth:`from_segments`.  ``v = 2π s / P`` where ``s`` is the arc
+    length from the start point and ``P`` the perimeter; the outline lies in the
+    plane ``z``.
+    """
+
+    def __init__(self, segments: list[_Seg], z: float = 0.0, name: str = "outline") -> None:
+        if not segments:
+            raise DesignError("segments", 0, "an outline needs at least one segment")
+        self._segs = tuple(segments)
+        self._z = float(z)
+        self.name = name
+        lengths = np.array([s.length for s in segments])
+        if np.any(lengths <= 0):
+            raise DesignError("segments", "zero-length segment", "every segment must have length > 0")
+        self._cum = np.concatenate([[0.0], np.cumsum(lengths)])
+        self.perimeter = float(self._cum[-1])
+
+    @classmethod
+    def from_segments(cls, items, z: float = 0.0, name: str = "outline") -> "Outline":
+        """Outline from a list of ``("line", (x0, y0), (x1, y1))`` and
+        ``("arc", (cx, cy), radius, theta0, sweep)`` items (angles in radians,
+        ``sweep > 0`` counter-clockwise), which must join end to start.
+        """
+        segs: list[_Seg] = []
+        for it in items:
+            if it[0] == "line":
+                p0, p1 = np.asarray(it[1], float), np.asarray(it[2], float)
+                segs.append(_Seg("line", float(np.hypot(*(p1 - p0))), tuple(p0), tuple(p1)))
+            elif it[0] == "arc":
+                c, r, t0, sw = np.asarray(it[1], float), float(it[2]), float(it[3]), float(it[4])
+                p0 = c + r * np.array([math.cos(t0), math.sin(t0)])
+                segs.append(_Seg("arc", abs(r * sw), tuple(p0), center=tuple(c), radius=r, theta0=t0, sweep=sw))
+            else:
+                raise DesignError("segment kind", it[0], "must be 'line' or 'arc'")
+        # check closure
+        ends = []
+        for s in segs:
+            if s.kind == "line":
+                ends.append(np.asarray(s.p1))
+            else:
+                t1 = s.theta0 + s.sweep
+                ends.append(np.asarray(s.center) + s.radius * np.array([math.cos(t1), math.sin(t1)]))
+        for i, s in enumerate(segs):
+            gap = float(np.hypot(*(ends[i - 1] - np.asarray(s.p0))))
+            if gap > 1e-9 * max(1.0, max(x.length for x in segs)):
+                raise DesignError("segments", f"gap {gap:.3g} mm before segment {i}", "segments must join end to start")
+        return cls(segs, z=z, name=name)
+
+    def evaluate(self, v, der: int = 0) -> np.ndarray:
+        v = np.asarray(v, dtype=float).reshape(-1)
+        s = np.mod(v, TWO_PI) * (self.perimeter / TWO_PI)
+        k = TWO_PI / self.perimeter  # dv/ds
+        idx = np.clip(np.searchsorted(self._cum, s, side="right") - 1, 0, len(self._segs) - 1)
+        out = np.zeros((v.size, 3))
+        for i, seg in enumerate(self._segs):
+            m = idx == i
+            if not np.any(m):
+                continue
+            t = s[m] - self._cum[i]
+            if seg.kind == "line":
+                p0, p1 = np.asarray(seg.p0), np.asarray(seg.p1)
+                d = (p1 - p0) / seg.length
+                if der == 0:
+                    out[m, :2] = p0 + t[:, None] * d
+                elif der == 1:
+                    out[m, :2] = d / k
+                # der 2: zero
+            else:
+                sgn = math.copysign(1.0, seg.sweep)
+                th = seg.theta0 + sgn * t / seg.radius
+                c, sn = np.cos(th), np.sin(th)
+                if der == 0:
+                    out[m, 0] = seg.center[0] + seg.radius * c
+                    out[m, 1] = seg.center[1] + seg.radius * sn
+                elif der == 1:
+                    out[m, 0] = -sgn * sn / k
+                    out[m, 1] = sgn * c / k
+                elif der == 2:
+                    out[m, 0] = -c / (seg.radius * k * k)
+                    out[m, 1] = -sn / (seg.radius * k * k)
+        if der == 0:
+            out[:, 2] = self._z
+        elif der not in (1, 2):
+            raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
+        return out
+
+    def area(self) -> float:
+        """Enclosed plan area (mm²), exact for lines and arcs (Green's theorem)."""
+        a = 0.0
+        for seg in self._segs:
+            if seg.kind == "line":
+                (x0, y0), (x1, y1) = seg.p0, seg.p1
+                a += 0.5 * (x0 * y1 - x1 * y0)
+            else:
+                cx, cy = seg.center
+                r, t0, sw = seg.radius, seg.theta0, seg.sweep
+                t1 = t0 + sw
+                a += 0.5 * (r * r * sw + cx * r * (math.sin(t1) - math.sin(t0)) - cy * r * (math.cos(t1) - math.cos(t0)))
+        return abs(a)
+
+
+def Stadium(length: float, width: float, z: float = 0.0) -> Outline:
+    """Stadium (capsule/oblong plan): two semicircles of diameter ``width`` joined by
+    straight sides; overall ``length`` along x and ``width`` along y (mm).
+    ``length == width`` gives a circle.
+    """
+    L = check_positive("length", length, "mm")
+    W = check_positive("width", width, "mm")
+    if W > L:
+        raise DesignError("width", W, f"must be <= length = {L:g} mm", "mm")
+    r = W / 2.0
+    h = L / 2.0 - r  # half straight length
+    if h == 0.0:
+        return Outline.from_segments([("arc", (0.0, 0.0), r, 0.0, TWO_PI)], z=z, name="stadium")
+    items = [
+        ("arc", (h, 0.0), r, 0.0, math.pi / 2),
+        ("line", (h, r), (-h, r)),
+        ("arc", (-h, 0.0), r, math.pi / 2, math.pi),
+        ("line", (-h, -r), (h, -r)),
+        ("arc", (h, 0.0), r, -math.pi / 2, math.pi / 2),
+    ]
+    return Outline.from_segments(items, z=z, name="stadium")
+
+
+def RoundedRectangle(length: float, width: float, corner_radius: float, z: float = 0.0) -> Outline:
+    """Rectangle ``length`` × ``width`` (mm, along x and y) with corners rounded to ``corner_radius``."""
+    L = check_positive("length", length, "mm")
+    W = check_positive("width", width, "mm")
+    rc = check_range("corner_radius", corner_radius, 0.0, min(L, W) / 2.0, "mm", lo_open=True)
+    hx, hy = L / 2.0 - rc, W / 2.0 - rc
+    items = []
+    if hy > 0:
+        items.append(("line", (L / 2, 0.0), (L / 2, hy)))
+    items.append(("arc", (hx, hy), rc, 0.0, math.pi / 2))
+    if hx > 0:
+        items.append(("line", (hx, W / 2), (-hx, W / 2)))
+    items.append(("arc", (-hx, hy), rc, math.pi / 2, math.pi / 2))
+    if hy > 0:
+        items.append(("line", (-L / 2, hy), (-L / 2, -hy)))
+    items.append(("arc", (-hx, -hy), rc, math.pi, math.pi / 2))
+    if hx > 0:
+        items.append(("line", (-hx, -W / 2), (hx, -W / 2)))
+    items.append(("arc", (hx, -hy), rc, 1.5 * math.pi, math.pi / 2))
+    if hy > 0:
+        items.append(("line", (L / 2, -hy), (L / 2, 0.0)))
+    if hx == 0 and hy == 0:
+        return Outline.from_segments([("arc", (0.0, 0.0), rc, 0.0, TWO_PI)], z=z, name="rounded_rectangle")
+    # the start point must be on +x axis: rotate list so it starts at (L/2, 0)
+    if hy == 0:
+        # first item is the arc from angle 0: split the last arc to start at angle 0 (already does)
+        pass
+    return Outline.from_segments(items, z=z, name="rounded_rectangle")
+
+
+class PointCurve(Curve):
+    """Closed curve through given points (mm), a periodic cubic spline in chord length.
+
+    Parameters
+    ----------
+    points : array_like, shape (m, 3) or (m, 2)
+        Points in order around the curve, not repeating the first one (2-D
+        points lie in the plane ``z``).
+    z : float
+        Height (mm) for 2-D points.
+    """
+
+    def __init__(self, points, z: float = 0.0) -> None:
+        p = np.asarray(points, dtype=float)
+        if p.ndim != 2 or p.shape[1] not in (2, 3) or p.shape[0] < 3:
+            raise DesignError("points", f"array of shape {p.shape}", "must be at least 3 points of 2 or 3 coordinates")
+        if not np.all(np.isfinite(p)):
+            raise DesignError("points", "non-finite value", "all coordinates must be finite numbers")
+        if p.shape[1] == 2:
+            p = np.column_stack([p, np.full(len(p), float(z))])
+        if np.linalg.norm(p[0] - p[-1]) == 0.0:
+            p = p[:-1]
+        seg = np.linalg.norm(np.diff(np.vstack([p, p[:1]]), axis=0), axis=1)
+        if np.any(seg == 0.0):
+            raise DesignError("points", "repeated point", "consecutive points must differ")
+        t = np.concatenate([[0.0], np.cumsum(seg)])
+        t = t * (TWO_PI / t[-1])
+        self.points = p
+        self._spline = CubicSpline(t, np.vstack([p, p[:1]]), bc_type="periodic", axis=0)
+
+    def evaluate(self, v, der: int = 0) -> np.ndarray:
+        v = np.mod(np.asarray(v, dtype=float).reshape(-1), TWO_PI)
+        if der not in (0, 1, 2):
+            raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
+        return self._spline(v, der)
+
+
+@dataclass(frozen=True)
+class Transformed(Curve):
+    """``matrix @ base(v) + offset``: a curve moved, rotated or scaled (mm)."""
+
+    base: Curve
+    matrix: np.ndarray = field(default_factory=lambda: np.eye(3))
+    offset: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+    def __post_init__(self) -> None:
+        m = np.asarray(self.matrix, dtype=float)
+        o = np.asarray(self.offset, dtype=float)
+        if m.shape != (3, 3) or o.shape != (3,) or not (np.all(np.isfinite(m)) and np.all(np.isfinite(o))):
+            raise DesignError("transform", "matrix/offset", "must be a finite 3×3 matrix and 3-vector")
+        object.__setattr__(self, "matrix", m)
+        object.__setattr__(self, "offset", o)
+
+    def evaluate(self, v, der: int = 0) -> np.ndarray:
+        p = self.base.evaluate(v, der) @ self.matrix.T
+        return p + self.offset if der == 0 else p
+
+    @property
+    def is_point(self) -> bool:
+        return bool(self.base.is_point) or not np.any(self.matrix[:, :2])
+
+
+def fourier_coefficients(curve: CurveLike, modes: int, samples: int | None = None):
+    """Real Fourier coefficients of a curve by FFT.
+
+    ``c(v) ≈ a0 + Σ_{n=1}^{N} (a_n cos nv + b_n sin nv)``.
+
+    Parameters
+    ----------
+    curve : curve
+    modes : int
+        ``N``, number of modes returned.
+    samples : int, optional
+        Number of equally spaced samples (default ``max(DEFAULT.samples, 8 N)``).
+
+    Returns
+    -------
+    a0 : ndarray (3,)
+    a, b : ndarray (N, 3)
+        Cosine and sine coefficients (mm).
+    """
+    m = samples or max(DEFAULT.samples, 8 * modes + 8)
+    pts = curve.evaluate(sample_v(m))
+    f = np.fft.rfft(pts, axis=0) / m
+    a0 = f[0].real
+    n = min(modes, m // 2 - 1)
+    a = np.zeros((modes, 3))
+    b = np.zeros((modes, 3))
+    a[:n] = 2.0 * f[1 : n + 1].real
+    b[:n] = -2.0 * f[1 : n + 1].imag
+    return a0, a, b
+
+
+def modes_needed(curve: CurveLike, tol: float | None = None, max_modes: int = 256, samples: int | None = None) -> int:
+    """Fewest modes ``N`` whose truncated series is within ``tol`` (mm) of the curve.
+
+    The error is measured at ``samples`` points (default 4096), not only at
+    the FFT nodes.  Returns ``max_modes + 1`` when even ``max_modes`` is not
+    enough (the remainder term then carries the rest).
+    """
+    tol = DEFAULT.fourier if tol is None else tol
+    m = samples or 4096
+    v = sample_v(m)
+    pts = curve.evaluate(v)
+    a0, a, b = fourier_coefficients(curve, max_modes, samples=max(4 * max_modes + 8, 1024))
+    n = np.arange(1, max_modes + 1)
+    cos = np.cos(np.outer(v, n))
+    sin = np.sin(np.outer(v, n))
+    # error of truncation at every N, computed cumulatively
+    approx = np.broadcast_to(a0, pts.shape).copy()
+    err0 = np.max(np.linalg.norm(pts - approx, axis=1))
+    if err0 <= tol:
+        return 0
+    for k in range(max_modes):
+        approx += np.outer(cos[:, k], a[k]) + np.outer(sin[:, k], b[k])
+        if np.max(np.linalg.norm(pts - approx, axis=1)) <= tol:
+            return k + 1
+    return max_modes + 1

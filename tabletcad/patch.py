@@ -1,0 +1,427 @@
+"""Bloor-Wilson PDE surface patches (thesis eqs 3.9-3.18).
+
+A patch is the solution ``X(u, v)``, ``u ∈ [0, 1]``, ``v ∈ [0, 2π)`` periodic,
+of ``(∂²/∂u² + a² ∂²/∂v²)² X = 0`` fixed by four boundary data per
+coordinate:
+
+* ``form="curves"`` (the thesis's form, eq 3.11): four closed curves at
+  ``u = 0, u1, u2, 1`` (default ``u1 = 1/3``, ``u2 = 2/3``);
+* ``form="hermite"`` (Bloor and Wilson's form): the curves at ``u = 0`` and
+  ``u = 1`` and the derivative curves ``X_u`` there.
+
+The solution is the analytic series of eq 3.12 truncated at ``N`` modes
+(eq 3.17) plus the remainder term ``R`` of eq 3.18, which makes the surface
+pass exactly through boundary data that ``N`` modes do not represent.  Each
+mode ``n`` has the profile ``Σ_k L_k(u; a n) c_{k,n}`` where ``L_k`` are the
+cardinal functions of :mod:`tabletcad.basis` and ``c_{k,n}`` the mode's
+coefficients in datum ``k``; ``R = Σ_k L_k(u; β) r_k(v)`` with ``r_k`` the
+part of datum ``k`` above mode ``N`` (``β`` defaults to ``a (N + 1)``, the
+decay of the first omitted mode; the thesis's ``N (a + 1)`` is available).
+
+Amplification: between interior curves a mode grows by the Lebesgue factor of
+its cardinal functions, about ``e^{a n / 4}`` for large ``a n``.  A patch
+whose fine detail (modes the curves need only below :attr:`Tolerances.stray`,
+plus ``R``) moves the surface by more than ``Tolerances.stray`` between the
+curves is refused with :class:`~tabletcad.errors.DesignError`; pass a smaller
+``a`` (or ``a="auto"``) for outlines such as a stadium.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from tabletcad.basis import basis, cardinal, cardinal_coefficients
+from tabletcad.curves import CurveLike, fourier_coefficients, modes_needed, sample_v
+from tabletcad.errors import DesignError, check_positive
+from tabletcad.tolerance import DEFAULT, Tolerances
+
+__all__ = ["PDEPatch", "AUTO_A_LADDER"]
+
+#: Smoothing parameters tried, in order, when ``a="auto"``.
+AUTO_A_LADDER = (1.0, 0.5, 0.25, 0.1, 0.05, 0.02, 0.01)
+
+
+def _trig(v: np.ndarray, n: np.ndarray, dv: int) -> tuple[np.ndarray, np.ndarray]:
+    """d^dv/dv^dv of cos(n v) and sin(n v); shapes (len(v), len(n))."""
+    nv = np.outer(v, n)
+    c, s = np.cos(nv), np.sin(nv)
+    k = dv % 4
+    fac = n.astype(float) ** dv
+    if k == 0:
+        return c * fac, s * fac
+    if k == 1:
+        return -s * fac, c * fac
+    if k == 2:
+        return -c * fac, -s * fac
+    return s * fac, -c * fac
+
+
+@dataclass(frozen=True, eq=False)
+class PDEPatch:
+    """One PDE surface patch.
+
+    Parameters
+    ----------
+    data : tuple of 4 curves
+        ``form="curves"``: the curves at ``u_nodes`` (the thesis's ``P1, d1, d2,
+        P2``).  ``form="hermite"``: ``(X(0, v), X(1, v), X_u(0, v), X_u(1, v))``.
+        Each is any object with ``evaluate(v, der)`` (see :mod:`tabletcad.curves`).
+    a : float or "auto"
+        Smoothing parameter ``a > 0`` of eq 3.9.  ``"auto"`` takes the first
+        value of :data:`AUTO_A_LADDER` whose surface passes the stray check.
+    modes : int, optional
+        Number of Fourier modes ``N`` carried analytically.  Default: the fewest
+        that represent every datum within ``tol.fourier``, capped at
+        ``tol.max_modes``.
+    u_nodes : tuple of 4 floats
+        ``(0, u1, u2, 1)`` for ``form="curves"``.
+    form : {"curves", "hermite"}
+    beta : float, optional
+        Decay rate of the remainder term (default ``a (N + 1)``).
+    tol : Tolerances
+    name : str
+    check : bool
+        Run the stray and fold checks on construction (default True).
+    """
+
+    data: tuple
+    a: float | str = 1.0
+    modes: int | None = None
+    u_nodes: tuple[float, float, float, float] = (0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0)
+    form: str = "curves"
+    beta: float | None = None
+    tol: Tolerances = field(default=DEFAULT, repr=False)
+    name: str = ""
+    check: bool = field(default=True, repr=False)
+
+    # ------------------------------------------------------------------ construction
+    def __post_init__(self) -> None:
+        data = tuple(self.data)
+        if len(data) != 4:
+            raise DesignError("curves", len(data), "a patch needs exactly 4 boundary data")
+        for i, c in enumerate(data):
+            if not isinstance(c, CurveLike):
+                raise DesignError(f"curve {i}", type(c).__name__, "must be a curve with evaluate(v, der)")
+        object.__setattr__(self, "data", data)
+        if self.form not in ("curves", "hermite"):
+            raise DesignError("form", self.form, "must be 'curves' or 'hermite'")
+        nodes = tuple(float(x) for x in self.u_nodes)
+        if len(nodes) != 4 or nodes[0] != 0.0 or nodes[3] != 1.0 or not (0.0 < nodes[1] < nodes[2] < 1.0):
+            raise DesignError("u_nodes", self.u_nodes, "must be (0, u1, u2, 1) with 0 < u1 < u2 < 1")
+        object.__setattr__(self, "u_nodes", nodes)
+
+        n_modes = self.modes
+        if n_modes is None:
+            need = max(modes_needed(c, self.tol.fourier, self.tol.max_modes) for c in data)
+            n_modes = min(need, self.tol.max_modes)
+        elif not (isinstance(n_modes, (int, np.integer)) and 0 <= n_modes <= 512):
+            raise DesignError("modes", n_modes, "must be an integer from 0 to 512")
+        object.__setattr__(self, "modes", int(n_modes))
+
+        if isinstance(self.a, str):
+            if self.a != "auto":
+                raise DesignError("a", self.a, "must be a number > 0 or 'auto'")
+            last: DesignError | None = None
+            for a in AUTO_A_LADDER:
+                object.__setattr__(self, "a", a)
+                self.__dict__.pop("_cards", None)
+                try:
+                    self._setup()
+                    if self.check:
+                        self._check_stray()
+                    last = None
+                    break
+                except DesignError as exc:
+                    last = exc
+            if last is not None:
+                raise last
+            if self.check:
+                self._check_fold()
+            return
+        object.__setattr__(self, "a", check_positive("a", self.a))
+        if self.a > 50:
+            raise DesignError("a", self.a, "must be <= 50 (larger values only amplify every mode)")
+        self._setup()
+        if self.check:
+            self._check_stray()
+            self._check_fold()
+
+    def _setup(self) -> None:
+        N = self.modes
+        beta = self.beta
+        if beta is None:
+            beta = self.a * (N + 1)
+        else:
+            beta = check_positive("beta", beta)
+        object.__setattr__(self, "_beta", float(beta))
+        # Fourier coefficients of every datum: a0 (4,3), a (4,N,3), b (4,N,3)
+        samples = max(self.tol.samples, 8 * N + 8)
+        a0 = np.zeros((4, 3))
+        ac = np.zeros((4, N, 3))
+        bc = np.zeros((4, N, 3))
+        for k, c in enumerate(self.data):
+            a0[k], ac[k], bc[k] = fourier_coefficients(c, N, samples)
+        object.__setattr__(self, "_a0", a0)
+        object.__setattr__(self, "_ac", ac)
+        object.__setattr__(self, "_bc", bc)
+        # is there anything above mode N?  (residual at dense samples)
+        v = sample_v(4 * samples)
+        res = max(float(np.max(np.abs(self._residual(k, v, 0)))) for k in range(4))
+        scale = max(1.0, float(np.max(np.abs(a0))), float(np.max(np.abs(ac))) if N else 0.0)
+        object.__setattr__(self, "_has_remainder", res > 1e-14 * scale)
+        object.__setattr__(self, "_lams", self.a * np.arange(N + 1))
+
+    # ------------------------------------------------------------------ pieces
+    @property
+    def beta_value(self) -> float:
+        """Decay rate ``β`` of the remainder term actually used."""
+        return self._beta
+
+    @property
+    def has_remainder(self) -> bool:
+        """True when some datum has content above mode ``N`` (so ``R != 0``)."""
+        return self._has_remainder
+
+    def _series(self, k: int, v: np.ndarray, dv: int, nmax: int | None = None) -> np.ndarray:
+        """Truncated Fourier series of datum ``k`` (or its v-derivative) at ``v``."""
+        N = self.modes if nmax is None else nmax
+        out = np.zeros((v.size, 3))
+        if dv == 0:
+            out += self._a0[k]
+        if N:
+            n = np.arange(1, N + 1)
+            c, s = _trig(v, n, dv)
+            out += c @ self._ac[k, :N] + s @ self._bc[k, :N]
+        return out
+
+    def _residual(self, k: int, v: np.ndarray, dv: int, nmax: int | None = None) -> np.ndarray:
+        return self.data[k].evaluate(v, dv) - self._series(k, v, dv, nmax)
+
+    def _cardinals(self, u: np.ndarray, du: int, lams) -> list[np.ndarray]:
+        return [cardinal(u, lam, self.u_nodes, self.form, du) for lam in lams]
+
+    # ------------------------------------------------------------------ evaluation
+    def evaluate(self, u, v, du: int = 0, dv: int = 0, *, nmin: int = 0, remainder: bool = True) -> np.ndarray:
+        """Surface point or partial derivative ``∂^{du+dv} X / ∂u^{du} ∂v^{dv}``.
+
+        Parameters
+        ----------
+        u, v : array_like
+            Parameters, broadcast against each other (``u`` in [0, 1]).
+        du, dv : int
+            Derivative orders (``du <= 2``).
+        nmin : int
+            Sum only modes ``n >= nmin`` (0: the whole surface).
+        remainder : bool
+            Include the remainder term ``R``.
+
+        Returns
+        -------
+        ndarray, shape ``broadcast(u, v).shape + (3,)`` in mm (per unit parameter
+        for derivatives).
+        """
+        u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
+        shape = u.shape
+        uf, vf = u.reshape(-1), v.reshape(-1)
+        out = np.zeros((uf.size, 3))
+        N = self.modes
+        for n in range(nmin, N + 1):
+            L = cardinal(uf, self._lams[n], self.u_nodes, self.form, du)  # (M, 4)
+            if n == 0:
+                if dv == 0:
+                    out += L @ self._a0
+                continue
+            A = L @ self._ac[:, n - 1]  # (M, 3)
+            B = L @ self._bc[:, n - 1]
+            c, s = _trig(vf, np.array([n]), dv)
+            out += A * c + B * s
+        if remainder and self._has_remainder:
+            L = cardinal(uf, self._beta, self.u_nodes, self.form, du)
+            for k in range(4):
+                out += L[:, k : k + 1] * self._residual(k, vf, dv)
+        return out.reshape(shape + (3,))
+
+    def evaluate_grid(self, u, v, du: int = 0, dv: int = 0) -> np.ndarray:
+        """Tensor-grid evaluation: ``X[i, j] = ∂X(u[i], v[j])``, shape (len(u), len(v), 3).
+
+        Uses matrix products (cost ~ (nu + nv)·N + nu·nv·N), the fast path
+        for pictures, meshes and quadrature.
+        """
+        u = np.asarray(u, dtype=float).reshape(-1)
+        v = np.asarray(v, dtype=float).reshape(-1)
+        N = self.modes
+        out = np.zeros((u.size, v.size, 3))
+        if dv == 0:
+            L0 = cardinal(u, 0.0, self.u_nodes, self.form, du)
+            out += (L0 @ self._a0)[:, None, :]
+        if N:
+            n = np.arange(1, N + 1)
+            A = np.empty((N, u.size, 3))
+            B = np.empty((N, u.size, 3))
+            for i in range(N):
+                L = cardinal(u, self._lams[i + 1], self.u_nodes, self.form, du)
+                A[i] = L @ self._ac[:, i]
+                B[i] = L @ self._bc[:, i]
+            c, s = _trig(v, n, dv)  # (nv, N)
+            out += np.einsum("nuc,vn->uvc", A, c, optimize=True) + np.einsum("nuc,vn->uvc", B, s, optimize=True)
+        if self._has_remainder:
+            L = cardinal(u, self._beta, self.u_nodes, self.form, du)  # (nu, 4)
+            r = np.stack([self._residual(k, v, dv) for k in range(4)])  # (4, nv, 3)
+            out += np.einsum("uk,kvc->uvc", L, r, optimize=True)
+        return out
+
+    def spine(self, u, du: int = 0) -> np.ndarray:
+        """The spine ``A0(u)`` (eq 3.13, mm), the ``n = 0`` term; shape ``u.shape + (3,)``."""
+        u = np.asarray(u, dtype=float)
+        L = cardinal(u.reshape(-1), 0.0, self.u_nodes, self.form, du)
+        return (L @ self._a0).reshape(u.shape + (3,))
+
+    def normal(self, u, v, *, eps: float = 1e-7) -> np.ndarray:
+        """Unit normal ``X_u × X_v / |X_u × X_v|`` (eq 6.4); at degenerate points
+        (poles) the limit from inside the patch is used."""
+        u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
+        xu = self.evaluate(u, v, du=1)
+        xv = self.evaluate(u, v, dv=1)
+        n = np.cross(xu, xv)
+        norm = np.linalg.norm(n, axis=-1)
+        scale = np.max(np.linalg.norm(xu, axis=-1)) + 1e-300
+        bad = norm <= 1e-9 * scale * scale
+        if np.any(bad):
+            ub = u[bad]
+            ush = np.where(ub > 0.5, ub - 1e-5, ub + 1e-5)
+            nb = np.cross(self.evaluate(ush, v[bad], du=1), self.evaluate(ush, v[bad], dv=1))
+            n[bad] = nb
+            norm[bad] = np.linalg.norm(nb, axis=-1)
+        return n / np.maximum(norm, 1e-300)[..., None]
+
+    # ------------------------------------------------------------------ coefficients (thesis form)
+    def mode_coefficients(self, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """Coefficients of mode ``n`` in the thesis's form (eqs 3.13-3.15).
+
+        For ``n = 0`` returns ``(a_0m, None)`` with ``A0 = Σ_m a_0m u^{m-1}``
+        (array (4, 3)).  For ``n >= 1`` returns ``(a_n, b_n)``, arrays (4, 3)
+        with rows ``(a_n1, a_n2, a_n3, a_n4)`` such that
+        ``A_n = (a_n1 + a_n3 u) e^{λu} + (a_n2 + a_n4 u) e^{-λu}``, ``λ = a n``
+        (the thesis writes ``e^{nu}``, i.e. ``a = 1``).  Large ``λ`` overflow:
+        only meaningful for ``λ`` below ~700.
+        """
+        if n == 0:
+            # basis {1, u, u², u³/3} at λ = 0
+            c = cardinal_coefficients(0.0, self.u_nodes, self.form) @ self._a0
+            return np.stack([c[0], c[1], c[2], c[3] / 3.0]), None
+        if not 1 <= n <= self.modes:
+            raise DesignError("n", n, f"must be between 0 and N = {self.modes}")
+        lam = float(self._lams[n])
+        C = cardinal_coefficients(lam, self.u_nodes, self.form)
+        out = []
+        for coef in (self._ac[:, n - 1], self._bc[:, n - 1]):
+            c = C @ coef  # coefficients of the computational basis, (4, 3)
+            if lam > 1.0:
+                em = math.exp(-lam)
+                out.append(np.stack([em * c[0], c[2], em * c[1], c[3]]))
+            else:
+                # cosh = (E+ + E-)/2 ; sinh(λu)/λ = (E+ - E-)/(2λ) ; u sinh/λ ; (u cosh - sinh/λ)/λ²
+                l2 = lam * lam
+                a1 = c[0] / 2 + c[1] / (2 * lam) - c[3] / (2 * lam * l2)
+                a2 = c[0] / 2 - c[1] / (2 * lam) + c[3] / (2 * lam * l2)
+                a3 = c[2] / (2 * lam) + c[3] / (2 * l2)
+                a4 = -c[2] / (2 * lam) + c[3] / (2 * l2)
+                out.append(np.stack([a1, a2, a3, a4]))
+        return out[0], out[1]
+
+    def radius_profile(self, u) -> np.ndarray:
+        """Radius ``r(u) = sqrt(A_1x² + A_1y²)`` of the first mode (eq 4.22), mm.
+
+        Exact for circles stacked along z; see :func:`tabletcad.reshape.circularity`.
+        """
+        u = np.asarray(u, dtype=float)
+        if self.modes < 1:
+            return np.zeros(u.shape)
+        L = cardinal(u.reshape(-1), self._lams[1], self.u_nodes, self.form)
+        A1 = L @ self._ac[:, 0]
+        return np.hypot(A1[:, 0], A1[:, 1]).reshape(u.shape)
+
+    # ------------------------------------------------------------------ checks
+    def stray(self, nu: int = 97, nv: int | None = None) -> float:
+        """Largest distance (mm) by which the patch's fine detail moves the surface.
+
+        Fine detail = the modes above those needed to represent every datum
+        within ``tol.stray / 4`` plus the remainder term.  At the curves it is
+        at most ``tol.stray / 4``; between them it grows with the mode's
+        amplification.
+        """
+        if self.form == "hermite":
+            idx = (0, 1)
+        else:
+            idx = (0, 1, 2, 3)
+        n_design = max(modes_needed(self.data[k], self.tol.stray / 4, self.modes) for k in idx)
+        if n_design >= self.modes and not self._has_remainder:
+            return 0.0
+        n_design = min(n_design, self.modes)
+        u = np.linspace(0.0, 1.0, nu)
+        v = sample_v(nv or max(256, 8 * self.modes))
+        fine = np.zeros((u.size, v.size, 3))
+        n = np.arange(n_design + 1, self.modes + 1)
+        if n.size:
+            A = np.stack([cardinal(u, self._lams[i], self.u_nodes, self.form) @ self._ac[:, i - 1] for i in n])
+            B = np.stack([cardinal(u, self._lams[i], self.u_nodes, self.form) @ self._bc[:, i - 1] for i in n])
+            c, s = _trig(v, n, 0)
+            fine += np.einsum("nuc,vn->uvc", A, c) + np.einsum("nuc,vn->uvc", B, s)
+        if self._has_remainder:
+            L = cardinal(u, self._beta, self.u_nodes, self.form)
+            r = np.stack([self._residual(k, v, 0) for k in range(4)])
+            if self.form == "hermite":
+                L = L[:, :2]
+                r = r[:2]
+            fine += np.einsum("uk,kvc->uvc", L, r)
+        return float(np.max(np.linalg.norm(fine, axis=-1)))
+
+    def _check_stray(self) -> None:
+        s = self.stray()
+        if s > self.tol.stray:
+            raise DesignError(
+                f"patch {self.name or '?'} smoothing parameter a",
+                self.a,
+                f"fine detail of the curves is amplified to {s:.3g} mm between them "
+                f"(allowed {self.tol.stray:g} mm): use a smaller a (e.g. a = 'auto') or fewer modes",
+            )
+
+    def _check_fold(self, nu: int = 65, nv: int = 128) -> None:
+        """Refuse a patch that folds over its spine (self-intersecting solid)."""
+        u = np.linspace(0.0, 1.0, nu)[1:-1]
+        v = sample_v(nv)
+        X = self.evaluate_grid(u, v)
+        Xu = self.evaluate_grid(u, v, du=1)
+        Xv = self.evaluate_grid(u, v, dv=1)
+        D = X - self.spine(u)[:, None, :]
+        det = np.einsum("uvc,uvc->uv", Xu, np.cross(Xv, D))
+        scale = float(np.max(np.abs(det))) if det.size else 0.0
+        if scale == 0.0:
+            return
+        pos = np.max(det) > 1e-6 * scale
+        neg = np.min(det) < -1e-6 * scale
+        if pos and neg:
+            i, j = np.unravel_index(np.argmin(det) if np.max(det) > -np.min(det) else np.argmax(det), det.shape)
+            raise DesignError(
+                f"patch {self.name or '?'} curves",
+                f"fold near u = {u[i]:.3f}, v = {v[j]:.3f}",
+                "the surface must not cross its spine (a radius would turn negative or the surface self-intersects)",
+            )
+
+    # ------------------------------------------------------------------ misc
+    @property
+    def curves(self) -> tuple:
+        """The boundary data (alias of ``data``)."""
+        return self.data
+
+    def replace_data(self, data, **kw) -> "PDEPatch":
+        """A new patch with other boundary data and the same settings (``modes`` re-chosen unless given)."""
+        args = dict(
+            a=self.a, modes=None, u_nodes=self.u_nodes, form=self.form, beta=None, tol=self.tol, name=self.name
+        )
+        args.update(kw)
+        return PDEPatch(tuple(data), **args)
