@@ -399,7 +399,8 @@ class PDEPatch:
         Xv = self.evaluate_grid(u, v, dv=1)
         D = X - self.spine(u)[:, None, :]
         det = np.einsum("uvc,uvc->uv", Xu, np.cross(Xv, D))
-        scale = float(np.max(np.abs(det))) if det.size else 0.0
+        mag = lambda a: float(np.max(np.linalg.norm(a, axis=-1)))  # noqa: E731
+        scale = mag(Xu) * mag(Xv) * mag(D)
         if scale == 0.0:
             return
         pos = np.max(det) > 1e-6 * scale

@@ -1,0 +1,326 @@
+"""Named constructors for the thesis's tablets (Tables 4.1 and 4.5), in mm.
+
+Every tablet stands on the plane z = 0 with its axis on the z axis.  Round
+tablets use circles, oval ones ellipses; each patch takes four curves at
+``u = 0, 1/3, 2/3, 1``.  Interior curves of a dome lie on its nominal
+spherical cap at equal angular steps (thesis eq 4.1); interior curves of a
+band are copies of its rim at equal heights; interior curves of a flat face
+are concentric at equal radial steps.  The Table 4.5 shapes are also
+reachable the thesis's way, by scaling coefficients of a Table 4.1 shape
+(:mod:`tabletcad.reshape`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+import numpy as np
+
+from tabletcad import nominal as nom
+from tabletcad.curves import Circle, Curve, Ellipse, Transformed
+from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.patch import PDEPatch
+from tabletcad.tablet import Tablet, Trim
+from tabletcad.tolerance import DEFAULT, Tolerances
+
+__all__ = [
+    "FAMILIES",
+    "Family",
+    "coaxial_tablet",
+    "flat_faced_round",
+    "spherical",
+    "shallow_convex_round",
+    "shallow_convex_oval",
+    "oblong",
+    "ring",
+    "deep_convex_round",
+    "oblate_spheroid",
+    "prolate_spheroid",
+    "rod",
+    "caplet",
+    "deep_convex_oval",
+]
+
+
+def _plan(rx: float, ry: float, z: float) -> Curve:
+    if rx == ry:
+        return Circle(rx, (0.0, 0.0, z))
+    return Ellipse(rx, ry, (0.0, 0.0, z))
+
+
+def coaxial_tablet(
+    sections: list[list[tuple[float, float]]],
+    aspect: float = 1.0,
+    *,
+    a: float | str = 1.0,
+    name: str = "tablet",
+    family: str = "free_form",
+    params: dict | None = None,
+    nominal=None,
+    trim: Trim | None = None,
+    tol: Tolerances = DEFAULT,
+) -> Tablet:
+    """Tablet from patches of coaxial plan curves.
+
+    Parameters
+    ----------
+    sections : list of patches, each a list of four ``(radius, z)`` pairs (mm)
+        Consecutive patches must share their end/start pair.  ``radius`` is the
+        semi-axis along y; along x it is ``radius * aspect`` (ellipses when
+        ``aspect != 1``).
+    aspect : float
+        Plan length / width.
+    """
+    patches = []
+    prev_last: Curve | None = None
+    for j, sec in enumerate(sections):
+        if len(sec) != 4:
+            raise DesignError(f"patch {j} curves", len(sec), "each patch needs 4 (radius, z) pairs")
+        curves = []
+        for k, (r, z) in enumerate(sec):
+            check_range(f"patch {j} curve {k} radius", r, 0.0, None, "mm")
+            if k == 0 and prev_last is not None:
+                curves.append(prev_last)
+            else:
+                curves.append(_plan(r * aspect, r, z))
+        prev_last = curves[-1]
+        patches.append(PDEPatch(tuple(curves), a=a, tol=tol, name=f"{name}[{j}]"))
+    return Tablet(
+        tuple(patches),
+        name=name,
+        family=family,
+        params=dict(params or {}),
+        nominal=nominal,
+        trim=trim or Trim(),
+        tol=tol,
+    )
+
+
+def _disc(r: float, z: float, inward: bool) -> list[tuple[float, float]]:
+    radii = [r, 2 * r / 3, r / 3, 0.0]
+    if not inward:
+        radii = radii[::-1]
+    return [(x, z) for x in radii]
+
+
+def _band(r: float, z0: float, z1: float) -> list[tuple[float, float]]:
+    return [(r, z0 + (z1 - z0) * k / 3.0) for k in range(4)]
+
+
+def _cap(r: float, z_rim: float, depth: float, up: bool) -> list[tuple[float, float]]:
+    """Curves on a spherical cap of rim radius ``r`` and ``depth`` at equal angles."""
+    if depth == 0.0:
+        return _disc(r, z_rim, inward=up) if up else _disc(r, z_rim, inward=False)
+    # a spherical cap up to a hemisphere; deeper domes are the hemisphere
+    # stretched along z (a half spheroid), as the thesis's coefficient scaling does
+    d_s = min(depth, r)
+    rc = (r * r + d_s * d_s) / (2.0 * d_s)
+    half = math.asin(min(1.0, r / rc))
+    stretch = depth / d_s
+    out = []
+    for k in range(4):
+        th = half * (1.0 - k / 3.0)  # polar angle from the apex
+        rad = rc * math.sin(th)
+        h = stretch * rc * (1.0 - math.cos(th))  # height below the apex
+        z = z_rim + depth - h if up else z_rim - depth + h
+        out.append((rad, z))
+    return out if up else out[::-1]
+
+
+# ---------------------------------------------------------------------------- Table 4.1
+def flat_faced_round(diameter: float = 10.0, thickness: float = 6.0, *, a: float | str = 1.0, tol=DEFAULT) -> Tablet:
+    """Flat-faced round tablet, 3 patches, 10 curves (Table 4.1: 10 × 6 mm)."""
+    D = check_positive("diameter", diameter, "mm")
+    T = check_positive("thickness", thickness, "mm")
+    R = D / 2
+    secs = [_disc(R, 0.0, inward=False), _band(R, 0.0, T), _disc(R, T, inward=True)]
+    return coaxial_tablet(
+        secs, a=a, name="flat_faced_round", family="flat_faced_round",
+        params=dict(diameter=D, thickness=T), nominal=nom.cylinder(R, 0.0, T), tol=tol,
+    )
+
+
+def spherical(diameter: float = 5.0, *, a: float | str = 1.0, tol=DEFAULT) -> Tablet:
+    """Spherical tablet, 2 patches, 7 curves at 30° steps (eqs 4.1-4.3; Table 4.1: 5 mm)."""
+    D = check_positive("diameter", diameter, "mm")
+    r = D / 2
+    psi = [-math.pi / 2, -math.pi / 3, -math.pi / 6, 0.0, math.pi / 6, math.pi / 3, math.pi / 2]
+    pts = [(r * math.cos(p) if abs(p) != math.pi / 2 else 0.0, r + r * math.sin(p)) for p in psi]
+    return coaxial_tablet(
+        [pts[0:4], pts[3:7]], a=a, name="spherical", family="spherical",
+        params=dict(diameter=D), nominal=nom.sphere(r, (0, 0, r)), tol=tol,
+    )
+
+
+def _convex(name, D, T, band, aspect=1.0, a=1.0, tol=DEFAULT, params=None):
+    R = D / 2
+    if not 0 < band <= T:
+        raise DesignError("band", band, f"must be > 0 and <= thickness = {T:g} mm", "mm")
+    d = (T - band) / 2
+    if d > R and aspect == 1.0:
+        raise DesignError("band", band, f"must be >= thickness - diameter = {T - D:g} mm (cup deeper than a hemisphere)", "mm")
+    secs = [_cap(R, d, d, up=False), _band(R, d, d + band), _cap(R, d + band, d, up=True)]
+    nominal = nom.convex_round(R, d, d + band, d) if aspect == 1.0 else None
+    return coaxial_tablet(secs, aspect, a=a, name=name, family=name, params=params, nominal=nominal, tol=tol)
+
+
+def shallow_convex_round(diameter: float = 10.0, thickness: float = 3.0, band: float = 2.0, *, a=1.0, tol=DEFAULT) -> Tablet:
+    """Shallow convex round tablet: spherical caps on a cylindrical band (Table 4.1: 10 × 3 mm)."""
+    D = check_positive("diameter", diameter, "mm")
+    T = check_positive("thickness", thickness, "mm")
+    b = check_positive("band", band, "mm")
+    return _convex("shallow_convex_round", D, T, b, a=a, tol=tol, params=dict(diameter=D, thickness=T, band=b))
+
+
+def shallow_convex_oval(width: float = 6.0, length: float = 12.0, thickness: float = 3.0, band: float = 2.0, *, a=1.0, tol=DEFAULT) -> Tablet:
+    """Shallow convex oval: elliptical plan ``length`` (x) × ``width`` (y), caps scaled
+    from the round cap profile (Table 4.1: 6 × 12 × 3 mm)."""
+    W = check_positive("width", width, "mm")
+    L = check_positive("length", length, "mm")
+    T = check_positive("thickness", thickness, "mm")
+    b = check_positive("band", band, "mm")
+    if L < W:
+        raise DesignError("length", L, f"must be >= width = {W:g} mm", "mm")
+    return _convex("shallow_convex_oval", W, T, b, aspect=L / W, a=a, tol=tol,
+                   params=dict(width=W, length=L, thickness=T, band=b))
+
+
+def oblong(diameter: float = 5.0, length: float = 15.0, dome: float = 1.0, *, a=1.0, tol=DEFAULT) -> Tablet:
+    """Oblong tablet standing on its axis: round section ``diameter``, overall
+    ``length`` along z, spherical domes of height ``dome`` (Table 4.1: 5 × 15 mm)."""
+    D = check_positive("diameter", diameter, "mm")
+    L = check_positive("length", length, "mm")
+    d = check_positive("dome", dome, "mm")
+    if d > D / 2:
+        raise DesignError("dome", d, f"must be <= diameter/2 = {D / 2:g} mm", "mm")
+    if 2 * d >= L:
+        raise DesignError("dome", d, f"must be < length/2 = {L / 2:g} mm", "mm")
+    R = D / 2
+    secs = [_cap(R, d, d, up=False), _band(R, d, L - d), _cap(R, L - d, d, up=True)]
+    return coaxial_tablet(secs, a=a, name="oblong", family="oblong", params=dict(diameter=D, length=L, dome=d),
+                          nominal=nom.convex_round(R, d, L - d, d), tol=tol)
+
+
+# ---------------------------------------------------------------------------- Table 4.5
+def ring(outer_diameter: float = 12.0, inner_diameter: float = 6.0, thickness: float = 4.5, *, a=1.0, tol=DEFAULT) -> Tablet:
+    """Ring tablet: the band of a flat-faced round tablet as a solid with
+    ``w ∈ [inner/outer, 1]`` (Table 4.5: 12 × 4.5 mm with a 6 mm hole)."""
+    Do = check_positive("outer_diameter", outer_diameter, "mm")
+    Di = check_range("inner_diameter", inner_diameter, 0.0, Do, "mm", lo_open=True, hi_open=True)
+    T = check_positive("thickness", thickness, "mm")
+    R = Do / 2
+    t = coaxial_tablet([_band(R, 0.0, T)], a=a, name="ring", family="ring",
+                       params=dict(outer_diameter=Do, inner_diameter=Di, thickness=T), tol=tol)
+    from dataclasses import replace
+
+    ri = Di / 2
+    f_out = nom.cylinder(R, 0.0, T)
+    return replace(t, trim=Trim(w=(Di / Do, 1.0)), nominal=lambda p: np.maximum(f_out(p), ri - np.hypot(p[:, 0], p[:, 1])))
+
+
+def deep_convex_round(diameter: float = 10.0, thickness: float = 4.0, band: float = 1.0, *, a=1.0, tol=DEFAULT) -> Tablet:
+    """Deep convex round (Table 4.5: 10 × 4 mm)."""
+    D = check_positive("diameter", diameter, "mm")
+    T = check_positive("thickness", thickness, "mm")
+    b = check_positive("band", band, "mm")
+    return _convex("deep_convex_round", D, T, b, a=a, tol=tol, params=dict(diameter=D, thickness=T, band=b))
+
+
+def _spheroid(name: str, diameter: float, height: float, a, tol) -> Tablet:
+    rx = diameter / 2
+    c = height / 2
+    psi = [-math.pi / 2, -math.pi / 3, -math.pi / 6, 0.0, math.pi / 6, math.pi / 3, math.pi / 2]
+    pts = [(rx * math.cos(p) if abs(p) != math.pi / 2 else 0.0, c + c * math.sin(p)) for p in psi]
+    return coaxial_tablet([pts[0:4], pts[3:7]], a=a, name=name, family=name,
+                          params=dict(diameter=diameter, height=height), nominal=nom.spheroid(rx, c, (0, 0, c)), tol=tol)
+
+
+def oblate_spheroid(diameter: float = 10.0, height: float = 2.5, *, a=1.0, tol=DEFAULT) -> Tablet:
+    """Oblate spheroid (Table 4.5: 10 × 2.5 mm)."""
+    D = check_positive("diameter", diameter, "mm")
+    H = check_positive("height", height, "mm")
+    if H > D:
+        raise DesignError("height", H, f"must be <= diameter = {D:g} mm for an oblate spheroid", "mm")
+    return _spheroid("oblate_spheroid", D, H, a, tol)
+
+
+def prolate_spheroid(diameter: float = 5.0, height: float = 10.0, *, a=1.0, tol=DEFAULT) -> Tablet:
+    """Prolate spheroid (Table 4.5: 5 × 10 mm)."""
+    D = check_positive("diameter", diameter, "mm")
+    H = check_positive("height", height, "mm")
+    if H < D:
+        raise DesignError("height", H, f"must be >= diameter = {D:g} mm for a prolate spheroid", "mm")
+    return _spheroid("prolate_spheroid", D, H, a, tol)
+
+
+def rod(diameter: float = 3.0, length: float = 7.5, dome: float = 0.2, *, a=1.0, tol=DEFAULT) -> Tablet:
+    """Rod: a short oblong (Table 4.5: 3 × 7.5 mm)."""
+    t = oblong(diameter, length, dome, a=a, tol=tol)
+    from dataclasses import replace
+
+    return replace(t, name="rod", family="rod")
+
+
+def caplet(width: float = 3.5, length: float = 7.0, height: float = 15.0, band: float = 10.0, *, a=1.0, tol=DEFAULT) -> Tablet:
+    """Caplet: an oval tablet stretched along its axis (Table 4.5: 3.5 × 7 × 15 mm)."""
+    t = shallow_convex_oval(width, length, height, band, a=a, tol=tol)
+    from dataclasses import replace
+
+    return replace(t, name="caplet", family="caplet")
+
+
+def deep_convex_oval(width: float = 6.0, length: float = 12.0, thickness: float = 3.1, band: float = 1.1, *, a=1.0, tol=DEFAULT) -> Tablet:
+    """Deep convex oval (Table 4.5: 6 × 12 × 3.1 mm)."""
+    t = shallow_convex_oval(width, length, thickness, band, a=a, tol=tol)
+    from dataclasses import replace
+
+    return replace(t, name="deep_convex_oval", family="deep_convex_oval")
+
+
+# ---------------------------------------------------------------------------- registry
+class Family:
+    """A named constructor with its parameters, units and defaults."""
+
+    def __init__(self, name: str, func: Callable[..., Tablet], params: dict[str, str], doc: str) -> None:
+        self.name = name
+        self.func = func
+        self.params = params  # name -> unit
+        self.doc = doc
+
+    @property
+    def defaults(self) -> dict[str, float]:
+        import inspect
+
+        sig = inspect.signature(self.func)
+        return {k: sig.parameters[k].default for k in self.params}
+
+    def build(self, **kw) -> Tablet:
+        unknown = set(kw) - set(self.params) - {"a"}
+        if unknown:
+            k = sorted(unknown)[0]
+            raise DesignError(f"[tablet] key {k!r}", kw[k], f"family {self.name!r} takes {', '.join(self.params)}")
+        return self.func(**kw)
+
+
+def _fam(func, **units) -> Family:
+    return Family(func.__name__, func, units, (func.__doc__ or "").strip().splitlines()[0])
+
+
+FAMILIES: dict[str, Family] = {
+    f.name: f
+    for f in [
+        _fam(flat_faced_round, diameter="mm", thickness="mm"),
+        _fam(spherical, diameter="mm"),
+        _fam(shallow_convex_round, diameter="mm", thickness="mm", band="mm"),
+        _fam(shallow_convex_oval, width="mm", length="mm", thickness="mm", band="mm"),
+        _fam(oblong, diameter="mm", length="mm", dome="mm"),
+        _fam(ring, outer_diameter="mm", inner_diameter="mm", thickness="mm"),
+        _fam(deep_convex_round, diameter="mm", thickness="mm", band="mm"),
+        _fam(oblate_spheroid, diameter="mm", height="mm"),
+        _fam(prolate_spheroid, diameter="mm", height="mm"),
+        _fam(rod, diameter="mm", length="mm", dome="mm"),
+        _fam(caplet, width="mm", length="mm", height="mm", band="mm"),
+        _fam(deep_convex_oval, width="mm", length="mm", thickness="mm", band="mm"),
+    ]
+}

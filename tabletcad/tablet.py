@@ -1,0 +1,400 @@
+"""Tablets: ordered PDE patches sharing boundary curves, and their solids.
+
+A :class:`Tablet` is a chain of :class:`~tabletcad.patch.PDEPatch` objects in
+which patch ``j``'s curve at ``u = 1`` is patch ``j + 1``'s curve at ``u = 0``
+(C0 by construction, thesis section 3.4.1).  Each patch also defines a solid
+``X(u, v, w) = A0(u) + w (X(u, v) - A0(u))``, ``w ∈ [0, 1]`` (eq 4.12),
+filling the region between its spine and its surface; the tablet's solid is
+the union of the patch solids.  A :class:`Trim` restricts ``u``, ``v`` and
+``w`` (the thesis's cut-away views; ``w ∈ [0.5, 1]`` makes the ring tablet).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Any, Callable
+
+import numpy as np
+
+from tabletcad.errors import DesignError, check_range
+from tabletcad.patch import PDEPatch
+from tabletcad.tolerance import DEFAULT, Tolerances
+
+__all__ = ["Trim", "Tablet", "Face", "solid_map"]
+
+TWO_PI = 2.0 * math.pi
+
+
+@dataclass(frozen=True)
+class Trim:
+    """Parameter ranges kept of every patch solid.
+
+    Attributes
+    ----------
+    u : (float, float)
+        Range of ``u`` in [0, 1].
+    v : (float, float)
+        Range of ``v`` in radians; a length of 2π means untrimmed.
+    w : (float, float)
+        Range of ``w`` in [0, 1]; ``w[0] > 0`` hollows the solid around the spine.
+    """
+
+    u: tuple[float, float] = (0.0, 1.0)
+    v: tuple[float, float] = (0.0, TWO_PI)
+    w: tuple[float, float] = (0.0, 1.0)
+
+    def __post_init__(self) -> None:
+        for name, (lo, hi), top in (("u", self.u, 1.0), ("w", self.w, 1.0)):
+            check_range(f"trim {name}[0]", lo, 0.0, 1.0)
+            check_range(f"trim {name}[1]", hi, 0.0, 1.0)
+            if not lo < hi:
+                raise DesignError(f"trim {name}", (lo, hi), "must be an increasing pair within [0, 1]")
+        v0, v1 = (float(x) for x in self.v)
+        if not (math.isfinite(v0) and math.isfinite(v1) and 0.0 < v1 - v0 <= TWO_PI + 1e-12):
+            raise DesignError("trim v", self.v, "must be an increasing pair spanning at most 2π rad")
+        object.__setattr__(self, "u", tuple(float(x) for x in self.u))
+        object.__setattr__(self, "v", (v0, v1))
+        object.__setattr__(self, "w", tuple(float(x) for x in self.w))
+
+    @property
+    def full_v(self) -> bool:
+        return self.v[1] - self.v[0] >= TWO_PI - 1e-12
+
+
+def solid_map(patch: PDEPatch, u, v, w, du: int = 0, dv: int = 0, dw: int = 0) -> np.ndarray:
+    """``X(u, v, w) = A0(u) + w (X(u, v) - A0(u))`` (eq 4.12) and first partials.
+
+    Only one of ``du, dv, dw`` may be 1.  Arrays broadcast; returns ``(..., 3)`` mm.
+    """
+    u, v, w = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (u, v, w)))
+    X = patch.evaluate(u, v, du=du, dv=dv)
+    if dv:
+        return w[..., None] * X
+    A = patch.spine(u, du=du)
+    if dw:
+        return X - A
+    return A + w[..., None] * (X - A)
+
+
+@dataclass(frozen=True)
+class Face:
+    """One face of the boundary of a (trimmed) patch solid, as a map of two parameters.
+
+    ``kind`` is ``"w"`` (a surface ``w = const`` over ``(u, v)``), ``"u"``
+    (``u = const`` over ``(w, v)``) or ``"v"`` (``v = const`` over ``(u, w)``);
+    ``sign`` (+1/-1) orients it outward for a positively oriented patch.
+    """
+
+    patch: int
+    kind: str
+    value: float
+    s_range: tuple[float, float]
+    t_range: tuple[float, float]
+    sign: float
+    periodic_t: bool = False
+
+    def evaluate(self, tablet: "Tablet", s, t, der: str = "") -> np.ndarray:
+        p = tablet.patches[self.patch]
+        s, t = np.broadcast_arrays(np.asarray(s, float), np.asarray(t, float))
+        c = np.full(s.shape, self.value)
+        if self.kind == "w":  # (s, t) = (u, v)
+            args = (s, t, c)
+            d = {"": {}, "s": {"du": 1}, "t": {"dv": 1}}[der]
+        elif self.kind == "u":  # (s, t) = (w, v)
+            args = (c, t, s)
+            d = {"": {}, "s": {"dw": 1}, "t": {"dv": 1}}[der]
+        else:  # "v": (s, t) = (u, w)
+            args = (s, c, t)
+            d = {"": {}, "s": {"du": 1}, "t": {"dw": 1}}[der]
+        return solid_map(p, *args, **d)
+
+
+@dataclass(frozen=True, eq=False)
+class Tablet:
+    """A tablet: ordered PDE patches forming a closed surface, plus its solid.
+
+    Parameters
+    ----------
+    patches : tuple of PDEPatch
+        In order along the chain (bottom to top for the thesis's shapes).
+    name : str
+        Design name (used for file names and the STEP product).
+    family : str
+        Family the tablet was built from (``"free_form"`` when given patch by patch).
+    params : dict
+        The family's parameters (mm), for reports.
+    trim : Trim
+        Parameter ranges kept (default: everything).
+    nominal : callable, optional
+        Signed distance ``f(points (m, 3)) -> (m,)`` (mm) to the exact shape the
+        tablet approximates, for :meth:`nominal_deviation`.
+    closed_ends : bool
+        True when the chain's first and last curves are points (a closed
+        surface); False makes the u-ends of the first and last patch part of the
+        boundary (e.g. the ring tablet's annular faces).
+    """
+
+    patches: tuple
+    name: str = "tablet"
+    family: str = "free_form"
+    params: dict = field(default_factory=dict)
+    trim: Trim = field(default_factory=Trim)
+    nominal: Callable[[np.ndarray], np.ndarray] | None = field(default=None, repr=False)
+    nominal_name: str = ""
+    tol: Tolerances = field(default=DEFAULT, repr=False)
+
+    def __post_init__(self) -> None:
+        patches = tuple(self.patches)
+        if not patches:
+            raise DesignError("patches", 0, "a tablet needs at least one patch")
+        for i, p in enumerate(patches):
+            if not isinstance(p, PDEPatch):
+                raise DesignError(f"patch {i}", type(p).__name__, "must be a PDEPatch")
+        object.__setattr__(self, "patches", patches)
+
+    # ------------------------------------------------------------------ topology
+    def _end_is_shared(self, i: int, end: int) -> bool:
+        """Whether patch ``i``'s u-end (0 or 1) is shared with a neighbour in the chain."""
+        j = i - 1 if end == 0 else i + 1
+        if not 0 <= j < len(self.patches):
+            return False
+        a = self.patches[i]
+        b = self.patches[j]
+        v = np.linspace(0.0, TWO_PI, 64, endpoint=False)
+        xa = a.evaluate(float(end), v)
+        xb = b.evaluate(float(1 - end), v)
+        scale = max(1.0, float(np.max(np.abs(xa))))
+        return float(np.max(np.linalg.norm(xa - xb, axis=1))) <= 1e-9 * scale
+
+    def _end_is_point(self, i: int, end: int) -> bool:
+        v = np.linspace(0.0, TWO_PI, 64, endpoint=False)
+        x = self.patches[i].evaluate(float(end), v)
+        return float(np.max(np.ptp(x, axis=0))) <= 1e-12 * max(1.0, float(np.max(np.abs(x))))
+
+    def faces(self) -> list[Face]:
+        """The faces bounding the (trimmed) solid, oriented outward (up to the global sign)."""
+        t = self.trim
+        out: list[Face] = []
+        full_u = t.u == (0.0, 1.0)
+        for i, _ in enumerate(self.patches):
+            out.append(Face(i, "w", t.w[1], t.u, t.v, +1.0, t.full_v))
+            if t.w[0] > 0.0:
+                out.append(Face(i, "w", t.w[0], t.u, t.v, -1.0, t.full_v))
+            for end, uval, sgn in ((0, t.u[0], +1.0), (1, t.u[1], -1.0)):
+                # X(u, v, w): the u-face orientation: outward normal ∝ ∓ X_v × X_w
+                if full_u and (self._end_is_point(i, end) or self._end_is_shared(i, end)):
+                    continue
+                out.append(Face(i, "u", uval, t.w, t.v, sgn, t.full_v))
+            if not t.full_v:
+                out.append(Face(i, "v", t.v[0], t.u, t.w, +1.0, False))
+                out.append(Face(i, "v", t.v[1], t.u, t.w, -1.0, False))
+        return out
+
+    # ------------------------------------------------------------------ quadrature
+    def _rules(self, face: Face, nu: int | None = None, nv: int | None = None):
+        nu = nu or self.tol.quad_u
+        nv = nv or self.tol.quad_v
+        xs, ws = np.polynomial.legendre.leggauss(nu)
+        s0, s1 = face.s_range
+        s = 0.5 * (s1 - s0) * (xs + 1.0) + s0
+        sw = 0.5 * (s1 - s0) * ws
+        t0, t1 = face.t_range
+        if face.periodic_t:
+            t = t0 + np.arange(nv) * (TWO_PI / nv)
+            tw = np.full(nv, TWO_PI / nv)
+        else:
+            xt, wt = np.polynomial.legendre.leggauss(nv if face.kind == "w" else max(nv // 4, 32))
+            t = 0.5 * (t1 - t0) * (xt + 1.0) + t0
+            tw = 0.5 * (t1 - t0) * wt
+        return s, sw, t, tw
+
+    def _face_integrals(self, face: Face, nu=None, nv=None) -> tuple[float, float, float]:
+        """(area, signed volume contribution (1/3)∫X·n dA, plan-area contribution ∫max(n_z,0) dA)."""
+        s, sw, t, tw = self._rules(face, nu, nv)
+        S, T = np.meshgrid(s, t, indexing="ij")
+        X = face.evaluate(self, S, T)
+        Xs = face.evaluate(self, S, T, "s")
+        Xt = face.evaluate(self, S, T, "t")
+        n = np.cross(Xs, Xt) * face.sign
+        W = np.outer(sw, tw)
+        dA = np.linalg.norm(n, axis=-1)
+        area = float(np.sum(W * dA))
+        vol = float(np.sum(W * np.einsum("...c,...c->...", X, n))) / 3.0
+        return area, vol, float(np.sum(W * n[..., 2]))
+
+    @property
+    def orientation(self) -> float:
+        """+1 if the patches' ``X_u × X_v`` points out of the solid, -1 if inward."""
+        vol = sum(self._face_integrals(f, 24, 64)[1] for f in self.faces())
+        return 1.0 if vol >= 0.0 else -1.0
+
+    def properties(self, nu: int | None = None, nv: int | None = None) -> dict[str, Any]:
+        """Area and volume by quadrature (eqs 4.8, 4.9), per face and in total.
+
+        Gauss-Legendre in ``u`` (and ``w``) and the trapezoidal rule in periodic
+        ``v`` (spectrally accurate for these smooth periodic integrands).
+
+        Returns
+        -------
+        dict with ``surface_area_mm2``, ``volume_mm3``, ``plan_area_mm2`` and
+        ``patches`` (per patch: ``surface_area_mm2`` of its outer surface and
+        ``volume_mm3``, its term ``(1/3)∫X·n dA`` of the divergence theorem,
+        which depends on the origin while the total does not).
+        """
+        sgn = None
+        per = [dict(surface_area_mm2=0.0, volume_mm3=0.0, other_faces_area_mm2=0.0) for _ in self.patches]
+        tot_a = tot_v = 0.0
+        rows = []
+        for f in self.faces():
+            a, v, pz = self._face_integrals(f, nu, nv)
+            rows.append((f, a, v, pz))
+        vol = sum(r[2] for r in rows)
+        sgn = 1.0 if vol >= 0 else -1.0
+        for f, a, v, pz in rows:
+            tot_a += a
+            tot_v += sgn * v
+            if f.kind == "w" and f.sign > 0:
+                per[f.patch]["surface_area_mm2"] += a
+            else:
+                per[f.patch]["other_faces_area_mm2"] += a
+            per[f.patch]["volume_mm3"] += sgn * v
+        # plan area: projection of the upward-facing surface
+        up = 0.0
+        for f, a, v, pz in rows:
+            up += self._upward(f, sgn, nu, nv)
+        return dict(
+            surface_area_mm2=tot_a,
+            volume_mm3=tot_v,
+            plan_area_mm2=up,
+            orientation=sgn,
+            patches=per,
+        )
+
+    def _upward(self, face: Face, sgn: float, nu, nv) -> float:
+        s, sw, t, tw = self._rules(face, nu, nv)
+        S, T = np.meshgrid(s, t, indexing="ij")
+        n = np.cross(face.evaluate(self, S, T, "s"), face.evaluate(self, S, T, "t")) * face.sign * sgn
+        return float(np.sum(np.outer(sw, tw) * np.maximum(n[..., 2], 0.0)))
+
+    def volume(self) -> float:
+        """Enclosed volume (mm³) by the divergence theorem (eq 4.9)."""
+        return self.properties()["volume_mm3"]
+
+    def surface_area(self) -> float:
+        """Surface area (mm²) of the solid's boundary (eq 4.8)."""
+        return self.properties()["surface_area_mm2"]
+
+    def solid_volume(self, nu: int | None = None, nv: int | None = None, nw: int = 3) -> float:
+        """Volume (mm³) as the triple integral of the solid map's Jacobian, an
+        independent check of :meth:`volume` (exact in ``w``: the Jacobian is
+        quadratic in ``w``)."""
+        t = self.trim
+        nu = nu or self.tol.quad_u
+        nv = nv or self.tol.quad_v
+        xu, wu = np.polynomial.legendre.leggauss(nu)
+        xw, ww = np.polynomial.legendre.leggauss(nw)
+        u = 0.5 * (t.u[1] - t.u[0]) * (xu + 1) + t.u[0]
+        uw = 0.5 * (t.u[1] - t.u[0]) * wu
+        w = 0.5 * (t.w[1] - t.w[0]) * (xw + 1) + t.w[0]
+        wwt = 0.5 * (t.w[1] - t.w[0]) * ww
+        if t.full_v:
+            v = np.arange(nv) * (TWO_PI / nv) + t.v[0]
+            vw = np.full(nv, TWO_PI / nv)
+        else:
+            xv, wv = np.polynomial.legendre.leggauss(nv)
+            v = 0.5 * (t.v[1] - t.v[0]) * (xv + 1) + t.v[0]
+            vw = 0.5 * (t.v[1] - t.v[0]) * wv
+        total = 0.0
+        for p in self.patches:
+            X = p.evaluate_grid(u, v)
+            Xu = p.evaluate_grid(u, v, du=1)
+            Xv = p.evaluate_grid(u, v, dv=1)
+            A = p.spine(u)[:, None, :]
+            Au = p.spine(u, du=1)[:, None, :]
+            D = X - A
+            Du = Xu - Au
+            for wk, wq in zip(w, wwt):
+                J = np.einsum("uvc,uvc->uv", Au + wk * Du, np.cross(wk * Xv, D))
+                total += wq * float(np.sum(np.outer(uw, vw) * J))
+        return abs(total)
+
+    # ------------------------------------------------------------------ geometry summaries
+    def sample(self, nu: int = 65, nv: int = 128) -> np.ndarray:
+        """Surface points of every patch on a (u, v) grid, shape (patches, nu, nv, 3)."""
+        t = self.trim
+        u = np.linspace(t.u[0], t.u[1], nu)
+        v = np.linspace(t.v[0], t.v[1], nv, endpoint=not t.full_v)
+        return np.stack([p.evaluate_grid(u, v) for p in self.patches])
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Axis-aligned bounding box (mm) of the surface, refined to ~1e-9 mm."""
+        from scipy.optimize import minimize
+
+        pts = self.sample(97, 256)
+        lo = pts.reshape(-1, 3).min(axis=0)
+        hi = pts.reshape(-1, 3).max(axis=0)
+        t = self.trim
+        u = np.linspace(t.u[0], t.u[1], 97)
+        v = np.linspace(t.v[0], t.v[1], 256, endpoint=not t.full_v)
+        for axis in range(3):
+            for sign, store in ((-1.0, lo), (1.0, hi)):
+                k = int(np.argmax(sign * pts[..., axis]))
+                pi, ui, vi = np.unravel_index(k, pts.shape[:3])
+                p = self.patches[pi]
+
+                def f(x, p=p, axis=axis, sign=sign):
+                    uu = min(max(x[0], t.u[0]), t.u[1])
+                    return -sign * float(p.evaluate(uu, x[1])[axis])
+
+                r = minimize(f, [u[ui], v[vi]], method="Nelder-Mead", options=dict(xatol=1e-10, fatol=1e-13))
+                val = -sign * r.fun
+                if sign > 0:
+                    store[axis] = max(store[axis], val)
+                else:
+                    store[axis] = min(store[axis], val)
+        return lo, hi
+
+    def dimensions(self) -> dict[str, float]:
+        """``length_mm`` (x extent), ``width_mm`` (y extent), ``height_mm`` (z extent)."""
+        lo, hi = self.bounds()
+        ext = hi - lo
+        return dict(length_mm=float(ext[0]), width_mm=float(ext[1]), height_mm=float(ext[2]))
+
+    def seams(self, nv: int = 720) -> list[dict[str, Any]]:
+        """For every curve shared by consecutive patches: largest gap (mm) and
+        largest angle (deg) between the two patches' normals."""
+        out = []
+        v = np.linspace(0.0, TWO_PI, nv, endpoint=False)
+        for i in range(len(self.patches) - 1):
+            a, b = self.patches[i], self.patches[i + 1]
+            xa, xb = a.evaluate(1.0, v), b.evaluate(0.0, v)
+            gap = float(np.max(np.linalg.norm(xa - xb, axis=1)))
+            if self._end_is_point(i, 1):
+                ang = float("nan")
+            else:
+                na, nb = a.normal(1.0, v), b.normal(0.0, v)
+                cosang = np.clip(np.einsum("ij,ij->i", na, nb), -1.0, 1.0)
+                ang = float(np.degrees(np.max(np.arccos(cosang))))
+            out.append(
+                dict(
+                    patches=[i, i + 1],
+                    max_gap_mm=gap,
+                    max_angle_deg=ang,
+                    g1=bool(ang == ang and ang <= self.tol.seam_angle_deg),
+                )
+            )
+        return out
+
+    def nominal_deviation(self, nu: int = 129, nv: int = 256) -> float | None:
+        """Largest distance (mm) of the surface from the nominal shape, or None."""
+        if self.nominal is None:
+            return None
+        pts = self.sample(nu, nv).reshape(-1, 3)
+        return float(np.max(np.abs(self.nominal(pts))))
+
+    # ------------------------------------------------------------------ variants
+    def trimmed(self, u=None, v=None, w=None) -> "Tablet":
+        """The same tablet with parameter ranges restricted (see :class:`Trim`)."""
+        t = self.trim
+        return replace(self, trim=Trim(u or t.u, v or t.v, w or t.w))
