@@ -1,0 +1,56 @@
+"""Small compatibility layer over OCP 7.8/7.9 (``TColgp_*``, ``TopoDS.Solid_s``) and
+OCP 8.0 (``OCP.collections``, ``TopoDS.Solid``).  Internal to :mod:`tabletcad.cad`."""
+
+from __future__ import annotations
+
+from OCP.TopAbs import TopAbs_ShapeEnum
+from OCP.TopoDS import TopoDS, TopoDS_Shape
+
+try:  # OCP >= 8.0
+    from OCP.collections import Array1_double as Array1OfReal
+    from OCP.collections import Array1_int as Array1OfInteger
+    from OCP.collections import Array2_gp_Pnt as Array2OfPnt
+except ImportError:  # pragma: no cover - OCP 7.x
+    from OCP.TColgp import TColgp_Array2OfPnt as Array2OfPnt
+    from OCP.TColStd import TColStd_Array1OfInteger as Array1OfInteger
+    from OCP.TColStd import TColStd_Array1OfReal as Array1OfReal
+
+__all__ = ["Array1OfReal", "Array1OfInteger", "Array2OfPnt", "cast", "shape_type"]
+
+_NAMES = {
+    TopAbs_ShapeEnum.TopAbs_VERTEX: "Vertex",
+    TopAbs_ShapeEnum.TopAbs_EDGE: "Edge",
+    TopAbs_ShapeEnum.TopAbs_WIRE: "Wire",
+    TopAbs_ShapeEnum.TopAbs_FACE: "Face",
+    TopAbs_ShapeEnum.TopAbs_SHELL: "Shell",
+    TopAbs_ShapeEnum.TopAbs_SOLID: "Solid",
+    TopAbs_ShapeEnum.TopAbs_COMPSOLID: "CompSolid",
+    TopAbs_ShapeEnum.TopAbs_COMPOUND: "Compound",
+}
+
+
+def shape_type(shape: TopoDS_Shape) -> str:
+    """``"Solid"``, ``"Shell"``, ``"Face"``... of a shape."""
+    return _NAMES[shape.ShapeType()]
+
+
+def cast(shape: TopoDS_Shape, kind: str | None = None):
+    """Downcast ``shape`` to ``TopoDS_<kind>`` (its own type by default) on any OCP version."""
+    kind = kind or shape_type(shape)
+    fn = getattr(TopoDS, kind, None) or getattr(TopoDS, kind + "_s")
+    return fn(shape)
+
+
+def explore(shape: TopoDS_Shape, kind: str) -> list:
+    """Distinct sub-shapes of ``kind`` (``"Face"``, ``"Edge"``, ``"Solid"``...), downcast."""
+    from OCP.TopExp import TopExp_Explorer
+
+    enum = {v: k for k, v in _NAMES.items()}[kind]
+    out: list = []
+    exp = TopExp_Explorer(shape, enum)
+    while exp.More():
+        cur = exp.Current()
+        if not any(cur.IsSame(o) for o in out):
+            out.append(cur)
+        exp.Next()
+    return [cast(o, kind) for o in out]

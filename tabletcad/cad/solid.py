@@ -1,0 +1,296 @@
+"""Fit, sew and validate closed solids from chains of surface patches; adaptive mass properties.
+
+The pipeline never returns a broken solid: every step is checked and a
+:class:`tabletcad.errors.GeometryError` names the patch (and the deviation or
+free edge) that failed.
+
+1. :func:`tabletcad.bspline.fit_patches` - B-spline fit of every patch within
+   ``tol`` (shared boundary rows are bit-identical between neighbours);
+2. :func:`tabletcad.cad.faces.make_face` - one periodic B-spline face per patch;
+3. ``BRepBuilderAPI_Sewing`` with tolerance ``max(2 tol, 1e-6)`` mm - no free
+   or multiple edges allowed, exactly one closed shell;
+4. ``BRepBuilderAPI_MakeSolid`` + ``BRepLib::OrientClosedSolid`` (matter
+   inside, positive volume) + ``BRepCheck_Analyzer``;
+5. volume/area/centroid by *adaptive* Gauss integration
+   (``BRepGProp::VolumeProperties(shape, props, eps)``, ``eps`` = 1e-9): the
+   default integration was measured up to ~1e-3 relative off on dense B-spline faces.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from OCP.BRep import BRep_Tool
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
+from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+from OCP.BRepGProp import BRepGProp
+from OCP.BRepLib import BRepLib
+from OCP.GProp import GProp_GProps
+from OCP.TopoDS import TopoDS_Shape, TopoDS_Solid
+
+from tabletcad.bspline import BSplineSurfaceData, SurfaceFit, fit_patches
+from tabletcad.cad._occ import cast, explore, shape_type
+from tabletcad.cad.faces import make_face
+from tabletcad.errors import GeometryError
+
+__all__ = [
+    "MassProperties",
+    "TabletSolid",
+    "mass_properties",
+    "build_solid",
+    "solid_from_surfaces",
+    "solid_from_tablet",
+    "sew_faces",
+    "check_solid",
+]
+
+DEFAULT_EPS = 1e-9
+
+
+@dataclass(frozen=True)
+class MassProperties:
+    """Volume (mm^3), area (mm^2), centroid (mm) and the integrator's relative error estimates."""
+
+    volume: float
+    area: float
+    centroid: tuple[float, float, float]
+    volume_error: float
+    area_error: float
+    eps: float | None
+
+
+def mass_properties(shape: TopoDS_Shape, eps: float | None = DEFAULT_EPS) -> MassProperties:
+    """Volume, area and centroid of ``shape``.
+
+    ``eps`` (relative, per face) selects OCCT's adaptive Gauss integration;
+    ``eps=None`` uses OCCT's default (non-adaptive) integration, which is what
+    FreeCAD's ``Shape.Volume`` does - only for comparisons.
+    """
+    vprops, sprops = GProp_GProps(), GProp_GProps()
+    if eps is None:
+        BRepGProp.VolumeProperties_s(shape, vprops)
+        BRepGProp.SurfaceProperties_s(shape, sprops)
+        verr = aerr = float("nan")
+    else:
+        if not 0 < eps <= 1e-3:
+            raise ValueError(f"eps = {eps} is not allowed: must be > 0 and <= 1e-3 (adaptive integration)")
+        verr = float(BRepGProp.VolumeProperties_s(shape, vprops, Eps=float(eps)))
+        aerr = float(BRepGProp.SurfaceProperties_s(shape, sprops, Eps=float(eps)))
+    c = vprops.CentreOfMass()
+    return MassProperties(float(vprops.Mass()), float(sprops.Mass()), (c.X(), c.Y(), c.Z()), verr, aerr, eps)
+
+
+@dataclass(frozen=True, eq=False)
+class TabletSolid:
+    """A validated, outward-oriented closed solid and how it was made.
+
+    ``volume_fit_bound`` = ``max_fit_deviation * area`` bounds the volume change
+    caused by replacing the patches with their B-splines (the surfaces are at
+    most ``max_fit_deviation`` apart, pointwise at equal parameters).
+    """
+
+    name: str
+    shape: TopoDS_Solid
+    faces: tuple
+    surfaces: tuple[BSplineSurfaceData, ...]
+    patch_names: tuple[str, ...]
+    fits: tuple[SurfaceFit, ...]
+    sew_tolerance: float
+    mass: MassProperties
+    timings: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def volume(self) -> float:
+        return self.mass.volume
+
+    @property
+    def area(self) -> float:
+        return self.mass.area
+
+    @property
+    def max_fit_deviation(self) -> float:
+        return max((f.max_deviation for f in self.fits), default=0.0)
+
+    @property
+    def volume_fit_bound(self) -> float:
+        return self.max_fit_deviation * self.mass.area
+
+    def summary(self) -> dict[str, Any]:
+        return {
+            "name": self.name,
+            "faces": len(self.faces),
+            "poles": [list(s.shape) for s in self.surfaces],
+            "fit_deviation_mm": [f.max_deviation for f in self.fits],
+            "volume_mm3": self.volume,
+            "area_mm2": self.area,
+            "volume_rel_error_estimate": self.mass.volume_error,
+            "sew_tolerance_mm": self.sew_tolerance,
+            "timings_s": dict(self.timings),
+        }
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def _patch_function(p: Any) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+    if hasattr(p, "evaluate"):
+        return lambda u, v, _p=p: np.asarray(_p.evaluate(u, v))
+    if callable(p):
+        return p
+    raise TypeError(f"a patch must be callable f(u, v) or have .evaluate(u, v), got {type(p).__name__}")
+
+
+def _patch_names(patches: Sequence[Any], names: Sequence[str] | None) -> list[str]:
+    if names is not None:
+        names = [str(n) for n in names]
+        if len(names) != len(patches):
+            raise ValueError(f"{len(names)} names given for {len(patches)} patches")
+        return names
+    out = []
+    for j, p in enumerate(patches):
+        n = getattr(p, "name", None)
+        out.append(f"patch {j} ({n})" if n else f"patch {j}")
+    return out
+
+
+def _owner(edge, faces: Sequence, names: Sequence[str]) -> str:
+    best, best_d = "?", math.inf
+    for f, n in zip(faces, names):
+        d = BRepExtrema_DistShapeShape(edge, f)
+        if d.IsDone() and d.Value() < best_d:
+            best, best_d = n, d.Value()
+    return best
+
+
+def sew_faces(faces: Sequence, names: Sequence[str], tolerance: float):
+    """Sew faces into exactly one closed shell; raise :class:`GeometryError` on free/multiple edges."""
+    sew = BRepBuilderAPI_Sewing(float(tolerance), True, True, True, False)
+    for f in faces:
+        sew.Add(f)
+    sew.Perform()
+    shape = sew.SewedShape()
+    if sew.NbFreeEdges() or sew.NbMultipleEdges():
+        free = [sew.FreeEdge(i) for i in range(1, sew.NbFreeEdges() + 1)]
+        owners = sorted({_owner(e, faces, names) for e in free})
+        raise GeometryError(
+            f"sewing with tolerance {tolerance:.3g} mm left {sew.NbFreeEdges()} free and "
+            f"{sew.NbMultipleEdges()} multiple edges (free edges on: {', '.join(owners) or '-'})",
+            shape,
+        )
+    shells = explore(shape, "Shell")
+    if len(shells) != 1:
+        raise GeometryError(f"sewing produced {len(shells)} shells, expected 1", shape)
+    shell = shells[0]
+    n_faces = len(explore(shell, "Face"))
+    if n_faces != len(faces):
+        raise GeometryError(f"sewn shell has {n_faces} faces, expected {len(faces)}", shell)
+    if not BRep_Tool.IsClosed_s(shell):
+        raise GeometryError("sewn shell is not closed", shell)
+    return shell
+
+
+def check_solid(solid: TopoDS_Shape, what: str = "solid") -> None:
+    """Raise :class:`GeometryError` unless ``solid`` is a valid solid (``BRepCheck_Analyzer``)."""
+    if solid.IsNull() or shape_type(solid) != "Solid":
+        raise GeometryError(f"{what} is not a solid", solid)
+    if not BRepCheck_Analyzer(solid).IsValid():
+        raise GeometryError(f"{what} fails BRepCheck_Analyzer", solid)
+
+
+def _make_solid(shell, name: str) -> TopoDS_Solid:
+    maker = BRepBuilderAPI_MakeSolid(shell)
+    if not maker.IsDone():
+        raise GeometryError(f"BRepBuilderAPI_MakeSolid failed for {name}", shell)
+    solid = cast(maker.Solid(), "Solid")
+    if not BRepLib.OrientClosedSolid_s(solid):
+        raise GeometryError(f"{name}: the sewn shell cannot be oriented (open or incoherent)", solid)
+    check_solid(solid, name)
+    return solid
+
+
+# --------------------------------------------------------------------------- public builders
+
+
+def solid_from_surfaces(
+    surfaces: Sequence[BSplineSurfaceData],
+    *,
+    name: str = "tablet",
+    names: Sequence[str] | None = None,
+    sew_tolerance: float = 2e-4,
+    eps: float = DEFAULT_EPS,
+    fits: Sequence[SurfaceFit] = (),
+    tol_degen: float = 1e-7,
+) -> TabletSolid:
+    """Faces -> sewn closed shell -> outward solid, validated; adaptive mass properties."""
+    t0 = time.perf_counter()
+    names = list(names) if names is not None else [f"patch {j}" for j in range(len(surfaces))]
+    faces = tuple(make_face(s, tol_degen=tol_degen, name=n) for s, n in zip(surfaces, names))
+    t1 = time.perf_counter()
+    shell = sew_faces(faces, names, sew_tolerance)
+    solid = _make_solid(shell, name)
+    t2 = time.perf_counter()
+    mass = mass_properties(solid, eps)
+    if not mass.volume > 0:
+        raise GeometryError(f"{name}: solid volume {mass.volume:.6g} mm^3 is not positive", solid)
+    t3 = time.perf_counter()
+    return TabletSolid(
+        name=name,
+        shape=solid,
+        faces=faces,
+        surfaces=tuple(surfaces),
+        patch_names=tuple(names),
+        fits=tuple(fits),
+        sew_tolerance=float(sew_tolerance),
+        mass=mass,
+        timings={"faces": t1 - t0, "sew_and_check": t2 - t1, "mass_properties": t3 - t2},
+    )
+
+
+def build_solid(
+    patches: Sequence[Any],
+    tol: float = 1e-4,
+    *,
+    name: str = "tablet",
+    names: Sequence[str] | None = None,
+    sew_tolerance: float | None = None,
+    eps: float = DEFAULT_EPS,
+    **fit_kwargs: Any,
+) -> TabletSolid:
+    """Fit every patch (callable ``f(u, v)`` or object with ``.evaluate``) within ``tol`` mm and build the solid.
+
+    Patches form a chain: patch ``j``'s ``u=1`` curve is patch ``j+1``'s ``u=0``
+    curve (the chain may close on itself, e.g. a ring).  ``sew_tolerance``
+    defaults to ``max(2 tol, 1e-6)`` mm.  Extra keyword arguments go to
+    :func:`tabletcad.bspline.fit_surface` (``nu``, ``nv``, ``max_nu``...).
+    """
+    t0 = time.perf_counter()
+    patches = list(patches)
+    if not patches:
+        raise GeometryError("no patches given", patches)
+    names = _patch_names(patches, names)
+    functions = [_patch_function(p) for p in patches]
+    fits = fit_patches(functions, tol, names=names, **fit_kwargs)
+    for fit, n in zip(fits, names):
+        if not fit.ok:  # fit_surface raises already; keep the guarantee explicit
+            raise GeometryError(f"B-spline fit of {n} misses tolerance: {fit.max_deviation:.3g} mm > {tol:.3g} mm", fit)
+    t1 = time.perf_counter()
+    sew_tol = float(sew_tolerance) if sew_tolerance is not None else max(2.0 * tol, 1e-6)
+    result = solid_from_surfaces(
+        [f.surface for f in fits], name=name, names=names, sew_tolerance=sew_tol, eps=eps, fits=fits
+    )
+    timings = {"fit": t1 - t0, **result.timings}
+    timings["total"] = time.perf_counter() - t0
+    object.__setattr__(result, "timings", timings)
+    return result
+
+
+def solid_from_tablet(tablet: Any, tol: float = 1e-4, **kwargs: Any) -> TabletSolid:
+    """:func:`build_solid` for an object with ``.patches`` (ordered chain) and optionally ``.name``."""
+    name = kwargs.pop("name", None) or getattr(tablet, "name", None) or "tablet"
+    return build_solid(tablet.patches, tol, name=str(name), **kwargs)
