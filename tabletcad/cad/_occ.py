@@ -54,3 +54,25 @@ def explore(shape: TopoDS_Shape, kind: str) -> list:
             out.append(cur)
         exp.Next()
     return [cast(o, kind) for o in out]
+
+
+class quiet:
+    """Context manager: raise the trace level of OCCT's default message printers (silences
+    the STEP translator's statistics on stdout); restores the previous levels on exit."""
+
+    def __enter__(self):
+        from OCP.Message import Message, Message_Gravity
+
+        self._saved = []
+        try:
+            for p in Message.DefaultMessenger_s().Printers():
+                self._saved.append((p, p.GetTraceLevel()))
+                p.SetTraceLevel(Message_Gravity.Message_Fail)
+        except Exception:  # pragma: no cover - messenger API differences
+            pass
+        return self
+
+    def __exit__(self, *exc):
+        for p, level in self._saved:
+            p.SetTraceLevel(level)
+        return False

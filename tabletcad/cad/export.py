@@ -1,0 +1,204 @@
+"""Exporters chosen by file suffix, each written atomically (:func:`tabletcad.io.atomic_path`).
+
+=========  ======================================================================
+suffix     format
+=========  ======================================================================
+.step/.stp STEP AP242 (``AP214`` on request), millimetres, PRODUCT named ``name``
+.stl       binary STL of the checked tessellation (mm)
+.3mf       3MF (unit millimetre) of the checked tessellation, object named ``name``
+.glb       binary glTF of the tessellation; glTF's unit is the metre, so vertices
+           are scaled by 1e-3 unless ``glb_scale`` says otherwise
+.brep      OCCT native BREP
+=========  ======================================================================
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from OCP.BRepTools import BRepTools
+from OCP.IFSelect import IFSelect_ReturnStatus
+from OCP.Interface import Interface_Static
+from OCP.STEPCAFControl import STEPCAFControl_Writer
+from OCP.STEPControl import STEPControl_Controller, STEPControl_StepModelType
+from OCP.TCollection import TCollection_ExtendedString
+from OCP.TDataStd import TDataStd_Name
+from OCP.TDocStd import TDocStd_Document
+from OCP.TopoDS import TopoDS_Shape
+from OCP.XCAFDoc import XCAFDoc_DocumentTool
+
+from tabletcad.cad._occ import quiet
+from tabletcad.cad.mesh import MeshResult, tessellate
+from tabletcad.errors import GeometryError
+from tabletcad.io import atomic_path
+
+__all__ = ["export", "export_step", "export_stl", "export_3mf", "export_glb", "export_brep", "SUFFIXES"]
+
+MESH_DEFAULTS = {"linear_deflection": 0.005, "angular_deflection": 0.2}
+
+
+def _shape_of(obj: Any) -> TopoDS_Shape:
+    """Accept a ``TopoDS_Shape``, a :class:`~tabletcad.cad.solid.TabletSolid` or a build123d/cadquery shape."""
+    if isinstance(obj, TopoDS_Shape):
+        return obj
+    for attr in ("shape", "wrapped"):
+        s = getattr(obj, attr, None)
+        if isinstance(s, TopoDS_Shape):
+            return s
+    raise TypeError(f"cannot export {type(obj).__name__}: expected a TopoDS_Shape or TabletSolid")
+
+
+def export_step(obj: Any, path: str | os.PathLike[str], *, name: str = "tablet", schema: str = "AP242") -> Path:
+    """STEP (``AP242`` -> OCCT's ``AP242DIS``, or ``AP214``) in millimetres; the PRODUCT is called ``name``."""
+    shape = _shape_of(obj)
+    schemas = {"AP242": "AP242DIS", "AP214": "AP214IS", "AP203": "AP203"}
+    if schema.upper() not in schemas:
+        raise ValueError(f"schema = {schema!r} is not allowed: must be one of {sorted(schemas)}")
+    STEPControl_Controller.Init_s()
+    Interface_Static.SetCVal_s("write.step.schema", schemas[schema.upper()])
+    Interface_Static.SetCVal_s("write.step.unit", "MM")
+    Interface_Static.SetIVal_s("write.surfacecurve.mode", 1)
+    doc = TDocStd_Document(TCollection_ExtendedString("XmlOcaf"))
+    XCAFDoc_DocumentTool.SetLengthUnit_s(doc, 1.0)  # the document is in millimetres
+    tool = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
+    label = tool.AddShape(shape, False)
+    TDataStd_Name.Set_s(label, TCollection_ExtendedString(str(name)))
+    writer = STEPCAFControl_Writer()
+    writer.SetNameMode(True)
+    with quiet():
+        ok = writer.Transfer(doc, STEPControl_StepModelType.STEPControl_AsIs)
+    if not ok:
+        raise GeometryError(f"STEP transfer of {name} failed", shape)
+    with atomic_path(path) as tmp, quiet():
+        status = writer.Write(str(tmp))
+        if status != IFSelect_ReturnStatus.IFSelect_RetDone:
+            raise GeometryError(f"writing STEP {path} failed: {status}", shape)
+    return Path(path)
+
+
+def _mesh_of(obj: Any, mesh: MeshResult | None, **kw: Any) -> MeshResult:
+    if mesh is not None:
+        return mesh
+    opts = {**MESH_DEFAULTS, **kw}
+    m = tessellate(_shape_of(obj), opts["linear_deflection"], opts["angular_deflection"])
+    if not m.ok:
+        raise GeometryError(
+            f"tessellation is not a closed manifold (manifold3d: {m.manifold_status}, "
+            f"watertight {m.watertight}, winding consistent {m.winding_consistent})",
+            m,
+        )
+    return m
+
+
+def export_stl(obj: Any, path, *, name: str = "tablet", mesh: MeshResult | None = None, **mesh_kw: Any) -> Path:
+    """Binary STL (little-endian, float32, facet normals) of the checked tessellation."""
+    m = _mesh_of(obj, mesh, **mesh_kw)
+    V, T = m.vertices, m.triangles
+    a, b, c = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
+    n = np.cross(b - a, c - a)
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    rec = np.zeros(len(T), dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")]))
+    rec["n"] = n
+    rec["v"] = np.stack([a, b, c], axis=1)
+    header = f"tabletcad binary STL, unit mm: {name}".encode("ascii", "replace")[:80].ljust(80, b" ")
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            fh.write(header)
+            fh.write(struct.pack("<I", len(T)))
+            fh.write(rec.tobytes())
+    return Path(path)
+
+
+_3MF_TYPES = """<?xml version="1.0" encoding="UTF-8"?>
+<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types">
+<Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/>
+<Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/>
+</Types>
+"""
+_3MF_RELS = """<?xml version="1.0" encoding="UTF-8"?>
+<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships">
+<Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/>
+</Relationships>
+"""
+
+
+def export_3mf(obj: Any, path, *, name: str = "tablet", mesh: MeshResult | None = None, **mesh_kw: Any) -> Path:
+    """3MF core (unit millimetre, one object named ``name``), written with the standard library."""
+    import zipfile
+    from xml.sax.saxutils import quoteattr
+
+    m = _mesh_of(obj, mesh, **mesh_kw)
+    verts = "".join(f'<vertex x="{x:.9g}" y="{y:.9g}" z="{z:.9g}"/>' for x, y, z in np.asarray(m.vertices))
+    tris = "".join(f'<triangle v1="{a}" v2="{b}" v3="{c}"/>' for a, b, c in np.asarray(m.triangles))
+    model = (
+        '<?xml version="1.0" encoding="UTF-8"?>\n'
+        '<model unit="millimeter" xml:lang="en-US" '
+        'xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02">\n'
+        f'<metadata name="Title">{_xml_text(name)}</metadata>\n'
+        f'<resources><object id="1" type="model" name={quoteattr(name)}><mesh>'
+        f"<vertices>{verts}</vertices><triangles>{tris}</triangles></mesh></object></resources>\n"
+        '<build><item objectid="1"/></build>\n</model>\n'
+    )
+    with atomic_path(path) as tmp:
+        with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+            zf.writestr("[Content_Types].xml", _3MF_TYPES)
+            zf.writestr("_rels/.rels", _3MF_RELS)
+            zf.writestr("3D/3dmodel.model", model)
+    return Path(path)
+
+
+def _xml_text(text: str) -> str:
+    from xml.sax.saxutils import escape
+
+    return escape(str(text))
+
+
+def export_glb(
+    obj: Any, path, *, name: str = "tablet", mesh: MeshResult | None = None, glb_scale: float = 1e-3, **mesh_kw: Any
+) -> Path:
+    """Binary glTF; vertices are multiplied by ``glb_scale`` (default mm -> m, glTF's unit)."""
+    import trimesh
+
+    m = _mesh_of(obj, mesh, **mesh_kw)
+    tm = trimesh.Trimesh(np.asarray(m.vertices) * float(glb_scale), m.triangles, process=False)
+    scene = trimesh.Scene()
+    scene.add_geometry(tm, node_name=name, geom_name=name)
+    data = trimesh.exchange.gltf.export_glb(scene)
+    with atomic_path(path) as tmp:
+        Path(tmp).write_bytes(data)
+    return Path(path)
+
+
+def export_brep(obj: Any, path, *, name: str = "tablet") -> Path:
+    """OCCT native BREP text."""
+    shape = _shape_of(obj)
+    with atomic_path(path) as tmp:
+        if not BRepTools.Write_s(shape, str(tmp)):
+            raise GeometryError(f"writing BREP {path} failed", shape)
+    return Path(path)
+
+
+SUFFIXES = {
+    ".step": export_step,
+    ".stp": export_step,
+    ".stl": export_stl,
+    ".3mf": export_3mf,
+    ".glb": export_glb,
+    ".brep": export_brep,
+}
+
+
+def export(obj: Any, path: str | os.PathLike[str], *, name: str | None = None, **kw: Any) -> Path:
+    """Write ``obj`` (TopoDS_Shape / TabletSolid / build123d / cadquery shape) in the format named by the suffix.
+
+    ``name`` defaults to ``obj.name`` (a TabletSolid) or ``"tablet"``.
+    """
+    suffix = Path(path).suffix.lower()
+    if suffix not in SUFFIXES:
+        raise ValueError(f"file suffix {suffix!r} is not allowed: must be one of {', '.join(sorted(SUFFIXES))}")
+    name = name or getattr(obj, "name", None) or "tablet"
+    return SUFFIXES[suffix](obj, path, name=str(name), **kw)

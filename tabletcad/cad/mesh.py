@@ -1,0 +1,193 @@
+"""Tessellation of a B-rep solid to numpy arrays, checked with manifold3d and trimesh.
+
+``BRepMesh_IncrementalMesh`` with an explicit linear deflection (mm, chord
+height) and angular deflection (rad).  Face triangulations are merged into one
+indexed mesh: coincident nodes on shared edges, seams and collapsed pole rows
+are welded (within ``weld_tol``) and triangles that became degenerate by the
+welding are dropped.  The signed volume of a closed mesh with chord height
+``d`` differs from the B-rep volume by at most about ``d * area``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from OCP.BRep import BRep_Tool
+from OCP.BRepMesh import BRepMesh_IncrementalMesh
+from OCP.TopAbs import TopAbs_Orientation
+from OCP.TopLoc import TopLoc_Location
+from OCP.TopoDS import TopoDS_Shape
+from scipy.spatial import cKDTree
+
+from tabletcad.cad._occ import explore
+from tabletcad.errors import GeometryError
+
+__all__ = ["MeshResult", "tessellate", "triangulate"]
+
+
+@dataclass(frozen=True, eq=False)
+class MeshResult:
+    """An indexed triangle mesh (mm) and its checks.
+
+    ``volume``/``area`` are computed from the triangles (float64);
+    ``manifold_*`` come from manifold3d (float32 vertices), ``watertight`` and
+    ``winding_consistent`` from trimesh.  ``ok`` is true when every check passed.
+    """
+
+    vertices: np.ndarray
+    triangles: np.ndarray
+    linear_deflection: float
+    angular_deflection: float
+    volume: float
+    area: float
+    manifold_status: str
+    manifold_genus: int | None
+    manifold_volume: float | None
+    watertight: bool | None
+    winding_consistent: bool | None
+
+    @property
+    def is_manifold(self) -> bool:
+        return self.manifold_status == "NoError"
+
+    @property
+    def ok(self) -> bool:
+        return self.is_manifold and bool(self.watertight) and bool(self.winding_consistent) and self.volume > 0
+
+    def to_trimesh(self):
+        import trimesh
+
+        return trimesh.Trimesh(self.vertices, self.triangles, process=False)
+
+
+def triangulate(
+    shape: TopoDS_Shape,
+    linear_deflection: float = 0.005,
+    angular_deflection: float = 0.2,
+    *,
+    relative: bool = False,
+    weld_tol: float = 1e-7,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Mesh ``shape`` and return welded ``(vertices (n, 3) float64, triangles (m, 3) int64)``, outward-wound."""
+    if linear_deflection <= 0 or angular_deflection <= 0:
+        raise ValueError("linear_deflection and angular_deflection must be > 0")
+    mesher = BRepMesh_IncrementalMesh(shape, float(linear_deflection), bool(relative), float(angular_deflection), False)
+    mesher.Perform()
+    if not mesher.IsDone():
+        raise GeometryError("BRepMesh_IncrementalMesh failed", shape)
+    verts, tris, offset = [], [], 0
+    for face in explore(shape, "Face"):
+        loc = TopLoc_Location()
+        tri = BRep_Tool.Triangulation_s(face, loc)
+        if tri is None:
+            raise GeometryError("a face has no triangulation after meshing", face)
+        trsf = loc.Transformation()
+        nodes = np.empty((tri.NbNodes(), 3))
+        for i in range(1, tri.NbNodes() + 1):
+            p = tri.Node(i).Transformed(trsf)
+            nodes[i - 1] = (p.X(), p.Y(), p.Z())
+        t = np.empty((tri.NbTriangles(), 3), dtype=np.int64)
+        for i in range(1, tri.NbTriangles() + 1):
+            t[i - 1] = tri.Triangle(i).Get()
+        t -= 1
+        if face.Orientation() == TopAbs_Orientation.TopAbs_REVERSED:
+            t = t[:, ::-1]
+        verts.append(nodes)
+        tris.append(t + offset)
+        offset += nodes.shape[0]
+    if not verts:
+        raise GeometryError("shape has no faces to mesh", shape)
+    V = np.concatenate(verts)
+    T = np.concatenate(tris)
+    return _weld(V, T, weld_tol)
+
+
+def _weld(V: np.ndarray, T: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    tree = cKDTree(V)
+    pairs = tree.query_pairs(tol, output_type="ndarray")
+    parent = np.arange(len(V))
+
+    def find(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for a, b in pairs:
+        ra, rb = find(a), find(b)
+        if ra != rb:
+            parent[max(ra, rb)] = min(ra, rb)
+    roots = np.array([find(i) for i in range(len(V))])
+    uniq, inverse = np.unique(roots, return_inverse=True)
+    T = inverse[T]
+    keep = (T[:, 0] != T[:, 1]) & (T[:, 1] != T[:, 2]) & (T[:, 0] != T[:, 2])
+    T = T[keep]
+    used = np.unique(T)
+    remap = -np.ones(len(uniq), dtype=np.int64)
+    remap[used] = np.arange(used.size)
+    return np.ascontiguousarray(V[uniq[used]]), np.ascontiguousarray(remap[T])
+
+
+def _signed_volume_area(V: np.ndarray, T: np.ndarray) -> tuple[float, float]:
+    a, b, c = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
+    vol = float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+    area = float(0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum())
+    return vol, area
+
+
+def _manifold_check(V: np.ndarray, T: np.ndarray) -> tuple[str, Any, Any]:
+    import manifold3d
+
+    mesh = manifold3d.Mesh(
+        vert_properties=np.ascontiguousarray(V, dtype=np.float32),
+        tri_verts=np.ascontiguousarray(T, dtype=np.uint32),
+    )
+    m = manifold3d.Manifold(mesh)
+    status = m.status()
+    name = getattr(status, "name", str(status).split(".")[-1])
+    if name != "NoError":
+        return name, None, None
+    return name, int(m.genus()), float(m.volume())
+
+
+def _trimesh_check(V: np.ndarray, T: np.ndarray) -> tuple[bool, bool]:
+    import trimesh
+
+    tm = trimesh.Trimesh(V, T, process=False)
+    return bool(tm.is_watertight), bool(tm.is_winding_consistent)
+
+
+def tessellate(
+    shape: TopoDS_Shape,
+    linear_deflection: float = 0.005,
+    angular_deflection: float = 0.2,
+    *,
+    relative: bool = False,
+    weld_tol: float = 1e-7,
+    check: bool = True,
+) -> MeshResult:
+    """Triangulate ``shape`` (deflections in mm and rad) and run the manifold3d / trimesh checks."""
+    V, T = triangulate(shape, linear_deflection, angular_deflection, relative=relative, weld_tol=weld_tol)
+    vol, area = _signed_volume_area(V, T)
+    status, genus, mvol = ("unchecked", None, None)
+    watertight = winding = None
+    if check:
+        status, genus, mvol = _manifold_check(V, T)
+        watertight, winding = _trimesh_check(V, T)
+    V.setflags(write=False)
+    T.setflags(write=False)
+    return MeshResult(
+        vertices=V,
+        triangles=T,
+        linear_deflection=float(linear_deflection),
+        angular_deflection=float(angular_deflection),
+        volume=vol,
+        area=area,
+        manifold_status=status,
+        manifold_genus=genus,
+        manifold_volume=mvol,
+        watertight=watertight,
+        winding_consistent=winding,
+    )
