@@ -1,0 +1,230 @@
+"""Derived compaction curves of a press record: pressure, density, porosity, Heckel term.
+
+Definitions (thesis eqs 2.2-2.3; units mm, N, MPa, mg):
+
+* pressure ``P = F / A`` (MPa), ``A`` the punch face area (mm²);
+* relative density (solid fraction) ``D = m / (ρ_true · A · h)``, ``h`` the
+  compliance-corrected thickness (mm), ``m`` in mg, ``ρ_true`` in mg/mm³;
+* porosity ``ε = 1 - D``; Heckel term ``ln(1 / (1 - D))``.
+
+Loading and unloading branches
+------------------------------
+The loading branch runs from the first row to the row of maximum compression,
+found as follows: scan the rows in order; the loading branch ends at the last
+row carrying the running force maximum before the force first falls by more
+than ``drop`` (default 2 %) of that maximum.  If the force never falls that
+far, the branch ends at the last row of the global force maximum.  The
+unloading branch follows it as long as the force keeps falling; if the force
+rises again by more than ``drop`` of the peak above its running minimum the
+record is *reloaded* (the thesis's Appendix B does this twice) and the rows
+from there on are excluded from both branches.  The result lists every range
+used so reports can state it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tabletcad.errors import DesignError, check_range
+from tabletcad.mechanics.pressdata import PressData
+from tabletcad.mechanics.validity import DataWarning, warn
+
+__all__ = ["Branches", "CompactionCurves", "split_branches", "compaction_curves", "relative_density"]
+
+
+@dataclass(frozen=True)
+class Branches:
+    """Row ranges (0-based, ``stop`` exclusive) of the loading and unloading branches.
+
+    Attributes
+    ----------
+    loading : (int, int)
+        Rows of the loading branch, start to maximum compression inclusive.
+    unloading : (int, int)
+        Rows of the unloading branch; empty (``start == stop``) if none.
+    peak : int
+        Row of maximum compression (last row of ``loading``).
+    reloading_from : int or None
+        First row of a renewed loading after the unloading branch, excluded.
+    """
+
+    loading: tuple[int, int]
+    unloading: tuple[int, int]
+    peak: int
+    reloading_from: int | None
+
+    @property
+    def loading_slice(self) -> slice:
+        return slice(*self.loading)
+
+    @property
+    def unloading_slice(self) -> slice:
+        return slice(*self.unloading)
+
+
+def split_branches(force, drop: float = 0.02) -> Branches:
+    """Split a force series into loading and unloading branches (see module docstring).
+
+    Parameters
+    ----------
+    force : array_like
+        Force per row, N, in recording order.
+    drop : float
+        Fraction of the running peak force that counts as a real fall or rise
+        (filters transducer noise); 0 < drop < 1.
+
+    Raises
+    ------
+    DesignError
+        If there is no loading branch (fewer than 3 rows up to the peak or a
+        non-positive peak force).
+    """
+    F = np.asarray(force, dtype=float)
+    check_range("drop", drop, 0.0, 1.0, lo_open=True, hi_open=True)
+    n = F.size
+    if n < 3:
+        raise DesignError("data", f"{n} rows", "need at least 3 rows with a loading branch")
+    runmax = np.maximum.accumulate(F)
+    fall = np.flatnonzero(F < (1.0 - drop) * runmax)
+    end = int(fall[0]) if fall.size else n
+    seg = F[:end]
+    peak = int(np.flatnonzero(seg == seg.max())[-1])
+    if peak < 2 or F[peak] <= 0.0 or F[peak] <= F[0]:
+        raise DesignError("data", f"peak force at row {peak + 1}", "has no loading branch (force must rise over >= 3 rows)")
+    reload_from = None
+    stop = peak + 1
+    if fall.size:
+        runmin = F[peak]
+        stop = n
+        for i in range(peak + 1, n):
+            runmin = min(runmin, F[i])
+            if F[i] > runmin + drop * F[peak]:
+                reload_from = i
+                hits = np.flatnonzero(F[peak + 1 : i] == runmin)
+                stop = int(hits[-1]) + peak + 2 if hits.size else peak + 1
+                break
+    return Branches(loading=(0, peak + 1), unloading=(peak + 1, stop), peak=peak, reloading_from=reload_from)
+
+
+def relative_density(thickness, mass_mg: float, true_density: float, area: float) -> np.ndarray:
+    """Relative density ``D = m / (ρ_true A h)`` (eq 2.3), dimensionless.
+
+    Parameters
+    ----------
+    thickness : array_like
+        Compact thickness, mm.
+    mass_mg : float
+        mg.
+    true_density : float
+        mg/mm³.
+    area : float
+        Punch face area, mm².
+    """
+    return float(mass_mg) / (float(true_density) * float(area) * np.asarray(thickness, dtype=float))
+
+
+@dataclass(frozen=True)
+class CompactionCurves:
+    """Derived curves of one press record (arrays over all rows).
+
+    Attributes
+    ----------
+    pressure : ndarray
+        MPa.
+    thickness : ndarray
+        Compliance-corrected thickness, mm.
+    relative_density : ndarray
+        Solid fraction, dimensionless.
+    porosity : ndarray
+        ``1 - relative_density``.
+    heckel : ndarray
+        ``ln(1/(1 - D))``; NaN where ``D >= 1``.
+    branches : Branches
+    line_numbers : ndarray of int
+        Source-file line of each row.
+    elastic_recovery : float or None
+        In-die elastic recovery ``(h_end - h_min) / h_min`` (fraction) over the
+        unloading branch, or ``None`` when the unloading branch does not reach
+        ``recovery_force_fraction`` of the peak force (then ``recovery_note``
+        says why).
+    recovery_note : str
+    """
+
+    pressure: np.ndarray
+    thickness: np.ndarray
+    relative_density: np.ndarray
+    porosity: np.ndarray
+    heckel: np.ndarray
+    branches: Branches
+    line_numbers: np.ndarray
+    elastic_recovery: float | None
+    recovery_note: str
+
+    @property
+    def loading(self) -> slice:
+        return self.branches.loading_slice
+
+    def describe_rows(self) -> str:
+        """One line naming the rows (source-file lines) used for each branch."""
+        b = self.branches
+        ln = self.line_numbers
+        s = f"loading rows {b.loading[0] + 1}-{b.loading[1]} (file lines {ln[b.loading[0]]}-{ln[b.loading[1] - 1]})"
+        if b.unloading[1] > b.unloading[0]:
+            s += f"; unloading rows {b.unloading[0] + 1}-{b.unloading[1]}"
+        if b.reloading_from is not None:
+            s += f"; rows {b.reloading_from + 1}-{ln.size} reload the compact and are not used"
+        return s
+
+
+def compaction_curves(
+    data: PressData, *, drop: float = 0.02, recovery_force_fraction: float = 0.1
+) -> CompactionCurves:
+    """Compute pressure, thickness, relative density, porosity and Heckel term.
+
+    Parameters
+    ----------
+    data : PressData
+    drop : float
+        Branch-splitting threshold, see :func:`split_branches`.
+    recovery_force_fraction : float
+        The unloading branch must end below this fraction of the peak force for
+        the in-die elastic recovery to be reported.
+    """
+    meta = data.metadata
+    P = data.force / meta.area
+    h = np.asarray(data.thickness, dtype=float)
+    D = relative_density(h, meta.mass_mg, meta.true_density, meta.area)
+    branches = split_branches(data.force, drop=drop)
+    over = D >= 1.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        H = np.where(over, np.nan, -np.log1p(-np.where(over, 0.0, D)))
+    lo, hi = branches.loading
+    n_over = int(over[lo:hi].sum())
+    if n_over:
+        warn(
+            DataWarning,
+            f"{n_over} loading row(s) have relative density >= 1 (check mass, true density, compliance); "
+            "their Heckel term is undefined",
+        )
+    ulo, uhi = branches.unloading
+    if uhi - ulo < 1:
+        er, note = None, "no unloading branch"
+    else:
+        h_min = float(h[branches.peak])
+        f_end = float(data.force[uhi - 1])
+        ratio = f_end / float(data.force[branches.peak])
+        if ratio > recovery_force_fraction:
+            er = None
+            note = f"unloading stops at {100 * ratio:.0f} % of the peak force"
+            if branches.reloading_from is not None:
+                note += " before the compact is reloaded"
+        else:
+            er = (float(h[uhi - 1]) - h_min) / h_min
+            note = ""
+    lines = data.line_numbers if data.line_numbers is not None else np.arange(1, P.size + 1)
+    return CompactionCurves(
+        pressure=P, thickness=h, relative_density=D, porosity=1.0 - D, heckel=H,
+        branches=branches, line_numbers=lines, elastic_recovery=er, recovery_note=note,
+    )

@@ -1,0 +1,499 @@
+"""Press data: force and punch-position records of a compaction run, with metadata.
+
+A record is a delimited text file (comma, semicolon or tab separated, ``#``
+comment lines allowed) with a header row.  Columns are recognised by name,
+case-insensitively and ignoring a trailing unit in parentheses:
+
+* force (N): a header containing ``force`` or ``load``;
+* punch displacement (mm): ``displacement``, ``disp`` or ``position``;
+* tablet thickness / punch gap (mm): ``thickness``, ``height`` or ``gap``;
+* time (s), optional: ``time``.
+
+Either a displacement or a thickness column is required.  Every other numeric
+column is kept in :attr:`PressData.extra` (the thesis sample carries its
+printed thickness, relative density, pressure and Heckel columns that way).
+
+The metadata (:class:`PressMetadata`) give the compact mass (mg), the true
+density (mg/mm³), the die diameter (mm) or punch face area (mm²) and an
+optional :class:`MachineCompliance`.  They can come from keyword arguments, a
+TOML file (keys below) or both (keywords win)::
+
+    mass_mg = 300.0
+    true_density = 1.3          # mg/mm³
+    diameter = 10.0             # mm  (or face_area = 78.54, mm²)
+    displacement_sign = "auto"  # or -1 / +1
+    displacement_zero = 0.0     # mm
+    [compliance]
+    slope = 2e-5                # mm/N
+    offset = 0.0267             # mm
+    # or: compensation_line = [2e-5, -0.0267]   (see MachineCompliance)
+    # or: force = [...], deflection = [...]     (calibration table)
+
+Punch gap from displacement: ``gap = displacement_zero + sign * displacement``.
+With ``displacement_sign = "auto"`` the sign is -1 when every reading is <= 0
+(readings are the negative distance between the punch faces, as in the
+thesis's Appendix B) and +1 otherwise (readings are the gap itself).  Data
+recorded as punch *travel* need an explicit ``displacement_zero`` (the gap at
+zero travel) and ``displacement_sign = -1``.
+
+Corrected thickness (mm): ``thickness = gap + compliance.deflection(F)``.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from tabletcad.errors import DesignError, check_finite, check_positive
+from tabletcad.mechanics.validity import DataWarning, warn
+
+__all__ = [
+    "MachineCompliance",
+    "PressMetadata",
+    "PressData",
+    "read_press_data",
+    "read_metadata",
+    "metadata_beside",
+]
+
+
+@dataclass(frozen=True)
+class MachineCompliance:
+    """Elastic deflection of press frame and punches as a function of force.
+
+    The deflection ``δ(F)`` (mm) is *added* to the measured punch gap to obtain
+    the true compact thickness: under load the tooling shortens, so the
+    position transducer over-states how far the punches have closed.
+
+    Either a line ``δ = slope·F + offset`` or a calibration table (force in N,
+    deflection in mm, interpolated linearly and extrapolated along the end
+    segments).
+
+    Attributes
+    ----------
+    slope : float
+        mm/N (line form).
+    offset : float
+        mm (line form).
+    table_force, table_deflection : tuple of float
+        Calibration table (table form); empty for the line form.
+    """
+
+    slope: float = 0.0
+    offset: float = 0.0
+    table_force: tuple[float, ...] = ()
+    table_deflection: tuple[float, ...] = ()
+
+    def __post_init__(self) -> None:
+        check_finite("compliance slope", self.slope, "mm/N")
+        check_finite("compliance offset", self.offset, "mm")
+        if len(self.table_force) != len(self.table_deflection):
+            raise DesignError(
+                "compliance table", f"{len(self.table_force)} forces, {len(self.table_deflection)} deflections",
+                "force and deflection lists must have the same length",
+            )
+        if self.table_force:
+            f = np.asarray(self.table_force, dtype=float)
+            d = np.asarray(self.table_deflection, dtype=float)
+            if f.size < 2 or not np.all(np.isfinite(f)) or not np.all(np.isfinite(d)):
+                raise DesignError("compliance table", f.size, "needs >= 2 finite (force, deflection) pairs")
+            if np.any(np.diff(f) <= 0):
+                raise DesignError("compliance table force", list(f), "must be strictly increasing", "N")
+
+    @classmethod
+    def from_compensation_line(cls, slope: float, intercept: float) -> "MachineCompliance":
+        """Compliance from a compensation-test line ``y = slope·x + intercept`` as printed.
+
+        The thesis's Appendix B prints ``y = 0.00002x - 0.0267``; its thickness
+        column equals ``-displacement + 0.00002·F + 0.0267`` to within the
+        printed rounding (checked on all 243 rows), i.e. the line is evaluated in
+        the machine's sign convention (compression negative) and subtracted.  In
+        the convention of this class that is ``δ(F) = slope·F - intercept``.
+        """
+        return cls(slope=float(slope), offset=-float(intercept))
+
+    @property
+    def is_table(self) -> bool:
+        return bool(self.table_force)
+
+    def deflection(self, force: np.ndarray | float) -> np.ndarray:
+        """Deflection (mm) at ``force`` (N)."""
+        F = np.asarray(force, dtype=float)
+        if not self.is_table:
+            return self.slope * F + self.offset
+        f = np.asarray(self.table_force)
+        d = np.asarray(self.table_deflection)
+        out = np.interp(F, f, d)
+        lo_slope = (d[1] - d[0]) / (f[1] - f[0])
+        hi_slope = (d[-1] - d[-2]) / (f[-1] - f[-2])
+        out = np.where(F < f[0], d[0] + lo_slope * (F - f[0]), out)
+        out = np.where(F > f[-1], d[-1] + hi_slope * (F - f[-1]), out)
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        if self.is_table:
+            return {"force": list(self.table_force), "deflection": list(self.table_deflection)}
+        return {"slope": self.slope, "offset": self.offset}
+
+
+@dataclass(frozen=True)
+class PressMetadata:
+    """What a press record needs besides its columns.
+
+    Attributes
+    ----------
+    mass_mg : float
+        Compact mass, mg.
+    true_density : float
+        True (skeletal) density of the powder, mg/mm³ (numerically g/cm³).
+    diameter : float or None
+        Die diameter, mm (flat round punches).
+    face_area : float or None
+        Punch face area, mm²; overrides ``diameter`` when given.
+    compliance : MachineCompliance or None
+        Machine deflection correction; ``None`` means none.
+    displacement_sign : int or "auto"
+        See the module docstring.
+    displacement_zero : float
+        mm; see the module docstring.
+    """
+
+    mass_mg: float
+    true_density: float
+    diameter: float | None = None
+    face_area: float | None = None
+    compliance: MachineCompliance | None = None
+    displacement_sign: int | str = "auto"
+    displacement_zero: float = 0.0
+    notes: str = ""
+
+    def __post_init__(self) -> None:
+        check_positive("mass", self.mass_mg, "mg")
+        check_positive("true density", self.true_density, "mg/mm³")
+        if self.diameter is None and self.face_area is None:
+            raise DesignError("diameter", None, "give the die diameter (mm) or the punch face area (mm²)", "mm")
+        if self.diameter is not None:
+            check_positive("diameter", self.diameter, "mm")
+        if self.face_area is not None:
+            check_positive("face area", self.face_area, "mm²")
+        if self.displacement_sign not in ("auto", 1, -1):
+            raise DesignError("displacement_sign", self.displacement_sign, "must be 'auto', 1 or -1")
+        check_finite("displacement_zero", self.displacement_zero, "mm")
+
+    @property
+    def area(self) -> float:
+        """Punch face area, mm²."""
+        if self.face_area is not None:
+            return float(self.face_area)
+        return math.pi * float(self.diameter) ** 2 / 4.0
+
+    def to_dict(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"mass_mg": self.mass_mg, "true_density": self.true_density}
+        if self.diameter is not None:
+            out["diameter"] = self.diameter
+        if self.face_area is not None:
+            out["face_area"] = self.face_area
+        if self.compliance is not None:
+            out["compliance"] = self.compliance.to_dict()
+        return out
+
+
+@dataclass(frozen=True)
+class PressData:
+    """One compaction record.
+
+    Attributes
+    ----------
+    force : ndarray
+        Upper-punch force, N.
+    gap : ndarray
+        Measured punch gap before compliance correction, mm.
+    thickness : ndarray
+        Compact thickness after compliance correction, mm.
+    time : ndarray or None
+        s, when the file had a time column.
+    displacement : ndarray or None
+        Raw displacement readings, mm, when the file had them.
+    metadata : PressMetadata
+    extra : dict of str to ndarray
+        Other numeric columns, keyed by their header.
+    line_numbers : ndarray of int
+        1-based line number in the source file of every kept row.
+    dropped_rows : int
+        Rows dropped because a required value was missing.
+    source : str
+        File name, or ``"<arrays>"``.
+    """
+
+    force: np.ndarray
+    gap: np.ndarray
+    thickness: np.ndarray
+    metadata: PressMetadata
+    time: np.ndarray | None = None
+    displacement: np.ndarray | None = None
+    extra: Mapping[str, np.ndarray] = field(default_factory=dict)
+    line_numbers: np.ndarray | None = None
+    dropped_rows: int = 0
+    source: str = "<arrays>"
+
+    def __len__(self) -> int:
+        return int(self.force.size)
+
+    @classmethod
+    def from_arrays(
+        cls,
+        force,
+        *,
+        metadata: PressMetadata,
+        displacement=None,
+        thickness=None,
+        time=None,
+    ) -> "PressData":
+        """Build a record from arrays (force in N, displacement or thickness in mm)."""
+        F = np.asarray(force, dtype=float).ravel()
+        if (displacement is None) == (thickness is None):
+            raise DesignError("columns", "displacement/thickness", "give exactly one of displacement or thickness")
+        pos = np.asarray(displacement if thickness is None else thickness, dtype=float).ravel()
+        if pos.size != F.size:
+            raise DesignError("columns", f"{F.size} forces, {pos.size} positions", "must have equal length")
+        t = None if time is None else np.asarray(time, dtype=float).ravel()
+        if t is not None and t.size != F.size:
+            raise DesignError("time", f"{t.size} values", f"must have {F.size} values")
+        for name, arr, unit in (("force", F, "N"), ("position", pos, "mm")):
+            bad = ~np.isfinite(arr)
+            if bad.any():
+                raise DesignError(name, float(arr[bad][0]), "must be finite numbers", unit)
+        return _assemble(F, pos, thickness is not None, t, metadata, {}, np.arange(1, F.size + 1), 0, "<arrays>")
+
+
+def _assemble(F, pos, is_thickness, t, meta, extra, lines, dropped, source) -> PressData:
+    if F.size == 0:
+        raise DesignError("data", source, "has no complete rows")
+    if is_thickness:
+        gap = pos.copy()
+        disp = None
+    else:
+        disp = pos
+        sign = meta.displacement_sign
+        if sign == "auto":
+            sign = -1 if np.all(disp <= 0.0) else 1
+        gap = meta.displacement_zero + sign * disp
+    thickness = gap if meta.compliance is None else gap + meta.compliance.deflection(F)
+    if np.any(thickness <= 0.0):
+        i = int(np.flatnonzero(thickness <= 0.0)[0])
+        raise DesignError(
+            f"thickness (line {int(lines[i])})", float(thickness[i]),
+            "must be > 0; check displacement_sign/displacement_zero", "mm",
+        )
+    for arr in (F, gap, thickness):
+        arr.setflags(write=False)
+    return PressData(
+        force=F, gap=gap, thickness=thickness, metadata=meta, time=t, displacement=disp,
+        extra=extra, line_numbers=lines, dropped_rows=dropped, source=source,
+    )
+
+
+_ROLE_PATTERNS = (
+    ("force", re.compile(r"force|load")),
+    ("thickness", re.compile(r"thickness|height|gap")),
+    ("displacement", re.compile(r"displacement|disp\b|disp\.|position")),
+    ("time", re.compile(r"^time|\btime\b")),
+)
+
+
+def _role(header: str) -> str | None:
+    h = re.sub(r"\(.*?\)", "", header).strip().lower()
+    for role, pat in _ROLE_PATTERNS:
+        if pat.search(h):
+            return role
+    return None
+
+
+def _read_table(text: str, source: str) -> tuple[list[str], list[tuple[int, list[str]]]]:
+    lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines()) if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise DesignError("data", source, "is empty")
+    head = lines[0][1]
+    if "\t" in head:
+        delim = "\t"
+    elif head.count(";") > head.count(","):
+        delim = ";"
+    else:
+        delim = ","
+    rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines)), delimiter=delim))
+    header = [h.strip() for h in rows[0]]
+    body = [(lines[k][0], [c.strip() for c in row]) for k, row in enumerate(rows[1:], start=1)]
+    return header, body
+
+
+_MISSING = {"", "na", "nan", "n/a", "null", "none", "-"}
+
+
+def read_press_data(
+    path: str | Path,
+    meta: str | Path | Mapping[str, Any] | PressMetadata | None = None,
+    **overrides: Any,
+) -> PressData:
+    """Read a press record from a CSV/TSV file.
+
+    Parameters
+    ----------
+    path : path
+        The data file.
+    meta : path, mapping, PressMetadata or None
+        Metadata: a TOML file, a mapping with the TOML keys, a ready
+        :class:`PressMetadata`, or ``None`` to use the TOML file with the same
+        stem beside ``path`` if there is one.
+    **overrides
+        Metadata keys (``mass_mg``, ``true_density``, ``diameter``,
+        ``face_area``, ``compliance``, ``displacement_sign``,
+        ``displacement_zero``) that override the file; ``None`` values are
+        ignored.  ``compliance`` may be a :class:`MachineCompliance` or a
+        ``(slope, offset)`` pair.
+
+    Returns
+    -------
+    PressData
+
+    Raises
+    ------
+    DesignError
+        Missing columns, non-numeric cells, or invalid metadata.  Rows with a
+        missing force or position are dropped with a :class:`DataWarning`
+        stating how many.
+    """
+    path = Path(path)
+    text = path.read_text(encoding="utf-8-sig")
+    header, body = _read_table(text, path.name)
+    roles: dict[str, int] = {}
+    for j, h in enumerate(header):
+        r = _role(h)
+        if r is not None and r not in roles:
+            roles[r] = j
+    if "force" not in roles:
+        raise DesignError("columns", header, "need a force column (header containing 'force')")
+    if "displacement" not in roles and "thickness" not in roles:
+        raise DesignError("columns", header, "need a displacement or thickness column")
+    pos_role = "displacement" if "displacement" in roles else "thickness"
+    used = {roles["force"], roles[pos_role]}
+    if "time" in roles:
+        used.add(roles["time"])
+    if pos_role == "displacement" and "thickness" in roles:
+        pass  # a printed thickness column beside a displacement column stays in `extra`
+    numeric_cols = list(range(len(header)))
+    values = np.full((len(body), len(header)), np.nan)
+    for k, (lineno, cells) in enumerate(body):
+        if len(cells) > len(header) and any(c for c in cells[len(header):]):
+            raise DesignError(f"line {lineno}", len(cells), f"has more cells than the {len(header)} headers")
+        for j in numeric_cols:
+            cell = cells[j] if j < len(cells) else ""
+            if cell.lower() in _MISSING:
+                continue
+            try:
+                values[k, j] = float(cell)
+            except ValueError:
+                if j in used:
+                    raise DesignError(f"{header[j]} (line {lineno})", cell, "must be a number") from None
+                values[:, j] = np.nan  # non-numeric optional column: ignore it entirely
+                numeric_cols = [c for c in numeric_cols if c != j]
+    need = [roles["force"], roles[pos_role]]
+    keep = np.all(np.isfinite(values[:, need]), axis=1)
+    dropped = int((~keep).sum())
+    if dropped:
+        warn(DataWarning, f"{path.name}: dropped {dropped} row(s) with a missing force or position value")
+    values = values[keep]
+    lines = np.array([body[k][0] for k in np.flatnonzero(keep)], dtype=int)
+    t = values[:, roles["time"]] if "time" in roles else None
+    if t is not None and not np.all(np.isfinite(t)):
+        warn(DataWarning, f"{path.name}: time column has missing values; time ignored")
+        t = None
+    extra = {
+        header[j]: values[:, j].copy() for j in numeric_cols if j not in used and np.any(np.isfinite(values[:, j]))
+    }
+    metadata = _resolve_metadata(path, meta, overrides)
+    return _assemble(
+        values[:, roles["force"]].copy(), values[:, roles[pos_role]].copy(), pos_role == "thickness",
+        t, metadata, extra, lines, dropped, path.name,
+    )
+
+
+def metadata_beside(path: str | Path) -> Path | None:
+    """The metadata TOML with the same stem next to ``path``, if it exists."""
+    cand = Path(path).with_suffix(".toml")
+    return cand if cand.is_file() else None
+
+
+def read_metadata(source: str | Path | Mapping[str, Any], **overrides: Any) -> PressMetadata:
+    """Build :class:`PressMetadata` from a TOML file or mapping plus keyword overrides."""
+    if isinstance(source, (str, Path)):
+        p = Path(source)
+        try:
+            raw = tomllib.loads(p.read_text(encoding="utf-8"))
+        except tomllib.TOMLDecodeError as exc:
+            raise DesignError("metadata", p.name, f"is not valid TOML ({exc})") from None
+    else:
+        raw = dict(source)
+    raw = dict(raw.get("press", raw))  # allow a [press] table
+    for k, v in overrides.items():
+        if v is not None:
+            raw[k] = v
+    comp = raw.get("compliance")
+    compliance: MachineCompliance | None
+    if comp is None or isinstance(comp, MachineCompliance):
+        compliance = comp
+    elif isinstance(comp, (tuple, list)) and len(comp) == 2:
+        compliance = MachineCompliance(slope=float(comp[0]), offset=float(comp[1]))
+    elif isinstance(comp, Mapping):
+        if "compensation_line" in comp:
+            s, b = comp["compensation_line"]
+            compliance = MachineCompliance.from_compensation_line(float(s), float(b))
+        elif "force" in comp:
+            compliance = MachineCompliance(
+                table_force=tuple(float(x) for x in comp["force"]),
+                table_deflection=tuple(float(x) for x in comp["deflection"]),
+            )
+        else:
+            compliance = MachineCompliance(slope=float(comp.get("slope", 0.0)), offset=float(comp.get("offset", 0.0)))
+    else:
+        raise DesignError("compliance", comp, "must be a (slope, offset) pair or a table")
+    missing = [k for k in ("mass_mg", "true_density") if k not in raw]
+    if missing:
+        raise DesignError(missing[0], None, "is required (metadata file or command-line option)")
+    sign = raw.get("displacement_sign", "auto")
+    if isinstance(sign, float) and sign in (1.0, -1.0):
+        sign = int(sign)
+    return PressMetadata(
+        mass_mg=raw["mass_mg"],
+        true_density=raw["true_density"],
+        diameter=raw.get("diameter"),
+        face_area=raw.get("face_area"),
+        compliance=compliance,
+        displacement_sign=sign,
+        displacement_zero=float(raw.get("displacement_zero", 0.0)),
+        notes=str(raw.get("notes", "")),
+    )
+
+
+def _resolve_metadata(path: Path, meta, overrides: Mapping[str, Any]) -> PressMetadata:
+    if isinstance(meta, PressMetadata):
+        if any(v is not None for v in overrides.values()):
+            base = meta.to_dict() | {
+                "compliance": meta.compliance,
+                "displacement_sign": meta.displacement_sign,
+                "displacement_zero": meta.displacement_zero,
+            }
+            return read_metadata(base, **overrides)
+        return meta
+    if meta is None:
+        meta = metadata_beside(path)
+    if meta is None:
+        return read_metadata({}, **overrides)
+    return read_metadata(meta, **overrides)
