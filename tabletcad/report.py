@@ -1,0 +1,84 @@
+"""The geometry report of a tablet (``report.json``): keys carry their units."""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+import numpy as np
+
+from tabletcad.tablet import Tablet
+
+__all__ = ["geometry_report", "to_json"]
+
+
+def geometry_report(tablet: Tablet) -> dict[str, Any]:
+    """Volume, area, dimensions, per-patch figures, seams and nominal deviation.
+
+    All lengths in mm, areas in mm², volumes in mm³, angles in degrees.
+    """
+    props = tablet.properties()
+    dims = tablet.dimensions()
+    solid_v = tablet.solid_volume()
+    seams = tablet.seams()
+    dev = tablet.nominal_deviation()
+    patches = []
+    for i, (p, pp) in enumerate(zip(tablet.patches, props["patches"])):
+        s = p.spine([0.0, 1.0])
+        patches.append(
+            dict(
+                index=i,
+                surface_area_mm2=pp["surface_area_mm2"],
+                volume_mm3=pp["volume_mm3"],
+                smoothing_parameter_a=float(p.a),
+                fourier_modes=int(p.modes),
+                remainder_term=bool(p.has_remainder),
+                form=p.form,
+                u_nodes=list(p.u_nodes),
+                spine_height_mm=float(s[1, 2] - s[0, 2]),
+                stray_mm=p.stray(),
+            )
+        )
+    v = props["volume_mm3"]
+    a = props["surface_area_mm2"]
+    rep: dict[str, Any] = dict(
+        units=dict(length="mm", area="mm2", volume="mm3", angle="deg"),
+        design=dict(name=tablet.name, family=tablet.family, params=dict(tablet.params)),
+        trim=dict(u=list(tablet.trim.u), v_rad=list(tablet.trim.v), w=list(tablet.trim.w)),
+        volume_mm3=v,
+        surface_area_mm2=a,
+        sa_to_volume_per_mm=a / v if v > 0 else math.nan,
+        solid_volume_mm3=solid_v,
+        volume_check_rel=abs(solid_v - v) / v if v > 0 else math.nan,
+        height_mm=dims["height_mm"],
+        width_mm=dims["width_mm"],
+        length_mm=dims["length_mm"],
+        plan_area_mm2=props["plan_area_mm2"],
+        patches=patches,
+        seams=seams,
+        nominal=None
+        if dev is None
+        else dict(max_deviation_um=dev * 1000.0),
+    )
+    return rep
+
+
+def _clean(o: Any) -> Any:
+    if isinstance(o, dict):
+        return {k: _clean(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_clean(v) for v in o]
+    if isinstance(o, (np.floating, float)):
+        x = float(o)
+        return x if math.isfinite(x) else None
+    if isinstance(o, np.integer):
+        return int(o)
+    if isinstance(o, np.bool_):
+        return bool(o)
+    return o
+
+
+def to_json(report: dict[str, Any]) -> str:
+    """JSON text (NaN/inf written as null)."""
+    return json.dumps(_clean(report), indent=2, sort_keys=False) + "\n"
