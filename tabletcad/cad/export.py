@@ -63,7 +63,7 @@ def export_step(obj: Any, path: str | os.PathLike[str], *, name: str = "tablet",
     Interface_Static.SetCVal_s("write.step.unit", "MM")
     Interface_Static.SetIVal_s("write.surfacecurve.mode", 1)
     doc = TDocStd_Document(TCollection_ExtendedString("XmlOcaf"))
-    XCAFDoc_DocumentTool.SetLengthUnit_s(doc, 1.0)  # the document is in millimetres
+    XCAFDoc_DocumentTool.SetLengthUnit_s(doc, 0.001)  # document unit in metres: shapes are in mm
     tool = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
     label = tool.AddShape(shape, False)
     TDataStd_Name.Set_s(label, TCollection_ExtendedString(str(name)))

@@ -1,0 +1,185 @@
+"""Independent read-back of written files (used by the tests).
+
+* :func:`ocp_read_step` re-reads a STEP file with OCP's ``STEPControl_Reader``
+  in a **fresh** Python process (no state shared with the writer).
+* :func:`freecad_read_step` runs :mod:`tabletcad.cad.freecad_check` under
+  ``freecadcmd`` (FreeCAD's own Python and its own OCCT build), with
+  ``FREECAD_USER_HOME`` set to a temporary folder, ``VIRTUAL_ENV`` unset and
+  the venv removed from ``PATH``.
+* :func:`freecad_build_bspline` rebuilds kernel-neutral surfaces with FreeCAD's
+  ``Part.BSplineSurface().buildFromPolesMultsKnots``.
+
+FreeCAD's ``Shape.Volume`` uses OCCT's default (non-adaptive) integration,
+measured up to ~1e-3 relative off on dense B-spline tablets: compare it with
+a relative tolerance of about 1e-3, or against OCP's default integration
+(``mass_properties(shape, eps=None)``) for a tight comparison.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from tabletcad.errors import TabletcadError
+
+__all__ = [
+    "find_freecadcmd",
+    "freecad_read_step",
+    "freecad_build_bspline",
+    "ocp_read_step",
+    "ReadbackError",
+]
+
+FREECAD_SCRIPT = Path(__file__).with_name("freecad_check.py")
+
+
+class ReadbackError(TabletcadError):
+    """The read-back subprocess failed or printed no result."""
+
+
+def _clean_env() -> dict[str, str]:
+    env = dict(os.environ)
+    venv = env.pop("VIRTUAL_ENV", None)
+    env.pop("PYTHONPATH", None)
+    env.pop("PYTHONHOME", None)
+    drop = {str(Path(sys.prefix) / "bin")}
+    if venv:
+        drop.add(str(Path(venv) / "bin"))
+    env["PATH"] = os.pathsep.join(p for p in env.get("PATH", "").split(os.pathsep) if p and p not in drop)
+    return env
+
+
+def find_freecadcmd() -> str | None:
+    """Path of ``freecadcmd`` (or ``FreeCADCmd``) outside the venv, or None."""
+    path = _clean_env()["PATH"]
+    for name in ("freecadcmd", "FreeCADCmd"):
+        exe = shutil.which(name, path=path)
+        if exe:
+            return exe
+    return None
+
+
+def _run_freecad(mode: str, input_path: Path, timeout: float) -> dict[str, Any]:
+    exe = find_freecadcmd()
+    if exe is None:
+        raise ReadbackError("freecadcmd not found on PATH")
+    with tempfile.TemporaryDirectory(prefix="tabletcad-fc-") as home:
+        out = Path(home) / "result.json"
+        env = _clean_env()
+        env.update(
+            FREECAD_USER_HOME=home,
+            TABLETCAD_FC_MODE=mode,
+            TABLETCAD_FC_INPUT=str(input_path),
+            TABLETCAD_FC_OUTPUT=str(out),
+        )
+        proc = subprocess.run(
+            [exe, str(FREECAD_SCRIPT)], env=env, cwd=home, capture_output=True, text=True, timeout=timeout
+        )
+        if not out.exists():
+            raise ReadbackError(
+                f"freecadcmd produced no result (exit {proc.returncode}): {proc.stdout[-2000:]} {proc.stderr[-2000:]}"
+            )
+        result = json.loads(out.read_text())
+    if not result.get("ok"):
+        raise ReadbackError(f"FreeCAD check failed: {result.get('error')}\n{result.get('traceback', '')}")
+    return result
+
+
+def freecad_read_step(path: str | os.PathLike[str], timeout: float = 300.0) -> dict[str, Any]:
+    """Read a STEP file with FreeCAD: ``{n_solids, valid, solids_valid, volume, area, labels, ...}``."""
+    return _run_freecad("read_step", Path(path).resolve(), timeout)
+
+
+def freecad_build_bspline(
+    surfaces: Sequence[Any], u: Sequence[float] = (), v: Sequence[float] = (), timeout: float = 300.0
+) -> dict[str, Any]:
+    """Rebuild :class:`~tabletcad.bspline.BSplineSurfaceData` with FreeCAD; values at ``(u, v)``, solid volume."""
+    payload = {"surfaces": [s.as_dict() for s in surfaces], "u": [float(x) for x in u], "v": [float(x) for x in v]}
+    with tempfile.TemporaryDirectory(prefix="tabletcad-fcin-") as d:
+        p = Path(d) / "surfaces.json"
+        p.write_text(json.dumps(payload))
+        return _run_freecad("bspline", p, timeout)
+
+
+_OCP_READER = r"""
+import json, sys
+from OCP.STEPControl import STEPControl_Reader
+from OCP.IFSelect import IFSelect_ReturnStatus
+from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.BRepGProp import BRepGProp
+from OCP.GProp import GProp_GProps
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopAbs import TopAbs_SOLID, TopAbs_FACE
+from OCP.Bnd import Bnd_Box
+from OCP.BRepBndLib import BRepBndLib
+reader = STEPControl_Reader()
+status = reader.ReadFile(sys.argv[1])
+if status != IFSelect_ReturnStatus.IFSelect_RetDone:
+    print("TABLETCAD_JSON:" + json.dumps({"ok": False, "error": str(status)})); sys.exit(0)
+reader.TransferRoots()
+shape = reader.OneShape()
+def count(kind):
+    e = TopExp_Explorer(shape, kind); n = 0
+    while e.More():
+        n += 1; e.Next()
+    return n
+def props(eps):
+    p = GProp_GProps()
+    if eps is None:
+        BRepGProp.VolumeProperties_s(shape, p)
+    else:
+        BRepGProp.VolumeProperties_s(shape, p, Eps=eps)
+    return p.Mass()
+sp = GProp_GProps(); BRepGProp.SurfaceProperties_s(shape, sp, Eps=1e-9)
+box = Bnd_Box(); BRepBndLib.AddOptimal_s(shape, box, False, False)
+pmin, pmax = box.CornerMin(), box.CornerMax()
+xmin, ymin, zmin, xmax, ymax, zmax = pmin.X(), pmin.Y(), pmin.Z(), pmax.X(), pmax.Y(), pmax.Z()
+names = []
+try:
+    model = reader.WS().Model()
+    from OCP.StepBasic import StepBasic_Product
+    for i in range(1, model.NbEntities() + 1):
+        ent = model.Value(i)
+        if isinstance(ent, StepBasic_Product):
+            names.append(ent.Name().ToCString())
+except Exception as exc:
+    names = ["?" + repr(exc)]
+print("TABLETCAD_JSON:" + json.dumps({
+    "ok": True,
+    "n_solids": count(TopAbs_SOLID),
+    "n_faces": count(TopAbs_FACE),
+    "valid": bool(BRepCheck_Analyzer(shape).IsValid()),
+    "volume": props(1e-9),
+    "volume_default": props(None),
+    "area": sp.Mass(),
+    "bbox": [xmin, ymin, zmin, xmax, ymax, zmax],
+    "products": names,
+}))
+"""
+
+
+def ocp_read_step(path: str | os.PathLike[str], timeout: float = 300.0, python: str | None = None) -> dict[str, Any]:
+    """Read STEP with OCP's ``STEPControl_Reader`` in a fresh process (``python`` defaults to this interpreter).
+
+    Returns ``{n_solids, n_faces, valid, volume (adaptive, eps 1e-9), volume_default, area, bbox, products}``.
+    """
+    proc = subprocess.run(
+        [python or sys.executable, "-c", _OCP_READER, str(Path(path).resolve())],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+    for line in proc.stdout.splitlines()[::-1]:
+        if line.startswith("TABLETCAD_JSON:"):
+            result = json.loads(line[len("TABLETCAD_JSON:"):])
+            if not result.get("ok"):
+                raise ReadbackError(f"STEPControl_Reader failed on {path}: {result.get('error')}")
+            return result
+    raise ReadbackError(f"OCP read-back printed no result (exit {proc.returncode}): {proc.stderr[-2000:]}")
