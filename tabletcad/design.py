@@ -121,6 +121,9 @@ def _curve(spec: Any, where: str, previous: Curve | None) -> Curve:
 
 def design_from_dict(data: dict, default_name: str = "tablet") -> Tablet:
     """Build a tablet from a parsed design (the TOML structure above)."""
+    from tabletcad.shapes import _load_plugins
+
+    _load_plugins()
     _check_keys("top-level", data, set(TOP_LEVEL_KEYS))
     if "tablet" not in data or not isinstance(data["tablet"], dict):
         raise DesignError("[tablet]", "missing", "a design needs a [tablet] table with a family")

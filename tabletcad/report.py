@@ -10,7 +10,23 @@ import numpy as np
 
 from tabletcad.tablet import Tablet
 
-__all__ = ["geometry_report", "to_json"]
+__all__ = ["geometry_report", "to_json", "register_report_section"]
+
+# Extra report sections: callables (tablet) -> dict merged into the report (or None to skip).
+_SECTIONS: list = []
+
+
+def register_report_section(func) -> None:
+    """Add a report section (e.g. the standard families' design report)."""
+    if func not in _SECTIONS:
+        _SECTIONS.append(func)
+
+
+def _load_sections() -> None:
+    try:
+        import tabletcad.families  # noqa: F401  (registers its sections when present)
+    except ImportError:
+        pass
 
 
 def geometry_report(tablet: Tablet) -> dict[str, Any]:
@@ -61,6 +77,11 @@ def geometry_report(tablet: Tablet) -> dict[str, Any]:
         if dev is None
         else dict(max_deviation_um=dev * 1000.0),
     )
+    _load_sections()
+    for section in _SECTIONS:
+        extra = section(tablet)
+        if extra:
+            rep.update(extra)
     return rep
 
 

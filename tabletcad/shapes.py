@@ -40,6 +40,7 @@ __all__ = [
     "rod",
     "caplet",
     "deep_convex_oval",
+    "register_family",
 ]
 
 
@@ -324,3 +325,15 @@ FAMILIES: dict[str, Family] = {
         _fam(deep_convex_oval, width="mm", length="mm", thickness="mm", band="mm"),
     ]
 }
+
+
+def register_family(family: Family) -> None:
+    """Make a family available to design files, ``tabletcad shapes`` and the optimiser."""
+    FAMILIES[family.name] = family
+
+
+def _load_plugins() -> None:
+    try:
+        import tabletcad.families  # noqa: F401  (registers the industry families when present)
+    except ImportError:
+        pass

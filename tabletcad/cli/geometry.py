@@ -16,8 +16,9 @@ __all__ = ["COMMANDS"]
 @click.option("--json", "as_json", is_flag=True, help="Print the families as JSON.")
 def shapes_cmd(as_json: bool) -> None:
     """List the tablet families and their parameters (with units and defaults)."""
-    from tabletcad.shapes import FAMILIES
+    from tabletcad.shapes import FAMILIES, _load_plugins
 
+    _load_plugins()
     if as_json:
         click.echo(json.dumps({n: dict(params=f.params, defaults=f.defaults, doc=f.doc) for n, f in FAMILIES.items()}, indent=2))
         return
