@@ -1,0 +1,99 @@
+"""The solid as build123d and cadquery objects (both imported lazily).
+
+Version constraints (verified in throwaway venvs, see the project report):
+
+* build123d 0.13.0 needs ``cadquery-ocp-novtk>=8.0,<8.1`` (OCP 8.0: array types
+  in ``OCP.collections``, ``TopoDS.Solid`` instead of ``TopoDS.Solid_s``).
+* cadquery 2.8.0 (newest) needs ``cadquery-ocp>=7.9.3.1,<8.0`` and does not
+  import on OCP 8.0 (``TColgp_HArray1OfPnt`` is gone); it also imports
+  ``OCP.IVtkOCC``, which only the VTK flavour ``cadquery-ocp`` ships, so it
+  cannot run on ``cadquery-ocp-novtk`` either.
+* One OCP wheel serving both: ``cadquery-ocp==7.9.3.1.1`` (+ ``vtk==9.6.2``) with
+  ``cadquery==2.8.0`` and ``build123d==0.12.0`` installed ``--no-deps`` (its
+  only unmet requirement is the distribution *name* ``cadquery-ocp-novtk``).
+
+Both libraries wrap the very same ``TopoDS_Shape`` object (no copy, no
+translation); this module only checks that the installed library uses the OCP
+that built the shape.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from OCP.TopoDS import TopoDS_Shape
+
+from tabletcad.cad._occ import cast, explore, shape_type
+
+__all__ = ["to_build123d", "to_build123d_part", "to_cadquery", "to_cadquery_workplane", "from_any"]
+
+_CQ_HINT = (
+    "cadquery is not importable with this OCP ({err}). cadquery 2.8 needs the VTK build "
+    "'cadquery-ocp>=7.9.3.1,<8.0'; a combined install is: pip install cadquery-ocp==7.9.3.1.1 "
+    "vtk==9.6.2 cadquery==2.8.0 && pip install --no-deps build123d==0.12.0 (plus build123d's other deps)"
+)
+_BD_HINT = "build123d is not importable ({err}); install the 'cad' extra (build123d==0.13.0 on cadquery-ocp-novtk 8.0)"
+
+
+def from_any(obj: Any) -> TopoDS_Shape:
+    """The ``TopoDS_Shape`` of a TabletSolid, build123d or cadquery object (or a shape itself)."""
+    if isinstance(obj, TopoDS_Shape):
+        return obj
+    for attr in ("shape", "wrapped"):
+        s = getattr(obj, attr, None)
+        if isinstance(s, TopoDS_Shape):
+            return s
+    val = getattr(obj, "val", None)  # cadquery Workplane
+    if callable(val):
+        return from_any(val())
+    raise TypeError(f"no TopoDS_Shape in {type(obj).__name__}")
+
+
+def _solid_of(obj: Any):
+    shape = from_any(obj)
+    if shape_type(shape) == "Solid":
+        return cast(shape, "Solid")
+    solids = explore(shape, "Solid")
+    if len(solids) != 1:
+        raise TypeError(f"expected exactly one solid, found {len(solids)}")
+    return solids[0]
+
+
+def _import_build123d():
+    try:
+        import build123d
+    except Exception as exc:  # ImportError, or OCP mismatch errors
+        raise ImportError(_BD_HINT.format(err=exc)) from exc
+    return build123d
+
+
+def _import_cadquery():
+    try:
+        import cadquery
+    except Exception as exc:
+        raise ImportError(_CQ_HINT.format(err=exc)) from exc
+    return cadquery
+
+
+def to_build123d(obj: Any):
+    """A ``build123d.Solid`` wrapping the solid (same ``TopoDS_Solid``)."""
+    bd = _import_build123d()
+    return bd.Solid(_solid_of(obj))
+
+
+def to_build123d_part(obj: Any):
+    """A ``build123d.Part`` (a compound holding the solid), usable in BuildPart / algebra mode."""
+    bd = _import_build123d()
+    return bd.Part(bd.Compound([bd.Solid(_solid_of(obj))]).wrapped)
+
+
+def to_cadquery(obj: Any):
+    """A ``cadquery.Solid`` wrapping the solid."""
+    cq = _import_cadquery()
+    return cq.Solid(_solid_of(obj))
+
+
+def to_cadquery_workplane(obj: Any, plane: str = "XY"):
+    """A ``cadquery.Workplane`` on ``plane`` whose stack holds the solid."""
+    cq = _import_cadquery()
+    return cq.Workplane(plane).add(cq.Solid(_solid_of(obj)))
