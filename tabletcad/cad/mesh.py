@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from OCP.BRep import BRep_Tool
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
+from OCP.BRepTools import BRepTools
 from OCP.TopAbs import TopAbs_Orientation
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS_Shape
@@ -73,6 +74,7 @@ def triangulate(
     """Mesh ``shape`` and return welded ``(vertices (n, 3) float64, triangles (m, 3) int64)``, outward-wound."""
     if linear_deflection <= 0 or angular_deflection <= 0:
         raise ValueError("linear_deflection and angular_deflection must be > 0")
+    BRepTools.Clean_s(shape)  # drop an older triangulation, or BRepMesh would keep it
     mesher = BRepMesh_IncrementalMesh(shape, float(linear_deflection), bool(relative), float(angular_deflection), False)
     mesher.Perform()
     if not mesher.IsDone():

@@ -1,0 +1,120 @@
+"""Tessellation checks, exporters and STEP read-back with OCP in a fresh process."""
+
+import os
+import re
+import struct
+import xml.etree.ElementTree as ET
+import zipfile
+
+import numpy as np
+import pytest
+
+
+def _need(module: str):
+    if os.environ.get("CI"):
+        return __import__(module)
+    return pytest.importorskip(module)
+
+
+_need("OCP")
+_need("manifold3d")
+trimesh = _need("trimesh")
+
+from tabletcad.cad.export import export  # noqa: E402
+from tabletcad.cad.mesh import tessellate  # noqa: E402
+from tabletcad.cad.readback import ocp_read_step  # noqa: E402
+from tabletcad.cad.solid import build_solid  # noqa: E402
+from tabletcad.cad.standins import cylinder, ring, sphere  # noqa: E402
+
+pytestmark = pytest.mark.cad
+STANDINS = [sphere(2.5), cylinder(2.5, 3.0), ring(1.5, 3.0, 2.0)]
+
+
+@pytest.fixture(scope="module", params=STANDINS, ids=lambda s: s.name)
+def built(request):
+    s = request.param
+    return s, build_solid(s.patches, 1e-4, name=s.name.replace(" ", "_"))
+
+
+@pytest.mark.parametrize("deflection", [0.01, 0.002])
+def test_mesh_is_closed_manifold_with_right_genus_and_volume(built, deflection):
+    s, ts = built
+    m = tessellate(ts.shape, deflection, 0.1)
+    assert m.is_manifold and m.watertight and m.winding_consistent and m.ok
+    assert m.manifold_genus == s.genus
+    # inscribed chords: the mesh loses at most ~ deflection * area of volume
+    assert 0 <= ts.volume - m.volume <= deflection * ts.area
+    assert m.manifold_volume == pytest.approx(m.volume, rel=1e-5)  # float32 vertices in manifold3d
+
+
+def test_finer_mesh_is_closer(built):
+    _, ts = built
+    coarse, fine = tessellate(ts.shape, 0.02, 0.2), tessellate(ts.shape, 0.002, 0.1)
+    assert abs(fine.volume - ts.volume) < abs(coarse.volume - ts.volume)
+
+
+def test_step_text_and_fresh_process_readback(built, tmp_path):
+    s, ts = built
+    path = export(ts, tmp_path / "part.step")
+    text = path.read_text()
+    assert "SI_UNIT(.MILLI.,.METRE.)" in text.replace(" ", "")
+    assert re.search(r"PRODUCT\s*\(\s*'%s'" % re.escape(ts.name), text)
+    assert "AP242" in text
+    r = ocp_read_step(path)
+    assert r["n_solids"] == 1 and r["valid"]
+    assert r["n_faces"] == len(s.patches)
+    assert r["products"] == [ts.name]
+    assert r["volume"] == pytest.approx(ts.volume, rel=1e-9)
+    assert r["area"] == pytest.approx(ts.area, rel=1e-9)
+    # millimetres really: the bounding box matches the part (catches a x1000 unit slip)
+    grid = np.meshgrid(np.linspace(0, 1, 41), np.linspace(0, 2 * np.pi, 73), indexing="ij")
+    extent = max(np.abs(p.evaluate(*grid)).max() for p in s.patches)
+    assert max(abs(x) for x in r["bbox"]) == pytest.approx(extent, abs=1e-3)
+
+
+def test_ap214_schema(tmp_path):
+    ts = build_solid(sphere(1.0).patches, name="s214")
+    text = export(ts, tmp_path / "a.stp", schema="AP214").read_text()
+    assert "AUTOMOTIVE_DESIGN" in text and "SI_UNIT(.MILLI.,.METRE.)" in text.replace(" ", "")
+
+
+def test_mesh_formats(tmp_path):
+    ts = build_solid(ring().patches, name="ring")
+    m = tessellate(ts.shape, 0.005, 0.2)
+    # STL (binary)
+    stl = export(ts, tmp_path / "r.stl", mesh=m)
+    raw = stl.read_bytes()
+    (n,) = struct.unpack("<I", raw[80:84])
+    assert n == len(m.triangles) and len(raw) == 84 + 50 * n
+    t = trimesh.load(stl, force="mesh")
+    assert t.is_watertight and t.volume == pytest.approx(m.volume, rel=1e-5)
+    # 3MF: unit millimetre, one named object, same triangles
+    p3 = export(ts, tmp_path / "r.3mf", mesh=m)
+    with zipfile.ZipFile(p3) as zf:
+        root = ET.fromstring(zf.read("3D/3dmodel.model"))
+    ns = {"m": "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"}
+    assert root.get("unit") == "millimeter"
+    obj = root.find(".//m:object", ns)
+    assert obj.get("name") == "ring"
+    assert len(obj.findall(".//m:triangle", ns)) == len(m.triangles)
+    # GLB: metres
+    glb = trimesh.load(export(ts, tmp_path / "r.glb", mesh=m), force="mesh")
+    assert glb.volume == pytest.approx(m.volume * 1e-9, rel=1e-5)
+    # BREP
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepTools import BRepTools
+    from OCP.TopoDS import TopoDS_Shape
+
+    from tabletcad.cad.solid import mass_properties
+
+    shape = TopoDS_Shape()
+    assert BRepTools.Read_s(shape, str(export(ts, tmp_path / "r.brep")), BRep_Builder())
+    assert mass_properties(shape).volume == pytest.approx(ts.volume, rel=1e-12)
+
+
+def test_unknown_suffix_and_atomicity(tmp_path):
+    ts = build_solid(sphere(1.0).patches)
+    with pytest.raises(ValueError, match="suffix"):
+        export(ts, tmp_path / "x.obj")
+    export(ts, tmp_path / "x.step")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["x.step"]  # no temporary left behind
