@@ -1,0 +1,149 @@
+"""Shared fixtures and settings for the tabletcad test suite.
+
+Hypothesis: the ``tabletcad`` profile (loaded by default, override with the
+``HYPOTHESIS_PROFILE`` environment variable) is derandomized and has no
+deadline, so property-based tests give the same examples on every machine and
+in CI.  Individual tests still set their own (small) ``max_examples``.
+
+Core helpers (used by ``tests/test_core_*.py``) are exposed through the
+session fixture :func:`kit`:
+
+* ``TrigCurve``: a band-limited closed curve given by its Fourier coefficients,
+  with exact derivatives (the patch's truncated series represents it exactly);
+* ``ReversedCurve``: ``c(-v)``, the same point set traversed the other way;
+* ``rotz(theta)``: the 3×3 rotation about the z axis;
+* ``rebuild(tablet, fn)``: the same tablet with every boundary curve replaced
+  by ``fn(curve)`` (shared curves stay shared: ``fn`` is applied once per
+  object);
+* ``gauss_area(patch, nu, nv)``: the area of a patch by our own tensor
+  Gauss-Legendre/trapezoid rule, independent of :class:`~tabletcad.tablet.Tablet`.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+try:  # hypothesis is a test dependency, but keep collection working without it
+    from hypothesis import HealthCheck, settings
+
+    settings.register_profile(
+        "tabletcad",
+        deadline=None,
+        derandomize=True,
+        print_blob=True,
+        suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+    )
+    settings.register_profile("tabletcad-dev", deadline=None, max_examples=200)
+    settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "tabletcad"))
+except ImportError:  # pragma: no cover
+    pass
+
+
+TWO_PI = 2.0 * math.pi
+
+
+class TrigCurve:
+    """``c(v) = a0 + Σ_{n=1}^{N} (a[n-1] cos nv + b[n-1] sin nv)`` (mm), exact derivatives."""
+
+    def __init__(self, a0, a=(), b=()) -> None:
+        self.a0 = np.asarray(a0, dtype=float).reshape(3)
+        self.a = np.asarray(a, dtype=float).reshape(-1, 3)
+        self.b = np.asarray(b, dtype=float).reshape(-1, 3)
+        if self.a.shape != self.b.shape:
+            raise ValueError("a and b must have the same number of modes")
+
+    @property
+    def modes(self) -> int:
+        return self.a.shape[0]
+
+    def evaluate(self, v, der: int = 0) -> np.ndarray:
+        v = np.asarray(v, dtype=float).reshape(-1)
+        out = np.zeros((v.size, 3))
+        if der == 0:
+            out += self.a0
+        for k in range(self.modes):
+            n = k + 1
+            c, s = np.cos(n * v), np.sin(n * v)
+            # d^der/dv^der of cos and sin
+            dc, ds = [(c, s), (-s, c), (-c, -s), (s, -c)][der % 4]
+            f = float(n) ** der
+            out += f * (np.outer(dc, self.a[k]) + np.outer(ds, self.b[k]))
+        return out
+
+    def __call__(self, v):
+        return self.evaluate(v)
+
+
+class ReversedCurve:
+    """The curve ``c(-v)``: same points, opposite direction of travel."""
+
+    def __init__(self, base) -> None:
+        self.base = base
+
+    def evaluate(self, v, der: int = 0) -> np.ndarray:
+        v = np.asarray(v, dtype=float).reshape(-1)
+        return self.base.evaluate(-v, der) * (-1.0) ** der
+
+
+def rotz(theta: float) -> np.ndarray:
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def rebuild(tablet, fn, **patch_kw):
+    """``tablet`` with each boundary curve ``c`` replaced by ``fn(c)`` (same a, nodes, form, trim)."""
+    from dataclasses import replace
+
+    from tabletcad.patch import PDEPatch
+
+    memo: dict[int, object] = {}
+
+    def once(c):
+        if id(c) not in memo:
+            memo[id(c)] = fn(c)
+        return memo[id(c)]
+
+    patches = []
+    for p in tablet.patches:
+        kw = dict(a=p.a, u_nodes=p.u_nodes, form=p.form, tol=p.tol, name=p.name)
+        kw.update(patch_kw)
+        patches.append(PDEPatch(tuple(once(c) for c in p.data), **kw))
+    return replace(tablet, patches=tuple(patches))
+
+
+def gauss_area(patch, nu: int = 48, nv: int = 256) -> float:
+    """∫∫ |X_u × X_v| du dv by Gauss-Legendre in u and the trapezoidal rule in v."""
+    x, w = np.polynomial.legendre.leggauss(nu)
+    u = 0.5 * (x + 1.0)
+    wu = 0.5 * w
+    v = np.arange(nv) * (TWO_PI / nv)
+    n = np.cross(patch.evaluate_grid(u, v, du=1), patch.evaluate_grid(u, v, dv=1))
+    return float(np.sum(wu[:, None] * np.linalg.norm(n, axis=-1)) * (TWO_PI / nv))
+
+
+@pytest.fixture(scope="session")
+def kit():
+    """Helper classes and functions for the core tests (see module docstring)."""
+    return SimpleNamespace(
+        TrigCurve=TrigCurve, ReversedCurve=ReversedCurve, rotz=rotz, rebuild=rebuild, gauss_area=gauss_area
+    )
+
+
+@pytest.fixture(scope="session")
+def family_tablet():
+    """``family_tablet(name)``: the default tablet of a shape family, built once per session."""
+    from tabletcad.shapes import FAMILIES
+
+    cache: dict[str, object] = {}
+
+    def get(name: str):
+        if name not in cache:
+            cache[name] = FAMILIES[name].build()
+        return cache[name]
+
+    return get
