@@ -1,0 +1,226 @@
+"""Boundary curves (tabletcad.curves): closed forms, parametrisation, derivatives, Fourier."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tabletcad.curves import (
+    Circle,
+    Ellipse,
+    Outline,
+    PointCurve,
+    RoundedRectangle,
+    Stadium,
+    Transformed,
+    fourier_coefficients,
+    modes_needed,
+    sample_v,
+)
+from tabletcad.errors import DesignError
+
+TWO_PI = 2 * math.pi
+
+
+def _shoelace(pts: np.ndarray) -> float:
+    x, y = pts[:, 0], pts[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+def _curves():
+    return {
+        "circle": Circle(2.5, (1.0, -2.0, 0.5)),
+        "ellipse": Ellipse(6.0, 3.0, (0.0, 0.0, 1.0)),
+        "stadium": Stadium(12.0, 6.0, z=0.3),
+        "stadium_long": Stadium(20.0, 3.0),
+        "rounded_rectangle": RoundedRectangle(10.0, 6.0, 1.5, z=-1.0),
+        "rounded_square": RoundedRectangle(8.0, 8.0, 0.5),
+        "polygon": PointCurve([(4, 0), (3, 3), (0, 4), (-3, 3), (-4, 0), (-3, -3), (0, -4), (3, -3)], z=2.0),
+        "transformed": Transformed(Stadium(9.0, 4.0), np.diag([1.0, 1.5, 1.0]), np.array([0.5, 0.0, 2.0])),
+    }
+
+
+CURVES = _curves()
+
+
+# ----------------------------------------------------------------------------- closed forms
+@pytest.mark.parametrize("L, W", [(12.0, 6.0), (15.0, 5.0), (7.0, 6.99), (20.0, 0.5)])
+def test_stadium_perimeter_and_area(L, W):
+    s = Stadium(L, W)
+    assert s.perimeter == pytest.approx(2 * (L - W) + math.pi * W, rel=1e-14)
+    assert s.area() == pytest.approx((L - W) * W + math.pi * (W / 2) ** 2, rel=1e-14)
+    # independent check: polygon area of a dense sampling (O(h²) convergent)
+    assert _shoelace(s.evaluate(sample_v(200_000))) == pytest.approx(s.area(), rel=1e-8)
+
+
+def test_stadium_equal_sides_is_circle():
+    s = Stadium(6.0, 6.0)
+    v = sample_v(64)
+    np.testing.assert_allclose(s.evaluate(v), Circle(3.0).evaluate(v), atol=1e-14)
+
+
+@pytest.mark.parametrize("L, W, rc", [(10.0, 6.0, 1.5), (8.0, 8.0, 0.5), (12.0, 4.0, 2.0), (5.0, 5.0, 2.5)])
+def test_rounded_rectangle_area_and_perimeter(L, W, rc):
+    r = RoundedRectangle(L, W, rc)
+    assert r.area() == pytest.approx(L * W - (4 - math.pi) * rc**2, rel=1e-14)
+    assert r.perimeter == pytest.approx(2 * (L + W) - (8 - 2 * math.pi) * rc, rel=1e-14)
+    assert _shoelace(r.evaluate(sample_v(200_000))) == pytest.approx(r.area(), rel=1e-8)
+    # extents
+    pts = r.evaluate(sample_v(40_000))
+    assert np.ptp(pts[:, 0]) == pytest.approx(L, abs=1e-6)
+    assert np.ptp(pts[:, 1]) == pytest.approx(W, abs=1e-6)
+
+
+@pytest.mark.parametrize("name", ["stadium", "stadium_long", "rounded_rectangle", "rounded_square"])
+def test_outline_starts_on_plus_x_axis_counter_clockwise(name):
+    c = CURVES[name]
+    p0 = c.evaluate(0.0)[0]
+    assert p0[1] == pytest.approx(0.0, abs=1e-14) and p0[0] > 0
+    assert _shoelace(c.evaluate(sample_v(4096))) > 0  # counter-clockwise
+
+
+def test_outline_rejects_gaps():
+    with pytest.raises(DesignError, match="segments"):
+        Outline.from_segments([("line", (0, 0), (1, 0)), ("line", (1, 0), (1, 1)), ("line", (1, 1.1), (0, 0))])
+    with pytest.raises(DesignError, match="width"):
+        Stadium(4.0, 6.0)
+
+
+# ----------------------------------------------------------------------------- parametrisation
+@pytest.mark.parametrize("name", ["stadium", "stadium_long", "rounded_rectangle", "rounded_square"])
+def test_arc_length_parametrisation(name):
+    c = CURVES[name]
+    P = c.perimeter
+    v = np.linspace(0.0, TWO_PI, 10_001)
+    speed = np.linalg.norm(c.evaluate(v, der=1), axis=1)
+    np.testing.assert_allclose(speed, P / TWO_PI, rtol=1e-13)
+    # independent of der=1: the chord length accumulated along a fine sampling is v·P/2π
+    pts = c.evaluate(v)
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+    np.testing.assert_allclose(s, v * P / TWO_PI, atol=1e-6 * P)
+
+
+def test_circle_and_ellipse_use_polar_angle():
+    v = np.linspace(0, TWO_PI, 37)
+    e = CURVES["ellipse"].evaluate(v)
+    np.testing.assert_allclose(e[:, 0], 6.0 * np.cos(v), atol=1e-14)
+    np.testing.assert_allclose(e[:, 1], 3.0 * np.sin(v), atol=1e-14)
+    np.testing.assert_allclose(e[:, 2], 1.0)
+
+
+@pytest.mark.parametrize("name", sorted(CURVES))
+def test_derivatives_agree_with_finite_differences(name):
+    c = CURVES[name]
+    h = 1e-6
+    v = np.linspace(0.013, TWO_PI - 0.013, 997)
+    d1 = (c.evaluate(v + h) - c.evaluate(v - h)) / (2 * h)
+    np.testing.assert_allclose(c.evaluate(v, der=1), d1, atol=1e-7 * max(1.0, np.max(np.abs(d1))))
+    d2 = (c.evaluate(v + h, der=1) - c.evaluate(v - h, der=1)) / (2 * h)
+    exact2 = c.evaluate(v, der=2)
+    # second derivatives of outlines jump at line/arc joins: skip points within 2h of a jump
+    jump = np.abs(c.evaluate(v + 2 * h, der=2) - c.evaluate(v - 2 * h, der=2))
+    ok = np.all(jump < 1e-2 * max(1.0, float(np.max(np.abs(exact2)))), axis=1)
+    assert ok.mean() > 0.95
+    np.testing.assert_allclose(exact2[ok], d2[ok], atol=1e-6 * max(1.0, np.max(np.abs(d2))))
+
+
+@pytest.mark.parametrize("name", sorted(CURVES))
+def test_curves_are_periodic(name):
+    c = CURVES[name]
+    for der in (0, 1):
+        np.testing.assert_allclose(c.evaluate(TWO_PI, der), c.evaluate(0.0, der), atol=1e-9)
+        np.testing.assert_allclose(c.evaluate(-0.3, der), c.evaluate(TWO_PI - 0.3, der), atol=1e-9)
+
+
+# ----------------------------------------------------------------------------- Fourier
+@pytest.mark.parametrize("rx, ry, c", [(6.0, 3.0, (0, 0, 1.0)), (2.0, 5.0, (1.5, -2.0, 3.0)), (4.0, 4.0, (0, 0, 0))])
+def test_ellipse_fourier_coefficients_exact(rx, ry, c):
+    e = Ellipse(rx, ry, c)
+    a0, a, b = fourier_coefficients(e, 6)
+    np.testing.assert_allclose(a0, c, atol=1e-14)
+    np.testing.assert_allclose(a[0], (rx, 0, 0), atol=1e-14)
+    np.testing.assert_allclose(b[0], (0, ry, 0), atol=1e-14)
+    np.testing.assert_allclose(a[1:], 0.0, atol=1e-14)
+    np.testing.assert_allclose(b[1:], 0.0, atol=1e-14)
+    assert modes_needed(e) == 1
+    assert e.modes_needed() == 1
+
+
+def test_point_and_offset_circle_modes():
+    assert modes_needed(Circle(0.0, (1.0, 2.0, 3.0))) == 0
+    assert Circle(0.0).is_point and not Circle(1.0).is_point
+    assert modes_needed(Circle(3.0, (5.0, 0.0, 0.0))) == 1
+
+
+def test_fourier_coefficients_of_known_trig_curve(kit):
+    a = np.array([[1.0, 0.2, 0.0], [0.0, 0.3, -0.1], [0.05, 0.0, 0.0]])
+    b = np.array([[0.0, 1.0, 0.0], [0.1, 0.0, 0.0], [0.0, 0.0, 0.02]])
+    c = kit.TrigCurve((0.5, -0.5, 2.0), a, b)
+    a0, fa, fb = fourier_coefficients(c, 5)
+    np.testing.assert_allclose(a0, (0.5, -0.5, 2.0), atol=1e-14)
+    np.testing.assert_allclose(fa[:3], a, atol=1e-14)
+    np.testing.assert_allclose(fb[:3], b, atol=1e-14)
+    np.testing.assert_allclose(fa[3:], 0, atol=1e-14)
+    assert modes_needed(c) == 3
+
+
+@pytest.mark.parametrize("name", ["stadium", "rounded_rectangle", "polygon"])
+def test_non_band_limited_outlines_need_many_modes(name):
+    """Curvature jumps make the coefficients decay only like n^-3: far more than 48 modes for 1e-9 mm."""
+    c = CURVES[name]
+    assert modes_needed(c, 1e-9, 64) == 65
+    n = modes_needed(c, 1e-3, 256)
+    assert 3 <= n <= 256
+    # and the truncation at that n is within 1e-3 mm on a dense grid
+    a0, a, b = fourier_coefficients(c, n)
+    v = sample_v(4096)
+    k = np.arange(1, n + 1)
+    approx = a0 + np.cos(np.outer(v, k)) @ a + np.sin(np.outer(v, k)) @ b
+    assert np.max(np.linalg.norm(approx - c.evaluate(v), axis=1)) <= 1e-3 * 1.01
+
+
+# ----------------------------------------------------------------------------- PointCurve
+def test_point_curve_passes_through_its_points():
+    rng = np.random.default_rng(7)
+    ang = np.sort(rng.uniform(0, TWO_PI, 13))
+    rad = rng.uniform(2.0, 4.0, 13)
+    pts = np.column_stack([rad * np.cos(ang), rad * np.sin(ang), rng.uniform(-0.5, 0.5, 13)])
+    c = PointCurve(pts)
+    seg = np.linalg.norm(np.diff(np.vstack([pts, pts[:1]]), axis=0), axis=1)
+    t = np.concatenate([[0.0], np.cumsum(seg)])[:-1] * TWO_PI / seg.sum()  # chord-length parameters
+    np.testing.assert_allclose(c.evaluate(t), pts, atol=1e-12)
+    # repeated closing point is dropped; 2-D input takes z
+    c2 = PointCurve(np.vstack([pts[:, :2], pts[:1, :2]]), z=1.25)
+    seg2 = np.linalg.norm(np.diff(np.vstack([pts[:, :2], pts[:1, :2]]), axis=0), axis=1)
+    t2 = np.concatenate([[0.0], np.cumsum(seg2)])[:-1] * TWO_PI / seg2.sum()
+    np.testing.assert_allclose(c2.evaluate(t2)[:, :2], pts[:, :2], atol=1e-12)
+    np.testing.assert_allclose(c2.evaluate(t2)[:, 2], 1.25)
+    # the spline is C2 and periodic
+    for der in (0, 1, 2):
+        np.testing.assert_allclose(c.evaluate(TWO_PI - 1e-12, der), c.evaluate(0.0, der), atol=1e-8)
+
+
+def test_point_curve_rejects_bad_input():
+    with pytest.raises(DesignError):
+        PointCurve([(0, 0), (1, 0)])
+    with pytest.raises(DesignError):
+        PointCurve([(0, 0), (1, 0), (1, 0), (0, 1)])
+    with pytest.raises(DesignError):
+        PointCurve([(0, 0), (1, np.nan), (0, 1)])
+
+
+# ----------------------------------------------------------------------------- transforms
+def test_transformed_moved_scaled_centroid():
+    s = Stadium(12.0, 6.0)
+    v = sample_v(128)
+    m = s.moved((1.0, 2.0, 3.0))
+    np.testing.assert_allclose(m.evaluate(v), s.evaluate(v) + (1, 2, 3), atol=1e-14)
+    np.testing.assert_allclose(m.evaluate(v, 1), s.evaluate(v, 1), atol=1e-14)
+    np.testing.assert_allclose(m.centroid(), (1, 2, 3), atol=1e-13)
+    h = s.at_height(4.5)
+    np.testing.assert_allclose(h.evaluate(v)[:, 2], 4.5)
+    sc = m.scaled_about_centroid(0.5, 2.0)
+    np.testing.assert_allclose(sc.evaluate(v), (s.evaluate(v) * (0.5, 0.5, 2.0)) + (1, 2, 3), atol=1e-13)
+    assert Transformed(s, np.diag([0.0, 0.0, 1.0])).is_point
