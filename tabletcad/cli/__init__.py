@@ -20,6 +20,7 @@ __all__ = ["main", "cli"]
 # so that a missing optional dependency only affects the commands that need it.
 _COMMAND_MODULES = [
     "tabletcad.cli.geometry",
+    "tabletcad.cli.mechanics",
 ]
 
 

@@ -1,0 +1,288 @@
+"""Mechanics commands: ``heckel``, ``strength``, ``contact``, ``shell``, ``love``.
+
+Units: mm, N, MPa, mg, mg/mm³.  Every command computes everything before it
+writes any file, so bad input (reported by ``tabletcad.cli.main`` as one
+``error:`` line, exit status 2) leaves nothing behind.  Warnings from the
+mechanics code are printed as ``warning:`` lines on stderr and, with
+``--json``, listed under ``"warnings"``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import warnings
+from pathlib import Path
+from typing import Any, Iterator
+
+import click
+import numpy as np
+
+from tabletcad.errors import DesignError
+
+__all__ = ["COMMANDS"]
+
+
+@contextlib.contextmanager
+def _collect() -> Iterator[list[str]]:
+    """Collect mechanics warnings (their text) and echo them on stderr at the end."""
+    from tabletcad.mechanics.validity import MechanicsWarning
+
+    msgs: list[str] = []
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always", MechanicsWarning)
+        yield msgs
+    for w in rec:
+        if issubclass(w.category, MechanicsWarning):
+            msgs.append(str(w.message))
+    for m in msgs:
+        click.echo(f"warning: {m}", err=True)
+
+
+def _emit(payload: dict[str, Any], as_json: bool, lines: list[str]) -> None:
+    if as_json:
+        click.echo(json.dumps(payload, indent=2, default=_jsonable))
+    else:
+        for ln in lines:
+            click.echo(ln)
+
+
+def _jsonable(o: Any) -> Any:
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, (np.floating, np.integer)):
+        return o.item()
+    raise TypeError(type(o).__name__)
+
+
+def _check_plot_suffix(path: Path | None) -> None:
+    if path is not None and path.suffix.lower() not in (".png", ".svg", ".pdf"):
+        raise DesignError("--plot", str(path), "must end in .png, .svg or .pdf")
+
+
+# --------------------------------------------------------------------------- heckel
+@click.command("heckel")
+@click.argument("data", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--meta", type=click.Path(exists=True, dir_okay=False, path_type=Path),
+              help="Metadata TOML (default: DATA's name with .toml, if present).")
+@click.option("--mass", type=float, help="Compact mass, mg.")
+@click.option("--true-density", type=float, help="True density, mg/mm³.")
+@click.option("--diameter", type=float, help="Die diameter, mm.")
+@click.option("--face-area", type=float, help="Punch face area, mm² (instead of --diameter).")
+@click.option("--compliance", nargs=2, type=float, metavar="SLOPE OFFSET",
+              help="Machine deflection δ = SLOPE·F + OFFSET (mm/N, mm) added to the punch gap.")
+@click.option("--window", nargs=2, type=float, metavar="LO HI",
+              help="Pressure window in MPa; default: automatic linear-region rule.")
+@click.option("--plot", "plot_file", type=click.Path(dir_okay=False, path_type=Path), help="Heckel plot (.png/.svg).")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: float | None,
+               diameter: float | None, face_area: float | None, compliance: tuple[float, float] | None,
+               window: tuple[float, float] | None, plot_file: Path | None, as_json: bool) -> None:
+    """Heckel analysis (eqs 2.2-2.3) of the loading branch of a press record DATA (CSV/TSV)."""
+    from tabletcad.mechanics.compaction import compaction_curves
+    from tabletcad.mechanics.heckel import fit_heckel, plot_heckel
+    from tabletcad.mechanics.pressdata import MachineCompliance, read_press_data
+
+    _check_plot_suffix(plot_file)
+    with _collect() as msgs:
+        comp = MachineCompliance(slope=compliance[0], offset=compliance[1]) if compliance else None
+        rec = read_press_data(data, meta, mass_mg=mass, true_density=true_density, diameter=diameter,
+                              face_area=face_area, compliance=comp)
+        curves = compaction_curves(rec)
+        fit = fit_heckel(curves, window=window)
+    payload = fit.to_dict() | {
+        "warnings": msgs,
+        "data": str(data),
+        "rows_dropped": rec.dropped_rows,
+        "branches": curves.describe_rows(),
+        "loading_rows": [curves.branches.loading[0] + 1, curves.branches.loading[1]],
+        "fitted_rows": [fit.rows[0] + 1, fit.rows[-1] + 1] if fit.rows else [],
+        "elastic_recovery": curves.elastic_recovery,
+        "metadata": rec.metadata.to_dict(),
+    }
+    if plot_file is not None:
+        plot_heckel(fit, plot_file, title=f"Heckel plot: {data.name}")
+    lo, hi = fit.window_MPa
+    _emit(payload, as_json, [
+        f"{data.name}: {curves.describe_rows()}",
+        f"window {lo:.4g}-{hi:.4g} MPa ({fit.method}), n = {fit.n_points}",
+        f"K = {fit.K_per_MPa:.5g} 1/MPa, A = {fit.A:.4f}, Py = {fit.Py_MPa:.4g} MPa, R² = {fit.r2:.5f}",
+    ] + ([f"plot -> {plot_file}"] if plot_file else []))
+
+
+# --------------------------------------------------------------------------- strength
+_METHODS = ("diametral", "axial", "pitt", "elongated-flat", "elongated-convex", "podczeck", "sphere")
+
+
+@click.command("strength")
+@click.argument("method", type=click.Choice(_METHODS))
+@click.option("--force", "F", type=float, required=True, help="Breaking (or yield) force, N.")
+@click.option("--diameter", "D", type=float, help="Diameter (width for elongated tablets), mm.")
+@click.option("--thickness", "t", type=float, help="Total thickness, mm.")
+@click.option("--band", "W", type=float, help="Central cylinder (band) thickness, mm.")
+@click.option("--length", "L", type=float, help="Length of an elongated tablet, mm (validity check).")
+@click.option("--face-radius", "R", type=float, help="Face radius of curvature, mm (Podczeck validity check).")
+@click.option("--material", help="Material from the table (sphere method), e.g. kostrolith.")
+@click.option("--E", "E", type=float, help="Young's modulus, MPa (sphere).")
+@click.option("--nu", type=float, help="Poisson's ratio (sphere).")
+@click.option("--radius", type=float, help="Sphere radius, mm (sphere).")
+@click.option("--s-y", "s_y", type=float, help="Micro-yield strength, MPa (sphere).")
+@click.option("--json", "as_json", is_flag=True)
+def strength_cmd(method: str, F: float, D, t, W, L, R, material, E, nu, radius, s_y, as_json: bool) -> None:
+    """Tensile strength (MPa) of a tablet from a breaking test (eqs 2.4-2.11)."""
+    from tabletcad.mechanics import strength as st
+
+    def need(name: str, v):
+        if v is None:
+            raise DesignError(name, None, f"is required for method {method!r}")
+        return v
+
+    with _collect() as msgs:
+        if method == "diametral":
+            sigma, eq = st.diametral_flat(F, need("--diameter", D), need("--thickness", t)), "2.4"
+        elif method == "axial":
+            sigma, eq = st.axial_flat(F, need("--diameter", D)), "2.5"
+        elif method == "pitt":
+            sigma, eq = st.pitt_convex(F, need("--diameter", D), need("--thickness", t), need("--band", W)), "2.7"
+        elif method == "elongated-flat":
+            sigma, eq = st.pitt_heasley_elongated_flat(F, need("--diameter", D), need("--thickness", t), L), "2.8"
+        elif method == "elongated-convex":
+            sigma, eq = st.pitt_heasley_elongated_convex(
+                F, need("--diameter", D), need("--thickness", t), need("--band", W), L), "2.9"
+        elif method == "podczeck":
+            sigma, eq = st.podczeck_convex(F, need("--diameter", D), need("--thickness", t), W, R), "Podczeck 2013"
+        else:
+            if material:
+                from tabletcad.mechanics.materials import get_material
+
+                m = get_material(material)
+                E = m.E if E is None else E
+                nu = m.nu if nu is None else nu
+                radius = m.radius if radius is None else radius
+                s_y = m.s_y if s_y is None else s_y
+            sigma = st.sphere_hertz(F, need("--E", E), need("--nu", nu), need("--radius", radius), need("--s-y", s_y))
+            eq = "2.10-2.11"
+    _emit({"method": method, "equation": eq, "tensile_strength_MPa": sigma, "warnings": msgs}, as_json,
+          [f"{method} (eq {eq}): tensile strength = {sigma:.5g} MPa"])
+
+
+# --------------------------------------------------------------------------- contact
+@click.command("contact")
+@click.option("--material", default="kostrolith", show_default=True, help="Material key in tabletcad/data/materials.toml.")
+@click.option("--force", "forces", type=float, multiple=True, required=True, help="Platen force, N (repeatable).")
+@click.option("--radius", type=float, help="Sphere radius, mm (default: the material's).")
+@click.option("--plot", "plot_file", type=click.Path(dir_okay=False, path_type=Path),
+              help="Force-displacement plot (.png/.svg).")
+@click.option("--json", "as_json", is_flag=True)
+def contact_cmd(material: str, forces: tuple[float, ...], radius: float | None, plot_file: Path | None,
+                as_json: bool) -> None:
+    """Compressed spherical tablet: displacement, height, contact radius, boundary circles (eqs 2.1, 5.19-5.26)."""
+    from tabletcad.mechanics import contact as ct
+    from tabletcad.mechanics.materials import get_material
+
+    _check_plot_suffix(plot_file)
+    with _collect() as msgs:
+        m = get_material(material)
+        results = [ct.compress_sphere(f, m, radius) for f in forces]
+        r = results[0].radius
+        wy = ct.yield_displacement(m.E, m.nu, r, m.s_y)
+        curve = ct.force_displacement_curve(m, max(2.0 * max(x.displacement for x in results), 3 * wy), radius=r)
+    payload = {
+        "material": m.name, "source": m.cited, "radius_mm": r, "yield_displacement_mm": wy,
+        "yield_force_eq2_1_N": curve.force_at_yield_ep, "yield_force_hertz_N": curve.force_at_yield_hertz,
+        "results": [x.to_dict() for x in results], "warnings": msgs,
+    }
+    if plot_file is not None:
+        ct.plot_force_displacement([curve], plot_file)
+    lines = [f"{m.name}: r_s = {r:g} mm, yield at ω' = {wy * 1000:.4g} µm "
+             f"(F = {curve.force_at_yield_ep:.4g} N by eq 2.1, {curve.force_at_yield_hertz:.4g} N by eq 5.19)"]
+    for x in results:
+        lines.append(f"F = {x.force:g} N: ω = {x.displacement:.5g} mm, height = {x.height:.5g} mm, "
+                     f"r_c = {x.contact_radius:.4g} mm (eq 5.23), sqrt(r_s ω/2) = {x.contact_radius_per_contact:.4g} mm")
+    _emit(payload, as_json, lines)
+
+
+# --------------------------------------------------------------------------- shell
+@click.command("shell")
+@click.option("--outer", "a", type=float, required=True, help="Outer radius a, mm.")
+@click.option("--inner", "b", type=float, required=True, help="Inner radius b, mm.")
+@click.option("--E", "E", type=float, required=True, help="Young's modulus, MPa.")
+@click.option("--nu", type=float, required=True, help="Poisson's ratio.")
+@click.option("--p-ext", type=float, required=True, help="Platen pressure on the loaded region, MPa.")
+@click.option("--p-int", type=float, default=0.0, show_default=True, help="Internal pressure, MPa.")
+@click.option("--psi", type=float, default=90.0, show_default=True, help="Half-angle of the loaded region, degrees.")
+@click.option("--region", type=click.Choice(["equator", "poles"]), default="equator", show_default=True)
+@click.option("--terms", type=int, default=400, show_default=True, help="Legendre orders kept.")
+@click.option("--csv", "csv_file", type=click.Path(dir_okay=False, path_type=Path), help="u_r(θ) table on both surfaces.")
+@click.option("--plot", "plot_file", type=click.Path(dir_okay=False, path_type=Path), help="u_r(θ) plot (.png/.svg).")
+@click.option("--json", "as_json", is_flag=True)
+def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file, as_json) -> None:
+    """Radial displacement of a thick elastic spherical shell (section 6.2.3) by Legendre series."""
+    from tabletcad.errors import check_range
+    from tabletcad.io import atomic_write_text
+    from tabletcad.mechanics.shell import plot_shell, solve_shell
+
+    _check_plot_suffix(plot_file)
+    check_range("--terms", terms, 2, 20000)
+    with _collect() as msgs:
+        sol = solve_shell(a, b, E, nu, p_ext=p_ext, p_int=p_int, psi=math.radians(check_range("--psi", psi, 0, 90, "deg")),
+                          n_terms=terms, region=region)
+        th = np.radians(np.linspace(0.0, 180.0, 181))
+        ua = sol.radial_displacement(a, th)
+        ub = sol.radial_displacement(b, th)
+        half = sol.radial_displacement(a, math.pi / 2, n_terms=terms // 2)
+    eq = float(ua[90])
+    payload = {
+        "outer_mm": a, "inner_mm": b, "E_MPa": E, "nu": nu, "p_ext_MPa": p_ext, "p_int_MPa": p_int, "psi_deg": psi,
+        "region": region, "terms": terms,
+        "u_r_outer_mm": {"theta_0": float(ua[0]), "theta_45": float(ua[45]), "theta_90": eq,
+                         "min": float(ua.min()), "max": float(ua.max())},
+        "u_r_inner_mm": {"theta_0": float(ub[0]), "theta_90": float(ub[90]), "min": float(ub.min()), "max": float(ub.max())},
+        "thickness_change_at_90deg_mm": eq - float(ub[90]),
+        "series_change_at_90deg_mm": eq - float(half),
+        "warnings": msgs,
+    }
+    if csv_file is not None:
+        rows = ["theta_deg,u_r_outer_mm,u_r_inner_mm"] + [f"{d:g},{x:.10g},{y:.10g}" for d, x, y in
+                                                        zip(np.degrees(th), ua, ub)]
+        atomic_write_text(csv_file, "\n".join(rows) + "\n")
+    if plot_file is not None:
+        plot_shell(sol, plot_file)
+    _emit(payload, as_json, [
+        f"shell a = {a:g} mm, b = {b:g} mm, E = {E:g} MPa, ν = {nu:g}; p_ext = {p_ext:g} MPa over "
+        f"{region} ψ = {psi:g}°, p_int = {p_int:g} MPa; {terms} orders",
+        f"u_r(a): θ=0° {ua[0]:.6g} mm, θ=90° {eq:.6g} mm; u_r(b): θ=0° {ub[0]:.6g} mm, θ=90° {ub[90]:.6g} mm",
+        f"series change at θ=90° from {terms // 2} to {terms} orders: {eq - half:.3g} mm",
+    ])
+
+
+# --------------------------------------------------------------------------- love
+@click.command("love")
+@click.option("--E", "E", type=float, default=2640.0, show_default=True, help="Young's modulus, MPa.")
+@click.option("--nu", type=float, default=0.21, show_default=True, help="Poisson's ratio.")
+@click.option("--h0", type=float, default=6.0, show_default=True, help="Initial bed height, mm.")
+@click.option("--z", type=float, default=3.0, show_default=True, help="Height where ω_z is taken, mm.")
+@click.option("--r", type=float, help="Radius where ω_z is taken, mm (default: die wall).")
+@click.option("--omega-z0", type=float, help="Adjustment ω_z0, mm (default: match --ref-displacement).")
+@click.option("--window", nargs=2, type=float, default=(10.0, 50.0), show_default=True, metavar="LO HI",
+              help="Simulated pressure range, MPa.")
+@click.option("--json", "as_json", is_flag=True)
+def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json) -> None:
+    """Simulated die compression with the thesis's eq 5.18 and its Heckel fit (thesis defaults)."""
+    from tabletcad.mechanics.love import simulate_compression
+
+    lo, hi = window
+    if not 0 < lo < hi:
+        raise DesignError("--window", window, "must be two increasing positive pressures", "MPa")
+    with _collect() as msgs:
+        sim = simulate_compression(np.linspace(lo, hi, 41), E=E, nu=nu, h0=h0, z=z, r=r, omega_z0=omega_z0)
+    f = sim.heckel
+    payload = {"K_per_MPa": f.K_per_MPa, "A": f.A, "Py_MPa": f.Py_MPa, "r2": f.r2, "window_MPa": list(f.window_MPa),
+               "n_points": f.n_points, "omega_z0_mm": sim.omega_z0, "assumptions": sim.assumptions, "warnings": msgs}
+    _emit(payload, as_json, [
+        f"ω_z0 = {sim.omega_z0:.5g} mm; K = {f.K_per_MPa:.5g} 1/MPa, A = {f.A:.4f}, Py = {f.Py_MPa:.4g} MPa, "
+        f"R² = {f.r2:.4f} over {lo:g}-{hi:g} MPa"])
+
+
+COMMANDS = [heckel_cmd, strength_cmd, contact_cmd, shell_cmd, love_cmd]
