@@ -94,7 +94,7 @@ def _write(tmp_path: Path, text: str, name="run.csv") -> Path:
     return p
 
 
-META = dict(mass_mg=300.0, true_density=1.3, diameter=10.0)
+META = {"mass_mg": 300.0, "true_density": 1.3, "diameter": 10.0}
 
 
 def test_missing_values_dropped_with_count(tmp_path):

@@ -13,8 +13,9 @@ import contextlib
 import json
 import math
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 import click
 import numpy as np
@@ -195,8 +196,8 @@ def contact_cmd(material: str, forces: tuple[float, ...], radius: float | None, 
     }
     if plot_file is not None:
         ct.plot_force_displacement([curve], plot_file)
-    lines = [f"{m.name}: r_s = {r:g} mm, yield at ω' = {wy * 1000:.4g} µm "
-             f"(F = {curve.force_at_yield_ep:.4g} N by eq 2.1, {curve.force_at_yield_hertz:.4g} N by eq 5.19)"]
+    lines = [(f"{m.name}: r_s = {r:g} mm, yield at ω' = {wy * 1000:.4g} µm "
+              f"(F = {curve.force_at_yield_ep:.4g} N by eq 2.1, {curve.force_at_yield_hertz:.4g} N by eq 5.19)")]
     for x in results:
         lines.append(f"F = {x.force:g} N: ω = {x.displacement:.5g} mm, height = {x.height:.5g} mm, "
                      f"r_c = {x.contact_radius:.4g} mm (eq 5.23), sqrt(r_s ω/2) = {x.contact_radius_per_contact:.4g} mm")
@@ -250,8 +251,8 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
     if plot_file is not None:
         plot_shell(sol, plot_file)
     _emit(payload, as_json, [
-        f"shell a = {a:g} mm, b = {b:g} mm, E = {E:g} MPa, ν = {nu:g}; p_ext = {p_ext:g} MPa over "
-        f"{region} ψ = {psi:g}°, p_int = {p_int:g} MPa; {terms} orders",
+        (f"shell a = {a:g} mm, b = {b:g} mm, E = {E:g} MPa, ν = {nu:g}; p_ext = {p_ext:g} MPa over "
+         f"{region} ψ = {psi:g}°, p_int = {p_int:g} MPa; {terms} orders"),
         f"u_r(a): θ=0° {ua[0]:.6g} mm, θ=90° {eq:.6g} mm; u_r(b): θ=0° {ub[0]:.6g} mm, θ=90° {ub[90]:.6g} mm",
         f"series change at θ=90° from {terms // 2} to {terms} orders: {eq - half:.3g} mm",
     ])
@@ -281,8 +282,8 @@ def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json) -> None:
     payload = {"K_per_MPa": f.K_per_MPa, "A": f.A, "Py_MPa": f.Py_MPa, "r2": f.r2, "window_MPa": list(f.window_MPa),
                "n_points": f.n_points, "omega_z0_mm": sim.omega_z0, "assumptions": sim.assumptions, "warnings": msgs}
     _emit(payload, as_json, [
-        f"ω_z0 = {sim.omega_z0:.5g} mm; K = {f.K_per_MPa:.5g} 1/MPa, A = {f.A:.4f}, Py = {f.Py_MPa:.4g} MPa, "
-        f"R² = {f.r2:.4f} over {lo:g}-{hi:g} MPa"])
+        (f"ω_z0 = {sim.omega_z0:.5g} mm; K = {f.K_per_MPa:.5g} 1/MPa, A = {f.A:.4f}, Py = {f.Py_MPa:.4g} MPa, "
+         f"R² = {f.r2:.4f} over {lo:g}-{hi:g} MPa")])
 
 
 COMMANDS = [heckel_cmd, strength_cmd, contact_cmd, shell_cmd, love_cmd]

@@ -31,7 +31,7 @@ from tabletcad.errors import DesignError, check_range
 from tabletcad.mechanics.pressdata import PressData
 from tabletcad.mechanics.validity import DataWarning, warn
 
-__all__ = ["Branches", "CompactionCurves", "split_branches", "compaction_curves", "relative_density"]
+__all__ = ["Branches", "CompactionCurves", "compaction_curves", "relative_density", "split_branches"]
 
 
 @dataclass(frozen=True)

@@ -37,7 +37,7 @@ from tabletcad.errors import DesignError, check_positive
 from tabletcad.mechanics.compaction import CompactionCurves
 from tabletcad.mechanics.validity import FitQualityWarning, warn
 
-__all__ = ["HeckelFit", "fit_heckel", "fit_heckel_arrays", "plot_heckel", "PY_PLAUSIBLE_MPA"]
+__all__ = ["PY_PLAUSIBLE_MPA", "HeckelFit", "fit_heckel", "fit_heckel_arrays", "plot_heckel"]
 
 #: Range of apparent yield pressure (MPa) outside which a warning is issued.
 PY_PLAUSIBLE_MPA = (10.0, 2000.0)
@@ -134,7 +134,7 @@ def _auto_window(P: np.ndarray, H: np.ndarray, min_points: int, max_residual: fl
     cxx = np.concatenate([[0.0], np.cumsum(P * P)])
     cxy = np.concatenate([[0.0], np.cumsum(P * H)])
     cyy = np.concatenate([[0.0], np.cumsum(H * H)])
-    for i in range(0, n - min_points + 1):
+    for i in range(n - min_points + 1):
         j = np.arange(i + min_points, n + 1)
         m = j - i
         sx, sy = cx[j] - cx[i], cy[j] - cy[i]

@@ -56,17 +56,17 @@ from tabletcad.mechanics.compaction import relative_density
 from tabletcad.mechanics.heckel import HeckelFit, fit_heckel_arrays
 
 __all__ = [
-    "LoveConstants",
-    "thesis_constants",
-    "love_fields",
-    "axial_displacement",
-    "adjustment_omega_z0",
-    "SimulatedCompression",
-    "simulate_compression",
-    "ConfinedCompression",
-    "confined_compression",
     "THESIS_H0",
     "THESIS_Z",
+    "ConfinedCompression",
+    "LoveConstants",
+    "SimulatedCompression",
+    "adjustment_omega_z0",
+    "axial_displacement",
+    "confined_compression",
+    "love_fields",
+    "simulate_compression",
+    "thesis_constants",
 ]
 
 #: Initial powder-bed height inferred from the thesis's numbers, mm.
@@ -234,9 +234,9 @@ def simulate_compression(
     fit = fit_heckel_arrays(P, D, window=(float(P.min()), float(P.max())))
     return SimulatedCompression(
         pressure=P, omega_z=w, thickness=h, relative_density=D, heckel=fit, omega_z0=float(omega_z0),
-        assumptions=dict(h0=h0, z=z, r=r, c=c, E=E, nu=nu, scale=scale, reference_pressure=reference_pressure,
-                         model_displacement_at_reference=model_ref,
-                         experimental_displacement=experimental_displacement),
+        assumptions={"h0": h0, "z": z, "r": r, "c": c, "E": E, "nu": nu, "scale": scale,
+                     "reference_pressure": reference_pressure, "model_displacement_at_reference": model_ref,
+                     "experimental_displacement": experimental_displacement},
     )
 
 

@@ -7,14 +7,15 @@ original sources).
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+import tomllib
+
 from tabletcad.errors import DesignError, check_positive, check_range
 
-__all__ = ["Material", "load_materials", "get_material", "MATERIALS_FILE"]
+__all__ = ["MATERIALS_FILE", "Material", "get_material", "load_materials"]
 
 MATERIALS_FILE = Path(__file__).resolve().parent.parent / "data" / "materials.toml"
 

@@ -45,23 +45,24 @@ import csv
 import io
 import math
 import re
-import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
+import tomllib
 
 from tabletcad.errors import DesignError, check_finite, check_positive
 from tabletcad.mechanics.validity import DataWarning, warn
 
 __all__ = [
     "MachineCompliance",
-    "PressMetadata",
     "PressData",
-    "read_press_data",
-    "read_metadata",
+    "PressMetadata",
     "metadata_beside",
+    "read_metadata",
+    "read_press_data",
 ]
 
 
@@ -109,7 +110,7 @@ class MachineCompliance:
                 raise DesignError("compliance table force", list(f), "must be strictly increasing", "N")
 
     @classmethod
-    def from_compensation_line(cls, slope: float, intercept: float) -> "MachineCompliance":
+    def from_compensation_line(cls, slope: float, intercept: float) -> MachineCompliance:
         """Compliance from a compensation-test line ``y = slope·x + intercept`` as printed.
 
         The thesis's Appendix B prints ``y = 0.00002x - 0.0267``; its thickness
@@ -256,7 +257,7 @@ class PressData:
         displacement=None,
         thickness=None,
         time=None,
-    ) -> "PressData":
+    ) -> PressData:
         """Build a record from arrays (force in N, displacement or thickness in mm)."""
         F = np.asarray(force, dtype=float).ravel()
         if (displacement is None) == (thickness is None):

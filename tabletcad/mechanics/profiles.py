@@ -24,11 +24,11 @@ from tabletcad.errors import DesignError
 __all__ = [
     "Profile",
     "RyshkewitchFit",
-    "tabletability",
-    "compressibility",
     "compactibility",
+    "compressibility",
     "fit_ryshkewitch_duckworth",
     "plot_profiles",
+    "tabletability",
 ]
 
 

@@ -53,12 +53,12 @@ from scipy.special import eval_legendre
 from tabletcad.errors import DesignError, check_positive, check_range
 
 __all__ = [
-    "band_coefficients",
     "ShellSolution",
-    "solve_shell",
+    "band_coefficients",
     "lame_displacement",
     "lame_stresses",
     "plot_shell",
+    "solve_shell",
 ]
 
 

@@ -45,15 +45,15 @@ from tabletcad.mechanics.contact import contact_radius_at_yield
 from tabletcad.mechanics.validity import ValidityWarning, warn
 
 __all__ = [
-    "diametral_flat",
+    "ELONGATED_FACTOR",
+    "ELONGATED_RATIO",
     "axial_flat",
+    "diametral_flat",
     "pitt_convex",
-    "pitt_heasley_elongated_flat",
     "pitt_heasley_elongated_convex",
+    "pitt_heasley_elongated_flat",
     "podczeck_convex",
     "sphere_hertz",
-    "ELONGATED_RATIO",
-    "ELONGATED_FACTOR",
 ]
 
 #: length/width above which the elongated-tablet factor applies (Pitt & Heasley).

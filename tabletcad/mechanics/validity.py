@@ -10,9 +10,9 @@ from __future__ import annotations
 import warnings
 
 __all__ = [
-    "MechanicsWarning",
     "DataWarning",
     "FitQualityWarning",
+    "MechanicsWarning",
     "ValidityWarning",
     "warn",
 ]

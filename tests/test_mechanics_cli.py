@@ -1,0 +1,149 @@
+"""The mechanics commands through ``tabletcad.cli.main``."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tabletcad.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLE = ROOT / "samples" / "press" / "lactose_appendix_b.csv"
+
+
+def run(capsys, *args):
+    rc = main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def test_heckel_json_with_thesis_window(capsys, tmp_path):
+    plot = tmp_path / "heckel.png"
+    rc, out, err = run(capsys, "heckel", SAMPLE, "--window", 10, 50, "--plot", plot, "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    assert {"K_per_MPa", "A", "Py_MPa", "r2", "window_MPa", "n_points"} <= set(d)
+    assert d["K_per_MPa"] == pytest.approx(0.0095647, rel=1e-4)
+    assert d["A"] == pytest.approx(0.87921, rel=1e-4)
+    assert d["Py_MPa"] == pytest.approx(104.55, rel=1e-4)
+    assert d["n_points"] == 29 and len(d["window_MPa"]) == 2
+    assert d["window_MPa"][0] >= 10 and d["window_MPa"][1] <= 50
+    assert d["loading_rows"] == [1, 81] and d["fitted_rows"] == [35, 63]
+    assert plot.stat().st_size > 1000
+
+
+def test_heckel_options_replace_metadata_file(capsys, tmp_path):
+    data = tmp_path / "run.csv"
+    shutil.copy(SAMPLE, data)  # no .toml beside it
+    rc, out, err = run(capsys, "heckel", data, "--mass", 300, "--true-density", 1.3, "--diameter", 10,
+                       "--compliance", 2e-5, 0.0267, "--window", 10, 50, "--json")
+    assert rc == 0, err
+    assert json.loads(out)["K_per_MPa"] == pytest.approx(0.0095647, rel=1e-4)
+    rc, out, err = run(capsys, "heckel", data, "--meta", SAMPLE.with_suffix(".toml"), "--window", 10, 50, "--json")
+    assert rc == 0 and json.loads(out)["A"] == pytest.approx(0.87921, rel=1e-4)
+
+
+@pytest.mark.parametrize(
+    "extra,match",
+    [
+        (["--mass", "-3"], "mass = -3 mg"),
+        (["--true-density", "0"], "true density"),
+        (["--diameter", "0"], "diameter"),
+        (["--window", "10", "10.5"], "need >= 3"),
+    ],
+)
+def test_heckel_bad_input_exit_2_and_no_file(capsys, tmp_path, extra, match):
+    plot = tmp_path / "bad.png"
+    rc, _, err = run(capsys, "heckel", SAMPLE, *extra, "--plot", plot)
+    assert rc == 2
+    assert err.startswith("error: ") and match in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1
+    assert not plot.exists() and list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "text,match",
+    [
+        ("force,displacement\n1,-5\nabc,-4\n3,-3\n", "must be a number"),
+        ("force,time\n1,0\n2,1\n3,2\n", "displacement or thickness"),
+        ("force,displacement\n100,-5\n90,-4.9\n80,-4.8\n", "no loading branch"),
+    ],
+)
+def test_heckel_bad_data(capsys, tmp_path, text, match):
+    data = tmp_path / "bad.csv"
+    data.write_text(text)
+    rc, _, err = run(capsys, "heckel", data, "--mass", 300, "--true-density", 1.3, "--diameter", 10,
+                     "--plot", tmp_path / "p.png")
+    assert rc == 2 and match in err and not (tmp_path / "p.png").exists()
+
+
+def test_heckel_missing_rows_warning(capsys, tmp_path):
+    lines = SAMPLE.read_text().splitlines()
+    lines[10] = ",".join([""] + lines[10].split(",")[1:])  # blank force in one data row
+    data = tmp_path / "gappy.csv"
+    data.write_text("\n".join(lines) + "\n")
+    rc, out, err = run(capsys, "heckel", data, "--meta", SAMPLE.with_suffix(".toml"), "--window", 10, 50, "--json")
+    assert rc == 0
+    assert "dropped 1 row" in err
+    d = json.loads(out)
+    assert d["rows_dropped"] == 1 and any("dropped 1 row" in w for w in d["warnings"])
+
+
+def test_strength_commands(capsys):
+    rc, out, _ = run(capsys, "strength", "diametral", "--force", 100, "--diameter", 10, "--thickness", 3, "--json")
+    assert rc == 0 and json.loads(out)["tensile_strength_MPa"] == pytest.approx(200 / (3.141592653589793 * 30))
+    rc, out, err = run(capsys, "strength", "pitt", "--force", 100, "--diameter", 10, "--thickness", 6, "--band", 5,
+                       "--json")
+    assert rc == 0 and "W/D" in err and json.loads(out)["warnings"]
+    rc, out, err = run(capsys, "strength", "sphere", "--force", 8.6, "--material", "kostrolith", "--radius", 0.7047)
+    assert rc == 0 and "MPa" in out
+    rc, out, err = run(capsys, "strength", "pitt", "--force", 100, "--diameter", 10)
+    assert rc == 2 and "--thickness" in err
+
+
+def test_contact_command(capsys, tmp_path):
+    plot = tmp_path / "fd.svg"
+    rc, out, err = run(capsys, "contact", "--material", "kostrolith", "--force", 3.5, "--plot", plot, "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    assert d["results"][0]["height_mm"] == pytest.approx(1.3444, abs=5e-5)
+    assert d["results"][0]["contact_radius_per_contact_mm"] == pytest.approx(0.1395, abs=5e-5)
+    assert len(d["results"][0]["circles"]) == 7 and plot.exists()
+    rc, out, err = run(capsys, "contact", "--material", "steel", "--force", 1)
+    assert rc == 2 and "must be one of" in err
+
+
+def test_shell_command(capsys, tmp_path):
+    csv = tmp_path / "u.csv"
+    rc, out, err = run(capsys, "shell", "--outer", 2.5, "--inner", 2.0, "--E", 100, "--nu", 0.3, "--p-ext", 3,
+                       "--p-int", 1, "--psi", 90, "--terms", 20, "--csv", csv, "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    from tabletcad.mechanics.shell import lame_displacement
+
+    assert d["u_r_outer_mm"]["theta_90"] == pytest.approx(float(lame_displacement(2.5, 2.5, 2.0, 100, 0.3, 3, 1)),
+                                                          rel=1e-10)
+    assert len(csv.read_text().splitlines()) == 182
+    bad = tmp_path / "bad.csv"
+    rc, out, err = run(capsys, "shell", "--outer", 2.0, "--inner", 2.5, "--E", 100, "--nu", 0.3, "--p-ext", 3,
+                       "--csv", bad)
+    assert rc == 2 and "inner radius" in err and not bad.exists()
+
+
+def test_love_command(capsys):
+    rc, out, err = run(capsys, "love", "--json")
+    assert rc == 0
+    d = json.loads(out)
+    assert d["omega_z0_mm"] == pytest.approx(-1.2935 + 0.2195875, rel=1e-9)
+    assert d["n_points"] == 41 and "poor linearity" in err
+
+
+def test_subprocess_entry_point(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "tabletcad", "heckel", str(SAMPLE), "--window", "10", "50"],
+                       capture_output=True, text=True, cwd=ROOT, timeout=120, check=False)
+    assert r.returncode == 0 and "Py = 104.6 MPa" in r.stdout
