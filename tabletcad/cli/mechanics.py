@@ -233,6 +233,12 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
         ua = sol.radial_displacement(a, th)
         ub = sol.radial_displacement(b, th)
         half = sol.radial_displacement(a, math.pi / 2, n_terms=terms // 2)
+        umax = float(max(np.abs(ua).max(), np.abs(ub).max()))
+        if umax > 0.05 * (a - b):
+            from tabletcad.mechanics.validity import ValidityWarning, warn
+
+            warn(ValidityWarning, f"displacements up to {umax:.3g} mm exceed 5 % of the wall thickness "
+                 f"{a - b:.3g} mm: outside linear (small-strain) elasticity")
     eq = float(ua[90])
     payload = {
         "outer_mm": a, "inner_mm": b, "E_MPa": E, "nu": nu, "p_ext_MPa": p_ext, "p_int_MPa": p_int, "psi_deg": psi,
