@@ -388,8 +388,8 @@ def hex_mesh(tablet: "Tablet", nodes: tuple[int, int, int] = (11, 21, 5), *, che
         u = u_all
         flat = _is_flat(P, total)
         if not flat:
-            vol, inverted = _oriented_volumes(P, sign)
-            if np.any(inverted):
+            vol *= sign
+            if np.any(vol <= 0.0):
                 u, P, S, vol = _drop_fold_nodes(patch, u_all, v, w, sign, p)
         scale = max(1.0, float(np.max(np.abs(S))))
         pole0 = t.u[0] == 0.0 and float(np.max(np.ptp(S[0], axis=0))) <= gap * scale
@@ -503,9 +503,9 @@ def hex_mesh(tablet: "Tablet", nodes: tuple[int, int, int] = (11, 21, 5), *, che
     used = np.zeros(raw.shape[0], dtype=bool)
     for conn in cells.values():
         used[conn.ravel()] = True
-    new = np.cumsum(used) - 1
+    new = np.cumsum(used, dtype=np.int64) - 1
     points = raw[used]
-    cells = {k: new[c].astype(np.int64) for k, c in cells.items()}
+    cells = {k: new[c] for k, c in cells.items()}
     return SolidMesh(
         points=points,
         cells=cells,
