@@ -63,7 +63,10 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, design_path: str | Path
         plot_tablet(tablet, staging / "tablet.png")
         (staging / "report.json").write_text(to_json(report), encoding="utf-8")
         out_dir.mkdir(parents=True, exist_ok=True)
+        umask = os.umask(0)
+        os.umask(umask)
         for f in sorted(staging.iterdir()):
+            os.chmod(f, 0o666 & ~umask)
             os.replace(f, out_dir / f.name)
         return report
     finally:

@@ -96,6 +96,10 @@ class Curve:
         m = np.diag([sxy, sxy, sz])
         return Transformed(self, m, c - m @ c)
 
+    def breakpoints(self) -> np.ndarray:
+        """Parameters ``v`` in [0, 2π) where the curve is not infinitely smooth (empty if none)."""
+        return np.zeros(0)
+
     @property
     def is_point(self) -> bool:
         """True when the curve is a single point (a pole of a patch)."""
@@ -267,6 +271,12 @@ class Outline(Curve):
             raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
         return out
 
+    def breakpoints(self) -> np.ndarray:
+        """Parameters of the segment junctions (curvature may jump there)."""
+        if len(self._segs) == 1:
+            return np.zeros(0)
+        return self._cum[:-1] * (TWO_PI / self.perimeter)
+
     def area(self) -> float:
         """Enclosed plan area (mm²), exact for lines and arcs (Green's theorem)."""
         a = 0.0
@@ -363,7 +373,12 @@ class PointCurve(Curve):
         t = np.concatenate([[0.0], np.cumsum(seg)])
         t = t * (TWO_PI / t[-1])
         self.points = p
+        self._knots = t[:-1]
         self._spline = CubicSpline(t, np.vstack([p, p[:1]]), bc_type="periodic", axis=0)
+
+    def breakpoints(self) -> np.ndarray:
+        """The spline's knots (the third derivative jumps there)."""
+        return self._knots.copy()
 
     def evaluate(self, v, der: int = 0) -> np.ndarray:
         v = np.mod(np.asarray(v, dtype=float).reshape(-1), TWO_PI)
@@ -387,6 +402,10 @@ class Transformed(Curve):
             raise DesignError("transform", "matrix/offset", "must be a finite 3×3 matrix and 3-vector")
         object.__setattr__(self, "matrix", m)
         object.__setattr__(self, "offset", o)
+
+    def breakpoints(self) -> np.ndarray:
+        bp = getattr(self.base, "breakpoints", None)
+        return bp() if bp is not None else np.zeros(0)
 
     def evaluate(self, v, der: int = 0) -> np.ndarray:
         p = self.base.evaluate(v, der) @ self.matrix.T

@@ -54,6 +54,7 @@ def geometry_report(tablet: Tablet) -> dict[str, Any]:
                 u_nodes=list(p.u_nodes),
                 spine_height_mm=float(s[1, 2] - s[0, 2]),
                 stray_mm=p.stray(),
+                fold_depth_mm=p.fold_depth(),
             )
         )
     v = props["volume_mm3"]

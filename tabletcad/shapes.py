@@ -1,6 +1,8 @@
 """Named constructors for the thesis's tablets (Tables 4.1 and 4.5), in mm.
 
-Every tablet stands on the plane z = 0 with its axis on the z axis.  Round
+Every tablet stands on the plane z = 0 with its axis on the z axis (the
+thesis's dome curves make the spine run backwards just before a pole, so a
+dome dips up to 1.6 µm below its pole: see ``PDEPatch.fold_depth``).  Round
 tablets use circles, oval ones ellipses; each patch takes four curves at
 ``u = 0, 1/3, 2/3, 1``.  Interior curves of a dome lie on its nominal
 spherical cap at equal angular steps (thesis eq 4.1); interior curves of a

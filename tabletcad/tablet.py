@@ -26,6 +26,22 @@ __all__ = ["Trim", "Tablet", "Face", "solid_map"]
 TWO_PI = 2.0 * math.pi
 
 
+def _composite_gauss(breaks: np.ndarray, n_total: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights over the periodic intervals between ``breaks``.
+
+    The integrand is smooth inside each interval, so the rule converges
+    spectrally where the trapezoidal rule would only converge algebraically.
+    """
+    b = np.sort(np.mod(breaks, TWO_PI))
+    edges = np.concatenate([b, [b[0] + TWO_PI]])
+    k = max(12, int(math.ceil(n_total / len(b))))
+    x, w = np.polynomial.legendre.leggauss(k)
+    lo, hi = edges[:-1, None], edges[1:, None]
+    nodes = 0.5 * (hi - lo) * (x + 1.0) + lo
+    weights = 0.5 * (hi - lo) * w
+    return np.mod(nodes.ravel(), TWO_PI), weights.ravel()
+
+
 @dataclass(frozen=True)
 class Trim:
     """Parameter ranges kept of every patch solid.
@@ -200,7 +216,10 @@ class Tablet:
         s = 0.5 * (s1 - s0) * (xs + 1.0) + s0
         sw = 0.5 * (s1 - s0) * ws
         t0, t1 = face.t_range
-        if face.periodic_t:
+        bps = self.patches[face.patch].breakpoints() if face.kind in ("w", "u") else np.zeros(0)
+        if face.periodic_t and bps.size:
+            t, tw = _composite_gauss(bps, nv)
+        elif face.periodic_t:
             t = t0 + np.arange(nv) * (TWO_PI / nv)
             tw = np.full(nv, TWO_PI / nv)
         else:
@@ -306,7 +325,12 @@ class Tablet:
             v = 0.5 * (t.v[1] - t.v[0]) * (xv + 1) + t.v[0]
             vw = 0.5 * (t.v[1] - t.v[0]) * wv
         total = 0.0
+        v_all, vw_all = v, vw
         for p in self.patches:
+            v, vw = v_all, vw_all
+            bps = p.breakpoints()
+            if t.full_v and bps.size:
+                v, vw = _composite_gauss(bps, nv)
             X = p.evaluate_grid(u, v)
             Xu = p.evaluate_grid(u, v, du=1)
             Xv = p.evaluate_grid(u, v, dv=1)

@@ -43,6 +43,10 @@ class Tolerances:
         Seam gap (mm) above which two patches are reported as not meeting.
     seam_angle_deg : float
         Normal angle (deg) below which a seam counts as tangent-continuous (G1).
+    fold : float
+        Largest depth (mm) to which a patch's solid map may fold back on
+        itself before the patch is refused (see :meth:`PDEPatch.fold_depth`);
+        the thesis's domes fold by ~1 µm at their poles.
     fit : float
         Largest deviation (mm) of a B-spline face from its PDE patch (CAD layer).
     nominal : float
@@ -58,6 +62,7 @@ class Tolerances:
     quad_v: int = 256
     seam_gap: float = 1e-7
     seam_angle_deg: float = 0.01
+    fold: float = 5e-3
     fit: float = 1e-4
     nominal: float = 1e-3
 
