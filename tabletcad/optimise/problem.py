@@ -182,7 +182,7 @@ class Constraint:
             return math.inf, math.inf, -math.inf
         if self.kind == "eq":
             d = abs(value - self.target)
-            return d, d / max(abs(self.target), 1e-300), -d
+            return d, d / (abs(self.target) if self.target != 0 else self.residual_scale), -d
         viol = 0.0
         slack = math.inf
         ref = 1.0
@@ -194,7 +194,7 @@ class Constraint:
             slack = min(slack, self.upper - value)
             if value > self.upper:
                 viol, ref = value - self.upper, self.upper
-        return viol, viol / max(abs(ref), 1e-300), slack
+        return viol, viol / (abs(ref) if ref != 0 else self.residual_scale), slack
 
     def satisfied(self, value: float) -> bool:
         viol, _, _ = self.violation(value)
