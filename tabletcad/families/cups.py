@@ -1,0 +1,212 @@
+"""Face profiles of tablet tooling in the ``(d, z)`` plane (mm).
+
+``d`` is the inward distance from the band edge, ``z`` the height above the
+band's top edge.  Every function checks its input and raises
+:class:`~tabletcad.errors.DesignError` naming the parameter, its value and the
+allowed range.  Conventions (as drawn on TSM / EU-ISO 18084 tooling drawings):
+
+* *land*: flat annulus at band height between the band edge and the cup;
+* *cup depth*: height of the face above the band's top edge (the land plane);
+* *single-radius cup*: one arc, horizontal at the centre, from the land's
+  inner edge: radius ``ρ = (w² + h²) / (2 h)`` for cup half-width ``w`` and
+  depth ``h`` (at most a hemisphere, ``h <= w``);
+* *compound cup*: a central (major) radius tangent to an edge (minor) radius;
+* *bevel*: a cone (or, swept, a plane) at ``bevel_angle`` to the face plane.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tabletcad.errors import DesignError, check_finite, check_range
+from tabletcad.families.profile import Arc2, Line2
+
+__all__ = [
+    "single_radius_cup",
+    "compound_cup_profile",
+    "land_line",
+    "bevel_line",
+    "cup_radius",
+    "CompoundCup",
+]
+
+
+def cup_radius(half_width: float, depth: float) -> float:
+    """Radius (mm) of a single-radius cup of ``half_width`` and ``depth`` (mm)."""
+    return (half_width**2 + depth**2) / (2.0 * depth)
+
+
+def land_line(land: float) -> list:
+    """The land as a profile element (empty when ``land == 0``)."""
+    return [Line2((0.0, 0.0), (land, 0.0), "land")] if land > 0 else []
+
+
+def bevel_line(angle_deg: float, width: float, d0: float = 0.0) -> Line2:
+    """Bevel from ``(d0, 0)`` rising at ``angle_deg`` over ``width`` (mm)."""
+    return Line2((d0, 0.0), (d0 + width, width * math.tan(math.radians(angle_deg))), "bevel")
+
+
+def single_radius_cup(d0: float, d1: float, depth: float, z0: float = 0.0, *, depth_name: str = "cup_depth") -> Arc2:
+    """Arc from ``(d0, z0)`` to ``(d1, z0 + depth)``, horizontal at ``d1``.
+
+    Raises
+    ------
+    DesignError
+        ``depth`` outside ``(0, d1 - d0]`` (deeper than a hemisphere).
+    """
+    w = d1 - d0
+    h = check_finite(depth_name, depth, "mm")
+    if not 0.0 < h <= w * (1 + 1e-12):
+        raise DesignError(depth_name, h, f"must be > 0 and <= {w:.6g} mm (a hemisphere over the {2 * w:.6g} mm wide cup)", "mm")
+    h = min(h, w)
+    rho = cup_radius(w, h)
+    c = (d1, z0 + h - rho)
+    phi0 = math.atan2(z0 - c[1], d0 - c[0])
+    return Arc2(c, rho, phi0, math.pi / 2, "cup")
+
+
+class CompoundCup:
+    """A compound cup: central radius ``Rc`` tangent to edge radius ``Re`` (mm).
+
+    Work in ``(r, z)`` with ``r`` measured from the cup's centre line and
+    ``z`` from the cup's edge: the edge arc passes through ``(w, 0)`` (``w``
+    the cup half-width), the central arc is centred on the axis at
+    ``(0, h - Rc)``, the arcs are internally tangent (centre distance
+    ``Rc - Re``).  Given the depth ``h`` the edge arc's centre is an
+    intersection of two circles; given the blend diameter ``2 r_b`` instead,
+    the depth follows directly.
+
+    Attributes
+    ----------
+    depth, blend_radius : float
+        Cup depth and radius of the tangent (blend) circle (mm).
+    edge_center, central_center : (float, float)
+        Arc centres in ``(r, z)``.
+    """
+
+    def __init__(self, half_width: float, central_radius: float, edge_radius: float,
+                 depth: float = 0.0, blend_diameter: float = 0.0) -> None:
+        w = half_width
+        Rc = check_range("central_radius", central_radius, 0.0, None, "mm", lo_open=True)
+        Re = check_range("edge_radius", edge_radius, 0.0, None, "mm", lo_open=True)
+        if Re >= Rc:
+            raise DesignError("edge_radius", Re, f"must be < central_radius = {Rc:g} mm (the radii must be internally tangent)", "mm")
+        if Rc < w:
+            # a central radius smaller than the half width cannot reach the edge as the upper arc
+            pass
+        if blend_diameter and depth:
+            raise DesignError("blend_diameter", blend_diameter, "give cup_depth or blend_diameter, not both (set one to 0)", "mm")
+        if blend_diameter:
+            rb = check_range("blend_diameter", blend_diameter, 0.0, 2 * min(w, Rc), "mm", lo_open=True, hi_open=True) / 2.0
+            C1 = np.array([0.0, -Rc])
+            B = np.array([rb, -Rc + math.sqrt(Rc * Rc - rb * rb)])
+            Ce = C1 + (Rc - Re) / Rc * (B - C1)
+            if abs(w - Ce[0]) > Re:
+                raise DesignError("edge_radius", Re, f"must be >= {abs(w - Ce[0]):.6g} mm to reach the cup edge from a {2 * rb:g} mm blend diameter", "mm")
+            zE = Ce[1] + math.sqrt(Re * Re - (w - Ce[0]) ** 2)
+            h = -zE
+            shift = np.array([0.0, h])
+            C1, Ce, B = C1 + shift, Ce + shift, B + shift
+        else:
+            h = check_finite("cup_depth", depth, "mm")
+            if not 0.0 < h:
+                raise DesignError("cup_depth", h, "must be > 0", "mm")
+            C1 = np.array([0.0, h - Rc])
+            E = np.array([w, 0.0])
+            Ce = _circle_intersection(C1, Rc - Re, E, Re, prefer_upper=True)
+            if Ce is None:
+                lo, hi = _depth_range(w, Rc, Re)
+                raise DesignError("cup_depth", h, f"must be between {lo:.6g} and {hi:.6g} mm for a {2 * w:g} mm cup with radii {Rc:g} and {Re:g} mm (the radii cannot be tangent)", "mm")
+            B = C1 + Rc * (Ce - C1) / (Rc - Re)
+        self.depth = float(h)
+        self.half_width = w
+        self.central_radius = Rc
+        self.edge_radius = Re
+        self.central_center = (float(C1[0]), float(C1[1]))
+        self.edge_center = (float(Ce[0]), float(Ce[1]))
+        self.blend_radius = float(B[0])
+        self._B = B
+        # validity: blend inside the cup, edge arc rising from the edge (no undercut)
+        if not (0.0 < B[0] < w):
+            lo, hi = _depth_range(w, Rc, Re)
+            raise DesignError("cup_depth" if not blend_diameter else "blend_diameter", depth or blend_diameter,
+                              f"gives a blend at r = {B[0]:.4g} mm outside the cup (0, {w:g}) mm; cup_depth must be between {lo:.6g} and {hi:.6g} mm", "mm")
+        if Ce[1] > 1e-12 * w:
+            raise DesignError("edge_radius", Re, "makes the cup wall overhang at the edge (edge-radius centre above the cup edge): use a larger edge radius or a shallower cup", "mm")
+        if B[1] < 0.0 or B[1] > h:
+            raise DesignError("cup_depth", h, "puts the blend outside the cup's height", "mm")
+
+    def elements(self, d0: float, z0: float = 0.0) -> list:
+        """Edge arc then central arc in the ``(d, z)`` plane, the cup edge at ``(d0, z0)``
+        (``d = d0 + w - r``)."""
+        w = self.half_width
+        ax = d0 + w  # d of the centre line
+        Ce = (ax - self.edge_center[0], z0 + self.edge_center[1])
+        C1 = (ax - self.central_center[0], z0 + self.central_center[1])
+        B = (ax - self._B[0], z0 + self._B[1])
+        phi_e0 = math.atan2(z0 - Ce[1], d0 - Ce[0])
+        phi_b = math.atan2(B[1] - Ce[1], B[0] - Ce[0])
+        phi_c0 = math.atan2(B[1] - C1[1], B[0] - C1[0])
+        return [
+            Arc2(Ce, self.edge_radius, phi_e0, phi_b, "cup edge radius"),
+            Arc2(C1, self.central_radius, phi_c0, math.pi / 2, "cup central radius"),
+        ]
+
+
+def _circle_intersection(c1, r1, c2, r2, prefer_upper: bool):
+    d = float(np.linalg.norm(c2 - c1))
+    if d == 0 or d > r1 + r2 or d < abs(r1 - r2):
+        return None
+    a = (r1 * r1 - r2 * r2 + d * d) / (2 * d)
+    h = math.sqrt(max(r1 * r1 - a * a, 0.0))
+    e = (c2 - c1) / d
+    p = c1 + a * e
+    perp = np.array([-e[1], e[0]])
+    s1, s2 = p + h * perp, p - h * perp
+    # the edge-arc centre lies inward of the cup edge (smaller r) and below it
+    cands = [s for s in (s1, s2) if s[0] < c2[0]]
+    if not cands:
+        return None
+    return max(cands, key=lambda s: s[1]) if prefer_upper else min(cands, key=lambda s: s[1])
+
+
+def _feasible(w: float, Rc: float, Re: float, h: float) -> bool:
+    C1 = np.array([0.0, h - Rc])
+    E = np.array([w, 0.0])
+    Ce = _circle_intersection(C1, Rc - Re, E, Re, prefer_upper=True)
+    if Ce is None:
+        return False
+    B = C1 + Rc * (Ce - C1) / (Rc - Re)
+    return bool(0.0 < B[0] < w and Ce[1] <= 1e-12 * w and 0.0 <= B[1] <= h)
+
+
+def _depth_range(w: float, Rc: float, Re: float) -> tuple[float, float]:
+    """Depths (mm) for which a compound cup of half-width ``w`` with radii ``Rc > Re`` exists
+    (scanned on a fine grid, then bisected at both ends)."""
+    hs = np.linspace(1e-6 * w, 2 * w, 2001)
+    ok = np.array([_feasible(w, Rc, Re, float(h)) for h in hs])
+    if not ok.any():
+        return (math.nan, math.nan)
+    i0, i1 = int(np.argmax(ok)), len(ok) - 1 - int(np.argmax(ok[::-1]))
+
+    def bisect(good, bad):
+        for _ in range(60):
+            mid = 0.5 * (good + bad)
+            if _feasible(w, Rc, Re, mid):
+                good = mid
+            else:
+                bad = mid
+        return good
+
+    lo = bisect(hs[i0], hs[i0 - 1]) if i0 > 0 else hs[0]
+    hi = bisect(hs[i1], hs[i1 + 1]) if i1 < len(hs) - 1 else hs[-1]
+    return (float(lo), float(hi))
+
+
+def compound_cup_profile(d0: float, half_width: float, central_radius: float, edge_radius: float,
+                         depth: float = 0.0, blend_diameter: float = 0.0) -> tuple[list, CompoundCup]:
+    """Elements of a compound cup whose edge is at ``d0`` (and the :class:`CompoundCup`)."""
+    cc = CompoundCup(half_width, central_radius, edge_radius, depth, blend_diameter)
+    return cc.elements(d0), cc

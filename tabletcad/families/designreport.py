@@ -1,0 +1,347 @@
+"""Design report of a family tablet: dimensions, cup, weight, punch-tip check, tensile strength, size.
+
+Registered as a report section (:func:`tabletcad.report.register_report_section`),
+so ``report.json`` of every tablet built from a family of this package gains
+
+* ``nominal_max_deviation_um``, ``nominal_tolerance_um``, ``nominal_certified``:
+  the certificate of :func:`tabletcad.families.sweep.certify`;
+* ``seams``: per seam ``max_gap_mm``, ``max_angle_deg``, ``g1``, ``expected_sharp``
+  (the nominal has an edge there) and ``as_expected``;
+* ``design_report``: the figures below, keys named with their units.
+
+Options that are not geometry (solid fraction, true density, breaking force,
+punch limits) come from :class:`ReportOptions`, set by ``tabletcad report``
+from the design file's ``[report]`` table or its command-line options.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import math
+import sys
+import warnings
+from dataclasses import asdict, dataclass
+from importlib import resources
+from typing import Any
+
+import numpy as np
+
+from tabletcad.errors import DesignError, check_range
+from tabletcad.families.sweep import SweepNominal, certify, sweep_properties
+from tabletcad.tablet import Tablet
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+__all__ = ["ReportOptions", "design_report", "report_section", "family_seams", "report_options",
+           "punch_rating_table", "tensile_strength", "FDA_MAX_DIMENSION_MM", "REPORT_KEYS"]
+
+#: FDA guidance "Size, Shape, and Other Physical Attributes of Generic Tablets and Capsules"
+#: (2015): the largest dimension of a generic tablet should not exceed 22 mm.
+FDA_MAX_DIMENSION_MM = 22.0
+
+#: Keys accepted in a design file's ``[report]`` table (and their units).
+REPORT_KEYS = {
+    "solid_fraction": "-",
+    "true_density_mg_mm3": "mg/mm3",
+    "breaking_force_N": "N",
+    "compaction_force_kN": "kN",
+    "max_punch_force_kN": "kN",
+    "max_punch_pressure_MPa": "MPa",
+}
+
+
+@dataclass(frozen=True)
+class ReportOptions:
+    """Non-geometric inputs of the design report (None = not given).
+
+    Attributes
+    ----------
+    solid_fraction : float
+        Tablet solid fraction (1 - porosity), in (0, 1].
+    true_density_mg_mm3 : float
+        True density of the formulation, mg/mm³ (= g/cm³).
+    breaking_force_N : float
+        Diametral breaking force (N) for the tensile strength.
+    compaction_force_kN : float
+        Compaction force (kN) to check against the punch-tip limit.
+    max_punch_force_kN, max_punch_pressure_MPa : float
+        User-given punch-tip limits (no public rating table is bundled).
+    """
+
+    solid_fraction: float | None = None
+    true_density_mg_mm3: float | None = None
+    breaking_force_N: float | None = None
+    compaction_force_kN: float | None = None
+    max_punch_force_kN: float | None = None
+    max_punch_pressure_MPa: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.solid_fraction is not None:
+            check_range("[report] solid_fraction", self.solid_fraction, 0.0, 1.0, lo_open=True)
+        for k in ("true_density_mg_mm3", "breaking_force_N", "compaction_force_kN", "max_punch_force_kN", "max_punch_pressure_MPa"):
+            v = getattr(self, k)
+            if v is not None:
+                check_range(f"[report] {k}", v, 0.0, None, REPORT_KEYS[k], lo_open=True)
+
+    @classmethod
+    def from_table(cls, table: Any) -> "ReportOptions":
+        if table is None:
+            return cls()
+        if not isinstance(table, dict):
+            raise DesignError("[report]", table, f"must be a table with keys {', '.join(REPORT_KEYS)}")
+        for k in table:
+            if k not in REPORT_KEYS:
+                raise DesignError(f"[report] key {k!r}", table[k], f"allowed keys are {', '.join(REPORT_KEYS)}")
+        return cls(**{k: float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else _bad(k, v) for k, v in table.items()})
+
+    def merged(self, **kw) -> "ReportOptions":
+        d = asdict(self)
+        d.update({k: v for k, v in kw.items() if v is not None})
+        return ReportOptions(**d)
+
+
+def _bad(k, v):
+    raise DesignError(f"[report] {k}", v, "must be a number", REPORT_KEYS[k])
+
+
+_OPTIONS: contextvars.ContextVar[ReportOptions] = contextvars.ContextVar("tabletcad_family_report_options", default=ReportOptions())
+
+
+@contextlib.contextmanager
+def report_options(opts: ReportOptions):
+    """Use ``opts`` for the report sections generated inside the ``with`` block."""
+    token = _OPTIONS.set(opts)
+    try:
+        yield
+    finally:
+        _OPTIONS.reset(token)
+
+
+# ---------------------------------------------------------------------------- pieces
+def family_seams(tablet: Tablet, nv: int = 720) -> list[dict[str, Any]]:
+    """Seam continuity of a family tablet.
+
+    Like :meth:`Tablet.seams` but (1) normals are ``X_u × X_v`` of each patch at
+    the shared curve and (2) points where the shared curve is degenerate
+    (``|X_v| ≈ 0``: a corner arc collapsed by the offset, where the seam is a
+    single point and one side has no surface) are skipped and counted.
+    """
+    nom = tablet.nominal
+    expected = list(getattr(nom, "expected_sharp", []))
+    v = np.linspace(0.0, 2 * math.pi, nv, endpoint=False)
+    if isinstance(nom, SweepNominal):
+        b = np.asarray(nom.outline.breaks)[:-1]
+        v = np.unique(np.concatenate([v, np.mod(b + 1e-7, 2 * math.pi), np.mod(b - 1e-7, 2 * math.pi)]))
+    out = []
+    for i in range(len(tablet.patches) - 1):
+        pa, pb = tablet.patches[i], tablet.patches[i + 1]
+        xa, xb = pa.evaluate(1.0, v), pb.evaluate(0.0, v)
+        gap = float(np.max(np.linalg.norm(xa - xb, axis=1)))
+        xv = pa.evaluate(1.0, v, dv=1)
+        scale = max(1e-300, float(np.max(np.linalg.norm(xv, axis=1))))
+        good = np.linalg.norm(xv, axis=1) > 1e-6 * scale
+        na = np.cross(pa.evaluate(1.0, v, du=1), xv)
+        nb = np.cross(pb.evaluate(0.0, v, du=1), pb.evaluate(0.0, v, dv=1))
+        la, lb = np.linalg.norm(na, axis=1), np.linalg.norm(nb, axis=1)
+        good &= (la > 1e-9 * la.max()) & (lb > 1e-9 * lb.max())
+        if np.any(good):
+            c = np.einsum("ij,ij->i", na[good], nb[good]) / (la[good] * lb[good])
+            ang = float(np.degrees(np.max(np.arccos(np.clip(c, -1.0, 1.0)))))
+        else:
+            ang = float("nan")
+        g1 = bool(ang == ang and ang <= tablet.tol.seam_angle_deg)
+        sharp = bool(expected[i]) if i < len(expected) else None
+        out.append(dict(
+            patches=[i, i + 1],
+            max_gap_mm=gap,
+            max_angle_deg=ang,
+            g1=g1,
+            expected_sharp=sharp,
+            as_expected=None if sharp is None else (g1 != sharp),
+            degenerate_points=int(np.sum(~good)),
+        ))
+    return out
+
+
+def punch_rating_table() -> dict[str, Any]:
+    """The bundled punch-tip rating table (``tabletcad/data/punch_ratings.toml``)."""
+    try:
+        text = resources.files("tabletcad").joinpath("data/punch_ratings.toml").read_text(encoding="utf-8")
+    except (FileNotFoundError, ModuleNotFoundError, OSError):
+        return dict(source=None, ratings=[])
+    data = tomllib.loads(text)
+    return dict(source=data.get("source"), note=data.get("note"), ratings=list(data.get("rating", [])))
+
+
+def _strength_module():
+    try:
+        from tabletcad.mechanics import strength as st  # noqa: PLC0415
+
+        return st
+    except ImportError:  # pragma: no cover - fallback when the mechanics package is absent
+        return _LocalStrength()
+
+
+class _LocalStrength:
+    """Fallback formulas (thesis eqs 2.4, 2.7-2.9), F in N, lengths in mm, result MPa."""
+
+    @staticmethod
+    def diametral_flat(F, D, t):  # eq 2.4
+        return 2.0 * F / (math.pi * D * t)
+
+    @staticmethod
+    def pitt_convex(F, D, t, W):  # eq 2.7, Pitt et al. 1988
+        return 10.0 * F / (math.pi * D * D * (2.84 * t / D - 0.126 * t / W + 3.15 * W / D + 0.01))
+
+    @classmethod
+    def pitt_heasley_elongated_flat(cls, F, D, t, length=None):  # eq 2.8
+        return 2.0 / 3.0 * cls.diametral_flat(F, D, t)
+
+    @classmethod
+    def pitt_heasley_elongated_convex(cls, F, D, t, W, length=None):  # eq 2.9
+        return 2.0 / 3.0 * cls.pitt_convex(F, D, t, W)
+
+
+def tensile_strength(info: dict, thickness: float, F: float) -> dict[str, Any]:
+    """Tensile strength (MPa) for breaking force ``F`` (N) by the formula valid for the shape.
+
+    Flat round: eq 2.4 ``2F/(πDt)``; convex round: eq 2.7 (Pitt et al. 1988);
+    elongated (capsule, oval, modified capsule): eqs 2.8/2.9 (Pitt & Heasley,
+    2/3 of the round value, ``D`` the width).  Other plans: none.  Range
+    warnings of the formulas are returned in ``range_flags``.
+    """
+    st = _strength_module()
+    shape = info.get("shape")
+    flat = info.get("face") == "flat"
+    band = info.get("band_mm")
+    D = info.get("width_mm")
+    Ln = info.get("length_mm")
+    flags: list[str] = []
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        if shape == "round":
+            if flat:
+                val, formula = st.diametral_flat(F, D, thickness), "eq 2.4: 2F/(pi D t) (flat-faced round)"
+                if info.get("cup_depth_mm", 0) > 0:
+                    flags.append("bevel/radius edge: the flat-disc formula is applied with the overall thickness (approximation)")
+            else:
+                val, formula = st.pitt_convex(F, D, thickness, band), "eq 2.7: Pitt et al. (1988), convex-faced round"
+        elif info.get("elongated"):
+            if flat:
+                val, formula = st.pitt_heasley_elongated_flat(F, D, thickness, length=Ln), "eq 2.8: Pitt & Heasley (2013), flat elongated, 2/3 of eq 2.4"
+            else:
+                val, formula = st.pitt_heasley_elongated_convex(F, D, thickness, band, length=Ln), "eq 2.9: Pitt & Heasley (2013), convex elongated, 2/3 of eq 2.7"
+        else:
+            return dict(tensile_strength_MPa=None, formula=None, breaking_force_N=F,
+                        range_flags=[f"no published tensile-strength formula for a {shape} plan"])
+    flags += [str(w.message) for w in rec]
+    return dict(tensile_strength_MPa=float(val), formula=formula, breaking_force_N=F, range_flags=flags,
+                within_range=not any(True for w in rec))
+
+
+def _punch_check(plan_area: float, opts: ReportOptions) -> dict[str, Any]:
+    table = punch_rating_table()
+    out: dict[str, Any] = dict(
+        tip_face_area_mm2=plan_area,
+        rating_table_source=table.get("source"),
+        rating_table_entries=len(table["ratings"]),
+        compaction_force_kN=opts.compaction_force_kN,
+        max_punch_force_kN=opts.max_punch_force_kN,
+        max_punch_pressure_MPa=opts.max_punch_pressure_MPa,
+    )
+    lim_force = None
+    basis = None
+    if opts.max_punch_force_kN is not None:
+        lim_force, basis = opts.max_punch_force_kN, "user-given max_punch_force_kN"
+    if opts.max_punch_pressure_MPa is not None:
+        f = opts.max_punch_pressure_MPa * plan_area / 1000.0
+        if lim_force is None or f < lim_force:
+            lim_force, basis = f, "user-given max_punch_pressure_MPa x tip face area"
+    out["allowed_force_kN"] = lim_force
+    out["limit_basis"] = basis or ("no limit given (no citable public punch-tip rating table is bundled: "
+                                    "give [report] max_punch_force_kN or max_punch_pressure_MPa)")
+    if opts.compaction_force_kN is not None:
+        out["compaction_pressure_MPa"] = opts.compaction_force_kN * 1000.0 / plan_area
+    if opts.compaction_force_kN is not None and lim_force is not None:
+        out["ok"] = bool(opts.compaction_force_kN <= lim_force)
+        out["utilisation"] = opts.compaction_force_kN / lim_force
+    else:
+        out["ok"] = None
+    return out
+
+
+def design_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str, Any]:
+    """The design report of a family tablet (see module docstring); keys carry units."""
+    nom = tablet.nominal
+    if not isinstance(nom, SweepNominal):
+        raise DesignError("tablet", tablet.name, "is not built from a tabletcad.families family")
+    opts = opts or _OPTIONS.get()
+    cert = nom.certificate
+    recert = cert is None or nom.patch_ids != tuple(id(p) for p in tablet.patches)
+    if recert:
+        cert = certify(tablet)
+    props = sweep_properties(tablet)
+    info = nom.info
+    T = nom.thickness
+    W = float(info.get("width_mm"))
+    Ln = float(info.get("length_mm"))
+    V = props["volume_mm3"]
+    A = props["surface_area_mm2"]
+    h = float(info.get("cup_depth_mm", 0.0))
+    rep: dict[str, Any] = dict(
+        family=tablet.family,
+        shape=info.get("shape"),
+        face=info.get("face"),
+        volume_mm3=V,
+        surface_area_mm2=A,
+        sa_to_volume_per_mm=A / V,
+        cup_volume_mm3=props["cup_volume_mm3"],
+        cup_surface_area_mm2=props["cup_surface_area_mm2"],
+        cup_depth_mm=h,
+        overall_thickness_mm=T,
+        band_mm=float(info.get("band_mm")),
+        land_mm=float(info.get("land_mm", 0.0)),
+        length_mm=Ln,
+        width_mm=W,
+        plan_area_mm2=props["plan_area_mm2"],
+        plan_area_exact_mm2=float(nom.outline.area),
+        plan_perimeter_mm=float(nom.outline.perimeter),
+        shape_factor=h / W,
+        params={k: v for k, v in info.items() if k not in ("shape", "face")},
+    )
+    if opts.solid_fraction is not None and opts.true_density_mg_mm3 is not None:
+        rep["weight_mg"] = V * opts.solid_fraction * opts.true_density_mg_mm3
+        rep["weight_basis"] = dict(solid_fraction=opts.solid_fraction, true_density_mg_mm3=opts.true_density_mg_mm3)
+    else:
+        rep["weight_mg"] = None
+        rep["weight_basis"] = "give [report] solid_fraction and true_density_mg_mm3"
+    rep["punch_tip_check"] = _punch_check(props["plan_area_mm2"], opts)
+    if opts.breaking_force_N is not None:
+        rep["tensile_strength"] = tensile_strength(dict(info, width_mm=W, length_mm=Ln), T, opts.breaking_force_N)
+    else:
+        rep["tensile_strength"] = dict(tensile_strength_MPa=None, note="give [report] breaking_force_N")
+    largest = max(Ln, W, T)
+    rep["fda_size"] = dict(largest_dimension_mm=largest, limit_mm=FDA_MAX_DIMENSION_MM,
+                           ok=bool(largest <= FDA_MAX_DIMENSION_MM),
+                           source="FDA guidance for industry: Size, Shape, and Other Physical Attributes of Generic Tablets and Capsules (2015)")
+    seams = family_seams(tablet)
+    return dict(
+        nominal_max_deviation_um=cert.max_deviation_mm * 1000.0,
+        nominal_tolerance_um=cert.tolerance_mm * 1000.0,
+        nominal_certified=bool(cert.passed),
+        nominal_recertified=bool(recert),
+        seams=seams,
+        seams_as_expected=all(s["as_expected"] is not False for s in seams),
+        design_report=rep,
+    )
+
+
+def report_section(tablet: Tablet) -> dict[str, Any] | None:
+    """Report section hook: the design report of family tablets, None for others."""
+    if not isinstance(tablet.nominal, SweepNominal):
+        return None
+    return design_report(tablet)

@@ -1,0 +1,634 @@
+"""Plan outlines for swept tablet faces, with exact inward offsets and distances.
+
+A tablet family with a shaped plan is a *sweep*: at every height of the cup
+profile the face is the outline offset inward by the profile's distance ``d``
+(section "sweep" in :mod:`tabletcad.families.sweep`).  This module supplies the
+outline: a closed, counter-clockwise, tangent-continuous (G1) chain of straight
+lines and circular arcs (:class:`PlanOutline`) or a periodic spline through
+given points (:class:`SplineOutline`).  Both offer
+
+* ``point(v, der)``, ``normal(v, der)``: the outline ``O(v)`` and its unit
+  inward normal ``N(v)`` (and ``v``-derivatives), ``v = 2π s / P`` with ``s``
+  the arc length of the *original* outline, so every offset ``O + d N`` is
+  parametrised by its foot point (offsets of lines stay lines, of arcs stay
+  concentric arcs of radius ``r ∓ d``);
+* ``signed_distance(xy)``: exact distance (mm) from plan points to the outline,
+  positive inside;
+* ``check_offset(d, parameter)``: refuse (``DesignError``) an inward offset
+  beyond the smallest convex arc radius or the inscribed radius.
+
+All lengths are millimetres, angles radians.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from tabletcad.errors import DesignError, check_positive, check_range
+
+__all__ = [
+    "Seg",
+    "PlanOutline",
+    "SplineOutline",
+    "circle_outline",
+    "stadium_outline",
+    "four_arc_oval",
+    "four_arc_oval_from_side_radius",
+    "rounded_polygon",
+    "rounded_rectangle_outline",
+    "outline_from_items",
+]
+
+TWO_PI = 2.0 * math.pi
+
+
+@dataclass(frozen=True)
+class Seg:
+    """One outline segment.
+
+    ``kind == "line"``: from ``p0`` to ``p1``.  ``kind == "arc"``: centre
+    ``center``, ``radius`` (mm), start angle ``theta0`` and signed ``sweep``
+    (rad, > 0 counter-clockwise = convex for a CCW outline).
+    """
+
+    kind: str
+    p0: tuple[float, float]
+    p1: tuple[float, float]
+    center: tuple[float, float] = (0.0, 0.0)
+    radius: float = 0.0
+    theta0: float = 0.0
+    sweep: float = 0.0
+
+    @property
+    def length(self) -> float:
+        if self.kind == "line":
+            return float(math.hypot(self.p1[0] - self.p0[0], self.p1[1] - self.p0[1]))
+        return abs(self.radius * self.sweep)
+
+    def tangent(self, end: int) -> np.ndarray:
+        """Unit tangent at the start (0) or end (1)."""
+        if self.kind == "line":
+            d = np.subtract(self.p1, self.p0)
+            return d / np.linalg.norm(d)
+        th = self.theta0 + (self.sweep if end else 0.0)
+        sg = math.copysign(1.0, self.sweep)
+        return sg * np.array([-math.sin(th), math.cos(th)])
+
+    def reversed(self) -> "Seg":
+        if self.kind == "line":
+            return Seg("line", self.p1, self.p0)
+        return Seg("arc", self.p1, self.p0, self.center, self.radius, self.theta0 + self.sweep, -self.sweep)
+
+
+def _line(p0, p1) -> Seg:
+    return Seg("line", (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1])))
+
+
+def _arc(c, r, t0, sw) -> Seg:
+    c = (float(c[0]), float(c[1]))
+    p0 = (c[0] + r * math.cos(t0), c[1] + r * math.sin(t0))
+    p1 = (c[0] + r * math.cos(t0 + sw), c[1] + r * math.sin(t0 + sw))
+    return Seg("arc", p0, p1, c, float(r), float(t0), float(sw))
+
+
+class PlanOutline:
+    """Closed CCW G1 chain of lines and arcs in the plane (mm).
+
+    Parameters
+    ----------
+    segs : list of Seg
+        Joined end to start; reversed automatically when clockwise.
+    name : str
+    parameter : str
+        Name used in error messages (e.g. ``"outline"``).
+
+    Raises
+    ------
+    DesignError
+        Gaps between segments, corners (tangent jumps), zero-length segments
+        or a self-intersecting outline.
+    """
+
+    def __init__(self, segs: list[Seg], name: str = "outline", parameter: str = "outline") -> None:
+        if not segs:
+            raise DesignError(parameter, "no segments", "an outline needs at least one line or arc")
+        segs = list(segs)
+        scale = max(max(abs(c) for s in segs for c in (*s.p0, *s.p1)), 1.0)
+        for i, s in enumerate(segs):
+            if not s.length > 1e-9 * scale:
+                raise DesignError(parameter, f"segment {i} of length {s.length:.3g} mm", "every segment must have length > 0")
+            if s.kind == "arc" and not s.radius > 0:
+                raise DesignError(parameter, f"arc {i} radius {s.radius:g}", "arc radii must be > 0 mm")
+        for i, s in enumerate(segs):
+            prev = segs[i - 1]
+            gap = math.hypot(prev.p1[0] - s.p0[0], prev.p1[1] - s.p0[1])
+            if gap > 1e-7 * scale:
+                raise DesignError(parameter, f"gap of {gap:.3g} mm before segment {i}", "segments must join end to start")
+            t_prev, t_next = prev.tangent(1), s.tangent(0)
+            ang = math.degrees(math.atan2(abs(np.cross(t_prev, t_next)), float(np.dot(t_prev, t_next))))
+            if ang > 1e-4:
+                raise DesignError(
+                    parameter, f"corner of {ang:.3g} deg before segment {i}",
+                    "the outline must be tangent-continuous (round every corner with an arc)",
+                )
+        self.name = name
+        self.parameter = parameter
+        if _signed_area(segs) < 0:
+            segs = [s.reversed() for s in reversed(segs)]
+        self.segs = tuple(segs)
+        self._len = np.array([s.length for s in self.segs])
+        self._cum = np.concatenate([[0.0], np.cumsum(self._len)])
+        self.perimeter = float(self._cum[-1])
+        self.area = abs(_signed_area(list(self.segs)))
+        self._check_simple()
+
+    # ------------------------------------------------------------------ geometry
+    @property
+    def breaks(self) -> np.ndarray:
+        """Parameters ``v`` (rad) of the segment joins, including 0 and 2π."""
+        return self._cum * (TWO_PI / self.perimeter)
+
+    @property
+    def min_convex_radius(self) -> float:
+        """Smallest radius of a convex arc (inf without arcs), mm."""
+        r = [s.radius for s in self.segs if s.kind == "arc" and s.sweep > 0]
+        return min(r) if r else math.inf
+
+    def _locate(self, v: np.ndarray):
+        s = np.mod(v, TWO_PI) * (self.perimeter / TWO_PI)
+        idx = np.clip(np.searchsorted(self._cum, s, side="right") - 1, 0, len(self.segs) - 1)
+        return s, idx
+
+    def frame(self, v) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Point ``O``, unit tangent ``T``, inward normal ``N`` (each (m, 2)) and
+        signed curvature ``κ`` (m,) (1/mm, > 0 on convex arcs) at ``v``."""
+        v = np.asarray(v, dtype=float).reshape(-1)
+        s, idx = self._locate(v)
+        O = np.zeros((v.size, 2))
+        T = np.zeros((v.size, 2))
+        k = np.zeros(v.size)
+        for i, seg in enumerate(self.segs):
+            m = idx == i
+            if not np.any(m):
+                continue
+            t = s[m] - self._cum[i]
+            if seg.kind == "line":
+                d = np.subtract(seg.p1, seg.p0) / seg.length
+                O[m] = np.asarray(seg.p0) + t[:, None] * d
+                T[m] = d
+            else:
+                sg = math.copysign(1.0, seg.sweep)
+                th = seg.theta0 + sg * t / seg.radius
+                c, sn = np.cos(th), np.sin(th)
+                O[m, 0] = seg.center[0] + seg.radius * c
+                O[m, 1] = seg.center[1] + seg.radius * sn
+                T[m, 0] = -sg * sn
+                T[m, 1] = sg * c
+                k[m] = sg / seg.radius
+        N = np.column_stack([-T[:, 1], T[:, 0]])
+        return O, T, N, k
+
+    @property
+    def speed(self) -> float:
+        """``ds/dv = P / 2π`` (mm per rad)."""
+        return self.perimeter / TWO_PI
+
+    def point(self, v, der: int = 0) -> np.ndarray:
+        """``d^der O / dv^der``, shape (m, 2)."""
+        O, T, N, k = self.frame(v)
+        g = self.speed
+        if der == 0:
+            return O
+        if der == 1:
+            return T * g
+        if der == 2:
+            return (k * g * g)[:, None] * N
+        raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
+
+    def normal(self, v, der: int = 0) -> np.ndarray:
+        """``d^der N / dv^der`` of the unit inward normal, shape (m, 2)."""
+        O, T, N, k = self.frame(v)
+        g = self.speed
+        if der == 0:
+            return N
+        if der == 1:
+            return -(k * g)[:, None] * T
+        if der == 2:
+            return -(k * k * g * g)[:, None] * N
+        raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
+
+    def centroid(self) -> np.ndarray:
+        """Area centroid (mm), exact for lines and arcs."""
+        sx = sy = 0.0
+        for s in self.segs:
+            if s.kind == "line":
+                (x0, y0), (x1, y1) = s.p0, s.p1
+                cr = x0 * y1 - x1 * y0
+                sx += (x0 + x1) * cr / 6.0
+                sy += (y0 + y1) * cr / 6.0
+            else:
+                # ∮ x² dy / 2 and -∮ y² dx / 2 over the arc, by Gauss-Legendre (exact to rounding)
+                xg, wg = np.polynomial.legendre.leggauss(24)
+                th = s.theta0 + 0.5 * s.sweep * (xg + 1)
+                w = 0.5 * s.sweep * wg
+                x = s.center[0] + s.radius * np.cos(th)
+                y = s.center[1] + s.radius * np.sin(th)
+                dx = -s.radius * np.sin(th)
+                dy = s.radius * np.cos(th)
+                sx += float(np.sum(w * x * x * dy)) / 2.0
+                sy -= float(np.sum(w * y * y * dx)) / 2.0
+        a = _signed_area(list(self.segs))
+        return np.array([sx / a, sy / a])
+
+    def extent(self) -> tuple[float, float]:
+        """Length (x) and width (y) of the outline's bounding box (mm)."""
+        p = self.frame(np.linspace(0, TWO_PI, 4096, endpoint=False))[0]
+        for s in self.segs:
+            if s.kind == "arc":
+                for ang in (0.0, math.pi / 2, math.pi, 1.5 * math.pi):
+                    rel = (ang - s.theta0) * math.copysign(1.0, s.sweep) % TWO_PI
+                    if rel <= abs(s.sweep):
+                        p = np.vstack([p, [s.center[0] + s.radius * math.cos(ang), s.center[1] + s.radius * math.sin(ang)]])
+        ext = np.ptp(p, axis=0)
+        return float(ext[0]), float(ext[1])
+
+    # ------------------------------------------------------------------ distances
+    def signed_distance(self, xy) -> np.ndarray:
+        """Exact distance (mm) from plan points ``xy`` (m, 2) to the outline, > 0 inside."""
+        p = np.asarray(xy, dtype=float).reshape(-1, 2)
+        best = np.full(len(p), np.inf)
+        sign = np.ones(len(p))
+        for s in self.segs:
+            if s.kind == "line":
+                a = np.asarray(s.p0)
+                d = np.subtract(s.p1, s.p0)
+                L2 = float(d @ d)
+                t = np.clip(((p - a) @ d) / L2, 0.0, 1.0)
+                foot = a + t[:, None] * d
+                n = np.array([-d[1], d[0]]) / math.sqrt(L2)
+                q = p - foot
+                dist = np.hypot(q[:, 0], q[:, 1])
+                sg = np.where(q @ n >= 0.0, 1.0, -1.0)
+            else:
+                c = np.asarray(s.center)
+                q = p - c
+                rho = np.hypot(q[:, 0], q[:, 1])
+                ang = np.arctan2(q[:, 1], q[:, 0])
+                sw = s.sweep
+                rel = np.mod((ang - s.theta0) * math.copysign(1.0, sw), TWO_PI)
+                inside_arc = rel <= abs(sw)
+                d_arc = np.abs(rho - s.radius)
+                # inward normal of a convex (ccw) arc points to the centre
+                sg_arc = np.where((s.radius - rho) * math.copysign(1.0, sw) >= 0.0, 1.0, -1.0)
+                e0 = np.hypot(p[:, 0] - s.p0[0], p[:, 1] - s.p0[1])
+                e1 = np.hypot(p[:, 0] - s.p1[0], p[:, 1] - s.p1[1])
+                t0, t1 = s.tangent(0), s.tangent(1)
+                n0 = np.array([-t0[1], t0[0]])
+                n1 = np.array([-t1[1], t1[0]])
+                sg0 = np.where((p - np.asarray(s.p0)) @ n0 >= 0.0, 1.0, -1.0)
+                sg1 = np.where((p - np.asarray(s.p1)) @ n1 >= 0.0, 1.0, -1.0)
+                dist = np.where(inside_arc, d_arc, np.minimum(e0, e1))
+                sg = np.where(inside_arc, sg_arc, np.where(e0 <= e1, sg0, sg1))
+            better = dist < best
+            best = np.where(better, dist, best)
+            sign = np.where(better, sg, sign)
+        return sign * best
+
+    def inscribed_radius(self) -> float:
+        """Largest inward distance reached inside the outline (mm), to ~1e-9 mm."""
+        from scipy.optimize import minimize
+
+        L, W = self.extent()
+        c0 = self.frame(np.linspace(0, TWO_PI, 512, endpoint=False))[0]
+        lo, hi = c0.min(axis=0), c0.max(axis=0)
+        g = np.stack(np.meshgrid(np.linspace(lo[0], hi[0], 81), np.linspace(lo[1], hi[1], 81)), -1).reshape(-1, 2)
+        sd = self.signed_distance(g)
+        x0 = g[int(np.argmax(sd))]
+        r = minimize(lambda x: -float(self.signed_distance(x[None])[0]), x0, method="Nelder-Mead",
+                     options=dict(xatol=1e-11, fatol=1e-13, maxiter=4000))
+        return max(float(-r.fun), float(sd.max()))
+
+    def check_offset(self, d: float, parameter: str) -> None:
+        """Refuse an inward offset ``d`` (mm) that is not a clean offset of this outline.
+
+        The offset is valid when ``d`` does not exceed the smallest convex arc
+        radius (arcs would turn inside out) and every offset point stays at
+        distance ``d`` from the outline (it has not passed the medial axis,
+        i.e. ``d`` is within the inscribed radius locally).
+        """
+        rmin = self.min_convex_radius
+        tol = 1e-9 * max(1.0, self.perimeter)
+        if d > rmin + tol:
+            raise DesignError(parameter, d, f"must be <= {rmin:.6g} mm, the smallest corner (arc) radius of the outline", "mm")
+        v = np.linspace(0.0, TWO_PI, 2048, endpoint=False)
+        v = np.concatenate([v, self.breaks[:-1]])
+        O, T, N, k = self.frame(v)
+        pts = O + d * N
+        dist = self.signed_distance(pts)
+        if np.min(dist) < d - 1e-7 * max(1.0, d):
+            r_in = self.inscribed_radius()
+            raise DesignError(parameter, d, f"must be <= {min(r_in, rmin):.6g} mm (the outline's inscribed radius: the offset would cross itself)", "mm")
+
+    # ------------------------------------------------------------------ checks
+    def _check_simple(self) -> None:
+        v = np.linspace(0.0, TWO_PI, 1537, endpoint=False)
+        v = np.unique(np.concatenate([v, self.breaks[:-1]]))
+        _check_polyline_simple(self.frame(v)[0], self.parameter)
+
+
+class SplineOutline(PlanOutline):
+    """Closed plan outline through given points: a periodic cubic spline (mm).
+
+    ``v`` is proportional to the chord length of the points.  Distances are
+    computed by nearest sample and Newton refinement (to ~1e-10 mm).
+    """
+
+    def __init__(self, points, name: str = "outline", parameter: str = "outline") -> None:
+        p = np.asarray(points, dtype=float)
+        if p.ndim != 2 or p.shape[1] != 2 or len(p) < 4 or not np.all(np.isfinite(p)):
+            raise DesignError(parameter, f"array of shape {p.shape}", "must be at least 4 finite (x, y) points in mm")
+        if np.linalg.norm(p[0] - p[-1]) == 0.0:
+            p = p[:-1]
+        seg = np.linalg.norm(np.diff(np.vstack([p, p[:1]]), axis=0), axis=1)
+        if np.any(seg == 0.0):
+            raise DesignError(parameter, "repeated point", "consecutive points must differ")
+        a = 0.5 * float(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
+        if a < 0:
+            p = p[::-1]
+            seg = np.linalg.norm(np.diff(np.vstack([p, p[:1]]), axis=0), axis=1)
+        _check_polyline_simple(p, parameter)
+        t = np.concatenate([[0.0], np.cumsum(seg)]) * (TWO_PI / float(np.sum(seg)))
+        self.points = p
+        self._sp = CubicSpline(t, np.vstack([p, p[:1]]), bc_type="periodic", axis=0)
+        self.name = name
+        self.parameter = parameter
+        self.segs = ()
+        vs = np.linspace(0.0, TWO_PI, 8192, endpoint=False)
+        self._vs = vs
+        self._ps = self._sp(vs)
+        sp1 = self._sp(vs, 1)
+        self.perimeter = float(np.sum(np.hypot(sp1[:, 0], sp1[:, 1])) * TWO_PI / vs.size)
+        self.area = abs(0.5 * float(np.sum(self._ps[:, 0] * sp1[:, 1] - self._ps[:, 1] * sp1[:, 0])) * TWO_PI / vs.size)
+        _check_polyline_simple(self._ps[::4], parameter)
+        from scipy.spatial import cKDTree
+
+        self._tree = cKDTree(self._ps)
+
+    @property
+    def breaks(self) -> np.ndarray:
+        return np.array([0.0, TWO_PI])
+
+    @property
+    def min_convex_radius(self) -> float:
+        O, T, N, k = self.frame(self._vs)
+        kmax = float(np.max(k))
+        return 1.0 / kmax if kmax > 0 else math.inf
+
+    def frame(self, v):
+        v = np.mod(np.asarray(v, dtype=float).reshape(-1), TWO_PI)
+        O = self._sp(v)
+        d1 = self._sp(v, 1)
+        d2 = self._sp(v, 2)
+        g = np.hypot(d1[:, 0], d1[:, 1])
+        T = d1 / g[:, None]
+        N = np.column_stack([-T[:, 1], T[:, 0]])
+        k = (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]) / g**3
+        return O, T, N, k
+
+    def point(self, v, der: int = 0) -> np.ndarray:
+        if der not in (0, 1, 2):
+            raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
+        return self._sp(np.mod(np.asarray(v, dtype=float).reshape(-1), TWO_PI), der)
+
+    def normal(self, v, der: int = 0) -> np.ndarray:
+        v = np.asarray(v, dtype=float).reshape(-1)
+        O, T, N, k = self.frame(v)
+        if der == 0:
+            return N
+        g = np.hypot(*self._sp(np.mod(v, TWO_PI), 1).T)
+        if der == 1:
+            return -(k * g)[:, None] * T
+        if der == 2:  # central difference of the exact first derivative
+            h = 1e-5
+            return (self.normal(v + h, 1) - self.normal(v - h, 1)) / (2 * h)
+        raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
+
+    def centroid(self) -> np.ndarray:
+        p, d1 = self._ps, self._sp(self._vs, 1)
+        w = TWO_PI / self._vs.size
+        a = 0.5 * float(np.sum(p[:, 0] * d1[:, 1] - p[:, 1] * d1[:, 0])) * w
+        sx = 0.5 * float(np.sum(p[:, 0] ** 2 * d1[:, 1])) * w
+        sy = -0.5 * float(np.sum(p[:, 1] ** 2 * d1[:, 0])) * w
+        return np.array([sx / a, sy / a])
+
+    def extent(self) -> tuple[float, float]:
+        ext = np.ptp(self._sp(np.linspace(0, TWO_PI, 20000, endpoint=False)), axis=0)
+        return float(ext[0]), float(ext[1])
+
+    def signed_distance(self, xy) -> np.ndarray:
+        p = np.asarray(xy, dtype=float).reshape(-1, 2)
+        _, i = self._tree.query(p)
+        t = self._vs[i]
+        for _ in range(6):
+            c = self._sp(t)
+            c1 = self._sp(t, 1)
+            c2 = self._sp(t, 2)
+            q = c - p
+            f = np.einsum("ij,ij->i", q, c1)
+            fp = np.einsum("ij,ij->i", c1, c1) + np.einsum("ij,ij->i", q, c2)
+            step = np.where(np.abs(fp) > 1e-300, f / fp, 0.0)
+            t = t - np.clip(step, -0.01, 0.01)
+        O, T, N, k = self.frame(t)
+        q = p - O
+        return np.einsum("ij,ij->i", q, N)  # q is along N at the foot point
+
+    def _check_simple(self) -> None:  # pragma: no cover - done in __init__
+        pass
+
+
+def _signed_area(segs: list[Seg]) -> float:
+    a = 0.0
+    for s in segs:
+        if s.kind == "line":
+            (x0, y0), (x1, y1) = s.p0, s.p1
+            a += 0.5 * (x0 * y1 - x1 * y0)
+        else:
+            cx, cy = s.center
+            r, t0, sw = s.radius, s.theta0, s.sweep
+            t1 = t0 + sw
+            a += 0.5 * (r * r * sw + cx * r * (math.sin(t1) - math.sin(t0)) - cy * r * (math.cos(t1) - math.cos(t0)))
+    return a
+
+
+def _check_polyline_simple(p: np.ndarray, parameter: str) -> None:
+    """Raise DesignError if the closed polyline ``p`` (m, 2) crosses itself."""
+    a = p
+    b = np.roll(p, -1, axis=0)
+    m = len(p)
+    # bounding-box prefilter, then exact orientation tests, non-adjacent pairs only
+    lo = np.minimum(a, b)
+    hi = np.maximum(a, b)
+    step = 256
+    for i0 in range(0, m, step):
+        i1 = min(m, i0 + step)
+        I = np.arange(i0, i1)[:, None]
+        J = np.arange(m)[None, :]
+        ov = (
+            (lo[I, 0] <= hi[J, 0]) & (lo[J, 0] <= hi[I, 0]) & (lo[I, 1] <= hi[J, 1]) & (lo[J, 1] <= hi[I, 1])
+        )
+        adj = (np.abs(I - J) <= 1) | (np.abs(I - J) == m - 1)
+        ii, jj = np.nonzero(ov & ~adj & (J > I))
+        if ii.size == 0:
+            continue
+        ii = ii + i0
+        p1, p2, p3, p4 = a[ii], b[ii], a[jj], b[jj]
+
+        def orient(x, y, z):
+            return (y[:, 0] - x[:, 0]) * (z[:, 1] - x[:, 1]) - (y[:, 1] - x[:, 1]) * (z[:, 0] - x[:, 0])
+
+        d1, d2 = orient(p3, p4, p1), orient(p3, p4, p2)
+        d3, d4 = orient(p1, p2, p3), orient(p1, p2, p4)
+        hit = (d1 * d2 < 0) & (d3 * d4 < 0)
+        if np.any(hit):
+            k = int(np.argmax(hit))
+            x, y = p1[k]
+            raise DesignError(parameter, f"self-intersecting near ({x:.3g}, {y:.3g}) mm", "must be a simple closed curve (it must not cross itself)")
+
+
+# ---------------------------------------------------------------------- constructors
+def outline_from_items(items, name: str = "outline", parameter: str = "outline") -> PlanOutline:
+    """Outline from ``("line", (x0, y0), (x1, y1))`` and
+    ``("arc", (cx, cy), radius, theta0, sweep)`` items (mm, rad), as in
+    :meth:`tabletcad.curves.Outline.from_segments`."""
+    segs = []
+    for i, it in enumerate(items):
+        if not isinstance(it, (list, tuple)) or not it:
+            raise DesignError(f"{parameter} item {i}", it, "must be ('line', p0, p1) or ('arc', center, radius, theta0, sweep)")
+        kind = it[0]
+        try:
+            if kind == "line" and len(it) == 3:
+                segs.append(_line(it[1], it[2]))
+            elif kind == "arc" and len(it) == 5:
+                segs.append(_arc(it[1], float(it[2]), float(it[3]), float(it[4])))
+            else:
+                raise TypeError
+        except (TypeError, ValueError, IndexError):
+            raise DesignError(f"{parameter} item {i}", it, "must be ('line', p0, p1) or ('arc', center, radius, theta0, sweep)") from None
+    return PlanOutline(segs, name=name, parameter=parameter)
+
+
+def circle_outline(radius: float) -> PlanOutline:
+    """Circle of ``radius`` (mm) about the origin, starting on +x (``v`` = polar angle)."""
+    r = check_positive("radius", radius, "mm")
+    return PlanOutline([_arc((0.0, 0.0), r, 0.0, TWO_PI)], name="circle")
+
+
+def stadium_outline(length: float, width: float, parameter: str = "width") -> PlanOutline:
+    """Stadium (capsule plan): ``length`` along x, ``width`` along y, end radius ``width/2`` (mm)."""
+    L = check_positive("length", length, "mm")
+    W = check_positive("width", width, "mm")
+    if W > L:
+        raise DesignError(parameter, W, f"must be <= length = {L:g} mm", "mm")
+    r = W / 2.0
+    h = L / 2.0 - r
+    if h <= 1e-12 * L:
+        return circle_outline(r)
+    return PlanOutline(
+        [
+            _arc((h, 0.0), r, -math.pi / 2, math.pi),
+            _line((h, r), (-h, r)),
+            _arc((-h, 0.0), r, math.pi / 2, math.pi),
+            _line((-h, -r), (h, -r)),
+        ],
+        name="stadium",
+    )
+
+
+def four_arc_oval(length: float, width: float, end_radius: float) -> PlanOutline:
+    """Oval of two end arcs (``end_radius``) and two side arcs, tangent (mm).
+
+    The side radius follows from tangency:
+    ``R_s = ((L/2 - r)² + W²/4 - r²) / (W - 2 r)``.  ``end_radius = width/2``
+    gives the stadium.
+    """
+    L = check_positive("length", length, "mm")
+    W = check_positive("width", width, "mm")
+    if W > L:
+        raise DesignError("width", W, f"must be <= length = {L:g} mm", "mm")
+    r = check_range("end_radius", end_radius, 0.0, W / 2.0, "mm", lo_open=True)
+    if abs(r - W / 2.0) <= 1e-12 * W:
+        return stadium_outline(L, W)
+    hx = L / 2.0 - r
+    Rs = (hx * hx + W * W / 4.0 - r * r) / (W - 2.0 * r)
+    if Rs <= r:
+        raise DesignError("end_radius", r, f"gives a side radius {Rs:.4g} mm not larger than the end radius", "mm")
+    cy = W / 2.0 - Rs  # centre of the upper side arc is (0, cy) (below the axis)
+    # tangent point between the right end arc (centre (hx, 0)) and the upper side arc
+    ang = math.atan2(0.0 - cy, hx - 0.0)  # direction from side-arc centre to end-arc centre
+    segs = [
+        _arc((hx, 0.0), r, -ang, 2 * ang),
+        _arc((0.0, cy), Rs, ang, math.pi - 2 * ang),
+        _arc((-hx, 0.0), r, math.pi - ang, 2 * ang),
+        _arc((0.0, -cy), Rs, math.pi + ang, math.pi - 2 * ang),
+    ]
+    return PlanOutline(segs, name="oval")
+
+
+def four_arc_oval_from_side_radius(length: float, width: float, side_radius: float) -> PlanOutline:
+    """Four-arc oval given its side radius (mm); the end radius follows from tangency:
+    ``r = (R_s W - (L² + W²)/4) / (2 R_s - L)``."""
+    L = check_positive("length", length, "mm")
+    W = check_positive("width", width, "mm")
+    Rs = check_positive("side_radius", side_radius, "mm")
+    if Rs <= L / 2.0:
+        raise DesignError("side_radius", Rs, f"must be > length/2 = {L / 2:g} mm", "mm")
+    r = (Rs * W - (L * L + W * W) / 4.0) / (2.0 * Rs - L)
+    if not 0.0 < r < W / 2.0:
+        lo = (L * L + W * W) / (4.0 * W)
+        raise DesignError("side_radius", Rs, f"must be > {lo:.6g} mm for a {L:g} x {W:g} mm oval (end radius would be <= 0)", "mm")
+    return four_arc_oval(L, W, r)
+
+
+def rounded_polygon(vertices, corner_radius: float, name: str = "polygon") -> PlanOutline:
+    """Convex polygon (vertices CCW, mm) with every corner rounded to ``corner_radius``."""
+    V = np.asarray(vertices, dtype=float)
+    n = len(V)
+    rc = check_positive("corner_radius", corner_radius, "mm")
+    segs: list[Seg] = []
+    tangent_pts = []
+    for i in range(n):
+        a, b, c = V[i - 1], V[i], V[(i + 1) % n]
+        u1 = (a - b) / np.linalg.norm(a - b)
+        u2 = (c - b) / np.linalg.norm(c - b)
+        half = 0.5 * math.acos(float(np.clip(u1 @ u2, -1, 1)))
+        t = rc / math.tan(half)
+        if t > 0.5 * min(np.linalg.norm(a - b), np.linalg.norm(c - b)) + 1e-12:
+            raise DesignError("corner_radius", rc, f"must be <= {0.5 * min(np.linalg.norm(a - b), np.linalg.norm(c - b)) * math.tan(half):.6g} mm (the rounded corners would overlap)", "mm")
+        bis = (u1 + u2) / np.linalg.norm(u1 + u2)
+        centre = b + bis * rc / math.sin(half)
+        p_in = b + u1 * t
+        p_out = b + u2 * t
+        th0 = math.atan2(p_in[1] - centre[1], p_in[0] - centre[0])
+        th1 = math.atan2(p_out[1] - centre[1], p_out[0] - centre[0])
+        sw = (th1 - th0) % TWO_PI
+        tangent_pts.append((p_in, p_out, centre, th0, sw))
+    for i in range(n):
+        p_in, p_out, centre, th0, sw = tangent_pts[i]
+        segs.append(_arc(centre, rc, th0, sw))
+        nxt = tangent_pts[(i + 1) % n][0]
+        if np.linalg.norm(nxt - p_out) > 1e-12:
+            segs.append(_line(p_out, nxt))
+    return PlanOutline(segs, name=name)
+
+
+def rounded_rectangle_outline(length: float, width: float, corner_radius: float) -> PlanOutline:
+    """Rectangle ``length`` (x) × ``width`` (y) with corners of ``corner_radius`` (mm)."""
+    L = check_positive("length", length, "mm")
+    W = check_positive("width", width, "mm")
+    rc = check_range("corner_radius", corner_radius, 0.0, min(L, W) / 2.0, "mm", lo_open=True)
+    hx, hy = L / 2.0, W / 2.0
+    return rounded_polygon([(hx, -hy), (hx, hy), (-hx, hy), (-hx, -hy)], rc, name="rounded_rectangle")
