@@ -20,7 +20,9 @@ __all__ = ["main", "cli"]
 # so that a missing optional dependency only affects the commands that need it.
 _COMMAND_MODULES = [
     "tabletcad.cli.geometry",
+    "tabletcad.cli.report",
     "tabletcad.cli.mechanics",
+    "tabletcad.cli.optimise",
 ]
 
 

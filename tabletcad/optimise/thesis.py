@@ -127,12 +127,19 @@ def round_tablet(radii, heights, *, name: str = "flat_faced_round", check: bool 
 def sphere_tablet(radii, heights, *, name: str = "spherical_tablet", check: bool = False, fast: bool = True) -> Tablet:
     """Two-patch tablet of section 6.2.2 from the upper half's circles P21, d21, d22, P22
     (``radii``, ``heights``), the lower half mirrored about the plane of P21 (eq 6.13:
-    P11 = P22, d11 = d22, d12 = d21).  A top circle of radius > 0 leaves flat contact
-    faces at both ends, which close the solid."""
+    P11 = P22, d11 = d22, d12 = d21).  A top circle of radius > 0 gets flat disc
+    patches (the contact faces) at both ends."""
+    return coaxial_fast(_sphere_sections(radii, heights), name=name, check=check, fast=fast)
+
+
+def _sphere_sections(radii, heights):
     ze = heights[0]
     up = list(zip(radii, heights))
     low = [(radii[3 - k], 2 * ze - heights[3 - k]) for k in range(4)]
-    return coaxial_fast([low, up], name=name, check=check, fast=fast)
+    secs = [low, up]
+    if radii[3] > 0:  # flat contact faces as patches, so that the CAD layer sees a closed chain
+        secs = [_disc(radii[3], low[0][1], up=False), low, up, _disc(radii[3], heights[3], up=True)]
+    return secs
 
 
 def _profile_max_radius(patch: PDEPatch) -> float:
@@ -433,8 +440,7 @@ def spherical_tablet_problem(
 
     def to_toml(x, d):
         r, z = parts(x)
-        low = [(r[3 - k], 2 * ze - z[3 - k]) for k in range(4)]
-        return free_form_toml(d.tablet, [low, list(zip(r, z))], name=f"spherical_tablet_{variant}_optimum",
+        return free_form_toml(d.tablet, _sphere_sections(r, z), name=f"spherical_tablet_{variant}_optimum",
                               comment=f"Optimum of the thesis's section 6.2.2 problem, variant {variant} (tabletcad optimise).\n"
                                       f"sigma_T^s (eq 6.7) = {d.strength:.6g} MPa at F_ep = {d.force:.6g} N; volume {d.volume:.9g} mm3")
 

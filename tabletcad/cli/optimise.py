@@ -1,0 +1,107 @@
+"""``tabletcad optimise PROBLEM.toml --out DIR``: design optimisation (thesis chapter 6)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import click
+
+__all__ = ["COMMANDS"]
+
+EXIT_FAILED = 3
+
+
+class OptimisationFailed(click.ClickException):
+    """The run finished without a certified feasible optimum (exit status 3)."""
+
+    exit_code = EXIT_FAILED
+
+
+@click.command("optimise")
+@click.argument("problem_file", metavar="PROBLEM.toml", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path), help="Output folder.")
+@click.option("--method", type=click.Choice(["SLSQP", "trust-constr", "multistart", "differential_evolution"]),
+              default=None, help="Solver (default: the file's [problem] method, else SLSQP).")
+@click.option("--starts", type=int, default=None, help="Number of Sobol starts for multistart.")
+@click.option("--maxiter", type=int, default=None, help="Iteration limit.")
+@click.option("--quiet", is_flag=True, help="No progress display.")
+def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: int | None, maxiter: int | None,
+                 quiet: bool) -> None:
+    """Optimise PROBLEM.toml; write optimum.toml, report.json, convergence.png (and tablet/ outputs) to OUT.
+
+    Exit status 0 on a converged feasible optimum, 3 when the run fails (report.json
+    says which constraint failed and by how much), 2 on bad input (nothing written).
+    """
+    from tabletcad.design import load_design
+    from tabletcad.errors import DesignError, TabletcadError
+    from tabletcad.io.atomic import atomic_write_text
+    from tabletcad.optimise.files import load_problem
+    from tabletcad.optimise.plot import plot_convergence
+    from tabletcad.optimise.report import result_report, summary, to_json
+    from tabletcad.optimise.solvers import solve
+    from tabletcad.tablet import Tablet
+
+    problem, default_method, opts = load_problem(problem_file)
+    if starts is not None:
+        if starts < 0:
+            raise DesignError("--starts", starts, "must be >= 0")
+        opts["starts"] = starts
+    if maxiter is not None:
+        if maxiter < 1:
+            raise DesignError("--maxiter", maxiter, "must be >= 1")
+        opts["maxiter"] = maxiter
+    method = method or default_method
+    build_error = ""
+    result = solve(problem, method, progress=not quiet, **opts)
+
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    staging = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+    try:
+        report = result_report(result, problem)
+        report["problem_file"] = str(problem_file)
+        written = []
+        if result.design is not None and problem.to_toml is not None:
+            text = problem.to_toml(result.x, result.design)
+            name = "optimum.toml" if result.success else "last_point.toml"
+            atomic_write_text(staging / name, text)
+            written.append(name)
+            if result.success:
+                # rebuild from the written file with default settings: what `tabletcad build` will see
+                written_tablet = load_design(staging / name)
+                tablet = getattr(result.design, "tablet", result.design)
+                if isinstance(tablet, Tablet) and isinstance(written_tablet, Tablet):
+                    from tabletcad.build import build_tablet
+
+                    try:
+                        rep = build_tablet(written_tablet, staging / "tablet", design_path=staging / name,
+                                           progress=not quiet)
+                        report["built_design"] = dict(folder="tablet", volume_mm3=rep.get("volume_mm3"),
+                                                      surface_area_mm2=rep.get("surface_area_mm2"))
+                        written.append("tablet/")
+                    except TabletcadError as exc:  # the optimum is reported even if an output stage fails
+                        build_error = str(exc).splitlines()[0]
+                        report["built_design"] = dict(error=build_error)
+        plot_convergence(result, staging / "convergence.png")
+        written.append("convergence.png")
+        atomic_write_text(staging / "report.json", to_json(report))
+        written.append("report.json")
+        out_dir.mkdir(parents=True, exist_ok=True)
+        for f in sorted(staging.iterdir()):
+            target = out_dir / f.name
+            if target.is_dir() and f.is_dir():
+                shutil.rmtree(target)
+            os.replace(f, target)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    click.echo(summary(result))
+    click.echo(f"-> {out_dir}/ ({', '.join(written)})")
+    if not result.success:
+        raise OptimisationFailed(f"optimisation {result.status}: {result.message}")
+    if build_error:
+        raise OptimisationFailed(f"optimum found but its tablet outputs failed: {build_error}")
+
+
+COMMANDS = [optimise_cmd]
