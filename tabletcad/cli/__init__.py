@@ -22,7 +22,6 @@ _COMMAND_MODULES = [
     "tabletcad.cli.geometry",
     "tabletcad.cli.report",
     "tabletcad.cli.mechanics",
-    "tabletcad.cli.optimise",
 ]
 
 

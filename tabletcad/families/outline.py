@@ -153,6 +153,13 @@ class PlanOutline:
         return self._cum * (TWO_PI / self.perimeter)
 
     @property
+    def smooth_breaks(self) -> np.ndarray:
+        """Joins in ``[0, 2π)`` where the curvature jumps (none for a single circle)."""
+        if len(self.segs) == 1:
+            return np.zeros(0)
+        return self.breaks[:-1]
+
+    @property
     def min_convex_radius(self) -> float:
         """Smallest radius of a convex arc (inf without arcs), mm."""
         r = [s.radius for s in self.segs if s.kind == "arc" and s.sweep > 0]
@@ -381,6 +388,10 @@ class SplineOutline(PlanOutline):
     @property
     def breaks(self) -> np.ndarray:
         return np.array([0.0, TWO_PI])
+
+    @property
+    def smooth_breaks(self) -> np.ndarray:
+        return np.asarray(self._sp.x[:-1], dtype=float)
 
     @property
     def min_convex_radius(self) -> float:

@@ -104,6 +104,12 @@ class SweepCurve(Curve):
     def is_point(self) -> bool:
         return self.alpha == 0.0 and self.beta == 0.0
 
+    def breakpoints(self) -> np.ndarray:
+        """``v`` of the outline's segment joins (where the offset is only piecewise smooth)."""
+        if self.is_point:
+            return np.zeros(0)
+        return np.asarray(getattr(self.outline, "smooth_breaks", self.outline.breaks[:-1]), dtype=float)
+
 
 @dataclass(frozen=True)
 class Certificate:
