@@ -22,6 +22,7 @@ _COMMAND_MODULES = [
     "tabletcad.cli.geometry",
     "tabletcad.cli.report",
     "tabletcad.cli.mechanics",
+    "tabletcad.cli.optimise",
 ]
 
 
