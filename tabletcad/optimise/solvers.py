@@ -293,6 +293,10 @@ def _finish(problem: Problem, ev: Evaluator, z, method: str, solver_ok: bool, ni
         message = f"solver did not converge: {solver_msg} (the last point satisfies the constraints but is not certified optimal)"
     else:
         message = f"converged: {solver_msg}"
+    history = list(history)
+    if r["ok"] and history and (history[-1].objective != float(r["f"])):
+        # the solver's returned point is not its last callback point: end the history with it
+        history.append(Iteration(len(history), float(r["f"]), float(ev.max_violation(z)), ev.nfev))
     extras: dict[str, Any] = {}
     if r["ok"] and problem.extras is not None:
         try:

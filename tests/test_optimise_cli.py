@@ -1,0 +1,53 @@
+"""``tabletcad optimise``: round trip through ``tabletcad build``, exit statuses."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from tabletcad.cli import main
+
+SAMPLES = Path(__file__).resolve().parent.parent / "samples" / "optimise"
+
+
+def test_round_trip_build(tmp_path):
+    out = tmp_path / "opt"
+    assert main(["optimise", str(SAMPLES / "spherical_tablet_b.toml"), "--out", str(out), "--quiet"]) == 0
+    for name in ("optimum.toml", "report.json", "convergence.png"):
+        assert (out / name).is_file()
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["success"] and rep["status"] == "converged"
+    assert rep["function_evaluations"] > 0 and rep["iterations"] > 0 and rep["wall_time_s"] > 0
+    vol = next(c for c in rep["constraints"] if c["name"].startswith("volume"))
+    assert "slack" in vol
+    build = tmp_path / "built"
+    assert main(["build", str(out / "optimum.toml"), "--out", str(build), "--quiet"]) == 0
+    built = json.loads((build / "report.json").read_text())
+    assert built["volume_mm3"] == pytest.approx(vol["value"], rel=1e-6)
+    assert built["volume_mm3"] == pytest.approx(1.44, rel=1e-6)
+
+
+def test_failure_exit_3(tmp_path, capsys):
+    out = tmp_path / "fail"
+    assert main(["optimise", str(SAMPLES / "softgel_capsule.toml"), "--out", str(out), "--quiet"]) == 3
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["success"] is False and rep["status"] == "infeasible"
+    assert "mu_r" in rep["message"]
+    assert not (out / "optimum.toml").exists()
+    assert "infeasible" in capsys.readouterr().err
+
+
+def test_bad_input_exit_2_nothing_written(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[problem]\nkind = "spherical_tablet"\n[parameters]\nvariant = "z"\n')
+    out = tmp_path / "out"
+    assert main(["optimise", str(bad), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error:")
+    assert not out.exists()
+    bad.write_text('[problem]\nkind = "family"\nfamily = "flat_faced_round"\nobjective = "volume_mm3"\n'
+                   '[variables]\ndiameter = { lower = 5, upper = 4 }\n')
+    assert main(["optimise", str(bad), "--out", str(out), "--quiet"]) == 2
+    assert not out.exists()
