@@ -92,14 +92,29 @@ class _Scaled:
         return out
 
 
-def _slsqp(sc: _Scaled, z0, maxiter: int, ftol: float):
+def _slsqp(sc: _Scaled, z0, maxiter: int, ftol: float, restarts: int = 2):
+    """SLSQP, warm-restarted from its own end point (at most ``restarts`` times) when it stops
+    without success or with a constraint still violated (e.g. "positive directional derivative
+    for linesearch" after a finite-difference gradient misled the line search)."""
     n = sc.ev.n
     sc.record(z0)
-    res = minimize(
-        sc.f, z0, jac=sc.g, method="SLSQP", bounds=[(0.0, 1.0)] * n, constraints=sc.slsqp_constraints(),
-        options=dict(maxiter=maxiter, ftol=ftol), callback=sc.record,
-    )
-    return res, bool(res.success), int(getattr(res, "nit", len(sc.history) - 1)), str(res.message)
+    nit = 0
+    z = np.asarray(z0, float)
+    scheme = sc.ev.fd_scheme
+    for attempt in range(restarts + 1):
+        res = minimize(
+            sc.f, z, jac=sc.g, method="SLSQP", bounds=[(0.0, 1.0)] * n, constraints=sc.slsqp_constraints(),
+            options=dict(maxiter=max(1, maxiter - nit), ftol=ftol), callback=sc.record,
+        )
+        nit += int(getattr(res, "nit", 0))
+        feas, _ = _feasible_value(sc.ev, res.x)
+        if (res.success and feas) or nit >= maxiter or np.array_equal(res.x, z):
+            break
+        z = np.clip(res.x, 0.0, 1.0)
+        sc.ev.fd_scheme = "central"  # restarts use central differences (error ~ step² instead of ~ step)
+    sc.ev.fd_scheme = scheme
+    msg = str(res.message) + (f" (after {attempt} warm restart{'s' if attempt > 1 else ''})" if attempt else "")
+    return res, bool(res.success), nit, msg
 
 
 def _trust_constr(sc: _Scaled, z0, maxiter: int, ftol: float):
