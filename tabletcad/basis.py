@@ -16,8 +16,12 @@ to compute them, so the basis is chosen for accuracy:
 
 * ``λ > 1``: scaled exponentials ``e^{λ(u-1)}, u e^{λ(u-1)}, e^{-λu},
   u e^{-λu}``, all bounded by 1 on ``[0, 1]`` (no overflow for any ``λ``);
-  the condition matrix is row-equilibrated before it is solved, which makes
-  it well conditioned however large ``λ`` is.
+  the condition matrix is row-equilibrated before it is solved.  With
+  interior nodes the cardinal functions themselves grow to ~``e^{λ/4}``
+  between the nodes, so they are accurate to ~1e-12 *relative to that
+  size*; a patch refuses modes amplified more than
+  ``Tolerances.max_amplification`` (1000-fold), which keeps the absolute
+  error at the nodes below ~1e-12.
 * ``0 <= λ <= 1``: ``cosh λu``, ``u sinhc λu``, ``u² sinhc λu`` and
   ``u³ g(λu)`` with ``g(x) = (x cosh x - sinh x)/x³``, which tend smoothly to
   ``1, u, u², u³/3`` as ``λ -> 0`` (the exponential basis degenerates there).
@@ -29,9 +33,16 @@ from functools import lru_cache
 
 import numpy as np
 
-__all__ = ["basis", "cardinal_coefficients", "cardinal", "lebesgue_max"]
+__all__ = ["basis", "cardinal_coefficients", "cardinal", "lebesgue_max", "LAMBDA_MAX"]
 
 _SMALL = 1.0  # λ at or below which the hyperbolic basis is used
+
+#: Largest λ accepted in the four-curve form (the Hermite form has no limit).  Beyond ~2200 the interior-node rows underflow; long
+#: before that (λ ≳ 30 for nodes at 1/3, 2/3) a mode is amplified more than
+#: 1000-fold between the curves, which :class:`tabletcad.patch.PDEPatch` refuses.
+#: For large λ the cardinal functions are accurate relative to their own size
+#: (~e^{λ/4} between the nodes), i.e. to ``eps·max|L|`` absolutely.
+LAMBDA_MAX = 1500.0
 
 
 def _sinhc(x: np.ndarray) -> np.ndarray:
@@ -121,6 +132,8 @@ def cardinal_coefficients(lam: float, nodes: tuple[float, float, float, float], 
         (the ends); conditions are ``X(0), X(1), X_u(0), X_u(1)`` in that order.
     form : {"curves", "hermite"}
     """
+    if lam < 0.0 or (form == "curves" and lam > LAMBDA_MAX):
+        raise ValueError(f"λ = {lam:g} is not allowed: must be between 0 and {LAMBDA_MAX:g}")
     if form == "curves":
         m = basis(np.asarray(nodes, dtype=float), lam, 0)
     elif form == "hermite":

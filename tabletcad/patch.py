@@ -174,6 +174,38 @@ class PDEPatch:
         scale = max(1.0, float(np.max(np.abs(a0))), float(np.max(np.abs(ac))) if N else 0.0)
         object.__setattr__(self, "_has_remainder", res > 1e-14 * scale)
         object.__setattr__(self, "_lams", self.a * np.arange(N + 1))
+        # modes with any non-zero coefficient; the others are skipped in every sum
+        amp = np.zeros(N + 1)
+        if N:
+            amp[1:] = np.maximum(np.max(np.abs(ac), axis=(0, 2)), np.max(np.abs(bc), axis=(0, 2)))
+        zero = 1e-15 * scale
+        object.__setattr__(self, "_active", [n for n in range(1, N + 1) if amp[n] > zero])
+        if self.check:
+            self._check_amplification(amp, zero)
+
+    def _check_amplification(self, amp: np.ndarray, zero: float) -> None:
+        """Refuse modes (and the remainder) amplified more than ``tol.max_amplification`` between the curves.
+
+        Such a mode's shape between the curves is set by the amplification,
+        not by the design (and beyond ``LAMBDA_MAX`` it cannot be computed).
+        """
+        from tabletcad.basis import LAMBDA_MAX, lebesgue_max
+
+        limit = self.tol.max_amplification
+        used = [(f"mode {n}", float(self._lams[n]), amp[n]) for n in self._active]
+        if self._has_remainder:
+            used.append(("the remainder term", self._beta, 1.0))
+        for what, lam, size in used:
+            big = lam > min(LAMBDA_MAX, 200.0)
+            lb = math.inf if big else lebesgue_max(lam, self.u_nodes, self.form)
+            if not math.isfinite(lb) or lb > limit:
+                raise DesignError(
+                    f"patch {self.name or '?'} smoothing parameter a",
+                    self.a,
+                    f"{what} (a·n = {lam:.3g}, amplitude {size:.3g} mm) would be amplified "
+                    f"{'beyond 1e80' if big else f'{lb:.3g}-fold'} between the curves (allowed {limit:g}): "
+                    "use a smaller a or fewer modes",
+                )
 
     # ------------------------------------------------------------------ pieces
     def breakpoints(self) -> np.ndarray:
@@ -247,12 +279,12 @@ class PDEPatch:
         uf, vf = u.reshape(-1), v.reshape(-1)
         out = np.zeros((uf.size, 3))
         N = self.modes
-        for n in range(nmin, N + 1):
-            L = cardinal(uf, self._lams[n], self.u_nodes, self.form, du)  # (M, 4)
-            if n == 0:
-                if dv == 0:
-                    out += L @ self._a0
+        if nmin == 0 and dv == 0:
+            out += cardinal(uf, 0.0, self.u_nodes, self.form, du) @ self._a0
+        for n in self._active:
+            if n < nmin:
                 continue
+            L = cardinal(uf, self._lams[n], self.u_nodes, self.form, du)  # (M, 4)
             A = L @ self._ac[:, n - 1]  # (M, 3)
             B = L @ self._bc[:, n - 1]
             c, s = _trig(vf, np.array([n]), dv)
@@ -276,15 +308,15 @@ class PDEPatch:
         if dv == 0:
             L0 = cardinal(u, 0.0, self.u_nodes, self.form, du)
             out += (L0 @ self._a0)[:, None, :]
-        if N:
-            n = np.arange(1, N + 1)
-            A = np.empty((N, u.size, 3))
-            B = np.empty((N, u.size, 3))
-            for i in range(N):
-                L = cardinal(u, self._lams[i + 1], self.u_nodes, self.form, du)
-                A[i] = L @ self._ac[:, i]
-                B[i] = L @ self._bc[:, i]
-            c, s = _trig(v, n, dv)  # (nv, N)
+        if self._active:
+            n = np.array(self._active)
+            A = np.empty((n.size, u.size, 3))
+            B = np.empty((n.size, u.size, 3))
+            for i, k in enumerate(n):
+                L = cardinal(u, self._lams[k], self.u_nodes, self.form, du)
+                A[i] = L @ self._ac[:, k - 1]
+                B[i] = L @ self._bc[:, k - 1]
+            c, s = _trig(v, n, dv)  # (nv, len(n))
             out += np.einsum("nuc,vn->uvc", A, c, optimize=True) + np.einsum("nuc,vn->uvc", B, s, optimize=True)
         if self._has_remainder:
             L = cardinal(u, self._beta, self.u_nodes, self.form, du)  # (nu, 4)
@@ -372,18 +404,16 @@ class PDEPatch:
         at most ``tol.stray / 4``; between them it grows with the mode's
         amplification.
         """
-        if self.form == "hermite":
-            idx = (0, 1)
-        else:
-            idx = (0, 1, 2, 3)
-        n_design = max(modes_needed(self.data[k], self.tol.stray / 4, self.modes) for k in idx)
+        # every datum's design content counts (in the Hermite form the derivative
+        # curves X_u(0), X_u(1) carry design modes of their own)
+        n_design = max(modes_needed(self.data[k], self.tol.stray / 4, self.modes) for k in range(4))
         if n_design >= self.modes and not self._has_remainder:
             return 0.0
         n_design = min(n_design, self.modes)
         u = np.linspace(0.0, 1.0, nu)
         v = sample_v(nv or max(256, 8 * self.modes))
         fine = np.zeros((u.size, v.size, 3))
-        n = np.arange(n_design + 1, self.modes + 1)
+        n = np.array([k for k in self._active if k > n_design], dtype=int)
         if n.size:
             A = np.stack([cardinal(u, self._lams[i], self.u_nodes, self.form) @ self._ac[:, i - 1] for i in n])
             B = np.stack([cardinal(u, self._lams[i], self.u_nodes, self.form) @ self._bc[:, i - 1] for i in n])
@@ -400,7 +430,7 @@ class PDEPatch:
 
     def _check_stray(self) -> None:
         s = self.stray()
-        if s > self.tol.stray:
+        if not s <= self.tol.stray:  # also refuses NaN
             raise DesignError(
                 f"patch {self.name or '?'} smoothing parameter a",
                 self.a,
@@ -442,7 +472,8 @@ class PDEPatch:
         return float(np.max(back))
 
     def _check_fold(self) -> None:
-        """Refuse a patch whose solid map folds deeper than ``tol.fold`` (self-intersection)."""
+        """Refuse a patch whose surface folds over itself, passes through its
+        spine, or whose solid map folds deeper than ``tol.fold``."""
         depth = self.fold_depth()
         object.__setattr__(self, "_fold_depth", depth)
         if depth > self.tol.fold:
@@ -451,6 +482,40 @@ class PDEPatch:
                 f"a fold {depth:.3g} mm deep",
                 f"the surface must not cross its spine by more than {self.tol.fold:g} mm "
                 "(a radius would turn negative or the surface self-intersects)",
+            )
+        ends = np.geomspace(1e-6, 0.05, 24)
+        u = np.unique(np.concatenate([ends, np.linspace(0.0, 1.0, 401)[1:-1], 1.0 - ends]))
+        v = sample_v(128)
+        X = self.evaluate_grid(u, v)
+        D = X - self.spine(u)[:, None, :]
+        # (a) the radius must not turn negative: the radial vector may not point
+        #     against that of the widest curve (the surface would pass through its spine)
+        Dn = np.linalg.norm(D, axis=-1)
+        k = int(np.argmax(Dn.max(axis=1)))
+        ref = D[k] / np.maximum(Dn[k], 1e-300)[:, None]
+        along = np.einsum("uvc,vc->uv", D, ref)
+        worst = float(-np.min(along))
+        if worst > self.tol.fold:
+            i, j = np.unravel_index(int(np.argmin(along)), along.shape)
+            raise DesignError(
+                f"patch {self.name or '?'} curves",
+                f"radius {-worst:.3g} mm at u = {u[i]:.3f}, v = {v[j]:.3f}",
+                "the radius about the spine must stay positive (the surface would pass through its spine)",
+            )
+        # (b) the surface itself must not fold back (normal reversing between neighbours)
+        Xu = self.evaluate_grid(u, v, du=1)
+        Xv = self.evaluate_grid(u, v, dv=1)
+        n = np.cross(Xu, Xv)
+        nn = np.linalg.norm(n, axis=-1)
+        big = nn > 1e-6 * float(np.max(nn))
+        dots = np.einsum("uvc,uvc->uv", n[1:], n[:-1])
+        rev = (dots < -0.5 * nn[1:] * nn[:-1]) & big[1:] & big[:-1]
+        if np.any(rev):
+            i, j = np.argwhere(rev)[0]
+            raise DesignError(
+                f"patch {self.name or '?'} curves",
+                f"surface folds back near u = {u[i]:.3f}, v = {v[j]:.3f}",
+                "the surface must not fold over itself (e.g. a flat face whose radius overshoots its rim)",
             )
 
     # ------------------------------------------------------------------ misc

@@ -30,6 +30,11 @@ class Tolerances:
         ``fourier`` (plus the remainder term) may move the surface between the
         curves.  A patch exceeding it is refused: its shape would be driven by
         amplified high-frequency content instead of by the design.
+    max_amplification : float
+        Largest factor by which a mode present in the design may be amplified
+        between interior curves (the maximum of its Lebesgue function); beyond
+        it the surface between the curves is set by the amplification rather
+        than by the design, and the patch is refused.
     max_modes : int
         Upper bound on the number of Fourier modes ``N`` carried analytically;
         content above it goes into the remainder term.
@@ -56,6 +61,7 @@ class Tolerances:
     interpolation: float = 1e-9
     fourier: float = 1e-9
     stray: float = 1e-3
+    max_amplification: float = 1e3
     max_modes: int = 48
     samples: int = 512
     quad_u: int = 48

@@ -120,13 +120,6 @@ def test_hermite_form_band_limited(kit):
         np.testing.assert_allclose(p.evaluate(u, V, du=du), c.evaluate(V), atol=1e-9)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="BUG patch.stray (hermite form): design modes of the derivative curves X_u(0), X_u(1) above the "
-    "end curves' modes count as 'fine detail', so a well-conditioned Hermite patch (ends circle/ellipse, "
-    "X_u(0) with a 0.2 mm mode 2) is refused at a = 1 ('amplified to 0.0258 mm'); Hermite cardinals are "
-    "bounded by 1, nothing is amplified",
-)
 def test_hermite_design_modes_of_derivative_curves_are_not_stray(kit):
     c0 = Circle(4.0, (0.0, 0.0, 0.0))
     c1 = Ellipse(3.0, 2.0, (0.5, 0.0, 3.0))
@@ -214,12 +207,6 @@ def test_flat_disc_patch_area(radii, nodes, kit):
     assert np.max(np.abs(p.evaluate_grid(np.linspace(0, 1, 11), V)[..., 2])) == 0.0
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="BUG patch._check_fold: for a flat patch det = X_u·(X_v × D) ≡ 0, so circles 0, 2, 4.5, 5 at z = 0 "
-    "(a = 1) are accepted though r(u) overshoots to 5.224 at u ≈ 0.89 and folds back: the face overlaps "
-    "itself (area 92.95 mm² for a 78.54 mm² disc)",
-)
 def test_fold_check_refuses_flat_disc_folding_back(kit):
     curves = _coaxial((0.0, 2.0, 4.5, 5.0), (0.0,) * 4)
     p = PDEPatch(curves, a=1.0, check=False)
@@ -369,12 +356,6 @@ def test_fold_check_accepts_valid_dome_and_band():
     PDEPatch(_coaxial((5.0, 5.0, 5.0, 5.0), (0.0, 1.0, 2.0, 3.0)), a=1.0)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="BUG patch._check_fold: det = X_u·(X_v × D) = -r²z' for coaxial circles is blind to the sign "
-    "of r, so circles 5, 0.1, 0.1, 5 (z = 0..3, a = 1), whose radius turns negative on u ≈ (0.35, 0.65) "
-    "(surface passes through its spine twice), are accepted",
-)
 @pytest.mark.parametrize("radii", [(5.0, 0.1, 0.1, 5.0), (5.0, 0.2, 5.0, 0.0)])
 def test_fold_check_refuses_radius_turning_negative(radii):
     curves = _coaxial(radii, (0.0, 1.0, 2.0, 3.0))
@@ -398,12 +379,6 @@ def _wobbly_stack(kit, n, eps=0.1):
     return tuple(out)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="BUG patch checks: curves of radius 4-5 mm with a 0.1 mm 3-lobe wobble and a = 50 (allowed) are "
-    "accepted though the surface reaches |X| ≈ 3.5e17 mm and winds 3 times round its spine mid-patch: "
-    "stray ignores design modes and _check_fold's threshold is relative to the exploded surface",
-)
 def test_patch_with_exploding_design_mode_is_refused(kit):
     curves = _wobbly_stack(kit, 3)
     p = PDEPatch(curves, a=50.0, check=False)
@@ -413,11 +388,6 @@ def test_patch_with_exploding_design_mode_is_refused(kit):
         PDEPatch(curves, a=50.0)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="BUG: PDEPatch(4 coaxial circles, a=50, modes=48) is accepted but evaluates to NaN everywhere "
-    "(cardinals NaN for λ >~ 2200; stray() returns NaN and `NaN > tol` is False, fold check likewise)",
-)
 def test_patch_with_nan_surface_is_refused():
     curves = _coaxial((4.0, 5.0, 5.0, 4.0), (0.0, 1.0, 2.0, 3.0))
     with warnings.catch_warnings():
