@@ -113,12 +113,14 @@ class CompoundCup:
             h = check_finite("cup_depth", depth, "mm")
             if not 0.0 < h:
                 raise DesignError("cup_depth", h, "must be > 0", "mm")
+            if not _feasible(w, Rc, Re, h):
+                lo, hi = _depth_range(w, Rc, Re)
+                if lo != lo:
+                    raise DesignError("edge_radius", Re, f"cannot be tangent to central_radius = {Rc:g} mm inside a {2 * w:g} mm cup for any depth", "mm")
+                raise DesignError("cup_depth", h, f"must be between {lo:.6g} and {hi:.6g} mm for a {2 * w:g} mm cup with radii {Rc:g} and {Re:g} mm (otherwise the radii cannot be tangent inside the cup)", "mm")
             C1 = np.array([0.0, h - Rc])
             E = np.array([w, 0.0])
             Ce = _circle_intersection(C1, Rc - Re, E, Re, prefer_upper=True)
-            if Ce is None:
-                lo, hi = _depth_range(w, Rc, Re)
-                raise DesignError("cup_depth", h, f"must be between {lo:.6g} and {hi:.6g} mm for a {2 * w:g} mm cup with radii {Rc:g} and {Re:g} mm (the radii cannot be tangent)", "mm")
             B = C1 + Rc * (Ce - C1) / (Rc - Re)
         self.depth = float(h)
         self.half_width = w

@@ -129,7 +129,7 @@ class PlanOutline:
             if gap > 1e-7 * scale:
                 raise DesignError(parameter, f"gap of {gap:.3g} mm before segment {i}", "segments must join end to start")
             t_prev, t_next = prev.tangent(1), s.tangent(0)
-            ang = math.degrees(math.atan2(abs(np.cross(t_prev, t_next)), float(np.dot(t_prev, t_next))))
+            ang = math.degrees(math.atan2(abs(float(t_prev[0] * t_next[1] - t_prev[1] * t_next[0])), float(np.dot(t_prev, t_next))))
             if ang > 1e-4:
                 raise DesignError(
                     parameter, f"corner of {ang:.3g} deg before segment {i}",
@@ -319,6 +319,29 @@ class PlanOutline:
                      options=dict(xatol=1e-11, fatol=1e-13, maxiter=4000))
         return max(float(-r.fun), float(sd.max()))
 
+    def _offset_is_clean(self, d: float) -> bool:
+        v = np.linspace(0.0, TWO_PI, 2048, endpoint=False)
+        v = np.concatenate([v, self.breaks[:-1]])
+        O, T, N, k = self.frame(v)
+        dist = self.signed_distance(O + d * N)
+        return bool(np.min(dist) >= d - 1e-7 * max(1.0, d))
+
+    def offset_limit(self) -> float:
+        """Largest inward offset (mm) that is a clean offset of the outline: at most
+        the smallest convex arc radius, and no offset point closer than ``d`` to
+        the outline (bisection to ~1e-9 mm)."""
+        hi = min(self.min_convex_radius, self.inscribed_radius())
+        if self._offset_is_clean(hi):
+            return hi
+        lo = 0.0
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            if self._offset_is_clean(mid):
+                lo = mid
+            else:
+                hi = mid
+        return lo
+
     def check_offset(self, d: float, parameter: str) -> None:
         """Refuse an inward offset ``d`` (mm) that is not a clean offset of this outline.
 
@@ -331,14 +354,9 @@ class PlanOutline:
         tol = 1e-9 * max(1.0, self.perimeter)
         if d > rmin + tol:
             raise DesignError(parameter, d, f"must be <= {rmin:.6g} mm, the smallest corner (arc) radius of the outline", "mm")
-        v = np.linspace(0.0, TWO_PI, 2048, endpoint=False)
-        v = np.concatenate([v, self.breaks[:-1]])
-        O, T, N, k = self.frame(v)
-        pts = O + d * N
-        dist = self.signed_distance(pts)
-        if np.min(dist) < d - 1e-7 * max(1.0, d):
-            r_in = self.inscribed_radius()
-            raise DesignError(parameter, d, f"must be <= {min(r_in, rmin):.6g} mm (the outline's inscribed radius: the offset would cross itself)", "mm")
+        if not self._offset_is_clean(d):
+            lim = self.offset_limit()
+            raise DesignError(parameter, d, f"must be <= {lim:.6g} mm (the outline's inscribed radius where it is narrowest: the offset would cross itself)", "mm")
 
     # ------------------------------------------------------------------ checks
     def _check_simple(self) -> None:
@@ -451,7 +469,7 @@ class SplineOutline(PlanOutline):
             q = c - p
             f = np.einsum("ij,ij->i", q, c1)
             fp = np.einsum("ij,ij->i", c1, c1) + np.einsum("ij,ij->i", q, c2)
-            step = np.where(np.abs(fp) > 1e-300, f / fp, 0.0)
+            step = np.divide(f, fp, out=np.zeros_like(f), where=np.abs(fp) > 1e-300)
             t = t - np.clip(step, -0.01, 0.01)
         O, T, N, k = self.frame(t)
         q = p - O

@@ -95,6 +95,8 @@ def outline_tablet(
     if reach is None:
         reach = ol.inscribed_radius()
     limit = min(ol.min_convex_radius, reach)
+    if not ol._offset_is_clean(limit):
+        limit = ol.offset_limit()
     cw = check_range("cup_width", cup_width, 0.0, None, "mm")
     if cw == 0.0:
         cw = limit

@@ -304,10 +304,15 @@ def build_sweep_tablet(
         # The patch's own stray check measures Fourier content the truncated series leaves to
         # the remainder term; for offsets with collapsed corner arcs (G0 in v) that content is
         # large although harmless (with a small a the remainder only interpolates).  The
-        # certificate below bounds the real deviation from the nominal instead; the fold check
-        # (a surface crossing its spine) still runs.
+        # certificate below bounds the real deviation from the nominal instead; the fold depth
+        # of the solid map (a surface crossing its spine) is still checked.
         patch = PDEPatch(tuple(data), a=a, form="hermite", tol=tol, name=f"{name}[{len(patches)}:{label}]", check=False)
-        patch._check_fold()
+        # the patches are cubic-like in u: a coarser u grid than the core default suffices
+        depth = patch.fold_depth(nu=65, nv=128)
+        if depth > tol.fold:
+            raise DesignError(f"patch {patch.name} curves", f"a fold {depth:.3g} mm deep",
+                              f"the surface must not cross its spine by more than {tol.fold:g} mm "
+                              "(the outline's offsets are not star-shaped about its centroid)")
         return patch
 
     prev_curve = None

@@ -1,0 +1,187 @@
+"""Bad input gives one-line DesignErrors naming parameter and range; the report CLI and section (issue 6)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from tabletcad import families as F
+from tabletcad.cli import main
+from tabletcad.errors import DesignError
+from tabletcad.families.outline import four_arc_oval, outline_from_items, stadium_outline
+
+
+@pytest.mark.parametrize(
+    "call,param,allowed",
+    [
+        (lambda: F.concave_round(10, 3, 6.0), "cup_depth", "<= 5 mm"),
+        (lambda: F.concave_round(10, 3, 1.0, land=6.0), "land", "< 5 mm"),
+        (lambda: F.capsule(18, 8, 3, 4.5), "cup_depth", "<= 4 mm"),
+        (lambda: F.compound_cup(10, 2.5, 1.2, central_radius=3.0, edge_radius=4.0), "edge_radius", "< central_radius"),
+        (lambda: F.compound_cup(10, 2.5, 0.2, central_radius=15.0, edge_radius=3.0), "cup_depth", "between"),
+        (lambda: F.compound_cup(10, 2.5, 1.2, blend_diameter=6.0), "blend_diameter", "not both"),
+        (lambda: F.ffre(10, 4, 2.5), "edge_radius", "<= 2 mm"),
+        (lambda: F.ffbe(10, 4, 30, 4.0), "bevel_width", "thickness/2"),
+        (lambda: F.ffbe(10, 4, 95, 0.5), "bevel_angle", "< 90"),
+        (lambda: F.rounded_triangle(10, 1.5, cup_width=2.0), "cup_width", "<= 1.5 mm"),
+        (lambda: F.rounded_triangle(10, 3.5), "corner_radius", "< 2.88675"),
+        (lambda: F.oval(12, 7, 4.0), "end_radius", "<= 3.5 mm"),
+        (lambda: F.modified_capsule(18, 8, side_radius=5.0), "side_radius", "> length/2"),
+        (lambda: F.outline_tablet([[0, 0], [4, 4], [4, 0], [0, 4]]), "outline", "must not cross itself"),
+        (lambda: F.outline_tablet([("line", (0, 0), (4, 0)), ("line", (4, 0), (4, 4)), ("line", (4, 4), (0, 0))]), "outline", "tangent-continuous"),
+        (lambda: F.concave_round(-10, 3, 1), "diameter", "> 0"),
+    ],
+)
+def test_bad_input_names_parameter_and_range(call, param, allowed):
+    with pytest.raises(DesignError) as ei:
+        call()
+    msg = str(ei.value)
+    assert ei.value.parameter == param
+    assert allowed in msg
+    assert "\n" not in msg
+
+
+def test_offset_checks():
+    st = stadium_outline(18, 8)
+    st.check_offset(4.0, "cup_width")  # exactly the end radius: fine
+    with pytest.raises(DesignError, match="cup_width"):
+        st.check_offset(4.01, "cup_width")
+    ov = four_arc_oval(12, 7, 2.5)
+    with pytest.raises(DesignError, match="smallest corner"):
+        ov.check_offset(2.6, "cup_width")
+    # a peanut: ends of ~1.3 mm radius but a 1.6 mm wide waist -> refused where it is narrowest
+    th = np.linspace(0, 2 * np.pi, 240, endpoint=False)
+    peanut = F.shaped.as_outline(np.column_stack([7 * np.cos(th), (0.8 + 3.2 * np.cos(th) ** 2) * np.sin(th)]))
+    assert peanut.min_convex_radius > 1.2
+    peanut.check_offset(0.7, "cup_width")
+    with pytest.raises(DesignError, match="narrowest") as ei:
+        peanut.check_offset(1.0, "cup_width")
+    lim = peanut.offset_limit()
+    assert 0.7 < lim < 1.0 and f"{lim:.6g}" in str(ei.value)
+
+
+def test_outline_offsets_are_exact():
+    ov = four_arc_oval(14, 8, 3.0)
+    v = np.linspace(0, 2 * np.pi, 1001)
+    O, T, N, k = ov.frame(v)
+    for d in (0.5, 1.5, 2.9):
+        assert np.allclose(ov.signed_distance(O + d * N), d, atol=1e-12)
+    # arcs offset to concentric arcs: distance of the right end offset to its centre
+    hx = 7 - 3.0
+    pts = O[np.abs(O[:, 1]) < 0.5] + 1.0 * N[np.abs(O[:, 1]) < 0.5]
+    right = pts[pts[:, 0] > 0]
+    assert np.allclose(np.hypot(right[:, 0] - hx, right[:, 1]), 2.0, atol=1e-12)
+
+
+def test_custom_outline_from_points_and_items():
+    th = np.linspace(0, 2 * np.pi, 60, endpoint=False)
+    pts = np.column_stack([6 * np.cos(th), 4 * np.sin(th)])  # an ellipse given as points
+    t = F.outline_tablet(pts, band=2.5, cup_depth=0.4, cup_width=1.0)
+    assert t.nominal.certificate.passed
+    d = F.sweep_properties(t)
+    assert d["plan_area_mm2"] == pytest.approx(math.pi * 24, rel=2e-3)  # spline through the points
+
+
+BAD = {
+    "cup too deep": '[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 3.0\ncup_depth = 7.0\n',
+    "land too wide": '[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 3.0\ncup_depth = 1.0\nland = 5.5\n',
+    "radii not tangent": '[tablet]\nfamily = "compound_cup"\ndiameter = 10.0\ncentral_radius = 2.0\nedge_radius = 3.0\n',
+    "self-intersecting": '[tablet]\nfamily = "custom_outline"\noutline = [[0, 0], [4, 4], [4, 0], [0, 4]]\nband = 2.0\ncup_depth = 0.3\n',
+    "bad report key": '[tablet]\nfamily = "concave_round"\n[report]\nweight = 3\n',
+    "bad solid fraction": '[tablet]\nfamily = "concave_round"\n[report]\nsolid_fraction = 1.5\n',
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD))
+def test_cli_bad_design_exits_2_and_writes_nothing(tmp_path, capsys, case):
+    d = tmp_path / "bad.toml"
+    d.write_text(BAD[case])
+    out = tmp_path / "rep.json"
+    assert main(["report", str(d), "--json", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error:")
+    assert not out.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
+
+
+def test_cli_build_bad_family_design_exits_2(tmp_path):
+    d = tmp_path / "bad.toml"
+    d.write_text(BAD["cup too deep"])
+    out = tmp_path / "out"
+    assert main(["build", str(d), "--out", str(out), "--quiet"]) == 2
+    assert not out.exists()
+
+
+def test_cli_report_writes_json_with_units(tmp_path, capsys):
+    d = tmp_path / "c.toml"
+    d.write_text('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 2.8\ncup_depth = 0.9\nland = 0.08\n'
+                 '[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1.5\nbreaking_force_N = 100.0\n')
+    out = tmp_path / "rep.json"
+    assert main(["report", str(d), "--json", str(out), "--compaction-force", "15", "--max-punch-pressure", "300"]) == 0
+    text = capsys.readouterr().out
+    assert "cup volume" in text and "tensile strength" in text and "FDA size" in text
+    rep = json.loads(out.read_text())
+    r = rep["design_report"]
+    R, a, h = 5.0, 4.92, 0.9
+    cap = math.pi * h * (3 * a * a + h * h) / 6
+    V = math.pi * R * R * 2.8 + 2 * cap
+    assert r["volume_mm3"] == pytest.approx(V, rel=1e-6)
+    assert r["cup_volume_mm3"] == pytest.approx(cap, rel=1e-5)
+    assert r["weight_mg"] == pytest.approx(V * 0.85 * 1.5, rel=1e-6)
+    assert r["overall_thickness_mm"] == pytest.approx(4.6)
+    assert r["shape_factor"] == pytest.approx(0.09)
+    assert r["plan_perimeter_mm"] == pytest.approx(10 * math.pi)
+    t = r["tensile_strength"]
+    assert "Pitt" in t["formula"]
+    den = 2.84 * 4.6 / 10 - 0.126 * 4.6 / 2.8 + 3.15 * 2.8 / 10 + 0.01
+    assert t["tensile_strength_MPa"] == pytest.approx(10 * 100 / (math.pi * 100 * den), rel=1e-12)
+    pc = r["punch_tip_check"]
+    assert pc["ok"] is True and pc["allowed_force_kN"] == pytest.approx(300 * math.pi * 25 / 1000)
+    assert "user-given" in pc["limit_basis"]
+    assert r["fda_size"]["ok"] is True
+    assert rep["nominal_max_deviation_um"] <= 1.0 and rep["nominal_certified"]
+    assert all("g1" in s and "expected_sharp" in s for s in rep["seams"])
+
+
+def test_registered_report_section_in_geometry_report():
+    from tabletcad.report import geometry_report
+
+    rep = geometry_report(F.compound_cup())
+    assert rep["nominal_max_deviation_um"] <= 1.0
+    assert rep["design_report"]["cup_depth_mm"] == pytest.approx(1.2)
+    kinds = [(s["g1"], s["expected_sharp"]) for s in rep["seams"]]
+    assert all(g1 != sharp for g1, sharp in kinds)
+    assert (True, False) in kinds and (False, True) in kinds
+
+
+def test_design_files_of_every_family_build(tmp_path):
+    from pathlib import Path
+
+    from tabletcad.cli.report import load_family_design
+
+    root = Path(__file__).resolve().parents[1] / "samples" / "families"
+    names = sorted(p.stem for p in root.glob("*.toml"))
+    assert {f.__name__ for f in F.FAMILY_FUNCTIONS} <= set(names)
+    for n in ("concave_round", "capsule", "custom_outline"):
+        t, table = load_family_design(root / f"{n}.toml")
+        assert t.nominal.certificate.passed
+
+
+def test_elongated_strength_uses_pitt_heasley():
+    from tabletcad.families.designreport import ReportOptions, design_report
+
+    t = F.capsule(18, 8, 2.0, 1.2)
+    r = design_report(t, ReportOptions(breaking_force_N=150.0))["design_report"]
+    ts = r["tensile_strength"]
+    assert "Pitt & Heasley" in ts["formula"]
+    den = 2.84 * 4.4 / 8 - 0.126 * 4.4 / 2.0 + 3.15 * 2.0 / 8 + 0.01
+    assert ts["tensile_strength_MPa"] == pytest.approx(2 / 3 * 10 * 150 / (math.pi * 64 * den), rel=1e-12)
+    flat = design_report(F.flat_face_round(10, 3), ReportOptions(breaking_force_N=100.0))["design_report"]
+    assert flat["tensile_strength"]["tensile_strength_MPa"] == pytest.approx(200 / (math.pi * 30))
+    tri = design_report(F.rounded_triangle(), ReportOptions(breaking_force_N=100.0))["design_report"]
+    assert tri["tensile_strength"]["tensile_strength_MPa"] is None
+    big = design_report(F.capsule(23, 9, 3, 1.0))["design_report"]
+    assert big["fda_size"]["ok"] is False and big["weight_mg"] is None
