@@ -1,0 +1,185 @@
+"""Design files, the geometry CLI (shapes, build, mesh), reports and reshaping (thesis section 4.4)."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tabletcad import reshape, shapes
+from tabletcad.cli import main
+from tabletcad.design import design_from_dict, load_design
+from tabletcad.errors import DesignError
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLES = sorted(p for p in (ROOT / "samples").glob("*.toml"))
+
+
+def _core_only_build(tablet, out):
+    """Build without the optional CAD stages (they have their own tests)."""
+    from tabletcad import build
+
+    saved = list(build._STAGES)
+    build._STAGES.clear()
+    old = build._load_optional_stages
+    build._load_optional_stages = lambda: None
+    try:
+        return build.build_tablet(tablet, out, progress=False)
+    finally:
+        build._STAGES[:] = saved
+        build._load_optional_stages = old
+
+
+@pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
+def test_every_sample_design_loads_and_reports(path, tmp_path):
+    t = load_design(path)
+    rep = _core_only_build(t, tmp_path / "out")
+    for key in ("volume_mm3", "surface_area_mm2", "height_mm", "width_mm", "length_mm", "patches", "seams"):
+        assert key in rep
+    assert rep["volume_mm3"] > 0 and rep["surface_area_mm2"] > 0
+    assert abs(rep["solid_volume_mm3"] - rep["volume_mm3"]) <= 1e-9 * rep["volume_mm3"]
+    for p in rep["patches"]:
+        assert {"surface_area_mm2", "volume_mm3"} <= set(p)
+    for s in rep["seams"]:
+        assert s["max_gap_mm"] <= 1e-9
+    on_disk = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert on_disk["volume_mm3"] == pytest.approx(rep["volume_mm3"], rel=1e-15)
+    png = (tmp_path / "out" / "tablet.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+
+
+def test_family_design_matches_constructor():
+    t = design_from_dict({"tablet": {"family": "shallow_convex_round", "diameter": 8.0, "thickness": 3.2, "band": 2.0}})
+    ref = shapes.shallow_convex_round(8.0, 3.2, 2.0)
+    assert t.volume() == pytest.approx(ref.volume(), rel=1e-14)
+    assert t.params == {"diameter": 8.0, "thickness": 3.2, "band": 2.0}
+
+
+def test_free_form_design_with_previous_and_trim():
+    d = {
+        "tablet": {"family": "free_form", "name": "cyl"},
+        "patch": [
+            {"curves": [{"type": "circle", "radius": r, "z": 0.0} for r in (0.0, 1.0, 2.0, 3.0)]},
+            {"curves": ["previous"] + [{"type": "circle", "radius": 3.0, "z": z} for z in (1.0, 2.0, 3.0)]},
+            {"curves": ["previous"] + [{"type": "circle", "radius": r, "z": 3.0} for r in (2.0, 1.0, 0.0)]},
+        ],
+        "trim": {"v": [0.0, math.pi]},
+    }
+    t = design_from_dict(d)
+    assert t.patches[1].data[0] is t.patches[0].data[3]
+    full = design_from_dict({k: v for k, v in d.items() if k != "trim"})
+    assert t.volume() == pytest.approx(full.volume() / 2, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    "data, fragment",
+    [
+        ({"tablet": {"family": "flat_faced_round", "diameter": 0.0, "thickness": 6.0}}, "diameter = 0"),
+        ({"tablet": {"family": "flat_faced_round", "diameter": -3.0, "thickness": 6.0}}, "diameter = -3"),
+        ({"tablet": {"family": "flat_faced_round", "diameter": float("nan"), "thickness": 6.0}}, "diameter"),
+        ({"tablet": {"family": "flat_faced_round", "diameter": float("inf"), "thickness": 6.0}}, "diameter"),
+        ({"tablet": {"family": "spherical", "diameter": "five"}}, "diameter"),
+        ({"tablet": {"family": "octagon", "diameter": 5.0}}, "family"),
+        ({"tablet": {"family": "spherical", "diamter": 5.0}}, "diamter"),
+        ({"tablet": {"family": "spherical"}, "colour": {}}, "colour"),
+        ({"shape": {}}, "shape"),
+        ({"tablet": {"family": "shallow_convex_round", "band": 5.0}}, "band"),
+        ({"tablet": {"family": "free_form"}, "patch": [{"curves": [{"type": "circle", "radius": 1.0}] * 3}]}, "curves"),
+        (
+            {"tablet": {"family": "free_form"},
+             "patch": [{"curves": [{"type": "circle", "radius": r, "z": z} for r, z in ((5, 0), (0.1, 1), (0.1, 2), (5, 3))]}]},
+            "radius",
+        ),
+    ],
+)
+def test_bad_designs_name_the_parameter(data, fragment):
+    with pytest.raises(DesignError) as exc:
+        design_from_dict(data)
+    msg = str(exc.value)
+    assert fragment in msg and "\n" not in msg and "not allowed" in msg
+
+
+def _run_cli(args, cwd):
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    return subprocess.run([sys.executable, "-m", "tabletcad", *args], cwd=cwd, env=env, capture_output=True, text=True, timeout=300)
+
+
+def test_cli_bad_design_exits_2_without_traceback_or_files(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[tablet]\nfamily = "flat_faced_round"\ndiameter = -10.0\nthickness = 6.0\n')
+    out = tmp_path / "out"
+    r = _run_cli(["build", str(bad), "--out", str(out)], tmp_path)
+    assert r.returncode == 2
+    assert r.stderr.strip().count("\n") == 0 and "Traceback" not in r.stderr
+    assert r.stderr.startswith("error: diameter = -10 mm is not allowed: must be > 0")
+    assert not out.exists()
+    assert [p.name for p in tmp_path.iterdir()] == ["bad.toml"]  # no staging folder left behind
+    r = _run_cli(["mesh", str(bad), "--nodes", "5", "9", "3", "--out", str(tmp_path / "m.vtu")], tmp_path)
+    assert r.returncode == 2 and not (tmp_path / "m.vtu").exists()
+
+
+def test_cli_mesh_and_shapes(tmp_path):
+    out = tmp_path / "sphere.vtu"
+    assert main(["mesh", str(ROOT / "samples" / "spherical.toml"), "--nodes", "11", "21", "5", "--out", str(out)]) == 0
+    import meshio
+
+    m = meshio.read(out)
+    assert len(m.points) > 100
+    assert main(["mesh", str(ROOT / "samples" / "spherical.toml"), "--nodes", "1", "21", "5", "--out", str(tmp_path / "x.vtu")]) == 2
+    assert main(["mesh", str(ROOT / "samples" / "spherical.toml"), "--nodes", "5", "21", "5", "--out", str(tmp_path / "x.obj")]) == 2
+    assert not (tmp_path / "x.vtu").exists() and not (tmp_path / "x.obj").exists()
+    r = _run_cli(["shapes"], tmp_path)
+    assert r.returncode == 0
+    for name in shapes.FAMILIES:
+        assert name in r.stdout
+
+
+def test_height_and_radius_expressions_eqs_4_16_4_22():
+    t = shapes.flat_faced_round(10.0, 6.0)
+    body = t.patches[1]
+    assert reshape.spine_height(body) == pytest.approx(6.0, abs=1e-12)
+    # eq 4.22: the radius from the first mode equals the surface's distance from the axis
+    u = np.linspace(0.0, 1.0, 11)
+    X = body.evaluate(u, 0.3)
+    assert np.allclose(reshape.radius(body, u), np.hypot(X[:, 0], X[:, 1]), atol=1e-12)
+    c = reshape.circularity(body)
+    assert c["eq_4_23_a"] < 1e-12 and c["eq_4_23_b"] < 1e-12 and c["higher_modes"] == 0.0
+    # thesis-form coefficients (eqs 3.13-3.15) give the spine height: A0z(1) - A0z(0)
+    a0, _ = body.mode_coefficients(0)
+    assert a0[1:, 2].sum() == pytest.approx(6.0, abs=1e-12)
+
+
+def test_table_4_5_by_coefficient_scaling():
+    tab = reshape.thesis_table_4_5()
+    dims = {n: d["tablet"].dimensions() for n, d in tab.items()}
+    assert dims["ring"]["height_mm"] == pytest.approx(4.5, abs=1e-9)
+    assert dims["ring"]["length_mm"] == pytest.approx(12.0, abs=0.01)
+    assert dims["deep_convex_round"]["height_mm"] == pytest.approx(4.0, abs=1e-6)  # domes dip ~0.2 µm at the poles
+    assert dims["oblate_spheroid"]["length_mm"] == pytest.approx(10.0, abs=0.02)
+    assert dims["oblate_spheroid"]["height_mm"] == pytest.approx(2.5, abs=0.005)
+    assert dims["prolate_spheroid"]["height_mm"] == pytest.approx(10.0, abs=0.01)
+    assert dims["caplet"]["height_mm"] == pytest.approx(15.0, abs=5e-3)
+    assert dims["deep_convex_oval"]["height_mm"] == pytest.approx(3.1, abs=1e-4)
+    # scaling the radius by k scales the volume of a band (ring) by k² (w-range kept)
+    ring = tab["ring"]["tablet"]
+    assert ring.trim.w == (0.5, 1.0)
+    body = reshape.scale_heights(reshape.select_patches(shapes.flat_faced_round(), [1]), [0.75])
+    from dataclasses import replace
+
+    from tabletcad.tablet import Trim
+
+    v1 = replace(body, trim=Trim(w=(0.5, 1.0))).volume()
+    assert ring.volume() == pytest.approx(1.44 * v1, rel=1e-9)
+
+
+def test_thesis_tables_sample_runs():
+    r = subprocess.run([sys.executable, str(ROOT / "samples" / "thesis_tables.py")], capture_output=True, text=True,
+                       env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "| flat_faced_round | 345.604 | 345.062 | 345.575 | 471.382 |" in r.stdout
