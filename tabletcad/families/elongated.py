@@ -26,8 +26,10 @@ __all__ = ["capsule", "modified_capsule", "oval"]
 
 def capsule(length: float = 18.0, width: float = 8.0, band: float = 3.0, cup_depth: float = 1.2, land: float = 0.0,
             central_radius: float = 0.0, edge_radius: float = 0.0, *, a=DEFAULT_A, tol: Tolerances = DEFAULT) -> Tablet:
-    """Capsule (stadium plan ``length`` × ``width``) with a cup of ``cup_depth`` across the width,
-    optional ``land``; ``central_radius`` and ``edge_radius`` both > 0 make a compound cup (mm)."""
+    """Capsule: stadium plan ``length`` × ``width``, cup across the width, optional land (mm).
+
+    ``central_radius`` and ``edge_radius`` both > 0 make the cup compound.
+    """
     Ln = check_positive("length", length, "mm")
     W = check_positive("width", width, "mm")
     ol = stadium_outline(Ln, W)

@@ -66,8 +66,10 @@ def _bevel_dims(R: float, T: float, angle: float, width: float, depth: float) ->
 
 def ffbe(diameter: float = 10.0, thickness: float = 4.0, bevel_angle: float = 30.0, bevel_width: float = 0.5,
          bevel_depth: float = 0.0, *, a=DEFAULT_A, tol: Tolerances = DEFAULT) -> Tablet:
-    """Round flat-face bevel-edge tablet: bevel at ``bevel_angle`` (deg, from the face plane),
-    ``bevel_width`` (radial, mm) or ``bevel_depth`` (axial, mm; give one, the other 0)."""
+    """Round flat-face bevel-edge tablet (bevel angle in deg from the face, bevel width or depth in mm).
+
+    ``bevel_width`` is radial, ``bevel_depth`` axial; give one and set the other to 0.
+    """
     D = check_positive("diameter", diameter, "mm")
     T = check_positive("thickness", thickness, "mm")
     R = D / 2.0
@@ -80,8 +82,7 @@ def ffbe(diameter: float = 10.0, thickness: float = 4.0, bevel_angle: float = 30
 
 def ffre(diameter: float = 10.0, thickness: float = 4.0, edge_radius: float = 1.0, *, a=DEFAULT_A,
          tol: Tolerances = DEFAULT) -> Tablet:
-    """Round flat-face radius-edge tablet: a toroidal edge of ``edge_radius`` (mm) tangent to
-    band and face (all seams G1)."""
+    """Round flat-face radius-edge tablet: toroidal edge of ``edge_radius`` (mm), all seams G1."""
     D = check_positive("diameter", diameter, "mm")
     T = check_positive("thickness", thickness, "mm")
     R = D / 2.0
@@ -95,8 +96,10 @@ def ffre(diameter: float = 10.0, thickness: float = 4.0, edge_radius: float = 1.
 
 def concave_round(diameter: float = 10.0, band: float = 3.0, cup_depth: float = 1.0, land: float = 0.0, *,
                   a=DEFAULT_A, tol: Tolerances = DEFAULT) -> Tablet:
-    """Round standard-concave tablet: single-radius (spherical) cups of ``cup_depth`` on a band,
-    optional flat ``land`` (mm) between band and cup."""
+    """Round standard-concave tablet: spherical cups of ``cup_depth`` on a band, optional ``land`` (mm).
+
+    The land is the flat annulus between the band and the cup.
+    """
     D = check_positive("diameter", diameter, "mm")
     b = check_positive("band", band, "mm")
     R = D / 2.0
@@ -109,8 +112,10 @@ def concave_round(diameter: float = 10.0, band: float = 3.0, cup_depth: float = 
 def compound_cup(diameter: float = 10.0, band: float = 2.5, cup_depth: float = 1.2, central_radius: float = 15.0,
                  edge_radius: float = 3.0, land: float = 0.0, blend_diameter: float = 0.0, *, a=DEFAULT_A,
                  tol: Tolerances = DEFAULT) -> Tablet:
-    """Round compound-cup tablet: ``central_radius`` tangent to ``edge_radius`` (mm); give
-    ``cup_depth`` or ``blend_diameter`` (the other 0).  The radius junction is G1."""
+    """Round compound-cup tablet: ``central_radius`` tangent to ``edge_radius`` (mm), G1 junction.
+
+    Give ``cup_depth`` or ``blend_diameter`` (the other 0).
+    """
     D = check_positive("diameter", diameter, "mm")
     b = check_positive("band", band, "mm")
     R = D / 2.0
@@ -126,8 +131,10 @@ def compound_cup(diameter: float = 10.0, band: float = 2.5, cup_depth: float = 1
 
 def concave_bevel(diameter: float = 10.0, band: float = 2.5, cup_depth: float = 0.8, bevel_angle: float = 30.0,
                   bevel_width: float = 0.6, *, a=DEFAULT_A, tol: Tolerances = DEFAULT) -> Tablet:
-    """Round concave tablet with a bevel edge: a bevel (``bevel_angle`` deg, ``bevel_width`` mm)
-    from the band, then a spherical cup of ``cup_depth`` (mm, measured from the bevel's inner edge)."""
+    """Round concave bevel-edge tablet: bevel (deg, mm) from the band, then a spherical cup (mm).
+
+    ``cup_depth`` is measured from the bevel's inner edge.
+    """
     D = check_positive("diameter", diameter, "mm")
     b = check_positive("band", band, "mm")
     R = D / 2.0

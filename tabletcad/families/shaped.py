@@ -132,8 +132,10 @@ def outline_tablet(
 
 def rounded_triangle(side: float = 10.0, corner_radius: float = 1.5, band: float = 2.5, cup_depth: float = 0.5,
                      land: float = 0.0, cup_width: float = 0.0, *, a=DEFAULT_A, tol: Tolerances = DEFAULT) -> Tablet:
-    """Rounded equilateral triangle: ``side`` of the sharp triangle, ``corner_radius`` (mm),
-    cup swept over the outline (horizontal at ``cup_width``, default the corner radius)."""
+    """Rounded equilateral triangle (``side`` of the sharp triangle, ``corner_radius``, mm), swept cup.
+
+    The cup is horizontal at ``cup_width`` (default: the corner radius); the centre is flat.
+    """
     s = check_positive("side", side, "mm")
     r_in = s / (2.0 * math.sqrt(3.0))
     rc = check_range("corner_radius", corner_radius, 0.0, r_in, "mm", lo_open=True, hi_open=True)
