@@ -15,7 +15,10 @@ Conventions (identical to OCCT's ``Geom_BSplineSurface`` and FreeCAD's
   same multiplicity; ``sum(mults) - mults[-1] == n_poles``.  Pole 0 is the
   first B-spline of the flat knot sequence extended by ``degree`` knots on each
   side (measured against OCCT 7.8/8.0: a uniform periodic cubic with all
-  multiplicities 1 has ``C(k0) = (P0 + 4 P1 + P2) / 6``).
+  multiplicities 1 has ``C(k0) = (P0 + 4 P1 + P2) / 6``).  When the first knot
+  has multiplicity ``m > 1`` OCCT starts the period at its *last* copy: the
+  flat period is ``k0, k1 x m1, ..., k_{n-1} x m_{n-1}, k_n x (m - 1)``
+  (checked by random-pole evaluation against ``Geom_BSplineSurface``).
 
 :func:`fit_surface` interpolates a parametric surface ``f(u, v) -> (..., 3)``
 (``u`` in [0, 1] clamped, ``v`` periodic with period ``2 pi``) at the
@@ -43,6 +46,8 @@ __all__ = [
     "fit_patches",
     "basis_functions",
     "flat_knots",
+    "periodic_knots",
+    "normalise_breaks",
     "enclosed_volume",
 ]
 
@@ -64,7 +69,11 @@ def flat_knots(knots: np.ndarray, mults: np.ndarray, degree: int, periodic: bool
     if not periodic:
         return np.repeat(knots, mults)
     period = knots[-1] - knots[0]
-    one = np.repeat(knots[:-1], mults[:-1])  # one period, length n_poles
+    # one period, length n_poles.  OCCT's pole 1 is the B-spline that starts at the *last*
+    # copy of the first knot (measured with OCCT 7.9/8.0): a first knot of multiplicity m
+    # contributes one copy here and the period's end knot the other m - 1.
+    m0 = int(mults[0])
+    one = np.concatenate([knots[:1], np.repeat(knots[1:-1], mults[1:-1]), np.repeat(knots[-1:], m0 - 1)])
     n = one.size
     if n < degree + 1:
         raise GeometryError(f"periodic B-spline needs at least degree+1 = {degree + 1} poles, got {n}")
@@ -305,6 +314,13 @@ class SurfaceFit:
     seconds: float
     u_samples: np.ndarray = field(repr=False)
     v_samples: np.ndarray = field(repr=False)
+    v_breaks: tuple[float, ...] = ()
+
+    @property
+    def poles(self) -> tuple[int, int]:
+        """Number of poles ``(u, v)`` of the surface (``nv`` counts v spans, not poles, when
+        there are breakpoints of multiplicity > 1)."""
+        return self.surface.shape
 
     @property
     def ok(self) -> bool:
@@ -327,24 +343,103 @@ def _clamped_interp_knots(x: np.ndarray, degree: int) -> tuple[np.ndarray, np.nd
     return knots, mults.astype(int)
 
 
-def _periodic_knots_and_samples(nv: int, degree: int, period: float = TWO_PI):
-    knots = np.linspace(0.0, period, nv + 1)
-    mults = np.ones(nv + 1, dtype=int)
-    h = period / nv
-    # odd degree: interpolate at the knots; even degree: at the knot midpoints
-    # (both give a well-conditioned circulant collocation matrix).
-    shift = 0.0 if degree % 2 == 1 else 0.5 * h
-    samples = knots[:-1] + shift
-    # the B-spline attached to pole 0 peaks at knot index (degree+1)/2 for odd
-    # degree: rotate the samples so that sample j sits at the peak of pole j's
-    # B-spline (keeps the matrix diagonally dominant; purely cosmetic for the solve).
+def normalise_breaks(v_breaks, period: float = TWO_PI, merge_tol: float = 1e-9) -> np.ndarray:
+    """Sorted distinct breakpoints in ``[0, period)``; values closer than ``merge_tol`` (also across
+    the period) are merged, keeping the smaller one."""
+    if v_breaks is None:
+        return np.zeros(0)
+    b = np.asarray(v_breaks, dtype=float).ravel()
+    if b.size == 0:
+        return np.zeros(0)
+    if not np.all(np.isfinite(b)):
+        raise GeometryError("v_breaks must be finite numbers", v_breaks)
+    b = np.mod(b, period)
+    b[b > period - merge_tol] = 0.0  # the same point as 0
+    b = np.sort(b)
+    b = b[np.concatenate([[True], np.diff(b) > merge_tol])]
+    if b[0] <= merge_tol:
+        b[0] = 0.0
+    return b
+
+
+def periodic_knots(
+    nv: int,
+    degree: int,
+    v_breaks=None,
+    break_mult: int | None = None,
+    period: float = TWO_PI,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Periodic ``v`` knots (distinct values, multiplicities) and interpolation parameters.
+
+    Without breakpoints: ``nv`` uniform spans with multiplicity 1 (``nv``
+    poles); odd degree interpolates at the knots, even degree at the span
+    midpoints (both are the Greville abscissae, a well-conditioned circulant
+    collocation matrix).
+
+    With breakpoints ``v_breaks`` (values in ``[0, period)``; sorted, merged
+    and wrapped here): every breakpoint is a knot of multiplicity
+    ``break_mult`` (default ``degree - 1``: the B-spline is C1 there; use
+    ``degree`` for C0) and each piece between consecutive breakpoints is cut
+    into ``max(1, round(nv * length / period))`` uniform spans, so the spline is
+    a polynomial of full order on every span of each smooth piece.  ``0`` is
+    always a knot (multiplicity 1 unless it is a breakpoint) so the parameter
+    range stays ``[0, period]``.  The interpolation parameters are the
+    Greville abscissae of the periodic B-splines, which satisfy the
+    Schoenberg-Whitney condition (every B-spline contains its own point inside
+    its support) for multiplicities ``<= degree``.
+    """
+    nv = int(nv)
+    breaks = normalise_breaks(v_breaks, period)
+    if breaks.size == 0:
+        knots = np.linspace(0.0, period, nv + 1)
+        mults = np.ones(nv + 1, dtype=int)
+        h = period / nv
+        shift = 0.0 if degree % 2 == 1 else 0.5 * h
+        return knots, mults, knots[:-1] + shift
+    mb = degree - 1 if break_mult is None else int(break_mult)
+    if not 1 <= mb <= degree:
+        raise ValueError(f"break_mult = {mb} is not allowed: must be in [1, degree = {degree}]")
+    anchors = breaks if breaks[0] == 0.0 else np.concatenate([[0.0], breaks])
+    anchor_mult = np.full(anchors.size, mb, dtype=int)
+    if breaks[0] != 0.0:
+        anchor_mult[0] = 1
+    ends = np.concatenate([anchors[1:], [period]])
+    lengths = ends - anchors
+    knots_l, mults_l = [], []
+    for a, e, L, m in zip(anchors, ends, lengths, anchor_mult):
+        n = max(1, int(round(nv * L / period)))
+        knots_l.append(a + (e - a) * np.arange(n) / n)
+        mults_l.append(np.concatenate([[m], np.ones(n - 1, dtype=int)]))
+    knots = np.concatenate(knots_l + [[period]])
+    mults = np.concatenate(mults_l + [[anchor_mult[0]]]).astype(int)
+    if np.any(np.diff(knots) <= 0):
+        raise GeometryError("periodic knots are not strictly increasing (breakpoints too close)", knots)
+    n_poles = int(mults[:-1].sum())
+    if n_poles < degree + 1:  # too few poles for a periodic B-spline: refine uniformly
+        return periodic_knots(nv + degree + 1, degree, v_breaks, break_mult, period)
+    t = flat_knots(knots, mults, degree, True)
+    # Greville abscissa of B-spline i: mean of its interior knots t[i+1 .. i+degree]
+    csum = np.concatenate([[0.0], np.cumsum(t)])
+    grev = (csum[degree + 1 : degree + 1 + n_poles] - csum[1 : 1 + n_poles]) / degree
+    samples = np.sort(np.mod(grev, period))
+    samples[np.abs(samples - period) < 1e-14 * period] = 0.0
+    samples = np.sort(samples)
+    if np.any(np.diff(samples) <= 0):
+        raise GeometryError("Greville abscissae are not distinct (degenerate knot vector)", knots)
     return knots, mults, samples
 
 
 def _eval_f(f: SurfaceFunction, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    U, V = np.meshgrid(u, v, indexing="ij")
-    X = np.asarray(f(U, V), dtype=float)
-    X = np.broadcast_to(X, U.shape + (3,))
+    """``f`` on the tensor grid ``u x v``; uses ``f.evaluate_grid(u, v)`` when ``f`` has one
+    (e.g. a PDE patch: matrix products instead of point-wise series, ~25x faster)."""
+    grid = getattr(f, "evaluate_grid", None)
+    shape = (np.size(u), np.size(v))
+    if grid is not None:
+        X = np.asarray(grid(np.asarray(u, dtype=float), np.asarray(v, dtype=float)), dtype=float)
+    else:
+        U, V = np.meshgrid(u, v, indexing="ij")
+        X = np.asarray(f(U, V), dtype=float)
+    X = np.broadcast_to(X, shape + (3,))
     if not np.all(np.isfinite(X)):
         raise GeometryError("surface function returned non-finite values", f)
     return np.array(X)
@@ -401,9 +496,11 @@ def _build(
     pole_tol: float,
     u_range: tuple[float, float],
     boundary_rows: tuple[np.ndarray | None, np.ndarray | None] = (None, None),
+    v_breaks=None,
+    break_mult: int | None = None,
 ):
     u = np.linspace(u_range[0], u_range[1], nu)
-    v_knots, v_mults, v = _periodic_knots_and_samples(nv, v_degree)
+    v_knots, v_mults, v = periodic_knots(nv, v_degree, v_breaks, break_mult)
     D = _eval_f(f, u, v)
     poles_flags = []
     for k, r in ((0, 0), (-1, 1)):
@@ -424,10 +521,11 @@ def _build(
 
 def _deviation(f: SurfaceFunction, data: BSplineSurfaceData, u: np.ndarray, v: np.ndarray, factor: int):
     """Errors on a grid ``factor`` x denser (includes midpoints between samples)."""
-    nu, nv = u.size, v.size
+    nu = u.size
     uc = np.linspace(u[0], u[-1], factor * (nu - 1) + 1)
-    h = TWO_PI / nv
-    vc = v[0] + np.arange(factor * nv) * (h / factor)
+    # ``factor`` points per gap between consecutive (periodic) samples; column ``factor * j`` is sample j
+    vs = np.concatenate([v, [v[0] + TWO_PI]])
+    vc = (vs[:-1, None] + (np.arange(factor) / factor)[None, :] * np.diff(vs)[:, None]).ravel()
     F = _eval_f(f, uc, vc)
     S = data.evaluate_grid(uc, vc)
     E = np.linalg.norm(S - F, axis=-1)
@@ -454,6 +552,8 @@ def fit_surface(
     u_range: tuple[float, float] = (0.0, 1.0),
     fixed_nv: bool = False,
     boundary_rows: tuple[np.ndarray | None, np.ndarray | None] = (None, None),
+    v_breaks: Sequence[float] | None = None,
+    v_break_mult: int | None = None,
     name: str = "surface",
     raise_on_failure: bool = True,
 ) -> SurfaceFit:
@@ -470,6 +570,14 @@ def fit_surface(
     (used by :func:`fit_patches` to share boundary rows); ``boundary_rows``
     overrides the sampled data of the ``u`` min / max rows.
 
+    ``v_breaks``: values of ``v`` where ``f`` is not smooth in ``v`` (e.g. the
+    junctions of an outline's arcs and lines, where the surface is only C1).
+    They become knots of multiplicity ``v_break_mult`` (default
+    ``v_degree - 1``, C1; ``v_degree`` gives C0) with uniform spans between
+    them and Greville interpolation points (see :func:`periodic_knots`), so
+    every smooth piece converges at the full order ``h^(v_degree+1)``.  ``nv``
+    then counts knot spans rather than poles.
+
     Raises :class:`GeometryError` naming ``name`` and the deviation if the
     tolerance cannot be met within ``max_nu``/``max_nv``/``max_iterations``
     (unless ``raise_on_failure`` is false).
@@ -481,12 +589,16 @@ def fit_surface(
     t0 = time.perf_counter()
     nu = max(int(nu), u_degree + 1)
     nv = max(int(nv), v_degree + 1)
+    breaks = normalise_breaks(v_breaks)
     best = None
     for it in range(1, max_iterations + 1):
-        data, u, v, flags, _ = _build(f, nu, nv, u_degree, v_degree, pole_tol, u_range, boundary_rows)
+        data, u, v, flags, _ = _build(
+            f, nu, nv, u_degree, v_degree, pole_tol, u_range, boundary_rows, breaks, v_break_mult
+        )
         dmax, drms, err_u, err_v, npts = _deviation(f, data, u, v, check_factor)
         best = SurfaceFit(
-            data, dmax, drms, tol, nu, nv, it, npts, flags[0], flags[1], time.perf_counter() - t0, u, v
+            data, dmax, drms, tol, nu, nv, it, npts, flags[0], flags[1], time.perf_counter() - t0, u, v,
+            tuple(float(b) for b in breaks),
         )
         if dmax <= tol:
             return best
@@ -511,7 +623,7 @@ def fit_surface(
     if raise_on_failure:
         raise GeometryError(
             f"B-spline fit of {name} misses tolerance: max deviation {best.max_deviation:.3g} mm > "
-            f"tol {tol:.3g} mm with {best.nu} x {best.nv} poles",
+            f"tol {tol:.3g} mm with {best.surface.shape[0]} x {best.surface.shape[1]} poles",
             best,
         )
     return best
@@ -527,6 +639,8 @@ def fit_patches(
     nu: int = 17,
     nv: int = 32,
     share_tol: float = 1e-9,
+    v_breaks: Sequence[float] | None = None,
+    v_break_mult: int | None = None,
     **kwargs,
 ) -> list[SurfaceFit]:
     """Fit a chain of patches (patch ``j``'s ``u=1`` curve is patch ``j+1``'s ``u=0`` curve).
@@ -537,17 +651,22 @@ def fit_patches(
     ``u=0``) is detected and shared too.  Raises :class:`GeometryError` naming
     the patch if a fit misses ``tol`` or if neighbouring boundaries disagree by
     more than ``share_tol``.
+
+    ``v_breaks`` (see :func:`fit_surface`) must be the union of the breakpoints
+    of the whole chain: every patch gets the same breakpoint knots, which keeps
+    the v knot vectors, hence the shared boundary rows, identical.
     """
     functions = list(functions)
     n = len(functions)
     names = list(names) if names is not None else [f"patch {j}" for j in range(n)]
     # pass 1: independent fits to find the v resolution each patch needs
+    kwargs.update(v_breaks=v_breaks, v_break_mult=v_break_mult)
     first = [
         fit_surface(fj, u_degree, v_degree, nu, nv, True, tol, name=names[j], **kwargs)
         for j, fj in enumerate(functions)
     ]
     nv_common = max(fit.nv for fit in first)
-    _, _, v = _periodic_knots_and_samples(nv_common, v_degree)
+    _, _, v = periodic_knots(nv_common, v_degree, v_breaks, v_break_mult)
     zeros = np.zeros(1)
     rows_end = [_eval_f(fj, np.array([1.0]), v)[0] for fj in functions]
     rows_start = [_eval_f(fj, zeros, v)[0] for fj in functions]

@@ -34,7 +34,7 @@ from OCP.BRepLib import BRepLib
 from OCP.GProp import GProp_GProps
 from OCP.TopoDS import TopoDS_Shape, TopoDS_Solid
 
-from tabletcad.bspline import BSplineSurfaceData, SurfaceFit, fit_patches
+from tabletcad.bspline import BSplineSurfaceData, SurfaceFit, fit_patches, normalise_breaks
 from tabletcad.cad._occ import cast, explore, shape_type
 from tabletcad.cad.faces import make_face
 from tabletcad.errors import GeometryError
@@ -48,6 +48,8 @@ __all__ = [
     "solid_from_tablet",
     "sew_faces",
     "check_solid",
+    "chain_breakpoints",
+    "PatchFunction",
 ]
 
 DEFAULT_EPS = 1e-9
@@ -138,12 +140,35 @@ class TabletSolid:
 # --------------------------------------------------------------------------- helpers
 
 
+class PatchFunction:
+    """``f(u, v) = patch.evaluate(u, v)``; keeps the patch's ``evaluate_grid`` (tensor grids by
+    matrix products), which :func:`tabletcad.bspline.fit_surface` uses when present."""
+
+    def __init__(self, patch: Any) -> None:
+        self.patch = patch
+        if hasattr(patch, "evaluate_grid"):
+            self.evaluate_grid = lambda u, v: np.asarray(patch.evaluate_grid(u, v))
+
+    def __call__(self, u, v) -> np.ndarray:
+        return np.asarray(self.patch.evaluate(u, v))
+
+
 def _patch_function(p: Any) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
     if hasattr(p, "evaluate"):
-        return lambda u, v, _p=p: np.asarray(_p.evaluate(u, v))
+        return PatchFunction(p)
     if callable(p):
         return p
     raise TypeError(f"a patch must be callable f(u, v) or have .evaluate(u, v), got {type(p).__name__}")
+
+
+def chain_breakpoints(patches: Sequence[Any]) -> np.ndarray:
+    """Union (sorted, in [0, 2 pi), values within 1e-9 merged) of the ``breakpoints()`` of the
+    patches that have them."""
+    pts = [np.asarray(p.breakpoints(), dtype=float).ravel() for p in patches if hasattr(p, "breakpoints")]
+    pts = [b for b in pts if b.size]
+    if not pts:
+        return np.zeros(0)
+    return normalise_breaks(np.concatenate(pts))
 
 
 def _patch_names(patches: Sequence[Any], names: Sequence[str] | None) -> list[str]:
@@ -267,7 +292,8 @@ def build_solid(
     Patches form a chain: patch ``j``'s ``u=1`` curve is patch ``j+1``'s ``u=0``
     curve (the chain may close on itself, e.g. a ring).  ``sew_tolerance``
     defaults to ``max(2 tol, 1e-6)`` mm.  Extra keyword arguments go to
-    :func:`tabletcad.bspline.fit_surface` (``nu``, ``nv``, ``max_nu``...).
+    :func:`tabletcad.bspline.fit_surface` (``nu``, ``nv``, ``max_nu``, ``v_breaks``...);
+    ``v_breaks`` defaults to the union of the patches' ``breakpoints()`` (if they have any).
     """
     t0 = time.perf_counter()
     patches = list(patches)
@@ -275,6 +301,8 @@ def build_solid(
         raise GeometryError("no patches given", patches)
     names = _patch_names(patches, names)
     functions = [_patch_function(p) for p in patches]
+    if "v_breaks" not in fit_kwargs:  # patches that know where they are not smooth in v
+        fit_kwargs["v_breaks"] = chain_breakpoints(patches)
     fits = fit_patches(functions, tol, names=names, **fit_kwargs)
     for fit, n in zip(fits, names):
         if not fit.ok:  # fit_surface raises already; keep the guarantee explicit

@@ -20,7 +20,7 @@ import numpy as np
 from tabletcad.errors import GeometryError
 from tabletcad.tablet import Tablet, solid_map
 
-__all__ = ["tablet_surface_functions", "tablet_solid"]
+__all__ = ["tablet_surface_functions", "tablet_solid", "tablet_breakpoints"]
 
 SurfaceFunction = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
@@ -40,7 +40,9 @@ def tablet_surface_functions(tablet: Tablet) -> tuple[list[SurfaceFunction], lis
     w0, w1 = t.w
     names = [p.name or f"patch {j}" for j, p in enumerate(tablet.patches)]
     if w0 == 0.0 and w1 == 1.0:
-        return [lambda u, v, _p=p: _p.evaluate(u, v) for p in tablet.patches], names
+        from tabletcad.cad.solid import PatchFunction  # keeps the patches' fast evaluate_grid
+
+        return [PatchFunction(p) for p in tablet.patches], names
     if len(tablet.patches) != 1:
         raise GeometryError(f"{tablet.name}: hollow (w-trimmed) solids are exported for one-patch tablets only", tablet)
     p = tablet.patches[0]
@@ -58,6 +60,18 @@ def tablet_surface_functions(tablet: Tablet) -> tuple[list[SurfaceFunction], lis
     return funcs, [f"{base} outer wall", f"{base} end u=1", f"{base} inner wall", f"{base} end u=0"]
 
 
+def tablet_breakpoints(tablet: Tablet) -> np.ndarray:
+    """Union of the ``v`` breakpoints of the tablet's patches (sorted, in [0, 2π)).
+
+    Every face of the solid (also the walls and end faces of a hollow tablet,
+    which share the patch's ``v``) is fitted with breakpoint knots at all of
+    them, so that the chain keeps one common ``v`` knot vector.
+    """
+    from tabletcad.cad.solid import chain_breakpoints
+
+    return chain_breakpoints(tablet.patches)
+
+
 def tablet_solid(tablet: Tablet, tol: float | None = None, **kwargs: Any):
     """Fit, sew and validate the tablet's solid; returns a :class:`~tabletcad.cad.solid.TabletSolid`.
 
@@ -71,4 +85,6 @@ def tablet_solid(tablet: Tablet, tol: float | None = None, **kwargs: Any):
     # where cubics need ~4x the poles for 1e-5 mm (and leave a 1e-6 volume bias)
     kwargs.setdefault("u_degree", 5)
     kwargs.setdefault("v_degree", 5)
+    # knots of multiplicity v_degree - 1 where an outline is only C1 (arc/line junctions)
+    kwargs.setdefault("v_breaks", tablet_breakpoints(tablet))
     return build_solid(funcs, tablet.tol.fit if tol is None else tol, name=tablet.name, names=names, **kwargs)
