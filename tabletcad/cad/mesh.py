@@ -1,7 +1,8 @@
 """Tessellation of a B-rep solid to numpy arrays, checked with manifold3d and trimesh.
 
 ``BRepMesh_IncrementalMesh`` with an explicit linear deflection (mm, chord
-height) and angular deflection (rad).  Face triangulations are merged into one
+height) and angular deflection (rad), OCCT's Delabella triangulator by default
+(``IMeshTools_Parameters``; surface deflection control on).  Face triangulations are merged into one
 indexed mesh: coincident nodes on shared edges, seams and collapsed pole rows
 are welded (within ``weld_tol``) and triangles that became degenerate by the
 welding are dropped.  The signed volume of a closed mesh with chord height
@@ -25,7 +26,7 @@ from scipy.spatial import cKDTree
 from tabletcad.cad._occ import explore
 from tabletcad.errors import GeometryError
 
-__all__ = ["MeshResult", "tessellate", "triangulate"]
+__all__ = ["MeshResult", "tessellate", "triangulate", "MESH_ALGOS"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -63,6 +64,49 @@ class MeshResult:
         return trimesh.Trimesh(self.vertices, self.triangles, process=False)
 
 
+MESH_ALGOS = ("delabella", "watson")
+
+
+def _mesh_parameters(linear_deflection: float, angular_deflection: float, relative: bool, algo: str):
+    from OCP.IMeshTools import IMeshTools_MeshAlgoType, IMeshTools_Parameters
+
+    p = IMeshTools_Parameters()
+    p.Deflection = float(linear_deflection)
+    p.Angle = float(angular_deflection)
+    p.Relative = bool(relative)
+    p.InParallel = False  # a tablet has 2-4 faces; threads cost more than they save
+    p.ControlSurfaceDeflection = True  # needed: without it the chord error is not bounded inside faces
+    p.MeshAlgo = {
+        "delabella": IMeshTools_MeshAlgoType.IMeshTools_MeshAlgoType_Delabella,
+        "watson": IMeshTools_MeshAlgoType.IMeshTools_MeshAlgoType_Watson,
+    }[algo]
+    return p
+
+
+def _face_arrays(face) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes ``(n, 3)`` (placed by the face's location) and 0-based triangles ``(m, 3)`` of one face.
+
+    The triangulation is read with one C++ call per node/triangle collected in a list
+    comprehension (no per-item numpy writes or ``gp_Pnt.Transformed``); the location is
+    applied as one 3x4 matrix product.
+    """
+    loc = TopLoc_Location()
+    tri = BRep_Tool.Triangulation_s(face, loc)
+    if tri is None:
+        raise GeometryError("a face has no triangulation after meshing", face)
+    nn, nt = tri.NbNodes(), tri.NbTriangles()
+    node, triangle = tri.Node, tri.Triangle
+    nodes = np.array([node(i).Coord() for i in range(1, nn + 1)], dtype=float).reshape(nn, 3)
+    t = np.array([triangle(i).Get() for i in range(1, nt + 1)], dtype=np.int64).reshape(nt, 3) - 1
+    if not loc.IsIdentity():
+        trsf = loc.Transformation()
+        M = np.array([[trsf.Value(r, c) for c in range(1, 5)] for r in range(1, 4)])
+        nodes = nodes @ M[:, :3].T + M[:, 3]
+    if face.Orientation() == TopAbs_Orientation.TopAbs_REVERSED:
+        t = t[:, ::-1]
+    return nodes, t
+
+
 def triangulate(
     shape: TopoDS_Shape,
     linear_deflection: float = 0.005,
@@ -70,32 +114,26 @@ def triangulate(
     *,
     relative: bool = False,
     weld_tol: float = 1e-7,
+    algo: str = "delabella",
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Mesh ``shape`` and return welded ``(vertices (n, 3) float64, triangles (m, 3) int64)``, outward-wound."""
+    """Mesh ``shape`` and return welded ``(vertices (n, 3) float64, triangles (m, 3) int64)``, outward-wound.
+
+    ``algo``: ``"delabella"`` (default; OCCT's Delabella 2-D Delaunay, ~3x faster than
+    ``"watson"``, OCCT's default Bowyer-Watson, for the same deflections and a
+    comparable triangle count; both with surface deflection control).
+    """
     if linear_deflection <= 0 or angular_deflection <= 0:
         raise ValueError("linear_deflection and angular_deflection must be > 0")
+    if algo not in MESH_ALGOS:
+        raise ValueError(f"algo = {algo!r} is not allowed: must be one of {', '.join(MESH_ALGOS)}")
     BRepTools.Clean_s(shape)  # drop an older triangulation, or BRepMesh would keep it
-    mesher = BRepMesh_IncrementalMesh(shape, float(linear_deflection), bool(relative), float(angular_deflection), False)
-    mesher.Perform()
+    params = _mesh_parameters(linear_deflection, angular_deflection, relative, algo)
+    mesher = BRepMesh_IncrementalMesh(shape, params)
     if not mesher.IsDone():
         raise GeometryError("BRepMesh_IncrementalMesh failed", shape)
     verts, tris, offset = [], [], 0
     for face in explore(shape, "Face"):
-        loc = TopLoc_Location()
-        tri = BRep_Tool.Triangulation_s(face, loc)
-        if tri is None:
-            raise GeometryError("a face has no triangulation after meshing", face)
-        trsf = loc.Transformation()
-        nodes = np.empty((tri.NbNodes(), 3))
-        for i in range(1, tri.NbNodes() + 1):
-            p = tri.Node(i).Transformed(trsf)
-            nodes[i - 1] = (p.X(), p.Y(), p.Z())
-        t = np.empty((tri.NbTriangles(), 3), dtype=np.int64)
-        for i in range(1, tri.NbTriangles() + 1):
-            t[i - 1] = tri.Triangle(i).Get()
-        t -= 1
-        if face.Orientation() == TopAbs_Orientation.TopAbs_REVERSED:
-            t = t[:, ::-1]
+        nodes, t = _face_arrays(face)
         verts.append(nodes)
         tris.append(t + offset)
         offset += nodes.shape[0]
@@ -107,21 +145,21 @@ def triangulate(
 
 
 def _weld(V: np.ndarray, T: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
-    tree = cKDTree(V)
-    pairs = tree.query_pairs(tol, output_type="ndarray")
-    parent = np.arange(len(V))
+    """Merge nodes closer than ``tol`` (transitively: connected components of the pair graph)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
 
-    def find(i):
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    for a, b in pairs:
-        ra, rb = find(a), find(b)
-        if ra != rb:
-            parent[max(ra, rb)] = min(ra, rb)
-    roots = np.array([find(i) for i in range(len(V))])
+    n = len(V)
+    pairs = cKDTree(V).query_pairs(tol, output_type="ndarray")
+    if len(pairs):
+        graph = coo_matrix((np.ones(len(pairs), dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+        _, labels = connected_components(graph, directed=False)
+    else:
+        labels = np.arange(n)
+    # representative of each component: its smallest node index (keeps the first face's node)
+    first = np.full(labels.max() + 1, n, dtype=np.int64)
+    np.minimum.at(first, labels, np.arange(n))
+    roots = first[labels]
     uniq, inverse = np.unique(roots, return_inverse=True)
     T = inverse[T]
     keep = (T[:, 0] != T[:, 1]) & (T[:, 1] != T[:, 2]) & (T[:, 0] != T[:, 2])
@@ -169,9 +207,10 @@ def tessellate(
     relative: bool = False,
     weld_tol: float = 1e-7,
     check: bool = True,
+    algo: str = "delabella",
 ) -> MeshResult:
     """Triangulate ``shape`` (deflections in mm and rad) and run the manifold3d / trimesh checks."""
-    V, T = triangulate(shape, linear_deflection, angular_deflection, relative=relative, weld_tol=weld_tol)
+    V, T = triangulate(shape, linear_deflection, angular_deflection, relative=relative, weld_tol=weld_tol, algo=algo)
     vol, area = _signed_volume_area(V, T)
     status, genus, mvol = ("unchecked", None, None)
     watertight = winding = None
