@@ -1,0 +1,237 @@
+"""CAD stage timing per sample tablet, beside the same nominal shape built directly in build123d.
+
+Run:  cd /work/main && /tmp/venv/bin/python benchmarks/bench_cad.py [--repeat 3] [samples/x.toml ...]
+
+For every sample design that is not a cut-away, prints (best of ``--repeat`` runs, one core):
+
+* ``solid``: :func:`tabletcad.cad.tablet_solid.tablet_solid` - B-spline fit of every
+  face, OCCT faces, sewing, ``BRepCheck_Analyzer``, adaptive mass properties;
+* ``check``: the stage's cross-checks (volume/area vs the core's quadrature, taken as
+  given - the quadrature itself is core work and not timed) and the tessellation
+  with its manifold3d/trimesh checks (:func:`tabletcad.cad.stage.check_tablet_solid`
+  minus the solid, which it rebuilds: ``check = stage total - solid``);
+* ``export``: tablet.step + tablet.stl + tablet.glb (:func:`tabletcad.cad.export.export`);
+* ``b123d``: the same *nominal* shape made directly in build123d from exact arcs -
+  a revolve of its profile (band, spherical caps / elliptic domes, sphere, spheroid,
+  ring rectangle) - with ``is_valid()``, its volume, and its own ``export_step`` and
+  ``export_stl`` at the same deflections (0.005 mm, 0.2 rad) as the tablet's STL;
+  oval tablets (not solids of revolution) use the round tablet of equal width and
+  the stadium an extruded ``SlotOverall`` plan (marked ``~``);
+* the ratio ``(solid + check + export) / b123d``.
+
+Figures only; nothing is asserted.  The design load (PDE solve) is printed apart.
+"""
+
+from __future__ import annotations
+
+import argparse
+import glob
+import math
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("MKL_NUM_THREADS", "1")
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+
+ROOT = Path(__file__).resolve().parents[1]
+LINEAR, ANGULAR = 0.005, 0.2
+
+
+# --------------------------------------------------------------------------- build123d nominal shapes
+
+
+def _revolve_profile(points_and_arcs):
+    """Closed profile in the XZ plane (x = radius, z) from ('line', p0, p1) / ('arc', ...) items, revolved about Z."""
+    import build123d as bd
+
+    edges = []
+    for item in points_and_arcs:
+        kind = item[0]
+        if kind == "line":
+            edges.append(bd.Edge.make_line(bd.Vector(item[1][0], 0, item[1][1]), bd.Vector(item[2][0], 0, item[2][1])))
+        elif kind == "arc3":  # exact circular arc through three points
+            p0, pm, p1 = (bd.Vector(p[0], 0, p[1]) for p in item[1:])
+            edges.append(bd.Edge.make_three_point_arc(p0, pm, p1))
+        else:  # "ellipse": centre (x, z), radii (rx along x, rz along z), angles (deg) in the XZ plane
+            _, (cx, cz), rx, rz, a0, a1 = item
+            plane = bd.Plane(origin=(cx, 0, cz), x_dir=(1, 0, 0), z_dir=(0, -1, 0))
+            if rx >= rz:
+                e = bd.Edge.make_ellipse(rx, rz, plane, a0, a1)
+            else:  # make_ellipse wants the major radius first: rotate the local frame by 90 deg
+                plane = bd.Plane(origin=(cx, 0, cz), x_dir=(0, 0, 1), z_dir=(0, -1, 0))
+                e = bd.Edge.make_ellipse(rz, rx, plane, a0 - 90.0, a1 - 90.0)
+            edges.append(e)
+    wire = bd.Wire(edges)
+    face = bd.Face(wire)
+    return bd.Solid.revolve(face, 360.0, bd.Axis.Z)
+
+
+def _cap_items(R: float, z_rim: float, depth: float, up: bool):
+    """Cap from the axis to the rim (bottom, up=False) or from the rim to the axis (top)."""
+    if depth <= 0.0:
+        return [("line", (0.0, z_rim), (R, z_rim))] if not up else [("line", (R, z_rim), (0.0, z_rim))]
+    if depth <= R:  # spherical cap: exact circle arc through three points
+        rc = (R * R + depth * depth) / (2.0 * depth)
+        half = math.asin(R / rc)
+        th = half / 2.0
+        if up:
+            zc = z_rim + depth - rc
+            return [("arc3", (R, z_rim), (rc * math.sin(th), zc + rc * math.cos(th)), (0.0, z_rim + depth))]
+        zc = z_rim - depth + rc
+        return [("arc3", (0.0, z_rim - depth), (rc * math.sin(th), zc - rc * math.cos(th)), (R, z_rim))]
+    # deeper than a hemisphere: half spheroid (an elliptic arc), as the shape families do
+    if up:
+        return [("ellipse", (0.0, z_rim), R, depth, 0.0, 90.0)]
+    return [("ellipse", (0.0, z_rim), R, depth, 270.0, 360.0)]
+
+
+def _band_tablet(R: float, z0: float, z1: float, d0: float, d1: float):
+    items = _cap_items(R, z0, d0, up=False)
+    if z1 > z0:
+        items.append(("line", (R, z0), (R, z1)))
+    items += _cap_items(R, z1, d1, up=True)
+    items.append(("line", (0.0, z1 + d1), (0.0, z0 - d0)))
+    return _revolve_profile(items)
+
+
+def nominal_build123d(tablet):
+    """(build123d solid, kind) for the nominal shape of a sample tablet; kind '~' marks a stand-in."""
+    import build123d as bd
+
+    f, p = tablet.family, dict(getattr(tablet, "params", {}) or {})
+    if f in ("shallow_convex_round", "deep_convex_round"):
+        T, b, D = p["thickness"], p["band"], p["diameter"]
+        d = (T - b) / 2
+        return _band_tablet(D / 2, d, d + b, d, d), "revolve"
+    if f in ("shallow_convex_oval", "deep_convex_oval", "caplet"):
+        T, b, W = p["thickness"], p["band"], p["width"]
+        d = (T - b) / 2
+        return _band_tablet(W / 2, d, d + b, d, d), "~revolve (round of equal width)"
+    if f == "flat_faced_round":
+        return _band_tablet(p["diameter"] / 2, 0.0, p["thickness"], 0.0, 0.0), "revolve"
+    if f in ("oblong", "rod"):
+        R, L, d = p["diameter"] / 2, p["length"], p["dome"]
+        return _band_tablet(R, d, L - d, d, d), "revolve"
+    if f == "spherical":
+        return bd.Solid.make_sphere(p["diameter"] / 2), "sphere"
+    if f in ("oblate_spheroid", "prolate_spheroid"):
+        R, c = p["diameter"] / 2, p["height"] / 2
+        items = [("ellipse", (0.0, 0.0), R, c, 270.0, 360.0), ("ellipse", (0.0, 0.0), R, c, 0.0, 90.0),
+                 ("line", (0.0, c), (0.0, -c))]
+        return _revolve_profile(items), "revolve"
+    if f == "ring":
+        ro, ri, T = p["outer_diameter"] / 2, p["inner_diameter"] / 2, p["thickness"]
+        items = [("line", (ri, 0.0), (ro, 0.0)), ("line", (ro, 0.0), (ro, T)), ("line", (ro, T), (ri, T)),
+                 ("line", (ri, T), (ri, 0.0))]
+        return _revolve_profile(items), "revolve"
+    # free form (the stadium sample): its bounding plan extruded
+    bb = tablet_bbox(tablet)
+    sk = bd.SlotOverall(bb[3] - bb[0], bb[4] - bb[1])
+    return bd.extrude(sk, amount=bb[5] - bb[2]).solids()[0], "~extruded SlotOverall plan"
+
+
+def tablet_bbox(tablet):
+    import numpy as np
+
+    u = np.linspace(0, 1, 33)
+    v = np.linspace(0, 2 * np.pi, 257)
+    pts = np.concatenate([p.evaluate_grid(u, v).reshape(-1, 3) for p in tablet.patches])
+    return (*pts.min(axis=0), *pts.max(axis=0))
+
+
+def time_build123d(tablet, tmp: Path):
+    import build123d as bd
+
+    t0 = time.perf_counter()
+    shape, kind = nominal_build123d(tablet)
+    ok = shape.is_valid
+    vol = shape.volume
+    bd.export_step(shape, str(tmp / "nominal.step"))
+    bd.export_stl(shape, str(tmp / "nominal.stl"), tolerance=LINEAR, angular_tolerance=ANGULAR)
+    return time.perf_counter() - t0, kind, ok, vol
+
+
+# --------------------------------------------------------------------------- tabletcad
+
+
+def time_tabletcad(tablet, report, tmp: Path):
+    from tabletcad.cad.export import export
+    from tabletcad.cad.stage import check_tablet_solid
+    from tabletcad.cad.tablet_solid import tablet_solid
+
+    t0 = time.perf_counter()
+    tablet_solid(tablet)
+    t1 = time.perf_counter()
+    solid, mesh, sections = check_tablet_solid(tablet, report)  # rebuilds the solid: check = total - solid
+    t2 = time.perf_counter()
+    export(solid, tmp / "tablet.step", name=tablet.name)
+    export(solid, tmp / "tablet.stl", name=tablet.name, mesh=mesh)
+    export(solid, tmp / "tablet.glb", name=tablet.name, mesh=mesh)
+    t3 = time.perf_counter()
+    solid_s = t1 - t0
+    return solid_s, (t2 - t1) - solid_s, t3 - t2, solid, mesh, sections
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("designs", nargs="*", help="design files (default: samples/*.toml, cut-aways skipped)")
+    ap.add_argument("--repeat", type=int, default=3, help="runs per tablet; the best is printed (default 3)")
+    args = ap.parse_args(argv)
+
+    import build123d  # noqa: F401  (imports outside the timings)
+    import manifold3d  # noqa: F401
+    import trimesh  # noqa: F401
+
+    from tabletcad.design import load_design
+
+    paths = args.designs or sorted(glob.glob(str(ROOT / "samples" / "*.toml")))
+    head = (f"{'sample':24s} {'load':>6s} {'solid':>6s} {'check':>6s} {'export':>6s} {'total':>6s} "
+            f"{'b123d':>6s} {'ratio':>5s}  {'poles':>10s} {'fit dev':>8s} {'tris':>6s} {'mesh-brep':>9s} "
+            f"{'bound':>8s}  nominal")
+    print(f"one core, best of {args.repeat}; seconds; deflections {LINEAR} mm / {ANGULAR} rad")
+    print(head)
+    totals, refs = [], []
+    with tempfile.TemporaryDirectory(prefix="bench-cad-") as d:
+        tmp = Path(d)
+        for path in paths:
+            t0 = time.perf_counter()
+            tablet = load_design(path)
+            load_s = time.perf_counter() - t0
+            tr = tablet.trim
+            if tr.u != (0.0, 1.0) or not tr.full_v:
+                print(f"{Path(path).stem:24s} (cut-away view: no solid)")
+                continue
+            report = {"volume_mm3": tablet.volume(), "surface_area_mm2": tablet.surface_area()}
+            best = None
+            for _ in range(max(1, args.repeat)):
+                r = time_tabletcad(tablet, report, tmp)
+                if best is None or sum(r[:3]) < sum(best[:3]):
+                    best = r
+            solid_s, check_s, export_s, solid, mesh, sections = best
+            ref = min((time_build123d(tablet, tmp) for _ in range(max(1, args.repeat))), key=lambda x: x[0])
+            total = solid_s + check_s + export_s
+            totals.append(total)
+            refs.append(ref[0])
+            poles = "x".join(str(n) for n in solid.surfaces[0].shape) + (f"+{len(solid.surfaces) - 1}" if len(solid.surfaces) > 1 else "")
+            rel = (mesh.manifold_volume - solid.volume) / solid.volume
+            bound = LINEAR * solid.area / solid.volume
+            print(
+                f"{Path(path).stem:24s} {load_s:6.2f} {solid_s:6.3f} {check_s:6.3f} {export_s:6.3f} {total:6.3f} "
+                f"{ref[0]:6.3f} {total / ref[0]:5.1f}  {poles:>10s} {solid.max_fit_deviation:8.1e} "
+                f"{len(mesh.triangles):6d} {rel:9.1e} {bound:8.1e}  {ref[1]}{'' if ref[2] else ' (INVALID)'}",
+                flush=True,
+            )
+    if totals:
+        print(f"{'mean':24s} {'':6s} {'':6s} {'':6s} {'':6s} {sum(totals) / len(totals):6.3f} "
+              f"{sum(refs) / len(refs):6.3f} {sum(totals) / sum(refs):5.1f}")
+    print("mesh-brep: (manifold3d mesh volume - B-rep volume) / B-rep volume; bound: deflection x area / volume")
+
+
+if __name__ == "__main__":
+    main()
