@@ -159,6 +159,12 @@ def design_from_dict(data: dict, default_name: str = "tablet") -> Tablet:
         tablet = _reshape(tablet, data["reshape"])
     if "trim" in data:
         tablet = _trim(tablet, data["trim"])
+    extras = {k: data[k] for k in ("report", "tooling") if k in data}
+    if extras:
+        for k, v in extras.items():
+            if not isinstance(v, dict):
+                raise DesignError(f"[{k}]", v, "must be a table")
+        tablet = replace(tablet, extras={**tablet.extras, **extras})
     return tablet
 
 

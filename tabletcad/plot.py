@@ -31,8 +31,7 @@ def plot_tablet(tablet: Tablet, path: str | Path, *, dpi: int = 130, nu: int = 4
     for face in tablet.faces():
         s = np.linspace(face.s_range[0], face.s_range[1], nu)
         tt = np.linspace(face.t_range[0], face.t_range[1], nv)
-        S, T = np.meshgrid(s, tt, indexing="ij")
-        Y = face.evaluate(tablet, S, T)
+        Y = face.evaluate_grid(tablet, s, tt)
         rgb = np.array(colours(face.patch % 10)[:3]) if face.kind == "w" else np.array([0.75, 0.75, 0.75])
         shade = ls.shade_rgb(np.broadcast_to(rgb, Y.shape[:2] + (3,)), Y[..., 2])
         ax.plot_surface(Y[..., 0], Y[..., 1], Y[..., 2], facecolors=shade, rstride=1, cstride=1,

@@ -110,6 +110,38 @@ class Face:
     sign: float
     periodic_t: bool = False
 
+    def evaluate_grid(self, tablet: "Tablet", s, t, der: str = "") -> np.ndarray:
+        """The face (or its ``s``/``t`` derivative) on the tensor grid ``s × t``: (len(s), len(t), 3) mm.
+
+        Uses the patches' fast ``evaluate_grid`` (the remainder series is
+        evaluated once per ``t``, not once per point).
+        """
+        p = tablet.patches[self.patch]
+        s = np.asarray(s, dtype=float).reshape(-1)
+        t = np.asarray(t, dtype=float).reshape(-1)
+        if self.kind == "w":  # (u, v) at w = value
+            if der == "t":
+                return self.value * p.evaluate_grid(s, t, dv=1)
+            du = 1 if der == "s" else 0
+            A = p.spine(s, du=du)[:, None, :]
+            return A + self.value * (p.evaluate_grid(s, t, du=du) - A)
+        if self.kind == "u":  # (w, v) at u = value
+            X = p.evaluate_grid([self.value], t, dv=1 if der == "t" else 0)[0]  # (nt, 3)
+            if der == "t":
+                return s[:, None, None] * X[None]
+            A = p.spine(np.array([self.value]))[0]
+            if der == "s":
+                return np.broadcast_to(X - A, (s.size,) + X.shape).copy()
+            return A + s[:, None, None] * (X - A)[None]
+        # "v": (u, w) at v = value
+        du = 1 if der == "s" else 0
+        X = p.evaluate_grid(s, [self.value], du=du)[:, 0, :]  # (ns, 3)
+        A = p.spine(s, du=du)
+        if der == "t":
+            Xp = p.evaluate_grid(s, [self.value])[:, 0, :]
+            return np.broadcast_to((Xp - p.spine(s))[:, None, :], (s.size, t.size, 3)).copy()
+        return A[:, None, :] + t[None, :, None] * (X - A)[:, None, :]
+
     def evaluate(self, tablet: "Tablet", s, t, der: str = "") -> np.ndarray:
         p = tablet.patches[self.patch]
         s, t = np.broadcast_arrays(np.asarray(s, float), np.asarray(t, float))
@@ -145,10 +177,9 @@ class Tablet:
     nominal : callable, optional
         Signed distance ``f(points (m, 3)) -> (m,)`` (mm) to the exact shape the
         tablet approximates, for :meth:`nominal_deviation`.
-    closed_ends : bool
-        True when the chain's first and last curves are points (a closed
-        surface); False makes the u-ends of the first and last patch part of the
-        boundary (e.g. the ring tablet's annular faces).
+    extras : dict
+        Tables of the design file that are not geometry (``report``,
+        ``tooling``), for the report sections and build stages that read them.
     """
 
     patches: tuple
@@ -159,6 +190,7 @@ class Tablet:
     nominal: Callable[[np.ndarray], np.ndarray] | None = field(default=None, repr=False)
     nominal_name: str = ""
     tol: Tolerances = field(default=DEFAULT, repr=False)
+    extras: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         patches = tuple(self.patches)
@@ -231,10 +263,9 @@ class Tablet:
     def _face_integrals(self, face: Face, nu=None, nv=None) -> tuple[float, float, float]:
         """(area, signed volume contribution (1/3)∫X·n dA, plan-area contribution ∫max(n_z,0) dA)."""
         s, sw, t, tw = self._rules(face, nu, nv)
-        S, T = np.meshgrid(s, t, indexing="ij")
-        X = face.evaluate(self, S, T)
-        Xs = face.evaluate(self, S, T, "s")
-        Xt = face.evaluate(self, S, T, "t")
+        X = face.evaluate_grid(self, s, t)
+        Xs = face.evaluate_grid(self, s, t, "s")
+        Xt = face.evaluate_grid(self, s, t, "t")
         n = np.cross(Xs, Xt) * face.sign
         W = np.outer(sw, tw)
         dA = np.linalg.norm(n, axis=-1)
@@ -426,7 +457,11 @@ class Tablet:
             if self._end_is_point(i, 1):
                 ang = float("nan")
             else:
-                na, nb = a.normal(1.0, v), b.normal(0.0, v)
+                # skip points where the shared curve has (nearly) zero speed, such as a
+                # corner collapsed to a point: the normals are undefined there
+                speed = np.linalg.norm(a.evaluate(1.0, v, dv=1), axis=-1)
+                ok = speed > 1e-6 * float(np.max(speed))
+                na, nb = a.normal(1.0, v[ok]), b.normal(0.0, v[ok])
                 cosang = np.clip(np.einsum("ij,ij->i", na, nb), -1.0, 1.0)
                 ang = float(np.degrees(np.max(np.arccos(cosang))))
             out.append(

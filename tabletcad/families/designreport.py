@@ -279,7 +279,10 @@ def design_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str
     nom = tablet.nominal
     if not isinstance(nom, SweepNominal):
         raise DesignError("tablet", tablet.name, "is not built from a tabletcad.families family")
-    opts = opts or _OPTIONS.get()
+    if opts is None:
+        opts = _OPTIONS.get()
+        if opts == ReportOptions() and isinstance(tablet.extras.get("report"), dict):
+            opts = ReportOptions.from_table(tablet.extras["report"])  # the design file's [report] table
     cert = nom.certificate
     recert = cert is None or nom.patch_ids != tuple(id(p) for p in tablet.patches)
     if recert:
