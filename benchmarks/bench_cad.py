@@ -213,7 +213,7 @@ def main(argv=None) -> None:
                 r = time_tabletcad(tablet, report, tmp)
                 if best is None or sum(r[:3]) < sum(best[:3]):
                     best = r
-            solid_s, check_s, export_s, solid, mesh, sections = best
+            solid_s, check_s, export_s, solid, mesh, _sections = best
             ref = min((time_build123d(tablet, tmp) for _ in range(max(1, args.repeat))), key=lambda x: x[0])
             total = solid_s + check_s + export_s
             totals.append(total)

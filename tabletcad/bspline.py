@@ -407,7 +407,7 @@ def periodic_knots(
     lengths = ends - anchors
     knots_l, mults_l = [], []
     for a, e, L, m in zip(anchors, ends, lengths, anchor_mult):
-        n = max(1, int(round(nv * L / period)))
+        n = max(1, round(nv * L / period))
         knots_l.append(a + (e - a) * np.arange(n) / n)
         mults_l.append(np.concatenate([[m], np.ones(n - 1, dtype=int)]))
     knots = np.concatenate(knots_l + [[period]])

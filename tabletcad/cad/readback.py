@@ -34,6 +34,7 @@ __all__ = [
     "freecad_read_step",
     "freecad_build_bspline",
     "ocp_read_step",
+    "ocp_read_steps",
     "ReadbackError",
 ]
 
@@ -119,50 +120,83 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopAbs import TopAbs_SOLID, TopAbs_FACE
 from OCP.Bnd import Bnd_Box
 from OCP.BRepBndLib import BRepBndLib
-reader = STEPControl_Reader()
-status = reader.ReadFile(sys.argv[1])
-if status != IFSelect_ReturnStatus.IFSelect_RetDone:
-    print("TABLETCAD_JSON:" + json.dumps({"ok": False, "error": str(status)})); sys.exit(0)
-reader.TransferRoots()
-shape = reader.OneShape()
-def count(kind):
-    e = TopExp_Explorer(shape, kind); n = 0
-    while e.More():
-        n += 1; e.Next()
-    return n
-def props(eps):
-    p = GProp_GProps()
-    if eps is None:
-        BRepGProp.VolumeProperties_s(shape, p)
-    else:
-        BRepGProp.VolumeProperties_s(shape, p, Eps=eps)
-    return p.Mass()
-sp = GProp_GProps(); BRepGProp.SurfaceProperties_s(shape, sp, Eps=1e-9)
-box = Bnd_Box(); BRepBndLib.AddOptimal_s(shape, box, False, False)
-pmin, pmax = box.CornerMin(), box.CornerMax()
-xmin, ymin, zmin, xmax, ymax, zmax = pmin.X(), pmin.Y(), pmin.Z(), pmax.X(), pmax.Y(), pmax.Z()
-names = []
-try:
-    model = reader.WS().Model()
-    from OCP.StepBasic import StepBasic_Product
-    for i in range(1, model.NbEntities() + 1):
-        ent = model.Value(i)
-        if isinstance(ent, StepBasic_Product):
-            names.append(ent.Name().ToCString())
-except Exception as exc:
-    names = ["?" + repr(exc)]
-print("TABLETCAD_JSON:" + json.dumps({
-    "ok": True,
-    "n_solids": count(TopAbs_SOLID),
-    "n_faces": count(TopAbs_FACE),
-    "valid": bool(BRepCheck_Analyzer(shape).IsValid()),
-    "volume": props(1e-9),
-    "volume_default": props(None),
-    "area": sp.Mass(),
-    "bbox": [xmin, ymin, zmin, xmax, ymax, zmax],
-    "products": names,
-}))
+
+def read(path):
+    reader = STEPControl_Reader()
+    status = reader.ReadFile(path)
+    if status != IFSelect_ReturnStatus.IFSelect_RetDone:
+        return {"ok": False, "error": str(status), "path": path}
+    reader.TransferRoots()
+    shape = reader.OneShape()
+    def count(kind):
+        e = TopExp_Explorer(shape, kind); n = 0
+        while e.More():
+            n += 1; e.Next()
+        return n
+    def props(eps):
+        p = GProp_GProps()
+        if eps is None:
+            BRepGProp.VolumeProperties_s(shape, p)
+        else:
+            BRepGProp.VolumeProperties_s(shape, p, Eps=eps)
+        return p.Mass()
+    sp = GProp_GProps(); BRepGProp.SurfaceProperties_s(shape, sp, Eps=1e-9)
+    box = Bnd_Box(); BRepBndLib.AddOptimal_s(shape, box, False, False)
+    pmin, pmax = box.CornerMin(), box.CornerMax()
+    names = []
+    try:
+        model = reader.WS().Model()
+        from OCP.StepBasic import StepBasic_Product
+        for i in range(1, model.NbEntities() + 1):
+            ent = model.Value(i)
+            if isinstance(ent, StepBasic_Product):
+                names.append(ent.Name().ToCString())
+    except Exception as exc:
+        names = ["?" + repr(exc)]
+    return {
+        "ok": True,
+        "path": path,
+        "n_solids": count(TopAbs_SOLID),
+        "n_faces": count(TopAbs_FACE),
+        "valid": bool(BRepCheck_Analyzer(shape).IsValid()),
+        "volume": props(1e-9),
+        "volume_default": props(None),
+        "area": sp.Mass(),
+        "bbox": [pmin.X(), pmin.Y(), pmin.Z(), pmax.X(), pmax.Y(), pmax.Z()],
+        "products": names,
+    }
+
+for path in sys.argv[1:]:
+    try:
+        result = read(path)
+    except Exception as exc:
+        result = {"ok": False, "error": repr(exc), "path": path}
+    print("TABLETCAD_JSON:" + json.dumps(result), flush=True)
 """
+
+
+def ocp_read_steps(
+    paths: Sequence[str | os.PathLike[str]], timeout: float = 300.0, python: str | None = None
+) -> list[dict[str, Any]]:
+    """:func:`ocp_read_step` for several files in *one* fresh process (one OCP import)."""
+    paths = [str(Path(p).resolve()) for p in paths]
+    proc = subprocess.run(
+        [python or sys.executable, "-c", _OCP_READER, *paths], capture_output=True, text=True, timeout=timeout
+    )
+    results = [
+        json.loads(line[len("TABLETCAD_JSON:"):])
+        for line in proc.stdout.splitlines()
+        if line.startswith("TABLETCAD_JSON:")
+    ]
+    if len(results) != len(paths):
+        raise ReadbackError(
+            f"OCP read-back printed {len(results)} results for {len(paths)} files "
+            f"(exit {proc.returncode}): {proc.stderr[-2000:]}"
+        )
+    for r in results:
+        if not r.get("ok"):
+            raise ReadbackError(f"STEPControl_Reader failed on {r.get('path')}: {r.get('error')}")
+    return results
 
 
 def ocp_read_step(path: str | os.PathLike[str], timeout: float = 300.0, python: str | None = None) -> dict[str, Any]:
@@ -170,16 +204,4 @@ def ocp_read_step(path: str | os.PathLike[str], timeout: float = 300.0, python: 
 
     Returns ``{n_solids, n_faces, valid, volume (adaptive, eps 1e-9), volume_default, area, bbox, products}``.
     """
-    proc = subprocess.run(
-        [python or sys.executable, "-c", _OCP_READER, str(Path(path).resolve())],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-    )
-    for line in proc.stdout.splitlines()[::-1]:
-        if line.startswith("TABLETCAD_JSON:"):
-            result = json.loads(line[len("TABLETCAD_JSON:"):])
-            if not result.get("ok"):
-                raise ReadbackError(f"STEPControl_Reader failed on {path}: {result.get('error')}")
-            return result
-    raise ReadbackError(f"OCP read-back printed no result (exit {proc.returncode}): {proc.stderr[-2000:]}")
+    return ocp_read_steps([path], timeout=timeout, python=python)[0]
