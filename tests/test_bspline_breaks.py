@@ -1,0 +1,86 @@
+"""Breakpoint-aware periodic knots of :mod:`tabletcad.bspline` (numpy only, no CAD kernel)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from tabletcad.bspline import fit_patches, fit_surface, flat_knots, normalise_breaks, periodic_knots
+from tabletcad.errors import GeometryError
+
+TWO_PI = 2 * math.pi
+
+
+def c1_surface(u, v):
+    """A cylinder-like surface whose radius is only C1 in v at v = 0 and v = pi."""
+    u, v = np.broadcast_arrays(np.asarray(u, float), np.asarray(v, float))
+    r = 2.0 + 0.3 * np.maximum(0.0, np.sin(v)) ** 2 + 0.1 * u
+    return np.stack([r * np.cos(v), r * np.sin(v), 3.0 * u], axis=-1)
+
+
+def test_normalise_breaks_sorts_wraps_and_merges():
+    b = normalise_breaks([TWO_PI, 3.0, 3.0 + 1e-12, -1.0, 1e-13])
+    np.testing.assert_allclose(b, [0.0, 3.0, TWO_PI - 1.0])
+    assert normalise_breaks(None).size == 0 and normalise_breaks([]).size == 0
+
+
+@pytest.mark.parametrize("degree", [3, 4, 5])
+@pytest.mark.parametrize("mult", ["c1", "c0"])
+def test_periodic_knots_structure_and_greville(degree, mult):
+    m = degree - 1 if mult == "c1" else degree
+    k, mm, s = periodic_knots(20, degree, [0.0, 1.0, 4.0], m)
+    assert k[0] == 0.0 and k[-1] == TWO_PI and mm[0] == mm[-1] == m
+    for b in (1.0, 4.0):
+        assert mm[np.argmin(abs(k - b))] == m and np.min(abs(k - b)) < 1e-15
+    n = int(mm[:-1].sum())
+    assert s.size == n and np.all(np.diff(s) > 0) and s[0] >= 0 and s[-1] < TWO_PI
+    # Schoenberg-Whitney: B-spline i contains its Greville point strictly inside its support
+    t = flat_knots(k, mm, degree, True)
+    grev = np.array([t[i + 1 : i + degree + 1].mean() for i in range(n)])
+    assert np.all((t[:n] < grev) & (grev < t[degree + 1 : degree + 1 + n]))
+
+
+def test_uniform_knots_unchanged_without_breaks():
+    k, mm, s = periodic_knots(16, 5)
+    np.testing.assert_array_equal(k, np.linspace(0, TWO_PI, 17))
+    np.testing.assert_array_equal(s, k[:-1])
+    _, _, s4 = periodic_knots(16, 4)
+    np.testing.assert_allclose(s4, k[:-1] + TWO_PI / 32)
+
+
+def _dev(nv, breaks):
+    fit = fit_surface(c1_surface, 5, 5, nu=9, nv=nv, tol=1e-15, fixed_nv=True, max_iterations=1,
+                      v_breaks=breaks, raise_on_failure=False)
+    return fit.max_deviation
+
+
+def test_breakpoint_knots_restore_full_order():
+    # with C1 knots at the breaks: ~h^6 (quintic); uniform knots: ~h^3 (the C1 kink)
+    e1, e2 = _dev(24, [0.0, math.pi]), _dev(48, [0.0, math.pi])
+    u1, u2 = _dev(24, None), _dev(48, None)
+    assert e1 / e2 > 25, (e1, e2)
+    assert u1 / u2 < 12, (u1, u2)
+    assert e2 < u2 / 100
+
+
+def test_fit_patches_share_breakpoint_knots():
+    f0 = c1_surface
+    f1 = lambda u, v: c1_surface(1.0 + 0 * u, v) + np.stack(  # noqa: E731
+        [0 * u, 0 * u, 2.0 * np.broadcast_to(u, np.broadcast(u, v).shape)], axis=-1)
+    fits = fit_patches([f0, f1], 1e-6, u_degree=5, v_degree=5, v_breaks=[math.pi, 0.0])
+    a, b = fits[0].surface, fits[1].surface
+    np.testing.assert_array_equal(a.v_knots, b.v_knots)
+    np.testing.assert_array_equal(a.v_mults, b.v_mults)
+    np.testing.assert_array_equal(a.poles[-1], b.poles[0])
+    assert max(f.max_deviation for f in fits) <= 1e-6
+    assert a.shape[1] < 120
+
+
+def test_unreachable_tolerance_raises_with_name():
+    with pytest.raises(GeometryError, match=r"fit of side .* max deviation"):
+        fit_surface(c1_surface, 5, 5, tol=1e-14, max_nv=40, max_iterations=2, v_breaks=[0.0, math.pi], name="side")
+
+
+def test_bad_break_multiplicity():
+    with pytest.raises(ValueError):
+        periodic_knots(10, 3, [1.0], 4)
