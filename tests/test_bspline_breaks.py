@@ -41,7 +41,7 @@ def test_periodic_knots_structure_and_greville(degree, mult):
 
 
 def test_uniform_knots_unchanged_without_breaks():
-    k, mm, s = periodic_knots(16, 5)
+    k, _mm, s = periodic_knots(16, 5)
     np.testing.assert_array_equal(k, np.linspace(0, TWO_PI, 17))
     np.testing.assert_array_equal(s, k[:-1])
     _, _, s4 = periodic_knots(16, 4)
@@ -65,7 +65,7 @@ def test_breakpoint_knots_restore_full_order():
 
 def test_fit_patches_share_breakpoint_knots():
     f0 = c1_surface
-    f1 = lambda u, v: c1_surface(1.0 + 0 * u, v) + np.stack(  # noqa: E731
+    f1 = lambda u, v: c1_surface(1.0 + 0 * u, v) + np.stack(
         [0 * u, 0 * u, 2.0 * np.broadcast_to(u, np.broadcast(u, v).shape)], axis=-1)
     fits = fit_patches([f0, f1], 1e-6, u_degree=5, v_degree=5, v_breaks=[math.pi, 0.0])
     a, b = fits[0].surface, fits[1].surface
