@@ -1,0 +1,198 @@
+"""Exact OCC Booleans on solids, each cross-checked with manifold3d on meshes.
+
+:func:`boolean` runs ``BRepAlgoAPI_Cut/Fuse/Common`` (non-destructive,
+parallel), merges faces split on the same surface
+(``ShapeUpgrade_UnifySameDomain``) and insists on exactly one solid that
+passes ``BRepCheck_Analyzer``.  :func:`checked_boolean` repeats the operation
+on manifold3d meshes (``Mesh64``, tessellated by :func:`tabletcad.cad.mesh.triangulate`)
+and compares the volume removed or added: a triangulation with chord height
+``d`` misplaces each surface by at most ``d``, so the two volume changes may
+differ by about ``d`` times the area of the tool's surface (``bound_mm3``).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
+from OCP.BRepBuilderAPI import BRepBuilderAPI_Transform
+from OCP.gp import gp_Trsf, gp_Vec
+from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
+from OCP.TopoDS import TopoDS_Shape
+
+from tabletcad.cad._occ import explore
+from tabletcad.cad.solid import check_solid, mass_properties
+from tabletcad.errors import GeometryError
+
+try:  # OCP >= 8.0
+    from OCP.collections import List_TopoDS_Shape as _ShapeList
+except ImportError:  # pragma: no cover - OCP 7.x
+    from OCP.TopTools import TopTools_ListOfShape as _ShapeList
+
+__all__ = ["boolean", "checked_boolean", "BooleanCheck", "to_manifold", "manifold_volume", "translated", "volume", "TIMER"]
+
+_ALGOS = {"cut": BRepAlgoAPI_Cut, "fuse": BRepAlgoAPI_Fuse, "common": BRepAlgoAPI_Common}
+
+#: seconds spent in OCC Booleans and in manifold3d (meshing + Booleans), for the benchmarks
+TIMER = {"occ_boolean_s": 0.0, "manifold_s": 0.0, "occ_booleans": 0, "manifold_booleans": 0}
+
+
+def _list(*shapes: TopoDS_Shape):
+    lst = _ShapeList()
+    for s in shapes:
+        lst.Append(s)
+    return lst
+
+
+def raw_boolean(op: str, a: TopoDS_Shape, b: TopoDS_Shape, fuzzy: float = 0.0, glue: bool = False) -> TopoDS_Shape:
+    """The OCC Boolean ``a op b`` as it comes (a compound, possibly empty).
+
+    ``glue``: ``BOPAlgo_GlueFull``, for arguments that only touch along shared faces."""
+    t0 = time.perf_counter()
+    algo = _ALGOS[op]()
+    algo.SetArguments(_list(a))
+    algo.SetTools(_list(b))
+    algo.SetRunParallel(True)
+    algo.SetNonDestructive(True)
+    if fuzzy > 0:
+        algo.SetFuzzyValue(float(fuzzy))
+    if glue:
+        from OCP.BOPAlgo import BOPAlgo_GlueEnum
+
+        algo.SetGlue(BOPAlgo_GlueEnum.BOPAlgo_GlueFull)
+    algo.Build()
+    TIMER["occ_boolean_s"] += time.perf_counter() - t0
+    TIMER["occ_booleans"] += 1
+    if not algo.IsDone() or (hasattr(algo, "HasErrors") and algo.HasErrors()):
+        raise GeometryError(f"OCC Boolean {op} failed", (a, b))
+    return algo.Shape()
+
+
+def boolean(op: str, a: TopoDS_Shape, b: TopoDS_Shape, *, what: str = "result", fuzzy: float = 0.0) -> TopoDS_Shape:
+    """``a op b`` as exactly one valid solid (faces on one surface merged)."""
+    shape = raw_boolean(op, a, b, fuzzy)
+    solids = explore(shape, "Solid")
+    if len(solids) != 1:
+        vols = ", ".join(f"{mass_properties(s, 1e-7).volume:.4g}" for s in solids[:6])
+        raise GeometryError(f"{what}: the {op} gave {len(solids)} solids (volumes {vols} mm^3), expected one", shape)
+    unify = ShapeUpgrade_UnifySameDomain(solids[0], True, True, False)
+    unify.Build()
+    solid = explore(unify.Shape(), "Solid")
+    solid = solid[0] if len(solid) == 1 else solids[0]
+    try:
+        check_solid(solid, what)
+    except GeometryError:
+        check_solid(solids[0], what)  # unification broke it: keep the raw result
+        solid = solids[0]
+    return solid
+
+
+def translated(shape: TopoDS_Shape, dx: float = 0.0, dy: float = 0.0, dz: float = 0.0) -> TopoDS_Shape:
+    """A copy of ``shape`` moved by ``(dx, dy, dz)`` mm (geometry copied, no location)."""
+    tr = gp_Trsf()
+    tr.SetTranslation(gp_Vec(float(dx), float(dy), float(dz)))
+    return BRepBuilderAPI_Transform(shape, tr, True).Shape()
+
+
+def volume(shape: TopoDS_Shape, eps: float = 1e-9) -> float:
+    """Volume (mm^3) by OCC's adaptive integration."""
+    return mass_properties(shape, eps).volume
+
+
+# ----------------------------------------------------------------------------- manifold3d
+def to_manifold(shape: TopoDS_Shape, deflection: float = 0.005, angular: float = 0.2):
+    """A ``manifold3d.Manifold`` from the OCC tessellation of ``shape`` (double precision)."""
+    import manifold3d
+
+    from tabletcad.cad.mesh import triangulate
+
+    t0 = time.perf_counter()
+    try:
+        V, T = triangulate(shape, deflection, angular)
+    except GeometryError:  # Delabella leaves some trimmed faces (letter counters) untriangulated
+        V, T = triangulate(shape, deflection, angular, algo="watson")
+    m = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=np.ascontiguousarray(V, dtype=np.float64),
+                                              tri_verts=np.ascontiguousarray(T, dtype=np.uint32)))
+    status = getattr(m.status(), "name", str(m.status()))
+    TIMER["manifold_s"] += time.perf_counter() - t0
+    if not str(status).endswith("NoError"):
+        raise GeometryError(f"manifold3d refused the tessellation: {status}", shape)
+    return m
+
+
+def manifold_volume(m) -> float:
+    """Volume (mm^3) of a manifold, summed in float64 from its ``Mesh64``."""
+    mesh = m.to_mesh64()
+    V = np.asarray(mesh.vert_properties, dtype=float)[:, :3]
+    T = np.asarray(mesh.tri_verts, dtype=np.int64)
+    if len(T) == 0:
+        return 0.0
+    a, b, c = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+def manifold_op(op: str, ma, mb):
+    t0 = time.perf_counter()
+    out = {"cut": lambda: ma - mb, "fuse": lambda: ma + mb, "common": lambda: ma ^ mb}[op]()
+    TIMER["manifold_s"] += time.perf_counter() - t0
+    TIMER["manifold_booleans"] += 1
+    return out
+
+
+@dataclass(frozen=True)
+class BooleanCheck:
+    """One Boolean and its manifold3d cross-check (volumes in mm^3)."""
+
+    what: str
+    op: str
+    occ_change_mm3: float
+    mesh_change_mm3: float
+    abs_diff_mm3: float
+    rel_diff: float
+    bound_mm3: float
+    deflection_mm: float
+    valid: bool
+    ok: bool
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def checked_boolean(
+    op: str,
+    a: TopoDS_Shape,
+    b: TopoDS_Shape,
+    *,
+    what: str,
+    deflection: float = 0.005,
+    check: bool = True,
+    a_manifold=None,
+    fuzzy: float = 0.0,
+) -> tuple[TopoDS_Shape, BooleanCheck | None]:
+    """:func:`boolean` plus the manifold3d check; raises :class:`GeometryError` if they disagree.
+
+    The "change" is the volume removed (cut), added (fuse) or kept (common).
+    """
+    result = boolean(op, a, b, what=what, fuzzy=fuzzy)
+    if not check:
+        return result, None
+    va, vr = volume(a), volume(result)
+    occ_change = {"cut": va - vr, "fuse": vr - va, "common": vr}[op]
+    ma = a_manifold if a_manifold is not None else to_manifold(a, deflection)
+    mb = to_manifold(b, deflection)
+    mr = manifold_op(op, ma, mb)
+    mva, mvr = manifold_volume(ma), manifold_volume(mr)
+    mesh_change = {"cut": mva - mvr, "fuse": mvr - mva, "common": mvr}[op]
+    area_b = mass_properties(b, 1e-6).area
+    bound = deflection * area_b
+    diff = abs(occ_change - mesh_change)
+    chk = BooleanCheck(what, op, occ_change, mesh_change, diff, diff / max(abs(occ_change), 1e-300), bound,
+                       deflection, True, diff <= bound)
+    if not chk.ok:
+        raise GeometryError(
+            f"{what}: OCC and manifold3d disagree on the {op}: {occ_change:.6g} vs {mesh_change:.6g} mm^3 "
+            f"(allowed {bound:.3g} mm^3 at {deflection} mm deflection)", (a, b))
+    return result, chk

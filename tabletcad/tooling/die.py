@@ -1,0 +1,94 @@
+"""The die: a cylinder with a bore that follows the tablet outline.
+
+The bore is the tablet's outline (the band; enlarged by the band's PDE bulge
+where the band is not exactly a prism) from the die's bottom up to the band's
+top edge at the closed position, and above it either straight or opening at
+``taper_deg`` to the die's top face.  The die's top face stands
+``penetration`` above the band's top edge (how far the upper punch enters the
+die at compression).  Standard TSM die sizes are used by default: "B"
+(30.16 mm × 22.22 mm) for tablets up to 16 mm, "D" (38.10 mm × 23.81 mm) up
+to 25.4 mm.
+"""
+
+from __future__ import annotations
+
+import math
+
+from OCP.BRepAdaptor import BRepAdaptor_Curve
+from OCP.BRepOffsetAPI import BRepOffsetAPI_ThruSections
+from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
+from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+
+from tabletcad.cad._occ import cast, explore
+from tabletcad.errors import DesignError
+from tabletcad.tooling.booleans import boolean, translated, volume
+from tabletcad.tooling.outline import TabletFrame, offset_wire, prism
+
+__all__ = ["die", "default_die_size", "MIN_WALL_MM"]
+
+MIN_WALL_MM = 2.0
+TSM_DIES = ((16.0, 30.16, 22.22, "B"), (25.4, 38.10, 23.81, "D"))
+
+
+def _max_radius(wire) -> float:
+    r = 0.0
+    for e in explore(wire, "Edge"):
+        c = BRepAdaptor_Curve(e)
+        a, b = c.FirstParameter(), c.LastParameter()
+        for k in range(65):
+            p = c.Value(a + (b - a) * k / 64.0)
+            r = max(r, math.hypot(p.X(), p.Y()))
+    return r
+
+
+def default_die_size(frame: TabletFrame) -> tuple[float, float, str]:
+    """``(outer diameter, height, TSM type)`` for the tablet's largest plan dimension."""
+    size = max(frame.length, frame.width)
+    for lim, od, h, name in TSM_DIES:
+        if size <= lim:
+            return od, h, name
+    raise DesignError("[tooling] die_outer_diameter_mm", "missing",
+                      f"give it for a tablet {size:.4g} mm long (larger than a TSM 'D' die takes, 25.4 mm)", "mm")
+
+
+def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, taper_deg: float = 0.0,
+        penetration: float | None = None):
+    """The die solid at the closed position and its facts (``(shape, info)``)."""
+    od0, h0, kind = default_die_size(frame) if outer_diameter is None or height is None else (None, None, "custom")
+    od = outer_diameter if outer_diameter is not None else od0
+    H = height if height is not None else h0
+    bulge = frame.band_bulge
+    bore = offset_wire(frame.outline, bulge) if bulge > 0 else frame.outline
+    r_bore = _max_radius(bore)
+    if od / 2.0 - r_bore < MIN_WALL_MM:
+        raise DesignError("[tooling] die_outer_diameter_mm", od,
+                          f"must be >= {2 * (r_bore + MIN_WALL_MM):.4g} mm (bore reaches {r_bore:.4g} mm from the axis, "
+                          f"walls need {MIN_WALL_MM} mm)", "mm")
+    pen = min(3.0, 0.25 * H) if penetration is None else penetration
+    z_top = frame.band_z[1] + pen
+    z_bot = z_top - H
+    if z_bot > frame.band_z[0] - 1.0:
+        raise DesignError("[tooling] die_height_mm", H,
+                          f"must be >= {pen + frame.band + 1.0:.4g} mm (upper punch entry {pen:.3g} mm + band "
+                          f"{frame.band:.4g} mm + 1 mm below the tablet)", "mm")
+    blank = translated(BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), od / 2.0, H).Shape(), dz=z_bot)
+    z_taper = frame.band_z[1] if taper_deg > 0 else z_top + 1.0
+    straight = prism(bore, z_bot - 1.0, min(z_taper, z_top + 1.0))
+    shape = boolean("cut", blank, straight, what="die bore")
+    grow = 0.0
+    if taper_deg > 0:
+        grow = (z_top - z_taper) * math.tan(math.radians(taper_deg))
+        top_wire = offset_wire(bore, grow + 1.0 * math.tan(math.radians(taper_deg)))
+        loft = BRepOffsetAPI_ThruSections(True, True, 1e-6)
+        loft.AddWire(cast(translated(bore, dz=z_taper), "Wire"))
+        loft.AddWire(cast(translated(top_wire, dz=z_top + 1.0), "Wire"))
+        loft.CheckCompatibility(False)
+        loft.Build()
+        shape = boolean("cut", shape, loft.Shape(), what="die taper")
+    info = dict(
+        outer_diameter_mm=od, height_mm=H, tsm_size=kind, top_z_mm=z_top, bottom_z_mm=z_bot,
+        punch_entry_mm=pen, bore=frame.outline_kind, bore_enlarged_by_band_bulge_mm=bulge,
+        bore_max_radius_mm=r_bore, taper_deg=taper_deg, taper_start_z_mm=z_taper if taper_deg > 0 else None,
+        bore_growth_at_top_mm=grow, volume_mm3=volume(shape),
+    )
+    return shape, info

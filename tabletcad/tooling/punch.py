@@ -1,0 +1,138 @@
+"""Upper and lower punch tips whose faces are the tablet's cups.
+
+A tip is the plan outline inset by the radial clearance, extruded from inside
+the tablet (mid band) to ``tip_length_mm`` beyond the band edge, minus the
+tablet solid: its face is the cup (scores become bars, debossed figures
+raised ones and embossed figures engravings).  Parts are made in the closed
+position (the tip edges at the band edges).
+
+Working-length datum: the tip's back face (``datum_plane_z_mm``) is the
+reference plane; the working-length point is the bottom of the punch cup
+(the tablet's extreme point on that face), recorded with its distance from
+the datum.  The full punch length is the toolmaker's; the datum distances let
+it be added.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tabletcad.tooling.booleans import checked_boolean, volume
+from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, prism, wire_length
+
+__all__ = ["PunchTip", "punch_tip", "cup_volume_within", "punch_volume_quadrature"]
+
+
+@dataclass(eq=False)
+class PunchTip:
+    """A punch tip solid (mm) at the closed position and its facts."""
+
+    name: str
+    shape: object
+    volume_mm3: float
+    info: dict = field(default_factory=dict)
+
+
+def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, tip_length: float, *,
+              check: bool = True, deflection: float = 0.005, tablet_manifold=None):
+    """The ``"upper"`` or ``"lower"`` punch tip; returns ``(PunchTip, BooleanCheck or None)``."""
+    tip_wire = offset_wire(frame.outline, -clearance)
+    z_mid = 0.5 * (frame.band_z[0] + frame.band_z[1])
+    if which == "upper":
+        edge = frame.band_z[1]
+        z0, z1 = z_mid, edge + tip_length
+        cup_point = frame.z_max
+        datum = z1
+    else:
+        edge = frame.band_z[0]
+        z0, z1 = edge - tip_length, z_mid
+        cup_point = frame.z_min
+        datum = z0
+    body = prism(tip_wire, z0, z1)
+    # the manifold check is on "prism minus tablet": the removed volume is the tablet inside the prism
+    shape, chk = checked_boolean("cut", body, tablet_shape, what=f"{which} punch tip", deflection=deflection,
+                                 check=check, a_manifold=None)
+    vol = volume(shape)
+    land = None if frame.land is None else frame.land - clearance
+    quad = punch_volume_quadrature(frame, clearance, tip_length, which)
+    info = dict(
+        tip_outline=frame.outline_kind,
+        tip_plan_area_mm2=face_area(plan_face(tip_wire)),
+        tip_perimeter_mm=wire_length(tip_wire),
+        tip_diameter_mm=None if frame.round_radius is None else 2.0 * (frame.round_radius - clearance),
+        tip_length_mm=tip_length,
+        clearance_mm=clearance,
+        land_mm=land,
+        tip_edge_z_mm=edge,
+        cup_depth_mm=frame.cup_depth_top if which == "upper" else frame.cup_depth_bottom,
+        working_length_datum=dict(
+            datum_plane_z_mm=datum,
+            cup_bottom_point_mm=[0.0, 0.0, cup_point],
+            datum_to_cup_bottom_mm=abs(datum - cup_point),
+            datum_to_tip_edge_mm=abs(datum - edge),
+            note="datum = back face of the tip; working length = head flat to cup bottom, i.e. "
+                 "(head flat to datum) + datum_to_cup_bottom_mm",
+        ),
+        volume_mm3=vol,
+        volume_quadrature_mm3=quad,
+        volume_rel_diff_vs_quadrature=None if quad is None else (vol - quad) / quad,
+    )
+    return PunchTip(f"{which}_punch", shape, vol, info), chk
+
+
+# ----------------------------------------------------------------------------- quadrature
+def _face_patches(frame: TabletFrame, which: str):
+    """Patches of the tablet's upper (lower) face: everything at or beyond the band edge."""
+    out = []
+    u = np.linspace(0.0, 1.0, 9)
+    for p in frame.tablet.patches:
+        z = p.evaluate(u, np.zeros_like(u))[:, 2]
+        if which == "upper" and np.all(z >= frame.band_z[1] - 1e-9) and np.ptp(z) + np.ptp(p.evaluate(u, 0.0 * u)[:, 0]) > 0:
+            out.append(p)
+        if which == "lower" and np.all(z <= frame.band_z[0] + 1e-9) and np.ptp(z) + np.ptp(p.evaluate(u, 0.0 * u)[:, 0]) > 0:
+            out.append(p)
+    return out
+
+
+def cup_volume_within(frame: TabletFrame, rho: float, which: str = "upper", n: int = 48) -> float | None:
+    """Volume (mm^3) between a round tablet's face and its band-edge plane inside radius ``rho``:
+    ``∫_0^ρ 2π r |z(r) - z_edge| dr`` by Gauss-Legendre on each face patch's profile (the
+    patches of a round tablet are surfaces of revolution); None for other tablets."""
+    from scipy.optimize import brentq
+
+    if frame.round_radius is None:
+        return None
+    z_e = frame.band_z[1] if which == "upper" else frame.band_z[0]
+    x, w = np.polynomial.legendre.leggauss(n)
+    total = 0.0
+    for p in _face_patches(frame, which):
+        def r_of(u, p=p):
+            return float(np.hypot(*p.evaluate(u, 0.0)[:2]))
+
+        r0, r1 = r_of(0.0), r_of(1.0)
+        lo, hi = 0.0, 1.0
+        if min(r0, r1) >= rho:
+            continue
+        if max(r0, r1) > rho:
+            us = brentq(lambda u: r_of(u) - rho, 0.0, 1.0, xtol=1e-15)
+            lo, hi = (0.0, us) if r0 < r1 else (us, 1.0)
+        u = 0.5 * (hi - lo) * (x + 1.0) + lo
+        X = p.evaluate(u, np.zeros_like(u))
+        Xu = p.evaluate(u, np.zeros_like(u), du=1)
+        r = np.hypot(X[:, 0], X[:, 1])
+        dr = (X[:, 0] * Xu[:, 0] + X[:, 1] * Xu[:, 1]) / np.maximum(r, 1e-300)
+        total += abs(float(np.sum(0.5 * (hi - lo) * w * 2.0 * math.pi * r * np.abs(X[:, 2] - z_e) * dr)))
+    return total
+
+
+def punch_volume_quadrature(frame: TabletFrame, clearance: float, tip_length: float, which: str = "upper") -> float | None:
+    """Volume (mm^3) of a plain round punch tip: cylinder of radius ``R - clearance`` and
+    ``tip_length`` minus the cup inside it (:func:`cup_volume_within`); None if not round."""
+    if frame.round_radius is None:
+        return None
+    rho = frame.round_radius - clearance
+    cup = cup_volume_within(frame, rho, which)
+    return math.pi * rho * rho * tip_length - cup

@@ -1,0 +1,132 @@
+"""Bisect and quadrisect score grooves, cut from the tablet solid by exact OCC Booleans.
+
+A groove is a prism along ``direction_deg`` (plan angle from x) through the
+tablet's axis, long enough to leave the tablet at both ends, whose cross
+section hangs from the face's highest point (``z_max``, or ``z_min`` for the
+bottom face) down to ``depth_mm``:
+
+* ``v``: a V of ``angle_deg`` (included angle); its width at the depth's top
+  is ``2 depth tan(angle/2)``;
+* ``u``: a round bottom of radius ``width_mm/2`` with vertical walls;
+* ``pressure_sensitive``: a V (``angle_deg``) ending ``depth/3`` above the
+  bottom in a parallel slot ``slot_width_mm`` wide (the break line).
+
+The groove bottom is straight.  A *standard* score must run out on the face
+(depth below the cup depth, so the punch's score bar stays above its tip edge);
+a *cut-through* score (``cut_through = true``) continues through the band edge
+and may be at most the cup depth plus a quarter of the band deep (two
+cut-through grooves leave at least half the band).  Quadrisects are two
+grooves crossing at 90 degrees.  Each cut is checked against manifold3d
+(:func:`tabletcad.tooling.booleans.checked_boolean`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
+from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
+from OCP.gp import gp_Pnt, gp_Vec
+
+from tabletcad.errors import DesignError, GeometryError
+from tabletcad.tooling.booleans import boolean, checked_boolean
+from tabletcad.tooling.outline import TabletFrame
+from tabletcad.tooling.spec import ScoreSpec
+
+__all__ = ["groove_profile", "groove_solid", "score_cutter", "apply_scores", "check_score"]
+
+RUN_OUT_MARGIN_MM = 0.005
+ABOVE_MM = 0.5  # the groove's walls continue this far above the face
+
+
+def groove_profile(s: ScoreSpec, z_bottom: float, z_top: float) -> list[tuple[float, float]]:
+    """Cross-section polygon ``(across, z)`` of a groove whose bottom is at ``z_bottom``,
+    opening towards ``z_top`` (above for the top face, below for the bottom face)."""
+    sg = 1.0 if z_top > z_bottom else -1.0
+    H = abs(z_top - z_bottom)
+    t = math.tan(math.radians(0.5 * s.angle_deg))
+    if s.profile == "v":
+        return [(0.0, z_bottom), (H * t, z_top), (-H * t, z_top)]
+    if s.profile == "u":
+        r = 0.5 * s.width_mm
+        zc = z_bottom + sg * r
+        pts = [(r * math.cos(a), zc - sg * r * math.sin(a)) for a in (math.pi * k / 24 for k in range(25))]
+        if H > r:
+            return [(r, z_top)] + pts + [(-r, z_top)]
+        raise DesignError("[[tooling.score]] width_mm", s.width_mm, "must be < 2 x (depth + 0.5 mm) for a U profile", "mm")
+    sw = 0.5 * s.slot_width_mm
+    sd = s.depth_mm / 3.0
+    z1 = z_bottom + sg * sd
+    h = H - sd
+    return [(-sw, z_bottom), (sw, z_bottom), (sw, z1), (sw + h * t, z_top), (-sw - h * t, z_top), (-sw, z1)]
+
+
+def groove_solid(profile: list[tuple[float, float]], direction_deg: float, length: float):
+    """Prism of ``profile`` (in the plane across ``direction_deg`` through the axis), ``length`` long, centred."""
+    th = math.radians(direction_deg)
+    d = (math.cos(th), math.sin(th))
+    n = (-math.sin(th), math.cos(th))
+    poly = BRepBuilderAPI_MakePolygon()
+    for s_, z in profile:
+        poly.Add(gp_Pnt(-0.5 * length * d[0] + s_ * n[0], -0.5 * length * d[1] + s_ * n[1], z))
+    poly.Close()
+    face = BRepBuilderAPI_MakeFace(poly.Wire(), True).Face()
+    return BRepPrimAPI_MakePrism(face, gp_Vec(length * d[0], length * d[1], 0.0)).Shape()
+
+
+def check_score(frame: TabletFrame, s: ScoreSpec, i: int = 0) -> None:
+    """Raise :class:`DesignError` if the score is deeper than the cup (and band) allow."""
+    w = f"[[tooling.score]] {i} depth_mm"
+    for face in s.face_list:
+        cup = frame.cup_depth_top if face == "top" else frame.cup_depth_bottom
+        if s.cut_through:
+            limit = cup + 0.25 * frame.band
+            if s.depth_mm > limit:
+                raise DesignError(w, s.depth_mm, f"must be <= cup depth + band/4 = {limit:.4g} mm on the {face} face "
+                                  "(a cut-through score must leave half the band)", "mm")
+        elif s.depth_mm > cup - RUN_OUT_MARGIN_MM:
+            raise DesignError(w, s.depth_mm, f"must be < the {face} cup depth {cup:.4g} mm minus {RUN_OUT_MARGIN_MM} mm "
+                              "(a standard score runs out on the face; set cut_through = true to cut the band)", "mm")
+
+
+def score_cutter(frame: TabletFrame, s: ScoreSpec, face: str):
+    """The solid removed by score ``s`` on ``face`` (one groove, or two fused for a quadrisect)."""
+    length = 2.0 * max(frame.length, frame.width) + 4.0
+    if face == "top":
+        zb = frame.z_max - s.depth_mm
+        zt = frame.z_max + ABOVE_MM
+    else:
+        zb = frame.z_min + s.depth_mm
+        zt = frame.z_min - ABOVE_MM
+    prof = groove_profile(s, zb, zt)
+    cutter = groove_solid(prof, s.direction_deg, length)
+    if s.kind == "quadrisect":
+        cutter = boolean("fuse", cutter, groove_solid(prof, s.direction_deg + 90.0, length), what="quadrisect cutter")
+    return cutter
+
+
+def apply_scores(frame: TabletFrame, shape, scores, *, check: bool = True, deflection: float = 0.005,
+                 a_manifold=None) -> tuple[Any, list, list[dict]]:
+    """Cut every score from ``shape``; returns ``(solid, Boolean checks, per-score info)``."""
+    checks, infos = [], []
+    for i, s in enumerate(scores):
+        check_score(frame, s, i)
+        for face in s.face_list:
+            cutter = score_cutter(frame, s, face)
+            try:
+                shape, chk = checked_boolean("cut", shape, cutter, what=f"score {i} ({s.kind}, {face})",
+                                             deflection=deflection, check=check, a_manifold=a_manifold)
+            except GeometryError as exc:
+                raise GeometryError(f"score {i} on the {face} face: {exc}", exc.obj) from None
+            a_manifold = None
+            if chk is not None:
+                checks.append(chk)
+            t = math.tan(math.radians(0.5 * s.angle_deg))
+            width = {"v": 2 * s.depth_mm * t, "u": s.width_mm,
+                     "pressure_sensitive": s.slot_width_mm + 2 * (2 * s.depth_mm / 3) * t}[s.profile]
+            infos.append(dict(index=i, kind=s.kind, profile=s.profile, face=face, depth_mm=s.depth_mm,
+                              width_at_face_centre_mm=width, angle_deg=s.angle_deg, cut_through=s.cut_through,
+                              direction_deg=s.direction_deg,
+                              removed_mm3=None if chk is None else chk.occ_change_mm3))
+    return shape, checks, infos

@@ -1,0 +1,205 @@
+"""The ``[tooling]`` table of a design file, checked key by key.
+
+::
+
+    [tooling]
+    clearance_mm = 0.025           # radial clearance, punch tip to die bore (>= 0)
+    tip_length_mm = 8.0            # punch tip length above (below) the tip edge
+    die_outer_diameter_mm = 30.16  # die outer diameter
+    die_height_mm = 22.22          # die height
+    taper_deg = 0.0                # die bore taper above the tablet, degrees (0 = straight)
+    gap_mm = 2.8                   # distance between the punch tip edges; default: closed (= band)
+
+    [[tooling.score]]              # bisect or quadrisect score
+    kind = "bisect"                # "bisect" | "quadrisect"
+    profile = "v"                  # "v" | "u" | "pressure_sensitive"
+    depth_mm = 0.3
+    angle_deg = 90.0               # included angle of a V (or of the V above a pressure-sensitive slot)
+    width_mm = 0.0                 # U width (also an alternative to angle_deg for a V)
+    cut_through = false            # true: the groove runs out through the band edge
+    faces = "top"                  # "top" | "bottom" | "both"
+    direction_deg = 90.0           # groove direction in plan, from the x axis
+
+    [[tooling.emboss]]             # text or a logo outline, debossed (cut) or embossed (raised)
+    text = "A10"                   # or: outline = [[x, y], ...] (closed polyline, mm)
+    mode = "deboss"                # "deboss" | "emboss"
+    face = "top"                   # "top" | "bottom"
+    height_mm = 2.0                # font size (text)
+    depth_mm = 0.15                # depth (deboss) or height (emboss), along the axis
+    draft_deg = 0.0                # stroke draft angle of the letter walls
+    font = "DejaVuSans-Bold"       # a DejaVu font name or a .ttf path
+    position_mm = [0.0, 0.0]
+    rotation_deg = 0.0
+    margin_mm = 0.2                # required distance from the punch tip edge
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from tabletcad.errors import DesignError, check_finite, check_positive, check_range
+
+__all__ = ["ToolingSpec", "ScoreSpec", "EmbossSpec", "parse_tooling", "FONT_DIR", "font_path"]
+
+FONT_DIR = Path("/usr/share/fonts/truetype/dejavu")
+
+
+@dataclass(frozen=True)
+class ScoreSpec:
+    kind: str = "bisect"
+    profile: str = "v"
+    depth_mm: float = 0.3
+    angle_deg: float = 90.0
+    width_mm: float = 0.0
+    cut_through: bool = False
+    faces: str = "top"
+    direction_deg: float = 90.0
+    slot_width_mm: float = 0.1
+
+    @property
+    def face_list(self) -> tuple[str, ...]:
+        return ("top", "bottom") if self.faces == "both" else (self.faces,)
+
+
+@dataclass(frozen=True)
+class EmbossSpec:
+    text: str | None = None
+    outline: tuple | None = None
+    mode: str = "deboss"
+    face: str = "top"
+    height_mm: float = 2.0
+    depth_mm: float = 0.15
+    draft_deg: float = 0.0
+    font: str = "DejaVuSans-Bold"
+    position_mm: tuple[float, float] = (0.0, 0.0)
+    rotation_deg: float = 0.0
+    margin_mm: float = 0.2
+
+
+@dataclass(frozen=True)
+class ToolingSpec:
+    clearance_mm: float = 0.025
+    tip_length_mm: float = 8.0
+    die_outer_diameter_mm: float | None = None
+    die_height_mm: float = 22.22
+    taper_deg: float = 0.0
+    gap_mm: float | None = None
+    scores: tuple[ScoreSpec, ...] = ()
+    emboss: tuple[EmbossSpec, ...] = ()
+    extra: dict = field(default_factory=dict)
+
+    def with_(self, **kw: Any) -> "ToolingSpec":
+        return replace(self, **kw)
+
+
+def _keys(where: str, table: Any, allowed: set[str]) -> dict:
+    if not isinstance(table, dict):
+        raise DesignError(where, table, "must be a table")
+    for k in table:
+        if k not in allowed:
+            raise DesignError(f"{where} key {k!r}", table[k], f"allowed keys are {', '.join(sorted(allowed))}")
+    return table
+
+
+def _choice(where: str, value: Any, options: tuple[str, ...]) -> str:
+    if value not in options:
+        raise DesignError(where, value, f"must be one of {', '.join(repr(o) for o in options)}")
+    return value
+
+
+def _bool(where: str, value: Any) -> bool:
+    if not isinstance(value, bool):
+        raise DesignError(where, value, "must be true or false")
+    return value
+
+
+def font_path(font: str) -> Path:
+    """A ``.ttf`` file: a path, or a DejaVu font name (``"DejaVuSans-Bold"``)."""
+    p = Path(font)
+    if p.suffix.lower() in (".ttf", ".otf") and p.is_file():
+        return p
+    q = FONT_DIR / f"{font}.ttf"
+    if q.is_file():
+        return q
+    names = sorted(x.stem for x in FONT_DIR.glob("*.ttf")) if FONT_DIR.is_dir() else []
+    raise DesignError("[[tooling.emboss]] font", font, f"must be a .ttf path or one of {', '.join(names[:8]) or 'the DejaVu fonts (not installed)'}...")
+
+
+def _score(i: int, t: Any) -> ScoreSpec:
+    w = f"[[tooling.score]] {i}"
+    d = ScoreSpec()
+    t = _keys(w, t, set(ScoreSpec.__dataclass_fields__))
+    kind = _choice(f"{w} kind", t.get("kind", d.kind), ("bisect", "quadrisect"))
+    profile = _choice(f"{w} profile", t.get("profile", d.profile), ("v", "u", "pressure_sensitive"))
+    depth = check_positive(f"{w} depth_mm", t.get("depth_mm", d.depth_mm), "mm")
+    angle = check_range(f"{w} angle_deg", t.get("angle_deg", d.angle_deg), 0.0, 180.0, "deg", lo_open=True, hi_open=True)
+    width = check_range(f"{w} width_mm", t.get("width_mm", d.width_mm), 0.0, None, "mm")
+    if profile == "u" and width <= 0:
+        raise DesignError(f"{w} width_mm", width, "must be > 0 for a U profile", "mm")
+    if profile == "v" and width > 0 and "angle_deg" not in t:
+        angle = math.degrees(2.0 * math.atan(0.5 * width / depth))
+    slot = check_positive(f"{w} slot_width_mm", t.get("slot_width_mm", d.slot_width_mm), "mm")
+    return ScoreSpec(kind, profile, depth, angle, width, _bool(f"{w} cut_through", t.get("cut_through", d.cut_through)),
+                     _choice(f"{w} faces", t.get("faces", d.faces), ("top", "bottom", "both")),
+                     check_finite(f"{w} direction_deg", t.get("direction_deg", d.direction_deg), "deg"), slot)
+
+
+def _emboss(i: int, t: Any) -> EmbossSpec:
+    w = f"[[tooling.emboss]] {i}"
+    d = EmbossSpec()
+    t = _keys(w, t, set(EmbossSpec.__dataclass_fields__))
+    text, outline = t.get("text"), t.get("outline")
+    if (text is None) == (outline is None):
+        raise DesignError(f"{w} text", text, "give either text or outline (a closed polyline [[x, y], ...])")
+    if text is not None and (not isinstance(text, str) or not text.strip()):
+        raise DesignError(f"{w} text", text, "must be a non-empty string")
+    if outline is not None:
+        ok = isinstance(outline, list) and len(outline) >= 3 and all(isinstance(p, list) and len(p) == 2 for p in outline)
+        if not ok:
+            raise DesignError(f"{w} outline", outline, "must be a list of at least 3 [x, y] points (mm)")
+        outline = tuple((check_finite(f"{w} outline", p[0], "mm"), check_finite(f"{w} outline", p[1], "mm")) for p in outline)
+    pos = t.get("position_mm", list(d.position_mm))
+    if not (isinstance(pos, list) and len(pos) == 2):
+        raise DesignError(f"{w} position_mm", pos, "must be [x, y] in mm")
+    font = t.get("font", d.font)
+    if text is not None:
+        font_path(font)
+    return EmbossSpec(
+        text, outline,
+        _choice(f"{w} mode", t.get("mode", d.mode), ("deboss", "emboss")),
+        _choice(f"{w} face", t.get("face", d.face), ("top", "bottom")),
+        check_positive(f"{w} height_mm", t.get("height_mm", d.height_mm), "mm"),
+        check_positive(f"{w} depth_mm", t.get("depth_mm", d.depth_mm), "mm"),
+        check_range(f"{w} draft_deg", t.get("draft_deg", d.draft_deg), 0.0, 30.0, "deg", hi_open=True),
+        font,
+        (check_finite(f"{w} position_mm", pos[0], "mm"), check_finite(f"{w} position_mm", pos[1], "mm")),
+        check_finite(f"{w} rotation_deg", t.get("rotation_deg", d.rotation_deg), "deg"),
+        check_range(f"{w} margin_mm", t.get("margin_mm", d.margin_mm), 0.0, None, "mm"),
+    )
+
+
+def parse_tooling(table: Any) -> ToolingSpec:
+    """A :class:`ToolingSpec` from the ``[tooling]`` table (raises :class:`DesignError`)."""
+    d = ToolingSpec()
+    keys = {"clearance_mm", "tip_length_mm", "die_outer_diameter_mm", "die_height_mm", "taper_deg", "gap_mm", "score", "emboss"}
+    t = _keys("[tooling]", table, keys)
+    clearance = check_range("[tooling] clearance_mm", t.get("clearance_mm", d.clearance_mm), 0.0, 1.0, "mm")
+    tip = check_positive("[tooling] tip_length_mm", t.get("tip_length_mm", d.tip_length_mm), "mm")
+    od = t.get("die_outer_diameter_mm")
+    od = None if od is None else check_positive("[tooling] die_outer_diameter_mm", od, "mm")
+    height = check_positive("[tooling] die_height_mm", t.get("die_height_mm", d.die_height_mm), "mm")
+    taper = check_range("[tooling] taper_deg", t.get("taper_deg", d.taper_deg), 0.0, 10.0, "deg", hi_open=True)
+    gap = t.get("gap_mm")
+    gap = None if gap is None else check_positive("[tooling] gap_mm", gap, "mm")
+    scores = t.get("score", [])
+    emb = t.get("emboss", [])
+    if not isinstance(scores, list):
+        raise DesignError("[[tooling.score]]", scores, "must be an array of tables")
+    if not isinstance(emb, list):
+        raise DesignError("[[tooling.emboss]]", emb, "must be an array of tables")
+    return ToolingSpec(clearance, tip, od, height, taper, gap,
+                       tuple(_score(i, s) for i, s in enumerate(scores)),
+                       tuple(_emboss(i, e) for i, e in enumerate(emb)))

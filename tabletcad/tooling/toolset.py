@@ -1,0 +1,114 @@
+"""A tablet's complete tooling: featured tablet, punch tips, die and their checks.
+
+:func:`make_tooling` is the one entry point used by the build stage, the
+batch API and the benchmarks; it returns a :class:`ToolSet` whose ``report``
+is the ``tooling`` section of ``report.json``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+from tabletcad.errors import DesignError
+from tabletcad.tablet import Tablet
+from tabletcad.tooling.booleans import TIMER, to_manifold, volume
+from tabletcad.tooling.spec import ToolingSpec
+
+__all__ = ["ToolSet", "make_tooling", "DEFLECTION_MM"]
+
+DEFLECTION_MM = 0.005
+
+
+@dataclass(eq=False)
+class ToolSet:
+    """Solids at the closed position (``parts``: tablet, upper_punch, lower_punch, die), the
+    upper punch's lift for the chosen gap, and the report section."""
+
+    tablet: Tablet
+    spec: ToolingSpec
+    frame: Any
+    parts: dict
+    lift_mm: float
+    report: dict = field(default_factory=dict)
+
+    def placed(self) -> dict:
+        """Parts at the press position of ``spec.gap_mm`` (the upper punch lifted by ``lift_mm``)."""
+        from tabletcad.tooling.booleans import translated
+
+        out = dict(self.parts)
+        if self.lift_mm:
+            out["upper_punch"] = translated(out["upper_punch"], dz=self.lift_mm)
+        return out
+
+
+def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None, check: bool = True,
+                 interference_check: bool = True, deflection: float = DEFLECTION_MM) -> ToolSet:
+    """Scores, embossing, punch tips and die for ``tablet`` (see :mod:`tabletcad.tooling`).
+
+    ``shape``: the tablet's B-rep if already built.  ``check``: cross-check every Boolean with
+    manifold3d; ``interference_check``: the closed-position overlap and gap check.
+    Raises :class:`DesignError` for impossible tooling and :class:`GeometryError` when a
+    Boolean or a check fails.
+    """
+    from tabletcad.tooling.die import die
+    from tabletcad.tooling.emboss import apply_emboss
+    from tabletcad.tooling.outline import tablet_frame
+    from tabletcad.tooling.punch import punch_tip
+    from tabletcad.tooling.scores import apply_scores, check_score
+
+    spec = spec or ToolingSpec()
+    t0 = time.perf_counter()
+    b0 = dict(TIMER)
+    frame = tablet_frame(tablet, shape)
+    gap_closed = frame.band
+    if spec.gap_mm is not None and spec.gap_mm < gap_closed - 1e-9:
+        raise DesignError("[tooling] gap_mm", spec.gap_mm, f"must be >= the band {gap_closed:.4g} mm (the closed position)", "mm")
+    for i, s in enumerate(spec.scores):  # fail on bad input before any Boolean
+        check_score(frame, s, i)
+    solid = frame.shape
+    v0 = volume(solid)
+    a_man = to_manifold(solid, deflection) if check and (spec.scores or spec.emboss) else None
+    solid, score_checks, score_info = apply_scores(frame, solid, spec.scores, check=check, deflection=deflection, a_manifold=a_man)
+    a_man = None
+    solid, emb_checks, emb_info = apply_emboss(frame, solid, spec.emboss, spec.clearance_mm, check=check, deflection=deflection)
+    t1 = time.perf_counter()
+    upper, chk_u = punch_tip(frame, solid, "upper", spec.clearance_mm, spec.tip_length_mm, check=check, deflection=deflection)
+    lower, chk_l = punch_tip(frame, solid, "lower", spec.clearance_mm, spec.tip_length_mm, check=check, deflection=deflection)
+    die_shape, die_info = die(frame, spec.die_outer_diameter_mm, None if spec.die_outer_diameter_mm is None and
+                              spec.die_height_mm == ToolingSpec().die_height_mm else spec.die_height_mm, spec.taper_deg)
+    t2 = time.perf_counter()
+    parts = {"tablet": solid, "upper_punch": upper.shape, "lower_punch": lower.shape, "die": die_shape}
+    gap = gap_closed if spec.gap_mm is None else spec.gap_mm
+    checks = [c for c in [*score_checks, *emb_checks, chk_u, chk_l] if c is not None]
+    report: dict[str, Any] = dict(
+        keys=dict(clearance_mm=spec.clearance_mm, tip_length_mm=spec.tip_length_mm,
+                  die_outer_diameter_mm=die_info["outer_diameter_mm"], die_height_mm=die_info["height_mm"],
+                  taper_deg=spec.taper_deg, gap_mm=gap),
+        tablet=dict(volume_plain_mm3=v0, volume_mm3=volume(solid), band_mm=frame.band, band_z_mm=list(frame.band_z),
+                    band_bulge_mm=frame.band_bulge, cup_depth_top_mm=frame.cup_depth_top,
+                    cup_depth_bottom_mm=frame.cup_depth_bottom, thickness_mm=frame.thickness,
+                    land_mm=frame.land, outline=frame.outline_kind, length_mm=frame.length, width_mm=frame.width),
+        scores=score_info,
+        emboss=emb_info,
+        upper_punch=upper.info,
+        lower_punch=lower.info,
+        die=die_info,
+        press_position=dict(punch_gap_mm=gap, closed_gap_mm=gap_closed, upper_punch_lift_mm=gap - gap_closed,
+                            closed=abs(gap - gap_closed) <= 1e-9),
+        booleans=[c.as_dict() for c in checks],
+        boolean_max_rel_diff_occ_vs_manifold3d=max((c.rel_diff for c in checks), default=None),
+    )
+    ts = ToolSet(tablet, spec, frame, parts, gap - gap_closed, report)
+    if interference_check:
+        from tabletcad.tooling.interference import interference
+
+        res = interference(solid, {k: v for k, v in parts.items() if k != "tablet"}, spec.clearance_mm, deflection=deflection,
+                           tablet_model=tablet)
+        report.update(interference_mm3=res["interference_mm3"], max_gap_mm=res["max_gap_mm"], interference=res)
+    t3 = time.perf_counter()
+    report["seconds"] = dict(features=t1 - t0, parts=t2 - t1, interference=t3 - t2, total=t3 - t0,
+                             occ_booleans=TIMER["occ_boolean_s"] - b0["occ_boolean_s"],
+                             manifold3d=TIMER["manifold_s"] - b0["manifold_s"])
+    return ts
