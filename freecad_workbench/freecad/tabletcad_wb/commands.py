@@ -1,0 +1,151 @@
+"""GUI commands of the tabletcad workbench (registered lazily by the workbench's Initialize())."""
+
+from __future__ import annotations
+
+import FreeCAD
+import FreeCADGui
+
+from . import icon, objects
+from .make import make_die, make_lower_punch, make_tablet, make_tooling, make_upper_punch
+
+TOOLBAR = [
+    "Tabletcad_Tablet",
+    "Tabletcad_TabletFromDesign",
+    "Tabletcad_UpperPunch",
+    "Tabletcad_LowerPunch",
+    "Tabletcad_Die",
+    "Tabletcad_Tooling",
+    "Tabletcad_ExportStep",
+]
+MENU = TOOLBAR
+
+
+def _selected_tablet():
+    """The selected Tablet, else the document's only (or last) Tablet."""
+    doc = FreeCAD.ActiveDocument
+    if doc is None:
+        return None
+    for o in FreeCADGui.Selection.getSelection():
+        if objects.is_tablet(o):
+            return o
+    tablets = [o for o in doc.Objects if objects.is_tablet(o)]
+    return tablets[-1] if tablets else None
+
+
+def _doc():
+    return FreeCAD.ActiveDocument or FreeCAD.newDocument("tabletcad")
+
+
+def _fit():
+    if FreeCADGui.ActiveDocument is not None:
+        FreeCADGui.SendMsgToActiveView("ViewFit")
+
+
+class _Command:
+    name = ""
+    icon = "Tablet"
+    menu = ""
+    tip = ""
+
+    def GetResources(self):
+        return {"Pixmap": icon(self.icon), "MenuText": self.menu, "ToolTip": self.tip}
+
+    def IsActive(self):
+        return True
+
+
+class TabletCommand(_Command):
+    name, icon = "Tabletcad_Tablet", "Tablet"
+    menu = "Tablet"
+    tip = "Create a parametric tablet (choose its family and dimensions in the property editor)"
+
+    def Activated(self):
+        doc = _doc()
+        doc.openTransaction("Create tablet")
+        make_tablet(doc, "flat_faced_round")
+        doc.commitTransaction()
+        _fit()
+
+
+class TabletFromDesignCommand(_Command):
+    name, icon = "Tabletcad_TabletFromDesign", "TabletDesign"
+    menu = "Tablet from design file..."
+    tip = "Create a tablet from a tabletcad design file (TOML)"
+
+    def Activated(self):
+        from PySide import QtGui
+
+        from . import core_root
+
+        root = core_root()
+        start = str(root / "samples") if root else ""
+        path, _ = QtGui.QFileDialog.getOpenFileName(None, "tabletcad design", start, "tabletcad design (*.toml)")
+        if path:
+            doc = _doc()
+            doc.openTransaction("Tablet from design")
+            make_tablet(doc, path)
+            doc.commitTransaction()
+            _fit()
+
+
+class _ToolCommand(_Command):
+    def IsActive(self):
+        return _selected_tablet() is not None
+
+
+class UpperPunchCommand(_ToolCommand):
+    name, icon, menu = "Tabletcad_UpperPunch", "UpperPunch", "Upper punch"
+    tip = "Upper punch of the selected tablet (follows the tablet)"
+
+    def Activated(self):
+        make_upper_punch(FreeCAD.ActiveDocument, _selected_tablet())
+
+
+class LowerPunchCommand(_ToolCommand):
+    name, icon, menu = "Tabletcad_LowerPunch", "LowerPunch", "Lower punch"
+    tip = "Lower punch of the selected tablet (follows the tablet)"
+
+    def Activated(self):
+        make_lower_punch(FreeCAD.ActiveDocument, _selected_tablet())
+
+
+class DieCommand(_ToolCommand):
+    name, icon, menu = "Tabletcad_Die", "Die", "Die"
+    tip = "Die of the selected tablet: bore = outline + clearance (follows the tablet)"
+
+    def Activated(self):
+        make_die(FreeCAD.ActiveDocument, _selected_tablet())
+
+
+class ToolingCommand(_ToolCommand):
+    name, icon, menu = "Tabletcad_Tooling", "Tooling", "Punches and die"
+    tip = "Upper punch, lower punch and die of the selected tablet"
+
+    def Activated(self):
+        make_tooling(FreeCAD.ActiveDocument, _selected_tablet())
+        _fit()
+
+
+class ExportStepCommand(_ToolCommand):
+    name, icon, menu = "Tabletcad_ExportStep", "ExportStep", "Export STEP..."
+    tip = "Write the tablets and their tooling as STEP files"
+
+    def Activated(self):
+        from PySide import QtGui
+
+        from . import tasks
+
+        d = QtGui.QFileDialog.getExistingDirectory(None, "STEP output folder")
+        if d:
+            tasks.export_step(FreeCAD.ActiveDocument, d)
+
+
+COMMANDS = [
+    TabletCommand, TabletFromDesignCommand, UpperPunchCommand, LowerPunchCommand, DieCommand, ToolingCommand, ExportStepCommand,
+]
+
+
+def register() -> None:
+    for cls in COMMANDS:
+        if cls.name not in FreeCADGui.listCommands():
+            FreeCADGui.addCommand(cls.name, cls())

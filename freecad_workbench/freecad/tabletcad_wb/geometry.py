@@ -1,0 +1,326 @@
+"""Core tablet -> FreeCAD Part solids (FreeCAD's Python: numpy/scipy, tabletcad's pure core, Part).
+
+The chain is the one of :mod:`tabletcad.cad.tablet_solid` without OCP:
+
+1. ``tablet_chain``: the tablet's surface functions (its patches, or for a
+   hollow tablet such as the ring: outer wall -> end -> inner wall -> end) and
+   the union of their ``v`` breakpoints;
+2. :func:`tabletcad.bspline.fit_patches` (quintic in ``u`` and ``v``, like
+   ``tablet_solid``) -> kernel-neutral :class:`~tabletcad.bspline.BSplineSurfaceData`;
+3. ``Part.BSplineSurface().buildFromPolesMultsKnots`` -> faces -> sewn
+   ``Part.Shell`` -> ``Part.Solid`` (outward, ``isValid()``, exactly one solid).
+
+Tooling is made with Part Booleans from the tablet's *rims* (the boundary rows
+of the chain that lie on the tablet's silhouette, taken from the fitted poles,
+so the tool's edge is the very curve of the tablet's edge):
+
+* upper punch: prism on the upper rim(s), ``length`` up, minus the tablet;
+* lower punch: prism on the lower rim(s), ``length`` down, minus the tablet;
+* die: cylinder of ``outer_diameter`` and ``height`` centred on the band,
+  minus the prism on the outer rim offset outward by ``clearance``.
+
+Nothing here imports OCP or build123d.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+
+import numpy as np
+
+__all__ = [
+    "TabletGeometry",
+    "build_tablet",
+    "tablet_chain",
+    "tablet_from_spec",
+    "punch_shape",
+    "die_shape",
+    "rims_from_json",
+]
+
+TWO_PI = 2.0 * math.pi
+
+
+# --------------------------------------------------------------------------- core side (numpy only)
+class _PatchFunction:
+    """``f(u, v) = patch.evaluate(u, v)`` keeping the patch's fast ``evaluate_grid``."""
+
+    def __init__(self, patch):
+        self.patch = patch
+        if hasattr(patch, "evaluate_grid"):
+            self.evaluate_grid = lambda u, v: np.asarray(patch.evaluate_grid(u, v))
+
+    def __call__(self, u, v):
+        return np.asarray(self.patch.evaluate(u, v))
+
+
+def tablet_chain(tablet):
+    """(surface functions, names, v breakpoints) of the tablet's closed solid.
+
+    Same chain as :func:`tabletcad.cad.tablet_solid.tablet_surface_functions`;
+    the untrimmed case is built here because that function imports its patch
+    wrapper from the OCP module :mod:`tabletcad.cad.solid`.
+    """
+    from tabletcad.bspline import normalise_breaks
+
+    t = tablet.trim
+    bps = [np.asarray(p.breakpoints(), dtype=float).ravel() for p in tablet.patches if hasattr(p, "breakpoints")]
+    bps = [b for b in bps if b.size]
+    breaks = normalise_breaks(np.concatenate(bps)) if bps else np.zeros(0)
+    if t.u == (0.0, 1.0) and t.full_v and t.w == (0.0, 1.0):
+        names = [p.name or f"patch {j}" for j, p in enumerate(tablet.patches)]
+        return [_PatchFunction(p) for p in tablet.patches], names, breaks
+    from tabletcad.cad.tablet_solid import tablet_surface_functions  # numpy-only for trimmed/hollow tablets
+
+    funcs, names = tablet_surface_functions(tablet)
+    return funcs, names, breaks
+
+
+def tablet_from_spec(family=None, params=None, design=None):
+    """A core Tablet from a family name and its parameters (mm, deg), or from a design file."""
+    from tabletcad import shapes
+
+    shapes._load_plugins()
+    if design:
+        from tabletcad.design import load_design
+
+        return load_design(design)
+    if family not in shapes.FAMILIES:
+        from tabletcad.errors import DesignError
+
+        raise DesignError("family", family, f"must be one of {', '.join(sorted(shapes.FAMILIES))}")
+    return shapes.FAMILIES[family].build(**(params or {}))
+
+
+def _rims(surfaces, hollow):
+    """Rim rows of the fitted chain: boundary rows (u = 0 or 1) that are horizontal
+    and lie on the silhouette (per v, as far out as the surface gets), plus, for a
+    hollow tablet, the boundary rows of the inner wall.  Returns a list of dicts
+    ``{z, inner, poles, knots, mults, degree}`` (the row's B-spline curve in v)."""
+    u = np.linspace(0.0, 1.0, 65)
+    out = []
+    s0 = surfaces[0]
+    v = np.linspace(0.0, TWO_PI, 181)[:-1]
+    rho = np.zeros(v.size)
+    for s in surfaces:
+        P = s.evaluate_grid(u, v)
+        rho = np.maximum(rho, np.hypot(P[..., 0], P[..., 1]).max(axis=0))
+    scale = max(float(rho.max()), 1e-9)
+    seen = []
+    for k, s in enumerate(surfaces):
+        for end in (0, -1):
+            row = s.poles[end]
+            z = row[:, 2]
+            if np.ptp(z) > 1e-7 * max(1.0, scale):
+                continue
+            pts = s.evaluate_grid(np.array([0.0 if end == 0 else 1.0]), v)[0]
+            r = np.hypot(pts[:, 0], pts[:, 1])
+            if r.max() < 1e-6 * scale:  # a pole (point row)
+                continue
+            # the thesis's PDE bands bulge between their curves by ~5e-4 of the radius
+            outer = bool(np.all(r >= rho - 2e-3 * scale))
+            inner = bool(hollow and k == 2)
+            if not (outer or inner):
+                continue
+            key = (round(float(z.mean()), 9), round(float(r.mean()), 9))
+            if key in seen:  # shared rows appear twice in the chain
+                continue
+            seen.append(key)
+            out.append(
+                dict(
+                    z=float(z.mean()),
+                    inner=inner and not outer,
+                    poles=row.tolist(),
+                    knots=list(map(float, s.v_knots)),
+                    mults=list(map(int, s.v_mults)),
+                    degree=int(s.v_degree),
+                )
+            )
+    if not any(not r["inner"] for r in out):
+        return []
+    return out
+
+
+class TabletGeometry:
+    """Result of :func:`build_tablet`: the Part solid and the core's figures."""
+
+    def __init__(self, tablet, solid, fits, props, rims, timings):
+        self.tablet = tablet
+        self.solid = solid
+        self.fits = fits
+        self.props = props
+        self.rims = rims
+        self.timings = timings
+
+    @property
+    def volume(self):
+        """Core quadrature volume (mm^3) of the PDE tablet (tabletcad's report value)."""
+        return self.props["volume_mm3"]
+
+    @property
+    def area(self):
+        return self.props["surface_area_mm2"]
+
+    @property
+    def max_fit_deviation(self):
+        return max(f.max_deviation for f in self.fits)
+
+    def rims_json(self):
+        return json.dumps(self.rims)
+
+
+# --------------------------------------------------------------------------- FreeCAD side
+def bspline_face(data):
+    """``Part.Face`` of a kernel-neutral BSplineSurfaceData (the surface's natural bounds)."""
+    import FreeCAD
+    import Part
+
+    bs = Part.BSplineSurface()
+    poles = [[FreeCAD.Vector(*map(float, p)) for p in row] for row in np.asarray(data.poles)]
+    bs.buildFromPolesMultsKnots(
+        poles,
+        [int(m) for m in data.u_mults],
+        [int(m) for m in data.v_mults],
+        [float(k) for k in data.u_knots],
+        [float(k) for k in data.v_knots],
+        bool(data.u_periodic),
+        bool(data.v_periodic),
+        int(data.u_degree),
+        int(data.v_degree),
+    )
+    return bs.toShape()
+
+
+def solid_from_faces(faces, sew_tolerance, what="tablet"):
+    """Sew faces into one closed shell and make an outward, valid solid (or raise)."""
+    import Part
+    from tabletcad.errors import GeometryError
+
+    shell = Part.Shell(faces)
+    shell.sewShape(sew_tolerance)
+    shells = shell.Shells if shell.ShapeType != "Shell" else [shell]
+    if len(shells) != 1:
+        raise GeometryError(f"{what}: sewing gave {len(shells)} shells, expected 1", shell)
+    shell = shells[0]
+    if not shell.isClosed():
+        raise GeometryError(f"{what}: sewn shell is not closed", shell)
+    solid = Part.Solid(shell)
+    if solid.Volume < 0:
+        solid.reverse()
+    if not solid.isValid():
+        raise GeometryError(f"{what}: solid is not valid (BRepCheck)", solid)
+    return solid
+
+
+def build_tablet(tablet, tol=None):
+    """Fit the tablet's chain, build the Part solid, compute the core's figures."""
+    from tabletcad.bspline import fit_patches
+
+    t0 = time.perf_counter()
+    funcs, names, breaks = tablet_chain(tablet)
+    tol = float(tablet.tol.fit if tol is None else tol)
+    fits = fit_patches(funcs, tol, names=names, u_degree=5, v_degree=5, v_breaks=breaks)
+    t1 = time.perf_counter()
+    faces = [bspline_face(f.surface) for f in fits]
+    solid = solid_from_faces(faces, max(2.0 * tol, 1e-6), tablet.name)
+    t2 = time.perf_counter()
+    props = tablet.properties()
+    t3 = time.perf_counter()
+    rims = _rims([f.surface for f in fits], hollow=tablet.trim.w[0] > 0.0)
+    timings = dict(fit=t1 - t0, part=t2 - t1, properties=t3 - t2, total=time.perf_counter() - t0)
+    return TabletGeometry(tablet, solid, fits, props, rims, timings)
+
+
+def rims_from_json(text):
+    return json.loads(text) if text else []
+
+
+def _rim_wire(rim, dz=0.0):
+    import FreeCAD
+    import Part
+
+    c = Part.BSplineCurve()
+    c.buildFromPolesMultsKnots(
+        [FreeCAD.Vector(x, y, z + dz) for x, y, z in rim["poles"]], rim["mults"], rim["knots"], True, rim["degree"]
+    )
+    return Part.Wire([c.toShape()])
+
+
+def _rim_face(rims):
+    import Part
+
+    outer = [r for r in rims if not r["inner"]]
+    inner = [r for r in rims if r["inner"]]
+    wires = [_rim_wire(r) for r in outer + inner]
+    if len(wires) == 1:
+        return Part.Face(wires[0])
+    return Part.Face(wires, "Part::FaceMakerBullseye")
+
+
+def _select(rims, which):
+    from tabletcad.errors import GeometryError
+
+    outer_z = [r["z"] for r in rims if not r["inner"]]
+    if not outer_z:
+        raise GeometryError("the tablet has no horizontal rim on its silhouette (no band edge to make tooling from)", rims)
+    z = max(outer_z) if which == "upper" else min(outer_z)
+    return [r for r in rims if abs(r["z"] - z) <= 1e-7 * max(1.0, abs(z))], z
+
+
+def punch_shape(tablet_shape, rims, which="upper", length=10.0):
+    """Punch tip: prism on the upper (lower) rims, ``length`` mm up (down), minus the tablet."""
+    import FreeCAD
+    from tabletcad.errors import DesignError, GeometryError
+
+    if not length > 0:
+        raise DesignError("punch length", length, "must be > 0", "mm")
+    sel, z = _select(rims, which)
+    sign = 1.0 if which == "upper" else -1.0
+    prism = _rim_face(sel).extrude(FreeCAD.Vector(0, 0, sign * float(length)))
+    result = prism.cut(tablet_shape)
+    solids = result.Solids
+    if len(solids) != 1:
+        raise GeometryError(f"{which} punch: Boolean gave {len(solids)} solids, expected 1", result)
+    punch = solids[0]
+    if not punch.isValid():
+        punch.fix(1e-7, 1e-7, 1e-7)
+    if not punch.isValid():
+        raise GeometryError(f"{which} punch: Boolean result is not valid", punch)
+    return punch
+
+
+def die_shape(rims, clearance=0.05, height=22.22, outer_diameter=38.1):
+    """Die: cylinder (``outer_diameter``, ``height``, centred on the band) minus the bore
+    (outer rim offset outward by ``clearance``)."""
+    import FreeCAD
+    import Part
+    from tabletcad.errors import DesignError, GeometryError
+
+    if not clearance > 0:
+        raise DesignError("die clearance", clearance, "must be > 0", "mm")
+    if not height > 0:
+        raise DesignError("die height", height, "must be > 0", "mm")
+    outer = [r for r in rims if not r["inner"]]
+    if not outer:
+        raise GeometryError("the tablet has no horizontal rim on its silhouette (no band to make a die for)", rims)
+    lo = min(outer, key=lambda r: r["z"])
+    z_lo, z_hi = lo["z"], max(r["z"] for r in outer)
+    wire = _rim_wire(lo)
+    bore_wire = wire.makeOffset2D(float(clearance), 0, False, False, False)
+    reach = float(np.max(np.hypot(*np.asarray(lo["poles"])[:, :2].T))) + clearance
+    if not outer_diameter / 2.0 > reach + 0.5:
+        raise DesignError(
+            "die outer diameter", outer_diameter, f"must exceed the bore by a 0.5 mm wall: > {2 * (reach + 0.5):.3f}", "mm"
+        )
+    zc = 0.5 * (z_lo + z_hi)
+    base = zc - height / 2.0
+    body = Part.makeCylinder(outer_diameter / 2.0, height, FreeCAD.Vector(0, 0, base))
+    bore = Part.Face(bore_wire)
+    bore.translate(FreeCAD.Vector(0, 0, base - 1.0 - z_lo))
+    bore_solid = bore.extrude(FreeCAD.Vector(0, 0, height + 2.0))
+    result = body.cut(bore_solid)
+    if len(result.Solids) != 1 or not result.Solids[0].isValid():
+        raise GeometryError("die: Boolean did not give one valid solid", result)
+    return result.Solids[0]

@@ -1,0 +1,128 @@
+"""Headless constructors (no GUI needed): ``make_tablet``, ``make_upper_punch``, ``make_lower_punch``,
+``make_die``, ``make_tooling``.
+
+Example (``freecadcmd``)::
+
+    import FreeCAD
+    from freecad.tabletcad_wb.make import make_tablet, make_tooling
+    doc = FreeCAD.newDocument("tablet")
+    t = make_tablet(doc, "concave_round", diameter=9.0, cup_depth=0.9)
+    up, low, die = make_tooling(doc, t)
+    doc.recompute()
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import FreeCAD
+
+from . import objects
+
+__all__ = ["make_tablet", "make_upper_punch", "make_lower_punch", "make_die", "make_tooling"]
+
+
+def _value(v, unit="mm"):
+    """Accept numbers (mm / deg), strings with units (``"9 mm"``) or Quantities."""
+    if isinstance(v, (int, float)):
+        return FreeCAD.Units.Quantity(float(v), FreeCAD.Units.Unit(unit))
+    return FreeCAD.Units.Quantity(v)
+
+
+def _new(doc, name):
+    return doc.addObject("Part::FeaturePython", name)
+
+
+def make_tablet(doc, design_or_family="flat_faced_round", name=None, recompute=True, **params):
+    """A parametric Tablet.
+
+    ``design_or_family``: a family name (see ``tabletcad shapes``) or the path
+    of a design file (TOML).  A plain family design (only a ``[tablet]`` table
+    with a family and numbers) becomes a family Tablet with its dimensions as
+    properties; any other design (free_form, trim, reshape, report/tooling
+    tables) is kept as ``Family = design_file`` with ``DesignFile`` set.
+    ``params``: dimensions by core name (``diameter=9.0``, ``cup_depth="0.8 mm"``),
+    plus ``density`` (``"1.2 g/cm^3"`` or kg/m^3) and ``fit_tolerance`` (mm).
+    """
+    density = params.pop("density", None)
+    fit_tol = params.pop("fit_tolerance", None)
+    design = None
+    label = name
+    family = str(design_or_family)
+    if family.endswith(".toml") or os.path.sep in family or Path(family).is_file():
+        design = Path(family).resolve()
+        plain = objects.design_is_parametric(design)
+        if plain is not None:
+            family, dims, design_name = plain
+            params = {**dims, **params}
+            design = None
+            label = label or design_name or Path(design_or_family).stem
+        else:
+            family = objects.DESIGN_FILE
+            label = label or Path(design_or_family).stem
+    obj = _new(doc, "Tablet")
+    objects.TabletProxy(obj, family)
+    if design is not None:
+        obj.DesignFile = str(design)
+    fam = objects._family(family) if family != objects.DESIGN_FILE else None
+    for k, v in params.items():
+        if fam is None or k not in fam.params:
+            raise ValueError(f"family {family!r} has no parameter {k!r}")
+        setattr(obj, objects.prop_name(k), _value(v, "deg" if fam.params[k] == "deg" else "mm"))
+    if density is not None:
+        q = FreeCAD.Units.Quantity(density) if isinstance(density, str) else FreeCAD.Units.Quantity(f"{float(density)} kg/m^3")
+        obj.Density = q
+    if fit_tol is not None:
+        obj.FitTolerance = _value(fit_tol)
+    obj.Label = label or family
+    objects.attach_view_provider(obj)
+    if recompute:
+        doc.recompute()
+    return obj
+
+
+def _punch(doc, tablet, which, length, recompute):
+    obj = _new(doc, "UpperPunch" if which == "upper" else "LowerPunch")
+    objects.PunchProxy(obj, tablet, which)
+    if length is not None:
+        obj.Length = _value(length)
+    obj.Label = f"{tablet.Label} {which} punch"
+    objects.attach_view_provider(obj)
+    if recompute:
+        doc.recompute()
+    return obj
+
+
+def make_upper_punch(doc, tablet, length=None, recompute=True):
+    """Upper punch tip linked to ``tablet`` (prism above the upper band edge minus the tablet)."""
+    return _punch(doc, tablet, "upper", length, recompute)
+
+
+def make_lower_punch(doc, tablet, length=None, recompute=True):
+    """Lower punch tip linked to ``tablet`` (prism below the lower band edge minus the tablet)."""
+    return _punch(doc, tablet, "lower", length, recompute)
+
+
+def make_die(doc, tablet, clearance=None, height=None, outer_diameter=None, recompute=True):
+    """Die linked to ``tablet``: cylinder minus the bore (tablet outline + clearance)."""
+    obj = _new(doc, "Die")
+    objects.DieProxy(obj, tablet)
+    for prop, v in (("Clearance", clearance), ("Height", height), ("OuterDiameter", outer_diameter)):
+        if v is not None:
+            setattr(obj, prop, _value(v))
+    obj.Label = f"{tablet.Label} die"
+    objects.attach_view_provider(obj)
+    if recompute:
+        doc.recompute()
+    return obj
+
+
+def make_tooling(doc, tablet, recompute=True):
+    """Upper punch, lower punch and die of ``tablet``."""
+    up = make_upper_punch(doc, tablet, recompute=False)
+    low = make_lower_punch(doc, tablet, recompute=False)
+    die = make_die(doc, tablet, recompute=False)
+    if recompute:
+        doc.recompute()
+    return up, low, die
