@@ -71,7 +71,7 @@ def geometry_report(tablet: Tablet) -> dict[str, Any]:
         height_mm=dims["height_mm"],
         width_mm=dims["width_mm"],
         length_mm=dims["length_mm"],
-        plan_area_mm2=props["plan_area_mm2"],
+        plan_area_mm2=tablet.plan_area(),
         patches=patches,
         seams=seams,
         nominal=None

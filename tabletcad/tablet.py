@@ -287,8 +287,7 @@ class Tablet:
 
         Returns
         -------
-        dict with ``surface_area_mm2``, ``volume_mm3``, ``plan_area_mm2`` and
-        ``patches`` (per patch: ``surface_area_mm2`` of its outer surface and
+        dict with ``surface_area_mm2``, ``volume_mm3`` and ``patches`` (per patch: ``surface_area_mm2`` of its outer surface and
         ``volume_mm3``, its term ``(1/3)∫X·n dA`` of the divergence theorem,
         which depends on the origin while the total does not).
         """
@@ -312,7 +311,6 @@ class Tablet:
         return dict(
             surface_area_mm2=tot_a,
             volume_mm3=tot_v,
-            plan_area_mm2=self.plan_area(),
             orientation=sgn,
             patches=per,
         )

@@ -53,7 +53,7 @@ __all__ = ["load_problem", "problem_from_dict", "family_problem", "QUANTITIES", 
 QUANTITIES = {
     "volume_mm3": ("mm3", lambda t: t.volume()),
     "surface_area_mm2": ("mm2", lambda t: t.surface_area()),
-    "plan_area_mm2": ("mm2", lambda t: t.properties()["plan_area_mm2"]),
+    "plan_area_mm2": ("mm2", lambda t: t.plan_area()),
     "length_mm": ("mm", lambda t: t.dimensions()["length_mm"]),
     "width_mm": ("mm", lambda t: t.dimensions()["width_mm"]),
     "height_mm": ("mm", lambda t: t.dimensions()["height_mm"]),
