@@ -85,6 +85,9 @@ def tablet_solid(tablet: Tablet, tol: float | None = None, **kwargs: Any):
     # where cubics need ~4x the poles for 1e-5 mm (and leave a 1e-6 volume bias)
     kwargs.setdefault("u_degree", 5)
     kwargs.setdefault("v_degree", 5)
+    # breakpoints (outline junctions) get full-multiplicity knots: the surface may be
+    # only C0 there (a cup swept over an offset outline whose corner collapses)
+    kwargs.setdefault("v_break_mult", kwargs["v_degree"])
     # knots of multiplicity v_degree - 1 where an outline is only C1 (arc/line junctions)
     kwargs.setdefault("v_breaks", tablet_breakpoints(tablet))
     return build_solid(funcs, tablet.tol.fit if tol is None else tol, name=tablet.name, names=names, **kwargs)
