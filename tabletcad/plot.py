@@ -1,4 +1,4 @@
-"""Pictures of tablets with matplotlib (PNG), patch by patch with their boundaries."""
+"""Pictures of tablets with matplotlib (PNG): shaded faces, one colour per patch, patch boundaries."""
 
 from __future__ import annotations
 
@@ -12,33 +12,62 @@ from tabletcad.tablet import Tablet
 __all__ = ["plot_tablet"]
 
 
-def plot_tablet(tablet: Tablet, path: str | Path, *, dpi: int = 130, nu: int = 41, nv: int = 97, title: str | None = None) -> Path:
-    """Render the tablet's patches (shaded, one colour each, boundary curves in black) to a PNG.
+def _quads(Y: np.ndarray) -> np.ndarray:
+    """Quadrilaterals (k, 4, 3) of a grid of points (ns, nt, 3)."""
+    return np.stack([Y[:-1, :-1], Y[1:, :-1], Y[1:, 1:], Y[:-1, 1:]], axis=-2).reshape(-1, 4, 3)
 
-    Trimmed tablets show their cut faces' outlines; ``w < 1`` inner walls are drawn too.
+
+def plot_tablet(
+    tablet: Tablet,
+    path: str | Path,
+    *,
+    dpi: int = 130,
+    nu: int = 33,
+    nv: int = 97,
+    title: str | None = None,
+    elev: float = 24.0,
+    azim: float = -60.0,
+) -> Path:
+    """Render the tablet's faces (Lambert-shaded, one colour per patch, cut faces grey)
+    with the patch boundary curves in black, to a PNG.
+
+    All faces go into one polygon collection so that matplotlib sorts them by
+    depth together (separate surfaces are drawn in artist order and hide each
+    other wrongly).
     """
     import matplotlib
 
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
-    from matplotlib.colors import LightSource
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     fig = plt.figure(figsize=(6.4, 5.6))
     ax = fig.add_subplot(111, projection="3d")
     colours = plt.get_cmap("tab10")
-    ls = LightSource(azdeg=315, altdeg=35)
-    allpts = []
+    el, az = np.radians(elev), np.radians(azim)
+    view = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+    light = view + np.array([0.3, -0.2, 0.6])
+    light /= np.linalg.norm(light)
+    polys, cols, edges, allpts = [], [], [], []
     for face in tablet.faces():
         s = np.linspace(face.s_range[0], face.s_range[1], nu)
-        tt = np.linspace(face.t_range[0], face.t_range[1], nv)
-        Y = face.evaluate_grid(tablet, s, tt)
-        rgb = np.array(colours(face.patch % 10)[:3]) if face.kind == "w" else np.array([0.75, 0.75, 0.75])
-        shade = ls.shade_rgb(np.broadcast_to(rgb, Y.shape[:2] + (3,)), Y[..., 2])
-        ax.plot_surface(Y[..., 0], Y[..., 1], Y[..., 2], facecolors=shade, rstride=1, cstride=1,
-                        linewidth=0, antialiased=True, shade=False)
-        for edge in (Y[0], Y[-1]):
-            ax.plot(edge[:, 0], edge[:, 1], edge[:, 2], color="k", linewidth=0.7)
+        t = np.linspace(face.t_range[0], face.t_range[1], nv)
+        Y = face.evaluate_grid(tablet, s, t)
+        q = _quads(Y)
+        n = np.cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 1])
+        n /= np.maximum(np.linalg.norm(n, axis=-1), 1e-300)[:, None]
+        lam = np.abs(n @ light)  # two-sided Lambert
+        base = np.array(colours(face.patch % 10)[:3]) if face.kind == "w" else np.array([0.72, 0.72, 0.72])
+        c = np.clip(base[None, :] * (0.35 + 0.75 * lam[:, None]), 0.0, 1.0)
+        polys.append(q)
+        cols.append(c)
+        if face.kind == "w":
+            edges.extend([Y[0], Y[-1]])
         allpts.append(Y.reshape(-1, 3))
+    coll = Poly3DCollection(np.concatenate(polys), facecolors=np.concatenate(cols), linewidths=0.0, antialiased=False)
+    ax.add_collection3d(coll)
+    for e in edges:
+        ax.plot(e[:, 0], e[:, 1], e[:, 2], color="k", linewidth=0.6)
     pts = np.vstack(allpts)
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     c = (lo + hi) / 2
@@ -50,7 +79,7 @@ def plot_tablet(tablet: Tablet, path: str | Path, *, dpi: int = 130, nu: int = 4
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("y (mm)")
     ax.set_zlabel("z (mm)")
-    ax.view_init(elev=22, azim=-60)
+    ax.view_init(elev=elev, azim=azim)
     ax.set_title(title or f"{tablet.name} ({tablet.family}, {len(tablet.patches)} patches)")
     path = Path(path)
     with atomic_path(path) as tmp:
