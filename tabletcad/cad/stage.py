@@ -105,3 +105,8 @@ def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any], design_path=
 
 
 register_stage("cad", cad_stage)
+
+try:  # the tooling stage (punches, die, drawings) registers itself after the CAD stage
+    import tabletcad.tooling.stage  # noqa: F401,E402
+except ImportError:  # pragma: no cover - tooling is optional
+    pass

@@ -103,17 +103,22 @@ def volume(shape: TopoDS_Shape, eps: float = 1e-9) -> float:
 
 
 # ----------------------------------------------------------------------------- manifold3d
+def mesh_arrays(shape: TopoDS_Shape, deflection: float = 0.005, angular: float = 0.2):
+    """``(V, T)`` of the tessellation (Delabella, falling back to Watson for faces it leaves empty)."""
+    from tabletcad.cad.mesh import triangulate
+
+    try:
+        return triangulate(shape, deflection, angular)
+    except GeometryError:  # Delabella leaves some trimmed faces (letter counters) untriangulated
+        return triangulate(shape, deflection, angular, algo="watson")
+
+
 def to_manifold(shape: TopoDS_Shape, deflection: float = 0.005, angular: float = 0.2):
     """A ``manifold3d.Manifold`` from the OCC tessellation of ``shape`` (double precision)."""
     import manifold3d
 
-    from tabletcad.cad.mesh import triangulate
-
     t0 = time.perf_counter()
-    try:
-        V, T = triangulate(shape, deflection, angular)
-    except GeometryError:  # Delabella leaves some trimmed faces (letter counters) untriangulated
-        V, T = triangulate(shape, deflection, angular, algo="watson")
+    V, T = mesh_arrays(shape, deflection, angular)
     m = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=np.ascontiguousarray(V, dtype=np.float64),
                                               tri_verts=np.ascontiguousarray(T, dtype=np.uint32)))
     status = getattr(m.status(), "name", str(m.status()))

@@ -20,7 +20,7 @@ import time
 import numpy as np
 from scipy.spatial import cKDTree
 
-from tabletcad.tooling.booleans import manifold_op, manifold_volume, raw_boolean, to_manifold, volume
+from tabletcad.tooling.booleans import mesh_arrays, manifold_op, manifold_volume, raw_boolean, to_manifold, volume
 
 __all__ = ["interference", "point_triangle_distance", "mesh_distance"]
 
@@ -129,8 +129,6 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
     """Overlaps (mm^3) between all pairs of ``{"tablet": shape, **parts}`` and the tablet's largest gap (mm).
 
     ``tablet_model``: the :class:`~tabletcad.tablet.Tablet`, whose patches add surface samples."""
-    from tabletcad.cad.mesh import triangulate
-
     t0 = time.perf_counter()
     shapes = {"tablet": tablet, **parts}
     manifolds = {k: to_manifold(s, deflection) for k, s in shapes.items()}
@@ -149,7 +147,7 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
     t1 = time.perf_counter()
     # gap: points on the tablet's surface (its mesh vertices, plus its PDE patches sampled densely
     # towards their edges, kept where they lie on the featured solid) against the parts' meshes
-    V, T = triangulate(tablet, deflection, 0.2)
+    V, T = mesh_arrays(tablet, deflection, 0.2)
     if tablet_model is not None:
         S = _surface_samples(tablet_model)
         keep = mesh_distance(S, *refine_triangles(V, T, 0.1), reach=0.2) <= 2.0 * deflection
@@ -157,10 +155,7 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
     dist = np.full(len(V), np.inf)
     h_split = max(4.0 * clearance, 0.05)
     for name, s in parts.items():
-        try:
-            Vp, Tp = triangulate(s, deflection, 0.2)
-        except Exception:  # pragma: no cover - Delabella failure on a trimmed face
-            Vp, Tp = triangulate(s, deflection, 0.2, algo="watson")
+        Vp, Tp = mesh_arrays(s, deflection, 0.2)
         lo, hi = V.min(axis=0) - 4 * h_split, V.max(axis=0) + 4 * h_split
         Vr, Tr = refine_triangles(Vp, Tp, h_split, lo, hi)
         if len(Tr):

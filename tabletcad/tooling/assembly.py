@@ -1,0 +1,77 @@
+"""STEP files of the tooling: one assembly with named parts, and each part alone.
+
+``assembly.step`` holds an XCAF assembly named ``<tablet>_tooling`` whose
+components are labelled ``tablet``, ``upper_punch``, ``lower_punch`` and
+``die``, in the press position of the chosen punch gap (the upper punch
+lifted by ``gap - band`` from the closed position).  ``upper_punch.step``,
+``lower_punch.step`` and ``die.step`` hold one part each at the closed
+position.  Every file is written atomically (:mod:`tabletcad.io.atomic`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from OCP.IFSelect import IFSelect_ReturnStatus
+from OCP.Interface import Interface_Static
+from OCP.STEPCAFControl import STEPCAFControl_Writer
+from OCP.STEPControl import STEPControl_Controller, STEPControl_StepModelType
+from OCP.TCollection import TCollection_ExtendedString
+from OCP.TDataStd import TDataStd_Name
+from OCP.TDocStd import TDocStd_Document
+from OCP.TopLoc import TopLoc_Location
+from OCP.gp import gp_Trsf, gp_Vec
+from OCP.XCAFDoc import XCAFDoc_DocumentTool
+
+from tabletcad.cad._occ import quiet
+from tabletcad.cad.export import export_step
+from tabletcad.errors import GeometryError
+from tabletcad.io import atomic_path
+
+__all__ = ["write_assembly", "write_parts", "PART_NAMES"]
+
+PART_NAMES = ("tablet", "upper_punch", "lower_punch", "die")
+
+
+def write_assembly(parts: dict, path, *, name: str = "tooling", offsets: dict | None = None) -> Path:
+    """Write an XCAF assembly of ``parts`` (name -> solid) to ``path``; ``offsets`` (name -> dz mm)
+    place components (as locations, the part shapes are stored once)."""
+    offsets = offsets or {}
+    STEPControl_Controller.Init_s()
+    Interface_Static.SetCVal_s("write.step.schema", "AP242DIS")
+    Interface_Static.SetCVal_s("write.step.unit", "MM")
+    Interface_Static.SetIVal_s("write.step.assembly", 1)
+    doc = TDocStd_Document(TCollection_ExtendedString("XmlOcaf"))
+    XCAFDoc_DocumentTool.SetLengthUnit_s(doc, 0.001)
+    tool = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
+    top = tool.NewShape()
+    TDataStd_Name.Set_s(top, TCollection_ExtendedString(str(name)))
+    for part in PART_NAMES:
+        if part not in parts:
+            continue
+        lab = tool.AddShape(parts[part], False)
+        TDataStd_Name.Set_s(lab, TCollection_ExtendedString(part))
+        tr = gp_Trsf()
+        tr.SetTranslation(gp_Vec(0.0, 0.0, float(offsets.get(part, 0.0))))
+        comp = tool.AddComponent(top, lab, TopLoc_Location(tr))
+        TDataStd_Name.Set_s(comp, TCollection_ExtendedString(part))
+    tool.UpdateAssemblies()
+    writer = STEPCAFControl_Writer()
+    writer.SetNameMode(True)
+    with quiet():
+        ok = writer.Transfer(doc, STEPControl_StepModelType.STEPControl_AsIs)
+    if not ok:
+        raise GeometryError(f"STEP transfer of the assembly {name} failed", parts)
+    with atomic_path(path) as tmp, quiet():
+        status = writer.Write(str(tmp))
+        if status != IFSelect_ReturnStatus.IFSelect_RetDone:
+            raise GeometryError(f"writing STEP {path} failed: {status}", parts)
+    return Path(path)
+
+
+def write_parts(parts: dict, out_dir, names=("upper_punch", "lower_punch", "die")) -> list[Path]:
+    """``<out_dir>/<name>.step`` for each part (one named solid per file)."""
+    out = []
+    for n in names:
+        out.append(export_step(parts[n], Path(out_dir) / f"{n}.step", name=n))
+    return out

@@ -1,0 +1,231 @@
+"""The tablet drawing toolmakers exchange: plan, front and side elevations with dimensions.
+
+Views are projections of the B-rep by OCC's hidden-line removal
+(``HLRBRep_Algo`` / ``HLRBRep_HLRToShape``): visible sharp edges and
+silhouettes drawn solid, hidden sharp edges dashed.  Third-angle layout: the
+front elevation (looking along +y), the plan above it (looking down -z) and
+the side elevation (looking along -x) to its right.  Dimensions state the
+design's numbers: diameter (or length and width), band, cup depth, overall
+thickness, cup/edge radii and land.  Written as ``drawing.svg`` and
+``drawing.pdf`` (matplotlib, text kept as text) and ``drawing.dxf`` (ezdxf,
+DIMENSION entities with the same texts).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from OCP.BRepAdaptor import BRepAdaptor_Curve
+from OCP.BRepLib import BRepLib
+from OCP.GCPnts import GCPnts_TangentialDeflection
+from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+from OCP.HLRAlgo import HLRAlgo_Projector
+from OCP.HLRBRep import HLRBRep_Algo, HLRBRep_HLRToShape
+
+from tabletcad.cad._occ import explore
+from tabletcad.io import atomic_path
+
+__all__ = ["project_view", "drawing_model", "write_drawing", "Drawing", "Dim"]
+
+VIEWS = {  # name: (view direction towards the viewer, horizontal axis of the sheet)
+    "plan": ((0.0, 0.0, 1.0), (1.0, 0.0, 0.0)),
+    "front": ((0.0, -1.0, 0.0), (1.0, 0.0, 0.0)),
+    "side": ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
+}
+
+
+def _polylines(compound, deflection: float = 0.002) -> list[np.ndarray]:
+    out = []
+    if compound is None or compound.IsNull():
+        return out
+    BRepLib.BuildCurves3d_s(compound)
+    for e in explore(compound, "Edge"):
+        try:
+            c = BRepAdaptor_Curve(e)
+            d = GCPnts_TangentialDeflection(c, 0.05, deflection)
+            pts = np.array([[d.Value(i).X(), d.Value(i).Y()] for i in range(1, d.NbPoints() + 1)])
+        except Exception:  # pragma: no cover - degenerate edge from the projection
+            continue
+        if len(pts) >= 2:
+            out.append(pts)
+    return out
+
+
+def project_view(shape, view: str) -> dict:
+    """``{"visible": [polylines], "hidden": [polylines]}`` (2-D, mm) of ``shape`` seen in ``view``."""
+    d, x = VIEWS[view]
+    algo = HLRBRep_Algo()
+    algo.Add(shape)
+    algo.Projector(HLRAlgo_Projector(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(*d), gp_Dir(*x))))
+    algo.Update()
+    algo.Hide()
+    h = HLRBRep_HLRToShape(algo)
+    vis = _polylines(h.VCompound()) + _polylines(h.OutLineVCompound())
+    hid = _polylines(h.HCompound())
+    return {"visible": vis, "hidden": hid}
+
+
+@dataclass
+class Dim:
+    """A linear dimension between two sheet points, drawn ``offset`` mm aside, with its text."""
+
+    p1: tuple[float, float]
+    p2: tuple[float, float]
+    offset: float
+    text: str
+    vertical: bool = False
+
+
+@dataclass
+class Drawing:
+    views: dict
+    origins: dict
+    dims: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
+    title: str = ""
+
+    def texts(self) -> list[str]:
+        return [d.text for d in self.dims] + list(self.notes)
+
+
+def _fmt(x: float) -> str:
+    return f"{x:.2f}" if abs(x) >= 0.1 else f"{x:.3f}"
+
+
+def drawing_model(ts) -> Drawing:
+    """Views and dimensions of a :class:`~tabletcad.tooling.toolset.ToolSet`'s tablet."""
+    fr = ts.frame
+    shape = ts.parts["tablet"]
+    views = {k: project_view(shape, k) for k in VIEWS}
+    L, W, T = fr.length, fr.width, fr.thickness
+    gap = 6.0 + 0.3 * max(L, W)
+    origins = {"front": (0.0, 0.0), "plan": (0.0, T / 2 + gap + W / 2), "side": (L / 2 + gap + W / 2, 0.0)}
+    # views are centred on the tablet's axis: front/side z runs from z_min to z_max
+    zc = 0.5 * (fr.z_min + fr.z_max)
+    origins = {k: (ox, oy - (zc if k != "plan" else 0.0)) for k, (ox, oy) in origins.items()}
+    fx, fy = origins["front"]
+    px, py = origins["plan"]
+    sx, sy = origins["side"]
+    x0, x1 = -L / 2, L / 2
+    dims: list[Dim] = []
+    if fr.round_radius is not None:
+        dims.append(Dim((px + x0, py), (px + x1, py), W / 2 + 2.0, f"Ø{_fmt(2 * fr.round_radius)}"))
+    else:
+        dims.append(Dim((px + x0, py), (px + x1, py), W / 2 + 2.0, f"L {_fmt(L)}"))
+        dims.append(Dim((sx - W / 2, sy + fr.z_min), (sx + W / 2, sy + fr.z_min), -2.0, f"W {_fmt(W)}"))
+    b0, b1 = fr.band_z
+    dims.append(Dim((fx + x1, fy + b0), (fx + x1, fy + b1), 2.0, f"band {_fmt(fr.band)}", vertical=True))
+    dims.append(Dim((fx + x1, fy + b1), (fx + x1, fy + fr.z_max), 2.0 + 4.0, f"cup {_fmt(fr.cup_depth_top)}", vertical=True))
+    dims.append(Dim((fx + x0, fy + fr.z_min), (fx + x0, fy + fr.z_max), -3.0, f"T {_fmt(T)}", vertical=True))
+    notes = [f"{ts.tablet.name} ({ts.tablet.family})", f"overall thickness {_fmt(T)} mm", f"band {_fmt(fr.band)} mm",
+             f"cup depth {_fmt(fr.cup_depth_top)} mm (bottom {_fmt(fr.cup_depth_bottom)} mm)"]
+    if fr.round_radius is not None:
+        notes.insert(1, f"diameter Ø{_fmt(2 * fr.round_radius)} mm")
+    else:
+        notes.insert(1, f"length {_fmt(L)} mm x width {_fmt(W)} mm")
+    radii = {k: v for k, v in fr.info.items() if k.endswith("radius_mm") and isinstance(v, (int, float)) and v > 0}
+    if not radii and fr.round_radius is not None and fr.cup_depth_top > 1e-6 and not fr.info:
+        R, d = fr.round_radius, fr.cup_depth_top
+        radii["cup_radius_mm"] = (R * R + d * d) / (2 * d)
+    for k, v in radii.items():
+        notes.append(f"{k[:-3].replace('_', ' ')} R{_fmt(v)} mm")
+    if fr.land is not None:
+        notes.append(f"land {_fmt(fr.land)} mm")
+    for s in ts.report.get("scores", []):
+        notes.append(f"{s['kind']} score {s['profile']} {_fmt(s['depth_mm'])} mm deep on the {s['face']} face")
+    for e in ts.report.get("emboss", []):
+        notes.append(f"{e['mode']} '{e['text'] or 'outline'}' {_fmt(e['depth_mm'])} mm on the {e['face']} face")
+    notes.append("mm; third-angle projection; generated from the B-rep (OCC HLR)")
+    return Drawing(views, origins, dims, notes, title=ts.tablet.name)
+
+
+def _sheet_lines(dr: Drawing):
+    for name, v in dr.views.items():
+        ox, oy = dr.origins[name]
+        for kind in ("visible", "hidden"):
+            for p in v[kind]:
+                yield kind, p + np.array([ox, oy])
+
+
+def _dim_geometry(d: Dim):
+    (x1, y1), (x2, y2) = d.p1, d.p2
+    if d.vertical:
+        x = max(x1, x2) + d.offset if d.offset > 0 else min(x1, x2) + d.offset
+        return (x, y1), (x, y2), [((x1, y1), (x, y1)), ((x2, y2), (x, y2))]
+    y = max(y1, y2) + d.offset if d.offset > 0 else min(y1, y2) + d.offset
+    return (x1, y), (x2, y), [((x1, y1), (x1, y)), ((x2, y2), (x2, y))]
+
+
+def _write_matplotlib(dr: Drawing, svg: Path, pdf: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    with matplotlib.rc_context({"svg.fonttype": "none", "pdf.fonttype": 42}):
+        fig, ax = plt.subplots(figsize=(11.69, 8.27))  # A4 landscape
+        for kind, p in _sheet_lines(dr):
+            ax.plot(p[:, 0], p[:, 1], color="k" if kind == "visible" else "0.4", lw=0.7 if kind == "visible" else 0.4,
+                    ls="-" if kind == "visible" else (0, (3, 2)))
+        for d in dr.dims:
+            a, b, ext = _dim_geometry(d)
+            for e0, e1 in ext:
+                ax.plot([e0[0], e1[0]], [e0[1], e1[1]], color="0.3", lw=0.3)
+            ax.annotate("", xy=a, xytext=b, arrowprops=dict(arrowstyle="<|-|>", lw=0.4, color="0.2", shrinkA=0, shrinkB=0))
+            mx, my = 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])
+            ax.text(mx + (0.4 if d.vertical else 0), my + (0 if d.vertical else 0.4), d.text, fontsize=7,
+                    rotation=90 if d.vertical else 0, ha="center" if not d.vertical else "left", va="bottom" if not d.vertical else "center")
+        for name, (ox, oy) in dr.origins.items():
+            ax.text(ox, oy - 0.6 * (max(abs(np.concatenate([q[:, 1] for q in dr.views[name]["visible"]] or [np.zeros(1)]))) + 2.5),
+                    name.upper() if name != "plan" else "PLAN", fontsize=8, ha="center", va="top")
+        xs = np.concatenate([p[:, 0] for _, p in _sheet_lines(dr)])
+        ys = np.concatenate([p[:, 1] for _, p in _sheet_lines(dr)])
+        ax.text(xs.max() + 8, ys.max(), "\n".join(dr.notes), fontsize=7, va="top", ha="left", family="DejaVu Sans")
+        ax.set_aspect("equal")
+        ax.axis("off")
+        ax.set_title(dr.title, fontsize=10)
+        fig.tight_layout()
+        with atomic_path(svg) as tmp:
+            fig.savefig(tmp, format="svg")
+        with atomic_path(pdf) as tmp:
+            fig.savefig(tmp, format="pdf")
+        plt.close(fig)
+
+
+def _write_dxf(dr: Drawing, path: Path) -> None:
+    import ezdxf
+
+    doc = ezdxf.new("R2010", setup=True, units=4)  # 4 = millimetres
+    doc.layers.add("VISIBLE", color=7)
+    doc.layers.add("HIDDEN", color=8, linetype="DASHED")
+    doc.layers.add("DIMENSIONS", color=1)
+    doc.layers.add("NOTES", color=3)
+    msp = doc.modelspace()
+    for kind, p in _sheet_lines(dr):
+        msp.add_lwpolyline([tuple(map(float, q)) for q in p], dxfattribs={"layer": kind.upper()})
+    for d in dr.dims:
+        a, b, _ = _dim_geometry(d)
+        base = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)
+        dim = msp.add_linear_dim(base=base, p1=d.p1, p2=d.p2, angle=90 if d.vertical else 0, text=d.text,
+                                 dimstyle="EZDXF", dxfattribs={"layer": "DIMENSIONS"})
+        dim.render()
+    xs = [float(q[0]) for _, p in _sheet_lines(dr) for q in p]
+    ys = [float(q[1]) for _, p in _sheet_lines(dr) for q in p]
+    msp.add_mtext("\\P".join(dr.notes), dxfattribs={"layer": "NOTES", "char_height": 0.8}).set_location((max(xs) + 8, max(ys)))
+    with atomic_path(path) as tmp:
+        doc.saveas(tmp)
+
+
+def write_drawing(ts, out_dir) -> list[Path]:
+    """``drawing.svg``, ``drawing.pdf`` and ``drawing.dxf`` of the tool set's tablet in ``out_dir``."""
+    out_dir = Path(out_dir)
+    dr = drawing_model(ts)
+    svg, pdf, dxf = out_dir / "drawing.svg", out_dir / "drawing.pdf", out_dir / "drawing.dxf"
+    _write_matplotlib(dr, svg, pdf)
+    _write_dxf(dr, dxf)
+    ts.report["drawing"] = dict(views=list(dr.views), dimension_texts=[d.text for d in dr.dims], notes=dr.notes,
+                                visible_polylines={k: len(v["visible"]) for k, v in dr.views.items()})
+    return [svg, pdf, dxf]
