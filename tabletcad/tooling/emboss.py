@@ -32,7 +32,7 @@ from tabletcad.tooling.booleans import boolean, checked_boolean, translated
 from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, polyline_wire
 from tabletcad.tooling.spec import EmbossSpec, font_path
 
-__all__ = ["figure_faces", "figure_prism", "apply_emboss", "check_fit"]
+__all__ = ["figure_faces", "figure_prism", "apply_emboss", "check_fit", "check_emboss", "face_heights"]
 
 
 def _transform(shape: TopoDS_Shape, trsf: gp_Trsf) -> TopoDS_Shape:
@@ -90,6 +90,17 @@ def check_fit(frame: TabletFrame, e: EmbossSpec, figure: TopoDS_Shape, clearance
                           f"outside the punch tip inset by {inset:.3g} mm (clearance + land + margin); "
                           "use a smaller height_mm or move it")
     return dict(figure_area_mm2=area, size_mm=list(size), inset_mm=inset)
+
+
+def check_emboss(frame: TabletFrame, e: EmbossSpec, clearance: float, i: int = 0):
+    """The placed figure and its fit facts; :class:`DesignError` if it does not fit or is too deep."""
+    figure = figure_faces(e)
+    info = check_fit(frame, e, figure, clearance, i)
+    cup = frame.cup_depth_top if e.face == "top" else frame.cup_depth_bottom
+    limit = cup + 0.25 * frame.band
+    if e.mode == "deboss" and e.depth_mm > limit:
+        raise DesignError(f"[[tooling.emboss]] {i} depth_mm", e.depth_mm, f"must be <= cup depth + band/4 = {limit:.4g} mm", "mm")
+    return figure, info
 
 
 def figure_prism(figure: TopoDS_Shape, z0: float, z1: float, draft_deg: float = 0.0, narrow_at: str = "z1") -> TopoDS_Shape:
@@ -157,14 +168,8 @@ def apply_emboss(frame: TabletFrame, shape, items, clearance: float, *, check: b
     """Emboss/deboss every item on ``shape``; returns ``(solid, Boolean checks, per-item info)``."""
     checks, infos = [], []
     for i, e in enumerate(items):
-        figure = figure_faces(e)
-        info = check_fit(frame, e, figure, clearance, i)
+        figure, info = check_emboss(frame, e, clearance, i)
         top = e.face == "top"
-        cup = frame.cup_depth_top if top else frame.cup_depth_bottom
-        limit = cup + 0.25 * frame.band
-        if e.mode == "deboss" and e.depth_mm > limit:
-            raise DesignError(f"[[tooling.emboss]] {i} depth_mm", e.depth_mm,
-                              f"must be <= cup depth + band/4 = {limit:.4g} mm", "mm")
         sg = 1.0 if top else -1.0
         # short prisms (OCC's surface intersections cost grows with the walls' height): from just
         # inside the tablet under the figure to just beyond the face's highest point

@@ -53,7 +53,7 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     Boolean or a check fails.
     """
     from tabletcad.tooling.die import die
-    from tabletcad.tooling.emboss import apply_emboss
+    from tabletcad.tooling.emboss import apply_emboss, check_emboss
     from tabletcad.tooling.outline import tablet_frame
     from tabletcad.tooling.punch import punch_tip
     from tabletcad.tooling.scores import apply_scores, check_score
@@ -67,6 +67,8 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
         raise DesignError("[tooling] gap_mm", spec.gap_mm, f"must be >= the band {gap_closed:.4g} mm (the closed position)", "mm")
     for i, s in enumerate(spec.scores):  # fail on bad input before any Boolean
         check_score(frame, s, i)
+    for i, e in enumerate(spec.emboss):
+        check_emboss(frame, e, spec.clearance_mm, i)
     solid = frame.shape
     v0 = volume(solid)
     a_man = to_manifold(solid, deflection) if check and (spec.scores or spec.emboss) else None
