@@ -216,7 +216,7 @@ def solid_from_faces(faces, sew_tolerance, what="tablet"):
 
 def build_tablet(tablet, tol=None):
     """Fit the tablet's chain, build the Part solid, compute the core's figures."""
-    from tabletcad.bspline import fit_patches
+    from tabletcad.bspline import enclosed_volume, fit_patches
 
     t0 = time.perf_counter()
     funcs, names, breaks = tablet_chain(tablet)
@@ -229,6 +229,9 @@ def build_tablet(tablet, tol=None):
     props = tablet.properties()
     t3 = time.perf_counter()
     rims = _rims([f.surface for f in fits], hollow=tablet.trim.w[0] > 0.0)
+    # exact volume of the B-spline solid (FreeCAD's Shape.Volume is OCCT's default integration,
+    # measured 8.5e-4 relative off on a free-form stadium tablet)
+    props = dict(props, solid_volume_mm3=abs(enclosed_volume([f.surface for f in fits])))
     timings = dict(fit=t1 - t0, part=t2 - t1, properties=t3 - t2, total=time.perf_counter() - t0)
     return TabletGeometry(tablet, solid, fits, props, rims, timings)
 

@@ -38,10 +38,11 @@ def make_tablet(doc, design_or_family="flat_faced_round", name=None, recompute=T
     """A parametric Tablet.
 
     ``design_or_family``: a family name (see ``tabletcad shapes``) or the path
-    of a design file (TOML).  A plain family design (only a ``[tablet]`` table
-    with a family and numbers) becomes a family Tablet with its dimensions as
-    properties; any other design (free_form, trim, reshape, report/tooling
-    tables) is kept as ``Family = design_file`` with ``DesignFile`` set.
+    of a design file (TOML).  A plain family design (a ``[tablet]`` table with a
+    family and numbers, optionally a ``[report]`` table, which does not change
+    the geometry) becomes a family Tablet with its dimensions as properties;
+    any other design (free_form, trim, reshape, tooling tables) is kept as
+    ``Family = design_file`` with ``DesignFile`` set.
     ``params``: dimensions by core name (``diameter=9.0``, ``cup_depth="0.8 mm"``),
     plus ``density`` (``"1.2 g/cm^3"`` or kg/m^3) and ``fit_tolerance`` (mm).
     """

@@ -128,6 +128,8 @@ class TabletProxy(_Proxy):
         if obj.Density.Value == 0.0:
             obj.Density = FreeCAD.Units.Quantity("1200 kg/m^3")
         self._add(obj, "App::PropertyVolume", "Volume", "Results", "volume of the PDE tablet (tabletcad quadrature)", mode=_READONLY)
+        self._add(obj, "App::PropertyVolume", "SolidVolume", "Results",
+                  "exact volume of the B-spline solid in Shape (Gauss quadrature of its faces)", mode=_READONLY)
         self._add(obj, "App::PropertyArea", "Area", "Results", "surface area of the PDE tablet (tabletcad quadrature)", mode=_READONLY)
         self._add(obj, "App::PropertyArea", "PlanArea", "Results", "area of the silhouette seen along z", mode=_READONLY)
         self._add(obj, "App::PropertyQuantity", "Weight", "Results", "Volume x Density", mode=_READONLY)
@@ -193,6 +195,7 @@ class TabletProxy(_Proxy):
         obj.Shape = geo.solid
         obj.Placement = pl
         obj.Volume = _qty(geo.volume, "mm^3")
+        obj.SolidVolume = _qty(geo.props["solid_volume_mm3"], "mm^3")
         obj.Area = _qty(geo.area, "mm^2")
         obj.PlanArea = _qty(geo.props.get("plan_area_mm2", float("nan")), "mm^2")
         obj.Weight = _qty(geo.volume, "mm^3") * obj.Density
@@ -248,10 +251,9 @@ class PunchProxy(_Proxy):
         rims = geometry.rims_from_json(tab.RimData)
         shape = geometry.punch_shape(_local_shape(tab), rims, obj.Which, float(obj.Length.Value))
         gap = float(obj.Gap.Value)
-        if gap:
-            shape.translate(FreeCAD.Vector(0, 0, gap if obj.Which == "upper" else -gap))
+        lift = FreeCAD.Placement(FreeCAD.Vector(0, 0, gap if obj.Which == "upper" else -gap), FreeCAD.Rotation())
         obj.Shape = shape
-        obj.Placement = tab.Placement
+        obj.Placement = tab.Placement.multiply(lift)  # the shape's own placement is the object's
         obj.Volume = _qty(shape.Volume, "mm^3")
 
 
@@ -307,7 +309,7 @@ class ViewProviderTabletcad:
         if t in _COLOURS:
             vobj.ShapeColor = _COLOURS[t]
         if t == DieProxy.Type:
-            vobj.Transparency = 60
+            vobj.Transparency = 75
 
     def attach(self, vobj):
         self.Object = vobj.Object
@@ -348,7 +350,7 @@ def design_is_parametric(path) -> tuple[str, dict, str] | None:
         data = tomllib.loads(open(os.fspath(path), encoding="utf-8").read())
     except Exception:
         return None
-    if set(data) != {"tablet"} or not isinstance(data.get("tablet"), dict):
+    if not {"tablet"} <= set(data) <= {"tablet", "report"} or not isinstance(data.get("tablet"), dict):
         return None
     tab = dict(data["tablet"])
     family = tab.pop("family", None)

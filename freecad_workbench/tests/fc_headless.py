@@ -1,0 +1,164 @@
+"""Headless checks of the workbench, run by tests/test_freecad_workbench.py under freecadcmd.
+
+Env: TABLETCAD_FC_OUTPUT (JSON result), TABLETCAD_FC_WORK (scratch folder), TABLETCAD_ROOT (repo).
+Stdlib + FreeCAD + the installed workbench only.
+"""
+
+import json
+import os
+import time
+import traceback
+
+import FreeCAD
+
+out_path = os.environ["TABLETCAD_FC_OUTPUT"]
+work = os.environ["TABLETCAD_FC_WORK"]
+root = os.environ["TABLETCAD_ROOT"]
+result = {"ok": False, "steps": []}
+
+
+def shape_info(o):
+    s = o.Shape
+    return {
+        "valid_obj": bool(o.isValid()),
+        "status": o.getStatusString(),
+        "null": bool(s.isNull()),
+        "valid": bool(s.isValid()) if not s.isNull() else False,
+        "n_solids": len(s.Solids),
+        "volume": float(s.Volume) if not s.isNull() else None,
+        "bbox": [s.BoundBox.XMin, s.BoundBox.YMin, s.BoundBox.ZMin, s.BoundBox.XMax, s.BoundBox.YMax, s.BoundBox.ZMax]
+        if not s.isNull() else None,
+    }
+
+
+def tablet_info(t):
+    d = shape_info(t)
+    d.update(
+        family=t.Family,
+        core_volume=float(t.Volume.Value),
+        core_area=float(t.Area.Value),
+        solid_volume=float(t.SolidVolume.Value),
+        weight_mg=float(t.Weight.Value) * 1e6,  # kg -> mg
+        density=float(t.Density.Value) * 1e6,  # kg/mm^3 -> mg/mm^3 (= g/cm^3)
+        fit_deviation=float(t.FitDeviation.Value),
+        recompute_s=float(t.RecomputeTime),
+        dims={p: float(getattr(t, p).Value) for p in t.PropertiesList if t.getGroupOfProperty(p) == "Dimensions"},
+        readonly_volume="ReadOnly" in t.getEditorMode("Volume"),
+    )
+    return d
+
+
+def step(name, **data):
+    result["steps"].append(dict(name=name, **data))
+
+
+try:
+    import freecad.tabletcad_wb as wb
+    from freecad.tabletcad_wb.make import make_die, make_lower_punch, make_tablet, make_tooling, make_upper_punch
+
+    result["core_root"] = str(wb.core_root())
+    import tabletcad.shapes
+
+    result["tabletcad_file"] = tabletcad.shapes.__file__
+    doc = FreeCAD.newDocument("wbtest")
+
+    # ---- every family asked for, default dimensions, each recomputed on creation
+    families = {
+        "flat_faced_round": {},
+        "ring": {},
+        "concave_round": {"diameter": 10.0, "cup_depth": 0.8},
+        "spherical": {},
+        "shallow_convex_round": {},
+        "compound_cup": {},
+    }
+    tabs = {}
+    for fam, params in families.items():
+        t0 = time.perf_counter()
+        tabs[fam] = make_tablet(doc, fam, **params)
+        step("create", family=fam, wall_s=time.perf_counter() - t0, tablet=tablet_info(tabs[fam]))
+
+    # ---- tooling of two tablets (round with cups, and the hollow ring)
+    tooling = {}
+    for fam in ("concave_round", "ring"):
+        t0 = time.perf_counter()
+        up = make_upper_punch(doc, tabs[fam], recompute=False)
+        low = make_lower_punch(doc, tabs[fam], recompute=False)
+        die = make_die(doc, tabs[fam], recompute=False)
+        doc.recompute()
+        tooling[fam] = (up, low, die)
+        step("tooling", family=fam, wall_s=time.perf_counter() - t0,
+             upper=shape_info(up), lower=shape_info(low), die=shape_info(die),
+             links=[o.Tablet.Name for o in (up, low, die)])
+
+    # ---- change a dimension: the solid and the linked tooling follow
+    t = tabs["concave_round"]
+    t.Diameter = 9.0
+    t0 = time.perf_counter()
+    doc.recompute()
+    up, low, die = tooling["concave_round"]
+    step("change", wall_s=time.perf_counter() - t0, tablet=tablet_info(t),
+         upper=shape_info(up), lower=shape_info(low), die=shape_info(die))
+
+    # ---- invalid values: error state, previous shape kept, tooling untouched
+    before = shape_info(t)
+    t.CupDepth = 8.0  # deeper than a hemisphere over the cup
+    doc.recompute()
+    step("cup_too_deep", tablet=tablet_info(t), before=before, state=list(t.State),
+         upper=shape_info(up), die=shape_info(die))
+    t.CupDepth = 0.8
+    t.Diameter = -3.0  # App::PropertyLength clamps to 0 mm: the core refuses it
+    doc.recompute()
+    step("negative_diameter", tablet=tablet_info(t), diameter=float(t.Diameter.Value), state=list(t.State),
+         before=before)
+    t.Diameter = 9.0
+    doc.recompute()
+    step("repaired", tablet=tablet_info(t), upper=shape_info(up), state=list(t.State))
+
+    # ---- exploded view: Gap lifts the punch off the tablet
+    z0 = up.Shape.BoundBox.ZMin
+    up.Gap = 2.0
+    doc.recompute()
+    step("gap", dz=up.Shape.BoundBox.ZMin - z0, upper=shape_info(up))
+    up.Gap = 0.0
+    doc.recompute()
+
+    # ---- family switch: Dimensions group follows the family
+    sw = make_tablet(doc, "flat_faced_round")
+    sw.Family = "shallow_convex_round"
+    sw.Band = 1.5
+    doc.recompute()
+    step("family_switch", tablet=tablet_info(sw))
+
+    # ---- design files: a plain family design (parametric) and a free-form one (design_file)
+    d1 = make_tablet(doc, os.path.join(root, "samples", "ring.toml"))
+    d2 = make_tablet(doc, os.path.join(root, "samples", "free_form_stadium.toml"))
+    d2die = make_die(doc, d2)
+    d2up = make_upper_punch(doc, d2)
+    step("design_ring", tablet=tablet_info(d1), label=d1.Label)
+    step("design_free_form", tablet=tablet_info(d2), label=d2.Label, design_file=d2.DesignFile,
+         die=shape_info(d2die), upper=shape_info(d2up))
+
+    # ---- save, reopen (proxies restored), change, recompute
+    path = os.path.join(work, "wbtest.FCStd")
+    doc.saveAs(path)
+    names = {fam: tabs[fam].Name for fam in tabs}
+    tool_names = [o.Name for o in tooling["ring"]]
+    FreeCAD.closeDocument(doc.Name)
+    doc = FreeCAD.openDocument(path)
+    proxies = {o.Name: type(o.Proxy).__name__ for o in doc.Objects}
+    ring = doc.getObject(names["ring"])
+    restored_density = float(ring.Density.Value) * 1e6
+    ring.Thickness = 5.0
+    t0 = time.perf_counter()
+    doc.recompute()
+    rup, rlow, rdie = (doc.getObject(n) for n in tool_names)
+    step("reopen", proxies=proxies, density=restored_density, wall_s=time.perf_counter() - t0,
+         tablet=tablet_info(ring), upper=shape_info(rup), lower=shape_info(rlow), die=shape_info(rdie),
+         all_valid=all(o.isValid() for o in doc.Objects))
+    doc.save()
+    result["ok"] = True
+except Exception as exc:
+    result["error"] = repr(exc)
+    result["traceback"] = traceback.format_exc()
+with open(out_path, "w") as fh:
+    json.dump(result, fh)
