@@ -21,7 +21,15 @@ from OCP.TDataStd import TDataStd_Name
 from OCP.TDocStd import TDocStd_Document
 from OCP.TopLoc import TopLoc_Location
 from OCP.gp import gp_Trsf, gp_Vec
-from OCP.XCAFDoc import XCAFDoc_DocumentTool
+from OCP.BRep import BRep_Builder
+from OCP.TDF import TDF_Label
+
+try:  # OCP >= 8.0
+    from OCP.collections import Sequence_TDF_Label as TDF_LabelSequence
+except ImportError:  # pragma: no cover - OCP 7.x
+    from OCP.TDF import TDF_LabelSequence
+from OCP.TopoDS import TopoDS_Compound
+from OCP.XCAFDoc import XCAFDoc_DocumentTool, XCAFDoc_ShapeTool
 
 from tabletcad.cad._occ import quiet
 from tabletcad.cad.export import export_step
@@ -38,24 +46,32 @@ def write_assembly(parts: dict, path, *, name: str = "tooling", offsets: dict | 
     place components (as locations, the part shapes are stored once)."""
     offsets = offsets or {}
     STEPControl_Controller.Init_s()
-    Interface_Static.SetCVal_s("write.step.schema", "AP242DIS")
+    Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
     Interface_Static.SetCVal_s("write.step.unit", "MM")
     Interface_Static.SetIVal_s("write.step.assembly", 1)
     doc = TDocStd_Document(TCollection_ExtendedString("XmlOcaf"))
     XCAFDoc_DocumentTool.SetLengthUnit_s(doc, 0.001)
     tool = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
-    top = tool.NewShape()
-    TDataStd_Name.Set_s(top, TCollection_ExtendedString(str(name)))
-    for part in PART_NAMES:
-        if part not in parts:
-            continue
-        lab = tool.AddShape(parts[part], False)
-        TDataStd_Name.Set_s(lab, TCollection_ExtendedString(part))
+    names = [p for p in PART_NAMES if p in parts]
+    builder, comp = BRep_Builder(), TopoDS_Compound()
+    builder.MakeCompound(comp)
+    for part in names:
         tr = gp_Trsf()
         tr.SetTranslation(gp_Vec(0.0, 0.0, float(offsets.get(part, 0.0))))
-        comp = tool.AddComponent(top, lab, TopLoc_Location(tr))
-        TDataStd_Name.Set_s(comp, TCollection_ExtendedString(part))
-    tool.UpdateAssemblies()
+        dz = float(offsets.get(part, 0.0))
+        builder.Add(comp, parts[part].Moved(TopLoc_Location(tr)) if dz else parts[part])
+    top = tool.AddShape(comp, True)  # an assembly: one component (and one part) per sub-shape
+    TDataStd_Name.Set_s(top, TCollection_ExtendedString(str(name)))
+    labels = TDF_LabelSequence()
+    XCAFDoc_ShapeTool.GetComponents_s(top, labels, False)
+    if labels.Length() != len(names):
+        raise GeometryError(f"the assembly has {labels.Length()} components, expected {len(names)}", parts)
+    for k, part in enumerate(names):
+        comp_label = labels.Value(k + 1)
+        TDataStd_Name.Set_s(comp_label, TCollection_ExtendedString(part))
+        ref = TDF_Label()
+        if XCAFDoc_ShapeTool.GetReferredShape_s(comp_label, ref):
+            TDataStd_Name.Set_s(ref, TCollection_ExtendedString(part))
     writer = STEPCAFControl_Writer()
     writer.SetNameMode(True)
     with quiet():

@@ -71,10 +71,17 @@ def raw_boolean(op: str, a: TopoDS_Shape, b: TopoDS_Shape, fuzzy: float = 0.0, g
     return algo.Shape()
 
 
-def boolean(op: str, a: TopoDS_Shape, b: TopoDS_Shape, *, what: str = "result", fuzzy: float = 0.0) -> TopoDS_Shape:
-    """``a op b`` as exactly one valid solid (faces on one surface merged)."""
+def boolean(op: str, a: TopoDS_Shape, b: TopoDS_Shape, *, what: str = "result", fuzzy: float = 0.0,
+            sliver: float = 0.0) -> TopoDS_Shape:
+    """``a op b`` as exactly one valid solid (faces on one surface merged).
+
+    ``sliver`` > 0: solids smaller than ``sliver`` times the largest are dropped (e.g. the hair-thin
+    ring between a zero-clearance punch tip and a PDE band that bows inward by a micrometre)."""
     shape = raw_boolean(op, a, b, fuzzy)
     solids = explore(shape, "Solid")
+    if sliver > 0 and len(solids) > 1:
+        vols = [mass_properties(s, 1e-7).volume for s in solids]
+        solids = [s for s, v in zip(solids, vols) if v >= sliver * max(vols)]
     if len(solids) != 1:
         vols = ", ".join(f"{mass_properties(s, 1e-7).volume:.4g}" for s in solids[:6])
         raise GeometryError(f"{what}: the {op} gave {len(solids)} solids (volumes {vols} mm^3), expected one", shape)
@@ -176,12 +183,13 @@ def checked_boolean(
     check: bool = True,
     a_manifold=None,
     fuzzy: float = 0.0,
+    sliver: float = 0.0,
 ) -> tuple[TopoDS_Shape, BooleanCheck | None]:
     """:func:`boolean` plus the manifold3d check; raises :class:`GeometryError` if they disagree.
 
     The "change" is the volume removed (cut), added (fuse) or kept (common).
     """
-    result = boolean(op, a, b, what=what, fuzzy=fuzzy)
+    result = boolean(op, a, b, what=what, fuzzy=fuzzy, sliver=sliver)
     if not check:
         return result, None
     va, vr = volume(a), volume(result)

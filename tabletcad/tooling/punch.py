@@ -54,7 +54,7 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
     body = prism(tip_wire, z0, z1)
     # the manifold check is on "prism minus tablet": the removed volume is the tablet inside the prism
     shape, chk = checked_boolean("cut", body, tablet_shape, what=f"{which} punch tip", deflection=deflection,
-                                 check=check, a_manifold=None)
+                                 check=check, a_manifold=None, sliver=1e-4)
     vol = volume(shape)
     land = None if frame.land is None else frame.land - clearance
     quad = punch_volume_quadrature(frame, clearance, tip_length, which)

@@ -1,0 +1,190 @@
+"""Tooling from the tablet: scores, embossing, punch tips, die, interference, drawings, batch."""
+
+import math
+import os
+from pathlib import Path
+
+import pytest
+
+
+def _need(module: str):
+    if os.environ.get("CI"):
+        return __import__(module)
+    return pytest.importorskip(module)
+
+
+_need("OCP")
+_need("build123d")
+_need("manifold3d")
+_need("ezdxf")
+
+from tabletcad.cad.solid import check_solid  # noqa: E402
+from tabletcad.cli import main  # noqa: E402
+from tabletcad.design import load_design  # noqa: E402
+from tabletcad.errors import DesignError, GeometryError  # noqa: E402
+from tabletcad.shapes import shallow_convex_round  # noqa: E402
+from tabletcad.tooling import EmbossSpec, ScoreSpec, ToolingSpec, make_tooling, parse_tooling, tooling_batch  # noqa: E402
+from tabletcad.tooling.stage import read_tooling_table  # noqa: E402
+
+pytestmark = pytest.mark.cad
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLES = ROOT / "samples" / "tooling"
+CLEARANCE = 0.025
+
+
+@pytest.fixture(scope="module")
+def thesis():
+    """The thesis's 10 x 3 mm shallow convex round with plain tooling and the closed-position check."""
+    t = shallow_convex_round()
+    return make_tooling(t, ToolingSpec(clearance_mm=CLEARANCE, tip_length_mm=8.0))
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    """``tabletcad build`` of the concave round sample (bisect, debossed text, taper, open gap)."""
+    out = tmp_path_factory.mktemp("build") / "concave"
+    assert main(["build", str(SAMPLES / "concave_round_bisect.toml"), "--out", str(out), "--quiet"]) == 0
+    import json
+
+    return out, json.loads((out / "report.json").read_text())
+
+
+def test_parts_are_single_valid_solids(thesis):
+    for name, shape in thesis.parts.items():
+        check_solid(shape, name)
+
+
+def test_closed_position_encloses_exactly_the_tablet(thesis):
+    r = thesis.report
+    assert r["interference_mm3"] == pytest.approx(0.0, abs=1e-9)
+    for p in r["interference"]["pairs"]:
+        assert p["occ_mm3"] == pytest.approx(0.0, abs=1e-9)
+        assert p["manifold3d_mm3"] <= p["manifold3d_bound_mm3"]
+    assert 0.0 < r["max_gap_mm"] <= CLEARANCE
+    bulge = r["die"]["bore_enlarged_by_band_bulge_mm"]  # the die clears the PDE band's bulge
+    assert 0.0 <= bulge < 0.005
+    assert r["interference"]["punch_die_clearance_mm"] == pytest.approx(CLEARANCE + bulge, abs=1e-6)
+
+
+def test_punch_volume_is_cylinder_minus_cup_by_quadrature(thesis):
+    for which in ("upper_punch", "lower_punch"):
+        info = thesis.report[which]
+        assert info["volume_rel_diff_vs_quadrature"] == pytest.approx(0.0, abs=1e-8)
+
+
+def test_punch_volume_from_tablet_properties_without_clearance():
+    # cup volume from the tablet's own quadrature: (V - pi R^2 band) / 2 for a symmetric tablet
+    t = shallow_convex_round()
+    ts = make_tooling(t, ToolingSpec(clearance_mm=0.0, tip_length_mm=5.0), check=False, interference_check=False)
+    V = t.properties()["volume_mm3"]
+    R, band = 5.0, 2.0
+    expected = math.pi * R * R * 5.0 - 0.5 * (V - math.pi * R * R * band)
+    assert ts.report["upper_punch"]["volume_mm3"] == pytest.approx(expected, rel=1e-7)
+    assert ts.report["lower_punch"]["volume_mm3"] == pytest.approx(expected, rel=1e-7)
+
+
+def test_build_writes_parts_assembly_drawing_and_report(built):
+    out, rep = built
+    for f in ("assembly.step", "upper_punch.step", "lower_punch.step", "die.step", "drawing.svg", "drawing.dxf", "drawing.pdf"):
+        assert (out / f).stat().st_size > 0, f
+    tool = rep["tooling"]
+    assert tool["interference_mm3"] == pytest.approx(0.0, abs=1e-9)
+    assert tool["max_gap_mm"] <= tool["keys"]["clearance_mm"]
+    assert tool["press_position"]["upper_punch_lift_mm"] == pytest.approx(0.5)
+    # the lower punch = plain tip (quadrature) + the letters debossed in the tablet's bottom face
+    lp = tool["lower_punch"]
+    added = [e["volume_changed_mm3"] for e in tool["emboss"] if e["face"] == "bottom"]
+    assert lp["volume_mm3"] - lp["volume_quadrature_mm3"] == pytest.approx(sum(added), rel=1e-6)
+    assert tool["upper_punch"]["working_length_datum"]["datum_to_tip_edge_mm"] == pytest.approx(8.0)
+
+
+def test_booleans_agree_between_occ_and_manifold3d(built):
+    _, rep = built
+    checks = rep["tooling"]["booleans"]
+    assert {c["what"].split()[0] for c in checks} >= {"score", "deboss", "upper", "lower"}
+    for c in checks:
+        assert c["valid"] and c["ok"]
+        assert c["abs_diff_mm3"] <= c["bound_mm3"]
+        assert c["rel_diff"] < 1e-2, c
+
+
+def test_drawing_states_the_design_numbers(built):
+    out, _ = built
+    svg = (out / "drawing.svg").read_text(encoding="utf-8")
+    dxf = (out / "drawing.dxf").read_text(encoding="utf-8", errors="replace")
+    for text in ("Ø10.00", "band 2.80", "cup 0.90", "T 4.60", "land 0.080", "R13.90"):
+        assert text in svg, text
+    for text in ("band 2.80", "cup 0.90", "T 4.60"):
+        assert text in dxf, text
+    assert "10.00" in dxf
+
+
+def test_emboss_and_scores_on_both_faces():
+    t = load_design(ROOT / "samples" / "families" / "concave_round.toml")
+    spec = ToolingSpec(scores=(ScoreSpec(kind="quadrisect", profile="u", width_mm=0.5, depth_mm=0.3, faces="bottom"),),
+                       emboss=(EmbossSpec(outline=((-1.0, 1.0), (1.0, 1.0), (0.0, 2.5)), mode="emboss", depth_mm=0.1,
+                                          draft_deg=10.0),))
+    ts = make_tooling(t, spec, interference_check=False)
+    assert ts.report["tablet"]["volume_mm3"] != pytest.approx(ts.report["tablet"]["volume_plain_mm3"])
+    for c in ts.report["booleans"]:
+        assert c["ok"] and c["rel_diff"] < 1e-2
+    for shape in ts.parts.values():
+        check_solid(shape)
+
+
+def test_capsule_sample_tooling():
+    t = load_design(SAMPLES / "capsule.toml")
+    try:
+        from tabletcad.cad.tablet_solid import tablet_solid
+
+        solid = tablet_solid(t)
+    except GeometryError as exc:  # the B-rep of elongated families is not built yet by the CAD layer
+        pytest.xfail(f"capsule B-rep: {exc}")
+    ts = make_tooling(t, parse_tooling(read_tooling_table(SAMPLES / "capsule.toml")), shape=solid.shape)
+    assert ts.report["interference_mm3"] == pytest.approx(0.0, abs=1e-9)
+
+
+@pytest.mark.parametrize("table, parameter", [
+    ({"score": [{"depth_mm": 0.6}]}, "depth_mm"),                                   # deeper than the 0.5 mm cup
+    ({"score": [{"depth_mm": 1.2, "cut_through": True}]}, "depth_mm"),              # > cup + band/4
+    ({"emboss": [{"text": "WWWWW", "height_mm": 3.0}]}, "text"),                    # does not fit the face
+    ({"emboss": [{"outline": [[0, 0], [6, 0], [0, 1]]}]}, "outline"),
+])
+def test_bad_tooling_is_a_design_error(table, parameter):
+    with pytest.raises(DesignError) as err:
+        make_tooling(shallow_convex_round(), parse_tooling(table), interference_check=False)
+    assert parameter in err.value.parameter and "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize("table", [{"clearance_mm": -0.01}, {"taper_deg": 12}, {"score": [{"profile": "w"}]},
+                                   {"bogus": 1}, {"emboss": [{"text": "A", "font": "NoSuchFont"}]}])
+def test_bad_keys_are_design_errors(table):
+    with pytest.raises(DesignError):
+        parse_tooling(table)
+
+
+@pytest.mark.parametrize("extra", [
+    "[tooling]\nclearance_mm = -0.02\n",
+    "[tooling]\n[[tooling.score]]\ndepth_mm = 0.9\n",
+    '[tooling]\n[[tooling.emboss]]\ntext = "TOO LONG"\nheight_mm = 4.0\n',
+])
+def test_cli_bad_tooling_exits_2_and_writes_nothing(tmp_path, capsys, extra):
+    d = tmp_path / "bad.toml"
+    d.write_text('[tablet]\nfamily = "shallow_convex_round"\ndiameter = 10.0\nthickness = 3.0\nband = 2.0\n\n' + extra)
+    out = tmp_path / "out"
+    assert main(["build", str(d), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err and err[-1].startswith("error:")
+    assert not out.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
+
+
+def test_batch_of_sizes(tmp_path):
+    sizes = [dict(diameter=d, thickness=0.3 * d, band=0.2 * d) for d in (6.0, 8.0)]
+    rows = tooling_batch("shallow_convex_round", sizes, {"clearance_mm": 0.02}, out_dir=tmp_path, progress=False,
+                         check=False, drawing=False)
+    assert len(rows) == 2
+    for k, r in enumerate(rows):
+        assert r["upper_punch_rel_diff_vs_quadrature"] == pytest.approx(0.0, abs=1e-8)
+        assert (tmp_path / f"shallow_convex_round_{k:03d}" / "assembly.step").exists()
