@@ -67,7 +67,9 @@ FREECADCMD = _which("freecadcmd", "FreeCADCmd")
 FREECAD = _which("freecad", "FreeCAD")
 if FREECADCMD is None:
     if CI:
-        raise RuntimeError("freecadcmd is required in CI for the FreeCAD workbench tests (Debian: freecad-python3)")
+        raise RuntimeError(
+            "freecadcmd is required in CI for the FreeCAD workbench tests (Debian: freecad-python3)"
+        )
     pytest.skip("freecadcmd not installed", allow_module_level=True)
 
 USER_CFG = """<?xml version="1.0" encoding="UTF-8" standalone="no" ?>
@@ -91,7 +93,9 @@ def fc_home():
     with tempfile.TemporaryDirectory(prefix="tabletcad-wb-") as home:
         env = _clean_env()
         env["FREECAD_USER_HOME"] = home
-        proc = subprocess.run(["bash", str(WB / "install.sh")], env=env, capture_output=True, text=True, timeout=120)
+        proc = subprocess.run(
+            ["bash", str(WB / "install.sh")], env=env, capture_output=True, text=True, timeout=120
+        )
         assert proc.returncode == 0, proc.stderr + proc.stdout
         installed = Path(proc.stdout.split("into ")[-1].split(" (core")[0].strip())
         assert (installed / "freecad" / "tabletcad_wb" / "__init__.py").is_file(), proc.stdout
@@ -111,11 +115,18 @@ def _run(exe: str, script: Path, home: Path, work: Path, timeout: float = 180.0,
         **(extra or {}),
     )
     t0 = time.perf_counter()
-    proc = subprocess.run([exe, str(script)], env=env, cwd=work, capture_output=True, text=True, timeout=timeout)
+    proc = subprocess.run(
+        [exe, str(script)], env=env, cwd=work, capture_output=True, text=True, timeout=timeout
+    )
     wall = time.perf_counter() - t0
-    assert out.exists(), f"{script.name} wrote no result (exit {proc.returncode}):\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
+    assert out.exists(), (
+        f"{script.name} wrote no result (exit {proc.returncode}):\n"
+        f"{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
+    )
     result = json.loads(out.read_text())
-    assert result.get("ok"), f"{script.name} failed: {result.get('error')}\n{result.get('traceback')}\n{proc.stdout[-2000:]}"
+    assert result.get("ok"), (
+        f"{script.name} failed: {result.get('error')}\n{result.get('traceback')}\n{proc.stdout[-2000:]}"
+    )
     result["_wall_s"] = wall
     return result
 
@@ -203,9 +214,13 @@ def test_change_property_tablet_and_tooling_follow(headless):
         assert step[part]["valid"] and step[part]["n_solids"] == 1
         assert step[part]["volume"] != pytest.approx(before[part]["volume"], rel=1e-6), part
     # punch outline follows the 9 mm tablet
-    assert step["upper"]["bbox"][3] - step["upper"]["bbox"][0] == pytest.approx(t["bbox"][3] - t["bbox"][0], abs=1e-6)
-    print(f"recompute after Diameter change (tablet + 2 punches + die): {step['wall_s']:.2f} s; "
-          f"tablet execute {t['recompute_s']:.3f} s")
+    assert step["upper"]["bbox"][3] - step["upper"]["bbox"][0] == pytest.approx(
+        t["bbox"][3] - t["bbox"][0], abs=1e-6
+    )
+    print(
+        f"recompute after Diameter change (tablet + 2 punches + die): {step['wall_s']:.2f} s; "
+        f"tablet execute {t['recompute_s']:.3f} s"
+    )
 
 
 def test_invalid_values_keep_previous_shape(headless):
@@ -237,7 +252,9 @@ def test_family_switch_rebuilds_dimension_properties(headless):
 def test_design_files(headless):
     (ring,) = _steps(headless, "design_ring")
     assert ring["tablet"]["family"] == "ring" and ring["tablet"]["dims"]["InnerDiameter"] == 6.0
-    assert ring["tablet"]["core_volume"] == pytest.approx(_core_volume(None, design=ROOT / "samples" / "ring.toml"), rel=1e-9)
+    assert ring["tablet"]["core_volume"] == pytest.approx(
+        _core_volume(None, design=ROOT / "samples" / "ring.toml"), rel=1e-9
+    )
     (ff,) = _steps(headless, "design_free_form")
     t = ff["tablet"]
     assert t["family"] == "design_file" and ff["design_file"].endswith("free_form_stadium.toml")
@@ -268,7 +285,9 @@ def test_save_reopen_recompute(headless):
 # ------------------------------------------------------------------------------------------- macros
 @pytest.fixture(scope="module")
 def macros(fc_home, tmp_path_factory):
-    return _run(FREECADCMD, SCRIPTS / "fc_macros.py", fc_home, tmp_path_factory.mktemp("fc_macros"), timeout=240)
+    return _run(
+        FREECADCMD, SCRIPTS / "fc_macros.py", fc_home, tmp_path_factory.mktemp("fc_macros"), timeout=240
+    )
 
 
 def test_macro_tablet_from_design(macros):
@@ -321,8 +340,12 @@ def _start_xvfb():
     if xvfb is None:
         return None, None
     r, w = os.pipe()
-    proc = subprocess.Popen([xvfb, "-displayfd", str(w), "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
-                            pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(
+        [xvfb, "-displayfd", str(w), "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
+        pass_fds=(w,),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     os.close(w)
     with os.fdopen(r) as fh:
         display = fh.readline().strip()
@@ -343,7 +366,11 @@ def test_gui_smoke_and_screenshot(fc_home, tmp_path):
     for p in (shot, window):
         p.unlink(missing_ok=True)
     xvfb, display = _start_xvfb()
-    extra = {"QT_QPA_PLATFORM": "offscreen", "TABLETCAD_FC_SHOT": str(shot), "TABLETCAD_FC_WINDOW": str(window)}
+    extra = {
+        "QT_QPA_PLATFORM": "offscreen",
+        "TABLETCAD_FC_SHOT": str(shot),
+        "TABLETCAD_FC_WINDOW": str(window),
+    }
     if display:
         extra.update(DISPLAY=display, TABLETCAD_FC_SAVEIMAGE="1")
     try:
@@ -368,4 +395,6 @@ def test_gui_smoke_and_screenshot(fc_home, tmp_path):
     else:
         import warnings
 
-        warnings.warn("Xvfb not found: the 3D-view screenshot (saveImage) was not taken, only the window grab")
+        warnings.warn(
+            "Xvfb not found: the 3D-view screenshot (saveImage) was not taken, only the window grab"
+        )

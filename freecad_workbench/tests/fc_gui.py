@@ -1,4 +1,6 @@
-"""GUI smoke test, run as ``freecad fc_gui.py`` (QT_QPA_PLATFORM=offscreen; DISPLAY of an Xvfb when there is one).
+"""GUI smoke test, run as ``freecad fc_gui.py``.
+
+QT_QPA_PLATFORM=offscreen, with DISPLAY of an Xvfb when there is one (OpenGL for saveImage).
 
 Loads the workbench, runs its commands, and writes the screenshot of the 3D view
 (ActiveView.saveImage, needs OpenGL: only when TABLETCAD_FC_SAVEIMAGE=1) and a grab of the
@@ -26,8 +28,10 @@ try:
     doc.recompute()
     FreeCADGui.Selection.clearSelection()
     FreeCADGui.Selection.addSelection(tab)
-    result["active"] = {c: FreeCADGui.Command.get(c).isActive() if hasattr(FreeCADGui, "Command") else None
-                        for c in ("Tabletcad_UpperPunch", "Tabletcad_Tooling")}
+    result["active"] = {
+        c: FreeCADGui.Command.get(c).isActive() if hasattr(FreeCADGui, "Command") else None
+        for c in ("Tabletcad_UpperPunch", "Tabletcad_Tooling")
+    }
     FreeCADGui.runCommand("Tabletcad_Tooling")
     for o in doc.Objects:
         if getattr(getattr(o, "Proxy", None), "Type", "") == "TabletcadPunch":
@@ -35,9 +39,16 @@ try:
     doc.recompute()
     FreeCADGui.Selection.clearSelection()
     result["objects"] = [
-        dict(name=o.Name, label=o.Label, valid=bool(o.isValid()), shape_valid=bool(o.Shape.isValid()),
-             view_provider=type(o.ViewObject.Proxy).__name__ if o.ViewObject is not None and o.ViewObject.Proxy else None,
-             icon=o.ViewObject.Proxy.getIcon() if o.ViewObject is not None and o.ViewObject.Proxy else None)
+        dict(
+            name=o.Name,
+            label=o.Label,
+            valid=bool(o.isValid()),
+            shape_valid=bool(o.Shape.isValid()),
+            view_provider=type(o.ViewObject.Proxy).__name__
+            if o.ViewObject is not None and o.ViewObject.Proxy
+            else None,
+            icon=o.ViewObject.Proxy.getIcon() if o.ViewObject is not None and o.ViewObject.Proxy else None,
+        )
         for o in doc.Objects
     ]
     view = FreeCADGui.ActiveDocument.ActiveView

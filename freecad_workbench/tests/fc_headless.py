@@ -26,8 +26,16 @@ def shape_info(o):
         "valid": bool(s.isValid()) if not s.isNull() else False,
         "n_solids": len(s.Solids),
         "volume": float(s.Volume) if not s.isNull() else None,
-        "bbox": [s.BoundBox.XMin, s.BoundBox.YMin, s.BoundBox.ZMin, s.BoundBox.XMax, s.BoundBox.YMax, s.BoundBox.ZMax]
-        if not s.isNull() else None,
+        "bbox": [
+            s.BoundBox.XMin,
+            s.BoundBox.YMin,
+            s.BoundBox.ZMin,
+            s.BoundBox.XMax,
+            s.BoundBox.YMax,
+            s.BoundBox.ZMax,
+        ]
+        if not s.isNull()
+        else None,
     }
 
 
@@ -42,7 +50,9 @@ def tablet_info(t):
         density=float(t.Density.Value) * 1e6,  # kg/mm^3 -> mg/mm^3 (= g/cm^3)
         fit_deviation=float(t.FitDeviation.Value),
         recompute_s=float(t.RecomputeTime),
-        dims={p: float(getattr(t, p).Value) for p in t.PropertiesList if t.getGroupOfProperty(p) == "Dimensions"},
+        dims={
+            p: float(getattr(t, p).Value) for p in t.PropertiesList if t.getGroupOfProperty(p) == "Dimensions"
+        },
         readonly_volume="ReadOnly" in t.getEditorMode("Volume"),
     )
     return d
@@ -54,7 +64,12 @@ def step(name, **data):
 
 try:
     import freecad.tabletcad_wb as wb
-    from freecad.tabletcad_wb.make import make_die, make_lower_punch, make_tablet, make_tooling, make_upper_punch
+    from freecad.tabletcad_wb.make import (
+        make_die,
+        make_lower_punch,
+        make_tablet,
+        make_upper_punch,
+    )
 
     result["core_root"] = str(wb.core_root())
     import tabletcad.shapes
@@ -86,9 +101,15 @@ try:
         die = make_die(doc, tabs[fam], recompute=False)
         doc.recompute()
         tooling[fam] = (up, low, die)
-        step("tooling", family=fam, wall_s=time.perf_counter() - t0,
-             upper=shape_info(up), lower=shape_info(low), die=shape_info(die),
-             links=[o.Tablet.Name for o in (up, low, die)])
+        step(
+            "tooling",
+            family=fam,
+            wall_s=time.perf_counter() - t0,
+            upper=shape_info(up),
+            lower=shape_info(low),
+            die=shape_info(die),
+            links=[o.Tablet.Name for o in (up, low, die)],
+        )
 
     # ---- change a dimension: the solid and the linked tooling follow
     t = tabs["concave_round"]
@@ -96,20 +117,37 @@ try:
     t0 = time.perf_counter()
     doc.recompute()
     up, low, die = tooling["concave_round"]
-    step("change", wall_s=time.perf_counter() - t0, tablet=tablet_info(t),
-         upper=shape_info(up), lower=shape_info(low), die=shape_info(die))
+    step(
+        "change",
+        wall_s=time.perf_counter() - t0,
+        tablet=tablet_info(t),
+        upper=shape_info(up),
+        lower=shape_info(low),
+        die=shape_info(die),
+    )
 
     # ---- invalid values: error state, previous shape kept, tooling untouched
     before = shape_info(t)
     t.CupDepth = 8.0  # deeper than a hemisphere over the cup
     doc.recompute()
-    step("cup_too_deep", tablet=tablet_info(t), before=before, state=list(t.State),
-         upper=shape_info(up), die=shape_info(die))
+    step(
+        "cup_too_deep",
+        tablet=tablet_info(t),
+        before=before,
+        state=list(t.State),
+        upper=shape_info(up),
+        die=shape_info(die),
+    )
     t.CupDepth = 0.8
     t.Diameter = -3.0  # App::PropertyLength clamps to 0 mm: the core refuses it
     doc.recompute()
-    step("negative_diameter", tablet=tablet_info(t), diameter=float(t.Diameter.Value), state=list(t.State),
-         before=before)
+    step(
+        "negative_diameter",
+        tablet=tablet_info(t),
+        diameter=float(t.Diameter.Value),
+        state=list(t.State),
+        before=before,
+    )
     t.Diameter = 9.0
     doc.recompute()
     step("repaired", tablet=tablet_info(t), upper=shape_info(up), state=list(t.State))
@@ -135,8 +173,14 @@ try:
     d2die = make_die(doc, d2)
     d2up = make_upper_punch(doc, d2)
     step("design_ring", tablet=tablet_info(d1), label=d1.Label)
-    step("design_free_form", tablet=tablet_info(d2), label=d2.Label, design_file=d2.DesignFile,
-         die=shape_info(d2die), upper=shape_info(d2up))
+    step(
+        "design_free_form",
+        tablet=tablet_info(d2),
+        label=d2.Label,
+        design_file=d2.DesignFile,
+        die=shape_info(d2die),
+        upper=shape_info(d2up),
+    )
 
     # ---- save, reopen (proxies restored), change, recompute
     path = os.path.join(work, "wbtest.FCStd")
@@ -152,9 +196,17 @@ try:
     t0 = time.perf_counter()
     doc.recompute()
     rup, rlow, rdie = (doc.getObject(n) for n in tool_names)
-    step("reopen", proxies=proxies, density=restored_density, wall_s=time.perf_counter() - t0,
-         tablet=tablet_info(ring), upper=shape_info(rup), lower=shape_info(rlow), die=shape_info(rdie),
-         all_valid=all(o.isValid() for o in doc.Objects))
+    step(
+        "reopen",
+        proxies=proxies,
+        density=restored_density,
+        wall_s=time.perf_counter() - t0,
+        tablet=tablet_info(ring),
+        upper=shape_info(rup),
+        lower=shape_info(rlow),
+        die=shape_info(rdie),
+        all_valid=all(o.isValid() for o in doc.Objects),
+    )
     doc.save()
     result["ok"] = True
 except Exception as exc:

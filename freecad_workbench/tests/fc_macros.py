@@ -32,10 +32,18 @@ try:
     os.environ["TABLETCAD_OUT"] = work
     # 1. tablet from a design file
     doc = FreeCAD.newDocument("macro_design")
-    s = run("tabletcad_tablet_from_design", TABLETCAD_DESIGN=os.path.join(root, "samples", "families", "concave_round.toml"))
+    s = run(
+        "tabletcad_tablet_from_design",
+        TABLETCAD_DESIGN=os.path.join(root, "samples", "families", "concave_round.toml"),
+    )
     t = [o for o in doc.Objects if getattr(getattr(o, "Proxy", None), "Type", "") == "TabletcadTablet"]
-    result["macros"]["design"] = dict(seconds=s, n=len(t), valid=[o.isValid() for o in t],
-                                      family=t[0].Family if t else None, volume=float(t[0].Volume.Value) if t else None)
+    result["macros"]["design"] = dict(
+        seconds=s,
+        n=len(t),
+        valid=[o.isValid() for o in t],
+        family=t[0].Family if t else None,
+        volume=float(t[0].Volume.Value) if t else None,
+    )
 
     # 2. STEP export of that tablet and its tooling, read back with Part.read
     s = run("tabletcad_export_step")
@@ -51,19 +59,37 @@ try:
 
     # 3. Heckel analysis (PNG written; shown only with the GUI)
     png = os.path.join(work, "lactose_appendix_b_heckel.png")
-    s = run("tabletcad_heckel", TABLETCAD_PRESS=os.path.join(root, "samples", "press", "lactose_appendix_b.csv"))
-    result["macros"]["heckel"] = dict(seconds=s, png=png, exists=os.path.exists(png),
-                                      size=os.path.getsize(png) if os.path.exists(png) else 0)
+    s = run(
+        "tabletcad_heckel", TABLETCAD_PRESS=os.path.join(root, "samples", "press", "lactose_appendix_b.csv")
+    )
+    result["macros"]["heckel"] = dict(
+        seconds=s,
+        png=png,
+        exists=os.path.exists(png),
+        size=os.path.getsize(png) if os.path.exists(png) else 0,
+    )
 
     # 4. optimisation: optimum loaded as a Tablet
     doc = FreeCAD.newDocument("macro_opt")
-    s = run("tabletcad_optimise", TABLETCAD_PROBLEM=os.path.join(root, "samples", "optimise", "cylinder_min_area.toml"))
+    s = run(
+        "tabletcad_optimise",
+        TABLETCAD_PROBLEM=os.path.join(root, "samples", "optimise", "cylinder_min_area.toml"),
+    )
     t = [o for o in doc.Objects if getattr(getattr(o, "Proxy", None), "Type", "") == "TabletcadTablet"]
     result["macros"]["optimise"] = dict(
-        seconds=s, n=len(t), valid=[o.isValid() for o in t], family=t[0].Family if t else None,
-        volume=float(t[0].Volume.Value) if t else None, area=float(t[0].Area.Value) if t else None,
-        dims={p: float(getattr(t[0], p).Value) for p in t[0].PropertiesList if t[0].getGroupOfProperty(p) == "Dimensions"}
-        if t else {},
+        seconds=s,
+        n=len(t),
+        valid=[o.isValid() for o in t],
+        family=t[0].Family if t else None,
+        volume=float(t[0].Volume.Value) if t else None,
+        area=float(t[0].Area.Value) if t else None,
+        dims={
+            p: float(getattr(t[0], p).Value)
+            for p in t[0].PropertiesList
+            if t[0].getGroupOfProperty(p) == "Dimensions"
+        }
+        if t
+        else {},
         design=sorted(f for f in os.listdir(work) if f.endswith(".toml")),
     )
     result["ok"] = True

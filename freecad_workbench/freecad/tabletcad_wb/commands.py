@@ -79,7 +79,9 @@ class TabletFromDesignCommand(_Command):
 
         root = core_root()
         start = str(root / "samples") if root else ""
-        path, _ = QtGui.QFileDialog.getOpenFileName(None, "tabletcad design", start, "tabletcad design (*.toml)")
+        path, _ = QtGui.QFileDialog.getOpenFileName(
+            None, "tabletcad design", start, "tabletcad design (*.toml)"
+        )
         if path:
             doc = _doc()
             doc.openTransaction("Tablet from design")
@@ -141,7 +143,13 @@ class ExportStepCommand(_ToolCommand):
 
 
 COMMANDS = [
-    TabletCommand, TabletFromDesignCommand, UpperPunchCommand, LowerPunchCommand, DieCommand, ToolingCommand, ExportStepCommand,
+    TabletCommand,
+    TabletFromDesignCommand,
+    UpperPunchCommand,
+    LowerPunchCommand,
+    DieCommand,
+    ToolingCommand,
+    ExportStepCommand,
 ]
 
 

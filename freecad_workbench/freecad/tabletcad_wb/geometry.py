@@ -33,11 +33,11 @@ import numpy as np
 __all__ = [
     "TabletGeometry",
     "build_tablet",
+    "die_shape",
+    "punch_shape",
+    "rims_from_json",
     "tablet_chain",
     "tablet_from_spec",
-    "punch_shape",
-    "die_shape",
-    "rims_from_json",
 ]
 
 TWO_PI = 2.0 * math.pi
@@ -66,7 +66,9 @@ def tablet_chain(tablet):
     from tabletcad.bspline import normalise_breaks
 
     t = tablet.trim
-    bps = [np.asarray(p.breakpoints(), dtype=float).ravel() for p in tablet.patches if hasattr(p, "breakpoints")]
+    bps = [
+        np.asarray(p.breakpoints(), dtype=float).ravel() for p in tablet.patches if hasattr(p, "breakpoints")
+    ]
     bps = [b for b in bps if b.size]
     breaks = normalise_breaks(np.concatenate(bps)) if bps else np.zeros(0)
     if t.u == (0.0, 1.0) and t.full_v and t.w == (0.0, 1.0):
@@ -101,7 +103,6 @@ def _rims(surfaces, hollow):
     ``{z, inner, poles, knots, mults, degree}`` (the row's B-spline curve in v)."""
     u = np.linspace(0.0, 1.0, 65)
     out = []
-    s0 = surfaces[0]
     v = np.linspace(0.0, TWO_PI, 181)[:-1]
     rho = np.zeros(v.size)
     for s in surfaces:
@@ -196,6 +197,7 @@ def bspline_face(data):
 def solid_from_faces(faces, sew_tolerance, what="tablet"):
     """Sew faces into one closed shell and make an outward, valid solid (or raise)."""
     import Part
+
     from tabletcad.errors import GeometryError
 
     shell = Part.Shell(faces)
@@ -246,7 +248,11 @@ def _rim_wire(rim, dz=0.0):
 
     c = Part.BSplineCurve()
     c.buildFromPolesMultsKnots(
-        [FreeCAD.Vector(x, y, z + dz) for x, y, z in rim["poles"]], rim["mults"], rim["knots"], True, rim["degree"]
+        [FreeCAD.Vector(x, y, z + dz) for x, y, z in rim["poles"]],
+        rim["mults"],
+        rim["knots"],
+        True,
+        rim["degree"],
     )
     return Part.Wire([c.toShape()])
 
@@ -267,7 +273,9 @@ def _select(rims, which):
 
     outer_z = [r["z"] for r in rims if not r["inner"]]
     if not outer_z:
-        raise GeometryError("the tablet has no horizontal rim on its silhouette (no band edge to make tooling from)", rims)
+        raise GeometryError(
+            "the tablet has no horizontal rim on its silhouette (no band edge to make tooling from)", rims
+        )
     z = max(outer_z) if which == "upper" else min(outer_z)
     return [r for r in rims if abs(r["z"] - z) <= 1e-7 * max(1.0, abs(z))], z
 
@@ -275,11 +283,12 @@ def _select(rims, which):
 def punch_shape(tablet_shape, rims, which="upper", length=10.0):
     """Punch tip: prism on the upper (lower) rims, ``length`` mm up (down), minus the tablet."""
     import FreeCAD
+
     from tabletcad.errors import DesignError, GeometryError
 
     if not length > 0:
         raise DesignError("punch length", length, "must be > 0", "mm")
-    sel, z = _select(rims, which)
+    sel, _ = _select(rims, which)
     sign = 1.0 if which == "upper" else -1.0
     prism = _rim_face(sel).extrude(FreeCAD.Vector(0, 0, sign * float(length)))
     result = prism.cut(tablet_shape)
@@ -299,6 +308,7 @@ def die_shape(rims, clearance=0.05, height=22.22, outer_diameter=38.1):
     (outer rim offset outward by ``clearance``)."""
     import FreeCAD
     import Part
+
     from tabletcad.errors import DesignError, GeometryError
 
     if not clearance > 0:
@@ -307,7 +317,9 @@ def die_shape(rims, clearance=0.05, height=22.22, outer_diameter=38.1):
         raise DesignError("die height", height, "must be > 0", "mm")
     outer = [r for r in rims if not r["inner"]]
     if not outer:
-        raise GeometryError("the tablet has no horizontal rim on its silhouette (no band to make a die for)", rims)
+        raise GeometryError(
+            "the tablet has no horizontal rim on its silhouette (no band to make a die for)", rims
+        )
     lo = min(outer, key=lambda r: r["z"])
     z_lo, z_hi = lo["z"], max(r["z"] for r in outer)
     wire = _rim_wire(lo)
@@ -315,7 +327,10 @@ def die_shape(rims, clearance=0.05, height=22.22, outer_diameter=38.1):
     reach = float(np.max(np.hypot(*np.asarray(lo["poles"])[:, :2].T))) + clearance
     if not outer_diameter / 2.0 > reach + 0.5:
         raise DesignError(
-            "die outer diameter", outer_diameter, f"must exceed the bore by a 0.5 mm wall: > {2 * (reach + 0.5):.3f}", "mm"
+            "die outer diameter",
+            outer_diameter,
+            f"must exceed the bore by a 0.5 mm wall: > {2 * (reach + 0.5):.3f}",
+            "mm",
         )
     zc = 0.5 * (z_lo + z_hi)
     base = zc - height / 2.0

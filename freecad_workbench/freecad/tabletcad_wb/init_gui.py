@@ -1,7 +1,6 @@
 """GUI entry point of ``freecad.tabletcad_wb``: FreeCAD imports it at start-up."""
 
 import FreeCADGui as Gui
-
 from freecad.tabletcad_wb import icon
 
 

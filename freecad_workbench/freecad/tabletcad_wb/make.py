@@ -20,7 +20,7 @@ import FreeCAD
 
 from . import objects
 
-__all__ = ["make_tablet", "make_upper_punch", "make_lower_punch", "make_die", "make_tooling"]
+__all__ = ["make_die", "make_lower_punch", "make_tablet", "make_tooling", "make_upper_punch"]
 
 
 def _value(v, unit="mm"):
@@ -72,7 +72,11 @@ def make_tablet(doc, design_or_family="flat_faced_round", name=None, recompute=T
             raise ValueError(f"family {family!r} has no parameter {k!r}")
         setattr(obj, objects.prop_name(k), _value(v, "deg" if fam.params[k] == "deg" else "mm"))
     if density is not None:
-        q = FreeCAD.Units.Quantity(density) if isinstance(density, str) else FreeCAD.Units.Quantity(f"{float(density)} kg/m^3")
+        q = (
+            FreeCAD.Units.Quantity(density)
+            if isinstance(density, str)
+            else FreeCAD.Units.Quantity(f"{float(density)} kg/m^3")
+        )
         obj.Density = q
     if fit_tol is not None:
         obj.FitTolerance = _value(fit_tol)

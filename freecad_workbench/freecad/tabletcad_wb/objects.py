@@ -19,13 +19,13 @@ from . import geometry
 
 __all__ = [
     "DESIGN_FILE",
-    "TabletProxy",
-    "PunchProxy",
     "DieProxy",
-    "family_names",
-    "prop_name",
-    "is_tablet",
+    "PunchProxy",
+    "TabletProxy",
     "ViewProviderTabletcad",
+    "family_names",
+    "is_tablet",
+    "prop_name",
 ]
 
 DESIGN_FILE = "design_file"
@@ -113,31 +113,93 @@ class TabletProxy(_Proxy):
     def _setup(self, obj):
         names = family_names() + [DESIGN_FILE]
         if "Family" not in obj.PropertiesList:
-            obj.addProperty("App::PropertyEnumeration", "Family", "Tablet", "tabletcad family (or design_file)")
+            obj.addProperty(
+                "App::PropertyEnumeration", "Family", "Tablet", "tabletcad family (or design_file)"
+            )
             obj.Family = names
         else:  # keep the list current with the installed families
             cur = obj.Family
             obj.Family = names
             if cur in names:
                 obj.Family = cur
-        self._add(obj, "App::PropertyFile", "DesignFile", "Tablet", "tabletcad design (TOML), used when Family is design_file")
-        self._add(obj, "App::PropertyLength", "FitTolerance", "Tablet",
-                  "largest distance between the B-spline faces and the PDE surfaces", _qty(1e-4, "mm"))
+        self._add(
+            obj,
+            "App::PropertyFile",
+            "DesignFile",
+            "Tablet",
+            "tabletcad design (TOML), used when Family is design_file",
+        )
+        self._add(
+            obj,
+            "App::PropertyLength",
+            "FitTolerance",
+            "Tablet",
+            "largest distance between the B-spline faces and the PDE surfaces",
+            _qty(1e-4, "mm"),
+        )
         self._add(obj, "App::PropertyQuantity", "Density", "Material", "apparent density of the tablet")
         obj.Density = FreeCAD.Units.Unit("kg/m^3")
         if obj.Density.Value == 0.0:
             obj.Density = FreeCAD.Units.Quantity("1200 kg/m^3")
-        self._add(obj, "App::PropertyVolume", "Volume", "Results", "volume of the PDE tablet (tabletcad quadrature)", mode=_READONLY)
-        self._add(obj, "App::PropertyVolume", "SolidVolume", "Results",
-                  "exact volume of the B-spline solid in Shape (Gauss quadrature of its faces)", mode=_READONLY)
-        self._add(obj, "App::PropertyArea", "Area", "Results", "surface area of the PDE tablet (tabletcad quadrature)", mode=_READONLY)
-        self._add(obj, "App::PropertyArea", "PlanArea", "Results", "area of the silhouette seen along z", mode=_READONLY)
+        self._add(
+            obj,
+            "App::PropertyVolume",
+            "Volume",
+            "Results",
+            "volume of the PDE tablet (tabletcad quadrature)",
+            mode=_READONLY,
+        )
+        self._add(
+            obj,
+            "App::PropertyVolume",
+            "SolidVolume",
+            "Results",
+            "exact volume of the B-spline solid in Shape (Gauss quadrature of its faces)",
+            mode=_READONLY,
+        )
+        self._add(
+            obj,
+            "App::PropertyArea",
+            "Area",
+            "Results",
+            "surface area of the PDE tablet (tabletcad quadrature)",
+            mode=_READONLY,
+        )
+        self._add(
+            obj,
+            "App::PropertyArea",
+            "PlanArea",
+            "Results",
+            "area of the silhouette seen along z",
+            mode=_READONLY,
+        )
         self._add(obj, "App::PropertyQuantity", "Weight", "Results", "Volume x Density", mode=_READONLY)
         obj.Weight = FreeCAD.Units.Unit("kg")
-        self._add(obj, "App::PropertyLength", "FitDeviation", "Results", "largest measured B-spline fit deviation", mode=_READONLY)
-        self._add(obj, "App::PropertyFloat", "RecomputeTime", "Results", "seconds of the last recompute", mode=_READONLY)
-        self._add(obj, "App::PropertyString", "RimData", "Internal",
-                  "rim curves (JSON) used by the punches and the die", mode=_READONLY | _HIDDEN, hidden=True)
+        self._add(
+            obj,
+            "App::PropertyLength",
+            "FitDeviation",
+            "Results",
+            "largest measured B-spline fit deviation",
+            mode=_READONLY,
+        )
+        self._add(
+            obj,
+            "App::PropertyFloat",
+            "RecomputeTime",
+            "Results",
+            "seconds of the last recompute",
+            mode=_READONLY,
+        )
+        self._add(
+            obj,
+            "App::PropertyString",
+            "RimData",
+            "Internal",
+            "rim curves (JSON) used by the punches and the die",
+            mode=_READONLY | _HIDDEN,
+            hidden=True,
+        )
 
     def _dimension_props(self, obj):
         return [p for p in obj.PropertiesList if obj.getGroupOfProperty(p) == "Dimensions"]
@@ -184,7 +246,9 @@ class TabletProxy(_Proxy):
         if s["design"] is not None and not s["design"]:
             from tabletcad.errors import DesignError
 
-            raise DesignError("DesignFile", "", "set a tabletcad design file (TOML) when Family is design_file")
+            raise DesignError(
+                "DesignFile", "", "set a tabletcad design file (TOML) when Family is design_file"
+            )
         return geometry.tablet_from_spec(s["family"], s["params"], s["design"])
 
     def execute(self, obj):
@@ -238,8 +302,22 @@ class PunchProxy(_Proxy):
         if "Which" not in obj.PropertiesList:
             obj.addProperty("App::PropertyEnumeration", "Which", "Punch", "upper or lower punch")
             obj.Which = ["upper", "lower"]
-        self._add(obj, "App::PropertyLength", "Length", "Punch", "length of the punch tip beyond the band edge", _qty(10.0, "mm"))
-        self._add(obj, "App::PropertyDistance", "Gap", "Punch", "lift-off from the tablet (exploded view)", _qty(0.0, "mm"))
+        self._add(
+            obj,
+            "App::PropertyLength",
+            "Length",
+            "Punch",
+            "length of the punch tip beyond the band edge",
+            _qty(10.0, "mm"),
+        )
+        self._add(
+            obj,
+            "App::PropertyDistance",
+            "Gap",
+            "Punch",
+            "lift-off from the tablet (exploded view)",
+            _qty(0.0, "mm"),
+        )
         self._add(obj, "App::PropertyVolume", "Volume", "Results", "volume of the punch tip", mode=_READONLY)
 
     def onDocumentRestored(self, obj):
@@ -251,7 +329,9 @@ class PunchProxy(_Proxy):
         rims = geometry.rims_from_json(tab.RimData)
         shape = geometry.punch_shape(_local_shape(tab), rims, obj.Which, float(obj.Length.Value))
         gap = float(obj.Gap.Value)
-        lift = FreeCAD.Placement(FreeCAD.Vector(0, 0, gap if obj.Which == "upper" else -gap), FreeCAD.Rotation())
+        lift = FreeCAD.Placement(
+            FreeCAD.Vector(0, 0, gap if obj.Which == "upper" else -gap), FreeCAD.Rotation()
+        )
         obj.Shape = shape
         obj.Placement = tab.Placement.multiply(lift)  # the shape's own placement is the object's
         obj.Volume = _qty(shape.Volume, "mm^3")
@@ -269,9 +349,25 @@ class DieProxy(_Proxy):
 
     def _setup(self, obj):
         self._add(obj, "App::PropertyLink", "Tablet", "Die", "the tablet this die forms")
-        self._add(obj, "App::PropertyLength", "Clearance", "Die", "radial clearance between bore and tablet outline", _qty(0.05, "mm"))
-        self._add(obj, "App::PropertyLength", "Height", "Die", "die height (TSM B die: 22.22 mm)", _qty(22.22, "mm"))
-        self._add(obj, "App::PropertyLength", "OuterDiameter", "Die", "die outer diameter (TSM B die: 30.16 mm)", _qty(30.16, "mm"))
+        self._add(
+            obj,
+            "App::PropertyLength",
+            "Clearance",
+            "Die",
+            "radial clearance between bore and tablet outline",
+            _qty(0.05, "mm"),
+        )
+        self._add(
+            obj, "App::PropertyLength", "Height", "Die", "die height (TSM B die: 22.22 mm)", _qty(22.22, "mm")
+        )
+        self._add(
+            obj,
+            "App::PropertyLength",
+            "OuterDiameter",
+            "Die",
+            "die outer diameter (TSM B die: 30.16 mm)",
+            _qty(30.16, "mm"),
+        )
         self._add(obj, "App::PropertyVolume", "Volume", "Results", "volume of the die", mode=_READONLY)
 
     def onDocumentRestored(self, obj):
@@ -281,7 +377,9 @@ class DieProxy(_Proxy):
     def execute(self, obj):
         tab = _tablet_of(obj)
         rims = geometry.rims_from_json(tab.RimData)
-        shape = geometry.die_shape(rims, float(obj.Clearance.Value), float(obj.Height.Value), float(obj.OuterDiameter.Value))
+        shape = geometry.die_shape(
+            rims, float(obj.Clearance.Value), float(obj.Height.Value), float(obj.OuterDiameter.Value)
+        )
         obj.Shape = shape
         obj.Placement = tab.Placement
         obj.Volume = _qty(shape.Volume, "mm^3")
@@ -344,7 +442,10 @@ def attach_view_provider(obj) -> None:
 
 def design_is_parametric(path) -> tuple[str, dict, str] | None:
     """(family, params, name) if the design file is a plain family design, else None."""
-    import tomllib
+    try:
+        import tomllib
+    except ImportError:  # Python < 3.11 (FreeCAD builds with an older Python)
+        import tomli as tomllib
 
     try:
         data = tomllib.loads(open(os.fspath(path), encoding="utf-8").read())

@@ -14,7 +14,7 @@ import FreeCAD
 from . import core_root, objects
 from .make import make_tablet, make_tooling
 
-__all__ = ["sample", "out_dir", "tablet_from_design", "export_step", "heckel", "optimise", "active_doc"]
+__all__ = ["active_doc", "export_step", "heckel", "optimise", "out_dir", "sample", "tablet_from_design"]
 
 
 def sample(rel: str) -> Path:
@@ -73,11 +73,17 @@ def export_step(doc=None, directory=None, with_tooling=True):
         raise RuntimeError(f"document {doc.Label} has no tabletcad Tablet")
     if with_tooling:
         for t in tablets:
-            linked = [o for o in t.InList if getattr(getattr(o, "Proxy", None), "Type", "") in ("TabletcadPunch", "TabletcadDie")]
+            linked = [
+                o
+                for o in t.InList
+                if getattr(getattr(o, "Proxy", None), "Type", "") in ("TabletcadPunch", "TabletcadDie")
+            ]
             if not linked:
                 make_tooling(doc, t, recompute=False)
         doc.recompute()
-    wanted = [o for o in doc.Objects if getattr(getattr(o, "Proxy", None), "Type", "").startswith("Tabletcad")]
+    wanted = [
+        o for o in doc.Objects if getattr(getattr(o, "Proxy", None), "Type", "").startswith("Tabletcad")
+    ]
     bad = [o.Label for o in wanted if not o.isValid() or o.Shape.isNull()]
     if bad:
         raise RuntimeError(f"not exported, recompute failed: {', '.join(bad)}")
@@ -109,8 +115,13 @@ def heckel(press_path, png=None, show=True):
     png = Path(png) if png else out_dir("tabletcad_heckel") / (press_path.stem + "_heckel.png")
     plot_heckel(fit, png, title=f"Heckel: {press_path.stem}")
     summary = dict(
-        Py_MPa=float(fit.Py_MPa), K_per_MPa=float(fit.K_per_MPa), A=float(fit.A), r2=float(fit.r2),
-        window_MPa=[float(x) for x in fit.window_MPa], n_points=int(fit.n_points), png=str(png),
+        Py_MPa=float(fit.Py_MPa),
+        K_per_MPa=float(fit.K_per_MPa),
+        A=float(fit.A),
+        r2=float(fit.r2),
+        window_MPa=[float(x) for x in fit.window_MPa],
+        n_points=int(fit.n_points),
+        png=str(png),
     )
     FreeCAD.Console.PrintMessage("tabletcad Heckel: " + json.dumps(summary) + "\n")
     if show and FreeCAD.GuiUp:
@@ -137,7 +148,8 @@ def optimise(problem_path, doc=None, directory=None, method=None, **solver_optio
     options = {**options, **solver_options}
     result = solve(problem, method or default_method, **options)
     FreeCAD.Console.PrintMessage(
-        f"tabletcad optimise: {result.status} {result.objective_name} = {result.objective:.6g} {result.objective_unit} "
+        f"tabletcad optimise: {result.status} {result.objective_name} = "
+        f"{result.objective:.6g} {result.objective_unit} "
         f"at {json.dumps({k: round(float(v), 6) for k, v in result.x.items()})}\n"
     )
     if problem.to_toml is None:
