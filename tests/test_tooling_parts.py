@@ -74,11 +74,12 @@ def test_punch_volume_is_cylinder_minus_cup_by_quadrature(thesis):
 
 
 def test_punch_volume_from_tablet_properties_without_clearance():
-    # cup volume from the tablet's own quadrature: (V - pi R^2 band) / 2 for a symmetric tablet
-    t = shallow_convex_round()
+    # cup volume from the tablet's own quadrature: (V - pi R^2 band) / 2 for a symmetric tablet whose
+    # band is a true cylinder (the family tablets'; the thesis's PDE band bows inward by ~1 µm)
+    t = load_design(ROOT / "samples" / "families" / "concave_round.toml")
     ts = make_tooling(t, ToolingSpec(clearance_mm=0.0, tip_length_mm=5.0), check=False, interference_check=False)
     V = t.properties()["volume_mm3"]
-    R, band = 5.0, 2.0
+    R, band = 5.0, 2.8
     expected = math.pi * R * R * 5.0 - 0.5 * (V - math.pi * R * R * band)
     assert ts.report["upper_punch"]["volume_mm3"] == pytest.approx(expected, rel=1e-7)
     assert ts.report["lower_punch"]["volume_mm3"] == pytest.approx(expected, rel=1e-7)
