@@ -5,7 +5,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 SAMPLE ?= samples/flat_faced_round.toml
 
-.PHONY: setup demo test bench
+.PHONY: setup demo test bench freecad-workbench
 
 setup:
 	bash .ci/setup
@@ -18,3 +18,7 @@ test: setup
 
 bench: setup
 	for b in benchmarks/bench_*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
+
+# link the FreeCAD workbench into FreeCAD's user Mod folder (see freecad_workbench/README.md)
+freecad-workbench: setup
+	bash freecad_workbench/install.sh
