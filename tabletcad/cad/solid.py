@@ -13,7 +13,9 @@ free edge) that failed.
    inside, positive volume) + ``BRepCheck_Analyzer``;
 5. volume/area/centroid by *adaptive* Gauss integration
    (``BRepGProp::VolumeProperties(shape, props, eps)``, ``eps`` = 1e-9): the
-   default integration was measured up to ~1e-3 relative off on dense B-spline faces.
+   default integration was measured up to ~1e-3 relative off on dense B-spline faces;
+   the boundary p-curves carry the faces' C0/C1 ``v`` knots so that the
+   integration splits there (:func:`tabletcad.cad.faces.knot_boundary_pcurves`).
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ from OCP.TopoDS import TopoDS_Shape, TopoDS_Solid
 
 from tabletcad.bspline import BSplineSurfaceData, SurfaceFit, fit_patches, normalise_breaks
 from tabletcad.cad._occ import cast, explore, shape_type
-from tabletcad.cad.faces import make_face
+from tabletcad.cad.faces import knot_boundary_pcurves, make_face
 from tabletcad.errors import GeometryError
 
 __all__ = [
@@ -258,6 +260,9 @@ def solid_from_surfaces(
     faces = tuple(make_face(s, tol_degen=tol_degen, name=n) for s, n in zip(surfaces, names))
     t1 = time.perf_counter()
     shell = sew_faces(faces, names, sew_tolerance)
+    # sewing may rebuild p-curves: make sure the boundary p-curves still carry the C0/C1
+    # v knots that BRepGProp needs to integrate across them (see tabletcad.cad.faces)
+    knot_boundary_pcurves(shell)
     solid = _make_solid(shell, name)
     t2 = time.perf_counter()
     mass = mass_properties(solid, eps)

@@ -316,12 +316,24 @@ def build_sweep_tablet(
         return patch
 
     prev_curve = None
+    # the plateau: one fan from the centre to the rim, or - when corners of the rim have
+    # collapsed to points - a fan to an inner curve Q plus a ring from Q to the rim (see _plateau_ring)
+    ring = _plateau_ring(outline, d_end, c) if not closes else None
     if not closes:
         zb = T - float(top[-1].point(1.0)[1])
         pole = SweepCurve(outline, 0.0, 0.0, (float(c[0]), float(c[1]), zb))
         rim = SweepCurve(outline, 1.0, d_end, (0.0, 0.0, zb))
-        du = SweepCurve(outline, 1.0, d_end, (-float(c[0]), -float(c[1]), 0.0))
-        patches.append(mk((pole, rim, du, du), "plateau"))
+        if ring is None:
+            du = SweepCurve(outline, 1.0, d_end, (-float(c[0]), -float(c[1]), 0.0))
+            patches.append(mk((pole, rim, du, du), "plateau"))
+        else:
+            lam, beta_q = ring
+            q = SweepCurve(outline, lam, beta_q, ((1 - lam) * float(c[0]), (1 - lam) * float(c[1]), zb))
+            du_in = SweepCurve(outline, lam, beta_q, (-lam * float(c[0]), -lam * float(c[1]), 0.0))
+            du_out = SweepCurve(outline, 1.0 - lam, d_end - beta_q, (-(1 - lam) * float(c[0]), -(1 - lam) * float(c[1]), 0.0))
+            patches.append(mk((pole, q, du_in, du_in), "plateau"))
+            expected.append(False)  # plane to plane
+            patches.append(mk((q, rim, du_out, du_out), "plateau ring"))
         expected.append(False)  # plateau -> face: tangent (the face ends horizontally)
         prev_curve = rim
     for i, p in enumerate(chain_pieces):
@@ -334,13 +346,23 @@ def build_sweep_tablet(
         if i < len(chain_pieces) - 1:
             expected.append(joints_sharp[i])
         prev_curve = X1
-    top_start = (1 if not closes else 0) + n_bottom + (1 if band > 0 else 0)
+    n_plateau = 0 if closes else (1 if ring is None else 2)
+    top_start = n_plateau + n_bottom + (1 if band > 0 else 0)
     if not closes:
         zt = float(top[-1].point(1.0)[1])
         pole = SweepCurve(outline, 0.0, 0.0, (float(c[0]), float(c[1]), zt))
-        du = SweepCurve(outline, -1.0, -d_end, (float(c[0]), float(c[1]), 0.0))
         expected.append(False)
-        patches.append(mk((prev_curve, pole, du, du), "plateau"))
+        if ring is None:
+            du = SweepCurve(outline, -1.0, -d_end, (float(c[0]), float(c[1]), 0.0))
+            patches.append(mk((prev_curve, pole, du, du), "plateau"))
+        else:
+            lam, beta_q = ring
+            q = SweepCurve(outline, lam, beta_q, ((1 - lam) * float(c[0]), (1 - lam) * float(c[1]), zt))
+            du_in = SweepCurve(outline, -lam, -beta_q, (lam * float(c[0]), lam * float(c[1]), 0.0))
+            du_out = SweepCurve(outline, -(1.0 - lam), -(d_end - beta_q), ((1 - lam) * float(c[0]), (1 - lam) * float(c[1]), 0.0))
+            patches.append(mk((prev_curve, q, du_out, du_out), "plateau ring"))
+            expected.append(False)
+            patches.append(mk((q, pole, du_in, du_in), "plateau"))
     nom.expected_sharp = expected
     nom.top_patch_range = (top_start, len(patches))
     tablet = Tablet(tuple(patches), name=name, family=family, params=dict(params), nominal=nom,
@@ -352,6 +374,41 @@ def build_sweep_tablet(
                 f"{family}: PDE surface deviates {cert.max_deviation_mm * 1e3:.3g} µm from the nominal "
                 f"(allowed {tol.nominal * 1e3:.3g} µm)", tablet)
     return tablet
+
+
+def _rim_collapses(outline, d: float) -> bool:
+    """Whether the offset of ``outline`` by ``d`` stands still over some ``v`` (convex arcs of
+    radius ``d`` collapsed to points: the corners of a rounded polygon at ``cup_width = corner_radius``)."""
+    segs = getattr(outline, "segs", ())
+    if segs:
+        return any(sg.kind == "arc" and sg.sweep > 0 and sg.radius <= d * (1 + 1e-9) for sg in segs)
+    v = np.linspace(0.0, TWO_PI, 4096, endpoint=False)
+    speed = np.linalg.norm(outline.point(v, 1) + d * outline.normal(v, 1), axis=1)
+    return bool(np.min(speed) <= 1e-9 * outline.speed)
+
+
+def _plateau_ring(outline, d_end: float, c: np.ndarray):
+    """``(λ, β)`` of the inner curve ``Q = c + λ (O + β/λ N - c)`` that splits a plateau whose rim
+    has collapsed corners, or None when the rim is a regular curve (one fan patch suffices).
+
+    A fan from the centre to a rim that stands still over a corner's ``v`` interval maps that
+    whole strip of ``(u, v)`` onto one line: a zero-area sliver inside the face that meshers
+    fold into a pocket (non-manifold STL).  Instead the fan ends on ``Q``, the offset by
+    ``d_end/2`` (whose corners are still arcs) shrunk towards the centre by ``λ``, and a ruled
+    ring joins ``Q`` to the rim: over a corner it is a thin triangle from ``Q``'s small arc to
+    the corner point, with positive area.  Both patches are planar, so they lie on the nominal.
+    """
+    if not _rim_collapses(outline, d_end):
+        return None
+    d_q = 0.5 * d_end
+    v = np.linspace(0.0, TWO_PI, 2048, endpoint=False)
+    O = outline.point(v)
+    N = outline.normal(v)
+    for lam in (0.5, 0.35, 0.25, 0.15, 0.1):
+        q = c + lam * (O + d_q * N - c)
+        if float(np.min(outline.signed_distance(q))) > d_end + 0.1 * lam * d_q:
+            return lam, lam * d_q
+    raise GeometryError(f"{outline.name}: no inner curve fits inside the plateau (d = {d_end:.4g} mm)", outline)
 
 
 def _v_samples(outline, nv: int) -> np.ndarray:
