@@ -36,7 +36,7 @@ from __future__ import annotations
 from tabletcad.families.elongated import capsule, modified_capsule, oval
 from tabletcad.families.round import compound_cup, concave_bevel, concave_round, ffbe, ffre, flat_face_round
 from tabletcad.families.shaped import almond, outline_tablet, rounded_rectangle, rounded_square, rounded_triangle
-from tabletcad.families.sweep import certify, sweep_properties
+from tabletcad.families.sweep import certify, nominal_volume, sweep_properties
 
 __all__ = [
     "FAMILY_FUNCTIONS",
@@ -50,6 +50,7 @@ __all__ = [
     "ffre",
     "flat_face_round",
     "modified_capsule",
+    "nominal_volume",
     "outline_tablet",
     "oval",
     "rounded_rectangle",

@@ -55,6 +55,7 @@ __all__ = [
     "build_sweep_tablet",
     "certify",
     "sweep_properties",
+    "nominal_volume",
     "DEFAULT_A",
     "REFINE",
 ]
@@ -502,3 +503,26 @@ def sweep_properties(tablet: Tablet, nu: int = 24, nv_per: int = 48) -> dict[str
         cup_volume_mm3=sgn * cup,
         cup_surface_area_mm2=top_area,
     )
+
+
+def nominal_volume(nominal: SweepNominal, n: int = 64) -> float:
+    """Volume (mm³) of the exact nominal solid, independent of the PDE patches.
+
+    The plan section at inward distance ``d`` is the outline's offset region, whose area
+    is Steiner's ``A(d) = A₀ - P d + π d²`` (``A₀`` area, ``P`` perimeter; exact for clean
+    offsets of a closed G1 outline, whose tangent turns once), so one face above the band
+    holds ``∫ A(d) dz`` along its profile (lines and arcs: ``n``-point Gauss-Legendre per
+    element of a smooth integrand, exact to rounding), and the solid is
+    ``A₀ · band + 2 ∫ A dz``.
+    """
+    ol = nominal.outline
+    A0, P = float(ol.area), float(ol.perimeter)
+    x, w = np.polynomial.legendre.leggauss(n)
+    t = 0.5 * (x + 1.0)
+    cup = 0.0
+    for e in nominal.top:
+        d, z = e.point(t).T
+        dz = e.tangent(t)[:, 1]
+        cup += 0.5 * float(np.sum(w * (A0 - P * d + math.pi * d * d) * dz))
+    band = nominal.band_z[1] - nominal.band_z[0]
+    return A0 * band + 2.0 * cup
