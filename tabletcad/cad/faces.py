@@ -20,14 +20,13 @@ on spheres, cylinders and rings (see tests/test_cad_solid.py), and FreeCAD's
 ``buildFromPolesMultsKnots(..., periodic)`` accepts exactly the same data.
 
 A boundary row that collapses to a *segment* (a stadium's offsets at its
-inscribed radius: the capsule's innermost cup patch) is a *slit*: the row
-curve runs along the segment and back, with the end arcs collapsed to points.
-Such a face is built by hand (:func:`slit_pieces`, ``_make_slit_face``): the
-row is cut at its C0 knots into pieces, the constant pieces become
-degenerated edges and each pair of pieces running along the same segment in
-opposite directions becomes ONE edge used twice by the face, with a p-curve
-on each side - a seam, like the periodic ``v`` seam, so the face closes on
-itself there and sewing sees no free edge.
+inscribed radius: the capsule's innermost cup patch) is a *slit*
+(:func:`slit_pieces`): the row curve runs along the segment and back, with
+the end arcs collapsed to points.  :func:`make_faces` gives such a surface
+as two faces, cut in ``v`` through one collapsed end, so that each half
+bounds the segment once and sewing joins the halves along it (and along the
+cut); one face using the segment edge twice would be valid in OCCT but is
+torn open by STEP readers.
 
 Boundary p-curves carry the surface's low-continuity ``v`` knots
 (:func:`knot_boundary_pcurves`).  OCCT's mass properties (``BRepGProp``)
@@ -54,8 +53,7 @@ from OCP.Geom import Geom_BSplineSurface
 from OCP.Geom2d import Geom2d_BSplineCurve
 from OCP.Geom2d import Geom2d_Line
 from OCP.gp import gp_Dir2d, gp_Pnt, gp_Pnt2d
-from OCP.TopAbs import TopAbs_Orientation
-from OCP.TopoDS import TopoDS_Edge, TopoDS_Face, TopoDS_Shape, TopoDS_Vertex, TopoDS_Wire
+from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 
 try:  # OCP >= 8.0
     from OCP.collections import Array1_gp_Pnt2d as Array1OfPnt2d
@@ -66,7 +64,7 @@ from tabletcad.bspline import BSplineSurfaceData
 from tabletcad.cad._occ import Array1OfInteger, Array1OfReal, Array2OfPnt
 from tabletcad.errors import GeometryError
 
-__all__ = ["make_geom_surface", "make_face", "surface_data_from_geom", "knot_boundary_pcurves", "slit_pieces"]
+__all__ = ["make_geom_surface", "make_face", "make_faces", "surface_data_from_geom", "knot_boundary_pcurves", "slit_pieces"]
 
 
 def _real_array(values) -> Array1OfReal:
@@ -117,14 +115,10 @@ def make_face(data: BSplineSurfaceData, *, tol_degen: float = 1e-7, name: str = 
     degenerated edge (a pole of the patch).
     """
     surf = make_geom_surface(data)
-    slits = {k: slit_pieces(data, k, tol_degen) for k in (0, -1)}
-    if any(v is not None for v in slits.values()):
-        face = _make_slit_face(data, surf, slits, tol_degen, name)
-    else:
-        maker = BRepBuilderAPI_MakeFace(surf, float(tol_degen))
-        if not maker.IsDone():
-            raise GeometryError(f"BRepBuilderAPI_MakeFace failed for {name} (error {maker.Error()})", data)
-        face = maker.Face()
+    maker = BRepBuilderAPI_MakeFace(surf, float(tol_degen))
+    if not maker.IsDone():
+        raise GeometryError(f"BRepBuilderAPI_MakeFace failed for {name} (error {maker.Error()})", data)
+    face = maker.Face()
     knot_boundary_pcurves(face)
     if not BRepCheck_Analyzer(face).IsValid():
         raise GeometryError(f"face of {name} is not valid (BRepCheck_Analyzer)", data)
@@ -171,7 +165,30 @@ def slit_pieces(data: BSplineSurfaceData, row: int, tol: float = 1e-7):
                 break
         else:
             return None
-    return [(cuts[i], cuts[i + 1], kinds[i], partner.get(i)) for i in range(len(kinds))], u_row
+    pieces = [(cuts[i], cuts[i + 1], kinds[i], partner.get(i)) for i in range(len(kinds))]
+    # consecutive collapsed pieces (e.g. two corner arcs of one end) are one point piece
+    merged: list = []
+    index: dict[int, int] = {}
+    for i, pc in enumerate(pieces):
+        if pc[2] == "point" and merged and merged[-1][2] == "point":
+            merged[-1] = (merged[-1][0], pc[1], "point", None)
+        else:
+            merged.append(pc)
+        index[i] = len(merged) - 1
+    merged = [(a, b, k, None if j is None else index[j]) for a, b, k, j in merged]
+    return merged, u_row
+
+
+def _slit_split(slit) -> float | None:
+    """``v`` at which a slit face is cut in two: the middle of the collapsed end that does not
+    hold the periodic seam; None for slits of another pattern (more than one segment)."""
+    pieces, _ = slit
+    v_first, v_last = pieces[0][0], pieces[-1][1]
+    runs = [p for p in pieces if p[2] == "run"]
+    inner = [p for p in pieces if p[2] == "point" and p[0] > v_first and p[1] < v_last]
+    if len(runs) != 2 or len(inner) != 1:
+        return None
+    return 0.5 * (inner[0][0] + inner[0][1])
 
 
 def _line2d(p, d) -> Geom2d_Line:
@@ -186,101 +203,151 @@ def _affine2d(t0: float, t1: float, p0, p1) -> Geom2d_BSplineCurve:
     return Geom2d_BSplineCurve(poles, _real_array([t0, t1]), _int_array([2, 2]), 1)
 
 
-def _make_slit_face(data: BSplineSurfaceData, surf: Geom_BSplineSurface, slits: dict, tol_degen: float,
-                    name: str) -> TopoDS_Face:
-    """The face of a periodic-in-v surface one or both of whose boundary rows are slits
-    (see :func:`slit_pieces`), built edge by edge; the other row is a closed edge or a pole."""
+def make_faces(data: BSplineSurfaceData, *, tol_degen: float = 1e-7, name: str = "surface") -> tuple[TopoDS_Face, ...]:
+    """The face(s) of one fitted surface: one periodic face (:func:`make_face`), or two halves
+    when a boundary row is a slit (:func:`slit_pieces`).
+
+    A slit row runs along a segment and back; as ONE face that segment would be an edge
+    used twice by the face, the two uses meeting around the segment's far end through a
+    degenerated edge.  STEP has no degenerated edges, so a reader sees that edge go out and
+    straight back and deletes it as a spike (the solid comes back open).  Cut in ``v``
+    through the middle of the collapsed end that does not hold the seam, each half uses the
+    segment once: two faces built edge by edge that share the segment edge (a p-curve on
+    each, the second one running backwards), the cut and the seam; only the other row is
+    left for sewing, as two edges.
+    """
+    slits = {k: slit_pieces(data, k, tol_degen) for k in (0, -1)}
+    if all(sl is None for sl in slits.values()):
+        return (make_face(data, tol_degen=tol_degen, name=name),)
+    if all(sl is not None for sl in slits.values()):
+        raise GeometryError(f"{name}: both boundary rows collapse to segments", data)
+    k_slit = 0 if slits[0] is not None else -1
+    slit = slits[k_slit]
+    v_cut = _slit_split(slit)
+    if v_cut is None:
+        raise GeometryError(f"{name}: a boundary row collapses to a pattern of segments this kernel does not cut", data)
+    return _slit_halves(data, k_slit, slit[0], v_cut, tol_degen, name)
+
+
+def _slit_halves(data: BSplineSurfaceData, k_slit: int, pieces, v_cut: float, tol_degen: float,
+                 name: str) -> tuple[TopoDS_Face, TopoDS_Face]:
+    from OCP.BRepLib import BRepLib
+    from OCP.TopAbs import TopAbs_Orientation
     from OCP.TopLoc import TopLoc_Location
+    from OCP.TopoDS import TopoDS_Edge, TopoDS_Vertex, TopoDS_Wire
 
     FWD, REV = TopAbs_Orientation.TopAbs_FORWARD, TopAbs_Orientation.TopAbs_REVERSED
     B = BRep_Builder()
     tol = max(float(tol_degen), 1e-7)
-    v_lo, v_hi = float(data.v_knots[0]), float(data.v_knots[-1])
-    u_lo, u_hi = float(data.u_knots[0]), float(data.u_knots[-1])
-    face = TopoDS_Face()
-    B.MakeFace(face, surf, TopLoc_Location(), tol)
-    vertices: list[tuple[np.ndarray, TopoDS_Vertex]] = []
+    surf = make_geom_surface(data)
+    u0, u1 = float(data.u_knots[0]), float(data.u_knots[-1])
+    v0, v1 = float(data.v_knots[0]), float(data.v_knots[-1])
+    u_s = u0 if k_slit == 0 else u1
+    u_o = u1 if k_slit == 0 else u0
+    row_o = data.poles[-1 if k_slit == 0 else 0]
+    if float(np.max(np.linalg.norm(row_o - row_o[0], axis=-1))) <= tol:
+        raise GeometryError(f"{name}: a slit opposite a pole is not supported", data)
+    faces = [TopoDS_Face(), TopoDS_Face()]
+    # one surface object per half: OCCT keys an edge's p-curves by (surface, location), so
+    # halves on a shared surface object would overwrite each other's p-curve of a shared edge
+    for f in faces:
+        B.MakeFace(f, make_geom_surface(data), TopLoc_Location(), tol)
+    ranges = [(v0, v_cut), (v_cut, v1)]
+    vertices: list = []
 
-    def vertex(u: float, v: float) -> TopoDS_Vertex:
+    def vertex(u: float, v: float):
         p = np.asarray(data.evaluate(np.array([u]), np.array([v])), dtype=float).reshape(3)
         for q, vx in vertices:
-            if float(np.linalg.norm(q - p)) <= tol:
+            if float(np.linalg.norm(q - p)) <= 10 * tol:
                 return vx
         vx = TopoDS_Vertex()
         B.MakeVertex(vx, gp_Pnt(*map(float, p)), tol)
         vertices.append((p, vx))
         return vx
 
-    def bounded(edge: TopoDS_Edge, v0: TopoDS_Vertex, v1: TopoDS_Vertex, a: float, b: float) -> TopoDS_Edge:
-        B.Add(edge, v0.Oriented(FWD))
-        B.Add(edge, v1.Oriented(REV))
+    def bounded(edge, va, vb, a: float, b: float):
+        B.Add(edge, va.Oriented(FWD))
+        B.Add(edge, vb.Oriented(REV))
         B.Range(edge, a, b)
         return edge
 
-    def degenerated(u: float, a: float, b: float) -> TopoDS_Edge:
+    def iso_v(v: float):
         e = TopoDS_Edge()
-        B.MakeEdge(e)
-        B.UpdateEdge(e, _line2d((u, 0.0), (0.0, 1.0)), face, tol)
-        B.Degenerated(e, True)
-        vx = vertex(u, a)
-        return bounded(e, vx, vx, a, b)
+        B.MakeEdge(e, surf.VIso(v), tol)
+        return bounded(e, vertex(u0, v), vertex(u1, v), u0, u1)
 
-    def row_side(k: int) -> list[tuple[TopoDS_Edge, TopAbs_Orientation]]:
-        """Edges of row ``k`` in the order of increasing v, each with its orientation along +v."""
-        u = u_lo if k == 0 else u_hi
-        slit = slits[k]
-        row = data.poles[k]
-        if slit is None:
-            if float(np.max(np.linalg.norm(row - row[0], axis=-1))) <= tol:  # a pole
-                return [(degenerated(u, v_lo, v_hi), FWD)]
-            e = TopoDS_Edge()
-            B.MakeEdge(e, surf.UIso(u), tol)
-            B.UpdateEdge(e, _line2d((u, 0.0), (0.0, 1.0)), face, tol)
-            vx = vertex(u, v_lo)
-            return [(bounded(e, vx, vx, v_lo, v_hi), FWD)]
-        pieces, _ = slit
-        out: list = [None] * len(pieces)
-        # the side is walked with +v on u = u_hi and with -v on u = u_lo (counter-clockwise in (u, v))
-        walk_fwd = k != 0
-        for i, (a, b, kind, j) in enumerate(pieces):
-            if kind == "point":
-                out[i] = (degenerated(u, a, b), FWD)
-            elif j is not None and out[j] is None and out[i] is None:
-                c, d = pieces[j][0], pieces[j][1]
-                e = TopoDS_Edge()
-                B.MakeEdge(e, surf.UIso(u), tol)
-                pc_i = _line2d((u, 0.0), (0.0, 1.0))  # piece i: parameter = v
-                pc_j = _affine2d(a, b, (u, d), (u, c))  # piece j: the same points backwards
-                # a closed edge's first p-curve is the one used where the edge is FORWARD in the wire
-                if walk_fwd:
-                    B.UpdateEdge(e, pc_i, pc_j, face, tol)
-                else:
-                    B.UpdateEdge(e, pc_j, pc_i, face, tol)
-                bounded(e, vertex(u, a), vertex(u, b), a, b)
-                out[i] = (e, FWD)
-                out[j] = (e, REV)
-        return out
+    seam = iso_v(v0)
+    cut = iso_v(v_cut)
+    B.UpdateEdge(seam, _line2d((0.0, v0), (1.0, 0.0)), faces[0], tol)
+    B.UpdateEdge(seam, _line2d((0.0, v1), (1.0, 0.0)), faces[1], tol)
+    for f in faces:
+        B.UpdateEdge(cut, _line2d((0.0, v_cut), (1.0, 0.0)), f, tol)
 
-    seam = TopoDS_Edge()
-    B.MakeEdge(seam, surf.VIso(v_lo), tol)
-    B.UpdateEdge(seam, _line2d((0.0, v_lo), (1.0, 0.0)), _line2d((0.0, v_hi), (1.0, 0.0)), face, tol)
-    side0 = row_side(0)
-    side1 = row_side(-1)
-    bounded(seam, vertex(u_lo, v_lo), vertex(u_hi, v_lo), u_lo, u_hi)
-    wire = TopoDS_Wire()
-    B.MakeWire(wire)
-    B.Add(wire, seam.Oriented(FWD))  # (u_lo, v_lo) -> (u_hi, v_lo)
-    for e, o in side1:  # u = u_hi, +v
-        B.Add(wire, e.Oriented(o))
-    B.Add(wire, seam.Oriented(REV))  # (u_hi, v_hi) -> (u_lo, v_hi)
-    for e, o in reversed(side0):  # u = u_lo, -v
-        B.Add(wire, e.Oriented(REV if o == FWD else FWD))
-    B.Add(face, wire)
-    from OCP.BRepLib import BRepLib
+    # The slit side of each half is ONE edge: the segment with its collapsed ends (the 3-D
+    # curve stands still there, as on a rim whose corners collapsed; no degenerated edges,
+    # which STEP cannot carry).  Parameter: v of half 0; on half 1 the p-curve runs the other
+    # way, piecewise linear so that it meets the same points: half 0's (start, run start, run
+    # end, end) match half 1's (end, run end, run start, start).
+    def run_of(h: int):
+        a_h, b_h = ranges[h]
+        rs = [p for p in pieces if p[2] == "run" and p[0] >= a_h - 1e-12 and p[1] <= b_h + 1e-12]
+        if len(rs) != 1:
+            raise GeometryError(f"{name}: each half of the slit face must hold one run of the segment", data)
+        return rs[0][0], rs[0][1]
 
-    BRepLib.SameParameter_s(face, tol)
-    BRepLib.UpdateTolerances_s(face)
-    return face
+    (lo0, hi0), (lo1, hi1) = ranges
+    (r00, r10), (r01, r11) = run_of(0), run_of(1)
+    pairs = [(lo0, hi1), (r00, r11), (r10, r01), (hi0, lo1)]
+    ts, ws = [pairs[0][0]], [pairs[0][1]]
+    for t_, w_ in pairs[1:]:
+        if t_ - ts[-1] <= 1e-12:
+            if abs(w_ - ws[-1]) > 1e-12:
+                raise GeometryError(f"{name}: the slit's collapsed ends do not match between the halves", data)
+            continue
+        ts.append(t_)
+        ws.append(w_)
+    m = len(ts)
+    poles = Array1OfPnt2d(1, m)
+    for i, w_ in enumerate(ws, start=1):
+        poles.SetValue(i, gp_Pnt2d(u_s, float(w_)))
+    back = Geom2d_BSplineCurve(poles, _real_array(ts), _int_array([2] + [1] * (m - 2) + [2]), 1)
+    seg = TopoDS_Edge()
+    B.MakeEdge(seg, surf.UIso(u_s), tol)
+    B.UpdateEdge(seg, _line2d((u_s, 0.0), (0.0, 1.0)), faces[0], tol)
+    B.UpdateEdge(seg, back, faces[1], tol)
+    bounded(seg, vertex(u_s, lo0), vertex(u_s, hi0), lo0, hi0)
+
+    def slit_side(h: int):
+        """The slit row of half ``h``, walked with increasing v."""
+        return [(seg, FWD if h == 0 else REV)]
+
+    def other_side(h: int):
+        a, b = ranges[h]
+        e = TopoDS_Edge()
+        B.MakeEdge(e, surf.UIso(u_o), tol)
+        B.UpdateEdge(e, _line2d((u_o, 0.0), (0.0, 1.0)), faces[h], tol)
+        return [(bounded(e, vertex(u_o, a), vertex(u_o, b), a, b), FWD)]
+
+    bottom = [(seam, FWD), (cut, FWD)]  # v = v_lo of each half, walked u0 -> u1
+    top = [(cut, REV), (seam, REV)]  # v = v_hi of each half, walked u1 -> u0
+    for h, f in enumerate(faces):
+        right = slit_side(h) if k_slit == -1 else other_side(h)  # u = u1, +v
+        left = slit_side(h) if k_slit == 0 else other_side(h)  # u = u0, walked -v
+        wire = TopoDS_Wire()
+        B.MakeWire(wire)
+        B.Add(wire, bottom[h][0].Oriented(bottom[h][1]))
+        for e, o in right:
+            B.Add(wire, e.Oriented(o))
+        B.Add(wire, top[h][0].Oriented(top[h][1]))
+        for e, o in reversed(left):
+            B.Add(wire, e.Oriented(REV if o == FWD else FWD))
+        B.Add(f, wire)
+    for f in faces:
+        BRepLib.SameParameter_s(f, tol)
+        knot_boundary_pcurves(f)
+        if not BRepCheck_Analyzer(f).IsValid():
+            raise GeometryError(f"half face of {name} is not valid (BRepCheck_Analyzer)", data)
+    return faces[0], faces[1]
 
 
 def _v_breaks(surf: Geom_BSplineSurface) -> list[float]:

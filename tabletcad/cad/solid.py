@@ -6,7 +6,8 @@ free edge) that failed.
 
 1. :func:`tabletcad.bspline.fit_patches` - B-spline fit of every patch within
    ``tol`` (shared boundary rows are bit-identical between neighbours);
-2. :func:`tabletcad.cad.faces.make_face` - one periodic B-spline face per patch;
+2. :func:`tabletcad.cad.faces.make_faces` - one periodic B-spline face per patch (two
+   halves for a patch whose boundary row collapses to a segment);
 3. ``BRepBuilderAPI_Sewing`` with tolerance ``max(2 tol, 1e-6)`` mm - no free
    or multiple edges allowed, exactly one closed shell;
 4. ``BRepBuilderAPI_MakeSolid`` + ``BRepLib::OrientClosedSolid`` (matter
@@ -38,7 +39,7 @@ from OCP.TopoDS import TopoDS_Shape, TopoDS_Solid
 
 from tabletcad.bspline import BSplineSurfaceData, SurfaceFit, fit_patches, normalise_breaks
 from tabletcad.cad._occ import cast, explore, shape_type
-from tabletcad.cad.faces import knot_boundary_pcurves, make_face
+from tabletcad.cad.faces import knot_boundary_pcurves, make_faces
 from tabletcad.errors import GeometryError
 
 __all__ = [
@@ -257,9 +258,16 @@ def solid_from_surfaces(
     """Faces -> sewn closed shell -> outward solid, validated; adaptive mass properties."""
     t0 = time.perf_counter()
     names = list(names) if names is not None else [f"patch {j}" for j in range(len(surfaces))]
-    faces = tuple(make_face(s, tol_degen=tol_degen, name=n) for s, n in zip(surfaces, names))
+    # one face per surface, two for a surface whose boundary row is a slit (make_faces)
+    faces_l: list = []
+    face_names: list[str] = []
+    for s, n in zip(surfaces, names):
+        fs = make_faces(s, tol_degen=tol_degen, name=n)
+        faces_l.extend(fs)
+        face_names.extend([n] if len(fs) == 1 else [f"{n} (part {k + 1})" for k in range(len(fs))])
+    faces = tuple(faces_l)
     t1 = time.perf_counter()
-    shell = sew_faces(faces, names, sew_tolerance)
+    shell = sew_faces(faces, face_names, sew_tolerance)
     # sewing may rebuild p-curves: make sure the boundary p-curves still carry the C0/C1
     # v knots that BRepGProp needs to integrate across them (see tabletcad.cad.faces)
     knot_boundary_pcurves(shell)
