@@ -46,14 +46,14 @@ _need("OCP")
 _need("manifold3d")
 _need("trimesh")
 
-from tabletcad.bspline import enclosed_volume  # noqa: E402
-from tabletcad.build import build_tablet  # noqa: E402
-from tabletcad.cad._occ import explore  # noqa: E402
-from tabletcad.cad.faces import slit_pieces  # noqa: E402
-from tabletcad.cad.solid import check_solid  # noqa: E402
-from tabletcad.cad.tablet_solid import tablet_solid  # noqa: E402
-from tabletcad.cli.report import load_family_design  # noqa: E402
-from tabletcad.families import nominal_volume  # noqa: E402
+from tabletcad.bspline import enclosed_volume
+from tabletcad.build import build_tablet
+from tabletcad.cad._occ import explore
+from tabletcad.cad.faces import slit_pieces
+from tabletcad.cad.solid import check_solid
+from tabletcad.cad.tablet_solid import tablet_solid
+from tabletcad.cli.report import load_family_design
+from tabletcad.families import nominal_volume
 
 pytestmark = pytest.mark.cad
 
@@ -62,7 +62,7 @@ SAMPLES = sorted((ROOT / "samples" / "families").glob("*.toml"))
 AGREE = 1e-6
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _tablet(path: Path):
     tablet, _ = load_family_design(path)
     return tablet

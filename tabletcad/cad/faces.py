@@ -46,12 +46,11 @@ B-splines is then reproduced to round-off.
 from __future__ import annotations
 
 import numpy as np
+from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
 from OCP.BRepCheck import BRepCheck_Analyzer
-from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.Geom import Geom_BSplineSurface
-from OCP.Geom2d import Geom2d_BSplineCurve
-from OCP.Geom2d import Geom2d_Line
+from OCP.Geom2d import Geom2d_BSplineCurve, Geom2d_Line
 from OCP.gp import gp_Dir2d, gp_Pnt, gp_Pnt2d
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 
@@ -64,7 +63,7 @@ from tabletcad.bspline import BSplineSurfaceData
 from tabletcad.cad._occ import Array1OfInteger, Array1OfReal, Array2OfPnt
 from tabletcad.errors import GeometryError
 
-__all__ = ["make_geom_surface", "make_face", "make_faces", "surface_data_from_geom", "knot_boundary_pcurves", "slit_pieces"]
+__all__ = ["knot_boundary_pcurves", "make_face", "make_faces", "make_geom_surface", "slit_pieces", "surface_data_from_geom"]
 
 
 def _real_array(values) -> Array1OfReal:

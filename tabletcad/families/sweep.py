@@ -521,7 +521,7 @@ def nominal_volume(nominal: SweepNominal, n: int = 64) -> float:
     t = 0.5 * (x + 1.0)
     cup = 0.0
     for e in nominal.top:
-        d, z = e.point(t).T
+        d = e.point(t)[:, 0]
         dz = e.tangent(t)[:, 1]
         cup += 0.5 * float(np.sum(w * (A0 - P * d + math.pi * d * d) * dz))
     band = nominal.band_z[1] - nominal.band_z[0]
