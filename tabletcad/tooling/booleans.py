@@ -77,7 +77,14 @@ def boolean(op: str, a: TopoDS_Shape, b: TopoDS_Shape, *, what: str = "result", 
 
     ``sliver`` > 0: solids smaller than ``sliver`` times the largest are dropped (e.g. the hair-thin
     ring between a zero-clearance punch tip and a PDE band that bows inward by a micrometre)."""
-    shape = raw_boolean(op, a, b, fuzzy)
+    try:
+        shape = raw_boolean(op, a, b, fuzzy)
+    except GeometryError:
+        if fuzzy > 0:
+            raise
+        # retry with a sub-micrometre fuzzy tolerance: B-spline faces that meet a tool
+        # exactly along a seam (e.g. a score across a capsule's centre-line seam) need it
+        shape = raw_boolean(op, a, b, 1e-5)
     solids = explore(shape, "Solid")
     if sliver > 0 and len(solids) > 1:
         vols = [mass_properties(s, 1e-7).volume for s in solids]
