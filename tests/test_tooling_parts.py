@@ -134,6 +134,18 @@ def test_emboss_and_scores_on_both_faces():
         check_solid(shape)
 
 
+@pytest.mark.xfail(strict=True, reason="known limitation: OCC Boolean fails where a score crosses the capsule "
+                   "cup's centre-line seam (two half-faces sharing a segment)")
+def test_capsule_score_across_centre_line():
+    t = load_design(SAMPLES / "capsule.toml")
+    from tabletcad.cad.tablet_solid import tablet_solid
+
+    solid = tablet_solid(t)
+    spec = parse_tooling({"clearance_mm": 0.02, "score": [{"kind": "bisect", "depth_mm": 0.4, "direction_deg": 90.0}]})
+    ts = make_tooling(t, spec, shape=solid.shape)
+    assert ts.report["interference_mm3"] == pytest.approx(0.0, abs=1e-9)
+
+
 def test_capsule_sample_tooling():
     t = load_design(SAMPLES / "capsule.toml")
     try:
