@@ -136,13 +136,15 @@ def design_from_dict(data: dict, default_name: str = "tablet") -> Tablet:
     if a is not None and a != "auto":
         a = check_finite("[tablet] a", a)
     if family is None:
-        raise DesignError("[tablet] family", "missing", f"must be one of {', '.join(FAMILIES)} or free_form")
+        raise DesignError("[tablet] family", "missing", f"must be one of {', '.join(FAMILIES)}, custom_outline or free_form")
     if family == "free_form":
         _check_keys("[tablet]", tab, set())
         tablet = _free_form(data.get("patch"), name, 1.0 if a is None else a)
+    elif family == "custom_outline":
+        tablet = _custom_outline(tab, name)
     else:
         if family not in FAMILIES:
-            raise DesignError("[tablet] family", family, f"must be one of {', '.join(FAMILIES)} or free_form")
+            raise DesignError("[tablet] family", family, f"must be one of {', '.join(FAMILIES)}, custom_outline or free_form")
         if "patch" in data:
             raise DesignError("[[patch]]", "given", f"patches are only read for family free_form, not {family!r}")
         fam = FAMILIES[family]
@@ -166,6 +168,27 @@ def design_from_dict(data: dict, default_name: str = "tablet") -> Tablet:
                 raise DesignError(f"[{k}]", v, "must be a table")
         tablet = replace(tablet, extras={**tablet.extras, **extras})
     return tablet
+
+
+_CUSTOM_KEYS = {"outline", "segments", "band", "cup_depth", "land", "cup_width", "central_radius", "edge_radius"}
+
+
+def _custom_outline(tab: dict, name: str) -> Tablet:
+    """Any closed plan outline with a cup swept over it (:func:`tabletcad.families.outline_tablet`).
+
+    ``outline = [[x, y], ...]`` (points, mm) or ``segments = [["line", [x0, y0], [x1, y1]],
+    ["arc", [cx, cy], r, theta0, sweep], ...]`` (angles in rad), plus ``band``,
+    ``cup_depth``, ``land``, ``cup_width``, ``central_radius``, ``edge_radius`` (mm).
+    """
+    from tabletcad.families import outline_tablet
+
+    _check_keys("[tablet]", tab, _CUSTOM_KEYS)
+    if ("outline" in tab) == ("segments" in tab):
+        raise DesignError("[tablet] outline", "missing" if "outline" not in tab else "both",
+                          "give either outline (points) or segments (lines and arcs)")
+    shape = tab["outline"] if "outline" in tab else [tuple(item) for item in tab["segments"]]
+    kw = {k: check_finite(f"[tablet] {k}", v, "mm") for k, v in tab.items() if k not in ("outline", "segments")}
+    return outline_tablet(shape, name=name, **kw)
 
 
 def _free_form(patches: Any, name: str, a) -> Tablet:

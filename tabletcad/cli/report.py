@@ -37,7 +37,6 @@ def load_family_design(path: Path):
     angles in rad) plus the keys of :func:`tabletcad.families.outline_tablet`.
     """
     from tabletcad.design import design_from_dict
-    from tabletcad.families import outline_tablet
 
     if not path.is_file():
         raise DesignError("design file", str(path), "must be an existing TOML file")
@@ -45,22 +44,6 @@ def load_family_design(path: Path):
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise DesignError("design file", path.name, f"must be valid TOML ({exc})") from None
-    tab = data.get("tablet")
-    if isinstance(tab, dict) and tab.get("family") == "custom_outline":
-        tab = dict(tab)
-        tab.pop("family")
-        name = tab.pop("name", path.stem)
-        for k in tab:
-            if k not in _CUSTOM_KEYS:
-                raise DesignError(f"[tablet] key {k!r}", tab[k], f"family 'custom_outline' takes {', '.join(sorted(_CUSTOM_KEYS))}")
-        if ("outline" in tab) == ("segments" in tab):
-            raise DesignError("[tablet] outline", "missing" if "outline" not in tab else "both", "give either outline (points) or segments (lines and arcs)")
-        shape = tab.pop("outline", None)
-        if shape is None:
-            shape = [tuple(item) for item in tab.pop("segments")]
-        kw = {k: v for k, v in tab.items()}
-        tablet = outline_tablet(shape, name=str(name), **kw)
-        return tablet, data.get("report")
     return design_from_dict(data, default_name=path.stem), data.get("report")
 
 
