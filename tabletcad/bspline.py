@@ -40,6 +40,8 @@ import numpy as np
 from tabletcad.errors import GeometryError
 
 __all__ = [
+    "PatchFunction",
+    "chain_breakpoints",
     "BSplineSurfaceData",
     "SurfaceFit",
     "fit_surface",
@@ -740,3 +742,28 @@ def enclosed_volume(surfaces: Sequence[BSplineSurfaceData]) -> float:
         integrand = np.einsum("...k,...k->...", S, np.cross(Su, Sv))
         total += float(np.einsum("i,j,ij->", uw, vw, integrand)) / 3.0
     return total
+
+
+class PatchFunction:
+    """``f(u, v) = patch.evaluate(u, v)``; keeps the patch's ``evaluate_grid`` (tensor grids by
+    matrix products), which :func:`tabletcad.bspline.fit_surface` uses when present."""
+
+    def __init__(self, patch) -> None:
+        self.patch = patch
+        if hasattr(patch, "evaluate_grid"):
+            self.evaluate_grid = lambda u, v: np.asarray(patch.evaluate_grid(u, v))
+
+    def __call__(self, u, v) -> np.ndarray:
+        return np.asarray(self.patch.evaluate(u, v))
+
+
+def chain_breakpoints(patches) -> np.ndarray:
+    """Union (sorted, in [0, 2 pi), values within 1e-9 merged) of the ``breakpoints()`` of the
+    patches that have them."""
+    pts = [np.asarray(p.breakpoints(), dtype=float).ravel() for p in patches if hasattr(p, "breakpoints")]
+    pts = [b for b in pts if b.size]
+    if not pts:
+        return np.zeros(0)
+    return normalise_breaks(np.concatenate(pts))
+
+

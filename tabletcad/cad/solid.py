@@ -37,7 +37,7 @@ from OCP.BRepLib import BRepLib
 from OCP.GProp import GProp_GProps
 from OCP.TopoDS import TopoDS_Shape, TopoDS_Solid
 
-from tabletcad.bspline import BSplineSurfaceData, SurfaceFit, fit_patches, normalise_breaks
+from tabletcad.bspline import PatchFunction, chain_breakpoints, BSplineSurfaceData, SurfaceFit, fit_patches
 from tabletcad.cad._occ import cast, explore, shape_type
 from tabletcad.cad.faces import knot_boundary_pcurves, make_faces
 from tabletcad.errors import GeometryError
@@ -143,35 +143,12 @@ class TabletSolid:
 # --------------------------------------------------------------------------- helpers
 
 
-class PatchFunction:
-    """``f(u, v) = patch.evaluate(u, v)``; keeps the patch's ``evaluate_grid`` (tensor grids by
-    matrix products), which :func:`tabletcad.bspline.fit_surface` uses when present."""
-
-    def __init__(self, patch: Any) -> None:
-        self.patch = patch
-        if hasattr(patch, "evaluate_grid"):
-            self.evaluate_grid = lambda u, v: np.asarray(patch.evaluate_grid(u, v))
-
-    def __call__(self, u, v) -> np.ndarray:
-        return np.asarray(self.patch.evaluate(u, v))
-
-
 def _patch_function(p: Any) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
     if hasattr(p, "evaluate"):
         return PatchFunction(p)
     if callable(p):
         return p
     raise TypeError(f"a patch must be callable f(u, v) or have .evaluate(u, v), got {type(p).__name__}")
-
-
-def chain_breakpoints(patches: Sequence[Any]) -> np.ndarray:
-    """Union (sorted, in [0, 2 pi), values within 1e-9 merged) of the ``breakpoints()`` of the
-    patches that have them."""
-    pts = [np.asarray(p.breakpoints(), dtype=float).ravel() for p in patches if hasattr(p, "breakpoints")]
-    pts = [b for b in pts if b.size]
-    if not pts:
-        return np.zeros(0)
-    return normalise_breaks(np.concatenate(pts))
 
 
 def _patch_names(patches: Sequence[Any], names: Sequence[str] | None) -> list[str]:

@@ -40,7 +40,7 @@ def tablet_surface_functions(tablet: Tablet) -> tuple[list[SurfaceFunction], lis
     w0, w1 = t.w
     names = [p.name or f"patch {j}" for j, p in enumerate(tablet.patches)]
     if w0 == 0.0 and w1 == 1.0:
-        from tabletcad.cad.solid import PatchFunction  # keeps the patches' fast evaluate_grid
+        from tabletcad.bspline import PatchFunction  # keeps the patches' fast evaluate_grid
 
         return [PatchFunction(p) for p in tablet.patches], names
     if len(tablet.patches) != 1:
@@ -67,7 +67,7 @@ def tablet_breakpoints(tablet: Tablet) -> np.ndarray:
     which share the patch's ``v``) is fitted with breakpoint knots at all of
     them, so that the chain keeps one common ``v`` knot vector.
     """
-    from tabletcad.cad.solid import chain_breakpoints
+    from tabletcad.bspline import chain_breakpoints
 
     return chain_breakpoints(tablet.patches)
 

@@ -44,40 +44,16 @@ TWO_PI = 2.0 * math.pi
 
 
 # --------------------------------------------------------------------------- core side (numpy only)
-class _PatchFunction:
-    """``f(u, v) = patch.evaluate(u, v)`` keeping the patch's fast ``evaluate_grid``."""
-
-    def __init__(self, patch):
-        self.patch = patch
-        if hasattr(patch, "evaluate_grid"):
-            self.evaluate_grid = lambda u, v: np.asarray(patch.evaluate_grid(u, v))
-
-    def __call__(self, u, v):
-        return np.asarray(self.patch.evaluate(u, v))
-
-
 def tablet_chain(tablet):
     """(surface functions, names, v breakpoints) of the tablet's closed solid.
 
-    Same chain as :func:`tabletcad.cad.tablet_solid.tablet_surface_functions`;
-    the untrimmed case is built here because that function imports its patch
-    wrapper from the OCP module :mod:`tabletcad.cad.solid`.
+    The same chain as :func:`tabletcad.cad.tablet_solid.tablet_surface_functions`
+    (numpy only: it imports no OCP), with the union of the patches' breakpoints.
     """
-    from tabletcad.bspline import normalise_breaks
-
-    t = tablet.trim
-    bps = [
-        np.asarray(p.breakpoints(), dtype=float).ravel() for p in tablet.patches if hasattr(p, "breakpoints")
-    ]
-    bps = [b for b in bps if b.size]
-    breaks = normalise_breaks(np.concatenate(bps)) if bps else np.zeros(0)
-    if t.u == (0.0, 1.0) and t.full_v and t.w == (0.0, 1.0):
-        names = [p.name or f"patch {j}" for j, p in enumerate(tablet.patches)]
-        return [_PatchFunction(p) for p in tablet.patches], names, breaks
-    from tabletcad.cad.tablet_solid import tablet_surface_functions  # numpy-only for trimmed/hollow tablets
+    from tabletcad.cad.tablet_solid import tablet_breakpoints, tablet_surface_functions
 
     funcs, names = tablet_surface_functions(tablet)
-    return funcs, names, breaks
+    return funcs, names, tablet_breakpoints(tablet)
 
 
 def tablet_from_spec(family=None, params=None, design=None):
