@@ -38,17 +38,25 @@ def files(tmp_path_factory):
 
 _PART_READ = """
 import json, os
-import Part
+import FreeCAD, Import, Part
 shape = Part.read(os.environ["TABLETCAD_FC_INPUT"])
 res = {"n_solids": len(shape.Solids), "valid": [bool(s.isValid()) for s in shape.Solids],
        "closed": [bool(s.isClosed()) for s in shape.Solids], "volumes": [s.Volume for s in shape.Solids]}
+# names: FreeCAD's own STEP import into a document.  Import.insert (ImportOCAF2) crashes on
+# multi-part assemblies in FreeCAD 0.20; the plain ImportOCAF path (mode 0, no link groups) works.
+prefs = FreeCAD.ParamGet("User parameter:BaseApp/Preferences/Mod/Import")
+prefs.SetBool("UseLinkGroup", False)
+prefs.SetInt("ImportMode", 0)
+Import.open(os.environ["TABLETCAD_FC_INPUT"])
+doc = FreeCAD.ActiveDocument
+res["named_solids"] = {o.Label: bool(o.Shape.isValid()) for o in doc.Objects
+                       if o.TypeId == "Part::Feature" and o.Shape.Solids}
 open(os.environ["TABLETCAD_FC_OUTPUT"], "w").write(json.dumps(res))
 """
 
 
 def _freecad_part_read(path, tmp_path):
-    """FreeCAD's ``Part.read`` only: FreeCAD 0.20's ``Import.insert`` (ImportOCAF2) crashes with
-    SIGSEGV on multi-part STEP assemblies written by OCCT 7.9/8.0, so names are checked separately."""
+    """FreeCAD reads the file with ``Part.read`` (solids) and ``Import.open`` (named parts)."""
     import json
     import subprocess
 
@@ -70,7 +78,9 @@ def test_freecad_reads_the_assembly_as_valid_solids_with_named_parts(files, tmp_
 
     expected = sorted(mass_properties(s, None).volume for s in ts.parts.values())
     assert sorted(r["volumes"]) == pytest.approx(expected, rel=1e-6)
-    # names: the XCAF product names, read back by OCP's STEP reader in a fresh process
+    # names as FreeCAD's own importer sees them: four valid, named solids
+    assert r["named_solids"] == {"tablet": True, "upper_punch": True, "lower_punch": True, "die": True}
+    # and the XCAF product names as OCP's STEP reader sees them in a fresh process
     from tabletcad.cad.readback import ocp_read_step
 
     products = ocp_read_step(out / "assembly.step")["products"]
