@@ -23,7 +23,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from tabletcad.errors import DesignError, check_finite, check_positive, check_range
-from tabletcad.tolerance import DEFAULT, Tolerances
+from tabletcad.tolerance import DEFAULT
 
 __all__ = [
     "Curve",

@@ -30,11 +30,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import numpy as np
 
-from tabletcad.basis import basis, cardinal, cardinal_coefficients
+from tabletcad.basis import cardinal, cardinal_coefficients
 from tabletcad.curves import CurveLike, fourier_coefficients, modes_needed, sample_v
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
@@ -278,7 +277,6 @@ class PDEPatch:
         shape = u.shape
         uf, vf = u.reshape(-1), v.reshape(-1)
         out = np.zeros((uf.size, 3))
-        N = self.modes
         if nmin == 0 and dv == 0:
             out += cardinal(uf, 0.0, self.u_nodes, self.form, du) @ self._a0
         for n in self._active:
@@ -303,7 +301,6 @@ class PDEPatch:
         """
         u = np.asarray(u, dtype=float).reshape(-1)
         v = np.asarray(v, dtype=float).reshape(-1)
-        N = self.modes
         out = np.zeros((u.size, v.size, 3))
         if dv == 0:
             L0 = cardinal(u, 0.0, self.u_nodes, self.form, du)

@@ -20,7 +20,7 @@ from typing import Callable
 import numpy as np
 
 from tabletcad import nominal as nom
-from tabletcad.curves import Circle, Curve, Ellipse, Transformed
+from tabletcad.curves import Circle, Curve, Ellipse
 from tabletcad.errors import DesignError, check_positive, check_range
 from tabletcad.patch import PDEPatch
 from tabletcad.tablet import Tablet, Trim

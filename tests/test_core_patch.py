@@ -15,7 +15,7 @@ import warnings
 import numpy as np
 import pytest
 
-from tabletcad.curves import Circle, Ellipse, PointCurve, RoundedRectangle, Stadium, Transformed, sample_v
+from tabletcad.curves import Circle, Ellipse, PointCurve, RoundedRectangle, Stadium, Transformed
 from tabletcad.errors import DesignError
 from tabletcad.patch import AUTO_A_LADDER, PDEPatch
 

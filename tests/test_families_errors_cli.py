@@ -11,7 +11,7 @@ import pytest
 from tabletcad import families as F
 from tabletcad.cli import main
 from tabletcad.errors import DesignError
-from tabletcad.families.outline import four_arc_oval, outline_from_items, stadium_outline
+from tabletcad.families.outline import four_arc_oval, stadium_outline
 
 
 @pytest.mark.parametrize(

@@ -116,7 +116,6 @@ def test_plots(tmp_path):
 
 
 def test_compressed_sphere_tablet():
-    pytest.importorskip("tabletcad.shapes")
     t = ct.compressed_sphere_tablet(3.5, "kostrolith")
     dims = t.dimensions()
     assert dims["height_mm"] == pytest.approx(1.3444, abs=5e-5)

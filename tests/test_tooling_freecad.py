@@ -1,7 +1,6 @@
 """FreeCAD (its own OCCT) reads the tooling STEP files: valid solids with the right names."""
 
 import os
-from pathlib import Path
 
 import pytest
 

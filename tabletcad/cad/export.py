@@ -52,32 +52,49 @@ def _shape_of(obj: Any) -> TopoDS_Shape:
     raise TypeError(f"cannot export {type(obj).__name__}: expected a TopoDS_Shape or TabletSolid")
 
 
-def export_step(obj: Any, path: str | os.PathLike[str], *, name: str = "tablet", schema: str = "AP242") -> Path:
-    """STEP (``AP242`` -> OCCT's ``AP242DIS``, or ``AP214``) in millimetres; the PRODUCT is called ``name``."""
-    shape = _shape_of(obj)
-    schemas = {"AP242": "AP242DIS", "AP214": "AP214IS", "AP203": "AP203"}
-    if schema.upper() not in schemas:
-        raise ValueError(f"schema = {schema!r} is not allowed: must be one of {sorted(schemas)}")
+_SCHEMAS = {"AP242": "AP242DIS", "AP214": "AP214IS", "AP203": "AP203"}
+
+
+def step_document(schema: str = "AP242", *, assembly: bool = False):
+    """A new XCAF document for STEP in millimetres and its shape tool: ``(doc, tool)``.
+
+    Sets OCCT's (process-global) STEP writer options every time, so one export
+    cannot leak its schema or assembly mode into the next.
+    """
+    if schema.upper() not in _SCHEMAS:
+        raise ValueError(f"schema = {schema!r} is not allowed: must be one of {sorted(_SCHEMAS)}")
     STEPControl_Controller.Init_s()
-    Interface_Static.SetCVal_s("write.step.schema", schemas[schema.upper()])
+    Interface_Static.SetCVal_s("write.step.schema", _SCHEMAS[schema.upper()])
     Interface_Static.SetCVal_s("write.step.unit", "MM")
     Interface_Static.SetIVal_s("write.surfacecurve.mode", 1)
+    Interface_Static.SetIVal_s("write.step.assembly", 1 if assembly else 0)
     doc = TDocStd_Document(TCollection_ExtendedString("XmlOcaf"))
     XCAFDoc_DocumentTool.SetLengthUnit_s(doc, 0.001)  # document unit in metres: shapes are in mm
-    tool = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
-    label = tool.AddShape(shape, False)
-    TDataStd_Name.Set_s(label, TCollection_ExtendedString(str(name)))
+    return doc, XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
+
+
+def write_step_document(doc, path: str | os.PathLike[str], *, what: str, obj: Any = None) -> Path:
+    """Transfer an XCAF document to STEP (names kept) and write it atomically to ``path``."""
     writer = STEPCAFControl_Writer()
     writer.SetNameMode(True)
     with quiet():
         ok = writer.Transfer(doc, STEPControl_StepModelType.STEPControl_AsIs)
     if not ok:
-        raise GeometryError(f"STEP transfer of {name} failed", shape)
+        raise GeometryError(f"STEP transfer of {what} failed", obj)
     with atomic_path(path) as tmp, quiet():
         status = writer.Write(str(tmp))
         if status != IFSelect_ReturnStatus.IFSelect_RetDone:
-            raise GeometryError(f"writing STEP {path} failed: {status}", shape)
+            raise GeometryError(f"writing STEP {path} failed: {status}", obj)
     return Path(path)
+
+
+def export_step(obj: Any, path: str | os.PathLike[str], *, name: str = "tablet", schema: str = "AP242") -> Path:
+    """STEP (``AP242`` -> OCCT's ``AP242DIS``, or ``AP214``) in millimetres; the PRODUCT is called ``name``."""
+    shape = _shape_of(obj)
+    doc, tool = step_document(schema)
+    label = tool.AddShape(shape, False)
+    TDataStd_Name.Set_s(label, TCollection_ExtendedString(str(name)))
+    return write_step_document(doc, path, what=str(name), obj=shape)
 
 
 def _mesh_of(obj: Any, mesh: MeshResult | None, **kw: Any) -> MeshResult:

@@ -25,7 +25,6 @@ else:  # pragma: no cover
 
 __all__ = ["COMMANDS", "load_family_design"]
 
-_CUSTOM_KEYS = {"outline", "segments", "band", "cup_depth", "land", "cup_width", "central_radius", "edge_radius", "a"}
 
 
 def load_family_design(path: Path):

@@ -14,7 +14,7 @@ the end radius, the default) and the face centre is a flat plateau.
 
 from __future__ import annotations
 
-from tabletcad.errors import check_positive, check_range
+from tabletcad.errors import check_positive
 from tabletcad.families.outline import four_arc_oval, four_arc_oval_from_side_radius, stadium_outline
 from tabletcad.families.shaped import outline_tablet
 from tabletcad.families.sweep import DEFAULT_A

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from tabletcad.errors import DesignError, check_finite, check_positive, check_range
+from tabletcad.errors import DesignError, check_positive, check_range
 from tabletcad.families.cups import CompoundCup, land_line, single_radius_cup
 from tabletcad.families.outline import (
     PlanOutline,

@@ -35,7 +35,7 @@ to well below a micrometre; :func:`certify` measures it.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np

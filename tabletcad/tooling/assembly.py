@@ -12,13 +12,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from OCP.IFSelect import IFSelect_ReturnStatus
-from OCP.Interface import Interface_Static
-from OCP.STEPCAFControl import STEPCAFControl_Writer
-from OCP.STEPControl import STEPControl_Controller, STEPControl_StepModelType
 from OCP.TCollection import TCollection_ExtendedString
 from OCP.TDataStd import TDataStd_Name
-from OCP.TDocStd import TDocStd_Document
 from OCP.TopLoc import TopLoc_Location
 from OCP.gp import gp_Trsf, gp_Vec
 from OCP.BRep import BRep_Builder
@@ -29,12 +24,10 @@ try:  # OCP >= 8.0
 except ImportError:  # pragma: no cover - OCP 7.x
     from OCP.TDF import TDF_LabelSequence
 from OCP.TopoDS import TopoDS_Compound
-from OCP.XCAFDoc import XCAFDoc_DocumentTool, XCAFDoc_ShapeTool
+from OCP.XCAFDoc import XCAFDoc_ShapeTool
 
-from tabletcad.cad._occ import quiet
-from tabletcad.cad.export import export_step
+from tabletcad.cad.export import export_step, step_document, write_step_document
 from tabletcad.errors import GeometryError
-from tabletcad.io import atomic_path
 
 __all__ = ["write_assembly", "write_parts", "PART_NAMES"]
 
@@ -45,13 +38,7 @@ def write_assembly(parts: dict, path, *, name: str = "tooling", offsets: dict | 
     """Write an XCAF assembly of ``parts`` (name -> solid) to ``path``; ``offsets`` (name -> dz mm)
     place components (as locations, the part shapes are stored once)."""
     offsets = offsets or {}
-    STEPControl_Controller.Init_s()
-    Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
-    Interface_Static.SetCVal_s("write.step.unit", "MM")
-    Interface_Static.SetIVal_s("write.step.assembly", 1)
-    doc = TDocStd_Document(TCollection_ExtendedString("XmlOcaf"))
-    XCAFDoc_DocumentTool.SetLengthUnit_s(doc, 0.001)
-    tool = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
+    doc, tool = step_document("AP214", assembly=True)
     names = [p for p in PART_NAMES if p in parts]
     builder, comp = BRep_Builder(), TopoDS_Compound()
     builder.MakeCompound(comp)
@@ -72,17 +59,7 @@ def write_assembly(parts: dict, path, *, name: str = "tooling", offsets: dict | 
         ref = TDF_Label()
         if XCAFDoc_ShapeTool.GetReferredShape_s(comp_label, ref):
             TDataStd_Name.Set_s(ref, TCollection_ExtendedString(part))
-    writer = STEPCAFControl_Writer()
-    writer.SetNameMode(True)
-    with quiet():
-        ok = writer.Transfer(doc, STEPControl_StepModelType.STEPControl_AsIs)
-    if not ok:
-        raise GeometryError(f"STEP transfer of the assembly {name} failed", parts)
-    with atomic_path(path) as tmp, quiet():
-        status = writer.Write(str(tmp))
-        if status != IFSelect_ReturnStatus.IFSelect_RetDone:
-            raise GeometryError(f"writing STEP {path} failed: {status}", parts)
-    return Path(path)
+    return write_step_document(doc, path, what=f"the assembly {name}", obj=parts)
 
 
 def write_parts(parts: dict, out_dir, names=("upper_punch", "lower_punch", "die")) -> list[Path]:

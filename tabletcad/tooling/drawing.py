@@ -13,7 +13,6 @@ DIMENSION entities with the same texts).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 

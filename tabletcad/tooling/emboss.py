@@ -28,7 +28,7 @@ from OCP.TopoDS import TopoDS_Shape
 
 from tabletcad.cad._occ import explore
 from tabletcad.errors import DesignError, GeometryError
-from tabletcad.tooling.booleans import boolean, checked_boolean, translated
+from tabletcad.tooling.booleans import checked_boolean, translated
 from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, polyline_wire
 from tabletcad.tooling.spec import EmbossSpec, font_path
 
@@ -203,7 +203,6 @@ def apply_emboss(frame: TabletFrame, shape, items, clearance: float, *, check: b
 
 def face_heights(shape, figure, top: bool) -> list[float]:
     """Heights (mm) where vertical lines through the figure's vertices meet the top (bottom) face of ``shape``."""
-    from OCP.BRep import BRep_Tool
     from OCP.gp import gp_Lin
     from OCP.IntCurvesFace import IntCurvesFace_ShapeIntersector
 

@@ -82,7 +82,11 @@ class _Proxy:
     def loads(self, state):
         self.__setstate__(state)
 
+    def _setup(self, obj):
+        """Add the object's properties (only those missing: also run on restore)."""
+
     def onDocumentRestored(self, obj):
+        self._setup(obj)  # units are not saved by FreeCAD 0.20; properties added since the save
         self._ready = True
 
     @staticmethod
@@ -224,10 +228,6 @@ class TabletProxy(_Proxy):
         if prop == "Family" and getattr(self, "_ready", False):
             self._sync_dimensions(obj, reset=True)
 
-    def onDocumentRestored(self, obj):
-        self._setup(obj)  # units of Density/Weight are not saved by FreeCAD 0.20; new properties
-        self._ready = True
-
     # ---------------------------------------------------------------- core
     def spec(self, obj) -> dict:
         """What the core is asked to build: ``{family, params, design}``."""
@@ -320,10 +320,6 @@ class PunchProxy(_Proxy):
         )
         self._add(obj, "App::PropertyVolume", "Volume", "Results", "volume of the punch tip", mode=_READONLY)
 
-    def onDocumentRestored(self, obj):
-        self._setup(obj)
-        self._ready = True
-
     def execute(self, obj):
         tab = _tablet_of(obj)
         rims = geometry.rims_from_json(tab.RimData)
@@ -369,10 +365,6 @@ class DieProxy(_Proxy):
             _qty(30.16, "mm"),
         )
         self._add(obj, "App::PropertyVolume", "Volume", "Results", "volume of the die", mode=_READONLY)
-
-    def onDocumentRestored(self, obj):
-        self._setup(obj)
-        self._ready = True
 
     def execute(self, obj):
         tab = _tablet_of(obj)
