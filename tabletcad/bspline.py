@@ -48,6 +48,7 @@ __all__ = [
     "fit_patches",
     "basis_functions",
     "flat_knots",
+    "segment_v",
     "periodic_knots",
     "normalise_breaks",
     "enclosed_volume",
@@ -82,6 +83,49 @@ def flat_knots(knots: np.ndarray, mults: np.ndarray, degree: int, periodic: bool
     head = one[n - degree:] - period
     tail = np.concatenate([one[: degree + 1] + period])
     return np.concatenate([head, one, tail])
+
+
+def segment_v(data: BSplineSurfaceData, a: float, b: float) -> BSplineSurfaceData:
+    """The part ``a <= v <= b`` of ``data`` as a surface clamped in ``v``, exactly.
+
+    ``a`` and ``b`` must be knots of multiplicity >= ``v_degree`` (C0 knots; a
+    periodic surface's first knot counts with its multiplicity) - there the
+    curve already splits into independent pieces, so the piece keeps the
+    poles of the B-splines active on ``(a, b)`` and the knots in between, with
+    ``a`` and ``b`` clamped (multiplicity ``degree + 1``).  On a periodic
+    surface the piece may run across the period's end (``b`` up to ``a +``
+    one period).
+    """
+    p = int(data.v_degree)
+    knots = np.asarray(data.v_knots, dtype=float)
+    mults = np.asarray(data.v_mults, dtype=int)
+    n = data.shape[1]
+    if data.v_periodic:
+        period = float(knots[-1] - knots[0])
+        m0 = int(mults[0])
+        one = np.concatenate([knots[:1], np.repeat(knots[1:-1], mults[1:-1]), np.repeat(knots[-1:], m0 - 1)])
+        # B-spline k of t uses pole (k - n + p) mod n (flat_knots starts p knots before the period)
+        t = np.concatenate([one - period, one, one + period, one[: p + 1] + 2.0 * period])
+        shift = p - n
+        if not (knots[0] <= a < knots[-1] and a < b <= a + period + 1e-12):
+            raise GeometryError(f"segment_v: [{a}, {b}] is not within one period from [{knots[0]}, {knots[-1]})", data)
+    else:
+        t = np.repeat(knots, mults)
+        shift = 0
+        if not (knots[0] <= a < b <= knots[-1]):
+            raise GeometryError(f"segment_v: [{a}, {b}] is not within [{knots[0]}, {knots[-1]}]", data)
+    scale = max(1.0, float(np.max(np.abs(t))))
+    for x in (a, b):
+        if int(np.sum(np.abs(t - x) <= 1e-12 * scale)) < p and not (not data.v_periodic and x in (knots[0], knots[-1])):
+            raise GeometryError(f"segment_v: v = {x} is not a knot of multiplicity >= {p}", data)
+    n_basis = t.size - p - 1
+    active = [k for k in range(n_basis) if t[k] < b - 1e-12 * scale and t[k + p + 1] > a + 1e-12 * scale]
+    inner = t[(t > a + 1e-12 * scale) & (t < b - 1e-12 * scale)]
+    vals, counts = np.unique(inner, return_counts=True)
+    new_knots = np.concatenate([[a], vals, [b]])
+    new_mults = np.concatenate([[p + 1], counts, [p + 1]]).astype(int)
+    poles = np.asarray(data.poles)[:, [(k + shift) % n for k in active], :]
+    return replace(data, poles=poles, v_knots=new_knots, v_mults=new_mults, v_periodic=False)
 
 
 def _find_span(t: np.ndarray, degree: int, n_basis: int, x: np.ndarray) -> np.ndarray:

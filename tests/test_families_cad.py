@@ -15,8 +15,9 @@ STEP, STL, GLB) must succeed, and the solid must be
   ``area × (certified deviation + fit deviation)``;
 * meshed into a watertight genus-0 manifold (STL/GLB).
 
-The capsule's innermost cup patches close on a segment, not a point: their faces
-are slit faces (one edge used twice, degenerated ends).  Plateaus whose rim has
+The capsule's innermost cup patches close on a segment, not a point: each is cut
+into four faces (two runs meeting along the segment, two fans on its ends;
+:mod:`tabletcad.slit`).  Plateaus whose rim has
 collapsed corners are a fan plus a ring (no zero-area strip).
 
 ``custom_outline.toml`` is read by ``tabletcad.cli.report.load_family_design`` (the
@@ -48,7 +49,7 @@ _need("trimesh")
 
 from tabletcad.bspline import enclosed_volume
 from tabletcad.build import build_tablet
-from tabletcad.cad._occ import explore
+from tabletcad.cad._occ import cast, explore
 from tabletcad.cad.faces import slit_pieces
 from tabletcad.cad.solid import check_solid
 from tabletcad.cad.tablet_solid import tablet_solid
@@ -97,7 +98,7 @@ def test_family_sample_builds_an_exact_solid(path, tmp_path):
     s = tablet_solid(t)
     assert len(explore(s.shape, "Solid")) == 1 and len(explore(s.shape, "Shell")) == 1
     check_solid(s.shape, t.name)
-    # one face per patch; two halves for a patch whose boundary row is a slit (capsule)
+    # one face per patch; four pieces for a patch whose boundary row is a slit (capsule)
     assert len(s.faces) == b["faces"] == len(explore(s.shape, "Face")) >= len(t.patches)
     assert s.max_fit_deviation <= t.tol.fit
     props = t.properties()
@@ -114,7 +115,8 @@ def test_family_sample_builds_an_exact_solid(path, tmp_path):
 def test_capsule_innermost_faces_are_cut_slit_faces(tmp_path):
     """The compound cup's central patches end on the centre segment: the row is cut at its C0
     knots into two collapsed ends and two runs along the segment, paired; each such surface
-    becomes two faces sharing the segment, and the solid survives a STEP round trip."""
+    becomes four faces - two runs sharing the straight segment edge, two fans with a pole at
+    its ends (the whole chain is cut alike) - and the solid survives a STEP round trip."""
     from OCP.BRepCheck import BRepCheck_Analyzer
     from OCP.STEPControl import STEPControl_Reader
 
@@ -132,7 +134,34 @@ def test_capsule_innermost_faces_are_cut_slit_faces(tmp_path):
         assert pieces[1][3] == 3 and pieces[3][3] == 1
     # the other rows are ordinary closed curves, not slits
     assert slit_pieces(first, -1) is None and slit_pieces(s.surfaces[len(s.surfaces) // 2], 0) is None
-    assert len(s.faces) == len(t.patches) + 2
+    # the chain is cut alike at the four outline junctions: four faces per patch
+    assert len(s.faces) == 4 * len(t.patches)
+    # the segment: one edge of the solid shared by two run faces, from (-5, 0) to (5, 0)
+    # (18 x 8 mm: the stadium's straight part) at the cup's top / bottom
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+    from OCP.TopExp import TopExp
+    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+
+    edge_faces = TopTools_IndexedDataMapOfShapeListOfShape()
+    TopExp.MapShapesAndAncestors_s(s.shape, TopAbs_EDGE, TopAbs_FACE, edge_faces)
+    z_top, z_bot = t.bounds()[1][2], t.bounds()[0][2]
+    segments, poles = [], 0
+    for i in range(1, edge_faces.Extent() + 1):
+        e = cast(edge_faces.FindKey(i), "Edge")
+        if BRep_Tool.Degenerated_s(e):
+            poles += 1
+            continue
+        c = BRepAdaptor_Curve(e)
+        pts = [c.Value(c.FirstParameter() + k * (c.LastParameter() - c.FirstParameter()) / 8) for k in range(9)]
+        if all(abs(p.Y()) < 1e-6 and min(abs(p.Z() - z_top), abs(p.Z() - z_bot)) < 1e-6 for p in pts):
+            segments.append((e, sorted([pts[0].X(), pts[-1].X()]), edge_faces.FindFromIndex(i).Size()))
+    assert poles == 4  # one per collapsed end, top and bottom
+    assert len(segments) == 2
+    for _, (x0, x1), n_faces in segments:
+        assert n_faces == 2
+        assert x0 == pytest.approx(-5.0, abs=1e-6) and x1 == pytest.approx(5.0, abs=1e-6)
     # STEP round trip (a reader has no degenerated edges: the slit halves must not need any)
     path = tmp_path / "capsule.step"
     export(s, path, name=t.name)
@@ -149,3 +178,35 @@ def test_collapsed_rim_plateau_is_fan_plus_ring():
     names = [p.name.split(":")[1].rstrip("]") for p in t.patches]
     assert names[:2] == ["plateau", "plateau ring"] and names[-2:] == ["plateau ring", "plateau"]
     assert len(t.nominal.expected_sharp) == len(t.patches) - 1
+
+
+def _family_cases():
+    from tabletcad import shapes
+
+    shapes._load_plugins()
+    cases = [(name, {}) for name in sorted(shapes.FAMILIES)]
+    # the rounded polygons in both regimes: cup narrower than the corner radius (regular rim)
+    # and the default, cupped exactly to it (collapsed rim corners)
+    cases += [("rounded_square", {"corner_radius": 2.5, "cup_width": 1.0}),
+              ("rounded_rectangle", {"corner_radius": 1.2}),
+              ("rounded_triangle", {}),
+              ("capsule", {"length": 12.0, "width": 7.9})]
+    return cases
+
+
+@pytest.mark.parametrize("family, params", _family_cases(), ids=lambda x: x if isinstance(x, str) else str(x))
+def test_every_family_builds_a_valid_solid(family, params):
+    """Each registered family with its default dimensions (and the rounded polygons and capsule
+    in other regimes) is one valid closed solid whose OCCT volume and area equal the core
+    quadrature and the exact volume of its B-spline faces."""
+    from tabletcad import shapes
+
+    t = shapes.FAMILIES[family].build(**params)
+    s = tablet_solid(t)
+    check_solid(s.shape, t.name)
+    assert len(explore(s.shape, "Solid")) == 1 and len(explore(s.shape, "Shell")) == 1
+    props = t.properties()
+    V, A = props["volume_mm3"], props["surface_area_mm2"]
+    assert abs(s.volume - V) <= AGREE * V
+    assert abs(s.area - A) <= AGREE * A
+    assert abs(abs(enclosed_volume(s.surfaces)) - s.volume) <= 1e-8 * V

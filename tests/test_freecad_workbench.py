@@ -23,6 +23,7 @@ warning says so.
 from __future__ import annotations
 
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -164,6 +165,7 @@ FAMILIES = {
     "spherical": {},
     "shallow_convex_round": {},
     "compound_cup": {},
+    "capsule": {},
 }
 
 
@@ -182,7 +184,7 @@ def test_tablet_solid_and_volume(headless, family):
     assert t["fit_deviation"] < 1e-4
 
 
-@pytest.mark.parametrize("family", ["concave_round", "ring"])
+@pytest.mark.parametrize("family", ["concave_round", "ring", "capsule"])
 def test_tooling_valid_and_linked(headless, family):
     (step,) = [s for s in _steps(headless, "tooling") if s["family"] == family]
     (tab,) = [s["tablet"] for s in _steps(headless, "create") if s["family"] == family]
@@ -200,6 +202,35 @@ def test_tooling_valid_and_linked(headless, family):
 
         # annular punch: pi (R^2 - r^2) x 10 mm
         assert up["volume"] == pytest.approx(math.pi * (36.0 - 9.0) * 10.0, rel=1e-3)
+
+
+def _outline_area_perimeter(segs):
+    """Plan area (Green's theorem) and perimeter of an outline of lines and arcs (mm^2, mm)."""
+    area = perim = 0.0
+    for sg in segs:
+        (x0, y0), (x1, y1) = sg.p0, sg.p1
+        if sg.kind == "line":
+            area += 0.5 * (x0 * y1 - x1 * y0)
+            perim += math.hypot(x1 - x0, y1 - y0)
+        else:
+            cx, cy = sg.center
+            area += 0.5 * (sg.radius**2 * sg.sweep + cx * (y1 - y0) - cy * (x1 - x0))
+            perim += abs(sg.radius * sg.sweep)
+    return abs(area), perim
+
+
+def test_capsule_die_bore_is_the_exact_outline_offset(headless):
+    """The workbench's die bore follows the capsule's exact outline (lines and arcs) offset by
+    the clearance: die volume = pi R^2 H - (A + P c + pi c^2) H (Steiner), A and P from the
+    core's outline; the punches carry the cup faces cut into four pieces each (tabletcad.slit)."""
+    from tabletcad import shapes
+
+    shapes._load_plugins()
+    (step,) = [s for s in _steps(headless, "tooling") if s["family"] == "capsule"]
+    A, P = _outline_area_perimeter(shapes.FAMILIES["capsule"].build().nominal.outline.segs)
+    c, H, OD = 0.05, 22.22, 30.16  # the Die object's defaults (TSM B)
+    expected = math.pi * (OD / 2) ** 2 * H - (A + P * c + math.pi * c * c) * H
+    assert step["die"]["volume"] == pytest.approx(expected, rel=1e-9)
 
 
 def test_change_property_tablet_and_tooling_follow(headless):

@@ -85,6 +85,7 @@ try:
         "spherical": {},
         "shallow_convex_round": {},
         "compound_cup": {},
+        "capsule": {},
     }
     tabs = {}
     for fam, params in families.items():
@@ -92,9 +93,9 @@ try:
         tabs[fam] = make_tablet(doc, fam, **params)
         step("create", family=fam, wall_s=time.perf_counter() - t0, tablet=tablet_info(tabs[fam]))
 
-    # ---- tooling of two tablets (round with cups, and the hollow ring)
+    # ---- tooling of three tablets (round with cups, the hollow ring, a capsule)
     tooling = {}
-    for fam in ("concave_round", "ring"):
+    for fam in ("concave_round", "ring", "capsule"):
         t0 = time.perf_counter()
         up = make_upper_punch(doc, tabs[fam], recompute=False)
         low = make_lower_punch(doc, tabs[fam], recompute=False)

@@ -6,8 +6,9 @@ free edge) that failed.
 
 1. :func:`tabletcad.bspline.fit_patches` - B-spline fit of every patch within
    ``tol`` (shared boundary rows are bit-identical between neighbours);
-2. :func:`tabletcad.cad.faces.make_faces` - one periodic B-spline face per patch (two
-   halves for a patch whose boundary row collapses to a segment);
+2. :func:`tabletcad.cad.faces.make_face` - one periodic B-spline face per patch, or
+   the whole chain cut alike into pieces where a boundary row stands still over part
+   of its length (:func:`tabletcad.slit.chain_face_surfaces`);
 3. ``BRepBuilderAPI_Sewing`` with tolerance ``max(2 tol, 1e-6)`` mm - no free
    or multiple edges allowed, exactly one closed shell;
 4. ``BRepBuilderAPI_MakeSolid`` + ``BRepLib::OrientClosedSolid`` (matter
@@ -37,10 +38,11 @@ from OCP.BRepLib import BRepLib
 from OCP.GProp import GProp_GProps
 from OCP.TopoDS import TopoDS_Shape, TopoDS_Solid
 
-from tabletcad.bspline import PatchFunction, chain_breakpoints, BSplineSurfaceData, SurfaceFit, fit_patches
+from tabletcad.bspline import BSplineSurfaceData, PatchFunction, SurfaceFit, chain_breakpoints, fit_patches
 from tabletcad.cad._occ import cast, explore, shape_type
-from tabletcad.cad.faces import knot_boundary_pcurves, make_faces
+from tabletcad.cad.faces import knot_boundary_pcurves, make_face
 from tabletcad.errors import GeometryError
+from tabletcad.slit import chain_face_surfaces
 
 __all__ = [
     "MassProperties",
@@ -235,13 +237,13 @@ def solid_from_surfaces(
     """Faces -> sewn closed shell -> outward solid, validated; adaptive mass properties."""
     t0 = time.perf_counter()
     names = list(names) if names is not None else [f"patch {j}" for j in range(len(surfaces))]
-    # one face per surface, two for a surface whose boundary row is a slit (make_faces)
+    # one face per surface; the whole chain cut alike where a boundary row stands still over
+    # part of its length (the capsule's centre line, collapsed outline corners: tabletcad.slit)
     faces_l: list = []
     face_names: list[str] = []
-    for s, n in zip(surfaces, names):
-        fs = make_faces(s, tol_degen=tol_degen, name=n)
-        faces_l.extend(fs)
-        face_names.extend([n] if len(fs) == 1 else [f"{n} (part {k + 1})" for k in range(len(fs))])
+    for pieces, n in zip(chain_face_surfaces(surfaces, tol_degen, names), names):
+        faces_l.extend(make_face(p, tol_degen=tol_degen, name=n) for p in pieces)
+        face_names.extend([n] if len(pieces) == 1 else [f"{n} (piece {k + 1})" for k in range(len(pieces))])
     faces = tuple(faces_l)
     t1 = time.perf_counter()
     shell = sew_faces(faces, face_names, sew_tolerance)

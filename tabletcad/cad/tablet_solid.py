@@ -20,7 +20,7 @@ import numpy as np
 from tabletcad.errors import GeometryError
 from tabletcad.tablet import Tablet, solid_map
 
-__all__ = ["tablet_surface_functions", "tablet_solid", "tablet_breakpoints"]
+__all__ = ["tablet_surface_functions", "tablet_solid", "tablet_breakpoints", "fit_options"]
 
 SurfaceFunction = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
@@ -72,6 +72,24 @@ def tablet_breakpoints(tablet: Tablet) -> np.ndarray:
     return chain_breakpoints(tablet.patches)
 
 
+def fit_options(tablet: Tablet, **kwargs: Any) -> dict[str, Any]:
+    """Keyword arguments of :func:`tabletcad.bspline.fit_patches` for the tablet's chain.
+
+    One place for every kernel (this OCP layer and the FreeCAD workbench):
+    quintic B-splines - 17 x 32 poles already fit the thesis's tablets to ~3e-8
+    mm, where cubics need ~4x the poles for 1e-5 mm (and leave a 1e-6 volume
+    bias); knots of full multiplicity at the outline breakpoints, where the
+    surface may be only C0 (a cup swept over an offset outline whose corner
+    collapses) and where a slit is cut (:mod:`tabletcad.slit`).  ``kwargs``
+    override the defaults.
+    """
+    kwargs.setdefault("u_degree", 5)
+    kwargs.setdefault("v_degree", 5)
+    kwargs.setdefault("v_break_mult", kwargs["v_degree"])
+    kwargs.setdefault("v_breaks", tablet_breakpoints(tablet))
+    return kwargs
+
+
 def tablet_solid(tablet: Tablet, tol: float | None = None, **kwargs: Any):
     """Fit, sew and validate the tablet's solid; returns a :class:`~tabletcad.cad.solid.TabletSolid`.
 
@@ -81,13 +99,5 @@ def tablet_solid(tablet: Tablet, tol: float | None = None, **kwargs: Any):
     from tabletcad.cad.solid import build_solid
 
     funcs, names = tablet_surface_functions(tablet)
-    # quintic B-splines: 17 x 32 poles already fit the thesis's tablets to ~3e-8 mm,
-    # where cubics need ~4x the poles for 1e-5 mm (and leave a 1e-6 volume bias)
-    kwargs.setdefault("u_degree", 5)
-    kwargs.setdefault("v_degree", 5)
-    # breakpoints (outline junctions) get full-multiplicity knots: the surface may be
-    # only C0 there (a cup swept over an offset outline whose corner collapses)
-    kwargs.setdefault("v_break_mult", kwargs["v_degree"])
-    # knots of multiplicity v_degree - 1 where an outline is only C1 (arc/line junctions)
-    kwargs.setdefault("v_breaks", tablet_breakpoints(tablet))
-    return build_solid(funcs, tablet.tol.fit if tol is None else tol, name=tablet.name, names=names, **kwargs)
+    return build_solid(funcs, tablet.tol.fit if tol is None else tol, name=tablet.name, names=names,
+                       **fit_options(tablet, **kwargs))

@@ -71,6 +71,25 @@ def raw_boolean(op: str, a: TopoDS_Shape, b: TopoDS_Shape, fuzzy: float = 0.0, g
     return algo.Shape()
 
 
+def _bspline_face_edges(shape):
+    """The edges of the B-spline faces of ``shape``, for ``UnifySameDomain.KeepShapes``.
+
+    The tablet's faces are exact pieces of its B-splines and are never merged; asking
+    OCCT 7.9 to try (faces mode) crashed the process on an almond's punch tip, whose cup
+    has pieces with a pole at the collapsed end arcs (tabletcad.slit).
+    """
+    from OCP.BRep import BRep_Tool
+    from OCP.Geom import Geom_BSplineSurface
+    from OCP.TopTools import TopTools_MapOfShape
+
+    keep = TopTools_MapOfShape()
+    for f in explore(shape, "Face"):
+        if isinstance(BRep_Tool.Surface_s(f), Geom_BSplineSurface):
+            for e in explore(f, "Edge"):
+                keep.Add(e)
+    return keep
+
+
 def boolean(op: str, a: TopoDS_Shape, b: TopoDS_Shape, *, what: str = "result", fuzzy: float = 0.0,
             sliver: float = 0.0) -> TopoDS_Shape:
     """``a op b`` as exactly one valid solid (faces on one surface merged).
@@ -93,6 +112,7 @@ def boolean(op: str, a: TopoDS_Shape, b: TopoDS_Shape, *, what: str = "result", 
         vols = ", ".join(f"{mass_properties(s, 1e-7).volume:.4g}" for s in solids[:6])
         raise GeometryError(f"{what}: the {op} gave {len(solids)} solids (volumes {vols} mm^3), expected one", shape)
     unify = ShapeUpgrade_UnifySameDomain(solids[0], True, True, False)
+    unify.KeepShapes(_bspline_face_edges(solids[0]))
     unify.Build()
     solid = explore(unify.Shape(), "Solid")
     solid = solid[0] if len(solid) == 1 else solids[0]

@@ -27,6 +27,10 @@ from tabletcad.tooling.outline import TabletFrame, offset_wire, prism
 __all__ = ["die", "default_die_size", "MIN_WALL_MM"]
 
 MIN_WALL_MM = 2.0
+#: smallest outward offset (mm) of the bore: OCCT's planar offset returns no wire for
+#: distances near its confusion tolerance (1.1e-7 mm gave none, 5e-7 mm works), so a band
+#: bulge below this is cleared by this much instead (far below any die-bore tolerance)
+MIN_BORE_OFFSET_MM = 1e-6
 TSM_DIES = ((16.0, 30.16, 22.22, "B"), (25.4, 38.10, 23.81, "D"))
 
 
@@ -57,7 +61,7 @@ def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, 
     od0, h0, kind = default_die_size(frame) if outer_diameter is None or height is None else (None, None, "custom")
     od = outer_diameter if outer_diameter is not None else od0
     H = height if height is not None else h0
-    bulge = frame.band_bulge
+    bulge = max(frame.band_bulge, MIN_BORE_OFFSET_MM) if frame.band_bulge > 0 else 0.0
     bore = offset_wire(frame.outline, bulge) if bulge > 0 else frame.outline
     r_bore = _max_radius(bore)
     if od / 2.0 - r_bore < MIN_WALL_MM:

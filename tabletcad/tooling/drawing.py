@@ -13,6 +13,7 @@ DIMENSION entities with the same texts).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -26,6 +27,7 @@ from OCP.HLRBRep import HLRBRep_Algo, HLRBRep_HLRToShape
 
 from tabletcad.cad._occ import explore
 from tabletcad.io import atomic_path
+from tabletcad.tolerance import DEFAULT as DEFAULT_TOLERANCES
 
 __all__ = ["project_view", "drawing_model", "write_drawing", "Drawing", "Dim"]
 
@@ -56,6 +58,10 @@ def _polylines(compound, deflection: float = 0.002) -> list[np.ndarray]:
 def project_view(shape, view: str) -> dict:
     """``{"visible": [polylines], "hidden": [polylines]}`` (2-D, mm) of ``shape`` seen in ``view``."""
     d, x = VIEWS[view]
+    # tangent (G1) edges - between the patches of a smooth cup, at the outline's line/arc
+    # junctions where a chain is cut (tabletcad.slit) - are not drawn, as on a toolmaker's
+    # drawing: OCCT stores an edge's continuity only when asked, else every edge counts as sharp
+    BRepLib.EncodeRegularity_s(shape, math.radians(DEFAULT_TOLERANCES.seam_angle_deg))
     algo = HLRBRep_Algo()
     algo.Add(shape)
     algo.Projector(HLRAlgo_Projector(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(*d), gp_Dir(*x))))
@@ -137,7 +143,7 @@ def drawing_model(ts) -> Drawing:
         notes.append(f"{s['kind']} score {s['profile']} {_fmt(s['depth_mm'])} mm deep on the {s['face']} face")
     for e in ts.report.get("emboss", []):
         notes.append(f"{e['mode']} '{e['text'] or 'outline'}' {_fmt(e['depth_mm'])} mm on the {e['face']} face")
-    notes.append("mm; third-angle projection; generated from the B-rep (OCC HLR)")
+    notes.append("all dimensions in mm; third-angle projection; generated from the B-rep (OCC HLR)")
     return Drawing(views, origins, dims, notes, title=ts.tablet.name)
 
 
@@ -158,35 +164,72 @@ def _dim_geometry(d: Dim):
     return (x1, y), (x2, y), [((x1, y1), (x1, y)), ((x2, y2), (x2, y))]
 
 
-def _write_matplotlib(dr: Drawing, svg: Path, pdf: Path) -> None:
+def _note_layout(notes: list[str], width_pt: float, height_pt: float) -> tuple[float, int, list[str]]:
+    """``(font size, columns, wrapped lines)`` that fit the notes into a ``width_pt`` x
+    ``height_pt`` box (DejaVu Sans: average glyph width below 0.62 em, lines 1.35 em apart)."""
+    import textwrap
+
+    for fs in (7.0, 6.0, 5.0, 4.5):
+        rows = max(1, int(height_pt // (1.4 * fs)))
+        for ncols in (1, 2, 3, 4):
+            chars = max(20, int((width_pt / ncols - 12.0) // (0.62 * fs)))
+            lines = [w for n in notes for w in (textwrap.wrap(n, chars) or [""])]
+            if len(lines) <= rows * ncols:
+                return fs, ncols, lines
+    return fs, ncols, lines[: rows * ncols - 1] + [f"... ({len(lines) - rows * ncols + 1} more lines in report.json)"]
+
+
+def sheet_figure(dr: Drawing):
+    """The A4 landscape matplotlib figure of ``dr``: the views above a title block that holds
+    the notes (in two columns when long), both placed in sheet coordinates so that nothing
+    runs past the sheet's edge whatever the tablet's size."""
     import matplotlib
 
     matplotlib.use("Agg", force=False)
+    import matplotlib.patches
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(11.69, 8.27))  # A4 landscape
+    block = 0.2  # title block height, fraction of the sheet
+    ax = fig.add_axes((0.04, block + 0.04, 0.92, 0.92 - block - 0.04))
+    for kind, p in _sheet_lines(dr):
+        ax.plot(p[:, 0], p[:, 1], color="k" if kind == "visible" else "0.4", lw=0.7 if kind == "visible" else 0.4,
+                ls="-" if kind == "visible" else (0, (3, 2)))
+    for d in dr.dims:
+        a, b, ext = _dim_geometry(d)
+        for e0, e1 in ext:
+            ax.plot([e0[0], e1[0]], [e0[1], e1[1]], color="0.3", lw=0.3)
+        ax.annotate("", xy=a, xytext=b, arrowprops=dict(arrowstyle="<|-|>", lw=0.4, color="0.2", shrinkA=0, shrinkB=0))
+        mx, my = 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])
+        ax.text(mx + (0.4 if d.vertical else 0), my + (0 if d.vertical else 0.4), d.text, fontsize=7,
+                rotation=90 if d.vertical else 0, ha="center" if not d.vertical else "left",
+                va="bottom" if not d.vertical else "center")
+    for name, (ox, oy) in dr.origins.items():
+        y = oy - 0.6 * (max(abs(np.concatenate([q[:, 1] for q in dr.views[name]["visible"]] or [np.zeros(1)]))) + 2.5)
+        ax.text(ox, y, name.upper(), fontsize=8, ha="center", va="top")
+        ax.update_datalim([(ox, y - 1.5)])  # keep the label inside the views' area
+    ax.autoscale_view()
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.margins(0.06)
+    ax.axis("off")
+    # title block: frame, title, notes
+    fig.add_artist(matplotlib.patches.Rectangle((0.04, 0.03), 0.92, block - 0.01, transform=fig.transFigure,
+                                                fill=False, lw=0.6, ec="0.2"))
+    fig.text(0.05, 0.03 + block - 0.025, dr.title, fontsize=10, ha="left", va="top", weight="bold")
+    fs, ncols, lines = _note_layout(list(dr.notes), 0.9 * 11.69 * 72.0, (block - 0.07) * 8.27 * 72.0)
+    rows = -(-len(lines) // ncols)
+    for c in range(ncols):
+        fig.text(0.05 + 0.9 * c / ncols, 0.03 + block - 0.055, "\n".join(lines[c * rows:(c + 1) * rows]), fontsize=fs,
+                 ha="left", va="top", family="DejaVu Sans", linespacing=1.35)
+    return fig
+
+
+def _write_matplotlib(dr: Drawing, svg: Path, pdf: Path) -> None:
+    import matplotlib
     import matplotlib.pyplot as plt
 
     with matplotlib.rc_context({"svg.fonttype": "none", "pdf.fonttype": 42}):
-        fig, ax = plt.subplots(figsize=(11.69, 8.27))  # A4 landscape
-        for kind, p in _sheet_lines(dr):
-            ax.plot(p[:, 0], p[:, 1], color="k" if kind == "visible" else "0.4", lw=0.7 if kind == "visible" else 0.4,
-                    ls="-" if kind == "visible" else (0, (3, 2)))
-        for d in dr.dims:
-            a, b, ext = _dim_geometry(d)
-            for e0, e1 in ext:
-                ax.plot([e0[0], e1[0]], [e0[1], e1[1]], color="0.3", lw=0.3)
-            ax.annotate("", xy=a, xytext=b, arrowprops=dict(arrowstyle="<|-|>", lw=0.4, color="0.2", shrinkA=0, shrinkB=0))
-            mx, my = 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])
-            ax.text(mx + (0.4 if d.vertical else 0), my + (0 if d.vertical else 0.4), d.text, fontsize=7,
-                    rotation=90 if d.vertical else 0, ha="center" if not d.vertical else "left", va="bottom" if not d.vertical else "center")
-        for name, (ox, oy) in dr.origins.items():
-            ax.text(ox, oy - 0.6 * (max(abs(np.concatenate([q[:, 1] for q in dr.views[name]["visible"]] or [np.zeros(1)]))) + 2.5),
-                    name.upper() if name != "plan" else "PLAN", fontsize=8, ha="center", va="top")
-        xs = np.concatenate([p[:, 0] for _, p in _sheet_lines(dr)])
-        ys = np.concatenate([p[:, 1] for _, p in _sheet_lines(dr)])
-        ax.text(xs.max() + 8, ys.max(), "\n".join(dr.notes), fontsize=7, va="top", ha="left", family="DejaVu Sans")
-        ax.set_aspect("equal")
-        ax.axis("off")
-        ax.set_title(dr.title, fontsize=10)
-        fig.tight_layout()
+        fig = sheet_figure(dr)
         with atomic_path(svg) as tmp:
             fig.savefig(tmp, format="svg")
         with atomic_path(pdf) as tmp:

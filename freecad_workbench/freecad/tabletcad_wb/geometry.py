@@ -195,23 +195,86 @@ def solid_from_faces(faces, sew_tolerance, what="tablet"):
 def build_tablet(tablet, tol=None):
     """Fit the tablet's chain, build the Part solid, compute the core's figures."""
     from tabletcad.bspline import enclosed_volume, fit_patches
+    from tabletcad.cad.tablet_solid import fit_options
+    from tabletcad.slit import chain_face_surfaces
 
     t0 = time.perf_counter()
     funcs, names, breaks = tablet_chain(tablet)
     tol = float(tablet.tol.fit if tol is None else tol)
-    fits = fit_patches(funcs, tol, names=names, u_degree=5, v_degree=5, v_breaks=breaks)
+    fits = fit_patches(funcs, tol, names=names, **fit_options(tablet, v_breaks=breaks))
     t1 = time.perf_counter()
-    faces = [bspline_face(f.surface) for f in fits]
+    # cut alike where a boundary row stands still over part of its length (tabletcad.slit)
+    pieces = chain_face_surfaces([f.surface for f in fits], 1e-7, names)
+    faces = [bspline_face(p) for ps in pieces for p in ps]
     solid = solid_from_faces(faces, max(2.0 * tol, 1e-6), tablet.name)
     t2 = time.perf_counter()
     props = tablet.properties()
     t3 = time.perf_counter()
     rims = _rims([f.surface for f in fits], hollow=tablet.trim.w[0] > 0.0)
+    outline = outline_segments(tablet)
+    if outline:  # the die bore follows the exact outline (lines and arcs), not the fitted rim
+        for r in rims:
+            if not r["inner"]:
+                r["outline"] = outline
     # exact volume of the B-spline solid (FreeCAD's Shape.Volume is OCCT's default integration,
     # measured 8.5e-4 relative off on a free-form stadium tablet)
     props = dict(props, solid_volume_mm3=abs(enclosed_volume([f.surface for f in fits])))
     timings = dict(fit=t1 - t0, part=t2 - t1, properties=t3 - t2, total=time.perf_counter() - t0)
     return TabletGeometry(tablet, solid, fits, props, rims, timings)
+
+
+def outline_segments(tablet):
+    """The tablet's exact plan outline as plain data (``[{kind, p0, p1, center, radius, theta0,
+    sweep}, ...]``, mm and rad), or None for a tablet without a nominal outline of lines and
+    arcs (the thesis's free-form tablets, round families whose rim is a circle anyway)."""
+    segs = getattr(getattr(getattr(tablet, "nominal", None), "outline", None), "segs", None)
+    if not segs or all(sg.kind == "arc" for sg in segs) and len(segs) == 1:
+        return None
+    return [dict(kind=sg.kind, p0=[float(x) for x in sg.p0], p1=[float(x) for x in sg.p1],
+                 center=[float(x) for x in sg.center], radius=float(sg.radius), theta0=float(sg.theta0),
+                 sweep=float(sg.sweep)) for sg in segs]
+
+
+def offset_outline_wire(segments, distance, z=0.0):
+    """``Part.Wire`` of the outline (:func:`outline_segments`) offset outward by ``distance`` mm
+    at height ``z``: lines move along their outward normal, arcs keep their centre and change
+    radius by ``distance`` (convex) or ``-distance`` (concave) - exact for a G1 outline."""
+    import FreeCAD
+    import Part
+
+    from tabletcad.errors import GeometryError
+
+    # orientation from the signed area (Green): +1 counter-clockwise
+    area = 0.0
+    for sg in segments:
+        (x0, y0), (x1, y1) = sg["p0"], sg["p1"]
+        if sg["kind"] == "line":
+            area += 0.5 * (x0 * y1 - x1 * y0)
+        else:
+            cx, cy = sg["center"]
+            area += 0.5 * (sg["radius"] ** 2 * sg["sweep"] + cx * (y1 - y0) - cy * (x1 - x0))
+    orient = 1.0 if area > 0 else -1.0
+    edges = []
+    for sg in segments:
+        if sg["kind"] == "line":
+            (x0, y0), (x1, y1) = sg["p0"], sg["p1"]
+            L = math.hypot(x1 - x0, y1 - y0)
+            nx, ny = orient * (y1 - y0) / L, -orient * (x1 - x0) / L
+            a = FreeCAD.Vector(x0 + distance * nx, y0 + distance * ny, z)
+            b = FreeCAD.Vector(x1 + distance * nx, y1 + distance * ny, z)
+            edges.append(Part.LineSegment(a, b).toShape())
+        else:
+            r = sg["radius"] + orient * math.copysign(1.0, sg["sweep"]) * distance
+            if not r > 0:
+                raise GeometryError(f"offsetting the outline by {distance} mm collapses an arc of radius {sg['radius']} mm",
+                                    sg)
+            circle = Part.Circle(FreeCAD.Vector(sg["center"][0], sg["center"][1], z), FreeCAD.Vector(0, 0, 1), r)
+            t0, t1 = sg["theta0"], sg["theta0"] + sg["sweep"]
+            edges.append(Part.ArcOfCircle(circle, min(t0, t1), max(t0, t1)).toShape())
+    wire = Part.Wire(Part.__sortEdges__(edges))
+    if not wire.isClosed():
+        raise GeometryError(f"the outline offset by {distance} mm is not closed (an outline corner is not G1)", wire)
+    return wire
 
 
 def rims_from_json(text):
@@ -230,7 +293,22 @@ def _rim_wire(rim, dz=0.0):
         True,
         rim["degree"],
     )
-    return Part.Wire([c.toShape()])
+    # one edge per C0 span (knots of multiplicity >= degree, where the fit put the outline's
+    # junctions): a single periodic edge with C0 knots makes Part's offset and Booleans fail
+    knots = [float(k) for k, m in zip(rim["knots"], rim["mults"]) if int(m) >= int(rim["degree"])]
+    lo, hi = float(rim["knots"][0]), float(rim["knots"][-1])
+    cuts = sorted({lo, hi, *knots})
+    if len(cuts) <= 2:
+        return Part.Wire([c.toShape()])
+    spans = list(zip(cuts[:-1], cuts[1:]))
+    if int(rim["mults"][0]) < int(rim["degree"]):  # the period's start is smooth: one span across it
+        spans = [(spans[-1][0], spans[0][1] + (hi - lo))] + spans[1:-1]
+    edges = []
+    for a, b in spans:
+        seg = c.copy()
+        seg.segment(a, b)  # a clamped, smooth piece: Part.OffsetCurve refuses C0 curves
+        edges.append(seg.toShape())
+    return Part.Wire(edges)
 
 
 def _rim_face(rims):
@@ -281,7 +359,8 @@ def punch_shape(tablet_shape, rims, which="upper", length=10.0):
 
 def die_shape(rims, clearance=0.05, height=22.22, outer_diameter=38.1):
     """Die: cylinder (``outer_diameter``, ``height``, centred on the band) minus the bore
-    (outer rim offset outward by ``clearance``)."""
+    (the exact plan outline when the tablet has one, else its outer rim, offset outward by
+    ``clearance``)."""
     import FreeCAD
     import Part
 
@@ -298,8 +377,10 @@ def die_shape(rims, clearance=0.05, height=22.22, outer_diameter=38.1):
         )
     lo = min(outer, key=lambda r: r["z"])
     z_lo, z_hi = lo["z"], max(r["z"] for r in outer)
-    wire = _rim_wire(lo)
-    bore_wire = wire.makeOffset2D(float(clearance), 0, False, False, False)
+    if lo.get("outline"):
+        bore_wire = offset_outline_wire(lo["outline"], float(clearance), z_lo)
+    else:
+        bore_wire = _rim_wire(lo).makeOffset2D(float(clearance), 0, False, False, False)
     reach = float(np.max(np.hypot(*np.asarray(lo["poles"])[:, :2].T))) + clearance
     if not outer_diameter / 2.0 > reach + 0.5:
         raise DesignError(
