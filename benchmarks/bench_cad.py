@@ -1,6 +1,6 @@
 """CAD stage timing per sample tablet, beside the same nominal shape built directly in build123d.
 
-Run:  cd /work/main && /tmp/venv/bin/python benchmarks/bench_cad.py [--repeat 3] [samples/x.toml ...]
+Run:  .venv/bin/python benchmarks/bench_cad.py [--repeat 3] [samples/x.toml ...]
 
 For every sample design that is not a cut-away, prints (best of ``--repeat`` runs, one core):
 

@@ -1,6 +1,6 @@
 """Timing of tabletcad.solid.hex_mesh against the thesis's MATLAB times and a naive baseline.
 
-Run:  cd /work/main && /tmp/venv/bin/python benchmarks/bench_mesh.py [--family NAME]
+Run:  .venv/bin/python benchmarks/bench_mesh.py [--family NAME]
 
 Prints, for the node counts of the thesis's Table 4.4 (11×21×5, 21×39×6 and
 41×39×6 nodes per patch; MATLAB R2008a on a 2.2 GHz Core 2 Duo took 8, 88
