@@ -92,7 +92,19 @@ BAD = {
     "self-intersecting": '[tablet]\nfamily = "custom_outline"\noutline = [[0, 0], [4, 4], [4, 0], [0, 4]]\nband = 2.0\ncup_depth = 0.3\n',
     "bad report key": '[tablet]\nfamily = "concave_round"\n[report]\nweight = 3\n',
     "bad solid fraction": '[tablet]\nfamily = "concave_round"\n[report]\nsolid_fraction = 1.5\n',
+    "flat centre too narrow": '[tablet]\nfamily = "modified_capsule"\nlength = 15.875\nwidth = 11.376\ncup_depth = 0.476\n',
 }
+
+
+def test_cup_width_leaving_too_narrow_a_plateau_names_cup_width():
+    """A wide modified capsule cupped to its corner radius (the default) leaves a flat centre too
+    narrow to split: refused naming cup_width and the corner radius; just below it builds."""
+    with pytest.raises(DesignError) as err:
+        F.modified_capsule(length=15.875, width=11.376, cup_depth=0.476)
+    assert err.value.parameter == "cup_width" and "smallest corner radius" in str(err.value)
+    limit = float(str(err.value).split("must be < ")[1].split(" mm")[0])
+    t = F.modified_capsule(length=15.875, width=11.376, cup_depth=0.476, cup_width=0.99 * limit)
+    assert t.nominal.certificate.passed
 
 
 @pytest.mark.parametrize("case", sorted(BAD))
