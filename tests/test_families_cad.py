@@ -210,3 +210,15 @@ def test_every_family_builds_a_valid_solid(family, params):
     assert abs(s.volume - V) <= AGREE * V
     assert abs(s.area - A) <= AGREE * A
     assert abs(abs(enclosed_volume(s.surfaces)) - s.volume) <= 1e-8 * V
+
+
+def test_tablet_solid_reuses_the_last_default_build_of_the_same_tablet():
+    """`tabletcad build` needs the solid in its CAD and tooling stages: the second default call on
+    the same tablet object returns the same solid; another object, or another tolerance, builds."""
+    t = _tablet(ROOT / "samples" / "families" / "concave_round.toml")
+    a = tablet_solid(t)
+    assert tablet_solid(t) is a
+    other, _ = load_family_design(ROOT / "samples" / "families" / "concave_round.toml")
+    b = tablet_solid(other)
+    assert b is not a and b.volume == pytest.approx(a.volume, rel=1e-12)
+    assert tablet_solid(other, tol=5e-5) is not b
