@@ -4,7 +4,7 @@ Two tablets give a patch whose boundary row is not a regular closed curve:
 
 * the capsule's innermost cup patch ends on the centre line - the offsets of a
   stadium shrink to a segment at the inscribed radius, so the row runs along that
-  segment and back (a *slit*, :func:`slit_pieces`), its end arcs collapsed to points;
+  segment and back (a *slit*), its end arcs collapsed to points;
 * an outline cupped exactly to its corner radius (the default of the rounded
   polygons) has a rim whose corner arcs are collapsed to points.
 
@@ -32,7 +32,7 @@ import numpy as np
 from tabletcad.bspline import BSplineSurfaceData, segment_v
 from tabletcad.errors import GeometryError
 
-__all__ = ["chain_face_surfaces", "face_surfaces", "row_pieces", "slit_pieces"]
+__all__ = ["chain_face_surfaces", "row_pieces"]
 
 
 def row_pieces(data: BSplineSurfaceData, row: int, tol: float = 1e-7):
@@ -61,62 +61,20 @@ def row_pieces(data: BSplineSurfaceData, row: int, tol: float = 1e-7):
     return pieces, pts, u_row
 
 
-def slit_pieces(data: BSplineSurfaceData, row: int, tol: float = 1e-7):
-    """The pieces of boundary row ``row`` if it is a slit, else None.
-
-    The row (:func:`row_pieces`) is a slit when every run has a partner run that
-    traverses the same points backwards (``S(v0 + t (v1 - v0)) = S(w1 - t (w1 - w0))``
-    within ``tol``) and there is at least one run.  Returns ``(pieces, u_row)`` with
-    pieces ``(v0, v1, kind, partner)``, consecutive point pieces merged.
-    """
-    found = row_pieces(data, row, tol)
-    if found is None:
-        return None
-    raw, pts, u_row = found
-    if len(raw) < 3:  # fewer than three pieces cannot be a fold with collapsed ends
-        return None
-    kinds = [k for _, _, k in raw]
-    runs = [i for i, k in enumerate(kinds) if k == "run"]
-    if not runs or len(runs) % 2:
-        return None
-    scale = max(1.0, float(np.max(np.abs(np.concatenate(pts)))))
-    partner: dict[int, int] = {}
-    for i in runs:
-        if i in partner:
-            continue
-        for j in runs:
-            if j != i and j not in partner and float(np.max(np.linalg.norm(pts[i] - pts[j][::-1], axis=-1))) <= tol * scale:
-                partner[i], partner[j] = j, i
-                break
-        else:
-            return None
-    pieces = [(a, b, k, partner.get(i)) for i, (a, b, k) in enumerate(raw)]
-    merged: list = []
-    index: dict[int, int] = {}
-    for i, pc in enumerate(pieces):
-        if pc[2] == "point" and merged and merged[-1][2] == "point":
-            merged[-1] = (merged[-1][0], pc[1], "point", None)
-        else:
-            merged.append(pc)
-        index[i] = len(merged) - 1
-    merged = [(a, b, k, None if j is None else index[j]) for a, b, k, j in merged]
-    return merged, u_row
-
-
 def _is_c0_knot(data: BSplineSurfaceData, v: float) -> bool:
     knots = np.asarray(data.v_knots, dtype=float)
     i = int(np.argmin(np.abs(knots - v)))
     return abs(float(knots[i]) - v) <= 1e-12 * max(1.0, abs(v)) and int(data.v_mults[i]) >= data.v_degree
 
 
-def _cuts(data: BSplineSurfaceData, tol: float) -> set[float]:
-    """``v`` values where ``data`` must be cut: the piece boundaries of each boundary row that
-    stands still over part of its length (both ``"point"`` and ``"run"`` pieces)."""
-    out: set[float] = set()
+def _standing_rows(data: BSplineSurfaceData, tol: float) -> dict[int, list]:
+    """``{row: pieces}`` for the boundary rows of ``data`` that stand still over part of their
+    length (:func:`row_pieces` gives both ``"point"`` and ``"run"`` pieces)."""
+    out = {}
     for k in (0, -1):
         found = row_pieces(data, k, tol)
         if found is not None and len({kind for _, _, kind in found[0]}) == 2:
-            out.update(x for a, b, _ in found[0] for x in (a, b))
+            out[k] = found[0]
     return out
 
 
@@ -139,42 +97,31 @@ def _pieces(data: BSplineSurfaceData, cuts: list[float], tol: float) -> tuple[BS
     return tuple(out)
 
 
-def face_surfaces(data: BSplineSurfaceData, tol: float = 1e-7, name: str = "surface") -> tuple[BSplineSurfaceData, ...]:
-    """The surfaces to make faces of one surface: ``(data,)``, or its pieces when a boundary row
-    stands still over part of its length (:func:`row_pieces` gives ``"point"`` and ``"run"``
-    pieces).  In a chain use :func:`chain_face_surfaces`, which cuts neighbours alike."""
-    return chain_face_surfaces([data], tol, [name])[0]
-
-
 def chain_face_surfaces(surfaces, tol: float = 1e-7, names=None) -> list[tuple[BSplineSurfaceData, ...]]:
-    """Per surface of a chain (neighbours share boundary rows), the surfaces to make faces of.
+    """Per surface of a chain (neighbours share boundary rows), the surfaces to make faces of:
+    ``(surface,)``, or its exact pieces.
 
     A boundary row that stands still over part of its length - the slit of the capsule's
-    centre line (:func:`slit_pieces`), or an outline whose corners collapse at the offset the
-    row lies on (a rounded square cupped exactly to its corner radius) - gives a closed
-    edge whose 3-D curve stops over those ``v`` intervals: sewing leaves free edges there and
-    Booleans fail across it.  Cut in ``v`` at the boundaries of such pieces, each face has
-    either a moving row or a pole there.  Every surface of the chain is cut at the same
-    ``v`` values (the chain shares its C0 knots), so that neighbouring faces meet edge to
-    edge and sewing never has to split an edge (it would re-project the p-curves, which
-    measurably spoils OCCT's mass properties: 1.8e-4 relative on a rounded square).  A
-    row whose poles spread by at most ``10 tol`` mm over a piece is snapped to one pole.
-    If the period's start is not a C0 knot, the first and last pieces are one piece across it.
+    centre line, or an outline whose corners collapse at the offset the row lies on (a
+    rounded square cupped exactly to its corner radius) - gives a closed edge whose 3-D
+    curve stops over those ``v`` intervals: sewing leaves free edges there and Booleans
+    fail across it.  Cut in ``v`` at the boundaries of such pieces, each face has either a
+    moving row or a pole there.  Every surface of the chain is cut at the same ``v`` values
+    (the chain shares its C0 knots), so that neighbouring faces meet edge to edge and
+    sewing never has to split an edge (it would re-project the p-curves, which measurably
+    spoils OCCT's mass properties: 1.8e-4 relative on a rounded square).  A row whose poles
+    spread by at most ``10 tol`` mm over a piece is snapped to one pole.  If the period's
+    start is not a C0 knot, the first and last pieces are one piece across it.
     """
     surfaces = list(surfaces)
     names = list(names) if names is not None else [f"surface {j}" for j in range(len(surfaces))]
     cuts: set[float] = set()
     for data, name in zip(surfaces, names):
-        c = _cuts(data, tol)
-        if c:
-            for k in (0, -1):
-                other = np.asarray(data.poles[-1 if k == 0 else 0])
-                row = row_pieces(data, k, tol)
-                mixed = row is not None and len({kind for _, _, kind in row[0]}) == 2
-                if mixed and float(np.max(np.linalg.norm(other - other[0], axis=-1))) <= tol:
-                    raise GeometryError(f"{name}: a row that stands still in part opposite a pole is not supported",
-                                        data)
-        cuts |= c
+        for k, pieces in _standing_rows(data, tol).items():
+            other = np.asarray(data.poles[-1 if k == 0 else 0])
+            if float(np.max(np.linalg.norm(other - other[0], axis=-1))) <= tol:
+                raise GeometryError(f"{name}: a row that stands still in part opposite a pole is not supported", data)
+            cuts.update(x for a, b, _ in pieces for x in (a, b))
     if not cuts:
         return [(s,) for s in surfaces]
     out = []

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from tabletcad.bspline import BSplineSurfaceData, enclosed_volume, fit_patches, segment_v
 from tabletcad.errors import GeometryError
-from tabletcad.slit import face_surfaces, slit_pieces
+from tabletcad.slit import chain_face_surfaces, row_pieces
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -89,11 +89,12 @@ def test_capsule_slit_cut_into_runs_and_fans(capsule_surfaces):
     directions; the ends are single poles at (+-5, 0); the pieces' enclosed volume is the
     whole's, to round-off."""
     t, surfaces = capsule_surfaces
-    for data, row in ((surfaces[0], 0), (surfaces[-1], -1)):
-        pieces = face_surfaces(data)
+    chain = chain_face_surfaces(surfaces)
+    for pieces, data, row in ((chain[0], surfaces[0], 0), (chain[-1], surfaces[-1], -1)):
         assert len(pieces) == 4
-        kinds = [p[2] for p in slit_pieces(data, row)[0]]
-        assert kinds == ["point", "run", "point", "run"]
+        raw, pts, _ = row_pieces(data, row)
+        assert [k for _, _, k in raw] == ["point", "run", "point", "run"]
+        np.testing.assert_allclose(pts[1], pts[3][::-1], atol=1e-7)  # one segment, there and back
         ends = [pieces[0].poles[row], pieces[2].poles[row]]
         for r in ends:
             assert np.all(r == r[0])  # snapped: one pole
@@ -106,22 +107,21 @@ def test_capsule_slit_cut_into_runs_and_fans(capsule_surfaces):
         for p, q in zip(pieces, pieces[1:] + pieces[:1]):
             np.testing.assert_allclose(p.poles[:, -1], q.poles[:, 0], atol=1e-7)
     whole = enclosed_volume(surfaces)
-    cut = enclosed_volume([p for s in surfaces for p in face_surfaces(s)])
+    cut = enclosed_volume([p for ps in chain for p in ps])
     assert cut == pytest.approx(whole, rel=1e-12)
     assert abs(whole) == pytest.approx(t.properties()["volume_mm3"], rel=1e-6)
 
 
-def test_ordinary_surfaces_are_not_cut(capsule_surfaces):
+def test_ordinary_chains_are_not_cut(capsule_surfaces):
+    """Rows that move everywhere (the capsule's band) leave a chain alone: one face per surface."""
     _, surfaces = capsule_surfaces
-    middle = surfaces[len(surfaces) // 2]
-    assert face_surfaces(middle) == (middle,)
+    middle = surfaces[len(surfaces) // 2 - 1: len(surfaces) // 2 + 2]
+    assert chain_face_surfaces(middle) == [(s,) for s in middle]
 
 
 def test_chain_is_cut_alike_and_neighbours_meet_row_to_row(capsule_surfaces):
     """Every surface of the capsule chain is cut at the same four v values, so that the pieces
     of neighbouring surfaces share their boundary rows bit for bit (sewing never splits an edge)."""
-    from tabletcad.slit import chain_face_surfaces
-
     _, surfaces = capsule_surfaces
     chain = chain_face_surfaces(surfaces)
     assert [len(ps) for ps in chain] == [4] * len(surfaces)
@@ -137,7 +137,6 @@ def test_rounded_square_cupped_to_its_corner_radius_is_cut_at_the_corners():
     rows is a single pole at the corner arc's centre (offset by the corner radius)."""
     from tabletcad import shapes
     from tabletcad.cad.tablet_solid import fit_options, tablet_surface_functions
-    from tabletcad.slit import chain_face_surfaces
 
     shapes._load_plugins()
     side, rc = 9.0, 1.5

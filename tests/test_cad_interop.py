@@ -7,14 +7,9 @@ import sys
 import pytest
 
 
-def _need(module: str):
-    if os.environ.get("CI"):
-        return __import__(module)
-    return pytest.importorskip(module)
 
-
-_need("OCP")
-bd = _need("build123d")
+pytest.importorskip("OCP")
+bd = pytest.importorskip("build123d")
 
 from tabletcad.cad.interop import from_any, to_build123d, to_build123d_part, to_cadquery  # noqa: E402
 from tabletcad.cad.solid import build_solid  # noqa: E402

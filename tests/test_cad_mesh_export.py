@@ -1,6 +1,5 @@
 """Tessellation checks, exporters and STEP read-back with OCP in a fresh process."""
 
-import os
 import re
 import struct
 import xml.etree.ElementTree as ET
@@ -10,15 +9,10 @@ import numpy as np
 import pytest
 
 
-def _need(module: str):
-    if os.environ.get("CI"):
-        return __import__(module)
-    return pytest.importorskip(module)
 
-
-_need("OCP")
-_need("manifold3d")
-trimesh = _need("trimesh")
+pytest.importorskip("OCP")
+pytest.importorskip("manifold3d")
+trimesh = pytest.importorskip("trimesh")
 
 from tabletcad.cad.export import export  # noqa: E402
 from tabletcad.cad.mesh import tessellate  # noqa: E402

@@ -29,32 +29,23 @@ from __future__ import annotations
 
 import functools
 import json
-import os
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-CI = bool(os.environ.get("CI"))
-
-
-def _need(module: str):
-    if CI:
-        return __import__(module)
-    return pytest.importorskip(module)
-
-
-_need("OCP")
-_need("manifold3d")
-_need("trimesh")
+pytest.importorskip("OCP")
+pytest.importorskip("manifold3d")
+pytest.importorskip("trimesh")
 
 from tabletcad.bspline import enclosed_volume
 from tabletcad.build import build_tablet
 from tabletcad.cad._occ import cast, explore
-from tabletcad.cad.faces import slit_pieces
 from tabletcad.cad.solid import check_solid
 from tabletcad.cad.tablet_solid import tablet_solid
 from tabletcad.cli.report import load_family_design
 from tabletcad.families import nominal_volume
+from tabletcad.slit import row_pieces
 
 pytestmark = pytest.mark.cad
 
@@ -127,13 +118,12 @@ def test_capsule_innermost_faces_are_cut_slit_faces(tmp_path):
     s = tablet_solid(t)
     first, last = s.surfaces[0], s.surfaces[-1]
     for data, row in ((first, 0), (last, -1)):
-        found = slit_pieces(data, row)
-        assert found is not None
-        pieces, _ = found
+        pieces, pts, _ = row_pieces(data, row)
         assert [p[2] for p in pieces] == ["point", "run", "point", "run"]
-        assert pieces[1][3] == 3 and pieces[3][3] == 1
-    # the other rows are ordinary closed curves, not slits
-    assert slit_pieces(first, -1) is None and slit_pieces(s.surfaces[len(s.surfaces) // 2], 0) is None
+        np.testing.assert_allclose(pts[1], pts[3][::-1], atol=1e-7)  # the segment, there and back
+    # the other rows are ordinary closed curves: they move everywhere
+    for data, row in ((first, -1), (s.surfaces[len(s.surfaces) // 2], 0)):
+        assert {p[2] for p in row_pieces(data, row)[0]} == {"run"}
     # the chain is cut alike at the four outline junctions: four faces per patch
     assert len(s.faces) == 4 * len(t.patches)
     # the segment: one edge of the solid shared by two run faces, from (-5, 0) to (5, 0)

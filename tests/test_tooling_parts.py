@@ -1,22 +1,16 @@
 """Tooling from the tablet: scores, embossing, punch tips, die, interference, drawings, batch."""
 
 import math
-import os
 from pathlib import Path
 
 import pytest
 
 
-def _need(module: str):
-    if os.environ.get("CI"):
-        return __import__(module)
-    return pytest.importorskip(module)
 
-
-_need("OCP")
-_need("build123d")
-_need("manifold3d")
-_need("ezdxf")
+pytest.importorskip("OCP")
+pytest.importorskip("build123d")
+pytest.importorskip("manifold3d")
+pytest.importorskip("ezdxf")
 
 from tabletcad.cad.solid import check_solid  # noqa: E402
 from tabletcad.cli import main  # noqa: E402

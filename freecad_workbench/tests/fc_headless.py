@@ -77,16 +77,8 @@ try:
     result["tabletcad_file"] = tabletcad.shapes.__file__
     doc = FreeCAD.newDocument("wbtest")
 
-    # ---- every family asked for, default dimensions, each recomputed on creation
-    families = {
-        "flat_faced_round": {},
-        "ring": {},
-        "concave_round": {"diameter": 10.0, "cup_depth": 0.8},
-        "spherical": {},
-        "shallow_convex_round": {},
-        "compound_cup": {},
-        "capsule": {},
-    }
+    # ---- every family asked for (tests/test_freecad_workbench.py: FAMILIES), each recomputed on creation
+    families = json.loads(os.environ["TABLETCAD_FC_FAMILIES"])
     tabs = {}
     for fam, params in families.items():
         t0 = time.perf_counter()
@@ -95,7 +87,7 @@ try:
 
     # ---- tooling of three tablets (round with cups, the hollow ring, a capsule)
     tooling = {}
-    for fam in ("concave_round", "ring", "capsule"):
+    for fam in json.loads(os.environ["TABLETCAD_FC_TOOLING"]):
         t0 = time.perf_counter()
         up = make_upper_punch(doc, tabs[fam], recompute=False)
         low = make_lower_punch(doc, tabs[fam], recompute=False)

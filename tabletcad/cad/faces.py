@@ -20,8 +20,8 @@ on spheres, cylinders and rings (see tests/test_cad_solid.py), and FreeCAD's
 ``buildFromPolesMultsKnots(..., periodic)`` accepts exactly the same data.
 
 A boundary row that collapses to a *segment* (a *slit*: the capsule's
-innermost cup patch) is cut into four exact pieces first
-(:mod:`tabletcad.slit`), each made into an ordinary face.
+innermost cup patch) is cut into exact pieces first, with the whole chain
+(:func:`tabletcad.slit.chain_face_surfaces`), each made into an ordinary face.
 
 Boundary p-curves carry the surface's low-continuity ``v`` knots
 (:func:`knot_boundary_pcurves`).  OCCT's mass properties (``BRepGProp``)
@@ -57,9 +57,8 @@ except ImportError:  # pragma: no cover - OCP 7.x
 from tabletcad.bspline import BSplineSurfaceData
 from tabletcad.cad._occ import Array1OfInteger, Array1OfReal, Array2OfPnt
 from tabletcad.errors import GeometryError
-from tabletcad.slit import face_surfaces, slit_pieces
 
-__all__ = ["knot_boundary_pcurves", "make_face", "make_faces", "make_geom_surface", "slit_pieces", "surface_data_from_geom"]
+__all__ = ["knot_boundary_pcurves", "make_face", "make_geom_surface", "surface_data_from_geom"]
 
 
 def _real_array(values) -> Array1OfReal:
@@ -120,17 +119,6 @@ def make_face(data: BSplineSurfaceData, *, tol_degen: float = 1e-7, name: str = 
     return face
 
 
-def make_faces(data: BSplineSurfaceData, *, tol_degen: float = 1e-7, name: str = "surface") -> tuple[TopoDS_Face, ...]:
-    """The face(s) of one fitted surface: one periodic face (:func:`make_face`), or one face per
-    piece when a boundary row stands still over part of its length
-    (:func:`tabletcad.slit.face_surfaces`).  A chain of surfaces is cut alike by
-    :func:`tabletcad.slit.chain_face_surfaces` (see :func:`tabletcad.cad.solid.solid_from_surfaces`)."""
-    pieces = face_surfaces(data, tol_degen, name)
-    if len(pieces) == 1:
-        return (make_face(data, tol_degen=tol_degen, name=name),)
-    return tuple(make_face(p, tol_degen=tol_degen, name=f"{name} (piece {k + 1})") for k, p in enumerate(pieces))
-
-
 def _v_breaks(surf: Geom_BSplineSurface) -> list[float]:
     """Interior ``v`` knots where the surface is at most C1 (multiplicity >= degree - 1)."""
     deg = surf.VDegree()
@@ -162,7 +150,7 @@ def knot_boundary_pcurves(shape: TopoDS_Shape) -> int:
         if not breaks:
             continue
         for edge in explore(face, "Edge"):
-            if BRep_Tool.IsClosed_s(edge, face):  # the seam (an iso-v line: no v range) or a slit
+            if BRep_Tool.IsClosed_s(edge, face):  # the seam (an iso-v line: no v range)
                 continue
             pc = BRep_Tool.CurveOnSurface_s(edge, face, 0.0, 0.0)
             if pc is None:

@@ -409,11 +409,9 @@ def _plateau_ring(outline, d_end: float, c: np.ndarray):
         q = c + lam * (O + d_q * N - c)
         if float(np.min(outline.signed_distance(q))) > d_end + 0.1 * lam * d_q:
             return lam, lam * d_q
-    radii = [sg.radius for sg in getattr(outline, "segs", ()) if sg.kind == "arc" and sg.sweep > 0]
-    allowed = (f"must be < {min(radii):.6g} mm (the outline's smallest corner radius: cupped that far in, "
-               f"{outline.name}'s flat centre is too narrow for its plateau patches)") if radii else (
-               "must be smaller: cupped that far in, the flat centre is too narrow for its plateau patches")
-    raise DesignError("cup_width", round(d_end, 6), allowed, "mm")
+    raise DesignError("cup_width", round(d_end, 6),
+                      f"must be < {outline.min_convex_radius:.6g} mm (the outline's smallest corner radius: cupped "
+                      f"that far in, {outline.name}'s flat centre is too narrow for its plateau patches)", "mm")
 
 
 def _v_samples(outline, nv: int) -> np.ndarray:

@@ -228,7 +228,7 @@ def outline_segments(tablet):
     sweep}, ...]``, mm and rad), or None for a tablet without a nominal outline of lines and
     arcs (the thesis's free-form tablets, round families whose rim is a circle anyway)."""
     segs = getattr(getattr(getattr(tablet, "nominal", None), "outline", None), "segs", None)
-    if not segs or all(sg.kind == "arc" for sg in segs) and len(segs) == 1:
+    if not segs or len(segs) == 1:  # none, or one circle
         return None
     return [dict(kind=sg.kind, p0=[float(x) for x in sg.p0], p1=[float(x) for x in sg.p1],
                  center=[float(x) for x in sg.center], radius=float(sg.radius), theta0=float(sg.theta0),
@@ -238,33 +238,24 @@ def outline_segments(tablet):
 def offset_outline_wire(segments, distance, z=0.0):
     """``Part.Wire`` of the outline (:func:`outline_segments`) offset outward by ``distance`` mm
     at height ``z``: lines move along their outward normal, arcs keep their centre and change
-    radius by ``distance`` (convex) or ``-distance`` (concave) - exact for a G1 outline."""
+    radius by ``distance`` (convex) or ``-distance`` (concave) - exact for a G1 outline.  The
+    segments run counter-clockwise (``PlanOutline`` reverses clockwise input)."""
     import FreeCAD
     import Part
 
     from tabletcad.errors import GeometryError
 
-    # orientation from the signed area (Green): +1 counter-clockwise
-    area = 0.0
-    for sg in segments:
-        (x0, y0), (x1, y1) = sg["p0"], sg["p1"]
-        if sg["kind"] == "line":
-            area += 0.5 * (x0 * y1 - x1 * y0)
-        else:
-            cx, cy = sg["center"]
-            area += 0.5 * (sg["radius"] ** 2 * sg["sweep"] + cx * (y1 - y0) - cy * (x1 - x0))
-    orient = 1.0 if area > 0 else -1.0
     edges = []
     for sg in segments:
         if sg["kind"] == "line":
             (x0, y0), (x1, y1) = sg["p0"], sg["p1"]
             L = math.hypot(x1 - x0, y1 - y0)
-            nx, ny = orient * (y1 - y0) / L, -orient * (x1 - x0) / L
+            nx, ny = (y1 - y0) / L, -(x1 - x0) / L  # right of the direction: outward
             a = FreeCAD.Vector(x0 + distance * nx, y0 + distance * ny, z)
             b = FreeCAD.Vector(x1 + distance * nx, y1 + distance * ny, z)
             edges.append(Part.LineSegment(a, b).toShape())
         else:
-            r = sg["radius"] + orient * math.copysign(1.0, sg["sweep"]) * distance
+            r = sg["radius"] + distance * math.copysign(1.0, sg["sweep"])
             if not r > 0:
                 raise GeometryError(f"offsetting the outline by {distance} mm collapses an arc of radius {sg['radius']} mm",
                                     sg)
