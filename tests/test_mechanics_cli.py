@@ -147,3 +147,47 @@ def test_subprocess_entry_point(tmp_path):
     r = subprocess.run([sys.executable, "-m", "tabletcad", "heckel", str(SAMPLE), "--window", "10", "50"],
                        capture_output=True, text=True, cwd=ROOT, timeout=120, check=False)
     assert r.returncode == 0 and "Py = 104.6 MPa" in r.stdout
+
+
+def _kN_um_ms_copy(tmp_path: Path, lower: bool = False) -> Path:
+    """Appendix B as a ';'-separated, decimal-comma export in kN, µm and ms (optionally with a lower punch)."""
+    from decimal import Decimal
+
+    rows = [ln.split(",") for ln in SAMPLE.read_text().splitlines() if ln and not ln.startswith("#")][1:]
+    head = "Time [ms];Upper Punch Force (kN);Punch distance (µm)" + (";Lower Punch Force (kN)" if lower else "")
+    out = [head]
+    for k, r in enumerate(rows):
+        cells = [str(k), format(Decimal(r[0]).scaleb(-3), "f"), format(Decimal(r[1]).scaleb(3), "f")]
+        out.append(";".join(c.replace(".", ",") for c in cells + (["0,001"] if lower else [])))
+    p = tmp_path / "export.csv"
+    p.write_text("\ufeff" + "\n".join(out) + "\n", encoding="utf-8")
+    return p
+
+
+def test_heckel_reads_units_from_headers(capsys, tmp_path):
+    data = _kN_um_ms_copy(tmp_path)
+    meta = SAMPLE.with_suffix(".toml")
+    rc, out, err = run(capsys, "heckel", data, "--meta", meta, "--window", 10, 50, "--json")
+    assert rc == 0, err
+    ref_rc, ref, _ = run(capsys, "heckel", SAMPLE, "--window", 10, 50, "--json")
+    d, r = json.loads(out), json.loads(ref)
+    assert ref_rc == 0 and (d["K_per_MPa"], d["A"], d["Py_MPa"]) == (r["K_per_MPa"], r["A"], r["Py_MPa"])
+    assert not d["warnings"]  # Py is plausible: the kN header was honoured (read as N it gives ~0.1 MPa)
+    # the same file with its force unit overridden as N (the issue's misreading): Py falls 1000x and is flagged
+    rc, out, err = run(capsys, "heckel", data, "--meta", meta, "--window", 0.01, 0.05, "--force-unit", "N",
+                       "--displacement-unit", "µm", "--json")
+    assert rc == 0 and "implausible yield pressure" in err
+    assert json.loads(out)["Py_MPa"] < 0.2  # (the compliance line then also sees 1000x smaller forces)
+
+
+def test_heckel_ambiguous_force_column_and_bad_unit(capsys, tmp_path):
+    data = _kN_um_ms_copy(tmp_path, lower=True)
+    meta = SAMPLE.with_suffix(".toml")
+    plot = tmp_path / "p.png"
+    rc, _, err = run(capsys, "heckel", data, "--meta", meta, "--window", 10, 50, "--plot", plot)
+    assert rc == 2 and err.count("\n") == 1 and "--force-column" in err and not plot.exists()
+    rc, out, err = run(capsys, "heckel", data, "--meta", meta, "--window", 10, 50, "--force-column",
+                       "Upper Punch Force (kN)", "--json")
+    assert rc == 0 and json.loads(out)["K_per_MPa"] == pytest.approx(0.0095647, rel=1e-4)
+    rc, _, err = run(capsys, "heckel", data, "--meta", meta, "--force-unit", "kip", "--plot", plot)
+    assert rc == 2 and err.startswith("error: --force-unit = 'kip' is not allowed") and not plot.exists()

@@ -150,3 +150,164 @@ def test_metadata_beside_file_is_found(tmp_path):
         d = read_press_data(p)
     assert d.metadata.area == 20.0
     assert np.allclose(d.gap, [5, 4.9, 4.8])
+
+
+# --------------------------------------------------------------------------- units, separators, column roles
+from decimal import Decimal  # noqa: E402
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from tabletcad.mechanics.heckel import fit_heckel  # noqa: E402
+from tabletcad.mechanics.units import UNITS, header_unit, strip_unit  # noqa: E402
+
+SAMPLE_META = SAMPLE.with_suffix(".toml")
+
+
+def _sample_columns():
+    """Force (N) and displacement (mm) cells of Appendix B as printed, and a 1 ms time column."""
+    _, rows = _printed_rows()
+    return [r[0] for r in rows], [r[1] for r in rows], [f"{k / 1000:.3f}" for k in range(len(rows))]
+
+
+def _convert(cell: str, unit: str, decimal_comma: bool) -> str:
+    """``cell`` (in N, mm or s) written in ``unit``: exact decimal shift for powers of ten, else 17 digits."""
+    _, factor, exponent = UNITS[unit]
+    if exponent is not None:
+        out = format(Decimal(cell).scaleb(-exponent), "f")
+    else:
+        out = repr(float(cell) / factor)
+    return out.replace(".", ",") if decimal_comma else out
+
+
+def _write_sample(tmp_path, fu="N", lu="mm", tu="s", delim=",", decimal_comma=False, style="({})", name="conv.csv",
+                  encoding="utf-8", comment="# converted copy of Appendix B\n"):
+    F, x, t = _sample_columns()
+    head = [f"Time {style.format(tu)}", f"Upper Punch Force {style.format(fu)}",
+            f"Punch displacement {style.format(lu)}"]
+    lines = [delim.join(head)] + [
+        delim.join([_convert(a, tu, decimal_comma), _convert(b, fu, decimal_comma), _convert(c, lu, decimal_comma)])
+        for a, b, c in zip(t, F, x)
+    ]
+    p = tmp_path / name
+    p.write_bytes((comment + "\n".join(lines) + "\n").encode(encoding))
+    return p
+
+
+def _fits(path, **kw):
+    c = compaction_curves(read_press_data(path, SAMPLE_META, **kw))
+    return c, fit_heckel(c, window=(10.0, 50.0)), fit_heckel(c)
+
+
+def test_kN_um_ms_decimal_comma_semicolon_gives_identical_heckel(tmp_path):
+    """Appendix B in N/mm/s with '.' and in kN/µm/ms with decimal commas and ';' gives bit-identical K, A, Py."""
+    c0, w0, a0 = _fits(_write_sample(tmp_path, name="n.csv"))
+    c1, w1, a1 = _fits(_write_sample(tmp_path, "kN", "µm", "ms", ";", True, "[{}]", "k.csv",
+                                     encoding="utf-8-sig"))
+    assert np.array_equal(c0.pressure, c1.pressure) and np.array_equal(c0.thickness, c1.thickness)
+    for f0, f1 in ((w0, w1), (a0, a1)):
+        assert (f0.K_per_MPa, f0.A, f0.Py_MPa, f0.r2) == (f1.K_per_MPa, f1.A, f1.Py_MPa, f1.r2)
+    # and the thesis-window fit is the one of the bundled sample
+    assert w0.K_per_MPa == pytest.approx(0.0095647, rel=1e-4) and w0.n_points == 29
+    d1 = read_press_data(tmp_path / "k.csv", SAMPLE_META)
+    assert d1.time[1] == pytest.approx(0.001, rel=1e-12) and d1.force[-1] == pytest.approx(float(_sample_columns()[0][-1]))
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    fu=st.sampled_from([k for k, v in UNITS.items() if v[0] == "force"]),
+    lu=st.sampled_from([k for k, v in UNITS.items() if v[0] == "length"]),
+    tu=st.sampled_from([k for k, v in UNITS.items() if v[0] == "time"]),
+    fmt=st.sampled_from([(",", False), (";", True), ("\t", True), ("\t", False), (";", False)]),
+    style=st.sampled_from(["({})", "[{}]", "_{}", "( {} )"]),
+)
+def test_any_unit_choice_gives_the_same_heckel(tmp_path_factory, fu, lu, tu, fmt, style):
+    tmp = tmp_path_factory.mktemp("units")
+    ref = getattr(test_any_unit_choice_gives_the_same_heckel, "ref", None)
+    if ref is None:
+        ref = _fits(_write_sample(tmp, name="ref.csv"))[1]
+        test_any_unit_choice_gives_the_same_heckel.ref = ref
+    _, w, _ = _fits(_write_sample(tmp, fu, lu, tu, fmt[0], fmt[1], style))
+    exact = all(UNITS[u][2] is not None for u in (fu, lu))
+    if exact:  # powers of ten are converted in the decimal text: the very same doubles
+        assert (w.K_per_MPa, w.A, w.Py_MPa) == (ref.K_per_MPa, ref.A, ref.Py_MPa)
+    else:  # one division when writing, one multiplication when reading
+        assert w.K_per_MPa == pytest.approx(ref.K_per_MPa, rel=1e-12)
+        assert w.A == pytest.approx(ref.A, rel=1e-12)
+    assert w.n_points == ref.n_points
+
+
+def test_units_override_headers_and_columns_are_chosen(tmp_path):
+    p = _write_sample(tmp_path, "kN", "µm", "ms", "\t", True, "({})")
+    lower = tmp_path / "two.csv"
+    lines = p.read_text().splitlines()
+    lines[1] += "\tLower Punch Force (kN)"
+    lines[2:] = [ln + "\t0,001" for ln in lines[2:]]
+    lower.write_text("\n".join(lines) + "\n")
+    with pytest.raises(DesignError, match=r"force column = .*Upper.*Lower.* is ambiguous; choose one with --force-column"):
+        read_press_data(lower, SAMPLE_META)
+    ref = read_press_data(p, SAMPLE_META)
+    d = read_press_data(lower, SAMPLE_META, columns={"force": "upper punch force (kN)"})
+    assert np.array_equal(d.force, ref.force) and "Lower Punch Force (kN)" in d.extra
+    d = read_press_data(lower, SAMPLE_META, columns={"force": "2"})
+    assert np.array_equal(d.force, ref.force)
+    # the same file declared in other units: the option wins over the header
+    d = read_press_data(p, SAMPLE_META, units={"force": "N", "displacement": "mm", "time": "s"})
+    assert np.allclose(d.force * 1000.0, ref.force, rtol=1e-14)
+    assert np.allclose(d.time, ref.time * 1000.0, rtol=1e-14)
+
+
+@pytest.mark.parametrize(
+    "header,kw,match",
+    [
+        ("Force (kN/cm2);Displacement (mm)", {}, r"unit of column 'Force \(kN/cm2\)' \(or give --force-unit\) = 'kN/cm2'"),
+        ("Force (mm);Displacement (mm)", {}, "is not a known force unit"),
+        ("Force [kN];Punch position [furlong]", {}, "furlong"),
+        ("Force;Displacement", {"units": {"force": "stone"}}, "--force-unit = 'stone' is not allowed"),
+        ("Force;Displacement", {"units": {"time": "mm"}}, "--time-unit = 'mm'"),
+        ("Force;Displacement", {"columns": {"force": "Kraft"}}, "--force-column = 'Kraft'"),
+        ("Force;Upper punch position (mm);Lower punch position (mm)", {}, "--displacement-column"),
+    ],
+)
+def test_unknown_units_and_ambiguous_roles_are_refused(tmp_path, header, kw, match):
+    n = header.count(";") + 1
+    p = _write(tmp_path, header + "\n" + "\n".join(";".join(["1,5"] * n) for _ in range(3)) + "\n")
+    with pytest.raises(DesignError, match=match):
+        read_press_data(p, **kw, **META)
+
+
+@pytest.mark.parametrize(
+    "header,role,unit",
+    [
+        ("Upper Punch Force (kN)", "force", "kN"),
+        ("Force [daN]", "force", "daN"),
+        ("Time [ms]", "time", "ms"),
+        ("Punch distance (mm)", "displacement", "mm"),
+        ("Displacement (µm)", "displacement", "µm"),
+        ("Displacement (\u03bcm)", "displacement", "µm"),
+        ("Displacement (um)", "displacement", "um"),
+        ("force_N", "force", "N"),
+        ("Tablet thickness in", "thickness", None),
+        ("Gap_in", "thickness", "in"),
+        ("Punch travel (cm)", "displacement", "cm"),
+        ("Load (lbf)", "force", "lbf"),
+        ("Elapsed time (min)", "time", "min"),
+        ("Compression force MN", "force", "MN"),
+        ("Height", "thickness", None),
+    ],
+)
+def test_header_roles_and_units(header, role, unit):
+    from tabletcad.mechanics.pressdata import _role
+
+    assert _role(header) == role and header_unit(header) == unit
+    assert unit is None or unit not in strip_unit(header).split()
+
+
+def test_cp1252_micro_sign_comments_and_inch(tmp_path):
+    text = "# exported by a press\r\nZeit [s]\tKraft\tForce (lbf)\tGap (\u00b5m)\r\n# note\r\n0\t0\t10\t5000\r\n0,1\t0\t20\t4900\r\n"
+    p = tmp_path / "w.tsv"
+    p.write_bytes(text.encode("cp1252"))
+    d = read_press_data(p, **META)
+    assert np.allclose(d.force, [44.482216152605, 88.96443230521], rtol=1e-14)
+    assert np.allclose(d.thickness, [5.0, 4.9]) and d.time is None
+    assert list(d.line_numbers) == [4, 5]

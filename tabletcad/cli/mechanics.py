@@ -75,12 +75,25 @@ def _check_plot_suffix(path: Path | None) -> None:
               help="Machine deflection δ = SLOPE·F + OFFSET (mm/N, mm) added to the punch gap.")
 @click.option("--window", nargs=2, type=float, metavar="LO HI",
               help="Pressure window in MPa; default: automatic linear-region rule.")
+@click.option("--force-column", help="Header (or 1-based number) of the force column, e.g. 'Upper Punch Force (kN)'.")
+@click.option("--displacement-column", help="Header (or number) of the punch displacement/position column.")
+@click.option("--thickness-column", help="Header (or number) of a thickness/gap column to use instead of displacement.")
+@click.option("--time-column", help="Header (or number) of the time column.")
+@click.option("--force-unit", help="Unit of the force column (N, kN, daN, MN, mN, lbf, kgf); overrides the header.")
+@click.option("--displacement-unit", help="Unit of the displacement or thickness column (mm, µm, um, cm, m, in).")
+@click.option("--time-unit", help="Unit of the time column (s, ms, µs, min, h).")
 @click.option("--plot", "plot_file", type=click.Path(dir_okay=False, path_type=Path), help="Heckel plot (.png/.svg).")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: float | None,
                diameter: float | None, face_area: float | None, compliance: tuple[float, float] | None,
-               window: tuple[float, float] | None, plot_file: Path | None, as_json: bool) -> None:
-    """Heckel analysis (eqs 2.2-2.3) of the loading branch of a press record DATA (CSV/TSV)."""
+               window: tuple[float, float] | None, force_column: str | None, displacement_column: str | None,
+               thickness_column: str | None, time_column: str | None, force_unit: str | None,
+               displacement_unit: str | None, time_unit: str | None, plot_file: Path | None, as_json: bool) -> None:
+    """Heckel analysis (eqs 2.2-2.3) of the loading branch of a press record DATA (CSV/TSV).
+
+    Units are read from the headers (``Force (kN)``, ``Time [ms]``...) and
+    converted to N, mm and s; the options override units and choose columns.
+    """
     from tabletcad.mechanics.compaction import compaction_curves
     from tabletcad.mechanics.heckel import fit_heckel, plot_heckel
     from tabletcad.mechanics.pressdata import MachineCompliance, read_press_data
@@ -88,8 +101,12 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
     _check_plot_suffix(plot_file)
     with _collect() as msgs:
         comp = MachineCompliance(slope=compliance[0], offset=compliance[1]) if compliance else None
-        rec = read_press_data(data, meta, mass_mg=mass, true_density=true_density, diameter=diameter,
-                              face_area=face_area, compliance=comp)
+        rec = read_press_data(
+            data, meta, mass_mg=mass, true_density=true_density, diameter=diameter, face_area=face_area,
+            compliance=comp,
+            columns={"force": force_column, "displacement": displacement_column, "thickness": thickness_column,
+                     "time": time_column},
+            units={"force": force_unit, "displacement": displacement_unit, "time": time_unit})
         curves = compaction_curves(rec)
         fit = fit_heckel(curves, window=window)
     payload = fit.to_dict() | {

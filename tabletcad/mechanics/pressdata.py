@@ -1,17 +1,28 @@
 """Press data: force and punch-position records of a compaction run, with metadata.
 
-A record is a delimited text file (comma, semicolon or tab separated, ``#``
-comment lines allowed) with a header row.  Columns are recognised by name,
-case-insensitively and ignoring a trailing unit in parentheses:
+A record is a delimited text file (comma, semicolon or tab separated, sniffed;
+decimal commas with ``;``/tab; UTF-8 with or without BOM, UTF-16, Windows-1252;
+``#`` comment lines allowed) with a header row.  Columns are recognised by
+name, case-insensitively and ignoring their unit:
 
-* force (N): a header containing ``force`` or ``load``;
-* punch displacement (mm): ``displacement``, ``disp`` or ``position``;
-* tablet thickness / punch gap (mm): ``thickness``, ``height`` or ``gap``;
-* time (s), optional: ``time``.
+* force: a header containing ``force`` or ``load`` (``Upper Punch Force``);
+* punch displacement: ``displacement``, ``disp``, ``position``, ``distance``,
+  ``travel`` or ``stroke``;
+* tablet thickness / punch gap: ``thickness``, ``height`` or ``gap``;
+* time, optional: ``time``.
+
+Units come from the header — ``Force (kN)``, ``Force [daN]``, ``Time [ms]``,
+``Displacement (µm)``, ``force_N`` — and are converted to N, mm and s
+(:mod:`tabletcad.mechanics.units`); a header without a unit means N, mm or s,
+an unknown unit is refused.  Two columns that could play one role (upper and
+lower punch force) are refused unless ``columns=`` (the CLI's
+``--force-column``...) chooses one; ``units=`` (``--force-unit``...) overrides
+a header's unit.
 
 Either a displacement or a thickness column is required.  Every other numeric
-column is kept in :attr:`PressData.extra` (the thesis sample carries its
-printed thickness, relative density, pressure and Heckel columns that way).
+column is kept, unconverted, in :attr:`PressData.extra` (the thesis sample
+carries its printed thickness, relative density, pressure and Heckel columns
+that way).
 
 The metadata (:class:`PressMetadata`) give the compact mass (mg), the true
 density (mg/mm³), the die diameter (mm) or punch face area (mm²) and an
@@ -54,6 +65,7 @@ import numpy as np
 import tomllib
 
 from tabletcad.errors import DesignError, check_finite, check_positive
+from tabletcad.mechanics.units import DIMENSIONS, header_unit, strip_unit, unit_factor
 from tabletcad.mechanics.validity import DataWarning, warn
 
 __all__ = [
@@ -305,45 +317,109 @@ def _assemble(F, pos, is_thickness, t, meta, extra, lines, dropped, source) -> P
 _ROLE_PATTERNS = (
     ("force", re.compile(r"force|load")),
     ("thickness", re.compile(r"thickness|height|gap")),
-    ("displacement", re.compile(r"displacement|disp\b|disp\.|position")),
+    ("displacement", re.compile(r"displacement|disp\b|disp\.|position|distance|travel|stroke")),
     ("time", re.compile(r"^time|\btime\b")),
 )
+#: column roles, and the option that chooses a column for each
+ROLES = ("force", "displacement", "thickness", "time")
 
 
 def _role(header: str) -> str | None:
-    h = re.sub(r"\(.*?\)", "", header).strip().lower()
+    h = strip_unit(header).lower()
     for role, pat in _ROLE_PATTERNS:
         if pat.search(h):
             return role
     return None
 
 
-def _read_table(text: str, source: str) -> tuple[list[str], list[tuple[int, list[str]]]]:
+def _decode(raw: bytes, source: str) -> str:
+    """UTF-8 (with or without BOM), UTF-16 with BOM, else Windows-1252 (old exports write µ as 0xB5)."""
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        return raw.decode("utf-16")
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return raw.decode("cp1252", errors="replace")
+
+
+def _sniff_delimiter(lines: list[str]) -> str:
+    """The delimiter (tab, ``;`` or ``,``) splitting the header and the first rows into equally many cells."""
+    sample = lines[: min(len(lines), 20)]
+    for d in ("\t", ";", ","):
+        counts = {len(next(csv.reader([ln], delimiter=d))) for ln in sample}
+        if len(counts) == 1 and counts.pop() > 1:
+            return d
+    head = sample[0]
+    return "\t" if "\t" in head else ";" if head.count(";") > head.count(",") else ","
+
+
+def _read_table(text: str, source: str) -> tuple[list[str], list[tuple[int, list[str]]], str]:
     lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines()) if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
         raise DesignError("data", source, "is empty")
-    head = lines[0][1]
-    if "\t" in head:
-        delim = "\t"
-    elif head.count(";") > head.count(","):
-        delim = ";"
-    else:
-        delim = ","
+    delim = _sniff_delimiter([ln for _, ln in lines])
     rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines)), delimiter=delim))
     header = [h.strip() for h in rows[0]]
     body = [(lines[k][0], [c.strip() for c in row]) for k, row in enumerate(rows[1:], start=1)]
-    return header, body
+    return header, body, delim
 
 
 _MISSING = {"", "na", "nan", "n/a", "null", "none", "-"}
+_NUMBER = re.compile(r"^([+-]?(?:\d+\.?\d*|\.\d+))(?:[eE]([+-]?\d+))?$")
+
+
+def _to_float(cell: str, exponent: int | None, decimal_comma: bool) -> float:
+    """``cell`` as a float; with ``exponent`` k the value of ``cell`` x 10^k, rounded once.
+
+    Raises ValueError when ``cell`` is not a number.
+    """
+    if decimal_comma:
+        cell = cell.replace(",", ".")
+    if not exponent:
+        return float(cell)
+    m = _NUMBER.match(cell)
+    if m is None:
+        raise ValueError(cell)
+    return float(f"{m.group(1)}e{int(m.group(2) or 0) + exponent}")
+
+
+def _pick(role: str, header: list[str], found: list[int], chosen: str | None) -> int | None:
+    """The column index for ``role``: the one named by its option, the only one found, or refuse."""
+    option = f"--{role}-column"
+    if chosen is not None:
+        names = [h.lower() for h in header]
+        key = str(chosen).strip().lower()
+        if key in names:
+            return names.index(key)
+        if key.isdigit() and 1 <= int(key) <= len(header):
+            return int(key) - 1
+        raise DesignError(option, str(chosen), f"must be one of the headers {header} or a column number 1-{len(header)}")
+    if len(found) > 1:
+        names = [header[j] for j in found]
+        raise DesignError(f"{role} column", names, f"is ambiguous; choose one with {option}")
+    return found[0] if found else None
 
 
 def read_press_data(
     path: str | Path,
     meta: str | Path | Mapping[str, Any] | PressMetadata | None = None,
+    *,
+    columns: Mapping[str, str | None] | None = None,
+    units: Mapping[str, str | None] | None = None,
     **overrides: Any,
 ) -> PressData:
-    """Read a press record from a CSV/TSV file.
+    """Read a press record from a delimited text file (CSV, ``;``-separated, TSV).
+
+    The delimiter is sniffed (the one that splits the header and the first
+    rows into equally many cells); with ``;`` or tab separators decimal commas
+    (``0,0000``) are read.  A UTF-8 BOM, UTF-16 with BOM and Windows-1252
+    (``µ`` as one byte) are decoded; ``#`` lines are comments.
+
+    Columns get their role from their header (module docstring; also
+    ``upper punch force``, ``punch distance``, ``travel``, ``stroke``), their
+    unit from the header (:func:`tabletcad.mechanics.units.header_unit`:
+    ``Force (kN)``, ``Time [ms]``, ``displacement_mm``) and are converted to
+    N, mm and s; a header without a unit is taken as N, mm or s.
 
     Parameters
     ----------
@@ -353,6 +429,15 @@ def read_press_data(
         Metadata: a TOML file, a mapping with the TOML keys, a ready
         :class:`PressMetadata`, or ``None`` to use the TOML file with the same
         stem beside ``path`` if there is one.
+    columns : mapping of role to header, optional
+        Chooses the column of a role (``force``, ``displacement``,
+        ``thickness``, ``time``) by header (case-insensitive) or 1-based
+        number; needed when two columns could play a role (upper and lower
+        punch force).  Choosing ``thickness`` makes it the position column.
+    units : mapping of role to unit, optional
+        Overrides the header's unit of a role (``force``: N, kN...;
+        ``displacement`` — also used for a thickness column — mm, µm...;
+        ``time``: s, ms...; see :data:`tabletcad.mechanics.units.UNITS`).
     **overrides
         Metadata keys (``mass_mg``, ``true_density``, ``diameter``,
         ``face_area``, ``compliance``, ``displacement_sign``,
@@ -367,28 +452,56 @@ def read_press_data(
     Raises
     ------
     DesignError
-        Missing columns, non-numeric cells, or invalid metadata.  Rows with a
-        missing force or position are dropped with a :class:`DataWarning`
-        stating how many.
+        Missing or ambiguous columns, an unknown unit, non-numeric cells, or
+        invalid metadata.  Rows with a missing force or position are dropped
+        with a :class:`DataWarning` stating how many.
     """
     path = Path(path)
-    text = path.read_text(encoding="utf-8-sig")
-    header, body = _read_table(text, path.name)
-    roles: dict[str, int] = {}
+    columns = {k: v for k, v in (columns or {}).items() if v is not None}
+    units = {k: v for k, v in (units or {}).items() if v is not None}
+    for k in list(columns) + list(units):
+        if k not in ROLES:
+            raise DesignError("column role", k, f"must be one of {', '.join(ROLES)}")
+    # options first: a bad option is reported before the file is read
+    option_units = {
+        role: unit_factor(u, DIMENSIONS[role], f"--{'displacement' if role == 'thickness' else role}-unit")
+        for role, u in units.items()
+    }
+    header, body, delim = _read_table(_decode(path.read_bytes(), path.name), path.name)
+    found: dict[str, list[int]] = {r: [] for r in ROLES}
     for j, h in enumerate(header):
         r = _role(h)
-        if r is not None and r not in roles:
+        if r is not None:
+            found[r].append(j)
+    roles: dict[str, int] = {}
+    for r in ROLES:
+        j = _pick(r, header, found[r], columns.get(r))
+        if j is not None:
             roles[r] = j
     if "force" not in roles:
-        raise DesignError("columns", header, "need a force column (header containing 'force')")
-    if "displacement" not in roles and "thickness" not in roles:
+        raise DesignError("columns", header, "need a force column (header containing 'force' or 'load')")
+    if "thickness" in columns:
+        pos_role = "thickness"
+    elif "displacement" in roles:
+        pos_role = "displacement"  # a printed thickness column beside it stays in `extra`
+    elif "thickness" in roles:
+        pos_role = "thickness"
+    else:
         raise DesignError("columns", header, "need a displacement or thickness column")
-    pos_role = "displacement" if "displacement" in roles else "thickness"
-    used = {roles["force"], roles[pos_role]}
-    if "time" in roles:
-        used.add(roles["time"])
-    if pos_role == "displacement" and "thickness" in roles:
-        pass  # a printed thickness column beside a displacement column stays in `extra`
+    factors: dict[int, tuple[float, int | None]] = {}
+    for r in ("force", pos_role, "time"):
+        if r not in roles:
+            continue
+        j = roles[r]
+        unit_role = "displacement" if r == "thickness" else r
+        if unit_role in option_units or r in option_units:
+            factors[j] = option_units.get(r, option_units.get(unit_role))
+            continue
+        u = header_unit(header[j])
+        factors[j] = (1.0, 0) if u is None else unit_factor(
+            u, DIMENSIONS[r], f"unit of column {header[j]!r} (or give --{unit_role}-unit)")
+    used = {roles["force"], roles[pos_role]} | ({roles["time"]} if "time" in roles else set())
+    decimal_comma = delim != "," and any("," in c for _, cells in body[:50] for c in cells)
     numeric_cols = list(range(len(header)))
     values = np.full((len(body), len(header)), np.nan)
     for k, (lineno, cells) in enumerate(body):
@@ -399,12 +512,15 @@ def read_press_data(
             if cell.lower() in _MISSING:
                 continue
             try:
-                values[k, j] = float(cell)
+                values[k, j] = _to_float(cell, factors.get(j, (1.0, 0))[1], decimal_comma)
             except ValueError:
                 if j in used:
                     raise DesignError(f"{header[j]} (line {lineno})", cell, "must be a number") from None
                 values[:, j] = np.nan  # non-numeric optional column: ignore it entirely
                 numeric_cols = [c for c in numeric_cols if c != j]
+    for j, (factor, exponent) in factors.items():
+        if exponent is None:
+            values[:, j] *= factor
     need = [roles["force"], roles[pos_role]]
     keep = np.all(np.isfinite(values[:, need]), axis=1)
     dropped = int((~keep).sum())
