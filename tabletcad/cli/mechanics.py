@@ -122,9 +122,10 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
     if plot_file is not None:
         plot_heckel(fit, plot_file, title=f"Heckel plot: {data.name}")
     lo, hi = fit.window_MPa
+    how = fit.method if fit.noise_sd is None else f"auto: widest run linear within the noise σ = {fit.noise_sd:.3g}"
     _emit(payload, as_json, [
         f"{data.name}: {curves.describe_rows()}",
-        f"window {lo:.4g}-{hi:.4g} MPa ({fit.method}), n = {fit.n_points}",
+        f"window {lo:.4g}-{hi:.4g} MPa ({how}), n = {fit.n_points}",
         f"K = {fit.K_per_MPa:.5g} 1/MPa, A = {fit.A:.4f}, Py = {fit.Py_MPa:.4g} MPa, R² = {fit.r2:.5f}",
     ] + ([f"plot -> {plot_file}"] if plot_file else []))
 

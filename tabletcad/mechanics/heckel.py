@@ -9,21 +9,50 @@ Choosing the linear region
 With ``window=(lo, hi)`` the fit uses every loading point with
 ``lo <= P <= hi`` (MPa, closed interval).
 
-With ``window=None`` the linear region is chosen by this rule (all numbers are
-parameters of :func:`fit_heckel`):
+With ``window=None`` the linear region is the widest run of points whose
+scatter about their own line is no larger than the data's noise.  No band,
+tolerance or scale is given by the user; the rule is:
 
-1. Candidates are the contiguous runs of loading points (ordered by pressure,
-   with ``P > 0`` and ``D < 1``) holding at least ``min_points`` points.
-2. Each candidate is fitted by ordinary least squares; it is *linear* when its
-   largest absolute residual is at most ``max_residual`` (in units of the
-   Heckel term; default 0.005, i.e. the data stay within ±0.005 of the line)
-   and its R² is at least ``min_r2`` (default 0.99).
-3. The selected window is the linear candidate with the widest pressure span;
-   ties go to the smaller residual standard deviation.
+1. **Noise from the data.**  Each point ``i`` (ordered by pressure) is
+   compared with the straight line through its two neighbours; the
+   difference, divided by its standard deviation factor
+   ``sqrt(1 + w² + (1 - w)²)`` (``w`` the relative position of ``P_i``
+   between its neighbours), has the noise's standard deviation σ wherever the
+   curve is locally straight.  σ is estimated robustly as 1.4826 × the median
+   absolute deviation of these scaled differences about their median
+   (:func:`heckel_noise_sd`); the median absorbs a slowly varying curvature,
+   and outliers do not inflate it.  ``noise_sd=`` replaces the estimate.
+2. **Lack-of-fit test.**  A run of ``m`` consecutive points is *linear* when
+   the residual sum of squares of its least-squares line is at most
+   ``σ² · χ²_{m-2}(1 - α/n)``: the upper ``α/n`` quantile of the chi-square
+   distribution with ``m - 2`` degrees of freedom, ``n`` the number of
+   loading points (a Bonferroni bound over the ``n`` places a window can end,
+   so that pure noise fails a linear run with probability at most ``α``,
+   default 0.05, anywhere in the record).
+3. **Widest run.**  Among runs of at least ``min_points`` points (default 8)
+   that are linear, the one with the widest pressure span is chosen; ties go
+   to the smaller residual standard deviation.  Up to ``EXHAUSTIVE_MAX``
+   (4096) loading points every run is tested.  Above, two shortcuts bound
+   the work: the first points tried are every ``s``-th of those that start a
+   linear run of ``min_points`` (``s`` = their number / 4096, rounded up),
+   then every one between the best of them and its grid neighbours; and the
+   longest linear run from a first point is found by bisection on its length,
+   which treats the test as monotone in the length (curvature only adds to
+   the residual sum as a run grows; noise can make a longer run pass where a
+   shorter one failed, and the bisection may then stop short).  The tests
+   check the result against the exhaustive search (span within 2 %).
 
-The bound in (2) must exceed about three times the noise standard deviation
-of the Heckel term, otherwise noise rather than curvature limits the window.
-If no candidate is linear, a :class:`DesignError` is raised.
+Both quantities in (2) scale with the square of the Heckel term's noise, so
+the chosen window does not depend on the units of pressure or on the noise
+level except through what the data can resolve: noisier data give a longer
+window (curvature hidden by noise), cleaner data a shorter one.  Adding a
+straight line to the Heckel term leaves the window unchanged.  Sums over a run
+come from prefix sums of the data centred and detrended by their global line
+(numerically stable), so any run's fit costs O(1) and the whole search
+O(n²) time up to 4096 points, O(n) above (4096 bisections plus the
+prefix sums), and O(n) memory (``benchmarks/bench_heckel.py``: about a
+second for 10⁶ rows).  If no run is linear a :class:`DesignError` asks for a
+window.
 """
 
 from __future__ import annotations
@@ -33,11 +62,11 @@ from pathlib import Path
 
 import numpy as np
 
-from tabletcad.errors import DesignError, check_positive
+from tabletcad.errors import DesignError, check_positive, check_range
 from tabletcad.mechanics.compaction import CompactionCurves
 from tabletcad.mechanics.validity import FitQualityWarning, warn
 
-__all__ = ["PY_PLAUSIBLE_MPA", "HeckelFit", "fit_heckel", "fit_heckel_arrays", "plot_heckel"]
+__all__ = ["PY_PLAUSIBLE_MPA", "HeckelFit", "fit_heckel", "fit_heckel_arrays", "heckel_noise_sd", "plot_heckel"]
 
 #: Range of apparent yield pressure (MPa) outside which a warning is issued.
 PY_PLAUSIBLE_MPA = (10.0, 2000.0)
@@ -73,6 +102,9 @@ class HeckelFit:
     requested_window_MPa : (float, float) or None
     warnings : tuple of str
         Messages also issued as :class:`FitQualityWarning`.
+    noise_sd : float or None
+        Noise standard deviation of the Heckel term the automatic rule used
+        (estimated or given); ``None`` for a given window.
     pressure, heckel : ndarray
         The loading-branch data the fit was chosen from (for plots).
     """
@@ -89,6 +121,7 @@ class HeckelFit:
     max_abs_residual: float
     requested_window_MPa: tuple[float, float] | None = None
     warnings: tuple[str, ...] = ()
+    noise_sd: float | None = None
     pressure: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
     heckel: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
 
@@ -108,6 +141,7 @@ class HeckelFit:
             "n_points": self.n_points,
             "method": self.method,
             "residual_sd": self.residual_sd,
+            "noise_sd": self.noise_sd,
             "warnings": list(self.warnings),
         }
 
@@ -125,41 +159,118 @@ def _ols(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float, np.ndarray]
     return k, a, r2, res
 
 
-def _auto_window(P: np.ndarray, H: np.ndarray, min_points: int, max_residual: float, min_r2: float):
-    n = P.size
-    best = None
-    # prefix sums give every window's OLS in O(1); residual maxima are then checked in O(len)
-    cx = np.concatenate([[0.0], np.cumsum(P)])
-    cy = np.concatenate([[0.0], np.cumsum(H)])
-    cxx = np.concatenate([[0.0], np.cumsum(P * P)])
-    cxy = np.concatenate([[0.0], np.cumsum(P * H)])
-    cyy = np.concatenate([[0.0], np.cumsum(H * H)])
-    for i in range(n - min_points + 1):
-        j = np.arange(i + min_points, n + 1)
+def heckel_noise_sd(pressure, heckel) -> float:
+    """Robust estimate of the noise standard deviation of the Heckel term (module docstring, step 1).
+
+    Parameters
+    ----------
+    pressure, heckel : array_like
+        MPa and ln(1/(1-D)), sorted by pressure.
+
+    Returns
+    -------
+    float
+        σ (dimensionless, the Heckel term's unit); 0 if fewer than three
+        distinct pressures.
+    """
+    P = np.asarray(pressure, dtype=float)
+    H = np.asarray(heckel, dtype=float)
+    left, right = P[1:-1] - P[:-2], P[2:] - P[1:-1]
+    span = left + right
+    ok = span > 0
+    if not ok.any():
+        return 0.0
+    w = left[ok] / span[ok]
+    e = H[1:-1][ok] - ((1.0 - w) * H[:-2][ok] + w * H[2:][ok])
+    z = e / np.sqrt(1.0 + w * w + (1.0 - w) ** 2)
+    return float(_MAD_TO_SD * np.median(np.abs(z - np.median(z))))
+
+
+#: Up to this many loading points every run is tested (exact); above, starts are sampled and lengths bisected.
+EXHAUSTIVE_MAX = 4096
+#: 1/Φ⁻¹(3/4): the median absolute deviation of a normal sample times this is its standard deviation.
+_MAD_TO_SD = 1.482602218505602
+
+
+class _RunSums:
+    """Prefix sums giving the least-squares residual sum of squares of any run ``[i, j)`` in O(1)."""
+
+    def __init__(self, P: np.ndarray, H: np.ndarray) -> None:
+        x = P - P.mean()
+        y = H - H.mean()
+        sxx = float(np.dot(x, x))
+        y = y - (float(np.dot(x, y)) / sxx if sxx > 0 else 0.0) * x  # detrend: small sums, no cancellation
+        zero = np.zeros(1)
+        self.x = np.concatenate([zero, np.cumsum(x)])
+        self.y = np.concatenate([zero, np.cumsum(y)])
+        self.xx = np.concatenate([zero, np.cumsum(x * x)])
+        self.xy = np.concatenate([zero, np.cumsum(x * y)])
+        self.yy = np.concatenate([zero, np.cumsum(y * y)])
+
+    def sse(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """Residual sum of squares of the runs ``[i, j)``; ``inf`` where the run has no pressure spread."""
         m = j - i
-        sx, sy = cx[j] - cx[i], cy[j] - cy[i]
-        sxx = cxx[j] - cxx[i] - sx * sx / m
-        sxy = cxy[j] - cxy[i] - sx * sy / m
-        syy = cyy[j] - cyy[i] - sy * sy / m
-        ok = sxx > 0
-        k = np.where(ok, sxy / np.where(ok, sxx, 1.0), 0.0)
-        sse = np.maximum(syy - k * sxy, 0.0)
-        r2 = np.where(syy > 0, 1.0 - sse / np.where(syy > 0, syy, 1.0), 1.0)
-        span = P[j - 1] - P[i]
-        for idx in np.flatnonzero(ok & (r2 >= min_r2)):
-            jj = int(j[idx])
-            if best is not None and span[idx] < best[0] - 1e-12:
-                continue
-            kk = float(k[idx])
-            a = (sy[idx] - kk * sx[idx]) / m[idx]
-            res = H[i:jj] - (kk * P[i:jj] + a)
-            if np.max(np.abs(res)) > max_residual:
-                continue
-            sd = float(np.sqrt(sse[idx] / max(m[idx] - 2, 1)))
-            cand = (float(span[idx]), -sd, i, jj)
-            if best is None or cand[:2] > best[:2]:
-                best = cand
-    return best
+        sx, sy = self.x[j] - self.x[i], self.y[j] - self.y[i]
+        sxx = self.xx[j] - self.xx[i] - sx * sx / m
+        sxy = self.xy[j] - self.xy[i] - sx * sy / m
+        syy = self.yy[j] - self.yy[i] - sy * sy / m
+        spread = sxx > 0
+        out = syy - np.where(spread, sxy * sxy / np.where(spread, sxx, 1.0), 0.0)
+        return np.where(spread, np.maximum(out, 0.0), np.inf)
+
+
+def _auto_window(P: np.ndarray, H: np.ndarray, min_points: int, sigma: float, alpha: float) -> tuple[int, int] | None:
+    """First and end index of the widest linear run (module docstring, steps 2-3), or None."""
+    from scipy.special import gammainccinv
+
+    n = P.size
+    sums = _RunSums(P, H)
+
+    def limit(m: np.ndarray) -> np.ndarray:
+        """σ² χ²_{m-2}(1 - α/n): the largest residual sum of squares of a linear run of m points."""
+        return sigma * sigma * 2.0 * gammainccinv((m - 2) / 2.0, alpha / n)
+
+    # every length is needed when every run is tested: tabulate once
+    table = limit(np.arange(n + 1).clip(min_points)) if n <= EXHAUSTIVE_MAX else None
+
+    def linear(i: np.ndarray, m: np.ndarray) -> np.ndarray:
+        return sums.sse(i, i + m) <= (limit(m) if table is None else table[m])
+
+    start = np.arange(0, n - min_points + 1)
+    start = start[sums.sse(start, start + min_points) <= limit(np.array([min_points]))[0]]
+    if start.size == 0:
+        return None
+
+    def longest(i: np.ndarray) -> np.ndarray:
+        """Length of the longest linear run from each start ``i``."""
+        if n <= EXHAUSTIVE_MAX:
+            out = np.empty(i.size, dtype=int)
+            for k, s in enumerate(i):  # every run from s, vectorised over its ends: exact
+                m = np.arange(min_points, n - s + 1)
+                out[k] = m[np.flatnonzero(linear(np.full(m.size, s), m))[-1]]
+            return out
+        lo, hi = np.full(i.size, min_points), n - i
+        while np.any(lo < hi):  # bisection on the length, all starts at once: lo passes, hi bounds the longest
+            active = lo < hi
+            mid = (lo + hi + 1) // 2
+            ok = linear(i, mid)
+            lo = np.where(active & ok, mid, lo)
+            hi = np.where(active & ~ok, mid - 1, hi)
+        return lo
+
+    if n <= EXHAUSTIVE_MAX:
+        cand = start
+    else:  # every stride-th linear start, then every start between the best one's grid neighbours
+        stride = -(-start.size // EXHAUSTIVE_MAX)
+        coarse = start[::stride]
+        k = int(np.argmax(P[np.minimum(coarse + longest(coarse) - 1, n - 1)] - P[coarse]))
+        near = start[max(0, (k - 1) * stride): (k + 1) * stride + 1]
+        cand = np.union1d(coarse, near)
+    length = longest(cand)
+    span = P[cand + length - 1] - P[cand]
+    sd = np.sqrt(sums.sse(cand, cand + length) / (length - 2))
+    best = np.lexsort((sd, -span))[0]
+    return int(cand[best]), int(cand[best] + length[best])
 
 
 def fit_heckel_arrays(
@@ -169,8 +280,8 @@ def fit_heckel_arrays(
     heckel=None,
     window: tuple[float, float] | None = None,
     min_points: int = 8,
-    max_residual: float = 0.005,
-    min_r2: float = 0.99,
+    noise_sd: float | None = None,
+    alpha: float = 0.05,
     rows=None,
 ) -> HeckelFit:
     """Heckel fit of loading-branch arrays.
@@ -183,8 +294,13 @@ def fit_heckel_arrays(
         Solid fraction D; or give ``heckel`` = ln(1/(1-D)) directly.
     window : (float, float) or None
         Pressure window in MPa; ``None`` selects it automatically (module docstring).
-    min_points, max_residual, min_r2
-        Parameters of the automatic rule.
+    min_points : int
+        Fewest points of an automatic window (module docstring, step 3).
+    noise_sd : float, optional
+        Noise standard deviation of the Heckel term; default: estimated from
+        the data (:func:`heckel_noise_sd`).
+    alpha : float
+        Family-wise level of the lack-of-fit test (module docstring, step 2).
     rows : array_like of int, optional
         Row index of each point, reported in the result.
 
@@ -223,18 +339,26 @@ def fit_heckel_arrays(
         x, y, used = Pg[sel], Hg[sel], ig[sel]
         method = "window"
         requested = (lo, hi)
+        sigma = None
     else:
         if min_points < 3:
             raise DesignError("min_points", min_points, "must be >= 3")
         if Pg.size < min_points:
             raise DesignError("data", f"{Pg.size} loading points", f"need >= {min_points} for automatic window")
-        best = _auto_window(Pg, Hg, min_points, max_residual, min_r2)
+        if noise_sd is None:
+            # the floor is the double-precision resolution of the Heckel term (exact, noise-free data)
+            sigma = max(heckel_noise_sd(Pg, Hg), 16.0 * np.finfo(float).eps * float(np.max(np.abs(Hg))))
+        else:
+            sigma = check_positive("noise_sd", noise_sd)
+        check_range("alpha", alpha, 0.0, 1.0, lo_open=True, hi_open=True)
+        best = _auto_window(Pg, Hg, min_points, sigma, alpha)
         if best is None:
             raise DesignError(
                 "window", "auto",
-                f"no run of >= {min_points} points is linear within {max_residual:g} (R² >= {min_r2:g}); give --window",
+                f"no run of >= {min_points} points is linear within the noise (σ = {sigma:.3g}) at the "
+                f"{alpha:g} level; give --window",
             )
-        i, j = best[2], best[3]
+        i, j = best
         x, y, used = Pg[i:j], Hg[i:j], ig[i:j]
         method = "auto"
         requested = None
@@ -257,7 +381,7 @@ def fit_heckel_arrays(
         K_per_MPa=k, A=a, Py_MPa=py, r2=r2, window_MPa=(float(x.min()), float(x.max())),
         n_points=int(x.size), rows=tuple(int(r) for r in used), method=method, residual_sd=sd,
         max_abs_residual=float(np.max(np.abs(res))), requested_window_MPa=requested,
-        warnings=tuple(msgs), pressure=Pg, heckel=Hg,
+        warnings=tuple(msgs), noise_sd=sigma, pressure=Pg, heckel=Hg,
     )
 
 
