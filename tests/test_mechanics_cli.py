@@ -191,3 +191,70 @@ def test_heckel_ambiguous_force_column_and_bad_unit(capsys, tmp_path):
     assert rc == 0 and json.loads(out)["K_per_MPa"] == pytest.approx(0.0095647, rel=1e-4)
     rc, _, err = run(capsys, "heckel", data, "--meta", meta, "--force-unit", "kip", "--plot", plot)
     assert rc == 2 and err.startswith("error: --force-unit = 'kip' is not allowed") and not plot.exists()
+
+
+SHELL = ["shell", "--outer", 2.5, "--inner", 2.0, "--E", 100, "--nu", 0.3, "--p-ext", 3, "--terms", 20]
+
+
+def _one_line_error(rc, err, *names):
+    assert rc == 2 and err.startswith("error: ") and err.count("\n") == 1 and "Traceback" not in err
+    for n in names:
+        assert n in err
+
+
+def test_shell_plot_under_a_file_writes_nothing(capsys, tmp_path):
+    (tmp_path / "blk").write_text("a file")
+    rc, _, err = run(capsys, *SHELL, "--csv", tmp_path / "u.csv", "--plot", tmp_path / "blk" / "p.png")
+    _one_line_error(rc, err, "--plot = ", "is a file, not a folder")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["blk"]
+
+
+def test_outputs_are_written_only_when_all_succeed(capsys, tmp_path, monkeypatch):
+    """A failure while making the second output (the plot) leaves neither it nor the first (the table)."""
+    import tabletcad.mechanics.shell as shell
+
+    def broken(sol, path):
+        Path(path).write_bytes(b"partial")
+        raise DesignError("plot", str(path), "failed on purpose")
+
+    from tabletcad.errors import DesignError
+
+    monkeypatch.setattr(shell, "plot_shell", broken)
+    rc, _, err = run(capsys, *SHELL, "--csv", tmp_path / "u.csv", "--plot", tmp_path / "p.png")
+    assert rc == 2 and err.splitlines()[-1].endswith("failed on purpose") and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []
+    monkeypatch.undo()
+    rc, _, err = run(capsys, *SHELL, "--csv", tmp_path / "u.csv", "--plot", tmp_path / "sub" / "p.svg")
+    assert rc == 0, err
+    assert (tmp_path / "u.csv").stat().st_size > 1000 and "<svg" in (tmp_path / "sub" / "p.svg").read_text()
+
+
+@pytest.mark.parametrize(
+    "args,names",
+    [
+        (["love", "--omega-z0", "nan"], ["--omega-z0 = nan"]),
+        (["love", "--z", "inf"], ["--z = inf"]),
+        (["love", "--h0", "-1"], ["--h0 = -1"]),
+        (["love", "--window", "10", "inf"], ["--window"]),
+        (["shell", "--outer", "nan", "--inner", "2", "--E", "100", "--nu", "0.3", "--p-ext", "3"], ["--outer = nan"]),
+        (["shell", "--outer", "2.5", "--inner", "2", "--E", "100", "--nu", "0.3", "--p-ext", "nan"], ["--p-ext = nan"]),
+        (["contact", "--force", "nan"], ["--force = nan"]),
+        (["heckel", SAMPLE, "--window", "nan", "50"], ["--window = nan"]),
+        (["heckel", "missing.csv"], ["DATA = 'missing.csv'", "does not exist"]),
+        (["heckel", SAMPLE, "--meta", "."], ["--meta = '.'", "is a folder"]),
+        (["heckel", SAMPLE, "--plot", "out.txt"], ["--plot = 'out.txt'"]),
+    ],
+)
+def test_every_mechanics_option_is_named_in_its_error(capsys, tmp_path, monkeypatch, args, names):
+    monkeypatch.chdir(tmp_path)
+    rc, _, err = run(capsys, *args)
+    _one_line_error(rc, err, *names)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("cmd", [["contact", "--force", "3.5"], ["heckel", SAMPLE, "--window", "10", "50"]])
+def test_plot_under_a_file_is_refused_before_computing(capsys, tmp_path, cmd):
+    (tmp_path / "blk").write_text("")
+    rc, _, err = run(capsys, *cmd, "--plot", tmp_path / "blk" / "x.png")
+    _one_line_error(rc, err, "--plot")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["blk"]

@@ -12,6 +12,8 @@ from __future__ import annotations
 import contextlib
 import json
 import math
+import os
+import tempfile
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
@@ -20,7 +22,7 @@ from typing import Any
 import click
 import numpy as np
 
-from tabletcad.errors import DesignError
+from tabletcad.errors import DesignError, check_finite, check_positive, check_range
 
 __all__ = ["COMMANDS"]
 
@@ -57,15 +59,59 @@ def _jsonable(o: Any) -> Any:
     raise TypeError(type(o).__name__)
 
 
-def _check_plot_suffix(path: Path | None) -> None:
-    if path is not None and path.suffix.lower() not in (".png", ".svg", ".pdf"):
-        raise DesignError("--plot", str(path), "must end in .png, .svg or .pdf")
+def _check_output(option: str, path: Path | None, suffixes: tuple[str, ...] = (".png", ".svg", ".pdf")) -> None:
+    """Refuse, before anything is computed, an output file that could not be written."""
+    if path is None:
+        return
+    if path.suffix.lower() not in suffixes:
+        raise DesignError(option, str(path), "must end in " + ", ".join(suffixes[:-1]) + f" or {suffixes[-1]}")
+    if path.is_dir():
+        raise DesignError(option, str(path), "is a folder; give a file name")
+    folder = path.absolute().parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise DesignError(option, str(path), f"cannot be created: {folder} is a file, not a folder")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise DesignError(option, str(path), f"cannot be created: folder {folder} is not writable")
+
+
+def _check_input(name: str, path: Path | None) -> None:
+    if path is not None and not path.is_file():
+        raise DesignError(name, str(path), "is a folder, not a file" if path.is_dir() else "does not exist")
+
+
+@contextlib.contextmanager
+def _staged(**targets: Path | None) -> Iterator[dict[str, Path]]:
+    """Temporary files standing for the outputs ``targets``; all are moved into place only if the body succeeds.
+
+    The body writes each output to ``staged[name]`` (same suffix as its
+    target).  If it raises, no target is touched; if moving one fails, the
+    targets already moved that did not exist before are removed again.
+    """
+    from tabletcad.io import atomic_write_bytes
+
+    with tempfile.TemporaryDirectory(prefix="tabletcad-") as tmp:
+        staged = {k: Path(tmp) / f"{k}{p.suffix}" for k, p in targets.items() if p is not None}
+        yield staged
+        created: list[Path] = []
+        try:
+            for k, src in staged.items():
+                dst = targets[k]
+                existed = dst.exists()
+                atomic_write_bytes(dst, src.read_bytes())
+                if not existed:
+                    created.append(dst)
+        except BaseException:
+            for dst in created:
+                dst.unlink(missing_ok=True)
+            raise
 
 
 # --------------------------------------------------------------------------- heckel
 @click.command("heckel")
-@click.argument("data", type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.option("--meta", type=click.Path(exists=True, dir_okay=False, path_type=Path),
+@click.argument("data", type=click.Path(path_type=Path))
+@click.option("--meta", type=click.Path(path_type=Path),
               help="Metadata TOML (default: DATA's name with .toml, if present).")
 @click.option("--mass", type=float, help="Compact mass, mg.")
 @click.option("--true-density", type=float, help="True density, mg/mm³.")
@@ -82,7 +128,7 @@ def _check_plot_suffix(path: Path | None) -> None:
 @click.option("--force-unit", help="Unit of the force column (N, kN, daN, MN, mN, lbf, kgf); overrides the header.")
 @click.option("--displacement-unit", help="Unit of the displacement or thickness column (mm, µm, um, cm, m, in).")
 @click.option("--time-unit", help="Unit of the time column (s, ms, µs, min, h).")
-@click.option("--plot", "plot_file", type=click.Path(dir_okay=False, path_type=Path), help="Heckel plot (.png/.svg).")
+@click.option("--plot", "plot_file", type=click.Path(path_type=Path), help="Heckel plot (.png/.svg).")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: float | None,
                diameter: float | None, face_area: float | None, compliance: tuple[float, float] | None,
@@ -98,7 +144,14 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
     from tabletcad.mechanics.heckel import fit_heckel, plot_heckel
     from tabletcad.mechanics.pressdata import MachineCompliance, read_press_data
 
-    _check_plot_suffix(plot_file)
+    _check_input("DATA", data)
+    _check_input("--meta", meta)
+    _check_output("--plot", plot_file)
+    if window is not None:
+        check_finite("--window", window[0], "MPa")
+        check_positive("--window", window[1], "MPa")
+        if not window[0] < window[1]:
+            raise DesignError("--window", window, "must be two increasing pressures", "MPa")
     with _collect() as msgs:
         comp = MachineCompliance(slope=compliance[0], offset=compliance[1]) if compliance else None
         rec = read_press_data(
@@ -119,8 +172,9 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
         "elastic_recovery": curves.elastic_recovery,
         "metadata": rec.metadata.to_dict(),
     }
-    if plot_file is not None:
-        plot_heckel(fit, plot_file, title=f"Heckel plot: {data.name}")
+    with _staged(plot=plot_file) as out:
+        if plot_file is not None:
+            plot_heckel(fit, out["plot"], title=f"Heckel plot: {data.name}")
     lo, hi = fit.window_MPa
     how = fit.method if fit.noise_sd is None else f"auto: widest run linear within the noise σ = {fit.noise_sd:.3g}"
     _emit(payload, as_json, [
@@ -191,7 +245,7 @@ def strength_cmd(method: str, F: float, D, t, W, L, R, material, E, nu, radius, 
 @click.option("--material", default="kostrolith", show_default=True, help="Material key in tabletcad/data/materials.toml.")
 @click.option("--force", "forces", type=float, multiple=True, required=True, help="Platen force, N (repeatable).")
 @click.option("--radius", type=float, help="Sphere radius, mm (default: the material's).")
-@click.option("--plot", "plot_file", type=click.Path(dir_okay=False, path_type=Path),
+@click.option("--plot", "plot_file", type=click.Path(path_type=Path),
               help="Force-displacement plot (.png/.svg).")
 @click.option("--json", "as_json", is_flag=True)
 def contact_cmd(material: str, forces: tuple[float, ...], radius: float | None, plot_file: Path | None,
@@ -200,7 +254,11 @@ def contact_cmd(material: str, forces: tuple[float, ...], radius: float | None, 
     from tabletcad.mechanics import contact as ct
     from tabletcad.mechanics.materials import get_material
 
-    _check_plot_suffix(plot_file)
+    _check_output("--plot", plot_file)
+    for f in forces:
+        check_finite("--force", f, "N")
+    if radius is not None:
+        check_positive("--radius", radius, "mm")
     with _collect() as msgs:
         m = get_material(material)
         results = [ct.compress_sphere(f, m, radius) for f in forces]
@@ -212,8 +270,9 @@ def contact_cmd(material: str, forces: tuple[float, ...], radius: float | None, 
         "yield_force_eq2_1_N": curve.force_at_yield_ep, "yield_force_hertz_N": curve.force_at_yield_hertz,
         "results": [x.to_dict() for x in results], "warnings": msgs,
     }
-    if plot_file is not None:
-        ct.plot_force_displacement([curve], plot_file)
+    with _staged(plot=plot_file) as out:
+        if plot_file is not None:
+            ct.plot_force_displacement([curve], out["plot"])
     lines = [(f"{m.name}: r_s = {r:g} mm, yield at ω' = {wy * 1000:.4g} µm "
               f"(F = {curve.force_at_yield_ep:.4g} N by eq 2.1, {curve.force_at_yield_hertz:.4g} N by eq 5.19)")]
     for x in results:
@@ -233,17 +292,26 @@ def contact_cmd(material: str, forces: tuple[float, ...], radius: float | None, 
 @click.option("--psi", type=float, default=90.0, show_default=True, help="Half-angle of the loaded region, degrees.")
 @click.option("--region", type=click.Choice(["equator", "poles"]), default="equator", show_default=True)
 @click.option("--terms", type=int, default=400, show_default=True, help="Legendre orders kept.")
-@click.option("--csv", "csv_file", type=click.Path(dir_okay=False, path_type=Path), help="u_r(θ) table on both surfaces.")
-@click.option("--plot", "plot_file", type=click.Path(dir_okay=False, path_type=Path), help="u_r(θ) plot (.png/.svg).")
+@click.option("--csv", "csv_file", type=click.Path(path_type=Path), help="u_r(θ) table on both surfaces.")
+@click.option("--plot", "plot_file", type=click.Path(path_type=Path), help="u_r(θ) plot (.png/.svg).")
 @click.option("--json", "as_json", is_flag=True)
 def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file, as_json) -> None:
     """Radial displacement of a thick elastic spherical shell (section 6.2.3) by Legendre series."""
-    from tabletcad.errors import check_range
-    from tabletcad.io import atomic_write_text
     from tabletcad.mechanics.shell import plot_shell, solve_shell
 
-    _check_plot_suffix(plot_file)
+    _check_output("--csv", csv_file, (".csv",))
+    _check_output("--plot", plot_file)
+    if csv_file is not None and plot_file is not None and csv_file.absolute() == plot_file.absolute():
+        raise DesignError("--plot", str(plot_file), "must differ from --csv")
     check_range("--terms", terms, 2, 20000)
+    for name, v in (("--outer", a), ("--inner", b), ("--E", E)):
+        check_positive(name, v, "MPa" if name == "--E" else "mm")
+    if b >= a:
+        raise DesignError("--inner", b, f"must be < --outer = {a:g} mm (inner radius below outer)", "mm")
+    check_range("--nu", nu, -1.0, 0.5, lo_open=True, hi_open=True)
+    check_finite("--p-ext", p_ext, "MPa")
+    check_finite("--p-int", p_int, "MPa")
+    check_range("--psi", psi, 0, 90, "deg")
     with _collect() as msgs:
         sol = solve_shell(a, b, E, nu, p_ext=p_ext, p_int=p_int, psi=math.radians(check_range("--psi", psi, 0, 90, "deg")),
                           n_terms=terms, region=region)
@@ -268,12 +336,13 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
         "series_change_at_90deg_mm": eq - float(half),
         "warnings": msgs,
     }
-    if csv_file is not None:
-        rows = ["theta_deg,u_r_outer_mm,u_r_inner_mm"] + [f"{d:g},{x:.10g},{y:.10g}" for d, x, y in
-                                                        zip(np.degrees(th), ua, ub)]
-        atomic_write_text(csv_file, "\n".join(rows) + "\n")
-    if plot_file is not None:
-        plot_shell(sol, plot_file)
+    with _staged(csv=csv_file, plot=plot_file) as out:
+        if csv_file is not None:
+            rows = ["theta_deg,u_r_outer_mm,u_r_inner_mm"] + [f"{d:g},{x:.10g},{y:.10g}" for d, x, y in
+                                                            zip(np.degrees(th), ua, ub)]
+            out["csv"].write_text("\n".join(rows) + "\n", encoding="utf-8")
+        if plot_file is not None:
+            plot_shell(sol, out["plot"])
     _emit(payload, as_json, [
         (f"shell a = {a:g} mm, b = {b:g} mm, E = {E:g} MPa, ν = {nu:g}; p_ext = {p_ext:g} MPa over "
          f"{region} ψ = {psi:g}°, p_int = {p_int:g} MPa; {terms} orders"),
@@ -298,8 +367,17 @@ def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json) -> None:
     from tabletcad.mechanics.love import simulate_compression
 
     lo, hi = window
-    if not 0 < lo < hi:
+    if not (math.isfinite(hi) and 0 < lo < hi):
         raise DesignError("--window", window, "must be two increasing positive pressures", "MPa")
+    # every option is checked here, by its own name, before the model runs
+    check_positive("--E", E, "MPa")
+    check_range("--nu", nu, 0.0, 0.5, hi_open=True)
+    check_positive("--h0", h0, "mm")
+    check_range("--z", z, 0.0, None, "mm")
+    if r is not None:
+        check_positive("--r", r, "mm")  # (r <= die radius is checked by the model)
+    if omega_z0 is not None:
+        check_finite("--omega-z0", omega_z0, "mm")
     with _collect() as msgs:
         sim = simulate_compression(np.linspace(lo, hi, 41), E=E, nu=nu, h0=h0, z=z, r=r, omega_z0=omega_z0)
     f = sim.heckel
