@@ -311,3 +311,16 @@ def test_cp1252_micro_sign_comments_and_inch(tmp_path):
     assert np.allclose(d.force, [44.482216152605, 88.96443230521], rtol=1e-14)
     assert np.allclose(d.thickness, [5.0, 4.9]) and d.time is None
     assert list(d.line_numbers) == [4, 5]
+
+
+def test_fast_and_line_by_line_reading_agree(tmp_path):
+    """A record without comments inside is split in one go; a '#' line in the body forces the row-by-row reader."""
+    lines = SAMPLE.read_text().splitlines()
+    fast = read_press_data(_write(tmp_path, "\n".join(lines) + "\n", "fast.csv"), SAMPLE_META)
+    slow_lines = lines[:20] + ["# a remark in the middle", ""] + lines[20:]
+    slow = read_press_data(_write(tmp_path, "\n".join(slow_lines) + "\n", "slow.csv"), SAMPLE_META)
+    assert np.array_equal(fast.force, slow.force) and np.array_equal(fast.thickness, slow.thickness)
+    assert list(slow.line_numbers[:15]) == list(fast.line_numbers[:15])  # 4 comments, header, 15 rows
+    assert np.array_equal(slow.line_numbers[15:], fast.line_numbers[15:] + 2)
+    with pytest.raises(DesignError, match="line 4 = 4 is not allowed: has more cells than the 2 headers"):
+        read_press_data(_write(tmp_path, "force,displacement\n1,-5\n2,-4.9\n3,-4.8,7\n"), **META)

@@ -55,7 +55,7 @@ from __future__ import annotations
 import csv
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -352,31 +352,50 @@ def _sniff_delimiter(lines: list[str]) -> str:
     return "\t" if "\t" in head else ";" if head.count(";") > head.count(",") else ","
 
 
-def _read_table(text: str, source: str) -> tuple[list[str], list[int], list[list[str]], str]:
-    """Header, 1-based line numbers and cells (unstripped) of the data rows, and the delimiter."""
-    numbered = [(i + 1, ln) for i, ln in enumerate(text.splitlines()) if ln.strip() and not ln.lstrip().startswith("#")]
-    if not numbered:
+_COMMENT_OR_BLANK = re.compile(r"(?:^|\n)[ \t]*(?:#|\n|$)")
+
+
+def _read_table(text: str, source: str) -> tuple[list[str], list[int], list[Sequence[str]], str]:
+    """Header, 1-based line numbers of the data rows, the cells column by column, and the delimiter."""
+    all_lines = text.splitlines()
+    first = next((i for i, ln in enumerate(all_lines) if ln.strip() and not ln.lstrip().startswith("#")), None)
+    if first is None:
         raise DesignError("data", source, "is empty")
-    lines = [ln for _, ln in numbered]
-    delim = _sniff_delimiter(lines)
-    if '"' in text:
-        rows = list(csv.reader(lines, delimiter=delim))
-    else:  # no quoting: a plain split is the same and ten times faster on long records
-        rows = [ln.split(delim) for ln in lines]
-    header = [h.strip() for h in rows[0]]
-    return header, [i for i, _ in numbered[1:]], rows[1:], delim
+    delim = _sniff_delimiter([ln for ln in all_lines[first: first + 40] if ln.strip() and not ln.lstrip().startswith("#")])
+    header = [h.strip() for h in next(csv.reader([all_lines[first]], delimiter=delim))]
+    ncol = len(header)
+    body = "\n".join(all_lines[first + 1:])
+    if body and '"' not in text and _COMMENT_OR_BLANK.search(body) is None:
+        # fast path for long records: no quotes, comments or blank lines; every row checked to hold ncol cells
+        codes = np.frombuffer(body.encode("utf-8"), dtype=np.uint8)
+        ends = np.append(np.flatnonzero(codes == 10), codes.size)
+        seps = np.searchsorted(np.flatnonzero(codes == ord(delim)), ends)
+        if np.all(np.diff(seps, prepend=0) == ncol - 1):
+            flat = body.replace("\n", delim).split(delim)
+            numbers = list(range(first + 2, first + 2 + ends.size))
+            return header, numbers, [flat[j::ncol] for j in range(ncol)], delim
+    numbered = [(i + 1, ln) for i, ln in enumerate(all_lines[first + 1:], start=first + 1)
+                if ln.strip() and not ln.lstrip().startswith("#")]
+    rows = list(csv.reader([ln for _, ln in numbered], delimiter=delim))
+    for k, cells in enumerate(rows):
+        if len(cells) != ncol:
+            if len(cells) > ncol and any(c.strip() for c in cells[ncol:]):
+                raise DesignError(f"line {numbered[k][0]}", len(cells), f"has more cells than the {ncol} headers")
+            rows[k] = (cells + [""] * ncol)[:ncol]
+    columns = [list(col) for col in zip(*rows)] if rows else [[] for _ in header]
+    return header, [i for i, _ in numbered], columns, delim
 
 
-def _parse_column(cells: tuple[str, ...], exponent: int | None, decimal_comma: bool) -> np.ndarray | int:
+def _parse_column(cells: Sequence[str], exponent: int | None, decimal_comma: bool) -> np.ndarray | int:
     """A column of cells as floats (``exponent`` as in :func:`_to_float`, missing values NaN).
 
     Returns the row index of the first cell that is not a number instead.
     """
     try:  # fast path: every cell a plain number
         if decimal_comma:
-            cells = tuple("\n".join(cells).replace(",", ".").split("\n"))
+            cells = "\n".join(cells).replace(",", ".").split("\n")
         if exponent and not any(("e" in c or "E" in c) for c in cells):
-            cells = tuple(c.strip() + f"e{exponent}" for c in cells)
+            cells = [c.strip() + f"e{exponent}" for c in cells]
         elif exponent:
             raise ValueError
         return np.array(cells, dtype=float)
@@ -497,7 +516,7 @@ def read_press_data(
         role: unit_factor(u, DIMENSIONS[role], f"--{'displacement' if role == 'thickness' else role}-unit")
         for role, u in units.items()
     }
-    header, line_numbers, rows, delim = _read_table(_decode(path.read_bytes(), path.name), path.name)
+    header, line_numbers, by_column, delim = _read_table(_decode(path.read_bytes(), path.name), path.name)
     found: dict[str, list[int]] = {r: [] for r in ROLES}
     for j, h in enumerate(header):
         r = _role(h)
@@ -531,17 +550,11 @@ def read_press_data(
         factors[j] = (1.0, 0) if u is None else unit_factor(
             u, DIMENSIONS[r], f"unit of column {header[j]!r} (or give --{unit_role}-unit)")
     used = {roles["force"], roles[pos_role]} | ({roles["time"]} if "time" in roles else set())
-    ncol = len(header)
-    for k, cells in enumerate(rows):
-        if len(cells) != ncol:
-            if len(cells) > ncol and any(c.strip() for c in cells[ncol:]):
-                raise DesignError(f"line {line_numbers[k]}", len(cells), f"has more cells than the {ncol} headers")
-            rows[k] = (cells + [""] * ncol)[:ncol]
-    decimal_comma = delim != "," and any("," in c for cells in rows[:50] for c in cells)
-    by_column = list(zip(*rows)) if rows else [() for _ in header]
-    values = np.full((len(rows), ncol), np.nan)
+    nrow = len(line_numbers)
+    decimal_comma = delim != "," and any("," in c for col in by_column for c in col[:50])
+    values = np.full((nrow, len(header)), np.nan)
     numeric_cols = []
-    for j in range(ncol):
+    for j in range(len(header)):
         col = _parse_column(by_column[j], factors.get(j, (1.0, 0))[1], decimal_comma)
         if isinstance(col, np.ndarray):
             values[:, j] = col
@@ -549,7 +562,7 @@ def read_press_data(
         elif j in used:
             raise DesignError(f"{header[j]} (line {line_numbers[col]})", by_column[j][col].strip(), "must be a number")
         # else: a non-numeric optional column is ignored entirely
-    del by_column
+        by_column[j] = []  # free the text as soon as it is read
     for j, (factor, exponent) in factors.items():
         if exponent is None:
             values[:, j] *= factor
