@@ -322,5 +322,5 @@ def test_fast_and_line_by_line_reading_agree(tmp_path):
     assert np.array_equal(fast.force, slow.force) and np.array_equal(fast.thickness, slow.thickness)
     assert list(slow.line_numbers[:15]) == list(fast.line_numbers[:15])  # 4 comments, header, 15 rows
     assert np.array_equal(slow.line_numbers[15:], fast.line_numbers[15:] + 2)
-    with pytest.raises(DesignError, match="line 4 = 4 is not allowed: has more cells than the 2 headers"):
+    with pytest.raises(DesignError, match="line 4 = 3 is not allowed: has more cells than the 2 headers"):
         read_press_data(_write(tmp_path, "force,displacement\n1,-5\n2,-4.9\n3,-4.8,7\n"), **META)
