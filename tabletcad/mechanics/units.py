@@ -5,7 +5,7 @@ Press exports label their columns ``Upper Punch Force (kN)``, ``Force [daN]``,
 header and :func:`unit_factor` gives the factor to tabletcad's units (force N,
 length mm, time s).  The table is small and explicit on purpose: the mechanics
 core must import with numpy and scipy alone (it runs inside FreeCAD's Python),
-and these 25 linear factors are all a press record needs (README, "Libraries
+and these 23 linear factors are all a press record needs (README, "Libraries
 and why").
 
 Power-of-ten factors (kN, daN, MN, mN, µm, cm, m, ms, µs) are stored as their
