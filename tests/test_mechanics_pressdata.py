@@ -251,6 +251,11 @@ def test_units_override_headers_and_columns_are_chosen(tmp_path):
     assert np.array_equal(d.force, ref.force) and "Lower Punch Force (kN)" in d.extra
     d = read_press_data(lower, SAMPLE_META, columns={"force": "2"})
     assert np.array_equal(d.force, ref.force)
+    # an unrecognised header can be given a role; the column it takes is not offered to its own role
+    renamed = tmp_path / "renamed.csv"
+    renamed.write_text(lower.read_text().replace("Punch displacement (µm)", "Weg (µm)"))
+    d = read_press_data(renamed, SAMPLE_META, columns={"displacement": "Weg (µm)", "force": "Lower Punch Force (kN)"})
+    assert np.allclose(d.force, 1.0) and np.array_equal(d.displacement, ref.displacement)
     # the same file declared in other units: the option wins over the header
     d = read_press_data(p, SAMPLE_META, units={"force": "N", "displacement": "mm", "time": "s"})
     assert np.allclose(d.force * 1000.0, ref.force, rtol=1e-14)
@@ -266,6 +271,8 @@ def test_units_override_headers_and_columns_are_chosen(tmp_path):
         ("Force;Displacement", {"units": {"force": "stone"}}, "--force-unit = 'stone' is not allowed"),
         ("Force;Displacement", {"units": {"time": "mm"}}, "--time-unit = 'mm'"),
         ("Force;Displacement", {"columns": {"force": "Kraft"}}, "--force-column = 'Kraft'"),
+        ("Force;Displacement", {"columns": {"force": "2", "displacement": "2"}},
+         "--displacement-column = '2' is not allowed: is already the force column"),
         ("Force;Upper punch position (mm);Lower punch position (mm)", {}, "--displacement-column"),
     ],
 )

@@ -523,10 +523,18 @@ def read_press_data(
         if r is not None:
             found[r].append(j)
     roles: dict[str, int] = {}
-    for r in ROLES:
-        j = _pick(r, header, found[r], columns.get(r))
-        if j is not None:
+    for r in ROLES:  # columns chosen by option first; a chosen column plays no other role
+        if r in columns:
+            j = _pick(r, header, [], columns[r])
+            if j in roles.values():
+                other = next(k for k, v in roles.items() if v == j)
+                raise DesignError(f"--{r}-column", columns[r], f"is already the {other} column")
             roles[r] = j
+    for r in ROLES:
+        if r not in columns:
+            j = _pick(r, header, [k for k in found[r] if k not in roles.values()], None)
+            if j is not None:
+                roles[r] = j
     if "force" not in roles:
         raise DesignError("columns", header, "need a force column (header containing 'force' or 'load')")
     if "thickness" in columns:
