@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import shutil
 import subprocess
 import sys
@@ -258,3 +259,30 @@ def test_plot_under_a_file_is_refused_before_computing(capsys, tmp_path, cmd):
     rc, _, err = run(capsys, *cmd, "--plot", tmp_path / "blk" / "x.png")
     _one_line_error(rc, err, "--plot")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["blk"]
+
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+_TOKENS = st.sampled_from([
+    "force", "Upper Punch Force (kN)", "Lower punch force [N]", "displacement", "Punch distance (µm)", "gap",
+    "Time [ms]", "thickness (furlong)", "load", "x", "1", "-5", "0,5", "2.5e3", "nan", "inf", "-", "", "1e400",
+    "#", '"', ",", ";", "\t", "\n", "\n", "\n", " ", "é", "\x00",
+])
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(body=st.lists(_TOKENS, min_size=0, max_size=60), window=st.booleans())
+def test_fuzzed_press_files_keep_the_one_line_contract(capsys, tmp_path, body, window):
+    data = tmp_path / "fuzz.csv"
+    data.write_text("".join(body), encoding="utf-8")
+    plot = tmp_path / "fuzz.png"
+    args = ["heckel", data, "--mass", 300, "--true-density", 1.3, "--diameter", 10, "--json"]
+    rc, out, err = run(capsys, *args, *(["--window", 1, 100] if window else []))
+    assert rc in (0, 2) and "Traceback" not in err
+    if rc == 2:
+        errors = [ln for ln in err.splitlines() if ln.startswith("error: ")]
+        assert len(errors) == 1 and err.splitlines()[-1] == errors[0] and " is not allowed: " in errors[0]
+        assert not plot.exists()
+    else:
+        assert math.isfinite(json.loads(out)["K_per_MPa"])

@@ -331,3 +331,12 @@ def test_fast_and_line_by_line_reading_agree(tmp_path):
     assert np.array_equal(slow.line_numbers[15:], fast.line_numbers[15:] + 2)
     with pytest.raises(DesignError, match="line 4 = 3 is not allowed: has more cells than the 2 headers"):
         read_press_data(_write(tmp_path, "force,displacement\n1,-5\n2,-4.9\n3,-4.8,7\n"), **META)
+
+
+def test_utf16_without_bom_and_tensile_forces(tmp_path):
+    p = tmp_path / "u16.csv"
+    p.write_bytes("force,displacement\n1,-5\n2,-4.9\n3,-4.8\n".encode("utf-16-le"))
+    assert np.allclose(read_press_data(p, **META).force, [1, 2, 3])
+    neg = _write(tmp_path, "force,displacement\n-1,5\n-2,4.5\n-3,4\n", "neg.csv")
+    with pytest.raises(DesignError, match=r"force \(row 1\) = -1 N is not allowed: has no loading branch"):
+        compaction_curves(read_press_data(neg, **META))

@@ -332,9 +332,12 @@ def _role(header: str) -> str | None:
 
 
 def _decode(raw: bytes, source: str) -> str:
-    """UTF-8 (with or without BOM), UTF-16 with BOM, else Windows-1252 (old exports write µ as 0xB5)."""
+    """UTF-8 (with or without BOM), UTF-16 (with or without BOM), else Windows-1252 (µ as the byte 0xB5)."""
     if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
         return raw.decode("utf-16")
+    head = raw[:4096]
+    if head.count(0) > len(head) // 4:  # UTF-16 without BOM: every other byte of ASCII text is 0
+        return raw.decode("utf-16-le" if head[1::2].count(0) > head[0::2].count(0) else "utf-16-be", errors="replace")
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError:
