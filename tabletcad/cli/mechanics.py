@@ -120,7 +120,7 @@ def _staged(**targets: Path | None) -> Iterator[dict[str, Path]]:
 @click.option("--compliance", nargs=2, type=float, metavar="SLOPE OFFSET",
               help="Machine deflection δ = SLOPE·F + OFFSET (mm/N, mm) added to the punch gap.")
 @click.option("--window", nargs=2, type=float, metavar="LO HI",
-              help="Pressure window in MPa; default: automatic linear-region rule.")
+              help="Pressure window in MPa; default: the widest run straight within the data's noise.")
 @click.option("--force-column", help="Header (or 1-based number) of the force column, e.g. 'Upper Punch Force (kN)'.")
 @click.option("--displacement-column", help="Header (or number) of the punch displacement/position column.")
 @click.option("--thickness-column", help="Header (or number) of a thickness/gap column to use instead of displacement.")
@@ -137,8 +137,10 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
                displacement_unit: str | None, time_unit: str | None, plot_file: Path | None, as_json: bool) -> None:
     """Heckel analysis (eqs 2.2-2.3) of the loading branch of a press record DATA (CSV/TSV).
 
-    Units are read from the headers (``Force (kN)``, ``Time [ms]``...) and
+    Units are read from the headers ('Force (kN)', 'Time [ms]', ...) and
     converted to N, mm and s; the options override units and choose columns.
+    Without --window the window is the widest run of points that is straight
+    within the record's own noise (README, "Compaction mechanics").
     """
     from tabletcad.mechanics.compaction import compaction_curves
     from tabletcad.mechanics.heckel import fit_heckel, plot_heckel
