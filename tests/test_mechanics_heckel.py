@@ -229,6 +229,9 @@ def test_appendix_b_auto_window():
     assert fit.A == pytest.approx(0.90327, rel=1e-4)
     assert fit.Py_MPa == pytest.approx(116.87, rel=1e-4)
     assert fit.r2 > 0.999
+    # the thesis's 10-50 MPa window scatters 9.4x the record's noise about its line
+    thesis = fit_heckel(compaction_curves(read_press_data(SAMPLE)), window=(10.0, 50.0))
+    assert thesis.residual_sd / fit.noise_sd == pytest.approx(9.4, abs=0.05)
 
 
 def test_exact_line_is_one_window_and_bad_parameters():
