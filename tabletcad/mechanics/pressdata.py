@@ -319,7 +319,7 @@ _ROLE_PATTERNS = (
     ("displacement", re.compile(r"displacement|disp\b|disp\.|position|distance|travel|stroke")),
     ("time", re.compile(r"^time|\btime\b")),
 )
-#: column roles, and the option that chooses a column for each
+#: column roles: the keys of ``columns=`` and ``units=`` (the CLI's ``--<role>-column``)
 ROLES = ("force", "displacement", "thickness", "time")
 
 
@@ -331,7 +331,7 @@ def _role(header: str) -> str | None:
     return None
 
 
-def _decode(raw: bytes, source: str) -> str:
+def _decode(raw: bytes) -> str:
     """UTF-8 (with or without BOM), UTF-16 (with or without BOM), else Windows-1252 (µ as the byte 0xB5)."""
     if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
         return raw.decode("utf-16")
@@ -519,7 +519,7 @@ def read_press_data(
         role: unit_factor(u, DIMENSIONS[role], f"--{'displacement' if role == 'thickness' else role}-unit")
         for role, u in units.items()
     }
-    header, line_numbers, by_column, delim = _read_table(_decode(path.read_bytes(), path.name), path.name)
+    header, line_numbers, by_column, delim = _read_table(_decode(path.read_bytes()), path.name)
     found: dict[str, list[int]] = {r: [] for r in ROLES}
     for j, h in enumerate(header):
         r = _role(h)
