@@ -53,6 +53,40 @@ def pytest_make_collect_report(collector):
     outcome = yield
     _fail_skip_in_ci(outcome.get_result())
 
+# --------------------------------------------------------------------------- core-only run
+# .ci/test runs the suite a second time in .venv-oldest (the oldest numpy/scipy pyproject
+# claims, no CAD library) with TABLETCAD_CORE_ONLY=1: files whose module-level ``pytestmark``
+# names the cad or freecad marker are not collected, and tests marked cad or freecad are
+# deselected.  Everything else must pass there too.
+_CORE_ONLY = bool(os.environ.get("TABLETCAD_CORE_ONLY"))
+_CAD_MARKS = ("cad", "freecad")
+
+
+def _file_needs_cad(path) -> bool:
+    import re
+
+    text = path.read_text(encoding="utf-8")
+    m = re.search(r"^pytestmark\s*=\s*(.+)$", text, re.MULTILINE)
+    return bool(m) and any(f"mark.{name}" in m.group(1) for name in _CAD_MARKS)
+
+
+def pytest_ignore_collect(collection_path, config):
+    if _CORE_ONLY and collection_path.suffix == ".py" and collection_path.name.startswith("test_"):
+        return _file_needs_cad(collection_path) or None
+    return None
+
+
+def pytest_collection_modifyitems(config, items):
+    if not _CORE_ONLY:
+        return
+    keep, drop = [], []
+    for item in items:
+        (drop if any(item.get_closest_marker(m) for m in _CAD_MARKS) else keep).append(item)
+    if drop:
+        config.hook.pytest_deselected(items=drop)
+        items[:] = keep
+
+
 try:  # hypothesis is a test dependency, but keep collection working without it
     from hypothesis import HealthCheck, settings
 

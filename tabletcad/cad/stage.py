@@ -19,6 +19,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+import OCP  # noqa: F401  (no OpenCascade: ImportError, and the build writes the core outputs only)
+
 from tabletcad.build import register_stage
 from tabletcad.errors import GeometryError
 from tabletcad.tablet import Tablet
