@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tabletcad.basis import cardinal, cardinal_coefficients
+from tabletcad.basis import cardinal, cardinal_coefficients, cardinals
 from tabletcad.curves import CurveLike, fourier_coefficients, modes_needed, sample_v
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
@@ -307,18 +307,18 @@ class PDEPatch:
             out += (L0 @ self._a0)[:, None, :]
         if self._active:
             n = np.array(self._active)
-            A = np.empty((n.size, u.size, 3))
-            B = np.empty((n.size, u.size, 3))
-            for i, k in enumerate(n):
-                L = cardinal(u, self._lams[k], self.u_nodes, self.form, du)
-                A[i] = L @ self._ac[:, k - 1]
-                B[i] = L @ self._bc[:, k - 1]
-            c, s = _trig(v, n, dv)  # (nv, len(n))
-            out += np.einsum("nuc,vn->uvc", A, c, optimize=True) + np.einsum("nuc,vn->uvc", B, s, optimize=True)
+            L = cardinals(u, self._lams[n], self.u_nodes, self.form, du)  # (n, nu, 4)
+            A = np.matmul(L, self._ac[:, n - 1].transpose(1, 0, 2))  # (n, nu, 3)
+            B = np.matmul(L, self._bc[:, n - 1].transpose(1, 0, 2))
+            c, s = _trig(v, n, dv)  # (nv, n)
+            # one matrix product: (nu*3, n+n) @ (n+n, nv)
+            AB = np.concatenate([A, B]).reshape(2 * n.size, -1)
+            cs = np.concatenate([c, s], axis=1)
+            out += (cs @ AB).reshape(v.size, u.size, 3).transpose(1, 0, 2)
         if self._has_remainder:
             L = cardinal(u, self._beta, self.u_nodes, self.form, du)  # (nu, 4)
             r = np.stack([self._residual(k, v, dv) for k in range(4)])  # (4, nv, 3)
-            out += np.einsum("uk,kvc->uvc", L, r, optimize=True)
+            out += (L @ r.reshape(4, -1)).reshape(u.size, v.size, 3)
         return out
 
     def spine(self, u, du: int = 0) -> np.ndarray:
