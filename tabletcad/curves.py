@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -447,6 +448,16 @@ def fourier_coefficients(curve: CurveLike, modes: int, samples: int | None = Non
     return a0, a, b
 
 
+@lru_cache(maxsize=8)
+def _trig_table(m: int, modes: int) -> tuple[np.ndarray, np.ndarray]:
+    """``cos(n v_j)``, ``sin(n v_j)`` for ``v_j = 2πj/m`` and ``n = 1..modes``, shape (m, modes), read-only."""
+    nv = np.outer(sample_v(m), np.arange(1, modes + 1))
+    c, s = np.cos(nv), np.sin(nv)
+    c.setflags(write=False)
+    s.setflags(write=False)
+    return c, s
+
+
 def modes_needed(curve: CurveLike, tol: float | None = None, max_modes: int = 256, samples: int | None = None) -> int:
     """Fewest modes ``N`` whose truncated series is within ``tol`` (mm) of the curve.
 
@@ -456,19 +467,20 @@ def modes_needed(curve: CurveLike, tol: float | None = None, max_modes: int = 25
     """
     tol = DEFAULT.fourier if tol is None else tol
     m = samples or 4096
-    v = sample_v(m)
-    pts = curve.evaluate(v)
+    pts = curve.evaluate(sample_v(m))
     a0, a, b = fourier_coefficients(curve, max_modes, samples=max(4 * max_modes + 8, 1024))
-    n = np.arange(1, max_modes + 1)
-    cos = np.cos(np.outer(v, n))
-    sin = np.sin(np.outer(v, n))
-    # error of truncation at every N, computed cumulatively
+    cos, sin = _trig_table(m, max_modes)
+    # error of truncation at every N, sixteen N at a time (running sums of the modes)
     approx = np.broadcast_to(a0, pts.shape).copy()
-    err0 = np.max(np.linalg.norm(pts - approx, axis=1))
-    if err0 <= tol:
+    if np.max(np.linalg.norm(pts - approx, axis=1)) <= tol:
         return 0
-    for k in range(max_modes):
-        approx += np.outer(cos[:, k], a[k]) + np.outer(sin[:, k], b[k])
-        if np.max(np.linalg.norm(pts - approx, axis=1)) <= tol:
-            return k + 1
+    for k0 in range(0, max_modes, 16):
+        k1 = min(k0 + 16, max_modes)
+        terms = cos[:, k0:k1, None] * a[None, k0:k1] + sin[:, k0:k1, None] * b[None, k0:k1]  # (m, block, 3)
+        run = approx[:, None, :] + np.cumsum(terms, axis=1)
+        err = np.max(np.linalg.norm(pts[:, None, :] - run, axis=2), axis=0)
+        ok = np.flatnonzero(err <= tol)
+        if ok.size:
+            return k0 + int(ok[0]) + 1
+        approx = run[:, -1, :]
     return max_modes + 1
