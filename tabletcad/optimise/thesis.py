@@ -181,6 +181,14 @@ def min_height_slope(heights) -> float:
     return min(c1 + 2 * c2 * u + 3 * c3 * u * u for u in cand)
 
 
+def _update_initial(init: dict, initial: dict | None) -> None:
+    """Override starting values by variable name; an unknown name is refused (not ignored)."""
+    for k in initial or {}:
+        if k not in init:
+            raise DesignError(f"initial {k}", initial[k], "is not a variable; variables are " + ", ".join(init))
+    init.update(initial or {})
+
+
 def free_form_toml(tablet: Tablet, sections, *, name: str, comment: str = "") -> str:
     """A ``free_form`` design file (``[[patch]]`` circle curves, ``"previous"``) for ``tabletcad build``."""
     lines = []
@@ -280,7 +288,7 @@ def flat_faced_round_problem(
     rlo, rhi = radius_bounds
     init = dict(r_P21=5.0, r_d21=5.0, r_d22=5.0, r_P22=5.0, z_d21=1.0, z_d22=2.0, z_P22=3.0,
                 P=float(np.mean(P_bounds)), A=float(np.mean(A_bounds)))
-    init.update(initial or {})
+    _update_initial(init, initial)
     vs = [Variable(n, rlo, rhi, init[n], "mm") for n in ("r_P21", "r_d21", "r_d22", "r_P22")]
     vs += [Variable(n, 0.0, height_max, init[n], "mm") for n in ("z_d21", "z_d22", "z_P22")]
     vs += [Variable("P", P_bounds[0], P_bounds[1], init["P"], "MPa"), Variable("A", A_bounds[0], A_bounds[1], init["A"])]
@@ -410,7 +418,7 @@ def spherical_tablet_problem(
     hh = 0.93 * (reference_radius or r0)  # half-height of the start: 7 % flatter than the reference sphere
     init = dict(r_P21=r0, r_d21=0.87 * r0, r_d22=0.55 * r0, r_P22=k_rc * r0,
                 z_d21=ze + 0.5 * hh, z_d22=ze + 0.85 * hh, z_P22=ze + hh)
-    init.update(initial or {})
+    _update_initial(init, initial)
     vs = [Variable("r_P21", rb[0], rb[1], init["r_P21"], "mm")]
     vs += [Variable(n, 0.0, rb[1], init[n], "mm") for n in ("r_d21", "r_d22", "r_P22")]
     vs += [Variable(n, ze, ze + 1.2 * rb[1], init[n], "mm") for n in ("z_d21", "z_d22", "z_P22")]
@@ -547,7 +555,7 @@ def softgel_capsule_problem(*, model: str = "lame", E: float = GELATIN["E"], nu:
     """
     st = THESIS_RESULTS["softgel_capsule"]["start"]
     init = dict(st)
-    init.update(initial or {})
+    _update_initial(init, initial)
     vs = [Variable("P_ext", GELATIN["P_ext"][0], GELATIN["P_ext"][1], init["P_ext"], "MPa"),
           Variable("r_d22", 1.0, 1.6, init["r_d22"], "mm"),
           Variable("a", 2.2, 3.0, init["a"], "mm"),
