@@ -129,18 +129,23 @@ def plain_name(where: str, v: Any) -> str:
 
 
 def pair(where: str, v: Any, unit: str = "", *, lo: float = 0.0, lo_open: bool = True) -> tuple[float, float]:
-    """Two numbers ``[lower, upper]`` with ``lo < lower <= upper``."""
+    """Two numbers ``[lower, upper]`` with ``lo < lower <= upper <= LIMITS[unit]``."""
     if not isinstance(v, list) or len(v) != 2:
         raise DesignError(where, _shown(v), f"must be two numbers [lower, upper]{' in ' + unit if unit else ''}")
-    a = number(f"{where} lower", v[0], unit, lo=lo, lo_open=lo_open)
-    b = number(f"{where} upper", v[1], unit, lo=lo, lo_open=lo_open)
+    hi = LIMITS.get(unit, 1e6)
+    a = number(f"{where} lower", v[0], unit, lo=lo, lo_open=lo_open, hi=hi)
+    b = number(f"{where} upper", v[1], unit, lo=lo, lo_open=lo_open, hi=hi)
     if a > b:
         raise DesignError(where, v, "must have lower <= upper", unit)
     return a, b
 
 
+#: Largest accepted magnitude per unit: generous for tablets, small enough that nothing overflows or runs for minutes.
+LIMITS = {"mm": 1000.0, "deg": 180.0, "mm2": 1e6, "mm3": 1e9, "mg": 1e9, "mg/mm3": 100.0, "MPa": 1e6, "N": 1e6, "": 1e6}
+
+
 def _positive(unit: str = "") -> Callable[[str, Any], float]:
-    return lambda w, v: number(w, v, unit, lo=0.0, lo_open=True)
+    return lambda w, v: number(w, v, unit, lo=0.0, lo_open=True, hi=LIMITS.get(unit, 1e6))
 
 
 def _poisson(w: str, v: Any) -> float:
@@ -166,7 +171,7 @@ def _initial(w: str, v: Any) -> dict:
     """Starting values by variable name (the names are checked against the problem's variables)."""
     if not isinstance(v, dict):
         raise DesignError(w, _shown(v), "must be a table of variable = starting value")
-    return {k: number(f"{w} {k}", val) for k, val in v.items()}
+    return {k: number(f"{w} {k}", val, lo=-LIMITS[""], hi=LIMITS[""]) for k, val in v.items()}
 
 
 #: Accepted ``[parameters]`` of the thesis problems (keyword arguments of ``thesis.<kind>_problem``).
@@ -175,14 +180,14 @@ THESIS_PARAMETERS: dict[str, dict[str, Callable[[str, Any], Any]]] = {
         mass_mg=_positive("mg"), true_density=_positive("mg/mm3"), E=_positive("MPa"), nu=_poisson,
         volume=_positive("mm3"), radius_bounds=_pairs("mm"), height_max=_positive("mm"), P_bounds=_pairs("MPa"),
         A_bounds=_pairs(), displacement=_choices("derived", "thesis"),
-        omega_z0=lambda w, v: number(w, v, "mm"), initial=_initial),
+        omega_z0=lambda w, v: number(w, v, "mm", lo=-LIMITS["mm"], hi=LIMITS["mm"]), initial=_initial),
     "spherical_tablet": dict(
         variant=_choices("a", "b"), force_bounds=_pairs("N"), radius_bounds=_pairs("mm"), volume=_positive("mm3"),
         material=_table(dict(E=_positive("MPa"), nu=_poisson, s_y=_positive("MPa"))),
         reference_radius=_positive("mm"), initial=_initial),
     "softgel_capsule": dict(
         model=_choices("lame", "band", "none"), E=_positive("MPa"), nu=_poisson,
-        P_int=lambda w, v: number(w, v, "MPa", lo=0.0), radius_constraints=lambda w, v: boolean(w, v),
+        P_int=lambda w, v: number(w, v, "MPa", lo=0.0, hi=LIMITS["MPa"]), radius_constraints=lambda w, v: boolean(w, v),
         initial=_initial),
 }
 
@@ -273,12 +278,14 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) ->
         if "lower" not in spec or "upper" not in spec:
             raise DesignError(f"[variables] {name}", spec, "needs lower and upper")
         unit = fam.params[name]
-        lo = number(f"[variables] {name} lower", spec["lower"], unit, lo=0.0)
-        hi = number(f"[variables] {name} upper", spec["upper"], unit, lo=0.0)
-        x0 = None if "initial" not in spec else number(f"[variables] {name} initial", spec["initial"], unit, lo=0.0)
+        lim = LIMITS.get(unit, LIMITS[""])
+        lo = number(f"[variables] {name} lower", spec["lower"], unit, lo=0.0, hi=lim)
+        hi = number(f"[variables] {name} upper", spec["upper"], unit, lo=0.0, hi=lim)
+        x0 = None if "initial" not in spec else number(f"[variables] {name} initial", spec["initial"], unit, lo=0.0, hi=lim)
         vs.append(Variable(name, lo, hi, x0, unit))
     _check_keys("[fixed]", fixed, set(fam.params) - set(variables))
-    fixed = {k: number(f"[fixed] {k}", v, fam.params[k], lo=0.0) for k, v in fixed.items()}
+    fixed = {k: number(f"[fixed] {k}", v, fam.params[k], lo=0.0, hi=LIMITS.get(fam.params[k], LIMITS[""]))
+             for k, v in fixed.items()}
     sense = prob.get("sense", "max")
     name = prob.get("name", f"{fam_name}_optimum")
 
@@ -292,7 +299,7 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) ->
         unit, f = QUANTITIES[obj_spec]
         objective = Objective(f, obj_spec, unit)
     elif isinstance(obj_spec, dict) and set(obj_spec) == {"linear"} and isinstance(obj_spec["linear"], dict):
-        coef = {k: number(f"[problem] objective linear {k}", v) for k, v in obj_spec["linear"].items()}
+        coef = {k: number(f"[problem] objective linear {k}", v, lo=-LIMITS[""], hi=LIMITS[""]) for k, v in obj_spec["linear"].items()}
         for k in coef:
             if k not in variables:
                 raise DesignError("[problem] objective linear", k, "must name variables")
@@ -308,10 +315,10 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) ->
         q = choice(f"[[constraint]] {k} quantity", c.get("quantity"), tuple(QUANTITIES))
         unit, f = QUANTITIES[q]
         # every quantity is a size (>= 0): a target must be > 0, bounds >= 0
-        kw = {kk: number(f"[[constraint]] {k} {kk}", c[kk], unit, lo=0.0, lo_open=kk == "target")
+        kw = {kk: number(f"[[constraint]] {k} {kk}", c[kk], unit, lo=0.0, lo_open=kk == "target", hi=LIMITS[unit])
               for kk in ("target", "lower", "upper") if kk in c}
-        kw.update({kk: number(f"[[constraint]] {k} {kk}", c[kk], "" if kk == "tol" else unit, lo=0.0, lo_open=True)
-                   for kk in ("tol", "scale") if kk in c})
+        kw.update({kk: number(f"[[constraint]] {k} {kk}", c[kk], "" if kk == "tol" else unit, lo=0.0, lo_open=True,
+                              hi=LIMITS["" if kk == "tol" else unit]) for kk in ("tol", "scale") if kk in c})
         relative = boolean(f"[[constraint]] {k} relative", c["relative"]) if "relative" in c else False
         cname = c.get("name", q)
         if not isinstance(cname, str) or not cname.strip() or "\n" in cname:
