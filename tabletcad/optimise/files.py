@@ -180,7 +180,8 @@ THESIS_PARAMETERS: dict[str, dict[str, Callable[[str, Any], Any]]] = {
         mass_mg=_positive("mg"), true_density=_positive("mg/mm3"), E=_positive("MPa"), nu=_poisson,
         volume=_positive("mm3"), radius_bounds=_pairs("mm"), height_max=_positive("mm"), P_bounds=_pairs("MPa"),
         A_bounds=_pairs(), displacement=_choices("derived", "thesis"),
-        omega_z0=lambda w, v: number(w, v, "mm", lo=-LIMITS["mm"], hi=LIMITS["mm"]), initial=_initial),
+        omega_z0=lambda w, v: number(w, v, "mm", lo=-LIMITS["mm"], hi=LIMITS["mm"]),
+        density=_choices("volume", "cylinder"), initial=_initial),
     "spherical_tablet": dict(
         variant=_choices("a", "b"), force_bounds=_pairs("N"), radius_bounds=_pairs("mm"), volume=_positive("mm3"),
         material=_table(dict(E=_positive("MPa"), nu=_poisson, s_y=_positive("MPa"))),

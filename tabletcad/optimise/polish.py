@@ -119,9 +119,12 @@ def polish(ev: Evaluator, z) -> tuple[np.ndarray, str]:
         z = np.clip(zn, 0.0, 1.0)
         steps += 1
     if _feasible(ev, z):
+        rows = f"{int(active.sum())} active row{'s' if active.sum() != 1 else ''}"
+        if steps == 0:
+            return z, f"feasibility polish: the end point already lies on its {rows}"
         moved = float(np.max(np.abs(z - z0)))
-        return z, (f"feasibility polish: {int(active.sum())} active row{'s' if active.sum() != 1 else ''} landed "
-                   f"in {steps} step{'s' if steps != 1 else ''} (largest move {moved:.2g} of a variable's range)")
+        return z, (f"feasibility polish: {rows} landed in {steps} step{'s' if steps != 1 else ''} "
+                   f"(largest move {moved:.2g} of a variable's range)")
     return z0, "feasibility polish did not reach a feasible point"
 
 
