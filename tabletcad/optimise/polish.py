@@ -99,6 +99,7 @@ def polish(ev: Evaluator, z) -> tuple[np.ndarray, str]:
     fixed = (z0 <= 0.0) | (z0 >= 1.0)
     z = z0.copy()
     steps = 0
+    best, stalled = math.inf, 0
     while steps < MAX_STEPS:
         res = ev.residuals(z)
         if not np.all(np.isfinite(res)):
@@ -106,6 +107,13 @@ def polish(ev: Evaluator, z) -> tuple[np.ndarray, str]:
         active |= (~eq) & (res < 0.0)
         done = np.all(np.abs(res[active]) <= TARGET * tol[active])
         if done and np.all(res[~eq] > -tol[~eq]) and _feasible(ev, z):
+            break
+        # Gauss-Newton converges quadratically near a regular point: two steps without halving the
+        # worst active residual mean the active set cannot be met from here (e.g. an infeasible problem)
+        worst = float(np.max(np.abs(res[active]) / np.maximum(tol[active], 1e-300)))
+        stalled = stalled + 1 if worst > 0.5 * best else 0
+        best = min(best, worst)
+        if stalled >= 2:
             break
         free = ~fixed
         if not free.any():
