@@ -52,9 +52,20 @@ else:  # pragma: no cover
 
 __all__ = ["load_problem", "problem_from_dict", "family_problem", "QUANTITIES", "SOLVER_KEYS"]
 
+_LAST_PROPERTIES: list = [None, None]
+
+
+def _properties(t) -> dict:
+    """``t.properties()`` computed once per design: the objective and the constraints of one
+    point ask for volume and area of the same tablet in turn (one quadrature instead of two)."""
+    if _LAST_PROPERTIES[0] is not t:
+        _LAST_PROPERTIES[:] = [t, t.properties()]
+    return _LAST_PROPERTIES[1]
+
+
 QUANTITIES = {
-    "volume_mm3": ("mm3", lambda t: t.volume()),
-    "surface_area_mm2": ("mm2", lambda t: t.surface_area()),
+    "volume_mm3": ("mm3", lambda t: _properties(t)["volume_mm3"]),
+    "surface_area_mm2": ("mm2", lambda t: _properties(t)["surface_area_mm2"]),
     "plan_area_mm2": ("mm2", lambda t: t.plan_area()),
     "length_mm": ("mm", lambda t: t.dimensions()["length_mm"]),
     "width_mm": ("mm", lambda t: t.dimensions()["width_mm"]),
