@@ -60,7 +60,7 @@ BAD = [
     ("name_escape", FAMILY.replace('sense = "min"', 'sense = "min"\nname = "../../escape"'), "[problem] name"),
     ("name_on_thesis_kind", SPHERE.replace('kind = "spherical_tablet"', 'kind = "spherical_tablet"\nname = "x"'),
      "[problem] name"),
-    ("initial_unknown", SPHERE + "initial = { r_P21 = 0.72, bogus = 1.0 }\n", "initial bogus"),
+    ("initial_unknown", SPHERE + "initial = { r_P21 = 0.72, bogus = 1.0 }\n", "[parameters] initial bogus"),
     ("initial_string", SPHERE + 'initial = { r_P21 = "0.72" }\n', "[parameters] initial r_P21"),
     ("parameter_unknown", SPHERE + "diameter = 5.0\n", "[parameters] key 'diameter'"),
     ("top_unknown", SPHERE + "\n[extra]\na = 1\n", "top-level key 'extra'"),
@@ -96,6 +96,14 @@ def test_bad_file_one_line_exit_2_nothing_written(tmp_path, capsys, name, text, 
     # nothing written: no output folder, no staging folder, only the problem file itself
     assert not out.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["problem.toml"]
+
+
+@pytest.mark.parametrize("option, value", [("--maxiter", "0"), ("--maxiter", "1000001"), ("--starts", "-1"),
+                                           ("--starts", "99999999")])
+def test_bad_cli_solver_options(tmp_path, capsys, option, value):
+    rc, err, out = _run(tmp_path, SPHERE, capsys, option, value)
+    assert rc == 2 and len(err) == 1 and ONE_LINE.match(err[0]) and err[0].startswith(f"error: {option} = ")
+    assert not out.exists()
 
 
 def test_long_values_are_shortened_in_the_error_line(tmp_path, capsys):

@@ -36,23 +36,18 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
     says which constraint failed and by how much), 2 on bad input (nothing written).
     """
     from tabletcad.design import load_design
-    from tabletcad.errors import DesignError, TabletcadError
+    from tabletcad.errors import TabletcadError
     from tabletcad.io.atomic import atomic_write_text
-    from tabletcad.optimise.files import load_problem
+    from tabletcad.optimise.files import SOLVER_KEYS, load_problem
     from tabletcad.optimise.plot import plot_convergence
     from tabletcad.optimise.report import result_report, summary, to_json
     from tabletcad.optimise.solvers import solve
     from tabletcad.tablet import Tablet
 
     problem, default_method, opts = load_problem(problem_file)
-    if starts is not None:
-        if starts < 0:
-            raise DesignError("--starts", starts, "must be >= 0")
-        opts["starts"] = starts
-    if maxiter is not None:
-        if maxiter < 1:
-            raise DesignError("--maxiter", maxiter, "must be >= 1")
-        opts["maxiter"] = maxiter
+    for key, value in (("starts", starts), ("maxiter", maxiter)):
+        if value is not None:  # the same limits as the file's [solver] table
+            opts[key] = SOLVER_KEYS[key](f"--{key}", value)
     method = method or default_method
     build_error = ""
     result = solve(problem, method, progress=not quiet, **opts)

@@ -269,7 +269,12 @@ def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
     spec = THESIS_PARAMETERS[kind]
     params = _check_keys("[parameters]", data.get("parameters", {}), set(spec))
     params = {k: spec[k](f"[parameters] {k}", v) for k, v in params.items()}
-    return thesis.make_problem(kind, **params), method, solver
+    try:
+        return thesis.make_problem(kind, **params), method, solver
+    except DesignError as exc:
+        if exc.parameter.startswith("initial "):  # name the table the key came from
+            raise DesignError(f"[parameters] {exc.parameter}", exc.value, exc.allowed, exc.unit) from None
+        raise
 
 
 def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) -> Problem:
