@@ -189,3 +189,20 @@ def test_fuzz_optimisation_files_keep_the_one_line_contract(tmp_path_factory, ca
         assert not out.exists() and sorted(p.name for p in tmp.iterdir()) == ["problem.toml"]
     else:
         assert accepted
+
+
+def test_bad_thesis_file_is_refused_before_the_solvers_and_the_pde_core_load(tmp_path):
+    """The checks need neither scipy.optimize nor the PDE core: a fresh process refuses the file
+    without importing them (nothing of the optimisation is set up for a bad file)."""
+    import subprocess
+    import sys
+
+    f = tmp_path / "bad.toml"
+    f.write_text(ROUND + "P_bounds = [50.0]\n")
+    code = ("import sys; from tabletcad.cli import main; "
+            f"rc = main(['optimise', {str(f)!r}, '--out', {str(tmp_path / 'out')!r}, '--quiet']); "
+            "print(rc, sorted(m for m in ('scipy.optimize', 'tabletcad.curves', 'matplotlib') if m in sys.modules))")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False)
+    assert r.stdout.split("\n")[0] == "2 []", (r.stdout, r.stderr)
+    assert r.stderr.strip().startswith("error: [parameters] P_bounds = [50.0] is not allowed:")
+    assert not (tmp_path / "out").exists()

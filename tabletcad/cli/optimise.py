@@ -35,19 +35,21 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
     Exit status 0 on a converged feasible optimum, 3 when the run fails (report.json
     says which constraint failed and by how much), 2 on bad input (nothing written).
     """
-    from tabletcad.design import load_design
-    from tabletcad.errors import TabletcadError
-    from tabletcad.io.atomic import atomic_write_text
     from tabletcad.optimise.files import SOLVER_KEYS, load_problem
-    from tabletcad.optimise.plot import plot_convergence
-    from tabletcad.optimise.report import result_report, summary, to_json
-    from tabletcad.optimise.solvers import solve
-    from tabletcad.tablet import Tablet
 
     problem, default_method, opts = load_problem(problem_file)
     for key, value in (("starts", starts), ("maxiter", maxiter)):
         if value is not None:  # the same limits as the file's [solver] table
             opts[key] = SOLVER_KEYS[key](f"--{key}", value)
+    # the rest only once the input is known to be valid (a bad file is refused without loading them)
+    from tabletcad.design import load_design
+    from tabletcad.errors import TabletcadError
+    from tabletcad.io.atomic import atomic_write_text
+    from tabletcad.optimise.plot import plot_convergence
+    from tabletcad.optimise.report import result_report, summary, to_json
+    from tabletcad.optimise.solvers import solve
+    from tabletcad.tablet import Tablet
+
     method = method or default_method
     build_error = ""
     result = solve(problem, method, progress=not quiet, **opts)

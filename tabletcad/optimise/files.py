@@ -43,7 +43,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from tabletcad.errors import DesignError
-from tabletcad.optimise.problem import Constraint, Objective, Problem, Variable
+from tabletcad.optimise.problem import METHODS, Constraint, Objective, Problem, Variable
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -238,13 +238,10 @@ def _check_keys(where: str, table: Any, allowed: set) -> dict:
 
 
 def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
-    from tabletcad.optimise import thesis
-    from tabletcad.optimise.solvers import METHODS
-
     _check_keys("top-level", data, _TOP)
     prob = _check_keys("[problem]", data.get("problem", {}), {"kind", "method", "family", "sense", "objective", "name"})
     kind = prob.get("kind")
-    kinds = (*thesis.PROBLEMS, "family")
+    kinds = (*THESIS_PARAMETERS, "family")
     if kind is None:
         raise DesignError("[problem] kind", "missing", "must be one of " + ", ".join(kinds))
     choice("[problem] kind", kind, kinds)
@@ -269,6 +266,8 @@ def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
     spec = THESIS_PARAMETERS[kind]
     params = _check_keys("[parameters]", data.get("parameters", {}), set(spec))
     params = {k: spec[k](f"[parameters] {k}", v) for k, v in params.items()}
+    from tabletcad.optimise import thesis  # the PDE core: imported once the file is known to be valid
+
     try:
         return thesis.make_problem(kind, **params), method, solver
     except DesignError as exc:

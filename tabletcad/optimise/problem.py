@@ -44,7 +44,12 @@ __all__ = [
     "Evaluator",
     "FEASIBILITY_TOL",
     "FD_STEP",
+    "METHODS",
 ]
+
+#: Solver methods of :func:`tabletcad.optimise.solve` (defined here so that problem files can be
+#: checked without importing :mod:`scipy.optimize`).
+METHODS = ("SLSQP", "trust-constr", "multistart", "differential_evolution")
 
 #: Default absolute feasibility tolerance (relative for ``relative=True`` constraints).
 FEASIBILITY_TOL = 1e-6

@@ -36,11 +36,9 @@ from scipy.optimize import Bounds, NonlinearConstraint, minimize
 
 from tabletcad.errors import DesignError
 from tabletcad.optimise.polish import KKT_TOL, kkt_residual, polish
-from tabletcad.optimise.problem import FD_STEP, Evaluator, Iteration, Problem, Result, now
+from tabletcad.optimise.problem import FD_STEP, METHODS, Evaluator, Iteration, Problem, Result, now
 
 __all__ = ["solve", "METHODS"]
-
-METHODS = ("SLSQP", "trust-constr", "multistart", "differential_evolution")
 
 
 class _Scaled:
