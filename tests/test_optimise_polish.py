@@ -95,3 +95,19 @@ def test_thesis_optimum_is_on_its_active_constraints(variant):
         if c.name.startswith(("axial force", "volume", "r_P22 = contact")):
             ref = 9.9 if c.name.startswith("axial") and variant == "a" else 10.5 if c.name.startswith("axial") else c.target
             assert abs(c.value - ref) <= TARGET * 1e-6 * max(abs(ref), 1.0), (c.name, c.value)
+
+
+def test_a_line_search_stop_counts_only_at_a_polished_kkt_point():
+    from tabletcad.optimise.solvers import _land
+
+    p = disc_problem()
+    ev = Evaluator(p)
+    s = 1 / math.sqrt(2) + 1e-7  # the optimum, 1.4e-7 outside the disc: what a line-search stop leaves
+    z, ok, msg = _land(ev, ev.to_z(np.array([s, s])), False, "Positive directional derivative for linesearch")
+    assert ok and "KKT" in msg and "landed" in msg
+    r, vals = ev.assess(z)
+    assert vals[0].satisfied and r["f"] == pytest.approx(math.sqrt(2), rel=1e-12)
+    # a feasible point on the circle away from the optimum is not certified
+    far = ev.to_z(np.array([math.cos(0.3), math.sin(0.3)]))
+    z, ok, msg = _land(ev, far, False, "Iteration limit reached")
+    assert not ok and "KKT" not in msg
