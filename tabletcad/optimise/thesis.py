@@ -367,7 +367,8 @@ def flat_faced_round_problem(
         c = math.sqrt(volume / (math.pi * h)) if density == "volume" else rhi
         w = float(love.axial_displacement(P, E, nu, c, h, h, c, omega_z0=omega_z0, scale=displacement))
         D = mass_mg / (true_density * math.pi * c * c * (h + w))
-        return P / (-math.log1p(-D) - A) if D < 1 else math.nan
+        den = -math.log1p(-D) - A if 0 < D < 1 else math.nan
+        return P / den if den > 0 else math.nan  # nan: no admissible design (eq 6.1 undefined)
 
     return Problem(
         name="flat_faced_round", variables=vs, objective=Objective(lambda d: d.strength, "tensile strength (eq 6.2)", "MPa"),
