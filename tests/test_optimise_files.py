@@ -106,6 +106,22 @@ def test_bad_cli_solver_options(tmp_path, capsys, option, value):
     assert not out.exists()
 
 
+@pytest.mark.parametrize("where", ["file", "below_file", "problem_is_folder"])
+def test_bad_paths_one_line(tmp_path, capsys, where):
+    f = tmp_path / "problem.toml"
+    f.write_text(SPHERE)
+    blocker = tmp_path / "blocker"
+    blocker.write_text("not a folder")
+    out = {"file": blocker, "below_file": blocker / "sub", "problem_is_folder": tmp_path / "out"}[where]
+    problem = tmp_path if where == "problem_is_folder" else f
+    rc = main(["optimise", str(problem), "--out", str(out), "--quiet"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and ONE_LINE.match(err[0]), err
+    assert err[0].startswith("error: problem file =" if where == "problem_is_folder" else "error: --out =")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["blocker", "problem.toml"]
+    assert blocker.read_text() == "not a folder"
+
+
 def test_long_values_are_shortened_in_the_error_line(tmp_path, capsys):
     rc, err, _ = _run(tmp_path, ROUND.replace("300.0", "1" + "0" * 400), capsys)
     assert rc == 2 and "(401 digits)" in err[0] and len(err[0]) < 200

@@ -21,8 +21,8 @@ class OptimisationFailed(click.ClickException):
 
 
 @click.command("optimise")
-@click.argument("problem_file", metavar="PROBLEM.toml", type=click.Path(dir_okay=False, path_type=Path))
-@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path), help="Output folder.")
+@click.argument("problem_file", metavar="PROBLEM.toml", type=click.Path(path_type=Path))
+@click.option("--out", "out_dir", required=True, type=click.Path(path_type=Path), help="Output folder.")
 @click.option("--method", type=click.Choice(["SLSQP", "trust-constr", "multistart", "differential_evolution"]),
               default=None, help="Solver (default: the file's [problem] method, else SLSQP).")
 @click.option("--starts", type=int, default=None, help="Number of Sobol starts for multistart.")
@@ -35,8 +35,15 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
     Exit status 0 on a converged feasible optimum, 3 when the run fails (report.json
     says which constraint failed and by how much), 2 on bad input (nothing written).
     """
+    from tabletcad.errors import DesignError
     from tabletcad.optimise.files import SOLVER_KEYS, load_problem
 
+    # paths are checked here (one line, exit 2) rather than by click (three lines of usage text)
+    for folder in (out_dir, *out_dir.parents):
+        if folder.exists():
+            if not folder.is_dir():
+                raise DesignError("--out", str(out_dir), f"must be a folder path ({str(folder)!r} is a file)")
+            break
     problem, default_method, opts = load_problem(problem_file)
     for key, value in (("starts", starts), ("maxiter", maxiter)):
         if value is not None:  # the same limits as the file's [solver] table
