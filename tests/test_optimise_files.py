@@ -99,7 +99,8 @@ def test_bad_file_one_line_exit_2_nothing_written(tmp_path, capsys, name, text, 
 
 
 @pytest.mark.parametrize("option, value", [("--maxiter", "0"), ("--maxiter", "1000001"), ("--starts", "-1"),
-                                           ("--starts", "99999999")])
+                                           ("--starts", "99999999"), ("--maxiter", "abc"), ("--starts", "2.5"),
+                                           ("--method", "newton"), ("--maxiter", "1" + "0" * 400)])
 def test_bad_cli_solver_options(tmp_path, capsys, option, value):
     rc, err, out = _run(tmp_path, SPHERE, capsys, option, value)
     assert rc == 2 and len(err) == 1 and ONE_LINE.match(err[0]) and err[0].startswith(f"error: {option} = ")

@@ -23,12 +23,13 @@ class OptimisationFailed(click.ClickException):
 @click.command("optimise")
 @click.argument("problem_file", metavar="PROBLEM.toml", type=click.Path(path_type=Path))
 @click.option("--out", "out_dir", required=True, type=click.Path(path_type=Path), help="Output folder.")
-@click.option("--method", type=click.Choice(["SLSQP", "trust-constr", "multistart", "differential_evolution"]),
-              default=None, help="Solver (default: the file's [problem] method, else SLSQP).")
-@click.option("--starts", type=int, default=None, help="Number of Sobol starts for multistart.")
-@click.option("--maxiter", type=int, default=None, help="Iteration limit.")
+@click.option("--method", default=None,
+              help="Solver: SLSQP, trust-constr, multistart or differential_evolution (default: the file's "
+                   "[problem] method, else SLSQP).")
+@click.option("--starts", default=None, help="Number of Sobol starts for multistart (integer).")
+@click.option("--maxiter", default=None, help="Iteration limit (integer).")
 @click.option("--quiet", is_flag=True, help="No progress display.")
-def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: int | None, maxiter: int | None,
+def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: str | None, maxiter: str | None,
                  quiet: bool) -> None:
     """Optimise PROBLEM.toml; write optimum.toml, report.json, convergence.png (and tablet/ outputs) to OUT.
 
@@ -36,9 +37,13 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
     says which constraint failed and by how much), 2 on bad input (nothing written).
     """
     from tabletcad.errors import DesignError
-    from tabletcad.optimise.files import SOLVER_KEYS, load_problem
+    from tabletcad.optimise.files import SOLVER_KEYS, choice, load_problem
+    from tabletcad.optimise.problem import METHODS
 
-    # paths are checked here (one line, exit 2) rather than by click (three lines of usage text)
+    # options are checked here (one line, exit 2) rather than by click (three lines of usage text)
+    if method is not None:
+        choice("--method", method, METHODS)
+
     for folder in (out_dir, *out_dir.parents):
         if folder.exists():
             if not folder.is_dir():
@@ -47,7 +52,7 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
     problem, default_method, opts = load_problem(problem_file)
     for key, value in (("starts", starts), ("maxiter", maxiter)):
         if value is not None:  # the same limits as the file's [solver] table
-            opts[key] = SOLVER_KEYS[key](f"--{key}", value)
+            opts[key] = SOLVER_KEYS[key](f"--{key}", int(value) if value.strip().lstrip("+-").isdigit() else value)
     # the rest only once the input is known to be valid (a bad file is refused without loading them)
     from tabletcad.design import load_design
     from tabletcad.errors import TabletcadError
