@@ -223,3 +223,27 @@ def test_bad_thesis_file_is_refused_before_the_solvers_and_the_pde_core_load(tmp
     assert r.stdout.split("\n")[0] == "2 []", (r.stdout, r.stderr)
     assert r.stderr.strip().startswith("error: [parameters] P_bounds = [50.0] is not allowed:")
     assert not (tmp_path / "out").exists()
+
+
+BAD_OPTIONS = {
+    "--method": ["newton", "", "slsqp", "SLSQP ", "1"],
+    "--starts": ["-1", "abc", "2.5", "1e3", "", "99999999", "1" + "0" * 60],
+    "--maxiter": ["0", "-5", "x", "1.0", "", "100001", "nan"],
+}
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(bad=st.lists(st.sampled_from(sorted(BAD_OPTIONS)), min_size=1, max_size=3, unique=True), data=st.data())
+def test_fuzz_bad_cli_options_one_line(tmp_path_factory, capsys, bad, data):
+    tmp = tmp_path_factory.mktemp("opts")
+    f = tmp / "problem.toml"
+    f.write_text(SPHERE)
+    args = []
+    for opt in bad:
+        args += [opt, data.draw(st.sampled_from(BAD_OPTIONS[opt]))]
+    out = tmp / "out"
+    rc = main(["optimise", str(f), "--out", str(out), "--quiet", *args])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and ONE_LINE.match(err[0]), (args, err)
+    assert any(err[0].startswith(f"error: {opt} = ") for opt in bad), err
+    assert not out.exists()
