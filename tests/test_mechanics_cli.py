@@ -140,7 +140,7 @@ def test_love_command(capsys):
     rc, out, err = run(capsys, "love", "--json")
     assert rc == 0
     d = json.loads(out)
-    assert d["omega_z0_mm"] == pytest.approx(-1.2935 + 0.2195875, rel=1e-9)
+    assert d["omega_z0_mm"] == pytest.approx(-1.2935 + 0.2155033388, rel=1e-9)  # default z = 2.9635 mm
     assert d["n_points"] == 41 and "poor linearity" in err
 
 

@@ -137,3 +137,28 @@ def test_confined_compression_exact_solution():
     # Hooke's law check: ε_r = (σ_r - ν(σ_θ + σ_z))/E = 0
     sr = float(cc.radial_stress)
     assert (sr - 0.21 * (sr - 10.0)) / 2640.0 == pytest.approx(0.0, abs=1e-15)
+
+
+def test_love_command_default_z_is_the_readme_figure(capsys):
+    """`tabletcad love` with its defaults gives the README's K = 0.01143, A = 0.8363 with the thesis's
+    ω_z0 = -1.078 mm, because its default z is the height where eq 5.18 gives the thesis's -0.2155 mm."""
+    import json
+
+    from scipy.optimize import brentq
+
+    from tabletcad.cli import main
+    from tabletcad.cli.mechanics import love_cmd
+
+    z_root = brentq(lambda z: float(love.axial_displacement(10.0, 2640, 0.21, 5.0, 6.0, z, 5.0)) + 0.2155, 2.5, 3.5,
+                    xtol=1e-12)
+    assert love.THESIS_Z == pytest.approx(z_root, abs=5e-5)
+    assert next(p.default for p in love_cmd.params if p.name == "z") == love.THESIS_Z
+    assert main(["love", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["assumptions"]["z"] == love.THESIS_Z
+    assert d["omega_z0_mm"] == pytest.approx(-1.078, abs=5e-5)
+    assert round(d["K_per_MPa"], 5) == 0.01143 and round(d["A"], 4) == 0.8363
+    # at the nominal thickness z = 3 mm the same chain gives K 0.01176: z matters at the 3 % level
+    assert main(["love", "--json", "--z", "3"]) == 0
+    d3 = json.loads(capsys.readouterr().out)
+    assert d3["K_per_MPa"] == pytest.approx(0.011763, rel=1e-4)

@@ -122,3 +122,18 @@ def test_build_cache_one_build_per_point():
     res = solve(p)
     assert res.success
     assert len(calls) == res.nfev
+
+
+def test_one_gradient_per_point():
+    """scipy asks for the objective gradient and each constraint block's Jacobian separately:
+    one finite-difference sweep (n + 1 builds) serves them all, and ngrad counts it once."""
+    from tabletcad.optimise.problem import Evaluator
+
+    ev = Evaluator(cylinder_problem(grads=False))
+    z = ev.z0()
+    g, J1, J2 = ev.grad(z), ev.jac(z), ev.jac(z.copy())
+    assert ev.ngrad == 1 and ev.nfev == 1 + ev.n
+    assert J1 is J2 and g.shape == (2,) and J1.shape == (1, 2)
+    ev.fd_scheme = "central"  # another scheme is another gradient
+    ev.grad(z)
+    assert ev.ngrad == 2 and ev.nfev == 1 + 2 * ev.n  # the forward points +h are reused by the central sweep

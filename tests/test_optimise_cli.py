@@ -12,9 +12,10 @@ from tabletcad.cli import main
 SAMPLES = Path(__file__).resolve().parent.parent / "samples" / "optimise"
 
 
-def test_round_trip_build(tmp_path):
+@pytest.mark.parametrize("sample", ["spherical_tablet_a", "spherical_tablet_b"])  # a: the README's example
+def test_round_trip_build(tmp_path, sample):
     out = tmp_path / "opt"
-    assert main(["optimise", str(SAMPLES / "spherical_tablet_b.toml"), "--out", str(out), "--quiet"]) == 0
+    assert main(["optimise", str(SAMPLES / f"{sample}.toml"), "--out", str(out), "--quiet"]) == 0
     for name in ("optimum.toml", "report.json", "convergence.png"):
         assert (out / name).is_file()
     rep = json.loads((out / "report.json").read_text())

@@ -6,6 +6,8 @@ asserts why (see tabletcad/optimise/thesis.py for the interpretations).
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from tabletcad.optimise import solve
@@ -22,22 +24,51 @@ def _feasible(res):
             assert c.violation <= 1e-6
 
 
-def test_flat_faced_round_reaches_its_upper_bound():
+def _round_closed_form(h0=3.5, volume=235.0, P=60.0, A=0.8738, m=300.0, rho=1.3, E=2640.0, nu=0.21):
+    """σ of eq 6.1 for the cylinder of the tablet's volume and height, with eq 5.18 (derived prefactor)
+    written out here: ω_z = P h0 / (2G) (ν h0²/c² - (1-ν)/2) at z = h0, r = c."""
+    c = math.sqrt(volume / (math.pi * h0))
+    G = E / (2 * (1 + nu))
+    w = P * h0 / (2 * G) * (nu * h0 * h0 / (c * c) - (1 - nu) / 2)
+    D = m / (rho * math.pi * c * c * (h0 + w))
+    return P / (math.log(1 / (1 - D)) - A), D, w
+
+
+def test_flat_faced_round_density_agrees_with_its_volume():
     p = T.flat_faced_round_problem()
     res = solve(p)
     _feasible(res)
-    bound = p.reference["upper_bound_MPa"]
-    # σ = P / (ln(1/(1-D)) - A) grows as D = m/(ρ π c² t) falls: P, A, c and the height end at their bounds
-    assert res.objective == pytest.approx(bound, rel=1e-6)
+    sigma, D, w = _round_closed_form()
+    assert sigma == pytest.approx(16.3057, abs=1e-4) and D == pytest.approx(0.98947, abs=1e-5)
+    # D = m h0 / (ρ V t): the density of 300 mg in the loaded volume of the 235 mm³ tablet (0.982 h0/t)
+    ex = res.extras
+    assert ex["relative_density"] == pytest.approx(300.0 * ex["height_mm"] / (1.3 * ex["volume_mm3"] * ex["compressed_thickness_mm"]), rel=1e-12)
+    assert 300.0 / (1.3 * 235.0) == pytest.approx(0.98199, abs=1e-5)
+    # σ falls with D, D with h0: the optimum is the tallest tablet, with P and A at their upper bounds
+    assert res.objective == pytest.approx(sigma, rel=1e-6)
+    assert res.objective == pytest.approx(p.reference["upper_bound_MPa"], rel=1e-6)
+    assert ex["relative_density"] == pytest.approx(D, rel=1e-6) and ex["omega_z_mm"] == pytest.approx(w, rel=1e-5)
     assert res.x["P"] == pytest.approx(60.0) and res.x["A"] == pytest.approx(0.8738)
-    assert res.extras["max_radius_mm"] == pytest.approx(5.15, abs=1e-6)
     assert res.x["z_P22"] == pytest.approx(3.5, abs=1e-6)
-    # the thesis's 103.3 MPa exceeds the bound: not attainable with m = 300 mg, ρ = 1.3 mg/mm³,
-    # c <= 5.15 mm, h <= 3.5 mm; its own designs violate eq 6.3 (curved) or fold (straight)
-    assert p.reference["strength"] > bound
+    # the thesis's 103.3 MPa is out of reach; its own designs violate eq 6.3 (curved) or fold (straight)
+    assert p.reference["strength"] > 6 * res.objective
     designs = T.thesis_designs()
     assert abs(designs["flat_faced_round_curved"]["volume_mm3"] - 235.0) > 1.0
     assert designs["flat_faced_round_straight"]["min_dz_du_mm"] < 0
+
+
+def test_flat_faced_round_printed_density_reading():
+    """Eq 6.2 as printed (c = largest radius): 0.798 dense at the bounds although 300 mg in 235 mm³ is 0.98."""
+    p = T.flat_faced_round_problem(density="cylinder")
+    res = solve(p)
+    _feasible(res)
+    bound = p.reference["upper_bound_MPa"]
+    # σ grows as D = m/(ρ π c² t) falls: P, A, c and the height end at their bounds
+    assert res.objective == pytest.approx(bound, rel=1e-6) and bound == pytest.approx(82.767, abs=1e-3)
+    assert res.extras["max_radius_mm"] == pytest.approx(5.15, abs=1e-6)
+    assert res.x["z_P22"] == pytest.approx(3.5, abs=1e-6)
+    assert res.extras["relative_density"] == pytest.approx(0.798, abs=1e-3)
+    assert res.extras["volume_mm3"] == pytest.approx(235.0, rel=1e-6)
 
 
 def test_flat_faced_round_printed_equation_is_infeasible():

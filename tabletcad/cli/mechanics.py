@@ -358,7 +358,9 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
 @click.option("--E", "E", type=float, default=2640.0, show_default=True, help="Young's modulus, MPa.")
 @click.option("--nu", type=float, default=0.21, show_default=True, help="Poisson's ratio.")
 @click.option("--h0", type=float, default=6.0, show_default=True, help="Initial bed height, mm.")
-@click.option("--z", type=float, default=3.0, show_default=True, help="Height where ω_z is taken, mm.")
+@click.option("--z", type=float, default=2.9635, show_default=True,
+              help="Height above the lower punch where ω_z is taken, mm (default: where eq 5.18 gives the thesis's "
+                   "-0.2155 mm at 10 MPa).")
 @click.option("--r", type=float, help="Radius where ω_z is taken, mm (default: die wall).")
 @click.option("--omega-z0", type=float, help="Adjustment ω_z0, mm (default: match --ref-displacement).")
 @click.option("--window", nargs=2, type=float, default=(10.0, 50.0), show_default=True, metavar="LO HI",

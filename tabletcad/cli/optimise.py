@@ -21,38 +21,47 @@ class OptimisationFailed(click.ClickException):
 
 
 @click.command("optimise")
-@click.argument("problem_file", metavar="PROBLEM.toml", type=click.Path(dir_okay=False, path_type=Path))
-@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path), help="Output folder.")
-@click.option("--method", type=click.Choice(["SLSQP", "trust-constr", "multistart", "differential_evolution"]),
-              default=None, help="Solver (default: the file's [problem] method, else SLSQP).")
-@click.option("--starts", type=int, default=None, help="Number of Sobol starts for multistart.")
-@click.option("--maxiter", type=int, default=None, help="Iteration limit.")
+@click.argument("problem_file", metavar="PROBLEM.toml", type=click.Path(path_type=Path))
+@click.option("--out", "out_dir", required=True, type=click.Path(path_type=Path), help="Output folder.")
+@click.option("--method", default=None,
+              help="Solver: SLSQP, trust-constr, multistart or differential_evolution (default: the file's "
+                   "[problem] method, else SLSQP).")
+@click.option("--starts", default=None, help="Number of Sobol starts for multistart (integer).")
+@click.option("--maxiter", default=None, help="Iteration limit (integer).")
 @click.option("--quiet", is_flag=True, help="No progress display.")
-def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: int | None, maxiter: int | None,
+def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: str | None, maxiter: str | None,
                  quiet: bool) -> None:
     """Optimise PROBLEM.toml; write optimum.toml, report.json, convergence.png (and tablet/ outputs) to OUT.
 
     Exit status 0 on a converged feasible optimum, 3 when the run fails (report.json
     says which constraint failed and by how much), 2 on bad input (nothing written).
     """
+    from tabletcad.errors import DesignError
+    from tabletcad.optimise.files import SOLVER_KEYS, choice, load_problem
+    from tabletcad.optimise.problem import METHODS
+
+    # options are checked here (one line, exit 2) rather than by click (three lines of usage text)
+    if method is not None:
+        choice("--method", method, METHODS)
+
+    for folder in (out_dir, *out_dir.parents):
+        if folder.exists():
+            if not folder.is_dir():
+                raise DesignError("--out", str(out_dir), f"must be a folder path ({str(folder)!r} is a file)")
+            break
+    problem, default_method, opts = load_problem(problem_file)
+    for key, value in (("starts", starts), ("maxiter", maxiter)):
+        if value is not None:  # the same limits as the file's [solver] table
+            opts[key] = SOLVER_KEYS[key](f"--{key}", int(value) if value.strip().lstrip("+-").isdigit() else value)
+    # the rest only once the input is known to be valid (a bad file is refused without loading them)
     from tabletcad.design import load_design
-    from tabletcad.errors import DesignError, TabletcadError
+    from tabletcad.errors import TabletcadError
     from tabletcad.io.atomic import atomic_write_text
-    from tabletcad.optimise.files import load_problem
     from tabletcad.optimise.plot import plot_convergence
     from tabletcad.optimise.report import result_report, summary, to_json
     from tabletcad.optimise.solvers import solve
     from tabletcad.tablet import Tablet
 
-    problem, default_method, opts = load_problem(problem_file)
-    if starts is not None:
-        if starts < 0:
-            raise DesignError("--starts", starts, "must be >= 0")
-        opts["starts"] = starts
-    if maxiter is not None:
-        if maxiter < 1:
-            raise DesignError("--maxiter", maxiter, "must be >= 1")
-        opts["maxiter"] = maxiter
     method = method or default_method
     build_error = ""
     result = solve(problem, method, progress=not quiet, **opts)

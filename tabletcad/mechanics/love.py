@@ -31,10 +31,12 @@ Assumptions made here where the thesis is silent
   as -1.2935 mm, which is 4.7065 - 6.0 (the Appendix B thickness at the first
   row at or above 10 MPa, 10.70 MPa, minus 6.0 mm).
 * The displacement is taken on the die wall ``r = c`` (the ν²/(ν-1) term
-  vanishes; on the axis ``r → 0`` eq 5.16 diverges) and at ``z = 3.0 mm``, the
-  nominal tablet thickness.  This gives -0.2196 mm at 10 MPa against the
-  thesis's -0.2155 mm (no natural choice of z, r, h0 reproduces -0.2155
-  exactly; z = 2.963 mm would).  Both are parameters.
+  vanishes; on the axis ``r → 0`` eq 5.16 diverges) at the height
+  ``z = 2.9635 mm`` above the fixed lower punch (:data:`THESIS_Z`): the height
+  at which eq 5.18 gives the thesis's model displacement, -0.2155 mm at
+  10 MPa, so that ω_z0 is the thesis's -1.078 mm.  It lies 0.04 mm below the
+  nominal 3 mm tablet thickness, which gives -0.2196 mm instead (no rounder
+  choice of z, r, h0 reproduces -0.2155).  Both are parameters.
 * The simulated compact thickness is ``h = h0 + ω_z`` and its relative density
   ``m / (ρ_true π c² h)``.
 * ``ω_z0`` is the experimental displacement at the reference pressure minus
@@ -71,8 +73,9 @@ __all__ = [
 
 #: Initial powder-bed height inferred from the thesis's numbers, mm.
 THESIS_H0 = 6.0
-#: Height at which the model displacement is evaluated (nominal tablet thickness), mm.
-THESIS_Z = 3.0
+#: Height above the fixed lower punch at which the model displacement is evaluated, mm: where eq 5.18
+#: (r = c, h0 = 6 mm) gives the thesis's -0.2155 mm at 10 MPa (root 2.96347; the nominal thickness 3 mm gives -0.2196).
+THESIS_Z = 2.9635
 
 
 @dataclass(frozen=True)

@@ -14,6 +14,7 @@ multi-start, differential evolution), :mod:`tabletcad.optimise.thesis`,
 from tabletcad.optimise.problem import (
     FD_STEP,
     FEASIBILITY_TOL,
+    METHODS,
     Constraint,
     ConstraintValue,
     Iteration,
@@ -22,7 +23,16 @@ from tabletcad.optimise.problem import (
     Result,
     Variable,
 )
-from tabletcad.optimise.solvers import METHODS, solve
+
+
+def __getattr__(name: str):
+    # solve imports scipy.optimize (~0.3 s): loaded on first use, so that a bad problem
+    # file is refused by `tabletcad optimise` before the solvers are imported
+    if name == "solve":
+        from tabletcad.optimise.solvers import solve
+
+        return solve
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = [
     "Variable",

@@ -36,12 +36,14 @@ Quantities are computed by :meth:`Tablet.properties` and :meth:`Tablet.dimension
 
 from __future__ import annotations
 
+import math
+import re
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
-from tabletcad.errors import DesignError, check_finite
-from tabletcad.optimise.problem import Constraint, Objective, Problem, Variable
+from tabletcad.errors import DesignError
+from tabletcad.optimise.problem import METHODS, Constraint, Objective, Problem, Variable
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -50,16 +52,167 @@ else:  # pragma: no cover
 
 __all__ = ["load_problem", "problem_from_dict", "family_problem", "QUANTITIES", "SOLVER_KEYS"]
 
+_LAST_PROPERTIES: list = [None, None]
+
+
+def _properties(t) -> dict:
+    """``t.properties()`` computed once per design: the objective and the constraints of one
+    point ask for volume and area of the same tablet in turn (one quadrature instead of two)."""
+    if _LAST_PROPERTIES[0] is not t:
+        _LAST_PROPERTIES[:] = [t, t.properties()]
+    return _LAST_PROPERTIES[1]
+
+
 QUANTITIES = {
-    "volume_mm3": ("mm3", lambda t: t.volume()),
-    "surface_area_mm2": ("mm2", lambda t: t.surface_area()),
+    "volume_mm3": ("mm3", lambda t: _properties(t)["volume_mm3"]),
+    "surface_area_mm2": ("mm2", lambda t: _properties(t)["surface_area_mm2"]),
     "plan_area_mm2": ("mm2", lambda t: t.plan_area()),
     "length_mm": ("mm", lambda t: t.dimensions()["length_mm"]),
     "width_mm": ("mm", lambda t: t.dimensions()["width_mm"]),
     "height_mm": ("mm", lambda t: t.dimensions()["height_mm"]),
 }
-SOLVER_KEYS = {"maxiter": int, "ftol": float, "fd_step": float, "fd_scheme": str, "starts": int, "seed": int, "popsize": int}
 _TOP = {"problem", "parameters", "solver", "variables", "fixed", "constraint"}
+#: A problem's ``name`` becomes a design and file name: a plain file name, no path.
+_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}")
+
+
+# ---------------------------------------------------------------------------- strict value checks
+def _shown(v: Any) -> Any:
+    """A value as shown in an error line (huge integers and long strings shortened)."""
+    if isinstance(v, int) and not isinstance(v, bool) and abs(v) > 10**15:
+        return f"{str(v)[:12]}... ({len(str(abs(v)))} digits)"
+    if isinstance(v, str) and len(v) > 60:
+        return v[:57] + "..."
+    return v
+
+
+def _range_text(lo, lo_open, hi, hi_open) -> str:
+    parts = []
+    if lo is not None:
+        parts.append(f"{'>' if lo_open else '>='} {lo:g}")
+    if hi is not None:
+        parts.append(f"{'<' if hi_open else '<='} {hi:g}")
+    return " and ".join(parts)
+
+
+def number(where: str, v: Any, unit: str = "", *, lo: float | None = None, lo_open: bool = False,
+           hi: float | None = None, hi_open: bool = False) -> float:
+    """A TOML number (int or float, never a string or boolean) within the given range."""
+    rng = _range_text(lo, lo_open, hi, hi_open)
+    allowed = "must be a finite number" + (f" {rng}" if rng else "") + (f" {unit}" if unit and rng else "")
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise DesignError(where, _shown(v), allowed, unit if isinstance(v, (int, float)) else "")
+    try:
+        x = float(v)
+    except OverflowError:
+        raise DesignError(where, _shown(v), allowed, unit) from None
+    if not math.isfinite(x) or (lo is not None and (x < lo or (lo_open and x == lo))) or (
+            hi is not None and (x > hi or (hi_open and x == hi))):
+        raise DesignError(where, _shown(v), allowed, unit)
+    return x
+
+
+def integer(where: str, v: Any, lo: int, hi: int) -> int:
+    """A TOML integer (never a float, string or boolean) in ``[lo, hi]``."""
+    if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
+        raise DesignError(where, _shown(v), f"must be an integer >= {lo} and <= {hi}")
+    return v
+
+
+def boolean(where: str, v: Any) -> bool:
+    """A TOML boolean (``true``/``false``; strings such as ``"false"`` are refused)."""
+    if not isinstance(v, bool):
+        raise DesignError(where, _shown(v), "must be a TOML boolean, true or false (unquoted)")
+    return v
+
+
+def choice(where: str, v: Any, allowed) -> str:
+    if not isinstance(v, str) or v not in allowed:
+        raise DesignError(where, _shown(v), "must be one of " + ", ".join(allowed))
+    return v
+
+
+def plain_name(where: str, v: Any) -> str:
+    """A name used for files: letters, digits, ``_ . -``, no path, at most 100 characters."""
+    if not isinstance(v, str) or not _NAME.fullmatch(v):
+        raise DesignError(where, _shown(v), "must be a plain file name (letters, digits, _ . -; no path)")
+    return v
+
+
+def pair(where: str, v: Any, unit: str = "", *, lo: float = 0.0, lo_open: bool = True) -> tuple[float, float]:
+    """Two numbers ``[lower, upper]`` with ``lo < lower <= upper <= LIMITS[unit]``."""
+    if not isinstance(v, list) or len(v) != 2:
+        raise DesignError(where, _shown(v), f"must be two numbers [lower, upper]{' in ' + unit if unit else ''}")
+    hi = LIMITS.get(unit, 1e6)
+    a = number(f"{where} lower", v[0], unit, lo=lo, lo_open=lo_open, hi=hi)
+    b = number(f"{where} upper", v[1], unit, lo=lo, lo_open=lo_open, hi=hi)
+    if a > b:
+        raise DesignError(where, v, "must have lower <= upper", unit)
+    return a, b
+
+
+#: Largest accepted magnitude per unit: generous for tablets, small enough that nothing overflows or runs for minutes.
+LIMITS = {"mm": 1000.0, "deg": 180.0, "mm2": 1e6, "mm3": 1e9, "mg": 1e9, "mg/mm3": 100.0, "MPa": 1e6, "N": 1e6, "": 1e6}
+
+
+def _positive(unit: str = "") -> Callable[[str, Any], float]:
+    return lambda w, v: number(w, v, unit, lo=0.0, lo_open=True, hi=LIMITS.get(unit, 1e6))
+
+
+def _poisson(w: str, v: Any) -> float:
+    return number(w, v, "", lo=0.0, hi=0.5, hi_open=True)
+
+
+def _pairs(unit: str = "") -> Callable[[str, Any], tuple]:
+    return lambda w, v: pair(w, v, unit)
+
+
+def _choices(*allowed: str) -> Callable[[str, Any], str]:
+    return lambda w, v: choice(w, v, allowed)
+
+
+def _table(spec: dict) -> Callable[[str, Any], dict]:
+    def check(w: str, v: Any) -> dict:
+        _check_keys(w, v, set(spec))
+        return {k: spec[k](f"{w} {k}", val) for k, val in v.items()}
+    return check
+
+
+def _initial(w: str, v: Any) -> dict:
+    """Starting values by variable name (the names are checked against the problem's variables)."""
+    if not isinstance(v, dict):
+        raise DesignError(w, _shown(v), "must be a table of variable = starting value")
+    return {k: number(f"{w} {k}", val, lo=-LIMITS[""], hi=LIMITS[""]) for k, val in v.items()}
+
+
+#: Accepted ``[parameters]`` of the thesis problems (keyword arguments of ``thesis.<kind>_problem``).
+THESIS_PARAMETERS: dict[str, dict[str, Callable[[str, Any], Any]]] = {
+    "flat_faced_round": dict(
+        mass_mg=_positive("mg"), true_density=_positive("mg/mm3"), E=_positive("MPa"), nu=_poisson,
+        volume=_positive("mm3"), radius_bounds=_pairs("mm"), height_max=_positive("mm"), P_bounds=_pairs("MPa"),
+        A_bounds=_pairs(), displacement=_choices("derived", "thesis"),
+        omega_z0=lambda w, v: number(w, v, "mm", lo=-LIMITS["mm"], hi=LIMITS["mm"]),
+        density=_choices("volume", "cylinder"), initial=_initial),
+    "spherical_tablet": dict(
+        variant=_choices("a", "b"), force_bounds=_pairs("N"), radius_bounds=_pairs("mm"), volume=_positive("mm3"),
+        material=_table(dict(E=_positive("MPa"), nu=_poisson, s_y=_positive("MPa"))),
+        reference_radius=_positive("mm"), initial=_initial),
+    "softgel_capsule": dict(
+        model=_choices("lame", "band", "none"), E=_positive("MPa"), nu=_poisson,
+        P_int=lambda w, v: number(w, v, "MPa", lo=0.0, hi=LIMITS["MPa"]), radius_constraints=lambda w, v: boolean(w, v),
+        initial=_initial),
+}
+
+#: ``[solver]`` options and their checks (the keyword arguments of :func:`~tabletcad.optimise.solve`).
+SOLVER_KEYS: dict[str, Callable[[str, Any], Any]] = {
+    "maxiter": lambda w, v: integer(w, v, 1, 100_000),
+    "ftol": lambda w, v: number(w, v, lo=0.0, lo_open=True, hi=1.0, hi_open=True),
+    "fd_step": lambda w, v: number(w, v, lo=0.0, lo_open=True, hi=0.1),
+    "fd_scheme": _choices("forward", "central"),
+    "starts": lambda w, v: integer(w, v, 0, 10_000),
+    "seed": lambda w, v: integer(w, v, 0, 2**32 - 1),
+    "popsize": lambda w, v: integer(w, v, 1, 1000),
+}
 
 
 def load_problem(path: str | Path) -> tuple[Problem, str, dict]:
@@ -76,29 +229,29 @@ def load_problem(path: str | Path) -> tuple[Problem, str, dict]:
 
 def _check_keys(where: str, table: Any, allowed: set) -> dict:
     if not isinstance(table, dict):
-        raise DesignError(where, table, "must be a table")
+        raise DesignError(where, _shown(table), "must be a table")
     for k in table:
         if k not in allowed:
-            raise DesignError(f"{where} key {k!r}", table[k], f"allowed keys are {', '.join(sorted(allowed))}")
+            raise DesignError(f"{where} key {_shown(k)!r}", _shown(table[k]),
+                              f"allowed keys are {', '.join(sorted(allowed)) or '(none)'}")
     return table
 
 
 def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
-    from tabletcad.optimise import thesis
-    from tabletcad.optimise.solvers import METHODS
-
     _check_keys("top-level", data, _TOP)
     prob = _check_keys("[problem]", data.get("problem", {}), {"kind", "method", "family", "sense", "objective", "name"})
     kind = prob.get("kind")
+    kinds = (*THESIS_PARAMETERS, "family")
     if kind is None:
-        raise DesignError("[problem] kind", "missing", "must be one of " + ", ".join(thesis.PROBLEMS) + " or family")
-    method = prob.get("method", "SLSQP")
-    if method not in METHODS:
-        raise DesignError("[problem] method", method, "must be one of " + ", ".join(METHODS))
-    solver = dict(_check_keys("[solver]", data.get("solver", {}), set(SOLVER_KEYS)))
-    for k, typ in SOLVER_KEYS.items():
-        if k in solver and not isinstance(solver[k], typ if typ is not float else (int, float)):
-            raise DesignError(f"[solver] {k}", solver[k], f"must be of type {typ.__name__}")
+        raise DesignError("[problem] kind", "missing", "must be one of " + ", ".join(kinds))
+    choice("[problem] kind", kind, kinds)
+    method = choice("[problem] method", prob.get("method", "SLSQP"), METHODS)
+    if "sense" in prob:
+        choice("[problem] sense", prob["sense"], ("max", "min"))
+    if "name" in prob:
+        plain_name("[problem] name", prob["name"])
+    solver_table = _check_keys("[solver]", data.get("solver", {}), set(SOLVER_KEYS))
+    solver = {k: SOLVER_KEYS[k](f"[solver] {k}", v) for k, v in solver_table.items()}
     if kind == "family":
         for k in ("parameters",):
             if k in data:
@@ -107,11 +260,20 @@ def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
     for k in ("variables", "fixed", "constraint"):
         if k in data:
             raise DesignError(f"[{k}]", "given", f"only family problems take it, not {kind!r}")
-    params = data.get("parameters", {})
-    if not isinstance(params, dict):
-        raise DesignError("[parameters]", params, "must be a table")
-    params = {k: (tuple(v) if isinstance(v, list) else v) for k, v in params.items()}
-    return thesis.make_problem(kind, **params), method, solver
+    for k in ("family", "sense", "objective", "name"):
+        if k in prob:
+            raise DesignError(f"[problem] {k}", _shown(prob[k]), f"only family problems take it, not {kind!r}")
+    spec = THESIS_PARAMETERS[kind]
+    params = _check_keys("[parameters]", data.get("parameters", {}), set(spec))
+    params = {k: spec[k](f"[parameters] {k}", v) for k, v in params.items()}
+    from tabletcad.optimise import thesis  # the PDE core: imported once the file is known to be valid
+
+    try:
+        return thesis.make_problem(kind, **params), method, solver
+    except DesignError as exc:
+        if exc.parameter.startswith("initial "):  # name the table the key came from
+            raise DesignError(f"[parameters] {exc.parameter}", exc.value, exc.allowed, exc.unit) from None
+        raise
 
 
 def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) -> Problem:
@@ -120,22 +282,26 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) ->
     from tabletcad.shapes import FAMILIES, _load_plugins
 
     _load_plugins()
-    fam_name = prob.get("family")
-    if fam_name not in FAMILIES:
-        raise DesignError("[problem] family", fam_name, "must be one of " + ", ".join(FAMILIES))
+    fam_name = choice("[problem] family", prob.get("family"), tuple(FAMILIES))
     fam = FAMILIES[fam_name]
     if not isinstance(variables, dict) or not variables:
-        raise DesignError("[variables]", variables, "must be a table of family parameters with lower/upper/initial")
+        raise DesignError("[variables]", _shown(variables), "must be a table of family parameters with lower/upper/initial")
     vs = []
     for name, spec in variables.items():
         if name not in fam.params:
-            raise DesignError(f"[variables] {name}", spec, f"family {fam_name!r} takes {', '.join(fam.params)}")
+            raise DesignError(f"[variables] {_shown(name)}", _shown(spec), f"family {fam_name!r} takes {', '.join(fam.params)}")
         _check_keys(f"[variables] {name}", spec, {"lower", "upper", "initial"})
         if "lower" not in spec or "upper" not in spec:
             raise DesignError(f"[variables] {name}", spec, "needs lower and upper")
-        vs.append(Variable(name, spec["lower"], spec["upper"], spec.get("initial"), fam.params[name]))
+        unit = fam.params[name]
+        lim = LIMITS.get(unit, LIMITS[""])
+        lo = number(f"[variables] {name} lower", spec["lower"], unit, lo=0.0, hi=lim)
+        hi = number(f"[variables] {name} upper", spec["upper"], unit, lo=0.0, hi=lim)
+        x0 = None if "initial" not in spec else number(f"[variables] {name} initial", spec["initial"], unit, lo=0.0, hi=lim)
+        vs.append(Variable(name, lo, hi, x0, unit))
     _check_keys("[fixed]", fixed, set(fam.params) - set(variables))
-    fixed = {k: check_finite(f"[fixed] {k}", v, fam.params[k]) for k, v in fixed.items()}
+    fixed = {k: number(f"[fixed] {k}", v, fam.params[k], lo=0.0, hi=LIMITS.get(fam.params[k], LIMITS[""]))
+             for k, v in fixed.items()}
     sense = prob.get("sense", "max")
     name = prob.get("name", f"{fam_name}_optimum")
 
@@ -149,26 +315,31 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) ->
         unit, f = QUANTITIES[obj_spec]
         objective = Objective(f, obj_spec, unit)
     elif isinstance(obj_spec, dict) and set(obj_spec) == {"linear"} and isinstance(obj_spec["linear"], dict):
-        coef = {k: check_finite(f"[problem] objective linear {k}", v) for k, v in obj_spec["linear"].items()}
+        coef = {k: number(f"[problem] objective linear {k}", v, lo=-LIMITS[""], hi=LIMITS[""]) for k, v in obj_spec["linear"].items()}
         for k in coef:
             if k not in variables:
                 raise DesignError("[problem] objective linear", k, "must name variables")
         objective = Objective(lambda t: sum(c * float(t.params[k]) for k, c in coef.items()),
                               " + ".join(f"{c:g} {k}" for k, c in coef.items()), "", grad=lambda x, d: dict(coef))
     else:
-        raise DesignError("[problem] objective", obj_spec, "must be a quantity name or {linear = {variable = coefficient}}")
+        raise DesignError("[problem] objective", _shown(obj_spec), "must be a quantity name or {linear = {variable = coefficient}}")
     if not isinstance(constraints, list):
-        raise DesignError("[[constraint]]", constraints, "must be an array of tables")
+        raise DesignError("[[constraint]]", _shown(constraints), "must be an array of tables")
     cons = []
     for k, c in enumerate(constraints):
         _check_keys(f"[[constraint]] {k}", c, {"quantity", "target", "lower", "upper", "relative", "tol", "scale", "name"})
-        q = c.get("quantity")
-        if q not in QUANTITIES:
-            raise DesignError(f"[[constraint]] {k} quantity", q, "must be one of " + ", ".join(QUANTITIES))
+        q = choice(f"[[constraint]] {k} quantity", c.get("quantity"), tuple(QUANTITIES))
         unit, f = QUANTITIES[q]
-        kw = {kk: c[kk] for kk in ("target", "lower", "upper", "tol", "scale") if kk in c}
-        cons.append(Constraint(c.get("name", q), f, kind="eq" if "target" in c else "ineq", relative=bool(c.get("relative", False)),
-                               unit=unit, **kw))
+        # every quantity is a size (>= 0): a target must be > 0, bounds >= 0
+        kw = {kk: number(f"[[constraint]] {k} {kk}", c[kk], unit, lo=0.0, lo_open=kk == "target", hi=LIMITS[unit])
+              for kk in ("target", "lower", "upper") if kk in c}
+        kw.update({kk: number(f"[[constraint]] {k} {kk}", c[kk], "" if kk == "tol" else unit, lo=0.0, lo_open=True,
+                              hi=LIMITS["" if kk == "tol" else unit]) for kk in ("tol", "scale") if kk in c})
+        relative = boolean(f"[[constraint]] {k} relative", c["relative"]) if "relative" in c else False
+        cname = c.get("name", q)
+        if not isinstance(cname, str) or not cname.strip() or "\n" in cname:
+            raise DesignError(f"[[constraint]] {k} name", _shown(cname), "must be a one-line text")
+        cons.append(Constraint(cname, f, kind="eq" if "target" in c else "ineq", relative=relative, unit=unit, **kw))
 
     def to_toml(x, d):
         return design_to_toml(fam_name, {**fixed, **x}, name=name)

@@ -44,7 +44,12 @@ __all__ = [
     "Evaluator",
     "FEASIBILITY_TOL",
     "FD_STEP",
+    "METHODS",
 ]
+
+#: Solver methods of :func:`tabletcad.optimise.solve` (defined here so that problem files can be
+#: checked without importing :mod:`scipy.optimize`).
+METHODS = ("SLSQP", "trust-constr", "multistart", "differential_evolution")
 
 #: Default absolute feasibility tolerance (relative for ``relative=True`` constraints).
 FEASIBILITY_TOL = 1e-6
@@ -425,6 +430,7 @@ class Evaluator:
             for k in range(len(c.scaled_residuals(0.0 if c.kind == "ineq" else c.target))):
                 self.rows.append((ci, k))
         self.last_error: str = ""
+        self._last_grad: tuple | None = None
 
     # -------------------------------------------------------------- conversions
     @property
@@ -509,8 +515,19 @@ class Evaluator:
         return worst
 
     def _grad_entries(self, z) -> tuple[np.ndarray, np.ndarray]:
-        """Gradients of the objective (minimisation sign) and of every residual row w.r.t. z."""
+        """Gradients of the objective (minimisation sign) and of every residual row w.r.t. z.
+
+        The last point's gradients are kept: scipy asks for the objective gradient and for
+        each constraint block's Jacobian at the same point in separate calls."""
         z = np.clip(np.asarray(z, dtype=float), 0.0, 1.0)
+        key = (z.tobytes(), self.fd_scheme)
+        if self._last_grad is not None and self._last_grad[0] == key:
+            return self._last_grad[1], self._last_grad[2]
+        gf, rows = self._grad_compute(z)
+        self._last_grad = (key, gf, rows)
+        return gf, rows
+
+    def _grad_compute(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         base = self.evaluate(z)
         n = self.n
         p = self.p

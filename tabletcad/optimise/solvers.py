@@ -35,11 +35,10 @@ import numpy as np
 from scipy.optimize import Bounds, NonlinearConstraint, minimize
 
 from tabletcad.errors import DesignError
-from tabletcad.optimise.problem import FD_STEP, Evaluator, Iteration, Problem, Result, now
+from tabletcad.optimise.polish import KKT_TOL, kkt_residual, polish
+from tabletcad.optimise.problem import FD_STEP, METHODS, Evaluator, Iteration, Problem, Result, now
 
 __all__ = ["solve", "METHODS"]
-
-METHODS = ("SLSQP", "trust-constr", "multistart", "differential_evolution")
 
 
 class _Scaled:
@@ -138,6 +137,23 @@ def _trust_constr(sc: _Scaled, z0, maxiter: int, ftol: float):
     return res, ok, int(getattr(res, "nit", len(sc.history) - 1)), str(res.message)
 
 
+def _land(ev: Evaluator, z, ok: bool, msg: str) -> tuple[np.ndarray, bool, str]:
+    """Feasibility polish of a solver's end point (:mod:`tabletcad.optimise.polish`).
+
+    A solver that stopped without success (e.g. a line-search failure) counts as
+    converged when the polished point is feasible and a KKT point to ``KKT_TOL``.
+    """
+    zp, note = polish(ev, z)
+    if note:
+        msg = f"{msg}; {note}"
+    if not ok and _feasible_value(ev, zp)[0]:
+        kkt = kkt_residual(ev, zp)
+        if kkt <= KKT_TOL:
+            ok = True
+            msg = f"{msg}; first-order optimality (KKT) residual {kkt:.2g} <= {KKT_TOL:g} at the polished point"
+    return zp, ok, msg
+
+
 def _feasible_value(ev: Evaluator, z) -> tuple[bool, float]:
     r, vals = ev.assess(z)
     feas = r["ok"] and all(v.satisfied for v in vals)
@@ -226,7 +242,8 @@ def solve(
             sc = _Scaled(ev, fscale)
             runner = _slsqp if method == "SLSQP" else _trust_constr
             res, ok, nit, msg = runner(sc, z0, maxiter, ftol)
-            return _finish(problem, ev, res.x, method, ok, nit, t0, sc.history, msg, starts=1, bar=bar)
+            z, ok, msg = _land(ev, res.x, ok, msg)
+            return _finish(problem, ev, z, method, ok, nit, t0, sc.history, msg, starts=1, bar=bar)
 
         if method == "multistart":
             from scipy.stats import qmc
@@ -242,12 +259,13 @@ def solve(
                 sc = _Scaled(ev, fscale)
                 res, ok, nit, msg = _slsqp(sc, np.asarray(zs, float), maxiter, ftol)
                 total_it += nit
-                feas, val = _feasible_value(ev, res.x)
+                z, ok, msg = _land(ev, res.x, ok, msg)
+                feas, val = _feasible_value(ev, z)
                 cand = (not feas, val, k)
                 if best is None or cand < best[0]:
-                    best = (cand, res, ok, msg, sc.history)
-            (_, _, kbest), res, ok, msg, hist = best
-            return _finish(problem, ev, res.x, method, ok, total_it, t0, hist,
+                    best = (cand, z, ok, msg, sc.history)
+            (_, _, kbest), z, ok, msg, hist = best
+            return _finish(problem, ev, z, method, ok, total_it, t0, hist,
                            f"best of {len(pts)} starts (start {kbest}): {msg}", starts=len(pts), bar=bar)
 
         # differential evolution + SLSQP polish
@@ -268,7 +286,8 @@ def solve(
                 tol=1e-8, seed=seed, polish=False, init="sobol", x0=z0, callback=cb,
             )
         res, ok, nit, msg = _slsqp(sc, de.x, maxiter, ftol)
-        return _finish(problem, ev, res.x, method, ok, gen[0] + nit, t0, sc.history,
+        z, ok, msg = _land(ev, res.x, ok, msg)
+        return _finish(problem, ev, z, method, ok, gen[0] + nit, t0, sc.history,
                        f"differential evolution: {de.message}; SLSQP polish: {msg}", starts=1, bar=bar)
     finally:
         if bar is not None:

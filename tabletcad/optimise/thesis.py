@@ -181,6 +181,14 @@ def min_height_slope(heights) -> float:
     return min(c1 + 2 * c2 * u + 3 * c3 * u * u for u in cand)
 
 
+def _update_initial(init: dict, initial: dict | None) -> None:
+    """Override starting values by variable name; an unknown name is refused (not ignored)."""
+    for k in initial or {}:
+        if k not in init:
+            raise DesignError(f"initial {k}", initial[k], "is not a variable; variables are " + ", ".join(init))
+    init.update(initial or {})
+
+
 def free_form_toml(tablet: Tablet, sections, *, name: str, comment: str = "") -> str:
     """A ``free_form`` design file (``[[patch]]`` circle curves, ``"previous"``) for ``tabletcad build``."""
     lines = []
@@ -218,23 +226,27 @@ class RoundDesign:
     relative_density: float
     heckel_term: float
     strength: float
+    c_load: float  # radius of the cylinder of eqs 5.18 and 6.1 (mm)
 
 
-def _round_eval(radii, heights, P, A, *, mass_mg, true_density, E, nu, displacement, omega_z0, check=False,
-                fast=True) -> RoundDesign:
+def _round_eval(radii, heights, P, A, *, mass_mg, true_density, E, nu, displacement, omega_z0, density="volume",
+                check=False, fast=True) -> RoundDesign:
     t = round_tablet(radii, heights, check=check, fast=fast)
     vol = t.volume()
     c = _profile_max_radius(t.patches[1])
     h0 = float(heights[3] - heights[0])
+    # the cylinder of eqs 5.18 and 6.1: the one with the tablet's volume and height ("volume"), whose
+    # π c² t is the loaded volume (V/h0) t, or the one of the largest radius (eq 6.2 as printed, "cylinder")
+    cl = math.sqrt(vol / (math.pi * h0)) if density == "volume" and vol > 0 and h0 > 0 else c
     # eq 5.18 at the loaded top face (z = h0) on the die wall (r = c), where its ν²/(ν-1) term vanishes
-    w = float(love.axial_displacement(P, E, nu, c, h0, h0, c, omega_z0=omega_z0, scale=displacement))
+    w = float(love.axial_displacement(P, E, nu, cl, h0, h0, cl, omega_z0=omega_z0, scale=displacement))
     th = h0 + w
-    dens = mass_mg / (true_density * math.pi * c * c * th) if th > 0 else math.inf
+    dens = mass_mg / (true_density * math.pi * cl * cl * th) if th > 0 else math.inf
     # eq 6.1/6.2: σ = P / (ln(1/(1-D)) - A); undefined for D >= 1 (reported by a constraint)
     H = -math.log1p(-min(dens, 1.0 - 1e-12)) if dens > 0 else 0.0
     den = H - A
     sig = P / den if den > 0 else P / 1e-12
-    return RoundDesign(t, tuple(radii), tuple(heights), P, A, vol, c, h0, w, th, dens, den, sig)
+    return RoundDesign(t, tuple(radii), tuple(heights), P, A, vol, c, h0, w, th, dens, den, sig, cl)
 
 
 def flat_faced_round_problem(
@@ -250,6 +262,7 @@ def flat_faced_round_problem(
     A_bounds=LACTOSE["A"],
     displacement: str = "derived",
     omega_z0: float = 0.0,
+    density: str = "volume",
     initial: dict | None = None,
 ) -> Problem:
     """Section 6.2.1: maximise σ of eq 6.2 of a round tablet at fixed volume (eq 6.3).
@@ -274,17 +287,39 @@ def flat_faced_round_problem(
     * The radius bounds of eq 6.5 hold for the circles *and* for the surface's
       largest radius ``c`` (between close circles a PDE surface bulges beyond
       them; without this the optimiser exploits the bulge, reaching c ≈ 5.35 mm).
-    * Two constraints make the objective meaningful: the relative density
-      ``D = m / (ρ_true π c² t) <= 1`` and ``ln(1/(1-D)) - A > 0``.
+    * Relative density (``density``): eq 6.1 is the Heckel density
+      ``D = m / (ρ_true π c² t)`` of a flat-faced cylinder of radius ``c``
+      under load (thickness ``t = h0 + ω_z``), and eq 5.18 is the displacement
+      of such a cylinder in a die.  ``density="volume"`` (default) applies both
+      to the cylinder with the tablet's volume ``V`` and height ``h0``,
+      ``c = sqrt(V / (π h0))``, so that ``π c² t = (V/h0) t`` is the tablet's
+      loaded volume and D agrees with the volume constraint:
+      ``D = m h0 / (ρ_true V t)`` (0.982 h0/t for 300 mg in 235 mm³); for a
+      cylindrical tablet this is eq 6.1 exactly.  ``density="cylinder"`` takes
+      ``c`` = the largest radius (eq 6.2 as printed, ``A1x² + A1y²``): for a
+      tablet that is not a cylinder it counts the empty space of the bounding
+      cylinder as pores (D = 0.798 at c = 5.15 mm, h0 = 3.5 mm, although 300 mg
+      in 235 mm³ is 0.98 dense), and its optimum is the largest bounding cylinder.
+    * With ``density="volume"`` σ depends on the design only through ``h0``,
+      P and A (the volume is fixed): the taller the tablet, the smaller the
+      axial strain ``ω_z/h0 = P/(2G) (ν h0²/c² - (1-ν)/2)`` of eq 5.18 and the
+      lower D.  The optimum is ``h0 = height_max`` with P and A at their upper
+      bounds, for any profile of that height and volume (the profile the
+      solver returns is one of them).
+    * Two constraints make the objective meaningful: ``D <= 1`` and
+      ``ln(1/(1-D)) - A > 0``.
     """
+    if density not in ("volume", "cylinder"):
+        raise DesignError("density", density, "must be 'volume' (V t / h0) or 'cylinder' (π c² t, eq 6.2 as printed)")
     rlo, rhi = radius_bounds
     init = dict(r_P21=5.0, r_d21=5.0, r_d22=5.0, r_P22=5.0, z_d21=1.0, z_d22=2.0, z_P22=3.0,
                 P=float(np.mean(P_bounds)), A=float(np.mean(A_bounds)))
-    init.update(initial or {})
+    _update_initial(init, initial)
     vs = [Variable(n, rlo, rhi, init[n], "mm") for n in ("r_P21", "r_d21", "r_d22", "r_P22")]
     vs += [Variable(n, 0.0, height_max, init[n], "mm") for n in ("z_d21", "z_d22", "z_P22")]
     vs += [Variable("P", P_bounds[0], P_bounds[1], init["P"], "MPa"), Variable("A", A_bounds[0], A_bounds[1], init["A"])]
-    kw = dict(mass_mg=mass_mg, true_density=true_density, E=E, nu=nu, displacement=displacement, omega_z0=omega_z0)
+    kw = dict(mass_mg=mass_mg, true_density=true_density, E=E, nu=nu, displacement=displacement, omega_z0=omega_z0,
+              density=density)
 
     def parts(x):
         return ((x["r_P21"], x["r_d21"], x["r_d22"], x["r_P22"]), (0.0, x["z_d21"], x["z_d22"], x["z_P22"]))
@@ -322,13 +357,18 @@ def flat_faced_round_problem(
                     compressed_thickness_mm=d.thickness, relative_density=d.relative_density,
                     heckel_denominator=d.heckel_term,
                     interpretation=dict(mass_mg=mass_mg, true_density=true_density, E=E, nu=nu,
-                                        displacement=displacement, omega_z0=omega_z0))
+                                        displacement=displacement, omega_z0=omega_z0, density=density))
 
     def bound(P=P_bounds[1], A=A_bounds[1]):
-        """σ at the largest c and height the bounds allow: an upper bound of the optimum (MPa)."""
-        w = float(love.axial_displacement(P, E, nu, rhi, height_max, height_max, rhi, omega_z0=omega_z0, scale=displacement))
-        D = mass_mg / (true_density * math.pi * rhi * rhi * (height_max + w))
-        return P / (-math.log1p(-D) - A) if D < 1 else math.nan
+        """σ of the best shape the bounds allow (MPa): with ``density="volume"`` the cylinder of height
+        ``height_max`` holding the volume (the optimum), with ``"cylinder"`` the largest bounding cylinder
+        (an upper bound of the optimum)."""
+        h = height_max
+        c = math.sqrt(volume / (math.pi * h)) if density == "volume" else rhi
+        w = float(love.axial_displacement(P, E, nu, c, h, h, c, omega_z0=omega_z0, scale=displacement))
+        D = mass_mg / (true_density * math.pi * c * c * (h + w))
+        den = -math.log1p(-D) - A if 0 < D < 1 else math.nan
+        return P / den if den > 0 else math.nan  # nan: no admissible design (eq 6.1 undefined)
 
     return Problem(
         name="flat_faced_round", variables=vs, objective=Objective(lambda d: d.strength, "tensile strength (eq 6.2)", "MPa"),
@@ -410,7 +450,7 @@ def spherical_tablet_problem(
     hh = 0.93 * (reference_radius or r0)  # half-height of the start: 7 % flatter than the reference sphere
     init = dict(r_P21=r0, r_d21=0.87 * r0, r_d22=0.55 * r0, r_P22=k_rc * r0,
                 z_d21=ze + 0.5 * hh, z_d22=ze + 0.85 * hh, z_P22=ze + hh)
-    init.update(initial or {})
+    _update_initial(init, initial)
     vs = [Variable("r_P21", rb[0], rb[1], init["r_P21"], "mm")]
     vs += [Variable(n, 0.0, rb[1], init[n], "mm") for n in ("r_d21", "r_d22", "r_P22")]
     vs += [Variable(n, ze, ze + 1.2 * rb[1], init[n], "mm") for n in ("z_d21", "z_d22", "z_P22")]
@@ -547,7 +587,7 @@ def softgel_capsule_problem(*, model: str = "lame", E: float = GELATIN["E"], nu:
     """
     st = THESIS_RESULTS["softgel_capsule"]["start"]
     init = dict(st)
-    init.update(initial or {})
+    _update_initial(init, initial)
     vs = [Variable("P_ext", GELATIN["P_ext"][0], GELATIN["P_ext"][1], init["P_ext"], "MPa"),
           Variable("r_d22", 1.0, 1.6, init["r_d22"], "mm"),
           Variable("a", 2.2, 3.0, init["a"], "mm"),
