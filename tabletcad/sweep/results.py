@@ -11,14 +11,13 @@ dictionary).  One row per design, in the sweep's order.
 While a sweep runs, each finished design is appended to
 ``results.partial.jsonl`` beside ``results.csv``; an interrupted sweep resumes
 from both, and the journal is removed once ``results.csv`` is complete.
-Floats are written with ``repr`` and read back with pandas' round-trip parser,
-so values survive the file exactly.
+Floats are written with ``repr`` and read back by Python's ``float``, so
+values survive the file exactly.
 """
 
 from __future__ import annotations
 
 import json
-import math
 import re
 from collections.abc import Iterable, Sequence
 from pathlib import Path
@@ -27,7 +26,7 @@ from typing import Any
 from tabletcad.errors import DesignError
 
 __all__ = ["RESULTS_CSV", "JOURNAL", "TAIL_COLUMNS", "results_frame", "write_results", "read_results",
-           "read_done", "append_journal", "plot_results"]
+           "read_done", "append_journal", "plot_results", "parse_cell"]
 
 RESULTS_CSV = "results.csv"
 JOURNAL = "results.partial.jsonl"
@@ -56,17 +55,42 @@ def write_results(df, path: str | Path) -> Path:
 
 
 def read_results(path: str | Path):
-    """Read a ``results.csv`` back (floats exactly as written)."""
+    """Read a ``results.csv`` back, every value exactly as written.
+
+    Cells (except the text columns ``status``, ``error`` and ``design_hash``) are parsed by Python itself (``int``, then ``float`` — exact for
+    ``repr`` output —, ``True``/``False``, else text; an empty cell is None),
+    so the columns have ``object`` dtype.
+    """
     import pandas as pd
 
     try:
-        df = pd.read_csv(path, float_precision="round_trip", keep_default_na=True)
+        df = pd.read_csv(path, dtype=str, keep_default_na=False)
     except (ValueError, pd.errors.ParserError) as exc:
         raise DesignError("results file", str(path), f"must be a results.csv written by tabletcad sweep ({exc})") from None
     missing = [c for c in TAIL_COLUMNS if c not in df.columns]
     if missing:
         raise DesignError("results file", str(path), f"has no {', '.join(missing)} column; it was not written by tabletcad sweep")
-    return df
+    out = df.astype(object)
+    for c in df.columns:
+        if c in TAIL_COLUMNS:  # text as written (a hash of digits stays text)
+            out[c] = [v if v != "" else None for v in df[c]]
+        else:
+            out[c] = [parse_cell(v) for v in df[c]]
+    return out
+
+
+def parse_cell(text: str) -> Any:
+    """The value of one CSV cell as :func:`write_results` wrote it."""
+    if text == "":
+        return None
+    if text in ("True", "False"):
+        return text == "True"
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
 
 
 def append_journal(path: Path, row: dict[str, Any]) -> None:
@@ -83,7 +107,7 @@ def read_done(out_dir: Path) -> dict[str, dict[str, Any]]:
     if csv.is_file():
         df = read_results(csv)
         for r in df.to_dict(orient="records"):
-            done[str(r["design_hash"])] = {k: _clean(v) for k, v in r.items()}
+            done[str(r["design_hash"])] = r
     journal = out_dir / JOURNAL
     if journal.is_file():
         for line in journal.read_text(encoding="utf-8").splitlines():
@@ -93,14 +117,6 @@ def read_done(out_dir: Path) -> dict[str, dict[str, Any]]:
                 continue
             done[str(r["design_hash"])] = r
     return done
-
-
-def _clean(v: Any) -> Any:
-    if isinstance(v, float) and math.isnan(v):
-        return None
-    if hasattr(v, "item"):
-        return v.item()
-    return v
 
 
 def _safe(name: str) -> str:

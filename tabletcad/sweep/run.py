@@ -131,4 +131,5 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
 def _restored(row: dict[str, Any], keys: tuple[str, ...], values: tuple[Any, ...]) -> dict[str, Any]:
     """A row of an earlier run; the varied values are taken from the sweep (identical by the hash)."""
     rest = {k: v for k, v in row.items() if k not in keys and k not in TAIL_COLUMNS}
-    return {**dict(zip(keys, values)), **rest, **{k: row.get(k) for k in TAIL_COLUMNS}}
+    return {**dict(zip(keys, values)), **rest, "status": row.get("status"), "error": row.get("error") or "",
+            "design_hash": row.get("design_hash")}
