@@ -100,8 +100,15 @@ def test_rows_are_in_sweep_order_and_a_failing_design_is_a_row(local_results):
               "design_report.tensile_strength.tensile_strength_MPa"):
         assert c in cols
     assert math.isnan(df.loc[1, "volume_mm3"])
-    # deeper cups: less volume, less weight; weight = volume x solid fraction x true density
-    assert df.loc[2, "volume_mm3"] < df.loc[0, "volume_mm3"]
+    # each cup is a spherical cap of depth h over the land's inner circle (radius a): pi h (3 a^2 + h^2) / 6
+    # (the report's quadrature agrees to 2.4e-6 relative), and two cups are all that changes the volume
+    for i, h in ((0, 0.7), (2, 1.0)):
+        a = 4.0 - 0.08
+        cap = math.pi * h * (3 * a * a + h * h) / 6.0
+        assert df.loc[i, "design_report.cup_volume_mm3"] == pytest.approx(cap, rel=1e-5)
+    assert df.loc[2, "volume_mm3"] - df.loc[0, "volume_mm3"] == pytest.approx(
+        2 * (df.loc[2, "design_report.cup_volume_mm3"] - df.loc[0, "design_report.cup_volume_mm3"]), rel=1e-9)
+    # weight = volume x solid fraction x true density
     assert df["design_report.weight_mg"][[0, 2]].tolist() == pytest.approx((df["volume_mm3"][[0, 2]] * 0.85 * 1.5).tolist(),
                                                                             rel=1e-9)
     assert not (out / JOURNAL).exists()

@@ -150,3 +150,19 @@ def test_an_earlier_results_csv_needs_resume(tmp_path, capsys):
     assert main(["sweep", str(p), "--out", str(out), "--workers", "1", "--quiet", "--resume"]) == 2
     assert "1 designs that are not in this sweep file" in capsys.readouterr().err
     assert sorted(q.name for q in out.iterdir()) == ["results.csv"]
+
+
+def test_sample_sweep_files():
+    from pathlib import Path
+
+    from tabletcad.sweep import load_sweep
+
+    root = Path(__file__).resolve().parents[1] / "samples" / "sweep"
+    grid = load_sweep(root / "concave_round_grid.toml")
+    assert grid.keys == ("tablet.cup_depth", "tablet.band") and len(grid.designs()) == 6
+    assert grid.points()[1] == (0.6, 3.2)
+    lhs = load_sweep(root / "concave_round_lhs.toml")
+    pts = np.array(lhs.points())
+    assert pts.shape == (40, 3) and pts[:, 0].min() >= 8.0 and pts[:, 0].max() < 12.0
+    assert sorted(np.floor((pts[:, 2] - 0.5) / 0.9 * 40).astype(int)) == list(range(40))
+    assert len({design_hash(d) for d in lhs.designs()}) == 40

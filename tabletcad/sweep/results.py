@@ -70,13 +70,9 @@ def read_results(path: str | Path):
     missing = [c for c in TAIL_COLUMNS if c not in df.columns]
     if missing:
         raise DesignError("results file", str(path), f"has no {', '.join(missing)} column; it was not written by tabletcad sweep")
-    out = df.astype(object)
-    for c in df.columns:
-        if c in TAIL_COLUMNS:  # text as written (a hash of digits stays text)
-            out[c] = [v if v != "" else None for v in df[c]]
-        else:
-            out[c] = [parse_cell(v) for v in df[c]]
-    return out
+    cols = {c: pd.Series([(v or None) if c in TAIL_COLUMNS else parse_cell(v) for v in df[c]], dtype=object)
+            for c in df.columns}  # the text columns stay text (a hash of digits too)
+    return pd.DataFrame(cols, columns=df.columns)
 
 
 def parse_cell(text: str) -> Any:
