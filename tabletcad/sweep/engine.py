@@ -30,7 +30,7 @@ from typing import Any
 from tabletcad.errors import DesignError
 from tabletcad.sweep.spec import OUTPUTS
 
-__all__ = ["evaluate_design", "map_tasks", "open_client", "flatten_report", "CONNECT_TIMEOUT_S", "error_message"]
+__all__ = ["evaluate_design", "sweep_task", "failed_design", "map_tasks", "open_client", "flatten_report", "CONNECT_TIMEOUT_S", "error_message"]
 
 CONNECT_TIMEOUT_S = 10.0
 """Seconds to wait for a Dask scheduler to answer before the sweep stops with a one-line error."""
@@ -124,7 +124,12 @@ def evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",)
             files = {}
         return dict(values=flatten_report(report), status="ok", error="", files=files)
     except Exception as exc:  # a failing design is a row, never the end of the sweep
-        return dict(values={}, status="error", error=error_message(exc), files={})
+        return failed_design(exc)
+
+
+def failed_design(exc: BaseException) -> dict[str, Any]:
+    """The result of a design that failed with ``exc`` (in the worker, or by losing its worker)."""
+    return dict(values={}, status="error", error=error_message(exc), files={})
 
 
 def sweep_task(item: tuple[dict[str, Any], str], **kw: Any) -> dict[str, Any]:
@@ -155,9 +160,18 @@ def open_client(workers: int | None = None, scheduler: str | None = None,
         finally:
             client.close()
         return
+    import dask
+
     n = workers if workers is not None else (os.cpu_count() or 1)
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                      silence_logs=logging.ERROR) as cluster, Client(cluster, set_as_default=False) as client:
+    # distributed sets MALLOC_TRIM_THRESHOLD_=65536 in every worker it spawns; glibc then maps and
+    # unmaps every large NumPy array, which made the report take 1.8x the CPU time of this process
+    # (benchmarks/bench_sweep.py).  The local workers keep glibc's adaptive default.
+    env = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
+           if k != "MALLOC_TRIM_THRESHOLD_"}
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": env}):
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                               silence_logs=logging.ERROR)
+    with cluster, Client(cluster, set_as_default=False) as client:
         yield client
 
 
@@ -165,7 +179,8 @@ def map_tasks(func: Callable[..., Any], items: Sequence[Any], *, kwargs: dict[st
               client: Any = None, workers: int | None = None, scheduler: str | None = None,
               connect_timeout: float = CONNECT_TIMEOUT_S, progress: bool = True, desc: str = "sweep",
               failed: Callable[[Any], bool] | None = None,
-              on_result: Callable[[int, Any], None] | None = None) -> list[Any]:
+              on_result: Callable[[int, Any], None] | None = None,
+              on_error: Callable[[BaseException], Any] | None = None) -> list[Any]:
     """``[func(item, **kwargs) for item in items]`` on Dask, results in the order of ``items``.
 
     ``func`` must be importable by the workers (a module-level function) and
@@ -174,7 +189,9 @@ def map_tasks(func: Callable[..., Any], items: Sequence[Any], *, kwargs: dict[st
     ``workers``; ``workers=0`` runs the loop in this process.  ``on_result(i,
     result)`` is called in this process as each result arrives (in completion
     order); ``failed(result)`` marks results counted as failed in the progress
-    bar.  An exception raised by ``func`` (or a lost worker) propagates.
+    bar.  An exception raised by ``func`` (or a worker lost while running it,
+    :class:`distributed.KilledWorker`) propagates, unless ``on_error(exc)`` is
+    given: its return value then stands for that item's result.
     """
     from tqdm import tqdm
 
@@ -202,14 +219,14 @@ def map_tasks(func: Callable[..., Any], items: Sequence[Any], *, kwargs: dict[st
         with contextlib.ExitStack() as stack:
             if client is None:
                 client = stack.enter_context(open_client(workers, scheduler, connect_timeout))
-            _run_on(client, func, items, kwargs, done)
+            _run_on(client, func, items, kwargs, done, on_error)
         return results
     finally:
         bar.close()
 
 
 def _run_on(client: Any, func: Callable[..., Any], items: Sequence[Any], kwargs: dict[str, Any],
-            done: Callable[[int, Any], None]) -> None:
+            done: Callable[[int, Any], None], on_error: Callable[[BaseException], Any] | None) -> None:
     from distributed import as_completed
 
     threads = max(1, sum(client.nthreads().values()))
@@ -229,7 +246,12 @@ def _run_on(client: Any, func: Callable[..., Any], items: Sequence[Any], kwargs:
     ac = as_completed(submit(window), loop=client.loop)
     for fut in ac:
         i = index.pop(fut.key)
-        res = fut.result()
+        try:
+            res = fut.result()
+        except Exception as exc:
+            if on_error is None:
+                raise
+            res = on_error(exc)
         fut.release()
         done(i, res)
         for nxt in submit(1):

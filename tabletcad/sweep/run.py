@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from tabletcad.errors import DesignError
-from tabletcad.sweep.engine import CONNECT_TIMEOUT_S, map_tasks, open_client, sweep_task
+from tabletcad.sweep.engine import CONNECT_TIMEOUT_S, failed_design, map_tasks, open_client, sweep_task
 from tabletcad.sweep.results import (JOURNAL, RESULTS_CSV, TAIL_COLUMNS, append_journal, plot_results, read_done,
                                      results_frame, write_results)
 from tabletcad.sweep.spec import SweepSpec, design_hash, load_sweep, parse_sweep
@@ -109,7 +109,7 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
 
     kw = dict(outputs=spec.outputs, name=spec.name, store=store)
     common = dict(kwargs=kw, progress=progress, desc=spec.name, failed=lambda r: r["status"] != "ok",
-                  on_result=on_result)
+                  on_result=on_result, on_error=failed_design)
     with contextlib.ExitStack() as stack:
         if items and client is None and workers != 0:  # connect first: an unreachable scheduler writes nothing
             n = None if scheduler is not None else min(workers or os.cpu_count() or 1, len(items))
