@@ -165,10 +165,11 @@ def open_client(workers: int | None = None, scheduler: str | None = None,
     n = workers if workers is not None else (os.cpu_count() or 1)
     # distributed sets MALLOC_TRIM_THRESHOLD_=65536 in every worker it spawns; glibc then maps and
     # unmaps every large NumPy array, which made the report take 1.8x the CPU time of this process
-    # (benchmarks/bench_sweep.py).  The local workers keep glibc's adaptive default.
+    # (benchmarks/bench_sweep.py).  The local workers keep glibc's adaptive default, and do not run
+    # the statistical profiler (a thread sampling every worker's stack every 10 ms).
     env = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
            if k != "MALLOC_TRIM_THRESHOLD_"}
-    with dask.config.set({"distributed.nanny.pre-spawn-environ": env}):
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": env, "distributed.worker.profile.enabled": False}):
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                                silence_logs=logging.ERROR)
     with cluster, Client(cluster, set_as_default=False) as client:
