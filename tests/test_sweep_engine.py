@@ -209,3 +209,18 @@ def test_tooling_batch_runs_on_the_cluster(local_client, tmp_path):
         assert r["upper_punch_rel_diff_vs_quadrature"] == pytest.approx(0.0, abs=1e-8)
         assert (tmp_path / f"shallow_convex_round_{k:03d}" / "assembly.step").read_bytes().startswith(b"ISO-10303-21;")
     assert rows[1]["tablet_volume_mm3"] > rows[0]["tablet_volume_mm3"]
+
+
+def test_local_workers_keep_the_adaptive_malloc_trim_and_no_profiler():
+    """distributed's MALLOC_TRIM_THRESHOLD_=65536 made the report cost 1.8x the CPU (bench_sweep.py)."""
+    import os
+
+    import dask
+
+    from tabletcad.sweep.engine import open_client
+
+    with open_client(1) as client:
+        env = client.run(lambda: (os.environ.get("MALLOC_TRIM_THRESHOLD_"),
+                                  dask.config.get("distributed.worker.profile.enabled")))
+    assert list(env.values()) == [(None, False)]
+    assert dask.config.get("distributed.nanny.pre-spawn-environ")["MALLOC_TRIM_THRESHOLD_"] == 65536  # restored
