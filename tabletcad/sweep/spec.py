@@ -18,7 +18,8 @@ A sweep file is TOML::
     "tablet.band" = [2.4, 2.8, 3.2]                           # mm, the values themselves
 
 A grid takes every combination (:func:`itertools.product`, the first key
-varying slowest, values in the order given).  A Latin hypercube
+varying slowest, values in the order given; range values are
+:func:`numpy.linspace` rounded to 12 significant digits).  A Latin hypercube
 (:class:`scipy.stats.qmc.LatinHypercube` with the file's ``seed``) draws
 ``samples`` points in the unit cube; a ``{min, max}`` range maps ``x`` to
 ``min + x (max - min)`` and a list picks the value at ``floor(x n)``.
@@ -217,7 +218,8 @@ def _axis(key: str, spec: Any, method: str) -> Axis:
         return Axis(key, values)
     import numpy as np
 
-    return Axis(key, tuple(float(v) for v in np.linspace(lo, hi, num)))
+    # rounded to 12 significant digits, so that 0.6 to 1.2 in 3 steps gives 0.9, not 0.8999999999999999
+    return Axis(key, tuple(float(f"{v:.12g}") for v in np.linspace(lo, hi, num)))
 
 
 def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
