@@ -224,3 +224,21 @@ def test_local_workers_keep_the_adaptive_malloc_trim_and_no_profiler():
                                   dask.config.get("distributed.worker.profile.enabled")))
     assert list(env.values()) == [(None, False)]
     assert dask.config.get("distributed.nanny.pre-spawn-environ")["MALLOC_TRIM_THRESHOLD_"] == 65536  # restored
+
+
+def test_a_lost_worker_is_a_failed_row_not_the_end():
+    """A task that kills its worker process (as a crash in a native library would) becomes an error result."""
+    import os
+
+    import dask
+    from distributed import KilledWorker
+
+    from tabletcad.sweep.engine import failed_design, map_tasks, open_client
+
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), open_client(1) as client:
+        res = map_tasks(os._exit, [3], client=client, progress=False, on_error=failed_design)
+        assert res[0]["status"] == "error" and res[0]["error"].startswith("KilledWorker")
+        client.wait_for_workers(1, timeout=120)  # the nanny restarts the worker
+        with pytest.raises(KilledWorker):
+            map_tasks(os._exit, [3], client=client, progress=False)
+        assert map_tasks(abs, [-2, 5], client=client, progress=False) == [2, 5]
