@@ -1,4 +1,5 @@
-"""Scripting API: tooling for a range of tablet sizes in one call (with a tqdm progress bar).
+"""Scripting API: tooling for a range of tablet sizes in one call (with a tqdm progress bar),
+in this process or on a Dask cluster (the sweep engine).
 
 >>> from tabletcad.tooling import tooling_batch, ToolingSpec
 >>> rows = tooling_batch("shallow_convex_round",
@@ -36,40 +37,67 @@ def tooling_for(tablet, spec: ToolingSpec | dict | None = None, out_dir=None, **
 
 def tooling_batch(family: str, sizes: Iterable[dict], spec: ToolingSpec | dict | None = None, *, out_dir=None,
                   progress: bool = True, check: bool = True, interference_check: bool = False,
-                  drawing: bool = True) -> list[dict]:
+                  drawing: bool = True, workers: int = 0, scheduler: str | None = None, client=None) -> list[dict]:
     """Tooling for every parameter set in ``sizes`` of ``family``; one summary row per size.
 
     Files go to ``out_dir/<family>_<k>/`` when ``out_dir`` is given.  Rows hold the parameters,
     tablet and punch volumes, the quadrature check, the largest OCC/manifold3d disagreement and
     the seconds spent (total and in OCC Booleans).
+
+    Runs on the sweep engine (:func:`tabletcad.sweep.engine.map_tasks`): in this process by
+    default (``workers=0``), on a local Dask cluster of ``workers`` processes, on the cluster of
+    ``scheduler`` (an address) or of an open ``client``.  Workers receive the parameters and
+    return the rows and the files' bytes, which are written here.
     """
-    from tqdm import tqdm
+    from tabletcad.sweep.engine import map_tasks
+
+    if isinstance(spec, dict):
+        spec = parse_tooling(spec)
+    _load_plugins()
+    if family not in FAMILIES:
+        from tabletcad.errors import DesignError
+
+        raise DesignError("family", family, f"must be one of {', '.join(FAMILIES)}")
+    sizes = [dict(p) for p in sizes]
+
+    def write(k: int, res: dict) -> None:
+        if out_dir is not None:
+            d = Path(out_dir) / f"{family}_{k:03d}"
+            d.mkdir(parents=True, exist_ok=True)
+            for name, data in res["files"].items():
+                (d / name).write_bytes(data)
+
+    results = map_tasks(_tooling_task, sizes, kwargs=dict(family=family, spec=spec, check=check,
+                                                          interference_check=interference_check, drawing=drawing,
+                                                          files=out_dir is not None),
+                        client=client, scheduler=scheduler, workers=None if client or scheduler else workers,
+                        progress=progress, desc=f"tooling {family}", on_result=write)
+    return [r["row"] for r in results]
+
+
+def _tooling_task(params: dict, *, family: str, spec: ToolingSpec | None, check: bool, interference_check: bool,
+                  drawing: bool, files: bool) -> dict:
+    """One size of :func:`tooling_batch` on a worker: its summary row and (optionally) its files as bytes."""
+    import tempfile
 
     from tabletcad.tooling.stage import write_tooling
     from tabletcad.tooling.toolset import make_tooling
 
     _load_plugins()
-    if isinstance(spec, dict):
-        spec = parse_tooling(spec)
-    fam = FAMILIES[family]
-    sizes = list(sizes)
-    rows = []
-    for k, params in enumerate(tqdm(sizes, desc=f"tooling {family}", unit="size", disable=not progress)):
-        t0 = time.perf_counter()
-        tablet = fam.build(**params)
-        ts = make_tooling(tablet, spec, check=check, interference_check=interference_check)
-        files = []
-        if out_dir is not None:
-            d = Path(out_dir) / f"{family}_{k:03d}"
-            d.mkdir(parents=True, exist_ok=True)
-            files = [p.name for p in write_tooling(ts, d, drawing=drawing)]
-        r = ts.report
-        rows.append(dict(
-            params=dict(params), tablet_volume_mm3=r["tablet"]["volume_mm3"],
-            upper_punch_volume_mm3=r["upper_punch"]["volume_mm3"],
-            upper_punch_rel_diff_vs_quadrature=r["upper_punch"]["volume_rel_diff_vs_quadrature"],
-            boolean_max_rel_diff=r["boolean_max_rel_diff_occ_vs_manifold3d"],
-            interference_mm3=r.get("interference_mm3"), max_gap_mm=r.get("max_gap_mm"),
-            seconds=time.perf_counter() - t0, occ_boolean_seconds=r["seconds"]["occ_booleans"], files=files,
-        ))
-    return rows
+    t0 = time.perf_counter()
+    tablet = FAMILIES[family].build(**params)
+    ts = make_tooling(tablet, spec, check=check, interference_check=interference_check)
+    data: dict[str, bytes] = {}
+    if files:
+        with tempfile.TemporaryDirectory(prefix="tabletcad-tooling-") as tmp:
+            data = {p.name: p.read_bytes() for p in write_tooling(ts, Path(tmp), drawing=drawing)}
+    r = ts.report
+    row = dict(
+        params=dict(params), tablet_volume_mm3=r["tablet"]["volume_mm3"],
+        upper_punch_volume_mm3=r["upper_punch"]["volume_mm3"],
+        upper_punch_rel_diff_vs_quadrature=r["upper_punch"]["volume_rel_diff_vs_quadrature"],
+        boolean_max_rel_diff=r["boolean_max_rel_diff_occ_vs_manifold3d"],
+        interference_mm3=r.get("interference_mm3"), max_gap_mm=r.get("max_gap_mm"),
+        seconds=time.perf_counter() - t0, occ_boolean_seconds=r["seconds"]["occ_booleans"], files=list(data),
+    )
+    return dict(row=row, files=data)

@@ -1,0 +1,135 @@
+"""``run_sweep``: a sweep file in, a pandas DataFrame (and ``results.csv``) out."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from pathlib import Path
+from typing import Any
+
+from tabletcad.errors import DesignError
+from tabletcad.sweep.engine import CONNECT_TIMEOUT_S, failed_design, map_tasks, open_client, sweep_task
+from tabletcad.sweep.results import (JOURNAL, RESULTS_CSV, TAIL_COLUMNS, append_journal, plot_results, read_done,
+                                     results_frame, write_results)
+from tabletcad.sweep.spec import SweepSpec, design_hash, load_sweep, parse_sweep
+
+__all__ = ["run_sweep"]
+
+
+def _spec(sweep: Any) -> SweepSpec:
+    if isinstance(sweep, SweepSpec):
+        return sweep
+    if isinstance(sweep, dict):
+        return parse_sweep(sweep)
+    return load_sweep(sweep)
+
+
+def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | None = None,
+              scheduler: str | None = None, client: Any = None, resume: bool = False, progress: bool = True,
+              store: str | None = None, plot: tuple[str, ...] = (),
+              connect_timeout: float = CONNECT_TIMEOUT_S):
+    """Run a sweep and return its results as a :class:`pandas.DataFrame` (one row per design).
+
+    Parameters
+    ----------
+    sweep : path, dict or SweepSpec
+        The sweep file (see :mod:`tabletcad.sweep.spec`), its parsed TOML or a parsed spec.
+    out_dir : path, optional
+        Folder for ``results.csv``, the resume journal, the files of file
+        outputs (``designs/<design_hash>/``) and plots.  Without it nothing is written.
+    workers, scheduler, client
+        The engine: a local cluster of ``workers`` processes (default: one per
+        CPU; ``0`` runs in this process), an existing scheduler's address, or an
+        open :class:`distributed.Client`.
+    resume : bool
+        Skip designs whose hash is already in ``out_dir/results.csv`` (or the journal).
+    store : str, optional
+        fsspec URL or folder the workers write file outputs to (overrides the
+        file's ``[sweep] store``); then no file bytes travel to the client.
+    plot : tuple of str
+        Report columns to plot against every varied key (``plot_<column>.png``).
+
+    Every check of the sweep file, the options and the scheduler connection
+    happens before any design is built; a failure raises
+    :class:`~tabletcad.errors.DesignError` and writes nothing.
+    """
+    spec = _spec(sweep)
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 0):
+        raise DesignError("--workers", workers, "must be an integer >= 1 (0 runs the designs in this process)")
+    if workers is not None and (scheduler is not None or client is not None):
+        raise DesignError("--workers", workers, "give either --workers or --scheduler, not both")
+    store = store if store is not None else spec.store
+    files_wanted = any(o != "report" for o in spec.outputs)
+    out = Path(out_dir) if out_dir is not None else None
+    if out is None:
+        if resume:
+            raise DesignError("--resume", True, "needs the --out folder of the earlier run")
+        if files_wanted and store is None:
+            raise DesignError("[sweep] outputs", ", ".join(spec.outputs), "file outputs need an --out folder or a store")
+        if plot:
+            raise DesignError("--plot", ", ".join(plot), "plots need an --out folder")
+    elif out.exists() and not out.is_dir():
+        raise DesignError("--out", str(out), "must be a folder")
+    designs = spec.designs()
+    hashes = [design_hash(d) for d in designs]
+    done: dict[str, dict[str, Any]] = {}
+    if out is not None and out.is_dir() and ((out / RESULTS_CSV).exists() or (out / JOURNAL).exists()):
+        if not resume:
+            raise DesignError("--out", str(out), f"already holds {RESULTS_CSV} of a sweep; give --resume or another folder")
+        done = read_done(out)
+        foreign = set(done) - set(hashes)
+        if foreign:
+            raise DesignError("--resume", str(out / RESULTS_CSV),
+                              f"holds {len(foreign)} designs that are not in this sweep file; use another --out folder")
+
+    todo: dict[str, dict[str, Any]] = {}
+    for h, d in zip(hashes, designs):
+        if h not in done and h not in todo:
+            todo[h] = d
+    items = [(d, h) for h, d in todo.items()]
+    values = dict(zip(hashes, spec.points()))
+    results: dict[str, dict[str, Any]] = {}
+
+    def row_of(h: str, res: dict[str, Any]) -> dict[str, Any]:
+        return {**dict(zip(spec.keys, values[h])), **res["values"], "status": res["status"], "error": res["error"],
+                "design_hash": h}
+
+    def on_result(i: int, res: dict[str, Any]) -> None:
+        h = items[i][1]
+        row = row_of(h, res)
+        results[h] = row
+        if out is None:
+            return
+        if res["files"]:
+            folder = out / "designs" / h
+            folder.mkdir(parents=True, exist_ok=True)
+            for name, data in res["files"].items():
+                (folder / name).write_bytes(data)
+        append_journal(out / JOURNAL, row)
+
+    kw = dict(outputs=spec.outputs, name=spec.name, store=store)
+    common = dict(kwargs=kw, progress=progress, desc=spec.name, failed=lambda r: r["status"] != "ok",
+                  on_result=on_result, on_error=failed_design)
+    with contextlib.ExitStack() as stack:
+        if items and client is None and workers != 0:  # connect first: an unreachable scheduler writes nothing
+            n = None if scheduler is not None else min(workers or os.cpu_count() or 1, len(items))
+            client = stack.enter_context(open_client(n, scheduler, connect_timeout))
+        if out is not None:
+            out.mkdir(parents=True, exist_ok=True)
+        map_tasks(sweep_task, items, client=client, workers=0 if client is None else None, **common)
+
+    rows = [results.get(h) or _restored(done[h], spec.keys, values[h]) for h in hashes]
+    df = results_frame(spec.keys, rows)
+    if out is not None:
+        write_results(df, out / RESULTS_CSV)
+        (out / JOURNAL).unlink(missing_ok=True)
+        if plot:
+            plot_results(df, spec.keys, plot, out)
+    return df
+
+
+def _restored(row: dict[str, Any], keys: tuple[str, ...], values: tuple[Any, ...]) -> dict[str, Any]:
+    """A row of an earlier run; the varied values are taken from the sweep (identical by the hash)."""
+    rest = {k: v for k, v in row.items() if k not in keys and k not in TAIL_COLUMNS}
+    return {**dict(zip(keys, values)), **rest, "status": row.get("status"), "error": row.get("error") or "",
+            "design_hash": row.get("design_hash")}

@@ -1,0 +1,285 @@
+"""Sweep files: a base design, the keys to vary and how to sample them.
+
+A sweep file is TOML::
+
+    [design]                     # an ordinary design: [design.tablet], [design.report], ...
+    [design.tablet]
+    family = "concave_round"
+    diameter = 10.0
+    band = 2.8
+    cup_depth = 0.9
+
+    [sweep]
+    method = "grid"              # or "lhs" (Latin hypercube) with samples and seed
+    outputs = ["report"]         # optionally also "step", "stl", "glb", "png", "tooling"
+
+    [sweep.vary]
+    "tablet.cup_depth" = { min = 0.5, max = 1.2, num = 8 }   # mm, inclusive end points
+    "tablet.band" = [2.4, 2.8, 3.2]                           # mm, the values themselves
+
+A grid takes every combination (:func:`itertools.product`, the first key
+varying slowest, values in the order given; range values are
+:func:`numpy.linspace` rounded to 12 significant digits).  A Latin hypercube
+(:class:`scipy.stats.qmc.LatinHypercube` with the file's ``seed``) draws
+``samples`` points in the unit cube; a ``{min, max}`` range maps ``x`` to
+``min + x (max - min)`` and a list picks the value at ``floor(x n)``.
+
+Every problem with the file is a :class:`~tabletcad.errors.DesignError`
+raised by :func:`parse_sweep` before any design is built.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from tabletcad.errors import DesignError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+__all__ = ["SweepSpec", "Axis", "OUTPUTS", "load_sweep", "parse_sweep", "design_hash", "set_key"]
+
+# outputs a design may produce besides its report -> the files of `tabletcad build` they stand for
+OUTPUTS = {
+    "report": (),
+    "step": ("tablet.step",),
+    "stl": ("tablet.stl",),
+    "glb": ("tablet.glb",),
+    "png": ("tablet.png",),
+    "tooling": ("assembly.step", "upper_punch.step", "lower_punch.step", "die.step", "drawing.svg", "drawing.dxf"),
+}
+_SWEEP_KEYS = {"method", "samples", "seed", "outputs", "vary", "store"}
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One varied key: the dotted ``key`` of the design and its ``values`` (grid) or range (lhs).
+
+    ``values`` is the list of values for a list axis or a grid range (``num``
+    points from ``lo`` to ``hi``, end points included); ``lo``/``hi`` are set
+    for ``{min, max}`` ranges (units of the design key).
+    """
+
+    key: str
+    values: tuple[Any, ...] = ()
+    lo: float | None = None
+    hi: float | None = None
+
+    def pick(self, x: float) -> Any:
+        """The value at ``x`` in [0, 1) of a Latin hypercube sample."""
+        if self.lo is not None and self.hi is not None:
+            return self.lo + x * (self.hi - self.lo)
+        n = len(self.values)
+        return self.values[min(int(math.floor(x * n)), n - 1)]
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """A parsed sweep: the base ``design`` dict, its ``axes``, sampling and ``outputs``."""
+
+    design: dict[str, Any]
+    axes: tuple[Axis, ...]
+    method: str = "grid"
+    samples: int | None = None
+    seed: int | None = None
+    outputs: tuple[str, ...] = ("report",)
+    store: str | None = None
+    name: str = "sweep"
+    keys: tuple[str, ...] = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "keys", tuple(a.key for a in self.axes))
+
+    def points(self) -> list[tuple[Any, ...]]:
+        """The varied values of every design, in the sweep's deterministic order."""
+        if self.method == "grid":
+            return list(itertools.product(*(a.values for a in self.axes)))
+        from scipy.stats import qmc
+
+        x = qmc.LatinHypercube(d=len(self.axes), seed=self.seed).random(self.samples)
+        return [tuple(a.pick(float(xi)) for a, xi in zip(self.axes, row)) for row in x]
+
+    def designs(self) -> list[dict[str, Any]]:
+        """The design dict of every point (the base design with the varied keys set)."""
+        out = []
+        for values in self.points():
+            d = copy.deepcopy(self.design)
+            for key, v in zip(self.keys, values):
+                set_key(d, key, v)
+            out.append(d)
+        return out
+
+
+def set_key(design: dict, key: str, value: Any) -> None:
+    """Set the dotted ``key`` (``"tablet.cup_depth"``) of a design dict in place."""
+    *path, leaf = key.split(".")
+    node = design
+    for p in path:
+        node = node.setdefault(p, {})
+    node[leaf] = value
+
+
+def design_hash(design: dict[str, Any]) -> str:
+    """A stable 16-hex-digit SHA-256 of a design dict (keys sorted, floats by ``repr``)."""
+    text = json.dumps(design, sort_keys=True, separators=(",", ":"), default=str)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
+def load_sweep(path: str | Path) -> SweepSpec:
+    """Read and check a sweep file (see module docstring)."""
+    path = Path(path)
+    if not path.is_file():
+        raise DesignError("sweep file", str(path), "must be an existing TOML file")
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise DesignError("sweep file", path.name, f"must be valid TOML ({exc})") from None
+    return parse_sweep(data, name=path.stem)
+
+
+def _number(where: str, v: Any) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(float(v)):
+        raise DesignError(where, v, "must be a finite number")
+    return float(v)
+
+
+def _known_keys(design: dict) -> set[str]:
+    """Dotted keys that may be varied: every scalar of the base design, and the family's parameters."""
+    keys: set[str] = set()
+
+    def walk(prefix: str, node: Any) -> None:
+        if isinstance(node, dict):
+            for k, v in node.items():
+                walk(f"{prefix}.{k}" if prefix else k, v)
+        elif prefix:
+            keys.add(prefix)
+
+    walk("", design)
+    tab = design.get("tablet", {})
+    fam = tab.get("family") if isinstance(tab, dict) else None
+    from tabletcad.shapes import FAMILIES, _load_plugins
+
+    _load_plugins()
+    if fam in FAMILIES:
+        keys |= {f"tablet.{k}" for k in FAMILIES[fam].params} | {"tablet.a", "tablet.name"}
+    try:
+        from dataclasses import fields
+
+        from tabletcad.families.designreport import ReportOptions
+
+        keys |= {f"report.{f.name}" for f in fields(ReportOptions)}
+    except ImportError:  # pragma: no cover
+        pass
+    return keys
+
+
+def _axis(key: str, spec: Any, method: str) -> Axis:
+    where = f"[sweep.vary] {key!r}"
+    if isinstance(spec, list):
+        if not spec:
+            raise DesignError(where, "[]", "an empty list sweeps nothing; give at least one value")
+        for v in spec:
+            if isinstance(v, (dict, list)):
+                raise DesignError(where, v, "list entries must be numbers, strings or booleans")
+        return Axis(key, tuple(spec))
+    if not isinstance(spec, dict):
+        raise DesignError(where, spec, "must be a list of values or a table { min = ..., max = ..., num = ... }")
+    allowed = {"min", "max", "num"} if method == "grid" else {"min", "max"}
+    for k in spec:
+        if k not in allowed:
+            raise DesignError(f"{where} key {k!r}", spec[k], f"a {method} range takes {', '.join(sorted(allowed))}")
+    for k in ("min", "max"):
+        if k not in spec:
+            raise DesignError(f"{where} {k}", "missing", f"a range needs {', '.join(sorted(allowed))}")
+    lo, hi = _number(f"{where} min", spec["min"]), _number(f"{where} max", spec["max"])
+    if hi < lo:
+        raise DesignError(f"{where} max", hi, f"the range is empty: max must be >= min = {lo:g}")
+    if method == "lhs":
+        return Axis(key, (), lo, hi)
+    if "num" not in spec:
+        raise DesignError(f"{where} num", "missing", "a grid range needs num (the number of values, >= 1)")
+    num = spec["num"]
+    if isinstance(num, bool) or not isinstance(num, int) or num <= 0:
+        raise DesignError(f"{where} num", num, "must be an integer >= 1")
+    if num == 1:
+        values: tuple[float, ...] = (lo,) if lo == hi else ()
+        if not values:
+            raise DesignError(f"{where} num", num, f"one value cannot span {lo:g} to {hi:g}; give num >= 2 or min = max")
+        return Axis(key, values)
+    import numpy as np
+
+    # rounded to 12 significant digits, so that 0.6 to 1.2 in 3 steps gives 0.9, not 0.8999999999999999
+    return Axis(key, tuple(float(f"{v:.12g}") for v in np.linspace(lo, hi, num)))
+
+
+def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
+    """Check a parsed sweep file and return its :class:`SweepSpec` (no design is built)."""
+    for k in data:
+        if k not in ("design", "sweep"):
+            raise DesignError(f"top-level key {k!r}", data[k], "a sweep file has a [design] and a [sweep] table")
+    design = data.get("design")
+    if not isinstance(design, dict) or not isinstance(design.get("tablet"), dict):
+        raise DesignError("[design]", "missing", "a sweep file needs a [design] table with a [design.tablet] table")
+    from tabletcad.design import TOP_LEVEL_KEYS
+
+    for k in design:
+        if k not in TOP_LEVEL_KEYS:
+            raise DesignError(f"[design] key {k!r}", design[k], f"allowed keys are {', '.join(TOP_LEVEL_KEYS)}")
+    sw = data.get("sweep")
+    if not isinstance(sw, dict):
+        raise DesignError("[sweep]", "missing", "a sweep file needs a [sweep] table with [sweep.vary]")
+    for k in sw:
+        if k not in _SWEEP_KEYS:
+            raise DesignError(f"[sweep] key {k!r}", sw[k], f"allowed keys are {', '.join(sorted(_SWEEP_KEYS))}")
+    method = sw.get("method", "grid")
+    if method not in ("grid", "lhs"):
+        raise DesignError("[sweep] method", method, "must be 'grid' or 'lhs'")
+    samples = seed = None
+    if method == "lhs":
+        if "samples" not in sw:
+            raise DesignError("[sweep] samples", "missing", "a Latin hypercube needs samples (an integer >= 1)")
+        samples = sw["samples"]
+        if isinstance(samples, bool) or not isinstance(samples, int) or samples <= 0:
+            raise DesignError("[sweep] samples", samples, "must be an integer >= 1")
+        if "seed" not in sw:
+            raise DesignError("[sweep] seed", "missing", "samples need a seed (an integer >= 0) so that the sweep can be repeated")
+        seed = sw["seed"]
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+            raise DesignError("[sweep] seed", seed, "must be an integer >= 0")
+    else:
+        for k in ("samples", "seed"):
+            if k in sw:
+                raise DesignError(f"[sweep] {k}", sw[k], "only a Latin hypercube (method = 'lhs') takes samples and seed")
+    outputs = sw.get("outputs", ["report"])
+    if isinstance(outputs, str):
+        outputs = [outputs]
+    if not isinstance(outputs, list) or not outputs:
+        raise DesignError("[sweep] outputs", outputs, f"must be a list of {', '.join(OUTPUTS)}")
+    for o in outputs:
+        if o not in OUTPUTS:
+            raise DesignError("[sweep] outputs", o, f"must be one of {', '.join(OUTPUTS)}")
+    store = sw.get("store")
+    if store is not None and (not isinstance(store, str) or not store.strip()):
+        raise DesignError("[sweep] store", store, "must be a folder path or fsspec URL")
+    vary = sw.get("vary")
+    if not isinstance(vary, dict) or not vary:
+        raise DesignError("[sweep.vary]", "missing" if vary is None else vary, "give at least one dotted design key to vary")
+    known = _known_keys(design)
+    axes = []
+    for key, spec in vary.items():
+        if key not in known:
+            raise DesignError("[sweep.vary] key", key, "must name a value of [design] or a parameter of its family "
+                              "(e.g. 'tablet.cup_depth'); known: " + ", ".join(sorted(known)))
+        axes.append(_axis(key, spec, method))
+    return SweepSpec(design=design, axes=tuple(axes), method=method, samples=samples, seed=seed,
+                     outputs=tuple(dict.fromkeys(["report", *outputs])), store=store, name=name)

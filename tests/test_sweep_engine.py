@@ -1,0 +1,244 @@
+"""The sweep engine for real: a local Dask cluster of two worker processes, and a separately
+started ``dask scheduler`` / ``dask worker`` pair on 127.0.0.1.
+
+Rows equal ``tabletcad build`` exactly, do not depend on the engine or the number of workers,
+come in the sweep's order, failed designs are rows, ``--resume`` skips finished designs, file
+outputs come back to the client as bytes, and ``tooling_batch`` runs on the same machinery.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import socket
+import subprocess
+import sys
+
+import pytest
+
+pytest.importorskip("distributed")
+pd = pytest.importorskip("pandas")
+
+from tabletcad.cli import main  # noqa: E402
+from tabletcad.design import design_from_dict  # noqa: E402
+from tabletcad.errors import DesignError  # noqa: E402
+from tabletcad.sweep import design_hash, parse_sweep, run_sweep  # noqa: E402
+from tabletcad.sweep.engine import flatten_report  # noqa: E402
+from tabletcad.sweep.results import JOURNAL, read_results  # noqa: E402
+
+TABLET = {"family": "concave_round", "diameter": 8.0, "band": 2.6, "cup_depth": 0.8, "land": 0.08}
+REPORT = {"solid_fraction": 0.85, "true_density_mg_mm3": 1.5, "breaking_force_N": 90.0}
+# three designs: two build, the deepest cup is impossible for an 8 mm tablet (a failed row)
+SWEEP = {"design": {"tablet": TABLET, "report": REPORT},
+         "sweep": {"vary": {"tablet.cup_depth": [0.7, 9.0, 1.0]}}}
+KEY = "tablet.cup_depth"
+
+
+@pytest.fixture(scope="module")
+def local_client():
+    from distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None) as cluster, \
+            Client(cluster, set_as_default=False) as client:
+        client.wait_for_workers(2, timeout=120)
+        yield client
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def scheduler_address(tmp_path_factory):
+    """``dask scheduler`` and one ``dask worker`` started as separate processes; stopped at the end."""
+    from distributed import Client
+
+    port = _free_port()
+    addr = f"tcp://127.0.0.1:{port}"
+    cwd = tmp_path_factory.mktemp("dask")
+    procs = [subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", str(port),
+                               "--no-dashboard"], cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        procs.append(subprocess.Popen([sys.executable, "-m", "dask", "worker", addr, "--nworkers", "1", "--nthreads", "1",
+                                       "--no-dashboard", "--host", "127.0.0.1"],
+                                      cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        with Client(addr, timeout="60s", set_as_default=False) as c:
+            c.wait_for_workers(1, timeout=120)
+        yield addr
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+        for p in reversed(procs):
+            try:
+                p.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait(timeout=30)
+
+
+@pytest.fixture(scope="module")
+def local_results(local_client, tmp_path_factory):
+    out = tmp_path_factory.mktemp("local") / "out"
+    df = run_sweep(SWEEP, out, client=local_client, progress=False)
+    return df, out
+
+
+def test_rows_are_in_sweep_order_and_a_failing_design_is_a_row(local_results):
+    df, out = local_results
+    assert isinstance(df, pd.DataFrame)
+    assert df[KEY].tolist() == [0.7, 9.0, 1.0]
+    assert df["status"].tolist() == ["ok", "error", "ok"]
+    with pytest.raises(DesignError) as exc:
+        design_from_dict({"tablet": {**TABLET, "cup_depth": 9.0}})
+    assert df["error"].tolist() == ["", str(exc.value), ""]
+    assert df["design_hash"].tolist() == [design_hash(d) for d in parse_sweep(SWEEP).designs()]
+    cols = df.columns.tolist()
+    assert cols[0] == KEY and cols[-3:] == ["status", "error", "design_hash"]
+    for c in ("volume_mm3", "surface_area_mm2", "design_report.weight_mg",
+              "design_report.tensile_strength.tensile_strength_MPa"):
+        assert c in cols
+    assert math.isnan(df.loc[1, "volume_mm3"])
+    # each cup is a spherical cap of depth h over the land's inner circle (radius a): pi h (3 a^2 + h^2) / 6
+    # (the report's quadrature agrees to 2.4e-6 relative), and two cups are all that changes the volume
+    for i, h in ((0, 0.7), (2, 1.0)):
+        a = 4.0 - 0.08
+        cap = math.pi * h * (3 * a * a + h * h) / 6.0
+        assert df.loc[i, "design_report.cup_volume_mm3"] == pytest.approx(cap, rel=1e-5)
+    assert df.loc[2, "volume_mm3"] - df.loc[0, "volume_mm3"] == pytest.approx(
+        2 * (df.loc[2, "design_report.cup_volume_mm3"] - df.loc[0, "design_report.cup_volume_mm3"]), rel=1e-9)
+    # weight = volume x solid fraction x true density
+    assert df["design_report.weight_mg"][[0, 2]].tolist() == pytest.approx((df["volume_mm3"][[0, 2]] * 0.85 * 1.5).tolist(),
+                                                                            rel=1e-9)
+    assert not (out / JOURNAL).exists()
+    back = read_results(out / "results.csv")
+    assert back.columns.tolist() == cols
+    for c in cols:
+        for a, b in zip(back[c], df[c]):
+            assert (a == b) or (a is None and (b == "" or b is None or (isinstance(b, float) and math.isnan(b)))), c
+
+
+def test_rows_equal_a_single_tabletcad_build_exactly(local_results, tmp_path):
+    df, _ = local_results
+    design = tmp_path / "sweep.toml"  # the sweep's name is the tablet's name
+    lines = ["[tablet]"] + [f"{k} = {v!r}" if not isinstance(v, str) else f'{k} = "{v}"' for k, v in TABLET.items()
+                            if k != "cup_depth"]
+    lines += ["cup_depth = 1.0", "[report]"] + [f"{k} = {v!r}" for k, v in REPORT.items()]
+    design.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    assert main(["build", str(design), "--out", str(tmp_path / "b"), "--quiet"]) == 0
+    built = flatten_report(json.loads((tmp_path / "b" / "report.json").read_text()))
+    row = df.iloc[2].to_dict()
+    compared = 0
+    for k, v in row.items():
+        if k in (KEY, "status", "error", "design_hash"):
+            continue
+        assert k in built, k
+        if built[k] is None:
+            assert v is None or (isinstance(v, float) and math.isnan(v)), k
+        else:
+            assert v == built[k], k  # exactly: same floats, not approximately
+        compared += 1
+    assert compared > 50
+
+
+def test_results_do_not_depend_on_the_engine_or_the_number_of_workers(local_results, scheduler_address, tmp_path):
+    _, out = local_results
+    text = (out / "results.csv").read_text()
+    assert main(["sweep", str(_sweep_file(tmp_path)), "--out", str(tmp_path / "remote"), "--scheduler", scheduler_address,
+                 "--quiet"]) == 0
+    assert (tmp_path / "remote" / "results.csv").read_text() == text
+    run_sweep(SWEEP, tmp_path / "serial", workers=0, progress=False)
+    assert (tmp_path / "serial" / "results.csv").read_text() == text
+
+
+def _sweep_file(tmp_path):
+    p = tmp_path / "sweep.toml"
+    p.write_text("[design.tablet]\n" + "\n".join(
+        f"{k} = {v!r}" if not isinstance(v, str) else f'{k} = "{v}"' for k, v in TABLET.items())
+        + "\n[design.report]\n" + "\n".join(f"{k} = {v!r}" for k, v in REPORT.items())
+        + '\n[sweep.vary]\n"tablet.cup_depth" = [0.7, 9.0, 1.0]\n', encoding="utf-8")
+    return p
+
+
+def test_resume_skips_finished_designs(local_results, local_client, tmp_path):
+    df, out = local_results
+    lines = (out / "results.csv").read_text().splitlines()
+    # an interrupted run: the journal holds the first design (marked so that a recomputation would show)
+    target = tmp_path / "out"
+    target.mkdir()
+    first = {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in df.iloc[0].to_dict().items()}
+    first["volume_mm3"] = -1.0
+    (target / JOURNAL).write_text(json.dumps(first) + "\n" + '{"design_hash": "cut sho', encoding="utf-8")
+    with pytest.raises(DesignError, match="give --resume"):
+        run_sweep(SWEEP, target, client=local_client, progress=False)
+    res = run_sweep(SWEEP, target, client=local_client, progress=False, resume=True)
+    assert res["volume_mm3"].tolist()[0] == -1.0  # not recomputed
+    assert res["status"].tolist() == ["ok", "error", "ok"]
+    new = (target / "results.csv").read_text().splitlines()
+    assert new[0] == lines[0] and new[2:] == lines[2:]
+    assert not (target / JOURNAL).exists()
+    # a finished sweep resumed again computes nothing and rewrites the same file
+    again = run_sweep(SWEEP, target, workers=0, progress=False, resume=True)
+    assert (target / "results.csv").read_text().splitlines() == new
+    assert again["volume_mm3"].tolist()[0] == -1.0
+
+
+def test_file_outputs_come_back_as_bytes_or_go_to_a_store(local_client, tmp_path):
+    sw = {"design": {"tablet": TABLET}, "sweep": {"outputs": ["step"], "vary": {"tablet.band": [2.6]}}}
+    df = run_sweep(sw, tmp_path / "out", client=local_client, progress=False)
+    assert df["status"].tolist() == ["ok"]
+    h = df["design_hash"][0]
+    step = (tmp_path / "out" / "designs" / h / "tablet.step").read_bytes()
+    assert step.startswith(b"ISO-10303-21;")
+    assert abs(df["brep.volume_mm3"][0] - df["volume_mm3"][0]) <= 1e-6 * df["volume_mm3"][0]
+    store = tmp_path / "store"
+    df2 = run_sweep(sw, tmp_path / "out2", client=local_client, progress=False, store=f"file://{store}")
+    assert (store / h / "tablet.step").is_file() and not (tmp_path / "out2" / "designs").exists()
+    assert df2["brep.volume_mm3"][0] == df["brep.volume_mm3"][0]
+
+
+def test_tooling_batch_runs_on_the_cluster(local_client, tmp_path):
+    from tabletcad.tooling import tooling_batch
+
+    sizes = [dict(diameter=d, thickness=0.3 * d, band=0.2 * d) for d in (6.0, 8.0)]
+    rows = tooling_batch("shallow_convex_round", sizes, {"clearance_mm": 0.02}, out_dir=tmp_path, progress=False,
+                         check=False, drawing=False, client=local_client)
+    assert [r["params"] for r in rows] == sizes
+    for k, r in enumerate(rows):
+        assert r["upper_punch_rel_diff_vs_quadrature"] == pytest.approx(0.0, abs=1e-8)
+        assert (tmp_path / f"shallow_convex_round_{k:03d}" / "assembly.step").read_bytes().startswith(b"ISO-10303-21;")
+    assert rows[1]["tablet_volume_mm3"] > rows[0]["tablet_volume_mm3"]
+
+
+def test_local_workers_keep_the_adaptive_malloc_trim_and_no_profiler():
+    """distributed's MALLOC_TRIM_THRESHOLD_=65536 made the report cost 1.8x the CPU (bench_sweep.py)."""
+    import os
+
+    import dask
+
+    from tabletcad.sweep.engine import open_client
+
+    with open_client(1) as client:
+        env = client.run(lambda: (os.environ.get("MALLOC_TRIM_THRESHOLD_"),
+                                  dask.config.get("distributed.worker.profile.enabled")))
+    assert list(env.values()) == [(None, False)]
+    assert dask.config.get("distributed.nanny.pre-spawn-environ")["MALLOC_TRIM_THRESHOLD_"] == 65536  # restored
+
+
+def test_a_lost_worker_is_a_failed_row_not_the_end():
+    """A task that kills its worker process (as a crash in a native library would) becomes an error result."""
+    import os
+
+    import dask
+    from distributed import KilledWorker
+
+    from tabletcad.sweep.engine import failed_design, map_tasks, open_client
+
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), open_client(1) as client:
+        res = map_tasks(os._exit, [3], client=client, progress=False, on_error=failed_design)
+        assert res[0]["status"] == "error" and res[0]["error"].startswith("KilledWorker")
+        client.wait_for_workers(1, timeout=120)  # the nanny restarts the worker
+        with pytest.raises(KilledWorker):
+            map_tasks(os._exit, [3], client=client, progress=False)
+        assert map_tasks(abs, [-2, 5], client=client, progress=False) == [2, 5]

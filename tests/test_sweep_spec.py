@@ -1,0 +1,168 @@
+"""Sweep files: sampling (grid order, Latin hypercube strata), design hashes, and bad files.
+
+Bad sweep files and options end with one ``error:`` line and exit status 2
+before any design is built: no output folder is created.
+"""
+
+from __future__ import annotations
+
+import itertools
+import socket
+import textwrap
+
+import numpy as np
+import pytest
+
+pytest.importorskip("distributed")
+pytest.importorskip("pandas")
+
+from tabletcad.cli import main  # noqa: E402
+from tabletcad.sweep import design_hash, parse_sweep  # noqa: E402
+from tabletcad.sweep.engine import flatten_report  # noqa: E402
+
+BASE = {"tablet": {"family": "concave_round", "diameter": 10.0, "band": 2.8, "cup_depth": 0.9, "land": 0.08}}
+
+
+def test_grid_is_the_product_in_file_order_with_inclusive_ranges():
+    spec = parse_sweep({"design": BASE, "sweep": {"vary": {
+        "tablet.cup_depth": {"min": 0.5, "max": 1.1, "num": 4}, "tablet.band": [3.0, 2.0, 2.5]}}})
+    assert spec.keys == ("tablet.cup_depth", "tablet.band")
+    depths = [0.5, 0.7, 0.9, 1.1]  # linspace rounded to 12 digits (not 0.7000000000000001)
+    assert spec.points() == list(itertools.product(depths, [3.0, 2.0, 2.5]))
+    assert spec.points()[0][0] == 0.5 and spec.points()[-1][0] == 1.1
+    designs = spec.designs()
+    assert len(designs) == 12
+    assert designs[5]["tablet"] == {**BASE["tablet"], "cup_depth": depths[1], "band": 2.5}
+    assert BASE["tablet"]["cup_depth"] == 0.9  # the base design is not modified
+    assert spec.outputs == ("report",)
+
+
+@pytest.mark.parametrize("n", [1, 7, 50])
+def test_latin_hypercube_fills_every_stratum_once_and_repeats_with_its_seed(n):
+    sw = {"method": "lhs", "samples": n, "seed": 3,
+          "vary": {"tablet.cup_depth": {"min": 0.5, "max": 1.5}, "tablet.band": {"min": 2.0, "max": 4.0},
+                   "tablet.diameter": [8.0, 9.0, 10.0, 11.0, 12.0]}}
+    spec = parse_sweep({"design": BASE, "sweep": sw})
+    pts = np.array(spec.points())
+    assert pts.shape == (n, 3)
+    for j, (lo, hi) in enumerate([(0.5, 1.5), (2.0, 4.0)]):
+        strata = np.floor((pts[:, j] - lo) / (hi - lo) * n).astype(int)
+        assert sorted(strata) == list(range(n))  # the Latin property: one sample per stratum
+    assert set(pts[:, 2]) <= {8.0, 9.0, 10.0, 11.0, 12.0}
+    assert spec.points() == parse_sweep({"design": BASE, "sweep": sw}).points()
+    other = parse_sweep({"design": BASE, "sweep": {**sw, "seed": 4}}).points()
+    assert (other != spec.points()) or n == 1
+
+
+def test_design_hash_is_stable_and_tells_designs_apart():
+    a = {"tablet": {"family": "concave_round", "cup_depth": 0.9, "band": 2.8}}
+    b = {"tablet": {"band": 2.8, "cup_depth": 0.9, "family": "concave_round"}}
+    assert design_hash(a) == design_hash(b)  # key order does not matter
+    assert design_hash(a) != design_hash({"tablet": {**a["tablet"], "cup_depth": 0.9000000000000001}})
+    assert len(design_hash(a)) == 16 and int(design_hash(a), 16) >= 0
+
+
+def test_flatten_report_keeps_scalars_under_dotted_names():
+    rep = {"v": 1.5, "ok": True, "name": "x", "none": None, "list": [1, 2],
+           "sec": {"w": np.float64(2.0), "deep": {"n": np.int64(3)}, "pts": [[0, 1]]}}
+    flat = flatten_report(rep)
+    assert flat == {"v": 1.5, "ok": True, "name": "x", "none": None, "sec.w": 2.0, "sec.deep.n": 3}
+    assert type(flat["sec.w"]) is float and type(flat["sec.deep.n"]) is int
+
+
+def _write(tmp_path, body: str):
+    p = tmp_path / "s.toml"
+    p.write_text(textwrap.dedent("""
+        [design.tablet]
+        family = "concave_round"
+        diameter = 10.0
+        band = 2.8
+        cup_depth = 0.9
+        """) + textwrap.dedent(body), encoding="utf-8")
+    return p
+
+
+BAD = {
+    "unknown key": ('[sweep.vary]\n"tablet.cup_dept" = [0.8, 0.9]\n', "[sweep.vary] key = 'tablet.cup_dept'"),
+    "unknown table": ('[sweep.vary]\n"tooling.clearance_mm" = [0.01]\n', "'tooling.clearance_mm'"),
+    "empty list": ('[sweep.vary]\n"tablet.cup_depth" = []\n', "an empty list sweeps nothing"),
+    "empty range": ('[sweep.vary]\n"tablet.cup_depth" = { min = 1.0, max = 0.5, num = 3 }\n', "the range is empty"),
+    "num zero": ('[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0, num = 0 }\n', "num = 0 is not allowed"),
+    "num negative": ('[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0, num = -2 }\n', "num = -2 is not allowed"),
+    "num missing": ('[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0 }\n', "num = 'missing'"),
+    "samples without seed": ('[sweep]\nmethod = "lhs"\nsamples = 10\n[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0 }\n',
+                             "[sweep] seed = 'missing'"),
+    "samples zero": ('[sweep]\nmethod = "lhs"\nsamples = 0\nseed = 1\n[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0 }\n',
+                     "[sweep] samples = 0"),
+    "unknown method": ('[sweep]\nmethod = "random"\n[sweep.vary]\n"tablet.cup_depth" = [0.8]\n', "[sweep] method = 'random'"),
+    "unknown output": ('[sweep]\noutputs = ["iges"]\n[sweep.vary]\n"tablet.cup_depth" = [0.8]\n', "[sweep] outputs = 'iges'"),
+    "no vary": ("[sweep]\n", "[sweep.vary] = 'missing'"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD))
+def test_bad_sweep_file_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, case):
+    body, expected = BAD[case]
+    p = _write(tmp_path, body)
+    out = tmp_path / "out"
+    assert main(["sweep", str(p), "--out", str(out), "--workers", "1", "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: ") and "is not allowed" in err[0]
+    assert expected in err[0]
+    assert not out.exists()
+
+
+def test_unreachable_scheduler_is_one_line_exit_2_after_the_connect_timeout(tmp_path, capsys):
+    p = _write(tmp_path, '[sweep.vary]\n"tablet.cup_depth" = [0.8, 0.9]\n')
+    with socket.socket() as s:  # a port nothing listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    out = tmp_path / "out"
+    code = main(["sweep", str(p), "--out", str(out), "--scheduler", f"tcp://127.0.0.1:{port}",
+                 "--connect-timeout", "2", "--quiet"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1 and err[0].startswith(f"error: --scheduler = 'tcp://127.0.0.1:{port}' is not allowed: "
+                                               "no Dask scheduler answered within 2 s")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("args, expected", [
+    (["--workers", "0"], "--workers = 0 is not allowed"),
+    (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "give either --workers or --scheduler"),
+])
+def test_bad_engine_options(tmp_path, capsys, args, expected):
+    p = _write(tmp_path, '[sweep.vary]\n"tablet.cup_depth" = [0.8]\n')
+    out = tmp_path / "out"
+    assert main(["sweep", str(p), "--out", str(out), "--quiet", *args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and expected in err[0]
+    assert not out.exists()
+
+
+def test_an_earlier_results_csv_needs_resume(tmp_path, capsys):
+    p = _write(tmp_path, '[sweep.vary]\n"tablet.cup_depth" = [0.8]\n')
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "results.csv").write_text("tablet.cup_depth,status,error,design_hash\n0.8,ok,,0000000000000000\n")
+    assert main(["sweep", str(p), "--out", str(out), "--workers", "1", "--quiet"]) == 2
+    assert "give --resume or another folder" in capsys.readouterr().err
+    assert main(["sweep", str(p), "--out", str(out), "--workers", "1", "--quiet", "--resume"]) == 2
+    assert "1 designs that are not in this sweep file" in capsys.readouterr().err
+    assert sorted(q.name for q in out.iterdir()) == ["results.csv"]
+
+
+def test_sample_sweep_files():
+    from pathlib import Path
+
+    from tabletcad.sweep import load_sweep
+
+    root = Path(__file__).resolve().parents[1] / "samples" / "sweep"
+    grid = load_sweep(root / "concave_round_grid.toml")
+    assert grid.keys == ("tablet.cup_depth", "tablet.band") and len(grid.designs()) == 6
+    assert grid.points()[1] == (0.6, 3.2) and grid.points()[2] == (0.9, 2.4)
+    lhs = load_sweep(root / "concave_round_lhs.toml")
+    pts = np.array(lhs.points())
+    assert pts.shape == (40, 3) and pts[:, 0].min() >= 8.0 and pts[:, 0].max() < 12.0
+    assert sorted(np.floor((pts[:, 2] - 0.5) / 0.9 * 40).astype(int)) == list(range(40))
+    assert len({design_hash(d) for d in lhs.designs()}) == 40
