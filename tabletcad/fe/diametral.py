@@ -234,6 +234,7 @@ def diametral(
     *,
     strip_width: float | None = None,
     mesh_size: float | None = None,
+    strip_mesh_size: float | None = None,
     material: Material | None = None,
     error_estimate: bool = True,
     solid: Any = None,
@@ -252,7 +253,9 @@ def diametral(
         Width of each loaded strip, mm; default ``D/10`` (``D`` = extent along the load).
     mesh_size : float, optional
         Element size away from the strips, mm; default ``min(t/2, min(plan extents)/12)``.
-        Within ``strip_width/2`` of the platens the size is ``strip_width/3``, near the centre ``mesh_size/1.5``.
+        Near the centre the size is ``mesh_size/1.5``.
+    strip_mesh_size : float, optional
+        Element size within ``strip_width/2`` of the platens, mm; default ``min(mesh_size, strip_width/3)``.
     material : Material, optional
         E and ν (stresses do not depend on E).
     error_estimate : bool
@@ -273,7 +276,7 @@ def diametral(
                           f"({0.5 * D:.4g} mm)", "mm")
     h = min(t / 2.0, float(min(ext[0], ext[1])) / 12.0) if mesh_size is None else check_positive(
         "mesh_size", mesh_size, "mm")
-    hs = min(h, b / 3.0)
+    hs = min(h, b / 3.0) if strip_mesh_size is None else check_positive("strip_mesh_size", strip_mesh_size, "mm")
     vol = float(tablet.volume())
     check_mesh_size(vol, h)
     check_mesh_size(vol * min(1.0, b / D), hs, "strip_width")
