@@ -1,0 +1,60 @@
+"""Benchmark of one FE diametral evaluation (the cost of FE inside an optimisation loop).
+
+For a few tablets, one coarse-mesh evaluation (``mesh_size`` = plan extent / 6,
+strip size = strip width, no error estimate) is timed in stages: B-rep solid
+(CAD layer, cached per tablet object), gmsh meshing, assembly + sparse direct
+solve + stress recovery; the centre stress is compared with the default mesh
+of the same tablet (measured in the same run) so that the coarse mesh's error
+is printed beside its time.  CPU time (``time.process_time``) is printed too:
+on a loaded machine wall time overstates the cost.
+
+Run: ``.venv/bin/python benchmarks/bench_fe.py`` (no assertions on time).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from tabletcad.design import design_from_dict  # noqa: E402
+from tabletcad.fe.diametral import diametral  # noqa: E402
+
+DESIGNS = {
+    "flat_face_round 10 x 3.5": {"family": "flat_face_round", "diameter": 10.0, "thickness": 3.5},
+    "concave_round 10, band 2.8, cup 0.9": {"family": "concave_round", "diameter": 10.0, "band": 2.8,
+                                            "cup_depth": 0.9, "land": 0.08},
+    "capsule 18 x 8, cup 1.3": {"family": "capsule", "length": 18.0, "width": 8.0, "band": 3.2, "cup_depth": 1.3,
+                                "land": 0.08, "central_radius": 12.0, "edge_radius": 2.0},
+}
+
+
+def main() -> None:
+    import tabletcad.families  # noqa: F401  (registers the families)
+    from tabletcad.cad.tablet_solid import tablet_solid
+
+    print(f"{'design':38s} {'solid s':>8s} {'coarse s':>9s} {'cpu s':>7s} {'dofs':>7s} {'σc coarse':>10s} "
+          f"{'σc default':>10s} {'diff %':>7s} {'default s':>9s}")
+    for name, d in DESIGNS.items():
+        t = design_from_dict({"tablet": d})
+        t0 = time.perf_counter()
+        solid = tablet_solid(t)
+        t_solid = time.perf_counter() - t0
+        lo, hi = t.bounds()
+        plan = float(min(hi[0] - lo[0], hi[1] - lo[1]))
+        c0, w0 = time.process_time(), time.perf_counter()
+        coarse = diametral(t, 100.0, "width", mesh_size=plan / 6, strip_mesh_size=plan / 10, error_estimate=False,
+                           solid=solid)
+        w_coarse, c_coarse = time.perf_counter() - w0, time.process_time() - c0
+        w0 = time.perf_counter()
+        fine = diametral(t, 100.0, "width", error_estimate=False, solid=solid)
+        w_fine = time.perf_counter() - w0
+        a, b = coarse.centre_tensile_stress_MPa, fine.centre_tensile_stress_MPa
+        print(f"{name:38s} {t_solid:8.2f} {w_coarse:9.2f} {c_coarse:7.2f} {coarse.dofs:7d} {a:10.5f} {b:10.5f} "
+              f"{100 * (a - b) / b:7.2f} {w_fine:9.2f}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
