@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 pytest.importorskip("skfem")
 pytest.importorskip("gmsh")
 pytest.importorskip("OCP")
 
+from tabletcad.fe.elasticity import von_mises  # noqa: E402
 from tabletcad.fe.punch import column_buckling, punch_stress, punch_tip_solid, tool_steels  # noqa: E402
 
 TOOLING = {"clearance_mm": 0.02, "tip_length_mm": 6.0}
@@ -29,18 +31,22 @@ def flat_tip():
 
 def test_flat_tip_carries_the_uniform_stress(flat_tip):
     shape, info = flat_tip
-    r = punch_stress(shape, info, 20.0, yield_MPa=1450.0, safety_factor=1.5, mesh_size=1.0)
+    # one element size everywhere: the cup face and the back face are the same polygon; between them the
+    # faceted side wall's sections vary by the polygon error (~1 %), so the stress is uniform to that level
+    r = punch_stress(shape, info, 20.0, yield_MPa=1450.0, safety_factor=1.5, mesh_size=1.0, face_refinement=1.0)
     A = math.pi * (4.0 - 0.02) ** 2
-    assert r.back_area_mm2 == pytest.approx(A, rel=2e-3)  # polygonal section of the circle
+    assert r.back_area_mm2 == pytest.approx(A, rel=0.015)  # inscribed polygon of ~25 sides: -(2π/25)²/6
     assert r.axial_area_mm2 == pytest.approx(r.back_area_mm2, rel=1e-9)
     assert r.uniform_stress_MPa == pytest.approx(20000.0 / r.back_area_mm2)
-    assert r.max_von_mises_MPa == pytest.approx(r.uniform_stress_MPa, rel=1e-7)
+    assert r.max_von_mises_MPa == pytest.approx(r.uniform_stress_MPa, rel=0.01)
+    vm = von_mises(r.solution.vertex_stress)
+    assert np.median(vm) == pytest.approx(r.uniform_stress_MPa, rel=0.003)
     assert r.reaction_N < 1e-7 * 20000.0
     # rating: yield / S / (σ per N), or the buckling force / S if lower (Johnson's parabola for a stubby tip)
     d = r.to_dict()
-    assert d["allowed_force_yield_kN"] == pytest.approx(1450.0 / 1.5 * r.back_area_mm2 / 1000.0, rel=1e-7)
     assert r.buckling["method"] == "Johnson"
     assert r.allowed_force_kN == pytest.approx(min(d["allowed_force_yield_kN"], r.buckling["critical_force_kN"] / 1.5))
+    assert d["allowed_force_yield_kN"] == pytest.approx(1450.0 / 1.5 * A / 1000.0, rel=0.02)
 
 
 def test_cup_depth_lowers_the_rating(flat_tip):
@@ -48,7 +54,7 @@ def test_cup_depth_lowers_the_rating(flat_tip):
     for cup, (shape, info) in [(0.0, flat_tip),
                                (0.6, _tip(family="concave_round", diameter=8.0, band=2.0, cup_depth=0.6, land=0.1)),
                                (1.2, _tip(family="concave_round", diameter=8.0, band=2.0, cup_depth=1.2, land=0.1))]:
-        r = punch_stress(shape, info, 20.0, yield_MPa=1450.0, mesh_size=0.8)
+        r = punch_stress(shape, info, 20.0, yield_MPa=1450.0, mesh_size=1.0)
         rated[cup] = r.allowed_force_kN
         print(f"\ncup depth {cup} mm: max von Mises {r.max_von_mises_MPa:.4g} MPa (F/A {r.uniform_stress_MPa:.4g}),"
               f" allowed {r.allowed_force_kN:.4g} kN, {r.dofs} unknowns")

@@ -5,8 +5,9 @@ the plan outline inset by the clearance, extruded to ``tip_length_mm`` beyond
 the band edge, minus the tablet, so its face is the cup (scores as bars,
 embossing as engravings).  The compaction force ``F`` is spread as a uniform
 normal pressure over the face that touches the powder (every boundary facet
-whose outward normal points towards the tablet, ``n·e < -0.05`` with ``e`` the
-punch axis pointing away from the tablet), scaled so that its axial resultant
+whose outward normal points towards the tablet, ``n·e < -0.3`` with ``e`` the
+punch axis pointing away from the tablet: cup walls up to 72° steep; the
+chordal triangles of the side wall tilt much less), scaled so that its axial resultant
 is ``F``; the back face of the tip (the datum plane) carries the reaction as
 a uniform pressure.  The tip is held by a 3-2-1 support that carries no load
 (the two resultants balance; any lateral resultant of an asymmetric face is
@@ -48,8 +49,9 @@ else:  # pragma: no cover
 
 __all__ = ["ToolSteel", "tool_steels", "PunchResult", "punch_stress", "punch_tip_solid", "column_buckling"]
 
-#: Cosine below which a facet's outward normal counts as facing the tablet (loaded by the powder).
-_FACING = -0.05
+#: Cosine below which a facet's outward normal counts as facing the tablet (loaded by the powder):
+#: the cup and land (cup walls up to 72° steep); chordal triangles of the side wall tilt far less.
+_FACING = -0.3
 
 
 @dataclass(frozen=True)
@@ -174,6 +176,7 @@ def punch_stress(
     nu: float = 0.29,
     mesh_size: float | None = None,
     effective_length_factor: float = 2.0,
+    face_refinement: float = 0.5,
 ) -> PunchResult:
     """Von Mises stress of a punch tip under ``force_kN`` spread over its cup face, and its rating.
 
@@ -190,7 +193,11 @@ def punch_stress(
     E, nu
         Steel elasticity (MPa; E enters only the buckling check).
     mesh_size : float, optional
-        Element size, mm; default ``min(tip width/8, tip_length/6)``, halved near the face.
+        Element size, mm; default ``min(tip width/8, tip_length/6)``.
+    face_refinement : float
+        Element size near the cup face as a fraction of ``mesh_size`` (1: none).
+    effective_length_factor : float
+        ``K`` of the buckling check.
     """
     F = check_positive("--force", force_kN, "kN") * 1000.0
     S = check_positive("--safety-factor", safety_factor, "")
@@ -207,7 +214,8 @@ def punch_stress(
     big = 1e3
     lo = [-big, -big, edge - 2.0 * cup - h] if which == "upper" else [-big, -big, edge - 2.0 * h]
     hi = [big, big, edge + 2.0 * h] if which == "upper" else [big, big, edge + 2.0 * cup + h]
-    mesh = mesh_solid(tip_shape, h, refinements=[Refinement(tuple(lo), tuple(hi), h / 2.0)])
+    refine = [] if face_refinement >= 1.0 else [Refinement(tuple(lo), tuple(hi), h * face_refinement)]
+    mesh = mesh_solid(tip_shape, h, refinements=refine)
     m = _skfem_mesh(mesh)
     bf = boundary_facets(m)
     cos = bf.normals @ axis
