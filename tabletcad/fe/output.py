@@ -38,14 +38,13 @@ def write_vtu(sol: ElasticSolution, path: str | Path) -> Path:
 def section(sol: ElasticSolution, axis: int, level: float, component: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
     """Exact cut of the mesh by the plane ``x[axis] = level``.
 
-    Returns triangles ``(k, 3, 3)`` (mm, in-plane coordinates in the other two
-    axes' order are taken by the caller) and the stress component at their
-    corners ``(k, 3)`` (MPa; the stress is linear in each element, so values at
-    the cut points are exact).
+    Returns triangles ``(k, 3, 3)`` (mm) and the stress component at their
+    corners ``(k, 3)`` (MPa), interpolated linearly along the cut edges from the
+    vertex-averaged stress field (:meth:`ElasticSolution.nodal_stress`).
     """
     m = sol.mesh
     X = m.p[:, m.t].transpose(2, 1, 0)  # (m, 4, 3)
-    S = sol.vertex_stress[..., component[0], component[1]]  # (m, 4)
+    S = sol.nodal_stress()[:, component[0], component[1]][m.t.T]  # (m, 4), vertex-averaged field
     d = X[..., axis] - level
     tris, vals = [], []
     cross = (d.min(axis=1) < 0) & (d.max(axis=1) > 0)
