@@ -87,3 +87,44 @@ def test_punch_needs_tooling(capsys, tmp_path, thin):
     assert err.startswith("error: [tooling]") and "needs a design file with a [tooling] table" in err
     assert err.count("\n") == 1
     assert not out.exists()
+
+
+TOOLED = THIN.replace("thickness = 1.0", "thickness = 2.0") + """
+[tooling]
+clearance_mm = 0.02
+tip_length_mm = 5.0
+"""
+
+
+def test_punch_json_and_files(capsys, tmp_path):
+    design = tmp_path / "tooled.toml"
+    design.write_text(TOOLED)
+    out = tmp_path / "punch"
+    rc, so, err = run(capsys, "fe", "punch", design, "--force", 5, "--steel", "S7_tempered_205C", "--mesh-size", 1.0,
+                      "--out", out, "--json")
+    assert rc == 0, err
+    d = json.loads(so)
+    assert d["steel"] == "S7_tempered_205C" and d["yield_MPa"] == 1450
+    # flat tip: σ_vM ≈ F/A, so the yield-based rating is ≈ σ_y/S · A
+    assert d["max_von_mises_MPa"] == pytest.approx(d["uniform_stress_MPa"], rel=0.02)
+    assert d["allowed_force_kN"] == pytest.approx(
+        min(1450 / 1.5 * 5 / d["max_von_mises_MPa"], d["buckling"]["critical_force_kN"] / 1.5), rel=1e-9)
+    assert sorted(p.name for p in out.iterdir()) == ["section.png", "stress.vtu"]
+
+
+@pytest.mark.parametrize(
+    "extra, match",
+    [
+        (["--force", "5"], "--yield-stress = None is not allowed: give --yield-stress (MPa) or --steel"),
+        (["--force", "5", "--steel", "unobtainium"], "--steel = 'unobtainium' is not allowed: must be one of"),
+        (["--force", "0", "--yield-stress", "1000"], "--force = 0 kN is not allowed: must be > 0"),
+        (["--force", "5", "--yield-stress", "1000", "--steel", "S7_tempered_205C"], "not both"),
+    ],
+)
+def test_punch_bad_input(capsys, tmp_path, extra, match):
+    design = tmp_path / "tooled.toml"
+    design.write_text(TOOLED)
+    out = tmp_path / "never"
+    rc, so, err = run(capsys, "fe", "punch", design, *extra, "--out", out)
+    assert rc == 2 and err.startswith("error: ") and match in err and err.count("\n") == 1, err
+    assert not out.exists()

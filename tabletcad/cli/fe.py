@@ -209,8 +209,9 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
         try:
             files.append(str(write_vtu(res.solution, out / "stress.vtu")))
             files.append(str(plot_section(
-                res.solution, out / "section.png", axis=1, level=float(res.solution.mesh.p[1].mean()), component=(2, 2),
-                title=f"{tablet.name}: {which} punch tip, σ_zz at {force:g} kN", label="σ_zz (MPa)")))
+                res.solution, out / "section.png", axis=1, level=float(res.solution.mesh.p[1].mean()),
+                component="von_mises", title=f"{tablet.name}: {which} punch tip, von Mises stress at {force:g} kN",
+                label="von Mises stress (MPa)")))
         except BaseException:
             for f in files:
                 Path(f).unlink(missing_ok=True)

@@ -35,16 +35,19 @@ def write_vtu(sol: ElasticSolution, path: str | Path) -> Path:
     return Path(path)
 
 
-def section(sol: ElasticSolution, axis: int, level: float, component: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+def section(sol: ElasticSolution, axis: int, level: float,
+            component: tuple[int, int] | str) -> tuple[np.ndarray, np.ndarray]:
     """Exact cut of the mesh by the plane ``x[axis] = level``.
 
     Returns triangles ``(k, 3, 3)`` (mm) and the stress component at their
-    corners ``(k, 3)`` (MPa), interpolated linearly along the cut edges from the
+    corners ``(k, 3)`` (MPa; ``component`` is a tensor index pair or ``"von_mises"``), interpolated linearly along the cut edges from the
     vertex-averaged stress field (:meth:`ElasticSolution.nodal_stress`).
     """
     m = sol.mesh
     X = m.p[:, m.t].transpose(2, 1, 0)  # (m, 4, 3)
-    S = sol.nodal_stress()[:, component[0], component[1]][m.t.T]  # (m, 4), vertex-averaged field
+    nodal = sol.nodal_stress()
+    field = von_mises(nodal) if component == "von_mises" else nodal[:, component[0], component[1]]
+    S = field[m.t.T]  # (m, 4), vertex-averaged field
     d = X[..., axis] - level
     tris, vals = [], []
     cross = (d.min(axis=1) < 0) & (d.max(axis=1) > 0)
@@ -71,7 +74,7 @@ def section(sol: ElasticSolution, axis: int, level: float, component: tuple[int,
 
 
 def plot_section(sol: ElasticSolution, path: str | Path, *, axis: int, level: float,
-                 component: tuple[int, int], title: str, label: str,
+                 component: tuple[int, int] | str, title: str, label: str,
                  limits: tuple[float, float] | None = None) -> Path:
     """Picture (PNG/SVG/PDF by suffix) of a stress component on the section ``x[axis] = level``.
 
@@ -88,10 +91,11 @@ def plot_section(sol: ElasticSolution, path: str | Path, *, axis: int, level: fl
     xy = tris[..., other].reshape(-1, 2)
     tri = Triangulation(xy[:, 0], xy[:, 1], np.arange(len(xy)).reshape(-1, 3))
     fig, ax = plt.subplots(figsize=(6.4, 5.2))
+    lim = float(np.percentile(np.abs(vals), 99)) or 1.0
     if limits is None:
-        lim = float(np.percentile(np.abs(vals), 99)) or 1.0
-        limits = (-lim, lim)
-    tpc = ax.tripcolor(tri, vals.ravel(), shading="gouraud", cmap="coolwarm", vmin=limits[0], vmax=limits[1])
+        limits = (0.0, lim) if component == "von_mises" else (-lim, lim)
+    cmap = "viridis" if component == "von_mises" else "coolwarm"
+    tpc = ax.tripcolor(tri, vals.ravel(), shading="gouraud", cmap=cmap, vmin=limits[0], vmax=limits[1])
     fig.colorbar(tpc, ax=ax, label=label)
     names = "xyz"
     ax.set_xlabel(f"{names[other[0]]} (mm)")
