@@ -128,3 +128,9 @@ def test_punch_bad_input(capsys, tmp_path, extra, match):
     rc, so, err = run(capsys, "fe", "punch", design, *extra, "--out", out)
     assert rc == 2 and err.startswith("error: ") and match in err and err.count("\n") == 1, err
     assert not out.exists()
+
+
+def test_strength_needs_its_inputs(capsys, thin):
+    rc, so, err = run(capsys, "fe", "strength", thin)
+    assert rc == 2 and err.count("\n") == 1
+    assert err.startswith("error: [report] tensile_strength_MPa = None is not allowed: give it, or all of"), err

@@ -6,7 +6,6 @@ Both are written atomically (:mod:`tabletcad.io.atomic`).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
