@@ -134,3 +134,9 @@ def test_strength_needs_its_inputs(capsys, thin):
     rc, so, err = run(capsys, "fe", "strength", thin)
     assert rc == 2 and err.count("\n") == 1
     assert err.startswith("error: [report] tensile_strength_MPa = None is not allowed: give it, or all of"), err
+
+
+def test_diametral_refuses_a_ring_fast(capsys):
+    ring = Path(__file__).resolve().parents[1] / "samples" / "ring.toml"
+    rc, so, err = run(capsys, "fe", "diametral", ring, "--force", 10)
+    assert rc == 2 and err.startswith("error: [trim] w = [0.5, 1.0] is not allowed: the diametral test needs a solid")

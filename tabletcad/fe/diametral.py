@@ -275,6 +275,9 @@ def diametral(
     """
     P = check_positive("force", force, "N")
     material = material or Material()
+    trim = getattr(tablet, "trim", None)
+    if trim is not None and trim.w[0] > 0:
+        raise DesignError("[trim] w", list(trim.w), "the diametral test needs a solid tablet (a ring's centre is empty)")
     lo, hi = (np.asarray(a, float) for a in tablet.bounds())
     ext = hi - lo
     ax = load_axis(direction, ext)
