@@ -70,3 +70,28 @@ def test_design_report_accepts_the_fe_inputs_in_report():
     o = ReportOptions.from_table({"tensile_strength_MPa": 2.0, "reference_breaking_force_N": 80.0,
                                   "reference_diameter_mm": 10.0, "reference_thickness_mm": 3.0})
     assert o.tensile_strength_MPa == 2.0 and o.reference_thickness_mm == 3.0
+
+
+def test_fe_objective_and_constraint_in_an_optimisation_problem():
+    """The coarse-mesh FE prediction plugs into tabletcad.optimise; one evaluation, checked against the API."""
+    from tabletcad.families import flat_face_round
+    from tabletcad.fe.objective import breaking_force, breaking_force_constraint, breaking_force_objective
+    from tabletcad.optimise.problem import Evaluator, Problem, Variable
+
+    prob = Problem(
+        name="strongest flat round of a given diameter", variables=(Variable("thickness", 1.5, 3.0, 2.0, "mm"),),
+        objective=breaking_force_objective(2.0, "x"),
+        build=lambda x: flat_face_round(diameter=8.0, thickness=x["thickness"]),
+        constraints=(breaking_force_constraint(2.0, 10.0, "x"),))
+    ev = Evaluator(prob)
+    t = prob.build(prob.x0())
+    direct = breaking_force(t, 2.0, "x")
+    assert prob.objective.func(t) == pytest.approx(direct, rel=1e-12)
+    assert prob.constraints[0].satisfied(direct)
+    # the re-check on the default (finer) mesh
+    fine = breaking_force(t, 2.0, "x", coarse=False)
+    print(f"\nFE breaking force of an 8 x 2 mm disc at σ_t = 2 MPa: coarse {direct:.4g} N, default mesh {fine:.4g} N")
+    assert direct == pytest.approx(fine, rel=0.1)
+    assert ev.n == 1
+    with pytest.raises(DesignError):
+        breaking_force_objective(-1.0)
