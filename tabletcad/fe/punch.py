@@ -17,8 +17,8 @@ reported as the reaction).  Linear elasticity, quadratic tetrahedra
 Rating: the largest von Mises stress (vertex-averaged field) per newton
 gives the allowed force ``F_allowed = σ_y / (S · σ_vM,max/F)`` for a steel's
 yield stress ``σ_y`` and a safety factor ``S``.  For a flat-faced tip the
-stress is the uniform ``F/A`` (checked in the tests); a cup concentrates it at
-the thin lip between cup and land, which lowers the rating.
+stress is the uniform ``F/A`` (checked in the tests); a cup raises the
+largest stress and lowers the rating (also tested).
 
 Buckling: the tip as a column of length ``L = tip_length_mm`` and the back
 face's smallest second moment of area ``I`` (radius of gyration
