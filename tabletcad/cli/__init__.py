@@ -23,6 +23,7 @@ _COMMAND_MODULES = [
     "tabletcad.cli.report",
     "tabletcad.cli.mechanics",
     "tabletcad.cli.optimise",
+    "tabletcad.cli.fe",
     "tabletcad.cli.sweep",
 ]
 

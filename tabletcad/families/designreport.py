@@ -51,6 +51,11 @@ REPORT_KEYS = {
     "compaction_force_kN": "kN",
     "max_punch_force_kN": "kN",
     "max_punch_pressure_MPa": "MPa",
+    # read by `tabletcad fe strength` (tabletcad.fe.prediction), which validates them
+    "tensile_strength_MPa": "MPa",
+    "reference_breaking_force_N": "N",
+    "reference_diameter_mm": "mm",
+    "reference_thickness_mm": "mm",
 }
 
 
@@ -70,6 +75,8 @@ class ReportOptions:
         Compaction force (kN) to check against the punch-tip limit.
     max_punch_force_kN, max_punch_pressure_MPa : float
         User-given punch-tip limits (no public rating table is bundled).
+    tensile_strength_MPa, reference_breaking_force_N, reference_diameter_mm, reference_thickness_mm : float
+        Inputs of the FE breaking-force prediction (``tabletcad fe strength``).
     """
 
     solid_fraction: float | None = None
@@ -78,6 +85,10 @@ class ReportOptions:
     compaction_force_kN: float | None = None
     max_punch_force_kN: float | None = None
     max_punch_pressure_MPa: float | None = None
+    tensile_strength_MPa: float | None = None
+    reference_breaking_force_N: float | None = None
+    reference_diameter_mm: float | None = None
+    reference_thickness_mm: float | None = None
 
     def __post_init__(self) -> None:
         if self.solid_fraction is not None:

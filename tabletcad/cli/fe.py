@@ -1,0 +1,232 @@
+"""Finite-element commands: ``tabletcad fe diametral``, ``fe strength`` and ``fe punch``.
+
+Units: mm, N (kN where named), MPa.  Everything is computed before any file
+is written; bad input is one ``error:`` line and exit status 2 (see
+:func:`tabletcad.cli.main`), and leaves nothing behind.  Needs the ``fe``
+extra (scikit-fem, gmsh) and the ``cad`` extra.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import click
+
+from tabletcad.errors import DesignError
+
+__all__ = ["COMMANDS"]
+
+
+def _require_fe() -> None:
+    try:
+        import gmsh  # noqa: F401
+        import skfem  # noqa: F401
+    except ImportError as exc:  # pragma: no cover - the fe extra is installed in CI
+        raise DesignError("tabletcad fe", exc.name, "needs the fe extra: pip install 'tabletcad[fe]'") from None
+
+
+def _echo(payload: dict[str, Any], as_json: bool, lines: list[str]) -> None:
+    if as_json:
+        click.echo(json.dumps(payload, indent=2))
+    else:
+        for ln in lines:
+            click.echo(ln)
+
+
+def _check_out(out: Path | None) -> None:
+    if out is not None and out.exists() and not out.is_dir():
+        raise DesignError("--out", str(out), "must be a folder (it is a file)")
+
+
+@click.group("fe")
+def fe_group() -> None:
+    """Finite-element stresses on the real shape (scikit-fem, quadratic tetrahedra; gmsh meshes)."""
+
+
+@fe_group.command("diametral")
+@click.argument("design", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--force", type=float, required=True, help="Force on each platen, N.")
+@click.option("--direction", default="width", show_default=True,
+              help="Load direction in plan: width|length|x|y (round tablets: any gives x unless y).")
+@click.option("--strip-width", type=float, default=None, help="Width of each loaded strip, mm [default: D/10].")
+@click.option("--mesh-size", type=float, default=None,
+              help="Element size away from the strips, mm [default: min(t/2, plan extent/12)].")
+@click.option("--E", "E", type=float, default=5000.0, show_default=True, help="Young's modulus, MPa (stresses do not depend on it).")
+@click.option("--nu", type=float, default=0.3, show_default=True, help="Poisson's ratio.")
+@click.option("--no-error-estimate", is_flag=True, help="Skip the second (coarser) mesh of the error estimate.")
+@click.option("--out", type=click.Path(file_okay=True, path_type=Path), default=None,
+              help="Folder for stress.vtu and section.png (tensile stress on the mid-thickness section).")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+def diametral_cmd(design: Path, force: float, direction: str, strip_width: float | None, mesh_size: float | None,
+                  E: float, nu: float, no_error_estimate: bool, out: Path | None, as_json: bool) -> None:
+    """Diametral compression of DESIGN.toml by FE: centre and largest tensile stress, shape factor."""
+    from tabletcad.cli.report import load_family_design
+    from tabletcad.errors import check_positive
+    from tabletcad.fe.diametral import DIRECTIONS
+
+    check_positive("--force", force, "N")
+    if direction not in DIRECTIONS:
+        raise DesignError("--direction", direction, "must be one of " + ", ".join(DIRECTIONS))
+    _check_out(out)
+    _require_fe()
+    from tabletcad.fe.diametral import diametral
+    from tabletcad.fe.elasticity import Material
+
+    material = Material(E=E, nu=nu)
+    tablet, _ = load_family_design(design)
+    res = diametral(tablet, force, direction, strip_width=strip_width, mesh_size=mesh_size, material=material,
+                    error_estimate=not no_error_estimate)
+    payload = {"design": str(design), **res.to_dict()}
+    files: list[str] = []
+    if out is not None:
+        from tabletcad.fe.output import plot_section, write_vtu
+
+        ax = "xy".index(res.axis)
+        px = 1 - ax
+        s = res.centre_tensile_stress_MPa
+        try:
+            files.append(str(write_vtu(res.solution, out / "stress.vtu")))
+            files.append(str(plot_section(
+                res.solution, out / "section.png", axis=2, level=res.centre_mm[2], component=(px, px),
+                title=f"{tablet.name}: σ_{'xy'[px]}{'xy'[px]} at mid-thickness, {force:g} N along {res.axis}",
+                label=f"σ_{'xy'[px]}{'xy'[px]} (MPa)", limits=(-3.0 * abs(s), 3.0 * abs(s)))))
+        except BaseException:
+            for f in files:
+                Path(f).unlink(missing_ok=True)
+            raise
+        payload["files"] = files
+    err = res.discretisation_error_MPa
+    _echo(payload, as_json, [
+        f"{tablet.name}: {force:g} N along {res.axis} ({direction}), strip {res.strip_width_mm:.4g} mm, "
+        f"D = {res.diameter_mm:.4g} mm, t = {res.thickness_mm:.4g} mm",
+        f"mesh: {res.nodes} nodes, {res.elements} quadratic tetrahedra, {res.dofs} unknowns (size {res.mesh_size_mm:.3g} mm)",
+        f"centre tensile stress {res.centre_tensile_stress_MPa:.5g} MPa"
+        + (f" (± {abs(err):.2g} MPa estimated)" if err is not None else ""),
+        f"2P/(πDt) = {res.line_load_MPa:.5g} MPa, shape factor {res.shape_factor:.4f}",
+        f"largest tensile stress {res.max_tensile_stress_MPa:.5g} MPa at "
+        + "(" + ", ".join(f"{v:.3g}" for v in res.max_tensile_location_mm) + ") mm",
+    ] + [f"-> {f}" for f in files])
+
+
+@fe_group.command("strength")
+@click.argument("design", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--tensile-strength", type=float, default=None, help="Tensile strength of the material, MPa.")
+@click.option("--reference-force", type=float, default=None,
+              help="Breaking force of a flat-faced round reference compact (same material, solid fraction), N.")
+@click.option("--reference-diameter", type=float, default=None, help="Reference compact diameter, mm.")
+@click.option("--reference-thickness", type=float, default=None, help="Reference compact thickness, mm.")
+@click.option("--direction", default="width", show_default=True, help="Load direction in plan: width|length|x|y.")
+@click.option("--mesh-size", type=float, default=None, help="Element size, mm [default as fe diametral].")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+def strength_cmd(design: Path, tensile_strength: float | None, reference_force: float | None,
+                 reference_diameter: float | None, reference_thickness: float | None, direction: str,
+                 mesh_size: float | None, as_json: bool) -> None:
+    """Breaking force of DESIGN.toml predicted by FE (elastic first-crack estimate).
+
+    Inputs from the options or the design file's [report] table: tensile_strength_MPa, or
+    reference_breaking_force_N, reference_diameter_mm and reference_thickness_mm.
+    """
+    from tabletcad.cli.report import load_family_design
+    from tabletcad.fe.diametral import DIRECTIONS
+
+    if direction not in DIRECTIONS:
+        raise DesignError("--direction", direction, "must be one of " + ", ".join(DIRECTIONS))
+    _require_fe()
+    from tabletcad.fe.prediction import StrengthInputs, predict_breaking_force
+
+    tablet, table = load_family_design(design)
+    inputs = StrengthInputs.from_table(table, tensile_strength_MPa=tensile_strength,
+                                       reference_breaking_force_N=reference_force,
+                                       reference_diameter_mm=reference_diameter,
+                                       reference_thickness_mm=reference_thickness)
+    pred = predict_breaking_force(tablet, inputs, direction, mesh_size=mesh_size, error_estimate=False)
+    d = pred.to_dict()
+    _echo({"design": str(design), **d}, as_json, [
+        f"{tablet.name}: predicted breaking force {pred.breaking_force_N:.4g} N across {direction} "
+        f"(elastic first-crack estimate; {pred.breaking_force_centre_N:.4g} N if the crack starts at the centre)",
+        f"tensile strength {pred.tensile_strength_MPa:.4g} MPa ({pred.tensile_strength_basis})",
+        f"largest tensile stress {pred.max_tensile_per_N:.5g} MPa per N at "
+        + "(" + ", ".join(f"{v:.3g}" for v in d["first_crack_location_mm"]) + ") mm; shape factor "
+        f"{d['shape_factor']:.4f}",
+    ])
+
+
+@fe_group.command("punch")
+@click.argument("design", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--force", type=float, required=True, help="Compaction force, kN.")
+@click.option("--punch", "which", type=click.Choice(["upper", "lower"]), default="upper", show_default=True)
+@click.option("--steel", default=None, help="Tool steel from tabletcad/data/tool_steels.toml (yield stress and E).")
+@click.option("--yield-stress", type=float, default=None, help="Steel yield stress, MPa (instead of --steel).")
+@click.option("--E", "E", type=float, default=None, help="Steel Young's modulus, MPa [default: the steel's, else 206000].")
+@click.option("--safety-factor", type=float, default=1.5, show_default=True)
+@click.option("--effective-length-factor", type=float, default=2.0, show_default=True,
+              help="Buckling: K of the tip column (2 = fixed at the barrel, free at the tip).")
+@click.option("--mesh-size", type=float, default=None, help="Element size, mm [default: tip width/8].")
+@click.option("--out", type=click.Path(file_okay=True, path_type=Path), default=None,
+              help="Folder for stress.vtu and section.png (von Mises stress on the tip's axial section).")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_stress: float | None, E: float | None,
+              safety_factor: float, effective_length_factor: float, mesh_size: float | None, out: Path | None,
+              as_json: bool) -> None:
+    """Punch-tip stress under the compaction force spread over the cup, and the allowed force."""
+    from tabletcad.cli.report import load_family_design
+    from tabletcad.errors import check_positive
+
+    check_positive("--force", force, "kN")
+    check_positive("--safety-factor", safety_factor)
+    check_positive("--effective-length-factor", effective_length_factor)
+    _check_out(out)
+    from tabletcad.fe.punch import tool_steels
+
+    steels = tool_steels()
+    if steel is not None and yield_stress is not None:
+        raise DesignError("--yield-stress", yield_stress, "give either --steel or --yield-stress, not both", "MPa")
+    if steel is not None:
+        if steel not in steels:
+            raise DesignError("--steel", steel, "must be one of " + ", ".join(steels))
+        yield_stress = steels[steel].yield_MPa
+        E = steels[steel].E_MPa if E is None else E
+    if yield_stress is None:
+        raise DesignError("--yield-stress", None, "give --yield-stress (MPa) or --steel " + "|".join(steels)
+                          + ": no rating is invented")
+    check_positive("--yield-stress", yield_stress, "MPa")
+    E = 206000.0 if E is None else check_positive("--E", E, "MPa")
+    _require_fe()
+    from tabletcad.fe.punch import punch_stress, punch_tip_solid
+    from tabletcad.tooling.stage import read_tooling_table
+
+    tablet, _ = load_family_design(design)
+    shape, tip = punch_tip_solid(tablet, read_tooling_table(design), which)
+    res = punch_stress(shape, tip, force, which, yield_MPa=yield_stress, safety_factor=safety_factor, E=E,
+                       mesh_size=mesh_size, effective_length_factor=effective_length_factor)
+    payload = {"design": str(design), "steel": steel, **res.to_dict()}
+    files: list[str] = []
+    if out is not None:
+        from tabletcad.fe.output import plot_section, write_vtu
+
+        try:
+            files.append(str(write_vtu(res.solution, out / "stress.vtu")))
+            files.append(str(plot_section(
+                res.solution, out / "section.png", axis=1, level=float(res.solution.mesh.p[1].mean()),
+                component="von_mises", title=f"{tablet.name}: {which} punch tip, von Mises stress at {force:g} kN",
+                label="von Mises stress (MPa)")))
+        except BaseException:
+            for f in files:
+                Path(f).unlink(missing_ok=True)
+            raise
+        payload["files"] = files
+    b = res.buckling
+    _echo(payload, as_json, [
+        f"{tablet.name}: {which} punch tip, {force:g} kN over the cup face ({res.loaded_area_mm2:.4g} mm2)",
+        f"mesh: {res.nodes} nodes, {res.elements} quadratic tetrahedra, {res.dofs} unknowns",
+        f"largest von Mises stress {res.max_von_mises_MPa:.5g} MPa at ("
+        + ", ".join(f"{v:.3g}" for v in res.max_von_mises_location_mm) + f") mm; F/A = {res.uniform_stress_MPa:.5g} MPa",
+        f"allowed force {res.allowed_force_kN:.4g} kN (yield {yield_stress:g} MPa / {safety_factor:g}"
+        + (f"; {b['method']} buckling {b['critical_force_kN']:.4g} kN at slenderness {b['slenderness']:.3g}" if b else "")
+        + ")",
+    ] + [f"-> {f}" for f in files])
+
+
+COMMANDS = [fe_group]

@@ -1,0 +1,288 @@
+"""Linear isotropic elasticity on quadratic tetrahedra (scikit-fem ``ElementTetP2``).
+
+Assembly uses scikit-fem's ``linear_elasticity`` form; the geometry is the
+linear tetrahedral mesh of :mod:`tabletcad.fe.mesh`, the displacement is
+quadratic, so the stress is linear in each element and is evaluated exactly
+at the element vertices (no smoothing).
+
+Loads are normal pressures on sets of boundary facets.  A tablet in a
+diametral test and a punch tip under a balanced load carry *self-equilibrated*
+loads: the body is then held by a statically determinate 3-2-1 support
+(three unknowns fixed at one node, two at a second, one at a third) that only
+removes the six rigid-body motions.  For a balanced load the support
+reactions are zero up to round-off (they are returned and checked), so the
+stresses are those of the free body; weak springs would instead load the body
+slightly everywhere.  For traction loads the stresses do not depend on E (and
+scale linearly with the load); E only scales the displacements.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from tabletcad.errors import DesignError, GeometryError, check_positive
+from tabletcad.fe.mesh import TetMesh
+
+__all__ = ["Material", "PressureLoad", "ElasticSolution", "boundary_facets", "solve_elasticity",
+           "principal_stresses", "von_mises"]
+
+
+@dataclass(frozen=True)
+class Material:
+    """Isotropic linear-elastic material.
+
+    Attributes
+    ----------
+    E : float
+        Young's modulus, MPa.
+    nu : float
+        Poisson's ratio, ``-1 < nu < 0.5``.
+    """
+
+    E: float = 5000.0
+    nu: float = 0.3
+
+    def __post_init__(self) -> None:
+        check_positive("E", self.E, "MPa")
+        if not (-1.0 < float(self.nu) < 0.5):
+            raise DesignError("nu", self.nu, "must be > -1 and < 0.5")
+
+    @property
+    def lame(self) -> tuple[float, float]:
+        """Lamé parameters (λ, μ), MPa."""
+        lam = self.E * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
+        return lam, self.E / (2.0 * (1.0 + self.nu))
+
+
+@dataclass(frozen=True, eq=False)
+class PressureLoad:
+    """A uniform normal pressure (MPa, positive pushes inwards) on boundary facets.
+
+    ``facets`` index the rows of :func:`boundary_facets`' arrays.
+    """
+
+    facets: np.ndarray
+    pressure: float
+
+
+@dataclass(frozen=True, eq=False)
+class BoundaryFacets:
+    """Boundary facets of a mesh: skfem facet ids, centroids (mm), outward unit normals and areas (mm²)."""
+
+    ids: np.ndarray
+    centroids: np.ndarray
+    normals: np.ndarray
+    areas: np.ndarray
+
+    def resultant(self, load: PressureLoad) -> np.ndarray:
+        """Force vector (N) of a pressure load: ``-p Σ n A``."""
+        f = load.facets
+        return -load.pressure * (self.normals[f] * self.areas[f, None]).sum(axis=0)
+
+
+def _skfem_mesh(mesh: TetMesh) -> Any:
+    import skfem
+
+    return skfem.MeshTet(np.ascontiguousarray(mesh.points.T, dtype=float),
+                         np.ascontiguousarray(mesh.tets.T, dtype=np.int64))
+
+
+def boundary_facets(m: Any) -> BoundaryFacets:
+    """Boundary facets of a skfem ``MeshTet`` with outward normals."""
+    ids = m.boundary_facets()
+    tri = m.p[:, m.facets[:, ids]]  # (3, 3 vertices, k)
+    c = tri.mean(axis=1).T
+    nrm = np.cross((tri[:, 1] - tri[:, 0]).T, (tri[:, 2] - tri[:, 0]).T)
+    area = 0.5 * np.linalg.norm(nrm, axis=1)
+    nrm /= (2.0 * area)[:, None]
+    cell = m.f2t[0, ids]
+    inside = m.p[:, m.t[:, cell]].mean(axis=1).T
+    flip = np.einsum("ij,ij->i", nrm, c - inside) < 0
+    nrm[flip] *= -1.0
+    return BoundaryFacets(ids=ids, centroids=c, normals=nrm, areas=area)
+
+
+@dataclass(frozen=True, eq=False)
+class ElasticSolution:
+    """A solved elastic problem.
+
+    Attributes
+    ----------
+    mesh : skfem.MeshTet
+        The mesh (vertices ``mesh.p`` (3, n), mm; tetrahedra ``mesh.t`` (4, m)).
+    displacement : ndarray, shape (n, 3)
+        Displacement at the mesh vertices, mm.
+    vertex_stress : ndarray, shape (m, 4, 3, 3)
+        Cauchy stress (MPa) at the four vertices of every element (exact for P2).
+    dofs : int
+        Number of unknowns.
+    reaction : float
+        Largest support reaction, N (zero for a balanced load).
+    load_scale : float
+        Largest load resultant component, N (to judge ``reaction``).
+    work : float
+        Work of the loads ``f·u`` (N·mm), twice the strain energy; it increases
+        towards its exact value as the mesh refines (the discrete body is stiffer).
+    """
+
+    mesh: Any
+    displacement: np.ndarray
+    vertex_stress: np.ndarray
+    dofs: int
+    reaction: float
+    load_scale: float
+    work: float = float("nan")
+
+    @property
+    def nodes(self) -> int:
+        return int(self.mesh.p.shape[1])
+
+    @property
+    def elements(self) -> int:
+        return int(self.mesh.t.shape[1])
+
+    def nodal_stress(self) -> np.ndarray:
+        """Stress (MPa) at every mesh vertex, shape (n, 3, 3): the mean of the element values there.
+
+        Element values jump between elements by the discretisation error; their
+        vertex mean is the usual smoothed field used to locate stress maxima.
+        """
+        m = self.mesh
+        acc = np.zeros((m.p.shape[1], 3, 3))
+        cnt = np.zeros(m.p.shape[1])
+        for k in range(4):
+            np.add.at(acc, m.t[k], self.vertex_stress[:, k])
+            np.add.at(cnt, m.t[k], 1.0)
+        return acc / cnt[:, None, None]
+
+    def recovered_stress_at(self, x: Sequence[float], radius: float) -> np.ndarray:
+        """Stress (3, 3), MPa, at ``x`` (mm) by a least-squares quadratic fit of the element values nearby.
+
+        The element stresses of every element whose centroid lies within
+        ``radius`` mm of ``x`` are sampled at its vertices and its centroid and fitted
+        by a complete quadratic polynomial in (x, y, z) (patch recovery in the
+        manner of Zienkiewicz and Zhu, 1992), which is evaluated at ``x``.  A single
+        element's value jumps by the discretisation error from one unstructured mesh
+        to the next; the fit averages this out, so the value converges smoothly.
+        """
+        q = np.asarray(x, float).ravel()
+        m = self.mesh
+        xv = m.p[:, m.t].transpose(2, 1, 0)  # (m, 4, 3)
+        cen = xv.mean(axis=1)
+        near = np.flatnonzero(np.linalg.norm(cen - q, axis=1) <= radius)
+        if near.size < 20:
+            raise GeometryError(f"stress recovery: only {near.size} elements within {radius:g} mm of {q.tolist()}", m)
+        pts = np.concatenate([xv[near].reshape(-1, 3), cen[near]]) - q
+        vals = np.concatenate([self.vertex_stress[near].reshape(-1, 9), self.vertex_stress[near].mean(axis=1).reshape(-1, 9)])
+        X, Y, Z = (pts / radius).T
+        A = np.column_stack([np.ones_like(X), X, Y, Z, X * X, Y * Y, Z * Z, X * Y, Y * Z, Z * X])
+        coef, *_ = np.linalg.lstsq(A, vals, rcond=None)
+        s = coef[0].reshape(3, 3)
+        return 0.5 * (s + s.T)
+
+    def stress_at(self, x: Sequence[float]) -> np.ndarray:
+        """Stress tensor (3, 3), MPa, at point ``x`` (mm), linear in its element."""
+        q = np.asarray(x, float).reshape(3, 1)
+        try:
+            e = int(self.mesh.element_finder()(*q)[0])
+        except ValueError:
+            raise GeometryError(f"point {np.ravel(q).tolist()} mm is outside the mesh", self.mesh) from None
+        v = self.mesh.p[:, self.mesh.t[:, e]]  # (3, 4)
+        A = np.vstack([v, np.ones(4)])
+        lam = np.linalg.solve(A, np.append(q.ravel(), 1.0))
+        return np.einsum("k,kij->ij", lam, self.vertex_stress[e])
+
+
+def principal_stresses(s: np.ndarray) -> np.ndarray:
+    """Principal stresses (ascending), MPa, of stress tensors ``(..., 3, 3)``."""
+    return np.linalg.eigvalsh(s)
+
+
+def von_mises(s: np.ndarray) -> np.ndarray:
+    """Von Mises equivalent stress, MPa, of stress tensors ``(..., 3, 3)``."""
+    dev = s - np.trace(s, axis1=-2, axis2=-1)[..., None, None] * np.eye(3) / 3.0
+    return np.sqrt(1.5 * np.einsum("...ij,...ij->...", dev, dev))
+
+
+def _supports(m: Any, basis: Any, centre: np.ndarray, arm: float) -> np.ndarray:
+    """The six unknowns of a 3-2-1 support at the vertices nearest ``centre``, ``centre + arm·x``, ``+ arm·y``."""
+    def near(q: np.ndarray) -> int:
+        return int(np.argmin(((m.p.T - q) ** 2).sum(axis=1)))
+
+    a = near(centre)
+    b = near(centre + [arm, 0.0, 0.0])
+    c = near(centre + [0.0, arm, 0.0])
+    pa, pb, pc = m.p[:, a], m.p[:, b], m.p[:, c]
+    if np.linalg.norm(np.cross(pb - pa, pc - pa)) < 1e-6 * arm**2:
+        raise GeometryError("supports: the three support vertices are collinear", m)
+    nd = basis.nodal_dofs
+    return np.array([nd[0, a], nd[1, a], nd[2, a], nd[1, b], nd[2, b], nd[2, c]])
+
+
+def solve_elasticity(
+    mesh: TetMesh,
+    material: Material,
+    loads: Sequence[PressureLoad],
+    *,
+    support_centre: Sequence[float],
+    support_arm: float,
+    facets: BoundaryFacets | None = None,
+    skmesh: Any = None,
+) -> ElasticSolution:
+    """Solve linear elasticity with pressure loads and a 3-2-1 support.
+
+    Parameters
+    ----------
+    mesh : TetMesh
+        Linear tetrahedra, mm.
+    material : Material
+        E (MPa), ν.
+    loads : sequence of PressureLoad
+        Normal pressures (MPa); their resultant should vanish (self-equilibrated).
+    support_centre, support_arm
+        Where the 3-2-1 support sits (mm) and the spacing of its three vertices (mm).
+    facets, skmesh
+        The :func:`boundary_facets` and skfem mesh the loads were selected on.
+    """
+    import scipy.sparse.linalg as spla
+    import skfem
+    from skfem.helpers import dot, sym_grad
+    from skfem.models.elasticity import linear_elasticity, linear_stress
+
+    m = skmesh if skmesh is not None else _skfem_mesh(mesh)
+    bf = facets if facets is not None else boundary_facets(m)
+    elem = skfem.ElementVector(skfem.ElementTetP2())
+    basis = skfem.Basis(m, elem, intorder=2)
+    lam, mu = material.lame
+    K = skfem.asm(linear_elasticity(lam, mu), basis)
+
+    @skfem.LinearForm
+    def pressure(v: Any, w: Any) -> Any:
+        return -dot(w.n, v)
+
+    f = np.zeros(basis.N)
+    scale = 0.0
+    for ld in loads:
+        fb = skfem.FacetBasis(m, elem, facets=bf.ids[ld.facets], intorder=2)
+        f += ld.pressure * pressure.assemble(fb)
+        scale = max(scale, float(np.abs(bf.resultant(ld)).max()))
+    D = _supports(m, basis, np.asarray(support_centre, float), float(support_arm))
+    free = np.setdiff1d(np.arange(basis.N), D)
+    Kf = K[free][:, free].tocsc()
+    lu = spla.splu(Kf, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
+    u = np.zeros(basis.N)
+    u[free] = lu.solve(f[free])
+    reaction = float(np.abs((K @ u - f)[D]).max())
+    # stresses at the element vertices: quadrature "points" at the reference vertices
+    ref = np.array([[0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
+    vb = skfem.Basis(m, elem, quadrature=(ref, np.full(4, 1.0 / 24.0)))
+    sig = linear_stress(lam, mu)(sym_grad(vb.interpolate(u)))  # (3, 3, m, 4)
+    vertex_stress = np.ascontiguousarray(np.transpose(sig, (2, 3, 0, 1)))
+    # vertex displacements (P2 nodal dofs at the vertices)
+    disp = u[basis.nodal_dofs].T
+    return ElasticSolution(mesh=m, displacement=disp, vertex_stress=vertex_stress, dofs=int(basis.N),
+                           reaction=reaction, load_scale=scale, work=float(f @ u))

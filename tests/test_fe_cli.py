@@ -1,0 +1,142 @@
+"""``tabletcad fe``: JSON keys, files, and one-line errors with exit status 2 and nothing written."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("skfem")
+pytest.importorskip("gmsh")
+pytest.importorskip("OCP")
+pytest.importorskip("meshio")
+
+from tabletcad.cli import main  # noqa: E402
+
+THIN = """
+[tablet]
+family = "flat_face_round"
+diameter = 8.0
+thickness = 1.0
+"""
+
+
+def run(capsys, *args):
+    rc = main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+@pytest.fixture
+def thin(tmp_path) -> Path:
+    p = tmp_path / "thin.toml"
+    p.write_text(THIN)
+    return p
+
+
+def test_diametral_json_and_files(capsys, tmp_path, thin):
+    import meshio
+
+    out = tmp_path / "res"
+    rc, so, err = run(capsys, "fe", "diametral", thin, "--force", 50, "--direction", "x", "--mesh-size", 0.6,
+                      "--out", out, "--json")
+    assert rc == 0, err
+    d = json.loads(so)
+    for k in ("centre_tensile_stress_MPa", "max_tensile_stress_MPa", "max_tensile_location_mm", "nodes", "elements",
+              "discretisation_error_MPa", "discretisation_error_relative", "shape_factor"):
+        assert k in d
+    ref = 2 * 50 / (3.141592653589793 * 8.0 * 1.0)
+    assert d["line_load_stress_MPa"] == pytest.approx(ref, rel=1e-12)
+    assert d["strip_width_mm"] == pytest.approx(0.8, rel=1e-12)  # D/10
+    assert d["centre_tensile_stress_MPa"] == pytest.approx(0.988 * ref, rel=0.03)
+    assert abs(d["discretisation_error_relative"]) < 0.03
+    assert d["reaction_N"] < 1e-8 * 50
+    assert len(d["max_tensile_location_mm"]) == 3
+    assert d["max_tensile_stress_MPa"] >= d["centre_tensile_stress_MPa"] * 0.999
+    assert sorted(p.name for p in out.iterdir()) == ["section.png", "stress.vtu"]
+    mesh = meshio.read(out / "stress.vtu")
+    assert len(mesh.points) == d["nodes"]
+    assert len(mesh.cells_dict["tetra"]) == d["elements"]
+    assert (out / "section.png").read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize(
+    "extra, match",
+    [
+        (["--force", "0"], "--force = 0 N is not allowed: must be > 0"),
+        (["--force", "-5"], "--force = -5 N is not allowed: must be > 0"),
+        (["--force", "10", "--direction", "diagonal"], "--direction = 'diagonal' is not allowed"),
+        (["--force", "10", "--strip-width", "5"], "strip_width = 5 mm is not allowed"),
+        (["--force", "10", "--mesh-size", "0.001"], "mesh_size = 0.001 mm is not allowed: must be >= "),
+        (["--force", "10", "--nu", "0.5"], "nu = 0.5 is not allowed"),
+    ],
+)
+def test_diametral_bad_input_one_line_exit_2_nothing_written(capsys, tmp_path, thin, extra, match):
+    out = tmp_path / "never"
+    rc, so, err = run(capsys, "fe", "diametral", thin, *extra, "--out", out)
+    assert rc == 2
+    assert err.count("\n") == 1 and err.startswith("error: ") and match in err, err
+    assert not out.exists()
+
+
+def test_punch_needs_tooling(capsys, tmp_path, thin):
+    out = tmp_path / "never"
+    rc, so, err = run(capsys, "fe", "punch", thin, "--force", 10, "--yield-stress", 1450)
+    assert rc == 2
+    assert err.startswith("error: [tooling]") and "needs a design file with a [tooling] table" in err
+    assert err.count("\n") == 1
+    assert not out.exists()
+
+
+TOOLED = THIN.replace("thickness = 1.0", "thickness = 2.0") + """
+[tooling]
+clearance_mm = 0.02
+tip_length_mm = 5.0
+"""
+
+
+def test_punch_json_and_files(capsys, tmp_path):
+    design = tmp_path / "tooled.toml"
+    design.write_text(TOOLED)
+    out = tmp_path / "punch"
+    rc, so, err = run(capsys, "fe", "punch", design, "--force", 5, "--steel", "S7_tempered_205C", "--mesh-size", 1.0,
+                      "--out", out, "--json")
+    assert rc == 0, err
+    d = json.loads(so)
+    assert d["steel"] == "S7_tempered_205C" and d["yield_MPa"] == 1450
+    # flat tip: σ_vM ≈ F/A, so the yield-based rating is ≈ σ_y/S · A
+    assert d["max_von_mises_MPa"] == pytest.approx(d["uniform_stress_MPa"], rel=0.02)
+    assert d["allowed_force_kN"] == pytest.approx(
+        min(1450 / 1.5 * 5 / d["max_von_mises_MPa"], d["buckling"]["critical_force_kN"] / 1.5), rel=1e-9)
+    assert sorted(p.name for p in out.iterdir()) == ["section.png", "stress.vtu"]
+
+
+@pytest.mark.parametrize(
+    "extra, match",
+    [
+        (["--force", "5"], "--yield-stress = None is not allowed: give --yield-stress (MPa) or --steel"),
+        (["--force", "5", "--steel", "unobtainium"], "--steel = 'unobtainium' is not allowed: must be one of"),
+        (["--force", "0", "--yield-stress", "1000"], "--force = 0 kN is not allowed: must be > 0"),
+        (["--force", "5", "--yield-stress", "1000", "--steel", "S7_tempered_205C"], "not both"),
+    ],
+)
+def test_punch_bad_input(capsys, tmp_path, extra, match):
+    design = tmp_path / "tooled.toml"
+    design.write_text(TOOLED)
+    out = tmp_path / "never"
+    rc, so, err = run(capsys, "fe", "punch", design, *extra, "--out", out)
+    assert rc == 2 and err.startswith("error: ") and match in err and err.count("\n") == 1, err
+    assert not out.exists()
+
+
+def test_strength_needs_its_inputs(capsys, thin):
+    rc, so, err = run(capsys, "fe", "strength", thin)
+    assert rc == 2 and err.count("\n") == 1
+    assert err.startswith("error: [report] tensile_strength_MPa = None is not allowed: give it, or all of"), err
+
+
+def test_diametral_refuses_a_ring_fast(capsys):
+    ring = Path(__file__).resolve().parents[1] / "samples" / "ring.toml"
+    rc, so, err = run(capsys, "fe", "diametral", ring, "--force", 10)
+    assert rc == 2 and err.startswith("error: [trim] w = [0.5, 1.0] is not allowed: the diametral test needs a solid")

@@ -1,0 +1,136 @@
+"""Elasticity on quadratic tetrahedra: closed forms that the discretisation must reproduce exactly."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("skfem")
+pytest.importorskip("gmsh")
+build123d = pytest.importorskip("build123d")
+
+from tabletcad.errors import DesignError  # noqa: E402
+from tabletcad.fe.elasticity import (  # noqa: E402
+    Material,
+    PressureLoad,
+    _skfem_mesh,
+    boundary_facets,
+    principal_stresses,
+    solve_elasticity,
+    von_mises,
+)
+from tabletcad.fe.mesh import MAX_DOFS, check_mesh_size, estimated_dofs, mesh_solid  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def box_mesh():
+    box = build123d.Box(4.0, 3.0, 2.0)  # centred at the origin
+    return mesh_solid(box.wrapped, 1.0)
+
+
+def _strain(sol):
+    """Symmetric part of G for the affine fit u = G x + a over all vertices (exact for affine fields)."""
+    X = np.hstack([sol.mesh.p.T, np.ones((sol.mesh.p.shape[1], 1))])
+    coef, res, *_ = np.linalg.lstsq(X, sol.displacement, rcond=None)
+    G = coef[:3].T
+    assert np.abs(X @ coef - sol.displacement).max() < 1e-10 * np.abs(sol.displacement).max()
+    return 0.5 * (G + G.T)
+
+
+def _solve(box_mesh, loads_of, material=Material()):
+    m = _skfem_mesh(box_mesh)
+    bf = boundary_facets(m)
+    loads = loads_of(bf)
+    return bf, solve_elasticity(box_mesh, material, loads, support_centre=(0, 0, 0), support_arm=1.0,
+                                facets=bf, skmesh=m)
+
+
+def test_mesh_of_a_box_fills_it(box_mesh):
+    assert box_mesh.volume() == pytest.approx(24.0, rel=1e-12)
+    assert box_mesh.points.min(axis=0) == pytest.approx([-2.0, -1.5, -1.0])
+    assert box_mesh.points.max(axis=0) == pytest.approx([2.0, 1.5, 1.0])
+
+
+def test_hydrostatic_pressure_gives_minus_p_identity_everywhere(box_mesh):
+    p = 7.5
+    bf, sol = _solve(box_mesh, lambda bf: [PressureLoad(np.arange(len(bf.ids)), p)])
+    assert np.abs(sol.vertex_stress + p * np.eye(3)).max() < 1e-9 * p
+    assert sol.reaction < 1e-9 * p * 24
+    # outward normals: the resultant of a closed surface's pressure vanishes, its area is the box's
+    assert np.abs(bf.resultant(PressureLoad(np.arange(len(bf.ids)), p))).max() < 1e-12
+    assert bf.areas.sum() == pytest.approx(2 * (12 + 8 + 6), rel=1e-12)
+    # volume change -p/K with K = E / (3 (1 - 2 nu))
+    mat = Material()
+    K = mat.E / (3 * (1 - 2 * mat.nu))
+    assert _strain(sol) == pytest.approx(-p / (3 * K) * np.eye(3), abs=1e-9 * p / K)
+
+
+def _ends(bf, axis=0):
+    return [PressureLoad(np.flatnonzero(s * bf.normals[:, axis] > 0.999), 3.0) for s in (-1.0, 1.0)]
+
+
+@pytest.mark.parametrize("E", [200.0, 210000.0])
+def test_uniaxial_compression_is_exact_and_independent_of_E(box_mesh, E):
+    bf, sol = _solve(box_mesh, _ends, Material(E=E, nu=0.25))
+    expect = np.zeros((3, 3))
+    expect[0, 0] = -3.0
+    assert np.abs(sol.vertex_stress - expect).max() < 1e-8
+    # the strain is σ/E along the load and -ν σ/E across it
+    assert _strain(sol) == pytest.approx(np.diag([-3.0 / E, 0.75 / E, 0.75 / E]), abs=1e-8 / E)
+    s = sol.stress_at([0.3, -0.2, 0.1])
+    assert s == pytest.approx(expect, abs=1e-8)
+    assert von_mises(s) == pytest.approx(3.0, rel=1e-8)
+    assert principal_stresses(s) == pytest.approx([-3.0, 0.0, 0.0], abs=1e-8)
+
+
+def test_von_mises_and_principal_closed_forms():
+    s = np.diag([100.0, 0.0, 0.0])
+    assert von_mises(s) == pytest.approx(100.0)
+    tau = np.array([[0.0, 40.0, 0.0], [40.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    assert von_mises(tau) == pytest.approx(40.0 * np.sqrt(3.0))
+    assert principal_stresses(tau) == pytest.approx([-40.0, 0.0, 40.0])
+    assert von_mises(-5.0 * np.eye(3)) == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("E, nu", [(0.0, 0.3), (-1.0, 0.3), (100.0, 0.5), (100.0, -1.0), (float("nan"), 0.3)])
+def test_bad_material_is_a_design_error(E, nu):
+    with pytest.raises(DesignError):
+        Material(E=E, nu=nu)
+
+
+def test_mesh_size_that_would_not_fit_is_refused():
+    assert estimated_dofs(1000.0, 1.0) == pytest.approx(33600.0)
+    assert check_mesh_size(500.0, 0.5) == 0.5
+    with pytest.raises(DesignError, match=r"mesh_size = 0\.01 mm is not allowed: must be >= .* mm"):
+        check_mesh_size(500.0, 0.01)
+    smallest = (33.6 * 500.0 / MAX_DOFS) ** (1 / 3)
+    check_mesh_size(500.0, smallest * 1.001)
+
+
+def test_core_imports_without_the_fe_libraries():
+    """The numerical core (and tabletcad.fe's own modules) import with scikit-fem and gmsh blocked."""
+    code = f"""
+import sys
+sys.path.insert(0, {str(REPO)!r})
+class Block:
+    def find_spec(self, name, path=None, target=None):
+        if name.split(".")[0] in ("skfem", "gmsh"):
+            raise ImportError(name + " blocked")
+sys.meta_path.insert(0, Block())
+import tabletcad, tabletcad.tablet, tabletcad.shapes, tabletcad.mechanics.strength
+import tabletcad.fe.mesh, tabletcad.fe.elasticity, tabletcad.fe.diametral
+v = tabletcad.shapes.FAMILIES["spherical"].build().properties()["volume_mm3"]
+assert not [m for m in sys.modules if m.split(".")[0] in ("skfem", "gmsh")]
+print(v)
+"""
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, env=env, cwd="/")
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert float(out.stdout.split()[-1]) > 0
