@@ -341,6 +341,15 @@ def _trim(tablet: Tablet, t: dict) -> Tablet:
     return replace(tablet, trim=Trim(**{**dict(u=tablet.trim.u, v=tablet.trim.v, w=tablet.trim.w), **kw}))
 
 
+def _factor(where: str, value: Any, tol: Tolerances = DEFAULT) -> float:
+    """A reshaping factor: > 0 and at most ``tol.max_length`` (a larger one takes any 1 mm
+    dimension past the size limit; the reshaped tablet's size is checked afterwards too)."""
+    x = _number(where, value)
+    if not 0.0 < x <= tol.max_length:
+        raise DesignError(where, value, f"must be > 0 and <= {tol.max_length:g}")
+    return x
+
+
 def _reshape(tablet: Tablet, r: dict) -> Tablet:
     from tabletcad import reshape
 
@@ -353,9 +362,9 @@ def _reshape(tablet: Tablet, r: dict) -> Tablet:
     if "spine" in r:
         if not isinstance(r["spine"], list):
             raise DesignError("reshape.spine", r["spine"], "must be a list with one factor per patch")
-        tablet = reshape.scale_heights(tablet, [_number(f"reshape.spine[{j}]", f) for j, f in enumerate(r["spine"])])
+        tablet = reshape.scale_heights(tablet, [_factor(f"reshape.spine[{j}]", f) for j, f in enumerate(r["spine"])])
     if "radius" in r:
-        tablet = reshape.scale_radius(tablet, _number("reshape.radius", r["radius"]))
+        tablet = reshape.scale_radius(tablet, _factor("reshape.radius", r["radius"]))
     return tablet
 
 

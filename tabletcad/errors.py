@@ -65,8 +65,9 @@ def _fmt(value: Any) -> str:
     if isinstance(value, float):
         return f"{value:.6g}"
     if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**15:
-        digits = int(value.bit_length() * math.log10(2)) + 1  # str() of a huge int may be refused
-        return f"{value:.6g}" if digits < 300 else f"an integer of about {digits} digits"
+        digits = int(value.bit_length() * math.log10(2))  # str() of a huge int may be refused
+        digits += 10**digits <= abs(value)
+        return f"{value:.6g}" if digits < 300 else f"an integer of {digits} digits"
     text = repr(value) if isinstance(value, str) else str(value)
     text = " ".join(text.split())  # one line, whatever the value holds
     return text if len(text) <= 80 else f"{text[:60]}...{text[-12:]}"

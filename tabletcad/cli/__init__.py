@@ -20,8 +20,6 @@ while click, numpy or the commands load is caught by :func:`main` too.
 from __future__ import annotations
 
 import sys
-from typing import Any
-
 __all__ = ["main", "cli"]
 
 # modules whose COMMANDS list is composed into the group, in this order
@@ -31,7 +29,7 @@ _COMMAND_MODULES = (
     "tabletcad.cli.mechanics",
     "tabletcad.cli.optimise",
 )
-_GROUP: Any = None
+_GROUP = None  # the click group, built by _group()
 
 
 def _say(line: str) -> None:
