@@ -197,7 +197,7 @@ def _log_internal(exc: BaseException) -> str:
 def _run(argv: list[str] | None) -> int:
     import click
 
-    from tabletcad.errors import DesignError, TabletcadError, one_token
+    from tabletcad.errors import DesignError, TabletcadError
 
     group = _group()
     args = list(sys.argv[1:] if argv is None else argv)
@@ -216,8 +216,6 @@ def _run(argv: list[str] | None) -> int:
         exc.show()
         return exc.exit_code
     except DesignError as exc:
-        if len(exc.parameter.split()) > 1:
-            exc = exc.renamed(one_token(exc.parameter))
         _say(f"error: {' '.join(str(exc).split())}")
         return 2
     except TabletcadError as exc:

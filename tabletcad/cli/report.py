@@ -15,7 +15,7 @@ from typing import Any
 
 import click
 
-from tabletcad.errors import DesignError
+from tabletcad.errors import DesignError, one_token
 
 __all__ = ["COMMANDS", "load_family_design"]
 
@@ -110,9 +110,12 @@ def report_cmd(design: Path, solid_fraction, true_density, breaking_force, compa
 
         raise DesignError("tablet.family", tablet.family,
                           "the design report needs an industry family: " + ", ".join(f.__name__ for f in FAMILY_FUNCTIONS) + ", custom_outline")
-    opts = ReportOptions.from_table(table).merged(
-        solid_fraction=solid_fraction, true_density_mg_mm3=true_density, breaking_force_N=breaking_force,
-        compaction_force_kN=compaction_force, max_punch_force_kN=max_punch_force, max_punch_pressure_MPa=max_punch_pressure)
+    try:
+        opts = ReportOptions.from_table(table).merged(
+            solid_fraction=solid_fraction, true_density_mg_mm3=true_density, breaking_force_N=breaking_force,
+            compaction_force_kN=compaction_force, max_punch_force_kN=max_punch_force, max_punch_pressure_MPa=max_punch_pressure)
+    except DesignError as exc:  # "[report] solid_fraction" -> "[report].solid_fraction": one token
+        raise exc.renamed(one_token(exc.parameter)) from None
     sec = design_report(tablet, opts)
     click.echo(_table(tablet.name, sec))
     if json_out is not None:
