@@ -323,8 +323,10 @@ def _free_form(patches: Any, name: str, a) -> Tablet:
             kw["a"] = _number(f"{where}.a", kw["a"])
         try:
             out.append(PDEPatch(tuple(cs), **kw))
-        except DesignError as exc:
-            raise exc.renamed(one_token(f"{where}.{exc.parameter}")) from None
+        except DesignError as exc:  # "patch NAME smoothing parameter a" -> "patch[j].a"
+            last = exc.parameter.split()[-1] if exc.parameter.split() else "?"
+            key = last if last in ("a", "modes", "u_nodes", "form", "curves") else exc.parameter
+            raise exc.renamed(one_token(f"{where}.{key}")) from None
         prev = cs[3]
     return Tablet(tuple(out), name=name, family="free_form")
 

@@ -251,3 +251,10 @@ def test_readme_says_how_to_reach_the_commands():
     after = text[text.index("## Two commands on a fresh machine"):]
     section = after[:after.index("\n## ", 5)]
     assert ".venv/bin/tabletcad" in section and ". .venv/bin/activate" in section
+
+
+def test_bare_command_prints_help_and_help_exits_0(capsys):
+    rc, out, err = run(capsys)
+    assert rc == 0 and out.startswith("Usage: tabletcad") and "build" in out and err == ""
+    rc, out, err = run(capsys, "mesh", "--help")
+    assert rc == 0 and "--nodes" in out and err == ""
