@@ -6,9 +6,16 @@ The numerical core (this package's top-level modules, ``families``,
 ``tabletcad.tooling`` add OpenCascade (OCP), build123d and manifold3d.
 """
 
-from importlib import metadata as _metadata
 
-try:
-    __version__ = _metadata.version("tabletcad")
-except _metadata.PackageNotFoundError:  # run from a source tree (e.g. inside FreeCAD)
-    __version__ = "0+source"
+
+def __getattr__(name: str) -> str:
+    # ``__version__`` is looked up on first use: importlib.metadata costs ~50 ms at start-up,
+    # a window in which Ctrl-C would escape the command line's handler
+    if name != "__version__":
+        raise AttributeError(f"module 'tabletcad' has no attribute {name!r}")
+    from importlib import metadata
+
+    try:
+        return metadata.version("tabletcad")
+    except metadata.PackageNotFoundError:  # run from a source tree (e.g. inside FreeCAD)
+        return "0+source"

@@ -40,18 +40,21 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from tabletcad.curves import Circle, Curve, Ellipse, PointCurve, RoundedRectangle, Stadium
-from tabletcad.errors import DesignError, check_finite
+from tabletcad.errors import DesignError, check_finite, one_token
 from tabletcad.patch import PDEPatch
 from tabletcad.shapes import FAMILIES
 from tabletcad.tablet import Tablet, Trim
+from tabletcad.tolerance import DEFAULT, Tolerances
 
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["load_design", "design_from_dict", "design_to_toml", "TOP_LEVEL_KEYS"]
+__all__ = ["load_design", "read_design_file", "design_from_dict", "design_to_toml", "TOP_LEVEL_KEYS"]
 
 TOP_LEVEL_KEYS = ("tablet", "patch", "trim", "reshape", "tooling", "report")
 _CURVE_KEYS = {
@@ -63,22 +66,65 @@ _CURVE_KEYS = {
 }
 
 
+def read_design_file(path: str | Path) -> dict[str, Any]:
+    """The parsed TOML of a design file; any problem with the file is a :class:`DesignError`
+    naming ``design_file`` (a folder, a missing or unreadable file, invalid or too deeply
+    nested TOML, an integer literal longer than Python converts)."""
+    path = Path(path)
+    if path.is_dir():
+        raise DesignError("design_file", str(path), "must be a TOML file, not a folder")
+    if not path.is_file():
+        raise DesignError("design_file", str(path), "must be an existing TOML file")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise DesignError("design_file", str(path), "must be UTF-8 text (TOML)") from None
+    except OSError as exc:
+        raise DesignError("design_file", str(path), f"must be a readable file ({exc.strerror})") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise DesignError("design_file", path.name, f"must be valid TOML ({exc})") from None
+    except RecursionError:
+        raise DesignError("design_file", path.name, "must be valid TOML nested less than a few hundred levels deep") from None
+    except ValueError as exc:  # e.g. an integer of more than 4300 digits
+        raise DesignError("design_file", path.name, f"must be valid TOML with numbers Python can read ({exc})") from None
+
+
 def load_design(path: str | Path) -> Tablet:
     """Read a TOML design file and build its tablet."""
     path = Path(path)
-    if not path.is_file():
-        raise DesignError("design file", str(path), "must be an existing TOML file")
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise DesignError("design file", path.name, f"must be valid TOML ({exc})") from None
-    return design_from_dict(data, default_name=path.stem)
+    return design_from_dict(read_design_file(path), default_name=path.stem)
+
+
+def _number(where: str, value: Any, unit: str = "", *, tol: Tolerances = DEFAULT) -> float:
+    """A number read from a design: an int or float (never a boolean or a string), finite,
+    and for lengths (``unit == "mm"``) within ``±tol.max_length``."""
+    if isinstance(value, bool):
+        raise DesignError(where, value, "must be a number (true and false are not numbers)", unit)
+    if not isinstance(value, (int, float)):
+        raise DesignError(where, value, "must be a number", unit)
+    x = check_finite(where, value, unit)
+    if unit == "mm" and abs(x) > tol.max_length:
+        raise DesignError(where, value, f"must be within ±{tol.max_length:g} mm (size limit, Tolerances.max_length)", unit)
+    return x
+
+
+def _lengths(where: str, value: Any, *, tol: Tolerances = DEFAULT) -> None:
+    """Check every number inside nested lists (points, outline segments) with :func:`_number`
+    as a length; strings are left to the reader of the list (segment kinds)."""
+    if isinstance(value, list):
+        for i, item in enumerate(value):
+            _lengths(f"{where}[{i}]", item, tol=tol)
+    elif not isinstance(value, str):
+        _number(where, value, "mm", tol=tol)
 
 
 def _check_keys(where: str, table: dict, allowed: set[str]) -> None:
     for k in table:
         if k not in allowed:
-            raise DesignError(f"{where} key {k!r}", table[k], f"allowed keys are {', '.join(sorted(allowed))}")
+            raise DesignError(one_token(f"{where}.{k}" if where else k), table[k],
+                              f"allowed keys{' of ' + where if where else ''} are {', '.join(sorted(allowed))}")
 
 
 def _curve(spec: Any, where: str, previous: Curve | None) -> Curve:
@@ -90,18 +136,18 @@ def _curve(spec: Any, where: str, previous: Curve | None) -> Curve:
         raise DesignError(where, spec, "must be a table with a 'type' or the string 'previous'")
     kind = spec["type"]
     if kind not in _CURVE_KEYS:
-        raise DesignError(f"{where} type", kind, f"must be one of {', '.join(_CURVE_KEYS)}")
+        raise DesignError(f"{where}.type", kind, f"must be one of {', '.join(_CURVE_KEYS)}")
     _check_keys(where, spec, _CURVE_KEYS[kind] | {"type", "z", "center"})
     for k in _CURVE_KEYS[kind]:
         if k not in spec:
-            raise DesignError(f"{where} {k}", "missing", f"a {kind} curve needs {', '.join(sorted(_CURVE_KEYS[kind]))}")
+            raise DesignError(f"{where}.{k}", "missing", f"a {kind} curve needs {', '.join(sorted(_CURVE_KEYS[kind]))}")
     if "center" in spec and "z" in spec:
-        raise DesignError(f"{where} z", spec["z"], "give either z or center, not both")
+        raise DesignError(f"{where}.z", spec["z"], "give either z or center, not both")
     center = spec.get("center", (0.0, 0.0, spec.get("z", 0.0)))
     if not (isinstance(center, (list, tuple)) and len(center) == 3):
-        raise DesignError(f"{where} center", center, "must be [x, y, z] in mm")
-    center = tuple(check_finite(f"{where} center", c, "mm") for c in center)
-    num = {k: check_finite(f"{where} {k}", spec[k], "mm") for k in _CURVE_KEYS[kind] if k != "points"}
+        raise DesignError(f"{where}.center", center, "must be [x, y, z] in mm")
+    center = tuple(_number(f"{where}.center", c, "mm") for c in center)
+    num = {k: _number(f"{where}.{k}", spec[k], "mm") for k in _CURVE_KEYS[kind] if k != "points"}
     try:
         if kind == "circle":
             c: Curve = Circle(num["radius"], center)
@@ -109,65 +155,108 @@ def _curve(spec: Any, where: str, previous: Curve | None) -> Curve:
         if kind == "ellipse":
             return Ellipse(num["rx"], num["ry"], center)
         if kind == "points":
-            return PointCurve(spec["points"], z=center[2]).moved((center[0], center[1], 0.0))
+            pts = spec["points"]
+            if not isinstance(pts, list) or not all(isinstance(q, list) and len(q) in (2, 3) for q in pts):
+                raise DesignError(f"{where}.points", pts, "must be a list of [x, y] or [x, y, z] points in mm")
+            _lengths(f"{where}.points", pts)
+            return PointCurve(pts, z=center[2]).moved((center[0], center[1], 0.0))
         if kind == "stadium":
             base = Stadium(num["length"], num["width"])
         else:
             base = RoundedRectangle(num["length"], num["width"], num["corner_radius"])
         return base.moved(center)
     except DesignError as exc:
-        raise DesignError(f"{where} {exc.parameter}", exc.value, exc.allowed, exc.unit) from None
+        if exc.parameter.startswith(where):
+            raise
+        raise exc.renamed(one_token(f"{where}.{exc.parameter}")) from None
 
 
 def design_from_dict(data: dict, default_name: str = "tablet") -> Tablet:
-    """Build a tablet from a parsed design (the TOML structure above)."""
+    """Build a tablet from a parsed design (the TOML structure above).
+
+    Everything is validated before geometry is built where it can be: unknown
+    and missing keys, booleans or strings given for numbers, lengths beyond
+    ``Tolerances.max_length``.  Errors name the parameter as one token
+    (``tablet.diameter``, ``patch[0].curves[1].radius``).
+    """
+    try:
+        return _design_from_dict(data, default_name)
+    except DesignError as exc:
+        if len(exc.parameter.split()) > 1:
+            raise exc.renamed(one_token(exc.parameter)) from None
+        raise
+
+
+def _design_from_dict(data: dict, default_name: str) -> Tablet:
     from tabletcad.shapes import _load_plugins
 
     _load_plugins()
-    _check_keys("top-level", data, set(TOP_LEVEL_KEYS))
+    if not isinstance(data, dict):
+        raise DesignError("design", type(data).__name__, "must be a TOML table")
+    _check_keys("", data, set(TOP_LEVEL_KEYS))
     if "tablet" not in data or not isinstance(data["tablet"], dict):
-        raise DesignError("[tablet]", "missing", "a design needs a [tablet] table with a family")
+        raise DesignError("tablet", "missing" if "tablet" not in data else data["tablet"],
+                          "a design needs a [tablet] table with a family")
     tab = dict(data["tablet"])
     family = tab.pop("family", None)
     name = tab.pop("name", None) or default_name
-    if not isinstance(name, str) or not name.strip() or any(ch in name for ch in '/\\"\n'):
-        raise DesignError("[tablet] name", name, "must be a plain non-empty name")
+    if not isinstance(name, str) or not name.strip() or any(ch in name for ch in '/\\"\n') or len(name) > 200:
+        raise DesignError("tablet.name", name, "must be a plain non-empty name (no / \\ or quotes, at most 200 characters)")
     a = tab.pop("a", None)
     if a is not None and a != "auto":
-        a = check_finite("[tablet] a", a)
+        a = _number("tablet.a", a)
+    families = ", ".join(FAMILIES) + ", custom_outline or free_form"
     if family is None:
-        raise DesignError("[tablet] family", "missing", f"must be one of {', '.join(FAMILIES)}, custom_outline or free_form")
+        raise DesignError("tablet.family", "missing", f"must be one of {families}")
+    if not isinstance(family, str):
+        raise DesignError("tablet.family", family, f"must be one of {families}")
+    for table in ("trim", "reshape", "report", "tooling"):
+        if table in data and not isinstance(data[table], dict):
+            raise DesignError(table, data[table], "must be a table")
     if family == "free_form":
-        _check_keys("[tablet]", tab, set())
+        _check_keys("tablet", tab, set())
         tablet = _free_form(data.get("patch"), name, 1.0 if a is None else a)
     elif family == "custom_outline":
         tablet = _custom_outline(tab, name)
     else:
         if family not in FAMILIES:
-            raise DesignError("[tablet] family", family, f"must be one of {', '.join(FAMILIES)}, custom_outline or free_form")
+            raise DesignError("tablet.family", family, f"must be one of {families}")
         if "patch" in data:
-            raise DesignError("[[patch]]", "given", f"patches are only read for family free_form, not {family!r}")
+            raise DesignError("patch", "given", f"[[patch]] tables are only read for family free_form, not {family!r}")
         fam = FAMILIES[family]
         kw = {}
         for k, v in tab.items():
             if k not in fam.params:
-                raise DesignError(f"[tablet] key {k!r}", v, f"family {family!r} takes {', '.join(fam.params)}")
-            kw[k] = check_finite(f"[tablet] {k}", v, fam.params[k])
+                raise DesignError(one_token(f"tablet.{k}"), v, f"family {family!r} takes {', '.join(fam.params)}")
+            kw[k] = _number(f"tablet.{k}", v, fam.params[k])
+        missing = [k for k in fam.params if k in fam.required and k not in kw]
+        if missing:
+            optional = [k for k in fam.params if k not in fam.required]
+            raise DesignError(f"tablet.{missing[0]}", "missing",
+                              f"family {family!r} needs {', '.join(fam.required)}"
+                              + (f" (optional: {', '.join(optional)})" if optional else ""))
         if a is not None:
             kw["a"] = a
         tablet = fam.build(**kw)
         tablet = replace(tablet, name=name)
     if "reshape" in data:
         tablet = _reshape(tablet, data["reshape"])
+        _check_size(tablet)
     if "trim" in data:
         tablet = _trim(tablet, data["trim"])
     extras = {k: data[k] for k in ("report", "tooling") if k in data}
     if extras:
-        for k, v in extras.items():
-            if not isinstance(v, dict):
-                raise DesignError(f"[{k}]", v, "must be a table")
         tablet = replace(tablet, extras={**tablet.extras, **extras})
     return tablet
+
+
+def _check_size(tablet: Tablet, tol: Tolerances = DEFAULT) -> None:
+    """Refuse a tablet (e.g. reshaped) whose overall size leaves ``±tol.max_length``."""
+    lo, hi = tablet.bounds()
+    big = float(max(np.max(np.abs(lo)), np.max(np.abs(hi))))
+    if not big <= tol.max_length:
+        raise DesignError("reshape", "factors", f"must keep the tablet within ±{tol.max_length:g} mm "
+                          f"(size limit, Tolerances.max_length; it reaches {big:.6g} mm)")
 
 
 _CUSTOM_KEYS = {"outline", "segments", "band", "cup_depth", "land", "cup_width", "central_radius", "edge_radius"}
@@ -182,39 +271,62 @@ def _custom_outline(tab: dict, name: str) -> Tablet:
     """
     from tabletcad.families import outline_tablet
 
-    _check_keys("[tablet]", tab, _CUSTOM_KEYS)
+    _check_keys("tablet", tab, _CUSTOM_KEYS)
     if ("outline" in tab) == ("segments" in tab):
-        raise DesignError("[tablet] outline", "missing" if "outline" not in tab else "both",
+        raise DesignError("tablet.outline", "missing" if "outline" not in tab else "both",
                           "give either outline (points) or segments (lines and arcs)")
-    shape = tab["outline"] if "outline" in tab else [tuple(item) for item in tab["segments"]]
-    kw = {k: check_finite(f"[tablet] {k}", v, "mm") for k, v in tab.items() if k not in ("outline", "segments")}
+    for k in ("band", "cup_depth"):
+        if k not in tab:
+            raise DesignError(f"tablet.{k}", "missing", "a custom_outline design needs outline or segments, band and cup_depth "
+                              "(optional: land, cup_width, central_radius, edge_radius)")
+    key = "outline" if "outline" in tab else "segments"
+    shape = tab[key]
+    if key == "outline" and not (isinstance(shape, list) and all(isinstance(q, list) and len(q) == 2 for q in shape)):
+        raise DesignError("tablet.outline", shape, "must be a list of [x, y] points in mm")
+    if key == "segments" and not (isinstance(shape, list) and all(isinstance(q, list) and q and isinstance(q[0], str) for q in shape)):
+        raise DesignError("tablet.segments", shape, 'must be a list of ["line", [x0, y0], [x1, y1]] or ["arc", [cx, cy], r, theta0, sweep] items')
+    _lengths(f"tablet.{key}", shape)
+    if key == "segments":
+        shape = [tuple(item) for item in shape]
+    kw = {k: _number(f"tablet.{k}", v, "mm") for k, v in tab.items() if k not in ("outline", "segments")}
     return outline_tablet(shape, name=name, **kw)
 
 
 def _free_form(patches: Any, name: str, a) -> Tablet:
     if not isinstance(patches, list) or not patches:
-        raise DesignError("[[patch]]", "missing", "a free_form design needs at least one [[patch]] with 4 curves")
+        raise DesignError("patch", "missing", "a free_form design needs at least one [[patch]] with 4 curves")
     out = []
     prev: Curve | None = None
     for j, p in enumerate(patches):
-        where = f"patch {j}"
+        where = f"patch[{j}]"
         if not isinstance(p, dict):
             raise DesignError(where, p, "must be a table")
-        _check_keys(f"[[patch]] {j}", p, {"curves", "form", "u_nodes", "a", "modes"})
+        _check_keys(where, p, {"curves", "form", "u_nodes", "a", "modes"})
         curves = p.get("curves")
         if not isinstance(curves, list) or len(curves) != 4:
-            raise DesignError(f"{where} curves", curves if not isinstance(curves, list) else len(curves), "must be a list of 4 curves")
-        cs = [_curve(c, f"{where} curve {k}", prev) for k, c in enumerate(curves)]
+            raise DesignError(f"{where}.curves", curves if not isinstance(curves, list) else len(curves), "must be a list of 4 curves")
+        cs = [_curve(c, f"{where}.curves[{k}]", prev) for k, c in enumerate(curves)]
         kw: dict[str, Any] = dict(a=p.get("a", a), name=f"{name}[{j}]")
         if "form" in p:
             kw["form"] = p["form"]
         if "u_nodes" in p:
-            kw["u_nodes"] = tuple(p["u_nodes"])
+            un = p["u_nodes"]
+            if not (isinstance(un, list) and len(un) == 4):
+                raise DesignError(f"{where}.u_nodes", un, "must be [0, u1, u2, 1] with 0 < u1 < u2 < 1")
+            kw["u_nodes"] = tuple(_number(f"{where}.u_nodes", x) for x in un)
         if "modes" in p:
-            kw["modes"] = p["modes"]
+            m = p["modes"]
+            if isinstance(m, bool) or not isinstance(m, int):
+                raise DesignError(f"{where}.modes", m, "must be an integer from 0 to 512")
+            kw["modes"] = m
         if kw["a"] != "auto":
-            kw["a"] = check_finite(f"{where} a", kw["a"])
-        out.append(PDEPatch(tuple(cs), **kw))
+            kw["a"] = _number(f"{where}.a", kw["a"])
+        try:
+            out.append(PDEPatch(tuple(cs), **kw))
+        except DesignError as exc:  # "patch NAME smoothing parameter a" -> "patch[j].a"
+            last = exc.parameter.split()[-1] if exc.parameter.split() else "?"
+            key = last if last in ("a", "modes", "u_nodes", "form", "curves") else exc.parameter
+            raise exc.renamed(one_token(f"{where}.{key}")) from None
         prev = cs[3]
     return Tablet(tuple(out), name=name, family="free_form")
 
@@ -222,31 +334,39 @@ def _free_form(patches: Any, name: str, a) -> Tablet:
 def _pair(where: str, val: Any) -> tuple[float, float]:
     if not (isinstance(val, list) and len(val) == 2):
         raise DesignError(where, val, "must be a pair [lo, hi]")
-    return (check_finite(where, val[0]), check_finite(where, val[1]))
+    return (_number(where, val[0]), _number(where, val[1]))
 
 
-def _trim(tablet: Tablet, t: Any) -> Tablet:
-    if not isinstance(t, dict):
-        raise DesignError("[trim]", t, "must be a table with u, v and/or w pairs")
-    _check_keys("[trim]", t, {"u", "v", "w"})
-    kw = {k: _pair(f"[trim] {k}", t[k]) for k in t}
+def _trim(tablet: Tablet, t: dict) -> Tablet:
+    _check_keys("trim", t, {"u", "v", "w"})
+    kw = {k: _pair(f"trim.{k}", t[k]) for k in t}
     return replace(tablet, trim=Trim(**{**dict(u=tablet.trim.u, v=tablet.trim.v, w=tablet.trim.w), **kw}))
 
 
-def _reshape(tablet: Tablet, r: Any) -> Tablet:
+def _factor(where: str, value: Any, tol: Tolerances = DEFAULT) -> float:
+    """A reshaping factor: > 0 and at most ``tol.max_length`` (a larger one takes any 1 mm
+    dimension past the size limit; the reshaped tablet's size is checked afterwards too)."""
+    x = _number(where, value)
+    if not 0.0 < x <= tol.max_length:
+        raise DesignError(where, value, f"must be > 0 and <= {tol.max_length:g}")
+    return x
+
+
+def _reshape(tablet: Tablet, r: dict) -> Tablet:
     from tabletcad import reshape
 
-    if not isinstance(r, dict):
-        raise DesignError("[reshape]", r, "must be a table with spine and/or radius")
-    _check_keys("[reshape]", r, {"spine", "radius", "patches"})
+    _check_keys("reshape", r, {"spine", "radius", "patches"})
     if "patches" in r:
-        tablet = reshape.select_patches(tablet, r["patches"])
+        idx = r["patches"]
+        if not (isinstance(idx, list) and all(isinstance(i, int) and not isinstance(i, bool) for i in idx)):
+            raise DesignError("reshape.patches", idx, "must be a list of patch indices (integers)")
+        tablet = reshape.select_patches(tablet, idx)
     if "spine" in r:
         if not isinstance(r["spine"], list):
-            raise DesignError("[reshape] spine", r["spine"], "must be a list with one factor per patch")
-        tablet = reshape.scale_heights(tablet, r["spine"])
+            raise DesignError("reshape.spine", r["spine"], "must be a list with one factor per patch")
+        tablet = reshape.scale_heights(tablet, [_factor(f"reshape.spine[{j}]", f) for j, f in enumerate(r["spine"])])
     if "radius" in r:
-        tablet = reshape.scale_radius(tablet, r["radius"])
+        tablet = reshape.scale_radius(tablet, _factor("reshape.radius", r["radius"]))
     return tablet
 
 

@@ -19,6 +19,7 @@ __all__ = [
     "check_finite",
     "check_positive",
     "check_range",
+    "one_token",
 ]
 
 
@@ -39,6 +40,10 @@ class DesignError(TabletcadError, ValueError):
             shown = f"{shown} {unit}"
         super().__init__(f"{parameter} = {shown} is not allowed: {allowed}")
 
+    def renamed(self, parameter: str) -> "DesignError":
+        """The same error for another parameter name (e.g. with the design-file table it came from)."""
+        return DesignError(parameter, self.value, self.allowed, self.unit)
+
 
 class GeometryError(TabletcadError):
     """A geometric construction failed; ``obj`` is what failed (patch, face, shell...)."""
@@ -48,17 +53,37 @@ class GeometryError(TabletcadError):
         super().__init__(message)
 
 
+def one_token(parameter: str) -> str:
+    """``parameter`` as one token (runs of whitespace become ``.``), as the one-line
+    error format ``error: <parameter> = <value> is not allowed: <range>`` shows it."""
+    return ".".join(parameter.split()) or "?"
+
+
 def _fmt(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"  # as TOML writes them
     if isinstance(value, float):
         return f"{value:.6g}"
-    return repr(value) if isinstance(value, str) else str(value)
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**15:
+        digits = int(value.bit_length() * math.log10(2))  # str() of a huge int may be refused
+        digits += 10**digits <= abs(value)
+        return f"{value:.6g}" if digits < 300 else f"an integer of {digits} digits"
+    text = repr(value) if isinstance(value, str) else str(value)
+    text = " ".join(text.split())  # one line, whatever the value holds
+    return text if len(text) <= 80 else f"{text[:60]}...{text[-12:]}"
 
 
 def check_finite(name: str, value: float, unit: str = "") -> float:
-    """Return ``float(value)`` or raise :class:`DesignError` if it is not a finite number."""
+    """Return ``float(value)`` or raise :class:`DesignError` if it is not a finite number.
+
+    Booleans are refused although Python's ``bool`` is a subclass of ``int``
+    (a TOML ``true`` is never a length), and so are integers too large for a float.
+    """
+    if isinstance(value, bool):
+        raise DesignError(name, value, "must be a finite number, not a boolean", unit)
     try:
         x = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise DesignError(name, value, "must be a finite number", unit) from None
     if not math.isfinite(x):
         raise DesignError(name, value, "must be a finite number", unit)

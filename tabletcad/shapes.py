@@ -283,7 +283,13 @@ def deep_convex_oval(width: float = 6.0, length: float = 12.0, thickness: float 
 
 # ---------------------------------------------------------------------------- registry
 class Family:
-    """A named constructor with its parameters, units and defaults."""
+    """A named constructor with its parameters, units and defaults.
+
+    A parameter is *optional* when its default switches a feature off (0 mm:
+    no land, no bevel depth, no blend, a cup as wide as the outline allows, a
+    single-radius cup); every other parameter is a dimension that a design file
+    must give (``required``).
+    """
 
     def __init__(self, name: str, func: Callable[..., Tablet], params: dict[str, str], doc: str) -> None:
         self.name = name
@@ -298,11 +304,22 @@ class Family:
         sig = inspect.signature(self.func)
         return {k: sig.parameters[k].default for k in self.params}
 
+    @property
+    def required(self) -> tuple[str, ...]:
+        """Parameters a design must give (those whose default is not 0, i.e. real dimensions)."""
+        return tuple(k for k, d in self.defaults.items() if d != 0.0)
+
+    @property
+    def description(self) -> str:
+        """The first paragraph of the constructor's docstring on one line (whole sentences)."""
+        text = (self.func.__doc__ or self.doc or "").strip().split("\n\n")[0]
+        return " ".join(text.replace("``", "").split())
+
     def build(self, **kw) -> Tablet:
         unknown = set(kw) - set(self.params) - {"a"}
         if unknown:
             k = sorted(unknown)[0]
-            raise DesignError(f"[tablet] key {k!r}", kw[k], f"family {self.name!r} takes {', '.join(self.params)}")
+            raise DesignError(f"tablet.{k}", kw[k], f"family {self.name!r} takes {', '.join(self.params)}")
         return self.func(**kw)
 
 

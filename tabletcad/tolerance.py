@@ -56,6 +56,19 @@ class Tolerances:
         Largest deviation (mm) of a B-spline face from its PDE patch (CAD layer).
     nominal : float
         Largest deviation (mm) of a PDE surface from a family's exact nominal.
+    max_length : float
+        Size limit (mm) of design input: every length, coordinate and overall
+        dimension read from a design file or the command line lies within
+        ``[-max_length, max_length]`` (1 m; the largest pharmaceutical and
+        veterinary boluses are a few cm).  Beyond it the numbers stop being a
+        tablet and rounding errors exceed the nanometre tolerances above.
+    memory_fraction : float
+        Share of the memory the system reports available (Linux ``MemAvailable``)
+        that one command may plan to use; a mesh estimated larger is refused
+        before it is allocated.
+    mesh_bytes_per_node : int
+        Peak memory (bytes) of a hexahedral mesh per node, for that estimate
+        (measured: ~170 bytes per node from ``tabletcad mesh`` at 2e5-8e5 nodes).
     """
 
     interpolation: float = 1e-9
@@ -71,6 +84,9 @@ class Tolerances:
     fold: float = 5e-3
     fit: float = 1e-4
     nominal: float = 1e-3
+    max_length: float = 1000.0
+    memory_fraction: float = 0.5
+    mesh_bytes_per_node: int = 200
 
 
 DEFAULT = Tolerances()

@@ -1,63 +1,286 @@
 """The ``tabletcad`` command line.
 
-Each group of commands lives in its own module and is registered here.  Every
-command reports bad input as one line on stderr and exits with status 2; no
-traceback is printed and no partial output file is left behind.
+Each group of commands lives in its own module and is composed here.  Exit
+status and stderr follow one contract:
+
+* 0: success;
+* 2: bad input (:class:`~tabletcad.errors.DesignError`, any other
+  :class:`~tabletcad.errors.TabletcadError`, and click's usage errors): one
+  line ``error: <parameter> = <value> is not allowed: <range>``, no traceback,
+  no partial output left behind;
+* 1: an internal error (any other exception, a bug): one line naming it and
+  the log file that holds the traceback;
+* 130: interrupted (Ctrl-C), also during start-up: one line ``interrupted``;
+* other codes a command documents (``optimise``: 3 when it finds no optimum).
+
+Nothing but the standard library is imported at module level, so that Ctrl-C
+while click, numpy or the commands load is caught by :func:`main` too.
 """
 
 from __future__ import annotations
 
-import importlib
 import sys
-
-import click
-
-from tabletcad.errors import TabletcadError
-
 __all__ = ["main", "cli"]
 
-# (module, attribute) of each command or command group; modules are imported lazily
-# so that a missing optional dependency only affects the commands that need it.
-_COMMAND_MODULES = [
+# modules whose COMMANDS list is composed into the group, in this order
+_COMMAND_MODULES = (
     "tabletcad.cli.geometry",
     "tabletcad.cli.report",
     "tabletcad.cli.mechanics",
     "tabletcad.cli.optimise",
     "tabletcad.cli.fe",
     "tabletcad.cli.sweep",
-]
+)
+_GROUP = None  # the click group, built by _group()
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(package_name="tabletcad")
-def cli() -> None:
-    """Design pharmaceutical tablets and tooling; all lengths in mm, forces in N, stresses in MPa."""
+def _say(line: str) -> None:
+    try:
+        sys.stderr.write(line + "\n")
+        sys.stderr.flush()
+    except (OSError, ValueError):  # stderr closed
+        pass
 
 
-for _name in _COMMAND_MODULES:
-    _mod = importlib.import_module(_name)
-    for _cmd in getattr(_mod, "COMMANDS", []):
-        cli.add_command(_cmd)
+def _group():
+    """The click group with every command (built once, on first use)."""
+    global _GROUP
+    if _GROUP is None:
+        import importlib
+
+        import click
+
+        @click.group(context_settings={"help_option_names": ["-h", "--help"]})
+        @click.version_option(package_name="tabletcad")
+        def group() -> None:
+            """Design pharmaceutical tablets and tooling; all lengths in mm, forces in N, stresses in MPa."""
+
+        for name in _COMMAND_MODULES:
+            for cmd in getattr(importlib.import_module(name), "COMMANDS", []):
+                _one_line_params(cmd)
+                group.add_command(cmd)
+        _GROUP = group
+    return _GROUP
+
+
+def __getattr__(name: str):  # ``tabletcad.cli.cli``: the click group, built lazily
+    if name == "cli":
+        return _group()
+    raise AttributeError(name)
+
+
+# ---------------------------------------------------------------------- click errors -> one line
+def _param_name(param) -> str:
+    if param is None:
+        return "argument"
+    opts = [o for o in getattr(param, "opts", []) if o.startswith("--")] or list(getattr(param, "opts", []))
+    if getattr(param, "param_type_name", "") == "option" and opts:
+        return max(opts, key=len)
+    return (param.human_readable_name or param.name or "argument").replace(" ", "_")
+
+
+def _allowed(inner, exc) -> str:
+    import click
+
+    if isinstance(inner, (click.IntRange, click.FloatRange)):
+        kind = "an integer" if isinstance(inner, click.IntRange) else "a number"
+        return f"must be {kind} {inner._describe_range()}"
+    if isinstance(inner, click.types.IntParamType):
+        return "must be an integer"
+    if isinstance(inner, click.types.FloatParamType):
+        return "must be a number"
+    if isinstance(inner, click.Choice):
+        return "must be one of " + ", ".join(map(str, inner.choices))
+    if isinstance(inner, click.Path):
+        kind = "file" if not inner.dir_okay else "folder" if not inner.file_okay else "file or folder"
+        text = f"must be {'an existing ' if inner.exists else 'a '}{kind} path"
+        if inner.dir_okay != inner.file_okay:
+            text += f", not an existing {'folder' if kind == 'file' else 'file'}"
+        return text
+    return " ".join(exc.format_message().split()).rstrip(".")
+
+
+def _one_line_params(cmd) -> None:
+    """Give every parameter of ``cmd`` (and its subcommands) a type whose conversion
+    failures are :class:`DesignError` naming the option and the value given."""
+    import click
+
+    from tabletcad.errors import DesignError
+
+    class OneLine(click.ParamType):
+        def __init__(self, inner: click.ParamType) -> None:
+            self.inner = inner
+            self.name = inner.name
+            self.envvar_list_splitter = inner.envvar_list_splitter
+
+        def convert(self, value, param, ctx):
+            try:
+                return self.inner.convert(value, param, ctx)
+            except click.BadParameter as exc:
+                raise DesignError(_param_name(param), value, _allowed(self.inner, exc)) from None
+
+        def get_metavar(self, *args, **kw):
+            return self.inner.get_metavar(*args, **kw)
+
+        def get_missing_message(self, *args, **kw):
+            return self.inner.get_missing_message(*args, **kw)
+
+        def to_info_dict(self):
+            return self.inner.to_info_dict()
+
+        def split_envvar_value(self, rv):
+            return self.inner.split_envvar_value(rv)
+
+        def shell_complete(self, *args, **kw):
+            return self.inner.shell_complete(*args, **kw)
+
+    for param in cmd.params:
+        t = param.type
+        if not getattr(t, "is_composite", False) and not isinstance(t, (OneLine, click.types.BoolParamType)) \
+                and not getattr(param, "is_flag", False):
+            param.type = OneLine(t)
+    for sub in getattr(cmd, "commands", {}).values():
+        _one_line_params(sub)
+
+
+def _usage_line(exc) -> str:
+    """One ``error:`` line for a click usage error not raised by a parameter's type."""
+    import click
+
+    from tabletcad.errors import DesignError
+
+    ctx = exc.ctx
+    where = ctx.command_path if ctx is not None else "tabletcad"
+    if isinstance(exc, click.NoSuchOption):
+        opts = []
+        if ctx is not None:
+            for p in ctx.command.params:
+                opts.extend(o for o in getattr(p, "opts", []) if o.startswith("--"))
+        return str(DesignError("option", exc.option_name, f"{where} takes " + (", ".join(opts) or "no options")))
+    if isinstance(exc, click.MissingParameter):
+        return str(DesignError(_param_name(exc.param), "missing", f"{where} needs it"))
+    if isinstance(exc, click.BadOptionUsage):
+        return str(DesignError(exc.option_name, "missing", f"{exc.option_name} needs a value"))
+    if isinstance(exc, click.BadParameter):
+        return str(DesignError(_param_name(exc.param), "given", " ".join(exc.format_message().split()).rstrip(".")))
+    msg = " ".join(exc.format_message().split()).rstrip(".")
+    if msg.startswith("No such command"):
+        names = ", ".join(sorted(_group().commands))
+        return str(DesignError("command", msg.split("'")[1] if "'" in msg else msg, f"must be one of {names}"))
+    if "unexpected extra argument" in msg:
+        extra = msg[msg.find("(") + 1:msg.rfind(")")] if "(" in msg else msg
+        return str(DesignError("argument", extra, f"{where} takes no further arguments (see {where} --help)"))
+    return str(DesignError("arguments", where, msg))
+
+
+# ---------------------------------------------------------------------- internal errors
+def _log_internal(exc: BaseException) -> str:
+    """Write the traceback of ``exc`` to a log file; return its path (or a note why not)."""
+    import os
+    import tempfile
+    import time
+    import traceback
+
+    text = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
+    head = f"tabletcad {' '.join(sys.argv[1:])}\n{time.strftime('%Y-%m-%d %H:%M:%S')}\n\n"
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    for folder in (os.path.join(base, "tabletcad"), os.path.join(tempfile.gettempdir(), "tabletcad")):
+        try:
+            os.makedirs(folder, exist_ok=True)
+            fd, path = tempfile.mkstemp(prefix=time.strftime("error-%Y%m%d-%H%M%S-"), suffix=".log", dir=folder)
+            with os.fdopen(fd, "w", encoding="utf-8") as f:
+                f.write(head + text)
+            return path
+        except OSError:
+            continue
+    return "(no log written: no writable cache folder)"
+
+
+def _run(argv: list[str] | None) -> int:
+    import click
+
+    from tabletcad.errors import DesignError, TabletcadError
+
+    group = _group()
+    args = list(sys.argv[1:] if argv is None else argv)
+    try:
+        with group.make_context("tabletcad", [str(a) for a in args]) as ctx:
+            group.invoke(ctx)
+    except click.exceptions.Exit as exc:  # --help, --version
+        return exc.exit_code
+    except click.UsageError as exc:
+        if type(exc).__name__ == "NoArgsIsHelpError" and exc.ctx is not None:  # bare `tabletcad`: the help
+            click.echo(exc.ctx.get_help())
+            return 0
+        _say("error: " + _usage_line(exc))
+        return 2
+    except click.exceptions.Abort:
+        _say("interrupted")
+        return 130
+    except click.ClickException as exc:  # a command's own status (optimise: 3)
+        exc.show()
+        return exc.exit_code
+    except DesignError as exc:
+        _say(f"error: {' '.join(str(exc).split())}")
+        return 2
+    except TabletcadError as exc:
+        msg = " ".join(str(exc).split()) or type(exc).__name__
+        _say(f"error: {msg}")
+        return 2
+    except OSError as exc:
+        if exc.filename is None:
+            raise
+        _say(str(DesignError("path", str(exc.filename), (exc.strerror or type(exc).__name__).lower())))
+        return 2
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point: run the CLI, mapping tabletcad errors to exit status 2."""
+    """Run the command line; return the exit status (see the module docstring)."""
     try:
-        cli.main(args=argv, prog_name="tabletcad", standalone_mode=False)
-    except click.exceptions.Abort:
-        click.echo("aborted", err=True)
-        return 1
-    except click.ClickException as exc:
-        exc.show()
-        return 2 if isinstance(exc, click.UsageError) else exc.exit_code
-    except (TabletcadError, ValueError) as exc:
-        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        click.echo(f"error: {msg}", err=True)
-        return 2
-    except OSError as exc:
-        click.echo(f"error: {exc}", err=True)
-        return 2
-    return 0
+        try:
+            return _run(argv)
+        except (KeyboardInterrupt, SystemExit):
+            raise
+        except BrokenPipeError:  # the reader of stdout went away (``| head``): stop quietly
+            import os
+
+            try:
+                os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            except (OSError, ValueError):
+                pass
+            return 141
+        except RecursionError as exc:
+            path = _log_internal(exc)
+            _say(f"error: internal error (RecursionError); traceback in {path}")
+            return 1
+        except BaseException as exc:  # noqa: BLE001 - the one place that turns bugs into exit 1
+            path = _log_internal(exc)
+            msg = " ".join(str(exc).split())
+            if len(msg) > 120:
+                msg = msg[:117] + "..."
+            _say(f"error: internal error ({type(exc).__name__}{': ' + msg if msg else ''}); traceback in {path}")
+            return 1
+    except KeyboardInterrupt:
+        _say("interrupted")
+        if argv is None:  # run as the program: end here with 130
+            _exit_now(130)
+        return 130
+
+
+def _exit_now(status: int) -> None:
+    """Flush and end the process with ``status`` at once.  Returning 130 was not enough: in about
+    one run in three, a Ctrl-C that arrived while modules were importing ended the process by
+    SIGINT (status -2) after ``interrupted`` had been printed and the KeyboardInterrupt caught
+    (CPython 3.11; seen in tests/test_cli_contract.py)."""
+    import os
+
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError, AttributeError):
+            pass
+    os._exit(status)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import click
 
 from tabletcad.errors import DesignError
+from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = ["COMMANDS"]
 
@@ -15,18 +17,27 @@ __all__ = ["COMMANDS"]
 @click.command("shapes")
 @click.option("--json", "as_json", is_flag=True, help="Print the families as JSON.")
 def shapes_cmd(as_json: bool) -> None:
-    """List the tablet families and their parameters (with units and defaults)."""
+    """List the tablet families: required and optional parameters (units, defaults) and what each is."""
+    import textwrap
+
     from tabletcad.shapes import FAMILIES, _load_plugins
 
     _load_plugins()
     if as_json:
-        click.echo(json.dumps({n: dict(params=f.params, defaults=f.defaults, doc=f.doc) for n, f in FAMILIES.items()}, indent=2))
+        click.echo(json.dumps({n: dict(params=f.params, required=list(f.required),
+                                       optional=[k for k in f.params if k not in f.required],
+                                       defaults=f.defaults, description=f.description)
+                               for n, f in FAMILIES.items()}, indent=2))
         return
     for name, fam in FAMILIES.items():
-        args = ", ".join(f"{k} [{u}] = {fam.defaults[k]:g}" for k, u in fam.params.items())
-        click.echo(f"{name:22s} {args}")
-        click.echo(f"{'':22s} {fam.doc}")
-    click.echo(f"{'free_form':22s} [[patch]] tables of 4 curves each (see README: design files)")
+        req = ", ".join(f"{k} [{fam.params[k]}]" for k in fam.required)
+        opt = ", ".join(f"{k} [{u}] = {fam.defaults[k]:g}" for k, u in fam.params.items() if k not in fam.required)
+        click.echo(f"{name:22s} required: {req}" + (f"; optional: {opt}" if opt else ""))
+        click.echo(textwrap.fill(fam.description, width=100, initial_indent=" " * 23, subsequent_indent=" " * 23))
+    click.echo(f"{'custom_outline':22s} required: outline [mm] (points) or segments (lines and arcs), band [mm], "
+               "cup_depth [mm]; optional: land, cup_width, central_radius, edge_radius [mm] = 0 (see README: design files)")
+    click.echo(f"{'free_form':22s} required: [[patch]] tables of 4 curves each (see README: design files)")
+    click.echo(f"{'':22s} every design may also give a (smoothing parameter, default 1 or the family's; \"auto\" to choose)")
 
 
 @click.command("build")
@@ -54,17 +65,45 @@ def mesh_cmd(design: Path, nodes: tuple[int, int, int], out_file: Path) -> None:
     from tabletcad.design import load_design
     from tabletcad.solid import hex_mesh, mesh_volume, write_mesh
 
-    for name, n in zip(("--nodes SX", "--nodes SY", "--nodes SZ"), nodes):
+    for n in nodes:
         if n < 2 or n > 2000:
-            raise DesignError(name, n, "must be an integer from 2 to 2000")
+            raise DesignError("--nodes", n, "must be an integer from 2 to 2000")
     suffix = out_file.suffix.lower()
     if suffix not in (".vtu", ".xdmf", ".msh", ".vtk"):
-        raise DesignError("--out suffix", suffix or "(none)", "must be .vtu, .xdmf, .msh or .vtk")
+        raise DesignError("--out", str(out_file), "must end in .vtu, .xdmf, .msh or .vtk")
     tablet = load_design(design)
+    _check_mesh_memory(nodes, len(tablet.patches))
     mesh = hex_mesh(tablet, nodes=nodes)
     write_mesh(mesh, out_file)
     counts = ", ".join(f"{len(c)} {k}" for k, c in mesh.cells.items() if len(c))
     click.echo(f"{out_file}: {len(mesh.points)} nodes, {counts}; mesh volume {mesh_volume(mesh):.6g} mm3")
+
+
+def available_memory() -> int | None:
+    """Bytes of memory the system reports available (Linux ``MemAvailable``; else free pages), or None."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+def _check_mesh_memory(nodes: tuple[int, int, int], n_patches: int, tol: Tolerances = DEFAULT) -> None:
+    """Refuse a mesh whose estimated peak memory exceeds ``tol.memory_fraction`` of the available memory."""
+    count = n_patches * nodes[0] * nodes[1] * nodes[2]
+    need = count * tol.mesh_bytes_per_node
+    avail = available_memory()
+    if avail is not None and need > tol.memory_fraction * avail:
+        most = int(tol.memory_fraction * avail / (tol.mesh_bytes_per_node * n_patches))
+        raise DesignError("--nodes", " ".join(map(str, nodes)),
+                          f"needs about {need / 2**30:.3g} GiB for {count:.3g} nodes ({n_patches} patches), more than "
+                          f"{tol.memory_fraction:g} of the {avail / 2**30:.3g} GiB available: keep SX*SY*SZ below {most:.3g}")
 
 
 COMMANDS = [shapes_cmd, build_cmd, mesh_cmd]

@@ -10,18 +10,12 @@ stderr, exit status 2, nothing written.
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 from typing import Any
 
 import click
 
-from tabletcad.errors import DesignError
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
+from tabletcad.errors import DesignError, one_token
 
 __all__ = ["COMMANDS", "load_family_design"]
 
@@ -35,15 +29,10 @@ def load_family_design(path: Path):
     (``["line", [x0, y0], [x1, y1]]`` / ``["arc", [cx, cy], r, theta0, sweep]``,
     angles in rad) plus the keys of :func:`tabletcad.families.outline_tablet`.
     """
-    from tabletcad.design import design_from_dict
+    from tabletcad.design import design_from_dict, read_design_file
 
-    if not path.is_file():
-        raise DesignError("design file", str(path), "must be an existing TOML file")
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise DesignError("design file", path.name, f"must be valid TOML ({exc})") from None
-    return design_from_dict(data, default_name=path.stem), data.get("report")
+    data = read_design_file(path)
+    return design_from_dict(data, default_name=Path(path).stem), data.get("report")
 
 
 def _fmt(v: Any, unit: str = "", digits: int = 6) -> str:
@@ -114,16 +103,19 @@ def report_cmd(design: Path, solid_fraction, true_density, breaking_force, compa
     from tabletcad.report import to_json
 
     if json_out is not None and json_out.suffix.lower() != ".json":
-        raise DesignError("--json suffix", json_out.suffix or "(none)", "must be .json")
+        raise DesignError("--json", str(json_out), "must end in .json")
     tablet, table = load_family_design(design)
     if not isinstance(tablet.nominal, SweepNominal):
         from tabletcad.families import FAMILY_FUNCTIONS
 
-        raise DesignError("[tablet] family", tablet.family,
+        raise DesignError("tablet.family", tablet.family,
                           "the design report needs an industry family: " + ", ".join(f.__name__ for f in FAMILY_FUNCTIONS) + ", custom_outline")
-    opts = ReportOptions.from_table(table).merged(
-        solid_fraction=solid_fraction, true_density_mg_mm3=true_density, breaking_force_N=breaking_force,
-        compaction_force_kN=compaction_force, max_punch_force_kN=max_punch_force, max_punch_pressure_MPa=max_punch_pressure)
+    try:
+        opts = ReportOptions.from_table(table).merged(
+            solid_fraction=solid_fraction, true_density_mg_mm3=true_density, breaking_force_N=breaking_force,
+            compaction_force_kN=compaction_force, max_punch_force_kN=max_punch_force, max_punch_pressure_MPa=max_punch_pressure)
+    except DesignError as exc:  # "[report] solid_fraction" -> "[report].solid_fraction": one token
+        raise exc.renamed(one_token(exc.parameter)) from None
     sec = design_report(tablet, opts)
     click.echo(_table(tablet.name, sec))
     if json_out is not None:

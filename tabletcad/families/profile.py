@@ -159,8 +159,9 @@ def pieces_for(element: Line2 | Arc2, target: float, max_angle: float = math.rad
         err = max(float(np.max(element.distance(hermite_points(p, u)))) for p in ps)
         if err <= target or n >= 4096:
             return ps
-        # error ~ φ⁶: jump close to the needed count
-        n = max(n + 1, math.ceil(n * (err / target) ** (1 / 6) * 1.02))
+        # error ~ φ⁶: jump close to the needed count.  Capped before the list is built: when
+        # rounding alone exceeds the target (coordinates ~1e100 mm) the jump asked for ~1e15 pieces
+        n = min(4096, max(n + 1, math.ceil(n * (err / target) ** (1 / 6) * 1.02))) if math.isfinite(err) else 4096
 
 
 def distance_to_chain(elements, q: np.ndarray) -> np.ndarray:

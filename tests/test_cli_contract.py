@@ -1,0 +1,260 @@
+"""The command line's contract on bad input, internal errors and Ctrl-C (issue 13 items 4, 5, 9; issue 19).
+
+Bad input: exit status 2, exactly one stderr line
+``error: <parameter> = <value> is not allowed: <range>``, nothing written (no
+output, no staging folder in the output's parent).  An internal error: exit 1,
+one line naming the log file that holds the traceback.  Ctrl-C: one line
+``interrupted``, exit 130.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+import tabletcad.cli as cli_mod
+from tabletcad.cli import main
+from tabletcad.design import design_from_dict
+from tabletcad.errors import DesignError
+from tabletcad.shapes import FAMILIES, _load_plugins
+
+ROOT = Path(__file__).resolve().parents[1]
+ONE_LINE = re.compile(r"^error: \S+ = .+ is not allowed: .+$")
+_load_plugins()
+
+
+def run(capsys, *args) -> tuple[int, str, str]:
+    rc = main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def assert_refused(rc: int, err: str, parameter: str) -> str:
+    """Exit 2 and one contract line naming ``parameter``; return the line."""
+    lines = err.splitlines()
+    assert rc == 2, err
+    assert len(lines) == 1 and "Traceback" not in err, err
+    assert ONE_LINE.match(lines[0]), lines[0]
+    assert lines[0].startswith(f"error: {parameter} = "), lines[0]
+    return lines[0]
+
+
+def design(tmp_path: Path, text: str, name: str = "d.toml") -> Path:
+    p = tmp_path / name
+    p.write_text(text, encoding="utf-8")
+    return p
+
+
+FLAT = '[tablet]\nfamily = "flat_faced_round"\nthickness = 6.0\n'
+
+
+@pytest.mark.parametrize(
+    "text, parameter, fragment",
+    [
+        (FLAT + "diameter = 1e300\n", "tablet.diameter", "within ±1000 mm"),
+        (FLAT + "diameter = " + "9" * 401 + "\n", "tablet.diameter", "an integer of 401 digits"),
+        (FLAT + "diameter = " + "9" * 5000 + "\n", "design_file", "numbers Python can read"),
+        (FLAT + "diameter = true\n", "tablet.diameter", "true and false are not numbers"),
+        (FLAT + 'diameter = "10"\n', "tablet.diameter", "must be a number"),
+        (FLAT + "diameter = -1e-300\n", "diameter", "> 0"),
+        (FLAT, "tablet.diameter", "needs diameter, thickness"),
+        ('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\ncup_depth = 1.0\nband = 1e300\n', "tablet.band", "within ±1000 mm"),
+        ('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 3.0\n', "tablet.cup_depth", "optional: land"),
+        ("x = " + "[" * 5000 + "]" * 5000 + "\n", "design_file", "nested"),
+        (FLAT + "diameter = 10.0\n[trim]\nv = [0.0, true]\n", "trim.v", "not numbers"),
+        (FLAT + "diameter = 10.0\n[reshape]\nradius = 1e300\n", "reshape.radius", "<= 1000"),
+        (FLAT + "diameter = 10.0\n[reshape]\nradius = 500.0\n", "reshape", "it reaches 25"),
+        ('[tablet]\nfamily = "custom_outline"\noutline = [[0, 0], [1e300, 0], [0, 5]]\nband = 2.0\ncup_depth = 0.3\n',
+         "tablet.outline[1][0]", "within ±1000 mm"),
+        ('[tablet]\nfamily = "free_form"\n[[patch]]\ncurves = [{type = "circle", radius = 1.0, z = false}, "previous", '
+         '"previous", "previous"]\n', "patch[0].curves[0].center", "not numbers"),
+        (FLAT + 'diameter = 10.0\n"bad key" = 1\n', "tablet.bad.key", "takes diameter, thickness"),
+        ("[tablet]\nfamily = 3\n", "tablet.family", "must be one of"),
+    ],
+)
+def test_bad_design_files_one_line_nothing_written(capsys, tmp_path, text, parameter, fragment):
+    src = design(tmp_path, text)
+    out = tmp_path / "out"
+    t0 = time.perf_counter()
+    rc, stdout, err = run(capsys, "build", src, "--out", out, "--quiet")
+    line = assert_refused(rc, err, parameter)
+    assert fragment in line
+    assert stdout == "" and not out.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.toml"]  # no staging folder left
+    # the design report and the mesher read design files the same way
+    assert run(capsys, "report", src)[0] == 2
+    assert run(capsys, "mesh", src, "--nodes", 3, 3, 3, "--out", tmp_path / "m.vtu")[0] == 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.toml"]
+    print(f"{parameter}: refused in {time.perf_counter() - t0:.2f} s")  # speed is shown, not asserted
+
+
+def test_design_from_dict_refuses_booleans_and_huge_integers():
+    for value in (True, False, 10**401, float("inf")):
+        with pytest.raises(DesignError) as ei:
+            design_from_dict({"tablet": {"family": "spherical", "diameter": value}})
+        assert ei.value.parameter == "tablet.diameter" and "\n" not in str(ei.value)
+
+
+def test_every_family_refuses_each_missing_required_parameter():
+    for name, fam in FAMILIES.items():
+        full = dict(fam.defaults)
+        assert fam.required and set(fam.required) <= set(fam.params)
+        for k in fam.required:
+            data = {"tablet": {"family": name, **{q: v for q, v in full.items() if q != k}}}
+            with pytest.raises(DesignError) as ei:
+                design_from_dict(data)
+            assert ei.value.parameter == f"tablet.{k}" and ei.value.value == "missing"
+        # optional parameters are exactly those that switch a feature off (default 0)
+        assert all(fam.defaults[k] == 0.0 for k in fam.params if k not in fam.required)
+
+
+def test_a_directory_as_design_file(capsys, tmp_path):
+    (tmp_path / "folder").mkdir()
+    for cmd in (["build", tmp_path / "folder", "--out", tmp_path / "o"], ["report", tmp_path / "folder"],
+                ["mesh", tmp_path / "folder", "--nodes", 3, 3, 3, "--out", tmp_path / "m.vtu"]):
+        rc, _, err = run(capsys, *cmd)
+        assert "folder" in assert_refused(rc, err, "DESIGN")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["folder"]
+
+
+def test_out_naming_an_existing_file(capsys, tmp_path):
+    (tmp_path / "taken").write_text("keep me")
+    rc, _, err = run(capsys, "build", ROOT / "samples" / "spherical.toml", "--out", tmp_path / "taken")
+    assert "not an existing file" in assert_refused(rc, err, "--out")
+    assert (tmp_path / "taken").read_text() == "keep me"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["taken"]
+
+
+@pytest.mark.parametrize(
+    "args, parameter, fragment",
+    [
+        (["mesh", "{sample}", "--nodes", "5", "x", "5", "--out", "{tmp}/m.vtu"], "--nodes", "must be an integer"),
+        (["mesh", "{sample}", "--nodes", "5", "2.5", "5", "--out", "{tmp}/m.vtu"], "--nodes", "must be an integer"),
+        (["mesh", "{sample}", "--nodes", "1", "21", "5", "--out", "{tmp}/m.vtu"], "--nodes", "from 2 to 2000"),
+        (["mesh", "{sample}", "--nodes", "5", "5", "5", "--out", "{tmp}/m.obj"], "--out", ".vtu"),
+        (["optimise", "{sample}", "--out", "{tmp}/o", "--method", "newton"], "--method", "SLSQP"),
+        (["report", "{sample}", "--solid-fraction", "half"], "--solid-fraction", "must be a number"),
+        (["build", "{sample}", "--out", "{tmp}/o", "--colour", "red"], "option", "takes --out"),
+        (["build", "{sample}"], "--out", "needs it"),
+        (["build", "{sample}", "--out"], "--out", "needs a value"),
+        (["build"], "DESIGN", "needs it"),
+        (["bild", "{sample}"], "command", "must be one of"),
+        (["build", "{sample}", "{sample}", "--out", "{tmp}/o"], "argument", "no further arguments"),
+    ],
+)
+def test_bad_arguments_one_line(capsys, tmp_path, args, parameter, fragment):
+    sample = ROOT / "samples" / "spherical.toml"
+    argv = [a.format(sample=sample, tmp=tmp_path) for a in args]
+    rc, out, err = run(capsys, *argv)
+    assert fragment in assert_refused(rc, err, parameter)
+    assert out == "" and list(tmp_path.iterdir()) == []
+
+
+def test_mesh_refused_by_memory_budget_before_allocating(capsys, tmp_path):
+    import tracemalloc
+
+    tracemalloc.start()
+    rc, _, err = run(capsys, "mesh", ROOT / "samples" / "spherical.toml", "--nodes", 2000, 2000, 2000,
+                     "--out", tmp_path / "m.vtu")
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    line = assert_refused(rc, err, "--nodes")
+    # 2 patches x 2000^3 nodes x 200 bytes = 3.2e12 bytes = 2980 GiB
+    assert "2.98e+03 GiB" in line and "1.6e+10 nodes (2 patches)" in line
+    assert peak < 200 * 2**20  # nothing close to the mesh was allocated
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_memory_budget_scales_with_available_memory(monkeypatch):
+    from tabletcad.cli import geometry
+
+    monkeypatch.setattr(geometry, "available_memory", lambda: 10_000_000)  # 10 MB
+    geometry._check_mesh_memory((10, 10, 10), 3)  # 3000 nodes x 200 B = 0.6 MB <= 5 MB
+    with pytest.raises(DesignError) as ei:
+        geometry._check_mesh_memory((30, 30, 30), 3)  # 81000 nodes x 200 B = 16.2 MB > 5 MB
+    assert ei.value.parameter == "--nodes" and "below 8.33e+03" in ei.value.allowed  # 5e6 / (200 * 3)
+
+
+def test_shapes_marks_required_and_optional_and_prints_whole_descriptions(capsys):
+    rc, out, _ = run(capsys, "shapes")
+    assert rc == 0
+    text = " ".join(out.split())
+    for name, fam in FAMILIES.items():
+        assert f"{name} required: " + ", ".join(f"{k} [{fam.params[k]}]" for k in fam.required) in text
+        doc = " ".join(fam.func.__doc__.strip().split("\n\n")[0].replace("``", "").split())
+        assert fam.description == doc and doc in text and doc[-1] in ".)"
+    assert "concave_round required: diameter [mm], band [mm], cup_depth [mm]; optional: land [mm] = 0" in text
+    rc, out, _ = run(capsys, "shapes", "--json")
+    d = json.loads(out)
+    assert d["concave_round"]["required"] == ["diameter", "band", "cup_depth"] and d["concave_round"]["optional"] == ["land"]
+    assert d["flat_faced_round"]["optional"] == []
+
+
+@pytest.mark.parametrize("exc", [ZeroDivisionError("division by zero"), ValueError("a bare ValueError is a bug")])
+def test_internal_error_exit_1_with_log(capsys, tmp_path, monkeypatch, exc):
+    import tabletcad.build
+
+    def broken(*a, **k):
+        raise exc
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    monkeypatch.setattr(tabletcad.build, "build_design", broken)
+    rc, out, err = run(capsys, "build", ROOT / "samples" / "spherical.toml", "--out", tmp_path / "o")
+    lines = err.splitlines()
+    assert rc == 1 and len(lines) == 1 and "Traceback" not in err
+    m = re.fullmatch(r"error: internal error \((\w+): (.+)\); traceback in (\S+)", lines[0])
+    assert m and m.group(1) == type(exc).__name__ and m.group(2) == str(exc)
+    log = Path(m.group(3))
+    assert log.parent == tmp_path / "cache" / "tabletcad"
+    assert "Traceback" in log.read_text() and f"{type(exc).__name__}: {exc}" in log.read_text()
+
+
+def test_ctrl_c_while_commands_load(capsys, monkeypatch):
+    import importlib
+
+    def interrupted(name, *a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli_mod, "_GROUP", None)
+    monkeypatch.setattr(importlib, "import_module", interrupted)
+    rc, out, err = run(capsys, "shapes")
+    assert rc == 130 and err == "interrupted\n" and out == ""
+
+
+def test_ctrl_c_during_a_build_subprocess(tmp_path):
+    """SIGINT at several moments of a real build (loading, building): one line, 130, nothing left."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    for delay in (0.5, 1.5, 3.0):
+        out = tmp_path / f"out{delay}"
+        p = subprocess.Popen([sys.executable, "-m", "tabletcad", "build", str(ROOT / "samples" / "families" / "capsule.toml"),
+                              "--out", str(out), "--quiet"], cwd=tmp_path, env=env,
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        time.sleep(delay)
+        p.send_signal(signal.SIGINT)
+        _, err = p.communicate(timeout=120)
+        if p.returncode == 0:  # finished before the signal (a very fast machine): nothing to check
+            continue
+        assert p.returncode == 130 and err == "interrupted\n", (delay, p.returncode, err)
+        assert not out.exists() and not any(q.name.startswith(f".{out.name}") for q in tmp_path.iterdir())
+
+
+def test_readme_says_how_to_reach_the_commands():
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    after = text[text.index("## Two commands on a fresh machine"):]
+    section = after[:after.index("\n## ", 5)]
+    assert ".venv/bin/tabletcad" in section and ". .venv/bin/activate" in section
+
+
+def test_bare_command_prints_help_and_help_exits_0(capsys):
+    rc, out, err = run(capsys)
+    assert rc == 0 and out.startswith("Usage: tabletcad") and "build" in out and err == ""
+    rc, out, err = run(capsys, "mesh", "--help")
+    assert rc == 0 and "--nodes" in out and err == ""
