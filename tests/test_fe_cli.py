@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.fe
 pytest.importorskip("skfem")
 pytest.importorskip("gmsh")
 pytest.importorskip("OCP")

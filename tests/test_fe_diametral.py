@@ -11,6 +11,7 @@ import math
 import numpy as np
 import pytest
 
+pytestmark = pytest.mark.fe
 skfem = pytest.importorskip("skfem")
 pytest.importorskip("gmsh")
 pytest.importorskip("OCP")

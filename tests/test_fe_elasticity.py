@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+pytestmark = pytest.mark.fe
 pytest.importorskip("skfem")
 pytest.importorskip("gmsh")
 build123d = pytest.importorskip("build123d")

@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+pytestmark = pytest.mark.fe
 pytest.importorskip("skfem")
 pytest.importorskip("gmsh")
 pytest.importorskip("OCP")

@@ -6,6 +6,7 @@ import math
 
 import pytest
 
+pytestmark = pytest.mark.fe
 pytest.importorskip("skfem")
 pytest.importorskip("gmsh")
 pytest.importorskip("OCP")

@@ -16,6 +16,7 @@ import sys
 
 import pytest
 
+pytestmark = pytest.mark.sweep
 pytest.importorskip("distributed")
 pd = pytest.importorskip("pandas")
 

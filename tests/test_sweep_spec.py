@@ -13,6 +13,7 @@ import textwrap
 import numpy as np
 import pytest
 
+pytestmark = pytest.mark.sweep
 pytest.importorskip("distributed")
 pytest.importorskip("pandas")
 
