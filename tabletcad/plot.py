@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import numpy as np
@@ -9,7 +10,7 @@ import numpy as np
 from tabletcad.io.atomic import atomic_path
 from tabletcad.tablet import Tablet
 
-__all__ = ["plot_tablet"]
+__all__ = ["plot_tablet", "tablet_figure", "tablet_png"]
 
 
 def _quads(Y: np.ndarray) -> np.ndarray:
@@ -17,11 +18,9 @@ def _quads(Y: np.ndarray) -> np.ndarray:
     return np.stack([Y[:-1, :-1], Y[1:, :-1], Y[1:, 1:], Y[:-1, 1:]], axis=-2).reshape(-1, 4, 3)
 
 
-def plot_tablet(
+def tablet_figure(
     tablet: Tablet,
-    path: str | Path,
     *,
-    dpi: int = 130,
     nu: int = 33,
     nv: int = 97,
     title: str | None = None,
@@ -35,15 +34,15 @@ def plot_tablet(
     depth together (separate surfaces are drawn in artist order and hide each
     other wrongly).
     """
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
+    from matplotlib import colormaps
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    fig = plt.figure(figsize=(6.4, 5.6))
+    fig = Figure(figsize=(6.4, 5.6))
+    FigureCanvasAgg(fig)  # no global backend: the figure owns its Agg canvas
     ax = fig.add_subplot(111, projection="3d")
-    colours = plt.get_cmap("tab10")
+    colours = colormaps["tab10"]
     el, az = np.radians(elev), np.radians(azim)
     view = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
     light = view + np.array([0.3, -0.2, 0.6])
@@ -81,8 +80,19 @@ def plot_tablet(
     ax.set_zlabel("z (mm)")
     ax.view_init(elev=elev, azim=azim)
     ax.set_title(title or f"{tablet.name} ({tablet.family}, {len(tablet.patches)} patches)")
+    return fig
+
+
+def tablet_png(tablet: Tablet, *, dpi: int = 130, **kw) -> bytes:
+    """The picture of :func:`tablet_figure` as PNG bytes (for notebooks' ``_repr_png_``)."""
+    buf = io.BytesIO()
+    tablet_figure(tablet, **kw).savefig(buf, dpi=dpi, format="png", bbox_inches="tight")
+    return buf.getvalue()
+
+
+def plot_tablet(tablet: Tablet, path: str | Path, *, dpi: int = 130, **kw) -> Path:
+    """Write the picture of :func:`tablet_figure` to ``path`` (PNG, written atomically)."""
     path = Path(path)
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=dpi, format="png", bbox_inches="tight")
-    plt.close(fig)
+        tablet_figure(tablet, **kw).savefig(tmp, dpi=dpi, format="png", bbox_inches="tight")
     return path
