@@ -274,36 +274,39 @@ def _compression_options(f):
     return _with_json(f)
 
 
-@click.command("kawakita")
-@_compression_options
-def kawakita_cmd(data: Path, pressure_column: str, thickness_column: str, h0: float | None,
-                 window: tuple[float, float] | None, as_json: bool, json_file: Path | None) -> None:
-    """Kawakita fit C = abP/(1+bP), C = (h0 - h)/h0, of a table of pressure (MPa) and thickness (mm)."""
-    from tabletcad.mechanics.kawakita import fit_kawakita
-
-    t = _compression_table(data, pressure_column, thickness_column, h0, window, json_file)
-    with _collect() as msgs:
-        fit = fit_kawakita(t["P"], t["h"], window=window, h0=h0)
-    lo, hi = fit.window_MPa
-    _finish(fit.to_dict() | {"data": str(data), "warnings": msgs}, as_json, json_file, [
-        f"Kawakita over {lo:.4g}-{hi:.4g} MPa (n = {fit.n_points}, h0 = {fit.h0:.4g} mm): "
-        f"a = {fit.a:.4g}, b = {fit.b_per_MPa:.4g} 1/MPa (1/b = {fit.inv_b_MPa:.4g} MPa), R² = {fit.r2:.5f}"])
+def _kawakita_line(fit) -> str:
+    return f"a = {fit.a:.4g}, b = {fit.b_per_MPa:.4g} 1/MPa (1/b = {fit.inv_b_MPa:.4g} MPa), R² = {fit.r2:.5f}"
 
 
-@click.command("walker")
-@_compression_options
-def walker_cmd(data: Path, pressure_column: str, thickness_column: str, h0: float | None,
-               window: tuple[float, float] | None, as_json: bool, json_file: Path | None) -> None:
-    """Walker fit 100 V/V0 = -W log10 P + c (V/V0 = h/h0) of a table of pressure (MPa) and thickness (mm)."""
-    from tabletcad.mechanics.kawakita import fit_walker
+def _walker_line(fit) -> str:
+    return f"W = {fit.W_percent_per_decade:.4g} % per decade, c = {fit.intercept_percent:.4g} %, R² = {fit.r2:.5f}"
 
-    t = _compression_table(data, pressure_column, thickness_column, h0, window, json_file)
-    with _collect() as msgs:
-        fit = fit_walker(t["P"], t["h"], window=window, h0=h0)
-    lo, hi = fit.window_MPa
-    _finish(fit.to_dict() | {"data": str(data), "warnings": msgs}, as_json, json_file, [
-        f"Walker over {lo:.4g}-{hi:.4g} MPa (n = {fit.n_points}, h0 = {fit.h0:.4g} mm): "
-        f"W = {fit.W_percent_per_decade:.4g} % per decade, c = {fit.intercept_percent:.4g} %, R² = {fit.r2:.5f}"])
+
+def _compression_command(name: str, fit_name: str, describe, doc: str):
+    """A command fitting ``tabletcad.mechanics.kawakita.<fit_name>`` to a pressure/thickness table."""
+
+    @click.command(name.lower(), help=doc)
+    @_compression_options
+    def command(data: Path, pressure_column: str, thickness_column: str, h0: float | None,
+                window: tuple[float, float] | None, as_json: bool, json_file: Path | None) -> None:
+        from tabletcad.mechanics import kawakita
+
+        t = _compression_table(data, pressure_column, thickness_column, h0, window, json_file)
+        with _collect() as msgs:
+            fit = getattr(kawakita, fit_name)(t["P"], t["h"], window=window, h0=h0)
+        lo, hi = fit.window_MPa
+        _finish(fit.to_dict() | {"data": str(data), "warnings": msgs}, as_json, json_file, [
+            f"{name} over {lo:.4g}-{hi:.4g} MPa (n = {fit.n_points}, h0 = {fit.h0:.4g} mm): {describe(fit)}"])
+
+    return command
+
+
+kawakita_cmd = _compression_command(
+    "Kawakita", "fit_kawakita", _kawakita_line,
+    "Kawakita fit C = abP/(1+bP), C = (h0 - h)/h0, of a table of pressure (MPa) and thickness (mm).")
+walker_cmd = _compression_command(
+    "Walker", "fit_walker", _walker_line,
+    "Walker fit 100 V/V0 = -W log10 P + c (V/V0 = h/h0) of a table of pressure (MPa) and thickness (mm).")
 
 
 @click.command("profiles")
