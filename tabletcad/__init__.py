@@ -7,15 +7,25 @@ The numerical core (this package's top-level modules, ``families``,
 """
 
 
+_LAZY = {"make": "model", "load": "model", "show": "model", "TabletModel": "model"}
 
-def __getattr__(name: str) -> str:
-    # ``__version__`` is looked up on first use: importlib.metadata costs ~50 ms at start-up,
-    # a window in which Ctrl-C would escape the command line's handler
-    if name != "__version__":
-        raise AttributeError(f"module 'tabletcad' has no attribute {name!r}")
-    from importlib import metadata
 
-    try:
-        return metadata.version("tabletcad")
-    except metadata.PackageNotFoundError:  # run from a source tree (e.g. inside FreeCAD)
-        return "0+source"
+def __getattr__(name: str):  # PEP 562: `import tabletcad` stays light
+    if name == "__version__":
+        # looked up on first use: importlib.metadata costs ~50 ms at start-up, a window in
+        # which Ctrl-C would escape the command line's handler
+        from importlib import metadata
+
+        try:
+            return metadata.version("tabletcad")
+        except metadata.PackageNotFoundError:  # run from a source tree (e.g. inside FreeCAD)
+            return "0+source"
+    if name in _LAZY:
+        from importlib import import_module
+
+        return getattr(import_module(f"tabletcad.{_LAZY[name]}"), name)
+    raise AttributeError(f"module 'tabletcad' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *_LAZY, "__version__"])

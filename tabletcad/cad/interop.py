@@ -1,16 +1,13 @@
 """The solid as build123d and cadquery objects (both imported lazily).
 
-Version constraints (verified in throwaway venvs, see the project report):
+Version constraints (the pins in ``pyproject.toml``):
 
-* build123d 0.13.0 needs ``cadquery-ocp-novtk>=8.0,<8.1`` (OCP 8.0: array types
-  in ``OCP.collections``, ``TopoDS.Solid`` instead of ``TopoDS.Solid_s``).
-* cadquery 2.8.0 (newest) needs ``cadquery-ocp>=7.9.3.1,<8.0`` and does not
-  import on OCP 8.0 (``TColgp_HArray1OfPnt`` is gone); it also imports
-  ``OCP.IVtkOCC``, which only the VTK flavour ``cadquery-ocp`` ships, so it
-  cannot run on ``cadquery-ocp-novtk`` either.
-* One OCP wheel serving both: ``cadquery-ocp==7.9.3.1.1`` (+ ``vtk==9.6.2``) with
-  ``cadquery==2.8.0`` and ``build123d==0.12.0`` installed ``--no-deps`` (its
-  only unmet requirement is the distribution *name* ``cadquery-ocp-novtk``).
+* One OpenCascade for everything, OCP 7.9.3.1.1: the ``cad`` extra installs
+  ``build123d==0.12.0`` on ``cadquery-ocp-novtk==7.9.3.1.1`` (build123d 0.13
+  moved to OCP 8.0, which cadquery 2.8.0 cannot import).
+* The ``cadquery`` extra adds ``cadquery==2.8.0`` with the VTK build
+  ``cadquery-ocp==7.9.3.1.1`` of the same OCP (cadquery imports ``OCP.IVtkOCC``,
+  which only the VTK wheel ships); both wheels install identical OCP files.
 
 Both libraries wrap the very same ``TopoDS_Shape`` object (no copy, no
 translation); this module only checks that the installed library uses the OCP
@@ -28,11 +25,13 @@ from tabletcad.cad._occ import cast, explore, shape_type
 __all__ = ["to_build123d", "to_build123d_part", "to_cadquery", "to_cadquery_workplane", "from_any"]
 
 _CQ_HINT = (
-    "cadquery is not importable with this OCP ({err}). cadquery 2.8 needs the VTK build "
-    "'cadquery-ocp>=7.9.3.1,<8.0'; a combined install is: pip install cadquery-ocp==7.9.3.1.1 "
-    "vtk==9.6.2 cadquery==2.8.0 && pip install --no-deps build123d==0.12.0 (plus build123d's other deps)"
+    "cadquery is not importable with this OCP ({err}); install the 'cadquery' extra "
+    "(cadquery==2.8.0 with cadquery-ocp==7.9.3.1.1, the OCP of build123d 0.12.0): pip install 'tabletcad[cad,cadquery]'"
 )
-_BD_HINT = "build123d is not importable ({err}); install the 'cad' extra (build123d==0.13.0 on cadquery-ocp-novtk 8.0)"
+_BD_HINT = (
+    "build123d is not importable ({err}); install the 'cad' extra "
+    "(build123d==0.12.0 on cadquery-ocp-novtk==7.9.3.1.1): pip install 'tabletcad[cad]'"
+)
 
 
 def from_any(obj: Any) -> TopoDS_Shape:

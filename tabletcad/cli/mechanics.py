@@ -1,4 +1,4 @@
-"""Mechanics commands: ``heckel``, ``strength``, ``contact``, ``shell``, ``love``.
+"""Mechanics commands: ``heckel``, ``kawakita``, ``walker``, ``profiles``, ``strength``, ``contact``, ``shell``, ``love``.
 
 Units: mm, N, MPa, mg, mg/mm³.  Every command computes everything before it
 writes any file, so bad input (reported by ``tabletcad.cli.main`` as one
@@ -184,6 +184,174 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
         f"window {lo:.4g}-{hi:.4g} MPa ({how}), n = {fit.n_points}",
         f"K = {fit.K_per_MPa:.5g} 1/MPa, A = {fit.A:.4f}, Py = {fit.Py_MPa:.4g} MPa, R² = {fit.r2:.5f}",
     ] + ([f"plot -> {plot_file}"] if plot_file else []))
+
+
+# --------------------------------------------------------------------------- kawakita, walker, profiles
+def _read_table(path: Path, columns: dict[str, str]) -> dict[str, np.ndarray]:
+    """Numeric columns of a CSV/TSV file with a header row, found by (case-insensitive) header name.
+
+    ``columns`` maps a key to the header; empty lines and ``#`` comments are skipped.
+    """
+    import csv
+
+    text = path.read_text(encoding="utf-8-sig")
+    rows = [r for r in csv.reader((ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")),
+                                  delimiter="\t" if "\t" in text.split("\n", 1)[0] else ",")]
+    if len(rows) < 2:
+        raise DesignError("DATA", str(path), "must hold a header row and at least one row of numbers")
+    header = [h.strip().lower() for h in rows[0]]
+    out = {}
+    for key, name in columns.items():
+        if name.strip().lower() not in header:
+            raise DesignError(f"column {name!r}", str(path), f"must be one of the header's columns: {', '.join(rows[0])}")
+        j = header.index(name.strip().lower())
+        vals = []
+        for i, r in enumerate(rows[1:], start=2):
+            try:
+                v = float(r[j])
+            except (IndexError, ValueError):
+                raise DesignError(f"{path.name} line {i}, column {name!r}", r[j] if j < len(r) else "missing",
+                                  "must be a number") from None
+            vals.append(check_finite(f"{path.name} line {i}, column {name!r}", v))
+        out[key] = np.asarray(vals, dtype=float)
+    return out
+
+
+def _check_window(window: tuple[float, float] | None) -> None:
+    if window is not None:
+        check_finite("--window", window[0], "MPa")
+        check_positive("--window", window[1], "MPa")
+        if not window[0] < window[1]:
+            raise DesignError("--window", window, "must be two increasing pressures", "MPa")
+
+
+_JSON_OPTS = [
+    click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout."),
+    click.option("--json-file", type=click.Path(path_type=Path), help="Write the result as JSON to this file."),
+]
+
+
+def _with_json(f):
+    for opt in reversed(_JSON_OPTS):
+        f = opt(f)
+    return f
+
+
+def _finish(payload: dict[str, Any], as_json: bool, json_file: Path | None, lines: list[str],
+            plot: tuple[Path | None, Any] = (None, None)) -> None:
+    """Write ``--json-file`` (and a plot) all-or-nothing, then print the lines or the JSON."""
+    plot_file, draw = plot
+    with _staged(json=json_file, plot=plot_file) as out:
+        if json_file is not None:
+            out["json"].write_text(json.dumps(payload, indent=2, default=_jsonable) + "\n", encoding="utf-8")
+        if plot_file is not None:
+            draw(out["plot"])
+    _emit(payload, as_json, lines + ([f"json -> {json_file}"] if json_file and not as_json else [])
+          + ([f"plot -> {plot_file}"] if plot_file and not as_json else []))
+
+
+def _compression_table(data: Path, pressure_column: str, thickness_column: str, h0: float | None,
+                       window, json_file: Path | None) -> dict[str, np.ndarray]:
+    _check_input("DATA", data)
+    _check_output("--json-file", json_file, (".json",))
+    _check_window(window)
+    if h0 is not None:
+        check_positive("--h0", h0, "mm")
+    return _read_table(data, {"P": pressure_column, "h": thickness_column})
+
+
+def _compression_options(f):
+    for opt in reversed([
+        click.argument("data", type=click.Path(path_type=Path)),
+        click.option("--pressure-column", default="pressure_MPa", show_default=True,
+                     help="Header of the compaction pressure column, MPa."),
+        click.option("--thickness-column", default="thickness_mm", show_default=True,
+                     help="Header of the compact thickness (punch gap) column, mm, loading branch."),
+        click.option("--h0", type=float, help="Reference thickness defining V0, mm (default: the first row's)."),
+        click.option("--window", nargs=2, type=float, metavar="LO HI", help="Pressure window, MPa (default: all P > 0)."),
+    ]):
+        f = opt(f)
+    return _with_json(f)
+
+
+def _kawakita_line(fit) -> str:
+    return f"a = {fit.a:.4g}, b = {fit.b_per_MPa:.4g} 1/MPa (1/b = {fit.inv_b_MPa:.4g} MPa), R² = {fit.r2:.5f}"
+
+
+def _walker_line(fit) -> str:
+    return f"W = {fit.W_percent_per_decade:.4g} % per decade, c = {fit.intercept_percent:.4g} %, R² = {fit.r2:.5f}"
+
+
+def _compression_command(name: str, fit_name: str, describe, doc: str):
+    """A command fitting ``tabletcad.mechanics.kawakita.<fit_name>`` to a pressure/thickness table."""
+
+    @click.command(name.lower(), help=doc)
+    @_compression_options
+    def command(data: Path, pressure_column: str, thickness_column: str, h0: float | None,
+                window: tuple[float, float] | None, as_json: bool, json_file: Path | None) -> None:
+        from tabletcad.mechanics import kawakita
+
+        t = _compression_table(data, pressure_column, thickness_column, h0, window, json_file)
+        with _collect() as msgs:
+            fit = getattr(kawakita, fit_name)(t["P"], t["h"], window=window, h0=h0)
+        lo, hi = fit.window_MPa
+        _finish(fit.to_dict() | {"data": str(data), "warnings": msgs}, as_json, json_file, [
+            f"{name} over {lo:.4g}-{hi:.4g} MPa (n = {fit.n_points}, h0 = {fit.h0:.4g} mm): {describe(fit)}"])
+
+    return command
+
+
+kawakita_cmd = _compression_command(
+    "Kawakita", "fit_kawakita", _kawakita_line,
+    "Kawakita fit C = abP/(1+bP), C = (h0 - h)/h0, of a table of pressure (MPa) and thickness (mm).")
+walker_cmd = _compression_command(
+    "Walker", "fit_walker", _walker_line,
+    "Walker fit 100 V/V0 = -W log10 P + c (V/V0 = h/h0) of a table of pressure (MPa) and thickness (mm).")
+
+
+@click.command("profiles")
+@click.argument("data", type=click.Path(path_type=Path))
+@click.option("--pressure-column", default="pressure_MPa", show_default=True, help="Compaction pressure, MPa.")
+@click.option("--solid-fraction-column", default="solid_fraction", show_default=True,
+              help="Solid fraction (relative density) of the ejected tablet, in (0, 1).")
+@click.option("--strength-column", default="tensile_strength_MPa", show_default=True, help="Tensile strength, MPa.")
+@click.option("--solid-fraction", "as_solid_fraction", is_flag=True,
+              help="Plot and report solid fraction instead of porosity.")
+@click.option("--plot", "plot_file", type=click.Path(path_type=Path), help="The three profiles (.png/.svg/.pdf).")
+@_with_json
+def profiles_cmd(data: Path, pressure_column: str, solid_fraction_column: str, strength_column: str,
+                 as_solid_fraction: bool, plot_file: Path | None, as_json: bool, json_file: Path | None) -> None:
+    """USP <1062> tabletability, compressibility and compactibility profiles, and the
+    Ryshkewitch-Duckworth fit (eq 2.6), of a table of tablets (one row per tablet or pressure)."""
+    from tabletcad.mechanics.profiles import (compactibility, compressibility, fit_ryshkewitch_duckworth,
+                                              plot_profiles, tabletability)
+
+    _check_input("DATA", data)
+    _check_output("--json-file", json_file, (".json",))
+    _check_output("--plot", plot_file)
+    if json_file is not None and plot_file is not None and json_file.absolute() == plot_file.absolute():
+        raise DesignError("--plot", str(plot_file), "must differ from --json-file")
+    t = _read_table(data, {"P": pressure_column, "sf": solid_fraction_column, "s": strength_column})
+    porosity = not as_solid_fraction
+    with _collect() as msgs:
+        profs = [tabletability(t["P"], t["s"]), compressibility(t["P"], t["sf"], as_porosity=porosity),
+                 compactibility(t["sf"], t["s"], as_porosity=porosity)]
+        rd = fit_ryshkewitch_duckworth(t["sf"], t["s"]) if len(t["P"]) >= 3 else None
+    payload: dict[str, Any] = {
+        "data": str(data),
+        "profiles": {p.name: {"x": p.x, "y": p.y, "x_label": p.x_label, "y_label": p.y_label} for p in profs},
+        "ryshkewitch_duckworth": None if rd is None else {"sigma0_MPa": rd.sigma0_MPa, "k": rd.k, "r2": rd.r2,
+                                                          "n_points": rd.n_points},
+        "warnings": msgs,
+    }
+    tab, comp, _ = profs
+    lines = [f"{data.name}: {len(t['P'])} tablets, {tab.x.min():.4g}-{tab.x.max():.4g} MPa",
+             f"tabletability: tensile strength {tab.y.min():.4g}-{tab.y.max():.4g} MPa",
+             f"compressibility: {'porosity' if porosity else 'solid fraction'} {comp.y.min():.4g}-{comp.y.max():.4g}"]
+    if rd is not None:
+        lines.append(f"Ryshkewitch-Duckworth (eq 2.6): sigma0 = {rd.sigma0_MPa:.4g} MPa, k = {rd.k:.4g}, "
+                     f"R² = {rd.r2:.5f}")
+    _finish(payload, as_json, json_file, lines, (plot_file, lambda p: plot_profiles(profs, p)))
 
 
 # --------------------------------------------------------------------------- strength
@@ -392,4 +560,4 @@ def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json) -> None:
          f"R² = {f.r2:.4f} over {lo:g}-{hi:g} MPa")])
 
 
-COMMANDS = [heckel_cmd, strength_cmd, contact_cmd, shell_cmd, love_cmd]
+COMMANDS = [heckel_cmd, kawakita_cmd, walker_cmd, profiles_cmd, strength_cmd, contact_cmd, shell_cmd, love_cmd]

@@ -285,6 +285,21 @@ def _punch_check(plan_area: float, opts: ReportOptions) -> dict[str, Any]:
     return out
 
 
+_RADIUS_KEYS = {"cup_radius_mm": "cup", "central_radius_mm": "central", "edge_radius_mm": "edge"}
+
+
+def _cup_radii(info: dict) -> dict[str, float]:
+    """The face's radii of curvature (mm) named ``cup`` (single-radius cup), ``central`` and
+    ``edge`` (compound cup, radius edge); empty for a flat face."""
+    return {name: float(info[k]) for k, name in _RADIUS_KEYS.items() if info.get(k) is not None}
+
+
+def _cup_radius(info: dict) -> float | None:
+    """The cup's (central) radius of curvature, mm, or None for a flat-faced tablet."""
+    r = _cup_radii(info)
+    return r.get("cup", r.get("central"))
+
+
 def design_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str, Any]:
     """The design report of a family tablet (see module docstring); keys carry units."""
     nom = tablet.nominal
@@ -325,6 +340,8 @@ def design_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str
         plan_area_exact_mm2=float(nom.outline.area),
         plan_perimeter_mm=float(nom.outline.perimeter),
         shape_factor=h / W,
+        cup_radius_mm=_cup_radius(info),
+        cup_radii_mm=_cup_radii(info),
         params={k: v for k, v in info.items() if k not in ("shape", "face")},
     )
     if opts.solid_fraction is not None and opts.true_density_mg_mm3 is not None:

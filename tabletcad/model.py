@@ -1,0 +1,305 @@
+"""Scripting facade: tablets and tooling parts that behave like build123d / cadquery objects.
+
+::
+
+    import tabletcad
+
+    m = tabletcad.make("concave_round", diameter=10, band=2, cup_depth=1)
+    m.volume                      # mm³, the core's quadrature
+    part = m.to_build123d()       # build123d.Solid (same TopoDS_Solid as m.to_occ())
+    wp = m.to_cadquery()          # cadquery.Workplane holding the solid
+    m.export("tablet.step")
+    tools = m.tooling(clearance_mm=0.03)
+    tools.upper_punch.to_build123d()
+
+The core :class:`tabletcad.tablet.Tablet` never imports OpenCascade; this
+module sits after it in the flow and imports the CAD layer only inside the
+methods that need it, so ``import tabletcad.model`` stays numpy-only.
+"""
+
+from __future__ import annotations
+
+import html
+import itertools
+import json
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tabletcad.errors import DesignError
+from tabletcad.tablet import Tablet
+
+__all__ = ["TabletModel", "PartModel", "ToolingModel", "make", "load", "show", "mesh_html"]
+
+#: Tessellation used for the notebook view (mm, rad): coarse enough for a small page.
+VIEW_DEFLECTION = (0.02, 0.35)
+_IDS = itertools.count()
+
+
+class _Shaped:
+    """The shared build123d/cadquery vocabulary of a tablet and of each tooling part."""
+
+    name: str
+
+    def to_occ(self):  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    def to_build123d(self):
+        """A ``build123d.Solid`` wrapping the very same ``TopoDS_Solid`` (no copy)."""
+        from tabletcad.cad.interop import to_build123d
+
+        return to_build123d(self.to_occ())
+
+    def to_cadquery(self, plane: str = "XY"):
+        """A ``cadquery.Workplane`` on ``plane`` whose stack holds the solid."""
+        from tabletcad.cad.interop import to_cadquery_workplane
+
+        return to_cadquery_workplane(self.to_occ(), plane)
+
+    @property
+    def occ_volume(self) -> float:
+        """Volume (mm³) of the B-rep by OpenCascade's adaptive integration."""
+        from tabletcad.cad.solid import mass_properties
+
+        return mass_properties(self.to_occ()).volume
+
+    def export(self, path: str | Path, **kw: Any) -> Path:
+        """Write the solid in the format named by the suffix (.step .stl .3mf .glb .brep)."""
+        from tabletcad.cad.export import export
+
+        return export(self.to_occ(), path, name=kw.pop("name", self.name), **kw)
+
+    def mesh(self, linear_deflection: float = 0.005, angular_deflection: float = 0.2, check: bool = False):
+        """:class:`tabletcad.cad.mesh.MeshResult` of the solid (mm, rad)."""
+        from tabletcad.cad.mesh import tessellate
+
+        return tessellate(self.to_occ(), linear_deflection, angular_deflection, check=check)
+
+    def _view_meshes(self) -> list[tuple[str, np.ndarray, np.ndarray]]:
+        m = self.mesh(*VIEW_DEFLECTION)
+        return [(self.name, m.vertices, m.triangles)]
+
+    def _repr_html_(self) -> str:
+        return mesh_html(self._view_meshes(), title=self.name)
+
+
+@dataclass(frozen=True, eq=False)
+class PartModel(_Shaped):
+    """One solid of a tool set (``tablet``, ``upper_punch``, ``lower_punch``, ``die``)."""
+
+    name: str
+    shape: Any  # TopoDS_Shape
+
+    def to_occ(self):
+        """The part's ``TopoDS_Shape`` (a solid)."""
+        return self.shape
+
+    @property
+    def volume(self) -> float:
+        """Volume (mm³) by OpenCascade's adaptive integration."""
+        return self.occ_volume
+
+    def __repr__(self) -> str:
+        return f"PartModel({self.name!r})"
+
+
+@dataclass(frozen=True, eq=False)
+class ToolingModel:
+    """A tablet's tool set (:func:`tabletcad.tooling.toolset.make_tooling`) as scriptable parts.
+
+    ``parts`` are at the closed position; :meth:`placed` lifts the upper punch to the
+    spec's gap.  ``report`` is the ``tooling`` section of ``report.json``.
+    """
+
+    toolset: Any  # tabletcad.tooling.toolset.ToolSet
+    parts: dict[str, PartModel] = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "parts", {k: PartModel(k, v) for k, v in self.toolset.parts.items()})
+
+    @property
+    def report(self) -> dict[str, Any]:
+        return self.toolset.report
+
+    def placed(self) -> dict[str, PartModel]:
+        """Parts at the press position of the spec's ``gap_mm``."""
+        return {k: PartModel(k, v) for k, v in self.toolset.placed().items()}
+
+    def __getitem__(self, name: str) -> PartModel:
+        return self.parts[name]
+
+    def __getattr__(self, name: str) -> PartModel:
+        parts = self.__dict__.get("parts", {})
+        if name in parts:
+            return parts[name]
+        raise AttributeError(name)
+
+    def _repr_html_(self) -> str:
+        meshes = []
+        for p in self.placed().values():
+            meshes.extend(p._view_meshes())
+        return mesh_html(meshes, title="tooling")
+
+    def __repr__(self) -> str:
+        return f"ToolingModel({', '.join(self.parts)})"
+
+
+@dataclass(frozen=True, eq=False)
+class TabletModel(_Shaped):
+    """A core :class:`~tabletcad.tablet.Tablet` (``.tablet``) with CAD, export and notebook methods.
+
+    The B-rep is fitted on first use (:func:`tabletcad.cad.tablet_solid.tablet_solid`) and kept.
+    """
+
+    tablet: Tablet
+
+    @property
+    def name(self) -> str:
+        return self.tablet.name
+
+    @property
+    def volume(self) -> float:
+        """Volume (mm³) from the core's Gauss quadrature of the PDE patches."""
+        return self.tablet.volume()
+
+    @cached_property
+    def solid(self):
+        """The validated :class:`~tabletcad.cad.solid.TabletSolid` (B-spline faces, sewn)."""
+        from tabletcad.cad.tablet_solid import tablet_solid
+
+        return tablet_solid(self.tablet)
+
+    def to_occ(self):
+        """The tablet's ``TopoDS_Solid``."""
+        return self.solid.shape
+
+    def report(self) -> dict[str, Any]:
+        """The geometry and design report (the content of ``report.json``)."""
+        from tabletcad.report import geometry_report
+
+        return geometry_report(self.tablet)
+
+    def tooling(self, spec: Any = None, **kw: Any) -> ToolingModel:
+        """Punch tips, die and the featured tablet.
+
+        ``spec``: a :class:`~tabletcad.tooling.spec.ToolingSpec`, a ``[tooling]`` table as a
+        dict, or ``None`` (the design's own ``[tooling]`` table, else the defaults);
+        keyword arguments replace fields of the spec (``clearance_mm=0.03``...).
+        """
+        from tabletcad.tooling.spec import ToolingSpec, parse_tooling
+        from tabletcad.tooling.toolset import make_tooling
+
+        if spec is None:
+            spec = self.tablet.extras.get("tooling", {})
+        if isinstance(spec, dict):
+            spec = parse_tooling({**spec, **kw})
+        elif isinstance(spec, ToolingSpec):
+            spec = spec.with_(**kw) if kw else spec
+        else:
+            raise DesignError("tooling spec", type(spec).__name__, "must be a ToolingSpec, a dict or None")
+        return ToolingModel(make_tooling(self.tablet, spec, shape=self.to_occ()))
+
+    def _repr_png_(self) -> bytes:
+        from tabletcad.plot import tablet_png
+
+        return tablet_png(self.tablet)
+
+    def __repr__(self) -> str:
+        return f"TabletModel({self.tablet.name!r}, family={self.tablet.family!r})"
+
+
+def make(family: str, **dims: Any) -> TabletModel:
+    """A tablet of a named family (``tabletcad shapes`` lists them) with dimensions in mm."""
+    from tabletcad.shapes import FAMILIES, _load_plugins
+
+    _load_plugins()
+    if family not in FAMILIES:
+        raise DesignError("family", family, f"must be one of {', '.join(FAMILIES)}")
+    return TabletModel(FAMILIES[family].build(**dims))
+
+
+def load(path: str | Path) -> TabletModel:
+    """A tablet from a TOML design file (:func:`tabletcad.design.load_design`)."""
+    from tabletcad.design import load_design
+
+    return TabletModel(load_design(path))
+
+
+def show(*objs: Any, **kw: Any):
+    """Show objects in VS Code through ``ocp_vscode.show`` when it is installed.
+
+    Models are passed as build123d solids.  Without ocp_vscode, prints one line and returns None.
+    """
+    try:
+        import ocp_vscode
+    except ImportError:
+        print("tabletcad.show: ocp_vscode is not installed (pip install ocp_vscode); "
+              "in Jupyter, display the object itself instead")
+        return None
+    shapes = []
+    for o in objs:
+        if isinstance(o, ToolingModel):
+            shapes.extend(p.to_build123d() for p in o.placed().values())
+        elif isinstance(o, _Shaped):
+            shapes.append(o.to_build123d())
+        else:
+            shapes.append(o)
+    return ocp_vscode.show(*shapes, **kw)
+
+
+_PALETTE = ("#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948")
+
+_VIEW_JS = r"""
+(function(){
+const root=document.getElementById(%(id)s), cv=root.querySelector('canvas'), g=cv.getContext('2d');
+const M=%(data)s; let ry=-0.8, rx=0.9, zoom=1, drag=null;
+let lo=[1e300,1e300,1e300], hi=[-1e300,-1e300,-1e300];
+for(const m of M) for(let i=0;i<m.v.length;i+=3) for(let k=0;k<3;k++){lo[k]=Math.min(lo[k],m.v[i+k]);hi[k]=Math.max(hi[k],m.v[i+k]);}
+const c=[0,1,2].map(k=>(lo[k]+hi[k])/2), R=Math.max(1e-9,Math.hypot(hi[0]-lo[0],hi[1]-lo[1],hi[2]-lo[2])/2);
+function rgb(h){return [1,3,5].map(i=>parseInt(h.substr(i,2),16));}
+function draw(){
+  const W=cv.width,H=cv.height,s=zoom*0.45*Math.min(W,H)/R, cy=Math.cos(ry),sy=Math.sin(ry),cx=Math.cos(rx),sx=Math.sin(rx);
+  const tris=[];
+  for(const m of M){const col=rgb(m.c), P=[];
+    for(let i=0;i<m.v.length;i+=3){const x=m.v[i]-c[0],y=m.v[i+1]-c[1],z=m.v[i+2]-c[2];
+      const x1=cy*x-sy*y, y1=sy*x+cy*y; P.push([x1, cx*y1-sx*z, sx*y1+cx*z]);}
+    for(let i=0;i<m.t.length;i+=3){const a=P[m.t[i]],b=P[m.t[i+1]],d=P[m.t[i+2]];
+      const u=[b[0]-a[0],b[1]-a[1],b[2]-a[2]],w=[d[0]-a[0],d[1]-a[1],d[2]-a[2]];
+      const n=[u[1]*w[2]-u[2]*w[1],u[2]*w[0]-u[0]*w[2],u[0]*w[1]-u[1]*w[0]], L=Math.hypot(n[0],n[1],n[2])||1;
+      const lam=Math.abs(0.3*n[0]-0.5*n[1]+0.8*n[2])/L/Math.hypot(0.3,0.5,0.8);
+      tris.push([a[1]+b[1]+d[1],a,b,d,col.map(q=>Math.round(q*(0.35+0.7*lam)))]);}}
+  tris.sort((p,q)=>q[0]-p[0]);
+  g.fillStyle='#fff'; g.fillRect(0,0,W,H);
+  for(const t of tris){g.beginPath();g.moveTo(W/2+s*t[1][0],H/2-s*t[1][2]);g.lineTo(W/2+s*t[2][0],H/2-s*t[2][2]);
+    g.lineTo(W/2+s*t[3][0],H/2-s*t[3][2]);g.closePath();const f='rgb('+t[4].join(',')+')';g.fillStyle=f;g.strokeStyle=f;g.fill();g.stroke();}
+}
+cv.onmousedown=e=>{drag=[e.clientX,e.clientY];}; window.addEventListener('mouseup',()=>{drag=null;});
+cv.onmousemove=e=>{if(!drag)return; ry+=(e.clientX-drag[0])*0.01; rx+=(e.clientY-drag[1])*0.01; drag=[e.clientX,e.clientY]; draw();};
+cv.onwheel=e=>{e.preventDefault(); zoom*=Math.exp(-e.deltaY*0.001); draw();};
+draw();
+})();
+"""
+
+
+def mesh_html(meshes: list[tuple[str, np.ndarray, np.ndarray]], *, title: str = "", width: int = 480,
+              height: int = 360) -> str:
+    """Self-contained HTML (a canvas and inline JavaScript, no network) showing triangle meshes.
+
+    ``meshes``: ``(name, vertices (n, 3) mm, triangles (m, 3) int)``; drag to rotate, wheel to zoom.
+    """
+    data = [
+        dict(n=name, c=_PALETTE[i % len(_PALETTE)],
+             v=[round(float(x), 4) for x in np.asarray(V, float).ravel()],
+             t=[int(k) for k in np.asarray(T).ravel()])
+        for i, (name, V, T) in enumerate(meshes)
+    ]
+    uid = f"tabletcad-view-{next(_IDS)}"
+    js = _VIEW_JS % {"id": json.dumps(uid), "data": json.dumps(data, separators=(",", ":"))}
+    names = ", ".join(html.escape(str(m[0])) for m in meshes)
+    return (f'<div id="{uid}" class="tabletcad-view"><canvas width="{width}" height="{height}" '
+            f'style="border:1px solid #ccc"></canvas><div style="font:12px sans-serif">'
+            f"{html.escape(title)}: {names} (drag to rotate, wheel to zoom; mm)</div>"
+            f"<script>{js}</script></div>")

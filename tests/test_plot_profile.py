@@ -1,0 +1,82 @@
+"""tabletcad.plot: pictures to scale, true side profiles, dimensions, several tablets at one scale."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from tabletcad.families import capsule, concave_round, flat_face_round
+from tabletcad.plot import side_profile, tablet_figure, tablet_png, tablets_figure
+
+D, BAND, CUP = 10.0, 2.0, 1.0
+R = ((D / 2) ** 2 + CUP**2) / (2 * CUP)
+
+
+@pytest.fixture(scope="module")
+def pair():
+    return concave_round(diameter=D, band=BAND, cup_depth=CUP), flat_face_round(diameter=D, thickness=BAND + 2 * CUP)
+
+
+def test_profiles_differ_where_the_cup_is(pair):
+    cc, ff = (side_profile(t) for t in pair)
+    hc, hf = cc.z_high - cc.z_low, ff.z_high - ff.z_low
+    assert np.allclose(cc.x, ff.x)
+    centre = np.abs(cc.x) < 0.3
+    rim = np.abs(cc.x) > 4.8
+    # same overall thickness at the centre, half of it at the rim for the cupped tablet
+    assert np.allclose(hc[centre], hf[centre], atol=0.02)
+    assert np.all(hf[rim] - hc[rim] > 1.5)
+    assert np.allclose(hf, BAND + 2 * CUP, atol=1e-9)
+    # the cupped silhouette is the spherical cup: z = band top + sqrt(R^2 - x^2) - (R - cup)
+    inner = np.abs(cc.x) < 4.5
+    exact = (BAND + CUP) + np.sqrt(R**2 - cc.x[inner] ** 2) - (R - CUP)
+    half_bin = 0.5 * (cc.x[1] - cc.x[0])
+    slope = np.abs(cc.x[inner]) / np.sqrt(R**2 - cc.x[inner] ** 2)
+    assert np.all(np.abs(cc.z_high[inner] - exact) <= slope * half_bin + 2e-3)
+
+
+def test_main_dimensions(pair):
+    o = side_profile(pair[0])
+    assert (o.band, o.cup_depth, o.thickness, o.length, o.width, o.round) == (
+        pytest.approx(BAND, abs=1e-9), pytest.approx(CUP, abs=1e-6), pytest.approx(BAND + 2 * CUP, abs=1e-6),
+        pytest.approx(D, abs=1e-6), pytest.approx(D, abs=1e-6), True)
+    assert np.allclose(np.hypot(*o.plan.T), D / 2, atol=1e-6)
+    f = side_profile(pair[1])
+    assert f.cup_depth == pytest.approx(0.0, abs=1e-9) and f.band == pytest.approx(BAND + 2 * CUP, abs=1e-9)
+    c = side_profile(capsule(length=18, width=8, band=3, cup_depth=1.2))
+    assert not c.round and c.length == pytest.approx(18, abs=1e-6) and c.width == pytest.approx(8, abs=1e-6)
+    assert c.band == pytest.approx(3, abs=1e-9) and c.cup_depth == pytest.approx(1.2, abs=1e-6)
+
+
+def test_figure_is_to_scale_and_dimensioned(pair):
+    fig = tablet_figure(pair[0])
+    ax3d, prof, plan = fig.axes
+    box = np.asarray(ax3d.get_box_aspect(), float)
+    assert box / box[0] == pytest.approx([1.0, 1.0, (BAND + 2 * CUP) / D], rel=1e-6)
+    assert prof.get_aspect() == 1.0 and plan.get_aspect() == 1.0
+    texts = {t.get_text() for a in (prof, plan) for t in a.texts}
+    assert {"band 2", "cup 1", "4", "⌀ 10"} <= texts
+    png = tablet_png(pair[1])
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_several_tablets_share_one_scale(pair):
+    t3 = capsule(length=18, width=8, band=3, cup_depth=1.2)
+    fig = tablets_figure([*pair, t3])
+    rows = np.array(fig.axes).reshape(2, 3)
+    spans = [[np.ptp(a.get_xlim()) for a in row] for row in rows]
+    assert np.allclose(spans, spans[0][0])
+    assert all(np.ptp(a.get_ylim()) == pytest.approx(np.ptp(rows[0, 0].get_ylim())) for a in rows[0])
+    with pytest.raises(ValueError):
+        tablets_figure([])
+
+
+def test_no_global_backend_is_set():
+    code = ("import sys, matplotlib; b = matplotlib.rcParams._get_backend_or_none(); "
+            "from tabletcad.shapes import flat_faced_round; from tabletcad.plot import tablet_png; "
+            "tablet_png(flat_faced_round()); "
+            "assert 'matplotlib.pyplot' not in sys.modules; "
+            "assert matplotlib.rcParams._get_backend_or_none() == b; print('ok')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr

@@ -1,0 +1,95 @@
+"""``tabletcad kawakita``, ``walker`` and ``profiles`` on closed-form synthetic tables."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tabletcad.cli import main
+
+A, B, H0 = 0.4, 0.05, 10.0  # Kawakita a, b (1/MPa), initial height (mm)
+W, C = 12.0, 95.0  # Walker % per decade, intercept %
+SIGMA0, K = 8.0, 6.0  # Ryshkewitch-Duckworth sigma0 (MPa), k
+P = np.array([0.0, 5, 10, 20, 40, 60, 80, 120, 160, 200])
+
+
+def run(capsys, *args):
+    rc = main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def _write(path: Path, header: str, cols) -> Path:
+    rows = [header] + [",".join(f"{v:.15g}" for v in r) for r in zip(*cols)]
+    path.write_text("\n".join(rows) + "\n", encoding="utf-8")
+    return path
+
+
+def test_kawakita_recovers_a_and_b(capsys, tmp_path):
+    h = H0 * (1 - A * B * P / (1 + B * P))
+    data = _write(tmp_path / "k.csv", "pressure_MPa,thickness_mm", (P, h))
+    rc, out, err = run(capsys, "kawakita", data, "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    assert d["a"] == pytest.approx(A, rel=1e-9) and d["b_per_MPa"] == pytest.approx(B, rel=1e-9)
+    assert d["inv_b_MPa"] == pytest.approx(1 / B, rel=1e-9) and d["r2"] == pytest.approx(1.0, abs=1e-12)
+    assert d["h0_mm"] == H0 and d["n_points"] == 9
+    rc, out, err = run(capsys, "kawakita", data, "--window", 10, 120)
+    assert rc == 0 and "a = 0.4," in out and "1/b = 20 MPa" in out and out.count("\n") == 1
+
+
+def test_walker_recovers_w_and_json_file(capsys, tmp_path):
+    Pp = P[1:]
+    h = H0 * (C - W * np.log10(Pp)) / 100
+    data = _write(tmp_path / "w.csv", "Pressure_MPa,Thickness_mm", (Pp, h))
+    jf = tmp_path / "sub" / "walker.json"
+    rc, out, err = run(capsys, "walker", data, "--h0", H0, "--json-file", jf)
+    assert rc == 0, err
+    d = json.loads(jf.read_text())
+    assert d["W_percent_per_decade"] == pytest.approx(W, rel=1e-9)
+    assert d["intercept_percent"] == pytest.approx(C, rel=1e-9)
+    assert f"json -> {jf}" in out and "W = 12 % per decade" in out
+
+
+def test_profiles_and_ryshkewitch(capsys, tmp_path):
+    Pp = P[1:]
+    sf = 0.6 + 0.35 * (1 - np.exp(-Pp / 80))
+    s = SIGMA0 * np.exp(K * (sf - 1))
+    data = _write(tmp_path / "p.csv", "pressure_MPa,solid_fraction,tensile_strength_MPa", (Pp, sf, s))
+    plot = tmp_path / "profiles.png"
+    rc, out, err = run(capsys, "profiles", data, "--json", "--plot", plot)
+    assert rc == 0, err
+    d = json.loads(out)
+    rd = d["ryshkewitch_duckworth"]
+    assert rd["sigma0_MPa"] == pytest.approx(SIGMA0, rel=1e-9) and rd["k"] == pytest.approx(K, rel=1e-9)
+    pr = d["profiles"]
+    assert pr["tabletability"]["y"] == pytest.approx(list(s), rel=1e-12)
+    assert pr["compressibility"]["y"] == pytest.approx(list(1 - sf), rel=1e-12)
+    assert pr["compactibility"]["x"] == pytest.approx(sorted(1 - sf), rel=1e-12)
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("args, param", [
+    (["--pressure-column", "nope"], "column 'nope'"),
+    (["--window", 50, 10], "--window"),
+    (["--json-file", "out.txt"], "--json-file"),
+    (["--h0", -1], "--h0"),
+])
+def test_bad_input_is_one_line_and_writes_nothing(capsys, tmp_path, monkeypatch, args, param):
+    monkeypatch.chdir(tmp_path)
+    data = _write(tmp_path / "k.csv", "pressure_MPa,thickness_mm", (P, H0 * (1 - A * B * P / (1 + B * P))))
+    before = sorted(tmp_path.iterdir())
+    rc, out, err = run(capsys, "kawakita", data, *args)
+    assert rc == 2 and out == ""
+    assert err.count("\n") == 1 and err.startswith(f"error: {param}")
+    assert sorted(tmp_path.iterdir()) == before
+
+
+def test_non_numeric_cell(capsys, tmp_path):
+    data = tmp_path / "bad.csv"
+    data.write_text("pressure_MPa,thickness_mm\n10,9.5\nx,9\n", encoding="utf-8")
+    rc, out, err = run(capsys, "walker", data)
+    assert rc == 2 and err == "error: bad.csv line 3, column 'pressure_MPa' = 'x' is not allowed: must be a number\n"

@@ -1,0 +1,151 @@
+"""The scripting facade (tabletcad.make / load, TabletModel): build123d, cadquery, notebooks."""
+
+import math
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("OCP")
+bd = pytest.importorskip("build123d")
+
+import tabletcad  # noqa: E402
+from tabletcad.errors import DesignError  # noqa: E402
+
+pytestmark = pytest.mark.cad
+ROOT = Path(__file__).resolve().parents[1]
+
+D, BAND, CUP = 10.0, 2.0, 1.0
+R_CUP = ((D / 2) ** 2 + CUP**2) / (2 * CUP)  # spherical cup radius (mm), land 0
+
+
+def _core_cylinder_cut(r: float) -> float:
+    """Closed form of the part of the concave round inside a coaxial cylinder of radius r (mm³)."""
+    R = R_CUP
+    # one cup above the band: int_0^r (sqrt(R^2 - p^2) - (R - CUP)) 2 pi p dp
+    cap = 2 * math.pi * ((R**3 - (R**2 - r**2) ** 1.5) / 3 - (R - CUP) * r**2 / 2)
+    return math.pi * r**2 * BAND + 2 * cap
+
+
+@pytest.fixture(scope="module")
+def model():
+    return tabletcad.make("concave_round", diameter=D, band=BAND, cup_depth=CUP)
+
+
+def test_lazy_exports_keep_import_light():
+    code = ("import sys, tabletcad; assert 'tabletcad.model' not in sys.modules; "
+            "m = tabletcad.TabletModel; assert 'tabletcad.model' in sys.modules; "
+            "assert not any(k.split('.')[0] in ('OCP', 'build123d', 'cadquery') for k in sys.modules); print('ok')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert "make" in dir(tabletcad) and callable(tabletcad.make)
+
+
+def test_volumes_agree_core_brep_closed_form(model):
+    # cup volume of a spherical cap of height CUP on a base of radius D/2
+    cap = math.pi * CUP**2 * (3 * R_CUP - CUP) / 3
+    exact = math.pi * (D / 2) ** 2 * BAND + 2 * cap
+    assert model.volume == pytest.approx(exact, rel=1e-6)
+    assert model.occ_volume == pytest.approx(model.volume, rel=1e-6)
+    assert model.to_build123d().volume == pytest.approx(model.volume, rel=1e-6)
+
+
+def test_build123d_boolean(model):
+    s = model.to_build123d()
+    assert isinstance(s, bd.Solid) and s.wrapped.IsSame(model.to_occ())
+    cut = s - bd.Cylinder(1.0, 20.0)
+    assert cut.is_valid
+    assert model.volume - cut.volume == pytest.approx(_core_cylinder_cut(1.0), rel=1e-5)
+
+
+def test_cadquery_hole_on_top_face():
+    cq = pytest.importorskip("cadquery")
+    m = tabletcad.make("flat_face_round", diameter=8.0, thickness=3.0)
+    wp = m.to_cadquery()
+    assert isinstance(wp, cq.Workplane)
+    holed = wp.faces(">Z").workplane().hole(2)
+    assert holed.val().isValid()
+    assert m.occ_volume == pytest.approx(m.volume, rel=1e-5)
+    from tabletcad.cad.solid import mass_properties
+
+    assert holed.val().Volume() == pytest.approx(mass_properties(holed.val().wrapped).volume, rel=1e-5)
+    removed = m.occ_volume - mass_properties(holed.val().wrapped).volume
+    # the hole's length is the B-rep's thickness, whose faces lie within the 10 nm PDE/nominal
+    # piece tolerance of z = 0 and z = 3: 2e-5 mm / 3 mm < 1e-5 relative
+    assert removed == pytest.approx(math.pi * 1.0**2 * 3.0, rel=1e-5)
+
+
+def test_load_report_export(tmp_path):
+    m = tabletcad.load(ROOT / "samples" / "families" / "concave_round.toml")
+    rep = m.report()
+    assert rep["volume_mm3"] == pytest.approx(m.volume, rel=1e-12)
+    p = m.export(tmp_path / "t.step")
+    assert p.is_file() and b"ISO-10303-21" in p.read_bytes()[:100]
+
+
+def test_repr_html_is_offline_and_holds_the_mesh(model):
+    h = model._repr_html_()
+    assert not re.search(r"https?://", h)
+    assert "<canvas" in h and "<script>" in h
+    data = re.search(r"const M=(\[.*?\]); let", h, re.S).group(1)
+    import json
+
+    (mesh,) = json.loads(data)
+    V = np.array(mesh["v"]).reshape(-1, 3)
+    T = np.array(mesh["t"]).reshape(-1, 3)
+    # the embedded mesh is the closed tablet: its signed volume is the tablet's within
+    # chordal deflection x area, and below it (the triangles are inscribed in a convex solid)
+    from tabletcad.model import VIEW_DEFLECTION
+
+    vol = np.einsum("ij,ij->i", V[T[:, 0]], np.cross(V[T[:, 1]], V[T[:, 2]])).sum() / 6
+    assert 0 < model.volume - vol <= VIEW_DEFLECTION[0] * model.tablet.surface_area()
+    assert V[:, 2].max() - V[:, 2].min() == pytest.approx(BAND + 2 * CUP, abs=1e-3)
+
+
+def test_repr_png(model):
+    png = model._repr_png_()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_show_without_ocp_vscode(model, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "ocp_vscode", None)  # import fails
+    assert tabletcad.show(model) is None
+    out = capsys.readouterr().out
+    assert out.count("\n") == 1 and "ocp_vscode" in out
+
+
+def test_make_unknown_family():
+    with pytest.raises(DesignError, match="family"):
+        tabletcad.make("no_such_family")
+
+
+@pytest.mark.slow
+def test_tooling_parts_have_the_same_vocabulary(model):
+    tools = model.tooling(clearance_mm=0.03)
+    assert set(tools.parts) == {"tablet", "upper_punch", "lower_punch", "die"}
+    assert tools.report["keys"]["clearance_mm"] == 0.03
+    up = tools.upper_punch
+    assert isinstance(up.to_build123d(), bd.Solid)
+    assert up.to_build123d().volume == pytest.approx(up.volume, rel=1e-9)
+    assert tools["tablet"].volume == pytest.approx(model.occ_volume, rel=1e-6)
+    assert not re.search(r"https?://", tools._repr_html_())
+
+
+def test_interop_hints_name_the_pinned_versions():
+    try:
+        import tomllib
+    except ImportError:  # Python 3.10
+        import tomli as tomllib
+
+    from tabletcad.cad import interop
+
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
+    pins = {r.split("==")[0]: r for r in [*extras["cad"], *extras["cadquery"]] if "==" in r}
+    for name in ("build123d", "cadquery-ocp-novtk"):
+        assert pins[name] in interop._BD_HINT
+    for name in ("cadquery", "cadquery-ocp"):
+        assert pins[name] in interop._CQ_HINT
+    assert "0.13" not in interop._BD_HINT + interop._CQ_HINT
