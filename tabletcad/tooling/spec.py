@@ -9,6 +9,12 @@
     die_height_mm = 22.22          # die height
     taper_deg = 0.0                # die bore taper above the tablet, degrees (0 = straight)
     gap_mm = 2.8                   # distance between the punch tip edges; default: closed (= band)
+    standard = "TSM"               # complete punches: "TSM" | "EU" | "custom" (absent: punch tips only)
+    type = "B"                     # "B" | "D" (TSM and EU; see tabletcad/data/tooling_standards.toml)
+    lower_tip_length_mm = 19.0     # lower punch tip length (default: tip_length_mm)
+
+    [tooling.punch]                # body dimensions the standard file does not hold (see standards.py)
+    head_diameter_mm = 25.4        # ... every key of tabletcad.tooling.standards.BODY_KEYS
 
     [[tooling.score]]              # bisect or quadrisect score
     kind = "bisect"                # "bisect" | "quadrisect"
@@ -41,6 +47,7 @@ from pathlib import Path
 from typing import Any
 
 from tabletcad.errors import DesignError, check_finite, check_positive, check_range
+from tabletcad.tooling.standards import PunchBody, resolve_body
 
 __all__ = ["ToolingSpec", "ScoreSpec", "EmbossSpec", "parse_tooling", "FONT_DIR", "font_path"]
 
@@ -90,6 +97,13 @@ class ToolingSpec:
     scores: tuple[ScoreSpec, ...] = ()
     emboss: tuple[EmbossSpec, ...] = ()
     extra: dict = field(default_factory=dict)
+    body: PunchBody | None = None
+    lower_tip_length_mm: float | None = None
+
+    @property
+    def lower_tip(self) -> float:
+        """The lower punch's tip length (mm)."""
+        return self.tip_length_mm if self.lower_tip_length_mm is None else self.lower_tip_length_mm
 
     def with_(self, **kw: Any) -> "ToolingSpec":
         return replace(self, **kw)
@@ -184,7 +198,8 @@ def _emboss(i: int, t: Any) -> EmbossSpec:
 def parse_tooling(table: Any) -> ToolingSpec:
     """A :class:`ToolingSpec` from the ``[tooling]`` table (raises :class:`DesignError`)."""
     d = ToolingSpec()
-    keys = {"clearance_mm", "tip_length_mm", "die_outer_diameter_mm", "die_height_mm", "taper_deg", "gap_mm", "score", "emboss"}
+    keys = {"clearance_mm", "tip_length_mm", "die_outer_diameter_mm", "die_height_mm", "taper_deg", "gap_mm", "score", "emboss",
+            "standard", "type", "punch", "lower_tip_length_mm"}
     t = _keys("[tooling]", table, keys)
     clearance = check_range("[tooling] clearance_mm", t.get("clearance_mm", d.clearance_mm), 0.0, 1.0, "mm")
     tip = check_positive("[tooling] tip_length_mm", t.get("tip_length_mm", d.tip_length_mm), "mm")
@@ -200,6 +215,22 @@ def parse_tooling(table: Any) -> ToolingSpec:
         raise DesignError("[[tooling.score]]", scores, "must be an array of tables")
     if not isinstance(emb, list):
         raise DesignError("[[tooling.emboss]]", emb, "must be an array of tables")
+    lower = t.get("lower_tip_length_mm")
+    lower = None if lower is None else check_positive("[tooling] lower_tip_length_mm", lower, "mm")
+    body = None
+    if "standard" in t or "type" in t or "punch" in t:
+        std = _choice("[tooling] standard", t.get("standard", "missing"), ("TSM", "EU", "custom"))
+        kind = None
+        if std != "custom":
+            kind = _choice("[tooling] type", t.get("type", "missing"), ("B", "D"))
+        body = resolve_body(std, kind, t.get("punch"), tip, tip if lower is None else lower)
+        if "die_height_mm" not in t:
+            raise DesignError("[tooling] die_height_mm", "missing", "required with complete punches: no citable "
+                              "public die height is bundled (tabletcad/data/tooling_standards.toml)", "mm")
+        if od is None:
+            if body.die_outer_diameter_mm is None:
+                raise DesignError("[tooling] die_outer_diameter_mm", "missing", "required with standard = 'custom'", "mm")
+            od = body.die_outer_diameter_mm
     return ToolingSpec(clearance, tip, od, height, taper, gap,
                        tuple(_score(i, s) for i, s in enumerate(scores)),
-                       tuple(_emboss(i, e) for i, e in enumerate(emb)))
+                       tuple(_emboss(i, e) for i, e in enumerate(emb)), body=body, lower_tip_length_mm=lower)

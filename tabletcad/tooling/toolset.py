@@ -43,6 +43,32 @@ class ToolSet:
         return out
 
 
+def _die_position(frame, spec: ToolingSpec) -> tuple[float, float]:
+    """``(top, bottom)`` z of the die at the closed position, as :func:`tabletcad.tooling.die.die` places it."""
+    pen = min(3.0, 0.25 * spec.die_height_mm)
+    top = frame.band_z[1] + pen
+    return top, top - spec.die_height_mm
+
+
+def _check_complete_punches(frame, spec: ToolingSpec) -> None:
+    """Bad complete-punch input (tablet larger than the barrel or the standard, a tip too short to keep
+    the barrel out of the die) as a DesignError, before any tooling geometry is built."""
+    from tabletcad.tooling.die import _max_radius
+    from tabletcad.tooling.punch_body import check_body_fits
+
+    check_body_fits(frame, spec.body, _max_radius(frame.outline))
+    top, bottom = _die_position(frame, spec)
+    need_up = top - frame.band_z[1]
+    if spec.tip_length_mm <= need_up:
+        raise DesignError("[tooling] tip_length_mm", spec.tip_length_mm,
+                          f"must be > {need_up:.4g} mm, the upper punch's entry into the die (the barrel stays out)", "mm")
+    need_low = frame.band_z[0] - bottom
+    if spec.lower_tip <= need_low:
+        raise DesignError("[tooling] lower_tip_length_mm", spec.lower_tip,
+                          f"must be > {need_low:.4g} mm: from the lower tip edge to the die's bottom face at the "
+                          f"closed position (the barrel stays out of the die)", "mm")
+
+
 def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None, check: bool = True,
                  interference_check: bool = True, deflection: float = DEFLECTION_MM) -> ToolSet:
     """Scores, embossing, punch tips and die for ``tablet`` (see :mod:`tabletcad.tooling`).
@@ -69,6 +95,8 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
         check_score(frame, s, i)
     for i, e in enumerate(spec.emboss):
         check_emboss(frame, e, spec.clearance_mm, i)
+    if spec.body is not None:
+        _check_complete_punches(frame, spec)
     solid = frame.shape
     v0 = volume(solid)
     a_man = to_manifold(solid, deflection) if check and (spec.scores or spec.emboss) else None
@@ -77,7 +105,15 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     solid, emb_checks, emb_info = apply_emboss(frame, solid, spec.emboss, spec.clearance_mm, check=check, deflection=deflection)
     t1 = time.perf_counter()
     upper, chk_u = punch_tip(frame, solid, "upper", spec.clearance_mm, spec.tip_length_mm, check=check, deflection=deflection)
-    lower, chk_l = punch_tip(frame, solid, "lower", spec.clearance_mm, spec.tip_length_mm, check=check, deflection=deflection)
+    lower, chk_l = punch_tip(frame, solid, "lower", spec.clearance_mm, spec.lower_tip, check=check, deflection=deflection)
+    if spec.body is not None:
+        from tabletcad.tooling.punch_body import complete_punch
+
+        for tip, tl in ((upper, spec.tip_length_mm), (lower, spec.lower_tip)):
+            which = tip.name.split("_")[0]
+            shape_, info_ = complete_punch(frame, tip.shape, which, spec.body, spec.clearance_mm, tl)
+            tip.info.update(tip_volume_mm3=tip.volume_mm3, body=info_)
+            tip.shape, tip.volume_mm3 = shape_, info_["volume_mm3"]
     die_shape, die_info = die(frame, spec.die_outer_diameter_mm, None if spec.die_outer_diameter_mm is None and
                               spec.die_height_mm == ToolingSpec().die_height_mm else spec.die_height_mm, spec.taper_deg)
     t2 = time.perf_counter()
