@@ -27,12 +27,13 @@
     direction_deg = 90.0           # groove direction in plan, from the x axis
 
     [[tooling.emboss]]             # text or a logo outline, debossed (cut) or embossed (raised)
-    text = "A10"                   # or: outline = [[x, y], ...] (closed polyline, mm)
+    text = "A10"                   # or: outline = [[x, y], ...] (closed polyline, mm), or svg = "logo.svg"
     mode = "deboss"                # "deboss" | "emboss"
     face = "top"                   # "top" | "bottom"
     height_mm = 2.0                # font size (text)
     depth_mm = 0.15                # depth (deboss) or height (emboss), along the axis
-    draft_deg = 0.0                # stroke draft angle of the letter walls
+    stroke_angle_deg = 0.0         # stroke angle: draft of the letter walls from the axis, 0 <= . < 60
+                                   # (``draft_deg`` is accepted as the same key)
     font = "DejaVuSans-Bold"       # a DejaVu font name or a .ttf path
     position_mm = [0.0, 0.0]
     rotation_deg = 0.0
@@ -84,6 +85,7 @@ class EmbossSpec:
     position_mm: tuple[float, float] = (0.0, 0.0)
     rotation_deg: float = 0.0
     margin_mm: float = 0.2
+    svg: str | None = None
 
 
 @dataclass(frozen=True)
@@ -164,10 +166,16 @@ def _score(i: int, t: Any) -> ScoreSpec:
 def _emboss(i: int, t: Any) -> EmbossSpec:
     w = f"[[tooling.emboss]] {i}"
     d = EmbossSpec()
-    t = _keys(w, t, set(EmbossSpec.__dataclass_fields__))
-    text, outline = t.get("text"), t.get("outline")
-    if (text is None) == (outline is None):
-        raise DesignError(f"{w} text", text, "give either text or outline (a closed polyline [[x, y], ...])")
+    t = _keys(w, t, set(EmbossSpec.__dataclass_fields__) | {"stroke_angle_deg"})
+    text, outline, svg = t.get("text"), t.get("outline"), t.get("svg")
+    if sum(x is not None for x in (text, outline, svg)) != 1:
+        raise DesignError(f"{w} text", text, "give exactly one of text, outline (a closed polyline [[x, y], ...]) or svg "
+                          "(a logo file)")
+    if svg is not None and not (isinstance(svg, str) and Path(svg).suffix.lower() == ".svg" and Path(svg).is_file()):
+        raise DesignError(f"{w} svg", svg, "must be the path of an existing .svg file")
+    if "stroke_angle_deg" in t and "draft_deg" in t:
+        raise DesignError(f"{w} draft_deg", t["draft_deg"], "give stroke_angle_deg or draft_deg, not both", "deg")
+    stroke = t.get("stroke_angle_deg", t.get("draft_deg", d.draft_deg))
     if text is not None and (not isinstance(text, str) or not text.strip()):
         raise DesignError(f"{w} text", text, "must be a non-empty string")
     if outline is not None:
@@ -187,11 +195,12 @@ def _emboss(i: int, t: Any) -> EmbossSpec:
         _choice(f"{w} face", t.get("face", d.face), ("top", "bottom")),
         check_positive(f"{w} height_mm", t.get("height_mm", d.height_mm), "mm"),
         check_positive(f"{w} depth_mm", t.get("depth_mm", d.depth_mm), "mm"),
-        check_range(f"{w} draft_deg", t.get("draft_deg", d.draft_deg), 0.0, 30.0, "deg", hi_open=True),
+        check_range(f"{w} stroke_angle_deg", stroke, 0.0, 60.0, "deg", hi_open=True),
         font,
         (check_finite(f"{w} position_mm", pos[0], "mm"), check_finite(f"{w} position_mm", pos[1], "mm")),
         check_finite(f"{w} rotation_deg", t.get("rotation_deg", d.rotation_deg), "deg"),
         check_range(f"{w} margin_mm", t.get("margin_mm", d.margin_mm), 0.0, None, "mm"),
+        svg,
     )
 
 
