@@ -152,7 +152,7 @@ def legibility(frame: TabletFrame, e: EmbossSpec, figure: TopoDS_Shape, clearanc
 
 
 def _inset(frame: TabletFrame, clearance: float, e: EmbossSpec) -> float:
-    return clearance + (frame.land or 0.0) + e.margin_mm
+    return clearance + frame.edge_land(e.face) + e.margin_mm
 
 
 def check_fit(frame: TabletFrame, e: EmbossSpec, figure: TopoDS_Shape, clearance: float, i: int = 0) -> dict:

@@ -25,6 +25,7 @@
     cut_through = false            # true: the groove runs out through the band edge
     faces = "top"                  # "top" | "bottom" | "both"
     direction_deg = 90.0           # groove direction in plan, from the x axis
+    length_mm = 4.0                # short (decorative) score: groove length, centred; default: across the face
 
     [[tooling.emboss]]             # text or a logo outline, debossed (cut) or embossed (raised)
     text = "A10"                   # or: outline = [[x, y], ...] (closed polyline, mm), or svg = "logo.svg"
@@ -66,6 +67,7 @@ class ScoreSpec:
     faces: str = "top"
     direction_deg: float = 90.0
     slot_width_mm: float = 0.1
+    length_mm: float | None = None
 
     @property
     def face_list(self) -> tuple[str, ...]:
@@ -158,9 +160,15 @@ def _score(i: int, t: Any) -> ScoreSpec:
     if profile == "v" and width > 0 and "angle_deg" not in t:
         angle = math.degrees(2.0 * math.atan(0.5 * width / depth))
     slot = check_positive(f"{w} slot_width_mm", t.get("slot_width_mm", d.slot_width_mm), "mm")
-    return ScoreSpec(kind, profile, depth, angle, width, _bool(f"{w} cut_through", t.get("cut_through", d.cut_through)),
+    cut = _bool(f"{w} cut_through", t.get("cut_through", d.cut_through))
+    length = t.get("length_mm")
+    if length is not None:
+        length = check_positive(f"{w} length_mm", length, "mm")
+        if cut:
+            raise DesignError(f"{w} length_mm", length, "a short score cannot be cut_through (it ends on the face)", "mm")
+    return ScoreSpec(kind, profile, depth, angle, width, cut,
                      _choice(f"{w} faces", t.get("faces", d.faces), ("top", "bottom", "both")),
-                     check_finite(f"{w} direction_deg", t.get("direction_deg", d.direction_deg), "deg"), slot)
+                     check_finite(f"{w} direction_deg", t.get("direction_deg", d.direction_deg), "deg"), slot, length)
 
 
 def _emboss(i: int, t: Any) -> EmbossSpec:

@@ -102,6 +102,13 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     a_man = to_manifold(solid, deflection) if check and (spec.scores or spec.emboss) else None
     solid, score_checks, score_info = apply_scores(frame, solid, spec.scores, check=check, deflection=deflection, a_manifold=a_man)
     a_man = None
+    split = None
+    if spec.scores:
+        from tabletcad.tooling.split import split_parts
+
+        rep = tablet.extras.get("report", {}) if isinstance(tablet.extras, dict) else {}
+        sf, rho = rep.get("solid_fraction"), rep.get("true_density_mg_mm3")
+        split = split_parts(frame, solid, spec.scores, density_mg_mm3=None if sf is None or rho is None else sf * rho)
     solid, emb_checks, emb_info = apply_emboss(frame, solid, spec.emboss, spec.clearance_mm, check=check, deflection=deflection)
     t1 = time.perf_counter()
     upper, chk_u = punch_tip(frame, solid, "upper", spec.clearance_mm, spec.tip_length_mm, check=check, deflection=deflection)
@@ -129,6 +136,7 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
                     cup_depth_bottom_mm=frame.cup_depth_bottom, thickness_mm=frame.thickness,
                     land_mm=frame.land, outline=frame.outline_kind, length_mm=frame.length, width_mm=frame.width),
         scores=score_info,
+        split=split,
         emboss=emb_info,
         upper_punch=upper.info,
         lower_punch=lower.info,
