@@ -13,6 +13,11 @@
     type = "B"                     # "B" | "D" (TSM and EU; see tabletcad/data/tooling_standards.toml)
     lower_tip_length_mm = 19.0     # lower punch tip length (default: tip_length_mm)
 
+    [tooling.drawing]              # title block and tolerances of the drawings
+    name = "Example 10 mm"         # name, number, revision, material, date, author: strings
+    tolerance_mm = 0.076           # general +- tolerance (default 0.076 mm, stated on the sheet)
+    tolerances = { cup_depth = 0.05 }   # per dimension: diameter, length, width, band, cup_depth, thickness
+
     [tooling.punch]                # body dimensions the standard file does not hold (see standards.py)
     head_diameter_mm = 25.4        # ... every key of tabletcad.tooling.standards.BODY_KEYS
 
@@ -90,6 +95,50 @@ class EmbossSpec:
     svg: str | None = None
 
 
+#: general +- tolerance (mm) printed on the drawings when the design gives none: 0.003 in, stated on the sheet
+#: as this program's default, not as a standard's value
+DEFAULT_TOLERANCE_MM = 0.076
+TOLERANCE_KEYS = ("diameter", "length", "width", "band", "cup_depth", "thickness", "land")
+TITLE_KEYS = ("name", "number", "revision", "material", "date", "author")
+
+
+@dataclass(frozen=True)
+class DrawingSpec:
+    """Title block texts and tolerances (mm) of the drawings (``[tooling.drawing]``)."""
+
+    name: str | None = None
+    number: str | None = None
+    revision: str | None = None
+    material: str | None = None
+    date: str | None = None
+    author: str | None = None
+    tolerance_mm: float = DEFAULT_TOLERANCE_MM
+    tolerance_given: bool = False
+    tolerances: tuple = ()
+
+    def tolerance(self, key: str) -> float:
+        """The +- tolerance (mm) of dimension ``key``."""
+        return dict(self.tolerances).get(key, self.tolerance_mm)
+
+
+def _drawing(t: Any) -> DrawingSpec:
+    w = "[tooling.drawing]"
+    t = _keys(w, t, set(TITLE_KEYS) | {"tolerance_mm", "tolerances"})
+    kw = {}
+    for k in TITLE_KEYS:
+        if k in t:
+            v = t[k]
+            if not isinstance(v, (str, int, float)) or isinstance(v, bool) or not str(v).strip():
+                raise DesignError(f"{w} {k}", v, "must be a non-empty string")
+            kw[k] = str(v)
+    if "tolerance_mm" in t:
+        kw["tolerance_mm"] = check_positive(f"{w} tolerance_mm", t["tolerance_mm"], "mm")
+        kw["tolerance_given"] = True
+    tol = _keys(f"{w} tolerances", t.get("tolerances", {}), set(TOLERANCE_KEYS))
+    kw["tolerances"] = tuple((k, check_positive(f"{w} tolerances.{k}", v, "mm")) for k, v in tol.items())
+    return DrawingSpec(**kw)
+
+
 @dataclass(frozen=True)
 class ToolingSpec:
     clearance_mm: float = 0.025
@@ -103,6 +152,7 @@ class ToolingSpec:
     extra: dict = field(default_factory=dict)
     body: PunchBody | None = None
     lower_tip_length_mm: float | None = None
+    drawing: DrawingSpec = DrawingSpec()
 
     @property
     def lower_tip(self) -> float:
@@ -216,7 +266,7 @@ def parse_tooling(table: Any) -> ToolingSpec:
     """A :class:`ToolingSpec` from the ``[tooling]`` table (raises :class:`DesignError`)."""
     d = ToolingSpec()
     keys = {"clearance_mm", "tip_length_mm", "die_outer_diameter_mm", "die_height_mm", "taper_deg", "gap_mm", "score", "emboss",
-            "standard", "type", "punch", "lower_tip_length_mm"}
+            "standard", "type", "punch", "lower_tip_length_mm", "drawing"}
     t = _keys("[tooling]", table, keys)
     clearance = check_range("[tooling] clearance_mm", t.get("clearance_mm", d.clearance_mm), 0.0, 1.0, "mm")
     tip = check_positive("[tooling] tip_length_mm", t.get("tip_length_mm", d.tip_length_mm), "mm")
@@ -250,4 +300,5 @@ def parse_tooling(table: Any) -> ToolingSpec:
             od = body.die_outer_diameter_mm
     return ToolingSpec(clearance, tip, od, height, taper, gap,
                        tuple(_score(i, s) for i, s in enumerate(scores)),
-                       tuple(_emboss(i, e) for i, e in enumerate(emb)), body=body, lower_tip_length_mm=lower)
+                       tuple(_emboss(i, e) for i, e in enumerate(emb)), body=body, lower_tip_length_mm=lower,
+                       drawing=_drawing(t.get("drawing", {})))

@@ -1,0 +1,84 @@
+"""Drawings a toolmaker can quote from: tolerances, title block, scale, punch and die sheet, no text on geometry."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("OCP")
+pytest.importorskip("ezdxf")
+pytest.importorskip("matplotlib")
+
+from tabletcad.design import load_design  # noqa: E402
+from tabletcad.tooling import make_tooling, parse_tooling  # noqa: E402
+from tabletcad.tooling.drawing import drawing_model, sheet_figure, tooling_model, write_drawing  # noqa: E402
+from tabletcad.tooling.stage import read_tooling_table  # noqa: E402
+
+pytestmark = pytest.mark.cad
+
+SAMPLE = Path(__file__).resolve().parents[1] / "samples" / "tooling" / "tsm_b_round.toml"
+
+
+@pytest.fixture(scope="module")
+def drawn(tmp_path_factory):
+    ts = make_tooling(load_design(SAMPLE), parse_tooling(read_tooling_table(SAMPLE)), check=False,
+                      interference_check=False)
+    out = tmp_path_factory.mktemp("drawings")
+    files = write_drawing(ts, out)
+    return ts, out, files
+
+
+def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
+    ts, out, files = drawn
+    assert sorted(p.name for p in files) == sorted(f"{a}.{b}" for a in ("drawing", "tooling") for b in ("svg", "pdf", "dxf"))
+    svg = (out / "drawing.svg").read_text(encoding="utf-8")
+    for text in ("Ø10.00 ±0.076", "band 2.80 ±0.076", "cup 0.90 ±0.050", "T 4.60 ±0.076",  # cup from the design
+                 "10 mm concave round, TSM B", "drawing no. TC-0001", "rev. A", "date: 2026-12-01",
+                 "author: tabletcad sample", "material: punches and die", "general tolerance ±0.076 mm"):
+        assert text in svg, text
+    scale = ts.report["drawing"]["scale"]
+    assert 1.0 < scale < 20.0 and f"scale {scale:.3g}:1" in svg
+    tsvg = (out / "tooling.svg").read_text(encoding="utf-8")
+    for text in ("overall 133.35 ±0.076", "Ø19.00", "Ø25.40", "tip 8.00", "tip 19.00", "Ø30.16 ±0.076", "H 22.22 ±0.076",
+                 "UPPER PUNCH", "LOWER PUNCH", "DIE", "drawing no. TC-0001-T", "TSM B tooling, angled heads"):
+        assert text in tsvg, text
+    dxf = (out / "tooling.dxf").read_text(encoding="utf-8", errors="replace")
+    assert "overall 133.35" in dxf and "TC-0001" in dxf
+
+
+def _segments_display(ax, dr):
+    pts = []
+    for name, v in dr.views.items():
+        ox, oy = dr.origins[name]
+        for p in v["visible"] + v["hidden"]:
+            q = np.asarray(p) + np.array([ox, oy])
+            t = np.linspace(0.0, 1.0, 9)[:, None]
+            dense = (q[:-1, None, :] * (1 - t) + q[1:, None, :] * t).reshape(-1, 2)  # points along every segment
+            pts.append(ax.transData.transform(dense))
+    return np.concatenate(pts)
+
+
+@pytest.mark.parametrize("which", ["tablet", "tooling"])
+def test_no_text_leaves_the_sheet_or_lies_on_the_views(drawn, which):
+    import matplotlib.pyplot as plt
+
+    ts, _, _ = drawn
+    dr = drawing_model(ts) if which == "tablet" else tooling_model(ts)
+    fig = sheet_figure(dr)
+    try:
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        ax = fig.axes[0]
+        pts = _segments_display(ax, dr)
+        labels = [t for t in ax.texts if t.get_text()]  # (the dimension arrows are empty annotations)
+        texts = fig.texts + labels
+        assert len(labels) == len(dr.dims) + len(dr.views)
+        for t in texts:
+            bb = t.get_window_extent(renderer)
+            assert fig.bbox.x0 <= bb.x0 and bb.x1 <= fig.bbox.x1 and fig.bbox.y0 <= bb.y0 and bb.y1 <= fig.bbox.y1
+        for t in labels:
+            bb = t.get_window_extent(renderer).expanded(0.98, 0.9)
+            inside = (pts[:, 0] > bb.x0) & (pts[:, 0] < bb.x1) & (pts[:, 1] > bb.y0) & (pts[:, 1] < bb.y1)
+            assert not inside.any(), f"{t.get_text()!r} lies on the {which} views"
+    finally:
+        plt.close(fig)
