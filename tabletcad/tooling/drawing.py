@@ -152,6 +152,14 @@ def drawing_model(ts) -> Drawing:
         notes.append(f"{s['kind']} score {s['profile']} {_fmt(s['depth_mm'])} mm deep on the {s['face']} face")
     for e in ts.report.get("emboss", []):
         notes.append(f"{e['mode']} '{e['text'] or 'outline'}' {_fmt(e['depth_mm'])} mm on the {e['face']} face")
+    r = ts.report.get("tip_rating") or {}
+    if r.get("rated_force_kN") is not None:
+        notes.append(f"tip force rating {r['rated_force_kN']:.3g} kN = {r['allowed_pressure_MPa']:g} MPa x "
+                     f"{r['tip_projected_area_mm2']:.4g} mm2 tip area (allowed pressure: {r['allowed_pressure_source']})")
+    for k, b in ((r.get("buckling") or {}).get("tips") or {}).items():
+        if b["buckling_load_kN"] is not None:
+            notes.append(f"{k} tip Euler buckling load {b['buckling_load_kN']:.3g} kN (K = 2, free length "
+                         f"{_fmt(b['free_length_mm'])} mm)")
     notes.append("all dimensions in mm; third-angle projection; generated from the B-rep (OCC HLR)")
     return Drawing(views, origins, _toleranced(dims, ts), notes, title=_title(ts), title_block=title_block(ts))
 

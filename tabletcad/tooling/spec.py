@@ -12,6 +12,10 @@
     standard = "TSM"               # complete punches: "TSM" | "EU" | "custom" (absent: punch tips only)
     type = "B"                     # "B" | "D" (TSM and EU; see tabletcad/data/tooling_standards.toml)
     lower_tip_length_mm = 19.0     # lower punch tip length (default: tip_length_mm)
+    allowed_tip_pressure_MPa = 300.0          # tip-force rating F = p x tip area; needs its source:
+    allowed_tip_pressure_source = "..."       # (no allowed pressure is bundled)
+    punch_youngs_modulus_MPa = 210000.0       # tip buckling (Euler); needs its source:
+    punch_youngs_modulus_source = "..."
 
     [tooling.drawing]              # title block and tolerances of the drawings
     name = "Example 10 mm"         # name, number, revision, material, date, author: strings
@@ -153,6 +157,10 @@ class ToolingSpec:
     body: PunchBody | None = None
     lower_tip_length_mm: float | None = None
     drawing: DrawingSpec = DrawingSpec()
+    allowed_tip_pressure_MPa: float | None = None
+    allowed_tip_pressure_source: str | None = None
+    punch_youngs_modulus_MPa: float | None = None
+    punch_youngs_modulus_source: str | None = None
 
     @property
     def lower_tip(self) -> float:
@@ -266,7 +274,8 @@ def parse_tooling(table: Any) -> ToolingSpec:
     """A :class:`ToolingSpec` from the ``[tooling]`` table (raises :class:`DesignError`)."""
     d = ToolingSpec()
     keys = {"clearance_mm", "tip_length_mm", "die_outer_diameter_mm", "die_height_mm", "taper_deg", "gap_mm", "score", "emboss",
-            "standard", "type", "punch", "lower_tip_length_mm", "drawing"}
+            "standard", "type", "punch", "lower_tip_length_mm", "drawing", "allowed_tip_pressure_MPa",
+            "allowed_tip_pressure_source", "punch_youngs_modulus_MPa", "punch_youngs_modulus_source"}
     t = _keys("[tooling]", table, keys)
     clearance = check_range("[tooling] clearance_mm", t.get("clearance_mm", d.clearance_mm), 0.0, 1.0, "mm")
     tip = check_positive("[tooling] tip_length_mm", t.get("tip_length_mm", d.tip_length_mm), "mm")
@@ -298,7 +307,19 @@ def parse_tooling(table: Any) -> ToolingSpec:
             if body.die_outer_diameter_mm is None:
                 raise DesignError("[tooling] die_outer_diameter_mm", "missing", "required with standard = 'custom'", "mm")
             od = body.die_outer_diameter_mm
+    sourced = {}
+    for key, unit in (("allowed_tip_pressure_MPa", "MPa"), ("punch_youngs_modulus_MPa", "MPa")):
+        skey = key.replace("_MPa", "_source")
+        if key in t:
+            sourced[key] = check_positive(f"[tooling] {key}", t[key], unit)
+            src = t.get(skey)
+            if not (isinstance(src, str) and src.strip()):
+                raise DesignError(f"[tooling] {skey}", src if src is not None else "missing",
+                                  f"must name the source of {key} (a non-empty string)")
+            sourced[skey] = src
+        elif skey in t:
+            raise DesignError(f"[tooling] {skey}", t[skey], f"give it together with {key}")
     return ToolingSpec(clearance, tip, od, height, taper, gap,
                        tuple(_score(i, s) for i, s in enumerate(scores)),
                        tuple(_emboss(i, e) for i, e in enumerate(emb)), body=body, lower_tip_length_mm=lower,
-                       drawing=_drawing(t.get("drawing", {})))
+                       drawing=_drawing(t.get("drawing", {})), **sourced)

@@ -146,6 +146,10 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
         booleans=[c.as_dict() for c in checks],
         boolean_max_rel_diff_occ_vs_manifold3d=max((c.rel_diff for c in checks), default=None),
     )
+    from tabletcad.tooling.rating import tip_rating
+
+    rep_table = tablet.extras.get("report", {}) if isinstance(tablet.extras, dict) else {}
+    report["tip_rating"] = tip_rating(frame, spec, rep_table)
     ts = ToolSet(tablet, spec, frame, parts, gap - gap_closed, report)
     if interference_check:
         from tabletcad.tooling.interference import interference
