@@ -43,21 +43,14 @@ class ToolSet:
         return out
 
 
-def _die_position(frame, spec: ToolingSpec) -> tuple[float, float]:
-    """``(top, bottom)`` z of the die at the closed position, as :func:`tabletcad.tooling.die.die` places it."""
-    pen = min(3.0, 0.25 * spec.die_height_mm)
-    top = frame.band_z[1] + pen
-    return top, top - spec.die_height_mm
-
-
 def _check_complete_punches(frame, spec: ToolingSpec) -> None:
     """Bad complete-punch input (tablet larger than the barrel or the standard, a tip too short to keep
     the barrel out of the die) as a DesignError, before any tooling geometry is built."""
-    from tabletcad.tooling.die import _max_radius
+    from tabletcad.tooling.die import _max_radius, die_position
     from tabletcad.tooling.punch_body import check_body_fits
 
     check_body_fits(frame, spec.body, _max_radius(frame.outline))
-    top, bottom = _die_position(frame, spec)
+    _, top, bottom = die_position(frame, spec.die_height_mm)
     need_up = top - frame.band_z[1]
     if spec.tip_length_mm <= need_up:
         raise DesignError("[tooling] tip_length_mm", spec.tip_length_mm,
