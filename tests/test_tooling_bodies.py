@@ -176,3 +176,24 @@ def test_barrel_smaller_than_the_tablet_and_oversize_tablets_are_design_errors()
         make_tooling(t, parse_tooling(custom), check=False, interference_check=False)
     with pytest.raises(DesignError, match=r"lower_tip_length_mm = 12 mm .* must be > 17 mm"):
         make_tooling(t, parse_tooling(_with(lower_tip_length_mm=12.0)), check=False, interference_check=False)
+
+
+@pytest.mark.cad
+@pytest.mark.parametrize("extra", [
+    '[tooling]\nstandard = "JIS"\ntype = "B"\ndie_height_mm = 22.0\n',                       # unknown standard
+    '[tooling]\nstandard = "EU"\ntype = "B"\ndie_height_mm = 22.0\ntip_length_mm = 130.0\n'  # tip longer than the punch
+    '[tooling.punch]\nhead_diameter_mm = 25.0\nhead_flat_diameter_mm = 12.0\nhead_rim_mm = 3.0\ndome_radius_mm = 30.0\n'
+    'neck_diameter_mm = 13.0\nneck_length_mm = 10.0\ntip_straight_mm = 4.0\ntip_relief_mm = 0.1\n',
+    '[tooling]\nstandard = "TSM"\ntype = "B"\n',                                               # required inputs missing
+])
+def test_cli_bad_complete_tooling_exits_2_with_one_line_and_writes_nothing(tmp_path, capsys, extra):
+    pytest.importorskip("OCP")
+    from tabletcad.cli import main
+
+    d = tmp_path / "bad.toml"
+    d.write_text('[tablet]\nfamily = "shallow_convex_round"\ndiameter = 10.0\nthickness = 3.0\nband = 2.0\n\n' + extra)
+    out = tmp_path / "out"
+    assert main(["build", str(d), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: [tooling")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
