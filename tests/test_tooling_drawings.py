@@ -34,7 +34,8 @@ def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
     svg = (out / "drawing.svg").read_text(encoding="utf-8")
     for text in ("Ø10.00 ±0.076", "band 2.80 ±0.076", "cup 0.90 ±0.050", "T 4.60 ±0.076",  # cup from the design
                  "10 mm concave round, TSM B", "drawing no. TC-0001", "rev. A", "date: 2026-12-01",
-                 "author: tabletcad sample", "material: punches and die", "general tolerance ±0.076 mm"):
+                 "author: tabletcad sample", "material: punches and die", "general tolerance ±0.076 mm",
+                 "SECTION A-A", "DETAIL B 10:1", "PLAN", "FRONT", "SIDE"):
         assert text in svg, text
     scale = ts.report["drawing"]["scale"]
     assert 1.0 < scale < 20.0 and f"scale {scale:.3g}:1" in svg

@@ -80,6 +80,53 @@ def project_view(shape, view: str) -> dict:
     return {"visible": vis, "hidden": hid}
 
 
+def section_view(shape, direction_deg: float) -> dict:
+    """The tablet cut by the plane through its axis across ``direction_deg`` (a score's direction):
+    ``{"visible": [polylines (across, z)], "hidden": []}``, seen from the side the score runs to."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
+
+    from tabletcad.tooling.booleans import raw_boolean
+
+    th = math.radians(direction_deg)
+    n = (-math.sin(th), math.cos(th))
+    R = 1e3
+    poly = BRepBuilderAPI_MakePolygon()
+    for u, z in ((-R, -R), (R, -R), (R, R), (-R, R)):
+        poly.Add(gp_Pnt(u * n[0], u * n[1], z))
+    poly.Close()
+    cut = raw_boolean("common", shape, BRepBuilderAPI_MakeFace(poly.Wire(), True).Face())
+    out = []
+    for e in explore(cut, "Edge"):
+        c = BRepAdaptor_Curve(e)
+        d = GCPnts_TangentialDeflection(c, 0.05, 0.002)
+        pts = [d.Value(i) for i in range(1, d.NbPoints() + 1)]
+        if len(pts) >= 2:
+            out.append(np.array([[p.X() * n[0] + p.Y() * n[1], p.Z()] for p in pts]))
+    return {"visible": out, "hidden": []}
+
+
+def detail_view(view: dict, centre: tuple[float, float], half: float, k: float) -> dict:
+    """The part of ``view`` within ``half`` mm of ``centre``, enlarged ``k`` times about it."""
+    c = np.asarray(centre, float)
+    out = []
+    step = half / 40.0
+    for p in view["visible"]:
+        # densify so that long straight edges through the window keep their inside part
+        seg = [np.linspace(a, b, max(2, int(np.ceil(np.linalg.norm(b - a) / step)) + 1))[:-1] for a, b in zip(p[:-1], p[1:])]
+        p = np.vstack(seg + [p[-1:]])
+        inside = np.all(np.abs(p - c) <= half, axis=1)
+        run: list = []
+        for q, ok in zip(p, inside):
+            if ok:
+                run.append(q)
+            elif run:
+                out.append(np.array(run))
+                run = []
+        if len(run) >= 2:
+            out.append(np.array(run))
+    return {"visible": [(p - c) * k for p in out if len(p) >= 2], "hidden": []}
+
+
 @dataclass
 class Dim:
     """A linear dimension between two sheet points, drawn ``offset`` mm aside, with its text."""
@@ -161,10 +208,31 @@ def drawing_model(ts) -> Drawing:
             notes.append(f"{k} tip Euler buckling load {b['buckling_load_kN']:.3g} kN (K = 2, free length "
                          f"{_fmt(b['free_length_mm'])} mm)")
     notes.append("all dimensions in mm; third-angle projection; generated from the B-rep (OCC HLR)")
+    # section across the (first) score, or across x, and a detail of the land and band edge
+    scores = ts.spec.scores
+    th = scores[0].direction_deg if scores else 90.0
+    sec = section_view(shape, th)
+    k = 10.0
+    half = max(0.6, 1.2 * (fr.land or 0.0) + 0.2 * fr.cup_depth_top + 0.3)
+    half_w = 0.5 * (W if abs(math.sin(math.radians(th))) < 0.5 else L)  # the section's half width
+    det = detail_view(sec, (half_w, fr.band_z[1]), half, k)
+    ox = L / 2 + gap + W / 2
+    sx_, sy_ = ox, py - zc
+    views["section A-A"] = sec
+    origins["section A-A"] = (sx_, sy_)
+    views[f"detail B {k:g}:1"] = det
+    origins[f"detail B {k:g}:1"] = (sx_ + max(L, W) / 2 + gap / 2 + k * half, py)
+    if scores:
+        sc = ts.report["scores"][0]
+        dims.append(Dim((sx_, sy_ + fr.z_max - sc["depth_mm"]), (sx_, sy_ + fr.z_max), 2.0 + half_w,
+                        f"score {_fmt(sc['depth_mm'])}", vertical=True))
+    notes.append(f"section A-A through the axis across {th:g} deg{' (the score)' if scores else ''}; "
+                 f"detail B: band edge and land, {k:g}:1")
     return Drawing(views, origins, _toleranced(dims, ts), notes, title=_title(ts), title_block=title_block(ts))
 
 
-_DIM_KEYS = {"Ø": "diameter", "L": "length", "W": "width", "band": "band", "cup": "cup_depth", "T": "thickness"}
+_DIM_KEYS = {"Ø": "diameter", "L": "length", "W": "width", "band": "band", "cup": "cup_depth", "T": "thickness",
+             "score": "score_depth"}
 
 
 def _toleranced(dims: list, ts) -> list:

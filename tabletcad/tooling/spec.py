@@ -102,7 +102,7 @@ class EmbossSpec:
 #: general +- tolerance (mm) printed on the drawings when the design gives none: 0.003 in, stated on the sheet
 #: as this program's default, not as a standard's value
 DEFAULT_TOLERANCE_MM = 0.076
-TOLERANCE_KEYS = ("diameter", "length", "width", "band", "cup_depth", "thickness", "land")
+TOLERANCE_KEYS = ("diameter", "length", "width", "band", "cup_depth", "thickness", "land", "score_depth")
 TITLE_KEYS = ("name", "number", "revision", "material", "date", "author")
 
 
