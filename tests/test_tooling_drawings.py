@@ -38,7 +38,10 @@ def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
                  "SECTION A-A", "DETAIL B 10:1", "PLAN", "FRONT", "SIDE"):
         assert text in svg, text
     scale = ts.report["drawing"]["scale"]
-    assert 1.0 < scale < 20.0 and f"scale {scale:.3g}:1" in svg
+    assert 1.0 < scale < 20.0 and f"scale {scale:.3g}:1   sheet A4" in svg
+    # the punches do not reach 1:1 on A4: the sheet grows until they do
+    td = ts.report["tooling_drawing"]
+    assert td["paper"] in ("A3", "A2") and td["scale"] >= 1.0
     tsvg = (out / "tooling.svg").read_text(encoding="utf-8")
     for text in ("overall 133.35 ±0.076", "Ø19.00", "Ø25.40", "tip 8.00", "tip 19.00", "Ø30.16 ±0.076", "H 22.22 ±0.076",
                  "UPPER PUNCH", "LOWER PUNCH", "DIE", "drawing no. TC-0001-T", "TSM B tooling, angled heads"):
@@ -65,7 +68,7 @@ def test_no_text_leaves_the_sheet_or_lies_on_the_views(drawn, which):
 
     ts, _, _ = drawn
     dr = drawing_model(ts) if which == "tablet" else tooling_model(ts)
-    fig = sheet_figure(dr)
+    fig = sheet_figure(dr, "A4" if which == "tablet" else ts.report["tooling_drawing"]["paper"])
     try:
         fig.canvas.draw()
         renderer = fig.canvas.get_renderer()

@@ -147,6 +147,7 @@ class Drawing:
     title: str = ""
     title_block: list = field(default_factory=list)
     scale: float | None = None
+    paper: str = "A4"
 
     def texts(self) -> list[str]:
         return [d.text for d in self.dims] + list(self.notes)
@@ -296,9 +297,13 @@ def _note_layout(notes: list[str], width_pt: float, height_pt: float) -> tuple[f
     return fs, ncols, lines[: rows * ncols - 1] + [f"... ({len(lines) - rows * ncols + 1} more lines in report.json)"]
 
 
-def sheet_figure(dr: Drawing):
-    """The A4 landscape matplotlib figure of ``dr``: the views above a title block that holds
-    the notes (in two columns when long), both placed in sheet coordinates so that nothing
+#: ISO 216 landscape sheets, inches (297 x 210, 420 x 297, 594 x 420 mm)
+PAPER = {"A4": (11.69, 8.27), "A3": (16.54, 11.69), "A2": (23.39, 16.54)}
+
+
+def sheet_figure(dr: Drawing, paper: str = "A4"):
+    """The landscape matplotlib figure of ``dr`` on ``paper``: the views above a title block that
+    holds the notes (in two columns when long), both placed in sheet coordinates so that nothing
     runs past the sheet's edge whatever the tablet's size."""
     import matplotlib
 
@@ -306,7 +311,9 @@ def sheet_figure(dr: Drawing):
     import matplotlib.patches
     import matplotlib.pyplot as plt
 
-    fig = plt.figure(figsize=(11.69, 8.27))  # A4 landscape
+    w_in, h_in = PAPER[paper]
+    fig = plt.figure(figsize=(w_in, h_in))
+    dr.paper = paper
     block = 0.2  # title block height, fraction of the sheet
     ax = fig.add_axes((0.04, block + 0.04, 0.92, 0.92 - block - 0.04))
     for kind, p in _sheet_lines(dr):
@@ -343,10 +350,10 @@ def sheet_figure(dr: Drawing):
     fig.add_artist(matplotlib.patches.Rectangle((0.04, 0.03), 0.92, block - 0.01, transform=fig.transFigure,
                                                 fill=False, lw=0.6, ec="0.2"))
     fig.text(0.05, 0.03 + block - 0.025, dr.title, fontsize=10, ha="left", va="top", weight="bold")
-    tb = list(dr.title_block) + [f"scale {_scale_text(scale)}   mm   third-angle projection"]
+    tb = list(dr.title_block) + [f"scale {_scale_text(scale)}   sheet {paper}   mm   third-angle projection"]
     fig.text(0.95, 0.03 + block - 0.02, "\n".join(tb), fontsize=6.5, ha="right", va="top", family="DejaVu Sans",
              linespacing=1.35)
-    fs, ncols, lines = _note_layout(list(dr.notes), 0.9 * 11.69 * 72.0, (block - 0.07 - 0.012 * len(tb)) * 8.27 * 72.0)
+    fs, ncols, lines = _note_layout(list(dr.notes), 0.9 * w_in * 72.0, (block - 0.07 - 0.012 * len(tb)) * h_in * 72.0)
     rows = -(-len(lines) // ncols)
     for c in range(ncols):
         fig.text(0.05 + 0.9 * c / ncols, 0.03 + block - 0.055 - 0.012 * len(tb), "\n".join(lines[c * rows:(c + 1) * rows]), fontsize=fs,
@@ -363,7 +370,11 @@ def _write_matplotlib(dr: Drawing, svg: Path, pdf: Path) -> None:
     import matplotlib.pyplot as plt
 
     with matplotlib.rc_context({"svg.fonttype": "none", "pdf.fonttype": 42}):
-        fig = sheet_figure(dr)
+        for paper in PAPER:  # the smallest sheet that shows the views at 1:1 or larger (else the largest)
+            fig = sheet_figure(dr, paper)
+            if dr.scale >= 1.0 or paper == "A2":
+                break
+            plt.close(fig)
         with atomic_path(svg) as tmp:
             fig.savefig(tmp, format="svg")
         with atomic_path(pdf) as tmp:
@@ -403,7 +414,7 @@ def write_drawing(ts, out_dir) -> list[Path]:
     _write_matplotlib(dr, svg, pdf)
     _write_dxf(dr, dxf)
     ts.report["drawing"] = dict(views=list(dr.views), dimension_texts=[d.text for d in dr.dims], notes=dr.notes,
-                                title=dr.title, title_block=dr.title_block, scale=dr.scale,
+                                title=dr.title, title_block=dr.title_block, scale=dr.scale, paper=dr.paper,
                                 visible_polylines={k: len(v["visible"]) for k, v in dr.views.items()})
     files = [svg, pdf, dxf]
     if ts.spec.body is not None:
@@ -412,7 +423,7 @@ def write_drawing(ts, out_dir) -> list[Path]:
         _write_matplotlib(tr, files[3], files[4])
         _write_dxf(tr, files[5])
         ts.report["tooling_drawing"] = dict(views=list(tr.views), dimension_texts=[d.text for d in tr.dims],
-                                            notes=tr.notes, scale=tr.scale)
+                                            notes=tr.notes, scale=tr.scale, paper=tr.paper)
     return files
 
 
