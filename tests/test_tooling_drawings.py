@@ -50,6 +50,13 @@ def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
     assert "overall 133.35" in dxf and "TC-0001" in dxf
 
 
+@pytest.fixture(scope="module")
+def capsule():
+    """A shaped tablet (length and width dimensioned in two views) with a score (section dimension)."""
+    p = SAMPLE.parent / "capsule.toml"
+    return make_tooling(load_design(p), parse_tooling(read_tooling_table(p)), check=False, interference_check=False)
+
+
 def _segments_display(ax, dr):
     pts = []
     for name, v in dr.views.items():
@@ -62,13 +69,19 @@ def _segments_display(ax, dr):
     return np.concatenate(pts)
 
 
-@pytest.mark.parametrize("which", ["tablet", "tooling"])
-def test_no_text_leaves_the_sheet_or_lies_on_the_views(drawn, which):
+@pytest.mark.parametrize("which", ["tablet", "tooling", "capsule"])
+def test_no_text_leaves_the_sheet_or_lies_on_the_views(drawn, capsule, which):
     import matplotlib.pyplot as plt
 
     ts, _, _ = drawn
-    dr = drawing_model(ts) if which == "tablet" else tooling_model(ts)
-    fig = sheet_figure(dr, "A4" if which == "tablet" else ts.report["tooling_drawing"]["paper"])
+    if which == "capsule":
+        dr, paper = drawing_model(capsule), "A4"
+        assert {"L 14.00 ±0.076", "W 6.00 ±0.076", "score 0.30 ±0.076"} <= {d.text for d in dr.dims}
+    elif which == "tablet":
+        dr, paper = drawing_model(ts), "A4"
+    else:
+        dr, paper = tooling_model(ts), ts.report["tooling_drawing"]["paper"]
+    fig = sheet_figure(dr, paper)
     try:
         fig.canvas.draw()
         renderer = fig.canvas.get_renderer()
@@ -80,9 +93,14 @@ def test_no_text_leaves_the_sheet_or_lies_on_the_views(drawn, which):
         for t in texts:
             bb = t.get_window_extent(renderer)
             assert fig.bbox.x0 <= bb.x0 and bb.x1 <= fig.bbox.x1 and fig.bbox.y0 <= bb.y0 and bb.y1 <= fig.bbox.y1
+        boxes = []
         for t in labels:
             bb = t.get_window_extent(renderer).expanded(0.98, 0.9)
             inside = (pts[:, 0] > bb.x0) & (pts[:, 0] < bb.x1) & (pts[:, 1] > bb.y0) & (pts[:, 1] < bb.y1)
             assert not inside.any(), f"{t.get_text()!r} lies on the {which} views"
+            boxes.append((t.get_text(), bb))
+        for k, (ta, a) in enumerate(boxes):  # and no two texts overlap
+            for tb, b in boxes[k + 1:]:
+                assert not a.overlaps(b), (ta, tb)
     finally:
         plt.close(fig)

@@ -331,9 +331,10 @@ def sheet_figure(dr: Drawing, paper: str = "A4"):
     for name, (ox, oy) in dr.origins.items():
         pts = np.concatenate([q for q in dr.views[name]["visible"]] or [np.zeros((1, 2))]) + np.array([ox, oy])
         ys = [pts[:, 1].min()]
-        for d in dr.dims:  # and under the dimension lines drawn across this view
+        lo, hi = pts.min(axis=0) - 1e-6, pts.max(axis=0) + 1e-6
+        for d in dr.dims:  # and under the dimension lines of this view (measured between its points)
             a, b, _ = _dim_geometry(d)
-            if not d.vertical and pts[:, 0].min() - 1e-9 <= 0.5 * (a[0] + b[0]) <= pts[:, 0].max() + 1e-9:
+            if not d.vertical and all(np.all((lo <= q) & (q <= hi)) for q in (np.asarray(d.p1), np.asarray(d.p2))):
                 ys.append(a[1] - 0.5)
         y = float(min(ys)) - 0.04 * float(np.ptp(pts[:, 1])) - 1.5  # under the view
         ax.text(ox, y, name.upper(), fontsize=8, ha="center", va="top")
