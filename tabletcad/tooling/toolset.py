@@ -95,14 +95,14 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     a_man = to_manifold(solid, deflection) if check and (spec.scores or spec.emboss) else None
     solid, score_checks, score_info = apply_scores(frame, solid, spec.scores, check=check, deflection=deflection, a_manifold=a_man)
     a_man = None
+    solid, emb_checks, emb_info = apply_emboss(frame, solid, spec.emboss, spec.clearance_mm, check=check, deflection=deflection)
+    rep_table = tablet.extras.get("report", {}) if isinstance(tablet.extras, dict) else {}
     split = None
-    if spec.scores:
+    if spec.scores:  # the finished tablet (scores and figures) split along its score planes
         from tabletcad.tooling.split import split_parts
 
-        rep = tablet.extras.get("report", {}) if isinstance(tablet.extras, dict) else {}
-        sf, rho = rep.get("solid_fraction"), rep.get("true_density_mg_mm3")
+        sf, rho = rep_table.get("solid_fraction"), rep_table.get("true_density_mg_mm3")
         split = split_parts(frame, solid, spec.scores, density_mg_mm3=None if sf is None or rho is None else sf * rho)
-    solid, emb_checks, emb_info = apply_emboss(frame, solid, spec.emboss, spec.clearance_mm, check=check, deflection=deflection)
     t1 = time.perf_counter()
     upper, chk_u = punch_tip(frame, solid, "upper", spec.clearance_mm, spec.tip_length_mm, check=check, deflection=deflection)
     lower, chk_l = punch_tip(frame, solid, "lower", spec.clearance_mm, spec.lower_tip, check=check, deflection=deflection)
@@ -141,7 +141,6 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     )
     from tabletcad.tooling.rating import tip_rating
 
-    rep_table = tablet.extras.get("report", {}) if isinstance(tablet.extras, dict) else {}
     report["tip_rating"] = tip_rating(frame, spec, rep_table)
     ts = ToolSet(tablet, spec, frame, parts, gap - gap_closed, report)
     if interference_check:
