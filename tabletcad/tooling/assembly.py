@@ -2,7 +2,7 @@
 
 ``assembly.step`` holds an XCAF assembly named ``<tablet>_tooling`` whose
 components are labelled ``tablet``, ``upper_punch``, ``lower_punch`` and
-``die``, in the press position of the chosen punch gap (the upper punch
+``die`` and coloured (:data:`PART_COLOURS`), in the press position of the chosen punch gap (the upper punch
 lifted by ``gap - band`` from the closed position).  ``upper_punch.step``,
 ``lower_punch.step`` and ``die.step`` hold one part each at the closed
 position.  Every file is written atomically (:mod:`tabletcad.io.atomic`).
@@ -24,14 +24,18 @@ try:  # OCP >= 8.0
 except ImportError:  # pragma: no cover - OCP 7.x
     from OCP.TDF import TDF_LabelSequence
 from OCP.TopoDS import TopoDS_Compound
-from OCP.XCAFDoc import XCAFDoc_ShapeTool
+from OCP.Quantity import Quantity_Color, Quantity_TOC_RGB
+from OCP.XCAFDoc import XCAFDoc_ColorGen, XCAFDoc_DocumentTool, XCAFDoc_ShapeTool
 
 from tabletcad.cad.export import export_step, step_document, write_step_document
 from tabletcad.errors import GeometryError
 
-__all__ = ["write_assembly", "write_parts", "PART_NAMES"]
+__all__ = ["write_assembly", "write_parts", "read_assembly_colours", "PART_NAMES", "PART_COLOURS"]
 
 PART_NAMES = ("tablet", "upper_punch", "lower_punch", "die")
+#: RGB (0-1) of each part in the assembly: white tablet, steel-blue punches, grey die
+PART_COLOURS = {"tablet": (0.95, 0.95, 0.92), "upper_punch": (0.45, 0.55, 0.75), "lower_punch": (0.35, 0.45, 0.65),
+                "die": (0.6, 0.6, 0.6)}
 
 
 def write_assembly(parts: dict, path, *, name: str = "tooling", offsets: dict | None = None) -> Path:
@@ -49,6 +53,7 @@ def write_assembly(parts: dict, path, *, name: str = "tooling", offsets: dict | 
         builder.Add(comp, parts[part].Moved(TopLoc_Location(tr)) if dz else parts[part])
     top = tool.AddShape(comp, True)  # an assembly: one component (and one part) per sub-shape
     TDataStd_Name.Set_s(top, TCollection_ExtendedString(str(name)))
+    colours = XCAFDoc_DocumentTool.ColorTool_s(doc.Main())
     labels = TDF_LabelSequence()
     XCAFDoc_ShapeTool.GetComponents_s(top, labels, False)
     if labels.Length() != len(names):
@@ -57,8 +62,11 @@ def write_assembly(parts: dict, path, *, name: str = "tooling", offsets: dict | 
         comp_label = labels.Value(k + 1)
         TDataStd_Name.Set_s(comp_label, TCollection_ExtendedString(part))
         ref = TDF_Label()
+        colour = Quantity_Color(*PART_COLOURS[part], Quantity_TOC_RGB)
+        colours.SetColor(comp_label, colour, XCAFDoc_ColorGen)
         if XCAFDoc_ShapeTool.GetReferredShape_s(comp_label, ref):
             TDataStd_Name.Set_s(ref, TCollection_ExtendedString(part))
+            colours.SetColor(ref, colour, XCAFDoc_ColorGen)
     return write_step_document(doc, path, what=f"the assembly {name}", obj=parts)
 
 
@@ -67,4 +75,35 @@ def write_parts(parts: dict, out_dir, names=("upper_punch", "lower_punch", "die"
     out = []
     for n in names:
         out.append(export_step(parts[n], Path(out_dir) / f"{n}.step", name=n))
+    return out
+
+
+def read_assembly_colours(path) -> dict:
+    """``{part name: (r, g, b)}`` of an assembly STEP as OCP's XCAF reader sees them (for checks)."""
+    from OCP.STEPCAFControl import STEPCAFControl_Reader
+    from OCP.TDocStd import TDocStd_Document
+    from OCP.Quantity import Quantity_TOC_RGB
+    from OCP.XCAFDoc import XCAFDoc_ColorSurf, XCAFDoc_ColorTool
+
+    doc = TDocStd_Document(TCollection_ExtendedString("XmlOcaf"))
+    reader = STEPCAFControl_Reader()
+    reader.SetColorMode(True)
+    reader.SetNameMode(True)
+    reader.ReadFile(str(path))
+    reader.Transfer(doc)
+    top = TDF_LabelSequence()
+    XCAFDoc_DocumentTool.ShapeTool_s(doc.Main()).GetFreeShapes(top)
+    comps = TDF_LabelSequence()
+    XCAFDoc_ShapeTool.GetComponents_s(top.Value(1), comps, False)
+    out = {}
+    for i in range(1, comps.Length() + 1):
+        ref, name = TDF_Label(), TDataStd_Name()
+        XCAFDoc_ShapeTool.GetReferredShape_s(comps.Value(i), ref)
+        if not ref.FindAttribute(TDataStd_Name.GetID_s(), name):
+            continue
+        c = Quantity_Color()
+        for lab in (comps.Value(i), ref):
+            if any(XCAFDoc_ColorTool.GetColor_s(lab, t, c) for t in (XCAFDoc_ColorGen, XCAFDoc_ColorSurf)):
+                out[name.Get().ToExtString()] = tuple(round(x, 4) for x in c.Values(Quantity_TOC_RGB))
+                break
     return out

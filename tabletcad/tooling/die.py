@@ -55,6 +55,12 @@ def default_die_size(frame: TabletFrame) -> tuple[float, float, str]:
                       f"give it for a tablet {size:.4g} mm long (larger than a TSM 'D' die takes, 25.4 mm)", "mm")
 
 
+def die_position(frame: TabletFrame, height: float, penetration: float | None = None) -> tuple[float, float, float]:
+    """``(upper punch entry, top z, bottom z)`` of a die ``height`` mm high at the closed position (mm)."""
+    pen = min(3.0, 0.25 * height) if penetration is None else penetration
+    return pen, frame.band_z[1] + pen, frame.band_z[1] + pen - height
+
+
 def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, taper_deg: float = 0.0,
         penetration: float | None = None):
     """The die solid at the closed position and its facts (``(shape, info)``)."""
@@ -68,9 +74,7 @@ def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, 
         raise DesignError("[tooling] die_outer_diameter_mm", od,
                           f"must be >= {2 * (r_bore + MIN_WALL_MM):.4g} mm (bore reaches {r_bore:.4g} mm from the axis, "
                           f"walls need {MIN_WALL_MM} mm)", "mm")
-    pen = min(3.0, 0.25 * H) if penetration is None else penetration
-    z_top = frame.band_z[1] + pen
-    z_bot = z_top - H
+    pen, z_top, z_bot = die_position(frame, H, penetration)
     if z_bot > frame.band_z[0] - 1.0:
         raise DesignError("[tooling] die_height_mm", H,
                           f"must be >= {pen + frame.band + 1.0:.4g} mm (upper punch entry {pen:.3g} mm + band "

@@ -6,9 +6,16 @@ silhouettes drawn solid, hidden sharp edges dashed.  Third-angle layout: the
 front elevation (looking along +y), the plan above it (looking down -z) and
 the side elevation (looking along -x) to its right.  Dimensions state the
 design's numbers: diameter (or length and width), band, cup depth, overall
-thickness, cup/edge radii and land.  Written as ``drawing.svg`` and
+thickness, cup/edge radii and land, each with its ± tolerance (the design's
+``[tooling.drawing] tolerances``, else its ``tolerance_mm``, else 0.076 mm stated
+on the sheet as this program's default).  The title block carries name,
+drawing number, revision, material, date and author from ``[tooling.drawing]``
+and the scale the views were drawn at.  Written as ``drawing.svg`` and
 ``drawing.pdf`` (matplotlib, text kept as text) and ``drawing.dxf`` (ezdxf,
-DIMENSION entities with the same texts).
+DIMENSION entities with the same texts).  With complete punches a second sheet,
+``tooling.svg``/``.pdf``/``.dxf``, shows the upper punch, lower punch and die
+in elevation with overall length, tip length, barrel, neck and head
+diameters, die diameter and height, and the die bore.
 """
 
 from __future__ import annotations
@@ -73,6 +80,53 @@ def project_view(shape, view: str) -> dict:
     return {"visible": vis, "hidden": hid}
 
 
+def section_view(shape, direction_deg: float) -> dict:
+    """The tablet cut by the plane through its axis across ``direction_deg`` (a score's direction):
+    ``{"visible": [polylines (across, z)], "hidden": []}``, seen from the side the score runs to."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
+
+    from tabletcad.tooling.booleans import raw_boolean
+
+    th = math.radians(direction_deg)
+    n = (-math.sin(th), math.cos(th))
+    R = 1e3
+    poly = BRepBuilderAPI_MakePolygon()
+    for u, z in ((-R, -R), (R, -R), (R, R), (-R, R)):
+        poly.Add(gp_Pnt(u * n[0], u * n[1], z))
+    poly.Close()
+    cut = raw_boolean("common", shape, BRepBuilderAPI_MakeFace(poly.Wire(), True).Face())
+    out = []
+    for e in explore(cut, "Edge"):
+        c = BRepAdaptor_Curve(e)
+        d = GCPnts_TangentialDeflection(c, 0.05, 0.002)
+        pts = [d.Value(i) for i in range(1, d.NbPoints() + 1)]
+        if len(pts) >= 2:
+            out.append(np.array([[p.X() * n[0] + p.Y() * n[1], p.Z()] for p in pts]))
+    return {"visible": out, "hidden": []}
+
+
+def detail_view(view: dict, centre: tuple[float, float], half: float, k: float) -> dict:
+    """The part of ``view`` within ``half`` mm of ``centre``, enlarged ``k`` times about it."""
+    c = np.asarray(centre, float)
+    out = []
+    step = half / 40.0
+    for p in view["visible"]:
+        # densify so that long straight edges through the window keep their inside part
+        seg = [np.linspace(a, b, max(2, int(np.ceil(np.linalg.norm(b - a) / step)) + 1))[:-1] for a, b in zip(p[:-1], p[1:])]
+        p = np.vstack(seg + [p[-1:]])
+        inside = np.all(np.abs(p - c) <= half, axis=1)
+        run: list = []
+        for q, ok in zip(p, inside):
+            if ok:
+                run.append(q)
+            elif run:
+                out.append(np.array(run))
+                run = []
+        if len(run) >= 2:
+            out.append(np.array(run))
+    return {"visible": [(p - c) * k for p in out if len(p) >= 2], "hidden": []}
+
+
 @dataclass
 class Dim:
     """A linear dimension between two sheet points, drawn ``offset`` mm aside, with its text."""
@@ -91,6 +145,9 @@ class Drawing:
     dims: list = field(default_factory=list)
     notes: list = field(default_factory=list)
     title: str = ""
+    title_block: list = field(default_factory=list)
+    scale: float | None = None
+    paper: str = "A4"
 
     def texts(self) -> list[str]:
         return [d.text for d in self.dims] + list(self.notes)
@@ -143,8 +200,69 @@ def drawing_model(ts) -> Drawing:
         notes.append(f"{s['kind']} score {s['profile']} {_fmt(s['depth_mm'])} mm deep on the {s['face']} face")
     for e in ts.report.get("emboss", []):
         notes.append(f"{e['mode']} '{e['text'] or 'outline'}' {_fmt(e['depth_mm'])} mm on the {e['face']} face")
+    r = ts.report.get("tip_rating") or {}
+    if r.get("rated_force_kN") is not None:
+        notes.append(f"tip force rating {r['rated_force_kN']:.3g} kN = {r['allowed_pressure_MPa']:g} MPa x "
+                     f"{r['tip_projected_area_mm2']:.4g} mm2 tip area (allowed pressure: {r['allowed_pressure_source']})")
+    for k, b in ((r.get("buckling") or {}).get("tips") or {}).items():
+        if b["buckling_load_kN"] is not None:
+            notes.append(f"{k} tip Euler buckling load {b['buckling_load_kN']:.3g} kN (K = 2, free length "
+                         f"{_fmt(b['free_length_mm'])} mm)")
     notes.append("all dimensions in mm; third-angle projection; generated from the B-rep (OCC HLR)")
-    return Drawing(views, origins, dims, notes, title=ts.tablet.name)
+    # section across the (first) score, or across x, and a detail of the land and band edge
+    scores = ts.spec.scores
+    th = scores[0].direction_deg if scores else 90.0
+    sec = section_view(shape, th)
+    k = 10.0
+    half = max(0.6, 1.2 * (fr.land or 0.0) + 0.2 * fr.cup_depth_top + 0.3)
+    half_w = 0.5 * (W if abs(math.sin(math.radians(th))) < 0.5 else L)  # the section's half width
+    det = detail_view(sec, (half_w, fr.band_z[1]), half, k)
+    ox = L / 2 + gap + W / 2
+    sx_, sy_ = ox, py - zc
+    views["section A-A"] = sec
+    origins["section A-A"] = (sx_, sy_)
+    views[f"detail B {k:g}:1"] = det
+    origins[f"detail B {k:g}:1"] = (sx_ + max(L, W) / 2 + gap / 2 + k * half, py)
+    if scores:
+        sc = ts.report["scores"][0]
+        dims.append(Dim((sx_, sy_ + fr.z_max - sc["depth_mm"]), (sx_, sy_ + fr.z_max), 2.0 + half_w,
+                        f"score {_fmt(sc['depth_mm'])}", vertical=True))
+    notes.append(f"section A-A through the axis across {th:g} deg{' (the score)' if scores else ''}; "
+                 f"detail B: band edge and land, {k:g}:1")
+    return Drawing(views, origins, _toleranced(dims, ts), notes, title=_title(ts), title_block=title_block(ts))
+
+
+_DIM_KEYS = {"Ø": "diameter", "L": "length", "W": "width", "band": "band", "cup": "cup_depth", "T": "thickness",
+             "score": "score_depth"}
+
+
+def _toleranced(dims: list, ts) -> list:
+    """``dims`` with ``±tolerance`` appended to each text (the drawing spec's value for its key)."""
+    from dataclasses import replace
+
+    dspec = ts.spec.drawing
+    out = []
+    for d in dims:
+        head = d.text.split()[0]
+        key = _DIM_KEYS.get(head, _DIM_KEYS.get(head[:1], None))
+        out.append(replace(d, text=f"{d.text} ±{_fmt(dspec.tolerance(key))}") if key else d)
+    return out
+
+
+def _title(ts) -> str:
+    d = ts.spec.drawing
+    return d.name or ts.tablet.name
+
+
+def title_block(ts, sheet: str = "tablet") -> list[str]:
+    """Title block lines: drawing number, revision, material, date, author and the tolerance note."""
+    d = ts.spec.drawing
+    number = d.number or "—"
+    rows = [f"drawing no. {number}{'' if sheet == 'tablet' else '-T'}   rev. {d.revision or '—'}   sheet: {sheet}",
+            f"material: {d.material or '—'}   date: {d.date or '—'}   author: {d.author or '—'}",
+            f"general tolerance ±{_fmt(d.tolerance_mm)} mm" + ("" if d.tolerance_given else
+                                                             " (tabletcad default, not a standard's value)")]
+    return rows
 
 
 def _sheet_lines(dr: Drawing):
@@ -179,9 +297,13 @@ def _note_layout(notes: list[str], width_pt: float, height_pt: float) -> tuple[f
     return fs, ncols, lines[: rows * ncols - 1] + [f"... ({len(lines) - rows * ncols + 1} more lines in report.json)"]
 
 
-def sheet_figure(dr: Drawing):
-    """The A4 landscape matplotlib figure of ``dr``: the views above a title block that holds
-    the notes (in two columns when long), both placed in sheet coordinates so that nothing
+#: ISO 216 landscape sheets, inches (297 x 210, 420 x 297, 594 x 420 mm)
+PAPER = {"A4": (11.69, 8.27), "A3": (16.54, 11.69), "A2": (23.39, 16.54)}
+
+
+def sheet_figure(dr: Drawing, paper: str = "A4"):
+    """The landscape matplotlib figure of ``dr`` on ``paper``: the views above a title block that
+    holds the notes (in two columns when long), both placed in sheet coordinates so that nothing
     runs past the sheet's edge whatever the tablet's size."""
     import matplotlib
 
@@ -189,7 +311,9 @@ def sheet_figure(dr: Drawing):
     import matplotlib.patches
     import matplotlib.pyplot as plt
 
-    fig = plt.figure(figsize=(11.69, 8.27))  # A4 landscape
+    w_in, h_in = PAPER[paper]
+    fig = plt.figure(figsize=(w_in, h_in))
+    dr.paper = paper
     block = 0.2  # title block height, fraction of the sheet
     ax = fig.add_axes((0.04, block + 0.04, 0.92, 0.92 - block - 0.04))
     for kind, p in _sheet_lines(dr):
@@ -205,23 +329,41 @@ def sheet_figure(dr: Drawing):
                 rotation=90 if d.vertical else 0, ha="center" if not d.vertical else "left",
                 va="bottom" if not d.vertical else "center")
     for name, (ox, oy) in dr.origins.items():
-        y = oy - 0.6 * (max(abs(np.concatenate([q[:, 1] for q in dr.views[name]["visible"]] or [np.zeros(1)]))) + 2.5)
+        pts = np.concatenate([q for q in dr.views[name]["visible"]] or [np.zeros((1, 2))]) + np.array([ox, oy])
+        ys = [pts[:, 1].min()]
+        lo, hi = pts.min(axis=0) - 1e-6, pts.max(axis=0) + 1e-6
+        for d in dr.dims:  # and under the dimension lines of this view (measured between its points)
+            a, b, _ = _dim_geometry(d)
+            if not d.vertical and all(np.all((lo <= q) & (q <= hi)) for q in (np.asarray(d.p1), np.asarray(d.p2))):
+                ys.append(a[1] - 0.5)
+        y = float(min(ys)) - 0.04 * float(np.ptp(pts[:, 1])) - 1.5  # under the view
         ax.text(ox, y, name.upper(), fontsize=8, ha="center", va="top")
         ax.update_datalim([(ox, y - 1.5)])  # keep the label inside the views' area
     ax.autoscale_view()
     ax.set_aspect("equal", adjustable="datalim")
     ax.margins(0.06)
     ax.axis("off")
+    fig.canvas.draw()  # fix the limits: the scale is paper mm per model mm
+    x0, x1 = ax.get_xlim()
+    scale = ax.get_window_extent().width / fig.dpi * 25.4 / (x1 - x0)
+    dr.scale = scale
     # title block: frame, title, notes
     fig.add_artist(matplotlib.patches.Rectangle((0.04, 0.03), 0.92, block - 0.01, transform=fig.transFigure,
                                                 fill=False, lw=0.6, ec="0.2"))
     fig.text(0.05, 0.03 + block - 0.025, dr.title, fontsize=10, ha="left", va="top", weight="bold")
-    fs, ncols, lines = _note_layout(list(dr.notes), 0.9 * 11.69 * 72.0, (block - 0.07) * 8.27 * 72.0)
+    tb = list(dr.title_block) + [f"scale {_scale_text(scale)}   sheet {paper}   mm   third-angle projection"]
+    fig.text(0.95, 0.03 + block - 0.02, "\n".join(tb), fontsize=6.5, ha="right", va="top", family="DejaVu Sans",
+             linespacing=1.35)
+    fs, ncols, lines = _note_layout(list(dr.notes), 0.9 * w_in * 72.0, (block - 0.07 - 0.012 * len(tb)) * h_in * 72.0)
     rows = -(-len(lines) // ncols)
     for c in range(ncols):
-        fig.text(0.05 + 0.9 * c / ncols, 0.03 + block - 0.055, "\n".join(lines[c * rows:(c + 1) * rows]), fontsize=fs,
+        fig.text(0.05 + 0.9 * c / ncols, 0.03 + block - 0.055 - 0.012 * len(tb), "\n".join(lines[c * rows:(c + 1) * rows]), fontsize=fs,
                  ha="left", va="top", family="DejaVu Sans", linespacing=1.35)
     return fig
+
+
+def _scale_text(scale: float) -> str:
+    return f"{scale:.3g}:1" if scale >= 1 else f"1:{1 / scale:.3g}"
 
 
 def _write_matplotlib(dr: Drawing, svg: Path, pdf: Path) -> None:
@@ -229,7 +371,11 @@ def _write_matplotlib(dr: Drawing, svg: Path, pdf: Path) -> None:
     import matplotlib.pyplot as plt
 
     with matplotlib.rc_context({"svg.fonttype": "none", "pdf.fonttype": 42}):
-        fig = sheet_figure(dr)
+        for paper in PAPER:  # the smallest sheet that shows the views at 1:1 or larger (else the largest)
+            fig = sheet_figure(dr, paper)
+            if dr.scale >= 1.0 or paper == "A2":
+                break
+            plt.close(fig)
         with atomic_path(svg) as tmp:
             fig.savefig(tmp, format="svg")
         with atomic_path(pdf) as tmp:
@@ -256,7 +402,7 @@ def _write_dxf(dr: Drawing, path: Path) -> None:
         dim.render()
     xs = [float(q[0]) for _, p in _sheet_lines(dr) for q in p]
     ys = [float(q[1]) for _, p in _sheet_lines(dr) for q in p]
-    msp.add_mtext("\\P".join(dr.notes), dxfattribs={"layer": "NOTES", "char_height": 0.8}).set_location((max(xs) + 8, max(ys)))
+    msp.add_mtext("\\P".join([dr.title, *dr.title_block, *dr.notes]), dxfattribs={"layer": "NOTES", "char_height": 0.8}).set_location((max(xs) + 8, max(ys)))
     with atomic_path(path) as tmp:
         doc.saveas(tmp)
 
@@ -269,5 +415,57 @@ def write_drawing(ts, out_dir) -> list[Path]:
     _write_matplotlib(dr, svg, pdf)
     _write_dxf(dr, dxf)
     ts.report["drawing"] = dict(views=list(dr.views), dimension_texts=[d.text for d in dr.dims], notes=dr.notes,
+                                title=dr.title, title_block=dr.title_block, scale=dr.scale, paper=dr.paper,
                                 visible_polylines={k: len(v["visible"]) for k, v in dr.views.items()})
-    return [svg, pdf, dxf]
+    files = [svg, pdf, dxf]
+    if ts.spec.body is not None:
+        tr = tooling_model(ts)
+        files += [out_dir / "tooling.svg", out_dir / "tooling.pdf", out_dir / "tooling.dxf"]
+        _write_matplotlib(tr, files[3], files[4])
+        _write_dxf(tr, files[5])
+        ts.report["tooling_drawing"] = dict(views=list(tr.views), dimension_texts=[d.text for d in tr.dims],
+                                            notes=tr.notes, scale=tr.scale, paper=tr.paper)
+    return files
+
+
+def tooling_model(ts) -> Drawing:
+    """Front elevations of the upper punch, lower punch and die (closed position, side by side)."""
+    rep = ts.report
+    up, lo, die = rep["upper_punch"]["body"], rep["lower_punch"]["body"], rep["die"]
+    fr = ts.frame
+    views = {k.replace("_", " "): project_view(ts.parts[k], "front") for k in ("upper_punch", "lower_punch", "die")}
+    Dh = max(up["head_diameter_mm"], up["barrel_diameter_mm"])
+    gap = 0.5 * Dh + 0.5 * die["outer_diameter_mm"] + 25.0
+    # side by side: upper punch, lower punch, die; lower punch and die lifted so all start near y = 0
+    origins = {"upper punch": (0.0, -fr.band_z[1]), "lower punch": (Dh + 25.0, lo["overall_length_mm"] - fr.band_z[0]),
+               "die": (Dh + 25.0 + gap, -die["bottom_z_mm"])}
+    dims: list[Dim] = []
+    tol = ts.spec.drawing.tolerance_mm
+    for name, b, edge, sgn in (("upper punch", up, fr.band_z[1], 1.0), ("lower punch", lo, fr.band_z[0], -1.0)):
+        ox, oy = origins[name]
+        z_tip, z_head = oy + edge, oy + b["head_flat_z_mm"]
+        z_shoulder = z_tip + sgn * b["tip_length_mm"]
+        rb, rh = 0.5 * b["barrel_diameter_mm"], 0.5 * b["head_diameter_mm"]
+        dims.append(Dim((ox - rh, min(z_tip, z_head)), (ox - rh, max(z_tip, z_head)), -4.0,
+                        f"overall {_fmt(b['overall_length_mm'])} ±{_fmt(tol)}", vertical=True))
+        dims.append(Dim((ox + rb, min(z_tip, z_shoulder)), (ox + rb, max(z_tip, z_shoulder)), 3.0,
+                        f"tip {_fmt(b['tip_length_mm'])}", vertical=True))
+        zb = z_shoulder + sgn * 0.5 * b["barrel_length_mm"]
+        dims.append(Dim((ox - rb, zb), (ox + rb, zb), 0.0, f"Ø{_fmt(b['barrel_diameter_mm'])}"))
+        zh = z_head - sgn * 0.5 * b["head_height_mm"]
+        dims.append(Dim((ox - rh, zh), (ox + rh, zh), sgn * (b["head_height_mm"] + 3.0), f"Ø{_fmt(b['head_diameter_mm'])}"))
+    ox, oy = origins["die"]
+    R = 0.5 * die["outer_diameter_mm"]
+    zb, zt = oy + die["bottom_z_mm"], oy + die["top_z_mm"]
+    dims.append(Dim((ox - R, zt), (ox + R, zt), 4.0, f"Ø{_fmt(die['outer_diameter_mm'])} ±{_fmt(tol)}"))
+    dims.append(Dim((ox + R, zb), (ox + R, zt), 3.0, f"H {_fmt(die['height_mm'])} ±{_fmt(tol)}", vertical=True))
+    notes = [f"{ts.tablet.name}: {up['standard']} {up['type'] or 'user-defined'} tooling, {up['head']} heads",
+             f"barrel Ø{_fmt(up['barrel_diameter_mm'])}, neck Ø{_fmt(up['neck_diameter_mm'])} x {_fmt(up['neck_length_mm'])}, "
+             f"head Ø{_fmt(up['head_diameter_mm'])} (flat Ø{_fmt(up['head_flat_diameter_mm'])})",
+             f"tip: straight {_fmt(up['tip_straight_mm'])}, relief {_fmt(up['tip_relief_mm'])} per side; "
+             f"upper tip {_fmt(up['tip_length_mm'])}, lower tip {_fmt(lo['tip_length_mm'])}",
+             f"die Ø{_fmt(die['outer_diameter_mm'])} x {_fmt(die['height_mm'])}, bore {die['bore']} + clearance "
+             f"{_fmt(ts.spec.clearance_mm)}, taper {die['taper_deg']:g} deg",
+             "standard dimensions: tabletcad/data/tooling_standards.toml (sources per value in report.json)"]
+    return Drawing(views, origins, dims, notes, title=f"{_title(ts)} — punches and die",
+                   title_block=title_block(ts, "punches and die"))

@@ -1,7 +1,9 @@
 """Embossed (raised) and debossed (cut) text or logo outlines on a tablet face.
 
-The figure is a set of plan faces at ``z = 0`` — text from a DejaVu font by
-build123d's ``Text`` (OCC ``Font_BRepTextBuilder``), or a closed polyline —
+The figure is a set of plan faces at ``z = 0`` — text from a DejaVu font (or
+any TTF) by build123d's ``Text`` (OCC ``Font_BRepTextBuilder``), a closed
+polyline, or a logo's filled outlines from an SVG file (build123d's
+``import_svg``, centred and scaled to ``height_mm`` tall) —
 rotated, moved to ``position_mm`` and, on the bottom face, mirrored so that
 it reads correctly when the tablet is turned over.  It is extruded along the
 axis into a prism (with ``draft_deg`` on its walls when asked) and made to
@@ -14,6 +16,15 @@ follow the face at a constant axial depth, the way a punch is engraved:
 
 Figures must lie inside the punch tip (outline inset by the clearance, the
 tablet's land and ``margin_mm``), else :class:`DesignError`.
+
+:func:`legibility` states the figures the trade checks against picking and
+sticking, as numbers (no pass/fail threshold is bundled, none being citable):
+the mean stroke width ``2A/P`` (area over half the perimeter, exact for long
+strokes of constant width), its ratio to the tablet's size, depth against cup
+depth and against stroke width, the land left between the figure and the tip
+edge, the smallest radius of the figure's curved edges and its sharp corners.
+A stroke angle that closes a stroke before its full depth
+(``depth · tan(angle) >= stroke width / 2``) is a :class:`DesignError`.
 """
 
 from __future__ import annotations
@@ -46,6 +57,8 @@ def figure_faces(e: EmbossSpec) -> TopoDS_Shape:
 
         txt = bd.Text(e.text, font_size=e.height_mm, font_path=str(font_path(e.font)))
         shape = txt.wrapped
+    elif e.svg is not None:
+        shape = svg_faces(e.svg, e.height_mm)
     else:
         shape = plan_face(polyline_wire(e.outline))
     trsf = gp_Trsf()
@@ -61,15 +74,92 @@ def figure_faces(e: EmbossSpec) -> TopoDS_Shape:
     return shape
 
 
+def svg_faces(path: str, height: float) -> TopoDS_Shape:
+    """The filled outlines of an SVG logo as plan faces, centred on the origin and ``height`` mm tall."""
+    import build123d as bd
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    faces = [s for s in bd.import_svg(path, align=None) if isinstance(s, bd.Face)]
+    if not faces:
+        raise DesignError("[[tooling.emboss]] svg", path, "has no filled outline (closed, filled path) to emboss")
+    comp = bd.Compound(faces).wrapped
+    box = Bnd_Box()
+    BRepBndLib.Add_s(comp, box)
+    lo, hi = box.CornerMin(), box.CornerMax()
+    tr = gp_Trsf()
+    tr.SetTranslation(gp_Vec(-0.5 * (lo.X() + hi.X()), -0.5 * (lo.Y() + hi.Y()), 0.0))
+    sc = gp_Trsf()
+    sc.SetScale(gp_Pnt(0, 0, 0), height / max(hi.Y() - lo.Y(), 1e-12))
+    return _transform(comp, sc.Multiplied(tr))
+
+
+def legibility(frame: TabletFrame, e: EmbossSpec, figure: TopoDS_Shape, clearance: float) -> dict:
+    """The figure's picking/legibility numbers (mm); see the module docstring."""
+    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+    from OCP.BRepLProp import BRepLProp_CLProps
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+
+    faces = explore(figure, "Face")
+    area = sum(face_area(f) for f in faces)
+    edges = explore(figure, "Edge")
+    perimeter = 0.0
+    r_min, sharp = math.inf, 0
+    for ed in edges:
+        c = BRepAdaptor_Curve(ed)
+        a, b = c.FirstParameter(), c.LastParameter()
+        from OCP.GCPnts import GCPnts_AbscissaPoint
+
+        perimeter += GCPnts_AbscissaPoint.Length_s(c)
+        props = BRepLProp_CLProps(c, 2, 1e-9)
+        for k in range(9):
+            props.SetParameter(a + (b - a) * k / 8.0)
+            if props.IsTangentDefined():
+                kappa = props.Curvature()
+                if kappa > 1e-9:
+                    r_min = min(r_min, 1.0 / kappa)
+    for w in explore(figure, "Wire"):  # corners: tangent jumps between consecutive edges
+        from OCP.BRepTools import BRepTools_WireExplorer
+        from OCP.TopoDS import TopoDS
+
+        ex, tans = BRepTools_WireExplorer(TopoDS.Wire_s(w)), []
+        while ex.More():
+            c = BRepAdaptor_Curve(ex.Current())
+            p, v0, v1 = gp_Pnt(), gp_Vec(), gp_Vec()
+            c.D1(c.FirstParameter(), p, v0)
+            c.D1(c.LastParameter(), p, v1)
+            rev = ex.Current().Orientation().name == "TopAbs_REVERSED"
+            tans.append((v1.Reversed(), v0.Reversed()) if rev else (v0, v1))
+            ex.Next()
+        for k in range(len(tans)):
+            t_end, t_start = tans[k][1], tans[(k + 1) % len(tans)][0]
+            if t_end.Magnitude() > 1e-12 and t_start.Magnitude() > 1e-12 and t_end.Angle(t_start) > math.radians(5.0):
+                sharp += 1
+    tip_edge = offset_wire(frame.outline, -clearance)
+    dss = BRepExtrema_DistShapeShape(figure, tip_edge)
+    land = float(dss.Value()) if dss.IsDone() else None
+    width = 2.0 * area / perimeter if perimeter > 0 else 0.0
+    cup = frame.cup_depth_top if e.face == "top" else frame.cup_depth_bottom
+    size = max(frame.length, frame.width)
+    return dict(stroke_width_mm=width, stroke_width_over_tablet_size=width / size, depth_mm=e.depth_mm,
+                depth_over_cup_depth=e.depth_mm / cup if cup > 0 else None,
+                depth_over_stroke_width=e.depth_mm / width if width > 0 else None,
+                land_to_tip_edge_mm=land, min_edge_radius_mm=None if math.isinf(r_min) else r_min,
+                sharp_corners=sharp, stroke_angle_deg=e.draft_deg,
+                stroke_closes_at_depth_mm=(0.5 * width / math.tan(math.radians(e.draft_deg))) if e.draft_deg > 0 else None,
+                method="stroke width = 2 x area / perimeter of the plan figure; land = exact distance figure to tip edge "
+                       "(outline inset by the clearance); radii sampled at 9 points per edge; corners: tangent jump > 5 deg")
+
+
 def _inset(frame: TabletFrame, clearance: float, e: EmbossSpec) -> float:
-    return clearance + (frame.land or 0.0) + e.margin_mm
+    return clearance + frame.edge_land(e.face) + e.margin_mm
 
 
 def check_fit(frame: TabletFrame, e: EmbossSpec, figure: TopoDS_Shape, clearance: float, i: int = 0) -> dict:
     """Raise :class:`DesignError` unless the figure lies inside the punch tip inset by land and margin."""
     inset = _inset(frame, clearance, e)
-    what = "text" if e.text is not None else "outline"
-    value = e.text if e.text is not None else f"{len(e.outline)} points"
+    what = "text" if e.text is not None else "svg" if e.svg is not None else "outline"
+    value = e.text if e.text is not None else e.svg if e.svg is not None else f"{len(e.outline)} points"
     try:
         region = plan_face(offset_wire(frame.outline, -inset))
     except GeometryError:
@@ -96,6 +186,12 @@ def check_emboss(frame: TabletFrame, e: EmbossSpec, clearance: float, i: int = 0
     """The placed figure and its fit facts; :class:`DesignError` if it does not fit or is too deep."""
     figure = figure_faces(e)
     info = check_fit(frame, e, figure, clearance, i)
+    info["legibility"] = leg = legibility(frame, e, figure, clearance)
+    if e.draft_deg > 0 and e.depth_mm * math.tan(math.radians(e.draft_deg)) >= 0.5 * leg["stroke_width_mm"]:
+        raise DesignError(f"[[tooling.emboss]] {i} stroke_angle_deg", e.draft_deg,
+                          f"must be < {math.degrees(math.atan(0.5 * leg['stroke_width_mm'] / e.depth_mm)):.3g} deg: the "
+                          f"walls of {leg['stroke_width_mm']:.3g} mm strokes would meet before the depth "
+                          f"{e.depth_mm:.3g} mm", "deg")
     cup = frame.cup_depth_top if e.face == "top" else frame.cup_depth_bottom
     limit = cup + 0.25 * frame.band
     if e.mode == "deboss" and e.depth_mm > limit:
@@ -103,16 +199,19 @@ def check_emboss(frame: TabletFrame, e: EmbossSpec, clearance: float, i: int = 0
     return figure, info
 
 
-def figure_prism(figure: TopoDS_Shape, z0: float, z1: float, draft_deg: float = 0.0, narrow_at: str = "z1") -> TopoDS_Shape:
-    """Prism of the plan figure from ``z0`` to ``z1``; with ``draft_deg`` the walls lean so that the
-    figure is nominal at ``z0`` and narrower towards ``z1``."""
+def figure_prism(figure: TopoDS_Shape, z0: float, z1: float, draft_deg: float = 0.0,
+                 z_nominal: float | None = None) -> TopoDS_Shape:
+    """Prism of the plan figure from ``z0`` to ``z1``; with ``draft_deg`` (the stroke angle) the walls
+    lean so that the figure is nominal at ``z_nominal`` (default ``z0``), narrower towards ``z1`` and
+    wider towards ``z0``."""
     faces = explore(figure, "Face")
     if draft_deg <= 0.0:
         from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
 
         solids = [translated(BRepPrimAPI_MakePrism(f, gp_Vec(0.0, 0.0, z1 - z0)).Shape(), dz=z0) for f in faces]
     else:
-        solids = [_placed(_draft_prism(f, abs(z1 - z0), draft_deg), z0, z1) for f in faces]
+        zn = z0 if z_nominal is None else z_nominal
+        solids = [_drafted(f, zn, abs(z1 - zn), abs(zn - z0), draft_deg, up=z1 > z0) for f in faces]
     if len(solids) == 1:
         return solids[0]
     from OCP.BRep import BRep_Builder
@@ -132,35 +231,53 @@ def _mirror_z(shape):
     return _transform(shape, m)
 
 
-def _draft_prism(face, height: float, draft_deg: float):
-    """``LocOpe_DPrism`` of a plan face at z = 0: ``z ∈ [0, height]``, walls leaning inward by ``draft_deg``."""
-    from OCP.Bnd import Bnd_Box
-    from OCP.BRepBndLib import BRepBndLib
-    from OCP.LocOpe import LocOpe_DPrism
-
+def _drafted(face, z_n: float, narrow: float, wide: float, draft_deg: float, up: bool):
+    """``LocOpe_DPrism`` of a plan face: nominal at ``z_n``, narrowing over ``narrow`` mm along the axis
+    (upwards if ``up``) and widening over ``wide`` mm the other way; walls at ``draft_deg`` to the axis.
+    LocOpe_DPrism measures its heights along the leaning walls (axial length / cos(angle)) and which
+    side each goes to depends on the face's orientation, so the result is checked and turned: its
+    narrow end face (the smaller planar end) up, its axial extents equal to ``narrow`` and ``wide``."""
     from OCP.BRepCheck import BRepCheck_Analyzer
+    from OCP.LocOpe import LocOpe_DPrism
     from OCP.ShapeFix import ShapeFix_Shape
 
-    solid = LocOpe_DPrism(face, float(height), math.radians(draft_deg)).Shape()
-    if not BRepCheck_Analyzer(solid).IsValid():
-        fix = ShapeFix_Shape(solid)
-        fix.Perform()
-        solid = fix.Shape()
+    c = math.cos(math.radians(draft_deg))
+    for h1, h2 in ((narrow, wide), (wide, narrow)):
+        solid = LocOpe_DPrism(face, float(h1) / c, float(h2) / c, math.radians(draft_deg)).Shape()
+        if not BRepCheck_Analyzer(solid).IsValid():
+            fix = ShapeFix_Shape(solid)
+            fix.Perform()
+            solid = fix.Shape()
+        solids = explore(solid, "Solid")
+        if len(solids) != 1:
+            raise GeometryError(f"drafted prism of a glyph gave {len(solids)} solids", face)
+        solid = solids[0]
+        lo, hi = _z_range(solid)
+        ends = {}
+        for f in explore(solid, "Face"):
+            flo, fhi = _z_range(f)
+            if fhi - flo < 1e-9:
+                ends["top" if abs(fhi - hi) < 1e-7 else "bottom"] = ends.get("top" if abs(fhi - hi) < 1e-7 else "bottom", 0.0) + face_area(f)
+        if ends.get("top", 0.0) > ends.get("bottom", 0.0):
+            solid = _mirror_z(solid)
+            lo, hi = -hi, -lo
+        if abs(hi - narrow) < 1e-6 and abs(-lo - wide) < 1e-6:
+            break
+    else:
+        raise GeometryError(f"drafted prism of a glyph: axial extents {lo:.6g}..{hi:.6g} mm, wanted "
+                            f"{-wide:.6g}..{narrow:.6g} mm", face)
+    if not up:
+        solid = _mirror_z(solid)
+    return translated(solid, dz=z_n)
+
+
+def _z_range(shape) -> tuple[float, float]:
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
     box = Bnd_Box()
-    BRepBndLib.Add_s(solid, box)
-    if box.CornerMax().Z() < 0.5 * height:  # the (mirrored) face pointed down
-        solid = _mirror_z(solid)
-    solids = explore(solid, "Solid")
-    if len(solids) != 1:
-        raise GeometryError(f"drafted prism of a glyph gave {len(solids)} solids", face)
-    return solids[0]
-
-
-def _placed(solid, z0: float, z1: float):
-    """Move a prism built on ``[0, h]`` so that its base is at ``z0`` and it extends towards ``z1``."""
-    if z1 < z0:
-        solid = _mirror_z(solid)
-    return translated(solid, dz=z0)
+    BRepBndLib.AddOptimal_s(shape, box, False, False)
+    return box.CornerMin().Z(), box.CornerMax().Z()
 
 
 def apply_emboss(frame: TabletFrame, shape, items, clearance: float, *, check: bool = True,
@@ -178,23 +295,28 @@ def apply_emboss(frame: TabletFrame, shape, items, clearance: float, *, check: b
         far = frame.z_max if top else frame.z_min
         inner = near - sg * ((e.depth_mm if e.mode == "deboss" else 0.0) + 0.05)
         outer = far + sg * ((e.depth_mm if e.mode == "emboss" else 0.0) + 0.05)
+        # stroke angle: the figure is nominal at the mean height of the face under it (exact on a flat
+        # face; on a cup its width at the face varies by +-spread/2 * tan(angle), reported)
+        z_face = sum(zs) / len(zs)
+        info["face_height_spread_mm"] = max(zs) - min(zs)
+        info["width_variation_at_face_mm"] = 0.5 * (max(zs) - min(zs)) * math.tan(math.radians(e.draft_deg))
         if e.mode == "deboss":
-            # draft: nominal at the face side, narrower towards the letter bottom
-            prism = figure_prism(figure, outer, inner, e.draft_deg)
+            # narrower towards the letter bottom, wider out of the tablet
+            prism = figure_prism(figure, outer, inner, e.draft_deg, z_nominal=z_face)
             shifted = translated(shape, dz=-sg * e.depth_mm)
             tool = _cut_each(prism, shifted, i)
             op = "cut"
         else:
-            prism = figure_prism(figure, inner, outer, e.draft_deg)
+            prism = figure_prism(figure, inner, outer, e.draft_deg, z_nominal=z_face)
             shifted = translated(shape, dz=sg * e.depth_mm)
             tool = _common_each(prism, shifted, i)
             op = "fuse"
-        shape, chk = checked_boolean(op, shape, tool, what=f"{e.mode} {i} ({e.text or 'outline'}, {e.face})",
+        shape, chk = checked_boolean(op, shape, tool, what=f"{e.mode} {i} ({e.text or e.svg or 'outline'}, {e.face})",
                                      deflection=deflection, check=check, a_manifold=a_manifold)
         a_manifold = None
         if chk is not None:
             checks.append(chk)
-        infos.append(dict(index=i, text=e.text, outline_points=None if e.outline is None else len(e.outline), mode=e.mode,
+        infos.append(dict(index=i, text=e.text, svg=e.svg, outline_points=None if e.outline is None else len(e.outline), mode=e.mode,
                           face=e.face, height_mm=e.height_mm, depth_mm=e.depth_mm, draft_deg=e.draft_deg,
                           font=e.font if e.text else None, volume_changed_mm3=None if chk is None else chk.occ_change_mm3,
                           **info))

@@ -79,6 +79,12 @@ class TabletFrame:
     def cup_depth_bottom(self) -> float:
         return self.band_z[0] - self.z_min
 
+    def edge_land(self, face: str = "top") -> float:
+        """The land to keep figures and short scores away from (mm): the family's land, except on a
+        flat face (no cup), where the whole face is flat and there is no land ring."""
+        cup = self.cup_depth_top if face == "top" else self.cup_depth_bottom
+        return 0.0 if cup < 1e-9 else (self.land or 0.0)
+
     @property
     def thickness(self) -> float:
         return self.z_max - self.z_min

@@ -16,7 +16,11 @@ The groove bottom is straight.  A *standard* score must run out on the face
 a *cut-through* score (``cut_through = true``) continues through the band edge
 and may be at most the cup depth plus a quarter of the band deep (two
 cut-through grooves leave at least half the band).  Quadrisects are two
-grooves crossing at 90 degrees.  Each cut is checked against manifold3d
+grooves crossing at 90 degrees.  A *short* (decorative) score (``length_mm``)
+is a groove of that length centred on the axis, with vertical ends; it must
+end inside the face (its footprint inside the outline inset by the land and
+the clearance, so its punch bar stays clear of the tip edge) and may be as deep
+as a cut-through score.  Each cut is checked against manifold3d
 (:func:`tabletcad.tooling.booleans.checked_boolean`).
 """
 
@@ -75,16 +79,48 @@ def groove_solid(profile: list[tuple[float, float]], direction_deg: float, lengt
     return BRepPrimAPI_MakePrism(face, gp_Vec(length * d[0], length * d[1], 0.0)).Shape()
 
 
+def groove_width(s: ScoreSpec) -> float:
+    """The groove's width at the face (mm) where it is ``depth_mm`` deep."""
+    t = math.tan(math.radians(0.5 * s.angle_deg))
+    return {"v": 2 * s.depth_mm * t, "u": s.width_mm,
+            "pressure_sensitive": s.slot_width_mm + 2 * (2 * s.depth_mm / 3) * t}[s.profile]
+
+
+def _check_short(frame: TabletFrame, s: ScoreSpec, i: int) -> None:
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.outline import face_area, offset_wire, plan_face
+
+    th = math.radians(s.direction_deg)
+    d, n = (math.cos(th), math.sin(th)), (-math.sin(th), math.cos(th))
+    a, b = 0.5 * s.length_mm, 0.5 * groove_width(s)
+    poly = BRepBuilderAPI_MakePolygon()
+    for u, v in ((-a, -b), (a, -b), (a, b), (-a, b)):
+        poly.Add(gp_Pnt(u * d[0] + v * n[0], u * d[1] + v * n[1], 0.0))
+    poly.Close()
+    foot = BRepBuilderAPI_MakeFace(poly.Wire(), True).Face()
+    inset = max(frame.edge_land(f) for f in s.face_list) + 0.05
+    outside = sum(face_area(f) for f in explore(BRepAlgoAPI_Cut(foot, plan_face(offset_wire(frame.outline, -inset))).Shape(),
+                                                  "Face"))
+    if outside > 1e-9:
+        raise DesignError(f"[[tooling.score]] {i} length_mm", s.length_mm,
+                          f"the short score must end on the face: its {2 * a:.3g} x {2 * b:.3g} mm footprint leaves the "
+                          f"outline inset by the land + 0.05 mm ({inset:.3g} mm)", "mm")
+
+
 def check_score(frame: TabletFrame, s: ScoreSpec, i: int = 0) -> None:
     """Raise :class:`DesignError` if the score is deeper than the cup (and band) allow."""
     w = f"[[tooling.score]] {i} depth_mm"
+    if s.length_mm is not None:
+        _check_short(frame, s, i)
     for face in s.face_list:
         cup = frame.cup_depth_top if face == "top" else frame.cup_depth_bottom
-        if s.cut_through:
+        if s.cut_through or s.length_mm is not None:
             limit = cup + 0.25 * frame.band
             if s.depth_mm > limit:
                 raise DesignError(w, s.depth_mm, f"must be <= cup depth + band/4 = {limit:.4g} mm on the {face} face "
-                                  "(a cut-through score must leave half the band)", "mm")
+                                  "(a cut-through or short score must leave half the band)", "mm")
         elif s.depth_mm > cup - RUN_OUT_MARGIN_MM:
             raise DesignError(w, s.depth_mm, f"must be < the {face} cup depth {cup:.4g} mm minus {RUN_OUT_MARGIN_MM} mm "
                               "(a standard score runs out on the face; set cut_through = true to cut the band)", "mm")
@@ -92,7 +128,7 @@ def check_score(frame: TabletFrame, s: ScoreSpec, i: int = 0) -> None:
 
 def score_cutter(frame: TabletFrame, s: ScoreSpec, face: str):
     """The solid removed by score ``s`` on ``face`` (one groove, or two fused for a quadrisect)."""
-    length = 2.0 * max(frame.length, frame.width) + 4.0
+    length = 2.0 * max(frame.length, frame.width) + 4.0 if s.length_mm is None else s.length_mm
     if face == "top":
         zb = frame.z_max - s.depth_mm
         zt = frame.z_max + ABOVE_MM
@@ -122,11 +158,9 @@ def apply_scores(frame: TabletFrame, shape, scores, *, check: bool = True, defle
             a_manifold = None
             if chk is not None:
                 checks.append(chk)
-            t = math.tan(math.radians(0.5 * s.angle_deg))
-            width = {"v": 2 * s.depth_mm * t, "u": s.width_mm,
-                     "pressure_sensitive": s.slot_width_mm + 2 * (2 * s.depth_mm / 3) * t}[s.profile]
             infos.append(dict(index=i, kind=s.kind, profile=s.profile, face=face, depth_mm=s.depth_mm,
-                              width_at_face_centre_mm=width, angle_deg=s.angle_deg, cut_through=s.cut_through,
+                              width_at_face_centre_mm=groove_width(s), angle_deg=s.angle_deg, cut_through=s.cut_through,
+                              length_mm=s.length_mm,
                               direction_deg=s.direction_deg,
                               removed_mm3=None if chk is None else chk.occ_change_mm3))
     return shape, checks, infos

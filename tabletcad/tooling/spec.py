@@ -9,6 +9,21 @@
     die_height_mm = 22.22          # die height
     taper_deg = 0.0                # die bore taper above the tablet, degrees (0 = straight)
     gap_mm = 2.8                   # distance between the punch tip edges; default: closed (= band)
+    standard = "TSM"               # complete punches: "TSM" | "EU" | "custom" (absent: punch tips only)
+    type = "B"                     # "B" | "D" (TSM and EU; see tabletcad/data/tooling_standards.toml)
+    lower_tip_length_mm = 19.0     # lower punch tip length (default: tip_length_mm)
+    allowed_tip_pressure_MPa = 300.0          # tip-force rating F = p x tip area; needs its source:
+    allowed_tip_pressure_source = "..."       # (no allowed pressure is bundled)
+    punch_youngs_modulus_MPa = 210000.0       # tip buckling (Euler); needs its source:
+    punch_youngs_modulus_source = "..."
+
+    [tooling.drawing]              # title block and tolerances of the drawings
+    name = "Example 10 mm"         # name, number, revision, material, date, author: strings
+    tolerance_mm = 0.076           # general +- tolerance (default 0.076 mm, stated on the sheet)
+    tolerances = { cup_depth = 0.05 }   # per dimension: diameter, length, width, band, cup_depth, thickness
+
+    [tooling.punch]                # body dimensions the standard file does not hold (see standards.py)
+    head_diameter_mm = 25.4        # ... every key of tabletcad.tooling.standards.BODY_KEYS
 
     [[tooling.score]]              # bisect or quadrisect score
     kind = "bisect"                # "bisect" | "quadrisect"
@@ -19,14 +34,16 @@
     cut_through = false            # true: the groove runs out through the band edge
     faces = "top"                  # "top" | "bottom" | "both"
     direction_deg = 90.0           # groove direction in plan, from the x axis
+    length_mm = 4.0                # short (decorative) score: groove length, centred; default: across the face
 
     [[tooling.emboss]]             # text or a logo outline, debossed (cut) or embossed (raised)
-    text = "A10"                   # or: outline = [[x, y], ...] (closed polyline, mm)
+    text = "A10"                   # or: outline = [[x, y], ...] (closed polyline, mm), or svg = "logo.svg"
     mode = "deboss"                # "deboss" | "emboss"
     face = "top"                   # "top" | "bottom"
     height_mm = 2.0                # font size (text)
     depth_mm = 0.15                # depth (deboss) or height (emboss), along the axis
-    draft_deg = 0.0                # stroke draft angle of the letter walls
+    stroke_angle_deg = 0.0         # stroke angle: draft of the letter walls from the axis, 0 <= . < 60
+                                   # (``draft_deg`` is accepted as the same key)
     font = "DejaVuSans-Bold"       # a DejaVu font name or a .ttf path
     position_mm = [0.0, 0.0]
     rotation_deg = 0.0
@@ -41,6 +58,7 @@ from pathlib import Path
 from typing import Any
 
 from tabletcad.errors import DesignError, check_finite, check_positive, check_range
+from tabletcad.tooling.standards import PunchBody, resolve_body
 
 __all__ = ["ToolingSpec", "ScoreSpec", "EmbossSpec", "parse_tooling", "FONT_DIR", "font_path"]
 
@@ -58,6 +76,7 @@ class ScoreSpec:
     faces: str = "top"
     direction_deg: float = 90.0
     slot_width_mm: float = 0.1
+    length_mm: float | None = None
 
     @property
     def face_list(self) -> tuple[str, ...]:
@@ -77,6 +96,51 @@ class EmbossSpec:
     position_mm: tuple[float, float] = (0.0, 0.0)
     rotation_deg: float = 0.0
     margin_mm: float = 0.2
+    svg: str | None = None
+
+
+#: general +- tolerance (mm) printed on the drawings when the design gives none: 0.003 in, stated on the sheet
+#: as this program's default, not as a standard's value
+DEFAULT_TOLERANCE_MM = 0.076
+TOLERANCE_KEYS = ("diameter", "length", "width", "band", "cup_depth", "thickness", "land", "score_depth")
+TITLE_KEYS = ("name", "number", "revision", "material", "date", "author")
+
+
+@dataclass(frozen=True)
+class DrawingSpec:
+    """Title block texts and tolerances (mm) of the drawings (``[tooling.drawing]``)."""
+
+    name: str | None = None
+    number: str | None = None
+    revision: str | None = None
+    material: str | None = None
+    date: str | None = None
+    author: str | None = None
+    tolerance_mm: float = DEFAULT_TOLERANCE_MM
+    tolerance_given: bool = False
+    tolerances: tuple = ()
+
+    def tolerance(self, key: str) -> float:
+        """The +- tolerance (mm) of dimension ``key``."""
+        return dict(self.tolerances).get(key, self.tolerance_mm)
+
+
+def _drawing(t: Any) -> DrawingSpec:
+    w = "[tooling.drawing]"
+    t = _keys(w, t, set(TITLE_KEYS) | {"tolerance_mm", "tolerances"})
+    kw = {}
+    for k in TITLE_KEYS:
+        if k in t:
+            v = t[k]
+            if not isinstance(v, (str, int, float)) or isinstance(v, bool) or not str(v).strip():
+                raise DesignError(f"{w} {k}", v, "must be a non-empty string")
+            kw[k] = str(v)
+    if "tolerance_mm" in t:
+        kw["tolerance_mm"] = check_positive(f"{w} tolerance_mm", t["tolerance_mm"], "mm")
+        kw["tolerance_given"] = True
+    tol = _keys(f"{w} tolerances", t.get("tolerances", {}), set(TOLERANCE_KEYS))
+    kw["tolerances"] = tuple((k, check_positive(f"{w} tolerances.{k}", v, "mm")) for k, v in tol.items())
+    return DrawingSpec(**kw)
 
 
 @dataclass(frozen=True)
@@ -90,6 +154,18 @@ class ToolingSpec:
     scores: tuple[ScoreSpec, ...] = ()
     emboss: tuple[EmbossSpec, ...] = ()
     extra: dict = field(default_factory=dict)
+    body: PunchBody | None = None
+    lower_tip_length_mm: float | None = None
+    drawing: DrawingSpec = DrawingSpec()
+    allowed_tip_pressure_MPa: float | None = None
+    allowed_tip_pressure_source: str | None = None
+    punch_youngs_modulus_MPa: float | None = None
+    punch_youngs_modulus_source: str | None = None
+
+    @property
+    def lower_tip(self) -> float:
+        """The lower punch's tip length (mm)."""
+        return self.tip_length_mm if self.lower_tip_length_mm is None else self.lower_tip_length_mm
 
     def with_(self, **kw: Any) -> "ToolingSpec":
         return replace(self, **kw)
@@ -142,18 +218,30 @@ def _score(i: int, t: Any) -> ScoreSpec:
     if profile == "v" and width > 0 and "angle_deg" not in t:
         angle = math.degrees(2.0 * math.atan(0.5 * width / depth))
     slot = check_positive(f"{w} slot_width_mm", t.get("slot_width_mm", d.slot_width_mm), "mm")
-    return ScoreSpec(kind, profile, depth, angle, width, _bool(f"{w} cut_through", t.get("cut_through", d.cut_through)),
+    cut = _bool(f"{w} cut_through", t.get("cut_through", d.cut_through))
+    length = t.get("length_mm")
+    if length is not None:
+        length = check_positive(f"{w} length_mm", length, "mm")
+        if cut:
+            raise DesignError(f"{w} length_mm", length, "a short score cannot be cut_through (it ends on the face)", "mm")
+    return ScoreSpec(kind, profile, depth, angle, width, cut,
                      _choice(f"{w} faces", t.get("faces", d.faces), ("top", "bottom", "both")),
-                     check_finite(f"{w} direction_deg", t.get("direction_deg", d.direction_deg), "deg"), slot)
+                     check_finite(f"{w} direction_deg", t.get("direction_deg", d.direction_deg), "deg"), slot, length)
 
 
 def _emboss(i: int, t: Any) -> EmbossSpec:
     w = f"[[tooling.emboss]] {i}"
     d = EmbossSpec()
-    t = _keys(w, t, set(EmbossSpec.__dataclass_fields__))
-    text, outline = t.get("text"), t.get("outline")
-    if (text is None) == (outline is None):
-        raise DesignError(f"{w} text", text, "give either text or outline (a closed polyline [[x, y], ...])")
+    t = _keys(w, t, set(EmbossSpec.__dataclass_fields__) | {"stroke_angle_deg"})
+    text, outline, svg = t.get("text"), t.get("outline"), t.get("svg")
+    if sum(x is not None for x in (text, outline, svg)) != 1:
+        raise DesignError(f"{w} text", text, "give exactly one of text, outline (a closed polyline [[x, y], ...]) or svg "
+                          "(a logo file)")
+    if svg is not None and not (isinstance(svg, str) and Path(svg).suffix.lower() == ".svg" and Path(svg).is_file()):
+        raise DesignError(f"{w} svg", svg, "must be the path of an existing .svg file")
+    if "stroke_angle_deg" in t and "draft_deg" in t:
+        raise DesignError(f"{w} draft_deg", t["draft_deg"], "give stroke_angle_deg or draft_deg, not both", "deg")
+    stroke = t.get("stroke_angle_deg", t.get("draft_deg", d.draft_deg))
     if text is not None and (not isinstance(text, str) or not text.strip()):
         raise DesignError(f"{w} text", text, "must be a non-empty string")
     if outline is not None:
@@ -173,18 +261,21 @@ def _emboss(i: int, t: Any) -> EmbossSpec:
         _choice(f"{w} face", t.get("face", d.face), ("top", "bottom")),
         check_positive(f"{w} height_mm", t.get("height_mm", d.height_mm), "mm"),
         check_positive(f"{w} depth_mm", t.get("depth_mm", d.depth_mm), "mm"),
-        check_range(f"{w} draft_deg", t.get("draft_deg", d.draft_deg), 0.0, 30.0, "deg", hi_open=True),
+        check_range(f"{w} stroke_angle_deg", stroke, 0.0, 60.0, "deg", hi_open=True),
         font,
         (check_finite(f"{w} position_mm", pos[0], "mm"), check_finite(f"{w} position_mm", pos[1], "mm")),
         check_finite(f"{w} rotation_deg", t.get("rotation_deg", d.rotation_deg), "deg"),
         check_range(f"{w} margin_mm", t.get("margin_mm", d.margin_mm), 0.0, None, "mm"),
+        svg,
     )
 
 
 def parse_tooling(table: Any) -> ToolingSpec:
     """A :class:`ToolingSpec` from the ``[tooling]`` table (raises :class:`DesignError`)."""
     d = ToolingSpec()
-    keys = {"clearance_mm", "tip_length_mm", "die_outer_diameter_mm", "die_height_mm", "taper_deg", "gap_mm", "score", "emboss"}
+    keys = {"clearance_mm", "tip_length_mm", "die_outer_diameter_mm", "die_height_mm", "taper_deg", "gap_mm", "score", "emboss",
+            "standard", "type", "punch", "lower_tip_length_mm", "drawing", "allowed_tip_pressure_MPa",
+            "allowed_tip_pressure_source", "punch_youngs_modulus_MPa", "punch_youngs_modulus_source"}
     t = _keys("[tooling]", table, keys)
     clearance = check_range("[tooling] clearance_mm", t.get("clearance_mm", d.clearance_mm), 0.0, 1.0, "mm")
     tip = check_positive("[tooling] tip_length_mm", t.get("tip_length_mm", d.tip_length_mm), "mm")
@@ -200,6 +291,35 @@ def parse_tooling(table: Any) -> ToolingSpec:
         raise DesignError("[[tooling.score]]", scores, "must be an array of tables")
     if not isinstance(emb, list):
         raise DesignError("[[tooling.emboss]]", emb, "must be an array of tables")
+    lower = t.get("lower_tip_length_mm")
+    lower = None if lower is None else check_positive("[tooling] lower_tip_length_mm", lower, "mm")
+    body = None
+    if "standard" in t or "type" in t or "punch" in t:
+        std = _choice("[tooling] standard", t.get("standard", "missing"), ("TSM", "EU", "custom"))
+        kind = None
+        if std != "custom":
+            kind = _choice("[tooling] type", t.get("type", "missing"), ("B", "D"))
+        body = resolve_body(std, kind, t.get("punch"), tip, tip if lower is None else lower)
+        if "die_height_mm" not in t:
+            raise DesignError("[tooling] die_height_mm", "missing", "required with complete punches: no citable "
+                              "public die height is bundled (tabletcad/data/tooling_standards.toml)", "mm")
+        if od is None:
+            if body.die_outer_diameter_mm is None:
+                raise DesignError("[tooling] die_outer_diameter_mm", "missing", "required with standard = 'custom'", "mm")
+            od = body.die_outer_diameter_mm
+    sourced = {}
+    for key, unit in (("allowed_tip_pressure_MPa", "MPa"), ("punch_youngs_modulus_MPa", "MPa")):
+        skey = key.replace("_MPa", "_source")
+        if key in t:
+            sourced[key] = check_positive(f"[tooling] {key}", t[key], unit)
+            src = t.get(skey)
+            if not (isinstance(src, str) and src.strip()):
+                raise DesignError(f"[tooling] {skey}", src if src is not None else "missing",
+                                  f"must name the source of {key} (a non-empty string)")
+            sourced[skey] = src
+        elif skey in t:
+            raise DesignError(f"[tooling] {skey}", t[skey], f"give it together with {key}")
     return ToolingSpec(clearance, tip, od, height, taper, gap,
                        tuple(_score(i, s) for i, s in enumerate(scores)),
-                       tuple(_emboss(i, e) for i, e in enumerate(emb)))
+                       tuple(_emboss(i, e) for i, e in enumerate(emb)), body=body, lower_tip_length_mm=lower,
+                       drawing=_drawing(t.get("drawing", {})), **sourced)

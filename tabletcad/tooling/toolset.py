@@ -43,6 +43,25 @@ class ToolSet:
         return out
 
 
+def _check_complete_punches(frame, spec: ToolingSpec) -> None:
+    """Bad complete-punch input (tablet larger than the barrel or the standard, a tip too short to keep
+    the barrel out of the die) as a DesignError, before any tooling geometry is built."""
+    from tabletcad.tooling.die import _max_radius, die_position
+    from tabletcad.tooling.punch_body import check_body_fits
+
+    check_body_fits(frame, spec.body, _max_radius(frame.outline))
+    _, top, bottom = die_position(frame, spec.die_height_mm)
+    need_up = top - frame.band_z[1]
+    if spec.tip_length_mm <= need_up:
+        raise DesignError("[tooling] tip_length_mm", spec.tip_length_mm,
+                          f"must be > {need_up:.4g} mm, the upper punch's entry into the die (the barrel stays out)", "mm")
+    need_low = frame.band_z[0] - bottom
+    if spec.lower_tip <= need_low:
+        raise DesignError("[tooling] lower_tip_length_mm", spec.lower_tip,
+                          f"must be > {need_low:.4g} mm: from the lower tip edge to the die's bottom face at the "
+                          f"closed position (the barrel stays out of the die)", "mm")
+
+
 def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None, check: bool = True,
                  interference_check: bool = True, deflection: float = DEFLECTION_MM) -> ToolSet:
     """Scores, embossing, punch tips and die for ``tablet`` (see :mod:`tabletcad.tooling`).
@@ -69,15 +88,32 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
         check_score(frame, s, i)
     for i, e in enumerate(spec.emboss):
         check_emboss(frame, e, spec.clearance_mm, i)
+    if spec.body is not None:
+        _check_complete_punches(frame, spec)
     solid = frame.shape
     v0 = volume(solid)
     a_man = to_manifold(solid, deflection) if check and (spec.scores or spec.emboss) else None
     solid, score_checks, score_info = apply_scores(frame, solid, spec.scores, check=check, deflection=deflection, a_manifold=a_man)
     a_man = None
     solid, emb_checks, emb_info = apply_emboss(frame, solid, spec.emboss, spec.clearance_mm, check=check, deflection=deflection)
+    rep_table = tablet.extras.get("report", {}) if isinstance(tablet.extras, dict) else {}
+    split = None
+    if spec.scores:  # the finished tablet (scores and figures) split along its score planes
+        from tabletcad.tooling.split import split_parts
+
+        sf, rho = rep_table.get("solid_fraction"), rep_table.get("true_density_mg_mm3")
+        split = split_parts(frame, solid, spec.scores, density_mg_mm3=None if sf is None or rho is None else sf * rho)
     t1 = time.perf_counter()
     upper, chk_u = punch_tip(frame, solid, "upper", spec.clearance_mm, spec.tip_length_mm, check=check, deflection=deflection)
-    lower, chk_l = punch_tip(frame, solid, "lower", spec.clearance_mm, spec.tip_length_mm, check=check, deflection=deflection)
+    lower, chk_l = punch_tip(frame, solid, "lower", spec.clearance_mm, spec.lower_tip, check=check, deflection=deflection)
+    if spec.body is not None:
+        from tabletcad.tooling.punch_body import complete_punch
+
+        for tip, tl in ((upper, spec.tip_length_mm), (lower, spec.lower_tip)):
+            which = tip.name.split("_")[0]
+            shape_, info_ = complete_punch(frame, tip.shape, which, spec.body, spec.clearance_mm, tl)
+            tip.info.update(tip_volume_mm3=tip.volume_mm3, body=info_)
+            tip.shape, tip.volume_mm3 = shape_, info_["volume_mm3"]
     die_shape, die_info = die(frame, spec.die_outer_diameter_mm, None if spec.die_outer_diameter_mm is None and
                               spec.die_height_mm == ToolingSpec().die_height_mm else spec.die_height_mm, spec.taper_deg)
     t2 = time.perf_counter()
@@ -93,6 +129,7 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
                     cup_depth_bottom_mm=frame.cup_depth_bottom, thickness_mm=frame.thickness,
                     land_mm=frame.land, outline=frame.outline_kind, length_mm=frame.length, width_mm=frame.width),
         scores=score_info,
+        split=split,
         emboss=emb_info,
         upper_punch=upper.info,
         lower_punch=lower.info,
@@ -102,6 +139,9 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
         booleans=[c.as_dict() for c in checks],
         boolean_max_rel_diff_occ_vs_manifold3d=max((c.rel_diff for c in checks), default=None),
     )
+    from tabletcad.tooling.rating import tip_rating
+
+    report["tip_rating"] = tip_rating(frame, spec, rep_table)
     ts = ToolSet(tablet, spec, frame, parts, gap - gap_closed, report)
     if interference_check:
         from tabletcad.tooling.interference import interference

@@ -1,0 +1,71 @@
+"""Punch-tip force rating by the projected-area pressure rule, and the tip's Euler buckling load.
+
+* **Rating**: ``F = p_allowed × A``, ``A`` the tip's projected (plan) area — the outline
+  inset by the clearance (mm²), ``p_allowed`` in MPa (= N/mm²).  No allowed pressure is
+  bundled (no citable public value was found, see ``tabletcad/data/punch_ratings.toml``):
+  it comes from ``[tooling] allowed_tip_pressure_MPa`` with its
+  ``allowed_tip_pressure_source``, else from the design's ``[report]
+  max_punch_pressure_MPa`` (reported as user-given).  The finite-element punch analysis
+  belongs to :mod:`tabletcad.fe`; this is the rule of thumb beside the drawing.
+* **Buckling** (what limits mini-tablet tips): the tip as an Euler column fixed at the barrel
+  and free at the face, ``P_cr = π² E I_min / (K L)²`` with ``K = 2`` (the conservative end
+  condition), ``L`` the tip length and ``I_min`` the smaller principal second moment of the
+  tip's smallest section (the relieved one when the tip has a relief).  ``E`` of the punch
+  steel comes from ``[tooling] punch_youngs_modulus_MPa`` with its source.
+"""
+
+from __future__ import annotations
+
+import math
+
+from OCP.BRepGProp import BRepGProp
+from OCP.GProp import GProp_GProps
+
+from tabletcad.tooling.outline import TabletFrame, offset_wire, plan_face
+
+__all__ = ["section_properties", "tip_rating", "EULER_K"]
+
+#: effective-length factor of a column fixed at one end and free at the other
+EULER_K = 2.0
+
+
+def section_properties(wire) -> tuple[float, float]:
+    """``(area mm², smallest principal second moment of area mm⁴)`` of the plan region bounded by ``wire``."""
+    props = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(plan_face(wire), props)
+    m = props.MatrixOfInertia()  # about the centroid; for a plane region in z = 0: [[Iyy, -Ixy], [-Ixy, Ixx]] block
+    a, b, c = m.Value(1, 1), m.Value(1, 2), m.Value(2, 2)
+    i_min = 0.5 * (a + c) - math.sqrt(0.25 * (a - c) ** 2 + b * b)
+    return props.Mass(), i_min
+
+
+def tip_rating(frame: TabletFrame, spec, report_table: dict | None = None) -> dict:
+    """The rating and buckling figures for the tool set's tips (see the module docstring)."""
+    rep = report_table or {}
+    area, _ = section_properties(offset_wire(frame.outline, -spec.clearance_mm))
+    out: dict = dict(tip_projected_area_mm2=area, rule="F = p_allowed x tip projected area")
+    p, src = spec.allowed_tip_pressure_MPa, spec.allowed_tip_pressure_source
+    if p is None and rep.get("max_punch_pressure_MPa") is not None:
+        p, src = float(rep["max_punch_pressure_MPa"]), "the design's [report] max_punch_pressure_MPa (user-given)"
+    out.update(allowed_pressure_MPa=p, allowed_pressure_source=src,
+               rated_force_kN=None if p is None else p * area / 1000.0)
+    force = rep.get("compaction_force_kN")
+    out["compaction_force_kN"] = force
+    out["utilisation"] = None if force is None or p is None else force / out["rated_force_kN"]
+    if p is None:
+        out["note"] = "no allowed pressure given ([tooling] allowed_tip_pressure_MPa with its source): no rating"
+    E = spec.punch_youngs_modulus_MPa
+    body = spec.body
+    relief = 0.0 if body is None else body.tip_relief_mm
+    _, i_min = section_properties(offset_wire(frame.outline, -spec.clearance_mm - relief))
+    tips = {}
+    for name, L in (("upper", spec.tip_length_mm), ("lower", spec.lower_tip)):
+        p_cr = None if E is None else math.pi ** 2 * E * i_min / (EULER_K * L) ** 2 / 1000.0
+        load = force if force is not None else out["rated_force_kN"]
+        tips[name] = dict(free_length_mm=L, buckling_load_kN=p_cr,
+                          safety_factor=None if p_cr is None or not load else p_cr / load)
+    out["buckling"] = dict(model="Euler column fixed at the barrel, free at the face (K = 2)", K=EULER_K,
+                           section_min_second_moment_mm4=i_min, youngs_modulus_MPa=E,
+                           youngs_modulus_source=spec.punch_youngs_modulus_source, tips=tips,
+                           note=None if E is not None else "no punch_youngs_modulus_MPa given: not computed")
+    return out

@@ -1,0 +1,199 @@
+"""Complete TSM/EU punches and dies: the standards file, the spec checks, the solids and their closed forms."""
+
+import math
+import re
+from pathlib import Path
+
+import pytest
+
+from tabletcad.errors import DesignError
+from tabletcad.tooling.spec import parse_tooling
+from tabletcad.tooling.standards import load_standards, resolve_body
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLES = ROOT / "samples" / "tooling"
+INCH = 25.4
+
+#: a complete EU B set: every [tooling.punch] key the standards file cannot supply
+EU_B = dict(standard="EU", type="B", die_height_mm=22.0, tip_length_mm=8.0, lower_tip_length_mm=19.0,
+            clearance_mm=0.025,
+            punch=dict(head_diameter_mm=25.0, head_flat_diameter_mm=12.0, head_rim_mm=3.0, dome_radius_mm=30.0,
+                       neck_diameter_mm=13.0, neck_length_mm=10.0, tip_straight_mm=4.0, tip_relief_mm=0.1))
+
+
+def _with(**kw):
+    t = {**EU_B, "punch": dict(EU_B["punch"])}
+    for k, v in kw.items():
+        if k.startswith("punch_"):
+            t["punch"][k[6:]] = v
+        elif v is None:
+            t.pop(k, None)
+        else:
+            t[k] = v
+    return t
+
+
+# ----------------------------------------------------------------------------- the data file
+def test_every_standard_number_cites_a_listed_public_source():
+    data = load_standards()
+    sources = data["sources"]
+    assert all(re.match(r"https://", s["url"]) and s["says"] for s in sources.values())
+    n = 0
+    for std in ("TSM", "EU"):
+        for kind in ("B", "D"):
+            for key, entry in data[std][kind].items():
+                if isinstance(entry, dict):
+                    assert entry["source"] and set(entry["source"]) <= set(sources), (std, kind, key)
+                    n += 1
+    assert n == 22
+
+
+def test_standard_values_agree_with_the_published_inch_figures_and_differences():
+    d = load_standards()
+    assert d["TSM"]["D"]["barrel_diameter_mm"]["value"] == pytest.approx(1.0 * INCH)
+    assert d["TSM"]["B"]["die_outer_diameter_mm"]["value"] == pytest.approx(1.1875 * INCH, abs=0.005)
+    assert d["TSM"]["D"]["die_outer_diameter_mm"]["value"] == pytest.approx(1.5 * INCH, abs=0.005)
+    # EU punches are 0.010 in longer than TSM (kos_differences); TSM is then 5.25 in
+    assert d["EU"]["B"]["overall_length_mm"]["value"] - d["TSM"]["B"]["overall_length_mm"]["value"] == \
+        pytest.approx(0.010 * INCH, abs=0.005)
+    assert d["TSM"]["B"]["overall_length_mm"]["value"] == pytest.approx(5.25 * INCH, abs=0.005)
+    assert (d["TSM"]["B"]["head"], d["EU"]["B"]["head"]) == ("angled", "domed")
+
+
+# ----------------------------------------------------------------------------- spec checks (no geometry)
+def test_standard_fills_barrel_length_angle_and_die_and_records_sources():
+    s = parse_tooling(EU_B)
+    b = s.body
+    assert (b.barrel_diameter_mm, b.overall_length_mm, b.inside_head_angle_deg) == (19.0, 133.60, 30.0)
+    assert s.die_outer_diameter_mm == 30.16 and s.die_height_mm == 22.0 and s.lower_tip == 19.0
+    assert set(b.sources) >= {"barrel_diameter_mm", "overall_length_mm", "inside_head_angle_deg", "die_outer_diameter_mm"}
+    assert "head_diameter_mm" not in b.sources  # the user's
+    # the overall length is tip + barrel + neck + head exactly
+    assert 8.0 + b.barrel_length_mm(8.0) + b.neck_length_mm + b.head_height_mm == pytest.approx(133.60, abs=1e-12)
+
+
+def test_user_defined_set_needs_every_dimension():
+    with pytest.raises(DesignError) as e:
+        parse_tooling(_with(standard="custom", type=None))
+    assert "[tooling.punch] head" in str(e.value) or "overall_length_mm" in str(e.value)
+
+
+@pytest.mark.parametrize("table, parameter", [
+    (_with(standard="JIS"), "[tooling] standard"),
+    (_with(type="E"), "[tooling] type"),
+    (_with(type=None), "[tooling] type"),
+    (_with(tip_length_mm=120.0), "[tooling] tip_length_mm"),          # a tip longer than the punch
+    (_with(lower_tip_length_mm=130.0), "[tooling] lower_tip_length_mm"),
+    (_with(punch_head_diameter_mm=None), "[tooling.punch] head_diameter_mm"),
+    (_with(die_height_mm=None), "[tooling] die_height_mm"),
+    (_with(punch_neck_diameter_mm=20.0), "[tooling.punch] neck_diameter_mm"),
+    (_with(punch_dome_radius_mm=10.0), "[tooling.punch] dome_radius_mm"),
+    (_with(punch_tip_straight_mm=9.0), "[tooling.punch] tip_straight_mm"),
+    (_with(punch_key=True), "[tooling.punch] key_width_mm"),
+    (_with(punch_bogus=1), "[tooling.punch] key 'bogus'"),
+])
+def test_bad_complete_tooling_is_one_design_error(table, parameter):
+    if "punch" in table:
+        table["punch"] = {k: v for k, v in table["punch"].items() if v is not None}
+    with pytest.raises(DesignError) as e:
+        parse_tooling(table)
+    assert str(e.value).startswith(parameter) and "\n" not in str(e.value)
+
+
+def test_tip_longer_than_the_punch_names_the_room_left():
+    b = resolve_body("TSM", "B", dict(EU_B["punch"], head_top_angle_deg=10.0), 8.0, 19.0)
+    room = b.overall_length_mm - b.neck_length_mm - b.head_height_mm
+    with pytest.raises(DesignError, match=f"must be < {room:.4g} mm"):
+        resolve_body("TSM", "B", dict(EU_B["punch"], head_top_angle_deg=10.0), room + 0.01, 19.0)
+
+
+# ----------------------------------------------------------------------------- solids (OCC)
+@pytest.fixture(scope="module")
+def eu_b():
+    pytest.importorskip("OCP")
+    pytest.importorskip("manifold3d")
+    from tabletcad.shapes import shallow_convex_round
+    from tabletcad.tooling.toolset import make_tooling
+
+    return make_tooling(shallow_convex_round(), parse_tooling(EU_B), check=False)
+
+
+@pytest.mark.cad
+def test_complete_parts_are_valid_single_solids_and_enclose_the_tablet(eu_b):
+    from tabletcad.cad.solid import check_solid
+
+    for name, shape in eu_b.parts.items():
+        check_solid(shape, name)
+    r = eu_b.report
+    assert r["interference_mm3"] == pytest.approx(0.0, abs=1e-9)
+    assert 0.0 < r["max_gap_mm"] <= 0.025
+    # punch to die: the clearance plus the bore's allowance for the PDE band's bulge
+    bulge = r["die"]["bore_enlarged_by_band_bulge_mm"]
+    assert r["interference"]["punch_die_clearance_mm"] == pytest.approx(0.025 + bulge, abs=1e-6)
+
+
+@pytest.mark.cad
+@pytest.mark.parametrize("which", ["upper_punch", "lower_punch"])
+def test_punch_volume_is_tip_minus_relief_plus_closed_form_body(eu_b, which):
+    info = eu_b.report[which]
+    body = info["body"]
+    expected = info["tip_volume_mm3"] - body["relief_volume_mm3"] + body["body_volume_closed_form_mm3"]
+    assert body["volume_mm3"] == pytest.approx(expected, rel=1e-7)
+    # relief: the ring between 10 - 2*0.025 and 10 - 2*0.125 mm circles over tip - straight
+    tip = body["tip_length_mm"]
+    ring = math.pi * (4.975 ** 2 - 4.875 ** 2) * (tip - 4.0)
+    assert body["relief_volume_mm3"] == pytest.approx(ring, rel=1e-9)
+
+
+@pytest.mark.cad
+def test_punch_extents_are_the_overall_length_and_the_barrel(eu_b):
+    from tabletcad.cad.solid import mass_properties  # noqa: F401 (OCC loaded)
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    z_lo, z_hi = eu_b.frame.band_z
+    for name, edge, sign in (("upper_punch", z_hi, 1.0), ("lower_punch", z_lo, -1.0)):
+        box = Bnd_Box()
+        BRepBndLib.AddOptimal_s(eu_b.parts[name], box, False, False)
+        x0, y0, zmin, x1, y1, zmax = box.Get()
+        head_flat = zmax if sign > 0 else zmin
+        assert sign * (head_flat - edge) == pytest.approx(133.60, abs=1e-6)
+        assert x1 - x0 == pytest.approx(25.0, abs=1e-6)  # the head is the widest part
+        assert eu_b.report[name]["body"]["head_flat_z_mm"] == pytest.approx(head_flat, abs=1e-6)
+
+
+@pytest.mark.cad
+def test_barrel_smaller_than_the_tablet_and_oversize_tablets_are_design_errors():
+    pytest.importorskip("OCP")
+    from tabletcad.shapes import shallow_convex_round
+    from tabletcad.tooling.toolset import make_tooling
+
+    t = shallow_convex_round()
+    custom = _with(standard="custom", type=None, die_outer_diameter_mm=30.0,
+                   punch_overall_length_mm=133.0, punch_barrel_diameter_mm=9.0, punch_inside_head_angle_deg=30.0,
+                   punch_neck_diameter_mm=7.0, punch_head="domed")
+    with pytest.raises(DesignError, match=r"barrel_diameter_mm = 9 mm .* circumscribed diameter 10 mm"):
+        make_tooling(t, parse_tooling(custom), check=False, interference_check=False)
+    with pytest.raises(DesignError, match=r"lower_tip_length_mm = 12 mm .* must be > 17 mm"):
+        make_tooling(t, parse_tooling(_with(lower_tip_length_mm=12.0)), check=False, interference_check=False)
+
+
+@pytest.mark.cad
+@pytest.mark.parametrize("extra", [
+    '[tooling]\nstandard = "JIS"\ntype = "B"\ndie_height_mm = 22.0\n',                       # unknown standard
+    '[tooling]\nstandard = "EU"\ntype = "B"\ndie_height_mm = 22.0\ntip_length_mm = 130.0\n'  # tip longer than the punch
+    '[tooling.punch]\nhead_diameter_mm = 25.0\nhead_flat_diameter_mm = 12.0\nhead_rim_mm = 3.0\ndome_radius_mm = 30.0\n'
+    'neck_diameter_mm = 13.0\nneck_length_mm = 10.0\ntip_straight_mm = 4.0\ntip_relief_mm = 0.1\n',
+    '[tooling]\nstandard = "TSM"\ntype = "B"\n',                                               # required inputs missing
+])
+def test_cli_bad_complete_tooling_exits_2_with_one_line_and_writes_nothing(tmp_path, capsys, extra):
+    pytest.importorskip("OCP")
+    from tabletcad.cli import main
+
+    d = tmp_path / "bad.toml"
+    d.write_text('[tablet]\nfamily = "shallow_convex_round"\ndiameter = 10.0\nthickness = 3.0\nband = 2.0\n\n' + extra)
+    out = tmp_path / "out"
+    assert main(["build", str(d), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: [tooling")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]

@@ -1,0 +1,106 @@
+"""Drawings a toolmaker can quote from: tolerances, title block, scale, punch and die sheet, no text on geometry."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("OCP")
+pytest.importorskip("ezdxf")
+pytest.importorskip("matplotlib")
+
+from tabletcad.design import load_design  # noqa: E402
+from tabletcad.tooling import make_tooling, parse_tooling  # noqa: E402
+from tabletcad.tooling.drawing import drawing_model, sheet_figure, tooling_model, write_drawing  # noqa: E402
+from tabletcad.tooling.stage import read_tooling_table  # noqa: E402
+
+pytestmark = pytest.mark.cad
+
+SAMPLE = Path(__file__).resolve().parents[1] / "samples" / "tooling" / "tsm_b_round.toml"
+
+
+@pytest.fixture(scope="module")
+def drawn(tmp_path_factory):
+    ts = make_tooling(load_design(SAMPLE), parse_tooling(read_tooling_table(SAMPLE)), check=False,
+                      interference_check=False)
+    out = tmp_path_factory.mktemp("drawings")
+    files = write_drawing(ts, out)
+    return ts, out, files
+
+
+def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
+    ts, out, files = drawn
+    assert sorted(p.name for p in files) == sorted(f"{a}.{b}" for a in ("drawing", "tooling") for b in ("svg", "pdf", "dxf"))
+    svg = (out / "drawing.svg").read_text(encoding="utf-8")
+    for text in ("Ø10.00 ±0.076", "band 2.80 ±0.076", "cup 0.90 ±0.050", "T 4.60 ±0.076",  # cup from the design
+                 "10 mm concave round, TSM B", "drawing no. TC-0001", "rev. A", "date: 2026-12-01",
+                 "author: tabletcad sample", "material: punches and die", "general tolerance ±0.076 mm",
+                 "SECTION A-A", "DETAIL B 10:1", "PLAN", "FRONT", "SIDE"):
+        assert text in svg, text
+    scale = ts.report["drawing"]["scale"]
+    assert 1.0 < scale < 20.0 and f"scale {scale:.3g}:1   sheet A4" in svg
+    # the punches do not reach 1:1 on A4: the sheet grows until they do
+    td = ts.report["tooling_drawing"]
+    assert td["paper"] in ("A3", "A2") and td["scale"] >= 1.0
+    tsvg = (out / "tooling.svg").read_text(encoding="utf-8")
+    for text in ("overall 133.35 ±0.076", "Ø19.00", "Ø25.40", "tip 8.00", "tip 19.00", "Ø30.16 ±0.076", "H 22.22 ±0.076",
+                 "UPPER PUNCH", "LOWER PUNCH", "DIE", "drawing no. TC-0001-T", "TSM B tooling, angled heads"):
+        assert text in tsvg, text
+    dxf = (out / "tooling.dxf").read_text(encoding="utf-8", errors="replace")
+    assert "overall 133.35" in dxf and "TC-0001" in dxf
+
+
+@pytest.fixture(scope="module")
+def capsule():
+    """A shaped tablet (length and width dimensioned in two views) with a score (section dimension)."""
+    p = SAMPLE.parent / "capsule.toml"
+    return make_tooling(load_design(p), parse_tooling(read_tooling_table(p)), check=False, interference_check=False)
+
+
+def _segments_display(ax, dr):
+    pts = []
+    for name, v in dr.views.items():
+        ox, oy = dr.origins[name]
+        for p in v["visible"] + v["hidden"]:
+            q = np.asarray(p) + np.array([ox, oy])
+            t = np.linspace(0.0, 1.0, 9)[:, None]
+            dense = (q[:-1, None, :] * (1 - t) + q[1:, None, :] * t).reshape(-1, 2)  # points along every segment
+            pts.append(ax.transData.transform(dense))
+    return np.concatenate(pts)
+
+
+@pytest.mark.parametrize("which", ["tablet", "tooling", "capsule"])
+def test_no_text_leaves_the_sheet_or_lies_on_the_views(drawn, capsule, which):
+    import matplotlib.pyplot as plt
+
+    ts, _, _ = drawn
+    if which == "capsule":
+        dr, paper = drawing_model(capsule), "A4"
+        assert {"L 14.00 ±0.076", "W 6.00 ±0.076", "score 0.30 ±0.076"} <= {d.text for d in dr.dims}
+    elif which == "tablet":
+        dr, paper = drawing_model(ts), "A4"
+    else:
+        dr, paper = tooling_model(ts), ts.report["tooling_drawing"]["paper"]
+    fig = sheet_figure(dr, paper)
+    try:
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        ax = fig.axes[0]
+        pts = _segments_display(ax, dr)
+        labels = [t for t in ax.texts if t.get_text()]  # (the dimension arrows are empty annotations)
+        texts = fig.texts + labels
+        assert len(labels) == len(dr.dims) + len(dr.views)
+        for t in texts:
+            bb = t.get_window_extent(renderer)
+            assert fig.bbox.x0 <= bb.x0 and bb.x1 <= fig.bbox.x1 and fig.bbox.y0 <= bb.y0 and bb.y1 <= fig.bbox.y1
+        boxes = []
+        for t in labels:
+            bb = t.get_window_extent(renderer).expanded(0.98, 0.9)
+            inside = (pts[:, 0] > bb.x0) & (pts[:, 0] < bb.x1) & (pts[:, 1] > bb.y0) & (pts[:, 1] < bb.y1)
+            assert not inside.any(), f"{t.get_text()!r} lies on the {which} views"
+            boxes.append((t.get_text(), bb))
+        for k, (ta, a) in enumerate(boxes):  # and no two texts overlap
+            for tb, b in boxes[k + 1:]:
+                assert not a.overlaps(b), (ta, tb)
+    finally:
+        plt.close(fig)

@@ -1,0 +1,72 @@
+"""Tip-force rating (projected-area pressure rule) and Euler buckling of the tip, against closed forms."""
+
+import math
+
+import pytest
+
+pytest.importorskip("OCP")
+
+from tabletcad.errors import DesignError  # noqa: E402
+from tabletcad.shapes import shallow_convex_round  # noqa: E402
+from tabletcad.tooling.outline import tablet_frame  # noqa: E402
+from tabletcad.tooling.rating import section_properties, tip_rating  # noqa: E402
+from tabletcad.tooling.spec import parse_tooling  # noqa: E402
+
+pytestmark = pytest.mark.cad
+
+SRC = "a test value, not a recommendation"
+
+
+@pytest.fixture(scope="module")
+def frame():
+    return tablet_frame(shallow_convex_round())  # 10 mm round
+
+
+def test_rating_and_buckling_are_the_closed_forms_for_a_round_tip(frame):
+    spec = parse_tooling(dict(clearance_mm=0.02, tip_length_mm=8.0, lower_tip_length_mm=19.0,
+                              allowed_tip_pressure_MPa=300.0, allowed_tip_pressure_source=SRC,
+                              punch_youngs_modulus_MPa=210000.0, punch_youngs_modulus_source=SRC))
+    r = tip_rating(frame, spec, {"compaction_force_kN": 15.0})
+    rt = 5.0 - 0.02
+    assert r["tip_projected_area_mm2"] == pytest.approx(math.pi * rt ** 2, rel=1e-9)
+    assert r["rated_force_kN"] == pytest.approx(300.0 * math.pi * rt ** 2 / 1000.0, rel=1e-9)
+    assert r["utilisation"] == pytest.approx(15.0 / r["rated_force_kN"], rel=1e-12)
+    assert r["allowed_pressure_source"] == SRC
+    i = math.pi * rt ** 4 / 4.0  # disc: I = pi r^4 / 4 about any diameter
+    assert r["buckling"]["section_min_second_moment_mm4"] == pytest.approx(i, rel=1e-9)
+    for name, L in (("upper", 8.0), ("lower", 19.0)):
+        b = r["buckling"]["tips"][name]
+        p_cr = math.pi ** 2 * 210000.0 * i / (2.0 * L) ** 2 / 1000.0
+        assert b["buckling_load_kN"] == pytest.approx(p_cr, rel=1e-9)
+        assert b["safety_factor"] == pytest.approx(p_cr / 15.0, rel=1e-9)
+    # a mini-tablet tip (2 mm) of the same length buckles (1/5)^4 = 1/625 as easily
+    assert r["buckling"]["tips"]["lower"]["buckling_load_kN"] / 625.0 == pytest.approx(
+        math.pi ** 2 * 210000.0 * math.pi * (rt / 5) ** 4 / 4 / 38.0 ** 2 / 1000.0, rel=1e-9)
+
+
+def test_rectangle_section_has_the_smaller_principal_moment():
+    from tabletcad.tooling.outline import polyline_wire
+
+    a, b = 6.0, 2.0
+    area, i_min = section_properties(polyline_wire([(-a / 2, -b / 2), (a / 2, -b / 2), (a / 2, b / 2), (-a / 2, b / 2)]))
+    assert area == pytest.approx(a * b, rel=1e-12)
+    assert i_min == pytest.approx(a * b ** 3 / 12.0, rel=1e-9)
+
+
+def test_without_a_sourced_pressure_there_is_no_rating(frame):
+    r = tip_rating(frame, parse_tooling({}), {})
+    assert r["rated_force_kN"] is None and "no allowed pressure" in r["note"]
+    assert r["buckling"]["tips"]["upper"]["buckling_load_kN"] is None
+    r = tip_rating(frame, parse_tooling({}), {"max_punch_pressure_MPa": 250.0})
+    assert r["rated_force_kN"] == pytest.approx(0.25 * r["tip_projected_area_mm2"]) and "user-given" in r["allowed_pressure_source"]
+
+
+@pytest.mark.parametrize("table, parameter", [
+    ({"allowed_tip_pressure_MPa": 300.0}, "allowed_tip_pressure_source"),
+    ({"allowed_tip_pressure_MPa": -3.0, "allowed_tip_pressure_source": SRC}, "allowed_tip_pressure_MPa"),
+    ({"punch_youngs_modulus_source": SRC}, "punch_youngs_modulus_source"),
+])
+def test_unsourced_or_bad_limits_are_design_errors(table, parameter):
+    with pytest.raises(DesignError) as e:
+        parse_tooling(table)
+    assert parameter in e.value.parameter
