@@ -71,6 +71,7 @@ def _pattern(shown: str) -> re.Pattern:
 
 def _workdir(tmp_path: Path) -> Path:
     (tmp_path / "samples").symlink_to(REPO / "samples")
+    (tmp_path / ".venv").symlink_to(Path(sys.executable).parent.parent)
     return tmp_path
 
 
@@ -121,8 +122,10 @@ def test_transcript_prints_what_the_readme_shows(text: str, tmp_path: Path) -> N
 
     def check() -> None:
         r = _run(cmd, cwd)
-        assert r.returncode == 0, f"{cmd!r} exited {r.returncode}:\n{r.stderr[-2000:]}"
-        printed = [_fold(s) for s in r.stdout.splitlines()]
+        refused = any(s.startswith("error: ") for s in expected)
+        want = 2 if refused else 0
+        assert r.returncode == want, f"{cmd!r} exited {r.returncode}, not {want}:\n{r.stderr[-2000:]}"
+        printed = [_fold(s) for s in (r.stderr if refused else r.stdout).splitlines()]
         missing = [s for s in expected if not any(_pattern(s).fullmatch(p) for p in printed)]
         assert not missing, f"{cmd!r} no longer prints:\n" + "\n".join(missing) + f"\n--- it printed:\n{r.stdout}"
 
