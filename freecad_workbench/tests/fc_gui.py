@@ -21,9 +21,39 @@ try:
     result["workbench"] = wb.name()
     result["commands"] = [c for c in FreeCADGui.listCommands() if c.startswith("Tabletcad_")]
     doc = FreeCAD.newDocument("gui")
+    from PySide import QtGui
+
+    from freecad.tabletcad_wb import taskpanel
+
+    # the Tablet command opens the task panel: family, dimensions, live validation, figures
     FreeCADGui.runCommand("Tabletcad_Tablet")
+    panel = taskpanel.current
+    result["panel_shown"] = FreeCADGui.Control.activeDialog()
+    panel.family.setCurrentIndex(panel.model.families.index("concave_round"))
+    result["panel_fields"] = sorted(panel.spins)
+    result["panel_suffix"] = panel.spins["diameter"].suffix()
+    panel.spins["cup_depth"].setValue(10.0)  # deeper than a hemisphere: refused as you type
+    result["panel_invalid"] = [panel.ok, panel.status.text()]
+    panel.spins["cup_depth"].setValue(1.0)
+    result["panel_valid"] = [panel.ok, panel.status.text(), panel.figures.text()]
+    mw = FreeCADGui.getMainWindow()
+    mw.resize(1200, 800)
+    QtGui.QApplication.processEvents()
+    if os.environ.get("TABLETCAD_FC_PANEL"):
+        result["panel_png"] = bool(mw.grab().save(os.environ["TABLETCAD_FC_PANEL"]))
+    result["panel_accept"] = bool(panel.accept())
+    result["panel_closed"] = FreeCADGui.Control.activeDialog() is False
     tab = doc.Objects[-1]
-    tab.Family = "concave_round"
+    result["panel_tablet"] = [tab.Family, float(tab.CupDepth.Value), bool(tab.isValid())]
+
+    # a refused value: what the Report view shows
+    tab.CupDepth = 10.0
+    doc.recompute()
+    QtGui.QApplication.processEvents()
+    reports = [w for w in mw.findChildren(QtGui.QTextEdit) if "report" in (w.objectName() or "").lower()]
+    text = reports[0].toPlainText() if reports else ""
+    result["report_view"] = [ln for ln in text.splitlines() if "cup_depth" in ln or "Traceback" in ln or "File " in ln]
+    result["report_found"] = bool(reports)
     tab.CupDepth = 1.0
     doc.recompute()
     FreeCADGui.Selection.clearSelection()
@@ -54,10 +84,6 @@ try:
     view = FreeCADGui.ActiveDocument.ActiveView
     view.viewIsometric()
     view.fitAll()
-    from PySide import QtGui
-
-    mw = FreeCADGui.getMainWindow()
-    mw.resize(1200, 800)
     QtGui.QApplication.processEvents()
     result["window"] = bool(mw.grab().save(os.environ["TABLETCAD_FC_WINDOW"]))
     if os.environ.get("TABLETCAD_FC_SAVEIMAGE") == "1":
@@ -65,6 +91,29 @@ try:
         view.saveImage(os.environ["TABLETCAD_FC_SHOT"], 1000, 750, "White")
         result["shot"] = os.environ["TABLETCAD_FC_SHOT"]
     result["ok"] = True
+    asm = os.environ.get("TABLETCAD_FC_ASSEMBLY")
+    if asm:  # FreeCAD's GUI STEP import of the tooling assembly: names and colours
+        with open(os.environ["TABLETCAD_FC_OUTPUT"], "w") as fh:
+            json.dump(result, fh)  # in case the import kills FreeCAD
+        from freecad.tabletcad_wb.tasks import import_step
+
+        d = FreeCAD.newDocument("assembly")
+        import_step(asm, d)  # ImportGui.insert (0.20: without link groups)
+        parts = {}
+        for o in d.Objects:
+            if o.TypeId == "Part::Feature" and o.Shape.Solids and o.ViewObject is not None:
+                vo = o.ViewObject
+                if hasattr(vo, "ShapeAppearance"):  # 1.0: materials
+                    cols = [list(m.DiffuseColor)[:3] for m in vo.ShapeAppearance]
+                else:
+                    cols = [list(c)[:3] for c in (vo.DiffuseColor or [vo.ShapeColor])]
+                parts[o.Label] = dict(valid=bool(o.Shape.isValid()), colours=cols)
+        result["assembly"] = parts
+        result["assembly_objects"] = [
+            [o.Name, o.Label, o.TypeId, len(o.Shape.Solids) if hasattr(o, "Shape") else None] for o in d.Objects
+        ]
+        prefs = FreeCAD.ParamGet("User parameter:BaseApp/Preferences/Mod/Import")
+        result["import_prefs"] = [prefs.GetBool("UseLinkGroup", True), prefs.GetInt("ImportMode", 0)]
 except Exception as exc:
     result["error"] = repr(exc)
     result["traceback"] = traceback.format_exc()

@@ -219,6 +219,7 @@ def build_tablet(tablet, tol=None):
     # exact volume of the B-spline solid (FreeCAD's Shape.Volume is OCCT's default integration,
     # measured 8.5e-4 relative off on a free-form stadium tablet)
     props = dict(props, solid_volume_mm3=abs(enclosed_volume([f.surface for f in fits])))
+    props["plan_area_mm2"] = plan_area(tablet, rims)
     timings = dict(fit=t1 - t0, part=t2 - t1, properties=t3 - t2, total=time.perf_counter() - t0)
     return TabletGeometry(tablet, solid, fits, props, rims, timings)
 
@@ -311,6 +312,16 @@ def _rim_face(rims):
     if len(wires) == 1:
         return Part.Face(wires[0])
     return Part.Face(wires, "Part::FaceMakerBullseye")
+
+
+def plan_area(tablet, rims):
+    """Area (mm²) of the tablet's silhouette along z: the face inside its upper rim (band
+    edge on the silhouette; minus the hole of a ring), exact to the fit; the core's sampled
+    ``tablet.plan_area()`` (about 1 s) only when the tablet has no horizontal rim."""
+    if rims:
+        sel, _ = _select(rims, "upper")
+        return float(_rim_face(sel).Area)
+    return float(tablet.plan_area())
 
 
 def _select(rims, which):
