@@ -401,7 +401,7 @@ def test_task_panel_form(headless):
     (st,) = _steps(headless, "form")
     assert [f[:3] for f in st["fields"]] == [[k, k.title().replace("_", ""), u] for k, u in fam.params.items()]
     assert [f[5] for f in st["fields"]] == [fam.defaults[k] for k in fam.params]
-    assert all(f[3] > 0 and f[4] >= 50 for f in st["fields"])
+    assert all(f[3] == 0.0 and f[4] == 100.0 for f in st["fields"])  # the core checks the rest
     ok, msg, figs = st["bad"]
     assert not ok and "cup_depth" in msg and "hemisphere" in msg and figs == {}
     ok, msg, figs = st["good"]
@@ -583,6 +583,8 @@ def test_gui_smoke_and_screenshot(fc, fc_home, tmp_path):
     }
     if display:
         extra.update(DISPLAY=display, TABLETCAD_FC_SAVEIMAGE="1")
+        if fc.version != "0.20":  # 1.0's offscreen platform hangs in QWidget.grab with the 3D view
+            extra["QT_QPA_PLATFORM"] = "xcb"
     try:
         r = _run(fc.gui, SCRIPTS / "fc_gui.py", fc_home, tmp_path, timeout=600, extra=extra)
     finally:

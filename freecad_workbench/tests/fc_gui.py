@@ -14,7 +14,15 @@ import traceback
 import FreeCAD
 import FreeCADGui
 
-result = {"ok": False}
+result = {"ok": False, "reached": []}
+
+
+def mark(name):  # how far the script got (written at once: a hang shows where)
+    result["reached"].append(name)
+    with open(os.environ["TABLETCAD_FC_OUTPUT"], "w") as fh:
+        json.dump(result, fh)
+
+
 try:
     FreeCADGui.activateWorkbench("TabletcadWorkbench")
     wb = FreeCADGui.activeWorkbench()
@@ -28,20 +36,25 @@ try:
     # the Tablet command opens the task panel: family, dimensions, live validation, figures
     FreeCADGui.runCommand("Tabletcad_Tablet")
     panel = taskpanel.current
+    mark("panel")
     result["panel_shown"] = FreeCADGui.Control.activeDialog()
     panel.family.setCurrentIndex(panel.model.families.index("concave_round"))
     result["panel_fields"] = sorted(panel.spins)
     result["panel_suffix"] = panel.spins["diameter"].suffix()
     panel.spins["cup_depth"].setValue(10.0)  # deeper than a hemisphere: refused as you type
     result["panel_invalid"] = [panel.ok, panel.status.text()]
+    mark("invalid")
     panel.spins["cup_depth"].setValue(1.0)
     result["panel_valid"] = [panel.ok, panel.status.text(), panel.figures.text()]
+    mark("valid")
     mw = FreeCADGui.getMainWindow()
     mw.resize(1200, 800)
     QtGui.QApplication.processEvents()
     if os.environ.get("TABLETCAD_FC_PANEL"):
         result["panel_png"] = bool(mw.grab().save(os.environ["TABLETCAD_FC_PANEL"]))
+    mark("panel_png")
     result["panel_accept"] = bool(panel.accept())
+    mark("accept")
     result["panel_closed"] = FreeCADGui.Control.activeDialog() is False
     tab = doc.Objects[-1]
     result["panel_tablet"] = [tab.Family, float(tab.CupDepth.Value), bool(tab.isValid())]
@@ -56,6 +69,7 @@ try:
     result["report_found"] = bool(reports)
     tab.CupDepth = 1.0
     doc.recompute()
+    mark("report")
     FreeCADGui.Selection.clearSelection()
     FreeCADGui.Selection.addSelection(tab)
     result["active"] = {
@@ -63,6 +77,7 @@ try:
         for c in ("Tabletcad_UpperPunch", "Tabletcad_Tooling")
     }
     FreeCADGui.runCommand("Tabletcad_Tooling")
+    mark("tooling")
     for o in doc.Objects:
         if getattr(getattr(o, "Proxy", None), "Type", "") == "TabletcadPunch":
             o.Gap = 4.0
@@ -84,6 +99,7 @@ try:
     view = FreeCADGui.ActiveDocument.ActiveView
     view.viewIsometric()
     view.fitAll()
+    mark("view")
     QtGui.QApplication.processEvents()
     result["window"] = bool(mw.grab().save(os.environ["TABLETCAD_FC_WINDOW"]))
     if os.environ.get("TABLETCAD_FC_SAVEIMAGE") == "1":

@@ -267,7 +267,7 @@ try:
     tool_names = [o.Name for o in tooling["ring"]]
     FreeCAD.closeDocument(doc.Name)
     doc = FreeCAD.openDocument(path)
-    proxies = {o.Name: type(o.Proxy).__name__ for o in doc.Objects}
+    proxies = {o.Name: type(o.Proxy).__name__ for o in doc.Objects if hasattr(o, "Proxy")}
     ring = doc.getObject(names["ring"])
     restored_density = float(ring.Density)
     ring.Thickness = 5.0

@@ -383,6 +383,9 @@ def die_shape(rims, clearance=0.05, height=22.22, outer_diameter=38.1):
         bore_wire = offset_outline_wire(lo["outline"], float(clearance), z_lo)
     else:
         bore_wire = _rim_wire(lo).makeOffset2D(float(clearance), 0, False, False, False)
+        # offset curves as B-splines: FreeCAD 1.0's STEP writer drops extrusions of offset
+        # curves (the die came back as an open shell of 3 of its 5 faces)
+        bore_wire = Part.Wire([e.toNurbs().Edges[0] for e in bore_wire.OrderedEdges])
     reach = float(np.max(np.hypot(*np.asarray(lo["poles"])[:, :2].T))) + clearance
     if not outer_diameter / 2.0 > reach + 0.5:
         raise DesignError(

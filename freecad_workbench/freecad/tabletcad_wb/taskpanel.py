@@ -19,7 +19,7 @@ __all__ = ["LIMITS", "TabletForm", "TabletTaskPanel", "edit_tablet"]
 current = None  # the panel shown last (scripts and tests drive it)
 
 # spin-box ranges by unit; the core's own checks (DesignError) give the exact allowed range
-LIMITS = {"mm": (0.01, 100.0, 3), "deg": (0.0, 90.0, 2)}
+LIMITS = {"mm": (0.0, 100.0, 3), "deg": (0.0, 90.0, 2)}
 DENSITY_LIMITS = (0.01, 30.0)  # mg/mm^3 (= g/cm^3)
 
 
