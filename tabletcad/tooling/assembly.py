@@ -2,7 +2,7 @@
 
 ``assembly.step`` holds an XCAF assembly named ``<tablet>_tooling`` whose
 components are labelled ``tablet``, ``upper_punch``, ``lower_punch`` and
-``die``, in the press position of the chosen punch gap (the upper punch
+``die`` and coloured (:data:`PART_COLOURS`, surface colours of the parts), in the press position of the chosen punch gap (the upper punch
 lifted by ``gap - band`` from the closed position).  ``upper_punch.step``,
 ``lower_punch.step`` and ``die.step`` hold one part each at the closed
 position.  Every file is written atomically (:mod:`tabletcad.io.atomic`).
@@ -24,14 +24,22 @@ try:  # OCP >= 8.0
 except ImportError:  # pragma: no cover - OCP 7.x
     from OCP.TDF import TDF_LabelSequence
 from OCP.TopoDS import TopoDS_Compound
-from OCP.XCAFDoc import XCAFDoc_ShapeTool
+from OCP.Quantity import Quantity_Color, Quantity_TypeOfColor
+from OCP.XCAFDoc import XCAFDoc_ColorType, XCAFDoc_DocumentTool, XCAFDoc_ShapeTool
 
 from tabletcad.cad.export import export_step, step_document, write_step_document
 from tabletcad.errors import GeometryError
 
-__all__ = ["write_assembly", "write_parts", "PART_NAMES"]
+__all__ = ["write_assembly", "write_parts", "PART_NAMES", "PART_COLOURS"]
 
 PART_NAMES = ("tablet", "upper_punch", "lower_punch", "die")
+# sRGB 0..1, as the FreeCAD workbench shows them: tablet off-white, punches steel blue, die grey
+PART_COLOURS = {
+    "tablet": (0.93, 0.93, 0.86),
+    "upper_punch": (0.62, 0.68, 0.78),
+    "lower_punch": (0.62, 0.68, 0.78),
+    "die": (0.55, 0.55, 0.58),
+}
 
 
 def write_assembly(parts: dict, path, *, name: str = "tooling", offsets: dict | None = None) -> Path:
@@ -49,6 +57,7 @@ def write_assembly(parts: dict, path, *, name: str = "tooling", offsets: dict | 
         builder.Add(comp, parts[part].Moved(TopLoc_Location(tr)) if dz else parts[part])
     top = tool.AddShape(comp, True)  # an assembly: one component (and one part) per sub-shape
     TDataStd_Name.Set_s(top, TCollection_ExtendedString(str(name)))
+    colours = XCAFDoc_DocumentTool.ColorTool_s(doc.Main())
     labels = TDF_LabelSequence()
     XCAFDoc_ShapeTool.GetComponents_s(top, labels, False)
     if labels.Length() != len(names):
@@ -59,6 +68,9 @@ def write_assembly(parts: dict, path, *, name: str = "tooling", offsets: dict | 
         ref = TDF_Label()
         if XCAFDoc_ShapeTool.GetReferredShape_s(comp_label, ref):
             TDataStd_Name.Set_s(ref, TCollection_ExtendedString(part))
+            r, g, b = PART_COLOURS[part]
+            colours.SetColor(ref, Quantity_Color(r, g, b, Quantity_TypeOfColor.Quantity_TOC_sRGB),
+                             XCAFDoc_ColorType.XCAFDoc_ColorSurf)
     return write_step_document(doc, path, what=f"the assembly {name}", obj=parts)
 
 
