@@ -95,6 +95,7 @@ try:
             icon=o.ViewObject.Proxy.getIcon() if o.ViewObject is not None and o.ViewObject.Proxy else None,
         )
         for o in doc.Objects
+        if getattr(getattr(o, "Proxy", None), "Type", "").startswith("Tabletcad")
     ]
     view = FreeCADGui.ActiveDocument.ActiveView
     view.viewIsometric()
@@ -106,6 +107,20 @@ try:
         # without an OpenGL context (plain offscreen platform) saveImage aborts FreeCAD
         view.saveImage(os.environ["TABLETCAD_FC_SHOT"], 1000, 750, "White")
         result["shot"] = os.environ["TABLETCAD_FC_SHOT"]
+    # TechDraw page (1.0 projects in a worker thread: wait for it in the event loop)
+    import time
+
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.Selection.addSelection(tab)
+    FreeCADGui.runCommand("Tabletcad_Drawing")
+    dims = [o for o in doc.Objects if o.TypeId == "TechDraw::DrawViewDimExtent"]
+    t_end = time.time() + 60.0
+    while time.time() < t_end and not all(d.getRawValue() > 0 for d in dims):
+        QtGui.QApplication.processEvents()
+        time.sleep(0.05)
+        doc.recompute()
+    result["drawing"] = {d.Label: float(d.getRawValue()) for d in dims}
+    mark("drawing")
     result["ok"] = True
     asm = os.environ.get("TABLETCAD_FC_ASSEMBLY")
     if asm:  # FreeCAD's GUI STEP import of the tooling assembly: names and colours

@@ -8,9 +8,10 @@ core's message (``obj.isValid()`` is False, ``obj.getStatusString()`` holds
 the message) and the previous valid shape stays in ``obj.Shape``.  The Report view
 then shows that message on one line; the traceback goes to FreeCAD's log only.
 
-Units: lengths, areas and volumes are FreeCAD quantities (mm, mm², mm³); ``Density``
-(mg/mm³ = g/cm³) and ``Weight`` (mg) are plain numbers with the unit in their
-tooltip, because FreeCAD's unit schemas show a mass in kg and a density in kg/m³.
+Units: the dimensions are FreeCAD lengths and angles (mm, °); the results (volumes,
+areas, ``Weight``) and ``Density`` are plain numbers in mm, mm², mm³, mg and mg/mm³,
+named in their property group and tooltip, because FreeCAD's unit schemas would show
+345 mm² as 3.46 cm², a mass in kg and a density in kg/m³.
 Labels follow the family (while the label is the family's name) and the tooling's
 labels follow the tablet's label.
 """
