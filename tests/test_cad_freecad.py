@@ -1,4 +1,5 @@
-"""FreeCAD (its own Python and OCCT) reads our STEP and rebuilds our B-spline data."""
+"""FreeCAD (its own Python and OCCT) reads our STEP and rebuilds our B-spline data, under each
+FreeCAD (Debian's 0.20 and 1.0 from the .ci/freecad1 root, ``tests/freecads.py``)."""
 
 
 import numpy as np
@@ -9,14 +10,17 @@ import pytest
 pytest.importorskip("OCP")
 
 from tabletcad.cad.export import export  # noqa: E402
-from tabletcad.cad.readback import find_freecadcmd, freecad_build_bspline, freecad_read_step  # noqa: E402
+import freecads  # noqa: E402
+from tabletcad.cad.readback import freecad_build_bspline, freecad_read_step  # noqa: E402
 from tabletcad.cad.solid import build_solid, mass_properties  # noqa: E402
 from tabletcad.cad.standins import cylinder, ring, sphere  # noqa: E402
 
 pytestmark = [pytest.mark.cad, pytest.mark.freecad]
 
-if find_freecadcmd() is None:
-    pytest.skip("freecadcmd not installed", allow_module_level=True)
+
+@pytest.fixture(scope="module", params=freecads.params())
+def fc(request) -> freecads.FreeCADInstall:
+    return request.param
 
 STANDINS = [sphere(2.5), cylinder(2.5, 3.0), ring(1.5, 3.0, 2.0)]
 
@@ -27,9 +31,9 @@ def built(request):
     return s, build_solid(s.patches, 1e-4, name=s.name.replace(" ", "_"))
 
 
-def test_freecad_reads_step(built, tmp_path):
+def test_freecad_reads_step(fc, built, tmp_path):
     s, ts = built
-    r = freecad_read_step(export(ts, tmp_path / "p.step"))
+    r = freecad_read_step(export(ts, tmp_path / "p.step"), freecadcmd=fc.cmd)
     assert r["n_solids"] == 1 and r["valid"] and r["solids_valid"] == [True] and r["solids_closed"] == [True]
     assert r["labels"] == [ts.name]
     # FreeCAD's Shape.Volume is OCCT's *default* integration: identical to ours with
@@ -38,11 +42,11 @@ def test_freecad_reads_step(built, tmp_path):
     assert r["volume"] == pytest.approx(ts.volume, rel=1e-3)
 
 
-def test_build_from_poles_mults_knots_is_the_same_surface(built):
+def test_build_from_poles_mults_knots_is_the_same_surface(fc, built):
     s, ts = built
     rng = np.random.default_rng(3)
     u, v = rng.random(40), rng.random(40) * 2 * np.pi
-    r = freecad_build_bspline(ts.surfaces, u, v)
+    r = freecad_build_bspline(ts.surfaces, u, v, freecadcmd=fc.cmd)
     for k, surf in enumerate(ts.surfaces):
         np.testing.assert_allclose(np.array(r["values"][k]), surf.evaluate(u, v), atol=1e-13)
         back = r["readback"][k]

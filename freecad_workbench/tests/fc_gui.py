@@ -14,18 +14,62 @@ import traceback
 import FreeCAD
 import FreeCADGui
 
-result = {"ok": False}
+result = {"ok": False, "reached": []}
+
+
+def mark(name):  # how far the script got (written at once: a hang shows where)
+    result["reached"].append(name)
+    with open(os.environ["TABLETCAD_FC_OUTPUT"], "w") as fh:
+        json.dump(result, fh)
+
+
 try:
     FreeCADGui.activateWorkbench("TabletcadWorkbench")
     wb = FreeCADGui.activeWorkbench()
     result["workbench"] = wb.name()
     result["commands"] = [c for c in FreeCADGui.listCommands() if c.startswith("Tabletcad_")]
     doc = FreeCAD.newDocument("gui")
+    from PySide import QtGui
+
+    from freecad.tabletcad_wb import taskpanel
+
+    # the Tablet command opens the task panel: family, dimensions, live validation, figures
     FreeCADGui.runCommand("Tabletcad_Tablet")
+    panel = taskpanel.current
+    mark("panel")
+    result["panel_shown"] = FreeCADGui.Control.activeDialog()
+    panel.family.setCurrentIndex(panel.model.families.index("concave_round"))
+    result["panel_fields"] = sorted(panel.spins)
+    result["panel_suffix"] = panel.spins["diameter"].suffix()
+    panel.spins["cup_depth"].setValue(10.0)  # deeper than a hemisphere: refused as you type
+    result["panel_invalid"] = [panel.ok, panel.status.text()]
+    mark("invalid")
+    panel.spins["cup_depth"].setValue(1.0)
+    result["panel_valid"] = [panel.ok, panel.status.text(), panel.figures.text()]
+    mark("valid")
+    mw = FreeCADGui.getMainWindow()
+    mw.resize(1200, 800)
+    QtGui.QApplication.processEvents()
+    if os.environ.get("TABLETCAD_FC_PANEL"):
+        result["panel_png"] = bool(mw.grab().save(os.environ["TABLETCAD_FC_PANEL"]))
+    mark("panel_png")
+    result["panel_accept"] = bool(panel.accept())
+    mark("accept")
+    result["panel_closed"] = FreeCADGui.Control.activeDialog() is False
     tab = doc.Objects[-1]
-    tab.Family = "concave_round"
+    result["panel_tablet"] = [tab.Family, float(tab.CupDepth.Value), bool(tab.isValid())]
+
+    # a refused value: what the Report view shows
+    tab.CupDepth = 10.0
+    doc.recompute()
+    QtGui.QApplication.processEvents()
+    reports = [w for w in mw.findChildren(QtGui.QTextEdit) if "report" in (w.objectName() or "").lower()]
+    text = reports[0].toPlainText() if reports else ""
+    result["report_view"] = [ln for ln in text.splitlines() if "cup_depth" in ln or "Traceback" in ln or "File " in ln]
+    result["report_found"] = bool(reports)
     tab.CupDepth = 1.0
     doc.recompute()
+    mark("report")
     FreeCADGui.Selection.clearSelection()
     FreeCADGui.Selection.addSelection(tab)
     result["active"] = {
@@ -33,6 +77,7 @@ try:
         for c in ("Tabletcad_UpperPunch", "Tabletcad_Tooling")
     }
     FreeCADGui.runCommand("Tabletcad_Tooling")
+    mark("tooling")
     for o in doc.Objects:
         if getattr(getattr(o, "Proxy", None), "Type", "") == "TabletcadPunch":
             o.Gap = 4.0
@@ -50,21 +95,56 @@ try:
             icon=o.ViewObject.Proxy.getIcon() if o.ViewObject is not None and o.ViewObject.Proxy else None,
         )
         for o in doc.Objects
+        if getattr(getattr(o, "Proxy", None), "Type", "").startswith("Tabletcad")
     ]
     view = FreeCADGui.ActiveDocument.ActiveView
     view.viewIsometric()
     view.fitAll()
-    from PySide import QtGui
-
-    mw = FreeCADGui.getMainWindow()
-    mw.resize(1200, 800)
+    mark("view")
     QtGui.QApplication.processEvents()
     result["window"] = bool(mw.grab().save(os.environ["TABLETCAD_FC_WINDOW"]))
     if os.environ.get("TABLETCAD_FC_SAVEIMAGE") == "1":
         # without an OpenGL context (plain offscreen platform) saveImage aborts FreeCAD
         view.saveImage(os.environ["TABLETCAD_FC_SHOT"], 1000, 750, "White")
         result["shot"] = os.environ["TABLETCAD_FC_SHOT"]
+    # TechDraw page (1.0 projects in a worker thread: wait for it in the event loop)
+    import time
+
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.Selection.addSelection(tab)
+    FreeCADGui.runCommand("Tabletcad_Drawing")
+    dims = [o for o in doc.Objects if o.TypeId == "TechDraw::DrawViewDimExtent"]
+    t_end = time.time() + 60.0
+    while time.time() < t_end and not all(d.getRawValue() > 0 for d in dims):
+        QtGui.QApplication.processEvents()
+        time.sleep(0.05)
+        doc.recompute()
+    result["drawing"] = {d.Label: float(d.getRawValue()) for d in dims}
+    mark("drawing")
     result["ok"] = True
+    asm = os.environ.get("TABLETCAD_FC_ASSEMBLY")
+    if asm:  # FreeCAD's GUI STEP import of the tooling assembly: names and colours
+        with open(os.environ["TABLETCAD_FC_OUTPUT"], "w") as fh:
+            json.dump(result, fh)  # in case the import kills FreeCAD
+        from freecad.tabletcad_wb.tasks import import_step
+
+        d = FreeCAD.newDocument("assembly")
+        import_step(asm, d)  # ImportGui.insert (0.20: without link groups)
+        parts = {}
+        for o in d.Objects:
+            if o.TypeId == "Part::Feature" and o.Shape.Solids and o.ViewObject is not None:
+                vo = o.ViewObject
+                if hasattr(vo, "ShapeAppearance"):  # 1.0: materials
+                    cols = [list(m.DiffuseColor)[:3] for m in vo.ShapeAppearance]
+                else:
+                    cols = [list(c)[:3] for c in (vo.DiffuseColor or [vo.ShapeColor])]
+                parts[o.Label] = dict(valid=bool(o.Shape.isValid()), colours=cols)
+        result["assembly"] = parts
+        result["assembly_objects"] = [
+            [o.Name, o.Label, o.TypeId, len(o.Shape.Solids) if hasattr(o, "Shape") else None] for o in d.Objects
+        ]
+        prefs = FreeCAD.ParamGet("User parameter:BaseApp/Preferences/Mod/Import")
+        result["import_prefs"] = [prefs.GetBool("UseLinkGroup", True), prefs.GetInt("ImportMode", 0)]
 except Exception as exc:
     result["error"] = repr(exc)
     result["traceback"] = traceback.format_exc()

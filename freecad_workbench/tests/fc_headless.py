@@ -39,16 +39,28 @@ def shape_info(o):
     }
 
 
+def _prop_value(o, p):
+    v = getattr(o, p)
+    if hasattr(v, "Value"):  # Quantity: value and unit as FreeCAD shows them
+        return [float(v.Value), v.UserString]
+    return v if isinstance(v, (int, float, str)) else str(v)
+
+
 def tablet_info(t):
     d = shape_info(t)
     d.update(
         family=t.Family,
-        core_volume=float(t.Volume.Value),
-        core_area=float(t.Area.Value),
-        solid_volume=float(t.SolidVolume.Value),
-        weight_mg=float(t.Weight.Value) * 1e6,  # kg -> mg
-        density=float(t.Density.Value) * 1e6,  # kg/mm^3 -> mg/mm^3 (= g/cm^3)
-        fit_deviation=float(t.FitDeviation.Value),
+        core_volume=float(t.Volume),
+        core_area=float(t.Area),
+        solid_volume=float(t.SolidVolume),
+        weight_mg=float(t.Weight),  # mg
+        density=float(t.Density),  # mg/mm^3 (= g/cm^3)
+        plan_area=float(t.PlanArea),
+        label=t.Label,
+        props={p: _prop_value(t, p) for p in t.PropertiesList if t.getGroupOfProperty(p).split(" (")[0] in ("Results", "Material", "Dimensions", "Tablet")},
+        rimdata_mode=list(t.getEditorMode("RimData")),
+        groups={p: t.getGroupOfProperty(p) for p in t.PropertiesList},
+        fit_deviation=float(t.FitDeviation),
         recompute_s=float(t.RecomputeTime),
         dims={
             p: float(getattr(t, p).Value) for p in t.PropertiesList if t.getGroupOfProperty(p) == "Dimensions"
@@ -68,9 +80,20 @@ try:
         make_die,
         make_lower_punch,
         make_tablet,
+        make_tooling,
         make_upper_punch,
     )
 
+    from freecad.tabletcad_wb import objects
+
+    result["log"] = []
+    _log = objects.log
+
+    def _record(text):
+        result["log"].append(text)
+        _log(text)
+
+    objects.log = _record  # what the workbench sends to FreeCAD's log
     result["core_root"] = str(wb.core_root())
     import tabletcad.shapes
 
@@ -122,7 +145,9 @@ try:
     # ---- invalid values: error state, previous shape kept, tooling untouched
     before = shape_info(t)
     t.CupDepth = 8.0  # deeper than a hemisphere over the cup
+    print("@@ cup_too_deep recompute", flush=True)
     doc.recompute()
+    print("@@ done", flush=True)
     step(
         "cup_too_deep",
         tablet=tablet_info(t),
@@ -155,10 +180,70 @@ try:
 
     # ---- family switch: Dimensions group follows the family
     sw = make_tablet(doc, "flat_faced_round")
+    label_before = sw.Label
+    swtools = make_tooling(doc, sw, recompute=False)
     sw.Family = "shallow_convex_round"
     sw.Band = 1.5
     doc.recompute()
-    step("family_switch", tablet=tablet_info(sw))
+    step(
+        "family_switch",
+        tablet=tablet_info(sw),
+        label_before=label_before,
+        tool_labels=[o.Label for o in swtools],
+        tools_valid=[bool(o.isValid()) for o in swtools],
+    )
+    sw.Label = "Aspirin 500"
+    step("rename", label=sw.Label, tool_labels=[o.Label for o in swtools])
+
+    # ---- unchanged geometry is not rebuilt: Density only rescales the weight
+    c = tabs["capsule"]
+    w0, n0 = float(c.Weight), c.Proxy.builds
+    c.Density = 0.6
+    t0 = time.perf_counter()
+    doc.recompute()
+    step("density", wall_s=time.perf_counter() - t0, w0=w0, builds=[n0, c.Proxy.builds], tablet=tablet_info(c))
+
+    # ---- TechDraw page: views and the main dimensions
+    from freecad.tabletcad_wb.techdraw import make_page
+
+    page, views, dims = make_page(doc, tabs["capsule"])
+    step(
+        "drawing",
+        page=page.TypeId,
+        template=os.path.basename(page.Template.Template),
+        views=[[v.TypeId, list(v.Direction), bool(v.isValid())] for v in views],
+        dims={k: [float(d.getRawValue()), d.Type, bool(d.isValid())] for k, d in dims.items()},
+        on_page=sorted(v.Name for v in page.Views),
+    )
+
+    # ---- the task panel's form (no Qt): fields, live validation, create with tooling, edit
+    from freecad.tabletcad_wb.taskpanel import TabletForm
+
+    form = TabletForm("concave_round")
+    fields = form.fields()
+    form.values["cup_depth"] = 10.0
+    bad = form.validate()
+    form.values.update(cup_depth=1.0, diameter=8.0)
+    good = form.validate()
+    made = form.create(doc, tooling=True)
+    linked = [o for o in made.InList if getattr(getattr(o, "Proxy", None), "Type", "").startswith("Tabletcad")]
+    edit = TabletForm.from_object(made)
+    same = dict(edit.values)
+    edit.set_family("flat_faced_round")
+    edit.values["thickness"] = 3.0
+    edit.density = 1.5
+    edit.apply(made)
+    doc.recompute()
+    step(
+        "form",
+        fields=fields,
+        bad=list(bad),
+        good=list(good),
+        from_object=same,
+        tablet=tablet_info(made),
+        tooling=sorted(o.Label for o in linked),
+        tooling_valid=[bool(o.isValid()) for o in linked],
+    )
 
     # ---- design files: a plain family design (parametric) and a free-form one (design_file)
     d1 = make_tablet(doc, os.path.join(root, "samples", "ring.toml"))
@@ -182,9 +267,9 @@ try:
     tool_names = [o.Name for o in tooling["ring"]]
     FreeCAD.closeDocument(doc.Name)
     doc = FreeCAD.openDocument(path)
-    proxies = {o.Name: type(o.Proxy).__name__ for o in doc.Objects}
+    proxies = {o.Name: type(o.Proxy).__name__ for o in doc.Objects if hasattr(o, "Proxy")}
     ring = doc.getObject(names["ring"])
-    restored_density = float(ring.Density.Value) * 1e6
+    restored_density = float(ring.Density)
     ring.Thickness = 5.0
     t0 = time.perf_counter()
     doc.recompute()

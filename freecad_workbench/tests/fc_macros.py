@@ -42,7 +42,7 @@ try:
         n=len(t),
         valid=[o.isValid() for o in t],
         family=t[0].Family if t else None,
-        volume=float(t[0].Volume.Value) if t else None,
+        volume=float(t[0].Volume) if t else None,
     )
 
     # 2. STEP export of that tablet and its tooling, read back with Part.read
@@ -81,8 +81,8 @@ try:
         n=len(t),
         valid=[o.isValid() for o in t],
         family=t[0].Family if t else None,
-        volume=float(t[0].Volume.Value) if t else None,
-        area=float(t[0].Area.Value) if t else None,
+        volume=float(t[0].Volume) if t else None,
+        area=float(t[0].Area) if t else None,
         dims={
             p: float(getattr(t[0], p).Value)
             for p in t[0].PropertiesList

@@ -67,10 +67,11 @@ def find_freecadcmd() -> str | None:
     return None
 
 
-def _run_freecad(mode: str, input_path: Path, timeout: float) -> dict[str, Any]:
-    exe = find_freecadcmd()
-    if exe is None:
+def _run_freecad(mode: str, input_path: Path, timeout: float, freecadcmd: Sequence[str] | None = None) -> dict[str, Any]:
+    exe = find_freecadcmd() if freecadcmd is None else None
+    if freecadcmd is None and exe is None:
         raise ReadbackError("freecadcmd not found on PATH")
+    cmd = list(freecadcmd) if freecadcmd is not None else [exe]
     with tempfile.TemporaryDirectory(prefix="tabletcad-fc-") as home:
         out = Path(home) / "result.json"
         env = _clean_env()
@@ -81,7 +82,7 @@ def _run_freecad(mode: str, input_path: Path, timeout: float) -> dict[str, Any]:
             TABLETCAD_FC_OUTPUT=str(out),
         )
         proc = subprocess.run(
-            [exe, str(FREECAD_SCRIPT)], env=env, cwd=home, capture_output=True, text=True, timeout=timeout
+            [*cmd, str(FREECAD_SCRIPT)], env=env, cwd=home, capture_output=True, text=True, timeout=timeout
         )
         if not out.exists():
             raise ReadbackError(
@@ -93,20 +94,28 @@ def _run_freecad(mode: str, input_path: Path, timeout: float) -> dict[str, Any]:
     return result
 
 
-def freecad_read_step(path: str | os.PathLike[str], timeout: float = 300.0) -> dict[str, Any]:
-    """Read a STEP file with FreeCAD: ``{n_solids, valid, solids_valid, volume, area, labels, ...}``."""
-    return _run_freecad("read_step", Path(path).resolve(), timeout)
+def freecad_read_step(
+    path: str | os.PathLike[str], timeout: float = 300.0, freecadcmd: Sequence[str] | None = None
+) -> dict[str, Any]:
+    """Read a STEP file with FreeCAD: ``{n_solids, valid, solids_valid, volume, area, labels, ...}``.
+
+    ``freecadcmd``: the command that runs FreeCAD's ``freecadcmd`` (default: the one on PATH)."""
+    return _run_freecad("read_step", Path(path).resolve(), timeout, freecadcmd)
 
 
 def freecad_build_bspline(
-    surfaces: Sequence[Any], u: Sequence[float] = (), v: Sequence[float] = (), timeout: float = 300.0
+    surfaces: Sequence[Any],
+    u: Sequence[float] = (),
+    v: Sequence[float] = (),
+    timeout: float = 300.0,
+    freecadcmd: Sequence[str] | None = None,
 ) -> dict[str, Any]:
     """Rebuild :class:`~tabletcad.bspline.BSplineSurfaceData` with FreeCAD; values at ``(u, v)``, solid volume."""
     payload = {"surfaces": [s.as_dict() for s in surfaces], "u": [float(x) for x in u], "v": [float(x) for x in v]}
     with tempfile.TemporaryDirectory(prefix="tabletcad-fcin-") as d:
         p = Path(d) / "surfaces.json"
         p.write_text(json.dumps(payload))
-        return _run_freecad("bspline", p, timeout)
+        return _run_freecad("bspline", p, timeout, freecadcmd)
 
 
 _OCP_READER = r"""

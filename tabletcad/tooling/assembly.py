@@ -2,7 +2,7 @@
 
 ``assembly.step`` holds an XCAF assembly named ``<tablet>_tooling`` whose
 components are labelled ``tablet``, ``upper_punch``, ``lower_punch`` and
-``die`` and coloured (:data:`PART_COLOURS`), in the press position of the chosen punch gap (the upper punch
+``die`` and coloured (:data:`PART_COLOURS`, surface colours of the parts), in the press position of the chosen punch gap (the upper punch
 lifted by ``gap - band`` from the closed position).  ``upper_punch.step``,
 ``lower_punch.step`` and ``die.step`` hold one part each at the closed
 position.  Every file is written atomically (:mod:`tabletcad.io.atomic`).
@@ -24,8 +24,8 @@ try:  # OCP >= 8.0
 except ImportError:  # pragma: no cover - OCP 7.x
     from OCP.TDF import TDF_LabelSequence
 from OCP.TopoDS import TopoDS_Compound
-from OCP.Quantity import Quantity_Color, Quantity_TOC_RGB
-from OCP.XCAFDoc import XCAFDoc_ColorGen, XCAFDoc_DocumentTool, XCAFDoc_ShapeTool
+from OCP.Quantity import Quantity_Color, Quantity_TypeOfColor
+from OCP.XCAFDoc import XCAFDoc_ColorType, XCAFDoc_DocumentTool, XCAFDoc_ShapeTool
 
 from tabletcad.cad.export import export_step, step_document, write_step_document
 from tabletcad.errors import GeometryError
@@ -33,9 +33,13 @@ from tabletcad.errors import GeometryError
 __all__ = ["write_assembly", "write_parts", "read_assembly_colours", "PART_NAMES", "PART_COLOURS"]
 
 PART_NAMES = ("tablet", "upper_punch", "lower_punch", "die")
-#: RGB (0-1) of each part in the assembly: white tablet, steel-blue punches, grey die
-PART_COLOURS = {"tablet": (0.95, 0.95, 0.92), "upper_punch": (0.45, 0.55, 0.75), "lower_punch": (0.35, 0.45, 0.65),
-                "die": (0.6, 0.6, 0.6)}
+# sRGB 0..1, as the FreeCAD workbench shows them: tablet off-white, punches steel blue, die grey
+PART_COLOURS = {
+    "tablet": (0.93, 0.93, 0.86),
+    "upper_punch": (0.62, 0.68, 0.78),
+    "lower_punch": (0.62, 0.68, 0.78),
+    "die": (0.55, 0.55, 0.58),
+}
 
 
 def write_assembly(parts: dict, path, *, name: str = "tooling", offsets: dict | None = None) -> Path:
@@ -62,11 +66,11 @@ def write_assembly(parts: dict, path, *, name: str = "tooling", offsets: dict | 
         comp_label = labels.Value(k + 1)
         TDataStd_Name.Set_s(comp_label, TCollection_ExtendedString(part))
         ref = TDF_Label()
-        colour = Quantity_Color(*PART_COLOURS[part], Quantity_TOC_RGB)
-        colours.SetColor(comp_label, colour, XCAFDoc_ColorGen)
         if XCAFDoc_ShapeTool.GetReferredShape_s(comp_label, ref):
             TDataStd_Name.Set_s(ref, TCollection_ExtendedString(part))
-            colours.SetColor(ref, colour, XCAFDoc_ColorGen)
+            r, g, b = PART_COLOURS[part]
+            colours.SetColor(ref, Quantity_Color(r, g, b, Quantity_TypeOfColor.Quantity_TOC_sRGB),
+                             XCAFDoc_ColorType.XCAFDoc_ColorSurf)
     return write_step_document(doc, path, what=f"the assembly {name}", obj=parts)
 
 
@@ -82,8 +86,7 @@ def read_assembly_colours(path) -> dict:
     """``{part name: (r, g, b)}`` of an assembly STEP as OCP's XCAF reader sees them (for checks)."""
     from OCP.STEPCAFControl import STEPCAFControl_Reader
     from OCP.TDocStd import TDocStd_Document
-    from OCP.Quantity import Quantity_TOC_RGB
-    from OCP.XCAFDoc import XCAFDoc_ColorSurf, XCAFDoc_ColorTool
+    from OCP.XCAFDoc import XCAFDoc_ColorTool
 
     doc = TDocStd_Document(TCollection_ExtendedString("XmlOcaf"))
     reader = STEPCAFControl_Reader()
@@ -103,7 +106,9 @@ def read_assembly_colours(path) -> dict:
             continue
         c = Quantity_Color()
         for lab in (comps.Value(i), ref):
-            if any(XCAFDoc_ColorTool.GetColor_s(lab, t, c) for t in (XCAFDoc_ColorGen, XCAFDoc_ColorSurf)):
-                out[name.Get().ToExtString()] = tuple(round(x, 4) for x in c.Values(Quantity_TOC_RGB))
+            kinds = (XCAFDoc_ColorType.XCAFDoc_ColorGen, XCAFDoc_ColorType.XCAFDoc_ColorSurf)
+            if any(XCAFDoc_ColorTool.GetColor_s(lab, t, c) for t in kinds):
+                srgb = c.Values(Quantity_TypeOfColor.Quantity_TOC_sRGB)
+                out[name.Get().ToExtString()] = tuple(round(x, 4) for x in srgb)
                 break
     return out

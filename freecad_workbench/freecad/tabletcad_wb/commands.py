@@ -16,6 +16,7 @@ TOOLBAR = [
     "Tabletcad_Die",
     "Tabletcad_Tooling",
     "Tabletcad_ExportStep",
+    "Tabletcad_Drawing",
 ]
 MENU = TOOLBAR
 
@@ -56,15 +57,13 @@ class _Command:
 
 class TabletCommand(_Command):
     name, icon = "Tabletcad_Tablet", "Tablet"
-    menu = "Tablet"
-    tip = "Create a parametric tablet (choose its family and dimensions in the property editor)"
+    menu = "Tablet..."
+    tip = "Create a parametric tablet: family, dimensions and density in a task panel, checked as you type"
 
     def Activated(self):
-        doc = _doc()
-        doc.openTransaction("Create tablet")
-        make_tablet(doc, "flat_faced_round")
-        doc.commitTransaction()
-        _fit()
+        from .taskpanel import edit_tablet
+
+        edit_tablet(None, _doc())
 
 
 class TabletFromDesignCommand(_Command):
@@ -142,6 +141,21 @@ class ExportStepCommand(_ToolCommand):
             tasks.export_step(FreeCAD.ActiveDocument, d)
 
 
+class DrawingCommand(_ToolCommand):
+    name, icon, menu = "Tabletcad_Drawing", "TabletDesign", "Drawing (TechDraw)"
+    tip = "TechDraw page of the selected tablet: top and side views with length, width and height"
+
+    def Activated(self):
+        from .techdraw import make_page
+
+        doc = FreeCAD.ActiveDocument
+        doc.openTransaction("Tablet drawing")
+        page, _, _ = make_page(doc, _selected_tablet())
+        doc.commitTransaction()
+        if hasattr(page, "ViewObject") and page.ViewObject is not None:
+            page.ViewObject.show()
+
+
 COMMANDS = [
     TabletCommand,
     TabletFromDesignCommand,
@@ -150,6 +164,7 @@ COMMANDS = [
     DieCommand,
     ToolingCommand,
     ExportStepCommand,
+    DrawingCommand,
 ]
 
 

@@ -44,7 +44,8 @@ def make_tablet(doc, design_or_family="flat_faced_round", name=None, recompute=T
     any other design (free_form, trim, reshape, tooling tables) is kept as
     ``Family = design_file`` with ``DesignFile`` set.
     ``params``: dimensions by core name (``diameter=9.0``, ``cup_depth="0.8 mm"``),
-    plus ``density`` (``"1.2 g/cm^3"`` or kg/m^3) and ``fit_tolerance`` (mm).
+    plus ``density`` (mg/mm³, or a string with units such as ``"1.2 g/cm^3"``) and
+    ``fit_tolerance`` (mm).
     """
     density = params.pop("density", None)
     fit_tol = params.pop("fit_tolerance", None)
@@ -71,13 +72,14 @@ def make_tablet(doc, design_or_family="flat_faced_round", name=None, recompute=T
         if fam is None or k not in fam.params:
             raise ValueError(f"family {family!r} has no parameter {k!r}")
         setattr(obj, objects.prop_name(k), _value(v, "deg" if fam.params[k] == "deg" else "mm"))
-    if density is not None:
-        q = (
-            FreeCAD.Units.Quantity(density)
-            if isinstance(density, str)
-            else FreeCAD.Units.Quantity(f"{float(density)} kg/m^3")
-        )
-        obj.Density = q
+    if density is not None:  # mg/mm^3, or a string with units ("1.2 g/cm^3")
+        if isinstance(density, str):
+            q = FreeCAD.Units.Quantity(density)
+            if q.Unit != FreeCAD.Units.Unit("kg/mm^3"):
+                raise ValueError(f"density {density!r} is not a density")
+            obj.Density = float(q.Value) * 1e6  # kg/mm^3 -> mg/mm^3
+        else:
+            obj.Density = float(density)
     if fit_tol is not None:
         obj.FitTolerance = _value(fit_tol)
     obj.Label = label or family

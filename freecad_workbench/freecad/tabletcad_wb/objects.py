@@ -5,13 +5,23 @@ assigns ``obj.Shape``.  When the core refuses the parameters (a
 :class:`tabletcad.errors.TabletcadError`: zero or negative diameter, cup too
 deep, ...) ``execute()`` raises: FreeCAD marks the object as failed with the
 core's message (``obj.isValid()`` is False, ``obj.getStatusString()`` holds
-the message) and the previous valid shape stays in ``obj.Shape``.
+the message) and the previous valid shape stays in ``obj.Shape``.  The Report view
+then shows that message on one line; the traceback goes to FreeCAD's log only.
+
+Units: the dimensions are FreeCAD lengths and angles (mm, °); the results (volumes,
+areas, ``Weight``) and ``Density`` are plain numbers in mm, mm², mm³, mg and mg/mm³,
+named in their property group and tooltip, because FreeCAD's unit schemas would show
+345 mm² as 3.46 cm², a mass in kg and a density in kg/m³.
+Labels follow the family (while the label is the family's name) and the tooling's
+labels follow the tablet's label.
 """
 
 from __future__ import annotations
 
 import os
+import sys
 import time
+import traceback
 
 import FreeCAD
 
@@ -31,7 +41,47 @@ __all__ = [
 DESIGN_FILE = "design_file"
 _READONLY = 1  # editor mode: read-only
 _OUTPUT = 8  # Prop_Output: setting it does not touch the object
-_HIDDEN = 4
+_HIDDEN = 2  # editor mode: hidden
+_EDITOR_MODES = {0: [], _READONLY: ["ReadOnly"], _HIDDEN: ["Hidden"], _READONLY | _HIDDEN: ["ReadOnly", "Hidden"]}
+DEFAULT_DENSITY = 1.2  # mg/mm^3
+# results are plain numbers in the units a formulation scientist uses, named in the group:
+# FreeCAD's unit schemas would show 345 mm² as 3.46 cm², a weight in kg, a density in kg/m³
+RESULTS = "Results (mm, mm², mm³, mg)"
+MATERIAL = "Material (mg/mm³)"
+
+
+def log(text: str) -> None:
+    """FreeCAD's log (not the Report view's messages)."""
+    FreeCAD.Console.PrintLog(text if text.endswith("\n") else text + "\n")
+
+
+def _tabletcad_error():
+    from tabletcad.errors import TabletcadError
+
+    return TabletcadError
+
+
+def _fail(obj, exc):
+    """Report a refused recompute: one line in the Report view, the traceback in the log.
+
+    FreeCAD prints the traceback of an exception raised by ``execute()`` as an error;
+    ``sys.tracebacklimit = 0`` shortens that to the exception's one line (it is reset by
+    the next tabletcad call, see :func:`_restore_traceback`)."""
+    log(f"tabletcad: {obj.Label}: " + traceback.format_exc())
+    sys.tracebacklimit = 0
+    if FreeCAD.GuiUp:
+        try:
+            from PySide import QtCore
+
+            QtCore.QTimer.singleShot(0, _restore_traceback)
+        except Exception:
+            pass
+    raise exc.with_traceback(None)
+
+
+def _restore_traceback():
+    if getattr(sys, "tracebacklimit", None) == 0:
+        del sys.tracebacklimit
 
 
 def family_names() -> list[str]:
@@ -70,6 +120,16 @@ class _Proxy:
         obj.Proxy = self
         self._ready = True
 
+    def execute(self, obj):
+        _restore_traceback()
+        try:
+            self.build(obj)
+        except _tabletcad_error() as exc:
+            _fail(obj, exc)
+
+    def build(self, obj):
+        """Compute ``obj.Shape`` and the results (subclasses)."""
+
     def __getstate__(self):
         return {"Type": self.Type, "version": 1}
 
@@ -91,12 +151,16 @@ class _Proxy:
 
     @staticmethod
     def _add(obj, kind, name, group, doc, default=None, mode=0, hidden=False):
+        if name in obj.PropertiesList and (
+            obj.getTypeIdOfProperty(name) != kind or obj.getGroupOfProperty(name) != group
+        ):
+            obj.removeProperty(name)  # a document of an earlier version (e.g. Quantity results)
         if name not in obj.PropertiesList:
             obj.addProperty(kind, name, group, doc, _OUTPUT if mode else 0, False, hidden)
             if default is not None:
                 setattr(obj, name, default)
         if mode:
-            obj.setEditorMode(name, mode)
+            obj.setEditorMode(name, _EDITOR_MODES[mode])
 
 
 # ============================================================================ Tablet
@@ -110,6 +174,7 @@ class TabletProxy(_Proxy):
         obj.Proxy = self
         self._setup(obj)
         obj.Family = family
+        self._family_label, self._label = obj.Family, obj.Label
         self._sync_dimensions(obj, reset=True)
         self._ready = True
 
@@ -141,58 +206,61 @@ class TabletProxy(_Proxy):
             "largest distance between the B-spline faces and the PDE surfaces",
             _qty(1e-4, "mm"),
         )
-        self._add(obj, "App::PropertyQuantity", "Density", "Material", "apparent density of the tablet")
-        obj.Density = FreeCAD.Units.Unit("kg/m^3")
-        if obj.Density.Value == 0.0:
-            obj.Density = FreeCAD.Units.Quantity("1200 kg/m^3")
+        if "Density" in obj.PropertiesList and obj.getTypeIdOfProperty("Density") == "App::PropertyQuantity":
+            # documents of the first workbench version: a Quantity in kg/m^3 (internally kg/mm^3)
+            old = float(obj.Density.Value) * 1e6 or DEFAULT_DENSITY
+            obj.removeProperty("Density")
+            self._add(obj, "App::PropertyFloat", "Density", MATERIAL, "apparent density, mg/mm³ (= g/cm³)", old)
+        self._add(
+            obj, "App::PropertyFloat", "Density", MATERIAL, "apparent density, mg/mm³ (= g/cm³)", DEFAULT_DENSITY
+        )
         self._add(
             obj,
-            "App::PropertyVolume",
+            "App::PropertyFloat",
             "Volume",
-            "Results",
-            "volume of the PDE tablet (tabletcad quadrature)",
+            RESULTS,
+            "volume of the PDE tablet, mm³ (tabletcad quadrature)",
             mode=_READONLY,
         )
         self._add(
             obj,
-            "App::PropertyVolume",
+            "App::PropertyFloat",
             "SolidVolume",
-            "Results",
-            "exact volume of the B-spline solid in Shape (Gauss quadrature of its faces)",
+            RESULTS,
+            "exact volume of the B-spline solid in Shape, mm³ (Gauss quadrature of its faces)",
             mode=_READONLY,
         )
         self._add(
             obj,
-            "App::PropertyArea",
+            "App::PropertyFloat",
             "Area",
-            "Results",
-            "surface area of the PDE tablet (tabletcad quadrature)",
+            RESULTS,
+            "surface area of the PDE tablet, mm² (tabletcad quadrature)",
             mode=_READONLY,
         )
         self._add(
             obj,
-            "App::PropertyArea",
+            "App::PropertyFloat",
             "PlanArea",
-            "Results",
-            "area of the silhouette seen along z",
+            RESULTS,
+            "area of the silhouette seen along z, mm²",
             mode=_READONLY,
         )
-        self._add(obj, "App::PropertyQuantity", "Weight", "Results", "Volume x Density", mode=_READONLY)
-        obj.Weight = FreeCAD.Units.Unit("kg")
+        self._add(obj, "App::PropertyFloat", "Weight", RESULTS, "tablet weight, mg (Volume x Density)", mode=_READONLY)
         self._add(
             obj,
-            "App::PropertyLength",
+            "App::PropertyFloat",
             "FitDeviation",
-            "Results",
-            "largest measured B-spline fit deviation",
+            RESULTS,
+            "largest measured B-spline fit deviation, mm",
             mode=_READONLY,
         )
         self._add(
             obj,
             "App::PropertyFloat",
             "RecomputeTime",
-            "Results",
-            "seconds of the last recompute",
+            RESULTS,
+            "seconds of the last recompute (s)",
             mode=_READONLY,
         )
         self._add(
@@ -204,6 +272,8 @@ class TabletProxy(_Proxy):
             mode=_READONLY | _HIDDEN,
             hidden=True,
         )
+        self._family_label = obj.Family
+        self._label = obj.Label
 
     def _dimension_props(self, obj):
         return [p for p in obj.PropertiesList if obj.getGroupOfProperty(p) == "Dimensions"]
@@ -225,8 +295,22 @@ class TabletProxy(_Proxy):
                 setattr(obj, p, _qty(defaults[k], "deg" if unit == "deg" else "mm"))
 
     def onChanged(self, obj, prop):
-        if prop == "Family" and getattr(self, "_ready", False):
+        if not getattr(self, "_ready", False):
+            return
+        if prop == "Family":
+            old = getattr(self, "_family_label", None)
+            self._family_label = obj.Family
+            suffix = obj.Label[len(old):] if old and obj.Label.startswith(old) else None
+            if suffix is not None and (suffix == "" or suffix.isdigit()):
+                obj.Label = obj.Family  # the label was the family's name (FreeCAD numbers it if taken)
             self._sync_dimensions(obj, reset=True)
+        elif prop == "Label":
+            old, self._label = getattr(self, "_label", None), obj.Label
+            if old and old != obj.Label:  # tooling labelled "<tablet> upper punch" follows
+                for o in obj.InList:
+                    if getattr(getattr(o, "Proxy", None), "Type", "") in (PunchProxy.Type, DieProxy.Type):
+                        if o.Label.startswith(old + " "):
+                            o.Label = obj.Label + o.Label[len(old):]
 
     # ---------------------------------------------------------------- core
     def spec(self, obj) -> dict:
@@ -251,20 +335,33 @@ class TabletProxy(_Proxy):
             )
         return geometry.tablet_from_spec(s["family"], s["params"], s["design"])
 
-    def execute(self, obj):
+    def build(self, obj):
+        from tabletcad.errors import DesignError
+
         t0 = time.perf_counter()
-        tablet = self.core_tablet(obj)
-        geo = geometry.build_tablet(tablet, tol=float(obj.FitTolerance.Value) or None)
-        pl = obj.Placement
-        obj.Shape = geo.solid
-        obj.Placement = pl
-        obj.Volume = _qty(geo.volume, "mm^3")
-        obj.SolidVolume = _qty(geo.props["solid_volume_mm3"], "mm^3")
-        obj.Area = _qty(geo.area, "mm^2")
-        obj.PlanArea = _qty(geo.props.get("plan_area_mm2", float("nan")), "mm^2")
-        obj.Weight = _qty(geo.volume, "mm^3") * obj.Density
-        obj.FitDeviation = _qty(geo.max_fit_deviation, "mm")
-        obj.RimData = geo.rims_json()
+        density = float(obj.Density)
+        if not (density > 0.0 and density < 1e3):
+            raise DesignError("Density", density, "0 < Density < 1000", "mg/mm³")
+        s = self.spec(obj)
+        key = repr((s, float(obj.FitTolerance.Value)))
+        if key != getattr(self, "_built", None) or obj.Shape.isNull() or not obj.RimData:
+            # rebuild only when the geometry's inputs changed (not for Density, Label, Placement)
+            tablet = self.core_tablet(obj)
+            geo = geometry.build_tablet(tablet, tol=float(obj.FitTolerance.Value) or None)
+            pl = obj.Placement
+            obj.Shape = geo.solid
+            obj.Placement = pl
+            obj.Volume = float(geo.volume)
+            obj.SolidVolume = float(geo.props["solid_volume_mm3"])
+            obj.Area = float(geo.area)
+            obj.PlanArea = float(geo.props["plan_area_mm2"])
+            obj.FitDeviation = float(geo.max_fit_deviation)
+            rims = geo.rims_json()
+            if rims != obj.RimData:
+                obj.RimData = rims
+            self._built = key
+            self.builds = getattr(self, "builds", 0) + 1  # solids built by this proxy (this session)
+        obj.Weight = float(obj.Volume) * density
         obj.RecomputeTime = time.perf_counter() - t0
 
 
@@ -318,9 +415,9 @@ class PunchProxy(_Proxy):
             "lift-off from the tablet (exploded view)",
             _qty(0.0, "mm"),
         )
-        self._add(obj, "App::PropertyVolume", "Volume", "Results", "volume of the punch tip", mode=_READONLY)
+        self._add(obj, "App::PropertyFloat", "Volume", "Results (mm³)", "volume of the punch tip, mm³", mode=_READONLY)
 
-    def execute(self, obj):
+    def build(self, obj):
         tab = _tablet_of(obj)
         rims = geometry.rims_from_json(tab.RimData)
         shape = geometry.punch_shape(_local_shape(tab), rims, obj.Which, float(obj.Length.Value))
@@ -330,7 +427,7 @@ class PunchProxy(_Proxy):
         )
         obj.Shape = shape
         obj.Placement = tab.Placement.multiply(lift)  # the shape's own placement is the object's
-        obj.Volume = _qty(shape.Volume, "mm^3")
+        obj.Volume = float(shape.Volume)
 
 
 class DieProxy(_Proxy):
@@ -364,9 +461,9 @@ class DieProxy(_Proxy):
             "die outer diameter (TSM B die: 30.16 mm)",
             _qty(30.16, "mm"),
         )
-        self._add(obj, "App::PropertyVolume", "Volume", "Results", "volume of the die", mode=_READONLY)
+        self._add(obj, "App::PropertyFloat", "Volume", "Results (mm³)", "volume of the die, mm³", mode=_READONLY)
 
-    def execute(self, obj):
+    def build(self, obj):
         tab = _tablet_of(obj)
         rims = geometry.rims_from_json(tab.RimData)
         shape = geometry.die_shape(
@@ -374,7 +471,7 @@ class DieProxy(_Proxy):
         )
         obj.Shape = shape
         obj.Placement = tab.Placement
-        obj.Volume = _qty(shape.Volume, "mm^3")
+        obj.Volume = float(shape.Volume)
 
 
 # ============================================================================ view providers (GUI only)
@@ -403,6 +500,31 @@ class ViewProviderTabletcad:
 
     def attach(self, vobj):
         self.Object = vobj.Object
+
+    def setEdit(self, vobj, mode=0):
+        """Double click / Edit: the tablet's task panel (tooling: FreeCAD's default)."""
+        if mode != 0 or not is_tablet(vobj.Object):
+            return None
+        from .taskpanel import edit_tablet
+
+        edit_tablet(vobj.Object)
+        return True
+
+    def unsetEdit(self, vobj, mode=0):
+        if mode != 0 or not is_tablet(vobj.Object):
+            return None
+        import FreeCADGui
+
+        FreeCADGui.Control.closeDialog()
+        return True
+
+    def doubleClicked(self, vobj):
+        if not is_tablet(vobj.Object):
+            return False
+        import FreeCADGui
+
+        FreeCADGui.ActiveDocument.setEdit(vobj.Object.Name, 0)
+        return True
 
     def getIcon(self):
         from . import icon

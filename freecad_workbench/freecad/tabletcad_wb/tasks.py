@@ -14,7 +14,16 @@ import FreeCAD
 from . import core_root, objects
 from .make import make_tablet, make_tooling
 
-__all__ = ["active_doc", "export_step", "heckel", "optimise", "out_dir", "sample", "tablet_from_design"]
+__all__ = [
+    "active_doc",
+    "export_step",
+    "heckel",
+    "import_step",
+    "optimise",
+    "out_dir",
+    "sample",
+    "tablet_from_design",
+]
 
 
 def sample(rel: str) -> Path:
@@ -97,6 +106,35 @@ def export_step(doc=None, directory=None, with_tooling=True):
     out["all"] = str(allp)
     FreeCAD.Console.PrintMessage(f"tabletcad: STEP written to {directory}\n")
     return out
+
+
+def import_step(path, doc=None):
+    """Insert a STEP file (e.g. the tooling's ``assembly.step``) with its part names and colours:
+    ``ImportGui.insert`` with the GUI up, else ``Import.insert``.
+
+    FreeCAD 0.20's importer with link groups (its default) crashes on every multi-part STEP
+    file, FreeCAD's own exports too (headless: SIGSEGV; GUI: caught, then one grey compound);
+    on 0.20 the Import preference ``UseLinkGroup`` is switched off for this import and
+    restored afterwards.  Returns the new document objects."""
+    doc = doc or active_doc()
+    prefs = FreeCAD.ParamGet("User parameter:BaseApp/Preferences/Mod/Import")
+    old = prefs.GetBool("UseLinkGroup", True)
+    legacy = tuple(int(x) for x in FreeCAD.Version()[:2]) < (1, 0)
+    before = {o.Name for o in doc.Objects}
+    try:
+        if legacy:
+            prefs.SetBool("UseLinkGroup", False)
+        if FreeCAD.GuiUp:
+            import ImportGui
+
+            ImportGui.insert(str(path), doc.Name)
+        else:
+            import Import
+
+            Import.insert(str(path), doc.Name)
+    finally:
+        prefs.SetBool("UseLinkGroup", old)
+    return [o for o in doc.Objects if o.Name not in before]
 
 
 def _safe(label: str) -> str:

@@ -1,0 +1,239 @@
+"""Task panel to create or edit a Tablet: family, dimensions (units, ranges), density,
+live validation by the core, the design's key figures, and "add punches and die".
+
+:class:`TabletForm` holds the panel's state and logic without Qt (tested headless);
+:class:`TabletTaskPanel` is the Qt form (FreeCAD's ``PySide`` shim) shown in the
+combo view by ``FreeCADGui.Control.showDialog``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import FreeCAD
+
+from . import objects
+
+__all__ = ["LIMITS", "TabletForm", "TabletTaskPanel", "edit_tablet"]
+
+current = None  # the panel shown last (scripts and tests drive it)
+
+# spin-box ranges by unit; the core's own checks (DesignError) give the exact allowed range
+LIMITS = {"mm": (0.0, 100.0, 3), "deg": (0.0, 90.0, 2)}
+DENSITY_LIMITS = (0.01, 30.0)  # mg/mm^3 (= g/cm^3)
+
+
+class TabletForm:
+    """What the panel edits, and the core's verdict on it (no Qt).
+
+    ``values`` are in the family's units (mm, deg); ``density`` in mg/mm³.
+    """
+
+    def __init__(self, family: str = "flat_faced_round", values: dict | None = None, density: float = 1.2):
+        self.families = objects.family_names()
+        self.density = float(density)
+        self.set_family(family)
+        if values:
+            self.values.update({k: float(v) for k, v in values.items() if k in self.values})
+
+    @classmethod
+    def from_object(cls, obj) -> TabletForm:
+        s = obj.Proxy.spec(obj)
+        return cls(s["family"] or "flat_faced_round", s["params"], float(obj.Density))
+
+    def set_family(self, family: str) -> None:
+        fam = objects._family(family)
+        if fam is None:
+            raise ValueError(f"unknown family {family!r}")
+        self.family = family
+        self.units = dict(fam.params)
+        self.values = {k: float(v) for k, v in fam.defaults.items() if v is not None}
+
+    def fields(self) -> list[tuple[str, str, str, float, float, float]]:
+        """``(parameter, label, unit, minimum, maximum, value)`` per dimension."""
+        out = []
+        for k, unit in self.units.items():
+            lo, hi, _ = LIMITS.get(unit, LIMITS["mm"])
+            out.append((k, objects.prop_name(k), unit, lo, hi, self.values.get(k, lo)))
+        return out
+
+    def validate(self) -> tuple[bool, str, dict]:
+        """``(ok, message, figures)``: the core builds the tablet (or says why not);
+        figures: volume (mm³), surface area (mm²), weight (mg), height (mm)."""
+        from tabletcad.errors import TabletcadError
+
+        if not (DENSITY_LIMITS[0] <= self.density <= DENSITY_LIMITS[1]):
+            return False, f"Density = {self.density:g} mg/mm³ is not allowed: {DENSITY_LIMITS[0]} to {DENSITY_LIMITS[1]}", {}
+        try:
+            tablet = objects._family(self.family).build(**self.values)
+            props = tablet.properties()
+            dims = tablet.dimensions()
+        except TabletcadError as exc:
+            return False, str(exc), {}
+        v = float(props["volume_mm3"])
+        figs = dict(
+            volume_mm3=v,
+            surface_area_mm2=float(props["surface_area_mm2"]),
+            weight_mg=v * self.density,
+            height_mm=float(dims.get("height_mm", float("nan"))),
+        )
+        figs = {k: x for k, x in figs.items() if math.isfinite(x)}
+        return True, "valid", figs
+
+    def apply(self, obj) -> None:
+        """Write the form into a Tablet object (family first: it resets the dimensions)."""
+        if obj.Family != self.family:
+            obj.Family = self.family
+        for k, unit in self.units.items():
+            q = FreeCAD.Units.Quantity(float(self.values[k]), FreeCAD.Units.Unit("deg" if unit == "deg" else "mm"))
+            setattr(obj, objects.prop_name(k), q)
+        obj.Density = float(self.density)
+
+    def create(self, doc, tooling: bool = False):
+        """A new Tablet (and its punches and die) from the form; recomputed."""
+        from .make import make_tablet, make_tooling
+
+        obj = make_tablet(doc, self.family, recompute=False, density=self.density, **self.values)
+        if tooling:
+            make_tooling(doc, obj, recompute=False)
+        doc.recompute()
+        return obj
+
+
+def _fmt_figures(figs: dict) -> str:
+    names = [
+        ("volume_mm3", "Volume", "mm³"),
+        ("surface_area_mm2", "Surface area", "mm²"),
+        ("weight_mg", "Weight", "mg"),
+        ("height_mm", "Height", "mm"),
+    ]
+    return "\n".join(f"{label}: {figs[k]:.4g} {unit}" for k, label, unit in names if k in figs)
+
+
+class TabletTaskPanel:
+    """The Qt panel (``self.form``) over a :class:`TabletForm`; ``obj`` is edited if given,
+    else ``accept()`` creates a new tablet in ``doc``."""
+
+    def __init__(self, obj=None, doc=None):
+        from PySide import QtGui
+
+        self.obj = obj
+        self.doc = doc or (obj.Document if obj is not None else FreeCAD.ActiveDocument)
+        self.model = TabletForm.from_object(obj) if obj is not None else TabletForm()
+        self.form = QtGui.QWidget()
+        self.form.setWindowTitle("tabletcad tablet")
+        layout = QtGui.QVBoxLayout(self.form)
+        top = QtGui.QFormLayout()
+        self.family = QtGui.QComboBox()
+        self.family.addItems(self.model.families)
+        self.family.setCurrentIndex(self.model.families.index(self.model.family))
+        top.addRow("Family", self.family)
+        self.density = QtGui.QDoubleSpinBox()
+        self.density.setRange(*DENSITY_LIMITS)
+        self.density.setDecimals(3)
+        self.density.setSingleStep(0.05)
+        self.density.setSuffix(" mg/mm³")
+        self.density.setValue(self.model.density)
+        top.addRow("Density", self.density)
+        layout.addLayout(top)
+        self.dims_box = QtGui.QGroupBox("Dimensions")
+        self.dims = QtGui.QFormLayout(self.dims_box)
+        layout.addWidget(self.dims_box)
+        self.status = QtGui.QLabel()
+        self.status.setWordWrap(True)
+        layout.addWidget(self.status)
+        self.figures = QtGui.QLabel()
+        layout.addWidget(self.figures)
+        self.tooling = QtGui.QCheckBox("Add upper punch, lower punch and die")
+        self.tooling.setChecked(False)
+        layout.addWidget(self.tooling)
+        layout.addStretch(1)
+        self.spins: dict[str, object] = {}
+        self._build_dimensions()
+        self.family.currentIndexChanged.connect(self._family_changed)
+        self.density.valueChanged.connect(self._changed)
+        self.refresh()
+
+    # ------------------------------------------------------------------ widgets
+    def _build_dimensions(self):
+        from PySide import QtGui
+
+        while self.dims.rowCount():
+            self.dims.removeRow(0)
+        self.spins = {}
+        for k, label, unit, lo, hi, value in self.model.fields():
+            sb = QtGui.QDoubleSpinBox()
+            _, _, decimals = LIMITS.get(unit, LIMITS["mm"])
+            sb.setDecimals(decimals)
+            sb.setRange(lo, hi)
+            sb.setSingleStep(0.1)
+            sb.setSuffix(" °" if unit == "deg" else f" {unit}")
+            sb.setValue(value)
+            sb.setToolTip(f"{k} ({unit}), {lo:g} to {hi:g}; the tablet is checked as you type")
+            sb.valueChanged.connect(self._changed)
+            self.dims.addRow(label, sb)
+            self.spins[k] = sb
+
+    def _family_changed(self, index):
+        self.model.set_family(self.model.families[int(index)])
+        self._build_dimensions()
+        self.refresh()
+
+    def _changed(self, *_):
+        self.model.values = {k: float(sb.value()) for k, sb in self.spins.items()}
+        self.model.density = float(self.density.value())
+        self.refresh()
+
+    def refresh(self) -> bool:
+        """Live validation: status line and key figures."""
+        ok, msg, figs = self.model.validate()
+        self.ok = ok
+        self.status.setText("✔ valid" if ok else f"✘ {msg}")
+        self.status.setStyleSheet("color: #1a7f37;" if ok else "color: #c62828;")
+        self.figures.setText(_fmt_figures(figs) if ok else "")
+        return ok
+
+    # ------------------------------------------------------------------ task dialog
+    def getStandardButtons(self):
+        from PySide import QtGui
+
+        return int(QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel)
+
+    def accept(self):
+        if not self.refresh():
+            FreeCAD.Console.PrintError(f"tabletcad: {self.status.text()[2:]}\n")
+            return False
+        self.doc.openTransaction("tabletcad tablet")
+        if self.obj is None:
+            self.obj = self.model.create(self.doc, tooling=self.tooling.isChecked())
+        else:
+            self.model.apply(self.obj)
+            if self.tooling.isChecked():
+                from .make import make_tooling
+
+                make_tooling(self.doc, self.obj, recompute=False)
+            self.doc.recompute()
+        self.doc.commitTransaction()
+        self._close()
+        return True
+
+    def reject(self):
+        self._close()
+        return True
+
+    def _close(self):
+        if FreeCAD.GuiUp:
+            import FreeCADGui
+
+            FreeCADGui.Control.closeDialog()
+
+
+def edit_tablet(obj=None, doc=None) -> TabletTaskPanel:
+    """Show the panel (GUI): edit ``obj`` or create a new tablet."""
+    import FreeCADGui
+
+    global current
+    panel = TabletTaskPanel(obj, doc)
+    FreeCADGui.Control.showDialog(panel)
+    current = panel
+    return panel
