@@ -28,6 +28,7 @@ from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = [
     "FAMILIES",
+    "THESIS_FAMILIES",
     "Family",
     "coaxial_tablet",
     "flat_faced_round",
@@ -344,6 +345,11 @@ FAMILIES: dict[str, Family] = {
         _fam(deep_convex_oval, width="mm", length="mm", thickness="mm", band="mm"),
     ]
 }
+
+
+#: The thesis's shapes, in a fixed order: a static list, whatever else has been imported
+#: (``FAMILIES`` gains the industry families when :mod:`tabletcad.families` loads).
+THESIS_FAMILIES: tuple[str, ...] = tuple(FAMILIES)
 
 
 def register_family(family: Family) -> None:
