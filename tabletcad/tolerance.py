@@ -56,6 +56,10 @@ class Tolerances:
         Largest deviation (mm) of a B-spline face from its PDE patch (CAD layer).
     nominal : float
         Largest deviation (mm) of a PDE surface from a family's exact nominal.
+    offset_regularity : float
+        Relative margin kept below a smooth (spline) outline's smallest radius of
+        curvature by the inward offsets of a cup: at exactly that radius the offset
+        stands still at one point (a singular rim that B-spline faces fold over).
     """
 
     interpolation: float = 1e-9
@@ -71,6 +75,7 @@ class Tolerances:
     fold: float = 5e-3
     fit: float = 1e-4
     nominal: float = 1e-3
+    offset_regularity: float = 1e-2
 
 
 DEFAULT = Tolerances()
