@@ -9,6 +9,7 @@ tablet, and builds killed with SIGKILL and SIGTERM.
 from __future__ import annotations
 
 import json
+import math
 import os
 import signal
 import subprocess
@@ -139,12 +140,45 @@ def test_tooling_build_then_cutaway_then_plain_rebuild(tmp_path, capsys):
     assert {p.name for p in out.iterdir()} == expected
     assert _listed(line2) == rep2["outputs"] and "drawing.svg" not in rep2["outputs"]
     assert "assembly.step" not in expected and "upper_punch.step" not in expected
+    # the cut-away is a solid: its STEP holds the trimmed volume of the report
+    assert {"tablet.step", "tablet.stl", "tablet.glb"} <= set(rep2["outputs"]) and "tablet_plain.step" not in expected
+    (cut,) = ocp_read_steps([out / "tablet.step"])
+    assert cut["valid"] and cut["n_solids"] == 1
+    assert cut["volume"] == pytest.approx(rep2["volume_mm3"], rel=1e-6)
+    assert rep2["volume_mm3"] == pytest.approx(0.75 * rep3_full_volume(), rel=1e-9)  # 3/4 of the round
 
     # a plain design into the folder: exactly its files (and the two that are not tabletcad's now)
     rep3, _ = _build(ROOT / "samples" / "flat_faced_round.toml", out, capsys)
     assert {p.name for p in out.iterdir()} == set(rep3["outputs"]) | {MANIFEST, "notes.txt", "drawing.svg"}
     assert set(rep3["outputs"]) == {"report.json", "tablet.png", "tablet.step", "tablet.stl", "tablet.glb"}
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
+def rep3_full_volume() -> float:
+    from dataclasses import replace
+
+    from tabletcad.design import load_design
+    from tabletcad.tablet import Trim
+
+    return replace(load_design(ROOT / "samples" / "cutaway_convex_round.toml"), trim=Trim()).volume()
+
+
+def test_cutaway_with_curved_cut_faces_is_not_cut(tmp_path):
+    """A swept almond's sections at constant v are not planes through the axis: no solid, a reason.
+    A round's section at v lies in the half-plane at angle v; the thesis oval's (ellipses of one
+    aspect ratio) in a half-plane too, at the ellipse's polar angle atan(b/a tan v)."""
+    from tabletcad.cad.stage import _cut_plane_angle, cutaway_solid
+    from tabletcad.design import design_from_dict
+
+    t = design_from_dict({"tablet": {"family": "almond"}, "trim": {"v": [0.0, 3.0]}})
+    reason = cutaway_solid(t, {"volume_mm3": t.volume()})
+    assert isinstance(reason, str) and "planes" in reason
+    r = design_from_dict({"tablet": {"family": "shallow_convex_round"}, "trim": {"v": [0.0, 3.0]}})
+    assert _cut_plane_angle(r, 0.0) == pytest.approx(0.0, abs=1e-12)
+    assert _cut_plane_angle(r, 3.0) == pytest.approx(3.0, abs=1e-9)
+    o = design_from_dict({"tablet": {"family": "shallow_convex_oval"}, "trim": {"v": [0.0, 1.0]}})
+    a, b = 6.0, 3.0  # half length and half width of the 12 x 6 mm oval
+    assert _cut_plane_angle(o, 1.0) == pytest.approx(math.atan2(b * math.sin(1.0), a * math.cos(1.0)), abs=1e-9)
 
 
 def _wait_for_staging(parent: Path, name: str, proc, timeout: float = 300.0) -> Path:

@@ -23,6 +23,7 @@ import numpy as np
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from scipy.spatial import cKDTree
 
+from tabletcad.cad._occ import explore
 from tabletcad.tooling.booleans import mesh_arrays, manifold_op, manifold_volume, raw_boolean, to_manifold, volume
 from tabletcad.tooling.die import MIN_BORE_OFFSET_MM
 
@@ -93,20 +94,39 @@ def refine_triangles(V: np.ndarray, T: np.ndarray, h: float, lo=None, hi=None) -
     return allt.reshape(-1, 3), np.arange(len(allt) * 3).reshape(-1, 3)
 
 
-def mesh_distance(points: np.ndarray, V: np.ndarray, T: np.ndarray, k: int = 12, reach: float = np.inf) -> np.ndarray:
-    """Distance from points to a triangle mesh: exact to each of the ``k`` triangles whose centres
-    are nearest (refine long triangles first: :func:`refine_triangles`); ``inf`` beyond ``reach``."""
+def mesh_distance(points: np.ndarray, V: np.ndarray, T: np.ndarray, k: int = 12, reach: float = np.inf,
+                  k_max: int = 3072) -> np.ndarray:
+    """Distance from points to a triangle mesh, exact to the nearest triangle; ``inf`` beyond ``reach``.
+
+    Exact point-to-triangle distances to the ``k`` triangles whose centres are nearest; a triangle
+    not among them has its centre farther than the ``k``-th, so it is at least that distance less
+    the largest centre-to-corner radius away.  Points whose best distance is not below that bound
+    (big flat triangles beside many small curved ones) are searched again with 4 ``k``, up to
+    ``k_max``.  Refine long triangles first (:func:`refine_triangles`) to keep the radius small.
+    """
     A, B, C = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
     centres = (A + B + C) / 3.0
-    k = min(k, len(T))
-    d, idx = cKDTree(centres).query(points, k=k, distance_upper_bound=reach)
-    idx = idx.reshape(len(points), -1)
+    radius = float(max(np.max(np.linalg.norm(X - centres, axis=1)) for X in (A, B, C))) if len(T) else 0.0
+    tree = cKDTree(centres)
     best = np.full(len(points), np.inf)
-    for j in range(idx.shape[1]):
-        t = idx[:, j]
-        ok = t < len(T)
-        if np.any(ok):
-            best[ok] = np.minimum(best[ok], point_triangle_distance(points[ok], A[t[ok]], B[t[ok]], C[t[ok]]))
+    todo = np.arange(len(points))
+    kk = k
+    while len(todo):
+        kq = min(kk, len(T))
+        d, idx = tree.query(points[todo], k=kq, distance_upper_bound=reach)
+        d, idx = d.reshape(len(todo), -1), idx.reshape(len(todo), -1)
+        b = np.full(len(todo), np.inf)
+        P = points[todo]
+        for j in range(idx.shape[1]):
+            t = idx[:, j]
+            ok = t < len(T)
+            if np.any(ok):
+                b[ok] = np.minimum(b[ok], point_triangle_distance(P[ok], A[t[ok]], B[t[ok]], C[t[ok]]))
+        best[todo] = b
+        if kq >= min(k_max, len(T)):
+            break
+        unsure = (b > 1e-12) & np.isfinite(d[:, -1]) & (d[:, -1] - radius < b)
+        todo, kk = todo[unsure], 4 * kk
     return best
 
 
@@ -118,6 +138,16 @@ def _occ_point_distance(p, shape) -> float:
     v = BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex()
     d = BRepExtrema_DistShapeShape(v, shape)
     return float(d.Value()) if d.IsDone() else float("inf")
+
+
+def _occ_nearest_point(p, shape) -> np.ndarray:
+    """The point of ``shape`` (a shell: its surface) nearest to ``p``."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+    from OCP.gp import gp_Pnt
+
+    v = BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex()
+    d = BRepExtrema_DistShapeShape(v, shape)
+    return np.array(d.PointOnShape2(1).Coord()) if d.IsDone() and d.NbSolution() else np.asarray(p, dtype=float)
 
 
 def _surface_samples(tablet, nu: int = 49, nv: int = 384) -> np.ndarray:
@@ -210,19 +240,44 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
         keep = mesh_distance(S, *refine_triangles(V, T, 0.1), reach=0.2) <= 2.0 * deflection
         V = np.vstack([V, S[keep]])
     n_mesh = len(V)
-    V = np.vstack([V, face_samples(tablet)])  # inside every B-rep face (letter walls, score flanks)
-    dist = np.full(len(V), np.inf)
+    V = np.vstack([V, face_samples(tablet, spacing=max(0.25 * clearance, 0.005))])  # inside every B-rep face
     h_split = max(4.0 * clearance, 0.05)
+    # the tools' chord heights must be well below the gaps to be ranked (a gap of clearance/2 on a
+    # land against chords of 5 µm would be outranked by chord artefacts on the cups)
+    tool_deflection = min(deflection, max(0.1 * clearance, 1e-3))
+    tools = []
     for name, s in parts.items():
-        Vp, Tp = mesh_arrays(s, deflection, 0.2)
+        Vp, Tp = mesh_arrays(s, tool_deflection, 0.2)
         lo, hi = V.min(axis=0) - 4 * h_split, V.max(axis=0) + 4 * h_split
         Vr, Tr = refine_triangles(Vp, Tp, h_split, lo, hi)
         if len(Tr):
-            dist = np.minimum(dist, mesh_distance(V, Vr, Tr, reach=2 * h_split))
+            tools.append((Vr, Tr))
+
+    def measure(P):
+        d = np.full((len(tools), len(P)), np.inf)
+        for j, (Vr, Tr) in enumerate(tools):
+            d[j] = mesh_distance(P, Vr, Tr, reach=2 * h_split)
+        return d.min(axis=0), d.argmin(axis=0)
+
+    dist, near = measure(V)
+    # tablet triangles whose corners are nearest to different tools (the land between a punch tip and
+    # the die bore): the gap peaks inside such triangles, away from every vertex - refine them
+    n_t = int(T.max()) + 1 if len(T) else 0
+    dc, nc = dist[:n_t][T], near[:n_t][T]
+    sel = nc.min(axis=1) != nc.max(axis=1)
+    n_refined = 0
+    if np.any(sel):
+        Vs, _ = refine_triangles(V[:n_t], T[sel], max(0.125 * clearance, 1e-3))
+        Vs = np.unique(Vs, axis=0)
+        ds, ns = measure(Vs)
+        V, dist = np.vstack([V, Vs]), np.concatenate([dist, ds])
+        n_refined = len(Vs)
     order = np.argsort(dist)[::-1][:refine]
-    exact = [min(_occ_point_distance(V[i], s) for s in parts.values()) for i in order]
-    # mesh vertices lie on the tablet's B-rep within the tessellation tolerance: the exact distance
-    # of a vertex is a gap of the B-rep to within ~1e-7 mm
+    # the worst points, moved onto the tablet's B-rep surface (mesh points lie within the chord height
+    # of it), measured exactly against every tool's B-rep
+    shell = explore(tablet, "Shell")[0]
+    on_surface = [_occ_nearest_point(V[i], shell) for i in order]
+    exact = [min(_occ_point_distance(q, s) for s in parts.values()) for q in on_surface]
     i_max = int(np.argmax(exact)) if exact else 0
     t2 = time.perf_counter()
     occ_max = max(p["occ_mm3"] for p in pairs)
@@ -234,11 +289,12 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
         interference_manifold3d_mm3=man_max,
         interference_manifold3d_bound_mm3=max(p["manifold3d_bound_mm3"] for p in pairs),
         max_gap_mm=float(exact[i_max]) if exact else float(np.max(dist)),
-        max_gap_point_mm=[float(x) for x in V[order[i_max]]] if exact else None,
+        max_gap_point_mm=[float(x) for x in on_surface[i_max]] if exact else None,
         punch_die_clearance_mm=min(p["min_distance_mm"] for p in pairs if p["parts"][1] == "die" and p["parts"][0].endswith("punch")),
-        max_gap_method=f"tablet surface points ({len(V)}: {n_mesh} mesh vertices and PDE samples, {len(V) - n_mesh} "
-                       f"on a (u, v) grid in every B-rep face) vs part meshes at {deflection} mm (largest "
-                       f"{float(np.max(dist)):.6g} mm), worst {len(order)} re-measured with BRepExtrema_DistShapeShape",
+        max_gap_method=f"tablet surface points ({len(V)}: {n_mesh} mesh vertices and PDE samples, "
+                       f"{len(V) - n_mesh - n_refined} on a (u, v) grid in every B-rep face, {n_refined} in refined "
+                       f"triangles between tools) vs part meshes at {tool_deflection:.3g} mm (largest {float(np.max(dist)):.6g} mm), "
+                       f"worst {len(order)} moved onto the tablet's B-rep and re-measured with BRepExtrema_DistShapeShape",
         max_gap_mesh_mm=float(np.max(dist)),
         clearance_mm=clearance,
         gap_within_clearance=bool((float(exact[i_max]) if exact else float(np.max(dist))) <= clearance * (1 + 1e-6) + 1e-7),
