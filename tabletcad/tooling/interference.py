@@ -106,7 +106,13 @@ def mesh_distance(points: np.ndarray, V: np.ndarray, T: np.ndarray, k: int = 12,
     """
     A, B, C = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
     centres = (A + B + C) / 3.0
-    radius = float(max(np.max(np.linalg.norm(X - centres, axis=1)) for X in (A, B, C))) if len(T) else 0.0
+    radii = np.max([np.linalg.norm(X - centres, axis=1) for X in (A, B, C)], axis=0) if len(T) else np.zeros(0)
+    if len(T) > 64 and radii.max() > 4.0 * np.median(radii):
+        # small curved-face triangles beside big flat ones: search each size class with its own bound
+        small = radii <= 4.0 * np.median(radii)
+        return np.minimum(mesh_distance(points, V, T[small], k, reach, k_max),
+                          mesh_distance(points, V, T[~small], k, reach, k_max))
+    radius = float(radii.max()) if len(T) else 0.0
     tree = cKDTree(centres)
     best = np.full(len(points), np.inf)
     todo = np.arange(len(points))
