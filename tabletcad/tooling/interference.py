@@ -259,11 +259,25 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
         if len(Tr):
             tools.append((Vr, Tr))
 
-    def measure(P):
+    def measure(P, k_max=12):
         d = np.full((len(tools), len(P)), np.inf)
         for j, (Vr, Tr) in enumerate(tools):
-            d[j] = mesh_distance(P, Vr, Tr, reach=2 * h_split)
+            d[j] = mesh_distance(P, Vr, Tr, reach=2 * h_split, k_max=k_max)
         return d.min(axis=0), d.argmin(axis=0)
+
+    def settle(dist):
+        """Exact mesh distances for the points that can hold the maximum: with ``k_max = 12`` a
+        distance is an upper bound; points are settled in batches from the largest bound down
+        until no unsettled bound exceeds the largest settled distance."""
+        order = np.argsort(dist)[::-1]
+        best = 0.0
+        for i0 in range(0, len(order), 4096):
+            batch = order[i0:i0 + 4096]
+            if dist[batch[0]] <= best:
+                break
+            dist[batch] = measure(V[batch], k_max=3072)[0]
+            best = max(best, float(np.max(dist[batch])))
+        return dist
 
     dist, near = measure(V)
     # tablet triangles whose corners are nearest to different tools (the land between a punch tip and
@@ -278,6 +292,7 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
         ds, ns = measure(Vs)
         V, dist = np.vstack([V, Vs]), np.concatenate([dist, ds])
         n_refined = len(Vs)
+    dist = settle(dist)
     order = np.argsort(dist)[::-1][:refine]
     # the worst points, moved onto the tablet's B-rep surface (mesh points lie within the chord height
     # of it), measured exactly against every tool's B-rep
