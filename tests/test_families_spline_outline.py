@@ -84,16 +84,19 @@ from hypothesis import strategies as st  # noqa: E402
 @st.composite
 def smooth_outlines(draw):
     """Points on a smooth star-shaped closed curve: an ellipse of 7-12 x 4-8 mm whose radius is
-    perturbed by modes 2-4 (amplitudes up to 6 %), sampled at 12-30 points."""
+    perturbed by modes 2-4 (amplitudes up to 6 %), sampled at 12-30 points; a cup 5-60 % as deep
+    as the default cup is wide."""
     n = draw(st.integers(12, 30))
     a = draw(st.floats(3.5, 6.0))
     b = draw(st.floats(2.0, min(a, 4.0)))
     amps = [draw(st.floats(-0.06, 0.06)) for _ in range(3)]
     phases = [draw(st.floats(0.0, 2.0 * math.pi)) for _ in range(3)]
-    cup = draw(st.floats(0.1, 0.8))
+    frac = draw(st.floats(0.05, 0.6))  # cup depth over the cup width (at most a hemisphere)
     t = 2.0 * np.pi * np.arange(n) / n
     r = 1.0 + sum(A * np.cos((m + 2) * t + p) for m, (A, p) in enumerate(zip(amps, phases)))
-    return np.round(np.column_stack([a * r * np.cos(t), b * r * np.sin(t)]), 4), cup
+    pts = np.round(np.column_stack([a * r * np.cos(t), b * r * np.sin(t)]), 4)
+    ol = SplineOutline(pts)
+    return pts, frac * min(ol.min_convex_radius, ol.inscribed_radius())
 
 
 @pytest.mark.cad

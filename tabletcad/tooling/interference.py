@@ -178,8 +178,6 @@ def face_samples(shape, spacing: float = 0.05, max_per_face: int = 2500) -> np.n
     from OCP.gp import gp_Pnt2d
     from OCP.TopAbs import TopAbs_State
 
-    from tabletcad.cad._occ import explore
-
     keep_states = (TopAbs_State.TopAbs_IN, TopAbs_State.TopAbs_ON)
     out = []
     for face in explore(shape, "Face"):
