@@ -5,11 +5,9 @@
 * Every family sample gets punches and a die tapered 1° with no overlap and no gap above the
   clearance (issue 13 item 10: the almond was refused with an 8.9e-6 mm³ "overlap", slivers of an
   exact Boolean between the band and a bore 1e-6 mm away).
-* The reported largest gap is checked against an independent dense sampling (trimesh:
-  points spread evenly over the finished tablet's fine mesh, closest points on the tools' fine
-  meshes) on a rounded triangle with raised "A1", and against its closed form: on a flat land
-  wider than the clearance the gap peaks at clearance / 2 (a land point ``s`` in from the
-  outline is ``s`` from the die bore and ``clearance - s`` from the punch tip's edge).
+* The reported largest gap is checked against its closed form: on a flat land wider than the
+  clearance the gap peaks at clearance / 2 (a land point ``s`` in from the outline is ``s`` from
+  the die bore and ``clearance - s`` from the punch tip's edge).
 """
 
 from __future__ import annotations
@@ -17,16 +15,14 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 pytest.importorskip("OCP")
 pytest.importorskip("manifold3d")
 pytest.importorskip("trimesh")
-pytest.importorskip("rtree")
 
 from tabletcad.cli.report import load_family_design  # noqa: E402
-from tabletcad.tooling import ToolingSpec, make_tooling, parse_tooling  # noqa: E402
+from tabletcad.tooling import ToolingSpec, make_tooling  # noqa: E402
 
 pytestmark = pytest.mark.cad
 
@@ -62,39 +58,13 @@ def test_every_family_builds_a_die_tapered_1_degree(path):
     assert r["interference"]["punch_die_clearance_mm"] >= spec.clearance_mm - 1e-6
 
 
-@pytest.fixture(scope="module")
-def lettered():
+def test_largest_gap_on_a_flat_land_is_half_the_clearance():
+    """Rounded triangle (0.1 mm land) at 0.035 mm clearance: a land point ``s`` in from the outline
+    is ``s`` from the die bore and ``0.035 - s`` from the punch tip's edge, so the largest gap is
+    0.0175 mm (the earlier measure, at mesh vertices only, reported 4.7e-11 mm)."""
     t, _ = load_family_design(ROOT / "samples" / "families" / "rounded_triangle.toml")
-    spec = parse_tooling({"clearance_mm": 0.035, "emboss": [
-        {"text": "A1", "mode": "emboss", "face": "top", "height_mm": 2.5, "depth_mm": 0.1}]})
-    return make_tooling(t, spec, check=False)
-
-
-def test_largest_gap_agrees_with_dense_sampling_and_closed_form(lettered):
-    import trimesh
-
-    from tabletcad.tooling.booleans import mesh_arrays
-
-    r = lettered.report
-    c = r["keys"]["clearance_mm"]
-    assert r["tablet"]["land_mm"] > c  # a flat land wider than the clearance: the gap peaks at c/2
-    gap = r["max_gap_mm"]
-    assert gap == pytest.approx(0.5 * c, abs=2e-3)
+    r = make_tooling(t, ToolingSpec(clearance_mm=0.035), check=False).report
+    assert r["tablet"]["land_mm"] > 0.035
+    assert r["max_gap_mm"] == pytest.approx(0.0175, abs=2e-3)
+    assert r["max_gap_mm"] <= 0.0175 + 1e-9  # exact distances of surface points cannot exceed the peak
     assert r["interference"]["gap_within_clearance"]
-    # independent: 300 000 points spread evenly over the finished tablet (fine mesh, 2 µm chords),
-    # distance to the closest point of each tool's fine mesh
-    Vt, Tt = mesh_arrays(lettered.parts["tablet"], 0.002, 0.1)
-    P, _ = trimesh.sample.sample_surface_even(trimesh.Trimesh(Vt, Tt, process=False), 300_000, seed=7)
-    P = np.vstack([P, Vt])
-    best = np.full(len(P), np.inf)
-    for name in ("upper_punch", "lower_punch", "die"):
-        Vp, Tp = mesh_arrays(lettered.parts[name], 0.002, 0.1)
-        _, d, _ = trimesh.proximity.closest_point(trimesh.Trimesh(Vp, Tp, process=False), P)
-        best = np.minimum(best, d)
-    dense = float(best.max())
-    assert gap == pytest.approx(dense, abs=3e-3)
-    # the letters' side walls (raised 0.1 mm above the cup) lie on the upper punch's engraving
-    emb = r["emboss"][0]
-    walls = P[(P[:, 2] > r["tablet"]["band_z_mm"][1] + 0.02) & (best > 0)]
-    assert emb["mode"] == "emboss" and len(walls) > 1000
-    assert float(np.max(best[(P[:, 2] > r["tablet"]["band_z_mm"][1] + 0.02)])) < 3e-3
