@@ -69,6 +69,10 @@ class Tolerances:
     mesh_bytes_per_node : int
         Peak memory (bytes) of a hexahedral mesh per node, for that estimate
         (measured: ~170 bytes per node from ``tabletcad mesh`` at 2e5-8e5 nodes).
+    offset_regularity : float
+        Relative margin kept below a smooth (spline) outline's smallest radius of
+        curvature by the inward offsets of a cup: at exactly that radius the offset
+        stands still at one point (a singular rim that B-spline faces fold over).
     """
 
     interpolation: float = 1e-9
@@ -87,6 +91,7 @@ class Tolerances:
     max_length: float = 1000.0
     memory_fraction: float = 0.5
     mesh_bytes_per_node: int = 200
+    offset_regularity: float = 1e-2
 
 
 DEFAULT = Tolerances()

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
+
+import numpy as np
 from typing import Any
 
 import OCP  # noqa: F401  (no OpenCascade: ImportError, and the build writes the core outputs only)
@@ -89,15 +91,123 @@ def check_tablet_solid(tablet: Tablet, report: dict[str, Any] | None = None):
     return solid, mesh, sections
 
 
+def _cut_plane_angle(tablet: Tablet, v: float) -> float | None:
+    """Plan angle (rad) of the half-plane holding the solid map's ``v = const`` face
+    ``A0(u) + w (X(u, v) - A0(u))`` of every patch, or None when that face is not such a
+    half-plane (spine off the z axis, or the section turning with ``u``)."""
+    u = np.linspace(0.0, 1.0, 33)
+    size = max(tablet.dimensions().values())
+    angles = []
+    for p in tablet.patches:
+        A = p.spine(u)
+        X = p.evaluate(u, np.full_like(u, v))
+        if np.max(np.abs(A[:, :2])) > 1e-9 * size:
+            return None
+        d = X[:, :2] - A[:, :2]
+        r = np.hypot(d[:, 0], d[:, 1])
+        ok = r > 1e-9 * size
+        angles.extend(np.arctan2(d[ok, 1], d[ok, 0]))
+    if not angles:
+        return None
+    a = np.unwrap(np.asarray(angles))
+    return float(a[0]) if np.ptp(a) <= 1e-9 else None
+
+
+def _wedge(phi0: float, phi1: float, radius: float, z0: float, z1: float):
+    """Prism over the plan sector ``phi0 <= φ <= phi1`` of the given radius (mm), z from z0 to z1."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
+    from OCP.gp import gp_Pnt, gp_Vec
+
+    n = max(2, int(np.ceil((phi1 - phi0) / (np.pi / 6.0))))
+    R = radius / np.cos((phi1 - phi0) / (2.0 * n))  # the polygon's chords stay outside the circle
+    poly = BRepBuilderAPI_MakePolygon()
+    poly.Add(gp_Pnt(0.0, 0.0, z0))
+    for f in np.linspace(phi0, phi1, n + 1):
+        poly.Add(gp_Pnt(R * np.cos(f), R * np.sin(f), z0))
+    poly.Close()
+    face = BRepBuilderAPI_MakeFace(poly.Wire(), True).Face()
+    return BRepPrimAPI_MakePrism(face, gp_Vec(0.0, 0.0, z1 - z0)).Shape()
+
+
+def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
+    """The solid of a tablet trimmed in ``v`` (a cut-away view): ``(solid shape, mesh, sections)``,
+    or a string saying why it is not built.
+
+    When every patch's ``v = v0`` and ``v = v1`` faces of the solid map are half-planes
+    through the z axis (tablets of revolution: circles about the spine), the cut-away is the
+    whole solid (hollow if ``[trim] w`` says so) in common with a wedge between those
+    half-planes (``BRepAlgoAPI_Common``).  Its volume must agree with the core's quadrature
+    over the trimmed domain within ``AGREEMENT_REL`` and its mesh must pass the checks.
+    """
+    from dataclasses import replace
+
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
+
+    from tabletcad.cad.mesh import tessellate
+    from tabletcad.cad.solid import check_solid, mass_properties
+    from tabletcad.cad.tablet_solid import tablet_solid
+    from tabletcad.tablet import Trim
+
+    t = tablet.trim
+    if t.u != (0.0, 1.0):
+        return "trimmed in u (its cut faces are not planes)"
+    v0, v1 = t.v
+    phi0, phi1 = _cut_plane_angle(tablet, v0), _cut_plane_angle(tablet, v1)
+    if phi0 is None or phi1 is None:
+        return "its cut faces are not planes through the axis (only tablets of revolution are cut as solids)"
+    # angles grow with v (counter-clockwise sections); the kept sector runs from phi0 to phi1
+    span = (phi1 - phi0) % (2.0 * np.pi) or 2.0 * np.pi
+    t0 = time.perf_counter()
+    whole = tablet_solid(replace(tablet, trim=Trim(w=t.w)))
+    size = 10.0 * max(tablet.dimensions().values())
+    common = BRepAlgoAPI_Common(whole.shape, _wedge(phi0, phi0 + span, size, -size, size))
+    if not common.IsDone():
+        raise GeometryError(f"{tablet.name}: cutting the cut-away solid failed", tablet)
+    from tabletcad.cad._occ import explore
+
+    solids = explore(common.Shape(), "Solid")
+    if len(solids) != 1:
+        raise GeometryError(f"{tablet.name}: the cut-away gave {len(solids)} solids, not one", tablet)
+    shape = solids[0]
+    check_solid(shape, f"{tablet.name} cut-away")
+    mass = mass_properties(shape)
+    v_q = report["volume_mm3"]
+    dv = (mass.volume - v_q) / v_q
+    t1 = time.perf_counter()
+    if abs(dv) > AGREEMENT_REL:
+        raise GeometryError(f"{tablet.name}: cut-away B-rep volume differs from the quadrature by {dv:.2e} relative "
+                            f"(allowed {AGREEMENT_REL:g})", shape)
+    mesh = tessellate(shape, MESH_LINEAR_MM, MESH_ANGULAR_RAD)
+    genus_expected = 0
+    if not mesh.ok or mesh.manifold_genus != genus_expected:
+        raise GeometryError(f"{tablet.name}: cut-away mesh check failed (manifold3d {mesh.manifold_status}, genus "
+                            f"{mesh.manifold_genus}, watertight {mesh.watertight}, winding {mesh.winding_consistent})", mesh)
+    sections = dict(
+        brep=dict(valid=True, volume_mm3=mass.volume, surface_area_mm2=mass.area, faces=len(explore(shape, "Face")),
+                  volume_rel_diff_vs_quadrature=dv, cutaway=f"whole solid in common with the wedge between the "
+                  f"half-planes at {phi0:.6g} and {phi0 + span:.6g} rad (BRepAlgoAPI_Common)", seconds=t1 - t0),
+        mesh=dict(manifold=mesh.is_manifold, watertight=bool(mesh.watertight), winding_consistent=bool(mesh.winding_consistent),
+                  genus=mesh.manifold_genus, genus_expected=genus_expected, volume_mm3=mesh.manifold_volume,
+                  volume_rel_diff_vs_brep=(mesh.volume - mass.volume) / mass.volume, triangles=int(len(mesh.triangles)),
+                  linear_deflection_mm=MESH_LINEAR_MM, angular_deflection_rad=MESH_ANGULAR_RAD),
+    )
+    return shape, mesh, sections
+
+
 def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any], design_path=None) -> None:
     """Write ``tablet.step``, ``tablet.stl`` and ``tablet.glb`` into ``out`` and extend ``report``."""
     from tabletcad.cad.export import export
 
     t = tablet.trim
     if t.u != (0.0, 1.0) or not t.full_v:
-        report["brep"] = dict(valid=None, skipped="cut-away view (trimmed in u or v): picture and mesh only")
-        return
-    solid, mesh, sections = check_tablet_solid(tablet, report)
+        cut = cutaway_solid(tablet, report)
+        if isinstance(cut, str):
+            report["brep"] = dict(valid=None, skipped=f"cut-away view: {cut}; picture only")
+            return
+        solid, mesh, sections = cut
+    else:
+        solid, mesh, sections = check_tablet_solid(tablet, report)
     t0 = time.perf_counter()
     export(solid, out / "tablet.step", name=tablet.name)
     export(solid, out / "tablet.stl", name=tablet.name, mesh=mesh)

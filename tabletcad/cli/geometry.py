@@ -49,7 +49,7 @@ def build_cmd(design: Path, out_dir: Path, quiet: bool) -> None:
     from tabletcad.build import build_design
 
     rep = build_design(design, out_dir, progress=not quiet)
-    written = sorted(p.name for p in out_dir.iterdir())
+    written = rep["outputs"]  # this build's files only (the folder may hold files tabletcad did not write)
     click.echo(
         f"{rep['design']['name']}: volume {rep['volume_mm3']:.6g} mm3, area {rep['surface_area_mm2']:.6g} mm2, "
         f"{rep['length_mm']:.4g} x {rep['width_mm']:.4g} x {rep['height_mm']:.4g} mm -> {out_dir}/ ({', '.join(written)})"

@@ -29,6 +29,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.tolerance import DEFAULT
 
 __all__ = [
     "Seg",
@@ -402,6 +403,7 @@ class SplineOutline(PlanOutline):
         from scipy.spatial import cKDTree
 
         self._tree = cKDTree(self._ps)
+        self._kmax: float | None = None
 
     @property
     def breaks(self) -> np.ndarray:
@@ -412,10 +414,41 @@ class SplineOutline(PlanOutline):
         return np.asarray(self._sp.x[:-1], dtype=float)
 
     @property
+    def max_curvature(self) -> float:
+        """Largest signed curvature of the spline (1/mm), to ~1e-12 relative.
+
+        Sampling alone misses a peak between samples (the offset at the sampled radius
+        would then loop); the largest sampled peaks are refined by bounded Brent
+        searches, and the knots, where the curvature of a cubic spline has corners,
+        are evaluated exactly.
+        """
+        if self._kmax is None:
+            from scipy.optimize import minimize_scalar
+
+            k = self.frame(self._vs)[3]
+            h = float(self._vs[1] - self._vs[0])
+            peaks = np.flatnonzero((k >= np.roll(k, 1)) & (k >= np.roll(k, -1)))
+            best = max(float(np.max(k)), float(np.max(self.frame(self.smooth_breaks)[3])))
+            for i in peaks[np.argsort(k[peaks])[::-1][:8]]:
+                r = minimize_scalar(lambda v: -float(self.frame(v)[3][0]), bounds=(self._vs[i] - h, self._vs[i] + h),
+                                    method="bounded", options=dict(xatol=1e-13))
+                best = max(best, -float(r.fun))
+            self._kmax = best
+        return self._kmax
+
+    @property
     def min_convex_radius(self) -> float:
-        O, T, N, k = self.frame(self._vs)
-        kmax = float(np.max(k))
-        return 1.0 / kmax if kmax > 0 else math.inf
+        """The largest inward offset whose curve is regular (mm): the smallest radius of
+        curvature less the relative margin ``Tolerances.offset_regularity``.
+
+        At exactly the smallest radius of curvature the offset stands still at one point
+        (its speed ``|O'|(1 - d κ)`` vanishes there): a singular rim whose B-spline faces
+        fold (duplicate triangles, a mesh that is not watertight).  Arc outlines collapse
+        whole corner arcs instead, which the sweep handles with a ring patch; a spline has
+        no such arcs, so its cups stop short of the singular offset.
+        """
+        kmax = self.max_curvature
+        return (1.0 - DEFAULT.offset_regularity) / kmax if kmax > 0 else math.inf
 
     def frame(self, v):
         v = np.mod(np.asarray(v, dtype=float).reshape(-1), TWO_PI)

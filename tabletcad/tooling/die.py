@@ -15,16 +15,16 @@ from __future__ import annotations
 import math
 
 from OCP.BRepAdaptor import BRepAdaptor_Curve
-from OCP.BRepOffsetAPI import BRepOffsetAPI_ThruSections
+from OCP.LocOpe import LocOpe_DPrism
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
 from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
 
 from tabletcad.cad._occ import cast, explore
-from tabletcad.errors import DesignError
+from tabletcad.errors import DesignError, GeometryError
 from tabletcad.tooling.booleans import boolean, translated, volume
-from tabletcad.tooling.outline import TabletFrame, offset_wire, prism
+from tabletcad.tooling.outline import TabletFrame, offset_wire, plan_face, prism
 
-__all__ = ["die", "default_die_size", "MIN_WALL_MM"]
+__all__ = ["die", "default_die_size", "tapered_prism", "MIN_WALL_MM"]
 
 MIN_WALL_MM = 2.0
 #: smallest outward offset (mm) of the bore: OCCT's planar offset returns no wire for
@@ -43,6 +43,26 @@ def _max_radius(wire) -> float:
             p = c.Value(a + (b - a) * k / 64.0)
             r = max(r, math.hypot(p.X(), p.Y()))
     return r
+
+
+def tapered_prism(wire, z0: float, z1: float, taper_deg: float):
+    """The plan ``wire`` extruded from ``z0`` to ``z1`` with its walls drafted outward by ``taper_deg``.
+
+    ``LocOpe_DPrism`` drafts every wall exactly (lines give planes, arcs cones): each section at
+    height ``z`` is the outline offset outward by ``(z - z0) tan(taper)``, with no twist between
+    the sections (a loft between the bottom wire and an offset top wire pairs their edges by
+    order and may twist inside the bore just above ``z0``, where the tablet's cup edge touches
+    the die).  Its volume is ``A h + P h² tan/2 + π h³ tan²/3`` for a convex outline of area
+    ``A`` and perimeter ``P`` (Steiner's formula).
+    """
+    h = z1 - z0
+    t = math.radians(taper_deg)
+    face = plan_face(cast(translated(wire, dz=z0), "Wire"))
+    builder = LocOpe_DPrism(face, h / math.cos(t), -t)
+    shape = builder.Shape()
+    if shape is None or shape.IsNull():
+        raise GeometryError(f"drafting the die bore by {taper_deg} deg failed", wire)
+    return shape
 
 
 def default_die_size(frame: TabletFrame) -> tuple[float, float, str]:
@@ -86,13 +106,8 @@ def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, 
     grow = 0.0
     if taper_deg > 0:
         grow = (z_top - z_taper) * math.tan(math.radians(taper_deg))
-        top_wire = offset_wire(bore, grow + 1.0 * math.tan(math.radians(taper_deg)))
-        loft = BRepOffsetAPI_ThruSections(True, True, 1e-6)
-        loft.AddWire(cast(translated(bore, dz=z_taper), "Wire"))
-        loft.AddWire(cast(translated(top_wire, dz=z_top + 1.0), "Wire"))
-        loft.CheckCompatibility(False)
-        loft.Build()
-        shape = boolean("cut", shape, loft.Shape(), what="die taper")
+        cone = tapered_prism(bore, z_taper, z_top + 1.0, taper_deg)
+        shape = boolean("cut", shape, cone, what="die taper")
     info = dict(
         outer_diameter_mm=od, height_mm=H, tsm_size=kind, top_z_mm=z_top, bottom_z_mm=z_bot,
         punch_entry_mm=pen, bore=frame.outline_kind, bore_enlarged_by_band_bulge_mm=bulge,

@@ -23,15 +23,35 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["tooling_stage", "read_tooling_table", "write_tooling"]
+__all__ = ["tooling_stage", "tooling_spec", "read_tooling_table", "write_tooling", "write_finished_tablet"]
 
 
-def read_tooling_table(design_path) -> dict | None:
-    """The ``[tooling]`` table of a design file, or None."""
+def read_tooling_table(design_path, tablet: Tablet | None = None) -> dict | None:
+    """The ``[tooling]`` table of a design (the tablet's ``extras`` or the design file), or None."""
+    if tablet is not None and "tooling" in tablet.extras:
+        return tablet.extras["tooling"]
     if design_path is None:
         return None
     data = tomllib.loads(Path(design_path).read_text(encoding="utf-8"))
     return data.get("tooling")
+
+
+def tooling_spec(*, tablet: Tablet, design_path=None):
+    """The checked :class:`~tabletcad.tooling.spec.ToolingSpec` of a design, or None without ``[tooling]``.
+
+    Raises :class:`DesignError` for a bad key or value and for a tablet that cannot have tooling
+    (cut-away, ring); the build calls it before any geometry is built.
+    """
+    table = read_tooling_table(design_path, tablet)
+    if table is None:
+        return None
+    from tabletcad.tooling.spec import parse_tooling
+
+    spec = parse_tooling(table)
+    t = tablet.trim
+    if t.u != (0.0, 1.0) or not t.full_v or t.w[0] > 0:
+        raise DesignError("[tooling]", tablet.name, "tooling needs a whole solid tablet (no [trim], no ring)")
+    return spec
 
 
 def write_tooling(ts, out: Path, *, drawing: bool = True) -> list[Path]:
@@ -50,25 +70,59 @@ def write_tooling(ts, out: Path, *, drawing: bool = True) -> list[Path]:
 
 
 def tooling_stage(*, tablet: Tablet, out: Path, report: dict[str, Any], design_path=None) -> None:
-    table = read_tooling_table(design_path)
-    if table is None:
+    """Tooling files of the design's ``[tooling]`` table; the finished tablet as ``tablet.*``.
+
+    The CAD stage wrote the plain PDE tablet as ``tablet.step/.stl/.glb``; when scores or
+    embossing change it, the plain STEP is kept as ``tablet_plain.step`` and ``tablet.*``
+    become the finished (scored, embossed) tablet, the one the punches fit.
+    """
+    spec = tooling_spec(tablet=tablet, design_path=design_path)
+    if spec is None:
         return
-    from tabletcad.tooling.spec import parse_tooling
     from tabletcad.tooling.toolset import make_tooling
 
-    spec = parse_tooling(table)
-    t = tablet.trim
-    if t.u != (0.0, 1.0) or not t.full_v or t.w[0] > 0:
-        raise DesignError("[tooling]", tablet.name, "tooling needs a whole solid tablet (no [trim], no ring)")
     ts = make_tooling(tablet, spec)
     res = ts.report
     if res.get("interference_mm3", 0.0) > 1e-6 or not res["interference"]["gap_within_clearance"]:
         raise GeometryError(
             f"{tablet.name}: tooling check failed: overlap {res['interference_mm3']:.3g} mm^3, largest gap "
             f"{res['max_gap_mm']:.4g} mm (clearance {spec.clearance_mm} mm)", ts)
-    files = write_tooling(ts, Path(out))
+    out = Path(out)
+    files = write_tooling(ts, out)
+    if spec.scores or spec.emboss:
+        files += write_finished_tablet(ts, out)
     res["files"] = sorted(p.name for p in files)
     report["tooling"] = res
 
 
-register_stage("tooling", tooling_stage)
+def write_finished_tablet(ts, out: Path) -> list[Path]:
+    """``tablet.step/.stl/.glb`` of the finished tablet (mesh checked), ``tablet_plain.step`` of the plain one."""
+    import os
+
+    from tabletcad.cad.export import export
+    from tabletcad.cad.mesh import tessellate
+    from tabletcad.cad.stage import MESH_ANGULAR_RAD, MESH_LINEAR_MM
+
+    out = Path(out)
+    name = ts.tablet.name
+    files = []
+    if (out / "tablet.step").exists():
+        os.replace(out / "tablet.step", out / "tablet_plain.step")
+    else:
+        export(ts.frame.shape, out / "tablet_plain.step", name=f"{name}_plain")
+    files.append(out / "tablet_plain.step")
+    finished = ts.parts["tablet"]
+    try:
+        mesh = tessellate(finished, MESH_LINEAR_MM, MESH_ANGULAR_RAD)
+    except GeometryError:  # Delabella leaves some trimmed faces (letter counters) empty: as mesh_arrays
+        mesh = tessellate(finished, MESH_LINEAR_MM, MESH_ANGULAR_RAD, algo="watson")
+    if not mesh.ok:
+        raise GeometryError(
+            f"{name}: mesh check of the finished tablet failed (manifold3d {mesh.manifold_status}, "
+            f"watertight {mesh.watertight}, winding {mesh.winding_consistent})", mesh)
+    files.append(export(finished, out / "tablet.step", name=name))
+    files += [export(finished, out / f"tablet{suffix}", name=name, mesh=mesh) for suffix in (".stl", ".glb")]
+    return files
+
+
+register_stage("tooling", tooling_stage, check=tooling_spec)

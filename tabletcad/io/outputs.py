@@ -1,0 +1,174 @@
+"""Output folders that a build owns: staging, publishing and the build manifest.
+
+A build writes everything into a staging folder ``.<name>.<random>`` beside the
+output folder ``<name>`` and, when every output succeeded, moves the files into
+place with :func:`publish`.  The output folder then holds a manifest,
+``.tabletcad-build.json``, naming every file of that build with its SHA-256.
+The next build into the same folder removes the files of the earlier build
+that it does not write itself, but only those listed by the earlier manifest
+*and unchanged since* (same hash): files that tabletcad did not write, or that
+someone edited after the build, are never touched.
+
+A staging folder carries a marker (``.tabletcad-staging.json``: process id,
+host, start time).  :func:`staging_folder` removes the current staging folder
+on any exception, on Ctrl-C and on SIGTERM; a build killed outright (SIGKILL,
+power loss) leaves its staging folder, and the next build into the same
+parent removes it once the process named in its marker is gone (or, on
+another host, once it is older than :data:`STALE_AFTER_S`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import shutil
+import signal
+import socket
+import tempfile
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+from tabletcad.io.atomic import atomic_write_text
+
+__all__ = ["MANIFEST", "STAGING_MARKER", "STALE_AFTER_S", "staging_folder", "publish", "read_manifest",
+           "clean_stale_staging", "file_sha256"]
+
+MANIFEST = ".tabletcad-build.json"
+STAGING_MARKER = ".tabletcad-staging.json"
+#: a staging folder of another host (its process cannot be asked) is stale after this many seconds
+STALE_AFTER_S = 24 * 3600.0
+
+
+def file_sha256(path: Path) -> str:
+    """Hex SHA-256 of a file's bytes."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def read_manifest(out_dir: str | os.PathLike[str]) -> dict[str, str]:
+    """``{relative file name: sha256}`` of the build recorded in ``out_dir`` (empty if none or unreadable)."""
+    try:
+        data = json.loads((Path(out_dir) / MANIFEST).read_text(encoding="utf-8"))
+        files = data["files"]
+        return {str(k): str(v) for k, v in files.items()} if isinstance(files, dict) else {}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return {}
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else
+        return True
+    except (OSError, OverflowError, ValueError):
+        return False
+    return True
+
+
+def _is_stale(folder: Path, now: float) -> bool:
+    """A staging folder whose build is over: its process is gone (same host) or it is old."""
+    try:
+        marker = json.loads((folder / STAGING_MARKER).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False  # not ours (no marker), or being created right now
+    if not isinstance(marker, dict):
+        return False
+    pid, host, started = marker.get("pid"), marker.get("host"), marker.get("started")
+    if host == socket.gethostname() and isinstance(pid, int) and pid != os.getpid():
+        return not _pid_alive(pid)
+    return isinstance(started, (int, float)) and now - started > STALE_AFTER_S
+
+
+def clean_stale_staging(out_dir: str | os.PathLike[str]) -> list[Path]:
+    """Remove staging folders ``.<name>.*`` of ``out_dir`` left by killed builds; return them."""
+    out_dir = Path(out_dir)
+    removed = []
+    now = time.time()
+    with contextlib.suppress(OSError):
+        for p in out_dir.parent.glob(f".{out_dir.name}.*"):
+            if p.is_dir() and not p.is_symlink() and _is_stale(p, now):
+                shutil.rmtree(p, ignore_errors=True)
+                removed.append(p)
+    return removed
+
+
+@contextlib.contextmanager
+def _sigterm_raises() -> Iterator[None]:
+    """While inside, SIGTERM raises :class:`SystemExit` (status 143) so that clean-up runs."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum, frame):  # noqa: ARG001
+        raise SystemExit(128 + signum)
+
+    old = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)
+
+
+@contextlib.contextmanager
+def staging_folder(out_dir: str | os.PathLike[str]) -> Iterator[Path]:
+    """A fresh staging folder beside ``out_dir``, removed on exit whatever happens.
+
+    Stale staging folders of earlier, killed builds into ``out_dir`` are removed
+    first.  SIGTERM and Ctrl-C inside the block remove the folder too.
+    """
+    out_dir = Path(out_dir)
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    clean_stale_staging(out_dir)
+    with _sigterm_raises():
+        staging = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+        try:
+            marker = dict(pid=os.getpid(), host=socket.gethostname(), started=time.time(), target=out_dir.name)
+            (staging / STAGING_MARKER).write_text(json.dumps(marker), encoding="utf-8")
+            yield staging
+        finally:
+            shutil.rmtree(staging, ignore_errors=True)
+
+
+def publish(staging: str | os.PathLike[str], out_dir: str | os.PathLike[str]) -> list[str]:
+    """Move the files of ``staging`` into ``out_dir`` and record them in its manifest.
+
+    Files of the earlier build in ``out_dir`` (its manifest) that this build did
+    not write are removed if they are unchanged since that build; nothing else
+    in ``out_dir`` is touched.  Returns the published names (relative, sorted).
+    """
+    staging, out_dir = Path(staging), Path(out_dir)
+    files = sorted(p.relative_to(staging) for p in staging.rglob("*") if p.is_file() and p.name != STAGING_MARKER)
+    hashes = {p.as_posix(): file_sha256(staging / p) for p in files}
+    earlier = read_manifest(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    umask = os.umask(0)
+    os.umask(umask)
+    for rel in files:
+        src, dst = staging / rel, out_dir / rel
+        dst.parent.mkdir(parents=True, exist_ok=True)
+        os.chmod(src, 0o666 & ~umask)
+        os.replace(src, dst)
+    for name, digest in earlier.items():
+        if name in hashes:
+            continue
+        old = out_dir / name
+        if ".." in Path(name).parts or Path(name).is_absolute():
+            continue  # a manifest never names anything outside the folder
+        with contextlib.suppress(OSError):
+            if old.is_file() and not old.is_symlink() and file_sha256(old) == digest:
+                old.unlink()
+                parent = old.parent
+                while parent != out_dir and not any(parent.iterdir()):  # folders the old build made
+                    parent.rmdir()
+                    parent = parent.parent
+    atomic_write_text(out_dir / MANIFEST, json.dumps(dict(tool="tabletcad", files=hashes), indent=1) + "\n")
+    return sorted(hashes)
