@@ -170,13 +170,16 @@ def test_cutaway_with_curved_cut_faces_is_not_cut(tmp_path):
     from tabletcad.cad.stage import _cut_plane_angle, cutaway_solid
     from tabletcad.design import design_from_dict
 
-    t = design_from_dict({"tablet": {"family": "almond"}, "trim": {"v": [0.0, 3.0]}})
+    t = design_from_dict({"tablet": {"family": "almond", "length": 15.0, "width": 7.5, "end_radius": 1.5, "band": 3.0,
+                                       "cup_depth": 0.6}, "trim": {"v": [0.0, 3.0]}})
     reason = cutaway_solid(t, {"volume_mm3": t.volume()})
     assert isinstance(reason, str) and "planes" in reason
-    r = design_from_dict({"tablet": {"family": "shallow_convex_round"}, "trim": {"v": [0.0, 3.0]}})
+    r = design_from_dict({"tablet": {"family": "shallow_convex_round", "diameter": 10.0, "thickness": 3.0, "band": 2.0},
+                          "trim": {"v": [0.0, 3.0]}})
     assert _cut_plane_angle(r, 0.0) == pytest.approx(0.0, abs=1e-12)
     assert _cut_plane_angle(r, 3.0) == pytest.approx(3.0, abs=1e-9)
-    o = design_from_dict({"tablet": {"family": "shallow_convex_oval"}, "trim": {"v": [0.0, 1.0]}})
+    o = design_from_dict({"tablet": {"family": "shallow_convex_oval", "width": 6.0, "length": 12.0, "thickness": 3.0,
+                                       "band": 2.0}, "trim": {"v": [0.0, 1.0]}})
     a, b = 6.0, 3.0  # half length and half width of the 12 x 6 mm oval
     assert _cut_plane_angle(o, 1.0) == pytest.approx(math.atan2(b * math.sin(1.0), a * math.cos(1.0)), abs=1e-9)
 

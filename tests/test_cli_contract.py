@@ -229,6 +229,20 @@ def test_ctrl_c_while_commands_load(capsys, monkeypatch):
     assert rc == 130 and err == "interrupted\n" and out == ""
 
 
+def _wait_until_numpy_loads(p: subprocess.Popen, timeout: float = 120.0) -> None:
+    """Wait until the child has numpy mapped: tabletcad's own code is running by then (a signal
+    earlier would land in Python's start-up, before any program can handle it)."""
+    maps = Path(f"/proc/{p.pid}/maps")
+    t_end = time.monotonic() + timeout
+    while time.monotonic() < t_end and p.poll() is None:
+        try:
+            if "_multiarray_umath" in maps.read_text():
+                return
+        except OSError:
+            return
+        time.sleep(0.01)
+
+
 def test_ctrl_c_during_a_build_subprocess(tmp_path):
     """SIGINT at several moments of a real build (loading, building): one line, 130, nothing left."""
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
@@ -237,7 +251,8 @@ def test_ctrl_c_during_a_build_subprocess(tmp_path):
         p = subprocess.Popen([sys.executable, "-m", "tabletcad", "build", str(ROOT / "samples" / "families" / "capsule.toml"),
                               "--out", str(out), "--quiet"], cwd=tmp_path, env=env,
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        time.sleep(delay)
+        _wait_until_numpy_loads(p)  # past Python's own start-up, whatever the machine's load
+        time.sleep(delay - 0.5)
         p.send_signal(signal.SIGINT)
         _, err = p.communicate(timeout=120)
         if p.returncode == 0:  # finished before the signal (a very fast machine): nothing to check

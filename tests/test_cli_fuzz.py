@@ -125,7 +125,7 @@ def _fake_build_design(design, out_dir, *, progress=True):
     t = load_design(design)
     Path(out_dir).mkdir(parents=True, exist_ok=True)
     dims = t.dimensions()
-    return dict(design=dict(name=t.name), volume_mm3=t.volume(), surface_area_mm2=t.surface_area(), **dims)
+    return dict(design=dict(name=t.name), volume_mm3=t.volume(), surface_area_mm2=t.surface_area(), outputs=[], **dims)
 
 
 def _check_contract(rc: int, err: str, context) -> None:
