@@ -1,0 +1,163 @@
+"""A build owns its output folder: real ``tabletcad build`` runs (CAD stage).
+
+A tooling build (finished tablet as ``tablet.*``, plain one as ``tablet_plain.step``)
+rebuilt as a cut-away and as a plain tablet, and builds killed with SIGKILL and SIGTERM.
+The publishing rules themselves are tested on plain files in ``test_build_outputs.py``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from tabletcad.cli import main
+from tabletcad.io.outputs import MANIFEST, STAGING_MARKER
+
+pytestmark = pytest.mark.cad
+
+pytest.importorskip("OCP")
+pytest.importorskip("manifold3d")
+pytest.importorskip("ezdxf")
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _build(design: Path, out: Path, capsys) -> tuple[dict, str]:
+    assert main(["build", str(design), "--out", str(out), "--quiet"]) == 0
+    line = capsys.readouterr().out.strip().splitlines()[-1]
+    return json.loads((out / "report.json").read_text()), line
+
+
+def _listed(line: str) -> list[str]:
+    return line.rsplit("(", 1)[1].rstrip(")").split(", ")
+
+
+@pytest.mark.cad
+@pytest.mark.slow
+def test_tooling_build_then_cutaway_then_plain_rebuild(tmp_path, capsys):
+    from tabletcad.cad.readback import ocp_read_steps
+
+    out = tmp_path / "out"
+    rep, line = _build(ROOT / "samples" / "tooling" / "concave_round_bisect.toml", out, capsys)
+    tool_files = {"assembly.step", "upper_punch.step", "lower_punch.step", "die.step", "drawing.svg", "drawing.dxf",
+                  "tablet_plain.step", "tablet.step", "tablet.stl", "tablet.glb"}
+    assert tool_files <= set(rep["outputs"])
+    assert _listed(line) == rep["outputs"] == sorted(read_manifest(out))
+    # tablet.step is the finished (scored, debossed) tablet, tablet_plain.step the PDE tablet
+    fin, plain = ocp_read_steps([out / "tablet.step", out / "tablet_plain.step"])
+    assert fin["valid"] and plain["valid"] and fin["n_solids"] == plain["n_solids"] == 1
+    assert fin["volume"] == pytest.approx(rep["tooling"]["tablet"]["volume_mm3"], rel=1e-6)
+    assert plain["volume"] == pytest.approx(rep["volume_mm3"], rel=1e-6)
+    removed = rep["tooling"]["tablet"]["volume_plain_mm3"] - rep["tooling"]["tablet"]["volume_mm3"]
+    assert plain["volume"] - fin["volume"] == pytest.approx(removed, rel=1e-5) and removed > 0.05
+    assert fin["n_faces"] > plain["n_faces"]
+
+    (out / "notes.txt").write_text("mine")
+    (out / "drawing.svg").write_text((out / "drawing.svg").read_text() + "<!-- edited -->")
+    rep2, line2 = _build(ROOT / "samples" / "cutaway_convex_round.toml", out, capsys)
+    expected = set(rep2["outputs"]) | {MANIFEST, "notes.txt", "drawing.svg"}
+    assert {p.name for p in out.iterdir()} == expected
+    assert _listed(line2) == rep2["outputs"] and "drawing.svg" not in rep2["outputs"]
+    assert "assembly.step" not in expected and "upper_punch.step" not in expected
+    # the cut-away is a solid: its STEP holds the trimmed volume of the report
+    assert {"tablet.step", "tablet.stl", "tablet.glb"} <= set(rep2["outputs"]) and "tablet_plain.step" not in expected
+    (cut,) = ocp_read_steps([out / "tablet.step"])
+    assert cut["valid"] and cut["n_solids"] == 1
+    assert cut["volume"] == pytest.approx(rep2["volume_mm3"], rel=1e-6)
+    assert rep2["volume_mm3"] == pytest.approx(0.75 * rep3_full_volume(), rel=1e-9)  # 3/4 of the round
+
+    # a plain design into the folder: exactly its files (and the two that are not tabletcad's now)
+    rep3, _ = _build(ROOT / "samples" / "flat_faced_round.toml", out, capsys)
+    assert {p.name for p in out.iterdir()} == set(rep3["outputs"]) | {MANIFEST, "notes.txt", "drawing.svg"}
+    assert set(rep3["outputs"]) == {"report.json", "tablet.png", "tablet.step", "tablet.stl", "tablet.glb"}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
+def rep3_full_volume() -> float:
+    from dataclasses import replace
+
+    from tabletcad.design import load_design
+    from tabletcad.tablet import Trim
+
+    return replace(load_design(ROOT / "samples" / "cutaway_convex_round.toml"), trim=Trim()).volume()
+
+
+def test_cutaway_with_curved_cut_faces_is_not_cut(tmp_path):
+    """A swept almond's sections at constant v are not planes through the axis: no solid, a reason.
+    A round's section at v lies in the half-plane at angle v; the thesis oval's (ellipses of one
+    aspect ratio) in a half-plane too, at the ellipse's polar angle atan(b/a tan v)."""
+    from tabletcad.cad.stage import _cut_plane_angle, cutaway_solid
+    from tabletcad.design import design_from_dict
+
+    t = design_from_dict({"tablet": {"family": "almond", "length": 15.0, "width": 7.5, "end_radius": 1.5, "band": 3.0,
+                                       "cup_depth": 0.6}, "trim": {"v": [0.0, 3.0]}})
+    reason = cutaway_solid(t, {"volume_mm3": t.volume()})
+    assert isinstance(reason, str) and "planes" in reason
+    r = design_from_dict({"tablet": {"family": "shallow_convex_round", "diameter": 10.0, "thickness": 3.0, "band": 2.0},
+                          "trim": {"v": [0.0, 3.0]}})
+    assert _cut_plane_angle(r, 0.0) == pytest.approx(0.0, abs=1e-12)
+    assert _cut_plane_angle(r, 3.0) == pytest.approx(3.0, abs=1e-9)
+    o = design_from_dict({"tablet": {"family": "shallow_convex_oval", "width": 6.0, "length": 12.0, "thickness": 3.0,
+                                       "band": 2.0}, "trim": {"v": [0.0, 1.0]}})
+    a, b = 6.0, 3.0  # half length and half width of the 12 x 6 mm oval
+    assert _cut_plane_angle(o, 1.0) == pytest.approx(math.atan2(b * math.sin(1.0), a * math.cos(1.0)), abs=1e-9)
+
+
+def _wait_for_staging(parent: Path, name: str, proc, timeout: float = 300.0) -> Path:
+    t_end = time.monotonic() + timeout
+    while time.monotonic() < t_end:
+        found = [p for p in parent.glob(f".{name}.*") if (p / STAGING_MARKER).is_file()]
+        if found:
+            return found[0]
+        assert proc.poll() is None, proc.communicate()
+        time.sleep(0.05)
+    raise AssertionError("no staging folder appeared")
+
+
+@pytest.mark.cad
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM], ids=["SIGKILL", "SIGTERM"])
+def test_killed_build_leaves_no_staging_folder_after_the_next_build(tmp_path, capsys, sig):
+    design = ROOT / "samples" / "flat_faced_round.toml"
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-m", "tabletcad", "build", str(design), "--out", str(out), "--quiet"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        staging = _wait_for_staging(tmp_path, "out", proc)
+        proc.send_signal(sig)
+        proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    if sig == signal.SIGKILL:
+        assert staging.is_dir()  # nothing could clean up ...
+    else:
+        assert proc.returncode == 128 + signal.SIGTERM
+        assert not staging.exists()  # ... SIGTERM removes the build's own staging folder
+    assert not out.exists()
+    rep, _ = _build(design, out, capsys)  # ... and the next build removes the stale one
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+    assert {p.name for p in out.iterdir()} == set(rep["outputs"]) | {MANIFEST}
+
+
+@pytest.mark.parametrize("extra", ["[tooling]\nbogus = 1\n", "[tooling]\n[[tooling.score]]\nprofile = \"w\"\n",
+                                   "[trim]\nv = [0.0, 3.0]\n[tooling]\nclearance_mm = 0.02\n"])
+def test_bad_tooling_table_is_refused_before_any_geometry(tmp_path, capsys, monkeypatch, extra):
+    import tabletcad.build as build
+
+    def no_geometry(*a, **k):
+        raise AssertionError("geometry built before [tooling] was checked")
+
+    monkeypatch.setattr(build, "geometry_report", no_geometry)
+    d = tmp_path / "bad.toml"
+    d.write_text('[tablet]\nfamily = "shallow_convex_round"\ndiameter = 10.0\nthickness = 3.0\nband = 2.0\n\n' + extra)
+    assert main(["build", str(d), "--out", str(tmp_path / "out")]) == 2  # progress on: still one line
+    cap = capsys.readouterr()
+    assert cap.out == "" and len(cap.err.strip().splitlines()) == 1 and cap.err.startswith("error: [")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
