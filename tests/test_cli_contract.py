@@ -273,3 +273,21 @@ def test_bare_command_prints_help_and_help_exits_0(capsys):
     assert rc == 0 and out.startswith("Usage: tabletcad") and "build" in out and err == ""
     rc, out, err = run(capsys, "mesh", "--help")
     assert rc == 0 and "--nodes" in out and err == ""
+
+
+@pytest.mark.parametrize("argv, extra", [
+    (["sweep", "samples/sweep/concave_round_grid.toml", "--out", "OUT"], "sweep"),
+    (["fe", "diametral", "samples/families/concave_round.toml", "--force", "100", "--out", "OUT"], "fe"),
+])
+def test_a_missing_extra_is_one_line_naming_it(tmp_path, capsys, monkeypatch, argv, extra):
+    """Without Dask or gmsh installed (simulated here; real in the core-only CI pass) the command
+    names the extra to install: exit 2, one line, nothing written."""
+    for name in ("distributed", "gmsh"):
+        monkeypatch.setitem(sys.modules, name, None)  # import raises ImportError
+    argv = [str(ROOT / a) if a.startswith("samples/") else str(tmp_path / "out") if a == "OUT" else a for a in argv]
+    assert main(argv) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err.splitlines() == [cap.err.strip()] and cap.err.startswith(f"error: tabletcad {extra} = ")
+    assert f"pip install 'tabletcad[{extra}]'" in cap.err
+    assert list(tmp_path.iterdir()) == []

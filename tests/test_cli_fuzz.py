@@ -228,15 +228,9 @@ def _custom(R: float, k: int, e: float, phase: float, band: float, cup: float, f
 
 custom_outlines = st.builds(_custom, st.floats(3.0, 6.0), st.sampled_from([2, 3]), st.floats(0.0, 0.08), st.floats(0.0, math.pi),
                             st.floats(1.5, 3.0), st.floats(0.1, 0.4), st.floats(0.4, 0.8))
-family_designs = st.one_of(
-    st.builds(_scaled, st.sampled_from(sorted(SAMPLES.values())), st.floats(0.7, 1.4)),
-    custom_outlines,
-)
 
 
-@settings(max_examples=3, suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow], deadline=None)
-@given(text=family_designs)
-def test_families_build_through_the_cli_with_a_valid_brep(tmp_path_factory, capsys, text):
+def _build_and_check(tmp_path_factory, capsys, text: str) -> None:
     folder = tmp_path_factory.mktemp("family")
     src = folder / "design.toml"
     src.write_text(text, encoding="utf-8")
@@ -250,3 +244,21 @@ def test_families_build_through_the_cli_with_a_valid_brep(tmp_path_factory, caps
     assert rel == pytest.approx(brep["volume_rel_diff_vs_quadrature"], abs=1e-12)
     assert abs(rel) < 2e-7, (rel, text)  # the B-rep from the quadrature (README: up to 5.3e-8 measured)
     assert abs(rep["solid_volume_mm3"] / rep["volume_mm3"] - 1.0) < 1e-9  # two quadratures of the core agree
+
+
+@pytest.mark.cad
+@pytest.mark.slow
+@pytest.mark.parametrize("family", sorted(SAMPLES))
+@settings(max_examples=2, suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow], deadline=None)
+@given(scale=st.floats(0.7, 1.4))
+def test_every_family_builds_through_the_cli_with_a_valid_brep(tmp_path_factory, capsys, family, scale):
+    """Every family's sample, every length scaled by a drawn factor, built by ``tabletcad build``."""
+    _build_and_check(tmp_path_factory, capsys, _scaled(SAMPLES[family], scale))
+
+
+@pytest.mark.cad
+@settings(max_examples=4, suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow], deadline=None)
+@given(text=custom_outlines)
+def test_custom_outlines_build_through_the_cli_with_a_valid_brep(tmp_path_factory, capsys, text):
+    _build_and_check(tmp_path_factory, capsys, text)
+

@@ -27,6 +27,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.cad  # the README describes (and runs) the full install: CAD, FE, Dask, FreeCAD
+
 try:
     import tomllib
 except ModuleNotFoundError:  # pragma: no cover - Python 3.10

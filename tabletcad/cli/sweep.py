@@ -11,6 +11,15 @@ from tabletcad.errors import DesignError
 __all__ = ["COMMANDS"]
 
 
+def _require_sweep() -> None:
+    """The sweep extra (Dask ``distributed``, pandas), or the one-line error naming it."""
+    try:
+        import distributed  # noqa: F401
+        import pandas  # noqa: F401
+    except ImportError as exc:
+        raise DesignError("tabletcad sweep", exc.name, "needs the sweep extra: pip install 'tabletcad[sweep]'") from None
+
+
 @click.command("sweep")
 @click.argument("sweep_file", metavar="SWEEP.toml", type=click.Path(dir_okay=False, path_type=Path))
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path),
@@ -25,6 +34,7 @@ __all__ = ["COMMANDS"]
 def sweep_cmd(sweep_file: Path, out_dir: Path, workers, scheduler, resume: bool, plots, store, connect_timeout,
               quiet: bool) -> None:
     """Build every design of SWEEP.toml and write OUT/results.csv (one row per design)."""
+    _require_sweep()
     from tabletcad.sweep import run_sweep
     from tabletcad.sweep.engine import CONNECT_TIMEOUT_S
 
