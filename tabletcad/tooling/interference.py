@@ -284,8 +284,10 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
     dc, nc = dist[:n_t][T], near[:n_t][T]
     sel = nc.min(axis=1) != nc.max(axis=1)
     n_refined = 0
+    # a gap peak between two tools has slope 1 on either side: points this far apart miss it by half
+    refined_spacing = max(0.125 * clearance, 1e-3)
     if np.any(sel):
-        Vs, _ = refine_triangles(V[:n_t], T[sel], max(0.125 * clearance, 1e-3))
+        Vs, _ = refine_triangles(V[:n_t], T[sel], refined_spacing)
         Vs = np.unique(Vs, axis=0)
         ds, ns = measure(Vs)
         V, dist = np.vstack([V, Vs]), np.concatenate([dist, ds])
@@ -315,6 +317,7 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
                        f"triangles between tools) vs part meshes at {tool_deflection:.3g} mm (largest {float(np.max(dist)):.6g} mm), "
                        f"worst {len(order)} moved onto the tablet's B-rep and re-measured with BRepExtrema_DistShapeShape",
         max_gap_mesh_mm=float(np.max(dist)),
+        max_gap_resolution_mm=0.5 * refined_spacing,
         clearance_mm=clearance,
         gap_within_clearance=bool((float(exact[i_max]) if exact else float(np.max(dist))) <= clearance * (1 + 1e-6) + 1e-7),
         pairs=pairs,
