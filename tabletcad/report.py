@@ -10,7 +10,7 @@ import numpy as np
 
 from tabletcad.tablet import Tablet
 
-__all__ = ["geometry_report", "to_json", "register_report_section"]
+__all__ = ["geometry_report", "to_json", "register_report_section", "flatten_report"]
 
 # Extra report sections: callables (tablet) -> dict merged into the report (or None to skip).
 _SECTIONS: list = []
@@ -104,3 +104,26 @@ def _clean(o: Any) -> Any:
 def to_json(report: dict[str, Any]) -> str:
     """JSON text (NaN/inf written as null)."""
     return json.dumps(_clean(report), indent=2, sort_keys=False) + "\n"
+
+
+def flatten_report(report: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    """Every scalar of a report (numbers, booleans, strings, None) under dotted keys; lists are left out.
+
+    ``{"volume_mm3": 1.0, "design_report": {"weight_mg": 2.0}}`` becomes
+    ``{"volume_mm3": 1.0, "design_report.weight_mg": 2.0}``.  NumPy scalars become
+    Python ones; the order is the report's own.
+    """
+    import numpy as np
+
+    out: dict[str, Any] = {}
+    for k, v in report.items():
+        name = f"{prefix}{k}"
+        if isinstance(v, dict):
+            out.update(flatten_report(v, name + "."))
+        elif isinstance(v, (list, tuple, np.ndarray)):
+            continue
+        elif isinstance(v, np.generic):
+            out[name] = v.item()
+        else:
+            out[name] = v
+    return out

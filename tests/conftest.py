@@ -56,10 +56,10 @@ def pytest_make_collect_report(collector):
 # --------------------------------------------------------------------------- core-only run
 # .ci/test runs the suite a second time in .venv-oldest (the oldest numpy/scipy pyproject
 # claims, no CAD, FE or Dask library) with TABLETCAD_CORE_ONLY=1: files whose module-level
-# ``pytestmark`` names the cad, freecad, fe or sweep marker are not collected, and tests so
+# ``pytestmark`` names the cad, freecad, fe, sweep or tables marker are not collected, and tests so
 # marked are deselected.  Everything else must pass there too.
 _CORE_ONLY = bool(os.environ.get("TABLETCAD_CORE_ONLY"))
-_CAD_MARKS = ("cad", "freecad", "fe", "sweep")
+_CAD_MARKS = ("cad", "freecad", "fe", "sweep", "tables")
 
 
 def _file_needs_cad(path) -> bool:

@@ -112,7 +112,7 @@ def test_cli_bad_design_exits_2_and_writes_nothing(tmp_path, capsys, case):
     d = tmp_path / "bad.toml"
     d.write_text(BAD[case])
     out = tmp_path / "rep.json"
-    assert main(["report", str(d), "--json", str(out)]) == 2
+    assert main(["report", str(d), "--json-file", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error:")
     assert not out.exists()
@@ -132,7 +132,7 @@ def test_cli_report_writes_json_with_units(tmp_path, capsys):
     d.write_text('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 2.8\ncup_depth = 0.9\nland = 0.08\n'
                  '[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1.5\nbreaking_force_N = 100.0\n')
     out = tmp_path / "rep.json"
-    assert main(["report", str(d), "--json", str(out), "--compaction-force", "15", "--max-punch-pressure", "300"]) == 0
+    assert main(["report", str(d), "--json-file", str(out), "--compaction-force", "15", "--max-punch-pressure", "300"]) == 0
     text = capsys.readouterr().out
     assert "cup volume" in text and "tensile strength" in text and "FDA size" in text
     rep = json.loads(out.read_text())

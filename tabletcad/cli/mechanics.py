@@ -12,8 +12,6 @@ from __future__ import annotations
 import contextlib
 import json
 import math
-import os
-import tempfile
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
@@ -22,6 +20,8 @@ from typing import Any
 import click
 import numpy as np
 
+from tabletcad.cli.outputs import check_output as _check_output
+from tabletcad.cli.outputs import staged as _staged
 from tabletcad.errors import DesignError, check_finite, check_positive, check_range
 
 __all__ = ["COMMANDS"]
@@ -59,53 +59,9 @@ def _jsonable(o: Any) -> Any:
     raise TypeError(type(o).__name__)
 
 
-def _check_output(option: str, path: Path | None, suffixes: tuple[str, ...] = (".png", ".svg", ".pdf")) -> None:
-    """Refuse, before anything is computed, an output file that could not be written."""
-    if path is None:
-        return
-    if path.suffix.lower() not in suffixes:
-        raise DesignError(option, str(path), "must end in " + ", ".join(suffixes[:-1]) + f" or {suffixes[-1]}")
-    if path.is_dir():
-        raise DesignError(option, str(path), "is a folder; give a file name")
-    folder = path.absolute().parent
-    while not folder.exists() and folder != folder.parent:
-        folder = folder.parent
-    if not folder.is_dir():
-        raise DesignError(option, str(path), f"cannot be created: {folder} is a file, not a folder")
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise DesignError(option, str(path), f"cannot be created: folder {folder} is not writable")
-
-
 def _check_input(name: str, path: Path | None) -> None:
     if path is not None and not path.is_file():
         raise DesignError(name, str(path), "is a folder, not a file" if path.is_dir() else "does not exist")
-
-
-@contextlib.contextmanager
-def _staged(**targets: Path | None) -> Iterator[dict[str, Path]]:
-    """Temporary files standing for the outputs ``targets``; all are moved into place only if the body succeeds.
-
-    The body writes each output to ``staged[name]`` (same suffix as its
-    target).  If it raises, no target is touched; if moving one fails, the
-    targets already moved that did not exist before are removed again.
-    """
-    from tabletcad.io import atomic_write_bytes
-
-    with tempfile.TemporaryDirectory(prefix="tabletcad-") as tmp:
-        staged = {k: Path(tmp) / f"{k}{p.suffix}" for k, p in targets.items() if p is not None}
-        yield staged
-        created: list[Path] = []
-        try:
-            for k, src in staged.items():
-                dst = targets[k]
-                existed = dst.exists()
-                atomic_write_bytes(dst, src.read_bytes())
-                if not existed:
-                    created.append(dst)
-        except BaseException:
-            for dst in created:
-                dst.unlink(missing_ok=True)
-            raise
 
 
 # --------------------------------------------------------------------------- heckel

@@ -1,8 +1,12 @@
 """``tabletcad report DESIGN.toml``: the design report of an industry-family tablet.
 
 Prints a readable table (volume, area, cup, plan, weight, punch-tip check,
-tensile strength, FDA size flag, nominal certificate and seams) and, with
-``--json``, writes the report as JSON.  Options not given on the command line
+tensile strength, FDA size flag, nominal certificate and seams), or one line
+per design for several designs; ``--json`` prints the report as JSON instead,
+``--json-file``, ``--csv`` and ``--xlsx`` write it (CSV and workbook: one row
+per design, every scalar of the report).  ``--solve-for`` with a target
+weight or volume first solves for the band, thickness or cup depth
+(:func:`tabletcad.families.inverse.solve_for`).  Options not given on the command line
 are read from the design file's ``[report]`` table.  Bad input: one line on
 stderr, exit status 2, nothing written.
 """
@@ -86,47 +90,177 @@ def _table(name: str, sec: dict[str, Any]) -> str:
     return "\n".join(f"{k:<{w}}  {v}" for k, v in rows)
 
 
+_SOLVABLE = ("band", "thickness", "cup_depth")
+
+
+def _solved(tablet, opts, vary: str, target_weight: float | None, target_volume: float | None):
+    """``tablet`` with ``vary`` solved for the target weight or volume; ``(tablet, inverse section)``."""
+    import inspect
+
+    from tabletcad.families.inverse import _family_function, solve_for
+
+    takes = inspect.signature(_family_function(tablet.family)).parameters
+    dims = {k: v for k, v in tablet.params.items() if k in takes}
+    try:
+        r = solve_for(tablet.family, target_weight_mg=target_weight, target_volume_mm3=target_volume, vary=vary,
+                      solid_fraction=opts.solid_fraction if target_weight is not None else None,
+                      true_density_mg_mm3=opts.true_density_mg_mm3 if target_weight is not None else None, **dims)
+    except DesignError as exc:
+        option = {"target_volume_mm3": "--target-volume", "target_weight_mg": "--target-weight"}.get(exc.parameter)
+        raise exc.renamed(option or one_token(exc.parameter)) from None
+    from dataclasses import replace
+
+    solved = replace(r.tablet, name=tablet.name) if hasattr(r.tablet, "name") else r.tablet
+    section = dict(solved_for=vary, value_mm=r.value, given_mm=dims.get(vary), target_weight_mg=target_weight,
+                   target_volume_mm3=target_volume, nominal_volume_mm3=r.volume_mm3, weight_mg=r.weight_mg,
+                   evaluations=r.evaluations)
+    return solved, section
+
+
+def _comparison(rows: list[tuple[str, dict[str, Any]]]) -> str:
+    """One line per design: the figures a designer compares."""
+    head = ("design", "family", "L x W x T mm", "band mm", "cup mm", "volume mm3", "area mm2", "SA/V 1/mm", "weight mg")
+    lines = [head]
+    for name, sec in rows:
+        r = sec["design_report"]
+        lines.append((name, r["family"], f"{r['length_mm']:.4g} x {r['width_mm']:.4g} x {r['overall_thickness_mm']:.4g}",
+                      f"{r['band_mm']:.4g}", f"{r['cup_depth_mm']:.4g}", f"{r['volume_mm3']:.6g}", f"{r['surface_area_mm2']:.6g}",
+                      f"{r['surface_area_mm2'] / r['volume_mm3']:.4g}", "-" if r["weight_mg"] is None else f"{r['weight_mg']:.6g}"))
+    w = [max(len(str(row[i])) for row in lines) for i in range(len(head))]
+    return "\n".join("  ".join(str(c).ljust(w[i]) if i < 2 else str(c).rjust(w[i]) for i, c in enumerate(row)).rstrip()
+                     for row in lines)
+
+
+def _write_tables(payloads: list[dict[str, Any]], csv_out: Path | None, xlsx_out: Path | None, staged: dict[str, Path]) -> None:
+    """One row per design: ``design``, ``file``, its family and dimensions (``tablet.<key>``, mm), then
+    every scalar of its report under dotted names (units in the names)."""
+    from tabletcad.report import flatten_report
+
+    rows = [{"design": p["design"]["name"], "file": p["design"]["file"], "tablet.family": p["design"]["family"],
+             **{f"tablet.{k}": v for k, v in p["design"]["params"].items() if isinstance(v, (int, float, str, bool))},
+             **{k: v for k, v in flatten_report(p).items() if not k.startswith(("design.", "units."))}}
+            for p in payloads]
+    columns: list[str] = []
+    for row in rows:
+        columns += [k for k in row if k not in columns]
+    if csv_out is not None:
+        import csv
+
+        with open(staged["csv"], "w", newline="", encoding="utf-8") as fh:
+            w = csv.DictWriter(fh, fieldnames=columns, restval="")
+            w.writeheader()
+            w.writerows({k: ("" if v is None else repr(v) if isinstance(v, float) else v) for k, v in row.items()}
+                        for row in rows)
+    if xlsx_out is not None:
+        from openpyxl import Workbook
+
+        wb = Workbook()
+        ws = wb.active
+        ws.title = "report"
+        ws.append(columns)
+        for row in rows:
+            ws.append([row.get(k) for k in columns])
+        ws.freeze_panes = "C2"
+        wb.save(staged["xlsx"])
+
+
 @click.command("report")
-@click.argument("design", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("designs", metavar="DESIGN.toml...", nargs=-1, required=True, type=click.Path(path_type=Path))
 @click.option("--solid-fraction", type=float, default=None, help="Solid fraction (1 - porosity), 0-1.")
 @click.option("--true-density", "true_density", type=float, default=None, help="True density, mg/mm3 (= g/cm3).")
 @click.option("--breaking-force", type=float, default=None, help="Breaking force, N (tensile strength).")
 @click.option("--compaction-force", type=float, default=None, help="Compaction force, kN (punch-tip check).")
 @click.option("--max-punch-force", type=float, default=None, help="Punch-tip force limit, kN (user-given).")
 @click.option("--max-punch-pressure", type=float, default=None, help="Punch-tip pressure limit, MPa (user-given).")
-@click.option("--json", "json_out", type=click.Path(dir_okay=False, path_type=Path), default=None, help="Also write the report as JSON here.")
-def report_cmd(design: Path, solid_fraction, true_density, breaking_force, compaction_force, max_punch_force,
-               max_punch_pressure, json_out: Path | None) -> None:
-    """Design report of DESIGN.toml (industry families): volumes, cup, weight, checks."""
+@click.option("--solve-for", "solve_for", type=click.Choice(_SOLVABLE), default=None,
+              help="Solve for this dimension (mm) to reach --target-weight or --target-volume; the others stay.")
+@click.option("--target-weight", type=float, default=None, help="Target weight, mg (needs solid fraction and true density).")
+@click.option("--target-volume", type=float, default=None, help="Target volume, mm3.")
+@click.option("--json", "as_json", is_flag=True, help="Print the report as JSON on stdout (a list for several designs).")
+@click.option("--json-file", type=click.Path(path_type=Path), default=None, help="Write the report as JSON to this file.")
+@click.option("--csv", "csv_out", type=click.Path(path_type=Path), default=None, help="Write one row per design (every scalar of the report) as CSV.")
+@click.option("--xlsx", "xlsx_out", type=click.Path(path_type=Path), default=None, help="The same table as an Excel workbook (needs openpyxl).")
+def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking_force, compaction_force, max_punch_force,
+               max_punch_pressure, solve_for, target_weight, target_volume, as_json: bool, json_file: Path | None,
+               csv_out: Path | None, xlsx_out: Path | None) -> None:
+    """Design report of one or more DESIGN.toml (industry families): volumes, cup, weight, checks.
+
+    One design prints its report; several print one line each.  --solve-for finds the band,
+    thickness or cup depth that gives --target-weight or --target-volume, then reports that design.
+    """
+    from tabletcad.cli.outputs import check_output, staged
     from tabletcad.families.designreport import ReportOptions, design_report
     from tabletcad.families.sweep import SweepNominal
     from tabletcad.report import to_json
 
-    if json_out is not None and json_out.suffix.lower() != ".json":
-        raise DesignError("--json", str(json_out), "must end in .json")
-    tablet, table = load_family_design(design)
-    if not isinstance(tablet.nominal, SweepNominal):
-        from tabletcad.families import FAMILY_FUNCTIONS
+    for d in designs:
+        if d.suffix.lower() == ".json":
+            raise DesignError("DESIGN", str(d), "is a design .toml; write JSON with --json-file (--json prints to stdout)")
+        if not d.is_file():
+            raise DesignError("DESIGN", str(d), "is a folder, not a file" if d.is_dir() else "does not exist")
+    check_output("--json-file", json_file, (".json",))
+    check_output("--csv", csv_out, (".csv",))
+    check_output("--xlsx", xlsx_out, (".xlsx",))
+    if xlsx_out is not None:
+        try:
+            import openpyxl  # noqa: F401
+        except ImportError:
+            raise DesignError("--xlsx", str(xlsx_out), "needs openpyxl: pip install 'tabletcad[tables]'") from None
+    if solve_for is None and (target_weight is not None or target_volume is not None):
+        raise DesignError("--solve-for", "missing", f"a target needs the dimension to solve for: {', '.join(_SOLVABLE)}")
+    if solve_for is not None and (target_weight is None) == (target_volume is None):
+        raise DesignError("--target-weight/--target-volume", "both" if target_weight is not None else "none",
+                          "give exactly one target for --solve-for")
 
-        raise DesignError("tablet.family", tablet.family,
-                          "the design report needs an industry family: " + ", ".join(f.__name__ for f in FAMILY_FUNCTIONS) + ", custom_outline")
-    try:
-        opts = ReportOptions.from_table(table).merged(
-            solid_fraction=solid_fraction, true_density_mg_mm3=true_density, breaking_force_N=breaking_force,
-            compaction_force_kN=compaction_force, max_punch_force_kN=max_punch_force, max_punch_pressure_MPa=max_punch_pressure)
-    except DesignError as exc:  # "[report] solid_fraction" -> "[report].solid_fraction": one token
-        raise exc.renamed(one_token(exc.parameter)) from None
-    sec = design_report(tablet, opts)
-    click.echo(_table(tablet.name, sec))
-    if json_out is not None:
-        from tabletcad.io.atomic import atomic_write_text
+    payloads, shown = [], []
+    for design in designs:
+        tablet, table = load_family_design(design)
+        if not isinstance(tablet.nominal, SweepNominal):
+            from tabletcad.families import FAMILY_FUNCTIONS
 
-        payload = dict(design=dict(name=tablet.name, family=tablet.family, params=dict(tablet.params)),
-                       units=dict(length="mm", area="mm2", volume="mm3", angle="deg", force="N (kN where named)", stress="MPa", mass="mg"),
-                       **sec)
+            raise DesignError("tablet.family", tablet.family,
+                              "the design report needs an industry family: " + ", ".join(f.__name__ for f in FAMILY_FUNCTIONS) + ", custom_outline")
+        try:
+            opts = ReportOptions.from_table(table).merged(
+                solid_fraction=solid_fraction, true_density_mg_mm3=true_density, breaking_force_N=breaking_force,
+                compaction_force_kN=compaction_force, max_punch_force_kN=max_punch_force, max_punch_pressure_MPa=max_punch_pressure)
+        except DesignError as exc:  # "[report] solid_fraction" -> "[report].solid_fraction": one token
+            raise exc.renamed(one_token(exc.parameter)) from None
+        inverse = None
+        if solve_for is not None:
+            tablet, inverse = _solved(tablet, opts, solve_for, target_weight, target_volume)
+        sec = design_report(tablet, opts)
+        payload = dict(design=dict(name=tablet.name, file=str(design), family=tablet.family, params=dict(tablet.params)),
+                       units=dict(length="mm", area="mm2", volume="mm3", angle="deg", force="N (kN where named)",
+                                  stress="MPa", mass="mg"),
+                       **({"inverse": inverse} if inverse is not None else {}), **sec)
         json.loads(to_json(payload))  # fail before writing if not serialisable
-        atomic_write_text(json_out, to_json(payload))
-        click.echo(f"-> {json_out}")
+        payloads.append(payload)
+        shown.append((tablet.name, sec))
+
+    document = payloads[0] if len(payloads) == 1 else payloads
+    with staged(json=json_file, csv=csv_out, xlsx=xlsx_out) as st:
+        if json_file is not None:
+            st["json"].write_text(to_json(document) if isinstance(document, dict)
+                                  else "[\n" + ",\n".join(to_json(p).rstrip("\n") for p in payloads) + "\n]\n",
+                                  encoding="utf-8")
+        if csv_out is not None or xlsx_out is not None:
+            _write_tables(payloads, csv_out, xlsx_out, st)
+    if as_json:
+        click.echo(to_json(document).rstrip("\n") if isinstance(document, dict)
+                   else "[\n" + ",\n".join(to_json(p).rstrip("\n") for p in payloads) + "\n]")
+        return
+    for p in payloads:
+        if "inverse" in p:
+            inv = p["inverse"]
+            target = (f"{inv['target_weight_mg']:.6g} mg" if inv["target_weight_mg"] is not None
+                      else f"{inv['target_volume_mm3']:.6g} mm3")
+            click.echo(f"{p['design']['name']}: {inv['solved_for']} = {inv['value_mm']:.6g} mm gives {target}"
+                       + (f" (was {inv['given_mm']:.6g} mm)" if inv["given_mm"] is not None else ""))
+    click.echo(_table(*shown[0]) if len(shown) == 1 else _comparison(shown))
+    for option, path in (("json", json_file), ("csv", csv_out), ("xlsx", xlsx_out)):
+        if path is not None:
+            click.echo(f"{option} -> {path}")
 
 
 COMMANDS = [report_cmd]

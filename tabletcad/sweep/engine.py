@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from tabletcad.errors import DesignError
+from tabletcad.report import flatten_report
 from tabletcad.sweep.spec import OUTPUTS
 
 __all__ = ["evaluate_design", "sweep_task", "failed_design", "map_tasks", "open_client", "flatten_report", "CONNECT_TIMEOUT_S", "error_message"]
@@ -45,29 +46,6 @@ def error_message(exc: BaseException) -> str:
     if isinstance(exc, DesignError):
         return msg
     return f"{type(exc).__name__}: {msg}" if msg else type(exc).__name__
-
-
-def flatten_report(report: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-    """Every scalar of a report (numbers, booleans, strings, None) under dotted keys; lists are left out.
-
-    ``{"volume_mm3": 1.0, "design_report": {"weight_mg": 2.0}}`` becomes
-    ``{"volume_mm3": 1.0, "design_report.weight_mg": 2.0}``.  NumPy scalars become
-    Python ones; the order is the report's own.
-    """
-    import numpy as np
-
-    out: dict[str, Any] = {}
-    for k, v in report.items():
-        name = f"{prefix}{k}"
-        if isinstance(v, dict):
-            out.update(flatten_report(v, name + "."))
-        elif isinstance(v, (list, tuple, np.ndarray)):
-            continue
-        elif isinstance(v, np.generic):
-            out[name] = v.item()
-        else:
-            out[name] = v
-    return out
 
 
 def _files_of(folder: Path, names: Sequence[str]) -> dict[str, bytes]:

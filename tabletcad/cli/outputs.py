@@ -1,0 +1,59 @@
+"""Output files of the commands: checked before anything is computed, written all or none."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+
+from tabletcad.errors import DesignError
+
+__all__ = ["check_output", "staged"]
+
+
+def check_output(option: str, path: Path | None, suffixes: tuple[str, ...] = (".png", ".svg", ".pdf")) -> None:
+    """Refuse, before anything is computed, an output file that could not be written."""
+    if path is None:
+        return
+    if path.suffix.lower() not in suffixes:
+        allowed = suffixes[0] if len(suffixes) == 1 else ", ".join(suffixes[:-1]) + f" or {suffixes[-1]}"
+        raise DesignError(option, str(path), f"must end in {allowed}")
+    if path.is_dir():
+        raise DesignError(option, str(path), "is a folder; give a file name")
+    folder = path.absolute().parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise DesignError(option, str(path), f"cannot be created: {folder} is a file, not a folder")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise DesignError(option, str(path), f"cannot be created: folder {folder} is not writable")
+
+
+
+@contextlib.contextmanager
+def staged(**targets: Path | None) -> Iterator[dict[str, Path]]:
+    """Temporary files standing for the outputs ``targets``; all are moved into place only if the body succeeds.
+
+    The body writes each output to ``staged[name]`` (same suffix as its
+    target).  If it raises, no target is touched; if moving one fails, the
+    targets already moved that did not exist before are removed again.
+    """
+    from tabletcad.io import atomic_write_bytes
+
+    with tempfile.TemporaryDirectory(prefix="tabletcad-") as tmp:
+        staged = {k: Path(tmp) / f"{k}{p.suffix}" for k, p in targets.items() if p is not None}
+        yield staged
+        created: list[Path] = []
+        try:
+            for k, src in staged.items():
+                dst = targets[k]
+                existed = dst.exists()
+                atomic_write_bytes(dst, src.read_bytes())
+                if not existed:
+                    created.append(dst)
+        except BaseException:
+            for dst in created:
+                dst.unlink(missing_ok=True)
+            raise
