@@ -7,9 +7,7 @@ The publishing rules, tested on plain files (no CAD).  Real ``tabletcad build`` 
 from __future__ import annotations
 
 import json
-import math
 import os
-import signal
 import subprocess
 import sys
 import time
@@ -17,7 +15,6 @@ from pathlib import Path
 
 import pytest
 
-from tabletcad.cli import main
 from tabletcad.io.outputs import MANIFEST, STAGING_MARKER, file_sha256, publish, read_manifest, staging_folder
 
 ROOT = Path(__file__).resolve().parents[1]

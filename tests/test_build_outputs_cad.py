@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from tabletcad.cli import main
-from tabletcad.io.outputs import MANIFEST, STAGING_MARKER
+from tabletcad.io.outputs import MANIFEST, STAGING_MARKER, read_manifest
 
 pytestmark = pytest.mark.cad
 

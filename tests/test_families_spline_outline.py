@@ -11,12 +11,9 @@ that radius, with the peak curvature found exactly (refined, not sampled).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 
-from tabletcad.families import outline_tablet
 from tabletcad.families.outline import SplineOutline
 from tabletcad.tolerance import DEFAULT
 
