@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 from pathlib import Path
 
@@ -58,10 +59,17 @@ def build_cmd(design: Path, out_dir: Path, quiet: bool) -> None:
 
 @click.command("mesh")
 @click.argument("design", type=click.Path(dir_okay=False, path_type=Path))
-@click.option("--nodes", nargs=3, type=int, required=True, metavar="SX SY SZ", help="Nodes along u, v and w per patch.")
+@click.option("--nodes", nargs=3, type=int, required=True, metavar="NU NV NW",
+              help="Nodes per patch along u (across the patch), v (around) and w (centre to surface); "
+                   "thesis Table 4.4's sx, sy, sz.")
 @click.option("--out", "out_file", required=True, type=click.Path(dir_okay=False, path_type=Path), help="Mesh file (.vtu, .xdmf, .msh, .vtk).")
 def mesh_cmd(design: Path, nodes: tuple[int, int, int], out_file: Path) -> None:
-    """Hexahedral solid mesh of DESIGN.toml (thesis section 4.3)."""
+    """Hexahedral solid mesh of DESIGN.toml (thesis section 4.3).
+
+    Prints the mesh volume beside the solid's exact volume, and warns on stderr when they
+    differ by more than Tolerances.mesh_volume (1 %): straight-edged cells cut the curved
+    faces, so a coarse mesh holds less volume than the tablet.
+    """
     from tabletcad.design import load_design
     from tabletcad.solid import hex_mesh, mesh_volume, write_mesh
 
@@ -76,7 +84,17 @@ def mesh_cmd(design: Path, nodes: tuple[int, int, int], out_file: Path) -> None:
     mesh = hex_mesh(tablet, nodes=nodes)
     write_mesh(mesh, out_file)
     counts = ", ".join(f"{len(c)} {k}" for k, c in mesh.cells.items() if len(c))
-    click.echo(f"{out_file}: {len(mesh.points)} nodes, {counts}; mesh volume {mesh_volume(mesh):.6g} mm3")
+    v_mesh, v_exact = mesh_volume(mesh), tablet.solid_volume()
+    rel = v_mesh / v_exact - 1.0
+    click.echo(f"{out_file}: {len(mesh.points)} nodes, {counts}; mesh volume {v_mesh:.6g} mm3 "
+               f"({rel * 100:+.3g} % of the exact {v_exact:.6g} mm3)")
+    if abs(rel) > tablet.tol.mesh_volume:
+        # the error falls as the square of the cell size in u and v (the solid map is linear in w):
+        # scale those node spacings to land at half the bound
+        s = math.sqrt(abs(rel) / (0.5 * tablet.tol.mesh_volume))
+        hint = f"{math.ceil((nodes[0] - 1) * s) + 1} {math.ceil((nodes[1] - 1) * s) + 1} {nodes[2]}"
+        click.echo(f"warning: the mesh volume is {abs(rel) * 100:.3g} % {'below' if rel < 0 else 'above'} the exact "
+                   f"volume (more than {tablet.tol.mesh_volume * 100:g} %): use more nodes, e.g. --nodes {hint}", err=True)
 
 
 def available_memory() -> int | None:
@@ -103,7 +121,7 @@ def _check_mesh_memory(nodes: tuple[int, int, int], n_patches: int, tol: Toleran
         most = int(tol.memory_fraction * avail / (tol.mesh_bytes_per_node * n_patches))
         raise DesignError("--nodes", " ".join(map(str, nodes)),
                           f"needs about {need / 2**30:.3g} GiB for {count:.3g} nodes ({n_patches} patches), more than "
-                          f"{tol.memory_fraction:g} of the {avail / 2**30:.3g} GiB available: keep SX*SY*SZ below {most:.3g}")
+                          f"{tol.memory_fraction:g} of the {avail / 2**30:.3g} GiB available: keep NU*NV*NW below {most:.3g}")
 
 
 COMMANDS = [shapes_cmd, build_cmd, mesh_cmd]
