@@ -85,7 +85,7 @@ def _table(name: str, sec: dict[str, Any]) -> str:
     rows.append(("nominal deviation (certified)", f"{sec['nominal_max_deviation_um']:.3g} um <= {sec['nominal_tolerance_um']:g} um: {_fmt(sec['nominal_certified'])}"))
     for s in sec["seams"]:
         kind = "sharp (nominal edge)" if s["expected_sharp"] else "G1"
-        rows.append((f"seam {s['patches'][0]}-{s['patches'][1]}", f"{s['max_angle_deg']:.4g} deg, gap {s['max_gap_mm']:.2g} mm, expected {kind}: {_fmt(s['as_expected'])}"))
+        rows.append((f"seam {s['patches'][0]}-{s['patches'][1]}", f"{s['max_angle_deg']:.3f} deg, gap {s['max_gap_mm'] * 1e3:.3f} um, expected {kind}: {_fmt(s['as_expected'])}"))
     w = max(len(k) for k, _ in rows)
     return "\n".join(f"{k:<{w}}  {v}" for k, v in rows)
 
