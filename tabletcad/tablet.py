@@ -42,6 +42,26 @@ def _composite_gauss(breaks: np.ndarray, n_total: int) -> tuple[np.ndarray, np.n
     return np.mod(nodes.ravel(), TWO_PI), weights.ravel()
 
 
+def _split_gauss(t0: float, t1: float, breaks: np.ndarray, n_total: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights over ``[t0, t1]`` split at the (periodic) ``breaks`` inside it.
+
+    A trimmed ``v`` range of a lines-and-arcs outline crosses the outline's joins, where the
+    integrand is only C0 or C1: one rule over the whole range converges algebraically (a
+    0.03 % volume error on a 3 rad cut-away of the almond at 256 nodes), one per smooth piece
+    spectrally.
+    """
+    b = np.mod(np.asarray(breaks, float), TWO_PI)
+    k0, k1 = math.floor((t0 - TWO_PI) / TWO_PI), math.ceil(t1 / TWO_PI) + 1
+    inner = np.unique(np.concatenate([b + TWO_PI * k for k in range(k0, k1)]))
+    span = t1 - t0
+    inner = inner[(inner > t0 + 1e-12 * span) & (inner < t1 - 1e-12 * span)]
+    edges = np.concatenate([[t0], inner, [t1]])
+    k = max(12, int(math.ceil(n_total / (len(edges) - 1))))
+    x, w = np.polynomial.legendre.leggauss(k)
+    lo, hi = edges[:-1, None], edges[1:, None]
+    return (0.5 * (hi - lo) * (x + 1.0) + lo).ravel(), (0.5 * (hi - lo) * w).ravel()
+
+
 @dataclass(frozen=True)
 class Trim:
     """Parameter ranges kept of every patch solid.
@@ -254,6 +274,8 @@ class Tablet:
         elif face.periodic_t:
             t = t0 + np.arange(nv) * (TWO_PI / nv)
             tw = np.full(nv, TWO_PI / nv)
+        elif bps.size:  # a trimmed v range: Gauss-Legendre per smooth piece between the outline's joins
+            t, tw = _split_gauss(t0, t1, bps, nv if face.kind == "w" else max(nv // 4, 32))
         else:
             xt, wt = np.polynomial.legendre.leggauss(nv if face.kind == "w" else max(nv // 4, 32))
             t = 0.5 * (t1 - t0) * (xt + 1.0) + t0
@@ -389,6 +411,8 @@ class Tablet:
             bps = p.breakpoints()
             if t.full_v and bps.size:
                 v, vw = _composite_gauss(bps, nv)
+            elif bps.size:
+                v, vw = _split_gauss(t.v[0], t.v[1], bps, nv)
             X = p.evaluate_grid(u, v)
             Xu = p.evaluate_grid(u, v, du=1)
             Xv = p.evaluate_grid(u, v, dv=1)

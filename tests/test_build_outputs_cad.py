@@ -89,17 +89,46 @@ def rep3_full_volume() -> float:
     return replace(load_design(ROOT / "samples" / "cutaway_convex_round.toml"), trim=Trim()).volume()
 
 
-def test_cutaway_with_curved_cut_faces_is_not_cut(tmp_path):
-    """A swept almond's sections at constant v are not planes through the axis: no solid, a reason.
-    A round's section at v lies in the half-plane at angle v; the thesis oval's (ellipses of one
+@pytest.mark.parametrize("design, trim", [
+    ("almond", (0.0, 3.0)), ("rounded_triangle", (0.5, 4.0)), ("capsule", (0.3, 2.0)),
+], ids=["almond", "rounded_triangle", "capsule"])
+def test_cutaway_with_curved_cut_faces_is_a_solid(tmp_path, capsys, design, trim):
+    """A swept outline's sections at constant v are ruled surfaces, not planes: the cut-away is
+    fitted and sewn directly.  Its STEP, read back in a fresh process, holds one valid solid
+    whose volume is the core's quadrature over the trimmed domain (Gauss-Legendre per smooth
+    piece between the outline's joins), which itself agrees with the independent Jacobian
+    integral at 8x the nodes."""
+    from dataclasses import replace
+
+    from tabletcad.cad.readback import ocp_read_steps
+    from tabletcad.cad.stage import _cut_plane_angle
+    from tabletcad.design import load_design
+    from tabletcad.tablet import Trim
+
+    t = replace(load_design(ROOT / "samples" / "families" / f"{design}.toml"), trim=Trim(v=trim))
+    assert _cut_plane_angle(t, trim[0]) is None  # not a half-plane: the direct construction
+    assert t.volume() == pytest.approx(t.solid_volume(nv=2048), rel=1e-10)
+    src = tmp_path / "cut.toml"
+    src.write_text((ROOT / "samples" / "families" / f"{design}.toml").read_text() + f"\n[trim]\nv = [{trim[0]}, {trim[1]}]\n")
+    rep, _ = _build(src, tmp_path / "out", capsys)
+    assert rep["brep"]["valid"] and "ruled cut faces" in rep["brep"]["cutaway"]
+    assert rep["volume_mm3"] == pytest.approx(t.volume(), rel=1e-12)
+    assert abs(rep["brep"]["volume_rel_diff_vs_quadrature"]) < 1e-7
+    if design == "almond":  # OCC's tessellation of this cut-away leaves cracks: STEP only, said in the report
+        assert "not a closed mesh" in rep["mesh"]["skipped"] and "tablet.stl" not in rep["outputs"]
+    else:
+        assert rep["mesh"]["watertight"] and rep["mesh"]["genus"] == 0 and "tablet.stl" in rep["outputs"]
+    (cut,) = ocp_read_steps([tmp_path / "out" / "tablet.step"])
+    assert cut["valid"] and cut["n_solids"] == 1
+    assert cut["volume"] == pytest.approx(rep["volume_mm3"], rel=1e-6)
+
+
+def test_cut_planes_of_rounds_and_ovals_are_half_planes():
+    """A round's section at v lies in the half-plane at angle v; the thesis oval's (ellipses of one
     aspect ratio) in a half-plane too, at the ellipse's polar angle atan(b/a tan v)."""
-    from tabletcad.cad.stage import _cut_plane_angle, cutaway_solid
+    from tabletcad.cad.stage import _cut_plane_angle
     from tabletcad.design import design_from_dict
 
-    t = design_from_dict({"tablet": {"family": "almond", "length": 15.0, "width": 7.5, "end_radius": 1.5, "band": 3.0,
-                                       "cup_depth": 0.6}, "trim": {"v": [0.0, 3.0]}})
-    reason = cutaway_solid(t, {"volume_mm3": t.volume()})
-    assert isinstance(reason, str) and "planes" in reason
     r = design_from_dict({"tablet": {"family": "shallow_convex_round", "diameter": 10.0, "thickness": 3.0, "band": 2.0},
                           "trim": {"v": [0.0, 3.0]}})
     assert _cut_plane_angle(r, 0.0) == pytest.approx(0.0, abs=1e-12)

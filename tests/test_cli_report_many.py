@@ -101,16 +101,20 @@ def test_solved_weight_matches_the_python_api(capsys):
     (["--csv", "OUT/r.txt"], "--csv"),
     ([str(FAM / "missing.toml"), "--csv", "OUT/r.csv"], "DESIGN"),
     ([str(ROOT / "samples" / "spherical.toml"), "--csv", "OUT/r.csv"], "tablet.family"),
+    (["--solve-for", "thickness", "--target-volume", "300"], "--solve-for"),  # concave_round takes no thickness
+    ([str(FAM / "custom_outline.toml"), "--solve-for", "band", "--target-volume", "300"], "tablet.family"),
+    (["--solve-for", "band", "--target-weight", "300", "--solid-fraction", "1.5"], "[report].solid_fraction"),
 ])
 def test_bad_use_is_one_line_and_writes_nothing(tmp_path, capsys, extra, parameter):
     out = tmp_path / "OUT"
     out.mkdir()
-    argv = ["report", str(FAM / "concave_round.toml"), *[a.replace("OUT", str(out)) for a in extra]]
+    first = [] if extra[0].endswith(".toml") else [str(FAM / "concave_round.toml")]
+    argv = ["report", *first, *[a.replace("OUT", str(out)) for a in extra]]
     assert main(argv) == 2
     cap = capsys.readouterr()
     assert cap.out == "" and cap.err.splitlines() == [cap.err.strip()]
     assert cap.err.startswith(f"error: {parameter} = ")
-    assert " or ." not in cap.err.split("is not allowed")[1] or "," in cap.err  # "must end in .csv", not "in or .csv"
+    assert "must end in or" not in cap.err  # "must end in .csv", not "must end in or .csv"
     assert list(out.iterdir()) == []
 
 
@@ -120,3 +124,12 @@ def test_xlsx_without_openpyxl_names_the_extra(tmp_path, capsys, monkeypatch):
     err = capsys.readouterr().err
     assert err.startswith("error: --xlsx = ") and "pip install 'tabletcad[tables]'" in err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_solve_for_refuses_a_design_whose_smoothing_or_reshape_it_would_drop(tmp_path, capsys):
+    d = tmp_path / "a.toml"
+    d.write_text((FAM / "concave_round.toml").read_text().replace("[tablet]\n", "[tablet]\na = 0.05\n", 1))
+    assert main(["report", str(d), "--solve-for", "band", "--target-volume", "280"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: --solve-for = 'band' is not allowed: the design sets a,") or \
+        err.startswith("error: --solve-for = band is not allowed: the design sets a,"), err

@@ -61,6 +61,41 @@ def tablet_surface_functions(tablet: Tablet) -> tuple[list[SurfaceFunction], lis
     return funcs, [f"{base} outer wall", f"{base} end u=1", f"{base} inner wall", f"{base} end u=0"]
 
 
+def cutaway_surface_functions(tablet: Tablet) -> tuple[list[SurfaceFunction], np.ndarray]:
+    """Surface functions ``f(s, θ)`` of a cut-away (``[trim] v = [v0, v1]``, ``w = [0, 1]``) and their
+    breakpoints in ``θ``: one closed chain, as the whole tablet's.
+
+    For each ``u`` the boundary of the solid map's ``(v, w)`` rectangle is walked once round
+    ``θ ∈ [0, 2π)``: the outer surface ``w = 1`` from ``v0`` to ``v1``, the cut face ``v = v1``
+    from ``w = 1`` in to the spine, then the cut face ``v = v0`` back out (the leg ``w = 0`` is the
+    spine itself, a point for each ``u``).  Each cut face is the ruled surface
+    ``A0(u) + w (X(u, v) - A0(u))`` of eq 4.12, whatever its shape; the corners and the
+    outline's joins inside ``[v0, v1]`` are the breakpoints (C0 knots).  The legs share
+    ``θ`` in proportion to their lengths for a round tablet (``v1 - v0`` : 1 : 1).
+    """
+    v0, v1 = tablet.trim.v
+    span = v1 - v0
+    ta = 2.0 * np.pi * span / (span + 2.0)
+    tb = ta + 0.5 * (2.0 * np.pi - ta)
+
+    def make(p):
+        def f(s, th):
+            s, th = np.broadcast_arrays(np.asarray(s, float), np.mod(np.asarray(th, float), 2.0 * np.pi))
+            v = np.where(th < ta, v0 + span * th / ta, np.where(th < tb, v1, v0))
+            w = np.where(th < ta, 1.0, np.where(th < tb, 1.0 - (th - ta) / (tb - ta), (th - tb) / (2.0 * np.pi - tb)))
+            return solid_map(p, s, v, w)
+        return f
+
+    from tabletcad.bspline import chain_breakpoints
+
+    breaks = [0.0, ta, tb]
+    for b in chain_breakpoints(tablet.patches):
+        vb = v0 + np.mod(b - v0, 2.0 * np.pi)
+        if v0 < vb < v1:
+            breaks.append((vb - v0) / span * ta)
+    return [make(p) for p in tablet.patches], np.array(sorted(breaks))
+
+
 def tablet_breakpoints(tablet: Tablet) -> np.ndarray:
     """Union of the ``v`` breakpoints of the tablet's patches (sorted, in [0, 2π)).
 

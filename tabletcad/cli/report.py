@@ -99,14 +99,17 @@ def _solved(tablet, opts, vary: str, target_weight: float | None, target_volume:
 
     from tabletcad.families.inverse import _family_function, solve_for
 
-    takes = inspect.signature(_family_function(tablet.family)).parameters
-    dims = {k: v for k, v in tablet.params.items() if k in takes}
     try:
+        takes = inspect.signature(_family_function(tablet.family)).parameters
+        dims = {k: v for k, v in tablet.params.items() if k in takes}
         r = solve_for(tablet.family, target_weight_mg=target_weight, target_volume_mm3=target_volume, vary=vary,
                       solid_fraction=opts.solid_fraction if target_weight is not None else None,
                       true_density_mg_mm3=opts.true_density_mg_mm3 if target_weight is not None else None, **dims)
-    except DesignError as exc:
-        option = {"target_volume_mm3": "--target-volume", "target_weight_mg": "--target-weight"}.get(exc.parameter)
+    except DesignError as exc:  # the Python API's argument names as the command's options
+        option = {"target_volume_mm3": "--target-volume", "target_weight_mg": "--target-weight", "vary": "--solve-for",
+                  vary: "--solve-for", "family": "tablet.family", "solid_fraction": "--solid-fraction",
+                  "true_density_mg_mm3": "--true-density",
+                  "solid_fraction, true_density_mg_mm3": "--solid-fraction/--true-density"}.get(exc.parameter)
         raise exc.renamed(option or one_token(exc.parameter)) from None
     from dataclasses import replace
 
@@ -228,6 +231,13 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
             raise exc.renamed(one_token(exc.parameter)) from None
         inverse = None
         if solve_for is not None:
+            from tabletcad.design import read_design_file
+
+            data = read_design_file(design)
+            carried = [k for k in ("a",) if k in data.get("tablet", {})] + (["[reshape]"] if "reshape" in data else [])
+            if carried:
+                raise DesignError("--solve-for", solve_for, f"the design sets {', '.join(carried)}, which the inverse "
+                                  "calculation does not carry (it rebuilds the family from its dimensions)")
             tablet, inverse = _solved(tablet, opts, solve_for, target_weight, target_volume)
         sec = design_report(tablet, opts)
         payload = dict(design=dict(name=tablet.name, file=str(design), family=tablet.family, params=dict(tablet.params)),

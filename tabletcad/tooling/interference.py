@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 import itertools
+import math
 import time
 
 import numpy as np
@@ -284,7 +285,8 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
     dc, nc = dist[:n_t][T], near[:n_t][T]
     sel = nc.min(axis=1) != nc.max(axis=1)
     n_refined = 0
-    # a gap peak between two tools has slope 1 on either side: points this far apart miss it by half
+    # the distance to the tools has slope <= 1: within triangles of edges <= h every point lies within
+    # h / sqrt(3) of a corner, so a peak inside a refined triangle is missed by at most that much
     refined_spacing = max(0.125 * clearance, 1e-3)
     if np.any(sel):
         Vs, _ = refine_triangles(V[:n_t], T[sel], refined_spacing)
@@ -317,7 +319,7 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
                        f"triangles between tools) vs part meshes at {tool_deflection:.3g} mm (largest {float(np.max(dist)):.6g} mm), "
                        f"worst {len(order)} moved onto the tablet's B-rep and re-measured with BRepExtrema_DistShapeShape",
         max_gap_mesh_mm=float(np.max(dist)),
-        max_gap_resolution_mm=0.5 * refined_spacing,
+        max_gap_resolution_mm=refined_spacing / math.sqrt(3.0) if n_refined else None,
         clearance_mm=clearance,
         gap_within_clearance=bool((float(exact[i_max]) if exact else float(np.max(dist))) <= clearance * (1 + 1e-6) + 1e-7),
         pairs=pairs,
