@@ -85,6 +85,9 @@ def mesh_cmd(design: Path, nodes: tuple[int, int, int], out_file: Path) -> None:
     write_mesh(mesh, out_file)
     counts = ", ".join(f"{len(c)} {k}" for k, c in mesh.cells.items() if len(c))
     v_mesh, v_exact = mesh_volume(mesh), tablet.solid_volume()
+    if not (math.isfinite(v_exact) and v_exact > 0.0):  # pragma: no cover - valid designs have a volume
+        click.echo(f"{out_file}: {len(mesh.points)} nodes, {counts}; mesh volume {v_mesh:.6g} mm3")
+        return
     rel = v_mesh / v_exact - 1.0
     click.echo(f"{out_file}: {len(mesh.points)} nodes, {counts}; mesh volume {v_mesh:.6g} mm3 "
                f"({rel * 100:+.3g} % of the exact {v_exact:.6g} mm3)")
