@@ -16,6 +16,7 @@ same thing for a circle.
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Protocol, runtime_checkable
@@ -417,6 +418,30 @@ class Transformed(Curve):
         return bool(self.base.is_point) or not np.any(self.matrix[:, :2])
 
 
+_MEMO: dict[int, tuple[weakref.ref, dict]] = {}
+
+
+def _memo(curve: CurveLike) -> dict | None:
+    """Results cached for one of tabletcad's own curves (immutable), or None for other objects.
+
+    A patch chain shares curves between neighbouring patches and checks each
+    datum more than once; the cache lives as long as the curve.
+    """
+    if not isinstance(curve, Curve):
+        return None
+    key = id(curve)
+    hit = _MEMO.get(key)
+    if hit is not None and hit[0]() is curve:
+        return hit[1]
+    try:
+        ref = weakref.ref(curve, lambda r, key=key: _MEMO.pop(key, None) if _MEMO.get(key, (None,))[0] is r else None)
+    except TypeError:
+        return None
+    table: dict = {}
+    _MEMO[key] = (ref, table)
+    return table
+
+
 def fourier_coefficients(curve: CurveLike, modes: int, samples: int | None = None):
     """Real Fourier coefficients of a curve by FFT.
 
@@ -437,6 +462,16 @@ def fourier_coefficients(curve: CurveLike, modes: int, samples: int | None = Non
         Cosine and sine coefficients (mm).
     """
     m = samples or max(DEFAULT.samples, 8 * modes + 8)
+    memo = _memo(curve)
+    if memo is not None:
+        key = ("fourier", modes, m)
+        if key not in memo:
+            memo[key] = _fourier(curve, modes, m)
+        return tuple(x.copy() for x in memo[key])
+    return _fourier(curve, modes, m)
+
+
+def _fourier(curve: CurveLike, modes: int, m: int):
     pts = curve.evaluate(sample_v(m))
     f = np.fft.rfft(pts, axis=0) / m
     a0 = f[0].real
@@ -467,20 +502,48 @@ def modes_needed(curve: CurveLike, tol: float | None = None, max_modes: int = 25
     """
     tol = DEFAULT.fourier if tol is None else tol
     m = samples or 4096
+    memo = _memo(curve)
+    if memo is None:
+        return _modes_needed(curve, tol, max_modes, m)
+    key = ("modes_needed", float(tol), int(max_modes), m)
+    if key not in memo:
+        memo[key] = _modes_needed(curve, tol, max_modes, m)
+    return memo[key]
+
+
+def _truncation_errors(pts, approx, a, b, cos, sin, k0: int, k1: int) -> np.ndarray:
+    """Largest distance of ``pts`` from ``approx`` plus modes ``k0+1 .. N``, for each ``N`` in ``k0+1 .. k1``."""
+    terms = cos[:, k0:k1, None] * a[None, k0:k1] + sin[:, k0:k1, None] * b[None, k0:k1]  # (m, block, 3)
+    run = np.broadcast_to(approx, pts.shape)[:, None, :] + np.cumsum(terms, axis=1)
+    return np.max(np.linalg.norm(pts[:, None, :] - run, axis=2), axis=0)
+
+
+def _modes_needed(curve: CurveLike, tol: float, max_modes: int, m: int) -> int:
     pts = curve.evaluate(sample_v(m))
     a0, a, b = fourier_coefficients(curve, max_modes, samples=max(4 * max_modes + 8, 1024))
     cos, sin = _trig_table(m, max_modes)
-    # error of truncation at every N, sixteen N at a time (running sums of the modes)
-    approx = np.broadcast_to(a0, pts.shape).copy()
-    if np.max(np.linalg.norm(pts - approx, axis=1)) <= tol:
+    if np.max(np.linalg.norm(pts - a0, axis=1)) <= tol:
         return 0
-    for k0 in range(0, max_modes, 16):
-        k1 = min(k0 + 16, max_modes)
-        terms = cos[:, k0:k1, None] * a[None, k0:k1] + sin[:, k0:k1, None] * b[None, k0:k1]  # (m, block, 3)
-        run = approx[:, None, :] + np.cumsum(terms, axis=1)
-        err = np.max(np.linalg.norm(pts[:, None, :] - run, axis=2), axis=0)
-        ok = np.flatnonzero(err <= tol)
+    # The error at a subset of the samples is a lower bound of the error at all of them:
+    # every N failing on the subset fails, so the full scan starts at the subset's first pass.
+    step = max(1, m // 256)
+    sub, sc, ss = pts[::step], cos[::step], sin[::step]
+    approx, start = np.broadcast_to(a0, sub.shape), None
+    for k0 in range(0, max_modes, 32):
+        k1 = min(k0 + 32, max_modes)
+        ok = np.flatnonzero(_truncation_errors(sub, approx, a, b, sc, ss, k0, k1) <= tol)
         if ok.size:
-            return k0 + int(ok[0]) + 1
-        approx = run[:, -1, :]
+            start = k0 + int(ok[0])  # modes 1..start fail; the full scan resumes after mode `start`
+            break
+        approx = approx + sc[:, k0:k1] @ a[k0:k1] + ss[:, k0:k1] @ b[k0:k1]
+    if start is None:
+        return max_modes + 1
+    approx = a0 + cos[:, :start] @ a[:start] + sin[:, :start] @ b[:start]
+    for k0 in range(start, max_modes, 16):
+        k1 = min(k0 + 16, max_modes)
+        err = _truncation_errors(pts, approx, a, b, cos, sin, k0, k1)
+        hit = np.flatnonzero(err <= tol)
+        if hit.size:
+            return k0 + int(hit[0]) + 1
+        approx = approx + cos[:, k0:k1] @ a[k0:k1] + sin[:, k0:k1] @ b[k0:k1]
     return max_modes + 1

@@ -150,6 +150,8 @@ class PDEPatch:
             self._check_fold()
 
     def _setup(self) -> None:
+        object.__setattr__(self, "_v_memo", {})
+        object.__setattr__(self, "_checks", {})
         N = self.modes
         beta = self.beta
         if beta is None:
@@ -242,12 +244,53 @@ class PDEPatch:
         if dv == 0:
             out += self._a0[k]
         if N:
-            n = np.arange(1, N + 1)
-            c, s = _trig(v, n, dv)
+            c, s = self._trig_cached(v, N, dv)
             out += c @ self._ac[k, :N] + s @ self._bc[k, :N]
         return out
 
+    def _memo(self, key: tuple, make):
+        """Small per-patch cache of arrays that depend only on ``v`` (trig tables, residuals).
+
+        The same ``v`` samples are evaluated many times (the surface and its
+        derivatives, every datum's residual); keys hold the samples' bytes, so
+        equal samples hit and no result is shared between different ones.
+        """
+        memo = self.__dict__.get("_v_memo")
+        if memo is None:
+            memo = {}
+            object.__setattr__(self, "_v_memo", memo)
+        hit = memo.get(key)
+        if hit is None:
+            hit = make()
+            if isinstance(hit, np.ndarray):
+                hit.setflags(write=False)
+            else:
+                for a in hit:
+                    a.setflags(write=False)
+            if len(memo) >= 48:
+                memo.pop(next(iter(memo)))
+            memo[key] = hit
+        return hit
+
+    def _trig_cached(self, v: np.ndarray, N: int, dv: int) -> tuple[np.ndarray, np.ndarray]:
+        """``_trig(v, 1..N, dv)`` (read-only), cached for repeated ``v``."""
+        if v.size < 64:
+            return _trig(v, np.arange(1, N + 1), dv)
+        return self._memo(("trig", N, dv, v.tobytes()), lambda: _trig(v, np.arange(1, N + 1), dv))
+
+    def _residuals(self, v: np.ndarray, dv: int) -> np.ndarray:
+        """Every datum's part above mode ``N`` (or its v-derivative) at ``v``: (4, len(v), 3) mm, read-only."""
+
+        def make() -> np.ndarray:
+            return np.stack([self.data[k].evaluate(v, dv) - self._series(k, v, dv) for k in range(4)])
+
+        if v.size < 64:
+            return make()
+        return self._memo(("res", dv, v.tobytes()), make)
+
     def _residual(self, k: int, v: np.ndarray, dv: int, nmax: int | None = None) -> np.ndarray:
+        if nmax is None:
+            return self._residuals(np.asarray(v, dtype=float).reshape(-1), dv)[k]
         return self.data[k].evaluate(v, dv) - self._series(k, v, dv, nmax)
 
     def _cardinals(self, u: np.ndarray, du: int, lams) -> list[np.ndarray]:
@@ -289,8 +332,9 @@ class PDEPatch:
             out += A * c + B * s
         if remainder and self._has_remainder:
             L = cardinal(uf, self._beta, self.u_nodes, self.form, du)
+            r = self._residuals(vf, dv)
             for k in range(4):
-                out += L[:, k : k + 1] * self._residual(k, vf, dv)
+                out += L[:, k : k + 1] * r[k]
         return out.reshape(shape + (3,))
 
     def evaluate_grid(self, u, v, du: int = 0, dv: int = 0) -> np.ndarray:
@@ -310,14 +354,17 @@ class PDEPatch:
             L = cardinals(u, self._lams[n], self.u_nodes, self.form, du)  # (n, nu, 4)
             A = np.matmul(L, self._ac[:, n - 1].transpose(1, 0, 2))  # (n, nu, 3)
             B = np.matmul(L, self._bc[:, n - 1].transpose(1, 0, 2))
-            c, s = _trig(v, n, dv)  # (nv, n)
+            if v.size < 64:
+                c, s = _trig(v, n, dv)  # (nv, n)
+            else:
+                c, s = self._memo(("active", dv, v.tobytes()), lambda: _trig(v, n, dv))
             # one matrix product: (nu*3, n+n) @ (n+n, nv)
             AB = np.concatenate([A, B]).reshape(2 * n.size, -1)
             cs = np.concatenate([c, s], axis=1)
             out += (cs @ AB).reshape(v.size, u.size, 3).transpose(1, 0, 2)
         if self._has_remainder:
             L = cardinal(u, self._beta, self.u_nodes, self.form, du)  # (nu, 4)
-            r = np.stack([self._residual(k, v, dv) for k in range(4)])  # (4, nv, 3)
+            r = self._residuals(v, dv)  # (4, nv, 3)
             out += (L @ r.reshape(4, -1)).reshape(u.size, v.size, 3)
         return out
 
@@ -401,6 +448,12 @@ class PDEPatch:
         at most ``tol.stray / 4``; between them it grows with the mode's
         amplification.
         """
+        key = ("stray", nu, nv)
+        if key not in self.__dict__.get("_checks", {}):
+            self.__dict__.setdefault("_checks", {})[key] = self._stray(nu, nv)
+        return self._checks[key]
+
+    def _stray(self, nu: int, nv: int | None) -> float:
         # every datum's design content counts (in the Hermite form the derivative
         # curves X_u(0), X_u(1) carry design modes of their own)
         n_design = max(modes_needed(self.data[k], self.tol.stray / 4, self.modes) for k in range(4))
@@ -418,7 +471,7 @@ class PDEPatch:
             fine += np.einsum("nuc,vn->uvc", A, c) + np.einsum("nuc,vn->uvc", B, s)
         if self._has_remainder:
             L = cardinal(u, self._beta, self.u_nodes, self.form)
-            r = np.stack([self._residual(k, v, 0) for k in range(4)])
+            r = self._residuals(v, 0)
             if self.form == "hermite":
                 L = L[:, :2]
                 r = r[:2]
@@ -445,6 +498,12 @@ class PDEPatch:
         slightly at their poles: the spine, a cubic through the curves' centres,
         runs backwards for ``u`` below ~0.015 (0.8 µm for the 5 mm sphere).
         """
+        key = ("fold", nu, nv)
+        if key not in self.__dict__.get("_checks", {}):
+            self.__dict__.setdefault("_checks", {})[key] = self._fold_depth_of(nu, nv)
+        return self._checks[key]
+
+    def _fold_depth_of(self, nu: int, nv: int) -> float:
         ends = np.geomspace(1e-6, 0.05, 48)
         u = np.unique(np.concatenate([ends, np.linspace(0.0, 1.0, nu)[1:-1], 1.0 - ends]))
         v = sample_v(nv)

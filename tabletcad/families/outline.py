@@ -528,6 +528,14 @@ def _signed_area(segs: list[Seg]) -> float:
 
 def _check_polyline_simple(p: np.ndarray, parameter: str) -> None:
     """Raise DesignError if the closed polyline ``p`` (m, 2) crosses itself."""
+    # Sufficient and cheap: vertices that turn once around an inner point with strictly
+    # increasing polar angle bound a star-shaped, hence simple, polygon (every tablet
+    # outline so far); the exact pairwise test below serves the rest.
+    c = p.mean(axis=0)
+    phi = np.arctan2(p[:, 1] - c[1], p[:, 0] - c[0])
+    dphi = np.mod(np.diff(np.concatenate([phi, phi[:1]])), 2.0 * math.pi)
+    if np.all(dphi > 1e-12) and np.all(dphi < math.pi) and abs(float(np.sum(dphi)) - 2.0 * math.pi) < 1e-9:
+        return
     a = p
     b = np.roll(p, -1, axis=0)
     m = len(p)
