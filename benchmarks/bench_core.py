@@ -11,6 +11,12 @@
    method), with each result's error against a high-precision reference
    (tabletcad's rule with 4x the points in each direction) and the time ratio.
 
+3. Load + geometry report (``load_design`` then ``geometry_report``: volume, area,
+   solid-map volume, polished bounds, plan area, seams, stray and fold checks,
+   nominal deviation and the family's design report) per sample design, best of
+   three, with the peak traced heap, beside the issue's goals (20 ms for thesis
+   shapes and round families, 60 ms for shaped and elongated ones).
+
 Run: ``python benchmarks/bench_core.py`` (no assertions on time).
 """
 
@@ -154,6 +160,40 @@ def bench_integrals(names=("flat_faced_round", "spherical")):
     print()
 
 
+def bench_report(paths=None, repeat=3):
+    import tracemalloc
+
+    from tabletcad.design import load_design
+    from tabletcad.report import geometry_report
+
+    root = Path(__file__).resolve().parents[1]
+    paths = paths or [root / "samples" / n for n in ("flat_faced_round.toml", "spherical.toml", "caplet.toml")] + [
+        root / "samples" / "families" / n for n in ("flat_face_round.toml", "concave_round.toml", "capsule.toml",
+                                                     "oval.toml", "rounded_triangle.toml", "almond.toml")]
+    print("Load + geometry report per design (best of %d; peak traced heap of one run)" % repeat)
+    print(f"  {'design':22s} {'load':>8s} {'report':>8s} {'total':>8s} {'goal':>6s} {'x goal':>7s} {'peak MiB':>9s}")
+    for path in paths:
+        best = (math.inf, math.inf)
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            t = load_design(path)
+            t1 = time.perf_counter()
+            geometry_report(t)
+            t2 = time.perf_counter()
+            if t2 - t0 < sum(best):
+                best = (t1 - t0, t2 - t1)
+        tracemalloc.start()
+        geometry_report(load_design(path))
+        peak = tracemalloc.get_traced_memory()[1] / 2**20
+        tracemalloc.stop()
+        shaped = {"capsule", "modified_capsule", "oval", "almond", "rounded_rectangle", "rounded_square",
+                  "rounded_triangle", "custom_outline"}
+        goal = 0.060 if t.family in shaped else 0.020
+        total = sum(best)
+        print(f"  {path.stem:22s} {best[0]:8.3f} {best[1]:8.3f} {total:8.3f} {goal:6.3f} {total / goal:7.1f} {peak:9.1f}")
+    print()
+
+
 if __name__ == "__main__":
     import numpy
     import scipy
@@ -161,3 +201,4 @@ if __name__ == "__main__":
     print(f"numpy {numpy.__version__}, scipy {scipy.__version__}, python {sys.version.split()[0]}\n")
     bench_evaluation()
     bench_integrals()
+    bench_report([Path(a) for a in sys.argv[1:]] or None)

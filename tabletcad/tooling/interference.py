@@ -8,7 +8,7 @@
   Points on every face of the finished tablet (its mesh vertices, its PDE
   patches sampled densely, and a grid inside every B-rep face: letter walls
   and score flanks have no mesh vertices inside them) are measured against the parts' meshes (exact
-  point-to-triangle distances, found with a k-d tree of triangle centres);
+  point-to-triangle distances, libigl's AABB tree);
   the worst points are re-measured exactly on the B-reps with
   ``BRepExtrema_DistShapeShape``.  It should not exceed the radial clearance
   (the ring between the punch tip and the die wall).
@@ -28,44 +28,7 @@ from tabletcad.cad._occ import explore
 from tabletcad.tooling.booleans import mesh_arrays, manifold_op, manifold_volume, raw_boolean, to_manifold, volume
 from tabletcad.tooling.die import MIN_BORE_OFFSET_MM
 
-__all__ = ["interference", "point_triangle_distance", "mesh_distance"]
-
-
-def point_triangle_distance(P: np.ndarray, A: np.ndarray, B: np.ndarray, C: np.ndarray) -> np.ndarray:
-    """Distances from points ``P`` (n, 3) to triangles ``ABC`` (n, 3 each), row by row (Ericson's regions)."""
-    ab, ac, ap = B - A, C - A, P - A
-    d1, d2 = np.einsum("ij,ij->i", ab, ap), np.einsum("ij,ij->i", ac, ap)
-    bp = P - B
-    d3, d4 = np.einsum("ij,ij->i", ab, bp), np.einsum("ij,ij->i", ac, bp)
-    cp = P - C
-    d5, d6 = np.einsum("ij,ij->i", ab, cp), np.einsum("ij,ij->i", ac, cp)
-    va = d3 * d6 - d5 * d4
-    vb = d5 * d2 - d1 * d6
-    vc = d1 * d4 - d3 * d2
-    denom = va + vb + vc
-    with np.errstate(divide="ignore", invalid="ignore"):
-        v = np.where(denom != 0, vb / denom, 0.0)
-        w = np.where(denom != 0, vc / denom, 0.0)
-        Q = A + ab * v[:, None] + ac * w[:, None]  # interior
-        # edges
-        t_ab = np.clip(d1 / np.where(d1 - d3 != 0, d1 - d3, 1), 0, 1)
-        t_ac = np.clip(d2 / np.where(d2 - d6 != 0, d2 - d6, 1), 0, 1)
-        t_bc = np.clip((d4 - d3) / np.where((d4 - d3) + (d5 - d6) != 0, (d4 - d3) + (d5 - d6), 1), 0, 1)
-    cands = [
-        (d1 <= 0) & (d2 <= 0), A,
-        (d3 >= 0) & (d4 <= d3), B,
-        (d6 >= 0) & (d5 <= d6), C,
-        (vc <= 0) & (d1 >= 0) & (d3 <= 0), A + ab * t_ab[:, None],
-        (vb <= 0) & (d2 >= 0) & (d6 <= 0), A + ac * t_ac[:, None],
-        (va <= 0) & ((d4 - d3) >= 0) & ((d5 - d6) >= 0), B + (C - B) * t_bc[:, None],
-    ]
-    out = Q.copy()
-    done = np.zeros(len(P), dtype=bool)
-    for k in range(0, len(cands), 2):
-        m = cands[k] & ~done
-        out[m] = cands[k + 1][m]
-        done |= m
-    return np.linalg.norm(P - out, axis=1)
+__all__ = ["interference", "MeshDistance", "mesh_distance", "largest_inside"]
 
 
 def refine_triangles(V: np.ndarray, T: np.ndarray, h: float, lo=None, hi=None) -> tuple[np.ndarray, np.ndarray]:
@@ -95,46 +58,94 @@ def refine_triangles(V: np.ndarray, T: np.ndarray, h: float, lo=None, hi=None) -
     return allt.reshape(-1, 3), np.arange(len(allt) * 3).reshape(-1, 3)
 
 
-def mesh_distance(points: np.ndarray, V: np.ndarray, T: np.ndarray, k: int = 12, reach: float = np.inf,
-                  k_max: int = 3072) -> np.ndarray:
-    """Distance from points to a triangle mesh, exact to the nearest triangle; ``inf`` beyond ``reach``.
+class MeshDistance:
+    """Exact distance (mm) from points to one triangle mesh ``(V, T)``; ``inf`` beyond ``reach``.
 
-    Exact point-to-triangle distances to the ``k`` triangles whose centres are nearest; a triangle
-    not among them has its centre farther than the ``k``-th, so it is at least that distance less
-    the largest centre-to-corner radius away.  Points whose best distance is not below that bound
-    (big flat triangles beside many small curved ones) are searched again with 4 ``k``, up to
-    ``k_max``.  Refine long triangles first (:func:`refine_triangles`) to keep the radius small.
+    libigl's AABB tree of the triangles (built once; exact point-to-triangle distances
+    in C++), asked only for the points within ``reach``: a point whose nearest triangle
+    centre is farther than ``reach`` plus the largest centre-to-corner radius is farther
+    than ``reach`` from every triangle (an AABB search far from the mesh is slow).
+    Agrees with a brute-force minimum over all triangles to rounding
+    (``tests/test_tooling_gap_distance.py``).
     """
-    A, B, C = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
-    centres = (A + B + C) / 3.0
-    radii = np.max([np.linalg.norm(X - centres, axis=1) for X in (A, B, C)], axis=0) if len(T) else np.zeros(0)
-    if len(T) > 64 and radii.max() > 4.0 * np.median(radii):
-        # small curved-face triangles beside big flat ones: search each size class with its own bound
-        small = radii <= 4.0 * np.median(radii)
-        return np.minimum(mesh_distance(points, V, T[small], k, reach, k_max),
-                          mesh_distance(points, V, T[~small], k, reach, k_max))
-    radius = float(radii.max()) if len(T) else 0.0
-    tree = cKDTree(centres)
-    best = np.full(len(points), np.inf)
-    todo = np.arange(len(points))
-    kk = k
-    while len(todo):
-        kq = min(kk, len(T))
-        d, idx = tree.query(points[todo], k=kq, distance_upper_bound=reach)
-        d, idx = d.reshape(len(todo), -1), idx.reshape(len(todo), -1)
-        b = np.full(len(todo), np.inf)
-        P = points[todo]
-        for j in range(idx.shape[1]):
-            t = idx[:, j]
-            ok = t < len(T)
-            if np.any(ok):
-                b[ok] = np.minimum(b[ok], point_triangle_distance(P[ok], A[t[ok]], B[t[ok]], C[t[ok]]))
-        best[todo] = b
-        if kq >= min(k_max, len(T)):
+
+    def __init__(self, V: np.ndarray, T: np.ndarray, reach: float = np.inf) -> None:
+        import igl
+
+        self.V = np.ascontiguousarray(V, dtype=float)
+        self.T = np.ascontiguousarray(T, dtype=np.int64).reshape(-1, 3)
+        self.reach = float(reach)
+        self.tree = None
+        self.centres = None
+        self.radius = 0.0
+        if len(self.T):
+            self.tree = igl.AABB()
+            self.tree.init(self.V, self.T)
+            if math.isfinite(self.reach):
+                tri = self.V[self.T]
+                centres = tri.mean(axis=1)
+                self.radius = float(np.max(np.linalg.norm(tri - centres[:, None, :], axis=2)))
+                self.centres = cKDTree(centres)
+
+    def __call__(self, points: np.ndarray) -> np.ndarray:
+        P = np.ascontiguousarray(points, dtype=float).reshape(-1, 3)
+        out = np.full(len(P), np.inf)
+        if not len(P) or self.tree is None:
+            return out
+        near = np.arange(len(P))
+        if self.centres is not None:
+            d, _ = self.centres.query(P, k=1, distance_upper_bound=self.reach + self.radius)
+            near = np.flatnonzero(np.isfinite(d))
+        if len(near):
+            d2 = self.tree.squared_distance(self.V, self.T, np.ascontiguousarray(P[near]))[0]
+            out[near] = np.sqrt(np.maximum(d2, 0.0))
+        return out
+
+
+def mesh_distance(points: np.ndarray, V: np.ndarray, T: np.ndarray, reach: float = np.inf) -> np.ndarray:
+    """Exact distance (mm) from every point to the triangle mesh ``(V, T)`` (see :class:`MeshDistance`)."""
+    return MeshDistance(V, T, reach)(points)
+
+
+def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best: float):
+    """Points where the 1-Lipschitz function ``f`` may exceed ``best`` inside triangles, by branch and bound.
+
+    ``tris`` (n, 3, 3) with ``values`` (n, 3), ``f`` at their corners.  Every point of a
+    triangle with longest edge ``L`` lies within ``L / √3`` of a corner, so ``f`` there is
+    at most ``max(corner values) + L / √3``: triangles whose bound does not exceed the
+    largest value found are dropped, the others split at the midpoint of their longest
+    edge (``f`` measured there) until their edges are ``<= spacing``.  A value larger than
+    every one returned can then only hide within ``spacing / √3`` of a measured point, as
+    with uniformly refined triangles, at a fraction of the points.
+
+    Returns the measured points (m, 3) and their values (m,).
+    """
+    pts, vals = [], []
+    for _ in range(200):
+        if not len(tris):
             break
-        unsure = (b > 1e-12) & np.isfinite(d[:, -1]) & (d[:, -1] - radius < b)
-        todo, kk = todo[unsure], 4 * kk
-    return best
+        e = np.stack([np.linalg.norm(tris[:, 1] - tris[:, 0], axis=1), np.linalg.norm(tris[:, 2] - tris[:, 1], axis=1),
+                      np.linalg.norm(tris[:, 0] - tris[:, 2], axis=1)], axis=1)
+        L = e.max(axis=1)
+        live = (values.max(axis=1) + L / math.sqrt(3.0) > best) & (L > spacing)
+        tris, values, e = tris[live], values[live], e[live]
+        if not len(tris):
+            break
+        k = np.argmax(e, axis=1)  # edge k joins corner k and k + 1
+        r = np.arange(len(tris))
+        i0, i1, i2 = k, (k + 1) % 3, (k + 2) % 3
+        a, b, c = tris[r, i0], tris[r, i1], tris[r, i2]
+        fa, fb, fc = values[r, i0], values[r, i1], values[r, i2]
+        m = 0.5 * (a + b)
+        fm = f(m)
+        pts.append(m)
+        vals.append(fm)
+        best = max(best, float(np.max(fm)))
+        tris = np.concatenate([np.stack([a, m, c], axis=1), np.stack([m, b, c], axis=1)])
+        values = np.concatenate([np.stack([fa, fm, fc], axis=1), np.stack([fm, fb, fc], axis=1)])
+    if not pts:
+        return np.zeros((0, 3)), np.zeros(0)
+    return np.concatenate(pts), np.concatenate(vals)
 
 
 def _occ_point_distance(p, shape) -> float:
@@ -242,65 +253,51 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
     V, T = mesh_arrays(tablet, deflection, 0.2)
     if tablet_model is not None:
         S = _surface_samples(tablet_model)
-        keep = mesh_distance(S, *refine_triangles(V, T, 0.1), reach=0.2) <= 2.0 * deflection
+        keep = mesh_distance(S, V, T) <= 2.0 * deflection
         V = np.vstack([V, S[keep]])
     n_mesh = len(V)
     V = np.vstack([V, face_samples(tablet, spacing=max(0.25 * clearance, 0.005))])  # inside every B-rep face
-    h_split = max(4.0 * clearance, 0.05)
     # the tools' chord heights must be well below the gaps to be ranked (a gap of clearance/2 on a
     # land against chords of 5 µm would be outranked by chord artefacts on the cups)
     tool_deflection = min(deflection, max(0.1 * clearance, 1e-3))
-    tools = []
-    for name, s in parts.items():
-        Vp, Tp = mesh_arrays(s, tool_deflection, 0.2)
-        lo, hi = V.min(axis=0) - 4 * h_split, V.max(axis=0) + 4 * h_split
-        Vr, Tr = refine_triangles(Vp, Tp, h_split, lo, hi)
-        if len(Tr):
-            tools.append((Vr, Tr))
+    # each tool's triangles near the tablet, long ones split (slivers of a die's flat faces
+    # make an AABB tree slow): distances are unchanged, only the search is cheaper
+    h_split = max(4.0 * clearance, 0.05)
+    lo, hi = V.min(axis=0) - 4 * h_split, V.max(axis=0) + 4 * h_split
+    tools = [MeshDistance(*refine_triangles(*mesh_arrays(s, tool_deflection, 0.2), h_split, lo, hi), reach=2 * h_split)
+             for s in parts.values()]
 
-    def measure(P, k_max=12):
-        d = np.full((len(tools), len(P)), np.inf)
-        for j, (Vr, Tr) in enumerate(tools):
-            d[j] = mesh_distance(P, Vr, Tr, reach=2 * h_split, k_max=k_max)
+    def measure(P):
+        d = np.stack([tool(P) for tool in tools])
         return d.min(axis=0), d.argmin(axis=0)
-
-    def settle(dist):
-        """Exact mesh distances for the points that can hold the maximum: with ``k_max = 12`` a
-        distance is an upper bound; points are settled in batches from the largest bound down
-        until no unsettled bound exceeds the largest settled distance."""
-        order = np.argsort(dist)[::-1]
-        best = 0.0
-        for i0 in range(0, len(order), 4096):
-            batch = order[i0:i0 + 4096]
-            if dist[batch[0]] <= best:
-                break
-            dist[batch] = measure(V[batch], k_max=3072)[0]
-            best = max(best, float(np.max(dist[batch])))
-        return dist
 
     dist, near = measure(V)
     # tablet triangles whose corners are nearest to different tools (the land between a punch tip and
-    # the die bore): the gap peaks inside such triangles, away from every vertex - refine them
+    # the die bore): the gap peaks inside such triangles, away from every vertex - search them
     n_t = int(T.max()) + 1 if len(T) else 0
-    dc, nc = dist[:n_t][T], near[:n_t][T]
+    nc = near[:n_t][T]
     sel = nc.min(axis=1) != nc.max(axis=1)
     n_refined = 0
     # the distance to the tools has slope <= 1: within triangles of edges <= h every point lies within
-    # h / sqrt(3) of a corner, so a peak inside a refined triangle is missed by at most that much
+    # h / sqrt(3) of a corner, so a peak inside a searched triangle is missed by at most that much
     refined_spacing = max(0.125 * clearance, 1e-3)
     if np.any(sel):
-        Vs, _ = refine_triangles(V[:n_t], T[sel], refined_spacing)
-        Vs = np.unique(Vs, axis=0)
-        ds, ns = measure(Vs)
+        Vs, ds = largest_inside(V[:n_t][T[sel]], dist[:n_t][T[sel]], lambda P: measure(P)[0], refined_spacing,
+                                float(np.max(dist)))
         V, dist = np.vstack([V, Vs]), np.concatenate([dist, ds])
         n_refined = len(Vs)
-    dist = settle(dist)
     order = np.argsort(dist)[::-1][:refine]
     # the worst points, moved onto the tablet's B-rep surface (mesh points lie within the chord height
     # of it), measured exactly against every tool's B-rep
     shell = explore(tablet, "Shell")[0]
     on_surface = [_occ_nearest_point(V[i], shell) for i in order]
-    exact = [min(_occ_point_distance(q, s) for s in parts.values()) for q in on_surface]
+    # a tool whose mesh is farther than the nearest tool's by more than ten chord heights cannot be
+    # the nearest B-rep (its exact distance is within a chord height of its mesh distance)
+    shapes_list = list(parts.values())
+    d_mesh = np.stack([tool(np.array(on_surface).reshape(-1, 3)) for tool in tools]) if on_surface else None
+    exact = [min(_occ_point_distance(q, shapes_list[j]) for j in range(len(tools))
+                 if d_mesh[j, i] <= d_mesh[:, i].min() + 10.0 * tool_deflection + 1e-9)
+             for i, q in enumerate(on_surface)]
     i_max = int(np.argmax(exact)) if exact else 0
     t2 = time.perf_counter()
     occ_max = max(p["occ_mm3"] for p in pairs)
@@ -315,8 +312,8 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
         max_gap_point_mm=[float(x) for x in on_surface[i_max]] if exact else None,
         punch_die_clearance_mm=min(p["min_distance_mm"] for p in pairs if p["parts"][1] == "die" and p["parts"][0].endswith("punch")),
         max_gap_method=f"tablet surface points ({len(V)}: {n_mesh} mesh vertices and PDE samples, "
-                       f"{len(V) - n_mesh - n_refined} on a (u, v) grid in every B-rep face, {n_refined} in refined "
-                       f"triangles between tools) vs part meshes at {tool_deflection:.3g} mm (largest {float(np.max(dist)):.6g} mm), "
+                       f"{len(V) - n_mesh - n_refined} on a (u, v) grid in every B-rep face, {n_refined} by branch and bound in "
+                       f"triangles between tools) vs part meshes at {tool_deflection:.3g} mm (exact point-to-mesh distances, libigl; largest {float(np.max(dist)):.6g} mm), "
                        f"worst {len(order)} moved onto the tablet's B-rep and re-measured with BRepExtrema_DistShapeShape",
         max_gap_mesh_mm=float(np.max(dist)),
         max_gap_resolution_mm=refined_spacing / math.sqrt(3.0) if n_refined else None,
