@@ -324,3 +324,31 @@ def test_mesh_reports_its_volume_error_and_warns_with_a_node_count_that_meets_th
     rel3, _, _ = mesh((2 * hint[0] - 1, 2 * hint[1] - 1, hint[2]))  # halved cells: a quarter of the error
     assert rel3 / rel2 == pytest.approx(0.25, abs=0.03)
     assert len(got.points) == 400
+
+
+def test_ctrl_c_while_a_build_publishes_leaves_the_whole_build(tmp_path, capsys, monkeypatch):
+    """SIGINT sent while the outputs are being moved into place (after the first file) waits until
+    every file and the manifest are there: the folder holds the whole build and the command says
+    it finished (exit 0), never half a build beside "interrupted"."""
+    import json as _json
+
+    import tabletcad.io.outputs as outputs
+
+    real_replace = os.replace
+    sent = []
+    out = tmp_path / "out"
+
+    def replace_then_interrupt(src, dst):  # os.replace is the os module's: atomic writes use it too
+        real_replace(src, dst)
+        if not sent and Path(dst).parent == out:
+            sent.append(dst)
+            os.kill(os.getpid(), signal.SIGINT)
+
+    monkeypatch.setattr(outputs.os, "replace", replace_then_interrupt)
+    rc, _, err = run(capsys, "build", str(ROOT / "samples" / "flat_faced_round.toml"), "--out", str(out), "--quiet")
+    assert sent, "the build never published"
+    assert rc == 0 and err == f"interrupted after the build was complete: outputs in {out}/\n"
+    manifest = _json.loads((out / outputs.MANIFEST).read_text())
+    assert sorted(manifest["files"]) == sorted(p.name for p in out.iterdir() if p.name != outputs.MANIFEST)
+    assert {"report.json", "tablet.png", "tablet.step"} <= set(manifest["files"])
+    assert not [q for q in tmp_path.iterdir() if q.name.startswith(".out.")]

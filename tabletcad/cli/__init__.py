@@ -10,7 +10,9 @@ status and stderr follow one contract:
   no partial output left behind;
 * 1: an internal error (any other exception, a bug): one line naming it and
   the log file that holds the traceback;
-* 130: interrupted (Ctrl-C), also during start-up: one line ``interrupted``;
+* 130: interrupted (Ctrl-C), also during start-up: one line ``interrupted``,
+  nothing written (a build puts its outputs in place with SIGINT held back, so
+  a Ctrl-C after that point finds a finished build: one line saying so, 0);
 * other codes a command documents (``optimise``: 3 when it finds no optimum).
 
 Nothing but the standard library is imported at module level, so that Ctrl-C
@@ -203,6 +205,7 @@ def _run(argv: list[str] | None) -> int:
 
     group = _group()
     args = list(sys.argv[1:] if argv is None else argv)
+    _published().clear()
     try:
         with group.make_context("tabletcad", [str(a) for a in args]) as ctx:
             group.invoke(ctx)
@@ -215,8 +218,7 @@ def _run(argv: list[str] | None) -> int:
         _say("error: " + _usage_line(exc))
         return 2
     except click.exceptions.Abort:
-        _say("interrupted")
-        return 130
+        return _interrupted()
     except click.ClickException as exc:  # a command's own status (optimise: 3)
         exc.show()
         return exc.exit_code
@@ -262,10 +264,27 @@ def main(argv: list[str] | None = None) -> int:
             _say(f"error: internal error ({type(exc).__name__}{': ' + msg if msg else ''}); traceback in {path}")
             return 1
     except KeyboardInterrupt:
-        _say("interrupted")
-        if argv is None:  # run as the program: end here with 130
-            _exit_now(130)
-        return 130
+        status = _interrupted()
+        if argv is None:  # run as the program: end here
+            _exit_now(status)
+        return status
+
+
+def _published() -> list:
+    """Output folders this process has published (:data:`tabletcad.io.outputs.published`)."""
+    mod = sys.modules.get("tabletcad.io.outputs")
+    return mod.published if mod is not None else []
+
+
+def _interrupted() -> int:
+    """Ctrl-C: ``interrupted`` and 130 with nothing written, or - when it came after the build
+    had put its outputs in place - the finished build's folder and 0."""
+    done = _published()
+    if done:
+        _say(f"interrupted after the build was complete: outputs in {done[-1]}/")
+        return 0
+    _say("interrupted")
+    return 130
 
 
 def _exit_now(status: int) -> None:

@@ -38,6 +38,11 @@ __all__ = ["MANIFEST", "STAGING_MARKER", "STALE_AFTER_S", "staging_folder", "pub
            "clean_stale_staging", "file_sha256"]
 
 MANIFEST = ".tabletcad-build.json"
+
+#: Output folders that :func:`publish` completed in this process.  The command line reads it: a
+#: Ctrl-C that reaches a build after its outputs are in place is too late to undo it, and the
+#: command reports the finished build rather than "interrupted" beside a full folder.
+published: list[Path] = []
 STAGING_MARKER = ".tabletcad-staging.json"
 #: a staging folder of another host (its process cannot be asked) is stale after this many seconds
 STALE_AFTER_S = 24 * 3600.0
@@ -138,6 +143,37 @@ def staging_folder(out_dir: str | os.PathLike[str]) -> Iterator[Path]:
             shutil.rmtree(staging, ignore_errors=True)
 
 
+@contextlib.contextmanager
+def _signals_deferred() -> Iterator[None]:
+    """While inside (main thread), SIGINT and SIGTERM wait: publishing is all or nothing.
+
+    Python runs signal handlers in the main thread whichever thread the system
+    delivers to, so holding handlers are installed for the block (a signal mask
+    would hold back only the main thread's deliveries); a signal that came
+    meanwhile goes to the previous handler when the block ends.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+
+    def hold(signum, frame):  # noqa: ARG001
+        caught.append(signum)
+
+    old = {s: signal.signal(s, hold) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for s, handler in old.items():
+            signal.signal(s, handler if handler is not None else signal.SIG_DFL)
+        for s in dict.fromkeys(caught):
+            handler = old[s]
+            if callable(handler):
+                handler(s, None)  # Python's default_int_handler raises KeyboardInterrupt
+            elif handler == signal.SIG_DFL or handler is None:
+                os.kill(os.getpid(), s)
+
+
 def publish(staging: str | os.PathLike[str], out_dir: str | os.PathLike[str]) -> list[str]:
     """Move the files of ``staging`` into ``out_dir`` and record them in its manifest.
 
@@ -149,6 +185,13 @@ def publish(staging: str | os.PathLike[str], out_dir: str | os.PathLike[str]) ->
     files = sorted(p.relative_to(staging) for p in staging.rglob("*") if p.is_file() and p.name != STAGING_MARKER)
     hashes = {p.as_posix(): file_sha256(staging / p) for p in files}
     earlier = read_manifest(out_dir)
+    with _signals_deferred():  # Ctrl-C or SIGTERM now would leave half a build in out_dir
+        _move_in(staging, out_dir, files, hashes, earlier)
+        published.append(out_dir)
+    return sorted(hashes)
+
+
+def _move_in(staging: Path, out_dir: Path, files: list[Path], hashes: dict[str, str], earlier: dict[str, str]) -> None:
     out_dir.mkdir(parents=True, exist_ok=True)
     umask = os.umask(0)
     os.umask(umask)
@@ -171,4 +214,3 @@ def publish(staging: str | os.PathLike[str], out_dir: str | os.PathLike[str]) ->
                     parent.rmdir()
                     parent = parent.parent
     atomic_write_text(out_dir / MANIFEST, json.dumps(dict(tool="tabletcad", files=hashes), indent=1) + "\n")
-    return sorted(hashes)
