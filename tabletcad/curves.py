@@ -102,6 +102,13 @@ class Curve:
         """Parameters ``v`` in [0, 2π) where the curve is not infinitely smooth (empty if none)."""
         return np.zeros(0)
 
+    def band_limit(self) -> int | None:
+        """Highest Fourier mode the curve has, when it is a finite trigonometric sum (None otherwise).
+
+        Lets :func:`modes_needed` stop there: a circle or an ellipse has mode 1 only.
+        """
+        return None
+
     @property
     def is_point(self) -> bool:
         """True when the curve is a single point (a pole of a patch)."""
@@ -142,6 +149,9 @@ class Circle(Curve):
     def is_point(self) -> bool:
         return self.radius == 0.0
 
+    def band_limit(self) -> int:
+        return 1
+
 
 @dataclass(frozen=True)
 class Ellipse(Curve):
@@ -170,6 +180,9 @@ class Ellipse(Curve):
         if der == 2:
             return np.stack([-self.rx * c, -self.ry * s, z], axis=-1)
         raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
+
+    def band_limit(self) -> int:
+        return 1
 
 
 @dataclass(frozen=True)
@@ -409,6 +422,10 @@ class Transformed(Curve):
         bp = getattr(self.base, "breakpoints", None)
         return bp() if bp is not None else np.zeros(0)
 
+    def band_limit(self) -> int | None:
+        bl = getattr(self.base, "band_limit", None)  # an affine map keeps a trigonometric sum's modes
+        return bl() if bl is not None else None
+
     def evaluate(self, v, der: int = 0) -> np.ndarray:
         p = self.base.evaluate(v, der) @ self.matrix.T
         return p + self.offset if der == 0 else p
@@ -520,6 +537,10 @@ def _truncation_errors(pts, approx, a, b, cos, sin, k0: int, k1: int) -> np.ndar
 
 def _modes_needed(curve: CurveLike, tol: float, max_modes: int, m: int) -> int:
     pts = curve.evaluate(sample_v(m))
+    limit = curve.band_limit() if isinstance(curve, Curve) else None
+    if limit is not None and limit <= 1 and limit <= max_modes:
+        # a0 is the mean of the samples for a trigonometric sum of degree < m: N = 0 or the whole curve
+        return 0 if np.max(np.linalg.norm(pts - pts.mean(axis=0), axis=1)) <= tol else limit
     a0, a, b = fourier_coefficients(curve, max_modes, samples=max(4 * max_modes + 8, 1024))
     cos, sin = _trig_table(m, max_modes)
     if np.max(np.linalg.norm(pts - a0, axis=1)) <= tol:

@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tabletcad.curves import (
     Circle,
@@ -224,3 +226,27 @@ def test_transformed_moved_scaled_centroid():
     sc = m.scaled_about_centroid(0.5, 2.0)
     np.testing.assert_allclose(sc.evaluate(v), (s.evaluate(v) * (0.5, 0.5, 2.0)) + (1, 2, 3), atol=1e-13)
     assert Transformed(s, np.diag([0.0, 0.0, 1.0])).is_point
+
+
+class _Plain:
+    """The same points without tabletcad's Curve type (no band limit, no cache): the general scan."""
+
+    def __init__(self, curve):
+        self.curve = curve
+
+    def evaluate(self, v, der=0):
+        return self.curve.evaluate(v, der)
+
+
+@settings(max_examples=60, deadline=None)
+@given(rx=st.floats(0.0, 20.0), ry=st.floats(0.0, 20.0), tol=st.sampled_from([1e-12, 1e-7, 1e-3, 0.5, 5.0]),
+       angle=st.floats(0.0, 6.3), zscale=st.floats(-2.0, 2.0))
+def test_band_limited_curves_need_the_modes_the_general_scan_finds(rx, ry, tol, angle, zscale):
+    from tabletcad.curves import Circle, Ellipse, Transformed, modes_needed
+
+    c, s = math.cos(angle), math.sin(angle)
+    for curve in (Circle(rx, (1.0, -2.0, 3.0)), Ellipse(rx, ry),
+                  Transformed(Ellipse(rx, ry, (0.5, 0.0, 1.0)), np.array([[c, -s, 0], [s, c, 0], [0.3, 0.1, zscale]]),
+                              np.array([1.0, 2.0, 3.0]))):
+        assert curve.band_limit() == 1
+        assert modes_needed(curve, tol, 64) == modes_needed(_Plain(curve), tol, 64)
