@@ -488,7 +488,15 @@ class PDEPatch:
                 f"(allowed {self.tol.stray:g} mm): use a smaller a (e.g. a = 'auto') or fewer modes",
             )
 
-    def fold_depth(self, nu: int = 257, nv: int = 128) -> float:
+    def _check_nv(self) -> int:
+        """``v`` samples for the fold checks: 128, or fewer for a surface that is a trigonometric
+        polynomial of low degree ``N`` in ``v`` (no remainder term): 16 (N + 1), at least 32, so
+        that the checks' products of three such factors (degree 3N) get five samples per period."""
+        if self._has_remainder or not self._active:
+            return 128 if self._has_remainder else 32
+        return int(min(128, max(32, 16 * (max(self._active) + 1))))
+
+    def fold_depth(self, nu: int = 257, nv: int | None = None) -> float:
         """How far (mm) the solid map of eq 4.12 runs backwards where it folds.
 
         The map ``X(u, v, w)`` folds where its Jacobian ``X_u · (X_v × (X - A0))``
@@ -497,7 +505,9 @@ class PDEPatch:
         ``u``-intervals; 0 when the map does not fold.  The thesis's domes fold
         slightly at their poles: the spine, a cubic through the curves' centres,
         runs backwards for ``u`` below ~0.015 (0.8 µm for the 5 mm sphere).
+        ``nv`` defaults to the fold checks' sampling in ``v`` (``_check_nv``).
         """
+        nv = self._check_nv() if nv is None else nv
         key = ("fold", nu, nv)
         if key not in self.__dict__.get("_checks", {}):
             self.__dict__.setdefault("_checks", {})[key] = self._fold_depth_of(nu, nv)
@@ -541,7 +551,7 @@ class PDEPatch:
             )
         ends = np.geomspace(1e-6, 0.05, 24)
         u = np.unique(np.concatenate([ends, np.linspace(0.0, 1.0, 401)[1:-1], 1.0 - ends]))
-        v = sample_v(128)
+        v = sample_v(self._check_nv())
         X = self.evaluate_grid(u, v)
         D = X - self.spine(u)[:, None, :]
         # (a) the radius must not turn negative: the radial vector may not point
