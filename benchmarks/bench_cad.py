@@ -113,8 +113,11 @@ def nominal_build123d(tablet):
         T, b, W = p["thickness"], p["band"], p["width"]
         d = (T - b) / 2
         return _band_tablet(W / 2, d, d + b, d, d), "~revolve (round of equal width)"
-    if f == "flat_faced_round":
+    if f in ("flat_faced_round", "flat_face_round") and "thickness" in p:
         return _band_tablet(p["diameter"] / 2, 0.0, p["thickness"], 0.0, 0.0), "revolve"
+    if f == "concave_round":  # the peer: band and spherical cups (a land, if any, left out: '~')
+        R, b, d = p["diameter"] / 2, p["band"], p["cup_depth"]
+        return _band_tablet(R, d, d + b, d, d), "revolve" if not p.get("land") else "~revolve (no land)"
     if f in ("oblong", "rod"):
         R, L, d = p["diameter"] / 2, p["length"], p["dome"]
         return _band_tablet(R, d, L - d, d, d), "revolve"
