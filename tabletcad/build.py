@@ -14,6 +14,7 @@ import os
 from pathlib import Path
 from typing import Any, Callable
 
+from tabletcad.errors import reraise_interrupt
 from tabletcad.design import load_design
 from tabletcad.io.outputs import STAGING_MARKER, publish, staging_folder
 from tabletcad.plot import plot_tablet
@@ -45,6 +46,7 @@ def _load_optional_stages() -> None:
     try:
         import tabletcad.cad.stage  # noqa: F401  (registers its stages)
     except ImportError as exc:  # the CAD layer is optional
+        reraise_interrupt(exc)  # ... but a Ctrl-C during its import is not its absence
         if os.environ.get("TABLETCAD_REQUIRE_CAD"):
             raise
         _ = exc

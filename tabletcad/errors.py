@@ -20,7 +20,25 @@ __all__ = [
     "check_positive",
     "check_range",
     "one_token",
+    "reraise_interrupt",
 ]
+
+
+def reraise_interrupt(exc: BaseException) -> None:
+    """Raise :class:`KeyboardInterrupt` if ``exc`` was caused by one.
+
+    A Ctrl-C while an extension module initialises (OCP, gmsh) surfaces as
+    ``ImportError: initialization failed`` caused by the KeyboardInterrupt;
+    code that treats an ImportError as "optional library absent" must not
+    swallow the user's interrupt.
+    """
+    seen: set[int] = set()
+    e: BaseException | None = exc
+    while e is not None and id(e) not in seen:
+        if isinstance(e, KeyboardInterrupt):
+            raise KeyboardInterrupt from exc
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
 
 
 class TabletcadError(Exception):

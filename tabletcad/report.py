@@ -25,8 +25,10 @@ def register_report_section(func) -> None:
 def _load_sections() -> None:
     try:
         import tabletcad.families  # noqa: F401  (registers its sections when present)
-    except ImportError:
-        pass
+    except ImportError as exc:
+        from tabletcad.errors import reraise_interrupt
+
+        reraise_interrupt(exc)
 
 
 def geometry_report(tablet: Tablet) -> dict[str, Any]:

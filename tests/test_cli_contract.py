@@ -350,5 +350,38 @@ def test_ctrl_c_while_a_build_publishes_leaves_the_whole_build(tmp_path, capsys,
     assert rc == 0 and err == f"interrupted after the build was complete: outputs in {out}/\n"
     manifest = _json.loads((out / outputs.MANIFEST).read_text())
     assert sorted(manifest["files"]) == sorted(p.name for p in out.iterdir() if p.name != outputs.MANIFEST)
-    assert {"report.json", "tablet.png", "tablet.step"} <= set(manifest["files"])
+    report = _json.loads((out / "report.json").read_text())
+    assert {"report.json", "tablet.png"} <= set(manifest["files"]) == set(report["outputs"])
     assert not [q for q in tmp_path.iterdir() if q.name.startswith(".out.")]
+
+
+def test_ctrl_c_while_an_extension_initialises_is_an_interrupt(tmp_path, capsys, monkeypatch):
+    """A Ctrl-C during an extension module's initialisation surfaces as ``ImportError:
+    initialization failed`` caused by the KeyboardInterrupt (seen importing OCP in a fresh clone):
+    that is "interrupted" and 130, not an internal error, nor "no CAD library" with a build that
+    leaves its CAD files out."""
+    import tabletcad.build
+
+    def interrupted_import():
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as exc:
+            raise ImportError("initialization failed") from exc
+
+    class InterruptedFinder:  # the real tabletcad.build._load_optional_stages meets the interrupted import
+        def find_spec(self, name, path=None, target=None):
+            if name == "tabletcad.cad.stage":
+                interrupted_import()
+            return None
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    monkeypatch.delitem(sys.modules, "tabletcad.cad.stage", raising=False)
+    monkeypatch.setattr(sys, "meta_path", [InterruptedFinder(), *sys.meta_path])
+    out = tmp_path / "out"
+    rc, _, err = run(capsys, "build", str(ROOT / "samples" / "spherical.toml"), "--out", str(out))
+    assert (rc, err) == (130, "interrupted\n") and not out.exists()
+    # and the same ImportError anywhere else in a command
+    monkeypatch.setattr(tabletcad.build, "_load_optional_stages", interrupted_import)
+    rc, _, err = run(capsys, "build", str(ROOT / "samples" / "spherical.toml"), "--out", str(out))
+    assert (rc, err) == (130, "interrupted\n") and not out.exists()
+    assert not (tmp_path / "cache").exists()  # no internal-error log

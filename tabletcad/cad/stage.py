@@ -244,5 +244,7 @@ register_stage("cad", cad_stage)
 
 try:  # the tooling stage (punches, die, drawings) registers itself after the CAD stage
     import tabletcad.tooling.stage  # noqa: F401,E402
-except ImportError:  # pragma: no cover - tooling is optional
-    pass
+except ImportError as _exc:  # pragma: no cover - tooling is optional
+    from tabletcad.errors import reraise_interrupt
+
+    reraise_interrupt(_exc)

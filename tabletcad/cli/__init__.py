@@ -257,6 +257,9 @@ def main(argv: list[str] | None = None) -> int:
             _say(f"error: internal error (RecursionError); traceback in {path}")
             return 1
         except BaseException as exc:  # noqa: BLE001 - the one place that turns bugs into exit 1
+            from tabletcad.errors import reraise_interrupt
+
+            reraise_interrupt(exc)  # e.g. ImportError "initialization failed" from a Ctrl-C in OCP's import
             path = _log_internal(exc)
             msg = " ".join(str(exc).split())
             if len(msg) > 120:
