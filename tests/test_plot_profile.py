@@ -80,3 +80,15 @@ def test_no_global_backend_is_set():
             "assert matplotlib.rcParams._get_backend_or_none() == b; print('ok')")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
+
+
+def test_no_module_sets_the_backend_or_uses_pyplot():
+    """Every figure tabletcad draws owns an Agg canvas: no ``matplotlib.use`` (which switches a
+    notebook's or FreeCAD's backend for the whole process) and no pyplot state anywhere in the package."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1] / "tabletcad"
+    offenders = [f"{p.relative_to(root.parent)}:{i}" for p in sorted(root.rglob("*.py"))
+                 for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+                 if "matplotlib.use(" in line or "matplotlib.pyplot" in line]
+    assert offenders == []

@@ -79,17 +79,17 @@ def plot_section(sol: ElasticSolution, path: str | Path, *, axis: int, level: fl
 
     ``limits`` (MPa) clip the colour scale (default: ±the 99th percentile of |value|).
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
     from matplotlib.tri import Triangulation
 
     tris, vals = section(sol, axis, level, component)
     other = [k for k in range(3) if k != axis]
     xy = tris[..., other].reshape(-1, 2)
     tri = Triangulation(xy[:, 0], xy[:, 1], np.arange(len(xy)).reshape(-1, 3))
-    fig, ax = plt.subplots(figsize=(6.4, 5.2))
+    fig = Figure(figsize=(6.4, 5.2))
+    FigureCanvasAgg(fig)  # its own canvas: the global backend is left alone
+    ax = fig.subplots()
     lim = float(np.percentile(np.abs(vals), 99)) or 1.0
     if limits is None:
         limits = (0.0, lim) if component == "von_mises" else (-lim, lim)
@@ -104,5 +104,4 @@ def plot_section(sol: ElasticSolution, path: str | Path, *, axis: int, level: fl
     path = Path(path)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=120, format=path.suffix.lstrip(".").lower())
-    plt.close(fig)
     return path

@@ -374,12 +374,12 @@ def compressed_sphere_tablet(force_N: float, material: Material | str, radius: f
 
 
 def _figure():
-    import matplotlib
-
-    matplotlib.use("Agg")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    return Figure(figsize=(6.0, 4.2), dpi=120)
+    fig = Figure(figsize=(6.0, 4.2), dpi=120)
+    FigureCanvasAgg(fig)  # its own canvas: the global backend is left alone
+    return fig
 
 
 def _save(fig, path) -> Path:

@@ -407,14 +407,13 @@ def plot_heckel(fit: HeckelFit, path: str | Path, *, title: str = "", others: di
     others : dict of str to HeckelFit, optional
         Further fits (e.g. a model) drawn as labelled lines over their windows.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     from tabletcad.io import atomic_path
 
     fig = Figure(figsize=(6.4, 4.4), dpi=120)
+    FigureCanvasAgg(fig)  # its own canvas: the global backend is left alone
     ax = fig.add_subplot(111)
     ax.plot(fit.pressure, fit.heckel, "o", ms=3, color="0.6", label="loading branch")
     lo, hi = fit.window_MPa

@@ -139,15 +139,14 @@ def fit_ryshkewitch_duckworth(relative_density, tensile_strength) -> Ryshkewitch
 
 def plot_profiles(profiles: list[Profile], path: str | Path) -> Path:
     """Write the profiles side by side (PNG/SVG by suffix), atomically."""
-    import matplotlib
-
-    matplotlib.use("Agg")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     from tabletcad.io import atomic_path
 
     n = max(len(profiles), 1)
     fig = Figure(figsize=(4.0 * n, 3.6), dpi=120)
+    FigureCanvasAgg(fig)  # its own canvas: the global backend is left alone
     for i, p in enumerate(profiles):
         ax = fig.add_subplot(1, n, i + 1)
         ax.plot(p.x, p.y, "o-", ms=3)

@@ -344,15 +344,14 @@ def lame_stresses(r, a: float, b: float, p_ext: float, p_int: float) -> tuple[np
 
 def plot_shell(sol: ShellSolution, path, n_theta: int = 361) -> Path:
     """Plot u_r on the outer and inner surfaces against θ (degrees); PNG/SVG by suffix."""
-    import matplotlib
-
-    matplotlib.use("Agg")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     from tabletcad.io import atomic_path
 
     th = np.linspace(0.0, math.pi, n_theta)
     fig = Figure(figsize=(6.4, 4.2), dpi=120)
+    FigureCanvasAgg(fig)  # its own canvas: the global backend is left alone
     ax = fig.add_subplot(111)
     ax.plot(np.degrees(th), sol.radial_displacement(sol.a, th), label=f"outer surface r = {sol.a:g} mm")
     ax.plot(np.degrees(th), sol.radial_displacement(sol.b, th), label=f"inner surface r = {sol.b:g} mm")

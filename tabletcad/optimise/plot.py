@@ -16,15 +16,15 @@ def plot_convergence(result: Result, path: str | Path, *, dpi: int = 120) -> Pat
     The violation is each constraint's violation divided by its solver scale
     (dimensionless), on a log axis; exact zeros are drawn at 1e-16.
     """
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
     it = [h.iteration for h in result.history]
     obj = [h.objective for h in result.history]
     viol = [max(h.max_violation, 1e-16) for h in result.history]
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(6.4, 5.6), sharex=True)
+    fig = Figure(figsize=(6.4, 5.6))
+    FigureCanvasAgg(fig)  # its own canvas: the global backend is left alone
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
     unit = f" ({result.objective_unit})" if result.objective_unit else ""
     ax1.plot(it, obj, "o-", color="tab:blue", ms=3)
     ax1.set_ylabel(f"{result.objective_name}{unit}")
@@ -40,5 +40,4 @@ def plot_convergence(result: Result, path: str | Path, *, dpi: int = 120) -> Pat
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=dpi, format="png")
-    plt.close(fig)
     return Path(path)

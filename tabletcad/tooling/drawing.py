@@ -305,14 +305,13 @@ def sheet_figure(dr: Drawing, paper: str = "A4"):
     """The landscape matplotlib figure of ``dr`` on ``paper``: the views above a title block that
     holds the notes (in two columns when long), both placed in sheet coordinates so that nothing
     runs past the sheet's edge whatever the tablet's size."""
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
     import matplotlib.patches
-    import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
     w_in, h_in = PAPER[paper]
-    fig = plt.figure(figsize=(w_in, h_in))
+    fig = Figure(figsize=(w_in, h_in))
+    FigureCanvasAgg(fig)  # its own canvas: the global backend is left alone
     dr.paper = paper
     block = 0.2  # title block height, fraction of the sheet
     ax = fig.add_axes((0.04, block + 0.04, 0.92, 0.92 - block - 0.04))
@@ -368,19 +367,16 @@ def _scale_text(scale: float) -> str:
 
 def _write_matplotlib(dr: Drawing, svg: Path, pdf: Path) -> None:
     import matplotlib
-    import matplotlib.pyplot as plt
 
     with matplotlib.rc_context({"svg.fonttype": "none", "pdf.fonttype": 42}):
         for paper in PAPER:  # the smallest sheet that shows the views at 1:1 or larger (else the largest)
             fig = sheet_figure(dr, paper)
             if dr.scale >= 1.0 or paper == "A2":
                 break
-            plt.close(fig)
         with atomic_path(svg) as tmp:
             fig.savefig(tmp, format="svg")
         with atomic_path(pdf) as tmp:
             fig.savefig(tmp, format="pdf")
-        plt.close(fig)
 
 
 def _write_dxf(dr: Drawing, path: Path) -> None:
