@@ -171,7 +171,7 @@ class PDEPatch:
         object.__setattr__(self, "_bc", bc)
         # is there anything above mode N?  (residual at dense samples)
         v = sample_v(4 * samples)
-        res = max(float(np.max(np.abs(self._residual(k, v, 0)))) for k in range(4))
+        res = float(np.max(np.abs(self._residuals(v, 0))))
         scale = max(1.0, float(np.max(np.abs(a0))), float(np.max(np.abs(ac))) if N else 0.0)
         object.__setattr__(self, "_has_remainder", res > 1e-14 * scale)
         object.__setattr__(self, "_lams", self.a * np.arange(N + 1))
@@ -237,9 +237,9 @@ class PDEPatch:
         """True when some datum has content above mode ``N`` (so ``R != 0``)."""
         return self._has_remainder
 
-    def _series(self, k: int, v: np.ndarray, dv: int, nmax: int | None = None) -> np.ndarray:
+    def _series(self, k: int, v: np.ndarray, dv: int) -> np.ndarray:
         """Truncated Fourier series of datum ``k`` (or its v-derivative) at ``v``."""
-        N = self.modes if nmax is None else nmax
+        N = self.modes
         out = np.zeros((v.size, 3))
         if dv == 0:
             out += self._a0[k]
@@ -287,11 +287,6 @@ class PDEPatch:
         if v.size < 64:
             return make()
         return self._memo(("res", dv, v.tobytes()), make)
-
-    def _residual(self, k: int, v: np.ndarray, dv: int, nmax: int | None = None) -> np.ndarray:
-        if nmax is None:
-            return self._residuals(np.asarray(v, dtype=float).reshape(-1), dv)[k]
-        return self.data[k].evaluate(v, dv) - self._series(k, v, dv, nmax)
 
     def _cardinals(self, u: np.ndarray, du: int, lams) -> list[np.ndarray]:
         return [cardinal(u, lam, self.u_nodes, self.form, du) for lam in lams]

@@ -349,10 +349,8 @@ class Tablet:
         tabletcad builds (~1e-12 relative from the polish, ~1e-9 from the
         ``v`` sampling of the default).
         """
-        t = self.trim
-        u = np.linspace(t.u[0], t.u[1], nu)
-        v = np.linspace(t.v[0], t.v[1], nv, endpoint=not t.full_v)
-        pts = np.stack([p.evaluate_grid(u, v) for p in self.patches])  # (patches, nu, nv, 3)
+        u, v = self._grid(nu, nv)
+        pts = self.sample(nu, nv)  # (patches, nu, nv, 3)
         c = 0.5 * (pts[..., :2].min(axis=(0, 1, 2)) + pts[..., :2].max(axis=(0, 1, 2)))
         d = pts[..., :2] - c
         r = np.hypot(d[..., 0], d[..., 1])
@@ -367,7 +365,7 @@ class Tablet:
             inner = (i[j] > 0) & (i[j] < nu - 1)
             if np.any(inner):
                 k = np.flatnonzero(inner)
-                uk, r2, dk = self._farthest_along_u(p, c, u[i[j, k]], v[k], rr[k] ** 2, u[1] - u[0])
+                _, r2, dk = self._farthest_along_u(p, c, u[i[j, k]], v[k], rr[k] ** 2, u[1] - u[0])
                 rr[k], dd[k] = np.sqrt(r2), dk
             keep = rr > 1e-9 * max(float(r.max()), 1.0)
             if np.count_nonzero(keep) < 8:
@@ -463,11 +461,14 @@ class Tablet:
 
     # ------------------------------------------------------------------ geometry summaries
     def sample(self, nu: int = 65, nv: int = 128) -> np.ndarray:
-        """Surface points of every patch on a (u, v) grid, shape (patches, nu, nv, 3)."""
-        t = self.trim
-        u = np.linspace(t.u[0], t.u[1], nu)
-        v = np.linspace(t.v[0], t.v[1], nv, endpoint=not t.full_v)
+        """Surface points of every patch on the grid of :meth:`_grid`, shape (patches, nu, nv, 3)."""
+        u, v = self._grid(nu, nv)
         return np.stack([p.evaluate_grid(u, v) for p in self.patches])
+
+    def _grid(self, nu: int, nv: int) -> tuple[np.ndarray, np.ndarray]:
+        """``nu`` equally spaced ``u`` and ``nv`` ``v`` over the trimmed ranges (``v`` periodic when untrimmed)."""
+        t = self.trim
+        return np.linspace(t.u[0], t.u[1], nu), np.linspace(t.v[0], t.v[1], nv, endpoint=not t.full_v)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Axis-aligned bounding box (mm) of the surface, refined to ~1e-9 mm.
@@ -488,9 +489,7 @@ class Tablet:
         pts = self.sample(97, 256)
         lo = pts.reshape(-1, 3).min(axis=0)
         hi = pts.reshape(-1, 3).max(axis=0)
-        t = self.trim
-        u = np.linspace(t.u[0], t.u[1], 97)
-        v = np.linspace(t.v[0], t.v[1], 256, endpoint=not t.full_v)
+        u, v = self._grid(97, 256)
         for axis in range(3):
             for sign, store in ((-1.0, lo), (1.0, hi)):
                 k = int(np.argmax(sign * pts[..., axis]))
