@@ -34,7 +34,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from scipy.integrate import dblquad  # noqa: E402
 
 from tabletcad.patch import PDEPatch  # noqa: E402
-from tabletcad.shapes import FAMILIES  # noqa: E402
+from tabletcad.families import FAMILIES  # noqa: E402
 
 TWO_PI = 2.0 * math.pi
 

@@ -33,7 +33,6 @@ DESIGNS = {
 
 
 def main() -> None:
-    import tabletcad.families  # noqa: F401  (registers the families)
     from tabletcad.cad.tablet_solid import tablet_solid
 
     print(f"{'design':38s} {'solid s':>8s} {'coarse s':>9s} {'cpu s':>7s} {'dofs':>7s} {'σc coarse':>10s} "

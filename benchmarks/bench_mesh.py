@@ -32,7 +32,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
-from tabletcad.shapes import FAMILIES  # noqa: E402
+from tabletcad.families import FAMILIES  # noqa: E402
 from tabletcad.solid import THESIS_NODES, _hex_volumes, hex_mesh, mesh_volume  # noqa: E402
 from tabletcad.tablet import solid_map  # noqa: E402
 

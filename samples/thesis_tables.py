@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 
-from tabletcad import shapes
+from tabletcad import families
 
 # thesis figures: (area mm², volume mm³), Tables 4.2(a), 4.2(b), 4.3
 THESIS = {
@@ -45,7 +45,7 @@ def exact(name: str, t) -> tuple[float, float] | None:
 
 def rows():
     for name, (ta, tv) in THESIS.items():
-        t = shapes.FAMILIES[name].build()
+        t = families.FAMILIES[name].build()
         pr = t.properties()
         ex = exact(name, t)
         dev = t.nominal_deviation()

@@ -54,7 +54,6 @@ __all__ = [
     "enclosed_volume",
 ]
 
-TWO_PI = 2.0 * math.pi
 SurfaceFunction = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 
@@ -389,7 +388,7 @@ def _clamped_interp_knots(x: np.ndarray, degree: int) -> tuple[np.ndarray, np.nd
     return knots, mults.astype(int)
 
 
-def normalise_breaks(v_breaks, period: float = TWO_PI, merge_tol: float = 1e-9) -> np.ndarray:
+def normalise_breaks(v_breaks, period: float = math.tau, merge_tol: float = 1e-9) -> np.ndarray:
     """Sorted distinct breakpoints in ``[0, period)``; values closer than ``merge_tol`` (also across
     the period) are merged, keeping the smaller one."""
     if v_breaks is None:
@@ -413,7 +412,7 @@ def periodic_knots(
     degree: int,
     v_breaks=None,
     break_mult: int | None = None,
-    period: float = TWO_PI,
+    period: float = math.tau,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Periodic ``v`` knots (distinct values, multiplicities) and interpolation parameters.
 
@@ -570,7 +569,7 @@ def _deviation(f: SurfaceFunction, data: BSplineSurfaceData, u: np.ndarray, v: n
     nu = u.size
     uc = np.linspace(u[0], u[-1], factor * (nu - 1) + 1)
     # ``factor`` points per gap between consecutive (periodic) samples; column ``factor * j`` is sample j
-    vs = np.concatenate([v, [v[0] + TWO_PI]])
+    vs = np.concatenate([v, [v[0] + math.tau]])
     vc = (vs[:-1, None] + (np.arange(factor) / factor)[None, :] * np.diff(vs)[:, None]).ravel()
     F = _eval_f(f, uc, vc)
     S = data.evaluate_grid(uc, vc)

@@ -4,79 +4,84 @@ Outputs are produced in a staging folder beside the target and moved into
 place only when all of them succeeded, so a failure leaves no partial file;
 the folder then holds exactly this build's files besides any files tabletcad
 did not write (:mod:`tabletcad.io.outputs`).
-The CAD outputs (STEP, STL, GLB, tooling) are added when the CAD layer
-(:mod:`tabletcad.cad`) can be imported.
+The CAD outputs (STEP, STL, GLB, tooling) are added when the ``cad`` extra
+is installed (:func:`cad_available`).
 """
 
 from __future__ import annotations
 
+import importlib.util
 import os
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
-from tabletcad.errors import reraise_interrupt
 from tabletcad.design import load_design
 from tabletcad.io.outputs import STAGING_MARKER, publish, staging_folder
 from tabletcad.plot import plot_tablet
 from tabletcad.report import geometry_report, to_json
 from tabletcad.tablet import Tablet
 
-__all__ = ["build_design", "build_tablet", "register_stage"]
+__all__ = ["build_design", "build_tablet", "cad_available", "CAD_MODULES"]
 
-# Extra stages: (name, callable (tablet, design_path, out, report) -> None, check or None), run in order.
-# A stage's check (tablet, design_path) -> None validates its input and raises DesignError before
-# any stage builds geometry.
-_STAGES: list[tuple[str, Callable[..., None]]] = []
-_CHECKS: dict[str, Callable[..., None]] = {}
+#: The modules of the ``cad`` extra the CAD stage imports (OpenCascade, the mesh checks).
+CAD_MODULES = ("OCP", "manifold3d", "trimesh")
 
 
-def register_stage(name: str, func: Callable[..., None], check: Callable[..., None] | None = None) -> None:
-    """Add an output stage (used by the CAD layer and tooling) run after the core outputs.
+def cad_available() -> bool:
+    """Whether the ``cad`` extra is installed, so that a build writes the CAD outputs.
 
-    ``check(tablet=..., design_path=...)``, if given, runs before any stage builds anything:
-    bad input of the stage is refused before the (slow) geometry.
+    Only looks the modules up (nothing is imported): once they are there, a
+    failure to import the CAD layer is an error, never a build without its
+    CAD files.  With the environment variable ``TABLETCAD_REQUIRE_CAD`` set the
+    answer is always yes (a missing module is then an error too).
     """
-    if name not in [n for n, _ in _STAGES]:
-        _STAGES.append((name, func))
-    if check is not None:
-        _CHECKS[name] = check
+    if os.environ.get("TABLETCAD_REQUIRE_CAD"):
+        return True
+    return all(importlib.util.find_spec(m) is not None for m in CAD_MODULES)
 
 
-def _load_optional_stages() -> None:
-    try:
-        import tabletcad.cad.stage  # noqa: F401  (registers its stages)
-    except ImportError as exc:  # the CAD layer is optional
-        reraise_interrupt(exc)  # ... but a Ctrl-C during its import is not its absence
-        if os.environ.get("TABLETCAD_REQUIRE_CAD"):
-            raise
-        _ = exc
+def build_tablet(tablet: Tablet, out_dir: str | Path, *, cad: bool | None = None, progress: bool = True) -> dict[str, Any]:
+    """Write ``report.json``, ``tablet.png``, the CAD files and the tooling of ``tablet`` into ``out_dir``.
 
-
-def build_tablet(tablet: Tablet, out_dir: str | Path, *, design_path: str | Path | None = None, progress: bool = True) -> dict[str, Any]:
-    """Write ``report.json``, ``tablet.png`` and the CAD files of ``tablet`` into ``out_dir``.
+    The steps, in order: the geometry report (:func:`~tabletcad.report.geometry_report`);
+    with ``cad`` (default: :func:`cad_available`) the solid, its checks and
+    ``tablet.step/.stl/.glb`` (:func:`tabletcad.cad.stage.cad_stage`), then, when the
+    tablet's design has a ``[tooling]`` table (``tablet.extras["tooling"]``), the punches,
+    die and drawings made from that solid (:func:`tabletcad.tooling.stage.tooling_stage`);
+    last the picture.  The ``[tooling]`` table is checked before any geometry is built.
 
     Returns the report; ``report["outputs"]`` names the files this build wrote.
-    Nothing in ``out_dir`` changes if any stage fails.  The folder is owned by
+    Nothing in ``out_dir`` changes if any step fails.  The folder is owned by
     the build (:mod:`tabletcad.io.outputs`): files of an earlier build that
     this one does not write are removed, files tabletcad did not write are kept.
     """
     out_dir = Path(out_dir)
-    _load_optional_stages()
-    stages = list(_STAGES)
-    for name, _ in stages:  # every stage's input is checked before any geometry is built
-        if name in _CHECKS:
-            _CHECKS[name](tablet=tablet, design_path=design_path)
-    with staging_folder(out_dir) as staging:
-        report = geometry_report(tablet)
-        try:
-            from tqdm import tqdm
+    cad = cad_available() if cad is None else cad
+    tooling = None
+    if cad:
+        from tabletcad.tooling.stage import tooling_spec
 
-            it = tqdm(stages, desc="build", unit="stage", disable=not progress or not stages, leave=False)
-        except ImportError:  # pragma: no cover
-            it = stages
-        for name, func in it:
-            func(tablet=tablet, design_path=design_path, out=staging, report=report)
-        plot_tablet(tablet, staging / "tablet.png")
+        tooling = tooling_spec(tablet)  # bad [tooling] input is refused before the (slow) geometry
+    steps = 2 + cad + (tooling is not None)
+    with staging_folder(out_dir) as staging:
+        from tqdm import tqdm
+
+        # the bar shows on a terminal only (disable=None), never in a log or a pipe
+        with tqdm(total=steps, desc="build", unit="step", disable=None if progress else True, leave=False) as bar:
+            report = geometry_report(tablet)
+            bar.update()
+            if cad:
+                from tabletcad.cad.stage import cad_stage
+
+                shape = cad_stage(tablet=tablet, out=staging, report=report)
+                bar.update()
+                if tooling is not None:
+                    from tabletcad.tooling.stage import tooling_stage
+
+                    tooling_stage(tablet=tablet, spec=tooling, shape=shape, out=staging, report=report)
+                    bar.update()
+            plot_tablet(tablet, staging / "tablet.png")
+            bar.update()
         names = sorted(p.name for p in staging.iterdir() if p.name != STAGING_MARKER) + ["report.json"]
         report["outputs"] = sorted(names)
         (staging / "report.json").write_text(to_json(report), encoding="utf-8")
@@ -86,5 +91,4 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, design_path: str | Path
 
 def build_design(design: str | Path, out_dir: str | Path, *, progress: bool = True) -> dict[str, Any]:
     """Load a design file and :func:`build_tablet` it."""
-    tablet = load_design(design)
-    return build_tablet(tablet, out_dir, design_path=design, progress=progress)
+    return build_tablet(load_design(design), out_dir, progress=progress)

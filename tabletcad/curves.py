@@ -42,12 +42,11 @@ __all__ = [
     "sample_v",
 ]
 
-TWO_PI = 2.0 * math.pi
 
 
 def sample_v(m: int) -> np.ndarray:
     """``m`` equally spaced parameters on ``[0, 2π)``."""
-    return np.arange(m) * (TWO_PI / m)
+    return np.arange(m) * (math.tau / m)
 
 
 def _vec3(name: str, value) -> np.ndarray:
@@ -250,8 +249,8 @@ class Outline(Curve):
 
     def evaluate(self, v, der: int = 0) -> np.ndarray:
         v = np.asarray(v, dtype=float).reshape(-1)
-        s = np.mod(v, TWO_PI) * (self.perimeter / TWO_PI)
-        k = TWO_PI / self.perimeter  # dv/ds
+        s = np.mod(v, math.tau) * (self.perimeter / math.tau)
+        k = math.tau / self.perimeter  # dv/ds
         idx = np.clip(np.searchsorted(self._cum, s, side="right") - 1, 0, len(self._segs) - 1)
         out = np.zeros((v.size, 3))
         for i, seg in enumerate(self._segs):
@@ -290,7 +289,7 @@ class Outline(Curve):
         """Parameters of the segment junctions (curvature may jump there)."""
         if len(self._segs) == 1:
             return np.zeros(0)
-        return self._cum[:-1] * (TWO_PI / self.perimeter)
+        return self._cum[:-1] * (math.tau / self.perimeter)
 
     def area(self) -> float:
         """Enclosed plan area (mm²), exact for lines and arcs (Green's theorem)."""
@@ -319,7 +318,7 @@ def Stadium(length: float, width: float, z: float = 0.0) -> Outline:
     r = W / 2.0
     h = L / 2.0 - r  # half straight length
     if h == 0.0:
-        return Outline.from_segments([("arc", (0.0, 0.0), r, 0.0, TWO_PI)], z=z, name="stadium")
+        return Outline.from_segments([("arc", (0.0, 0.0), r, 0.0, math.tau)], z=z, name="stadium")
     items = [
         ("arc", (h, 0.0), r, 0.0, math.pi / 2),
         ("line", (h, r), (-h, r)),
@@ -352,7 +351,7 @@ def RoundedRectangle(length: float, width: float, corner_radius: float, z: float
     if hy > 0:
         items.append(("line", (L / 2, -hy), (L / 2, 0.0)))
     if hx == 0 and hy == 0:
-        return Outline.from_segments([("arc", (0.0, 0.0), rc, 0.0, TWO_PI)], z=z, name="rounded_rectangle")
+        return Outline.from_segments([("arc", (0.0, 0.0), rc, 0.0, math.tau)], z=z, name="rounded_rectangle")
     # the start point must be on +x axis: rotate list so it starts at (L/2, 0)
     if hy == 0:
         # first item is the arc from angle 0: split the last arc to start at angle 0 (already does)
@@ -386,7 +385,7 @@ class PointCurve(Curve):
         if np.any(seg == 0.0):
             raise DesignError("points", "repeated point", "consecutive points must differ")
         t = np.concatenate([[0.0], np.cumsum(seg)])
-        t = t * (TWO_PI / t[-1])
+        t = t * (math.tau / t[-1])
         self.points = p
         self._knots = t[:-1]
         self._spline = CubicSpline(t, np.vstack([p, p[:1]]), bc_type="periodic", axis=0)
@@ -396,7 +395,7 @@ class PointCurve(Curve):
         return self._knots.copy()
 
     def evaluate(self, v, der: int = 0) -> np.ndarray:
-        v = np.mod(np.asarray(v, dtype=float).reshape(-1), TWO_PI)
+        v = np.mod(np.asarray(v, dtype=float).reshape(-1), math.tau)
         if der not in (0, 1, 2):
             raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
         return self._spline(v, der)

@@ -45,7 +45,7 @@ import numpy as np
 from tabletcad.curves import Circle, Curve, Ellipse, PointCurve, RoundedRectangle, Stadium
 from tabletcad.errors import DesignError, check_finite, one_token
 from tabletcad.patch import PDEPatch
-from tabletcad.shapes import FAMILIES
+from tabletcad.families import FAMILIES
 from tabletcad.tablet import Tablet, Trim
 from tabletcad.tolerance import DEFAULT, Tolerances
 
@@ -188,9 +188,6 @@ def design_from_dict(data: dict, default_name: str = "tablet") -> Tablet:
 
 
 def _design_from_dict(data: dict, default_name: str) -> Tablet:
-    from tabletcad.shapes import _load_plugins
-
-    _load_plugins()
     if not isinstance(data, dict):
         raise DesignError("design", type(data).__name__, "must be a TOML table")
     _check_keys("", data, set(TOP_LEVEL_KEYS))

@@ -31,6 +31,7 @@ import numpy as np
 
 from tabletcad.errors import DesignError
 from tabletcad.tablet import Tablet
+from tabletcad.tolerance import DEFAULT
 
 __all__ = ["TabletModel", "PartModel", "ToolingModel", "make", "load", "show", "mesh_html"]
 
@@ -72,7 +73,8 @@ class _Shaped:
 
         return export(self.to_occ(), path, name=kw.pop("name", self.name), **kw)
 
-    def mesh(self, linear_deflection: float = 0.005, angular_deflection: float = 0.2, check: bool = False):
+    def mesh(self, linear_deflection: float = DEFAULT.mesh_deflection, angular_deflection: float = DEFAULT.mesh_angle,
+             check: bool = False):
         """:class:`tabletcad.cad.mesh.MeshResult` of the solid (mm, rad)."""
         from tabletcad.cad.mesh import tessellate
 
@@ -213,9 +215,8 @@ class TabletModel(_Shaped):
 
 def make(family: str, **dims: Any) -> TabletModel:
     """A tablet of a named family (``tabletcad shapes`` lists them) with dimensions in mm."""
-    from tabletcad.shapes import FAMILIES, _load_plugins
+    from tabletcad.families import FAMILIES
 
-    _load_plugins()
     if family not in FAMILIES:
         raise DesignError("family", family, f"must be one of {', '.join(FAMILIES)}")
     return TabletModel(FAMILIES[family].build(**dims))

@@ -8,28 +8,11 @@ from typing import Any
 
 import numpy as np
 
+from tabletcad.families.designreport import design_report
+from tabletcad.families.sweep import SweepNominal
 from tabletcad.tablet import Tablet
 
-__all__ = ["geometry_report", "to_json", "register_report_section", "flatten_report"]
-
-# Extra report sections: callables (tablet) -> dict merged into the report (or None to skip).
-_SECTIONS: list = []
-
-
-def register_report_section(func) -> None:
-    """Add a report section (e.g. the standard families' design report)."""
-    if func not in _SECTIONS:
-        _SECTIONS.append(func)
-
-
-def _load_sections() -> None:
-    try:
-        import tabletcad.families  # noqa: F401  (registers its sections when present)
-    except ImportError as exc:
-        from tabletcad.errors import reraise_interrupt
-
-        reraise_interrupt(exc)
-
+__all__ = ["geometry_report", "to_json", "flatten_report"]
 
 def geometry_report(tablet: Tablet) -> dict[str, Any]:
     """Volume, area, dimensions, per-patch figures, seams and nominal deviation.
@@ -80,11 +63,8 @@ def geometry_report(tablet: Tablet) -> dict[str, Any]:
         if dev is None
         else dict(max_deviation_um=dev * 1000.0),
     )
-    _load_sections()
-    for section in _SECTIONS:
-        extra = section(tablet)
-        if extra:
-            rep.update(extra)
+    if isinstance(tablet.nominal, SweepNominal):  # the industry families' design report
+        rep.update(design_report(tablet))
     return rep
 
 

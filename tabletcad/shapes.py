@@ -15,21 +15,22 @@ reachable the thesis's way, by scaling coefficients of a Table 4.1 shape
 from __future__ import annotations
 
 import math
-from typing import Callable
+from types import MappingProxyType
+from typing import Mapping
 
 import numpy as np
 
 from tabletcad import nominal as nom
 from tabletcad.curves import Circle, Curve, Ellipse
 from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.family import Family
 from tabletcad.patch import PDEPatch
 from tabletcad.tablet import Tablet, Trim
 from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = [
-    "FAMILIES",
     "THESIS_FAMILIES",
-    "Family",
+    "THESIS_SHAPES",
     "coaxial_tablet",
     "flat_faced_round",
     "spherical",
@@ -43,7 +44,6 @@ __all__ = [
     "rod",
     "caplet",
     "deep_convex_oval",
-    "register_family",
 ]
 
 
@@ -282,83 +282,14 @@ def deep_convex_oval(width: float = 6.0, length: float = 12.0, thickness: float 
     return replace(t, name="deep_convex_oval", family="deep_convex_oval")
 
 
-# ---------------------------------------------------------------------------- registry
-class Family:
-    """A named constructor with its parameters, units and defaults.
+# ---------------------------------------------------------------------------- catalogue
+#: The thesis's shapes (Tables 4.1 and 4.5, in that order), a static mapping; every parameter in mm.
+#: Every family, these and the industry families, is in :data:`tabletcad.families.FAMILIES`.
+THESIS_SHAPES: Mapping[str, Family] = MappingProxyType({
+    f.__name__: Family.of(f)
+    for f in (flat_faced_round, spherical, shallow_convex_round, shallow_convex_oval, oblong, ring,
+              deep_convex_round, oblate_spheroid, prolate_spheroid, rod, caplet, deep_convex_oval)
+})
 
-    A parameter is *optional* when its default switches a feature off (0 mm:
-    no land, no bevel depth, no blend, a cup as wide as the outline allows, a
-    single-radius cup); every other parameter is a dimension that a design file
-    must give (``required``).
-    """
-
-    def __init__(self, name: str, func: Callable[..., Tablet], params: dict[str, str], doc: str) -> None:
-        self.name = name
-        self.func = func
-        self.params = params  # name -> unit
-        self.doc = doc
-
-    @property
-    def defaults(self) -> dict[str, float]:
-        import inspect
-
-        sig = inspect.signature(self.func)
-        return {k: sig.parameters[k].default for k in self.params}
-
-    @property
-    def required(self) -> tuple[str, ...]:
-        """Parameters a design must give (those whose default is not 0, i.e. real dimensions)."""
-        return tuple(k for k, d in self.defaults.items() if d != 0.0)
-
-    @property
-    def description(self) -> str:
-        """The first paragraph of the constructor's docstring on one line (whole sentences)."""
-        text = (self.func.__doc__ or self.doc or "").strip().split("\n\n")[0]
-        return " ".join(text.replace("``", "").split())
-
-    def build(self, **kw) -> Tablet:
-        unknown = set(kw) - set(self.params) - {"a"}
-        if unknown:
-            k = sorted(unknown)[0]
-            raise DesignError(f"tablet.{k}", kw[k], f"family {self.name!r} takes {', '.join(self.params)}")
-        return self.func(**kw)
-
-
-def _fam(func, **units) -> Family:
-    return Family(func.__name__, func, units, (func.__doc__ or "").strip().splitlines()[0])
-
-
-FAMILIES: dict[str, Family] = {
-    f.name: f
-    for f in [
-        _fam(flat_faced_round, diameter="mm", thickness="mm"),
-        _fam(spherical, diameter="mm"),
-        _fam(shallow_convex_round, diameter="mm", thickness="mm", band="mm"),
-        _fam(shallow_convex_oval, width="mm", length="mm", thickness="mm", band="mm"),
-        _fam(oblong, diameter="mm", length="mm", dome="mm"),
-        _fam(ring, outer_diameter="mm", inner_diameter="mm", thickness="mm"),
-        _fam(deep_convex_round, diameter="mm", thickness="mm", band="mm"),
-        _fam(oblate_spheroid, diameter="mm", height="mm"),
-        _fam(prolate_spheroid, diameter="mm", height="mm"),
-        _fam(rod, diameter="mm", length="mm", dome="mm"),
-        _fam(caplet, width="mm", length="mm", height="mm", band="mm"),
-        _fam(deep_convex_oval, width="mm", length="mm", thickness="mm", band="mm"),
-    ]
-}
-
-
-#: The thesis's shapes, in a fixed order: a static list, whatever else has been imported
-#: (``FAMILIES`` gains the industry families when :mod:`tabletcad.families` loads).
-THESIS_FAMILIES: tuple[str, ...] = tuple(FAMILIES)
-
-
-def register_family(family: Family) -> None:
-    """Make a family available to design files, ``tabletcad shapes`` and the optimiser."""
-    FAMILIES[family.name] = family
-
-
-def _load_plugins() -> None:
-    try:
-        import tabletcad.families  # noqa: F401  (registers the industry families when present)
-    except ImportError:
-        pass
+#: The names of the thesis's shapes, in the order of Tables 4.1 and 4.5.
+THESIS_FAMILIES: tuple[str, ...] = tuple(THESIS_SHAPES)

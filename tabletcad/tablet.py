@@ -23,7 +23,6 @@ from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = ["Trim", "Tablet", "Face", "solid_map"]
 
-TWO_PI = 2.0 * math.pi
 
 
 def _composite_gauss(breaks: np.ndarray, n_total: int) -> tuple[np.ndarray, np.ndarray]:
@@ -32,14 +31,14 @@ def _composite_gauss(breaks: np.ndarray, n_total: int) -> tuple[np.ndarray, np.n
     The integrand is smooth inside each interval, so the rule converges
     spectrally where the trapezoidal rule would only converge algebraically.
     """
-    b = np.sort(np.mod(breaks, TWO_PI))
-    edges = np.concatenate([b, [b[0] + TWO_PI]])
+    b = np.sort(np.mod(breaks, math.tau))
+    edges = np.concatenate([b, [b[0] + math.tau]])
     k = max(12, int(math.ceil(n_total / len(b))))
     x, w = np.polynomial.legendre.leggauss(k)
     lo, hi = edges[:-1, None], edges[1:, None]
     nodes = 0.5 * (hi - lo) * (x + 1.0) + lo
     weights = 0.5 * (hi - lo) * w
-    return np.mod(nodes.ravel(), TWO_PI), weights.ravel()
+    return np.mod(nodes.ravel(), math.tau), weights.ravel()
 
 
 def _split_gauss(t0: float, t1: float, breaks: np.ndarray, n_total: int) -> tuple[np.ndarray, np.ndarray]:
@@ -50,9 +49,9 @@ def _split_gauss(t0: float, t1: float, breaks: np.ndarray, n_total: int) -> tupl
     0.03 % volume error on a 3 rad cut-away of the almond at 256 nodes), one per smooth piece
     spectrally.
     """
-    b = np.mod(np.asarray(breaks, float), TWO_PI)
-    k0, k1 = math.floor((t0 - TWO_PI) / TWO_PI), math.ceil(t1 / TWO_PI) + 1
-    inner = np.unique(np.concatenate([b + TWO_PI * k for k in range(k0, k1)]))
+    b = np.mod(np.asarray(breaks, float), math.tau)
+    k0, k1 = math.floor((t0 - math.tau) / math.tau), math.ceil(t1 / math.tau) + 1
+    inner = np.unique(np.concatenate([b + math.tau * k for k in range(k0, k1)]))
     span = t1 - t0
     inner = inner[(inner > t0 + 1e-12 * span) & (inner < t1 - 1e-12 * span)]
     edges = np.concatenate([[t0], inner, [t1]])
@@ -77,7 +76,7 @@ class Trim:
     """
 
     u: tuple[float, float] = (0.0, 1.0)
-    v: tuple[float, float] = (0.0, TWO_PI)
+    v: tuple[float, float] = (0.0, math.tau)
     w: tuple[float, float] = (0.0, 1.0)
 
     def __post_init__(self) -> None:
@@ -87,7 +86,7 @@ class Trim:
             if not lo < hi:
                 raise DesignError(f"trim {name}", (lo, hi), "must be an increasing pair within [0, 1]")
         v0, v1 = (float(x) for x in self.v)
-        if not (math.isfinite(v0) and math.isfinite(v1) and 0.0 < v1 - v0 <= TWO_PI + 1e-12):
+        if not (math.isfinite(v0) and math.isfinite(v1) and 0.0 < v1 - v0 <= math.tau + 1e-12):
             raise DesignError("trim v", self.v, "must be an increasing pair spanning at most 2π rad")
         object.__setattr__(self, "u", tuple(float(x) for x in self.u))
         object.__setattr__(self, "v", (v0, v1))
@@ -95,7 +94,7 @@ class Trim:
 
     @property
     def full_v(self) -> bool:
-        return self.v[1] - self.v[0] >= TWO_PI - 1e-12
+        return self.v[1] - self.v[0] >= math.tau - 1e-12
 
 
 def solid_map(patch: PDEPatch, u, v, w, du: int = 0, dv: int = 0, dw: int = 0) -> np.ndarray:
@@ -229,14 +228,14 @@ class Tablet:
             return False
         a = self.patches[i]
         b = self.patches[j]
-        v = np.linspace(0.0, TWO_PI, 64, endpoint=False)
+        v = np.linspace(0.0, math.tau, 64, endpoint=False)
         xa = a.evaluate(float(end), v)
         xb = b.evaluate(float(1 - end), v)
         scale = max(1.0, float(np.max(np.abs(xa))))
         return float(np.max(np.linalg.norm(xa - xb, axis=1))) <= 1e-9 * scale
 
     def _end_is_point(self, i: int, end: int) -> bool:
-        v = np.linspace(0.0, TWO_PI, 64, endpoint=False)
+        v = np.linspace(0.0, math.tau, 64, endpoint=False)
         x = self.patches[i].evaluate(float(end), v)
         return float(np.max(np.ptp(x, axis=0))) <= 1e-12 * max(1.0, float(np.max(np.abs(x))))
 
@@ -272,8 +271,8 @@ class Tablet:
         if face.periodic_t and bps.size:
             t, tw = _composite_gauss(bps, nv)
         elif face.periodic_t:
-            t = t0 + np.arange(nv) * (TWO_PI / nv)
-            tw = np.full(nv, TWO_PI / nv)
+            t = t0 + np.arange(nv) * (math.tau / nv)
+            tw = np.full(nv, math.tau / nv)
         elif bps.size:  # a trimmed v range: Gauss-Legendre per smooth piece between the outline's joins
             t, tw = _split_gauss(t0, t1, bps, nv if face.kind == "w" else max(nv // 4, 32))
         else:
@@ -356,7 +355,7 @@ class Tablet:
         r = np.hypot(d[..., 0], d[..., 1])
         i = np.argmax(r, axis=1)  # farthest point along each v line: (patches, nv)
         m = 4 * nv
-        grid = (np.arange(m) + 0.5) * (TWO_PI / m) - math.pi
+        grid = (np.arange(m) + 0.5) * (math.tau / m) - math.pi
         env_full = np.zeros(m)
         cols = np.arange(nv)
         for j, p in enumerate(self.patches):  # each patch's outer curve r_j(φ), then the envelope over patches
@@ -372,7 +371,7 @@ class Tablet:
                 continue
             phi = np.arctan2(dd[keep, 1], dd[keep, 0])
             order = np.argsort(phi)
-            env_full = np.maximum(env_full, np.interp(grid, phi[order], rr[keep][order], period=TWO_PI))
+            env_full = np.maximum(env_full, np.interp(grid, phi[order], rr[keep][order], period=math.tau))
         hole = 0.0
         if self.trim.w[0] > 0.0:  # hollow solid (ring): subtract the see-through hole
             A = np.stack([p.spine(np.linspace(self.trim.u[0], self.trim.u[1], nu)) for p in self.patches])
@@ -381,8 +380,8 @@ class Tablet:
             di = inner[0, 0, :, :2] - c
             phi = np.arctan2(di[:, 1], di[:, 0])
             order = np.argsort(phi)
-            hole = 0.5 * float(np.sum(np.interp(grid, phi[order], ri[order], period=TWO_PI) ** 2)) * (TWO_PI / m)
-        return float(0.5 * np.sum(env_full**2) * (TWO_PI / m)) - hole
+            hole = 0.5 * float(np.sum(np.interp(grid, phi[order], ri[order], period=math.tau) ** 2)) * (math.tau / m)
+        return float(0.5 * np.sum(env_full**2) * (math.tau / m)) - hole
 
     def _farthest_along_u(self, p: PDEPatch, c: np.ndarray, u0: np.ndarray, v: np.ndarray, best: np.ndarray, h: float):
         """Newton polish of ``max_u |X_xy(u, v) - c|²`` from the samples ``u0`` (one per ``v``).
@@ -432,8 +431,8 @@ class Tablet:
         w = 0.5 * (t.w[1] - t.w[0]) * (xw + 1) + t.w[0]
         wwt = 0.5 * (t.w[1] - t.w[0]) * ww
         if t.full_v:
-            v = np.arange(nv) * (TWO_PI / nv) + t.v[0]
-            vw = np.full(nv, TWO_PI / nv)
+            v = np.arange(nv) * (math.tau / nv) + t.v[0]
+            vw = np.full(nv, math.tau / nv)
         else:
             xv, wv = np.polynomial.legendre.leggauss(nv)
             v = 0.5 * (t.v[1] - t.v[0]) * (xv + 1) + t.v[0]
@@ -537,7 +536,7 @@ class Tablet:
         """For every curve shared by consecutive patches: largest gap (mm) and
         largest angle (deg) between the two patches' normals."""
         out = []
-        v = np.linspace(0.0, TWO_PI, nv, endpoint=False)
+        v = np.linspace(0.0, math.tau, nv, endpoint=False)
         for i in range(len(self.patches) - 1):
             a, b = self.patches[i], self.patches[i + 1]
             xa, xb = a.evaluate(1.0, v), b.evaluate(0.0, v)

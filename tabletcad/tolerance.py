@@ -73,6 +73,16 @@ class Tolerances:
         Relative margin kept below a smooth (spline) outline's smallest radius of
         curvature by the inward offsets of a cup: at exactly that radius the offset
         stands still at one point (a singular rim that B-spline faces fold over).
+    mesh_deflection : float
+        Linear deflection (mm) of the triangle meshes of solids: the largest distance
+        between a triangle and its face (STL, GLB, the mesh checks, the tooling's
+        manifold3d cross-checks).
+    mesh_angle : float
+        Angular deflection (rad) of those meshes: the largest angle between
+        neighbouring triangles' normals along a face.
+    brep_agreement : float
+        Largest relative difference allowed between a B-rep solid's volume or area
+        (OCC mass properties) and the core's quadrature of the same tablet.
     mesh_volume : float
         Relative difference between a hexahedral mesh's volume and the solid's exact
         volume above which ``tabletcad mesh`` warns (straight-edged cells cut the
@@ -96,6 +106,9 @@ class Tolerances:
     memory_fraction: float = 0.5
     mesh_bytes_per_node: int = 200
     offset_regularity: float = 1e-2
+    mesh_deflection: float = 0.005
+    mesh_angle: float = 0.2
+    brep_agreement: float = 1e-6
     mesh_volume: float = 1e-2
 
 

@@ -196,7 +196,7 @@ def kit():
 @pytest.fixture(scope="session")
 def family_tablet():
     """``family_tablet(name)``: the default tablet of a shape family, built once per session."""
-    from tabletcad.shapes import FAMILIES
+    from tabletcad.families import FAMILIES
 
     cache: dict[str, object] = {}
 

@@ -135,12 +135,11 @@ def test_rounded_square_cupped_to_its_corner_radius_is_cut_at_the_corners():
     """Rounded square, cup width = corner radius (the default): the rim's corner arcs collapse
     to points; the chain is cut at the 8 outline junctions and each corner piece of the rim
     rows is a single pole at the corner arc's centre (offset by the corner radius)."""
-    from tabletcad import shapes
+    from tabletcad import families
     from tabletcad.cad.tablet_solid import fit_options, tablet_surface_functions
 
-    shapes._load_plugins()
     side, rc = 9.0, 1.5
-    t = shapes.FAMILIES["rounded_square"].build(side=side, corner_radius=rc)
+    t = families.FAMILIES["rounded_square"].build(side=side, corner_radius=rc)
     funcs, names = tablet_surface_functions(t)
     fits = fit_patches(funcs, t.tol.fit, names=names, **fit_options(t))
     surfaces = [f.surface for f in fits]

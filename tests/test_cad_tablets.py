@@ -346,7 +346,7 @@ def _check_random(t, genus: int) -> None:
 @settings(max_examples=4, deadline=None)
 @given(D=st.floats(5.0, 12.0), T=st.floats(2.0, 5.0), frac=st.floats(0.4, 0.9))
 def test_random_shallow_convex_round(D, T, frac):
-    from tabletcad.shapes import FAMILIES
+    from tabletcad.families import FAMILIES
 
     _check_random(FAMILIES["shallow_convex_round"].build(diameter=D, thickness=T, band=frac * T), 0)
 
@@ -354,7 +354,7 @@ def test_random_shallow_convex_round(D, T, frac):
 @settings(max_examples=3, deadline=None)
 @given(D=st.floats(2.0, 12.0))
 def test_random_spherical(D):
-    from tabletcad.shapes import FAMILIES
+    from tabletcad.families import FAMILIES
 
     _check_random(FAMILIES["spherical"].build(diameter=D), 0)
 
@@ -362,7 +362,7 @@ def test_random_spherical(D):
 @settings(max_examples=3, deadline=None)
 @given(OD=st.floats(6.0, 14.0), frac=st.floats(0.2, 0.7), T=st.floats(1.5, 6.0))
 def test_random_ring(OD, frac, T):
-    from tabletcad.shapes import FAMILIES
+    from tabletcad.families import FAMILIES
 
     _check_random(FAMILIES["ring"].build(outer_diameter=OD, inner_diameter=frac * OD, thickness=T), 1)
 

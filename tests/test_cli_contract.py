@@ -24,11 +24,10 @@ import tabletcad.cli as cli_mod
 from tabletcad.cli import main
 from tabletcad.design import design_from_dict
 from tabletcad.errors import DesignError
-from tabletcad.shapes import FAMILIES, _load_plugins
+from tabletcad.families import FAMILIES
 
 ROOT = Path(__file__).resolve().parents[1]
 ONE_LINE = re.compile(r"^error: \S+ = .+ is not allowed: .+$")
-_load_plugins()
 
 
 def run(capsys, *args) -> tuple[int, str, str]:
@@ -368,7 +367,7 @@ def test_ctrl_c_while_an_extension_initialises_is_an_interrupt(tmp_path, capsys,
         except KeyboardInterrupt as exc:
             raise ImportError("initialization failed") from exc
 
-    class InterruptedFinder:  # the real tabletcad.build._load_optional_stages meets the interrupted import
+    class InterruptedFinder:  # the build's import of the CAD stage meets the interrupted import
         def find_spec(self, name, path=None, target=None):
             if name == "tabletcad.cad.stage":
                 interrupted_import()
@@ -381,7 +380,7 @@ def test_ctrl_c_while_an_extension_initialises_is_an_interrupt(tmp_path, capsys,
     rc, _, err = run(capsys, "build", str(ROOT / "samples" / "spherical.toml"), "--out", str(out))
     assert (rc, err) == (130, "interrupted\n") and not out.exists()
     # and the same ImportError anywhere else in a command
-    monkeypatch.setattr(tabletcad.build, "_load_optional_stages", interrupted_import)
+    monkeypatch.setattr(tabletcad.build, "geometry_report", lambda *a, **k: interrupted_import())
     rc, _, err = run(capsys, "build", str(ROOT / "samples" / "spherical.toml"), "--out", str(out))
     assert (rc, err) == (130, "interrupted\n") and not out.exists()
     assert not (tmp_path / "cache").exists()  # no internal-error log

@@ -26,7 +26,7 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from tabletcad.cli import main
-from tabletcad.shapes import FAMILIES, _load_plugins
+from tabletcad.families import FAMILIES
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -35,7 +35,6 @@ else:  # pragma: no cover
 
 ROOT = Path(__file__).resolve().parents[1]
 ONE_LINE = re.compile(r"^error: \S+ = .+ is not allowed: .+$")
-_load_plugins()
 FAMILY_NAMES = sorted(FAMILIES)
 PARAM_NAMES = sorted({k for f in FAMILIES.values() for k in f.params} | {"a", "name", "outline", "segments"})
 

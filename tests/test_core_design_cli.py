@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tabletcad import reshape, shapes
+from tabletcad import families, reshape, shapes
 from tabletcad.cli import main
 from tabletcad.design import design_from_dict, load_design
 from tabletcad.errors import DesignError
@@ -23,17 +23,9 @@ SAMPLES = sorted(p for p in (ROOT / "samples").glob("*.toml"))
 
 def _core_only_build(tablet, out):
     """Build without the optional CAD stages (they have their own tests)."""
-    from tabletcad import build
+    from tabletcad.build import build_tablet
 
-    saved = list(build._STAGES)
-    build._STAGES.clear()
-    old = build._load_optional_stages
-    build._load_optional_stages = lambda: None
-    try:
-        return build.build_tablet(tablet, out, progress=False)
-    finally:
-        build._STAGES[:] = saved
-        build._load_optional_stages = old
+    return build_tablet(tablet, out, cad=False, progress=False)
 
 
 @pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
@@ -136,7 +128,7 @@ def test_cli_mesh_and_shapes(tmp_path):
     assert not (tmp_path / "x.vtu").exists() and not (tmp_path / "x.obj").exists()
     r = _run_cli(["shapes"], tmp_path)
     assert r.returncode == 0
-    for name in shapes.FAMILIES:
+    for name in families.FAMILIES:
         assert name in r.stdout
 
 

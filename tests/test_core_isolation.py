@@ -32,8 +32,8 @@ for b in BLOCKED:
     else:
         raise SystemExit(f"blocking failed for {{b}}")
 
-import tabletcad, tabletcad.patch, tabletcad.tablet, tabletcad.shapes, tabletcad.curves, tabletcad.basis
-t = tabletcad.shapes.FAMILIES["{family}"].build()
+import tabletcad, tabletcad.patch, tabletcad.tablet, tabletcad.shapes, tabletcad.families, tabletcad.curves, tabletcad.basis
+t = tabletcad.families.FAMILIES["{family}"].build()
 v = t.properties()["volume_mm3"]
 loaded = sorted(m for m in sys.modules if m.split(".")[0] in BLOCKED)
 assert not loaded, loaded
@@ -50,7 +50,7 @@ def _run(python: str, family: str = "spherical", blocked=BLOCKED) -> float:
 
 
 def _volume_here(family: str) -> float:
-    from tabletcad.shapes import FAMILIES
+    from tabletcad.families import FAMILIES
 
     return FAMILIES[family].build().properties()["volume_mm3"]
 

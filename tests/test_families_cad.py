@@ -171,10 +171,9 @@ def test_collapsed_rim_plateau_is_fan_plus_ring():
 
 
 def _family_cases():
-    from tabletcad import shapes
+    from tabletcad import families
 
-    shapes._load_plugins()
-    cases = [(name, {}) for name in sorted(shapes.FAMILIES)]
+    cases = [(name, {}) for name in sorted(families.FAMILIES)]
     # the rounded polygons in both regimes: cup narrower than the corner radius (regular rim)
     # and the default, cupped exactly to it (collapsed rim corners)
     cases += [("rounded_square", {"corner_radius": 2.5, "cup_width": 1.0}),
@@ -186,12 +185,12 @@ def _family_cases():
 
 @pytest.mark.parametrize("family, params", _family_cases(), ids=lambda x: x if isinstance(x, str) else str(x))
 def test_every_family_builds_a_valid_solid(family, params):
-    """Each registered family with its default dimensions (and the rounded polygons and capsule
+    """Each catalogued family with its default dimensions (and the rounded polygons and capsule
     in other regimes) is one valid closed solid whose OCCT volume and area equal the core
     quadrature and the exact volume of its B-spline faces."""
-    from tabletcad import shapes
+    from tabletcad import families
 
-    t = shapes.FAMILIES[family].build(**params)
+    t = families.FAMILIES[family].build(**params)
     s = tablet_solid(t)
     check_solid(s.shape, t.name)
     assert len(explore(s.shape, "Solid")) == 1 and len(explore(s.shape, "Shell")) == 1

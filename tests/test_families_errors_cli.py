@@ -158,7 +158,7 @@ def test_cli_report_writes_json_with_units(tmp_path, capsys):
     assert all("g1" in s and "expected_sharp" in s for s in rep["seams"])
 
 
-def test_registered_report_section_in_geometry_report():
+def test_design_report_is_part_of_the_geometry_report():
     from tabletcad.report import geometry_report
 
     rep = geometry_report(F.compound_cup())

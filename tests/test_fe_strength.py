@@ -76,7 +76,8 @@ def test_design_report_accepts_the_fe_inputs_in_report():
 def test_fe_objective_and_constraint_in_an_optimisation_problem():
     """The coarse-mesh FE prediction plugs into tabletcad.optimise; one evaluation, checked against the API."""
     from tabletcad.families import flat_face_round
-    from tabletcad.fe.objective import breaking_force, breaking_force_constraint, breaking_force_objective
+    from tabletcad.fe.objective import breaking_force
+    from tabletcad.optimise.strength import breaking_force_constraint, breaking_force_objective
     from tabletcad.optimise.problem import Evaluator, Problem, Variable
 
     prob = Problem(

@@ -186,12 +186,11 @@ def _run(exe: tuple[str, ...], script: Path, home: Path, work: Path, timeout: fl
 
 def _core_volume(family: str | None, params: dict | None = None, design: Path | None = None) -> float:
     """tabletcad's own report value (volume_mm3) in this (venv) Python."""
-    from tabletcad import shapes
+    from tabletcad import families
     from tabletcad.design import load_design
     from tabletcad.report import geometry_report
 
-    shapes._load_plugins()
-    tablet = load_design(design) if design else shapes.FAMILIES[family].build(**(params or {}))
+    tablet = load_design(design) if design else families.FAMILIES[family].build(**(params or {}))
     return geometry_report(tablet)["volume_mm3"]
 
 
@@ -279,11 +278,10 @@ def test_capsule_die_bore_is_the_exact_outline_offset(headless):
     """The workbench's die bore follows the capsule's exact outline (lines and arcs) offset by
     the clearance: die volume = pi R^2 H - (A + P c + pi c^2) H (Steiner), A and P from the
     core's outline; the punches carry the cup faces cut into four pieces each (tabletcad.slit)."""
-    from tabletcad import shapes
+    from tabletcad import families
 
-    shapes._load_plugins()
     (step,) = [s for s in _steps(headless, "tooling") if s["family"] == "capsule"]
-    A, P = _outline_area_perimeter(shapes.FAMILIES["capsule"].build().nominal.outline.segs)
+    A, P = _outline_area_perimeter(families.FAMILIES["capsule"].build().nominal.outline.segs)
     c, H, OD = 0.05, 22.22, 30.16  # the Die object's defaults (TSM B)
     expected = math.pi * (OD / 2) ** 2 * H - (A + P * c + math.pi * c * c) * H
     assert step["die"]["volume"] == pytest.approx(expected, rel=1e-9)
@@ -341,9 +339,8 @@ def test_properties_finite_in_user_units_and_internal_data_hidden(headless):
     """Every property of every tablet finite; lengths/areas/volumes are mm-based quantities,
     Weight (mg) and Density (mg/mm^3) plain numbers; RimData hidden and read-only; PlanArea
     exact: pi D^2/4 for round outlines, the annulus for the ring, Green's area for the capsule."""
-    from tabletcad import shapes
+    from tabletcad import families
 
-    shapes._load_plugins()
     for step in _steps(headless, "create"):
         t = step["tablet"]
         for name, v in t["props"].items():
@@ -360,13 +357,13 @@ def test_properties_finite_in_user_units_and_internal_data_hidden(headless):
         assert t["props"]["Density"] == pytest.approx(1.2) and t["weight_mg"] > 0
         assert sorted(t["rimdata_mode"]) == ["Hidden", "ReadOnly"]
         fam, params = step["family"], FAMILIES[step["family"]]
-        d = params.get("diameter", shapes.FAMILIES[fam].defaults.get("diameter"))
+        d = params.get("diameter", families.FAMILIES[fam].defaults.get("diameter"))
         if fam == "ring":
-            d = shapes.FAMILIES[fam].defaults["outer_diameter"]
-            r = shapes.FAMILIES[fam].defaults["inner_diameter"] / 2
+            d = families.FAMILIES[fam].defaults["outer_diameter"]
+            r = families.FAMILIES[fam].defaults["inner_diameter"] / 2
             assert t["plan_area"] == pytest.approx(math.pi * ((d / 2) ** 2 - r * r), rel=1e-6)
         elif fam == "capsule":
-            A, _ = _outline_area_perimeter(shapes.FAMILIES["capsule"].build().nominal.outline.segs)
+            A, _ = _outline_area_perimeter(families.FAMILIES["capsule"].build().nominal.outline.segs)
             assert t["plan_area"] == pytest.approx(A, rel=1e-6)
         elif d is not None:
             assert t["plan_area"] == pytest.approx(math.pi * d * d / 4, rel=1e-6), fam
@@ -396,10 +393,9 @@ def test_task_panel_form(headless):
     """The panel's form: the family's fields with units and ranges, the core's verdict as you
     type (its one-line message when refused), key figures that match the core, a tablet with
     its tooling from the form, and an edit that switches the family."""
-    from tabletcad import shapes
+    from tabletcad import families
 
-    shapes._load_plugins()
-    fam = shapes.FAMILIES["concave_round"]
+    fam = families.FAMILIES["concave_round"]
     (st,) = _steps(headless, "form")
     assert [f[:3] for f in st["fields"]] == [[k, k.title().replace("_", ""), u] for k, u in fam.params.items()]
     assert [f[5] for f in st["fields"]] == [fam.defaults[k] for k in fam.params]
@@ -422,11 +418,10 @@ def test_task_panel_form(headless):
 def test_techdraw_page_with_main_dimensions(headless):
     """A TechDraw page of the capsule: top and side views on FreeCAD's A4 template and extent
     dimensions equal to the core's length, width and height."""
-    from tabletcad import shapes
+    from tabletcad import families
 
-    shapes._load_plugins()
     (st,) = _steps(headless, "drawing")
-    dims = shapes.FAMILIES["capsule"].build().dimensions()
+    dims = families.FAMILIES["capsule"].build().dimensions()
     assert st["page"] == "TechDraw::DrawPage" and st["template"].startswith("A4_Landscape")
     assert [v[1] for v in st["views"]] == [[0.0, 0.0, 1.0], [0.0, -1.0, 0.0]] and all(v[2] for v in st["views"])
     for key in ("length", "width", "height"):
@@ -609,19 +604,18 @@ def test_gui_smoke_and_screenshot(fc, fc_home, tmp_path):
         assert part["valid"]
         assert all(c == pytest.approx(list(PART_COLOURS[name]), abs=0.01) for c in part["colours"]), (name, part)
     # task panel: shown by the Tablet command, fields of the family with units, live validation
-    from tabletcad import shapes
+    from tabletcad import families
 
-    shapes._load_plugins()
-    assert r["panel_shown"] and r["panel_fields"] == sorted(shapes.FAMILIES["concave_round"].params)
+    assert r["panel_shown"] and r["panel_fields"] == sorted(families.FAMILIES["concave_round"].params)
     assert r["panel_suffix"] == " mm"
     assert r["panel_invalid"][0] is False and "cup_depth" in r["panel_invalid"][1] and "hemisphere" in r["panel_invalid"][1]
     assert r["panel_valid"][0] is True and "Volume" in r["panel_valid"][2] and "mg" in r["panel_valid"][2]
     assert r["panel_accept"] and r["panel_closed"]
     assert r["panel_tablet"] == ["concave_round", 1.0, True]
     # the TechDraw page of the concave round tablet: length, width and height as the core has them
-    from tabletcad import shapes as _shapes
+    from tabletcad import families as _families
 
-    core_dims = _shapes.FAMILIES["concave_round"].build(cup_depth=1.0).dimensions()
+    core_dims = _families.FAMILIES["concave_round"].build(cup_depth=1.0).dimensions()
     assert sorted(r["drawing"]) == ["concave_round height", "concave_round length", "concave_round width"]
     for key, value in r["drawing"].items():
         # TechDraw's extent of the projected edges: 1.0 measured 3.1e-6 mm off on the diameter

@@ -18,7 +18,7 @@ from tabletcad.design import load_design  # noqa: E402
 from tabletcad.errors import DesignError, GeometryError  # noqa: E402
 from tabletcad.shapes import shallow_convex_round  # noqa: E402
 from tabletcad.tooling import EmbossSpec, ScoreSpec, ToolingSpec, make_tooling, parse_tooling, tooling_batch  # noqa: E402
-from tabletcad.tooling.stage import read_tooling_table  # noqa: E402
+from tabletcad.tooling.stage import tooling_spec  # noqa: E402
 
 pytestmark = pytest.mark.cad
 
@@ -155,7 +155,7 @@ def test_capsule_sample_tooling():
         solid = tablet_solid(t)
     except GeometryError as exc:  # the B-rep of elongated families is not built yet by the CAD layer
         pytest.xfail(f"capsule B-rep: {exc}")
-    ts = make_tooling(t, parse_tooling(read_tooling_table(SAMPLES / "capsule.toml")), shape=solid.shape)
+    ts = make_tooling(t, tooling_spec(t), shape=solid.shape)
     assert ts.report["interference_mm3"] == pytest.approx(0.0, abs=1e-9)
 
 

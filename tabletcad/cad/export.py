@@ -35,10 +35,11 @@ from tabletcad.cad._occ import quiet
 from tabletcad.cad.mesh import MeshResult, tessellate
 from tabletcad.errors import GeometryError
 from tabletcad.io import atomic_path
+from tabletcad.tolerance import DEFAULT
 
 __all__ = ["export", "export_step", "export_stl", "export_3mf", "export_glb", "export_brep", "SUFFIXES"]
 
-MESH_DEFAULTS = {"linear_deflection": 0.005, "angular_deflection": 0.2}
+MESH_DEFAULTS = {"linear_deflection": DEFAULT.mesh_deflection, "angular_deflection": DEFAULT.mesh_angle}
 
 
 def _shape_of(obj: Any) -> TopoDS_Shape:

@@ -25,6 +25,7 @@ from scipy.spatial import cKDTree
 
 from tabletcad.cad._occ import explore
 from tabletcad.errors import GeometryError
+from tabletcad.tolerance import DEFAULT
 
 __all__ = ["MeshResult", "tessellate", "triangulate", "MESH_ALGOS"]
 
@@ -109,8 +110,8 @@ def _face_arrays(face) -> tuple[np.ndarray, np.ndarray]:
 
 def triangulate(
     shape: TopoDS_Shape,
-    linear_deflection: float = 0.005,
-    angular_deflection: float = 0.2,
+    linear_deflection: float = DEFAULT.mesh_deflection,
+    angular_deflection: float = DEFAULT.mesh_angle,
     *,
     relative: bool = False,
     weld_tol: float = 1e-7,
@@ -201,8 +202,8 @@ def _trimesh_check(V: np.ndarray, T: np.ndarray) -> tuple[bool, bool]:
 
 def tessellate(
     shape: TopoDS_Shape,
-    linear_deflection: float = 0.005,
-    angular_deflection: float = 0.2,
+    linear_deflection: float = DEFAULT.mesh_deflection,
+    angular_deflection: float = DEFAULT.mesh_angle,
     *,
     relative: bool = False,
     weld_tol: float = 1e-7,

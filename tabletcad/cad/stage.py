@@ -1,6 +1,6 @@
 """The CAD stage of ``tabletcad build``: solid, checks, STEP/STL/GLB, report sections.
 
-Registered with :func:`tabletcad.build.register_stage` on import.  It adds to
+:func:`tabletcad.build.build_tablet` calls :func:`cad_stage`, which adds to
 ``report.json``:
 
 * ``brep``: ``valid``, ``volume_mm3`` and ``surface_area_mm2`` (adaptive OCC
@@ -21,17 +21,15 @@ from pathlib import Path
 import numpy as np
 from typing import Any
 
-import OCP  # noqa: F401  (no OpenCascade: ImportError, and the build writes the core outputs only)
-
-from tabletcad.build import register_stage
 from tabletcad.errors import GeometryError
 from tabletcad.tablet import Tablet
+from tabletcad.tolerance import DEFAULT
 
 __all__ = ["cad_stage", "check_tablet_solid", "MESH_LINEAR_MM", "MESH_ANGULAR_RAD", "AGREEMENT_REL"]
 
-MESH_LINEAR_MM = 0.005
-MESH_ANGULAR_RAD = 0.2
-AGREEMENT_REL = 1e-6
+MESH_LINEAR_MM = DEFAULT.mesh_deflection
+MESH_ANGULAR_RAD = DEFAULT.mesh_angle
+AGREEMENT_REL = DEFAULT.brep_agreement
 
 
 def check_tablet_solid(tablet: Tablet, report: dict[str, Any] | None = None):
@@ -218,8 +216,12 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
     return shape, mesh, sections
 
 
-def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any], design_path=None) -> None:
-    """Write ``tablet.step``, ``tablet.stl`` and ``tablet.glb`` into ``out`` and extend ``report``."""
+def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any]):
+    """Write ``tablet.step``, ``tablet.stl`` and ``tablet.glb`` into ``out`` and extend ``report``.
+
+    Returns the ``TopoDS_Shape`` written (the solid, or its cut-away), or None when no solid
+    is built (a cut-away of a kind the CAD layer does not make: the report says why).
+    """
     from tabletcad.cad.export import export
 
     t = tablet.trim
@@ -227,24 +229,16 @@ def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any], design_path=
         cut = cutaway_solid(tablet, report)
         if isinstance(cut, str):
             report["brep"] = dict(valid=None, skipped=f"cut-away view: {cut}; picture only")
-            return
-        solid, mesh, sections = cut
+            return None
+        shape, mesh, sections = cut
     else:
         solid, mesh, sections = check_tablet_solid(tablet, report)
+        shape = solid.shape
     t0 = time.perf_counter()
-    export(solid, out / "tablet.step", name=tablet.name)
+    export(shape, out / "tablet.step", name=tablet.name)
     if mesh is not None:  # a cut-away whose tessellation failed its checks writes the STEP only
-        export(solid, out / "tablet.stl", name=tablet.name, mesh=mesh)
-        export(solid, out / "tablet.glb", name=tablet.name, mesh=mesh)
+        export(shape, out / "tablet.stl", name=tablet.name, mesh=mesh)
+        export(shape, out / "tablet.glb", name=tablet.name, mesh=mesh)
     sections["brep"]["export_seconds"] = time.perf_counter() - t0
     report.update(sections)
-
-
-register_stage("cad", cad_stage)
-
-try:  # the tooling stage (punches, die, drawings) registers itself after the CAD stage
-    import tabletcad.tooling.stage  # noqa: F401,E402
-except ImportError as _exc:  # pragma: no cover - tooling is optional
-    from tabletcad.errors import reraise_interrupt
-
-    reraise_interrupt(_exc)
+    return shape

@@ -13,7 +13,6 @@ pictures and meshes, not B-rep exports, and are refused here.
 
 from __future__ import annotations
 
-import weakref
 from typing import Any, Callable
 
 import numpy as np
@@ -126,27 +125,14 @@ def fit_options(tablet: Tablet, **kwargs: Any) -> dict[str, Any]:
     return kwargs
 
 
-# the last default build, for the stages of one `tabletcad build` (the CAD stage and the
-# tooling stage both need the solid): one slot, held only while the tablet lives
-_LAST: list = [None, None]
-
-
 def tablet_solid(tablet: Tablet, tol: float | None = None, **kwargs: Any):
     """Fit, sew and validate the tablet's solid; returns a :class:`~tabletcad.cad.solid.TabletSolid`.
 
     ``tol`` is the largest allowed distance (mm) between each B-spline face
-    and its PDE surface (default ``tablet.tol.fit``).  With the defaults (no
-    ``tol``, no keyword arguments) the result for the same tablet object is
-    reused by the next call (one slot; the solid is immutable once built).
+    and its PDE surface (default ``tablet.tol.fit``).
     """
     from tabletcad.cad.solid import build_solid
 
-    default = tol is None and not kwargs
-    if default and _LAST[0] is not None and _LAST[0]() is tablet:
-        return _LAST[1]
     funcs, names = tablet_surface_functions(tablet)
-    solid = build_solid(funcs, tablet.tol.fit if tol is None else tol, name=tablet.name, names=names,
-                        **fit_options(tablet, **kwargs))
-    if default:
-        _LAST[:] = [weakref.ref(tablet), solid]
-    return solid
+    return build_solid(funcs, tablet.tol.fit if tol is None else tol, name=tablet.name, names=names,
+                       **fit_options(tablet, **kwargs))

@@ -195,10 +195,9 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
     E = 206000.0 if E is None else check_positive("--E", E, "MPa")
     _require_fe()
     from tabletcad.fe.punch import punch_stress, punch_tip_solid
-    from tabletcad.tooling.stage import read_tooling_table
 
     tablet, _ = load_family_design(design)
-    shape, tip = punch_tip_solid(tablet, read_tooling_table(design), which)
+    shape, tip = punch_tip_solid(tablet, tablet.extras.get("tooling"), which)
     res = punch_stress(shape, tip, force, which, yield_MPa=yield_stress, safety_factor=safety_factor, E=E,
                        mesh_size=mesh_size, effective_length_factor=effective_length_factor)
     payload = {"design": str(design), "steel": steel, **res.to_dict()}

@@ -21,9 +21,8 @@ def shapes_cmd(as_json: bool) -> None:
     """List the tablet families: required and optional parameters (units, defaults) and what each is."""
     import textwrap
 
-    from tabletcad.shapes import FAMILIES, _load_plugins
+    from tabletcad.families import FAMILIES
 
-    _load_plugins()
     if as_json:
         click.echo(json.dumps({n: dict(params=f.params, required=list(f.required),
                                        optional=[k for k in f.params if k not in f.required],

@@ -85,8 +85,7 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
                     from tabletcad.build import build_tablet
 
                     try:
-                        rep = build_tablet(written_tablet, staging / "tablet", design_path=staging / name,
-                                           progress=not quiet)
+                        rep = build_tablet(written_tablet, staging / "tablet", progress=not quiet)
                         report["built_design"] = dict(folder="tablet", volume_mm3=rep.get("volume_mm3"),
                                                       surface_area_mm2=rep.get("surface_area_mm2"))
                         written.append("tablet/")

@@ -28,7 +28,7 @@ __all__ = ["COMMANDS", "load_family_design"]
 def load_family_design(path: Path):
     """Read a design file; return ``(tablet, report_table)``.
 
-    Besides the registered families, ``family = "custom_outline"`` is read
+    Besides the families of :data:`tabletcad.families.FAMILIES`, ``family = "custom_outline"`` is read
     here with ``outline = [[x, y], ...]`` (points, mm) or ``segments = [...]``
     (``["line", [x0, y0], [x1, y1]]`` / ``["arc", [cx, cy], r, theta0, sweep]``,
     angles in rad) plus the keys of :func:`tabletcad.families.outline_tablet`.

@@ -1,9 +1,10 @@
-"""Tablet shapes that industry presses, as families with exact nominal geometry.
+"""Tablet shapes that industry presses, as families with exact nominal geometry, and the
+catalogue of every family.
 
-Importing this package registers every family with
-:func:`tabletcad.shapes.register_family` (so design files, ``tabletcad shapes``
-and the optimiser see them) and the design report with
-:func:`tabletcad.report.register_report_section`.
+:data:`FAMILIES` is the static mapping from a family's name to its
+:class:`~tabletcad.family.Family`: the thesis's shapes
+(:data:`tabletcad.shapes.THESIS_SHAPES`) and the industry families below.  Design
+files, ``tabletcad shapes``, sweeps and the optimiser read it.
 
 Each family builds a nominal description (a face profile of lines and arcs
 revolved about the axis or swept along inward offsets of a plan outline, see
@@ -33,13 +34,20 @@ Any other plan outline (points or lines and arcs): :func:`outline_tablet`.
 
 from __future__ import annotations
 
+from types import MappingProxyType
+from typing import Mapping
+
 from tabletcad.families.elongated import capsule, modified_capsule, oval
 from tabletcad.families.round import compound_cup, concave_bevel, concave_round, ffbe, ffre, flat_face_round
 from tabletcad.families.shaped import almond, outline_tablet, rounded_rectangle, rounded_square, rounded_triangle
 from tabletcad.families.sweep import certify, nominal_volume, sweep_properties
+from tabletcad.family import Family
+from tabletcad.shapes import THESIS_SHAPES
 
 __all__ = [
+    "FAMILIES",
     "FAMILY_FUNCTIONS",
+    "INDUSTRY_FAMILIES",
     "almond",
     "capsule",
     "certify",
@@ -67,20 +75,10 @@ FAMILY_FUNCTIONS = (
     rounded_triangle, rounded_square, rounded_rectangle,
 )
 
+#: The industry families' names, in the order of the table above.
+INDUSTRY_FAMILIES: tuple[str, ...] = tuple(f.__name__ for f in FAMILY_FUNCTIONS)
 
-def _register() -> None:
-    import inspect
-
-    from tabletcad.report import register_report_section
-    from tabletcad.shapes import Family, register_family
-
-    from tabletcad.families.designreport import report_section
-
-    for f in FAMILY_FUNCTIONS:
-        sig = inspect.signature(f)
-        params = {k: _UNITS.get(k, "mm") for k, p in sig.parameters.items() if p.kind is p.POSITIONAL_OR_KEYWORD}
-        register_family(Family(f.__name__, f, params, (f.__doc__ or "").strip().splitlines()[0]))
-    register_report_section(report_section)
-
-
-_register()
+#: Every family by name: the thesis's shapes, then the industry families (static).
+FAMILIES: Mapping[str, Family] = MappingProxyType(
+    {**THESIS_SHAPES, **{f.__name__: Family.of(f, _UNITS) for f in FAMILY_FUNCTIONS}}
+)

@@ -1,7 +1,7 @@
 """Design report of a family tablet: dimensions, cup, weight, punch-tip check, tensile strength, size.
 
-Registered as a report section (:func:`tabletcad.report.register_report_section`),
-so ``report.json`` of every tablet built from a family of this package gains
+:func:`tabletcad.report.geometry_report` adds it to the report of every tablet
+built from a family of this package, so its ``report.json`` gains
 
 * ``nominal_max_deviation_um``, ``nominal_tolerance_um``, ``nominal_certified``:
   the certificate of :func:`tabletcad.families.sweep.certify`;
@@ -36,7 +36,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["ReportOptions", "design_report", "report_section", "family_seams", "report_options",
+__all__ = ["ReportOptions", "design_report", "family_seams", "report_options",
            "punch_rating_table", "tensile_strength", "FDA_MAX_DIMENSION_MM", "REPORT_KEYS"]
 
 #: FDA guidance "Size, Shape, and Other Physical Attributes of Generic Tablets and Capsules"
@@ -369,10 +369,3 @@ def design_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str
         seams_as_expected=all(s["as_expected"] is not False for s in seams),
         design_report=rep,
     )
-
-
-def report_section(tablet: Tablet) -> dict[str, Any] | None:
-    """Report section hook: the design report of family tablets, None for others."""
-    if not isinstance(tablet.nominal, SweepNominal):
-        return None
-    return design_report(tablet)

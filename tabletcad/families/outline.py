@@ -44,7 +44,6 @@ __all__ = [
     "outline_from_items",
 ]
 
-TWO_PI = 2.0 * math.pi
 
 
 @dataclass(frozen=True)
@@ -151,7 +150,7 @@ class PlanOutline:
     @property
     def breaks(self) -> np.ndarray:
         """Parameters ``v`` (rad) of the segment joins, including 0 and 2π."""
-        return self._cum * (TWO_PI / self.perimeter)
+        return self._cum * (math.tau / self.perimeter)
 
     @property
     def smooth_breaks(self) -> np.ndarray:
@@ -167,7 +166,7 @@ class PlanOutline:
         return min(r) if r else math.inf
 
     def _locate(self, v: np.ndarray):
-        s = np.mod(v, TWO_PI) * (self.perimeter / TWO_PI)
+        s = np.mod(v, math.tau) * (self.perimeter / math.tau)
         idx = np.clip(np.searchsorted(self._cum, s, side="right") - 1, 0, len(self.segs) - 1)
         return s, idx
 
@@ -203,7 +202,7 @@ class PlanOutline:
     @property
     def speed(self) -> float:
         """``ds/dv = P / 2π`` (mm per rad)."""
-        return self.perimeter / TWO_PI
+        return self.perimeter / math.tau
 
     def point(self, v, der: int = 0) -> np.ndarray:
         """``d^der O / dv^der``, shape (m, 2)."""
@@ -254,11 +253,11 @@ class PlanOutline:
 
     def extent(self) -> tuple[float, float]:
         """Length (x) and width (y) of the outline's bounding box (mm)."""
-        p = self.frame(np.linspace(0, TWO_PI, 4096, endpoint=False))[0]
+        p = self.frame(np.linspace(0, math.tau, 4096, endpoint=False))[0]
         for s in self.segs:
             if s.kind == "arc":
                 for ang in (0.0, math.pi / 2, math.pi, 1.5 * math.pi):
-                    rel = (ang - s.theta0) * math.copysign(1.0, s.sweep) % TWO_PI
+                    rel = (ang - s.theta0) * math.copysign(1.0, s.sweep) % math.tau
                     if rel <= abs(s.sweep):
                         p = np.vstack([p, [s.center[0] + s.radius * math.cos(ang), s.center[1] + s.radius * math.sin(ang)]])
         ext = np.ptp(p, axis=0)
@@ -287,7 +286,7 @@ class PlanOutline:
                 rho = np.hypot(q[:, 0], q[:, 1])
                 ang = np.arctan2(q[:, 1], q[:, 0])
                 sw = s.sweep
-                rel = np.mod((ang - s.theta0) * math.copysign(1.0, sw), TWO_PI)
+                rel = np.mod((ang - s.theta0) * math.copysign(1.0, sw), math.tau)
                 inside_arc = rel <= abs(sw)
                 d_arc = np.abs(rho - s.radius)
                 # inward normal of a convex (ccw) arc points to the centre
@@ -311,7 +310,7 @@ class PlanOutline:
         from scipy.optimize import minimize
 
         L, W = self.extent()
-        c0 = self.frame(np.linspace(0, TWO_PI, 512, endpoint=False))[0]
+        c0 = self.frame(np.linspace(0, math.tau, 512, endpoint=False))[0]
         lo, hi = c0.min(axis=0), c0.max(axis=0)
         g = np.stack(np.meshgrid(np.linspace(lo[0], hi[0], 81), np.linspace(lo[1], hi[1], 81)), -1).reshape(-1, 2)
         sd = self.signed_distance(g)
@@ -321,7 +320,7 @@ class PlanOutline:
         return max(float(-r.fun), float(sd.max()))
 
     def _offset_is_clean(self, d: float) -> bool:
-        v = np.linspace(0.0, TWO_PI, 2048, endpoint=False)
+        v = np.linspace(0.0, math.tau, 2048, endpoint=False)
         v = np.concatenate([v, self.breaks[:-1]])
         O, T, N, k = self.frame(v)
         dist = self.signed_distance(O + d * N)
@@ -361,7 +360,7 @@ class PlanOutline:
 
     # ------------------------------------------------------------------ checks
     def _check_simple(self) -> None:
-        v = np.linspace(0.0, TWO_PI, 1537, endpoint=False)
+        v = np.linspace(0.0, math.tau, 1537, endpoint=False)
         v = np.unique(np.concatenate([v, self.breaks[:-1]]))
         _check_polyline_simple(self.frame(v)[0], self.parameter)
 
@@ -387,18 +386,18 @@ class SplineOutline(PlanOutline):
             p = p[::-1]
             seg = np.linalg.norm(np.diff(np.vstack([p, p[:1]]), axis=0), axis=1)
         _check_polyline_simple(p, parameter)
-        t = np.concatenate([[0.0], np.cumsum(seg)]) * (TWO_PI / float(np.sum(seg)))
+        t = np.concatenate([[0.0], np.cumsum(seg)]) * (math.tau / float(np.sum(seg)))
         self.points = p
         self._sp = CubicSpline(t, np.vstack([p, p[:1]]), bc_type="periodic", axis=0)
         self.name = name
         self.parameter = parameter
         self.segs = ()
-        vs = np.linspace(0.0, TWO_PI, 8192, endpoint=False)
+        vs = np.linspace(0.0, math.tau, 8192, endpoint=False)
         self._vs = vs
         self._ps = self._sp(vs)
         sp1 = self._sp(vs, 1)
-        self.perimeter = float(np.sum(np.hypot(sp1[:, 0], sp1[:, 1])) * TWO_PI / vs.size)
-        self.area = abs(0.5 * float(np.sum(self._ps[:, 0] * sp1[:, 1] - self._ps[:, 1] * sp1[:, 0])) * TWO_PI / vs.size)
+        self.perimeter = float(np.sum(np.hypot(sp1[:, 0], sp1[:, 1])) * math.tau / vs.size)
+        self.area = abs(0.5 * float(np.sum(self._ps[:, 0] * sp1[:, 1] - self._ps[:, 1] * sp1[:, 0])) * math.tau / vs.size)
         _check_polyline_simple(self._ps[::4], parameter)
         from scipy.spatial import cKDTree
 
@@ -407,7 +406,7 @@ class SplineOutline(PlanOutline):
 
     @property
     def breaks(self) -> np.ndarray:
-        return np.array([0.0, TWO_PI])
+        return np.array([0.0, math.tau])
 
     @property
     def smooth_breaks(self) -> np.ndarray:
@@ -451,7 +450,7 @@ class SplineOutline(PlanOutline):
         return (1.0 - DEFAULT.offset_regularity) / kmax if kmax > 0 else math.inf
 
     def frame(self, v):
-        v = np.mod(np.asarray(v, dtype=float).reshape(-1), TWO_PI)
+        v = np.mod(np.asarray(v, dtype=float).reshape(-1), math.tau)
         O = self._sp(v)
         d1 = self._sp(v, 1)
         d2 = self._sp(v, 2)
@@ -464,14 +463,14 @@ class SplineOutline(PlanOutline):
     def point(self, v, der: int = 0) -> np.ndarray:
         if der not in (0, 1, 2):
             raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
-        return self._sp(np.mod(np.asarray(v, dtype=float).reshape(-1), TWO_PI), der)
+        return self._sp(np.mod(np.asarray(v, dtype=float).reshape(-1), math.tau), der)
 
     def normal(self, v, der: int = 0) -> np.ndarray:
         v = np.asarray(v, dtype=float).reshape(-1)
         O, T, N, k = self.frame(v)
         if der == 0:
             return N
-        g = np.hypot(*self._sp(np.mod(v, TWO_PI), 1).T)
+        g = np.hypot(*self._sp(np.mod(v, math.tau), 1).T)
         if der == 1:
             return -(k * g)[:, None] * T
         if der == 2:  # central difference of the exact first derivative
@@ -481,14 +480,14 @@ class SplineOutline(PlanOutline):
 
     def centroid(self) -> np.ndarray:
         p, d1 = self._ps, self._sp(self._vs, 1)
-        w = TWO_PI / self._vs.size
+        w = math.tau / self._vs.size
         a = 0.5 * float(np.sum(p[:, 0] * d1[:, 1] - p[:, 1] * d1[:, 0])) * w
         sx = 0.5 * float(np.sum(p[:, 0] ** 2 * d1[:, 1])) * w
         sy = -0.5 * float(np.sum(p[:, 1] ** 2 * d1[:, 0])) * w
         return np.array([sx / a, sy / a])
 
     def extent(self) -> tuple[float, float]:
-        ext = np.ptp(self._sp(np.linspace(0, TWO_PI, 20000, endpoint=False)), axis=0)
+        ext = np.ptp(self._sp(np.linspace(0, math.tau, 20000, endpoint=False)), axis=0)
         return float(ext[0]), float(ext[1])
 
     def signed_distance(self, xy) -> np.ndarray:
@@ -594,7 +593,7 @@ def outline_from_items(items, name: str = "outline", parameter: str = "outline")
 def circle_outline(radius: float) -> PlanOutline:
     """Circle of ``radius`` (mm) about the origin, starting on +x (``v`` = polar angle)."""
     r = check_positive("radius", radius, "mm")
-    return PlanOutline([_arc((0.0, 0.0), r, 0.0, TWO_PI)], name="circle")
+    return PlanOutline([_arc((0.0, 0.0), r, 0.0, math.tau)], name="circle")
 
 
 def stadium_outline(length: float, width: float, parameter: str = "width") -> PlanOutline:
@@ -684,7 +683,7 @@ def rounded_polygon(vertices, corner_radius: float, name: str = "polygon") -> Pl
         p_out = b + u2 * t
         th0 = math.atan2(p_in[1] - centre[1], p_in[0] - centre[0])
         th1 = math.atan2(p_out[1] - centre[1], p_out[0] - centre[0])
-        sw = (th1 - th0) % TWO_PI
+        sw = (th1 - th0) % math.tau
         tangent_pts.append((p_in, p_out, centre, th0, sw))
     for i in range(n):
         p_in, p_out, centre, th0, sw = tangent_pts[i]

@@ -60,7 +60,6 @@ __all__ = [
     "REFINE",
 ]
 
-TWO_PI = 2.0 * math.pi
 
 #: Smoothing parameter of the family patches (small: nearly cubic Hermite in u for every mode).
 DEFAULT_A = 0.01
@@ -383,7 +382,7 @@ def _rim_collapses(outline, d: float) -> bool:
     segs = getattr(outline, "segs", ())
     if segs:
         return any(sg.kind == "arc" and sg.sweep > 0 and sg.radius <= d * (1 + 1e-9) for sg in segs)
-    v = np.linspace(0.0, TWO_PI, 4096, endpoint=False)
+    v = np.linspace(0.0, math.tau, 4096, endpoint=False)
     speed = np.linalg.norm(outline.point(v, 1) + d * outline.normal(v, 1), axis=1)
     return bool(np.min(speed) <= 1e-9 * outline.speed)
 
@@ -402,7 +401,7 @@ def _plateau_ring(outline, d_end: float, c: np.ndarray):
     if not _rim_collapses(outline, d_end):
         return None
     d_q = 0.5 * d_end
-    v = np.linspace(0.0, TWO_PI, 2048, endpoint=False)
+    v = np.linspace(0.0, math.tau, 2048, endpoint=False)
     O = outline.point(v)
     N = outline.normal(v)
     for lam in (0.5, 0.35, 0.25, 0.15, 0.1):
@@ -415,10 +414,10 @@ def _plateau_ring(outline, d_end: float, c: np.ndarray):
 
 
 def _v_samples(outline, nv: int) -> np.ndarray:
-    v = np.linspace(0.0, TWO_PI, nv, endpoint=False)
+    v = np.linspace(0.0, math.tau, nv, endpoint=False)
     b = np.asarray(outline.breaks)[:-1]
     eps = 1e-9
-    return np.unique(np.concatenate([v, b, np.mod(b - eps, TWO_PI), b + eps]))
+    return np.unique(np.concatenate([v, b, np.mod(b - eps, math.tau), b + eps]))
 
 
 def certify(tablet: Tablet, nu: int = 33, nv: int = 512) -> Certificate:
@@ -451,7 +450,7 @@ def _rule_v(outline, n_per: int):
     b = np.asarray(outline.breaks)
     if len(b) == 2:
         m = 4 * n_per
-        return np.arange(m) * (TWO_PI / m), np.full(m, TWO_PI / m)
+        return np.arange(m) * (math.tau / m), np.full(m, math.tau / m)
     x, w = np.polynomial.legendre.leggauss(n_per)
     vs, ws = [], []
     for lo, hi in zip(b[:-1], b[1:]):

@@ -12,7 +12,8 @@ One module per concept:
 * :mod:`tabletcad.fe.prediction` -- breaking force of any shape from a
   tensile strength or a reference test (elastic first-crack estimate);
 * :mod:`tabletcad.fe.punch` -- punch-tip stress and force rating;
-* :mod:`tabletcad.fe.objective` -- the prediction as an optimisation objective or constraint;
+* :mod:`tabletcad.fe.objective` -- the prediction on a coarse mesh, the figure an optimisation
+  evaluates (:mod:`tabletcad.optimise.strength` makes it an objective or constraint);
 * :mod:`tabletcad.fe.output` -- ``stress.vtu`` and the central-section picture.
 
 Units: mm, N, MPa.  This package needs the ``fe`` extra (scikit-fem, gmsh) and

@@ -8,7 +8,8 @@ Public API::
 See :mod:`tabletcad.optimise.problem` (problem definition, scaling, caching,
 finite differences), :mod:`tabletcad.optimise.solvers` (SLSQP, trust-constr,
 multi-start, differential evolution), :mod:`tabletcad.optimise.thesis`,
-:mod:`tabletcad.optimise.report` and :mod:`tabletcad.optimise.plot`.
+:mod:`tabletcad.optimise.report`, :mod:`tabletcad.optimise.plot` and
+:mod:`tabletcad.optimise.strength` (the FE breaking force as objective or constraint).
 """
 
 from tabletcad.optimise.problem import (

@@ -277,11 +277,10 @@ def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
 
 
 def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) -> Problem:
-    """A :class:`Problem` over the parameters of a registered tablet family."""
+    """A :class:`Problem` over the parameters of a tablet family (:data:`tabletcad.families.FAMILIES`)."""
     from tabletcad.design import design_to_toml
-    from tabletcad.shapes import FAMILIES, _load_plugins
+    from tabletcad.families import FAMILIES
 
-    _load_plugins()
     fam_name = choice("[problem] family", prob.get("family"), tuple(FAMILIES))
     fam = FAMILIES[fam_name]
     if not isinstance(variables, dict) or not variables:

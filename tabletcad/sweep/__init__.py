@@ -4,8 +4,8 @@
 >>> df = run_sweep("samples/sweep/concave_round_grid.toml", "out/sweep", workers=2)  # doctest: +SKIP
 
 Modules: :mod:`~tabletcad.sweep.spec` (the sweep file and its sampling),
-:mod:`~tabletcad.sweep.engine` (the Dask machinery, also used by
-:func:`tabletcad.tooling.tooling_batch`), :mod:`~tabletcad.sweep.results`
+:mod:`~tabletcad.sweep.engine` (one design in, plain data out, run on
+:mod:`tabletcad.parallel`), :mod:`~tabletcad.sweep.results`
 (``results.csv``, resume journal, plots) and :mod:`~tabletcad.sweep.run`
 (:func:`run_sweep`).  Needs the ``sweep`` extra (``dask[distributed]``, pandas).
 """

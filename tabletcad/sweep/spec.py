@@ -167,9 +167,8 @@ def _known_keys(design: dict) -> set[str]:
     walk("", design)
     tab = design.get("tablet", {})
     fam = tab.get("family") if isinstance(tab, dict) else None
-    from tabletcad.shapes import FAMILIES, _load_plugins
+    from tabletcad.families import FAMILIES
 
-    _load_plugins()
     if fam in FAMILIES:
         keys |= {f"tablet.{k}" for k in FAMILIES[fam].params} | {"tablet.a", "tablet.name"}
     try:

@@ -1,5 +1,5 @@
 """Scripting API: tooling for a range of tablet sizes in one call (with a tqdm progress bar),
-in this process or on a Dask cluster (the sweep engine).
+in this process or on a Dask cluster (:mod:`tabletcad.parallel`).
 
 >>> from tabletcad.tooling import tooling_batch, ToolingSpec
 >>> rows = tooling_batch("shallow_convex_round",
@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 from typing import Any, Iterable
 
-from tabletcad.shapes import FAMILIES, _load_plugins
+from tabletcad.families import FAMILIES
 from tabletcad.tooling.spec import ToolingSpec, parse_tooling
 
 __all__ = ["tooling_batch", "tooling_for"]
@@ -44,16 +44,15 @@ def tooling_batch(family: str, sizes: Iterable[dict], spec: ToolingSpec | dict |
     tablet and punch volumes, the quadrature check, the largest OCC/manifold3d disagreement and
     the seconds spent (total and in OCC Booleans).
 
-    Runs on the sweep engine (:func:`tabletcad.sweep.engine.map_tasks`): in this process by
+    Runs on :func:`tabletcad.parallel.map_tasks`: in this process by
     default (``workers=0``), on a local Dask cluster of ``workers`` processes, on the cluster of
     ``scheduler`` (an address) or of an open ``client``.  Workers receive the parameters and
     return the rows and the files' bytes, which are written here.
     """
-    from tabletcad.sweep.engine import map_tasks
+    from tabletcad.parallel import map_tasks
 
     if isinstance(spec, dict):
         spec = parse_tooling(spec)
-    _load_plugins()
     if family not in FAMILIES:
         from tabletcad.errors import DesignError
 
@@ -83,7 +82,6 @@ def _tooling_task(params: dict, *, family: str, spec: ToolingSpec | None, check:
     from tabletcad.tooling.stage import write_tooling
     from tabletcad.tooling.toolset import make_tooling
 
-    _load_plugins()
     t0 = time.perf_counter()
     tablet = FAMILIES[family].build(**params)
     ts = make_tooling(tablet, spec, check=check, interference_check=interference_check)

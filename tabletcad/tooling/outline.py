@@ -39,7 +39,6 @@ from tabletcad.tooling.booleans import translated
 
 __all__ = ["TabletFrame", "tablet_frame", "offset_wire", "prism", "plan_face", "wire_length", "face_area"]
 
-TWO_PI = 2.0 * math.pi
 
 
 @dataclass(eq=False)
@@ -197,7 +196,7 @@ def _band_patch(tablet: Tablet) -> tuple[int, float, float, float] | None:
     convex round: 1.4 µm), which the die bore has to clear: ``bulge`` (mm) is
     the largest outward plan distance of the patch from its end curve (0 when it bows inward).
     """
-    v = np.linspace(0.0, TWO_PI, 96, endpoint=False)
+    v = np.linspace(0.0, math.tau, 96, endpoint=False)
     for i, p in enumerate(tablet.patches):
         x0, x1 = p.evaluate(0.0, v), p.evaluate(1.0, v)
         if float(np.ptp(x0[:, 2])) > 1e-9 or float(np.ptp(x1[:, 2])) > 1e-9:

@@ -1,4 +1,8 @@
-"""The tooling stage of ``tabletcad build``: runs when the design file has a ``[tooling]`` table.
+"""The tooling stage of ``tabletcad build``: runs when the design has a ``[tooling]`` table.
+
+:func:`tabletcad.build.build_tablet` checks the table with :func:`tooling_spec`
+before any geometry is built, then calls :func:`tooling_stage` with the solid
+the CAD stage made.
 
 Writes ``assembly.step``, ``upper_punch.step``, ``lower_punch.step``,
 ``die.step``, ``drawing.svg`` and ``drawing.dxf`` into the build's staging
@@ -10,39 +14,24 @@ exits with status 2 and the build writes nothing).
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 from typing import Any
 
-from tabletcad.build import register_stage
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.tablet import Tablet
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
-
-__all__ = ["tooling_stage", "tooling_spec", "read_tooling_table", "write_tooling", "write_finished_tablet"]
+__all__ = ["tooling_stage", "tooling_spec", "write_tooling", "write_finished_tablet"]
 
 
-def read_tooling_table(design_path, tablet: Tablet | None = None) -> dict | None:
-    """The ``[tooling]`` table of a design (the tablet's ``extras`` or the design file), or None."""
-    if tablet is not None and "tooling" in tablet.extras:
-        return tablet.extras["tooling"]
-    if design_path is None:
-        return None
-    data = tomllib.loads(Path(design_path).read_text(encoding="utf-8"))
-    return data.get("tooling")
+def tooling_spec(tablet: Tablet):
+    """The checked :class:`~tabletcad.tooling.spec.ToolingSpec` of the tablet's design, or None.
 
-
-def tooling_spec(*, tablet: Tablet, design_path=None):
-    """The checked :class:`~tabletcad.tooling.spec.ToolingSpec` of a design, or None without ``[tooling]``.
-
-    Raises :class:`DesignError` for a bad key or value and for a tablet that cannot have tooling
-    (cut-away, ring); the build calls it before any geometry is built.
+    The design's ``[tooling]`` table is ``tablet.extras["tooling"]``
+    (:func:`tabletcad.design.design_from_dict` puts it there).  Raises
+    :class:`DesignError` for a bad key or value and for a tablet that cannot have
+    tooling (cut-away, ring); the build calls it before any geometry is built.
     """
-    table = read_tooling_table(design_path, tablet)
+    table = tablet.extras.get("tooling")
     if table is None:
         return None
     from tabletcad.tooling.spec import parse_tooling
@@ -69,19 +58,17 @@ def write_tooling(ts, out: Path, *, drawing: bool = True) -> list[Path]:
     return files
 
 
-def tooling_stage(*, tablet: Tablet, out: Path, report: dict[str, Any], design_path=None) -> None:
-    """Tooling files of the design's ``[tooling]`` table; the finished tablet as ``tablet.*``.
+def tooling_stage(*, tablet: Tablet, spec, shape, out: Path, report: dict[str, Any]) -> None:
+    """Tooling files of ``spec`` (the design's checked ``[tooling]`` table); the finished tablet as ``tablet.*``.
 
-    The CAD stage wrote the plain PDE tablet as ``tablet.step/.stl/.glb``; when scores or
-    embossing change it, the plain STEP is kept as ``tablet_plain.step`` and ``tablet.*``
-    become the finished (scored, embossed) tablet, the one the punches fit.
+    ``shape`` is the tablet's solid (``TopoDS_Shape``) that the CAD stage built and wrote as
+    ``tablet.step/.stl/.glb``; when scores or embossing change it, the plain STEP is kept as
+    ``tablet_plain.step`` and ``tablet.*`` become the finished (scored, embossed) tablet, the
+    one the punches fit.
     """
-    spec = tooling_spec(tablet=tablet, design_path=design_path)
-    if spec is None:
-        return
     from tabletcad.tooling.toolset import make_tooling
 
-    ts = make_tooling(tablet, spec)
+    ts = make_tooling(tablet, spec, shape=shape)
     res = ts.report
     if res.get("interference_mm3", 0.0) > 1e-6 or not res["interference"]["gap_within_clearance"]:
         raise GeometryError(
@@ -123,6 +110,3 @@ def write_finished_tablet(ts, out: Path) -> list[Path]:
     files.append(export(finished, out / "tablet.step", name=name))
     files += [export(finished, out / f"tablet{suffix}", name=name, mesh=mesh) for suffix in (".stl", ".glb")]
     return files
-
-
-register_stage("tooling", tooling_stage, check=tooling_spec)

@@ -14,11 +14,12 @@ from typing import Any
 from tabletcad.errors import DesignError
 from tabletcad.tablet import Tablet
 from tabletcad.tooling.booleans import TIMER, to_manifold, volume
+from tabletcad.tolerance import DEFAULT
 from tabletcad.tooling.spec import ToolingSpec
 
 __all__ = ["ToolSet", "make_tooling", "DEFLECTION_MM"]
 
-DEFLECTION_MM = 0.005
+DEFLECTION_MM = DEFAULT.mesh_deflection
 
 
 @dataclass(eq=False)

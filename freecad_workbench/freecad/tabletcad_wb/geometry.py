@@ -40,7 +40,6 @@ __all__ = [
     "tablet_from_spec",
 ]
 
-TWO_PI = 2.0 * math.pi
 
 
 # --------------------------------------------------------------------------- core side (numpy only)
@@ -58,18 +57,17 @@ def tablet_chain(tablet):
 
 def tablet_from_spec(family=None, params=None, design=None):
     """A core Tablet from a family name and its parameters (mm, deg), or from a design file."""
-    from tabletcad import shapes
+    from tabletcad import families
 
-    shapes._load_plugins()
     if design:
         from tabletcad.design import load_design
 
         return load_design(design)
-    if family not in shapes.FAMILIES:
+    if family not in families.FAMILIES:
         from tabletcad.errors import DesignError
 
-        raise DesignError("family", family, f"must be one of {', '.join(sorted(shapes.FAMILIES))}")
-    return shapes.FAMILIES[family].build(**(params or {}))
+        raise DesignError("family", family, f"must be one of {', '.join(sorted(families.FAMILIES))}")
+    return families.FAMILIES[family].build(**(params or {}))
 
 
 def _rims(surfaces, hollow):
@@ -79,7 +77,7 @@ def _rims(surfaces, hollow):
     ``{z, inner, poles, knots, mults, degree}`` (the row's B-spline curve in v)."""
     u = np.linspace(0.0, 1.0, 65)
     out = []
-    v = np.linspace(0.0, TWO_PI, 181)[:-1]
+    v = np.linspace(0.0, math.tau, 181)[:-1]
     rho = np.zeros(v.size)
     for s in surfaces:
         P = s.evaluate_grid(u, v)

@@ -85,10 +85,9 @@ def _restore_traceback():
 
 
 def family_names() -> list[str]:
-    from tabletcad import shapes
+    from tabletcad import families
 
-    shapes._load_plugins()
-    return sorted(shapes.FAMILIES)
+    return sorted(families.FAMILIES)
 
 
 def prop_name(param: str) -> str:
@@ -101,10 +100,9 @@ def is_tablet(obj) -> bool:
 
 
 def _family(name):
-    from tabletcad import shapes
+    from tabletcad import families
 
-    shapes._load_plugins()
-    return shapes.FAMILIES.get(name)
+    return families.FAMILIES.get(name)
 
 
 def _qty(value, unit):

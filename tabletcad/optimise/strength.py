@@ -1,0 +1,46 @@
+"""The finite-element breaking force as an optimisation objective or constraint.
+
+Both evaluate :func:`tabletcad.fe.objective.breaking_force` (coarse mesh; needs
+the ``fe`` extra, imported on the first evaluation).  Every evaluation remeshes
+the design, so the value is not a smooth function of the variables at the scale
+of the mesh: prefer the derivative-free ``differential_evolution`` method, and
+re-check the optimum on the default mesh (``tabletcad fe strength``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from tabletcad.errors import check_positive
+from tabletcad.optimise.problem import Constraint, Objective
+
+__all__ = ["breaking_force_objective", "breaking_force_constraint"]
+
+_NAME = "FE breaking force (elastic first crack, coarse mesh)"
+
+
+def _force(tensile_strength_MPa: float, direction: str):
+    def force(tablet: Any) -> float:
+        from tabletcad.fe.objective import breaking_force
+
+        return breaking_force(tablet, tensile_strength_MPa, direction)
+
+    return force
+
+
+def breaking_force_objective(tensile_strength_MPa: float, direction: str = "width") -> Objective:
+    """An :class:`~tabletcad.optimise.problem.Objective`: the predicted breaking force (N), to maximise.
+
+    ``tensile_strength_MPa`` is the formulation's tensile strength (MPa); ``direction`` the
+    loading direction in plan (``width``, ``length``, ``x`` or ``y``).
+    """
+    check_positive("tensile_strength_MPa", tensile_strength_MPa, "MPa")
+    return Objective(func=_force(tensile_strength_MPa, direction), name=_NAME, unit="N")
+
+
+def breaking_force_constraint(tensile_strength_MPa: float, lower_N: float, direction: str = "width") -> Constraint:
+    """A :class:`~tabletcad.optimise.problem.Constraint`: predicted breaking force >= ``lower_N`` (N)."""
+    check_positive("tensile_strength_MPa", tensile_strength_MPa, "MPa")
+    check_positive("lower_N", lower_N, "N")
+    return Constraint(name=_NAME, func=_force(tensile_strength_MPa, direction), kind="ineq",
+                      lower=lower_N, unit="N", scale=lower_N)

@@ -1,0 +1,157 @@
+"""Running one function over many items: in this process, on a local Dask cluster, or on a remote one.
+
+:func:`map_tasks` is the machinery shared by :func:`tabletcad.sweep.run_sweep`
+and :func:`tabletcad.tooling.tooling_batch`: it runs a function over items on a
+local cluster of worker processes (``workers=N``), on an existing cluster
+(``scheduler="tcp://host:port"`` or ``client=``), or in this process
+(``workers=0``, the serial loop), with a bounded number of tasks in flight and
+a progress bar showing items done, failed and the rate.  Dask ``distributed``
+(the ``sweep`` extra) is imported only when a cluster is used.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import itertools
+import logging
+import os
+from collections.abc import Callable, Iterator, Sequence
+from typing import Any
+
+from tabletcad.errors import DesignError
+
+__all__ = ["map_tasks", "open_client", "CONNECT_TIMEOUT_S", "IN_FLIGHT_PER_WORKER"]
+
+CONNECT_TIMEOUT_S = 10.0
+"""Seconds to wait for a Dask scheduler to answer before the sweep stops with a one-line error."""
+
+IN_FLIGHT_PER_WORKER = 4
+"""Tasks queued per worker thread; keeps the scheduler's memory flat for sweeps of millions of designs."""
+
+
+@contextlib.contextmanager
+def open_client(workers: int | None = None, scheduler: str | None = None,
+                connect_timeout: float = CONNECT_TIMEOUT_S) -> Iterator[Any]:
+    """A Dask client: to ``scheduler`` when given, else to a new local cluster of ``workers`` processes.
+
+    The local cluster has one thread per worker process (OpenCascade and the
+    quadrature hold the GIL) and no dashboard.  An unreachable scheduler raises
+    :class:`~tabletcad.errors.DesignError` after ``connect_timeout`` seconds.
+    """
+    from distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout=f"{connect_timeout}s", set_as_default=False)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise DesignError("--scheduler", scheduler,
+                              f"no Dask scheduler answered within {connect_timeout:g} s ({type(exc).__name__})") from None
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    import dask
+
+    n = workers if workers is not None else (os.cpu_count() or 1)
+    # distributed sets MALLOC_TRIM_THRESHOLD_=65536 in every worker it spawns; glibc then maps and
+    # unmaps every large NumPy array, which made the report take 1.8x the CPU time of this process
+    # (benchmarks/bench_sweep.py).  The local workers keep glibc's adaptive default, and do not run
+    # the statistical profiler (a thread sampling every worker's stack every 10 ms).
+    env = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
+           if k != "MALLOC_TRIM_THRESHOLD_"}
+    # An earlier nanny in this process may have left its 65536 in os.environ, which workers inherit.
+    inherited = os.environ.pop("MALLOC_TRIM_THRESHOLD_") if os.environ.get("MALLOC_TRIM_THRESHOLD_") == "65536" else None
+    try:
+        with dask.config.set({"distributed.nanny.pre-spawn-environ": env, "distributed.worker.profile.enabled": False}):
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   silence_logs=logging.ERROR)
+    finally:
+        if inherited is not None:
+            os.environ["MALLOC_TRIM_THRESHOLD_"] = inherited
+    with cluster, Client(cluster, set_as_default=False) as client:
+        yield client
+
+
+def map_tasks(func: Callable[..., Any], items: Sequence[Any], *, kwargs: dict[str, Any] | None = None,
+              client: Any = None, workers: int | None = None, scheduler: str | None = None,
+              connect_timeout: float = CONNECT_TIMEOUT_S, progress: bool = True, desc: str = "sweep",
+              failed: Callable[[Any], bool] | None = None,
+              on_result: Callable[[int, Any], None] | None = None,
+              on_error: Callable[[BaseException], Any] | None = None) -> list[Any]:
+    """``[func(item, **kwargs) for item in items]`` on Dask, results in the order of ``items``.
+
+    ``func`` must be importable by the workers (a module-level function) and
+    its items and results plain data.  ``client`` (an open
+    :class:`distributed.Client`) wins over ``scheduler``, which wins over
+    ``workers``; ``workers=0`` runs the loop in this process.  ``on_result(i,
+    result)`` is called in this process as each result arrives (in completion
+    order); ``failed(result)`` marks results counted as failed in the progress
+    bar.  An exception raised by ``func`` (or a worker lost while running it,
+    :class:`distributed.KilledWorker`) propagates, unless ``on_error(exc)`` is
+    given: its return value then stands for that item's result.
+    """
+    from tqdm import tqdm
+
+    kwargs = kwargs or {}
+    results: list[Any] = [None] * len(items)
+    bar = tqdm(total=len(items), desc=desc, unit="design", disable=not progress, dynamic_ncols=True)
+    n_failed = 0
+    bar.set_postfix(failed=0, refresh=False)
+
+    def done(i: int, res: Any) -> None:
+        nonlocal n_failed
+        results[i] = res
+        if failed is not None and failed(res):
+            n_failed += 1
+        if on_result is not None:
+            on_result(i, res)
+        bar.update(1)
+        bar.set_postfix(failed=n_failed, refresh=False)
+
+    try:
+        if client is None and scheduler is None and workers == 0:
+            for i, item in enumerate(items):
+                done(i, func(item, **kwargs))
+            return results
+        with contextlib.ExitStack() as stack:
+            if client is None:
+                client = stack.enter_context(open_client(workers, scheduler, connect_timeout))
+            _run_on(client, func, items, kwargs, done, on_error)
+        return results
+    finally:
+        bar.close()
+
+
+def _run_on(client: Any, func: Callable[..., Any], items: Sequence[Any], kwargs: dict[str, Any],
+            done: Callable[[int, Any], None], on_error: Callable[[BaseException], Any] | None) -> None:
+    from distributed import as_completed
+
+    threads = max(1, sum(client.nthreads().values()))
+    window = IN_FLIGHT_PER_WORKER * threads
+    index: dict[str, int] = {}
+    it = iter(enumerate(items))
+    task = functools.partial(func, **kwargs) if kwargs else func
+
+    def submit(n: int) -> list[Any]:
+        futs = []
+        for i, item in itertools.islice(it, n):
+            fut = client.submit(task, item, pure=False)
+            index[fut.key] = i
+            futs.append(fut)
+        return futs
+
+    ac = as_completed(submit(window), loop=client.loop)
+    for fut in ac:
+        i = index.pop(fut.key)
+        try:
+            res = fut.result()
+        except Exception as exc:
+            if on_error is None:
+                raise
+            res = on_error(exc)
+        fut.release()
+        done(i, res)
+        for nxt in submit(1):
+            ac.add(nxt)

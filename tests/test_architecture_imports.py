@@ -1,0 +1,216 @@
+"""The package's structure, read from its source: the import graph (lazy imports included) has
+no cycle and every import follows the flow design -> curves -> PDE patches -> B-spline data ->
+B-rep and meshes -> exports and tooling, with mechanics, FE and optimisation reading designs and
+solids; the family catalogue is one static mapping; nothing registers itself at import time."""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PKG = ROOT / "tabletcad"
+
+# Layers of the flow, lowest first.  A module may import its own layer (without a cycle) and the
+# layers below it, never a layer above.  Keys are module names or package prefixes.  The package
+# itself (``tabletcad/__init__.py``) imports nothing: its ``make``, ``load`` and ``show`` are
+# looked up in ``tabletcad.model`` on first use, as attributes, never by an import of the package.
+LAYERS: list[tuple[str, ...]] = [
+    ("tabletcad", "tabletcad.errors", "tabletcad.tolerance", "tabletcad.io", "tabletcad.parallel"),  # support
+    ("tabletcad.basis", "tabletcad.curves", "tabletcad.bspline", "tabletcad.slit", "tabletcad.nominal"),  # maths
+    ("tabletcad.patch",),  # PDE patches
+    ("tabletcad.tablet",),  # a tablet: patches, trims, checks
+    ("tabletcad.family", "tabletcad.shapes", "tabletcad.reshape"),  # the thesis's shapes
+    ("tabletcad.mechanics",),  # compaction and strength formulas (they read dimensions)
+    ("tabletcad.families",),  # industry families, their design report, the catalogue of all
+    ("tabletcad.design", "tabletcad.report", "tabletcad.plot", "tabletcad.solid"),  # design files, report, volume mesh
+    ("tabletcad.cad",),  # B-rep solids, meshes, exports: OpenCascade
+    ("tabletcad.tooling",),  # punches, die, drawings from the solids
+    ("tabletcad.fe",),  # finite elements on the solids and the punch tips
+    ("tabletcad.optimise",),  # optimisation reads designs, mechanics and FE
+    ("tabletcad.model", "tabletcad.build"),  # the scripting facade and the build pipeline
+    ("tabletcad.sweep",),  # sweeps drive builds
+    ("tabletcad.cli", "tabletcad.__main__"),  # the command line
+]
+CAD_LIBRARIES = ("OCP", "build123d", "cadquery")
+
+
+def _modules() -> dict[str, Path]:
+    mods = {}
+    for p in PKG.rglob("*.py"):
+        parts = list(p.relative_to(ROOT).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        mods[".".join(parts)] = p
+    return mods
+
+
+MODULES = _modules()
+
+
+def _resolve(name: str) -> str | None:
+    while name and name not in MODULES:
+        name = name.rpartition(".")[0]
+    return name or None
+
+
+def _imports(module: str) -> list[tuple[str, int]]:
+    """Every import of ``module`` anywhere in its file (functions included): (imported name, line)."""
+    path = MODULES[module]
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    out = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            out += [(a.name, node.lineno) for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - node.level + 1]
+                mod = ".".join(base + ([node.module] if node.module else []))
+            else:
+                mod = node.module or ""
+            out.append((mod, node.lineno))
+            out += [(f"{mod}.{a.name}", node.lineno) for a in node.names]
+    return out
+
+
+def _graph() -> dict[str, dict[str, int]]:
+    """Module -> {imported tabletcad module: line}."""
+    graph: dict[str, dict[str, int]] = {m: {} for m in MODULES}
+    for m in MODULES:
+        for name, line in _imports(m):
+            if name.split(".")[0] == "tabletcad":
+                target = _resolve(name)
+                if target is not None and target != m:
+                    graph[m].setdefault(target, line)
+    return graph
+
+
+def _layer(module: str) -> int:
+    best, rank = -1, None
+    for i, layer in enumerate(LAYERS):
+        for key in layer:
+            inside = module == key or (key != "tabletcad" and module.startswith(key + "."))
+            if inside and len(key) > best:
+                best, rank = len(key), i
+    assert rank is not None, f"{module} is in no layer: add it to LAYERS"
+    return rank
+
+
+def _cycles(graph: dict[str, dict[str, int]]) -> list[list[str]]:
+    """Strongly connected components of more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    found: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                found.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return found
+
+
+def test_the_graph_is_read_from_every_import_including_lazy_ones():
+    graph = _graph()
+    # a lazy import inside a function counts: the build imports the CAD stage only when it runs
+    assert "tabletcad.cad.stage" in graph["tabletcad.build"]
+    assert len(MODULES) > 100 and sum(map(len, graph.values())) > 300
+
+
+def test_no_import_cycle():
+    assert _cycles(_graph()) == []
+
+
+def test_a_cycle_is_found_when_there_is_one():
+    graph = {"a": {"b": 1}, "b": {"c": 1}, "c": {"a": 1}, "d": {"a": 1}}
+    assert _cycles(graph) == [["a", "b", "c"]]
+
+
+def test_every_import_follows_the_flow():
+    against = [
+        f"{m} (layer {_layer(m)}) imports {t} (layer {_layer(t)}) at line {line}"
+        for m, targets in _graph().items() for t, line in targets.items() if _layer(t) > _layer(m)
+    ]
+    assert against == []
+
+
+def test_only_the_cad_layer_imports_opencascade():
+    """OCP, build123d and cadquery are imported by tabletcad.cad and tabletcad.tooling alone."""
+    bad = [
+        f"{m}:{line} {name}" for m in MODULES if not m.startswith(("tabletcad.cad", "tabletcad.tooling"))
+        for name, line in _imports(m) if name.split(".")[0] in CAD_LIBRARIES
+    ]
+    assert bad == []
+
+
+def test_nothing_registers_itself_at_import_time():
+    """No in-tree code adds to a registry when imported: the catalogue, the report and the build's
+    steps are written out where they are used."""
+    for name in ("register_stage", "register_family", "register_report_section", "_load_plugins"):
+        hits = [str(p.relative_to(ROOT)) for p in PKG.rglob("*.py") if name in p.read_text(encoding="utf-8")]
+        assert hits == [], name
+
+
+FRESH = r"""
+import sys
+sys.path.insert(0, {root!r})
+import tabletcad.families as F
+before = dict(F.FAMILIES)
+from tabletcad.report import geometry_report
+from tabletcad.design import load_design
+geometry_report(F.FAMILIES["concave_round"].build())
+import tabletcad.build, tabletcad.model, tabletcad.optimise.files
+assert dict(F.FAMILIES) == before
+try:
+    F.FAMILIES["mine"] = None
+except TypeError:
+    pass
+else:
+    raise SystemExit("FAMILIES is writable")
+print(len(before), ",".join(before))
+"""
+
+
+def test_the_family_catalogue_is_static():
+    """The same families whatever was imported before, and a read-only mapping."""
+    from tabletcad.families import FAMILIES, INDUSTRY_FAMILIES
+    from tabletcad.shapes import THESIS_FAMILIES
+
+    out = subprocess.run([sys.executable, "-c", FRESH.format(root=str(ROOT))], capture_output=True, text=True,
+                         timeout=300, cwd="/")
+    assert out.returncode == 0, out.stderr[-2000:]
+    n, names = out.stdout.split()
+    assert int(n) == len(FAMILIES) == 25 and names.split(",") == list(FAMILIES)
+    assert list(FAMILIES) == [*THESIS_FAMILIES, *INDUSTRY_FAMILIES]
+    assert not hasattr(__import__("tabletcad.shapes").shapes, "FAMILIES")
+
+
+@pytest.mark.parametrize("layer", range(len(LAYERS)))
+def test_every_layer_names_modules_that_exist(layer):
+    for key in LAYERS[layer]:
+        assert key in MODULES, key
