@@ -104,7 +104,7 @@ def nominal_build123d(tablet):
     """(build123d solid, kind) for the nominal shape of a sample tablet; kind '~' marks a stand-in."""
     import build123d as bd
 
-    f, p = tablet.family, dict(getattr(tablet, "params", {}) or {})
+    f, p = tablet.family.removeprefix("thesis."), dict(getattr(tablet, "params", {}) or {})
     if f in ("shallow_convex_round", "deep_convex_round"):
         T, b, D = p["thickness"], p["band"], p["diameter"]
         d = (T - b) / 2

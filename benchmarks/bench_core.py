@@ -135,7 +135,7 @@ def _patch_integrands(p):
     return area, volume
 
 
-def bench_integrals(names=("flat_faced_round", "spherical")):
+def bench_integrals(names=("thesis.flat_faced_round", "thesis.spherical")):
     print("Area and volume: tabletcad quadrature vs scipy dblquad (thesis method), same integrands")
     print(f"  {'tablet':18s} {'quantity':8s} {'reference':>20s} {'tabletcad err':>14s} {'dblquad err':>12s}"
           f" {'t tabletcad':>12s} {'t dblquad':>10s} {'ratio':>8s}")

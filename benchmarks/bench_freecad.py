@@ -70,7 +70,7 @@ def main() -> None:
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--families", nargs="+", default=["flat_faced_round", "concave_round", "ring", "capsule"])
+    ap.add_argument("--families", nargs="+", default=["thesis.flat_faced_round", "concave_round", "thesis.ring", "capsule"])
     args = ap.parse_args()
     print(f"{'FreeCAD':8s} {'family':18s} {'first s':>8s} {'change s':>9s} {'cached s':>9s} {'core s':>8s}"
           f" {'chg/core':>9s} {'chg/0.5s':>9s}")

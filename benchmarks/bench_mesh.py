@@ -87,7 +87,7 @@ def best_time(fn, repeat: int) -> float:
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--family", default="oblate_spheroid", help="tablet family (default: a spheroid, as Fig. 4.5)")
+    ap.add_argument("--family", default="thesis.oblate_spheroid", help="tablet family (default: a spheroid, as Fig. 4.5)")
     ap.add_argument("--repeat", type=int, default=5)
     args = ap.parse_args(argv)
 

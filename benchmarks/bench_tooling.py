@@ -30,7 +30,7 @@ def batch() -> None:
     sizes = [dict(diameter=d, thickness=0.3 * d, band=0.2 * d) for d in [6.0 + 0.5 * k for k in range(20)]]
     b0 = TIMER["occ_boolean_s"]
     t0 = time.perf_counter()
-    rows = tooling_batch("shallow_convex_round", sizes, ToolingSpec(clearance_mm=0.02), progress=True, check=False)
+    rows = tooling_batch("thesis.shallow_convex_round", sizes, ToolingSpec(clearance_mm=0.02), progress=True, check=False)
     dt = time.perf_counter() - t0
     occ = TIMER["occ_boolean_s"] - b0
     worst = max(abs(r["upper_punch_rel_diff_vs_quadrature"]) for r in rows)

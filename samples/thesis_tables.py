@@ -45,7 +45,7 @@ def exact(name: str, t) -> tuple[float, float] | None:
 
 def rows():
     for name, (ta, tv) in THESIS.items():
-        t = families.FAMILIES[name].build()
+        t = families.FAMILIES[f"thesis.{name}"].build()
         pr = t.properties()
         ex = exact(name, t)
         dev = t.nominal_deviation()

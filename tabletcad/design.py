@@ -3,7 +3,7 @@
 A design names a family and its dimensions (mm)::
 
     [tablet]
-    family = "flat_faced_round"
+    family = "thesis.flat_faced_round"
     diameter = 10.0
     thickness = 6.0
 
@@ -45,7 +45,8 @@ import numpy as np
 from tabletcad.curves import Circle, Curve, Ellipse, PointCurve, RoundedRectangle, Stadium
 from tabletcad.errors import DesignError, check_finite, one_token
 from tabletcad.patch import PDEPatch
-from tabletcad.families import FAMILIES
+from tabletcad.families import FAMILIES, RENAMED
+from tabletcad.families import family as lookup_family
 from tabletcad.tablet import Tablet, Trim
 from tabletcad.tolerance import DEFAULT, Tolerances
 
@@ -216,11 +217,12 @@ def _design_from_dict(data: dict, default_name: str) -> Tablet:
     elif family == "custom_outline":
         tablet = _custom_outline(tab, name)
     else:
-        if family not in FAMILIES:
+        if family not in FAMILIES and family not in RENAMED:
             raise DesignError("tablet.family", family, f"must be one of {families}")
+        fam = lookup_family(family, stacklevel=4)  # an old name: one warning, then its new family
+        family = fam.name
         if "patch" in data:
             raise DesignError("patch", "given", f"[[patch]] tables are only read for family free_form, not {family!r}")
-        fam = FAMILIES[family]
         kw = {}
         for k, v in tab.items():
             if k not in fam.params:

@@ -215,11 +215,9 @@ class TabletModel(_Shaped):
 
 def make(family: str, **dims: Any) -> TabletModel:
     """A tablet of a named family (``tabletcad shapes`` lists them) with dimensions in mm."""
-    from tabletcad.families import FAMILIES
+    from tabletcad.families import family as lookup_family
 
-    if family not in FAMILIES:
-        raise DesignError("family", family, f"must be one of {', '.join(FAMILIES)}")
-    return TabletModel(FAMILIES[family].build(**dims))
+    return TabletModel(lookup_family(family, parameter="family", stacklevel=3).build(**dims))
 
 
 def load(path: str | Path) -> TabletModel:

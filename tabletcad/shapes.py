@@ -29,7 +29,6 @@ from tabletcad.tablet import Tablet, Trim
 from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = [
-    "THESIS_FAMILIES",
     "THESIS_SHAPES",
     "coaxial_tablet",
     "flat_faced_round",
@@ -140,7 +139,7 @@ def flat_faced_round(diameter: float = 10.0, thickness: float = 6.0, *, a: float
     R = D / 2
     secs = [_disc(R, 0.0, inward=False), _band(R, 0.0, T), _disc(R, T, inward=True)]
     return coaxial_tablet(
-        secs, a=a, name="flat_faced_round", family="flat_faced_round",
+        secs, a=a, name="flat_faced_round", family="thesis.flat_faced_round",
         params=dict(diameter=D, thickness=T), nominal=nom.cylinder(R, 0.0, T), tol=tol,
     )
 
@@ -152,7 +151,7 @@ def spherical(diameter: float = 5.0, *, a: float | str = 1.0, tol=DEFAULT) -> Ta
     psi = [-math.pi / 2, -math.pi / 3, -math.pi / 6, 0.0, math.pi / 6, math.pi / 3, math.pi / 2]
     pts = [(r * math.cos(p) if abs(p) != math.pi / 2 else 0.0, r + r * math.sin(p)) for p in psi]
     return coaxial_tablet(
-        [pts[0:4], pts[3:7]], a=a, name="spherical", family="spherical",
+        [pts[0:4], pts[3:7]], a=a, name="spherical", family="thesis.spherical",
         params=dict(diameter=D), nominal=nom.sphere(r, (0, 0, r)), tol=tol,
     )
 
@@ -166,7 +165,7 @@ def _convex(name, D, T, band, aspect=1.0, a=1.0, tol=DEFAULT, params=None):
         raise DesignError("band", band, f"must be >= thickness - diameter = {T - D:g} mm (cup deeper than a hemisphere)", "mm")
     secs = [_cap(R, d, d, up=False), _band(R, d, d + band), _cap(R, d + band, d, up=True)]
     nominal = nom.convex_round(R, d, d + band, d) if aspect == 1.0 else None
-    return coaxial_tablet(secs, aspect, a=a, name=name, family=name, params=params, nominal=nominal, tol=tol)
+    return coaxial_tablet(secs, aspect, a=a, name=name, family=f"thesis.{name}", params=params, nominal=nominal, tol=tol)
 
 
 def shallow_convex_round(diameter: float = 10.0, thickness: float = 3.0, band: float = 2.0, *, a=1.0, tol=DEFAULT) -> Tablet:
@@ -202,7 +201,7 @@ def oblong(diameter: float = 5.0, length: float = 15.0, dome: float = 1.0, *, a=
         raise DesignError("dome", d, f"must be < length/2 = {L / 2:g} mm", "mm")
     R = D / 2
     secs = [_cap(R, d, d, up=False), _band(R, d, L - d), _cap(R, L - d, d, up=True)]
-    return coaxial_tablet(secs, a=a, name="oblong", family="oblong", params=dict(diameter=D, length=L, dome=d),
+    return coaxial_tablet(secs, a=a, name="oblong", family="thesis.oblong", params=dict(diameter=D, length=L, dome=d),
                           nominal=nom.convex_round(R, d, L - d, d), tol=tol)
 
 
@@ -214,7 +213,7 @@ def ring(outer_diameter: float = 12.0, inner_diameter: float = 6.0, thickness: f
     Di = check_range("inner_diameter", inner_diameter, 0.0, Do, "mm", lo_open=True, hi_open=True)
     T = check_positive("thickness", thickness, "mm")
     R = Do / 2
-    t = coaxial_tablet([_band(R, 0.0, T)], a=a, name="ring", family="ring",
+    t = coaxial_tablet([_band(R, 0.0, T)], a=a, name="ring", family="thesis.ring",
                        params=dict(outer_diameter=Do, inner_diameter=Di, thickness=T), tol=tol)
     from dataclasses import replace
 
@@ -236,7 +235,7 @@ def _spheroid(name: str, diameter: float, height: float, a, tol) -> Tablet:
     c = height / 2
     psi = [-math.pi / 2, -math.pi / 3, -math.pi / 6, 0.0, math.pi / 6, math.pi / 3, math.pi / 2]
     pts = [(rx * math.cos(p) if abs(p) != math.pi / 2 else 0.0, c + c * math.sin(p)) for p in psi]
-    return coaxial_tablet([pts[0:4], pts[3:7]], a=a, name=name, family=name,
+    return coaxial_tablet([pts[0:4], pts[3:7]], a=a, name=name, family=f"thesis.{name}",
                           params=dict(diameter=diameter, height=height), nominal=nom.spheroid(rx, c, (0, 0, c)), tol=tol)
 
 
@@ -263,7 +262,7 @@ def rod(diameter: float = 3.0, length: float = 7.5, dome: float = 0.2, *, a=1.0,
     t = oblong(diameter, length, dome, a=a, tol=tol)
     from dataclasses import replace
 
-    return replace(t, name="rod", family="rod")
+    return replace(t, name="rod", family="thesis.rod")
 
 
 def caplet(width: float = 3.5, length: float = 7.0, height: float = 15.0, band: float = 10.0, *, a=1.0, tol=DEFAULT) -> Tablet:
@@ -271,7 +270,7 @@ def caplet(width: float = 3.5, length: float = 7.0, height: float = 15.0, band: 
     t = shallow_convex_oval(width, length, height, band, a=a, tol=tol)
     from dataclasses import replace
 
-    return replace(t, name="caplet", family="caplet")
+    return replace(t, name="caplet", family="thesis.caplet")
 
 
 def deep_convex_oval(width: float = 6.0, length: float = 12.0, thickness: float = 3.1, band: float = 1.1, *, a=1.0, tol=DEFAULT) -> Tablet:
@@ -279,17 +278,15 @@ def deep_convex_oval(width: float = 6.0, length: float = 12.0, thickness: float 
     t = shallow_convex_oval(width, length, thickness, band, a=a, tol=tol)
     from dataclasses import replace
 
-    return replace(t, name="deep_convex_oval", family="deep_convex_oval")
+    return replace(t, name="deep_convex_oval", family="thesis.deep_convex_oval")
 
 
 # ---------------------------------------------------------------------------- catalogue
 #: The thesis's shapes (Tables 4.1 and 4.5, in that order), a static mapping; every parameter in mm.
-#: Every family, these and the industry families, is in :data:`tabletcad.families.FAMILIES`.
+#: Every family is in :data:`tabletcad.families.FAMILIES`, where these are named ``thesis.<name>``
+#: (``thesis.flat_faced_round``): the plain names belong to the industry families.
 THESIS_SHAPES: Mapping[str, Family] = MappingProxyType({
     f.__name__: Family.of(f)
     for f in (flat_faced_round, spherical, shallow_convex_round, shallow_convex_oval, oblong, ring,
               deep_convex_round, oblate_spheroid, prolate_spheroid, rod, caplet, deep_convex_oval)
 })
-
-#: The names of the thesis's shapes, in the order of Tables 4.1 and 4.5.
-THESIS_FAMILIES: tuple[str, ...] = tuple(THESIS_SHAPES)

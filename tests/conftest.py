@@ -195,14 +195,15 @@ def kit():
 
 @pytest.fixture(scope="session")
 def family_tablet():
-    """``family_tablet(name)``: the default tablet of a shape family, built once per session."""
-    from tabletcad.families import FAMILIES
+    """``family_tablet(name)``: the default tablet of a thesis shape (``tabletcad.shapes.THESIS_SHAPES``),
+    built once per session."""
+    from tabletcad.shapes import THESIS_SHAPES
 
     cache: dict[str, object] = {}
 
     def get(name: str):
         if name not in cache:
-            cache[name] = FAMILIES[name].build()
+            cache[name] = THESIS_SHAPES[name].build()
         return cache[name]
 
     return get

@@ -129,11 +129,11 @@ def test_cut_planes_of_rounds_and_ovals_are_half_planes():
     from tabletcad.cad.stage import _cut_plane_angle
     from tabletcad.design import design_from_dict
 
-    r = design_from_dict({"tablet": {"family": "shallow_convex_round", "diameter": 10.0, "thickness": 3.0, "band": 2.0},
+    r = design_from_dict({"tablet": {"family": "thesis.shallow_convex_round", "diameter": 10.0, "thickness": 3.0, "band": 2.0},
                           "trim": {"v": [0.0, 3.0]}})
     assert _cut_plane_angle(r, 0.0) == pytest.approx(0.0, abs=1e-12)
     assert _cut_plane_angle(r, 3.0) == pytest.approx(3.0, abs=1e-9)
-    o = design_from_dict({"tablet": {"family": "shallow_convex_oval", "width": 6.0, "length": 12.0, "thickness": 3.0,
+    o = design_from_dict({"tablet": {"family": "thesis.shallow_convex_oval", "width": 6.0, "length": 12.0, "thickness": 3.0,
                                        "band": 2.0}, "trim": {"v": [0.0, 1.0]}})
     a, b = 6.0, 3.0  # half length and half width of the 12 x 6 mm oval
     assert _cut_plane_angle(o, 1.0) == pytest.approx(math.atan2(b * math.sin(1.0), a * math.cos(1.0)), abs=1e-9)
@@ -185,7 +185,7 @@ def test_bad_tooling_table_is_refused_before_any_geometry(tmp_path, capsys, monk
 
     monkeypatch.setattr(build, "geometry_report", no_geometry)
     d = tmp_path / "bad.toml"
-    d.write_text('[tablet]\nfamily = "shallow_convex_round"\ndiameter = 10.0\nthickness = 3.0\nband = 2.0\n\n' + extra)
+    d.write_text('[tablet]\nfamily = "thesis.shallow_convex_round"\ndiameter = 10.0\nthickness = 3.0\nband = 2.0\n\n' + extra)
     assert main(["build", str(d), "--out", str(tmp_path / "out")]) == 2  # progress on: still one line
     cap = capsys.readouterr()
     assert cap.out == "" and len(cap.err.strip().splitlines()) == 1 and cap.err.startswith("error: [")

@@ -348,7 +348,7 @@ def _check_random(t, genus: int) -> None:
 def test_random_shallow_convex_round(D, T, frac):
     from tabletcad.families import FAMILIES
 
-    _check_random(FAMILIES["shallow_convex_round"].build(diameter=D, thickness=T, band=frac * T), 0)
+    _check_random(FAMILIES["thesis.shallow_convex_round"].build(diameter=D, thickness=T, band=frac * T), 0)
 
 
 @settings(max_examples=3, deadline=None)
@@ -356,7 +356,7 @@ def test_random_shallow_convex_round(D, T, frac):
 def test_random_spherical(D):
     from tabletcad.families import FAMILIES
 
-    _check_random(FAMILIES["spherical"].build(diameter=D), 0)
+    _check_random(FAMILIES["thesis.spherical"].build(diameter=D), 0)
 
 
 @settings(max_examples=3, deadline=None)
@@ -364,7 +364,7 @@ def test_random_spherical(D):
 def test_random_ring(OD, frac, T):
     from tabletcad.families import FAMILIES
 
-    _check_random(FAMILIES["ring"].build(outer_diameter=OD, inner_diameter=frac * OD, thickness=T), 1)
+    _check_random(FAMILIES["thesis.ring"].build(outer_diameter=OD, inner_diameter=frac * OD, thickness=T), 1)
 
 
 # --------------------------------------------------------------------------- failures

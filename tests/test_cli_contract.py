@@ -52,7 +52,7 @@ def design(tmp_path: Path, text: str, name: str = "d.toml") -> Path:
     return p
 
 
-FLAT = '[tablet]\nfamily = "flat_faced_round"\nthickness = 6.0\n'
+FLAT = '[tablet]\nfamily = "thesis.flat_faced_round"\nthickness = 6.0\n'
 
 
 @pytest.mark.parametrize(
@@ -98,7 +98,7 @@ def test_bad_design_files_one_line_nothing_written(capsys, tmp_path, text, param
 def test_design_from_dict_refuses_booleans_and_huge_integers():
     for value in (True, False, 10**401, float("inf")):
         with pytest.raises(DesignError) as ei:
-            design_from_dict({"tablet": {"family": "spherical", "diameter": value}})
+            design_from_dict({"tablet": {"family": "thesis.spherical", "diameter": value}})
         assert ei.value.parameter == "tablet.diameter" and "\n" not in str(ei.value)
 
 
@@ -194,7 +194,7 @@ def test_shapes_marks_required_and_optional_and_prints_whole_descriptions(capsys
     rc, out, _ = run(capsys, "shapes", "--json")
     d = json.loads(out)
     assert d["concave_round"]["required"] == ["diameter", "band", "cup_depth"] and d["concave_round"]["optional"] == ["land"]
-    assert d["flat_faced_round"]["optional"] == []
+    assert d["thesis.flat_faced_round"]["optional"] == []
 
 
 @pytest.mark.parametrize("exc", [ZeroDivisionError("division by zero"), ValueError("a bare ValueError is a bug")])

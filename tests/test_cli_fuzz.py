@@ -112,7 +112,7 @@ designs = st.one_of(
                                                          "colour": values}),
     st.dictionaries(texts(6), values, max_size=3),
 )
-FRAGMENTS = ["[tablet]", "[[patch]]", "family = ", '"flat_faced_round"', "diameter = ", "1e300", "[", "]", "{", "}", "=",
+FRAGMENTS = ["[tablet]", "[[patch]]", "family = ", '"thesis.flat_faced_round"', "diameter = ", "1e300", "[", "]", "{", "}", "=",
              '"', "'", "\n", "true", "-", "0x1F", "nan", "\x00", "é", "#", "a.b = 1", "[tablet]\n[tablet]\n", "\\u0000"]
 raw_text = st.lists(st.one_of(st.sampled_from(FRAGMENTS), texts(8)), max_size=25).map("".join)
 

@@ -47,7 +47,7 @@ def test_every_sample_design_loads_and_reports(path, tmp_path):
 
 
 def test_family_design_matches_constructor():
-    t = design_from_dict({"tablet": {"family": "shallow_convex_round", "diameter": 8.0, "thickness": 3.2, "band": 2.0}})
+    t = design_from_dict({"tablet": {"family": "thesis.shallow_convex_round", "diameter": 8.0, "thickness": 3.2, "band": 2.0}})
     ref = shapes.shallow_convex_round(8.0, 3.2, 2.0)
     assert t.volume() == pytest.approx(ref.volume(), rel=1e-14)
     assert t.params == {"diameter": 8.0, "thickness": 3.2, "band": 2.0}
@@ -72,16 +72,16 @@ def test_free_form_design_with_previous_and_trim():
 @pytest.mark.parametrize(
     "data, fragment",
     [
-        ({"tablet": {"family": "flat_faced_round", "diameter": 0.0, "thickness": 6.0}}, "diameter = 0"),
-        ({"tablet": {"family": "flat_faced_round", "diameter": -3.0, "thickness": 6.0}}, "diameter = -3"),
-        ({"tablet": {"family": "flat_faced_round", "diameter": float("nan"), "thickness": 6.0}}, "diameter"),
-        ({"tablet": {"family": "flat_faced_round", "diameter": float("inf"), "thickness": 6.0}}, "diameter"),
-        ({"tablet": {"family": "spherical", "diameter": "five"}}, "diameter"),
+        ({"tablet": {"family": "thesis.flat_faced_round", "diameter": 0.0, "thickness": 6.0}}, "diameter = 0"),
+        ({"tablet": {"family": "thesis.flat_faced_round", "diameter": -3.0, "thickness": 6.0}}, "diameter = -3"),
+        ({"tablet": {"family": "thesis.flat_faced_round", "diameter": float("nan"), "thickness": 6.0}}, "diameter"),
+        ({"tablet": {"family": "thesis.flat_faced_round", "diameter": float("inf"), "thickness": 6.0}}, "diameter"),
+        ({"tablet": {"family": "thesis.spherical", "diameter": "five"}}, "diameter"),
         ({"tablet": {"family": "octagon", "diameter": 5.0}}, "family"),
-        ({"tablet": {"family": "spherical", "diamter": 5.0}}, "diamter"),
-        ({"tablet": {"family": "spherical"}, "colour": {}}, "colour"),
+        ({"tablet": {"family": "thesis.spherical", "diamter": 5.0}}, "diamter"),
+        ({"tablet": {"family": "thesis.spherical"}, "colour": {}}, "colour"),
         ({"shape": {}}, "shape"),
-        ({"tablet": {"family": "shallow_convex_round", "band": 5.0}}, "band"),
+        ({"tablet": {"family": "thesis.shallow_convex_round", "band": 5.0}}, "band"),
         ({"tablet": {"family": "free_form"}, "patch": [{"curves": [{"type": "circle", "radius": 1.0}] * 3}]}, "curves"),
         (
             {"tablet": {"family": "free_form"},
@@ -104,7 +104,7 @@ def _run_cli(args, cwd):
 
 def test_cli_bad_design_exits_2_without_traceback_or_files(tmp_path):
     bad = tmp_path / "bad.toml"
-    bad.write_text('[tablet]\nfamily = "flat_faced_round"\ndiameter = -10.0\nthickness = 6.0\n')
+    bad.write_text('[tablet]\nfamily = "thesis.flat_faced_round"\ndiameter = -10.0\nthickness = 6.0\n')
     out = tmp_path / "out"
     r = _run_cli(["build", str(bad), "--out", str(out)], tmp_path)
     assert r.returncode == 2

@@ -41,7 +41,7 @@ print(repr(v))
 """
 
 
-def _run(python: str, family: str = "spherical", blocked=BLOCKED) -> float:
+def _run(python: str, family: str = "thesis.spherical", blocked=BLOCKED) -> float:
     code = SCRIPT.format(repo=REPO, blocked=list(blocked), family=family)
     env = {k: val for k, val in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
     out = subprocess.run([python, "-c", code], capture_output=True, text=True, timeout=120, env=env, cwd="/")
@@ -57,7 +57,7 @@ def _volume_here(family: str) -> float:
 
 def test_core_imports_and_computes_with_cad_libraries_blocked():
     v = _run(sys.executable)
-    assert v == pytest.approx(_volume_here("spherical"), rel=1e-13)
+    assert v == pytest.approx(_volume_here("thesis.spherical"), rel=1e-13)
 
 
 def _debian_python():
@@ -73,7 +73,7 @@ def _debian_python():
     return exe, probe.stdout.strip()
 
 
-@pytest.mark.parametrize("family", ["spherical", "flat_faced_round", "shallow_convex_oval"])
+@pytest.mark.parametrize("family", ["thesis.spherical", "thesis.flat_faced_round", "thesis.shallow_convex_oval"])
 def test_same_volume_on_debian_numpy_124(family):
     """FreeCAD's Python on Debian ships numpy 1.24 / scipy 1.10: same numbers to 1e-12.
 

@@ -1,4 +1,4 @@
-"""Tablets (tabletcad.tablet) built from every thesis family (tabletcad.shapes.THESIS_FAMILIES).
+"""Tablets (tabletcad.tablet) built from every thesis family (tabletcad.shapes.THESIS_SHAPES).
 
 Volume by the divergence theorem (thesis eq 4.9) is checked against the
 independent triple integral of the solid map (eq 4.12), against invariances
@@ -13,10 +13,10 @@ import math
 import numpy as np
 import pytest
 
-from tabletcad.shapes import THESIS_FAMILIES
+from tabletcad.shapes import THESIS_SHAPES
 from tabletcad.tablet import Trim
 
-NAMES = sorted(THESIS_FAMILIES)
+NAMES = sorted(THESIS_SHAPES)
 AXISYMMETRIC = ["flat_faced_round", "spherical", "shallow_convex_round"]
 #: smaller quadrature where a test is about geometry, not accuracy (still converged to ~1e-12)
 Q = dict(nu=32, nv=96)

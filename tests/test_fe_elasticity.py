@@ -127,7 +127,7 @@ class Block:
 sys.meta_path.insert(0, Block())
 import tabletcad, tabletcad.tablet, tabletcad.families, tabletcad.mechanics.strength
 import tabletcad.fe.mesh, tabletcad.fe.elasticity, tabletcad.fe.diametral
-v = tabletcad.families.FAMILIES["spherical"].build().properties()["volume_mm3"]
+v = tabletcad.families.FAMILIES["thesis.spherical"].build().properties()["volume_mm3"]
 assert not [m for m in sys.modules if m.split(".")[0] in ("skfem", "gmsh")]
 print(v)
 """

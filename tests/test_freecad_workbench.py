@@ -197,15 +197,15 @@ def _core_volume(family: str | None, params: dict | None = None, design: Path | 
 # ------------------------------------------------------------------------------------------- headless
 # the families fc_headless.py creates (default dimensions unless given) and those it makes tooling for
 FAMILIES = {
-    "flat_faced_round": {},
-    "ring": {},
+    "thesis.flat_faced_round": {},
+    "thesis.ring": {},
     "concave_round": {"diameter": 10.0, "cup_depth": 0.8},
-    "spherical": {},
-    "shallow_convex_round": {},
+    "thesis.spherical": {},
+    "thesis.shallow_convex_round": {},
     "compound_cup": {},
     "capsule": {},
 }
-TOOLING_FAMILIES = ["concave_round", "ring", "capsule"]
+TOOLING_FAMILIES = ["concave_round", "thesis.ring", "capsule"]
 
 
 @pytest.fixture(scope="module")
@@ -252,7 +252,7 @@ def test_tooling_valid_and_linked(headless, family):
     assert up["bbox"][2] <= tab["bbox"][5] + 1e-6 and low["bbox"][5] >= tab["bbox"][2] - 1e-6
     assert up["bbox"][5] == pytest.approx(up["bbox"][2] + 10.0, abs=1e-6)
     assert die["bbox"][0] == pytest.approx(-30.16 / 2, abs=1e-6)
-    if family == "ring":
+    if family == "thesis.ring":
         import math
 
         # annular punch: pi (R^2 - r^2) x 10 mm
@@ -358,7 +358,7 @@ def test_properties_finite_in_user_units_and_internal_data_hidden(headless):
         assert sorted(t["rimdata_mode"]) == ["Hidden", "ReadOnly"]
         fam, params = step["family"], FAMILIES[step["family"]]
         d = params.get("diameter", families.FAMILIES[fam].defaults.get("diameter"))
-        if fam == "ring":
+        if fam == "thesis.ring":
             d = families.FAMILIES[fam].defaults["outer_diameter"]
             r = families.FAMILIES[fam].defaults["inner_diameter"] / 2
             assert t["plan_area"] == pytest.approx(math.pi * ((d / 2) ** 2 - r * r), rel=1e-6)
@@ -371,10 +371,10 @@ def test_properties_finite_in_user_units_and_internal_data_hidden(headless):
 
 def test_labels_follow_family_and_tablet_name(headless):
     (sw,) = _steps(headless, "family_switch")
-    assert sw["label_before"].startswith("flat_faced_round")
+    assert sw["label_before"].startswith("thesis.flat_faced_round")
     label = sw["tablet"]["label"]
-    suffix = label[len("shallow_convex_round"):]
-    assert label.startswith("shallow_convex_round") and (suffix == "" or suffix.isdigit()), label
+    suffix = label[len("thesis.shallow_convex_round"):]
+    assert label.startswith("thesis.shallow_convex_round") and (suffix == "" or suffix.isdigit()), label
     assert sw["tool_labels"] == [f"{label} upper punch", f"{label} lower punch", f"{label} die"]
     assert all(sw["tools_valid"])
     (rn,) = _steps(headless, "rename")
@@ -408,8 +408,8 @@ def test_task_panel_form(headless):
     assert figs["weight_mg"] == pytest.approx(1.2 * core, rel=1e-12)
     assert st["from_object"] == {**fam.defaults, "diameter": 8.0, "cup_depth": 1.0}
     t = st["tablet"]
-    assert t["family"] == "flat_faced_round" and t["dims"] == {"Diameter": 10.0, "Thickness": 3.0}
-    assert t["core_volume"] == pytest.approx(_core_volume("flat_faced_round", {"thickness": 3.0}), rel=1e-9)
+    assert t["family"] == "thesis.flat_faced_round" and t["dims"] == {"Diameter": 10.0, "Thickness": 3.0}
+    assert t["core_volume"] == pytest.approx(_core_volume("thesis.flat_faced_round", {"thickness": 3.0}), rel=1e-9)
     assert t["weight_mg"] == pytest.approx(1.5 * t["core_volume"], rel=1e-12)
     assert len(st["tooling"]) == 3 and all(st["tooling_valid"])
     assert all(lbl.startswith(t["label"] + " ") for lbl in st["tooling"]), (t["label"], st["tooling"])
@@ -442,13 +442,13 @@ def test_punch_gap_lifts_the_punch(headless):
 def test_family_switch_rebuilds_dimension_properties(headless):
     (step,) = _steps(headless, "family_switch")
     t = step["tablet"]
-    assert t["family"] == "shallow_convex_round" and set(t["dims"]) == {"Diameter", "Thickness", "Band"}
-    assert t["core_volume"] == pytest.approx(_core_volume("shallow_convex_round", {"band": 1.5}), rel=1e-9)
+    assert t["family"] == "thesis.shallow_convex_round" and set(t["dims"]) == {"Diameter", "Thickness", "Band"}
+    assert t["core_volume"] == pytest.approx(_core_volume("thesis.shallow_convex_round", {"band": 1.5}), rel=1e-9)
 
 
 def test_design_files(headless):
     (ring,) = _steps(headless, "design_ring")
-    assert ring["tablet"]["family"] == "ring" and ring["tablet"]["dims"]["InnerDiameter"] == 6.0
+    assert ring["tablet"]["family"] == "thesis.ring" and ring["tablet"]["dims"]["InnerDiameter"] == 6.0
     assert ring["tablet"]["core_volume"] == pytest.approx(
         _core_volume(None, design=ROOT / "samples" / "ring.toml"), rel=1e-9
     )
@@ -471,7 +471,7 @@ def test_save_reopen_recompute(headless):
     assert step["all_valid"]
     t = step["tablet"]
     assert t["dims"]["Thickness"] == 5.0
-    assert t["core_volume"] == pytest.approx(_core_volume("ring", {"thickness": 5.0}), rel=1e-9)
+    assert t["core_volume"] == pytest.approx(_core_volume("thesis.ring", {"thickness": 5.0}), rel=1e-9)
     assert t["volume"] == pytest.approx(t["core_volume"], rel=1e-6)
     for part in ("upper", "lower", "die"):
         assert step[part]["valid"] and step[part]["n_solids"] == 1
@@ -515,7 +515,7 @@ def test_macro_heckel(macros):
 
 def test_macro_optimise(macros):
     m = macros["macros"]["optimise"]
-    assert m["n"] == 1 and m["valid"] == [True] and m["family"] == "flat_faced_round"
+    assert m["n"] == 1 and m["valid"] == [True] and m["family"] == "thesis.flat_faced_round"
     assert m["volume"] == pytest.approx(235.0, rel=1e-4)
     # minimum area of a near-cylinder at fixed volume: diameter ~ thickness
     assert m["dims"]["Diameter"] == pytest.approx(m["dims"]["Thickness"], rel=0.05)

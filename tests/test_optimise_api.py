@@ -56,7 +56,7 @@ def test_pde_tablet_analytic_optimum():
     curves, so scaling the plan by s and the height by t scales the volume by s² t exactly,
     V = k D² T, and the optimum of D + T has D = 2T."""
     data = {
-        "problem": {"kind": "family", "family": "flat_faced_round", "sense": "min",
+        "problem": {"kind": "family", "family": "thesis.flat_faced_round", "sense": "min",
                     "objective": {"linear": {"diameter": 1.0, "thickness": 1.0}}},
         "variables": {"diameter": {"lower": 4.0, "upper": 14.0, "initial": 10.0},
                       "thickness": {"lower": 1.0, "upper": 8.0, "initial": 3.0}},

@@ -48,7 +48,7 @@ def test_bad_input_exit_2_nothing_written(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error:")
     assert not out.exists()
-    bad.write_text('[problem]\nkind = "family"\nfamily = "flat_faced_round"\nobjective = "volume_mm3"\n'
+    bad.write_text('[problem]\nkind = "family"\nfamily = "thesis.flat_faced_round"\nobjective = "volume_mm3"\n'
                    '[variables]\ndiameter = { lower = 5, upper = 4 }\n')
     assert main(["optimise", str(bad), "--out", str(out), "--quiet"]) == 2
     assert not out.exists()

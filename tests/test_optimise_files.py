@@ -18,7 +18,7 @@ ONE_LINE = re.compile(r"^error: (?P<param>.+?) = (?P<value>.+) is not allowed: (
 
 FAMILY = """[problem]
 kind = "family"
-family = "flat_faced_round"
+family = "thesis.flat_faced_round"
 sense = "min"
 objective = "surface_area_mm2"
 

@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tabletcad.errors import DesignError
-from tabletcad.families import FAMILIES, THESIS_FAMILIES
+from tabletcad.shapes import THESIS_SHAPES
 from tabletcad.solid import SolidMesh, THESIS_NODES, cell_volumes, hex_mesh, mesh_volume, write_mesh
 
 LEVELS = [(9, 17, 5), (17, 33, 9), (33, 65, 17)]  # every spacing halved per level
@@ -20,7 +20,7 @@ LEVELS = [(9, 17, 5), (17, 33, 9), (33, 65, 17)]  # every spacing halved per lev
 
 @lru_cache(maxsize=None)
 def tablet(name: str):
-    return FAMILIES[name].build()
+    return THESIS_SHAPES[name].build()
 
 
 # ---------------------------------------------------------------------------- independent checks
@@ -136,7 +136,7 @@ def fitted_slope(t) -> tuple[float, list[float], list[SolidMesh]]:
     return slope, errs, meshes
 
 
-@pytest.mark.parametrize("name", sorted(THESIS_FAMILIES))
+@pytest.mark.parametrize("name", sorted(THESIS_SHAPES))
 def test_volume_converges_at_second_order_and_cells_are_positive(name):
     t = tablet(name)
     slope, errs, meshes = fitted_slope(t)

@@ -203,7 +203,7 @@ def test_tooling_batch_runs_on_the_cluster(local_client, tmp_path):
     from tabletcad.tooling import tooling_batch
 
     sizes = [dict(diameter=d, thickness=0.3 * d, band=0.2 * d) for d in (6.0, 8.0)]
-    rows = tooling_batch("shallow_convex_round", sizes, {"clearance_mm": 0.02}, out_dir=tmp_path, progress=False,
+    rows = tooling_batch("thesis.shallow_convex_round", sizes, {"clearance_mm": 0.02}, out_dir=tmp_path, progress=False,
                          check=False, drawing=False, client=local_client)
     assert [r["params"] for r in rows] == sizes
     for k, r in enumerate(rows):

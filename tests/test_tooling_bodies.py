@@ -191,7 +191,7 @@ def test_cli_bad_complete_tooling_exits_2_with_one_line_and_writes_nothing(tmp_p
     from tabletcad.cli import main
 
     d = tmp_path / "bad.toml"
-    d.write_text('[tablet]\nfamily = "shallow_convex_round"\ndiameter = 10.0\nthickness = 3.0\nband = 2.0\n\n' + extra)
+    d.write_text('[tablet]\nfamily = "thesis.shallow_convex_round"\ndiameter = 10.0\nthickness = 3.0\nband = 2.0\n\n' + extra)
     out = tmp_path / "out"
     assert main(["build", str(d), "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()

@@ -185,7 +185,7 @@ def test_bad_keys_are_design_errors(table):
 ])
 def test_cli_bad_tooling_exits_2_and_writes_nothing(tmp_path, capsys, extra):
     d = tmp_path / "bad.toml"
-    d.write_text('[tablet]\nfamily = "shallow_convex_round"\ndiameter = 10.0\nthickness = 3.0\nband = 2.0\n\n' + extra)
+    d.write_text('[tablet]\nfamily = "thesis.shallow_convex_round"\ndiameter = 10.0\nthickness = 3.0\nband = 2.0\n\n' + extra)
     out = tmp_path / "out"
     assert main(["build", str(d), "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
@@ -196,7 +196,7 @@ def test_cli_bad_tooling_exits_2_and_writes_nothing(tmp_path, capsys, extra):
 
 def test_batch_of_sizes(tmp_path):
     sizes = [dict(diameter=d, thickness=0.3 * d, band=0.2 * d) for d in (6.0, 8.0)]
-    rows = tooling_batch("shallow_convex_round", sizes, {"clearance_mm": 0.02}, out_dir=tmp_path, progress=False,
+    rows = tooling_batch("thesis.shallow_convex_round", sizes, {"clearance_mm": 0.02}, out_dir=tmp_path, progress=False,
                          check=False, drawing=False)
     assert len(rows) == 2
     for k, r in enumerate(rows):

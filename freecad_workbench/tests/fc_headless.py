@@ -179,10 +179,10 @@ try:
     doc.recompute()
 
     # ---- family switch: Dimensions group follows the family
-    sw = make_tablet(doc, "flat_faced_round")
+    sw = make_tablet(doc, "thesis.flat_faced_round")
     label_before = sw.Label
     swtools = make_tooling(doc, sw, recompute=False)
-    sw.Family = "shallow_convex_round"
+    sw.Family = "thesis.shallow_convex_round"
     sw.Band = 1.5
     doc.recompute()
     step(
@@ -229,7 +229,7 @@ try:
     linked = [o for o in made.InList if getattr(getattr(o, "Proxy", None), "Type", "").startswith("Tabletcad")]
     edit = TabletForm.from_object(made)
     same = dict(edit.values)
-    edit.set_family("flat_faced_round")
+    edit.set_family("thesis.flat_faced_round")
     edit.values["thickness"] = 3.0
     edit.density = 1.5
     edit.apply(made)
@@ -264,11 +264,11 @@ try:
     path = os.path.join(work, "wbtest.FCStd")
     doc.saveAs(path)
     names = {fam: tabs[fam].Name for fam in tabs}
-    tool_names = [o.Name for o in tooling["ring"]]
+    tool_names = [o.Name for o in tooling["thesis.ring"]]
     FreeCAD.closeDocument(doc.Name)
     doc = FreeCAD.openDocument(path)
     proxies = {o.Name: type(o.Proxy).__name__ for o in doc.Objects if hasattr(o, "Proxy")}
-    ring = doc.getObject(names["ring"])
+    ring = doc.getObject(names["thesis.ring"])
     restored_density = float(ring.Density)
     ring.Thickness = 5.0
     t0 = time.perf_counter()

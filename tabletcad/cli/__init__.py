@@ -237,11 +237,20 @@ def _run(argv: list[str] | None) -> int:
     return 0
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning on the command line: one line, ``warning: <message>``, no source line."""
+    _say("warning: " + " ".join(str(message).split()))
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit status (see the module docstring)."""
+    import warnings
+
     try:
         try:
-            return _run(argv)
+            with warnings.catch_warnings():
+                warnings.showwarning = _show_warning
+                return _run(argv)
         except (KeyboardInterrupt, SystemExit):
             raise
         except BrokenPipeError:  # the reader of stdout went away (``| head``): stop quietly

@@ -21,7 +21,7 @@ def shapes_cmd(as_json: bool) -> None:
     """List the tablet families: required and optional parameters (units, defaults) and what each is."""
     import textwrap
 
-    from tabletcad.families import FAMILIES
+    from tabletcad.families import FAMILIES, INDUSTRY_FAMILIES, THESIS_FAMILIES
 
     if as_json:
         click.echo(json.dumps({n: dict(params=f.params, required=list(f.required),
@@ -29,15 +29,21 @@ def shapes_cmd(as_json: bool) -> None:
                                        defaults=f.defaults, description=f.description)
                                for n, f in FAMILIES.items()}, indent=2))
         return
+    w = max(map(len, FAMILIES)) + 1
+    heads = {INDUSTRY_FAMILIES[0]: "Industry families (exact nominal shapes, certified PDE patches):",
+             THESIS_FAMILIES[0]: "The thesis's shapes (PDE patches through the thesis's curves, Tables 4.1 and 4.5):"}
     for name, fam in FAMILIES.items():
+        if name in heads:
+            click.echo(("" if name == INDUSTRY_FAMILIES[0] else "\n") + heads[name])
         req = ", ".join(f"{k} [{fam.params[k]}]" for k in fam.required)
         opt = ", ".join(f"{k} [{u}] = {fam.defaults[k]:g}" for k, u in fam.params.items() if k not in fam.required)
-        click.echo(f"{name:22s} required: {req}" + (f"; optional: {opt}" if opt else ""))
-        click.echo(textwrap.fill(fam.description, width=100, initial_indent=" " * 23, subsequent_indent=" " * 23))
-    click.echo(f"{'custom_outline':22s} required: outline [mm] (points) or segments (lines and arcs), band [mm], "
+        click.echo(f"{name:{w}s} required: {req}" + (f"; optional: {opt}" if opt else ""))
+        click.echo(textwrap.fill(fam.description, width=100, initial_indent=" " * (w + 1), subsequent_indent=" " * (w + 1)))
+    click.echo("\nDesigns of any shape:")
+    click.echo(f"{'custom_outline':{w}s} required: outline [mm] (points) or segments (lines and arcs), band [mm], "
                "cup_depth [mm]; optional: land, cup_width, central_radius, edge_radius [mm] = 0 (see README: design files)")
-    click.echo(f"{'free_form':22s} required: [[patch]] tables of 4 curves each (see README: design files)")
-    click.echo(f"{'':22s} every design may also give a (smoothing parameter, default 1 or the family's; \"auto\" to choose)")
+    click.echo(f"{'free_form':{w}s} required: [[patch]] tables of 4 curves each (see README: design files)")
+    click.echo(f"{'':{w}s} every design may also give a (smoothing parameter, default 1 or the family's; \"auto\" to choose)")
 
 
 @click.command("build")

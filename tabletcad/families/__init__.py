@@ -2,9 +2,11 @@
 catalogue of every family.
 
 :data:`FAMILIES` is the static mapping from a family's name to its
-:class:`~tabletcad.family.Family`: the thesis's shapes
-(:data:`tabletcad.shapes.THESIS_SHAPES`) and the industry families below.  Design
-files, ``tabletcad shapes``, sweeps and the optimiser read it.
+:class:`~tabletcad.family.Family`: the industry families below, then the
+thesis's shapes (:data:`tabletcad.shapes.THESIS_SHAPES`) named ``thesis.<name>``.
+Design files, ``tabletcad shapes``, sweeps, tooling batches, the optimiser and the
+FreeCAD workbench look names up with :func:`family`, which still accepts the
+thesis's shapes under their old plain names (:data:`RENAMED`) with a warning.
 
 Each family builds a nominal description (a face profile of lines and arcs
 revolved about the axis or swept along inward offsets of a plan outline, see
@@ -34,12 +36,15 @@ Any other plan outline (points or lines and arcs): :func:`outline_tablet`.
 
 from __future__ import annotations
 
+import warnings
+from dataclasses import replace
 from types import MappingProxyType
 from typing import Mapping
 
 from tabletcad.families.elongated import capsule, modified_capsule, oval
 from tabletcad.families.round import compound_cup, concave_bevel, concave_round, ffbe, ffre, flat_face_round
 from tabletcad.families.shaped import almond, outline_tablet, rounded_rectangle, rounded_square, rounded_triangle
+from tabletcad.errors import DesignError
 from tabletcad.families.sweep import certify, nominal_volume, sweep_properties
 from tabletcad.family import Family
 from tabletcad.shapes import THESIS_SHAPES
@@ -48,6 +53,9 @@ __all__ = [
     "FAMILIES",
     "FAMILY_FUNCTIONS",
     "INDUSTRY_FAMILIES",
+    "RENAMED",
+    "THESIS_FAMILIES",
+    "family",
     "almond",
     "capsule",
     "certify",
@@ -78,7 +86,35 @@ FAMILY_FUNCTIONS = (
 #: The industry families' names, in the order of the table above.
 INDUSTRY_FAMILIES: tuple[str, ...] = tuple(f.__name__ for f in FAMILY_FUNCTIONS)
 
-#: Every family by name: the thesis's shapes, then the industry families (static).
-FAMILIES: Mapping[str, Family] = MappingProxyType(
-    {**THESIS_SHAPES, **{f.__name__: Family.of(f, _UNITS) for f in FAMILY_FUNCTIONS}}
-)
+#: The catalogue names of the thesis's shapes (Tables 4.1 and 4.5): ``thesis.<name>``.
+THESIS_FAMILIES: tuple[str, ...] = tuple(f"thesis.{n}" for n in THESIS_SHAPES)
+
+#: Every family by name: the industry families, then the thesis's shapes (static, read-only).
+FAMILIES: Mapping[str, Family] = MappingProxyType({
+    **{f.__name__: Family.of(f, _UNITS) for f in FAMILY_FUNCTIONS},
+    **{f"thesis.{n}": replace(f, name=f"thesis.{n}") for n, f in THESIS_SHAPES.items()},
+})
+
+#: Names of earlier releases, still accepted with a one-line :class:`FutureWarning`: the thesis's
+#: shapes before they moved under ``thesis.`` (``flat_faced_round`` is now
+#: ``thesis.flat_faced_round``; the industry ``flat_face_round`` keeps its name).
+RENAMED: Mapping[str, str] = MappingProxyType({n: f"thesis.{n}" for n in THESIS_SHAPES})
+
+#: The release after which the old names are refused.
+RENAMED_UNTIL = "0.3"
+
+
+def family(name: str, *, parameter: str = "tablet.family", stacklevel: int = 2) -> Family:
+    """The family called ``name`` in :data:`FAMILIES`; a name of :data:`RENAMED` gives its new
+    family with a one-line :class:`FutureWarning`.
+
+    Raises :class:`~tabletcad.errors.DesignError` naming ``parameter`` for any other name.
+    """
+    if isinstance(name, str) and name in RENAMED:
+        new = RENAMED[name]
+        warnings.warn(f"family {name!r} is now {new!r}; the old name is accepted until tabletcad {RENAMED_UNTIL}",
+                      FutureWarning, stacklevel=stacklevel)
+        name = new
+    if not isinstance(name, str) or name not in FAMILIES:
+        raise DesignError(parameter, name, f"must be one of {', '.join(FAMILIES)}")
+    return FAMILIES[name]

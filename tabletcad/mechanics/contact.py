@@ -370,7 +370,7 @@ def compressed_sphere_tablet(force_N: float, material: Material | str, radius: f
     cs = compress_sphere(force_N, material, radius)
     pts = list(cs.circles)
     params = {"force_N": cs.force, "radius": cs.radius, "height": cs.height}
-    return coaxial_tablet([pts[0:4], pts[3:7]], name="compressed_sphere", family="spherical", params=params, **kw)
+    return coaxial_tablet([pts[0:4], pts[3:7]], name="compressed_sphere", family="thesis.spherical", params=params, **kw)
 
 
 def _figure():

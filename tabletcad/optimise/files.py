@@ -16,7 +16,7 @@ A problem over the parameters of any tablet family (``tabletcad shapes``)::
 
     [problem]
     kind = "family"
-    family = "flat_faced_round"
+    family = "thesis.flat_faced_round"
     sense = "min"
     objective = "surface_area_mm2"   # or { linear = { diameter = 1.0, thickness = 1.0 } }
 
@@ -279,9 +279,13 @@ def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
 def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) -> Problem:
     """A :class:`Problem` over the parameters of a tablet family (:data:`tabletcad.families.FAMILIES`)."""
     from tabletcad.design import design_to_toml
-    from tabletcad.families import FAMILIES
+    from tabletcad.families import FAMILIES, RENAMED
+    from tabletcad.families import family as lookup_family
 
-    fam_name = choice("[problem] family", prob.get("family"), tuple(FAMILIES))
+    fam_name = prob.get("family")
+    if isinstance(fam_name, str) and fam_name in RENAMED:
+        fam_name = lookup_family(fam_name, parameter="[problem] family", stacklevel=3).name
+    fam_name = choice("[problem] family", fam_name, tuple(FAMILIES))
     fam = FAMILIES[fam_name]
     if not isinstance(variables, dict) or not variables:
         raise DesignError("[variables]", _shown(variables), "must be a table of family parameters with lower/upper/initial")

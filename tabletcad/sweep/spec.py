@@ -167,8 +167,9 @@ def _known_keys(design: dict) -> set[str]:
     walk("", design)
     tab = design.get("tablet", {})
     fam = tab.get("family") if isinstance(tab, dict) else None
-    from tabletcad.families import FAMILIES
+    from tabletcad.families import FAMILIES, RENAMED
 
+    fam = RENAMED.get(fam, fam) if isinstance(fam, str) else fam  # each design warns of an old name when built
     if fam in FAMILIES:
         keys |= {f"tablet.{k}" for k in FAMILIES[fam].params} | {"tablet.a", "tablet.name"}
     try:

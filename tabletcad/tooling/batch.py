@@ -2,7 +2,7 @@
 in this process or on a Dask cluster (:mod:`tabletcad.parallel`).
 
 >>> from tabletcad.tooling import tooling_batch, ToolingSpec
->>> rows = tooling_batch("shallow_convex_round",
+>>> rows = tooling_batch("thesis.shallow_convex_round",
 ...                      [dict(diameter=d, thickness=0.3 * d, band=0.2 * d) for d in (6, 8, 10)],
 ...                      ToolingSpec(clearance_mm=0.02), out_dir="tools")   # doctest: +SKIP
 """
@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any, Iterable
 
 from tabletcad.families import FAMILIES
+from tabletcad.families import family as lookup_family
 from tabletcad.tooling.spec import ToolingSpec, parse_tooling
 
 __all__ = ["tooling_batch", "tooling_for"]
@@ -53,10 +54,7 @@ def tooling_batch(family: str, sizes: Iterable[dict], spec: ToolingSpec | dict |
 
     if isinstance(spec, dict):
         spec = parse_tooling(spec)
-    if family not in FAMILIES:
-        from tabletcad.errors import DesignError
-
-        raise DesignError("family", family, f"must be one of {', '.join(FAMILIES)}")
+    family = lookup_family(family, parameter="family", stacklevel=3).name
     sizes = [dict(p) for p in sizes]
 
     def write(k: int, res: dict) -> None:
@@ -83,7 +81,7 @@ def _tooling_task(params: dict, *, family: str, spec: ToolingSpec | None, check:
     from tabletcad.tooling.toolset import make_tooling
 
     t0 = time.perf_counter()
-    tablet = FAMILIES[family].build(**params)
+    tablet = FAMILIES[family].build(**params)  # the catalogue name (tooling_batch resolved it)
     ts = make_tooling(tablet, spec, check=check, interference_check=interference_check)
     data: dict[str, bytes] = {}
     if files:

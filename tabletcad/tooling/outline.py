@@ -282,8 +282,9 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
         else:
             wire, kind = _section_wire(shape, 0.5 * (band_z[0] + band_z[1])), "section of the band"
     land = info.get("land_mm")
-    if land is None and tablet.family in ("shallow_convex_round", "deep_convex_round", "shallow_convex_oval",
-                                          "deep_convex_oval", "caplet", "flat_faced_round", "oblong", "rod"):
+    if land is None and tablet.family in ("thesis.shallow_convex_round", "thesis.deep_convex_round",
+                                          "thesis.shallow_convex_oval", "thesis.deep_convex_oval", "thesis.caplet",
+                                          "thesis.flat_faced_round", "thesis.oblong", "thesis.rod"):
         land = 0.0
     bulge = found[3] if found is not None else 0.0
     return TabletFrame(tablet, shape, (float(band_z[0]), float(band_z[1])), bulge, float(lo[2]), float(hi[2]), wire, kind,

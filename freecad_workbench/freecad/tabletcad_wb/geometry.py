@@ -63,11 +63,7 @@ def tablet_from_spec(family=None, params=None, design=None):
         from tabletcad.design import load_design
 
         return load_design(design)
-    if family not in families.FAMILIES:
-        from tabletcad.errors import DesignError
-
-        raise DesignError("family", family, f"must be one of {', '.join(sorted(families.FAMILIES))}")
-    return families.FAMILIES[family].build(**(params or {}))
+    return families.family(family, parameter="family", stacklevel=3).build(**(params or {}))
 
 
 def _rims(surfaces, hollow):

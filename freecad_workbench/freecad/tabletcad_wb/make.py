@@ -34,7 +34,7 @@ def _new(doc, name):
     return doc.addObject("Part::FeaturePython", name)
 
 
-def make_tablet(doc, design_or_family="flat_faced_round", name=None, recompute=True, **params):
+def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, recompute=True, **params):
     """A parametric Tablet.
 
     ``design_or_family``: a family name (see ``tabletcad shapes``) or the path
@@ -63,6 +63,10 @@ def make_tablet(doc, design_or_family="flat_faced_round", name=None, recompute=T
         else:
             family = objects.DESIGN_FILE
             label = label or Path(design_or_family).stem
+    if family != objects.DESIGN_FILE:  # an old name of a renamed family: one warning, its new name
+        from tabletcad.families import family as lookup_family
+
+        family = lookup_family(family, parameter="family", stacklevel=3).name
     obj = _new(doc, "Tablet")
     objects.TabletProxy(obj, family)
     if design is not None:

@@ -100,9 +100,10 @@ def is_tablet(obj) -> bool:
 
 
 def _family(name):
+    """The family of a Family property value (an old name of a renamed family gives the new one)."""
     from tabletcad import families
 
-    return families.FAMILIES.get(name)
+    return families.FAMILIES.get(families.RENAMED.get(name, name))
 
 
 def _qty(value, unit):
@@ -167,7 +168,7 @@ class TabletProxy(_Proxy):
 
     Type = "TabletcadTablet"
 
-    def __init__(self, obj, family: str = "flat_faced_round"):
+    def __init__(self, obj, family: str = "thesis.flat_faced_round"):
         self._ready = False
         obj.Proxy = self
         self._setup(obj)
@@ -184,8 +185,10 @@ class TabletProxy(_Proxy):
                 "App::PropertyEnumeration", "Family", "Tablet", "tabletcad family (or design_file)"
             )
             obj.Family = names
-        else:  # keep the list current with the installed families
-            cur = obj.Family
+        else:  # keep the list current with the installed families (a document saved with a
+            from tabletcad.families import RENAMED  # family's old name opens with its new one)
+
+            cur = RENAMED.get(obj.Family, obj.Family)
             obj.Family = names
             if cur in names:
                 obj.Family = cur

@@ -29,7 +29,7 @@ class TabletForm:
     ``values`` are in the family's units (mm, deg); ``density`` in mg/mm³.
     """
 
-    def __init__(self, family: str = "flat_faced_round", values: dict | None = None, density: float = 1.2):
+    def __init__(self, family: str = "thesis.flat_faced_round", values: dict | None = None, density: float = 1.2):
         self.families = objects.family_names()
         self.density = float(density)
         self.set_family(family)
@@ -39,7 +39,7 @@ class TabletForm:
     @classmethod
     def from_object(cls, obj) -> TabletForm:
         s = obj.Proxy.spec(obj)
-        return cls(s["family"] or "flat_faced_round", s["params"], float(obj.Density))
+        return cls(s["family"] or "thesis.flat_faced_round", s["params"], float(obj.Density))
 
     def set_family(self, family: str) -> None:
         fam = objects._family(family)

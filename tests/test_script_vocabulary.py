@@ -1,0 +1,90 @@
+"""One vocabulary: the industry families own the plain names, the thesis's shapes live under
+``thesis.``; the old plain names still work for a release, with one line of warning."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import pytest
+
+from tabletcad.design import design_from_dict, load_design
+from tabletcad.errors import DesignError
+from tabletcad.families import FAMILIES, INDUSTRY_FAMILIES, RENAMED, THESIS_FAMILIES, family
+from tabletcad.shapes import THESIS_SHAPES
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLES = sorted(p for p in ROOT.joinpath("samples").rglob("*.toml") if "[tablet]" in p.read_text(encoding="utf-8"))
+
+
+def test_names_are_one_namespace():
+    assert set(THESIS_FAMILIES) == {f"thesis.{n}" for n in THESIS_SHAPES}
+    assert not set(INDUSTRY_FAMILIES) & set(THESIS_SHAPES)  # no plain name is both
+    assert list(FAMILIES) == [*INDUSTRY_FAMILIES, *THESIS_FAMILIES]
+    assert all(FAMILIES[n].name == n for n in FAMILIES)
+    assert dict(RENAMED) == {n: f"thesis.{n}" for n in THESIS_SHAPES}
+    # the near-twins of the first wave are told apart by the prefix
+    assert "flat_face_round" in FAMILIES and "thesis.flat_faced_round" in FAMILIES and "flat_faced_round" not in FAMILIES
+
+
+@pytest.mark.parametrize("old", sorted(RENAMED))
+def test_an_old_name_builds_the_same_tablet_with_one_warning(old):
+    dims = FAMILIES[f"thesis.{old}"].defaults
+    with pytest.warns(FutureWarning) as rec:
+        t = design_from_dict({"tablet": {"family": old, **dims}})
+    assert [str(w.message) for w in rec] == [
+        f"family {old!r} is now 'thesis.{old}'; the old name is accepted until tabletcad 0.3"]
+    assert rec[0].filename == __file__  # attributed to the caller, not to tabletcad's internals
+    new = FAMILIES[f"thesis.{old}"].build()
+    assert t.family == new.family == f"thesis.{old}"
+    assert t.volume() == new.volume()
+
+
+def test_lookup_refuses_unknown_names_naming_the_parameter():
+    with pytest.raises(DesignError) as e:
+        family("flat_faced_rnd", parameter="[problem] family")
+    assert e.value.parameter == "[problem] family" and "thesis.flat_faced_round" in str(e.value)
+    with pytest.raises(DesignError):
+        family(["capsule"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert family("capsule") is FAMILIES["capsule"]
+
+
+@pytest.mark.parametrize("path", SAMPLES, ids=lambda p: str(p.relative_to(ROOT)))
+def test_every_sample_uses_the_current_names(path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FutureWarning)
+        load_design(path)
+
+
+def test_command_line_prints_the_warning_as_one_line(tmp_path):
+    design = tmp_path / "old.toml"
+    design.write_text('[tablet]\nfamily = "spherical"\ndiameter = 6.0\n', encoding="utf-8")
+    exe = Path(sys.executable).with_name("tabletcad")
+    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "tabletcad"]
+    out = subprocess.run([*cmd, "mesh", str(design), "--nodes", "9", "9", "5", "--out", str(tmp_path / "m.vtu")], capture_output=True, text=True,
+                         timeout=300, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    lines = [ln for ln in out.stderr.splitlines() if ln.strip()]
+    assert lines[0] == "warning: family 'spherical' is now 'thesis.spherical'; the old name is accepted until tabletcad 0.3"
+    assert not any("Warning" in ln or "File " in ln for ln in lines)
+
+
+def test_every_command_takes_the_new_names(tmp_path):
+    """Design files, the scripting facade, tooling batches and optimisation problems read thesis.* names."""
+    import tabletcad
+    from tabletcad.optimise.files import family_problem
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FutureWarning)
+        assert tabletcad.make("thesis.spherical", diameter=6.0).tablet.family == "thesis.spherical"
+        prob = family_problem({"family": "thesis.flat_faced_round", "objective": "surface_area_mm2", "sense": "min"},
+                              {"thickness": {"lower": 2.0, "upper": 6.0, "initial": 4.0}}, {"diameter": 10.0}, [])
+    assert prob.variables[0].name == "thickness"
+    with pytest.warns(FutureWarning):
+        old = family_problem({"family": "flat_faced_round", "objective": "surface_area_mm2", "sense": "min"},
+                             {"thickness": {"lower": 2.0, "upper": 6.0, "initial": 4.0}}, {"diameter": 10.0}, [])
+    assert old.description == prob.description
