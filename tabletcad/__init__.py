@@ -7,7 +7,7 @@ The numerical core (this package's top-level modules, ``families``,
 """
 
 
-_LAZY = {"make": "model", "load": "model", "show": "model", "TabletModel": "model"}
+_LAZY = {"make": "model", "load": "model", "show": "model", "TabletModel": "model", "Design": "design"}
 
 
 def __getattr__(name: str):  # PEP 562: `import tabletcad` stays light

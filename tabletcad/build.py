@@ -15,7 +15,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from tabletcad.design import load_design
+from tabletcad.design import Design
 from tabletcad.io.outputs import STAGING_MARKER, publish, staging_folder
 from tabletcad.plot import plot_tablet
 from tabletcad.report import geometry_report, to_json
@@ -89,6 +89,8 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, cad: bool | None = None
         return report
 
 
-def build_design(design: str | Path, out_dir: str | Path, *, progress: bool = True) -> dict[str, Any]:
-    """Load a design file and :func:`build_tablet` it."""
-    return build_tablet(load_design(design), out_dir, progress=progress)
+def build_design(design: str | Path | Design, out_dir: str | Path, *, progress: bool = True) -> dict[str, Any]:
+    """:func:`build_tablet` of a design (a :class:`~tabletcad.design.Design` or a design file)."""
+    if not isinstance(design, Design):
+        design = Design.from_toml(design)
+    return build_tablet(design.build(), out_dir, progress=progress)

@@ -34,9 +34,12 @@ one factor per patch, ``radius`` = one factor) — the thesis's section 4.4.
 
 from __future__ import annotations
 
+import copy
+import json
 import math
+import re
 import sys
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -55,7 +58,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["load_design", "read_design_file", "design_from_dict", "design_to_toml", "TOP_LEVEL_KEYS"]
+__all__ = ["Design", "load_design", "read_design_file", "design_from_dict", "design_to_toml", "toml_text", "TOP_LEVEL_KEYS"]
 
 TOP_LEVEL_KEYS = ("tablet", "patch", "trim", "reshape", "tooling", "report")
 _CURVE_KEYS = {
@@ -93,9 +96,8 @@ def read_design_file(path: str | Path) -> dict[str, Any]:
 
 
 def load_design(path: str | Path) -> Tablet:
-    """Read a TOML design file and build its tablet."""
-    path = Path(path)
-    return design_from_dict(read_design_file(path), default_name=path.stem)
+    """Read a TOML design file and build its tablet: ``Design.from_toml(path).build()``."""
+    return Design.from_toml(path).build()
 
 
 def _number(where: str, value: Any, unit: str = "", *, tol: Tolerances = DEFAULT) -> float:
@@ -172,81 +174,169 @@ def _curve(spec: Any, where: str, previous: Curve | None) -> Curve:
         raise exc.renamed(one_token(f"{where}.{exc.parameter}")) from None
 
 
-def design_from_dict(data: dict, default_name: str = "tablet") -> Tablet:
-    """Build a tablet from a parsed design (the TOML structure above).
+_TABLES = ("trim", "reshape", "report", "tooling")
 
-    Everything is validated before geometry is built where it can be: unknown
-    and missing keys, booleans or strings given for numbers, lengths beyond
-    ``Tolerances.max_length``.  Errors name the parameter as one token
-    (``tablet.diameter``, ``patch[0].curves[1].radius``).
+
+@dataclass(frozen=True)
+class Design:
+    """A design as data: the tables of a design file, checked, before any geometry is built.
+
+    Separate from the :class:`~tabletcad.tablet.Tablet` it builds (:meth:`build`), it reads from
+    and writes to TOML (:meth:`from_toml`, :meth:`to_toml`) and plain dictionaries
+    (:meth:`from_dict`, :meth:`to_dict`: what sweeps vary and send to their workers).  Family
+    names are current: an old name is replaced by its new one when the design is read.
+
+    Attributes
+    ----------
+    tablet : dict
+        The ``[tablet]`` table: ``family``, ``name`` and the family's dimensions (mm, deg).
+    patch : list or None
+        The ``[[patch]]`` tables of a ``free_form`` design.
+    trim, reshape, report, tooling : dict or None
+        The optional tables of the same names.
+    comment : str
+        Lines written as ``#`` comments at the top of :meth:`to_toml` (not part of the value).
+
+    The tables are the design's own copies; treat them as read-only.
     """
-    try:
-        return _design_from_dict(data, default_name)
-    except DesignError as exc:
-        if len(exc.parameter.split()) > 1:
-            raise exc.renamed(one_token(exc.parameter)) from None
-        raise
 
+    tablet: dict
+    patch: Any = None
+    trim: dict | None = None
+    reshape: dict | None = None
+    report: dict | None = None
+    tooling: dict | None = None
+    comment: str = field(default="", compare=False, repr=False)
 
-def _design_from_dict(data: dict, default_name: str) -> Tablet:
-    if not isinstance(data, dict):
-        raise DesignError("design", type(data).__name__, "must be a TOML table")
-    _check_keys("", data, set(TOP_LEVEL_KEYS))
-    if "tablet" not in data or not isinstance(data["tablet"], dict):
-        raise DesignError("tablet", "missing" if "tablet" not in data else data["tablet"],
-                          "a design needs a [tablet] table with a family")
-    tab = dict(data["tablet"])
-    family = tab.pop("family", None)
-    name = tab.pop("name", None) or default_name
-    if not isinstance(name, str) or not name.strip() or any(ch in name for ch in '/\\"\n') or len(name) > 200:
-        raise DesignError("tablet.name", name, "must be a plain non-empty name (no / \\ or quotes, at most 200 characters)")
-    a = tab.pop("a", None)
-    if a is not None and a != "auto":
-        a = _number("tablet.a", a)
-    families = ", ".join(FAMILIES) + ", custom_outline or free_form"
-    if family is None:
-        raise DesignError("tablet.family", "missing", f"must be one of {families}")
-    if not isinstance(family, str):
-        raise DesignError("tablet.family", family, f"must be one of {families}")
-    for table in ("trim", "reshape", "report", "tooling"):
-        if table in data and not isinstance(data[table], dict):
-            raise DesignError(table, data[table], "must be a table")
-    if family == "free_form":
-        _check_keys("tablet", tab, set())
-        tablet = _free_form(data.get("patch"), name, 1.0 if a is None else a)
-    elif family == "custom_outline":
-        tablet = _custom_outline(tab, name)
-    else:
-        if family not in FAMILIES and family not in RENAMED:
+    @property
+    def name(self) -> str:
+        return self.tablet["name"]
+
+    @property
+    def family(self) -> str:
+        return self.tablet["family"]
+
+    @classmethod
+    def from_dict(cls, data: Any, default_name: str = "tablet", *, comment: str = "") -> Design:
+        """A design from its dictionary (the TOML structure above); the name defaults to ``default_name``.
+
+        Checks what needs no geometry: the top-level tables, the name, the family.  The
+        dimensions are checked by :meth:`build`, before any geometry is built.
+        """
+        try:
+            return cls._from_dict(data, default_name, comment)
+        except DesignError as exc:
+            if len(exc.parameter.split()) > 1:
+                raise exc.renamed(one_token(exc.parameter)) from None
+            raise
+
+    @classmethod
+    def _from_dict(cls, data: Any, default_name: str, comment: str) -> Design:
+        if not isinstance(data, dict):
+            raise DesignError("design", type(data).__name__, "must be a TOML table")
+        _check_keys("", data, set(TOP_LEVEL_KEYS))
+        if "tablet" not in data or not isinstance(data["tablet"], dict):
+            raise DesignError("tablet", "missing" if "tablet" not in data else data["tablet"],
+                              "a design needs a [tablet] table with a family")
+        data = copy.deepcopy(data)
+        tab = data["tablet"]
+        name = tab.get("name") or default_name
+        if not isinstance(name, str) or not name.strip() or any(ch in name for ch in '/\\"\n') or len(name) > 200:
+            raise DesignError("tablet.name", name, "must be a plain non-empty name (no / \\ or quotes, at most 200 characters)")
+        family = tab.get("family")
+        families = ", ".join(FAMILIES) + ", custom_outline or free_form"
+        if family is None:
+            raise DesignError("tablet.family", "missing", f"must be one of {families}")
+        if not isinstance(family, str):
             raise DesignError("tablet.family", family, f"must be one of {families}")
-        fam = lookup_family(family, stacklevel=4)  # an old name: one warning, then its new family
-        family = fam.name
-        if "patch" in data:
-            raise DesignError("patch", "given", f"[[patch]] tables are only read for family free_form, not {family!r}")
-        kw = {}
-        for k, v in tab.items():
-            if k not in fam.params:
-                raise DesignError(one_token(f"tablet.{k}"), v, f"family {family!r} takes {', '.join(fam.params)}")
-            kw[k] = _number(f"tablet.{k}", v, fam.params[k])
-        missing = [k for k in fam.params if k in fam.required and k not in kw]
-        if missing:
-            optional = [k for k in fam.params if k not in fam.required]
-            raise DesignError(f"tablet.{missing[0]}", "missing",
-                              f"family {family!r} needs {', '.join(fam.required)}"
-                              + (f" (optional: {', '.join(optional)})" if optional else ""))
-        if a is not None:
-            kw["a"] = a
-        tablet = fam.build(**kw)
-        tablet = replace(tablet, name=name)
-    if "reshape" in data:
-        tablet = _reshape(tablet, data["reshape"])
-        _check_size(tablet)
-    if "trim" in data:
-        tablet = _trim(tablet, data["trim"])
-    extras = {k: data[k] for k in ("report", "tooling") if k in data}
-    if extras:
-        tablet = replace(tablet, extras={**tablet.extras, **extras})
-    return tablet
+        for table in _TABLES:
+            if table in data and not isinstance(data[table], dict):
+                raise DesignError(table, data[table], "must be a table")
+        if family not in ("free_form", "custom_outline"):
+            if family not in FAMILIES and family not in RENAMED:
+                raise DesignError("tablet.family", family, f"must be one of {families}")
+            family = lookup_family(family).name  # an old name: one warning, then its new family
+        tablet = {"family": family, "name": name, **{k: v for k, v in tab.items() if k not in ("family", "name")}}
+        return cls(tablet, data.get("patch"), **{t: data.get(t) for t in _TABLES}, comment=comment)
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> Design:
+        """The design of a TOML file; its name defaults to the file's stem."""
+        path = Path(path)
+        return cls.from_dict(read_design_file(path), default_name=path.stem)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The design as a plain dictionary (a copy; :meth:`from_dict` reads it back)."""
+        out: dict[str, Any] = {"tablet": copy.deepcopy(self.tablet)}
+        if self.patch is not None:
+            out["patch"] = copy.deepcopy(self.patch)
+        for t in _TABLES:
+            if getattr(self, t) is not None:
+                out[t] = copy.deepcopy(getattr(self, t))
+        return out
+
+    def to_toml(self) -> str:
+        """The design as TOML text (:meth:`from_toml` reads it back to an equal design)."""
+        return toml_text(self.to_dict(), comment=self.comment)
+
+    def build(self) -> Tablet:
+        """The tablet of this design (its ``extras`` hold the ``[report]`` and ``[tooling]`` tables).
+
+        Everything is validated before geometry is built where it can be: unknown
+        and missing keys, booleans or strings given for numbers, lengths beyond
+        ``Tolerances.max_length``.  Errors name the parameter as one token
+        (``tablet.diameter``, ``patch[0].curves[1].radius``).
+        """
+        try:
+            return self._build()
+        except DesignError as exc:
+            if len(exc.parameter.split()) > 1:
+                raise exc.renamed(one_token(exc.parameter)) from None
+            raise
+
+    def _build(self) -> Tablet:
+        tab = dict(self.tablet)
+        family, name = tab.pop("family"), tab.pop("name")
+        a = tab.pop("a", None)
+        if a is not None and a != "auto":
+            a = _number("tablet.a", a)
+        if family == "free_form":
+            _check_keys("tablet", tab, set())
+            tablet = _free_form(self.patch, name, 1.0 if a is None else a)
+        elif family == "custom_outline":
+            tablet = _custom_outline(tab, name)
+        else:
+            if self.patch is not None:
+                raise DesignError("patch", "given", f"[[patch]] tables are only read for family free_form, not {family!r}")
+            fam = FAMILIES[family]
+            kw = {}
+            for k, v in tab.items():
+                if k not in fam.params:
+                    raise DesignError(one_token(f"tablet.{k}"), v, f"family {family!r} takes {', '.join(fam.params)}")
+                kw[k] = _number(f"tablet.{k}", v, fam.params[k])
+            missing = [k for k in fam.params if k in fam.required and k not in kw]
+            if missing:
+                optional = [k for k in fam.params if k not in fam.required]
+                raise DesignError(f"tablet.{missing[0]}", "missing",
+                                  f"family {family!r} needs {', '.join(fam.required)}"
+                                  + (f" (optional: {', '.join(optional)})" if optional else ""))
+            if a is not None:
+                kw["a"] = a
+            tablet = replace(fam.build(**kw), name=name)
+        if self.reshape is not None:
+            tablet = _reshape(tablet, self.reshape)
+            _check_size(tablet)
+        if self.trim is not None:
+            tablet = _trim(tablet, self.trim)
+        extras = {k: copy.deepcopy(getattr(self, k)) for k in ("report", "tooling") if getattr(self, k) is not None}
+        if extras:
+            tablet = replace(tablet, extras={**tablet.extras, **extras})
+        return tablet
+
+
+def design_from_dict(data: dict, default_name: str = "tablet") -> Tablet:
+    """Build a tablet from a parsed design (the TOML structure above): ``Design.from_dict(...).build()``."""
+    return Design.from_dict(data, default_name).build()
 
 
 def _check_size(tablet: Tablet, tol: Tolerances = DEFAULT) -> None:
@@ -370,14 +460,84 @@ def _reshape(tablet: Tablet, r: dict) -> Tablet:
 
 
 def design_to_toml(family: str, params: dict[str, float], name: str | None = None, extra: str = "") -> str:
-    """TOML text of a family design (used by the optimiser to write its optimum)."""
-    lines = ["[tablet]"]
-    if name:
-        lines.append(f'name = "{name}"')
-    lines.append(f'family = "{family}"')
-    for k, v in params.items():
-        if isinstance(v, str):
-            lines.append(f'{k} = "{v}"')
+    """TOML text of a family design (used by the optimiser to write its optimum); ``extra`` is appended."""
+    tablet = {**({"name": name} if name else {}), "family": family, **params}
+    return toml_text({"tablet": tablet}) + extra
+
+
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+
+
+def _toml_key(key: str) -> str:
+    return key if _BARE_KEY.fullmatch(key) else _toml_string(key)
+
+
+def _toml_string(text: str) -> str:
+    if any(0xD800 <= ord(ch) <= 0xDFFF for ch in text):
+        raise DesignError("design", text, "must be text TOML can hold (no lone surrogates)")
+    # TOML basic strings take JSON's escapes; DEL is a control character to TOML, not to JSON
+    return json.dumps(text, ensure_ascii=False).replace("\x7f", "\\u007f")
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return repr(value) if math.isfinite(value) else ("nan" if math.isnan(value) else "inf" if value > 0 else "-inf")
+    if isinstance(value, str):
+        return _toml_string(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{_toml_key(str(k))} = {_toml_value(v)}" for k, v in value.items()) + " }" if value else "{}"
+    if isinstance(value, np.generic):
+        return _toml_value(value.item())
+    raise DesignError("design", repr(value), "must hold numbers, text, booleans, lists and tables only")
+
+
+def _toml_table(lines: list[str], path: str, table: dict) -> None:
+    """Append ``table`` at ``path``: its keys (lists holding lists or tables one item per line),
+    then its non-empty sub-tables as ``[path.key]`` sections."""
+    subs = [(k, v) for k, v in table.items() if isinstance(v, dict) and v]
+    for k, v in table.items():
+        if isinstance(v, dict) and v:
+            continue
+        if isinstance(v, list) and len(v) > 1 and any(isinstance(x, (dict, list)) for x in v):
+            lines.append(f"{_toml_key(k)} = [")  # curves, points, segments
+            lines += [f"  {_toml_value(x)}," for x in v]
+            lines.append("]")
         else:
-            lines.append(f"{k} = {float(v)!r}" if math.isfinite(float(v)) else f"{k} = nan")
-    return "\n".join(lines) + "\n" + extra
+            lines.append(f"{_toml_key(k)} = {_toml_value(v)}")
+    for k, v in subs:
+        sub = f"{path}.{_toml_key(k)}" if path else _toml_key(k)
+        lines += ["", f"[{sub}]"]
+        _toml_table(lines, sub, v)
+
+
+def _is_table_array(v: Any) -> bool:
+    return isinstance(v, list) and bool(v) and all(isinstance(x, dict) for x in v)
+
+
+def toml_text(data: dict[str, Any], comment: str = "") -> str:
+    """TOML text of a design dictionary: ``tomllib.loads(toml_text(d)) == d``.
+
+    Top-level tables become ``[table]`` sections (their sub-tables ``[table.key]``), top-level
+    lists of tables ``[[table]]`` (``[[patch]]``); lists holding lists or tables are written one
+    item per line; ``comment`` lines come first as ``#`` comments.
+    """
+    lines = [f"# {c}" if c else "#" for c in comment.strip().splitlines()]
+    top = [k for k, v in data.items() if not (isinstance(v, dict) and v) and not _is_table_array(v)]
+    _toml_table(lines, "", {k: data[k] for k in top})
+    for k, v in data.items():
+        if k in top:
+            continue
+        if isinstance(v, dict):
+            lines += ["", f"[{_toml_key(k)}]"]
+            _toml_table(lines, _toml_key(k), v)
+        else:
+            for item in v:
+                lines += ["", f"[[{_toml_key(k)}]]"]
+                _toml_table(lines, _toml_key(k), item)
+    return "\n".join(lines).lstrip("\n") + "\n"

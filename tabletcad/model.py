@@ -217,7 +217,7 @@ def make(family: str, **dims: Any) -> TabletModel:
     """A tablet of a named family (``tabletcad shapes`` lists them) with dimensions in mm."""
     from tabletcad.families import family as lookup_family
 
-    return TabletModel(lookup_family(family, parameter="family", stacklevel=3).build(**dims))
+    return TabletModel(lookup_family(family, parameter="family").build(**dims))
 
 
 def load(path: str | Path) -> TabletModel:

@@ -36,6 +36,8 @@ Any other plan outline (points or lines and arcs): :func:`outline_tablet`.
 
 from __future__ import annotations
 
+import os
+import sys
 import warnings
 from dataclasses import replace
 from types import MappingProxyType
@@ -104,16 +106,29 @@ RENAMED: Mapping[str, str] = MappingProxyType({n: f"thesis.{n}" for n in THESIS_
 RENAMED_UNTIL = "0.3"
 
 
-def family(name: str, *, parameter: str = "tablet.family", stacklevel: int = 2) -> Family:
+_PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def _outside_stacklevel() -> int:
+    """The ``stacklevel`` of the first frame outside the tabletcad package, seen from the caller."""
+    level, frame = 1, sys._getframe(1)
+    while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE_DIR + os.sep):
+        frame = frame.f_back
+        level += 1
+    return level
+
+
+def family(name: str, *, parameter: str = "tablet.family") -> Family:
     """The family called ``name`` in :data:`FAMILIES`; a name of :data:`RENAMED` gives its new
     family with a one-line :class:`FutureWarning`.
 
     Raises :class:`~tabletcad.errors.DesignError` naming ``parameter`` for any other name.
+    The warning is attributed to the first caller outside tabletcad (a user's script, a test).
     """
     if isinstance(name, str) and name in RENAMED:
         new = RENAMED[name]
         warnings.warn(f"family {name!r} is now {new!r}; the old name is accepted until tabletcad {RENAMED_UNTIL}",
-                      FutureWarning, stacklevel=stacklevel)
+                      FutureWarning, stacklevel=_outside_stacklevel())
         name = new
     if not isinstance(name, str) or name not in FAMILIES:
         raise DesignError(parameter, name, f"must be one of {', '.join(FAMILIES)}")

@@ -284,7 +284,7 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) ->
 
     fam_name = prob.get("family")
     if isinstance(fam_name, str) and fam_name in RENAMED:
-        fam_name = lookup_family(fam_name, parameter="[problem] family", stacklevel=3).name
+        fam_name = lookup_family(fam_name, parameter="[problem] family").name
     fam_name = choice("[problem] family", fam_name, tuple(FAMILIES))
     fam = FAMILIES[fam_name]
     if not isinstance(variables, dict) or not variables:

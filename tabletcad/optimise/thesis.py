@@ -191,21 +191,11 @@ def _update_initial(init: dict, initial: dict | None) -> None:
 
 def free_form_toml(tablet: Tablet, sections, *, name: str, comment: str = "") -> str:
     """A ``free_form`` design file (``[[patch]]`` circle curves, ``"previous"``) for ``tabletcad build``."""
-    lines = []
-    for c in comment.strip().splitlines():
-        lines.append(f"# {c}" if c else "#")
-    lines += ["[tablet]", 'family = "free_form"', f'name = "{name}"', "a = 1.0", ""]
-    for j, sec in enumerate(sections):
-        lines.append("[[patch]]")
-        lines.append("curves = [")
-        for k, (r, z) in enumerate(sec):
-            if k == 0 and j > 0:
-                lines.append('  "previous",')
-            else:
-                lines.append(f'  {{ type = "circle", radius = {float(r)!r}, z = {float(z)!r} }},')
-        lines.append("]")
-        lines.append("")
-    return "\n".join(lines)
+    from tabletcad.design import Design
+
+    patches = [{"curves": ["previous" if k == 0 and j > 0 else {"type": "circle", "radius": float(r), "z": float(z)}
+                           for k, (r, z) in enumerate(sec)]} for j, sec in enumerate(sections)]
+    return Design({"family": "free_form", "name": name, "a": 1.0}, patches, comment=comment).to_toml()
 
 
 # ---------------------------------------------------------------------------- (a) round tablet

@@ -54,7 +54,7 @@ def tooling_batch(family: str, sizes: Iterable[dict], spec: ToolingSpec | dict |
 
     if isinstance(spec, dict):
         spec = parse_tooling(spec)
-    family = lookup_family(family, parameter="family", stacklevel=3).name
+    family = lookup_family(family, parameter="family").name
     sizes = [dict(p) for p in sizes]
 
     def write(k: int, res: dict) -> None:
