@@ -88,3 +88,50 @@ def test_every_command_takes_the_new_names(tmp_path):
         old = family_problem({"family": "flat_faced_round", "objective": "surface_area_mm2", "sense": "min"},
                              {"thickness": {"lower": 2.0, "upper": 6.0, "initial": 4.0}}, {"diameter": 10.0}, [])
     assert old.description == prob.description
+
+
+THESIS_SAMPLES = sorted(ROOT.joinpath("samples").glob("*.toml"))
+
+
+@pytest.mark.parametrize("path", THESIS_SAMPLES, ids=lambda p: p.stem)
+def test_report_serves_the_thesis_shapes_and_free_form_designs(path, capsys):
+    """The design report of a tablet without a family nominal: its own geometry, the strength formula
+    its shape has (eq 2.4 flat round, eq 2.7 convex round, eq 2.9 convex oval), no certificate."""
+    import json
+    import math
+
+    from tabletcad.cli import main
+
+    rc = main(["report", str(path), "--json", "--breaking-force", "100", "--solid-fraction", "0.8", "--true-density", "1.5"])
+    out, err = capsys.readouterr()
+    assert rc == 0, err
+    doc = json.loads(out)
+    r, t = doc["design_report"], load_design(path)
+    dims, props = t.dimensions(), t.properties()
+    assert r["family"] == t.family and doc["nominal_certified"] is None
+    assert r["volume_mm3"] == props["volume_mm3"] and r["surface_area_mm2"] == props["surface_area_mm2"]
+    assert r["weight_mg"] == pytest.approx(props["volume_mm3"] * 0.8 * 1.5, rel=1e-12)
+    D, T, F = dims["width_mm"], dims["height_mm"], 100.0
+    ts = r["tensile_strength"]["tensile_strength_MPa"]
+    p = t.params
+    if t.family == "thesis.flat_faced_round":
+        assert ts == pytest.approx(2 * F / (math.pi * D * T), rel=1e-12)
+    elif t.family in ("thesis.shallow_convex_round", "thesis.deep_convex_round") and path.stem != "cutaway_convex_round":
+        W = p["band"]
+        assert r["cup_depth_mm"] == pytest.approx((p["thickness"] - W) / 2, rel=1e-12)
+        pitt = 10 * F / (math.pi * D * D * (2.84 * T / D - 0.126 * T / W + 3.15 * W / D + 0.01))
+        assert ts == pytest.approx(pitt, rel=1e-12)
+    elif t.family in ("thesis.shallow_convex_oval", "thesis.deep_convex_oval"):
+        W = p["band"]
+        pitt = 10 * F / (math.pi * D * D * (2.84 * T / D - 0.126 * T / W + 3.15 * W / D + 0.01))
+        assert ts == pytest.approx(2 / 3 * pitt, rel=1e-12)
+    else:
+        assert ts is None and r["shape"] is None
+
+
+def test_report_solve_for_names_the_families_it_serves(capsys):
+    from tabletcad.cli import main
+
+    rc = main(["report", str(ROOT / "samples" / "spherical.toml"), "--solve-for", "band", "--target-volume", "100"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1 and err.startswith("error: tablet.family = 'thesis.spherical'")

@@ -51,8 +51,9 @@ def _fmt(v: Any, unit: str = "", digits: int = 6) -> str:
 
 def _table(name: str, sec: dict[str, Any]) -> str:
     r = sec["design_report"]
+    kind = f"{r['shape']}, {r['face']} face" if r["shape"] is not None else "no shape formulas"
     rows = [
-        ("design", f"{name} ({r['family']}, {r['shape']}, {r['face']} face)"),
+        ("design", f"{name} ({r['family']}, {kind})"),
         ("length x width x thickness", f"{r['length_mm']:.4g} x {r['width_mm']:.4g} x {r['overall_thickness_mm']:.4g} mm"),
         ("band (wall) height", _fmt(r["band_mm"], "mm")),
         ("land", _fmt(r["land_mm"], "mm")),
@@ -82,10 +83,17 @@ def _table(name: str, sec: dict[str, Any]) -> str:
                      f"({pc['compaction_pressure_MPa']:.4g} MPa on {pc['tip_face_area_mm2']:.4g} mm2; {pc['limit_basis']})"))
     fda = r["fda_size"]
     rows.append(("FDA size (largest <= 22 mm)", f"{'OK' if fda['ok'] else 'TOO LARGE'} ({fda['largest_dimension_mm']:.4g} mm)"))
-    rows.append(("nominal deviation (certified)", f"{sec['nominal_max_deviation_um']:.3g} um <= {sec['nominal_tolerance_um']:g} um: {_fmt(sec['nominal_certified'])}"))
+    if sec["nominal_certified"] is not None:
+        rows.append(("nominal deviation (certified)", f"{sec['nominal_max_deviation_um']:.3g} um <= {sec['nominal_tolerance_um']:g} um: {_fmt(sec['nominal_certified'])}"))
+    elif sec["nominal_max_deviation_um"] is not None:
+        rows.append(("PDE surface vs exact shape", f"{sec['nominal_max_deviation_um']:.3g} um (not certified: the thesis's curves)"))
     for s in sec["seams"]:
-        kind = "sharp (nominal edge)" if s["expected_sharp"] else "G1"
-        rows.append((f"seam {s['patches'][0]}-{s['patches'][1]}", f"{s['max_angle_deg']:.3f} deg, gap {s['max_gap_mm'] * 1e3:.3f} um, expected {kind}: {_fmt(s['as_expected'])}"))
+        angle = "-" if s["max_angle_deg"] != s["max_angle_deg"] else f"{s['max_angle_deg']:.3f} deg"  # nan: a pole
+        if s["expected_sharp"] is None:
+            expected = "G1" if s["g1"] else "an edge"
+        else:
+            expected = f"expected {'sharp (nominal edge)' if s['expected_sharp'] else 'G1'}: {_fmt(s['as_expected'])}"
+        rows.append((f"seam {s['patches'][0]}-{s['patches'][1]}", f"{angle}, gap {s['max_gap_mm'] * 1e3:.3f} um, {expected}"))
     w = max(len(k) for k, _ in rows)
     return "\n".join(f"{k:<{w}}  {v}" for k, v in rows)
 
@@ -186,13 +194,13 @@ def _write_tables(payloads: list[dict[str, Any]], csv_out: Path | None, xlsx_out
 def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking_force, compaction_force, max_punch_force,
                max_punch_pressure, solve_for, target_weight, target_volume, as_json: bool, json_file: Path | None,
                csv_out: Path | None, xlsx_out: Path | None) -> None:
-    """Design report of one or more DESIGN.toml (industry families): volumes, cup, weight, checks.
+    """Design report of one or more DESIGN.toml (any family): volumes, cup, weight, checks.
 
     One design prints its report; several print one line each.  --solve-for finds the band,
     thickness or cup depth that gives --target-weight or --target-volume, then reports that design.
     """
     from tabletcad.cli.outputs import check_output, staged
-    from tabletcad.families.designreport import ReportOptions, design_report
+    from tabletcad.families.designreport import ReportOptions, design_report, shape_report
     from tabletcad.families.sweep import SweepNominal
     from tabletcad.report import to_json
 
@@ -218,11 +226,6 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
     payloads, shown = [], []
     for design in designs:
         tablet, table = load_family_design(design)
-        if not isinstance(tablet.nominal, SweepNominal):
-            from tabletcad.families import FAMILY_FUNCTIONS
-
-            raise DesignError("tablet.family", tablet.family,
-                              "the design report needs an industry family: " + ", ".join(f.__name__ for f in FAMILY_FUNCTIONS) + ", custom_outline")
         try:
             opts = ReportOptions.from_table(table).merged(
                 solid_fraction=solid_fraction, true_density_mg_mm3=true_density, breaking_force_N=breaking_force,
@@ -239,7 +242,9 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
                 raise DesignError("--solve-for", solve_for, f"the design sets {', '.join(carried)}, which the inverse "
                                   "calculation does not carry (it rebuilds the family from its dimensions)")
             tablet, inverse = _solved(tablet, opts, solve_for, target_weight, target_volume)
-        sec = design_report(tablet, opts)
+        # industry families: the certified report; the thesis's shapes and free-form designs:
+        # the same figures from their own geometry, without a certificate
+        sec = design_report(tablet, opts) if isinstance(tablet.nominal, SweepNominal) else shape_report(tablet, opts)
         payload = dict(design=dict(name=tablet.name, file=str(design), family=tablet.family, params=dict(tablet.params)),
                        units=dict(length="mm", area="mm2", volume="mm3", angle="deg", force="N (kN where named)",
                                   stress="MPa", mass="mg"),

@@ -36,7 +36,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["ReportOptions", "design_report", "family_seams", "report_options",
+__all__ = ["ReportOptions", "design_report", "shape_report", "family_seams", "report_options",
            "punch_rating_table", "tensile_strength", "FDA_MAX_DIMENSION_MM", "REPORT_KEYS"]
 
 #: FDA guidance "Size, Shape, and Other Physical Attributes of Generic Tablets and Capsules"
@@ -344,21 +344,7 @@ def design_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str
         cup_radii_mm=_cup_radii(info),
         params={k: v for k, v in info.items() if k not in ("shape", "face")},
     )
-    if opts.solid_fraction is not None and opts.true_density_mg_mm3 is not None:
-        rep["weight_mg"] = V * opts.solid_fraction * opts.true_density_mg_mm3
-        rep["weight_basis"] = dict(solid_fraction=opts.solid_fraction, true_density_mg_mm3=opts.true_density_mg_mm3)
-    else:
-        rep["weight_mg"] = None
-        rep["weight_basis"] = "give [report] solid_fraction and true_density_mg_mm3"
-    rep["punch_tip_check"] = _punch_check(props["plan_area_mm2"], opts)
-    if opts.breaking_force_N is not None:
-        rep["tensile_strength"] = tensile_strength(dict(info, width_mm=W, length_mm=Ln), T, opts.breaking_force_N)
-    else:
-        rep["tensile_strength"] = dict(tensile_strength_MPa=None, note="give [report] breaking_force_N")
-    largest = max(Ln, W, T)
-    rep["fda_size"] = dict(largest_dimension_mm=largest, limit_mm=FDA_MAX_DIMENSION_MM,
-                           ok=bool(largest <= FDA_MAX_DIMENSION_MM),
-                           source="FDA guidance for industry: Size, Shape, and Other Physical Attributes of Generic Tablets and Capsules (2015)")
+    _add_figures(rep, dict(info, width_mm=W, length_mm=Ln), T, opts)
     seams = family_seams(tablet)
     return dict(
         nominal_max_deviation_um=cert.max_deviation_mm * 1000.0,
@@ -367,5 +353,86 @@ def design_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str
         nominal_recertified=bool(recert),
         seams=seams,
         seams_as_expected=all(s["as_expected"] is not False for s in seams),
+        design_report=rep,
+    )
+
+
+def _add_figures(rep: dict[str, Any], info: dict[str, Any], T: float, opts: ReportOptions) -> None:
+    """Weight, punch-tip check, tensile strength and FDA size from ``rep``'s volume and plan area."""
+    V, W, Ln = rep["volume_mm3"], info["width_mm"], info["length_mm"]
+    if opts.solid_fraction is not None and opts.true_density_mg_mm3 is not None:
+        rep["weight_mg"] = V * opts.solid_fraction * opts.true_density_mg_mm3
+        rep["weight_basis"] = dict(solid_fraction=opts.solid_fraction, true_density_mg_mm3=opts.true_density_mg_mm3)
+    else:
+        rep["weight_mg"] = None
+        rep["weight_basis"] = "give [report] solid_fraction and true_density_mg_mm3"
+    rep["punch_tip_check"] = _punch_check(rep["plan_area_mm2"], opts)
+    if opts.breaking_force_N is None:
+        rep["tensile_strength"] = dict(tensile_strength_MPa=None, note="give [report] breaking_force_N")
+    elif info.get("shape") is None:
+        rep["tensile_strength"] = dict(tensile_strength_MPa=None, breaking_force_N=opts.breaking_force_N,
+                                       note="no published tensile-strength formula for this shape")
+    else:
+        rep["tensile_strength"] = tensile_strength(info, T, opts.breaking_force_N)
+    largest = max(Ln, W, T)
+    rep["fda_size"] = dict(largest_dimension_mm=largest, limit_mm=FDA_MAX_DIMENSION_MM,
+                           ok=bool(largest <= FDA_MAX_DIMENSION_MM),
+                           source="FDA guidance for industry: Size, Shape, and Other Physical Attributes of Generic Tablets and Capsules (2015)")
+
+
+# The thesis's shapes whose faces the strength formulas know: (shape, face) and how to read
+# the band (the cylindrical wall, mm) from the family's parameters.
+_THESIS_SHAPES = {
+    "thesis.flat_faced_round": ("round", "flat", lambda p: p["thickness"]),
+    "thesis.shallow_convex_round": ("round", "convex", lambda p: p["band"]),
+    "thesis.deep_convex_round": ("round", "convex", lambda p: p["band"]),
+    "thesis.shallow_convex_oval": ("oval", "convex", lambda p: p["band"]),
+    "thesis.deep_convex_oval": ("oval", "convex", lambda p: p["band"]),
+}
+
+
+def shape_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str, Any]:
+    """The design report of a tablet without a family nominal: the thesis's shapes, free-form designs.
+
+    The same keys as :func:`design_report`, from the tablet's own geometry (quadrature volume and
+    area, plan area, overall dimensions); band and cup depth come from the family's parameters
+    where it has them (the thesis's convex rounds and ovals: cup depth = (thickness - band) / 2),
+    else they are None (also for a trimmed, cut-away tablet).  The tensile strength uses eq 2.4 (flat round), eq 2.7 (convex round) or
+    eqs 2.8/2.9 (convex oval, Pitt & Heasley, across the width); other shapes have no formula.
+    There is no certificate: ``nominal_max_deviation_um`` is the PDE surface's largest distance
+    from the exact shape when the family has one (the thesis's curves, not a tolerance).
+    """
+    if opts is None:
+        opts = _OPTIONS.get()
+        if opts == ReportOptions() and isinstance(tablet.extras.get("report"), dict):
+            opts = ReportOptions.from_table(tablet.extras["report"])
+    props = tablet.properties()
+    dims = tablet.dimensions()
+    V, A = props["volume_mm3"], props["surface_area_mm2"]
+    Ln, W, T = dims["length_mm"], dims["width_mm"], dims["height_mm"]
+    whole = tablet.trim.u == (0.0, 1.0) and tablet.trim.full_v and tablet.trim.w == (0.0, 1.0)
+    # a cut-away or trimmed tablet is a view: no shape formula applies to it
+    shape, face, band_of = _THESIS_SHAPES.get(tablet.family, (None, None, None)) if whole else (None, None, None)
+    p = dict(tablet.params)
+    band = float(band_of(p)) if band_of is not None else None
+    cup = None if band is None else (0.0 if face == "flat" else (float(p["thickness"]) - band) / 2.0)
+    rep: dict[str, Any] = dict(
+        family=tablet.family, shape=shape, face=face, volume_mm3=V, surface_area_mm2=A, sa_to_volume_per_mm=A / V,
+        cup_volume_mm3=None, cup_surface_area_mm2=None, cup_depth_mm=cup, overall_thickness_mm=T, band_mm=band,
+        land_mm=0.0 if shape is not None else None, length_mm=Ln, width_mm=W, plan_area_mm2=tablet.plan_area(),
+        plan_area_exact_mm2=None, plan_perimeter_mm=None, shape_factor=None if cup is None else cup / W,
+        cup_radius_mm=None, cup_radii_mm={}, params=p,
+    )
+    _add_figures(rep, dict(shape=shape, face=face, band_mm=band, cup_depth_mm=cup or 0.0, width_mm=W, length_mm=Ln,
+                           elongated=shape == "oval"), T, opts)
+    dev = tablet.nominal_deviation()
+    seams = [dict(s, expected_sharp=None, as_expected=None) for s in tablet.seams()]
+    return dict(
+        nominal_max_deviation_um=None if dev is None else dev * 1000.0,
+        nominal_tolerance_um=None,
+        nominal_certified=None,
+        nominal_recertified=False,
+        seams=seams,
+        seams_as_expected=None,
         design_report=rep,
     )
