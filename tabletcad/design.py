@@ -295,8 +295,10 @@ class Design:
             raise
 
     def _build(self) -> Tablet:
+        if not isinstance(self.tablet, dict):
+            raise DesignError("tablet", self.tablet, "a design needs a [tablet] table with a family")
         tab = dict(self.tablet)
-        family, name = tab.pop("family"), tab.pop("name")
+        family, name = tab.pop("family", None), tab.pop("name", None) or "tablet"
         a = tab.pop("a", None)
         if a is not None and a != "auto":
             a = _number("tablet.a", a)
@@ -306,9 +308,10 @@ class Design:
         elif family == "custom_outline":
             tablet = _custom_outline(tab, name)
         else:
+            fam = lookup_family(family)  # a Design made directly may hold an old or unknown name
+            family = fam.name
             if self.patch is not None:
                 raise DesignError("patch", "given", f"[[patch]] tables are only read for family free_form, not {family!r}")
-            fam = FAMILIES[family]
             kw = {}
             for k, v in tab.items():
                 if k not in fam.params:
@@ -468,7 +471,9 @@ def design_to_toml(family: str, params: dict[str, float], name: str | None = Non
 _BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
 
 
-def _toml_key(key: str) -> str:
+def _toml_key(key: Any) -> str:
+    if not isinstance(key, str):
+        raise DesignError("design", repr(key), "keys must be text")
     return key if _BARE_KEY.fullmatch(key) else _toml_string(key)
 
 
@@ -484,14 +489,15 @@ def _toml_value(value: Any) -> str:
         return "true" if value else "false"
     if isinstance(value, int):
         return str(value)
-    if isinstance(value, float):
+    if isinstance(value, float):  # also numpy.float64, whose repr is "np.float64(...)"
+        value = float(value)
         return repr(value) if math.isfinite(value) else ("nan" if math.isnan(value) else "inf" if value > 0 else "-inf")
     if isinstance(value, str):
         return _toml_string(value)
     if isinstance(value, (list, tuple)):
         return "[" + ", ".join(_toml_value(v) for v in value) + "]"
     if isinstance(value, dict):
-        return "{ " + ", ".join(f"{_toml_key(str(k))} = {_toml_value(v)}" for k, v in value.items()) + " }" if value else "{}"
+        return "{ " + ", ".join(f"{_toml_key(k)} = {_toml_value(v)}" for k, v in value.items()) + " }" if value else "{}"
     if isinstance(value, np.generic):
         return _toml_value(value.item())
     raise DesignError("design", repr(value), "must hold numbers, text, booleans, lists and tables only")
@@ -527,6 +533,7 @@ def toml_text(data: dict[str, Any], comment: str = "") -> str:
     lists of tables ``[[table]]`` (``[[patch]]``); lists holding lists or tables are written one
     item per line; ``comment`` lines come first as ``#`` comments.
     """
+    comment = "".join(ch if ch == "\t" or (ord(ch) >= 0x20 and ord(ch) != 0x7F) or ch == "\n" else " " for ch in comment)
     lines = [f"# {c}" if c else "#" for c in comment.strip().splitlines()]
     top = [k for k, v in data.items() if not (isinstance(v, dict) and v) and not _is_table_array(v)]
     _toml_table(lines, "", {k: data[k] for k in top})

@@ -83,7 +83,8 @@ def _rebuild(tablet: Tablet, maps: list) -> Tablet:
             data.append(nc)
         done[id(p.data[3])] = data[3]
         patches.append(p.replace_data(data, modes=None if p.has_remainder else p.modes))
-    return replace(tablet, patches=tuple(patches))
+    # the family's dimensions and exact shape no longer describe the reshaped tablet
+    return replace(tablet, patches=tuple(patches), nominal=None, params={})
 
 
 def scale_heights(tablet: Tablet, factors) -> Tablet:
@@ -125,7 +126,7 @@ def select_patches(tablet: Tablet, indices) -> Tablet:
     for i in idx:
         if not 0 <= i < len(tablet.patches):
             raise DesignError("patch index", i, f"must be between 0 and {len(tablet.patches) - 1}")
-    return replace(tablet, patches=tuple(tablet.patches[i] for i in idx), nominal=None)
+    return replace(tablet, patches=tuple(tablet.patches[i] for i in idx), nominal=None, params={})
 
 
 def thesis_table_4_5() -> dict[str, dict]:
@@ -138,7 +139,8 @@ def thesis_table_4_5() -> dict[str, dict]:
     out: dict[str, dict] = {}
 
     def add(name, t, dims, changes):
-        out[name] = dict(tablet=replace(t, name=name, family=name, nominal=None), thesis_dims_mm=dims, changes=changes)
+        out[name] = dict(tablet=replace(t, name=name, family=f"thesis.{name}", nominal=None), thesis_dims_mm=dims,
+                         changes=changes)
 
     ffr = shapes.flat_faced_round()
     body = select_patches(ffr, [1])

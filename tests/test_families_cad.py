@@ -201,13 +201,21 @@ def test_every_family_builds_a_valid_solid(family, params):
     assert abs(abs(enclosed_volume(s.surfaces)) - s.volume) <= 1e-8 * V
 
 
-def test_tablet_solid_reuses_the_last_default_build_of_the_same_tablet():
-    """`tabletcad build` needs the solid in its CAD and tooling stages: the second default call on
-    the same tablet object returns the same solid; another object, or another tolerance, builds."""
-    t = _tablet(ROOT / "samples" / "families" / "concave_round.toml")
-    a = tablet_solid(t)
-    assert tablet_solid(t) is a
-    other, _ = load_family_design(ROOT / "samples" / "families" / "concave_round.toml")
-    b = tablet_solid(other)
-    assert b is not a and b.volume == pytest.approx(a.volume, rel=1e-12)
-    assert tablet_solid(other, tol=5e-5) is not b
+def test_the_build_fits_the_solid_once_for_its_cad_and_tooling_steps(tmp_path, monkeypatch):
+    """Explicit composition: the build hands the CAD step's solid to the tooling step (no global
+    cache, no second fit), and the tooling fits the same tablet the STEP file holds."""
+    import tabletcad.cad.solid as solid_module
+    from tabletcad.build import build_design
+
+    calls = []
+    real = solid_module.build_solid
+
+    def counting(*args, **kwargs):
+        calls.append(kwargs.get("name"))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(solid_module, "build_solid", counting)
+    rep = build_design(ROOT / "samples" / "tooling" / "shallow_convex_round.toml", tmp_path / "out", progress=False)
+    assert len(calls) == 1, calls
+    assert {"tablet.step", "upper_punch.step", "die.step"} <= set(rep["outputs"])
+    assert rep["tooling"]["interference_mm3"] == pytest.approx(0.0, abs=1e-6)

@@ -88,3 +88,23 @@ def test_toml_text_round_trips_through_tomllib(data):
 def test_non_finite_numbers_are_written_as_toml_special_floats():
     back = tomllib.loads(toml_text({"t": {"a": math.inf, "b": -math.inf, "c": math.nan}}))
     assert back["t"]["a"] == math.inf and back["t"]["b"] == -math.inf and math.isnan(back["t"]["c"])
+
+
+def test_a_design_made_directly_is_checked_when_built():
+    with pytest.warns(FutureWarning):
+        t = Design({"family": "spherical", "diameter": 5.0}).build()
+    assert t.family == "thesis.spherical" and t.name == "tablet"
+    with pytest.raises(DesignError) as e:
+        Design({"family": "no_such", "name": "x"}).build()
+    assert e.value.parameter == "tablet.family"
+
+
+def test_writer_takes_numpy_scalars_and_refuses_what_toml_cannot_hold():
+    import numpy as np
+
+    text = toml_text({"tablet": {"d": np.float64(1.5), "n": np.int64(3)}}, comment="made by\x00 a test\x7f")
+    assert tomllib.loads(text) == {"tablet": {"d": 1.5, "n": 3}}
+    with pytest.raises(DesignError):
+        toml_text({"tablet": {1: 2.0}})
+    with pytest.raises(DesignError):
+        toml_text({"tablet": {"x": object()}})

@@ -135,3 +135,30 @@ def test_report_solve_for_names_the_families_it_serves(capsys):
     rc = main(["report", str(ROOT / "samples" / "spherical.toml"), "--solve-for", "band", "--target-volume", "100"])
     err = capsys.readouterr().err
     assert rc == 2 and err.count("\n") == 1 and err.startswith("error: tablet.family = 'thesis.spherical'")
+
+
+def test_report_compares_designs_of_any_family(capsys):
+    from tabletcad.cli import main
+
+    rc = main(["report", str(ROOT / "samples" / "spherical.toml"), str(ROOT / "samples" / "flat_faced_round.toml"),
+               str(ROOT / "samples" / "families" / "concave_round.toml")])
+    out, err = capsys.readouterr()
+    assert rc == 0, err
+    rows = {ln.split()[0]: ln.split() for ln in out.splitlines()[1:]}
+    assert rows["spherical"][1] == "thesis.spherical" and rows["spherical"][7:9] == ["-", "-"]  # no band, no cup
+    assert rows["flat_faced_round"][7:9] == ["6", "0"] and rows["concave_round"][7:9] == ["2.8", "0.9"]
+
+
+def test_report_of_a_reshaped_thesis_shape_claims_no_formula(tmp_path, capsys):
+    """[reshape] scales the patches: the family's band and thickness no longer describe the tablet."""
+    import json
+
+    from tabletcad.cli import main
+
+    d = tmp_path / "r.toml"
+    d.write_text('[tablet]\nfamily = "thesis.shallow_convex_round"\ndiameter = 10.0\nthickness = 3.0\nband = 2.0\n'
+                 '[reshape]\nspine = [3, 0.5, 3]\n', encoding="utf-8")
+    assert main(["report", str(d), "--json", "--breaking-force", "50"]) == 0
+    r = json.loads(capsys.readouterr().out)["design_report"]
+    assert r["band_mm"] is None and r["cup_depth_mm"] is None and r["tensile_strength"]["tensile_strength_MPa"] is None
+    assert r["overall_thickness_mm"] == pytest.approx(4.0, abs=1e-6)

@@ -208,7 +208,7 @@ def test_tooling_batch_runs_on_the_cluster(local_client, tmp_path):
     assert [r["params"] for r in rows] == sizes
     for k, r in enumerate(rows):
         assert r["upper_punch_rel_diff_vs_quadrature"] == pytest.approx(0.0, abs=1e-8)
-        assert (tmp_path / f"shallow_convex_round_{k:03d}" / "assembly.step").read_bytes().startswith(b"ISO-10303-21;")
+        assert (tmp_path / f"thesis.shallow_convex_round_{k:03d}" / "assembly.step").read_bytes().startswith(b"ISO-10303-21;")
     assert rows[1]["tablet_volume_mm3"] > rows[0]["tablet_volume_mm3"]
 
 

@@ -201,7 +201,7 @@ def test_batch_of_sizes(tmp_path):
     assert len(rows) == 2
     for k, r in enumerate(rows):
         assert r["upper_punch_rel_diff_vs_quadrature"] == pytest.approx(0.0, abs=1e-8)
-        assert (tmp_path / f"shallow_convex_round_{k:03d}" / "assembly.step").exists()
+        assert (tmp_path / f"thesis.shallow_convex_round_{k:03d}" / "assembly.step").exists()
 
 
 @pytest.mark.parametrize("size, n_notes", [(10.0, 9), (25.0, 20), (3.0, 3), (12.0, 90)])

@@ -128,6 +128,11 @@ def _solved(tablet, opts, vary: str, target_weight: float | None, target_volume:
     return solved, section
 
 
+def _g(value: float | None) -> str:
+    """A figure to 4 significant digits, ``-`` when the shape has none."""
+    return "-" if value is None else f"{value:.4g}"
+
+
 def _comparison(rows: list[tuple[str, dict[str, Any]]]) -> str:
     """One line per design: the figures a designer compares."""
     head = ("design", "family", "L x W x T mm", "band mm", "cup mm", "volume mm3", "area mm2", "SA/V 1/mm", "weight mg")
@@ -135,7 +140,7 @@ def _comparison(rows: list[tuple[str, dict[str, Any]]]) -> str:
     for name, sec in rows:
         r = sec["design_report"]
         lines.append((name, r["family"], f"{r['length_mm']:.4g} x {r['width_mm']:.4g} x {r['overall_thickness_mm']:.4g}",
-                      f"{r['band_mm']:.4g}", f"{r['cup_depth_mm']:.4g}", f"{r['volume_mm3']:.6g}", f"{r['surface_area_mm2']:.6g}",
+                      _g(r["band_mm"]), _g(r["cup_depth_mm"]), f"{r['volume_mm3']:.6g}", f"{r['surface_area_mm2']:.6g}",
                       f"{r['surface_area_mm2'] / r['volume_mm3']:.4g}", "-" if r["weight_mg"] is None else f"{r['weight_mg']:.6g}"))
     w = [max(len(str(row[i])) for row in lines) for i in range(len(head))]
     return "\n".join("  ".join(str(c).ljust(w[i]) if i < 2 else str(c).rjust(w[i]) for i, c in enumerate(row)).rstrip()

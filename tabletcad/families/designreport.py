@@ -397,7 +397,7 @@ def shape_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str,
     The same keys as :func:`design_report`, from the tablet's own geometry (quadrature volume and
     area, plan area, overall dimensions); band and cup depth come from the family's parameters
     where it has them (the thesis's convex rounds and ovals: cup depth = (thickness - band) / 2),
-    else they are None (also for a trimmed, cut-away tablet).  The tensile strength uses eq 2.4 (flat round), eq 2.7 (convex round) or
+    else they are None (also for a trimmed, cut-away tablet and a reshaped one).  The tensile strength uses eq 2.4 (flat round), eq 2.7 (convex round) or
     eqs 2.8/2.9 (convex oval, Pitt & Heasley, across the width); other shapes have no formula.
     There is no certificate: ``nominal_max_deviation_um`` is the PDE surface's largest distance
     from the exact shape when the family has one (the thesis's curves, not a tolerance).
@@ -410,10 +410,11 @@ def shape_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str,
     dims = tablet.dimensions()
     V, A = props["volume_mm3"], props["surface_area_mm2"]
     Ln, W, T = dims["length_mm"], dims["width_mm"], dims["height_mm"]
-    whole = tablet.trim.u == (0.0, 1.0) and tablet.trim.full_v and tablet.trim.w == (0.0, 1.0)
-    # a cut-away or trimmed tablet is a view: no shape formula applies to it
-    shape, face, band_of = _THESIS_SHAPES.get(tablet.family, (None, None, None)) if whole else (None, None, None)
     p = dict(tablet.params)
+    whole = tablet.trim.u == (0.0, 1.0) and tablet.trim.full_v and tablet.trim.w == (0.0, 1.0)
+    # a cut-away view, or a reshaped tablet (its family's dimensions no longer describe it): no formula
+    known = whole and bool(p)
+    shape, face, band_of = _THESIS_SHAPES.get(tablet.family, (None, None, None)) if known else (None, None, None)
     band = float(band_of(p)) if band_of is not None else None
     cup = None if band is None else (0.0 if face == "flat" else (float(p["thickness"]) - band) / 2.0)
     rep: dict[str, Any] = dict(

@@ -57,8 +57,9 @@ def evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",)
     Returns ``dict(values=..., status="ok"|"error", error=..., files=...)``:
     ``values`` holds every scalar of the report (:func:`flatten_report`) — the
     geometry report of :func:`tabletcad.report.geometry_report`, which is the
-    ``report.json`` of ``tabletcad build``; with file outputs the report of
-    :func:`tabletcad.build.build_tablet` itself.  ``files`` maps file names to
+    ``report.json`` of ``tabletcad build``; with file or tooling outputs the report of
+    :func:`tabletcad.build.build_tablet` itself (a failed tooling check is then a failed design,
+    as in ``tabletcad build``).  ``files`` maps file names to
     bytes (empty when ``store`` is given: the worker then writes them to
     ``store/folder/`` through fsspec).
     """
@@ -69,23 +70,22 @@ def evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",)
         files: dict[str, bytes] = {}
         wanted = [f for o in outputs if o not in ("report", "tooling") for f in OUTPUTS[o]]
         with tempfile.TemporaryDirectory(prefix="tabletcad-sweep-") as tmp:
-            if wanted:
+            if wanted or "tooling" in outputs:
                 from tabletcad.build import build_tablet
 
-                # the build's own tooling step is left out: "tooling" is its own output (below)
-                plain = replace(tablet, extras={k: v for k, v in tablet.extras.items() if k != "tooling"})
-                report = build_tablet(plain, Path(tmp) / "build", progress=False)
+                # the build's own steps, as `tabletcad build` runs them: with the "tooling" output the
+                # design's [tooling] table (the defaults without one) is built from the CAD step's solid;
+                # without it the tablet's files are the plain tablet and [tooling] is not built
+                extras = {k: v for k, v in tablet.extras.items() if k != "tooling"}
+                if "tooling" in outputs:
+                    extras["tooling"] = dict(design.get("tooling") or {})
+                    wanted += list(OUTPUTS["tooling"])
+                report = build_tablet(replace(tablet, extras=extras), Path(tmp) / "build", cad=True, progress=False)
                 files.update(_files_of(Path(tmp) / "build", wanted))
             else:
                 from tabletcad.report import geometry_report
 
                 report = geometry_report(tablet)
-            if "tooling" in outputs:
-                from tabletcad.tooling.batch import tooling_for
-
-                ts = tooling_for(tablet, dict(design.get("tooling") or {}), out_dir=Path(tmp) / "tooling")
-                report["tooling"] = ts.report
-                files.update(_files_of(Path(tmp) / "tooling", OUTPUTS["tooling"]))
         if store is not None and files:
             _store_files(store, folder, files)
             files = {}

@@ -63,7 +63,7 @@ def tablet_from_spec(family=None, params=None, design=None):
         from tabletcad.design import load_design
 
         return load_design(design)
-    return families.family(family, parameter="family", stacklevel=3).build(**(params or {}))
+    return families.family(family, parameter="family").build(**(params or {}))
 
 
 def _rims(surfaces, hollow):

@@ -66,7 +66,7 @@ def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, reco
     if family != objects.DESIGN_FILE:  # an old name of a renamed family: one warning, its new name
         from tabletcad.families import family as lookup_family
 
-        family = lookup_family(family, parameter="family", stacklevel=3).name
+        family = lookup_family(family, parameter="family").name
     obj = _new(doc, "Tablet")
     objects.TabletProxy(obj, family)
     if design is not None:

@@ -172,7 +172,8 @@ class TabletProxy(_Proxy):
         self._ready = False
         obj.Proxy = self
         self._setup(obj)
-        obj.Family = family
+        fam = _family(family)
+        obj.Family = fam.name if fam is not None else family  # the catalogue's name for an old one
         self._family_label, self._label = obj.Family, obj.Label
         self._sync_dimensions(obj, reset=True)
         self._ready = True

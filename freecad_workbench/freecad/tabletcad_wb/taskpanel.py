@@ -45,7 +45,7 @@ class TabletForm:
         fam = objects._family(family)
         if fam is None:
             raise ValueError(f"unknown family {family!r}")
-        self.family = family
+        self.family = fam.name  # the catalogue's name (an old name of a renamed family becomes the new one)
         self.units = dict(fam.params)
         self.values = {k: float(v) for k, v in fam.defaults.items() if v is not None}
 
