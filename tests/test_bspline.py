@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tabletcad.bspline import BSplineSurfaceData, enclosed_volume, fit_patches, fit_surface
-from tabletcad.cad.standins import cylinder, ring, sphere
+from support.standins import cylinder, ring, sphere
 from tabletcad.errors import GeometryError
 
 TOL = 1e-4  # mm

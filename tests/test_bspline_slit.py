@@ -73,7 +73,7 @@ def test_segment_v_refuses_a_smooth_knot():
 
 @pytest.fixture(scope="module")
 def capsule_surfaces():
-    from tabletcad.cad.tablet_solid import tablet_breakpoints, tablet_surface_functions  # numpy-only helpers
+    from tabletcad.surfaces import tablet_breakpoints, tablet_surface_functions  # numpy-only helpers
     from tabletcad.design import load_design
 
     t = load_design(ROOT / "samples" / "families" / "capsule.toml")
@@ -136,7 +136,7 @@ def test_rounded_square_cupped_to_its_corner_radius_is_cut_at_the_corners():
     to points; the chain is cut at the 8 outline junctions and each corner piece of the rim
     rows is a single pole at the corner arc's centre (offset by the corner radius)."""
     from tabletcad import families
-    from tabletcad.cad.tablet_solid import fit_options, tablet_surface_functions
+    from tabletcad.surfaces import fit_options, tablet_surface_functions
 
     side, rc = 9.0, 1.5
     t = families.FAMILIES["rounded_square"].build(side=side, corner_radius=rc)

@@ -42,7 +42,7 @@ def _listed(line: str) -> list[str]:
 @pytest.mark.cad
 @pytest.mark.slow
 def test_tooling_build_then_cutaway_then_plain_rebuild(tmp_path, capsys):
-    from tabletcad.cad.readback import ocp_read_steps
+    from support.readback import ocp_read_steps
 
     out = tmp_path / "out"
     rep, line = _build(ROOT / "samples" / "tooling" / "concave_round_bisect.toml", out, capsys)
@@ -100,7 +100,7 @@ def test_cutaway_with_curved_cut_faces_is_a_solid(tmp_path, capsys, design, trim
     integral at 8x the nodes."""
     from dataclasses import replace
 
-    from tabletcad.cad.readback import ocp_read_steps
+    from support.readback import ocp_read_steps
     from tabletcad.cad.stage import _cut_plane_angle
     from tabletcad.design import load_design
     from tabletcad.tablet import Trim

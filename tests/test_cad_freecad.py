@@ -11,9 +11,9 @@ pytest.importorskip("OCP")
 
 from tabletcad.cad.export import export  # noqa: E402
 import freecads  # noqa: E402
-from tabletcad.cad.readback import freecad_build_bspline, freecad_read_step  # noqa: E402
+from support.readback import freecad_build_bspline, freecad_read_step  # noqa: E402
 from tabletcad.cad.solid import build_solid, mass_properties  # noqa: E402
-from tabletcad.cad.standins import cylinder, ring, sphere  # noqa: E402
+from support.standins import cylinder, ring, sphere  # noqa: E402
 
 pytestmark = [pytest.mark.cad, pytest.mark.freecad]
 

@@ -13,7 +13,7 @@ bd = pytest.importorskip("build123d")
 
 from tabletcad.cad.interop import from_any, to_build123d, to_build123d_part, to_cadquery  # noqa: E402
 from tabletcad.cad.solid import build_solid  # noqa: E402
-from tabletcad.cad.standins import ring, sphere  # noqa: E402
+from support.standins import ring, sphere  # noqa: E402
 
 pytestmark = pytest.mark.cad
 

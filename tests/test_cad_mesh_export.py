@@ -16,9 +16,9 @@ trimesh = pytest.importorskip("trimesh")
 
 from tabletcad.cad.export import export  # noqa: E402
 from tabletcad.cad.mesh import tessellate  # noqa: E402
-from tabletcad.cad.readback import ocp_read_step  # noqa: E402
+from support.readback import ocp_read_step  # noqa: E402
 from tabletcad.cad.solid import build_solid  # noqa: E402
-from tabletcad.cad.standins import cylinder, ring, sphere  # noqa: E402
+from support.standins import cylinder, ring, sphere  # noqa: E402
 
 pytestmark = pytest.mark.cad
 STANDINS = [sphere(2.5), cylinder(2.5, 3.0), ring(1.5, 3.0, 2.0)]

@@ -14,7 +14,7 @@ pytest.importorskip("OCP")
 from tabletcad.bspline import enclosed_volume  # noqa: E402
 from tabletcad.cad.faces import make_face, make_geom_surface, surface_data_from_geom  # noqa: E402
 from tabletcad.cad.solid import build_solid, mass_properties, solid_from_tablet  # noqa: E402
-from tabletcad.cad.standins import cylinder, ring, sphere  # noqa: E402
+from support.standins import cylinder, ring, sphere  # noqa: E402
 from tabletcad.errors import GeometryError  # noqa: E402
 
 pytestmark = pytest.mark.cad

@@ -41,10 +41,11 @@ from tabletcad.bspline import _eval_f, enclosed_volume, periodic_knots
 from tabletcad.cad._occ import explore, shape_type
 from tabletcad.cad.export import export
 from tabletcad.cad.mesh import tessellate
-from tabletcad.cad.readback import find_freecadcmd, freecad_build_bspline, freecad_read_step, ocp_read_steps
+from support.readback import find_freecadcmd, freecad_build_bspline, freecad_read_step, ocp_read_steps
 from tabletcad.cad.solid import mass_properties
 from tabletcad.cad.stage import MESH_ANGULAR_RAD, MESH_LINEAR_MM
-from tabletcad.cad.tablet_solid import tablet_breakpoints, tablet_solid, tablet_surface_functions
+from tabletcad.surfaces import tablet_breakpoints, tablet_surface_functions
+from tabletcad.cad.tablet_solid import tablet_solid
 from tabletcad.design import design_from_dict, load_design
 from tabletcad.errors import GeometryError
 

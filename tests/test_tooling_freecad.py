@@ -14,7 +14,7 @@ pytest.importorskip("OCP")
 pytest.importorskip("manifold3d")
 
 import freecads  # noqa: E402
-from tabletcad.cad.readback import freecad_read_step  # noqa: E402
+from support.readback import freecad_read_step  # noqa: E402
 from tabletcad.shapes import shallow_convex_round  # noqa: E402
 from tabletcad.tooling import ToolingSpec, make_tooling, write_tooling  # noqa: E402
 
@@ -95,7 +95,7 @@ def test_freecad_reads_the_assembly_as_valid_solids_with_named_parts(fc, files, 
     # names as FreeCAD's own importer sees them: four valid, named solids
     assert r["named_solids"] == {"tablet": True, "upper_punch": True, "lower_punch": True, "die": True}
     # and the XCAF product names as OCP's STEP reader sees them in a fresh process
-    from tabletcad.cad.readback import ocp_read_step
+    from support.readback import ocp_read_step
 
     products = ocp_read_step(out / "assembly.step")["products"]
     assert {"tablet", "upper_punch", "lower_punch", "die"} <= set(products)

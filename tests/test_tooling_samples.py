@@ -10,7 +10,7 @@ import pytest
 pytest.importorskip("OCP")
 pytest.importorskip("manifold3d")
 
-from tabletcad.cad.readback import _clean_env, find_freecadcmd  # noqa: E402
+from support.readback import _clean_env, find_freecadcmd  # noqa: E402
 from tabletcad.design import load_design  # noqa: E402
 from tabletcad.tooling import make_tooling, write_tooling  # noqa: E402
 from tabletcad.tooling.assembly import PART_COLOURS, read_assembly_colours  # noqa: E402

@@ -5,8 +5,6 @@
 * :mod:`tabletcad.cad.mesh`    - tessellation + manifold3d / trimesh checks
 * :mod:`tabletcad.cad.export`  - STEP / STL / 3MF / GLB / BREP writers chosen by suffix
 * :mod:`tabletcad.cad.interop` - build123d / cadquery wrappers (imported lazily)
-* :mod:`tabletcad.cad.readback` - re-read STEP with OCP in a fresh process and with FreeCAD
-* :mod:`tabletcad.cad.standins` - analytic stand-in patches (sphere, cylinder, ring), numpy only
 """
 
 from importlib import import_module

@@ -163,7 +163,7 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
         if t.w != (0.0, 1.0):
             return "hollow ([trim] w) with cut faces that are not planes through the axis"
         from tabletcad.cad.solid import build_solid
-        from tabletcad.cad.tablet_solid import cutaway_surface_functions, fit_options
+        from tabletcad.surfaces import cutaway_surface_functions, fit_options
 
         funcs, breaks = cutaway_surface_functions(tablet)
         names = [f"{p.name or f'patch {j}'} cut-away" for j, p in enumerate(tablet.patches)]

@@ -1,128 +1,21 @@
 """The B-rep solid of a :class:`~tabletcad.tablet.Tablet`.
 
-Every face of the tablet's solid is fitted by a B-spline (kernel-neutral data
-from :mod:`tabletcad.bspline`), the faces are sewn into one closed shell and
-the shell becomes an outward solid checked by ``BRepCheck_Analyzer``.
-
-An ordinary tablet's faces are its patches (a chain whose neighbours share
-boundary curves).  A hollow tablet (``trim.w[0] > 0``, e.g. the ring) is the
-closed chain outer wall -> end face at ``u = 1`` -> inner wall (reversed) ->
-end face at ``u = 0``.  Tablets trimmed in ``u`` or ``v`` (cut-away views) are
-pictures and meshes, not B-rep exports, and are refused here.
+Every face of the tablet's solid (:mod:`tabletcad.surfaces`: its patches, or the
+walls and end faces of a hollow tablet) is fitted by a B-spline (kernel-neutral
+data from :mod:`tabletcad.bspline`), the faces are sewn into one closed shell and
+the shell becomes an outward solid checked by ``BRepCheck_Analyzer``.  Tablets
+trimmed in ``u`` or ``v`` (cut-away views) are refused here: the CAD stage builds
+their solids (:func:`tabletcad.cad.stage.cutaway_solid`).
 """
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import Any
 
-import numpy as np
+from tabletcad.surfaces import fit_options, tablet_surface_functions
+from tabletcad.tablet import Tablet
 
-from tabletcad.errors import GeometryError
-from tabletcad.tablet import Tablet, solid_map
-
-__all__ = ["tablet_surface_functions", "tablet_solid", "tablet_breakpoints", "fit_options"]
-
-SurfaceFunction = Callable[[np.ndarray, np.ndarray], np.ndarray]
-
-
-def tablet_surface_functions(tablet: Tablet) -> tuple[list[SurfaceFunction], list[str]]:
-    """Surface functions ``f(s, v) -> (..., 3)`` (mm), ``s ∈ [0, 1]``, forming a chain.
-
-    Raises :class:`GeometryError` for tablets trimmed in ``u`` or ``v``.
-    """
-    t = tablet.trim
-    if t.u != (0.0, 1.0) or not t.full_v:
-        raise GeometryError(
-            f"{tablet.name}: tablets trimmed in u or v (cut-away views) are not exported as solids; "
-            "remove [trim] u/v to export, or use the picture and mesh outputs",
-            tablet,
-        )
-    w0, w1 = t.w
-    names = [p.name or f"patch {j}" for j, p in enumerate(tablet.patches)]
-    if w0 == 0.0 and w1 == 1.0:
-        from tabletcad.bspline import PatchFunction  # keeps the patches' fast evaluate_grid
-
-        return [PatchFunction(p) for p in tablet.patches], names
-    if len(tablet.patches) != 1:
-        raise GeometryError(f"{tablet.name}: hollow (w-trimmed) solids are exported for one-patch tablets only", tablet)
-    p = tablet.patches[0]
-
-    def lerp(a: float, b: float, s: np.ndarray) -> np.ndarray:
-        return a + (b - a) * s
-
-    funcs: list[SurfaceFunction] = [
-        lambda s, v: solid_map(p, s, v, np.full(np.broadcast(s, v).shape, w1)),  # outer wall u: 0 -> 1
-        lambda s, v: solid_map(p, np.ones(np.broadcast(s, v).shape), v, lerp(w1, w0, np.asarray(s))),  # end u=1
-        lambda s, v: solid_map(p, 1.0 - np.asarray(s), v, np.full(np.broadcast(s, v).shape, w0)),  # inner wall
-        lambda s, v: solid_map(p, np.zeros(np.broadcast(s, v).shape), v, lerp(w0, w1, np.asarray(s))),  # end u=0
-    ]
-    base = names[0]
-    return funcs, [f"{base} outer wall", f"{base} end u=1", f"{base} inner wall", f"{base} end u=0"]
-
-
-def cutaway_surface_functions(tablet: Tablet) -> tuple[list[SurfaceFunction], np.ndarray]:
-    """Surface functions ``f(s, θ)`` of a cut-away (``[trim] v = [v0, v1]``, ``w = [0, 1]``) and their
-    breakpoints in ``θ``: one closed chain, as the whole tablet's.
-
-    For each ``u`` the boundary of the solid map's ``(v, w)`` rectangle is walked once round
-    ``θ ∈ [0, 2π)``: the outer surface ``w = 1`` from ``v0`` to ``v1``, the cut face ``v = v1``
-    from ``w = 1`` in to the spine, then the cut face ``v = v0`` back out (the leg ``w = 0`` is the
-    spine itself, a point for each ``u``).  Each cut face is the ruled surface
-    ``A0(u) + w (X(u, v) - A0(u))`` of eq 4.12, whatever its shape; the corners and the
-    outline's joins inside ``[v0, v1]`` are the breakpoints (C0 knots).  The legs share
-    ``θ`` in proportion to their lengths for a round tablet (``v1 - v0`` : 1 : 1).
-    """
-    v0, v1 = tablet.trim.v
-    span = v1 - v0
-    ta = 2.0 * np.pi * span / (span + 2.0)
-    tb = ta + 0.5 * (2.0 * np.pi - ta)
-
-    def make(p):
-        def f(s, th):
-            s, th = np.broadcast_arrays(np.asarray(s, float), np.mod(np.asarray(th, float), 2.0 * np.pi))
-            v = np.where(th < ta, v0 + span * th / ta, np.where(th < tb, v1, v0))
-            w = np.where(th < ta, 1.0, np.where(th < tb, 1.0 - (th - ta) / (tb - ta), (th - tb) / (2.0 * np.pi - tb)))
-            return solid_map(p, s, v, w)
-        return f
-
-    from tabletcad.bspline import chain_breakpoints
-
-    breaks = [0.0, ta, tb]
-    for b in chain_breakpoints(tablet.patches):
-        vb = v0 + np.mod(b - v0, 2.0 * np.pi)
-        if v0 < vb < v1:
-            breaks.append((vb - v0) / span * ta)
-    return [make(p) for p in tablet.patches], np.array(sorted(breaks))
-
-
-def tablet_breakpoints(tablet: Tablet) -> np.ndarray:
-    """Union of the ``v`` breakpoints of the tablet's patches (sorted, in [0, 2π)).
-
-    Every face of the solid (also the walls and end faces of a hollow tablet,
-    which share the patch's ``v``) is fitted with breakpoint knots at all of
-    them, so that the chain keeps one common ``v`` knot vector.
-    """
-    from tabletcad.bspline import chain_breakpoints
-
-    return chain_breakpoints(tablet.patches)
-
-
-def fit_options(tablet: Tablet, **kwargs: Any) -> dict[str, Any]:
-    """Keyword arguments of :func:`tabletcad.bspline.fit_patches` for the tablet's chain.
-
-    One place for every kernel (this OCP layer and the FreeCAD workbench):
-    quintic B-splines - 17 x 32 poles already fit the thesis's tablets to ~3e-8
-    mm, where cubics need ~4x the poles for 1e-5 mm (and leave a 1e-6 volume
-    bias); knots of full multiplicity at the outline breakpoints, where the
-    surface may be only C0 (a cup swept over an offset outline whose corner
-    collapses) and where a slit is cut (:mod:`tabletcad.slit`).  ``kwargs``
-    override the defaults.
-    """
-    kwargs.setdefault("u_degree", 5)
-    kwargs.setdefault("v_degree", 5)
-    kwargs.setdefault("v_break_mult", kwargs["v_degree"])
-    kwargs.setdefault("v_breaks", tablet_breakpoints(tablet))
-    return kwargs
+__all__ = ["tablet_solid"]
 
 
 def tablet_solid(tablet: Tablet, tol: float | None = None, **kwargs: Any):

@@ -49,7 +49,7 @@ def tablet_chain(tablet):
     The same chain as :func:`tabletcad.cad.tablet_solid.tablet_surface_functions`
     (numpy only: it imports no OCP), with the union of the patches' breakpoints.
     """
-    from tabletcad.cad.tablet_solid import tablet_breakpoints, tablet_surface_functions
+    from tabletcad.surfaces import tablet_breakpoints, tablet_surface_functions
 
     funcs, names = tablet_surface_functions(tablet)
     return funcs, names, tablet_breakpoints(tablet)
@@ -189,7 +189,7 @@ def solid_from_faces(faces, sew_tolerance, what="tablet"):
 def build_tablet(tablet, tol=None):
     """Fit the tablet's chain, build the Part solid, compute the core's figures."""
     from tabletcad.bspline import enclosed_volume, fit_patches
-    from tabletcad.cad.tablet_solid import fit_options
+    from tabletcad.surfaces import fit_options
     from tabletcad.slit import chain_face_surfaces
 
     t0 = time.perf_counter()

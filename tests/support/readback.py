@@ -2,7 +2,7 @@
 
 * :func:`ocp_read_step` re-reads a STEP file with OCP's ``STEPControl_Reader``
   in a **fresh** Python process (no state shared with the writer).
-* :func:`freecad_read_step` runs :mod:`tabletcad.cad.freecad_check` under
+* :func:`freecad_read_step` runs :mod:`support.freecad_check` under
   ``freecadcmd`` (FreeCAD's own Python and its own OCCT build), with
   ``FREECAD_USER_HOME`` set to a temporary folder, ``VIRTUAL_ENV`` unset and
   the venv removed from ``PATH``.

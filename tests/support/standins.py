@@ -4,7 +4,7 @@ Each factory returns an ordered chain of :class:`AnalyticPatch` objects with
 the interface of the PDE patches (``evaluate(u, v)`` -> ``(..., 3)``,
 ``u`` in [0, 1], ``v`` periodic in [0, 2 pi)); patch ``j``'s ``u=1`` curve is
 patch ``j+1``'s ``u=0`` curve, and the closed-form volume and area are known.
-Used by the CAD tests and benchmarks until :mod:`tabletcad.patch` exists.
+The CAD tests fit and sew them: geometry with closed-form volume and area, independent of the PDE core.
 """
 
 from __future__ import annotations
