@@ -28,6 +28,7 @@ from tabletcad.errors import DesignError, check_finite, check_positive, check_ra
 from tabletcad.tolerance import DEFAULT
 
 __all__ = [
+    "Seg",
     "Curve",
     "CurveLike",
     "Circle",
@@ -185,15 +186,57 @@ class Ellipse(Curve):
 
 
 @dataclass(frozen=True)
-class _Seg:
-    kind: str  # "line" or "arc"
-    length: float
+class Seg:
+    """One line or circular arc in a plane (mm): the one 2-D segment type of tabletcad.
+
+    ``kind == "line"``: from ``p0`` to ``p1``.  ``kind == "arc"``: centre
+    ``center``, ``radius`` (mm), start angle ``theta0`` and signed ``sweep``
+    (rad, > 0 counter-clockwise = convex for a CCW outline); ``p0`` and ``p1`` are its
+    end points.  Build with :meth:`line` and :meth:`arc`.
+    """
+
+    kind: str
     p0: tuple[float, float]
-    p1: tuple[float, float] = (0.0, 0.0)
+    p1: tuple[float, float]
     center: tuple[float, float] = (0.0, 0.0)
     radius: float = 0.0
     theta0: float = 0.0
-    sweep: float = 0.0  # signed
+    sweep: float = 0.0
+
+    @classmethod
+    def line(cls, p0, p1) -> Seg:
+        """The line from ``p0`` to ``p1`` (mm)."""
+        return cls("line", (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1])))
+
+    @classmethod
+    def arc(cls, c, r: float, t0: float, sw: float) -> Seg:
+        """The arc about ``c`` of radius ``r`` (mm) from angle ``t0`` through the signed ``sw`` (rad)."""
+        c = (float(c[0]), float(c[1]))
+        p0 = (c[0] + r * math.cos(t0), c[1] + r * math.sin(t0))
+        p1 = (c[0] + r * math.cos(t0 + sw), c[1] + r * math.sin(t0 + sw))
+        return cls("arc", p0, p1, c, float(r), float(t0), float(sw))
+
+    @property
+    def length(self) -> float:
+        """Arc length (mm)."""
+        if self.kind == "line":
+            return float(math.hypot(self.p1[0] - self.p0[0], self.p1[1] - self.p0[1]))
+        return abs(self.radius * self.sweep)
+
+    def tangent(self, end: int) -> np.ndarray:
+        """Unit tangent at the start (0) or end (1)."""
+        if self.kind == "line":
+            d = np.subtract(self.p1, self.p0)
+            return d / np.linalg.norm(d)
+        th = self.theta0 + (self.sweep if end else 0.0)
+        sg = math.copysign(1.0, self.sweep)
+        return sg * np.array([-math.sin(th), math.cos(th)])
+
+    def reversed(self) -> Seg:
+        """The same segment run the other way."""
+        if self.kind == "line":
+            return Seg("line", self.p1, self.p0)
+        return Seg("arc", self.p1, self.p0, self.center, self.radius, self.theta0 + self.sweep, -self.sweep)
 
 
 class Outline(Curve):
@@ -204,7 +247,7 @@ class Outline(Curve):
     plane ``z``.
     """
 
-    def __init__(self, segments: list[_Seg], z: float = 0.0, name: str = "outline") -> None:
+    def __init__(self, segments: list[Seg], z: float = 0.0, name: str = "outline") -> None:
         if not segments:
             raise DesignError("segments", 0, "an outline needs at least one segment")
         self._segs = tuple(segments)
@@ -222,15 +265,12 @@ class Outline(Curve):
         ``("arc", (cx, cy), radius, theta0, sweep)`` items (angles in radians,
         ``sweep > 0`` counter-clockwise), which must join end to start.
         """
-        segs: list[_Seg] = []
+        segs: list[Seg] = []
         for it in items:
             if it[0] == "line":
-                p0, p1 = np.asarray(it[1], float), np.asarray(it[2], float)
-                segs.append(_Seg("line", float(np.hypot(*(p1 - p0))), tuple(p0), tuple(p1)))
+                segs.append(Seg.line(it[1], it[2]))
             elif it[0] == "arc":
-                c, r, t0, sw = np.asarray(it[1], float), float(it[2]), float(it[3]), float(it[4])
-                p0 = c + r * np.array([math.cos(t0), math.sin(t0)])
-                segs.append(_Seg("arc", abs(r * sw), tuple(p0), center=tuple(c), radius=r, theta0=t0, sweep=sw))
+                segs.append(Seg.arc(it[1], float(it[2]), float(it[3]), float(it[4])))
             else:
                 raise DesignError("segment kind", it[0], "must be 'line' or 'arc'")
         # check closure

@@ -23,11 +23,11 @@ All lengths are millimetres, angles radians.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from tabletcad.curves import Seg
 from tabletcad.errors import DesignError, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
 
@@ -46,53 +46,7 @@ __all__ = [
 
 
 
-@dataclass(frozen=True)
-class Seg:
-    """One outline segment.
-
-    ``kind == "line"``: from ``p0`` to ``p1``.  ``kind == "arc"``: centre
-    ``center``, ``radius`` (mm), start angle ``theta0`` and signed ``sweep``
-    (rad, > 0 counter-clockwise = convex for a CCW outline).
-    """
-
-    kind: str
-    p0: tuple[float, float]
-    p1: tuple[float, float]
-    center: tuple[float, float] = (0.0, 0.0)
-    radius: float = 0.0
-    theta0: float = 0.0
-    sweep: float = 0.0
-
-    @property
-    def length(self) -> float:
-        if self.kind == "line":
-            return float(math.hypot(self.p1[0] - self.p0[0], self.p1[1] - self.p0[1]))
-        return abs(self.radius * self.sweep)
-
-    def tangent(self, end: int) -> np.ndarray:
-        """Unit tangent at the start (0) or end (1)."""
-        if self.kind == "line":
-            d = np.subtract(self.p1, self.p0)
-            return d / np.linalg.norm(d)
-        th = self.theta0 + (self.sweep if end else 0.0)
-        sg = math.copysign(1.0, self.sweep)
-        return sg * np.array([-math.sin(th), math.cos(th)])
-
-    def reversed(self) -> "Seg":
-        if self.kind == "line":
-            return Seg("line", self.p1, self.p0)
-        return Seg("arc", self.p1, self.p0, self.center, self.radius, self.theta0 + self.sweep, -self.sweep)
-
-
-def _line(p0, p1) -> Seg:
-    return Seg("line", (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1])))
-
-
-def _arc(c, r, t0, sw) -> Seg:
-    c = (float(c[0]), float(c[1]))
-    p0 = (c[0] + r * math.cos(t0), c[1] + r * math.sin(t0))
-    p1 = (c[0] + r * math.cos(t0 + sw), c[1] + r * math.sin(t0 + sw))
-    return Seg("arc", p0, p1, c, float(r), float(t0), float(sw))
+_line, _arc = Seg.line, Seg.arc
 
 
 class PlanOutline:
