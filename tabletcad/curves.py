@@ -202,19 +202,81 @@ class Seg:
     radius: float = 0.0
     theta0: float = 0.0
     sweep: float = 0.0
+    label: str = ""
 
     @classmethod
-    def line(cls, p0, p1) -> Seg:
+    def line(cls, p0, p1, label: str = "") -> Seg:
         """The line from ``p0`` to ``p1`` (mm)."""
-        return cls("line", (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1])))
+        return cls("line", (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1])), label=label)
 
     @classmethod
-    def arc(cls, c, r: float, t0: float, sw: float) -> Seg:
+    def arc(cls, c, r: float, t0: float, sw: float, label: str = "") -> Seg:
         """The arc about ``c`` of radius ``r`` (mm) from angle ``t0`` through the signed ``sw`` (rad)."""
         c = (float(c[0]), float(c[1]))
         p0 = (c[0] + r * math.cos(t0), c[1] + r * math.sin(t0))
         p1 = (c[0] + r * math.cos(t0 + sw), c[1] + r * math.sin(t0 + sw))
-        return cls("arc", p0, p1, c, float(r), float(t0), float(sw))
+        return cls("arc", p0, p1, c, float(r), float(t0), float(sw), label)
+
+    def point(self, t) -> np.ndarray:
+        """Points at ``t in [0, 1]`` (``(..., 2)``, mm): linear in length along a line, in angle on an arc."""
+        t = np.asarray(t, dtype=float)
+        if self.kind == "line":
+            return (1 - t)[..., None] * np.asarray(self.p0) + t[..., None] * np.asarray(self.p1)
+        ph = self.theta0 + self.sweep * t
+        return np.stack([self.center[0] + self.radius * np.cos(ph), self.center[1] + self.radius * np.sin(ph)], -1)
+
+    def derivative(self, t) -> np.ndarray:
+        """``d point / dt`` at ``t`` (``(..., 2)``, mm)."""
+        t = np.asarray(t, dtype=float)
+        if self.kind == "line":
+            return np.broadcast_to(np.subtract(self.p1, self.p0), t.shape + (2,)).copy()
+        ph = self.theta0 + self.sweep * t
+        k = self.radius * self.sweep
+        return np.stack([-k * np.sin(ph), k * np.cos(ph)], -1)
+
+    def hermite(self, t0: float, t1: float):
+        """``(P0, P1, D0, D1)`` of the cubic Hermite curve standing for ``[t0, t1]`` (mm).
+
+        A line's is exact.  An arc's end tangents have length ``4 ρ tan(φ/4)`` for its angle
+        ``φ``, which puts the cubic's midpoint on the arc (error ~ ``ρ φ⁶``).
+        """
+        P0, P1 = self.point(t0), self.point(t1)
+        if self.kind == "line":
+            D = P1 - P0
+            return P0, P1, D, D
+        k = 4.0 * math.tan(self.sweep * (t1 - t0) / 4.0) * self.radius  # signed with the sweep
+        ph0, ph1 = self.theta0 + self.sweep * t0, self.theta0 + self.sweep * t1
+        return P0, P1, k * np.array([-math.sin(ph0), math.cos(ph0)]), k * np.array([-math.sin(ph1), math.cos(ph1)])
+
+    def distance(self, q: np.ndarray) -> np.ndarray:
+        """Exact distance (mm) from points ``q`` (m, 2) to the segment."""
+        if self.kind == "line":
+            a = np.asarray(self.p0)
+            d = np.subtract(self.p1, self.p0)
+            t = np.clip(((q - a) @ d) / float(d @ d), 0.0, 1.0)
+            r = q - (a + t[:, None] * d)
+            return np.hypot(r[:, 0], r[:, 1])
+        r = q - np.asarray(self.center)
+        rho = np.hypot(r[:, 0], r[:, 1])
+        ang = np.arctan2(r[:, 1], r[:, 0])
+        rel = np.mod((ang - self.theta0) * math.copysign(1.0, self.sweep), 2 * math.pi)
+        on = rel <= abs(self.sweep)
+        e0 = np.linalg.norm(q - self.point(0.0), axis=1)
+        e1 = np.linalg.norm(q - self.point(1.0), axis=1)
+        return np.where(on, np.abs(rho - self.radius), np.minimum(e0, e1))
+
+    def mirrored(self, ym: float) -> Seg:
+        """The mirror image in the line ``y = ym``, run the other way (so a chain stays a chain)."""
+        if self.kind == "line":
+            return Seg.line((self.p1[0], 2 * ym - self.p1[1]), (self.p0[0], 2 * ym - self.p0[1]), self.label)
+        return Seg.arc((self.center[0], 2 * ym - self.center[1]), self.radius, -(self.theta0 + self.sweep), self.sweep,
+                       self.label)
+
+    def translated(self, dx: float, dy: float) -> Seg:
+        """The same segment moved by ``(dx, dy)`` (mm)."""
+        if self.kind == "line":
+            return Seg.line((self.p0[0] + dx, self.p0[1] + dy), (self.p1[0] + dx, self.p1[1] + dy), self.label)
+        return Seg.arc((self.center[0] + dx, self.center[1] + dy), self.radius, self.theta0, self.sweep, self.label)
 
     @property
     def length(self) -> float:
@@ -235,8 +297,8 @@ class Seg:
     def reversed(self) -> Seg:
         """The same segment run the other way."""
         if self.kind == "line":
-            return Seg("line", self.p1, self.p0)
-        return Seg("arc", self.p1, self.p0, self.center, self.radius, self.theta0 + self.sweep, -self.sweep)
+            return Seg("line", self.p1, self.p0, label=self.label)
+        return Seg("arc", self.p1, self.p0, self.center, self.radius, self.theta0 + self.sweep, -self.sweep, self.label)
 
 
 class Outline(Curve):

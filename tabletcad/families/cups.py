@@ -21,7 +21,8 @@ import math
 import numpy as np
 
 from tabletcad.errors import DesignError, check_finite, check_range
-from tabletcad.families.profile import Arc2, Line2
+from tabletcad.curves import Seg
+from tabletcad.families.profile import profile_arc, profile_line
 
 __all__ = [
     "single_radius_cup",
@@ -40,15 +41,15 @@ def cup_radius(half_width: float, depth: float) -> float:
 
 def land_line(land: float) -> list:
     """The land as a profile element (empty when ``land == 0``)."""
-    return [Line2((0.0, 0.0), (land, 0.0), "land")] if land > 0 else []
+    return [profile_line((0.0, 0.0), (land, 0.0), "land")] if land > 0 else []
 
 
-def bevel_line(angle_deg: float, width: float, d0: float = 0.0) -> Line2:
+def bevel_line(angle_deg: float, width: float, d0: float = 0.0) -> Seg:
     """Bevel from ``(d0, 0)`` rising at ``angle_deg`` over ``width`` (mm)."""
-    return Line2((d0, 0.0), (d0 + width, width * math.tan(math.radians(angle_deg))), "bevel")
+    return profile_line((d0, 0.0), (d0 + width, width * math.tan(math.radians(angle_deg))), "bevel")
 
 
-def single_radius_cup(d0: float, d1: float, depth: float, z0: float = 0.0, *, depth_name: str = "cup_depth") -> Arc2:
+def single_radius_cup(d0: float, d1: float, depth: float, z0: float = 0.0, *, depth_name: str = "cup_depth") -> Seg:
     """Arc from ``(d0, z0)`` to ``(d1, z0 + depth)``, horizontal at ``d1``.
 
     Raises
@@ -64,7 +65,7 @@ def single_radius_cup(d0: float, d1: float, depth: float, z0: float = 0.0, *, de
     rho = cup_radius(w, h)
     c = (d1, z0 + h - rho)
     phi0 = math.atan2(z0 - c[1], d0 - c[0])
-    return Arc2(c, rho, phi0, math.pi / 2, "cup")
+    return profile_arc(c, rho, phi0, math.pi / 2, "cup")
 
 
 class CompoundCup:
@@ -152,8 +153,8 @@ class CompoundCup:
         phi_b = math.atan2(B[1] - Ce[1], B[0] - Ce[0])
         phi_c0 = math.atan2(B[1] - C1[1], B[0] - C1[0])
         return [
-            Arc2(Ce, self.edge_radius, phi_e0, phi_b, "cup edge radius"),
-            Arc2(C1, self.central_radius, phi_c0, math.pi / 2, "cup central radius"),
+            profile_arc(Ce, self.edge_radius, phi_e0, phi_b, "cup edge radius"),
+            profile_arc(C1, self.central_radius, phi_c0, math.pi / 2, "cup central radius"),
         ]
 
 

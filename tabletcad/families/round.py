@@ -13,7 +13,7 @@ import math
 from tabletcad.errors import DesignError, check_positive, check_range
 from tabletcad.families.cups import CompoundCup, bevel_line, land_line, single_radius_cup
 from tabletcad.families.outline import circle_outline
-from tabletcad.families.profile import Arc2, Line2
+from tabletcad.families.profile import profile_arc, profile_line
 from tabletcad.families.sweep import DEFAULT_A, build_sweep_tablet
 from tabletcad.tablet import Tablet
 from tabletcad.tolerance import DEFAULT, Tolerances
@@ -39,7 +39,7 @@ def flat_face_round(diameter: float = 10.0, thickness: float = 4.0, *, a=DEFAULT
     """Round flat-face plain tablet (sharp edges): a cylinder ``diameter`` × ``thickness`` (mm)."""
     D = check_positive("diameter", diameter, "mm")
     T = check_positive("thickness", thickness, "mm")
-    face = [Line2((0.0, 0.0), (D / 2.0, 0.0), "flat face")]
+    face = [profile_line((0.0, 0.0), (D / 2.0, 0.0), "flat face")]
     return _round("flat_face_round", D, face, T, dict(diameter=D, thickness=T),
                   dict(face="flat", cup_depth_mm=0.0, land_mm=D / 2.0), a, tol)
 
@@ -74,7 +74,7 @@ def ffbe(diameter: float = 10.0, thickness: float = 4.0, bevel_angle: float = 30
     T = check_positive("thickness", thickness, "mm")
     R = D / 2.0
     w, dep = _bevel_dims(R, T, bevel_angle, bevel_width, bevel_depth)
-    face = [bevel_line(bevel_angle, w), Line2((w, dep), (R, dep), "flat face")]
+    face = [bevel_line(bevel_angle, w), profile_line((w, dep), (R, dep), "flat face")]
     return _round("ffbe", D, face, T - 2 * dep,
                   dict(diameter=D, thickness=T, bevel_angle=float(bevel_angle), bevel_width=float(bevel_width), bevel_depth=float(bevel_depth)),
                   dict(face="flat", cup_depth_mm=dep, bevel_width_mm=w, bevel_depth_mm=dep, bevel_angle_deg=float(bevel_angle), land_mm=0.0), a, tol)
@@ -87,9 +87,9 @@ def ffre(diameter: float = 10.0, thickness: float = 4.0, edge_radius: float = 1.
     T = check_positive("thickness", thickness, "mm")
     R = D / 2.0
     re = check_range("edge_radius", edge_radius, 0.0, min(R, T / 2.0), "mm", lo_open=True)
-    face = [Arc2((re, 0.0), re, math.pi, math.pi / 2, "edge radius")]
+    face = [profile_arc((re, 0.0), re, math.pi, math.pi / 2, "edge radius")]
     if re < R:
-        face.append(Line2((re, re), (R, re), "flat face"))
+        face.append(profile_line((re, re), (R, re), "flat face"))
     return _round("ffre", D, face, T - 2 * re, dict(diameter=D, thickness=T, edge_radius=re),
                   dict(face="flat", cup_depth_mm=re, edge_radius_mm=re, land_mm=0.0), a, tol)
 

@@ -30,7 +30,7 @@ from tabletcad.families.outline import (
     rounded_polygon,
     rounded_rectangle_outline,
 )
-from tabletcad.families.profile import Line2
+from tabletcad.families.profile import profile_line
 from tabletcad.families.round import smoothing
 from tabletcad.families.sweep import DEFAULT_A, build_sweep_tablet
 from tabletcad.tablet import Tablet
@@ -109,7 +109,7 @@ def outline_tablet(
     Re = check_range("edge_radius", edge_radius, 0.0, None, "mm")
     extra: dict = {}
     if h == 0.0:
-        face = [Line2((0.0, 0.0), (cw, 0.0), "flat face")]
+        face = [profile_line((0.0, 0.0), (cw, 0.0), "flat face")]
     elif Rc > 0 or Re > 0:
         if not (Rc > 0 and Re > 0):
             raise DesignError("edge_radius" if Rc > 0 else "central_radius", Re if Rc > 0 else Rc, "must be > 0 for a compound cup (give both radii, or neither)", "mm")

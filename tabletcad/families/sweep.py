@@ -43,7 +43,7 @@ import numpy as np
 from tabletcad.curves import Curve
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.families.outline import PlanOutline
-from tabletcad.families.profile import Arc2, Line2, Piece, distance_to_chain, joint_is_smooth, pieces_for
+from tabletcad.families.profile import Piece, profile_line, distance_to_chain, joint_is_smooth, pieces_for
 from tabletcad.patch import PDEPatch
 from tabletcad.tablet import Tablet
 from tabletcad.tolerance import DEFAULT, Tolerances
@@ -163,7 +163,7 @@ class SweepNominal:
         self.bottom = list(bottom)
         self.band_z = band_z
         self.thickness = thickness
-        self.chain = list(bottom) + ([Line2((0.0, band_z[0]), (0.0, band_z[1]), "band")] if band_z[1] > band_z[0] else []) + list(top)
+        self.chain = list(bottom) + ([profile_line((0.0, band_z[0]), (0.0, band_z[1]), "band")] if band_z[1] > band_z[0] else []) + list(top)
         self.info = dict(info or {})
         self.expected_sharp: list[bool] = []
         self.certificate: Certificate | None = None
@@ -196,7 +196,7 @@ def _graph(elements, d_far: float, reverse: bool = False):
     """Dense (d, z) samples of a face for ``np.interp`` (d increasing)."""
     pts = []
     for e in elements:
-        n = 2 if isinstance(e, Line2) else 2049
+        n = 2 if e.kind == "line" else 2049
         pts.append(e.point(np.linspace(0.0, 1.0, n)))
     p = np.vstack(pts)
     o = np.argsort(p[:, 0], kind="stable")
@@ -212,13 +212,7 @@ def _elements_smooth(prev, nxt) -> bool:
 
 
 def _place(elements: Sequence, dz: float) -> list:
-    out = []
-    for e in elements:
-        if isinstance(e, Line2):
-            out.append(Line2((e.p0[0], e.p0[1] + dz), (e.p1[0], e.p1[1] + dz), e.label))
-        else:
-            out.append(Arc2((e.center[0], e.center[1] + dz), e.radius, e.phi0, e.phi1, e.label))
-    return out
+    return [e.translated(0.0, dz) for e in elements]
 
 
 def build_sweep_tablet(
@@ -242,7 +236,7 @@ def build_sweep_tablet(
     ----------
     outline : PlanOutline
         Plan outline (mm).
-    face : sequence of Line2/Arc2
+    face : sequence of tabletcad.curves.Seg
         Top-face profile in ``(d, z)`` with ``z`` measured from the band's top
         edge (``z = 0`` at ``d = 0``), running inward and ending either at the
         outline's ``reach`` (the offsets close: a point for a circle, a segment
@@ -270,7 +264,7 @@ def build_sweep_tablet(
     bottom = [e.mirrored(zm) for e in reversed(top)]
     closes = d_end >= reach * (1.0 - 1e-12)
     if not closes:
-        end_dir = face[-1].tangent(np.array(1.0))
+        end_dir = face[-1].derivative(np.array(1.0))
         if abs(float(end_dir[1])) > 1e-9 * float(np.linalg.norm(end_dir)):
             raise DesignError("face profile", f"ends at d = {d_end:.4g} mm with a slope",
                               f"must end horizontally (a flat plateau) or reach the centre (d = {reach:.6g} mm)")
@@ -279,15 +273,15 @@ def build_sweep_tablet(
     nominal_bottom = list(bottom)
     if not closes:
         z_top_end = float(top[-1].point(1.0)[1])
-        nominal_top.append(Line2((d_end, z_top_end), (d_far, z_top_end), "plateau"))
-        nominal_bottom.insert(0, Line2((d_far, T - z_top_end), (d_end, T - z_top_end), "plateau"))
+        nominal_top.append(profile_line((d_end, z_top_end), (d_far, z_top_end), "plateau"))
+        nominal_bottom.insert(0, profile_line((d_far, T - z_top_end), (d_end, T - z_top_end), "plateau"))
     nom = SweepNominal(outline, nominal_top, nominal_bottom, (h_face, h_face + band), T, d_far, info)
 
     target = refine * tol.nominal
     # pieces along the chain: bottom (centre -> edge), band, top (edge -> centre)
     chain_pieces: list[Piece] = []
     joints_sharp: list[bool] = []
-    elems: list = list(bottom) + ([Line2((0.0, h_face), (0.0, h_face + band), "band")] if band > 0 else []) + list(top)
+    elems: list = list(bottom) + ([profile_line((0.0, h_face), (0.0, h_face + band), "band")] if band > 0 else []) + list(top)
     for k, e in enumerate(elems):
         ps = pieces_for(e, target)
         if chain_pieces:
@@ -523,7 +517,7 @@ def nominal_volume(nominal: SweepNominal, n: int = 64) -> float:
     cup = 0.0
     for e in nominal.top:
         d = e.point(t)[:, 0]
-        dz = e.tangent(t)[:, 1]
+        dz = e.derivative(t)[:, 1]
         cup += 0.5 * float(np.sum(w * (A0 - P * d + math.pi * d * d) * dz))
     band = nominal.band_z[1] - nominal.band_z[0]
     return A0 * band + 2.0 * cup
