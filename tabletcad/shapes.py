@@ -63,8 +63,10 @@ def coaxial_tablet(
     nominal=None,
     trim: Trim | None = None,
     tol: Tolerances = DEFAULT,
+    modes: int | None = None,
+    check: bool = True,
 ) -> Tablet:
-    """Tablet from patches of coaxial plan curves.
+    """Tablet from patches of coaxial plan curves: the one coaxial builder.
 
     Parameters
     ----------
@@ -74,6 +76,11 @@ def coaxial_tablet(
         ``aspect != 1``).
     aspect : float
         Plan length / width.
+    modes : int, optional
+        Fourier modes per patch (default: as many as the curves need; 1 is exact for circles,
+        the optimiser's fast builds, :func:`tabletcad.optimise.thesis.coaxial_fast`).
+    check : bool
+        Run each patch's stray and fold checks (default True).
     """
     patches = []
     prev_last: Curve | None = None
@@ -88,7 +95,7 @@ def coaxial_tablet(
             else:
                 curves.append(_plan(r * aspect, r, z))
         prev_last = curves[-1]
-        patches.append(PDEPatch(tuple(curves), a=a, tol=tol, name=f"{name}[{j}]"))
+        patches.append(PDEPatch(tuple(curves), a=a, modes=modes, tol=tol, name=f"{name}[{j}]", check=check))
     return Tablet(
         tuple(patches),
         name=name,

@@ -26,12 +26,12 @@ from typing import Any
 
 import numpy as np
 
-from tabletcad.curves import Circle
 from tabletcad.errors import DesignError
 from tabletcad.mechanics import contact, love, shell, strength
 from tabletcad.mechanics.materials import get_material
 from tabletcad.optimise.problem import Constraint, Objective, Problem, Variable
 from tabletcad.patch import PDEPatch
+from tabletcad.shapes import coaxial_tablet
 from tabletcad.tablet import Tablet
 from tabletcad.tolerance import DEFAULT
 
@@ -88,27 +88,10 @@ _FAST = replace(DEFAULT, quad_v=16)
 
 # ---------------------------------------------------------------------------- geometry
 def coaxial_fast(sections, *, name: str = "tablet", check: bool = False, a: float = 1.0, fast: bool = True) -> Tablet:
-    """Tablet of patches of coaxial circles ``[(radius, z) × 4]`` (like
-    :func:`tabletcad.shapes.coaxial_tablet`), built with one Fourier mode per patch.
-
-    ``fast=True`` uses a 16-point rule in ``v`` (exact for surfaces of
-    revolution); ``check`` runs the patches' stray and fold checks.
-    """
-    tol = _FAST if fast else DEFAULT
-    patches = []
-    prev = None
-    for j, sec in enumerate(sections):
-        curves = []
-        for k, (r, z) in enumerate(sec):
-            if k == 0 and prev is not None:
-                curves.append(prev)
-            else:
-                if not (r >= 0.0 and math.isfinite(r) and math.isfinite(z)):
-                    raise DesignError(f"patch {j} curve {k} radius", r, "must be a finite number >= 0", "mm")
-                curves.append(Circle(float(r), (0.0, 0.0, float(z))))
-        prev = curves[-1]
-        patches.append(PDEPatch(tuple(curves), a=a, modes=1, tol=tol, check=check, name=f"{name}[{j}]"))
-    return Tablet(tuple(patches), name=name, family="free_form", tol=tol)
+    """:func:`tabletcad.shapes.coaxial_tablet` of circles ``[(radius, z) × 4]`` with one Fourier
+    mode per patch (exact for circles); ``fast=True`` uses a 16-point rule in ``v`` (exact for
+    surfaces of revolution); ``check`` runs the patches' stray and fold checks."""
+    return coaxial_tablet(sections, a=a, name=name, modes=1, check=check, tol=_FAST if fast else DEFAULT)
 
 
 def _disc(r: float, z: float, up: bool) -> list[tuple[float, float]]:
