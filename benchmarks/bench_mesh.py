@@ -1,4 +1,4 @@
-"""Timing of tabletcad.solid.hex_mesh against the thesis's MATLAB times and a naive baseline.
+"""Timing of tabletcad.volume_mesh.hex_mesh against the thesis's MATLAB times and a naive baseline.
 
 Run:  .venv/bin/python benchmarks/bench_mesh.py [--family NAME]
 
@@ -6,7 +6,7 @@ Prints, for the node counts of the thesis's Table 4.4 (11×21×5, 21×39×6 and
 41×39×6 nodes per patch; MATLAB R2008a on a 2.2 GHz Core 2 Duo took 8, 88
 and 195 s) and for a mesh of about one million cells:
 
-* the vectorised :func:`~tabletcad.solid.hex_mesh` time (best of several runs,
+* the vectorised :func:`~tabletcad.volume_mesh.hex_mesh` time (best of several runs,
   one core, checks on);
 * a baseline measured in the same run: a straightforward per-cell Python loop
   building the same cells (per-point evaluation of eq 4.12, node merging by a
@@ -33,7 +33,8 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
 from tabletcad.families import FAMILIES  # noqa: E402
-from tabletcad.solid import THESIS_NODES, _hex_volumes, hex_mesh, mesh_volume  # noqa: E402
+from tabletcad.volume_mesh import THESIS_NODES, hex_mesh, mesh_volume  # noqa: E402
+from tabletcad.volume_mesh.hexahedra import _hex_volumes  # noqa: E402
 from tabletcad.tablet import solid_map  # noqa: E402
 
 MATLAB_S = {(11, 21, 5): 8.0, (21, 39, 6): 88.0, (41, 39, 6): 195.0}

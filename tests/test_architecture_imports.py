@@ -27,7 +27,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("tabletcad.family", "tabletcad.shapes", "tabletcad.reshape"),  # the thesis's shapes
     ("tabletcad.mechanics",),  # compaction and strength formulas (they read dimensions)
     ("tabletcad.families",),  # industry families, their design report, the catalogue of all
-    ("tabletcad.design", "tabletcad.report", "tabletcad.plot", "tabletcad.solid", "tabletcad.surfaces"),  # design
+    ("tabletcad.design", "tabletcad.report", "tabletcad.plot", "tabletcad.volume_mesh", "tabletcad.surfaces"),  # design
     # files, report, pictures, volume mesh, the solid's faces as surface functions for the fit
     ("tabletcad.cad",),  # B-rep solids, meshes, exports: OpenCascade
     ("tabletcad.tooling",),  # punches, die, drawings from the solids

@@ -1,4 +1,4 @@
-"""Hexahedral meshes of the tablet solid (tabletcad.solid; thesis section 4.3, eq 4.12)."""
+"""Hexahedral meshes of the tablet solid (tabletcad.volume_mesh; thesis section 4.3, eq 4.12)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from tabletcad.errors import DesignError
 from tabletcad.shapes import THESIS_SHAPES
-from tabletcad.solid import SolidMesh, THESIS_NODES, cell_volumes, hex_mesh, mesh_volume, write_mesh
+from tabletcad.volume_mesh import SolidMesh, THESIS_NODES, cell_volumes, hex_mesh, mesh_volume, write_mesh
 
 LEVELS = [(9, 17, 5), (17, 33, 9), (33, 65, 17)]  # every spacing halved per level
 

@@ -76,7 +76,7 @@ def mesh_cmd(design: Path, nodes: tuple[int, int, int], out_file: Path) -> None:
     faces, so a coarse mesh holds less volume than the tablet.
     """
     from tabletcad.design import load_design
-    from tabletcad.solid import hex_mesh, mesh_volume, write_mesh
+    from tabletcad.volume_mesh import hex_mesh, mesh_volume, write_mesh
 
     for n in nodes:
         if n < 2 or n > 2000:
