@@ -70,7 +70,9 @@ def side_profile(tablet: Tablet, n: int = 121, *, nu: int = 65, nv: int = 257,
     """The side profile (silhouette along y), the plan outline and the main dimensions (mm).
 
     The band is the nominal's ``band_z`` when the family has one, else the silhouette's
-    height at the rim; the cup depth is the top's height above the band's top.
+    height at the rim; the cup depth is the top's height above the band's top.  Length, width
+    and thickness are an industry family's exact nominal dimensions (its surface is certified
+    within 1 µm of them), else the surface's polished extremes (:meth:`Tablet.bounds`).
     """
     grids = grids if grids is not None else _face_grids(tablet, nu, nv)
     P = np.vstack([Y.reshape(-1, 3) for _, Y in grids])
@@ -100,10 +102,19 @@ def side_profile(tablet: Tablet, n: int = 121, *, nu: int = 65, nv: int = 257,
         rim = slice(0, max(1, len(x) // 50))
         band_z = (float(np.max(zl[rim])), float(np.min(zh[rim])))
     band = float(band_z[1] - band_z[0])
-    blo, bhi = tablet.bounds()  # extremes polished on the surface, not just sampled
-    ext = np.asarray(bhi) - np.asarray(blo)
+    info = getattr(tablet.nominal, "info", None) or {}
+    T = getattr(tablet.nominal, "thickness", None)
+    if "length_mm" in info and "width_mm" in info and T is not None:
+        # an industry family: its exact nominal dimensions (the surface is certified within 1 µm of
+        # them), which a dimensioned drawing shows; standing on z = 0
+        ext = np.array([info["length_mm"], info["width_mm"], T], dtype=float)
+        top = float(T)
+    else:
+        blo, bhi = tablet.bounds()  # extremes polished on the surface, not just sampled
+        ext = np.asarray(bhi) - np.asarray(blo)
+        top = float(bhi[2])
     return TabletOutline(x=x, z_low=zl, z_high=zh, plan=plan, band=band, thickness=float(ext[2]),
-                         cup_depth=max(0.0, float(bhi[2] - band_z[1])), length=float(ext[0]), width=float(ext[1]),
+                         cup_depth=max(0.0, top - float(band_z[1])), length=float(ext[0]), width=float(ext[1]),
                          round=abs(ext[0] - ext[1]) <= 1e-3 * max(ext[0], ext[1]))
 
 
