@@ -1,7 +1,7 @@
 """The thesis's chapter 6 problems: feasible optima, comparison with the reported figures.
 
 Where the thesis's figure is not attainable under its own formulation the test
-asserts why (see tabletcad/optimise/thesis.py for the interpretations).
+asserts why (see tabletcad/optimise/thesis/ for the interpretations).
 """
 
 from __future__ import annotations
