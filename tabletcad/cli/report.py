@@ -103,14 +103,21 @@ _SOLVABLE = ("band", "thickness", "cup_depth")
 
 def _solved(tablet, opts, vary: str, target_weight: float | None, target_volume: float | None):
     """``tablet`` with ``vary`` solved for the target weight or volume; ``(tablet, inverse section)``."""
+    import functools
     import inspect
 
     from tabletcad.families.inverse import _family_function, solve_for
 
     try:
-        takes = inspect.signature(_family_function(tablet.family)).parameters
+        if tablet.family == "custom_outline":  # its outline stays, its cup dimensions vary
+            from tabletcad.families import outline_tablet
+
+            family = functools.partial(outline_tablet, tablet.nominal.outline)
+        else:
+            family = _family_function(tablet.family)
+        takes = inspect.signature(family).parameters
         dims = {k: v for k, v in tablet.params.items() if k in takes}
-        r = solve_for(tablet.family, target_weight_mg=target_weight, target_volume_mm3=target_volume, vary=vary,
+        r = solve_for(family, target_weight_mg=target_weight, target_volume_mm3=target_volume, vary=vary,
                       solid_fraction=opts.solid_fraction if target_weight is not None else None,
                       true_density_mg_mm3=opts.true_density_mg_mm3 if target_weight is not None else None, **dims)
     except DesignError as exc:  # the Python API's argument names as the command's options

@@ -92,7 +92,8 @@ def solve_for(
     Parameters
     ----------
     family : str or callable
-        An industry family name (``tabletcad shapes``) or its function.
+        An industry family name (``tabletcad shapes``) or its function; for any other plan
+        outline, ``functools.partial(outline_tablet, outline)`` (a custom_outline design).
     target_volume_mm3, target_weight_mg : float
         Exactly one target; a weight needs ``solid_fraction`` (0, 1] and ``true_density_mg_mm3``.
     vary : {"band", "thickness", "cup_depth"}
@@ -108,7 +109,7 @@ def solve_for(
         the family can reach by changing ``vary`` alone (the message gives that range).
     """
     func = _family_function(family)
-    name = func.__name__
+    name = getattr(func, "__name__", None) or getattr(getattr(func, "func", None), "__name__", "family")
     takes = [k for k, p in inspect.signature(func).parameters.items() if p.kind is p.POSITIONAL_OR_KEYWORD]
     if vary not in VARY or vary not in takes:
         allowed = [v for v in VARY if v in takes]
