@@ -135,3 +135,40 @@ print(v)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, env=env, cwd="/")
     assert out.returncode == 0, out.stderr[-2000:]
     assert float(out.stdout.split()[-1]) > 0
+
+
+def test_gmsh_failures_are_retried_then_one_geometry_error():
+    """gmsh raises a bare Exception when it cannot mesh (seen: "PLC Error: A segment and a facet
+    intersect" on a coarse concave round); the mesher retries with the RETRIES settings, then gives up
+    with a GeometryError naming gmsh's message (a one-line error, not an internal one)."""
+    from tabletcad.errors import GeometryError
+    from tabletcad.fe.mesh import RETRIES, _generate
+
+    class FakeGmsh:
+        def __init__(self, fail: int):
+            self.fail, self.calls, self.options, self.cleared = fail, 0, {}, 0
+
+            class Opt:
+                setNumber = staticmethod(lambda k, v: self.options.__setitem__(k, v))
+
+            class Mesh:
+                @staticmethod
+                def generate(dim):
+                    self.calls += 1
+                    if self.calls <= self.fail:
+                        raise Exception("PLC Error:  A segment and a facet intersect at point")
+
+                @staticmethod
+                def clear():
+                    self.cleared += 1
+
+            self.option = Opt()
+            self.model = type("M", (), {"mesh": Mesh})()
+
+    ok = FakeGmsh(fail=1)
+    _generate(ok, None)
+    assert ok.calls == 2 and ok.cleared == 1 and ok.options == RETRIES[0]
+    bad = FakeGmsh(fail=99)
+    with pytest.raises(GeometryError, match="PLC Error"):
+        _generate(bad, None)
+    assert bad.calls == 1 + len(RETRIES)

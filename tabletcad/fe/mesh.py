@@ -143,6 +143,29 @@ def _add_plane(gmsh: Any, plane: CutPlane, lo: np.ndarray, hi: np.ndarray) -> tu
     return (2, occ.addPlaneSurface([loop]))
 
 
+#: What :func:`mesh_solid` changes, in order, when gmsh fails to mesh a solid: a surface mesh that
+#: follows the curvature (a coarse one can leave facets of the curved cup crossing the band's, "PLC
+#: Error: A segment and a facet intersect"), then the Frontal-Delaunay surface and HXT volume algorithms.
+RETRIES = ({"Mesh.MeshSizeFromCurvature": 16}, {"Mesh.Algorithm": 6, "Mesh.Algorithm3D": 10})
+
+
+def _generate(gmsh, solid) -> None:
+    """``gmsh.model.mesh.generate(3)``, retried with the settings of :data:`RETRIES`; a solid none of
+    them meshes is a :class:`GeometryError` naming gmsh's message."""
+    first = None
+    for settings in ({}, *RETRIES):
+        for k, v in settings.items():
+            gmsh.option.setNumber(k, v)
+        try:
+            gmsh.model.mesh.generate(3)
+            return
+        except Exception as exc:  # gmsh raises Exception with its last error message
+            first = first or str(exc)
+            gmsh.model.mesh.clear()
+    raise GeometryError(f"mesh: gmsh could not mesh the solid ({first}), also with {len(RETRIES)} other settings",
+                        solid)
+
+
 def mesh_solid(
     solid: Any,
     size: float,
@@ -210,7 +233,7 @@ def mesh_solid(
                 gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
             gmsh.option.setNumber("Mesh.MeshSizeMax", float(size))
             gmsh.option.setNumber("Mesh.MeshSizeMin", float(min([size] + [r.size for r in refinements])) / 4)
-            gmsh.model.mesh.generate(3)
+            _generate(gmsh, solid)
             tags, xyz, _ = gmsh.model.mesh.getNodes()
             etypes, _, enodes = gmsh.model.mesh.getElements(3)
         tets_tags = np.concatenate([n for t, n in zip(etypes, enodes) if t == 4]) if len(etypes) else np.zeros(0)
