@@ -250,6 +250,10 @@ def main(argv: list[str] | None = None) -> int:
         try:
             with warnings.catch_warnings():
                 warnings.showwarning = _show_warning
+                # libraries' deprecation notes are for their callers' developers, not for the user of
+                # a command (Python hides them outside __main__ too; pytest would show them)
+                warnings.simplefilter("ignore", DeprecationWarning)
+                warnings.simplefilter("ignore", PendingDeprecationWarning)
                 return _run(argv)
         except (KeyboardInterrupt, SystemExit):
             raise
