@@ -300,15 +300,23 @@ def _cup_radius(info: dict) -> float | None:
     return r.get("cup", r.get("central"))
 
 
+def _options(tablet: Tablet, opts: ReportOptions | None) -> ReportOptions:
+    """The report's options: those given, else the command's (``_OPTIONS``), else the design file's
+    ``[report]`` table."""
+    if opts is not None:
+        return opts
+    opts = _OPTIONS.get()
+    if opts == ReportOptions() and isinstance(tablet.extras.get("report"), dict):
+        return ReportOptions.from_table(tablet.extras["report"])
+    return opts
+
+
 def design_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str, Any]:
     """The design report of a family tablet (see module docstring); keys carry units."""
     nom = tablet.nominal
     if not isinstance(nom, SweepNominal):
         raise DesignError("tablet", tablet.name, "is not built from a tabletcad.families family")
-    if opts is None:
-        opts = _OPTIONS.get()
-        if opts == ReportOptions() and isinstance(tablet.extras.get("report"), dict):
-            opts = ReportOptions.from_table(tablet.extras["report"])  # the design file's [report] table
+    opts = _options(tablet, opts)
     cert = nom.certificate
     recert = cert is None or nom.patch_ids != tuple(id(p) for p in tablet.patches)
     if recert:
@@ -402,10 +410,7 @@ def shape_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str,
     There is no certificate: ``nominal_max_deviation_um`` is the PDE surface's largest distance
     from the exact shape when the family has one (the thesis's curves, not a tolerance).
     """
-    if opts is None:
-        opts = _OPTIONS.get()
-        if opts == ReportOptions() and isinstance(tablet.extras.get("report"), dict):
-            opts = ReportOptions.from_table(tablet.extras["report"])
+    opts = _options(tablet, opts)
     props = tablet.properties()
     dims = tablet.dimensions()
     V, A = props["volume_mm3"], props["surface_area_mm2"]
