@@ -191,7 +191,7 @@ def main(argv=None) -> None:
     import manifold3d  # noqa: F401
     import trimesh  # noqa: F401
 
-    from tabletcad.design import load_design
+    from tabletcad.pipeline.design import load_design
 
     paths = args.designs or sorted(glob.glob(str(ROOT / "samples" / "*.toml")))
     head = (f"{'sample':24s} {'load':>6s} {'solid':>6s} {'check':>6s} {'export':>6s} {'total':>6s} "

@@ -33,7 +33,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from scipy.integrate import dblquad  # noqa: E402
 
-from tabletcad.patch import PDEPatch  # noqa: E402
+from tabletcad.geometry.patch import PDEPatch  # noqa: E402
 from tabletcad.families import FAMILIES  # noqa: E402
 
 TWO_PI = 2.0 * math.pi
@@ -163,8 +163,8 @@ def bench_integrals(names=("thesis.flat_faced_round", "thesis.spherical")):
 def bench_report(paths=None, repeat=3):
     import tracemalloc
 
-    from tabletcad.design import load_design
-    from tabletcad.report import geometry_report
+    from tabletcad.pipeline.design import load_design
+    from tabletcad.pipeline.report import geometry_report
 
     root = Path(__file__).resolve().parents[1]
     paths = paths or [root / "samples" / n for n in ("flat_faced_round.toml", "spherical.toml", "caplet.toml")] + [

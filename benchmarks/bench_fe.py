@@ -19,7 +19,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from tabletcad.design import design_from_dict  # noqa: E402
+from tabletcad.pipeline.design import design_from_dict  # noqa: E402
 from tabletcad.fe.diametral import diametral  # noqa: E402
 
 # design -> (tablet table, compare with a finer mesh?); the capsule's finer mesh needs ~2-3 GB

@@ -35,7 +35,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from tabletcad.families import FAMILIES  # noqa: E402
 from tabletcad.volume_mesh import THESIS_NODES, hex_mesh, mesh_volume  # noqa: E402
 from tabletcad.volume_mesh.hexahedra import _hex_volumes  # noqa: E402
-from tabletcad.tablet import solid_map  # noqa: E402
+from tabletcad.geometry.tablet import solid_map  # noqa: E402
 
 MATLAB_S = {(11, 21, 5): 8.0, (21, 39, 6): 88.0, (41, 39, 6): 195.0}
 CORNERS = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]

@@ -1,4 +1,4 @@
-"""Benchmark of tablet pictures: time per stage of ``tabletcad.plot`` for three families.
+"""Benchmark of tablet pictures: time per stage of ``tabletcad.pipeline.plot`` for three families.
 
 Figures, measured in the same run: the whole picture (``tablet_png``: sampling, the
 three panels and the PNG encoding), the side profile alone (sampling, silhouette,
@@ -17,7 +17,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from tabletcad.families import capsule, concave_round, flat_face_round  # noqa: E402
-from tabletcad.plot import side_profile, tablet_figure, tablet_png  # noqa: E402
+from tabletcad.pipeline.plot import side_profile, tablet_figure, tablet_png  # noqa: E402
 
 
 def _best(factory, f, n: int = 3) -> float:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import time
 
-from tabletcad.shapes import shallow_convex_round
+from tabletcad.families.thesis import shallow_convex_round
 from tabletcad.tooling import ScoreSpec, ToolingSpec, make_tooling, tooling_batch
 from tabletcad.tooling.booleans import TIMER, manifold_op, manifold_volume, raw_boolean, to_manifold, volume
 from tabletcad.tooling.outline import offset_wire, prism, tablet_frame

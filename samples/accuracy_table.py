@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from tabletcad.cad.stage import check_tablet_solid
-from tabletcad.design import load_design
+from tabletcad.pipeline.design import load_design
 from tabletcad.families import nominal_volume
 
 ROOT = Path(__file__).resolve().parent

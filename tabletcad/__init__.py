@@ -1,13 +1,18 @@
 """tabletcad: pharmaceutical tablets and their compression tooling, from PDE surfaces to exact STEP solids.
 
 Units throughout: millimetres, newtons, megapascals (N/mm^2), milligrams, mg/mm^3.
-The numerical core (this package's top-level modules, ``families``,
-``mechanics``, ``optimise``) needs numpy and scipy only; ``tabletcad.cad`` and
-``tabletcad.tooling`` add OpenCascade (OCP), build123d and manifold3d.
+The packages follow the flow design -> boundary curves -> PDE patches -> B-spline data ->
+B-rep solids and meshes -> exports and tooling: ``geometry`` (curves, PDE patches,
+tablets), ``families`` (the catalogue), ``mechanics``, ``brep`` (kernel-neutral B-spline
+data), ``volume_mesh``, ``pipeline`` (design files, reports, pictures, the build),
+``cad`` and ``tooling`` (OpenCascade), ``fe``, ``optimise``, ``sweep`` and ``cli``.
+Everything but ``cad`` and ``tooling`` needs numpy and scipy only; those two add
+OpenCascade (OCP), build123d and manifold3d.
 """
 
 
-_LAZY = {"make": "model", "load": "model", "show": "model", "TabletModel": "model", "Design": "design"}
+_LAZY = {"make": "pipeline.model", "load": "pipeline.model", "show": "pipeline.model", "TabletModel": "pipeline.model",
+         "Design": "pipeline.design"}
 
 
 def __getattr__(name: str):  # PEP 562: `import tabletcad` stays light

@@ -16,7 +16,7 @@ session fixture :func:`kit`:
   by ``fn(curve)`` (shared curves stay shared: ``fn`` is applied once per
   object);
 * ``gauss_area(patch, nu, nv)``: the area of a patch by our own tensor
-  Gauss-Legendre/trapezoid rule, independent of :class:`~tabletcad.tablet.Tablet`.
+  Gauss-Legendre/trapezoid rule, independent of :class:`~tabletcad.geometry.tablet.Tablet`.
 """
 
 from __future__ import annotations
@@ -158,7 +158,7 @@ def rebuild(tablet, fn, **patch_kw):
     """``tablet`` with each boundary curve ``c`` replaced by ``fn(c)`` (same a, nodes, form, trim)."""
     from dataclasses import replace
 
-    from tabletcad.patch import PDEPatch
+    from tabletcad.geometry.patch import PDEPatch
 
     memo: dict[int, object] = {}
 
@@ -195,9 +195,9 @@ def kit():
 
 @pytest.fixture(scope="session")
 def family_tablet():
-    """``family_tablet(name)``: the default tablet of a thesis shape (``tabletcad.shapes.THESIS_SHAPES``),
+    """``family_tablet(name)``: the default tablet of a thesis shape (``tabletcad.families.thesis.THESIS_SHAPES``),
     built once per session."""
-    from tabletcad.shapes import THESIS_SHAPES
+    from tabletcad.families.thesis import THESIS_SHAPES
 
     cache: dict[str, object] = {}
 

@@ -18,22 +18,27 @@ PKG = ROOT / "tabletcad"
 # Layers of the flow, lowest first.  A module may import its own layer (without a cycle) and the
 # layers below it, never a layer above.  Keys are module names or package prefixes.  The package
 # itself (``tabletcad/__init__.py``) imports nothing: its ``make``, ``load`` and ``show`` are
-# looked up in ``tabletcad.model`` on first use, as attributes, never by an import of the package.
+# looked up in ``tabletcad.pipeline.model`` on first use, as attributes, never by an import of the package.
 LAYERS: list[tuple[str, ...]] = [
     ("tabletcad", "tabletcad.errors", "tabletcad.tolerance", "tabletcad.io", "tabletcad.parallel"),  # support
-    ("tabletcad.basis", "tabletcad.curves", "tabletcad.bspline", "tabletcad.slit", "tabletcad.nominal"),  # maths
-    ("tabletcad.patch",),  # PDE patches
-    ("tabletcad.tablet",),  # a tablet: patches, trims, checks
-    ("tabletcad.family", "tabletcad.shapes", "tabletcad.reshape"),  # the thesis's shapes
+    ("tabletcad.geometry", "tabletcad.geometry.basis", "tabletcad.geometry.curves",
+     "tabletcad.geometry.nominal"),  # maths: the PDE's cardinal functions, boundary curves, nominal shapes
+    ("tabletcad.geometry.patch",),  # PDE patches
+    ("tabletcad.geometry.tablet",),  # a tablet: patches, trims, checks
+    ("tabletcad.families",),  # the catalogue: the thesis's shapes and the industry families
     ("tabletcad.mechanics",),  # compaction and strength formulas (they read dimensions)
-    ("tabletcad.families",),  # industry families, their design report, the catalogue of all
-    ("tabletcad.design", "tabletcad.report", "tabletcad.plot", "tabletcad.volume_mesh", "tabletcad.surfaces"),  # design
-    # files, report, pictures, volume mesh, the solid's faces as surface functions for the fit
+    ("tabletcad.brep",),  # kernel-neutral B-spline data of the solid's faces
+    ("tabletcad.volume_mesh",),  # hexahedral meshes from the PDE solid map
+    ("tabletcad.tooling.spec", "tabletcad.tooling.standards"),  # the [tooling] table as data (no kernel):
+    # a Design holds it parsed
+    ("tabletcad.pipeline.design", "tabletcad.pipeline.designreport", "tabletcad.pipeline.report",
+     "tabletcad.pipeline.plot"),  # design files, the design and geometry reports, pictures
     ("tabletcad.cad",),  # B-rep solids, meshes, exports: OpenCascade
     ("tabletcad.tooling",),  # punches, die, drawings from the solids
     ("tabletcad.fe",),  # finite elements on the solids and the punch tips
     ("tabletcad.optimise",),  # optimisation reads designs, mechanics and FE
-    ("tabletcad.model", "tabletcad.build"),  # the scripting facade and the build pipeline
+    ("tabletcad.pipeline", "tabletcad.pipeline.model", "tabletcad.pipeline.build"),  # the scripting
+    # facade and the build, which run everything above
     ("tabletcad.sweep",),  # sweeps drive builds
     ("tabletcad.cli", "tabletcad.__main__"),  # the command line
 ]
@@ -139,7 +144,7 @@ def _cycles(graph: dict[str, dict[str, int]]) -> list[list[str]]:
 def test_the_graph_is_read_from_every_import_including_lazy_ones():
     graph = _graph()
     # a lazy import inside a function counts: the build imports the CAD stage only when it runs
-    assert "tabletcad.cad.stage" in graph["tabletcad.build"]
+    assert "tabletcad.cad.stage" in graph["tabletcad.pipeline.build"]
     assert len(MODULES) > 100 and sum(map(len, graph.values())) > 300
 
 
@@ -182,10 +187,10 @@ import sys
 sys.path.insert(0, {root!r})
 import tabletcad.families as F
 before = dict(F.FAMILIES)
-from tabletcad.report import geometry_report
-from tabletcad.design import load_design
+from tabletcad.pipeline.report import geometry_report
+from tabletcad.pipeline.design import load_design
 geometry_report(F.FAMILIES["concave_round"].build())
-import tabletcad.build, tabletcad.model, tabletcad.optimise.files
+import tabletcad.pipeline.build, tabletcad.pipeline.model, tabletcad.optimise.files
 assert dict(F.FAMILIES) == before
 try:
     F.FAMILIES["mine"] = None
@@ -207,7 +212,9 @@ def test_the_family_catalogue_is_static():
     n, names = out.stdout.split()
     assert int(n) == len(FAMILIES) == 25 and names.split(",") == list(FAMILIES)
     assert list(FAMILIES) == [*INDUSTRY_FAMILIES, *THESIS_FAMILIES]
-    assert not hasattr(__import__("tabletcad.shapes").shapes, "FAMILIES")
+    import tabletcad.families.thesis as thesis
+
+    assert not hasattr(thesis, "FAMILIES")
 
 
 @pytest.mark.parametrize("layer", range(len(LAYERS)))

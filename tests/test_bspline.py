@@ -7,7 +7,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tabletcad.bspline import BSplineSurfaceData, enclosed_volume, fit_patches, fit_surface
+from tabletcad.brep.fit import fit_patches, fit_surface
+from tabletcad.brep.surface import BSplineSurfaceData, enclosed_volume
 from support.standins import cylinder, ring, sphere
 from tabletcad.errors import GeometryError
 

@@ -1,11 +1,12 @@
-"""Breakpoint-aware periodic knots of :mod:`tabletcad.bspline` (numpy only, no CAD kernel)."""
+"""Breakpoint-aware periodic knots of :mod:`tabletcad.brep` (numpy only, no CAD kernel)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from tabletcad.bspline import fit_patches, fit_surface, flat_knots, normalise_breaks, periodic_knots
+from tabletcad.brep.fit import fit_patches, fit_surface
+from tabletcad.brep.knots import flat_knots, normalise_breaks, periodic_knots
 from tabletcad.errors import GeometryError
 
 TWO_PI = 2 * math.pi

@@ -9,9 +9,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tabletcad.bspline import BSplineSurfaceData, enclosed_volume, fit_patches, segment_v
+from tabletcad.brep.fit import fit_patches
+from tabletcad.brep.surface import BSplineSurfaceData, enclosed_volume, segment_v
 from tabletcad.errors import GeometryError
-from tabletcad.slit import chain_face_surfaces, row_pieces
+from tabletcad.brep.slit import chain_face_surfaces, row_pieces
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -73,8 +74,8 @@ def test_segment_v_refuses_a_smooth_knot():
 
 @pytest.fixture(scope="module")
 def capsule_surfaces():
-    from tabletcad.surfaces import tablet_breakpoints, tablet_surface_functions  # numpy-only helpers
-    from tabletcad.design import load_design
+    from tabletcad.brep.surfaces import tablet_breakpoints, tablet_surface_functions  # numpy-only helpers
+    from tabletcad.pipeline.design import load_design
 
     t = load_design(ROOT / "samples" / "families" / "capsule.toml")
     funcs, names = tablet_surface_functions(t)
@@ -136,7 +137,7 @@ def test_rounded_square_cupped_to_its_corner_radius_is_cut_at_the_corners():
     to points; the chain is cut at the 8 outline junctions and each corner piece of the rim
     rows is a single pole at the corner arc's centre (offset by the corner radius)."""
     from tabletcad import families
-    from tabletcad.surfaces import fit_options, tablet_surface_functions
+    from tabletcad.brep.surfaces import fit_options, tablet_surface_functions
 
     side, rc = 9.0, 1.5
     t = families.FAMILIES["rounded_square"].build(side=side, corner_radius=rc)

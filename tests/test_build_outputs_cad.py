@@ -83,8 +83,8 @@ def test_tooling_build_then_cutaway_then_plain_rebuild(tmp_path, capsys):
 def rep3_full_volume() -> float:
     from dataclasses import replace
 
-    from tabletcad.design import load_design
-    from tabletcad.tablet import Trim
+    from tabletcad.pipeline.design import load_design
+    from tabletcad.geometry.tablet import Trim
 
     return replace(load_design(ROOT / "samples" / "cutaway_convex_round.toml"), trim=Trim()).volume()
 
@@ -102,8 +102,8 @@ def test_cutaway_with_curved_cut_faces_is_a_solid(tmp_path, capsys, design, trim
 
     from support.readback import ocp_read_steps
     from tabletcad.cad.stage import _cut_plane_angle
-    from tabletcad.design import load_design
-    from tabletcad.tablet import Trim
+    from tabletcad.pipeline.design import load_design
+    from tabletcad.geometry.tablet import Trim
 
     t = replace(load_design(ROOT / "samples" / "families" / f"{design}.toml"), trim=Trim(v=trim))
     assert _cut_plane_angle(t, trim[0]) is None  # not a half-plane: the direct construction
@@ -127,7 +127,7 @@ def test_cut_planes_of_rounds_and_ovals_are_half_planes():
     """A round's section at v lies in the half-plane at angle v; the thesis oval's (ellipses of one
     aspect ratio) in a half-plane too, at the ellipse's polar angle atan(b/a tan v)."""
     from tabletcad.cad.stage import _cut_plane_angle
-    from tabletcad.design import design_from_dict
+    from tabletcad.pipeline.design import design_from_dict
 
     r = design_from_dict({"tablet": {"family": "thesis.shallow_convex_round", "diameter": 10.0, "thickness": 3.0, "band": 2.0},
                           "trim": {"v": [0.0, 3.0]}})
@@ -178,7 +178,7 @@ def test_killed_build_leaves_no_staging_folder_after_the_next_build(tmp_path, ca
 @pytest.mark.parametrize("extra", ["[tooling]\nbogus = 1\n", "[tooling]\n[[tooling.score]]\nprofile = \"w\"\n",
                                    "[trim]\nv = [0.0, 3.0]\n[tooling]\nclearance_mm = 0.02\n"])
 def test_bad_tooling_table_is_refused_before_any_geometry(tmp_path, capsys, monkeypatch, extra):
-    import tabletcad.build as build
+    import tabletcad.pipeline.build as build
 
     def no_geometry(*a, **k):
         raise AssertionError("geometry built before [tooling] was checked")

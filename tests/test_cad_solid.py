@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 pytest.importorskip("OCP")
 
-from tabletcad.bspline import enclosed_volume  # noqa: E402
+from tabletcad.brep.surface import enclosed_volume  # noqa: E402
 from tabletcad.cad.faces import make_face, make_geom_surface, surface_data_from_geom  # noqa: E402
 from tabletcad.cad.solid import build_solid, mass_properties, solid_from_tablet  # noqa: E402
 from support.standins import cylinder, ring, sphere  # noqa: E402
@@ -76,7 +76,7 @@ def test_gap_between_patches_is_rejected():
 
 
 def test_open_chain_is_rejected_by_sewing():
-    from tabletcad.bspline import fit_surface
+    from tabletcad.brep.fit import fit_surface
     from tabletcad.cad.solid import solid_from_surfaces
 
     s = cylinder(2.5, 3.0)
@@ -96,7 +96,7 @@ def test_tablet_like_object_with_patches_attribute():
 
 
 def test_face_of_degenerate_row_is_valid():
-    from tabletcad.bspline import fit_surface
+    from tabletcad.brep.fit import fit_surface
     from tabletcad.cad._occ import explore
     from OCP.BRep import BRep_Tool
 

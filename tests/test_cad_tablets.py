@@ -37,16 +37,18 @@ pytest.importorskip("hypothesis")
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tabletcad.bspline import _eval_f, enclosed_volume, periodic_knots
+from tabletcad.brep.fit import _eval_f
+from tabletcad.brep.knots import periodic_knots
+from tabletcad.brep.surface import enclosed_volume
 from tabletcad.cad._occ import explore, shape_type
 from tabletcad.cad.export import export
 from tabletcad.cad.mesh import tessellate
 from support.readback import find_freecadcmd, freecad_build_bspline, freecad_read_step, ocp_read_steps
 from tabletcad.cad.solid import mass_properties
 from tabletcad.cad.stage import MESH_ANGULAR_RAD, MESH_LINEAR_MM
-from tabletcad.surfaces import tablet_breakpoints, tablet_surface_functions
+from tabletcad.brep.surfaces import tablet_breakpoints, tablet_surface_functions
 from tabletcad.cad.tablet_solid import tablet_solid
-from tabletcad.design import design_from_dict, load_design
+from tabletcad.pipeline.design import design_from_dict, load_design
 from tabletcad.errors import GeometryError
 
 pytestmark = pytest.mark.cad
@@ -312,7 +314,7 @@ def test_periodic_breakpoint_knots_accepted_by_freecad():
 
 def test_periodic_knots_match_occt():
     """Random poles on breakpoint knot vectors evaluate identically in numpy and OCCT."""
-    from tabletcad.bspline import BSplineSurfaceData
+    from tabletcad.brep.surface import BSplineSurfaceData
     from tabletcad.cad.faces import make_geom_surface
 
     rng = np.random.default_rng(2)

@@ -22,7 +22,7 @@ import pytest
 
 import tabletcad.cli as cli_mod
 from tabletcad.cli import main
-from tabletcad.design import design_from_dict
+from tabletcad.pipeline.design import design_from_dict
 from tabletcad.errors import DesignError
 from tabletcad.families import FAMILIES
 
@@ -199,13 +199,13 @@ def test_shapes_marks_required_and_optional_and_prints_whole_descriptions(capsys
 
 @pytest.mark.parametrize("exc", [ZeroDivisionError("division by zero"), ValueError("a bare ValueError is a bug")])
 def test_internal_error_exit_1_with_log(capsys, tmp_path, monkeypatch, exc):
-    import tabletcad.build
+    import tabletcad.pipeline.build
 
     def broken(*a, **k):
         raise exc
 
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
-    monkeypatch.setattr(tabletcad.build, "build_design", broken)
+    monkeypatch.setattr(tabletcad.pipeline.build, "build_design", broken)
     rc, out, err = run(capsys, "build", ROOT / "samples" / "spherical.toml", "--out", tmp_path / "o")
     lines = err.splitlines()
     assert rc == 1 and len(lines) == 1 and "Traceback" not in err
@@ -298,7 +298,7 @@ def test_mesh_reports_its_volume_error_and_warns_with_a_node_count_that_meets_th
     the 1 % bound, and halving the cells in u and v quarters the error."""
     import meshio
 
-    from tabletcad.design import load_design
+    from tabletcad.pipeline.design import load_design
     from tabletcad.tolerance import DEFAULT
 
     src = ROOT / "samples" / "flat_faced_round.toml"
@@ -359,7 +359,7 @@ def test_ctrl_c_while_an_extension_initialises_is_an_interrupt(tmp_path, capsys,
     initialization failed`` caused by the KeyboardInterrupt (seen importing OCP in a fresh clone):
     that is "interrupted" and 130, not an internal error, nor "no CAD library" with a build that
     leaves its CAD files out."""
-    import tabletcad.build
+    import tabletcad.pipeline.build
 
     def interrupted_import():
         try:
@@ -381,7 +381,7 @@ def test_ctrl_c_while_an_extension_initialises_is_an_interrupt(tmp_path, capsys,
     rc, _, err = run(capsys, "build", str(ROOT / "samples" / "spherical.toml"), "--out", str(out))
     assert (rc, err) == (130, "interrupted\n") and not out.exists()
     # and the same ImportError anywhere else in a command
-    monkeypatch.setattr(tabletcad.build, "geometry_report", lambda *a, **k: interrupted_import())
+    monkeypatch.setattr(tabletcad.pipeline.build, "geometry_report", lambda *a, **k: interrupted_import())
     rc, _, err = run(capsys, "build", str(ROOT / "samples" / "spherical.toml"), "--out", str(out))
     assert (rc, err) == (130, "interrupted\n") and not out.exists()
     assert not (tmp_path / "cache").exists()  # no internal-error log

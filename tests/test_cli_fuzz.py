@@ -119,7 +119,7 @@ raw_text = st.lists(st.one_of(st.sampled_from(FRAGMENTS), texts(8)), max_size=25
 
 def _fake_build_design(design, out_dir, *, progress=True):
     """Everything ``build`` does before its CAD stages: read and validate the design, build the PDE tablet."""
-    from tabletcad.design import load_design
+    from tabletcad.pipeline.design import load_design
 
     t = load_design(design)
     Path(out_dir).mkdir(parents=True, exist_ok=True)
@@ -139,9 +139,9 @@ def _check_contract(rc: int, err: str, context) -> None:
 @given(doc=st.one_of(designs.map(_toml), designs.map(_toml), designs.map(_toml), raw_text),
        command=st.sampled_from(["build", "report", "mesh"]))
 def test_fuzzed_design_files_keep_the_one_line_contract(tmp_path_factory, capsys, monkeypatch, doc, command):
-    import tabletcad.build
+    import tabletcad.pipeline.build
 
-    monkeypatch.setattr(tabletcad.build, "build_design", _fake_build_design)
+    monkeypatch.setattr(tabletcad.pipeline.build, "build_design", _fake_build_design)
     folder = tmp_path_factory.mktemp("fuzz")
     src = folder / "design.toml"
     src.write_text(doc, encoding="utf-8", errors="surrogatepass")
@@ -164,9 +164,9 @@ TOKENS = ["--out", "--nodes", "--quiet", "--json", "--solid-fraction", "--breaki
 @given(command=st.sampled_from(["build", "report", "mesh", "shapes"]),
        tokens=st.lists(st.one_of(st.sampled_from(TOKENS), texts(6)), max_size=8))
 def test_fuzzed_arguments_keep_the_one_line_contract(tmp_path_factory, capsys, monkeypatch, command, tokens):
-    import tabletcad.build
+    import tabletcad.pipeline.build
 
-    monkeypatch.setattr(tabletcad.build, "build_design", _fake_build_design)
+    monkeypatch.setattr(tabletcad.pipeline.build, "build_design", _fake_build_design)
     folder = tmp_path_factory.mktemp("args")
     monkeypatch.chdir(folder)  # relative outputs land here
     (folder / "bad.toml").write_text("[tablet]\nfamily = 'spherical'\ndiameter = true\n")

@@ -1,4 +1,4 @@
-"""Cardinal functions of the per-mode ODE (tabletcad.basis).
+"""Cardinal functions of the per-mode ODE (tabletcad.geometry.basis).
 
 For mode ``n`` the Bloor-Wilson equation of order 2 reduces to
 ``(D² - λ²)² A = 0`` with ``λ = a n``; the cardinal functions ``L_k(u; λ)``
@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tabletcad.basis import basis, cardinal, cardinal_coefficients, lebesgue_max
+from tabletcad.geometry.basis import basis, cardinal, cardinal_coefficients, lebesgue_max
 
 LAMS = [0.0, 1e-12, 1e-6, 1e-3, 0.05, 0.1, 0.5, 0.999, 1.0, 1.0 + 1e-12, 1.5, 3.0, 10.0, 30.0, 48.0, 100.0, 700.0, 1000.0]
 NODE_SETS = [(0.0, 1 / 3, 2 / 3, 1.0), (0.0, 0.1, 0.85, 1.0), (0.0, 0.45, 0.55, 1.0)]
@@ -64,7 +64,7 @@ def test_curves_form_is_identity_at_nodes_relative_to_size_up_to_lambda_1000(nod
 
 def test_curves_form_refuses_lambda_beyond_its_range():
     """Beyond LAMBDA_MAX the interior rows underflow: a clear error instead of NaN."""
-    from tabletcad.basis import LAMBDA_MAX
+    from tabletcad.geometry.basis import LAMBDA_MAX
 
     with pytest.raises(ValueError, match="λ = 3000"):
         cardinal(np.array(NODE_SETS[0]), 3000.0, NODE_SETS[0])

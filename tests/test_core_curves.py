@@ -1,4 +1,4 @@
-"""Boundary curves (tabletcad.curves): closed forms, parametrisation, derivatives, Fourier."""
+"""Boundary curves (tabletcad.geometry.curves): closed forms, parametrisation, derivatives, Fourier."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tabletcad.curves import (
+from tabletcad.geometry.curves import (
     Circle,
     Ellipse,
     Outline,
@@ -242,7 +242,7 @@ class _Plain:
 @given(rx=st.floats(0.0, 20.0), ry=st.floats(0.0, 20.0), tol=st.sampled_from([1e-12, 1e-7, 1e-3, 0.5, 5.0]),
        angle=st.floats(0.0, 6.3), zscale=st.floats(-2.0, 2.0))
 def test_band_limited_curves_need_the_modes_the_general_scan_finds(rx, ry, tol, angle, zscale):
-    from tabletcad.curves import Circle, Ellipse, Transformed, modes_needed
+    from tabletcad.geometry.curves import Circle, Ellipse, Transformed, modes_needed
 
     c, s = math.cos(angle), math.sin(angle)
     for curve in (Circle(rx, (1.0, -2.0, 3.0)), Ellipse(rx, ry),

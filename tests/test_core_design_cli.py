@@ -12,9 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tabletcad import families, reshape, shapes
+from tabletcad import families
+from tabletcad.families import reshape
+from tabletcad.families import thesis as shapes
 from tabletcad.cli import main
-from tabletcad.design import design_from_dict, load_design
+from tabletcad.pipeline.design import design_from_dict, load_design
 from tabletcad.errors import DesignError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -23,7 +25,7 @@ SAMPLES = sorted(p for p in (ROOT / "samples").glob("*.toml"))
 
 def _core_only_build(tablet, out):
     """Build without the optional CAD stages (they have their own tests)."""
-    from tabletcad.build import build_tablet
+    from tabletcad.pipeline.build import build_tablet
 
     return build_tablet(tablet, out, cad=False, progress=False)
 
@@ -164,7 +166,7 @@ def test_table_4_5_by_coefficient_scaling():
     body = reshape.scale_heights(reshape.select_patches(shapes.flat_faced_round(), [1]), [0.75])
     from dataclasses import replace
 
-    from tabletcad.tablet import Trim
+    from tabletcad.geometry.tablet import Trim
 
     v1 = replace(body, trim=Trim(w=(0.5, 1.0))).volume()
     assert ring.volume() == pytest.approx(1.44 * v1, rel=1e-9)

@@ -32,7 +32,7 @@ for b in BLOCKED:
     else:
         raise SystemExit(f"blocking failed for {{b}}")
 
-import tabletcad, tabletcad.patch, tabletcad.tablet, tabletcad.shapes, tabletcad.families, tabletcad.surfaces, tabletcad.curves, tabletcad.basis
+import tabletcad, tabletcad.geometry.patch, tabletcad.geometry.tablet, tabletcad.families.thesis, tabletcad.families, tabletcad.brep.surfaces, tabletcad.geometry.curves, tabletcad.geometry.basis
 t = tabletcad.families.FAMILIES["{family}"].build()
 v = t.properties()["volume_mm3"]
 loaded = sorted(m for m in sys.modules if m.split(".")[0] in BLOCKED)

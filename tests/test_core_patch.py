@@ -1,4 +1,4 @@
-"""PDE surface patches (tabletcad.patch.PDEPatch).
+"""PDE surface patches (tabletcad.geometry.patch.PDEPatch).
 
 Checks the defining properties: the surface passes through its boundary data
 (curves form and Hermite form, band-limited or not), it solves the
@@ -15,9 +15,9 @@ import warnings
 import numpy as np
 import pytest
 
-from tabletcad.curves import Circle, Ellipse, PointCurve, RoundedRectangle, Stadium, Transformed
+from tabletcad.geometry.curves import Circle, Ellipse, PointCurve, RoundedRectangle, Stadium, Transformed
 from tabletcad.errors import DesignError
-from tabletcad.patch import AUTO_A_LADDER, PDEPatch
+from tabletcad.geometry.patch import AUTO_A_LADDER, PDEPatch
 
 TWO_PI = 2 * math.pi
 V = np.linspace(0.0, TWO_PI, 720, endpoint=False) + 0.0037  # not the FFT nodes
@@ -181,7 +181,7 @@ def test_remainder_decays_like_first_omitted_mode():
     p = PDEPatch(curves, a=0.1, check=False)
     u = np.linspace(0.0, 1.0, 7)
     R = p.evaluate(u[:, None], V[None, :]) - p.evaluate(u[:, None], V[None, :], remainder=False)
-    from tabletcad.basis import cardinal
+    from tabletcad.geometry.basis import cardinal
 
     L = cardinal(u, p.beta_value, p.u_nodes)
     expect = sum(

@@ -11,9 +11,9 @@ hypothesis = pytest.importorskip("hypothesis")
 from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
-from tabletcad.curves import Ellipse, Stadium, Transformed  # noqa: E402
-from tabletcad.patch import PDEPatch  # noqa: E402
-from tabletcad.shapes import coaxial_tablet  # noqa: E402
+from tabletcad.geometry.curves import Ellipse, Stadium, Transformed  # noqa: E402
+from tabletcad.geometry.patch import PDEPatch  # noqa: E402
+from tabletcad.families.thesis import coaxial_tablet  # noqa: E402
 
 TWO_PI = 2 * math.pi
 V = np.linspace(0.0, TWO_PI, 256, endpoint=False) + 0.011
@@ -25,7 +25,7 @@ SETTINGS = dict(deadline=None, derandomize=True, max_examples=8)
 def domed_sections(draw):
     """Cap - band - cap: curves on spherical caps of random rim radius and depths (radii monotone in
     each dome, the package's own dome layout) around a band of random height; random plan aspect."""
-    from tabletcad.shapes import _band, _cap
+    from tabletcad.families.thesis import _band, _cap
 
     R = draw(st.floats(2.0, 8.0))
     d_bot = draw(st.floats(0.15, 1.0)) * R

@@ -1,4 +1,4 @@
-"""Tablets (tabletcad.tablet) built from every thesis family (tabletcad.shapes.THESIS_SHAPES).
+"""Tablets (tabletcad.geometry.tablet) built from every thesis family (tabletcad.families.thesis.THESIS_SHAPES).
 
 Volume by the divergence theorem (thesis eq 4.9) is checked against the
 independent triple integral of the solid map (eq 4.12), against invariances
@@ -13,8 +13,8 @@ import math
 import numpy as np
 import pytest
 
-from tabletcad.shapes import THESIS_SHAPES
-from tabletcad.tablet import Trim
+from tabletcad.families.thesis import THESIS_SHAPES
+from tabletcad.geometry.tablet import Trim
 
 NAMES = sorted(THESIS_SHAPES)
 AXISYMMETRIC = ["flat_faced_round", "spherical", "shallow_convex_round"]

@@ -1,6 +1,6 @@
 """Every family sample (``samples/families/*.toml``) as an exact, validated B-rep solid.
 
-For each sample the whole build (``tabletcad.build.build_tablet``: report, picture,
+For each sample the whole build (``tabletcad.pipeline.build.build_tablet``: report, picture,
 STEP, STL, GLB) must succeed, and the solid must be
 
 * one valid solid (``BRepCheck_Analyzer``) in one closed shell;
@@ -17,7 +17,7 @@ STEP, STL, GLB) must succeed, and the solid must be
 
 The capsule's innermost cup patches close on a segment, not a point: each is cut
 into four faces (two runs meeting along the segment, two fans on its ends;
-:mod:`tabletcad.slit`).  Plateaus whose rim has
+:mod:`tabletcad.brep.slit`).  Plateaus whose rim has
 collapsed corners are a fan plus a ring (no zero-area strip).
 
 ``custom_outline.toml`` is read by ``tabletcad.cli.report.load_family_design`` (the
@@ -38,14 +38,14 @@ pytest.importorskip("OCP")
 pytest.importorskip("manifold3d")
 pytest.importorskip("trimesh")
 
-from tabletcad.bspline import enclosed_volume
-from tabletcad.build import build_tablet
+from tabletcad.brep.surface import enclosed_volume
+from tabletcad.pipeline.build import build_tablet
 from tabletcad.cad._occ import cast, explore
 from tabletcad.cad.solid import check_solid
 from tabletcad.cad.tablet_solid import tablet_solid
 from tabletcad.cli.report import load_family_design
 from tabletcad.families import nominal_volume
-from tabletcad.slit import row_pieces
+from tabletcad.brep.slit import row_pieces
 
 pytestmark = pytest.mark.cad
 
@@ -55,9 +55,12 @@ AGREE = 1e-6
 
 
 @functools.cache
+def _design(path: Path):
+    return load_family_design(path)  # (tablet, design)
+
+
 def _tablet(path: Path):
-    tablet, _ = load_family_design(path)
-    return tablet
+    return _design(path)[0]
 
 
 def test_every_family_has_a_sample():
@@ -70,13 +73,13 @@ def test_every_family_has_a_sample():
 
 @pytest.mark.parametrize("path", SAMPLES, ids=[p.stem for p in SAMPLES])
 def test_family_sample_builds_an_exact_solid(path, tmp_path):
-    t = _tablet(path)
+    t, design = _design(path)
     cert = t.nominal.certificate
     assert cert is not None and cert.passed and cert.max_deviation_mm <= t.tol.nominal <= 1e-3
 
     # the whole build: report, picture, STEP, STL, GLB
     out = tmp_path / path.stem
-    rep = build_tablet(t, out, progress=False)
+    rep = build_tablet(t, out, tooling=design.tooling_spec, options=design.report_options, progress=False)
     for name in ("tablet.step", "tablet.stl", "tablet.glb", "tablet.png", "report.json"):
         assert (out / name).is_file() and (out / name).stat().st_size > 0, name
     assert json.loads((out / "report.json").read_text())["brep"]["valid"] is True
@@ -205,7 +208,7 @@ def test_the_build_fits_the_solid_once_for_its_cad_and_tooling_steps(tmp_path, m
     """Explicit composition: the build hands the CAD step's solid to the tooling step (no global
     cache, no second fit), and the tooling fits the same tablet the STEP file holds."""
     import tabletcad.cad.solid as solid_module
-    from tabletcad.build import build_design
+    from tabletcad.pipeline.build import build_design
 
     calls = []
     real = solid_module.build_solid

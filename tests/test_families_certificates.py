@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from tabletcad import families as F
 from tabletcad.families.cups import _depth_range
-from tabletcad.families.designreport import family_seams
+from tabletcad.pipeline.designreport import family_seams
 from tabletcad.families.sweep import certify
 from tabletcad.families import FAMILIES
 

@@ -159,7 +159,7 @@ def test_cli_report_writes_json_with_units(tmp_path, capsys):
 
 
 def test_design_report_is_part_of_the_geometry_report():
-    from tabletcad.report import geometry_report
+    from tabletcad.pipeline.report import geometry_report
 
     rep = geometry_report(F.compound_cup())
     assert rep["nominal_max_deviation_um"] <= 1.0
@@ -178,12 +178,12 @@ def test_design_files_of_every_family_build(tmp_path):
     names = sorted(p.stem for p in root.glob("*.toml"))
     assert {f.__name__ for f in F.FAMILY_FUNCTIONS} <= set(names)
     for n in ("concave_round", "capsule", "custom_outline"):
-        t, table = load_family_design(root / f"{n}.toml")
+        t, _ = load_family_design(root / f"{n}.toml")
         assert t.nominal.certificate.passed
 
 
 def test_elongated_strength_uses_pitt_heasley():
-    from tabletcad.families.designreport import ReportOptions, design_report
+    from tabletcad.pipeline.designreport import ReportOptions, design_report
 
     t = F.capsule(18, 8, 2.0, 1.2)
     r = design_report(t, ReportOptions(breaking_force_N=150.0))["design_report"]

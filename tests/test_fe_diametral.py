@@ -27,7 +27,7 @@ from tabletcad.fe.diametral import (  # noqa: E402
 
 
 def _tablet(**kw):
-    from tabletcad.design import design_from_dict
+    from tabletcad.pipeline.design import design_from_dict
 
     return design_from_dict({"tablet": kw})
 

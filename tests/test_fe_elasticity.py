@@ -125,7 +125,7 @@ class Block:
         if name.split(".")[0] in ("skfem", "gmsh"):
             raise ImportError(name + " blocked")
 sys.meta_path.insert(0, Block())
-import tabletcad, tabletcad.tablet, tabletcad.families, tabletcad.mechanics.strength
+import tabletcad, tabletcad.geometry.tablet, tabletcad.families, tabletcad.mechanics.strength
 import tabletcad.fe.mesh, tabletcad.fe.elasticity, tabletcad.fe.diametral
 v = tabletcad.families.FAMILIES["thesis.spherical"].build().properties()["volume_mm3"]
 assert not [m for m in sys.modules if m.split(".")[0] in ("skfem", "gmsh")]

@@ -14,15 +14,16 @@ pytest.importorskip("OCP")
 
 from tabletcad.fe.elasticity import von_mises  # noqa: E402
 from tabletcad.fe.punch import column_buckling, punch_stress, punch_tip_solid, tool_steels  # noqa: E402
+from tabletcad.tooling.spec import parse_tooling  # noqa: E402
 
 TOOLING = {"clearance_mm": 0.02, "tip_length_mm": 6.0}
 
 
 def _tip(**tablet):
-    from tabletcad.design import design_from_dict
+    from tabletcad.pipeline.design import design_from_dict
 
     t = design_from_dict({"tablet": tablet})
-    return punch_tip_solid(t, TOOLING, "upper")
+    return punch_tip_solid(t, parse_tooling(TOOLING), "upper")
 
 
 @pytest.fixture(scope="module")

@@ -66,7 +66,7 @@ def test_inputs_from_the_report_table_command_line_first():
 
 
 def test_design_report_accepts_the_fe_inputs_in_report():
-    from tabletcad.families.designreport import ReportOptions
+    from tabletcad.pipeline.designreport import ReportOptions
 
     o = ReportOptions.from_table({"tensile_strength_MPa": 2.0, "reference_breaking_force_N": 80.0,
                                   "reference_diameter_mm": 10.0, "reference_thickness_mm": 3.0})

@@ -187,8 +187,8 @@ def _run(exe: tuple[str, ...], script: Path, home: Path, work: Path, timeout: fl
 def _core_volume(family: str | None, params: dict | None = None, design: Path | None = None) -> float:
     """tabletcad's own report value (volume_mm3) in this (venv) Python."""
     from tabletcad import families
-    from tabletcad.design import load_design
-    from tabletcad.report import geometry_report
+    from tabletcad.pipeline.design import load_design
+    from tabletcad.pipeline.report import geometry_report
 
     tablet = load_design(design) if design else families.FAMILIES[family].build(**(params or {}))
     return geometry_report(tablet)["volume_mm3"]
@@ -221,7 +221,7 @@ def _steps(result, name):
 
 def test_core_is_the_repository_and_pure(headless):
     assert Path(headless["core_root"]) == ROOT
-    assert Path(headless["tabletcad_file"]).resolve() == ROOT / "tabletcad" / "shapes.py"
+    assert Path(headless["tabletcad_file"]).resolve() == ROOT / "tabletcad" / "families" / "thesis.py"
 
 
 @pytest.mark.parametrize("family", list(FAMILIES))
@@ -277,7 +277,7 @@ def _outline_area_perimeter(segs):
 def test_capsule_die_bore_is_the_exact_outline_offset(headless):
     """The workbench's die bore follows the capsule's exact outline (lines and arcs) offset by
     the clearance: die volume = pi R^2 H - (A + P c + pi c^2) H (Steiner), A and P from the
-    core's outline; the punches carry the cup faces cut into four pieces each (tabletcad.slit)."""
+    core's outline; the punches carry the cup faces cut into four pieces each (tabletcad.brep.slit)."""
     from tabletcad import families
 
     (step,) = [s for s in _steps(headless, "tooling") if s["family"] == "capsule"]
@@ -555,7 +555,7 @@ def _start_xvfb():
 def _assembly_step(tmp_path: Path) -> Path:
     """The tooling assembly STEP of a shallow convex round tablet (tabletcad's own writer)."""
     pytest.importorskip("OCP")
-    from tabletcad.shapes import shallow_convex_round
+    from tabletcad.families.thesis import shallow_convex_round
     from tabletcad.tooling import ToolingSpec, make_tooling
     from tabletcad.tooling.assembly import write_assembly
 

@@ -218,7 +218,7 @@ def test_bad_thesis_file_is_refused_before_the_solvers_and_the_pde_core_load(tmp
     f.write_text(ROUND + "P_bounds = [50.0]\n")
     code = ("import sys; from tabletcad.cli import main; "
             f"rc = main(['optimise', {str(f)!r}, '--out', {str(tmp_path / 'out')!r}, '--quiet']); "
-            "print(rc, sorted(m for m in ('scipy.optimize', 'tabletcad.curves', 'matplotlib') if m in sys.modules))")
+            "print(rc, sorted(m for m in ('scipy.optimize', 'tabletcad.geometry.curves', 'matplotlib') if m in sys.modules))")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False)
     assert r.stdout.split("\n")[0] == "2 []", (r.stdout, r.stderr)
     assert r.stderr.strip().startswith("error: [parameters] P_bounds = [50.0] is not allowed:")

@@ -1,4 +1,4 @@
-"""tabletcad.plot: pictures to scale, true side profiles, dimensions, several tablets at one scale."""
+"""tabletcad.pipeline.plot: pictures to scale, true side profiles, dimensions, several tablets at one scale."""
 
 import subprocess
 import sys
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from tabletcad.families import capsule, concave_round, flat_face_round
-from tabletcad.plot import side_profile, tablet_figure, tablet_png, tablets_figure
+from tabletcad.pipeline.plot import side_profile, tablet_figure, tablet_png, tablets_figure
 
 D, BAND, CUP = 10.0, 2.0, 1.0
 R = ((D / 2) ** 2 + CUP**2) / (2 * CUP)
@@ -74,7 +74,7 @@ def test_several_tablets_share_one_scale(pair):
 
 def test_no_global_backend_is_set():
     code = ("import sys, matplotlib; b = matplotlib.rcParams._get_backend_or_none(); "
-            "from tabletcad.shapes import flat_faced_round; from tabletcad.plot import tablet_png; "
+            "from tabletcad.families.thesis import flat_faced_round; from tabletcad.pipeline.plot import tablet_png; "
             "tablet_png(flat_faced_round()); "
             "assert 'matplotlib.pyplot' not in sys.modules; "
             "assert matplotlib.rcParams._get_backend_or_none() == b; print('ok')")

@@ -11,7 +11,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tabletcad.design import Design, design_to_toml, load_design, toml_text
+from tabletcad.pipeline.design import Design, design_to_toml, load_design, toml_text
+from tabletcad.pipeline.designreport import ReportOptions
 from tabletcad.errors import DesignError
 
 if sys.version_info >= (3, 11):
@@ -43,7 +44,8 @@ def test_the_design_owns_its_tables_and_is_separate_from_the_tablet():
     assert d.tablet["diameter"] == 10.0 and d.tablet["band"] == 3.0 and d.name == "cr10"
     assert d.family == "concave_round" and d.tooling == {"clearance_mm": 0.02} and d.report is None
     t = d.build()
-    assert t.params["diameter"] == 10.0 and t.extras["tooling"] == {"clearance_mm": 0.02}
+    assert t.params["diameter"] == 10.0 and not hasattr(t, "extras")  # the tablet is geometry only
+    assert d.tooling_spec.clearance_mm == 0.02 and d.report_options == ReportOptions()
 
 
 def test_an_old_family_name_is_read_as_the_new_one():

@@ -6,7 +6,7 @@ import pytest
 
 from tabletcad.errors import DesignError
 from tabletcad.families import compound_cup, concave_round, flat_face_round
-from tabletcad.families.designreport import design_report
+from tabletcad.pipeline.designreport import design_report
 from tabletcad.families.inverse import solve_for
 
 

@@ -36,8 +36,8 @@ def model():
 
 
 def test_lazy_exports_keep_import_light():
-    code = ("import sys, tabletcad; assert 'tabletcad.model' not in sys.modules; "
-            "m = tabletcad.TabletModel; assert 'tabletcad.model' in sys.modules; "
+    code = ("import sys, tabletcad; assert 'tabletcad.pipeline.model' not in sys.modules; "
+            "m = tabletcad.TabletModel; assert 'tabletcad.pipeline.model' in sys.modules; "
             "assert not any(k.split('.')[0] in ('OCP', 'build123d', 'cadquery') for k in sys.modules); print('ok')")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
@@ -98,7 +98,7 @@ def test_repr_html_is_offline_and_holds_the_mesh(model):
     T = np.array(mesh["t"]).reshape(-1, 3)
     # the embedded mesh is the closed tablet: its signed volume is the tablet's within
     # chordal deflection x area, and below it (the triangles are inscribed in a convex solid)
-    from tabletcad.model import VIEW_DEFLECTION
+    from tabletcad.pipeline.model import VIEW_DEFLECTION
 
     vol = np.einsum("ij,ij->i", V[T[:, 0]], np.cross(V[T[:, 1]], V[T[:, 2]])).sum() / 6
     assert 0 < model.volume - vol <= VIEW_DEFLECTION[0] * model.tablet.surface_area()

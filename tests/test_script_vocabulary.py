@@ -10,10 +10,10 @@ from pathlib import Path
 
 import pytest
 
-from tabletcad.design import design_from_dict, load_design
+from tabletcad.pipeline.design import design_from_dict, load_design
 from tabletcad.errors import DesignError
 from tabletcad.families import FAMILIES, INDUSTRY_FAMILIES, RENAMED, THESIS_FAMILIES, family
-from tabletcad.shapes import THESIS_SHAPES
+from tabletcad.families.thesis import THESIS_SHAPES
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLES = sorted(p for p in ROOT.joinpath("samples").rglob("*.toml") if "[tablet]" in p.read_text(encoding="utf-8"))

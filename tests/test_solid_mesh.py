@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tabletcad.errors import DesignError
-from tabletcad.shapes import THESIS_SHAPES
+from tabletcad.families.thesis import THESIS_SHAPES
 from tabletcad.volume_mesh import SolidMesh, THESIS_NODES, cell_volumes, hex_mesh, mesh_volume, write_mesh
 
 LEVELS = [(9, 17, 5), (17, 33, 9), (33, 65, 17)]  # every spacing halved per level

@@ -21,7 +21,7 @@ pytest.importorskip("distributed")
 pd = pytest.importorskip("pandas")
 
 from tabletcad.cli import main  # noqa: E402
-from tabletcad.design import design_from_dict  # noqa: E402
+from tabletcad.pipeline.design import design_from_dict  # noqa: E402
 from tabletcad.errors import DesignError  # noqa: E402
 from tabletcad.sweep import design_hash, parse_sweep, run_sweep  # noqa: E402
 from tabletcad.sweep.engine import flatten_report  # noqa: E402

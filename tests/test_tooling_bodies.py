@@ -112,7 +112,7 @@ def test_tip_longer_than_the_punch_names_the_room_left():
 def eu_b():
     pytest.importorskip("OCP")
     pytest.importorskip("manifold3d")
-    from tabletcad.shapes import shallow_convex_round
+    from tabletcad.families.thesis import shallow_convex_round
     from tabletcad.tooling.toolset import make_tooling
 
     return make_tooling(shallow_convex_round(), parse_tooling(EU_B), check=False)
@@ -165,7 +165,7 @@ def test_punch_extents_are_the_overall_length_and_the_barrel(eu_b):
 @pytest.mark.cad
 def test_barrel_smaller_than_the_tablet_and_oversize_tablets_are_design_errors():
     pytest.importorskip("OCP")
-    from tabletcad.shapes import shallow_convex_round
+    from tabletcad.families.thesis import shallow_convex_round
     from tabletcad.tooling.toolset import make_tooling
 
     t = shallow_convex_round()

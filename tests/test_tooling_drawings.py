@@ -9,10 +9,10 @@ pytest.importorskip("OCP")
 pytest.importorskip("ezdxf")
 pytest.importorskip("matplotlib")
 
-from tabletcad.design import load_design  # noqa: E402
+from tabletcad.pipeline.design import load_design  # noqa: E402
 from tabletcad.tooling import make_tooling  # noqa: E402
 from tabletcad.tooling.drawing import drawing_model, sheet_figure, tooling_model, write_drawing  # noqa: E402
-from tabletcad.tooling.stage import tooling_spec  # noqa: E402
+from tabletcad.pipeline.design import Design  # noqa: E402
 
 pytestmark = pytest.mark.cad
 
@@ -21,7 +21,7 @@ SAMPLE = Path(__file__).resolve().parents[1] / "samples" / "tooling" / "tsm_b_ro
 
 @pytest.fixture(scope="module")
 def drawn(tmp_path_factory):
-    ts = make_tooling(load_design(SAMPLE), tooling_spec(load_design(SAMPLE)), check=False,
+    ts = make_tooling(load_design(SAMPLE), Design.from_toml(SAMPLE).tooling_spec, check=False,
                       interference_check=False)
     out = tmp_path_factory.mktemp("drawings")
     files = write_drawing(ts, out)
@@ -54,7 +54,7 @@ def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
 def capsule():
     """A shaped tablet (length and width dimensioned in two views) with a score (section dimension)."""
     p = SAMPLE.parent / "capsule.toml"
-    return make_tooling(load_design(p), tooling_spec(load_design(p)), check=False, interference_check=False)
+    return make_tooling(load_design(p), Design.from_toml(p).tooling_spec, check=False, interference_check=False)
 
 
 def _segments_display(ax, dr):

@@ -8,7 +8,7 @@ import pytest
 pytest.importorskip("OCP")
 pytest.importorskip("build123d")
 
-from tabletcad.design import load_design  # noqa: E402
+from tabletcad.pipeline.design import load_design  # noqa: E402
 from tabletcad.errors import DesignError  # noqa: E402
 from tabletcad.tooling.emboss import check_emboss  # noqa: E402
 from tabletcad.tooling.outline import tablet_frame  # noqa: E402

@@ -15,7 +15,7 @@ pytest.importorskip("manifold3d")
 
 import freecads  # noqa: E402
 from support.readback import freecad_read_step  # noqa: E402
-from tabletcad.shapes import shallow_convex_round  # noqa: E402
+from tabletcad.families.thesis import shallow_convex_round  # noqa: E402
 from tabletcad.tooling import ToolingSpec, make_tooling, write_tooling  # noqa: E402
 
 pytestmark = [pytest.mark.cad, pytest.mark.freecad]

@@ -6,8 +6,9 @@ import pytest
 
 pytest.importorskip("OCP")
 
+from tabletcad.pipeline.designreport import ReportOptions  # noqa: E402
 from tabletcad.errors import DesignError  # noqa: E402
-from tabletcad.shapes import shallow_convex_round  # noqa: E402
+from tabletcad.families.thesis import shallow_convex_round  # noqa: E402
 from tabletcad.tooling.outline import tablet_frame  # noqa: E402
 from tabletcad.tooling.rating import section_properties, tip_rating  # noqa: E402
 from tabletcad.tooling.spec import parse_tooling  # noqa: E402
@@ -26,7 +27,7 @@ def test_rating_and_buckling_are_the_closed_forms_for_a_round_tip(frame):
     spec = parse_tooling(dict(clearance_mm=0.02, tip_length_mm=8.0, lower_tip_length_mm=19.0,
                               allowed_tip_pressure_MPa=300.0, allowed_tip_pressure_source=SRC,
                               punch_youngs_modulus_MPa=210000.0, punch_youngs_modulus_source=SRC))
-    r = tip_rating(frame, spec, {"compaction_force_kN": 15.0})
+    r = tip_rating(frame, spec, ReportOptions(compaction_force_kN=15.0))
     rt = 5.0 - 0.02
     assert r["tip_projected_area_mm2"] == pytest.approx(math.pi * rt ** 2, rel=1e-9)
     assert r["rated_force_kN"] == pytest.approx(300.0 * math.pi * rt ** 2 / 1000.0, rel=1e-9)
@@ -54,10 +55,10 @@ def test_rectangle_section_has_the_smaller_principal_moment():
 
 
 def test_without_a_sourced_pressure_there_is_no_rating(frame):
-    r = tip_rating(frame, parse_tooling({}), {})
+    r = tip_rating(frame, parse_tooling({}), None)
     assert r["rated_force_kN"] is None and "no allowed pressure" in r["note"]
     assert r["buckling"]["tips"]["upper"]["buckling_load_kN"] is None
-    r = tip_rating(frame, parse_tooling({}), {"max_punch_pressure_MPa": 250.0})
+    r = tip_rating(frame, parse_tooling({}), ReportOptions(max_punch_pressure_MPa=250.0))
     assert r["rated_force_kN"] == pytest.approx(0.25 * r["tip_projected_area_mm2"]) and "user-given" in r["allowed_pressure_source"]
 
 

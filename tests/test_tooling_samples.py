@@ -11,10 +11,10 @@ pytest.importorskip("OCP")
 pytest.importorskip("manifold3d")
 
 from support.readback import _clean_env, find_freecadcmd  # noqa: E402
-from tabletcad.design import load_design  # noqa: E402
+from tabletcad.pipeline.design import load_design  # noqa: E402
 from tabletcad.tooling import make_tooling, write_tooling  # noqa: E402
 from tabletcad.tooling.assembly import PART_COLOURS, read_assembly_colours  # noqa: E402
-from tabletcad.tooling.stage import tooling_spec  # noqa: E402
+from tabletcad.pipeline.design import Design  # noqa: E402
 
 pytestmark = [pytest.mark.cad, pytest.mark.freecad]
 
@@ -48,7 +48,7 @@ def built(tmp_path_factory):
     root = tmp_path_factory.mktemp("samples")
     res = {}
     for p in SAMPLES:
-        ts = make_tooling(load_design(p), tooling_spec(load_design(p)), check=False, interference_check=False)
+        ts = make_tooling(load_design(p), Design.from_toml(p).tooling_spec, check=False, interference_check=False)
         out = root / p.stem
         out.mkdir()
         write_tooling(ts, out, drawing=False)

@@ -10,7 +10,7 @@ pytest.importorskip("manifold3d")
 
 from scipy.integrate import quad  # noqa: E402
 
-from tabletcad.design import load_design  # noqa: E402
+from tabletcad.pipeline.design import load_design  # noqa: E402
 from tabletcad.errors import DesignError  # noqa: E402
 from tabletcad.tooling.spec import ScoreSpec, ToolingSpec, parse_tooling  # noqa: E402
 from tabletcad.tooling.split import split_directions  # noqa: E402

@@ -95,9 +95,9 @@ try:
 
     objects.log = _record  # what the workbench sends to FreeCAD's log
     result["core_root"] = str(wb.core_root())
-    import tabletcad.shapes
+    import tabletcad.families.thesis
 
-    result["tabletcad_file"] = tabletcad.shapes.__file__
+    result["tabletcad_file"] = tabletcad.families.thesis.__file__
     doc = FreeCAD.newDocument("wbtest")
 
     # ---- every family asked for (tests/test_freecad_workbench.py: FAMILIES), each recomputed on creation

@@ -1,4 +1,4 @@
-"""Kernel-neutral :class:`~tabletcad.bspline.BSplineSurfaceData` -> OCCT surfaces and faces.
+"""Kernel-neutral :class:`~tabletcad.brep.surface.BSplineSurfaceData` -> OCCT surfaces and faces.
 
 Design choice: the surface stays **periodic in v** (``Geom_BSplineSurface`` with
 ``VPeriodic=True``) and the face is made from the whole surface with
@@ -21,7 +21,7 @@ on spheres, cylinders and rings (see tests/test_cad_solid.py), and FreeCAD's
 
 A boundary row that collapses to a *segment* (a *slit*: the capsule's
 innermost cup patch) is cut into exact pieces first, with the whole chain
-(:func:`tabletcad.slit.chain_face_surfaces`), each made into an ordinary face.
+(:func:`tabletcad.brep.slit.chain_face_surfaces`), each made into an ordinary face.
 
 Boundary p-curves carry the surface's low-continuity ``v`` knots
 (:func:`knot_boundary_pcurves`).  OCCT's mass properties (``BRepGProp``)
@@ -54,7 +54,7 @@ try:  # OCP >= 8.0
 except ImportError:  # pragma: no cover - OCP 7.x
     from OCP.TColgp import TColgp_Array1OfPnt2d as Array1OfPnt2d
 
-from tabletcad.bspline import BSplineSurfaceData
+from tabletcad.brep.surface import BSplineSurfaceData
 from tabletcad.cad._occ import Array1OfInteger, Array1OfReal, Array2OfPnt
 from tabletcad.errors import GeometryError
 

@@ -4,11 +4,11 @@ The pipeline never returns a broken solid: every step is checked and a
 :class:`tabletcad.errors.GeometryError` names the patch (and the deviation or
 free edge) that failed.
 
-1. :func:`tabletcad.bspline.fit_patches` - B-spline fit of every patch within
+1. :func:`tabletcad.brep.fit.fit_patches` - B-spline fit of every patch within
    ``tol`` (shared boundary rows are bit-identical between neighbours);
 2. :func:`tabletcad.cad.faces.make_face` - one periodic B-spline face per patch, or
    the whole chain cut alike into pieces where a boundary row stands still over part
-   of its length (:func:`tabletcad.slit.chain_face_surfaces`);
+   of its length (:func:`tabletcad.brep.slit.chain_face_surfaces`);
 3. ``BRepBuilderAPI_Sewing`` with tolerance ``max(2 tol, 1e-6)`` mm - no free
    or multiple edges allowed, exactly one closed shell;
 4. ``BRepBuilderAPI_MakeSolid`` + ``BRepLib::OrientClosedSolid`` (matter
@@ -38,11 +38,12 @@ from OCP.BRepLib import BRepLib
 from OCP.GProp import GProp_GProps
 from OCP.TopoDS import TopoDS_Shape, TopoDS_Solid
 
-from tabletcad.bspline import BSplineSurfaceData, PatchFunction, SurfaceFit, chain_breakpoints, fit_patches
+from tabletcad.brep.fit import PatchFunction, SurfaceFit, chain_breakpoints, fit_patches
+from tabletcad.brep.surface import BSplineSurfaceData
 from tabletcad.cad._occ import cast, explore, shape_type
 from tabletcad.cad.faces import knot_boundary_pcurves, make_face
 from tabletcad.errors import GeometryError
-from tabletcad.slit import chain_face_surfaces
+from tabletcad.brep.slit import chain_face_surfaces
 
 __all__ = [
     "MassProperties",
@@ -238,7 +239,7 @@ def solid_from_surfaces(
     t0 = time.perf_counter()
     names = list(names) if names is not None else [f"patch {j}" for j in range(len(surfaces))]
     # one face per surface; the whole chain cut alike where a boundary row stands still over
-    # part of its length (the capsule's centre line, collapsed outline corners: tabletcad.slit)
+    # part of its length (the capsule's centre line, collapsed outline corners: tabletcad.brep.slit)
     faces_l: list = []
     face_names: list[str] = []
     for pieces, n in zip(chain_face_surfaces(surfaces, tol_degen, names), names):
@@ -284,7 +285,7 @@ def build_solid(
     Patches form a chain: patch ``j``'s ``u=1`` curve is patch ``j+1``'s ``u=0``
     curve (the chain may close on itself, e.g. a ring).  ``sew_tolerance``
     defaults to ``max(2 tol, 1e-6)`` mm.  Extra keyword arguments go to
-    :func:`tabletcad.bspline.fit_surface` (``nu``, ``nv``, ``max_nu``, ``v_breaks``...);
+    :func:`tabletcad.brep.fit.fit_surface` (``nu``, ``nv``, ``max_nu``, ``v_breaks``...);
     ``v_breaks`` defaults to the union of the patches' ``breakpoints()`` (if they have any).
     """
     t0 = time.perf_counter()

@@ -1,6 +1,6 @@
 """The CAD stage of ``tabletcad build``: solid, checks, STEP/STL/GLB, report sections.
 
-:func:`tabletcad.build.build_tablet` calls :func:`cad_stage`, which adds to
+:func:`tabletcad.pipeline.build.build_tablet` calls :func:`cad_stage`, which adds to
 ``report.json``:
 
 * ``brep``: ``valid``, ``volume_mm3`` and ``surface_area_mm2`` (adaptive OCC
@@ -22,7 +22,7 @@ import numpy as np
 from typing import Any
 
 from tabletcad.errors import GeometryError
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT
 
 __all__ = ["cad_stage", "check_tablet_solid", "MESH_LINEAR_MM", "MESH_ANGULAR_RAD", "AGREEMENT_REL"]
@@ -149,7 +149,7 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
     from tabletcad.cad.mesh import tessellate
     from tabletcad.cad.solid import check_solid, mass_properties
     from tabletcad.cad.tablet_solid import tablet_solid
-    from tabletcad.tablet import Trim
+    from tabletcad.geometry.tablet import Trim
 
     t = tablet.trim
     if t.u != (0.0, 1.0):
@@ -163,7 +163,7 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
         if t.w != (0.0, 1.0):
             return "hollow ([trim] w) with cut faces that are not planes through the axis"
         from tabletcad.cad.solid import build_solid
-        from tabletcad.surfaces import cutaway_surface_functions, fit_options
+        from tabletcad.brep.surfaces import cutaway_surface_functions, fit_options
 
         funcs, breaks = cutaway_surface_functions(tablet)
         names = [f"{p.name or f'patch {j}'} cut-away" for j, p in enumerate(tablet.patches)]

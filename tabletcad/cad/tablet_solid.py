@@ -1,8 +1,8 @@
-"""The B-rep solid of a :class:`~tabletcad.tablet.Tablet`.
+"""The B-rep solid of a :class:`~tabletcad.geometry.tablet.Tablet`.
 
-Every face of the tablet's solid (:mod:`tabletcad.surfaces`: its patches, or the
+Every face of the tablet's solid (:mod:`tabletcad.brep.surfaces`: its patches, or the
 walls and end faces of a hollow tablet) is fitted by a B-spline (kernel-neutral
-data from :mod:`tabletcad.bspline`), the faces are sewn into one closed shell and
+data from :mod:`tabletcad.brep`), the faces are sewn into one closed shell and
 the shell becomes an outward solid checked by ``BRepCheck_Analyzer``.  Tablets
 trimmed in ``u`` or ``v`` (cut-away views) are refused here: the CAD stage builds
 their solids (:func:`tabletcad.cad.stage.cutaway_solid`).
@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from tabletcad.surfaces import fit_options, tablet_surface_functions
-from tabletcad.tablet import Tablet
+from tabletcad.brep.surfaces import fit_options, tablet_surface_functions
+from tabletcad.geometry.tablet import Tablet
 
 __all__ = ["tablet_solid"]
 

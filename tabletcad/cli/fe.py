@@ -136,8 +136,8 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
     _require_fe()
     from tabletcad.fe.prediction import StrengthInputs, predict_breaking_force
 
-    tablet, table = load_family_design(design)
-    inputs = StrengthInputs.from_table(table, tensile_strength_MPa=tensile_strength,
+    tablet, spec = load_family_design(design)
+    inputs = StrengthInputs.from_table(spec.report, tensile_strength_MPa=tensile_strength,
                                        reference_breaking_force_N=reference_force,
                                        reference_diameter_mm=reference_diameter,
                                        reference_thickness_mm=reference_thickness)
@@ -196,8 +196,8 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
     _require_fe()
     from tabletcad.fe.punch import punch_stress, punch_tip_solid
 
-    tablet, _ = load_family_design(design)
-    shape, tip = punch_tip_solid(tablet, tablet.extras.get("tooling"), which)
+    tablet, spec = load_family_design(design)
+    shape, tip = punch_tip_solid(tablet, spec.tooling_spec, which)
     res = punch_stress(shape, tip, force, which, yield_MPa=yield_stress, safety_factor=safety_factor, E=E,
                        mesh_size=mesh_size, effective_length_factor=effective_length_factor)
     payload = {"design": str(design), "steel": steel, **res.to_dict()}

@@ -52,7 +52,7 @@ def shapes_cmd(as_json: bool) -> None:
 @click.option("--quiet", is_flag=True, help="No progress display.")
 def build_cmd(design: Path, out_dir: Path, quiet: bool) -> None:
     """Build DESIGN.toml: report.json, tablet.png and CAD files in OUT."""
-    from tabletcad.build import build_design
+    from tabletcad.pipeline.build import build_design
 
     rep = build_design(design, out_dir, progress=not quiet)
     written = rep["outputs"]  # this build's files only (the folder may hold files tabletcad did not write)
@@ -75,7 +75,7 @@ def mesh_cmd(design: Path, nodes: tuple[int, int, int], out_file: Path) -> None:
     differ by more than Tolerances.mesh_volume (1 %): straight-edged cells cut the curved
     faces, so a coarse mesh holds less volume than the tablet.
     """
-    from tabletcad.design import load_design
+    from tabletcad.pipeline.design import load_design
     from tabletcad.volume_mesh import hex_mesh, mesh_volume, write_mesh
 
     for n in nodes:

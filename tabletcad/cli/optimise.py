@@ -54,13 +54,13 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
         if value is not None:  # the same limits as the file's [solver] table
             opts[key] = SOLVER_KEYS[key](f"--{key}", int(value) if value.strip().lstrip("+-").isdigit() else value)
     # the rest only once the input is known to be valid (a bad file is refused without loading them)
-    from tabletcad.design import load_design
+    from tabletcad.pipeline.design import Design
     from tabletcad.errors import TabletcadError
     from tabletcad.io.atomic import atomic_write_text
     from tabletcad.optimise.plot import plot_convergence
     from tabletcad.optimise.report import result_report, summary, to_json
     from tabletcad.optimise.solvers import solve
-    from tabletcad.tablet import Tablet
+    from tabletcad.geometry.tablet import Tablet
 
     method = method or default_method
     build_error = ""
@@ -79,13 +79,13 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
             written.append(name)
             if result.success:
                 # rebuild from the written file with default settings: what `tabletcad build` will see
-                written_tablet = load_design(staging / name)
+                written_design = Design.from_toml(staging / name)
                 tablet = getattr(result.design, "tablet", result.design)
-                if isinstance(tablet, Tablet) and isinstance(written_tablet, Tablet):
-                    from tabletcad.build import build_tablet
+                if isinstance(tablet, Tablet):
+                    from tabletcad.pipeline.build import build_design
 
                     try:
-                        rep = build_tablet(written_tablet, staging / "tablet", progress=not quiet)
+                        rep = build_design(written_design, staging / "tablet", progress=not quiet)
                         report["built_design"] = dict(folder="tablet", volume_mm3=rep.get("volume_mm3"),
                                                       surface_area_mm2=rep.get("surface_area_mm2"))
                         written.append("tablet/")

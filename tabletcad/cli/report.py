@@ -26,17 +26,17 @@ __all__ = ["COMMANDS", "load_family_design"]
 
 
 def load_family_design(path: Path):
-    """Read a design file; return ``(tablet, report_table)``.
+    """Read a design file; return ``(tablet, design)`` (the :class:`~tabletcad.pipeline.design.Design`).
 
     Besides the families of :data:`tabletcad.families.FAMILIES`, ``family = "custom_outline"`` is read
     here with ``outline = [[x, y], ...]`` (points, mm) or ``segments = [...]``
     (``["line", [x0, y0], [x1, y1]]`` / ``["arc", [cx, cy], r, theta0, sweep]``,
     angles in rad) plus the keys of :func:`tabletcad.families.outline_tablet`.
     """
-    from tabletcad.design import design_from_dict, read_design_file
+    from tabletcad.pipeline.design import Design
 
-    data = read_design_file(path)
-    return design_from_dict(data, default_name=Path(path).stem), data.get("report")
+    design = Design.from_toml(path)
+    return design.build(), design
 
 
 def _fmt(v: Any, unit: str = "", digits: int = 6) -> str:
@@ -157,7 +157,7 @@ def _comparison(rows: list[tuple[str, dict[str, Any]]]) -> str:
 def _write_tables(payloads: list[dict[str, Any]], csv_out: Path | None, xlsx_out: Path | None, staged: dict[str, Path]) -> None:
     """One row per design: ``design``, ``file``, its family and dimensions (``tablet.<key>``, mm), then
     every scalar of its report under dotted names (units in the names)."""
-    from tabletcad.report import flatten_report
+    from tabletcad.pipeline.report import flatten_report
 
     rows = [{"design": p["design"]["name"], "file": p["design"]["file"], "tablet.family": p["design"]["family"],
              **{f"tablet.{k}": v for k, v in p["design"]["params"].items() if isinstance(v, (int, float, str, bool))},
@@ -212,9 +212,9 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
     thickness or cup depth that gives --target-weight or --target-volume, then reports that design.
     """
     from tabletcad.cli.outputs import check_output, staged
-    from tabletcad.families.designreport import ReportOptions, design_report, shape_report
+    from tabletcad.pipeline.designreport import design_report, shape_report
     from tabletcad.families.sweep import SweepNominal
-    from tabletcad.report import to_json
+    from tabletcad.pipeline.report import to_json
 
     for d in designs:
         if d.suffix.lower() == ".json":
@@ -237,16 +237,16 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
 
     payloads, shown = [], []
     for design in designs:
-        tablet, table = load_family_design(design)
+        tablet, spec = load_family_design(design)
         try:
-            opts = ReportOptions.from_table(table).merged(
+            opts = spec.report_options.merged(
                 solid_fraction=solid_fraction, true_density_mg_mm3=true_density, breaking_force_N=breaking_force,
                 compaction_force_kN=compaction_force, max_punch_force_kN=max_punch_force, max_punch_pressure_MPa=max_punch_pressure)
         except DesignError as exc:  # "[report] solid_fraction" -> "[report].solid_fraction": one token
             raise exc.renamed(one_token(exc.parameter)) from None
         inverse = None
         if solve_for is not None:
-            from tabletcad.design import read_design_file
+            from tabletcad.pipeline.design import read_design_file
 
             data = read_design_file(design)
             carried = [k for k in ("a",) if k in data.get("tablet", {})] + (["[reshape]"] if "reshape" in data else [])

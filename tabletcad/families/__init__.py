@@ -2,8 +2,8 @@
 catalogue of every family.
 
 :data:`FAMILIES` is the static mapping from a family's name to its
-:class:`~tabletcad.family.Family`: the industry families below, then the
-thesis's shapes (:data:`tabletcad.shapes.THESIS_SHAPES`) named ``thesis.<name>``.
+:class:`~tabletcad.families.family.Family`: the industry families below, then the
+thesis's shapes (:data:`tabletcad.families.thesis.THESIS_SHAPES`) named ``thesis.<name>``.
 Design files, ``tabletcad shapes``, sweeps, tooling batches, the optimiser and the
 FreeCAD workbench look names up with :func:`family`, which still accepts the
 thesis's shapes under their old plain names (:data:`RENAMED`) with a warning.
@@ -48,8 +48,8 @@ from tabletcad.families.round import compound_cup, concave_bevel, concave_round,
 from tabletcad.families.shaped import almond, outline_tablet, rounded_rectangle, rounded_square, rounded_triangle
 from tabletcad.errors import DesignError
 from tabletcad.families.sweep import certify, nominal_volume, sweep_properties
-from tabletcad.family import Family
-from tabletcad.shapes import THESIS_SHAPES
+from tabletcad.families.family import Family
+from tabletcad.families.thesis import THESIS_SHAPES
 
 __all__ = [
     "FAMILIES",

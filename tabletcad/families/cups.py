@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from tabletcad.errors import DesignError, check_finite, check_range
-from tabletcad.curves import Seg
+from tabletcad.geometry.curves import Seg
 from tabletcad.families.profile import profile_arc, profile_line
 
 __all__ = [

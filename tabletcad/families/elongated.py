@@ -18,7 +18,7 @@ from tabletcad.errors import check_positive
 from tabletcad.families.outline import four_arc_oval, four_arc_oval_from_side_radius, stadium_outline
 from tabletcad.families.shaped import outline_tablet
 from tabletcad.families.sweep import DEFAULT_A
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = ["capsule", "modified_capsule", "oval"]

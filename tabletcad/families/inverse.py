@@ -27,7 +27,7 @@ from scipy.optimize import brentq
 
 from tabletcad.errors import DesignError, check_positive, check_range
 from tabletcad.families.sweep import SweepNominal, nominal_volume
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
 
 __all__ = ["InverseResult", "solve_for", "VARY"]
 

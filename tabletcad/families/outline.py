@@ -27,7 +27,7 @@ import math
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from tabletcad.curves import Seg
+from tabletcad.geometry.curves import Seg
 from tabletcad.errors import DesignError, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
 
@@ -526,7 +526,7 @@ def _check_polyline_simple(p: np.ndarray, parameter: str) -> None:
 def outline_from_items(items, name: str = "outline", parameter: str = "outline") -> PlanOutline:
     """Outline from ``("line", (x0, y0), (x1, y1))`` and
     ``("arc", (cx, cy), radius, theta0, sweep)`` items (mm, rad), as in
-    :meth:`tabletcad.curves.Outline.from_segments`."""
+    :meth:`tabletcad.geometry.curves.Outline.from_segments`."""
     segs = []
     for i, it in enumerate(items):
         if not isinstance(it, (list, tuple)) or not it:

@@ -6,7 +6,7 @@ inward; revolved about the axis (round tablets, ``d = R - r``) or swept along
 the inward offsets of an outline it is the tablet's exact nominal face.  Arcs
 revolve or sweep into spheres and tori, lines into cones, planes and cylinders.
 
-The elements are :class:`tabletcad.curves.Seg` lines and arcs (:func:`profile_line`,
+The elements are :class:`tabletcad.geometry.curves.Seg` lines and arcs (:func:`profile_line`,
 :func:`profile_arc`).  Each element is split into *pieces* whose cubic Hermite interpolant (exact end
 points, exact tangent directions) stays within a target distance of the
 element; a piece becomes one PDE patch in Hermite form.  For an arc piece of
@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tabletcad.curves import Seg
+from tabletcad.geometry.curves import Seg
 
 __all__ = ["profile_line", "profile_arc", "Piece", "hermite_points", "pieces_for", "distance_to_chain",
            "joint_is_smooth"]

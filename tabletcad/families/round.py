@@ -1,6 +1,6 @@
 """Round tablet families: flat face (plain, bevel edge, radius edge), concave, compound cup, concave bevel.
 
-Every function returns a certified :class:`~tabletcad.tablet.Tablet` standing
+Every function returns a certified :class:`~tabletcad.geometry.tablet.Tablet` standing
 on ``z = 0`` with its axis on z; all lengths in mm, angles in degrees.  The
 nominal is the face profile revolved about the axis (cylinder band, planes,
 cones, spheres, tori); see :mod:`tabletcad.families.sweep`.
@@ -15,7 +15,7 @@ from tabletcad.families.cups import CompoundCup, bevel_line, land_line, single_r
 from tabletcad.families.outline import circle_outline
 from tabletcad.families.profile import profile_arc, profile_line
 from tabletcad.families.sweep import DEFAULT_A, build_sweep_tablet
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = ["flat_face_round", "ffbe", "ffre", "concave_round", "compound_cup", "concave_bevel", "smoothing"]

@@ -33,7 +33,7 @@ from tabletcad.families.outline import (
 from tabletcad.families.profile import profile_line
 from tabletcad.families.round import smoothing
 from tabletcad.families.sweep import DEFAULT_A, build_sweep_tablet
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = ["outline_tablet", "rounded_triangle", "rounded_square", "rounded_rectangle", "almond", "as_outline"]

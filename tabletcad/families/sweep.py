@@ -23,7 +23,7 @@ PDE representation
 ------------------
 Each profile element is split into pieces (:func:`profile.pieces_for`) whose
 cubic Hermite interpolant is within ``refine × tol.nominal`` of it; each piece
-becomes a :class:`~tabletcad.patch.PDEPatch` in Hermite form with data
+becomes a :class:`~tabletcad.geometry.patch.PDEPatch` in Hermite form with data
 ``X(0) = S(d0, v)``, ``X(1) = S(d1, v)``, ``X_u = D_d N(v) + D_z e_z`` (the
 piece's end derivatives).  Consecutive patches share their curves (C0) and
 their tangent directions wherever the profile is smooth (G1 by construction).
@@ -40,12 +40,12 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from tabletcad.curves import Curve
+from tabletcad.geometry.curves import Curve
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.families.outline import PlanOutline
 from tabletcad.families.profile import Piece, profile_line, distance_to_chain, joint_is_smooth, pieces_for
-from tabletcad.patch import PDEPatch
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.patch import PDEPatch
+from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = [
@@ -236,7 +236,7 @@ def build_sweep_tablet(
     ----------
     outline : PlanOutline
         Plan outline (mm).
-    face : sequence of tabletcad.curves.Seg
+    face : sequence of tabletcad.geometry.curves.Seg
         Top-face profile in ``(d, z)`` with ``z`` measured from the band's top
         edge (``z = 0`` at ``d = 0``), running inward and ending either at the
         outline's ``reach`` (the offsets close: a point for a circle, a segment

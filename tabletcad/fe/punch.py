@@ -147,19 +147,17 @@ class PunchResult:
         }
 
 
-def punch_tip_solid(tablet: Any, tooling_table: dict[str, Any] | None, which: str = "upper") -> tuple[Any, dict[str, Any]]:
-    """The ``which`` punch tip's solid and its info dict, from a design's ``[tooling]`` table."""
+def punch_tip_solid(tablet: Any, spec: Any, which: str = "upper") -> tuple[Any, dict[str, Any]]:
+    """The ``which`` punch tip's solid and its info dict, from a design's ``[tooling]`` specification
+    (:attr:`tabletcad.pipeline.design.Design.tooling_spec`)."""
     if which not in ("upper", "lower"):
         raise DesignError("punch", which, "must be upper or lower")
-    if tooling_table is None:
+    if spec is None:
         raise DesignError("[tooling]", tablet.name, "fe punch needs a design file with a [tooling] table")
-    from tabletcad.tooling.spec import parse_tooling
+    from tabletcad.tooling.stage import check_tooling
     from tabletcad.tooling.toolset import make_tooling
 
-    spec = parse_tooling(tooling_table)
-    t = tablet.trim
-    if t.u != (0.0, 1.0) or not t.full_v or t.w[0] > 0:
-        raise DesignError("[tooling]", tablet.name, "tooling needs a whole solid tablet (no [trim], no ring)")
+    check_tooling(tablet, spec)
     ts = make_tooling(tablet, spec, check=False, interference_check=False)
     return ts.parts[f"{which}_punch"], ts.report[f"{which}_punch"]
 

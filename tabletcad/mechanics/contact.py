@@ -360,12 +360,12 @@ def compress_sphere(force_N: float, material: Material | str, radius: float | No
 
 
 def compressed_sphere_tablet(force_N: float, material: Material | str, radius: float | None = None, **kw):
-    """The compressed sphere as a two-patch :class:`tabletcad.tablet.Tablet` (needs the geometry core).
+    """The compressed sphere as a two-patch :class:`tabletcad.geometry.tablet.Tablet` (needs the geometry core).
 
     Builds the tablet from :attr:`CompressedSphere.circles` with
-    :func:`tabletcad.shapes.coaxial_tablet`; ``kw`` is passed on to it.
+    :func:`tabletcad.families.thesis.coaxial_tablet`; ``kw`` is passed on to it.
     """
-    from tabletcad.shapes import coaxial_tablet
+    from tabletcad.families.thesis import coaxial_tablet
 
     cs = compress_sphere(force_N, material, radius)
     pts = list(cs.circles)

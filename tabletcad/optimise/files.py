@@ -278,7 +278,7 @@ def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
 
 def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) -> Problem:
     """A :class:`Problem` over the parameters of a tablet family (:data:`tabletcad.families.FAMILIES`)."""
-    from tabletcad.design import design_to_toml
+    from tabletcad.pipeline.design import design_to_toml
     from tabletcad.families import FAMILIES, RENAMED
     from tabletcad.families import family as lookup_family
 

@@ -2,7 +2,7 @@
 
 A :class:`Problem` names its design variables (:class:`Variable`, each with
 bounds and a starting value), a ``build(x) -> design`` function that turns a
-dict of variable values into a design object (a :class:`~tabletcad.tablet.Tablet`
+dict of variable values into a design object (a :class:`~tabletcad.geometry.tablet.Tablet`
 or any small model object), an objective computed from that design and
 constraints (:class:`Constraint`) computed from the design or from ``x``.
 

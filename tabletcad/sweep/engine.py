@@ -15,14 +15,13 @@ worker processes, or on an existing cluster.
 from __future__ import annotations
 
 import tempfile
-from dataclasses import replace
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from tabletcad.errors import DesignError
 from tabletcad.parallel import CONNECT_TIMEOUT_S, map_tasks, open_client
-from tabletcad.report import flatten_report
+from tabletcad.pipeline.report import flatten_report
 from tabletcad.sweep.spec import OUTPUTS
 
 __all__ = ["evaluate_design", "sweep_task", "failed_design", "map_tasks", "open_client", "flatten_report", "CONNECT_TIMEOUT_S", "error_message"]
@@ -56,36 +55,40 @@ def evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",)
 
     Returns ``dict(values=..., status="ok"|"error", error=..., files=...)``:
     ``values`` holds every scalar of the report (:func:`flatten_report`) — the
-    geometry report of :func:`tabletcad.report.geometry_report`, which is the
+    geometry report of :func:`tabletcad.pipeline.report.geometry_report`, which is the
     ``report.json`` of ``tabletcad build``; with file or tooling outputs the report of
-    :func:`tabletcad.build.build_tablet` itself (a failed tooling check is then a failed design,
+    :func:`tabletcad.pipeline.build.build_tablet` itself (a failed tooling check is then a failed design,
     as in ``tabletcad build``).  ``files`` maps file names to
     bytes (empty when ``store`` is given: the worker then writes them to
     ``store/folder/`` through fsspec).
     """
     try:
-        from tabletcad.design import design_from_dict
+        from tabletcad.pipeline.design import Design
 
-        tablet = design_from_dict(design, default_name=name)
+        spec = Design.from_dict(design, default_name=name)
+        tablet = spec.build()
         files: dict[str, bytes] = {}
         wanted = [f for o in outputs if o not in ("report", "tooling") for f in OUTPUTS[o]]
         with tempfile.TemporaryDirectory(prefix="tabletcad-sweep-") as tmp:
             if wanted or "tooling" in outputs:
-                from tabletcad.build import build_tablet
+                from tabletcad.pipeline.build import build_tablet
 
                 # the build's own steps, as `tabletcad build` runs them: with the "tooling" output the
                 # design's [tooling] table (the defaults without one) is built from the CAD step's solid;
                 # without it the tablet's files are the plain tablet and [tooling] is not built
-                extras = {k: v for k, v in tablet.extras.items() if k != "tooling"}
+                tooling = None
                 if "tooling" in outputs:
-                    extras["tooling"] = dict(design.get("tooling") or {})
+                    from tabletcad.tooling.spec import ToolingSpec
+
+                    tooling = spec.tooling_spec or ToolingSpec()
                     wanted += list(OUTPUTS["tooling"])
-                report = build_tablet(replace(tablet, extras=extras), Path(tmp) / "build", cad=True, progress=False)
+                report = build_tablet(tablet, Path(tmp) / "build", tooling=tooling, options=spec.report_options,
+                                      cad=True, progress=False)
                 files.update(_files_of(Path(tmp) / "build", wanted))
             else:
-                from tabletcad.report import geometry_report
+                from tabletcad.pipeline.report import geometry_report
 
-                report = geometry_report(tablet)
+                report = geometry_report(tablet, spec.report_options)
         if store is not None and files:
             _store_files(store, folder, files)
             files = {}

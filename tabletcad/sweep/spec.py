@@ -175,7 +175,7 @@ def _known_keys(design: dict) -> set[str]:
     try:
         from dataclasses import fields
 
-        from tabletcad.families.designreport import ReportOptions
+        from tabletcad.pipeline.designreport import ReportOptions
 
         keys |= {f"report.{f.name}" for f in fields(ReportOptions)}
     except ImportError:  # pragma: no cover
@@ -230,7 +230,7 @@ def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
     design = data.get("design")
     if not isinstance(design, dict) or not isinstance(design.get("tablet"), dict):
         raise DesignError("[design]", "missing", "a sweep file needs a [design] table with a [design.tablet] table")
-    from tabletcad.design import TOP_LEVEL_KEYS
+    from tabletcad.pipeline.design import TOP_LEVEL_KEYS
 
     for k in design:
         if k not in TOP_LEVEL_KEYS:

@@ -76,7 +76,7 @@ def _bspline_face_edges(shape):
 
     The tablet's faces are exact pieces of its B-splines and are never merged; asking
     OCCT 7.9 to try (faces mode) crashed the process on an almond's punch tip, whose cup
-    has pieces with a pole at the collapsed end arcs (tabletcad.slit).
+    has pieces with a pole at the collapsed end arcs (tabletcad.brep.slit).
     """
     from OCP.BRep import BRep_Tool
     from OCP.Geom import Geom_BSplineSurface

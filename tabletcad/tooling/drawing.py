@@ -66,7 +66,7 @@ def project_view(shape, view: str) -> dict:
     """``{"visible": [polylines], "hidden": [polylines]}`` (2-D, mm) of ``shape`` seen in ``view``."""
     d, x = VIEWS[view]
     # tangent (G1) edges - between the patches of a smooth cup, at the outline's line/arc
-    # junctions where a chain is cut (tabletcad.slit) - are not drawn, as on a toolmaker's
+    # junctions where a chain is cut (tabletcad.brep.slit) - are not drawn, as on a toolmaker's
     # drawing: OCCT stores an edge's continuity only when asked, else every edge counts as sharp
     BRepLib.EncodeRegularity_s(shape, math.radians(DEFAULT_TOLERANCES.seam_angle_deg))
     algo = HLRBRep_Algo()

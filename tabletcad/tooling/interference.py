@@ -213,7 +213,7 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
                  tablet_model=None) -> dict:
     """Overlaps (mm^3) between all pairs of ``{"tablet": shape, **parts}`` and the tablet's largest gap (mm).
 
-    ``tablet_model``: the :class:`~tabletcad.tablet.Tablet`, whose patches add surface samples."""
+    ``tablet_model``: the :class:`~tabletcad.geometry.tablet.Tablet`, whose patches add surface samples."""
     t0 = time.perf_counter()
     shapes = {"tablet": tablet, **parts}
     manifolds = {k: to_manifold(s, deflection) for k, s in shapes.items()}

@@ -34,7 +34,7 @@ from OCP.TopoDS import TopoDS_Shape
 
 from tabletcad.cad._occ import cast, explore
 from tabletcad.errors import DesignError, GeometryError
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
 from tabletcad.tooling.booleans import translated
 
 __all__ = ["TabletFrame", "tablet_frame", "offset_wire", "prism", "plan_face", "wire_length", "face_area"]
@@ -272,7 +272,7 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
             wire, kind = segments_wire(segs), "lines and arcs"
     else:
         curve = tablet.patches[found[0]].data[0] if found is not None else None
-        from tabletcad.curves import Circle, Ellipse
+        from tabletcad.geometry.curves import Circle, Ellipse
 
         if isinstance(curve, Circle):
             round_radius = float(curve.radius)

@@ -21,6 +21,7 @@ import math
 from OCP.BRepGProp import BRepGProp
 from OCP.GProp import GProp_GProps
 
+from tabletcad.pipeline.designreport import ReportOptions
 from tabletcad.tooling.outline import TabletFrame, offset_wire, plan_face
 
 __all__ = ["section_properties", "tip_rating", "EULER_K"]
@@ -39,17 +40,21 @@ def section_properties(wire) -> tuple[float, float]:
     return props.Mass(), i_min
 
 
-def tip_rating(frame: TabletFrame, spec, report_table: dict | None = None) -> dict:
-    """The rating and buckling figures for the tool set's tips (see the module docstring)."""
-    rep = report_table or {}
+def tip_rating(frame: TabletFrame, spec, options: ReportOptions | None = None) -> dict:
+    """The rating and buckling figures for the tool set's tips (see the module docstring).
+
+    ``options``: the design's report options (its user-given punch pressure limit and compaction
+    force), or None.
+    """
+    options = ReportOptions() if options is None else options
     area, _ = section_properties(offset_wire(frame.outline, -spec.clearance_mm))
     out: dict = dict(tip_projected_area_mm2=area, rule="F = p_allowed x tip projected area")
     p, src = spec.allowed_tip_pressure_MPa, spec.allowed_tip_pressure_source
-    if p is None and rep.get("max_punch_pressure_MPa") is not None:
-        p, src = float(rep["max_punch_pressure_MPa"]), "the design's [report] max_punch_pressure_MPa (user-given)"
+    if p is None and options.max_punch_pressure_MPa is not None:
+        p, src = options.max_punch_pressure_MPa, "the design's [report] max_punch_pressure_MPa (user-given)"
     out.update(allowed_pressure_MPa=p, allowed_pressure_source=src,
                rated_force_kN=None if p is None else p * area / 1000.0)
-    force = rep.get("compaction_force_kN")
+    force = options.compaction_force_kN
     out["compaction_force_kN"] = force
     out["utilisation"] = None if force is None or p is None else force / out["rated_force_kN"]
     if p is None:

@@ -1,8 +1,9 @@
 """The tooling stage of ``tabletcad build``: runs when the design has a ``[tooling]`` table.
 
-:func:`tabletcad.build.build_tablet` checks the table with :func:`tooling_spec`
-before any geometry is built, then calls :func:`tooling_stage` with the solid
-the CAD stage made.
+The design parses and checks the table (:attr:`tabletcad.pipeline.design.Design.tooling_spec`);
+:func:`tabletcad.pipeline.build.build_tablet` checks with :func:`check_tooling` that the
+tablet can have tooling before any geometry is built, then calls :func:`tooling_stage` with
+the solid the CAD stage made.
 
 Writes ``assembly.step``, ``upper_punch.step``, ``lower_punch.step``,
 ``die.step``, ``drawing.svg`` and ``drawing.dxf`` into the build's staging
@@ -18,29 +19,22 @@ from pathlib import Path
 from typing import Any
 
 from tabletcad.errors import DesignError, GeometryError
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
+from tabletcad.pipeline.designreport import ReportOptions
+from tabletcad.tooling.spec import ToolingSpec
 
-__all__ = ["tooling_stage", "tooling_spec", "write_tooling", "write_finished_tablet"]
+__all__ = ["check_tooling", "tooling_stage", "write_tooling", "write_finished_tablet"]
 
 
-def tooling_spec(tablet: Tablet):
-    """The checked :class:`~tabletcad.tooling.spec.ToolingSpec` of the tablet's design, or None.
+def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
+    """Refuse a tablet that cannot have tooling (a cut-away or a ring), before any geometry is built.
 
-    The design's ``[tooling]`` table is ``tablet.extras["tooling"]``
-    (:func:`tabletcad.design.design_from_dict` puts it there).  Raises
-    :class:`DesignError` for a bad key or value and for a tablet that cannot have
-    tooling (cut-away, ring); the build calls it before any geometry is built.
+    ``spec`` is the design's checked ``[tooling]`` table
+    (:attr:`tabletcad.pipeline.design.Design.tooling_spec`); raises :class:`DesignError`.
     """
-    table = tablet.extras.get("tooling")
-    if table is None:
-        return None
-    from tabletcad.tooling.spec import parse_tooling
-
-    spec = parse_tooling(table)
     t = tablet.trim
     if t.u != (0.0, 1.0) or not t.full_v or t.w[0] > 0:
         raise DesignError("[tooling]", tablet.name, "tooling needs a whole solid tablet (no [trim], no ring)")
-    return spec
 
 
 def write_tooling(ts, out: Path, *, drawing: bool = True) -> list[Path]:
@@ -58,17 +52,19 @@ def write_tooling(ts, out: Path, *, drawing: bool = True) -> list[Path]:
     return files
 
 
-def tooling_stage(*, tablet: Tablet, spec, shape, out: Path, report: dict[str, Any]) -> None:
+def tooling_stage(*, tablet: Tablet, spec: ToolingSpec, shape, out: Path, report: dict[str, Any],
+                  options: ReportOptions | None = None) -> None:
     """Tooling files of ``spec`` (the design's checked ``[tooling]`` table); the finished tablet as ``tablet.*``.
 
     ``shape`` is the tablet's solid (``TopoDS_Shape``) that the CAD stage built and wrote as
     ``tablet.step/.stl/.glb``; when scores or embossing change it, the plain STEP is kept as
     ``tablet_plain.step`` and ``tablet.*`` become the finished (scored, embossed) tablet, the
-    one the punches fit.
+    one the punches fit.  ``options`` (the design's ``[report]`` table) gives the density for the
+    masses of the split parts.
     """
     from tabletcad.tooling.toolset import make_tooling
 
-    ts = make_tooling(tablet, spec, shape=shape)
+    ts = make_tooling(tablet, spec, shape=shape, options=options)
     res = ts.report
     if res.get("interference_mm3", 0.0) > 1e-6 or not res["interference"]["gap_within_clearance"]:
         raise GeometryError(

@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tabletcad.errors import DesignError
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
+from tabletcad.pipeline.designreport import ReportOptions
 from tabletcad.tooling.booleans import TIMER, to_manifold, volume
 from tabletcad.tolerance import DEFAULT
 from tabletcad.tooling.spec import ToolingSpec
@@ -64,10 +65,12 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
 
 
 def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None, check: bool = True,
-                 interference_check: bool = True, deflection: float = DEFLECTION_MM) -> ToolSet:
+                 interference_check: bool = True, deflection: float = DEFLECTION_MM,
+                 options: ReportOptions | None = None) -> ToolSet:
     """Scores, embossing, punch tips and die for ``tablet`` (see :mod:`tabletcad.tooling`).
 
-    ``shape``: the tablet's B-rep if already built.  ``check``: cross-check every Boolean with
+    ``shape``: the tablet's B-rep if already built.  ``options``: the design's report options;
+    their solid fraction and true density give the masses of the parts a score splits.  ``check``: cross-check every Boolean with
     manifold3d; ``interference_check``: the closed-position overlap and gap check.
     Raises :class:`DesignError` for impossible tooling and :class:`GeometryError` when a
     Boolean or a check fails.
@@ -97,12 +100,11 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     solid, score_checks, score_info = apply_scores(frame, solid, spec.scores, check=check, deflection=deflection, a_manifold=a_man)
     a_man = None
     solid, emb_checks, emb_info = apply_emboss(frame, solid, spec.emboss, spec.clearance_mm, check=check, deflection=deflection)
-    rep_table = tablet.extras.get("report", {}) if isinstance(tablet.extras, dict) else {}
     split = None
     if spec.scores:  # the finished tablet (scores and figures) split along its score planes
         from tabletcad.tooling.split import split_parts
 
-        sf, rho = rep_table.get("solid_fraction"), rep_table.get("true_density_mg_mm3")
+        sf, rho = (None, None) if options is None else (options.solid_fraction, options.true_density_mg_mm3)
         split = split_parts(frame, solid, spec.scores, density_mg_mm3=None if sf is None or rho is None else sf * rho)
     t1 = time.perf_counter()
     upper, chk_u = punch_tip(frame, solid, "upper", spec.clearance_mm, spec.tip_length_mm, check=check, deflection=deflection)
@@ -142,7 +144,7 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     )
     from tabletcad.tooling.rating import tip_rating
 
-    report["tip_rating"] = tip_rating(frame, spec, rep_table)
+    report["tip_rating"] = tip_rating(frame, spec, options)
     ts = ToolSet(tablet, spec, frame, parts, gap - gap_closed, report)
     if interference_check:
         from tabletcad.tooling.interference import interference

@@ -9,7 +9,7 @@ surface.  The thesis meshes it with "cuboids": a structured grid of ``sx``
 nodes along ``u``, ``sy`` along ``v`` and ``sz`` along ``w`` (its Table 4.4
 uses 11×21×5, 21×39×6 and 41×39×6 nodes, i.e. ``(sx-1)(sy-1)(sz-1)`` = 800,
 3800 and 7600 cuboids per patch), over the parameter ranges the tablet's
-:class:`~tabletcad.tablet.Trim` keeps.
+:class:`~tabletcad.geometry.tablet.Trim` keeps.
 
 :func:`hex_mesh` builds that grid for every patch of a tablet, fully
 vectorised, and turns it into a *conforming* finite-element mesh:
@@ -46,14 +46,14 @@ to :meth:`Tablet.solid_volume` at second order in the node spacing.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
 from tabletcad.errors import DesignError, GeometryError
 
 if TYPE_CHECKING:  # pragma: no cover
-    from tabletcad.tablet import Tablet
+    from tabletcad.geometry.tablet import Tablet
 
 __all__ = [
     "SolidMesh",
@@ -334,7 +334,7 @@ def hex_mesh(tablet: "Tablet", nodes: tuple[int, int, int] = (11, 21, 5), *, che
     Parameters
     ----------
     tablet : Tablet
-        The tablet; its :class:`~tabletcad.tablet.Trim` gives the ``u``, ``v``
+        The tablet; its :class:`~tabletcad.geometry.tablet.Trim` gives the ``u``, ``v``
         and ``w`` ranges meshed (e.g. the ring's ``w ∈ [0.5, 1]`` or a cut-away
         ``v ∈ [π/2, 2π]``).
     nodes : (sx, sy, sz)
@@ -365,16 +365,55 @@ def hex_mesh(tablet: "Tablet", nodes: tuple[int, int, int] = (11, 21, 5), *, che
     """
     t = tablet.trim
     sx, sy, sz = _check_nodes(nodes, t.v[1] - t.v[0])
-    gap = float(tablet.tol.seam_gap)
-    u_all = np.linspace(t.u[0], t.u[1], sx)
-    v = np.linspace(t.v[0], t.v[1], sy)
-    w = np.linspace(t.w[0], t.w[1], sz)
-    spine_layer = t.w[0] == 0.0
-    full_u = t.u[0] == 0.0 and t.u[1] == 1.0
+    grids = _patch_grids(tablet, np.linspace(t.u[0], t.u[1], sx), np.linspace(t.v[0], t.v[1], sy),
+                         np.linspace(t.w[0], t.w[1], sz))
+    offsets = np.cumsum([0] + [g.P.shape[0] * sy * sz for g in grids])
+    raw, rep = _merged_nodes(tablet, grids, offsets)
+    if check:
+        _check_merge(tablet, raw, rep, offsets)
+    blocks: dict[str, list[np.ndarray]] = {k: [] for k in CELL_TYPES}
+    pids: dict[str, list[np.ndarray]] = {k: [] for k in CELL_TYPES}
+    dropped = 0
+    for p, g in enumerate(grids):
+        cells, n_dropped = _patch_cells(tablet, p, g, int(offsets[p]), rep, check)
+        dropped += n_dropped
+        for kind, conn in cells:
+            blocks[kind].append(conn)
+            pids[kind].append(np.full(conn.shape[0], p, dtype=np.int32))
+    cells = {k: np.concatenate(b) for k, b in blocks.items() if b}
+    if not cells:
+        raise GeometryError("the tablet's solid has no cell of positive volume", tablet)
+    # compact: keep only referenced nodes
+    used = np.zeros(raw.shape[0], dtype=bool)
+    for conn in cells.values():
+        used[conn.ravel()] = True
+    new = np.cumsum(used, dtype=np.int64) - 1
+    return SolidMesh(points=raw[used], cells={k: new[c] for k, c in cells.items()},
+                     patch_id={k: np.concatenate(pids[k]) for k in cells}, nodes=(sx, sy, sz),
+                     u_nodes=tuple(g.u for g in grids), dropped=dropped)
 
-    # ------------------------------------------------------------------ nodes
-    grids = []  # per patch: (u, P, vol, flat, sign, pole0, pole1, shared)
-    offsets = [0]
+
+class _Grid(NamedTuple):
+    """One patch's nodes: ``u`` values kept, points ``P`` (nu, sy, sz, 3), cell volumes, whether the
+    patch is flat (no volume), its orientation sign, poles at ``u = 0``/``1``, and whether its
+    ``u = 0`` row is the previous patch's ``u = 1`` row."""
+
+    u: np.ndarray
+    P: np.ndarray
+    vol: np.ndarray
+    flat: bool
+    sign: float
+    pole0: bool
+    pole1: bool
+    shared: bool
+
+
+def _patch_grids(tablet: "Tablet", u_all: np.ndarray, v: np.ndarray, w: np.ndarray) -> list[_Grid]:
+    """Every patch's node grid over the trim ranges (fold nodes dropped), with its degeneracies."""
+    t = tablet.trim
+    gap = float(tablet.tol.seam_gap)
+    full_u = t.u[0] == 0.0 and t.u[1] == 1.0
+    grids: list[_Grid] = []
     for p, patch in enumerate(tablet.patches):
         P, S = _patch_grid(patch, u_all, v, w)
         vol = _structured_volumes(P)
@@ -391,124 +430,110 @@ def hex_mesh(tablet: "Tablet", nodes: tuple[int, int, int] = (11, 21, 5), *, che
         pole1 = t.u[1] == 1.0 and float(np.max(np.ptp(S[-1], axis=0))) <= gap * scale
         shared = False
         if p > 0 and full_u:
-            prev_end = grids[-1][1][-1, :, -1]  # previous patch's surface at u = 1
+            prev_end = grids[-1].P[-1, :, -1]  # previous patch's surface at u = 1
             shared = float(np.max(np.linalg.norm(prev_end - S[0], axis=-1))) <= gap * scale
-        grids.append((u, P, vol, flat, sign, pole0, pole1, shared))
-        offsets.append(offsets[-1] + P.shape[0] * sy * sz)
+        grids.append(_Grid(u, P, vol, flat, sign, pole0, pole1, shared))
+    return grids
 
-    raw = np.empty((offsets[-1], 3))
-    rep = np.arange(offsets[-1], dtype=np.intp)
-    for p, (u, P, vol, flat, sign, pole0, pole1, shared) in enumerate(grids):
-        nu = u.size
-        raw[offsets[p] : offsets[p + 1]] = P.reshape(-1, 3)
+
+def _merged_nodes(tablet: "Tablet", grids: list[_Grid], offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """All nodes (``raw``, patch after patch) and each node's representative index ``rep``: the
+    seam in ``v``, the spine, the poles and the rows shared between patches merged by index."""
+    t = tablet.trim
+    sy, sz = grids[0].P.shape[1:3]
+    raw = np.empty((int(offsets[-1]), 3))
+    rep = np.arange(int(offsets[-1]), dtype=np.intp)
+    for p, g in enumerate(grids):
+        nu = g.u.size
+        raw[offsets[p] : offsets[p + 1]] = g.P.reshape(-1, 3)
         r = rep[offsets[p] : offsets[p + 1]].reshape(nu, sy, sz)  # a view: edits land in rep
         if t.full_v:
             r[:, -1, :] = r[:, 0, :]
-        if spine_layer:
+        if t.w[0] == 0.0:  # the spine layer
             r[:, :, 0] = r[:, 0:1, 0]
-        if pole0:
+        if g.pole0:
             r[0] = r[0, 0, 0]
-        if pole1:
+        if g.pole1:
             r[-1] = r[-1, 0, 0]
-        if shared:
-            nprev = grids[p - 1][0].size
+        if g.shared:
+            nprev = grids[p - 1].u.size
             r[0] = rep[offsets[p - 1] : offsets[p]].reshape(nprev, sy, sz)[-1]
+    return raw, rep
 
-    if check:
-        if not np.array_equal(rep[rep], rep):  # pragma: no cover - index logic
-            raise GeometryError("node merge is not idempotent (internal error)")
-        dist = np.linalg.norm(raw - raw[rep], axis=1)
-        scale = max(1.0, float(np.max(np.abs(raw))))
-        bad = dist > gap * scale
-        if np.any(bad):
-            k = int(np.argmax(dist))
-            p = int(np.searchsorted(offsets, k, side="right")) - 1
-            raise GeometryError(
-                f"{int(np.sum(bad))} merged nodes are up to {dist[k]:.3g} mm from their representative "
-                f"(patch {p}); the degeneracies assumed by index do not hold",
-                tablet,
-            )
 
-    # ------------------------------------------------------------------ cells
-    blocks: dict[str, list[np.ndarray]] = {k: [] for k in CELL_TYPES}
-    pids: dict[str, list[np.ndarray]] = {k: [] for k in CELL_TYPES}
-    dropped = 0
-    for p, (u, P, vol, flat, sign, pole0, pole1, shared) in enumerate(grids):
-        nu = u.size
-        shape = (nu - 1, sy - 1, sz - 1)
-        # corner raw indices; a negatively oriented patch swaps η -> 1 - η
-        offs = _HEX_OFFSETS.copy()
-        if sign < 0:
-            offs[:, 1] = 1 - offs[:, 1]
-        ii = np.arange(nu - 1)[:, None, None]
-        jj = np.arange(sy - 1)[None, :, None]
-        kk = np.arange(sz - 1)[None, None, :]
-        base = offsets[p] + (ii * sy + jj) * sz + kk  # (nu-1, sy-1, sz-1)
-        corner = np.empty(shape + (8,), dtype=np.intp)
-        for c, (a, b, d) in enumerate(offs):
-            corner[..., c] = rep[base + (a * sy + b) * sz + d]
-        # classify by index: which degeneracies touch the cell
-        spine = np.zeros(shape, dtype=bool)
-        if spine_layer:
-            spine[:, :, 0] = True
-        at0 = np.zeros(shape, dtype=bool)
-        at1 = np.zeros(shape, dtype=bool)
-        if pole0:
-            at0[0] = True
-        if pole1:
-            at1[-1] = True
-        keep = ~(at0 & at1) if not flat else np.zeros(shape, dtype=bool)
-        if check and np.any(keep & (vol <= 0.0)):  # pragma: no cover - guarded by _drop_fold_nodes
-            raise GeometryError(f"patch {p}: cells of non-positive volume", tablet.patches[p])
-        dropped += int(np.sum(~keep))
-        kinds = {
-            "hexahedron": keep & ~spine & ~at0 & ~at1,
-            "wedge": keep & spine & ~at0 & ~at1,
-            "pyramid0": keep & ~spine & at0,
-            "pyramid1": keep & ~spine & at1,
-            "tetra0": keep & spine & at0,
-            "tetra1": keep & spine & at1,
-        }
-        for name, mask in kinds.items():
-            if not np.any(mask):
-                continue
-            cc = corner[mask]
-            if check:
-                for x, y in _COLLAPSED[name]:
-                    if not np.array_equal(cc[:, x], cc[:, y]):  # pragma: no cover - index logic
-                        raise GeometryError(f"patch {p}: {name} cells with corners {x}, {y} not merged")
-            conn = cc[:, _TEMPLATES[name]]
-            if check:
-                srt = np.sort(conn, axis=1)
-                if np.any(srt[:, 1:] == srt[:, :-1]):  # pragma: no cover - index logic
-                    raise GeometryError(f"patch {p}: {name} cells with repeated nodes")
-            kind = name.rstrip("01")
-            blocks[kind].append(conn)
-            pids[kind].append(np.full(conn.shape[0], p, dtype=np.int32))
+def _check_merge(tablet: "Tablet", raw: np.ndarray, rep: np.ndarray, offsets: np.ndarray) -> None:
+    """Every merged node within ``tablet.tol.seam_gap`` (relative to the size, at least 1 mm) of its
+    representative; raises :class:`GeometryError` when the degeneracies assumed by index do not hold."""
+    if not np.array_equal(rep[rep], rep):  # pragma: no cover - index logic
+        raise GeometryError("node merge is not idempotent (internal error)")
+    dist = np.linalg.norm(raw - raw[rep], axis=1)
+    scale = max(1.0, float(np.max(np.abs(raw))))
+    bad = dist > float(tablet.tol.seam_gap) * scale
+    if np.any(bad):
+        k = int(np.argmax(dist))
+        p = int(np.searchsorted(offsets, k, side="right")) - 1
+        raise GeometryError(
+            f"{int(np.sum(bad))} merged nodes are up to {dist[k]:.3g} mm from their representative "
+            f"(patch {p}); the degeneracies assumed by index do not hold",
+            tablet,
+        )
 
-    cells = {}
-    patch_id = {}
-    for kind in CELL_TYPES:
-        if blocks[kind]:
-            cells[kind] = np.concatenate(blocks[kind])
-            patch_id[kind] = np.concatenate(pids[kind])
-    if not cells:
-        raise GeometryError("the tablet's solid has no cell of positive volume", tablet)
-    # compact: keep only referenced nodes
-    used = np.zeros(raw.shape[0], dtype=bool)
-    for conn in cells.values():
-        used[conn.ravel()] = True
-    new = np.cumsum(used, dtype=np.int64) - 1
-    points = raw[used]
-    cells = {k: new[c] for k, c in cells.items()}
-    return SolidMesh(
-        points=points,
-        cells=cells,
-        patch_id=patch_id,
-        nodes=(sx, sy, sz),
-        u_nodes=tuple(g[0] for g in grids),
-        dropped=dropped,
-    )
+
+def _patch_cells(tablet: "Tablet", p: int, g: _Grid, offset: int, rep: np.ndarray,
+                 check: bool) -> tuple[list[tuple[str, np.ndarray]], int]:
+    """The cells of patch ``p`` as ``(kind, connectivity)`` blocks, and the number of cells dropped
+    (collapsed to nothing, or all cells of a flat patch)."""
+    sy, sz = g.P.shape[1:3]
+    nu = g.u.size
+    shape = (nu - 1, sy - 1, sz - 1)
+    # corner raw indices; a negatively oriented patch swaps η -> 1 - η
+    offs = _HEX_OFFSETS.copy()
+    if g.sign < 0:
+        offs[:, 1] = 1 - offs[:, 1]
+    ii = np.arange(nu - 1)[:, None, None]
+    jj = np.arange(sy - 1)[None, :, None]
+    kk = np.arange(sz - 1)[None, None, :]
+    base = offset + (ii * sy + jj) * sz + kk  # (nu-1, sy-1, sz-1)
+    corner = np.empty(shape + (8,), dtype=np.intp)
+    for c, (a, b, d) in enumerate(offs):
+        corner[..., c] = rep[base + (a * sy + b) * sz + d]
+    # classify by index: which degeneracies touch the cell
+    spine = np.zeros(shape, dtype=bool)
+    if tablet.trim.w[0] == 0.0:
+        spine[:, :, 0] = True
+    at0 = np.zeros(shape, dtype=bool)
+    at1 = np.zeros(shape, dtype=bool)
+    if g.pole0:
+        at0[0] = True
+    if g.pole1:
+        at1[-1] = True
+    keep = ~(at0 & at1) if not g.flat else np.zeros(shape, dtype=bool)
+    if check and np.any(keep & (g.vol <= 0.0)):  # pragma: no cover - guarded by _drop_fold_nodes
+        raise GeometryError(f"patch {p}: cells of non-positive volume", tablet.patches[p])
+    kinds = {
+        "hexahedron": keep & ~spine & ~at0 & ~at1,
+        "wedge": keep & spine & ~at0 & ~at1,
+        "pyramid0": keep & ~spine & at0,
+        "pyramid1": keep & ~spine & at1,
+        "tetra0": keep & spine & at0,
+        "tetra1": keep & spine & at1,
+    }
+    out = []
+    for name, mask in kinds.items():
+        if not np.any(mask):
+            continue
+        cc = corner[mask]
+        if check:
+            for x, y in _COLLAPSED[name]:
+                if not np.array_equal(cc[:, x], cc[:, y]):  # pragma: no cover - index logic
+                    raise GeometryError(f"patch {p}: {name} cells with corners {x}, {y} not merged")
+        conn = cc[:, _TEMPLATES[name]]
+        if check:
+            srt = np.sort(conn, axis=1)
+            if np.any(srt[:, 1:] == srt[:, :-1]):  # pragma: no cover - index logic
+                raise GeometryError(f"patch {p}: {name} cells with repeated nodes")
+        out.append((name.rstrip("01"), conn))
+    return out, int(np.sum(~keep))
 
 
 # ---------------------------------------------------------------------------- output

@@ -110,7 +110,7 @@ def freecad_build_bspline(
     timeout: float = 300.0,
     freecadcmd: Sequence[str] | None = None,
 ) -> dict[str, Any]:
-    """Rebuild :class:`~tabletcad.bspline.BSplineSurfaceData` with FreeCAD; values at ``(u, v)``, solid volume."""
+    """Rebuild :class:`~tabletcad.brep.surface.BSplineSurfaceData` with FreeCAD; values at ``(u, v)``, solid volume."""
     payload = {"surfaces": [s.as_dict() for s in surfaces], "u": [float(x) for x in u], "v": [float(x) for x in v]}
     with tempfile.TemporaryDirectory(prefix="tabletcad-fcin-") as d:
         p = Path(d) / "surfaces.json"

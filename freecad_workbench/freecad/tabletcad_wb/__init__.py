@@ -1,7 +1,7 @@
 """tabletcad as a FreeCAD workbench (``freecad.tabletcad_wb``).
 
 Inside FreeCAD only the *pure* tabletcad core is used (numpy, scipy and
-:mod:`tabletcad.bspline`); faces, shells, solids and Booleans come from
+:mod:`tabletcad.brep`); faces, shells, solids and Booleans come from
 FreeCAD's own ``Part`` module.  The project's virtual environment (OCP,
 build123d) is never imported into FreeCAD's Python.
 
@@ -29,7 +29,7 @@ ICON_DIR = Path(__file__).resolve().parent / "icons"
 
 
 def _is_root(p: Path) -> bool:
-    return (p / "tabletcad" / "shapes.py").is_file()
+    return (p / "tabletcad" / "families" / "thesis.py").is_file()
 
 
 def core_root() -> Path | None:

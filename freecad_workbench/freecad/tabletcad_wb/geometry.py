@@ -5,8 +5,8 @@ The chain is the one of :mod:`tabletcad.cad.tablet_solid` without OCP:
 1. ``tablet_chain``: the tablet's surface functions (its patches, or for a
    hollow tablet such as the ring: outer wall -> end -> inner wall -> end) and
    the union of their ``v`` breakpoints;
-2. :func:`tabletcad.bspline.fit_patches` (quintic in ``u`` and ``v``, like
-   ``tablet_solid``) -> kernel-neutral :class:`~tabletcad.bspline.BSplineSurfaceData`;
+2. :func:`tabletcad.brep.fit.fit_patches` (quintic in ``u`` and ``v``, like
+   ``tablet_solid``) -> kernel-neutral :class:`~tabletcad.brep.surface.BSplineSurfaceData`;
 3. ``Part.BSplineSurface().buildFromPolesMultsKnots`` -> faces -> sewn
    ``Part.Shell`` -> ``Part.Solid`` (outward, ``isValid()``, exactly one solid).
 
@@ -49,7 +49,7 @@ def tablet_chain(tablet):
     The same chain as :func:`tabletcad.cad.tablet_solid.tablet_surface_functions`
     (numpy only: it imports no OCP), with the union of the patches' breakpoints.
     """
-    from tabletcad.surfaces import tablet_breakpoints, tablet_surface_functions
+    from tabletcad.brep.surfaces import tablet_breakpoints, tablet_surface_functions
 
     funcs, names = tablet_surface_functions(tablet)
     return funcs, names, tablet_breakpoints(tablet)
@@ -60,7 +60,7 @@ def tablet_from_spec(family=None, params=None, design=None):
     from tabletcad import families
 
     if design:
-        from tabletcad.design import load_design
+        from tabletcad.pipeline.design import load_design
 
         return load_design(design)
     return families.family(family, parameter="family").build(**(params or {}))
@@ -188,16 +188,17 @@ def solid_from_faces(faces, sew_tolerance, what="tablet"):
 
 def build_tablet(tablet, tol=None):
     """Fit the tablet's chain, build the Part solid, compute the core's figures."""
-    from tabletcad.bspline import enclosed_volume, fit_patches
-    from tabletcad.surfaces import fit_options
-    from tabletcad.slit import chain_face_surfaces
+    from tabletcad.brep.fit import fit_patches
+    from tabletcad.brep.surface import enclosed_volume
+    from tabletcad.brep.surfaces import fit_options
+    from tabletcad.brep.slit import chain_face_surfaces
 
     t0 = time.perf_counter()
     funcs, names, breaks = tablet_chain(tablet)
     tol = float(tablet.tol.fit if tol is None else tol)
     fits = fit_patches(funcs, tol, names=names, **fit_options(tablet, v_breaks=breaks))
     t1 = time.perf_counter()
-    # cut alike where a boundary row stands still over part of its length (tabletcad.slit)
+    # cut alike where a boundary row stands still over part of its length (tabletcad.brep.slit)
     pieces = chain_face_surfaces([f.surface for f in fits], 1e-7, names)
     faces = [bspline_face(p) for ps in pieces for p in ps]
     solid = solid_from_faces(faces, max(2.0 * tol, 1e-6), tablet.name)

@@ -9,9 +9,9 @@ import numpy as np
 
 from tabletcad.errors import DesignError
 from tabletcad.mechanics.materials import get_material
-from tabletcad.patch import PDEPatch
-from tabletcad.shapes import coaxial_tablet
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.patch import PDEPatch
+from tabletcad.families.thesis import coaxial_tablet
+from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT
 
 __all__ = ["LACTOSE", "KOSTROLITH", "GELATIN", "THESIS_MINUTES", "THESIS_RESULTS", "coaxial_fast", "round_tablet", "sphere_tablet", "min_height_slope", "free_form_toml"]
@@ -58,7 +58,7 @@ _FAST = replace(DEFAULT, quad_v=16)
 
 
 def coaxial_fast(sections, *, name: str = "tablet", check: bool = False, a: float = 1.0, fast: bool = True) -> Tablet:
-    """:func:`tabletcad.shapes.coaxial_tablet` of circles ``[(radius, z) × 4]`` with one Fourier
+    """:func:`tabletcad.families.thesis.coaxial_tablet` of circles ``[(radius, z) × 4]`` with one Fourier
     mode per patch (exact for circles); ``fast=True`` uses a 16-point rule in ``v`` (exact for
     surfaces of revolution); ``check`` runs the patches' stray and fold checks."""
     return coaxial_tablet(sections, a=a, name=name, modes=1, check=check, tol=_FAST if fast else DEFAULT)
@@ -144,7 +144,7 @@ def _update_initial(init: dict, initial: dict | None) -> None:
 
 def free_form_toml(tablet: Tablet, sections, *, name: str, comment: str = "") -> str:
     """A ``free_form`` design file (``[[patch]]`` circle curves, ``"previous"``) for ``tabletcad build``."""
-    from tabletcad.design import Design
+    from tabletcad.pipeline.design import Design
 
     patches = [{"curves": ["previous" if k == 0 and j > 0 else {"type": "circle", "radius": float(r), "z": float(z)}
                            for k, (r, z) in enumerate(sec)]} for j, sec in enumerate(sections)]

@@ -14,7 +14,7 @@ from tabletcad.optimise.thesis.common import (
     LACTOSE, THESIS_RESULTS, _disc, _profile_max_radius, _update_initial, free_form_toml, min_height_slope,
     round_tablet,
 )
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
 
 __all__ = ["RoundDesign", "flat_faced_round_problem"]
 

@@ -11,7 +11,7 @@ from tabletcad.optimise.problem import Constraint, Objective, Problem, Variable
 from tabletcad.optimise.thesis.common import (
     GELATIN, THESIS_RESULTS, _update_initial, coaxial_fast, free_form_toml,
 )
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
 
 __all__ = ["Capsule", "capsule", "softgel_capsule_problem"]
 

@@ -12,7 +12,7 @@ from tabletcad.optimise.thesis.common import (
     KOSTROLITH, THESIS_RESULTS, _sphere_sections, _update_initial, free_form_toml, min_height_slope,
     sphere_tablet,
 )
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
 
 __all__ = ["SphereDesign", "spherical_tablet_problem"]
 

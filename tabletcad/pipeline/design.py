@@ -45,12 +45,14 @@ from typing import Any
 
 import numpy as np
 
-from tabletcad.curves import Circle, Curve, Ellipse, PointCurve, RoundedRectangle, Stadium
+from tabletcad.geometry.curves import Circle, Curve, Ellipse, PointCurve, RoundedRectangle, Stadium
 from tabletcad.errors import DesignError, check_finite, one_token
-from tabletcad.patch import PDEPatch
+from tabletcad.geometry.patch import PDEPatch
 from tabletcad.families import FAMILIES, RENAMED
 from tabletcad.families import family as lookup_family
-from tabletcad.tablet import Tablet, Trim
+from tabletcad.pipeline.designreport import ReportOptions
+from tabletcad.tooling.spec import ToolingSpec, parse_tooling
+from tabletcad.geometry.tablet import Tablet, Trim
 from tabletcad.tolerance import DEFAULT, Tolerances
 
 if sys.version_info >= (3, 11):
@@ -181,7 +183,7 @@ _TABLES = ("trim", "reshape", "report", "tooling")
 class Design:
     """A design as data: the tables of a design file, checked, before any geometry is built.
 
-    Separate from the :class:`~tabletcad.tablet.Tablet` it builds (:meth:`build`), it reads from
+    Separate from the :class:`~tabletcad.geometry.tablet.Tablet` it builds (:meth:`build`), it reads from
     and writes to TOML (:meth:`from_toml`, :meth:`to_toml`) and plain dictionaries
     (:meth:`from_dict`, :meth:`to_dict`: what sweeps vary and send to their workers).  Family
     names are current: an old name is replaced by its new one when the design is read.
@@ -196,8 +198,13 @@ class Design:
         The optional tables of the same names.
     comment : str
         Lines written as ``#`` comments at the top of :meth:`to_toml` (not part of the value).
+    report_options : ReportOptions
+        The ``[report]`` table, checked (derived; not an argument).
+    tooling_spec : ToolingSpec or None
+        The ``[tooling]`` table, checked (derived; not an argument), or None without one.
 
-    The tables are the design's own copies; treat them as read-only.
+    The tables are the design's own copies; treat them as read-only.  A bad ``[report]`` or
+    ``[tooling]`` value is refused when the design is made, before any geometry.
     """
 
     tablet: dict
@@ -207,6 +214,12 @@ class Design:
     report: dict | None = None
     tooling: dict | None = None
     comment: str = field(default="", compare=False, repr=False)
+    report_options: ReportOptions = field(init=False, compare=False, repr=False)
+    tooling_spec: ToolingSpec | None = field(init=False, compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "report_options", ReportOptions.from_table(self.report))
+        object.__setattr__(self, "tooling_spec", None if self.tooling is None else parse_tooling(self.tooling))
 
     @property
     def name(self) -> str:
@@ -280,7 +293,8 @@ class Design:
         return toml_text(self.to_dict(), comment=self.comment)
 
     def build(self) -> Tablet:
-        """The tablet of this design (its ``extras`` hold the ``[report]`` and ``[tooling]`` tables).
+        """The tablet of this design (geometry only: :attr:`report_options` and
+        :attr:`tooling_spec` stay with the design).
 
         Everything is validated before geometry is built where it can be: unknown
         and missing keys, booleans or strings given for numbers, lengths beyond
@@ -331,9 +345,6 @@ class Design:
             _check_size(tablet)
         if self.trim is not None:
             tablet = _trim(tablet, self.trim)
-        extras = {k: copy.deepcopy(getattr(self, k)) for k in ("report", "tooling") if getattr(self, k) is not None}
-        if extras:
-            tablet = replace(tablet, extras={**tablet.extras, **extras})
         return tablet
 
 
@@ -445,7 +456,7 @@ def _factor(where: str, value: Any, tol: Tolerances = DEFAULT) -> float:
 
 
 def _reshape(tablet: Tablet, r: dict) -> Tablet:
-    from tabletcad import reshape
+    from tabletcad.families import reshape
 
     _check_keys("reshape", r, {"spine", "radius", "patches"})
     if "patches" in r:

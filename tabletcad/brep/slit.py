@@ -14,7 +14,7 @@ tear the face open and OCCT's Booleans fail where a tool crosses it.
 :func:`chain_face_surfaces` therefore cuts every surface of the chain in ``v``
 at the row's C0 knots (the outline junctions, where the fit puts knots of
 multiplicity ``degree``), each piece an exact clamped part of the same B-spline
-(:func:`tabletcad.bspline.segment_v`).  A piece's row then either moves or is a
+(:func:`tabletcad.brep.surface.segment_v`).  A piece's row then either moves or is a
 single pole (a degenerated edge, like a sphere's pole); a capsule cup becomes two
 cylinder-like runs meeting along the segment and two dome-like fans at its ends,
 the topology a toolmaker's CAD gives it.
@@ -29,7 +29,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from tabletcad.bspline import BSplineSurfaceData, segment_v
+from tabletcad.brep.surface import BSplineSurfaceData, segment_v
 from tabletcad.errors import GeometryError
 
 __all__ = ["chain_face_surfaces", "row_pieces"]

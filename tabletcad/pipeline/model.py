@@ -12,9 +12,9 @@
     tools = m.tooling(clearance_mm=0.03)
     tools.upper_punch.to_build123d()
 
-The core :class:`tabletcad.tablet.Tablet` never imports OpenCascade; this
+The core :class:`tabletcad.geometry.tablet.Tablet` never imports OpenCascade; this
 module sits after it in the flow and imports the CAD layer only inside the
-methods that need it, so ``import tabletcad.model`` stays numpy-only.
+methods that need it, so ``import tabletcad.pipeline.model`` stays numpy-only.
 """
 
 from __future__ import annotations
@@ -30,7 +30,8 @@ from typing import Any
 import numpy as np
 
 from tabletcad.errors import DesignError
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
+from tabletcad.pipeline.design import Design
 from tabletcad.tolerance import DEFAULT
 
 __all__ = ["TabletModel", "PartModel", "ToolingModel", "make", "load", "show", "mesh_html"]
@@ -151,12 +152,16 @@ class ToolingModel:
 
 @dataclass(frozen=True, eq=False)
 class TabletModel(_Shaped):
-    """A core :class:`~tabletcad.tablet.Tablet` (``.tablet``) with CAD, export and notebook methods.
+    """A core :class:`~tabletcad.geometry.tablet.Tablet` (``.tablet``) with CAD, export and notebook methods.
 
     The B-rep is fitted on first use (:func:`tabletcad.cad.tablet_solid.tablet_solid`) and kept.
+    ``design``: the :class:`~tabletcad.pipeline.design.Design` it was built from (:func:`load`),
+    whose ``[report]`` options and ``[tooling]`` specification :meth:`report` and :meth:`tooling`
+    use; None for a tablet made in Python (:func:`make`).
     """
 
     tablet: Tablet
+    design: Design | None = None
 
     @property
     def name(self) -> str:
@@ -180,9 +185,9 @@ class TabletModel(_Shaped):
 
     def report(self) -> dict[str, Any]:
         """The geometry and design report (the content of ``report.json``)."""
-        from tabletcad.report import geometry_report
+        from tabletcad.pipeline.report import geometry_report
 
-        return geometry_report(self.tablet)
+        return geometry_report(self.tablet, None if self.design is None else self.design.report_options)
 
     def tooling(self, spec: Any = None, **kw: Any) -> ToolingModel:
         """Punch tips, die and the featured tablet.
@@ -195,17 +200,18 @@ class TabletModel(_Shaped):
         from tabletcad.tooling.toolset import make_tooling
 
         if spec is None:
-            spec = self.tablet.extras.get("tooling", {})
+            spec = ToolingSpec() if self.design is None or self.design.tooling_spec is None else self.design.tooling_spec
         if isinstance(spec, dict):
             spec = parse_tooling({**spec, **kw})
         elif isinstance(spec, ToolingSpec):
             spec = spec.with_(**kw) if kw else spec
         else:
             raise DesignError("tooling spec", type(spec).__name__, "must be a ToolingSpec, a dict or None")
-        return ToolingModel(make_tooling(self.tablet, spec, shape=self.to_occ()))
+        return ToolingModel(make_tooling(self.tablet, spec, shape=self.to_occ(),
+                                         options=None if self.design is None else self.design.report_options))
 
     def _repr_png_(self) -> bytes:
-        from tabletcad.plot import tablet_png
+        from tabletcad.pipeline.plot import tablet_png
 
         return tablet_png(self.tablet)
 
@@ -221,10 +227,10 @@ def make(family: str, **dims: Any) -> TabletModel:
 
 
 def load(path: str | Path) -> TabletModel:
-    """A tablet from a TOML design file (:func:`tabletcad.design.load_design`)."""
-    from tabletcad.design import load_design
-
-    return TabletModel(load_design(path))
+    """The tablet of a TOML design file, with the design (:meth:`Design.from_toml
+    <tabletcad.pipeline.design.Design.from_toml>`)."""
+    design = Design.from_toml(path)
+    return TabletModel(design.build(), design)
 
 
 def show(*objs: Any, **kw: Any):

@@ -15,11 +15,13 @@ import os
 from pathlib import Path
 from typing import Any
 
-from tabletcad.design import Design
+from tabletcad.geometry.tablet import Tablet
 from tabletcad.io.outputs import STAGING_MARKER, publish, staging_folder
-from tabletcad.plot import plot_tablet
-from tabletcad.report import geometry_report, to_json
-from tabletcad.tablet import Tablet
+from tabletcad.pipeline.design import Design
+from tabletcad.pipeline.designreport import ReportOptions
+from tabletcad.pipeline.plot import plot_tablet
+from tabletcad.pipeline.report import geometry_report, to_json
+from tabletcad.tooling.spec import ToolingSpec
 
 __all__ = ["build_design", "build_tablet", "cad_available", "CAD_MODULES"]
 
@@ -40,15 +42,17 @@ def cad_available() -> bool:
     return all(importlib.util.find_spec(m) is not None for m in CAD_MODULES)
 
 
-def build_tablet(tablet: Tablet, out_dir: str | Path, *, cad: bool | None = None, progress: bool = True) -> dict[str, Any]:
+def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | None = None,
+                 options: ReportOptions | None = None, cad: bool | None = None, progress: bool = True) -> dict[str, Any]:
     """Write ``report.json``, ``tablet.png``, the CAD files and the tooling of ``tablet`` into ``out_dir``.
 
-    The steps, in order: the geometry report (:func:`~tabletcad.report.geometry_report`);
-    with ``cad`` (default: :func:`cad_available`) the solid, its checks and
-    ``tablet.step/.stl/.glb`` (:func:`tabletcad.cad.stage.cad_stage`), then, when the
-    tablet's design has a ``[tooling]`` table (``tablet.extras["tooling"]``), the punches,
-    die and drawings made from that solid (:func:`tabletcad.tooling.stage.tooling_stage`);
-    last the picture.  The ``[tooling]`` table is checked before any geometry is built.
+    The steps, in order: the geometry report (:func:`~tabletcad.pipeline.report.geometry_report`,
+    with the report ``options``); with ``cad`` (default: :func:`cad_available`) the solid, its
+    checks and ``tablet.step/.stl/.glb`` (:func:`tabletcad.cad.stage.cad_stage`), then, with a
+    ``tooling`` specification, the punches, die and drawings made from that solid
+    (:func:`tabletcad.tooling.stage.tooling_stage`); last the picture.  Whether the tablet can
+    have tooling is checked before any geometry is built.  :func:`build_design` takes both
+    from a design.
 
     Returns the report; ``report["outputs"]`` names the files this build wrote.
     Nothing in ``out_dir`` changes if any step fails.  The folder is owned by
@@ -57,18 +61,19 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, cad: bool | None = None
     """
     out_dir = Path(out_dir)
     cad = cad_available() if cad is None else cad
-    tooling = None
-    if cad:
-        from tabletcad.tooling.stage import tooling_spec
+    if not cad:
+        tooling = None
+    elif tooling is not None:
+        from tabletcad.tooling.stage import check_tooling
 
-        tooling = tooling_spec(tablet)  # bad [tooling] input is refused before the (slow) geometry
+        check_tooling(tablet, tooling)  # refused before the (slow) geometry
     steps = 2 + cad + (tooling is not None)
     with staging_folder(out_dir) as staging:
         from tqdm import tqdm
 
         # the bar shows on a terminal only (disable=None), never in a log or a pipe
         with tqdm(total=steps, desc="build", unit="step", disable=None if progress else True, leave=False) as bar:
-            report = geometry_report(tablet)
+            report = geometry_report(tablet, options)
             bar.update()
             if cad:
                 from tabletcad.cad.stage import cad_stage
@@ -78,7 +83,7 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, cad: bool | None = None
                 if tooling is not None:
                     from tabletcad.tooling.stage import tooling_stage
 
-                    tooling_stage(tablet=tablet, spec=tooling, shape=shape, out=staging, report=report)
+                    tooling_stage(tablet=tablet, spec=tooling, shape=shape, out=staging, report=report, options=options)
                     bar.update()
             plot_tablet(tablet, staging / "tablet.png")
             bar.update()
@@ -89,8 +94,11 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, cad: bool | None = None
         return report
 
 
-def build_design(design: str | Path | Design, out_dir: str | Path, *, progress: bool = True) -> dict[str, Any]:
-    """:func:`build_tablet` of a design (a :class:`~tabletcad.design.Design` or a design file)."""
+def build_design(design: str | Path | Design, out_dir: str | Path, *, cad: bool | None = None,
+                 progress: bool = True) -> dict[str, Any]:
+    """:func:`build_tablet` of a design (a :class:`~tabletcad.pipeline.design.Design` or a design file):
+    its tablet, its ``[tooling]`` specification and its ``[report]`` options."""
     if not isinstance(design, Design):
         design = Design.from_toml(design)
-    return build_tablet(design.build(), out_dir, progress=progress)
+    return build_tablet(design.build(), out_dir, tooling=design.tooling_spec, options=design.report_options,
+                        cad=cad, progress=progress)

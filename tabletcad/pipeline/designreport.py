@@ -1,6 +1,6 @@
 """Design report of a family tablet: dimensions, cup, weight, punch-tip check, tensile strength, size.
 
-:func:`tabletcad.report.geometry_report` adds it to the report of every tablet
+:func:`tabletcad.pipeline.report.geometry_report` adds it to the report of every tablet
 built from a family of this package, so its ``report.json`` gains
 
 * ``nominal_max_deviation_um``, ``nominal_tolerance_um``, ``nominal_certified``:
@@ -16,8 +16,6 @@ from the design file's ``[report]`` table or its command-line options.
 
 from __future__ import annotations
 
-import contextlib
-import contextvars
 import math
 import sys
 import warnings
@@ -29,14 +27,14 @@ import numpy as np
 
 from tabletcad.errors import DesignError, check_range
 from tabletcad.families.sweep import SweepNominal, certify, sweep_properties
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
 
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["ReportOptions", "design_report", "shape_report", "family_seams", "report_options",
+__all__ = ["ReportOptions", "design_report", "shape_report", "family_seams",
            "punch_rating_table", "tensile_strength", "FDA_MAX_DIMENSION_MM", "REPORT_KEYS"]
 
 #: FDA guidance "Size, Shape, and Other Physical Attributes of Generic Tablets and Capsules"
@@ -117,19 +115,6 @@ class ReportOptions:
 
 def _bad(k, v):
     raise DesignError(f"[report] {k}", v, "must be a number", REPORT_KEYS[k])
-
-
-_OPTIONS: contextvars.ContextVar[ReportOptions] = contextvars.ContextVar("tabletcad_family_report_options", default=ReportOptions())
-
-
-@contextlib.contextmanager
-def report_options(opts: ReportOptions):
-    """Use ``opts`` for the report sections generated inside the ``with`` block."""
-    token = _OPTIONS.set(opts)
-    try:
-        yield
-    finally:
-        _OPTIONS.reset(token)
 
 
 # ---------------------------------------------------------------------------- pieces
@@ -300,23 +285,12 @@ def _cup_radius(info: dict) -> float | None:
     return r.get("cup", r.get("central"))
 
 
-def _options(tablet: Tablet, opts: ReportOptions | None) -> ReportOptions:
-    """The report's options: those given, else the command's (``_OPTIONS``), else the design file's
-    ``[report]`` table."""
-    if opts is not None:
-        return opts
-    opts = _OPTIONS.get()
-    if opts == ReportOptions() and isinstance(tablet.extras.get("report"), dict):
-        return ReportOptions.from_table(tablet.extras["report"])
-    return opts
-
-
 def design_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str, Any]:
     """The design report of a family tablet (see module docstring); keys carry units."""
     nom = tablet.nominal
     if not isinstance(nom, SweepNominal):
         raise DesignError("tablet", tablet.name, "is not built from a tabletcad.families family")
-    opts = _options(tablet, opts)
+    opts = ReportOptions() if opts is None else opts
     cert = nom.certificate
     recert = cert is None or nom.patch_ids != tuple(id(p) for p in tablet.patches)
     if recert:
@@ -410,7 +384,7 @@ def shape_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str,
     There is no certificate: ``nominal_max_deviation_um`` is the PDE surface's largest distance
     from the exact shape when the family has one (the thesis's curves, not a tolerance).
     """
-    opts = _options(tablet, opts)
+    opts = ReportOptions() if opts is None else opts
     props = tablet.properties()
     dims = tablet.dimensions()
     V, A = props["volume_mm3"], props["surface_area_mm2"]

@@ -13,7 +13,7 @@ The solution is the analytic series of eq 3.12 truncated at ``N`` modes
 (eq 3.17) plus the remainder term ``R`` of eq 3.18, which makes the surface
 pass exactly through boundary data that ``N`` modes do not represent.  Each
 mode ``n`` has the profile ``Σ_k L_k(u; a n) c_{k,n}`` where ``L_k`` are the
-cardinal functions of :mod:`tabletcad.basis` and ``c_{k,n}`` the mode's
+cardinal functions of :mod:`tabletcad.geometry.basis` and ``c_{k,n}`` the mode's
 coefficients in datum ``k``; ``R = Σ_k L_k(u; β) r_k(v)`` with ``r_k`` the
 part of datum ``k`` above mode ``N`` (``β`` defaults to ``a (N + 1)``, the
 decay of the first omitted mode; the thesis's ``N (a + 1)`` is available).
@@ -33,8 +33,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tabletcad.basis import cardinal, cardinal_coefficients, cardinals
-from tabletcad.curves import CurveLike, fourier_coefficients, modes_needed, sample_v
+from tabletcad.geometry.basis import cardinal, cardinal_coefficients, cardinals
+from tabletcad.geometry.curves import CurveLike, fourier_coefficients, modes_needed, sample_v
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
 
@@ -68,7 +68,7 @@ class PDEPatch:
     data : tuple of 4 curves
         ``form="curves"``: the curves at ``u_nodes`` (the thesis's ``P1, d1, d2,
         P2``).  ``form="hermite"``: ``(X(0, v), X(1, v), X_u(0, v), X_u(1, v))``.
-        Each is any object with ``evaluate(v, der)`` (see :mod:`tabletcad.curves`).
+        Each is any object with ``evaluate(v, der)`` (see :mod:`tabletcad.geometry.curves`).
     a : float or "auto"
         Smoothing parameter ``a > 0`` of eq 3.9.  ``"auto"`` takes the first
         value of :data:`AUTO_A_LADDER` whose surface passes the stray check.
@@ -190,7 +190,7 @@ class PDEPatch:
         Such a mode's shape between the curves is set by the amplification,
         not by the design (and beyond ``LAMBDA_MAX`` it cannot be computed).
         """
-        from tabletcad.basis import LAMBDA_MAX, lebesgue_max
+        from tabletcad.geometry.basis import LAMBDA_MAX, lebesgue_max
 
         limit = self.tol.max_amplification
         used = [(f"mode {n}", float(self._lams[n]), amp[n]) for n in self._active]
@@ -425,7 +425,7 @@ class PDEPatch:
     def radius_profile(self, u) -> np.ndarray:
         """Radius ``r(u) = sqrt(A_1x² + A_1y²)`` of the first mode (eq 4.22), mm.
 
-        Exact for circles stacked along z; see :func:`tabletcad.reshape.circularity`.
+        Exact for circles stacked along z; see :func:`tabletcad.families.reshape.circularity`.
         """
         u = np.asarray(u, dtype=float)
         if self.modes < 1:

@@ -9,7 +9,7 @@ spherical cap at equal angular steps (thesis eq 4.1); interior curves of a
 band are copies of its rim at equal heights; interior curves of a flat face
 are concentric at equal radial steps.  The Table 4.5 shapes are also
 reachable the thesis's way, by scaling coefficients of a Table 4.1 shape
-(:mod:`tabletcad.reshape`).
+(:mod:`tabletcad.families.reshape`).
 """
 
 from __future__ import annotations
@@ -20,12 +20,12 @@ from typing import Mapping
 
 import numpy as np
 
-from tabletcad import nominal as nom
-from tabletcad.curves import Circle, Curve, Ellipse
+from tabletcad.geometry import nominal as nom
+from tabletcad.geometry.curves import Circle, Curve, Ellipse
 from tabletcad.errors import DesignError, check_positive, check_range
-from tabletcad.family import Family
-from tabletcad.patch import PDEPatch
-from tabletcad.tablet import Tablet, Trim
+from tabletcad.families.family import Family
+from tabletcad.geometry.patch import PDEPatch
+from tabletcad.geometry.tablet import Tablet, Trim
 from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = [

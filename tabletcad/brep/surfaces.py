@@ -6,7 +6,7 @@ tablet's faces are its patches.  A hollow tablet (``trim.w[0] > 0``, e.g. the ri
 closed chain outer wall -> end face at ``u = 1`` -> inner wall (reversed) -> end face at
 ``u = 0``.  A cut-away (``[trim] v``) is one closed chain over ``theta``.  :func:`fit_options`
 holds the fit's settings for every kernel: the OCP layer (:mod:`tabletcad.cad.tablet_solid`)
-and the FreeCAD workbench both fit these functions with :func:`tabletcad.bspline.fit_patches`.
+and the FreeCAD workbench both fit these functions with :func:`tabletcad.brep.fit.fit_patches`.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from typing import Any, Callable
 import numpy as np
 
 from tabletcad.errors import GeometryError
-from tabletcad.tablet import Tablet, solid_map
+from tabletcad.geometry.tablet import Tablet, solid_map
 
 __all__ = ["SurfaceFunction", "tablet_surface_functions", "cutaway_surface_functions", "tablet_breakpoints",
            "fit_options"]
@@ -39,7 +39,7 @@ def tablet_surface_functions(tablet: Tablet) -> tuple[list[SurfaceFunction], lis
     w0, w1 = t.w
     names = [p.name or f"patch {j}" for j, p in enumerate(tablet.patches)]
     if w0 == 0.0 and w1 == 1.0:
-        from tabletcad.bspline import PatchFunction  # keeps the patches' fast evaluate_grid
+        from tabletcad.brep.fit import PatchFunction  # keeps the patches' fast evaluate_grid
 
         return [PatchFunction(p) for p in tablet.patches], names
     if len(tablet.patches) != 1:
@@ -84,7 +84,7 @@ def cutaway_surface_functions(tablet: Tablet) -> tuple[list[SurfaceFunction], np
             return solid_map(p, s, v, w)
         return f
 
-    from tabletcad.bspline import chain_breakpoints
+    from tabletcad.brep.fit import chain_breakpoints
 
     breaks = [0.0, ta, tb]
     for b in chain_breakpoints(tablet.patches):
@@ -101,20 +101,20 @@ def tablet_breakpoints(tablet: Tablet) -> np.ndarray:
     which share the patch's ``v``) is fitted with breakpoint knots at all of
     them, so that the chain keeps one common ``v`` knot vector.
     """
-    from tabletcad.bspline import chain_breakpoints
+    from tabletcad.brep.fit import chain_breakpoints
 
     return chain_breakpoints(tablet.patches)
 
 
 def fit_options(tablet: Tablet, **kwargs: Any) -> dict[str, Any]:
-    """Keyword arguments of :func:`tabletcad.bspline.fit_patches` for the tablet's chain.
+    """Keyword arguments of :func:`tabletcad.brep.fit.fit_patches` for the tablet's chain.
 
     One place for every kernel (this OCP layer and the FreeCAD workbench):
     quintic B-splines - 17 x 32 poles already fit the thesis's tablets to ~3e-8
     mm, where cubics need ~4x the poles for 1e-5 mm (and leave a 1e-6 volume
     bias); knots of full multiplicity at the outline breakpoints, where the
     surface may be only C0 (a cup swept over an offset outline whose corner
-    collapses) and where a slit is cut (:mod:`tabletcad.slit`).  ``kwargs``
+    collapses) and where a slit is cut (:mod:`tabletcad.brep.slit`).  ``kwargs``
     override the defaults.
     """
     kwargs.setdefault("u_degree", 5)

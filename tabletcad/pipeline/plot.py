@@ -21,7 +21,7 @@ from typing import Sequence
 import numpy as np
 
 from tabletcad.io.atomic import atomic_path
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
 
 __all__ = ["plot_tablet", "plot_tablets", "tablet_figure", "tablets_figure", "tablet_png", "side_profile",
            "TabletOutline"]

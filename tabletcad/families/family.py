@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping
 from tabletcad.errors import DesignError
 
 if TYPE_CHECKING:  # pragma: no cover
-    from tabletcad.tablet import Tablet
+    from tabletcad.geometry.tablet import Tablet
 
 __all__ = ["Family"]
 

@@ -17,10 +17,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from tabletcad.curves import Transformed
+from tabletcad.geometry.curves import Transformed
 from tabletcad.errors import DesignError, check_positive
-from tabletcad.patch import PDEPatch
-from tabletcad.tablet import Tablet, Trim
+from tabletcad.geometry.patch import PDEPatch
+from tabletcad.geometry.tablet import Tablet, Trim
 
 __all__ = [
     "spine_height",
@@ -54,7 +54,7 @@ def circularity(patch: PDEPatch, samples: int = 33) -> dict[str, float]:
     u = np.linspace(0.0, 1.0, samples)
     if patch.modes < 1:
         return dict(eq_4_23_a=0.0, eq_4_23_b=0.0, higher_modes=0.0)
-    from tabletcad.basis import cardinal
+    from tabletcad.geometry.basis import cardinal
 
     L = cardinal(u, patch.a * 1.0, patch.u_nodes, patch.form)
     A1 = L @ patch._ac[:, 0]
@@ -134,7 +134,7 @@ def thesis_table_4_5() -> dict[str, dict]:
 
     Returns ``name -> dict(tablet=..., thesis_dims_mm=..., changes=...)``.
     """
-    from tabletcad import shapes
+    from tabletcad.families import thesis
 
     out: dict[str, dict] = {}
 
@@ -142,18 +142,18 @@ def thesis_table_4_5() -> dict[str, dict]:
         out[name] = dict(tablet=replace(t, name=name, family=f"thesis.{name}", nominal=None), thesis_dims_mm=dims,
                          changes=changes)
 
-    ffr = shapes.flat_faced_round()
+    ffr = thesis.flat_faced_round()
     body = select_patches(ffr, [1])
     ring = scale_radius(scale_heights(body, [0.75]), 1.2)
     add("ring", replace(ring, trim=Trim(w=(0.5, 1.0))), "12 x 4.5", "0.75 A0z2, 1.2 r, w in [0.5, 1]")
-    scr = shapes.shallow_convex_round()
+    scr = thesis.shallow_convex_round()
     add("deep_convex_round", scale_heights(scr, [3, 0.5, 3]), "10 x 4", "3 A0z1, 0.5 A0z2, 3 A0z3")
-    sph = shapes.spherical()
+    sph = thesis.spherical()
     add("oblate_spheroid", scale_radius(scale_heights(sph, [0.5, 0.5]), 2.0), "10 x 2.5", "0.5 A0z1, 0.5 A0z2, 2 r")
     add("prolate_spheroid", scale_heights(sph, [2, 2]), "5 x 10", "2 A0z1, 2 A0z2")
-    obl = shapes.oblong()
+    obl = thesis.oblong()
     add("rod", scale_radius(scale_heights(obl, [0.2, 0.6, 0.2]), 0.6), "3 x 7.5", "0.2 A0z1, 0.6 A0z2, 0.2 A0z3, 0.6 r")
-    ova = shapes.shallow_convex_oval()
+    ova = thesis.shallow_convex_oval()
     add("caplet", scale_radius(scale_heights(ova, [5, 5, 5]), 0.585), "3.5 x 7 x 15", "5 A0z1, 5 A0z2, 5 A0z3, 0.585 r")
     add("deep_convex_oval", scale_heights(ova, [2, 0.55, 2]), "6 x 12 x 3.1", "2 A0z1, 0.55 A0z2, 2 A0z3")
     return out

@@ -2,7 +2,7 @@
 
 Each function returns ``f(points (m, 3)) -> (m,)``, negative inside.  Used to
 certify how far a PDE surface lies from the shape it stands for
-(:meth:`tabletcad.tablet.Tablet.nominal_deviation`).
+(:meth:`tabletcad.geometry.tablet.Tablet.nominal_deviation`).
 """
 
 from __future__ import annotations

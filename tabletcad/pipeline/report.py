@@ -8,16 +8,19 @@ from typing import Any
 
 import numpy as np
 
-from tabletcad.families.designreport import design_report
+from tabletcad.pipeline.designreport import ReportOptions, design_report
 from tabletcad.families.sweep import SweepNominal
-from tabletcad.tablet import Tablet
+from tabletcad.geometry.tablet import Tablet
 
 __all__ = ["geometry_report", "to_json", "flatten_report"]
 
-def geometry_report(tablet: Tablet) -> dict[str, Any]:
+def geometry_report(tablet: Tablet, options: ReportOptions | None = None) -> dict[str, Any]:
     """Volume, area, dimensions, per-patch figures, seams and nominal deviation.
 
-    All lengths in mm, areas in mm², volumes in mm³, angles in degrees.
+    All lengths in mm, areas in mm², volumes in mm³, angles in degrees.  A tablet of an
+    industry family also gets its design report (:func:`~tabletcad.pipeline.designreport.design_report`),
+    which reads ``options`` (a design's ``[report]`` table: :attr:`Design.report_options
+    <tabletcad.pipeline.design.Design.report_options>`).
     """
     props = tablet.properties()
     dims = tablet.dimensions()
@@ -64,7 +67,7 @@ def geometry_report(tablet: Tablet) -> dict[str, Any]:
         else dict(max_deviation_um=dev * 1000.0),
     )
     if isinstance(tablet.nominal, SweepNominal):  # the industry families' design report
-        rep.update(design_report(tablet))
+        rep.update(design_report(tablet, options))
     return rep
 
 

@@ -39,7 +39,7 @@ _SMALL = 1.0  # λ at or below which the hyperbolic basis is used
 
 #: Largest λ accepted in the four-curve form (the Hermite form has no limit).  Beyond ~2200 the interior-node rows underflow; long
 #: before that (λ ≳ 30 for nodes at 1/3, 2/3) a mode is amplified more than
-#: 1000-fold between the curves, which :class:`tabletcad.patch.PDEPatch` refuses.
+#: 1000-fold between the curves, which :class:`tabletcad.geometry.patch.PDEPatch` refuses.
 #: For large λ the cardinal functions are accurate relative to their own size
 #: (~e^{λ/4} between the nodes), i.e. to ``eps·max|L|`` absolutely.
 LAMBDA_MAX = 1500.0

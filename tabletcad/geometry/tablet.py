@@ -1,6 +1,6 @@
 """Tablets: ordered PDE patches sharing boundary curves, and their solids.
 
-A :class:`Tablet` is a chain of :class:`~tabletcad.patch.PDEPatch` objects in
+A :class:`Tablet` is a chain of :class:`~tabletcad.geometry.patch.PDEPatch` objects in
 which patch ``j``'s curve at ``u = 1`` is patch ``j + 1``'s curve at ``u = 0``
 (C0 by construction, thesis section 3.4.1).  Each patch also defines a solid
 ``X(u, v, w) = A0(u) + w (X(u, v) - A0(u))``, ``w ∈ [0, 1]`` (eq 4.12),
@@ -18,7 +18,7 @@ from typing import Any, Callable
 import numpy as np
 
 from tabletcad.errors import DesignError, check_range
-from tabletcad.patch import PDEPatch
+from tabletcad.geometry.patch import PDEPatch
 from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = ["Trim", "Tablet", "Face", "solid_map"]
@@ -196,9 +196,6 @@ class Tablet:
     nominal : callable, optional
         Signed distance ``f(points (m, 3)) -> (m,)`` (mm) to the exact shape the
         tablet approximates, for :meth:`nominal_deviation`.
-    extras : dict
-        Tables of the design file that are not geometry (``report``,
-        ``tooling``), for the report sections and build stages that read them.
     """
 
     patches: tuple
@@ -209,7 +206,6 @@ class Tablet:
     nominal: Callable[[np.ndarray], np.ndarray] | None = field(default=None, repr=False)
     nominal_name: str = ""
     tol: Tolerances = field(default=DEFAULT, repr=False)
-    extras: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         patches = tuple(self.patches)

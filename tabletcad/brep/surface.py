@@ -1,0 +1,247 @@
+"""Kernel-neutral tensor-product B-spline surfaces (numpy only; never imports a CAD kernel).
+
+FreeCAD's own Python and the OCP layer in :mod:`tabletcad.cad` both build their
+surfaces from the same :class:`BSplineSurfaceData`.
+
+Conventions (identical to OCCT's ``Geom_BSplineSurface`` and FreeCAD's
+``Part.BSplineSurface.buildFromPolesMultsKnots``):
+
+* ``poles`` has shape ``(nu, nv, 3)``; knots are the *distinct* knot values,
+  ``*_mults`` their multiplicities.
+* Non-periodic direction: ``sum(mults) == n_poles + degree + 1`` (clamped ends
+  have multiplicity ``degree + 1``).
+* Periodic direction: the first and last knot bound one period and carry the
+  same multiplicity; ``sum(mults) - mults[-1] == n_poles``.  Pole 0 is the
+  first B-spline of the flat knot sequence extended by ``degree`` knots on each
+  side (measured against OCCT 7.8/8.0: a uniform periodic cubic with all
+  multiplicities 1 has ``C(k0) = (P0 + 4 P1 + P2) / 6``).  When the first knot
+  has multiplicity ``m > 1`` OCCT starts the period at its *last* copy: the
+  flat period is ``k0, k1 x m1, ..., k_{n-1} x m_{n-1}, k_n x (m - 1)``
+  (checked by random-pole evaluation against ``Geom_BSplineSurface``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from tabletcad.brep.knots import basis_derivatives, flat_knots
+from tabletcad.errors import GeometryError
+
+__all__ = ["BSplineSurfaceData", "enclosed_volume", "segment_v"]
+
+
+def _frozen(a: np.ndarray, dtype=float) -> np.ndarray:
+    a = np.array(a, dtype=dtype, copy=True)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True, eq=False)
+class BSplineSurfaceData:
+    """A non-rational tensor-product B-spline surface, independent of any CAD kernel.
+
+    Arrays are stored as read-only copies.  ``u_periodic``/``v_periodic`` follow
+    OCCT's convention (see the module docstring).
+    """
+
+    poles: np.ndarray
+    u_knots: np.ndarray
+    u_mults: np.ndarray
+    v_knots: np.ndarray
+    v_mults: np.ndarray
+    u_degree: int = 3
+    v_degree: int = 3
+    u_periodic: bool = False
+    v_periodic: bool = True
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "poles", _frozen(self.poles))
+        object.__setattr__(self, "u_knots", _frozen(self.u_knots))
+        object.__setattr__(self, "v_knots", _frozen(self.v_knots))
+        object.__setattr__(self, "u_mults", _frozen(self.u_mults, int))
+        object.__setattr__(self, "v_mults", _frozen(self.v_mults, int))
+        object.__setattr__(self, "u_degree", int(self.u_degree))
+        object.__setattr__(self, "v_degree", int(self.v_degree))
+        object.__setattr__(self, "u_periodic", bool(self.u_periodic))
+        object.__setattr__(self, "v_periodic", bool(self.v_periodic))
+        if self.poles.ndim != 3 or self.poles.shape[2] != 3:
+            raise GeometryError(f"poles must have shape (nu, nv, 3), got {self.poles.shape}", self)
+        if not np.all(np.isfinite(self.poles)):
+            raise GeometryError("poles contain non-finite values", self)
+        nu, nv, _ = self.poles.shape
+        for name, knots, mults, deg, per, n in (
+            ("u", self.u_knots, self.u_mults, self.u_degree, self.u_periodic, nu),
+            ("v", self.v_knots, self.v_mults, self.v_degree, self.v_periodic, nv),
+        ):
+            if knots.ndim != 1 or knots.shape != mults.shape or knots.size < 2:
+                raise GeometryError(f"{name}: knots and mults must be 1-D of equal length >= 2", self)
+            if np.any(np.diff(knots) <= 0):
+                raise GeometryError(f"{name}: knots must be strictly increasing", self)
+            if deg < 1:
+                raise GeometryError(f"{name}: degree must be >= 1", self)
+            expected = int(mults[:-1].sum()) if per else int(mults.sum()) - deg - 1
+            if expected != n:
+                raise GeometryError(f"{name}: knots/mults imply {expected} poles, poles have {n}", self)
+
+    # ---------------------------------------------------------------- helpers
+    @property
+    def shape(self) -> tuple[int, int]:
+        """``(nu, nv)``: number of poles in each direction."""
+        return self.poles.shape[0], self.poles.shape[1]
+
+    @property
+    def u_range(self) -> tuple[float, float]:
+        return float(self.u_knots[0]), float(self.u_knots[-1])
+
+    @property
+    def v_range(self) -> tuple[float, float]:
+        return float(self.v_knots[0]), float(self.v_knots[-1])
+
+    def flat_u_knots(self) -> np.ndarray:
+        return flat_knots(self.u_knots, self.u_mults, self.u_degree, self.u_periodic)
+
+    def flat_v_knots(self) -> np.ndarray:
+        return flat_knots(self.v_knots, self.v_mults, self.v_degree, self.v_periodic)
+
+    def _dir(self, which: str):
+        if which == "u":
+            knots, mults, deg, per, n = self.u_knots, self.u_mults, self.u_degree, self.u_periodic, self.shape[0]
+        else:
+            knots, mults, deg, per, n = self.v_knots, self.v_mults, self.v_degree, self.v_periodic, self.shape[1]
+        t = flat_knots(knots, mults, deg, per)
+        n_basis = n + deg if per else n
+        return t, deg, per, n, n_basis, float(knots[0]), float(knots[-1])
+
+    def _basis(self, which: str, x: np.ndarray, order: int):
+        t, deg, per, n, n_basis, lo, hi = self._dir(which)
+        x = np.asarray(x, dtype=float)
+        if per:
+            x = lo + np.mod(x - lo, hi - lo)
+        span, N = basis_derivatives(t, deg, n_basis, x, order)
+        idx = span[..., None] - deg + np.arange(deg + 1)
+        if per:
+            idx = idx % n
+        return idx, N
+
+    def evaluate(self, u, v, du: int = 0, dv: int = 0) -> np.ndarray:
+        """Point (or first partial derivative with ``du=1``/``dv=1``) at ``(u, v)``; broadcasts, returns ``(..., 3)``."""
+        u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
+        iu, Nu = self._basis("u", u, du)
+        iv, Nv = self._basis("v", v, dv)
+        P = self.poles[iu[..., :, None], iv[..., None, :]]  # (..., pu+1, pv+1, 3)
+        return np.einsum("...i,...j,...ijk->...k", Nu, Nv, P)
+
+    def evaluate_grid(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Points on the tensor grid ``u x v`` (1-D arrays); returns ``(len(u), len(v), 3)``."""
+        Bu = self.collocation("u", u)
+        Bv = self.collocation("v", v)
+        return np.einsum("ai,ijk,bj->abk", Bu, self.poles, Bv, optimize=True)
+
+    def collocation(self, which: str, x: np.ndarray) -> np.ndarray:
+        """Dense matrix ``B[a, i]`` = value of the B-spline attached to pole ``i`` at ``x[a]``."""
+        x = np.asarray(x, dtype=float).ravel()
+        idx, N = self._basis(which, x, 0)
+        n = self.shape[0] if which == "u" else self.shape[1]
+        B = np.zeros((x.size, n))
+        rows = np.repeat(np.arange(x.size), idx.shape[1])
+        np.add.at(B, (rows, idx.ravel()), N.ravel())
+        return B
+
+    def degenerate_rows(self, tol: float = 0.0) -> tuple[bool, bool]:
+        """Whether the pole rows at ``u`` min / max collapse to a single point (within ``tol``)."""
+        first, last = self.poles[0], self.poles[-1]
+        return (
+            bool(np.max(np.abs(first - first[0])) <= tol),
+            bool(np.max(np.abs(last - last[0])) <= tol),
+        )
+
+    def as_dict(self) -> dict:
+        """Plain-Python representation (lists), e.g. for JSON or FreeCAD's Python."""
+        return {
+            "poles": self.poles.tolist(),
+            "u_knots": self.u_knots.tolist(),
+            "u_mults": self.u_mults.tolist(),
+            "v_knots": self.v_knots.tolist(),
+            "v_mults": self.v_mults.tolist(),
+            "u_degree": self.u_degree,
+            "v_degree": self.v_degree,
+            "u_periodic": self.u_periodic,
+            "v_periodic": self.v_periodic,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "BSplineSurfaceData":
+        return cls(**{k: d[k] for k in cls.__dataclass_fields__})
+
+
+def segment_v(data: BSplineSurfaceData, a: float, b: float) -> BSplineSurfaceData:
+    """The part ``a <= v <= b`` of ``data`` as a surface clamped in ``v``, exactly.
+
+    ``a`` and ``b`` must be knots of multiplicity >= ``v_degree`` (C0 knots; a
+    periodic surface's first knot counts with its multiplicity) - there the
+    curve already splits into independent pieces, so the piece keeps the
+    poles of the B-splines active on ``(a, b)`` and the knots in between, with
+    ``a`` and ``b`` clamped (multiplicity ``degree + 1``).  On a periodic
+    surface the piece may run across the period's end (``b`` up to ``a +``
+    one period).
+    """
+    p = int(data.v_degree)
+    knots = np.asarray(data.v_knots, dtype=float)
+    mults = np.asarray(data.v_mults, dtype=int)
+    n = data.shape[1]
+    if data.v_periodic:
+        period = float(knots[-1] - knots[0])
+        m0 = int(mults[0])
+        one = np.concatenate([knots[:1], np.repeat(knots[1:-1], mults[1:-1]), np.repeat(knots[-1:], m0 - 1)])
+        # B-spline k of t uses pole (k - n + p) mod n (flat_knots starts p knots before the period)
+        t = np.concatenate([one - period, one, one + period, one[: p + 1] + 2.0 * period])
+        shift = p - n
+        if not (knots[0] <= a < knots[-1] and a < b <= a + period + 1e-12):
+            raise GeometryError(f"segment_v: [{a}, {b}] is not within one period from [{knots[0]}, {knots[-1]})", data)
+    else:
+        t = np.repeat(knots, mults)
+        shift = 0
+        if not (knots[0] <= a < b <= knots[-1]):
+            raise GeometryError(f"segment_v: [{a}, {b}] is not within [{knots[0]}, {knots[-1]}]", data)
+    scale = max(1.0, float(np.max(np.abs(t))))
+    for x in (a, b):
+        if int(np.sum(np.abs(t - x) <= 1e-12 * scale)) < p and not (not data.v_periodic and x in (knots[0], knots[-1])):
+            raise GeometryError(f"segment_v: v = {x} is not a knot of multiplicity >= {p}", data)
+    n_basis = t.size - p - 1
+    active = [k for k in range(n_basis) if t[k] < b - 1e-12 * scale and t[k + p + 1] > a + 1e-12 * scale]
+    inner = t[(t > a + 1e-12 * scale) & (t < b - 1e-12 * scale)]
+    vals, counts = np.unique(inner, return_counts=True)
+    new_knots = np.concatenate([[a], vals, [b]])
+    new_mults = np.concatenate([[p + 1], counts, [p + 1]]).astype(int)
+    poles = np.asarray(data.poles)[:, [(k + shift) % n for k in active], :]
+    return replace(data, poles=poles, v_knots=new_knots, v_mults=new_mults, v_periodic=False)
+
+
+def enclosed_volume(surfaces: Sequence[BSplineSurfaceData]) -> float:
+    """Signed volume enclosed by a closed chain of B-spline patches (divergence theorem).
+
+    ``V = 1/3 sum_k  integral S . (S_u x S_v) du dv``; the integrand is a
+    polynomial on every knot span, so Gauss-Legendre with ``ceil(3p/2)`` points
+    per span and direction is exact up to round-off.  The sign follows the
+    parametrisation (positive when ``S_u x S_v`` points outward).
+    """
+    total = 0.0
+    for s in surfaces:
+        rules = []
+        for knots, deg in ((s.u_knots, s.u_degree), (s.v_knots, s.v_degree)):
+            n = int(math.ceil(3 * deg / 2)) + 1
+            x, w = np.polynomial.legendre.leggauss(n)
+            a, b = knots[:-1, None], knots[1:, None]
+            rules.append(((((b - a) * x + (a + b)) / 2).ravel(), (((b - a) / 2) * w).ravel()))
+        (uq, uw), (vq, vw) = rules
+        U, V = np.meshgrid(uq, vq, indexing="ij")
+        S = s.evaluate(U, V)
+        Su = s.evaluate(U, V, du=1)
+        Sv = s.evaluate(U, V, dv=1)
+        integrand = np.einsum("...k,...k->...", S, np.cross(Su, Sv))
+        total += float(np.einsum("i,j,ij->", uw, vw, integrand)) / 3.0
+    return total
