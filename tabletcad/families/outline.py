@@ -27,7 +27,7 @@ import math
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from tabletcad.geometry.curves import Seg
+from tabletcad.geometry.curves import Seg, signed_area
 from tabletcad.errors import DesignError, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
 
@@ -91,13 +91,13 @@ class PlanOutline:
                 )
         self.name = name
         self.parameter = parameter
-        if _signed_area(segs) < 0:
+        if signed_area(segs) < 0:
             segs = [s.reversed() for s in reversed(segs)]
         self.segs = tuple(segs)
         self._len = np.array([s.length for s in self.segs])
         self._cum = np.concatenate([[0.0], np.cumsum(self._len)])
         self.perimeter = float(self._cum[-1])
-        self.area = abs(_signed_area(list(self.segs)))
+        self.area = abs(signed_area(list(self.segs)))
         self._check_simple()
 
     # ------------------------------------------------------------------ geometry
@@ -202,7 +202,7 @@ class PlanOutline:
                 dy = s.radius * np.cos(th)
                 sx += float(np.sum(w * x * x * dy)) / 2.0
                 sy -= float(np.sum(w * y * y * dx)) / 2.0
-        a = _signed_area(list(self.segs))
+        a = signed_area(list(self.segs))
         return np.array([sx / a, sy / a])
 
     def extent(self) -> tuple[float, float]:
@@ -463,20 +463,6 @@ class SplineOutline(PlanOutline):
 
     def _check_simple(self) -> None:  # pragma: no cover - done in __init__
         pass
-
-
-def _signed_area(segs: list[Seg]) -> float:
-    a = 0.0
-    for s in segs:
-        if s.kind == "line":
-            (x0, y0), (x1, y1) = s.p0, s.p1
-            a += 0.5 * (x0 * y1 - x1 * y0)
-        else:
-            cx, cy = s.center
-            r, t0, sw = s.radius, s.theta0, s.sweep
-            t1 = t0 + sw
-            a += 0.5 * (r * r * sw + cx * r * (math.sin(t1) - math.sin(t0)) - cy * r * (math.cos(t1) - math.cos(t0)))
-    return a
 
 
 def _check_polyline_simple(p: np.ndarray, parameter: str) -> None:

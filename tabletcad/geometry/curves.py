@@ -29,6 +29,7 @@ from tabletcad.tolerance import DEFAULT
 
 __all__ = [
     "Seg",
+    "signed_area",
     "Curve",
     "CurveLike",
     "Circle",
@@ -301,6 +302,22 @@ class Seg:
         return Seg("arc", self.p1, self.p0, self.center, self.radius, self.theta0 + self.sweep, -self.sweep, self.label)
 
 
+def signed_area(segs) -> float:
+    """Signed area (mm²) enclosed by a closed chain of :class:`Seg` (positive counter-clockwise):
+    Green's theorem ``A = 1/2 ∮ (x dy - y dx)``, exact for lines and arcs."""
+    a = 0.0
+    for s in segs:
+        if s.kind == "line":
+            (x0, y0), (x1, y1) = s.p0, s.p1
+            a += 0.5 * (x0 * y1 - x1 * y0)
+        else:
+            cx, cy = s.center
+            r, t0, sw = s.radius, s.theta0, s.sweep
+            t1 = t0 + sw
+            a += 0.5 * (r * r * sw + cx * r * (math.sin(t1) - math.sin(t0)) - cy * r * (math.cos(t1) - math.cos(t0)))
+    return a
+
+
 class Outline(Curve):
     """Closed plan outline of straight lines and circular arcs, parametrised by arc length.
 
@@ -395,17 +412,7 @@ class Outline(Curve):
 
     def area(self) -> float:
         """Enclosed plan area (mm²), exact for lines and arcs (Green's theorem)."""
-        a = 0.0
-        for seg in self._segs:
-            if seg.kind == "line":
-                (x0, y0), (x1, y1) = seg.p0, seg.p1
-                a += 0.5 * (x0 * y1 - x1 * y0)
-            else:
-                cx, cy = seg.center
-                r, t0, sw = seg.radius, seg.theta0, seg.sweep
-                t1 = t0 + sw
-                a += 0.5 * (r * r * sw + cx * r * (math.sin(t1) - math.sin(t0)) - cy * r * (math.cos(t1) - math.cos(t0)))
-        return abs(a)
+        return abs(signed_area(self._segs))
 
 
 def Stadium(length: float, width: float, z: float = 0.0) -> Outline:
