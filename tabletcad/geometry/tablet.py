@@ -21,7 +21,7 @@ from tabletcad.errors import DesignError, check_range
 from tabletcad.geometry.patch import PDEPatch
 from tabletcad.tolerance import DEFAULT, Tolerances
 
-__all__ = ["Trim", "Tablet", "Face", "solid_map"]
+__all__ = ["Band", "Trim", "Tablet", "Face", "solid_map"]
 
 
 
@@ -175,6 +175,33 @@ class Face:
             args = (s, c, t)
             d = {"": {}, "s": {"du": 1}, "t": {"dw": 1}}[der]
         return solid_map(p, *args, **d)
+
+
+@dataclass(frozen=True)
+class Band:
+    """The band of a tablet: the patch that is its side wall (the die forms it).
+
+    Attributes
+    ----------
+    patch : int
+        Index of the band patch.
+    z0, z1 : float
+        Heights (mm) of its bottom and top edges.
+    bulge : float
+        Largest outward plan distance (mm) of the patch from its end curve (0 when it bows
+        inward): the PDE surface between the two edges may bulge a little (the thesis's
+        10 mm shallow convex round: 1.4 µm), which a die bore has to clear.
+    """
+
+    patch: int
+    z0: float
+    z1: float
+    bulge: float
+
+    @property
+    def height(self) -> float:
+        """The band's height (mm)."""
+        return self.z1 - self.z0
 
 
 @dataclass(frozen=True, eq=False)
@@ -331,6 +358,32 @@ class Tablet:
             orientation=sgn,
             patches=per,
         )
+
+    def band(self) -> Band | None:
+        """The band patch (:class:`Band`), or None when the tablet has none (a sphere, a free form).
+
+        A band patch has plan-identical horizontal end curves at different heights and stays
+        within 1 % of that height of its end curve in plan (a side wall, not a dome).
+        """
+        v = np.linspace(0.0, math.tau, 96, endpoint=False)
+        for i, p in enumerate(self.patches):
+            x0, x1 = p.evaluate(0.0, v), p.evaluate(1.0, v)
+            if float(np.ptp(x0[:, 2])) > 1e-9 or float(np.ptp(x1[:, 2])) > 1e-9:
+                continue
+            if float(np.max(np.abs(x1[:, :2] - x0[:, :2]))) > 1e-9:
+                continue
+            z0, z1 = float(x0[0, 2]), float(x1[0, 2])
+            if abs(z1 - z0) <= 1e-6:
+                continue
+            X = p.evaluate_grid(np.linspace(0.0, 1.0, 65), v)
+            dev = X[..., :2] - x0[None, :, :2]
+            if float(np.max(np.linalg.norm(dev, axis=-1))) > 0.01 * abs(z1 - z0):
+                continue
+            out = x0[:, :2] - x0[:, :2].mean(axis=0)  # outward (star-shaped outlines about their centroid)
+            out /= np.maximum(np.linalg.norm(out, axis=1, keepdims=True), 1e-300)
+            bulge = max(0.0, float(np.max(np.einsum("uvc,vc->uv", dev, out))))
+            return Band(i, min(z0, z1), max(z0, z1), bulge)
+        return None
 
     def plan_area(self, nu: int = 129, nv: int = 2048) -> float:
         """Area (mm²) of the silhouette seen along z (the tablet's plan).

@@ -188,36 +188,6 @@ def prism(wire, z0: float, z1: float) -> TopoDS_Shape:
 
 
 # ----------------------------------------------------------------------------- band
-def _band_patch(tablet: Tablet) -> tuple[int, float, float, float] | None:
-    """``(patch index, z bottom, z top, bulge)`` of the band patch, or None.
-
-    A band patch has plan-identical horizontal end curves at different heights;
-    the PDE surface between them may bulge a little (the thesis's 10 mm shallow
-    convex round: 1.4 µm), which the die bore has to clear: ``bulge`` (mm) is
-    the largest outward plan distance of the patch from its end curve (0 when it bows inward).
-    """
-    v = np.linspace(0.0, math.tau, 96, endpoint=False)
-    for i, p in enumerate(tablet.patches):
-        x0, x1 = p.evaluate(0.0, v), p.evaluate(1.0, v)
-        if float(np.ptp(x0[:, 2])) > 1e-9 or float(np.ptp(x1[:, 2])) > 1e-9:
-            continue
-        if float(np.max(np.abs(x1[:, :2] - x0[:, :2]))) > 1e-9:
-            continue
-        z0, z1 = float(x0[0, 2]), float(x1[0, 2])
-        if abs(z1 - z0) <= 1e-6:
-            continue
-        u = np.linspace(0.0, 1.0, 65)
-        X = p.evaluate_grid(u, v)
-        dev = X[..., :2] - x0[None, :, :2]
-        if float(np.max(np.linalg.norm(dev, axis=-1))) > 0.01 * abs(z1 - z0):
-            continue
-        out = x0[:, :2] - x0[:, :2].mean(axis=0)  # outward (star-shaped outlines about their centroid)
-        out /= np.maximum(np.linalg.norm(out, axis=1, keepdims=True), 1e-300)
-        bulge = max(0.0, float(np.max(np.einsum("uvc,vc->uv", dev, out))))
-        return i, min(z0, z1), max(z0, z1), bulge
-    return None
-
-
 def _section_wire(shape, z: float) -> Any:
     sec = BRepAlgoAPI_Section(shape, gp_Pln(gp_Pnt(0, 0, z), gp_Dir(0, 0, 1)))
     sec.Build()
@@ -249,9 +219,9 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
     nom = tablet.nominal
     outline_nom = getattr(nom, "outline", None)
     band_z = getattr(nom, "band_z", None)
-    found = _band_patch(tablet)
+    found = tablet.band()
     if band_z is None and found is not None:
-        band_z = (found[1], found[2])
+        band_z = (found.z0, found.z1)
     if band_z is None or not band_z[1] - band_z[0] > 1e-6:
         raise DesignError("[tooling]", tablet.family,
                           "tooling needs a tablet with a band (a cylindrical side wall the die forms); this one has none")
@@ -271,7 +241,7 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
         else:
             wire, kind = segments_wire(segs), "lines and arcs"
     else:
-        curve = tablet.patches[found[0]].data[0] if found is not None else None
+        curve = tablet.patches[found.patch].data[0] if found is not None else None
         from tabletcad.geometry.curves import Circle, Ellipse
 
         if isinstance(curve, Circle):
@@ -286,6 +256,6 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
                                           "thesis.shallow_convex_oval", "thesis.deep_convex_oval", "thesis.caplet",
                                           "thesis.flat_faced_round", "thesis.oblong", "thesis.rod"):
         land = 0.0
-    bulge = found[3] if found is not None else 0.0
+    bulge = found.bulge if found is not None else 0.0
     return TabletFrame(tablet, shape, (float(band_z[0]), float(band_z[1])), bulge, float(lo[2]), float(hi[2]), wire, kind,
                        round_radius, None if land is None else float(land), float(hi[0] - lo[0]), float(hi[1] - lo[1]), info)
