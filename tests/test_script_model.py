@@ -117,6 +117,29 @@ def test_show_without_ocp_vscode(model, capsys, monkeypatch):
     assert out.count("\n") == 1 and "ocp_vscode" in out
 
 
+def test_a_core_tablet_goes_to_build123d_cadquery_and_ocp_vscode(model, monkeypatch):
+    """The tablet most scripts hold (a family's or the thesis's constructor) converts like a model."""
+    import types
+
+    from tabletcad.cad.interop import to_build123d, to_cadquery_workplane
+    from tabletcad.families import concave_round
+
+    t = concave_round(diameter=D, band=BAND, cup_depth=CUP)
+    s = to_build123d(t)
+    assert isinstance(s, bd.Solid) and s.is_valid and s.volume == pytest.approx(model.volume, rel=1e-6)
+    assert to_cadquery_workplane(t).val().Volume() == pytest.approx(model.volume, rel=1e-6)
+    shown = []
+    monkeypatch.setitem(sys.modules, "ocp_vscode", types.SimpleNamespace(show=lambda *objs, **kw: shown.extend(objs)))
+    tabletcad.show(t, model)
+    assert [type(o) for o in shown] == [bd.Solid, bd.Solid]
+    assert shown[0].volume == pytest.approx(shown[1].volume, rel=1e-9)
+
+
+def test_every_view_has_its_own_element_id(model):
+    ids = {re.search(r'<div id="([^"]+)"', model._repr_html_()).group(1) for _ in range(3)}
+    assert len(ids) == 3
+
+
 def test_make_unknown_family():
     with pytest.raises(DesignError, match="family"):
         tabletcad.make("no_such_family")
@@ -132,6 +155,10 @@ def test_tooling_parts_have_the_same_vocabulary(model):
     assert up.to_build123d().volume == pytest.approx(up.volume, rel=1e-9)
     assert tools["tablet"].volume == pytest.approx(model.occ_volume, rel=1e-6)
     assert not re.search(r"https?://", tools._repr_html_())
+    import struct
+
+    for png in (up._repr_png_(), tools._repr_png_()):  # a picture of a part, and of the placed tool set
+        assert png[:8] == b"\x89PNG\r\n\x1a\n" and struct.unpack(">II", png[16:24]) == (320, 320)
 
 
 def test_interop_hints_name_the_pinned_versions():

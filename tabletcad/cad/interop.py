@@ -21,6 +21,7 @@ from typing import Any
 from OCP.TopoDS import TopoDS_Shape
 
 from tabletcad.cad._occ import cast, explore, shape_type
+from tabletcad.geometry.tablet import Tablet
 
 __all__ = ["to_build123d", "to_build123d_part", "to_cadquery", "to_cadquery_workplane", "from_any"]
 
@@ -35,9 +36,21 @@ _BD_HINT = (
 
 
 def from_any(obj: Any) -> TopoDS_Shape:
-    """The ``TopoDS_Shape`` of a TabletSolid, build123d or cadquery object (or a shape itself)."""
+    """The ``TopoDS_Shape`` of a tablet, a TabletSolid, a build123d or cadquery object (or a shape itself).
+
+    A core :class:`~tabletcad.geometry.tablet.Tablet` gets its validated B-rep solid
+    (:func:`tabletcad.cad.tablet_solid.tablet_solid`: fitted, sewn and checked); a scripting
+    model (``tabletcad.make``, ``tabletcad.load``, a tooling part) gives its own.
+    """
     if isinstance(obj, TopoDS_Shape):
         return obj
+    if isinstance(obj, Tablet):
+        from tabletcad.cad.tablet_solid import tablet_solid
+
+        return tablet_solid(obj).shape
+    to_occ = getattr(obj, "to_occ", None)
+    if callable(to_occ):
+        return from_any(to_occ())
     for attr in ("shape", "wrapped"):
         s = getattr(obj, attr, None)
         if isinstance(s, TopoDS_Shape):

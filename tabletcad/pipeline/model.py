@@ -20,7 +20,8 @@ methods that need it, so ``import tabletcad.pipeline.model`` stays numpy-only.
 from __future__ import annotations
 
 import html
-import itertools
+import io
+import uuid
 import json
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -34,11 +35,10 @@ from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.design import Design
 from tabletcad.tolerance import DEFAULT
 
-__all__ = ["TabletModel", "PartModel", "ToolingModel", "make", "load", "show", "mesh_html"]
+__all__ = ["TabletModel", "PartModel", "ToolingModel", "make", "load", "show", "mesh_html", "mesh_png"]
 
 #: Tessellation used for the notebook view (mm, rad): coarse enough for a small page.
 VIEW_DEFLECTION = (0.02, 0.35)
-_IDS = itertools.count()
 
 
 class _Shaped:
@@ -87,6 +87,9 @@ class _Shaped:
 
     def _repr_html_(self) -> str:
         return mesh_html(self._view_meshes(), title=self.name)
+
+    def _repr_png_(self) -> bytes:
+        return mesh_png(self._view_meshes(), title=self.name)
 
 
 @dataclass(frozen=True, eq=False)
@@ -145,6 +148,12 @@ class ToolingModel:
         for p in self.placed().values():
             meshes.extend(p._view_meshes())
         return mesh_html(meshes, title="tooling")
+
+    def _repr_png_(self) -> bytes:
+        meshes = []
+        for p in self.placed().values():
+            meshes.extend(p._view_meshes())
+        return mesh_png(meshes, title="tooling")
 
     def __repr__(self) -> str:
         return f"ToolingModel({', '.join(self.parts)})"
@@ -236,7 +245,8 @@ def load(path: str | Path) -> TabletModel:
 def show(*objs: Any, **kw: Any):
     """Show objects in VS Code through ``ocp_vscode.show`` when it is installed.
 
-    Models are passed as build123d solids.  Without ocp_vscode, prints one line and returns None.
+    Models and core tablets are passed as build123d solids.  Without ocp_vscode, prints one line
+    and returns None.
     """
     try:
         import ocp_vscode
@@ -246,6 +256,8 @@ def show(*objs: Any, **kw: Any):
         return None
     shapes = []
     for o in objs:
+        if isinstance(o, Tablet):
+            o = TabletModel(o)
         if isinstance(o, ToolingModel):
             shapes.extend(p.to_build123d() for p in o.placed().values())
         elif isinstance(o, _Shaped):
@@ -301,10 +313,46 @@ def mesh_html(meshes: list[tuple[str, np.ndarray, np.ndarray]], *, title: str = 
              t=[int(k) for k in np.asarray(T).ravel()])
         for i, (name, V, T) in enumerate(meshes)
     ]
-    uid = f"tabletcad-view-{next(_IDS)}"
+    uid = f"tabletcad-view-{uuid.uuid4().hex}"  # unique across kernels and notebooks on one page
     js = _VIEW_JS % {"id": json.dumps(uid), "data": json.dumps(data, separators=(",", ":"))}
     names = ", ".join(html.escape(str(m[0])) for m in meshes)
     return (f'<div id="{uid}" class="tabletcad-view"><canvas width="{width}" height="{height}" '
             f'style="border:1px solid #ccc"></canvas><div style="font:12px sans-serif">'
             f"{html.escape(title)}: {names} (drag to rotate, wheel to zoom; mm)</div>"
             f"<script>{js}</script></div>")
+
+
+def mesh_png(meshes: list[tuple[str, np.ndarray, np.ndarray]], *, title: str = "", size: float = 4.0) -> bytes:
+    """PNG bytes of triangle meshes drawn shaded in one 3-D view with equal axes (mm).
+
+    ``meshes``: ``(name, vertices (n, 3) mm, triangles (m, 3) int)``.  The figure has its own Agg
+    canvas: no global matplotlib backend is set.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.colors import to_rgb
+    from matplotlib.figure import Figure
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    fig = Figure(figsize=(size, size))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(projection="3d")
+    light = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    for i, (name, V, T) in enumerate(meshes):
+        V, T = np.asarray(V, float), np.asarray(T, int)
+        tri = V[T]
+        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+        shade = 0.35 + 0.65 * np.clip(n @ light, 0.0, 1.0)
+        colours = np.clip(np.outer(shade, to_rgb(_PALETTE[i % len(_PALETTE)])), 0.0, 1.0)
+        alpha = 0.25 if name == "die" and len(meshes) > 1 else 1.0  # the die would hide the punches
+        ax.add_collection3d(Poly3DCollection(tri, facecolors=colours, linewidths=0.0, alpha=alpha, label=name))
+        lo, hi = np.minimum(lo, V.min(axis=0)), np.maximum(hi, V.max(axis=0))
+    c, r = (lo + hi) / 2, float(np.max(hi - lo)) / 2
+    ax.set(xlim=(c[0] - r, c[0] + r), ylim=(c[1] - r, c[1] + r), zlim=(c[2] - r, c[2] + r))
+    ax.set_box_aspect((1, 1, 1))
+    ax.set_axis_off()
+    ax.set_title(f"{title} ({2 * r:.3g} mm across)" if title else f"{2 * r:.3g} mm across", fontsize=9)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=80)
+    return buf.getvalue()
