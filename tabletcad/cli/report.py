@@ -39,7 +39,9 @@ def load_family_design(path: Path):
     return design.build(), design
 
 
-def _fmt(v: Any, unit: str = "", digits: int = 6) -> str:
+def _fmt(v: Any, unit: str = "", digits: int = 4) -> str:
+    """A figure with ``digits`` significant figures (4: 0.1 % and below a micrometre on a tablet's
+    dimensions), its unit, "-" for None and yes/NO for booleans."""
     if v is None:
         return "-"
     if isinstance(v, bool):
@@ -49,15 +51,41 @@ def _fmt(v: Any, unit: str = "", digits: int = 6) -> str:
     return str(v) + (f" {unit}" if unit else "")
 
 
+def _nominal_note(r: dict[str, Any]) -> str:
+    """`` (PDE surface; nominal 10 x 10 x 3 mm)`` when the thesis's PDE surface measures other than
+    the design's own dimensions at the printed precision (its curves bulge between the boundary
+    curves), else ``""``."""
+    p = r.get("params") or {}
+    L = p.get("length", p.get("diameter"))
+    W = p.get("width", p.get("diameter"))
+    T = p.get("thickness")
+    if L is None or W is None or not r["family"].startswith("thesis."):
+        return ""
+    nominal = (f"{L:.4g}", f"{W:.4g}") + ((f"{T:.4g}",) if T is not None else ())
+    measured = (f"{r['length_mm']:.4g}", f"{r['width_mm']:.4g}", f"{r['overall_thickness_mm']:.4g}")[: len(nominal)]
+    return "" if nominal == measured else f" (PDE surface; nominal {' x '.join(nominal)} mm)"
+
+
+def _cup_radii(r: dict[str, Any]) -> str:
+    """``13.9 mm`` (a single-radius cup), ``central 16 mm, edge 2.5 mm`` (a compound cup), or ``-``
+    (a flat face, or a shape without a cup radius)."""
+    radii = r.get("cup_radii_mm") or {}
+    if len(radii) > 1:
+        return ", ".join(f"{k} {_fmt(v, 'mm')}" for k, v in radii.items())
+    return _fmt(r.get("cup_radius_mm"), "mm")
+
+
 def _table(name: str, sec: dict[str, Any]) -> str:
     r = sec["design_report"]
     kind = f"{r['shape']}, {r['face']} face" if r["shape"] is not None else "no shape formulas"
     rows = [
         ("design", f"{name} ({r['family']}, {kind})"),
-        ("length x width x thickness", f"{r['length_mm']:.4g} x {r['width_mm']:.4g} x {r['overall_thickness_mm']:.4g} mm"),
+        ("length x width x thickness", f"{r['length_mm']:.4g} x {r['width_mm']:.4g} x {r['overall_thickness_mm']:.4g} mm"
+                                       + _nominal_note(r)),
         ("band (wall) height", _fmt(r["band_mm"], "mm")),
         ("land", _fmt(r["land_mm"], "mm")),
         ("cup depth", _fmt(r["cup_depth_mm"], "mm")),
+        ("cup radius" if len(r.get("cup_radii_mm") or {}) <= 1 else "cup radii", _cup_radii(r)),
         ("shape factor (cup depth / width)", _fmt(r["shape_factor"])),
         ("volume", _fmt(r["volume_mm3"], "mm3")),
         ("surface area", _fmt(r["surface_area_mm2"], "mm2")),
@@ -142,13 +170,17 @@ def _g(value: float | None) -> str:
 
 def _comparison(rows: list[tuple[str, dict[str, Any]]]) -> str:
     """One line per design: the figures a designer compares."""
-    head = ("design", "family", "L x W x T mm", "band mm", "cup mm", "volume mm3", "area mm2", "SA/V 1/mm", "weight mg")
+    head = ("design", "family", "L x W x T mm", "band mm", "cup mm", "cup radius mm", "volume mm3", "area mm2",
+            "SA/V 1/mm", "weight mg")
     lines = [head]
     for name, sec in rows:
         r = sec["design_report"]
+        radii = r.get("cup_radii_mm") or {}
+        radius = "/".join(f"{v:.4g}" for v in radii.values()) if radii else "-"
         lines.append((name, r["family"], f"{r['length_mm']:.4g} x {r['width_mm']:.4g} x {r['overall_thickness_mm']:.4g}",
-                      _g(r["band_mm"]), _g(r["cup_depth_mm"]), f"{r['volume_mm3']:.6g}", f"{r['surface_area_mm2']:.6g}",
-                      f"{r['surface_area_mm2'] / r['volume_mm3']:.4g}", "-" if r["weight_mg"] is None else f"{r['weight_mg']:.6g}"))
+                      _g(r["band_mm"]), _g(r["cup_depth_mm"]), radius, f"{r['volume_mm3']:.4g}",
+                      f"{r['surface_area_mm2']:.4g}", f"{r['surface_area_mm2'] / r['volume_mm3']:.4g}",
+                      "-" if r["weight_mg"] is None else f"{r['weight_mg']:.4g}"))
     w = [max(len(str(row[i])) for row in lines) for i in range(len(head))]
     return "\n".join("  ".join(str(c).ljust(w[i]) if i < 2 else str(c).rjust(w[i]) for i, c in enumerate(row)).rstrip()
                      for row in lines)

@@ -403,6 +403,9 @@ def shape_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str,
         plan_area_exact_mm2=None, plan_perimeter_mm=None, shape_factor=None if cup is None else cup / W,
         cup_radius_mm=None, cup_radii_mm={}, params=p,
     )
+    if shape == "round" and face == "convex" and cup:  # the thesis's caps lie on spheres
+        r_cup = ((float(p["diameter"]) / 2.0) ** 2 + cup**2) / (2.0 * cup)
+        rep.update(cup_radius_mm=r_cup, cup_radii_mm={"cup": r_cup})
     _add_figures(rep, dict(shape=shape, face=face, band_mm=band, cup_depth_mm=cup or 0.0, width_mm=W, length_mm=Ln,
                            elongated=shape == "oval"), T, opts)
     dev = tablet.nominal_deviation()
