@@ -63,7 +63,7 @@ FLAT = '[tablet]\nfamily = "thesis.flat_faced_round"\nthickness = 6.0\n'
         (FLAT + "diameter = " + "9" * 5000 + "\n", "design_file", "numbers Python can read"),
         (FLAT + "diameter = true\n", "tablet.diameter", "true and false are not numbers"),
         (FLAT + 'diameter = "10"\n', "tablet.diameter", "must be a number"),
-        (FLAT + "diameter = -1e-300\n", "diameter", "> 0"),
+        (FLAT + "diameter = -1e-300\n", "tablet.diameter", "> 0"),
         (FLAT, "tablet.diameter", "needs diameter, thickness"),
         ('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\ncup_depth = 1.0\nband = 1e300\n', "tablet.band", "within ±1000 mm"),
         ('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 3.0\n', "tablet.cup_depth", "optional: land"),

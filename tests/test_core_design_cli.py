@@ -111,7 +111,7 @@ def test_cli_bad_design_exits_2_without_traceback_or_files(tmp_path):
     r = _run_cli(["build", str(bad), "--out", str(out)], tmp_path)
     assert r.returncode == 2
     assert r.stderr.strip().count("\n") == 0 and "Traceback" not in r.stderr
-    assert r.stderr.startswith("error: diameter = -10 mm is not allowed: must be > 0")
+    assert r.stderr.startswith("error: tablet.diameter = -10 mm is not allowed: must be > 0")
     assert not out.exists()
     assert [p.name for p in tmp_path.iterdir()] == ["bad.toml"]  # no staging folder left behind
     r = _run_cli(["mesh", str(bad), "--nodes", "5", "9", "3", "--out", str(tmp_path / "m.vtu")], tmp_path)

@@ -73,7 +73,7 @@ def test_profiles_and_ryshkewitch(capsys, tmp_path):
 
 
 @pytest.mark.parametrize("args, param", [
-    (["--pressure-column", "nope"], "column 'nope'"),
+    (["--pressure-column", "nope"], "column = 'nope'"),
     (["--window", 50, 10], "--window"),
     (["--json-file", "out.txt"], "--json-file"),
     (["--h0", -1], "--h0"),
@@ -93,3 +93,44 @@ def test_non_numeric_cell(capsys, tmp_path):
     data.write_text("pressure_MPa,thickness_mm\n10,9.5\nx,9\n", encoding="utf-8")
     rc, out, err = run(capsys, "walker", data)
     assert rc == 2 and err == "error: bad.csv line 3, column 'pressure_MPa' = 'x' is not allowed: must be a number\n"
+
+
+ROOT = Path(__file__).resolve().parents[1]
+_JSON_COMMANDS = {
+    "heckel": [ROOT / "samples" / "press" / "lactose_appendix_b.csv"],
+    "strength": ["diametral", "--force", 100, "--diameter", 10, "--thickness", 4],
+    "contact": ["--force", 10, "--force", 20],
+    "shell": ["--outer", 5, "--inner", 4, "--E", 1000, "--nu", 0.3, "--p-ext", 1, "--terms", 40],
+    "love": [],
+    "shapes": [],
+}
+
+
+def _no_warnings(d):
+    return {k: v for k, v in d.items() if k != "warnings"}
+
+
+@pytest.mark.parametrize("command", list(_JSON_COMMANDS))
+def test_json_file_writes_what_json_prints(capsys, tmp_path, command):
+    """--json prints and --json-file writes the same document, on every command that has a result."""
+    args = _JSON_COMMANDS[command]
+    rc, out, err = run(capsys, command, *args, "--json")
+    assert rc == 0, err
+    printed = json.loads(out)
+    target = tmp_path / "result.json"
+    rc, out, err = run(capsys, command, *args, "--json-file", target)
+    assert rc == 0, err
+    assert out.rstrip().endswith(f"json -> {target}")
+    written = json.loads(target.read_text(encoding="utf-8"))
+    assert _no_warnings(written) == _no_warnings(printed) and written
+    bad = tmp_path / "result.txt"
+    rc, out, err = run(capsys, command, *args, "--json-file", bad)
+    assert rc == 2 and err == f"error: --json-file = '{bad}' is not allowed: must end in .json\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["result.json"]
+
+
+def test_shapes_json_gives_no_default_for_a_required_dimension(capsys):
+    rc, out, err = run(capsys, "shapes", "--json")
+    d = json.loads(out)["concave_round"]
+    assert d["defaults"] == {"diameter": None, "band": None, "cup_depth": None, "land": 0.0}
+    assert d["required"] == ["diameter", "band", "cup_depth"] and d["optional"] == ["land"]

@@ -16,19 +16,32 @@ __all__ = ["COMMANDS"]
 
 
 @click.command("shapes")
-@click.option("--json", "as_json", is_flag=True, help="Print the families as JSON.")
-def shapes_cmd(as_json: bool) -> None:
+@click.option("--json", "as_json", is_flag=True, help="Print the families as JSON on stdout.")
+@click.option("--json-file", type=click.Path(path_type=Path), help="Write the families as JSON to this file.")
+def shapes_cmd(as_json: bool, json_file: Path | None) -> None:
     """List the tablet families: required and optional parameters (units, defaults) and what each is."""
     import textwrap
 
+    from tabletcad.cli.outputs import check_output, staged
     from tabletcad.families import FAMILIES, INDUSTRY_FAMILIES, THESIS_FAMILIES
 
-    if as_json:
-        click.echo(json.dumps({n: dict(params=f.params, required=list(f.required),
-                                       optional=[k for k in f.params if k not in f.required],
-                                       defaults=f.defaults, description=f.description)
-                               for n, f in FAMILIES.items()}, indent=2))
-        return
+    check_output("--json-file", json_file, (".json",))
+    if as_json or json_file is not None:
+        # a required parameter has no default: its constructor's value is only an example
+        text = json.dumps({n: dict(params=f.params, required=list(f.required),
+                                   optional=[k for k in f.params if k not in f.required],
+                                   defaults={k: (None if k in f.required else v) for k, v in f.defaults.items()},
+                                   description=f.description)
+                           for n, f in FAMILIES.items()}, indent=2)
+        with staged(json=json_file) as out:
+            if json_file is not None:
+                out["json"].write_text(text + "\n", encoding="utf-8")
+        if as_json:
+            click.echo(text)
+            return
+        if json_file is not None:
+            click.echo(f"json -> {json_file}")
+            return
     w = max(map(len, FAMILIES)) + 1
     heads = {INDUSTRY_FAMILIES[0]: "Industry families (exact nominal shapes, certified PDE patches):",
              THESIS_FAMILIES[0]: "The thesis's shapes (PDE patches through the thesis's curves, Tables 4.1 and 4.5):"}
@@ -43,7 +56,8 @@ def shapes_cmd(as_json: bool) -> None:
     click.echo(f"{'custom_outline':{w}s} required: outline [mm] (points) or segments (lines and arcs), band [mm], "
                "cup_depth [mm]; optional: land, cup_width, central_radius, edge_radius [mm] = 0 (see README: design files)")
     click.echo(f"{'free_form':{w}s} required: [[patch]] tables of 4 curves each (see README: design files)")
-    click.echo(f"{'':{w}s} every design may also give a (smoothing parameter, default 1 or the family's; \"auto\" to choose)")
+    click.echo(f"{'':{w}s} every design may also give the smoothing parameter a (default 1, or the family's; "
+               "\"auto\" chooses it)")
 
 
 @click.command("build")

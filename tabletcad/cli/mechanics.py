@@ -64,6 +64,18 @@ def _check_input(name: str, path: Path | None) -> None:
         raise DesignError(name, str(path), "is a folder, not a file" if path.is_dir() else "does not exist")
 
 
+_JSON_OPTS = [
+    click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout."),
+    click.option("--json-file", type=click.Path(path_type=Path), help="Write the result as JSON to this file."),
+]
+
+
+def _with_json(f):
+    for opt in reversed(_JSON_OPTS):
+        f = opt(f)
+    return f
+
+
 # --------------------------------------------------------------------------- heckel
 @click.command("heckel")
 @click.argument("data", type=click.Path(path_type=Path))
@@ -85,12 +97,13 @@ def _check_input(name: str, path: Path | None) -> None:
 @click.option("--displacement-unit", help="Unit of the displacement or thickness column (mm, µm, um, cm, m, in).")
 @click.option("--time-unit", help="Unit of the time column (s, ms, µs, min, h).")
 @click.option("--plot", "plot_file", type=click.Path(path_type=Path), help="Heckel plot (.png/.svg).")
-@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+@_with_json
 def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: float | None,
                diameter: float | None, face_area: float | None, compliance: tuple[float, float] | None,
                window: tuple[float, float] | None, force_column: str | None, displacement_column: str | None,
                thickness_column: str | None, time_column: str | None, force_unit: str | None,
-               displacement_unit: str | None, time_unit: str | None, plot_file: Path | None, as_json: bool) -> None:
+               displacement_unit: str | None, time_unit: str | None, plot_file: Path | None, as_json: bool,
+               json_file: Path | None) -> None:
     """Heckel analysis (eqs 2.2-2.3) of the loading branch of a press record DATA (CSV/TSV).
 
     Units are read from the headers ('Force (kN)', 'Time [ms]', ...) and
@@ -105,6 +118,7 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
     _check_input("DATA", data)
     _check_input("--meta", meta)
     _check_output("--plot", plot_file)
+    _check_json_file(json_file, plot=plot_file)
     if window is not None:
         check_finite("--window", window[0], "MPa")
         check_positive("--window", window[1], "MPa")
@@ -130,16 +144,13 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
         "elastic_recovery": curves.elastic_recovery,
         "metadata": rec.metadata.to_dict(),
     }
-    with _staged(plot=plot_file) as out:
-        if plot_file is not None:
-            plot_heckel(fit, out["plot"], title=f"Heckel plot: {data.name}")
     lo, hi = fit.window_MPa
     how = fit.method if fit.noise_sd is None else f"auto: widest run linear within the noise σ = {fit.noise_sd:.3g}"
-    _emit(payload, as_json, [
+    _finish(payload, as_json, json_file, [
         f"{data.name}: {curves.describe_rows()}",
         f"window {lo:.4g}-{hi:.4g} MPa ({how}), n = {fit.n_points}",
-        f"K = {fit.K_per_MPa:.5g} 1/MPa, A = {fit.A:.4f}, Py = {fit.Py_MPa:.4g} MPa, R² = {fit.r2:.5f}",
-    ] + ([f"plot -> {plot_file}"] if plot_file else []))
+        f"K = {fit.K_per_MPa:.4g} 1/MPa, A = {fit.A:.4g}, Py = {fit.Py_MPa:.4g} MPa, R² = {fit.r2:.4f}",
+    ], (plot_file, lambda path: plot_heckel(fit, path, title=f"Heckel plot: {data.name}")))
 
 
 # --------------------------------------------------------------------------- kawakita, walker, profiles
@@ -159,7 +170,7 @@ def _read_table(path: Path, columns: dict[str, str]) -> dict[str, np.ndarray]:
     out = {}
     for key, name in columns.items():
         if name.strip().lower() not in header:
-            raise DesignError(f"column {name!r}", str(path), f"must be one of the header's columns: {', '.join(rows[0])}")
+            raise DesignError("column", name, f"must be one of the header's columns of {path.name}: {', '.join(rows[0])}")
         j = header.index(name.strip().lower())
         vals = []
         for i, r in enumerate(rows[1:], start=2):
@@ -181,16 +192,12 @@ def _check_window(window: tuple[float, float] | None) -> None:
             raise DesignError("--window", window, "must be two increasing pressures", "MPa")
 
 
-_JSON_OPTS = [
-    click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout."),
-    click.option("--json-file", type=click.Path(path_type=Path), help="Write the result as JSON to this file."),
-]
-
-
-def _with_json(f):
-    for opt in reversed(_JSON_OPTS):
-        f = opt(f)
-    return f
+def _check_json_file(json_file: Path | None, **others: Path | None) -> None:
+    """``--json-file`` ends in .json and is none of the command's other output files."""
+    _check_output("--json-file", json_file, (".json",))
+    for option, path in others.items():
+        if json_file is not None and path is not None and json_file.absolute() == path.absolute():
+            raise DesignError("--json-file", str(json_file), f"must differ from --{option}")
 
 
 def _finish(payload: dict[str, Any], as_json: bool, json_file: Path | None, lines: list[str],
@@ -327,10 +334,13 @@ _METHODS = ("diametral", "axial", "pitt", "elongated-flat", "elongated-convex", 
 @click.option("--nu", type=float, help="Poisson's ratio (sphere).")
 @click.option("--radius", type=float, help="Sphere radius, mm (sphere).")
 @click.option("--s-y", "s_y", type=float, help="Micro-yield strength, MPa (sphere).")
-@click.option("--json", "as_json", is_flag=True)
-def strength_cmd(method: str, F: float, D, t, W, L, R, material, E, nu, radius, s_y, as_json: bool) -> None:
+@_with_json
+def strength_cmd(method: str, F: float, D, t, W, L, R, material, E, nu, radius, s_y, as_json: bool,
+                 json_file: Path | None) -> None:
     """Tensile strength (MPa) of a tablet from a breaking test (eqs 2.4-2.11)."""
     from tabletcad.mechanics import strength as st
+
+    _check_json_file(json_file)
 
     def need(name: str, v):
         if v is None:
@@ -362,8 +372,8 @@ def strength_cmd(method: str, F: float, D, t, W, L, R, material, E, nu, radius, 
                 s_y = m.s_y if s_y is None else s_y
             sigma = st.sphere_hertz(F, need("--E", E), need("--nu", nu), need("--radius", radius), need("--s-y", s_y))
             eq = "2.10-2.11"
-    _emit({"method": method, "equation": eq, "tensile_strength_MPa": sigma, "warnings": msgs}, as_json,
-          [f"{method} (eq {eq}): tensile strength = {sigma:.5g} MPa"])
+    _finish({"method": method, "equation": eq, "tensile_strength_MPa": sigma, "warnings": msgs}, as_json, json_file,
+            [f"{method} (eq {eq}): tensile strength = {sigma:.4g} MPa"])
 
 
 # --------------------------------------------------------------------------- contact
@@ -373,14 +383,15 @@ def strength_cmd(method: str, F: float, D, t, W, L, R, material, E, nu, radius, 
 @click.option("--radius", type=float, help="Sphere radius, mm (default: the material's).")
 @click.option("--plot", "plot_file", type=click.Path(path_type=Path),
               help="Force-displacement plot (.png/.svg).")
-@click.option("--json", "as_json", is_flag=True)
+@_with_json
 def contact_cmd(material: str, forces: tuple[float, ...], radius: float | None, plot_file: Path | None,
-                as_json: bool) -> None:
+                as_json: bool, json_file: Path | None) -> None:
     """Compressed spherical tablet: displacement, height, contact radius, boundary circles (eqs 2.1, 5.19-5.26)."""
     from tabletcad.mechanics import contact as ct
     from tabletcad.mechanics.materials import get_material
 
     _check_output("--plot", plot_file)
+    _check_json_file(json_file, plot=plot_file)
     for f in forces:
         check_finite("--force", f, "N")
     if radius is not None:
@@ -396,15 +407,12 @@ def contact_cmd(material: str, forces: tuple[float, ...], radius: float | None, 
         "yield_force_eq2_1_N": curve.force_at_yield_ep, "yield_force_hertz_N": curve.force_at_yield_hertz,
         "results": [x.to_dict() for x in results], "warnings": msgs,
     }
-    with _staged(plot=plot_file) as out:
-        if plot_file is not None:
-            ct.plot_force_displacement([curve], out["plot"])
     lines = [(f"{m.name}: r_s = {r:g} mm, yield at ω' = {wy * 1000:.4g} µm "
               f"(F = {curve.force_at_yield_ep:.4g} N by eq 2.1, {curve.force_at_yield_hertz:.4g} N by eq 5.19)")]
     for x in results:
-        lines.append(f"F = {x.force:g} N: ω = {x.displacement:.5g} mm, height = {x.height:.5g} mm, "
+        lines.append(f"F = {x.force:g} N: ω = {x.displacement:.4g} mm, height = {x.height:.4g} mm, "
                      f"r_c = {x.contact_radius:.4g} mm (eq 5.23), sqrt(r_s ω/2) = {x.contact_radius_per_contact:.4g} mm")
-    _emit(payload, as_json, lines)
+    _finish(payload, as_json, json_file, lines, (plot_file, lambda path: ct.plot_force_displacement([curve], path)))
 
 
 # --------------------------------------------------------------------------- shell
@@ -420,8 +428,8 @@ def contact_cmd(material: str, forces: tuple[float, ...], radius: float | None, 
 @click.option("--terms", type=int, default=400, show_default=True, help="Legendre orders kept.")
 @click.option("--csv", "csv_file", type=click.Path(path_type=Path), help="u_r(θ) table on both surfaces.")
 @click.option("--plot", "plot_file", type=click.Path(path_type=Path), help="u_r(θ) plot (.png/.svg).")
-@click.option("--json", "as_json", is_flag=True)
-def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file, as_json) -> None:
+@_with_json
+def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file, as_json, json_file) -> None:
     """Radial displacement of a thick elastic spherical shell (section 6.2.3) by Legendre series."""
     from tabletcad.mechanics.shell import plot_shell, solve_shell
 
@@ -429,6 +437,7 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
     _check_output("--plot", plot_file)
     if csv_file is not None and plot_file is not None and csv_file.absolute() == plot_file.absolute():
         raise DesignError("--plot", str(plot_file), "must differ from --csv")
+    _check_json_file(json_file, csv=csv_file, plot=plot_file)
     check_range("--terms", terms, 2, 20000)
     for name, v in (("--outer", a), ("--inner", b), ("--E", E)):
         check_positive(name, v, "MPa" if name == "--E" else "mm")
@@ -462,7 +471,9 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
         "series_change_at_90deg_mm": eq - float(half),
         "warnings": msgs,
     }
-    with _staged(csv=csv_file, plot=plot_file) as out:
+    with _staged(csv=csv_file, plot=plot_file, json=json_file) as out:
+        if json_file is not None:
+            out["json"].write_text(json.dumps(payload, indent=2, default=_jsonable) + "\n", encoding="utf-8")
         if csv_file is not None:
             rows = ["theta_deg,u_r_outer_mm,u_r_inner_mm"] + [f"{d:g},{x:.10g},{y:.10g}" for d, x, y in
                                                             zip(np.degrees(th), ua, ub)]
@@ -472,9 +483,10 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
     _emit(payload, as_json, [
         (f"shell a = {a:g} mm, b = {b:g} mm, E = {E:g} MPa, ν = {nu:g}; p_ext = {p_ext:g} MPa over "
          f"{region} ψ = {psi:g}°, p_int = {p_int:g} MPa; {terms} orders"),
-        f"u_r(a): θ=0° {ua[0]:.6g} mm, θ=90° {eq:.6g} mm; u_r(b): θ=0° {ub[0]:.6g} mm, θ=90° {ub[90]:.6g} mm",
+        f"u_r(a): θ=0° {ua[0]:.4g} mm, θ=90° {eq:.4g} mm; u_r(b): θ=0° {ub[0]:.4g} mm, θ=90° {ub[90]:.4g} mm",
         f"series change at θ=90° from {terms // 2} to {terms} orders: {eq - half:.3g} mm",
-    ])
+    ] + [f"{option} -> {path}" for option, path in (("json", json_file), ("csv", csv_file), ("plot", plot_file))
+         if path is not None and not as_json])
 
 
 # --------------------------------------------------------------------------- love
@@ -489,11 +501,12 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
 @click.option("--omega-z0", type=float, help="Adjustment ω_z0, mm (default: match --ref-displacement).")
 @click.option("--window", nargs=2, type=float, default=(10.0, 50.0), show_default=True, metavar="LO HI",
               help="Simulated pressure range, MPa.")
-@click.option("--json", "as_json", is_flag=True)
-def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json) -> None:
+@_with_json
+def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json, json_file) -> None:
     """Simulated die compression with the thesis's eq 5.18 and its Heckel fit (thesis defaults)."""
     from tabletcad.mechanics.love import simulate_compression
 
+    _check_json_file(json_file)
     lo, hi = window
     if not (math.isfinite(hi) and 0 < lo < hi):
         raise DesignError("--window", window, "must be two increasing positive pressures", "MPa")
@@ -511,8 +524,8 @@ def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json) -> None:
     f = sim.heckel
     payload = {"K_per_MPa": f.K_per_MPa, "A": f.A, "Py_MPa": f.Py_MPa, "r2": f.r2, "window_MPa": list(f.window_MPa),
                "n_points": f.n_points, "omega_z0_mm": sim.omega_z0, "assumptions": sim.assumptions, "warnings": msgs}
-    _emit(payload, as_json, [
-        (f"ω_z0 = {sim.omega_z0:.5g} mm; K = {f.K_per_MPa:.5g} 1/MPa, A = {f.A:.4f}, Py = {f.Py_MPa:.4g} MPa, "
+    _finish(payload, as_json, json_file, [
+        (f"ω_z0 = {sim.omega_z0:.4g} mm; K = {f.K_per_MPa:.4g} 1/MPa, A = {f.A:.4g}, Py = {f.Py_MPa:.4g} MPa, "
          f"R² = {f.r2:.4f} over {lo:g}-{hi:g} MPa")])
 
 

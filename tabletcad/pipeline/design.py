@@ -339,7 +339,13 @@ class Design:
                                   + (f" (optional: {', '.join(optional)})" if optional else ""))
             if a is not None:
                 kw["a"] = a
-            tablet = replace(fam.build(**kw), name=name)
+            try:
+                built = fam.build(**kw)
+            except DesignError as exc:  # the constructor names its parameter: the design file says tablet.<name>
+                if exc.parameter in fam.params or exc.parameter == "a":
+                    raise exc.renamed(f"tablet.{exc.parameter}") from None
+                raise
+            tablet = replace(built, name=name)
         if self.reshape is not None:
             tablet = _reshape(tablet, self.reshape)
             _check_size(tablet)
