@@ -68,11 +68,16 @@ def build_cmd(design: Path, out_dir: Path, quiet: bool) -> None:
     """Build DESIGN.toml: report.json, tablet.png and CAD files in OUT."""
     from tabletcad.pipeline.build import build_design
 
+    from tabletcad.cli.report import nominal_note
+
     rep = build_design(design, out_dir, progress=not quiet)
     written = rep["outputs"]  # this build's files only (the folder may hold files tabletcad did not write)
+    d = rep["design"]
+    size = f"{rep['length_mm']:.4g} x {rep['width_mm']:.4g} x {rep['height_mm']:.4g} mm"
     click.echo(
-        f"{rep['design']['name']}: volume {rep['volume_mm3']:.6g} mm3, area {rep['surface_area_mm2']:.6g} mm2, "
-        f"{rep['length_mm']:.4g} x {rep['width_mm']:.4g} x {rep['height_mm']:.4g} mm -> {out_dir}/ ({', '.join(written)})"
+        f"{d['name']}: volume {rep['volume_mm3']:.4g} mm3, area {rep['surface_area_mm2']:.4g} mm2, {size}"
+        f"{nominal_note(d['family'], d['params'], rep['length_mm'], rep['width_mm'], rep['height_mm'])} "
+        f"-> {out_dir}/ ({', '.join(written)})"
     )
 
 

@@ -21,7 +21,7 @@ import click
 
 from tabletcad.errors import DesignError, one_token
 
-__all__ = ["COMMANDS", "load_family_design"]
+__all__ = ["COMMANDS", "load_family_design", "nominal_note"]
 
 
 
@@ -51,19 +51,22 @@ def _fmt(v: Any, unit: str = "", digits: int = 4) -> str:
     return str(v) + (f" {unit}" if unit else "")
 
 
-def _nominal_note(r: dict[str, Any]) -> str:
-    """`` (PDE surface; nominal 10 x 10 x 3 mm)`` when the thesis's PDE surface measures other than
-    the design's own dimensions at the printed precision (its curves bulge between the boundary
-    curves), else ``""``."""
-    p = r.get("params") or {}
-    L = p.get("length", p.get("diameter"))
-    W = p.get("width", p.get("diameter"))
-    T = p.get("thickness")
-    if L is None or W is None or not r["family"].startswith("thesis."):
+def nominal_note(family: str, params: dict[str, Any], length: float, width: float, thickness: float) -> str:
+    """`` (PDE surface; nominal 10 x 10 x 3 mm)`` when one of the thesis's shapes measures other than
+    its design's own dimensions at the printed precision (its PDE surface bulges between the
+    thesis's boundary curves), else ``""``."""
+    L = params.get("length", params.get("diameter"))
+    W = params.get("width", params.get("diameter"))
+    T = params.get("thickness")
+    if L is None or W is None or not family.startswith("thesis."):
         return ""
     nominal = (f"{L:.4g}", f"{W:.4g}") + ((f"{T:.4g}",) if T is not None else ())
-    measured = (f"{r['length_mm']:.4g}", f"{r['width_mm']:.4g}", f"{r['overall_thickness_mm']:.4g}")[: len(nominal)]
+    measured = (f"{length:.4g}", f"{width:.4g}", f"{thickness:.4g}")[: len(nominal)]
     return "" if nominal == measured else f" (PDE surface; nominal {' x '.join(nominal)} mm)"
+
+
+def _nominal_note(r: dict[str, Any]) -> str:
+    return nominal_note(r["family"], r.get("params") or {}, r["length_mm"], r["width_mm"], r["overall_thickness_mm"])
 
 
 def _cup_radii(r: dict[str, Any]) -> str:
