@@ -30,6 +30,7 @@ from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = [
     "THESIS_SHAPES",
+    "NO_LAND",
     "coaxial_tablet",
     "flat_faced_round",
     "spherical",
@@ -289,6 +290,13 @@ def deep_convex_oval(width: float = 6.0, length: float = 12.0, thickness: float 
 
 
 # ---------------------------------------------------------------------------- catalogue
+#: The thesis's shapes with a band whose faces meet it at its edge: their land (the flat ring
+#: between the cup and the band) is 0 mm by construction (the face patch starts on the band's
+#: edge curve).  The tooling reads it; the industry families carry ``land_mm`` in their nominal.
+NO_LAND: frozenset[str] = frozenset(f"thesis.{n}" for n in (
+    "flat_faced_round", "shallow_convex_round", "deep_convex_round", "shallow_convex_oval", "deep_convex_oval",
+    "caplet", "oblong", "rod"))
+
 #: The thesis's shapes (Tables 4.1 and 4.5, in that order), a static mapping; every parameter in mm.
 #: Every family is in :data:`tabletcad.families.FAMILIES`, where these are named ``thesis.<name>``
 #: (``thesis.flat_faced_round``): the plain names belong to the industry families.

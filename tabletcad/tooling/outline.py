@@ -34,6 +34,7 @@ from OCP.TopoDS import TopoDS_Shape
 
 from tabletcad.cad._occ import cast, explore
 from tabletcad.errors import DesignError, GeometryError
+from tabletcad.families.thesis import NO_LAND
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tooling.booleans import translated
 
@@ -252,9 +253,7 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
         else:
             wire, kind = _section_wire(shape, 0.5 * (band_z[0] + band_z[1])), "section of the band"
     land = info.get("land_mm")
-    if land is None and tablet.family in ("thesis.shallow_convex_round", "thesis.deep_convex_round",
-                                          "thesis.shallow_convex_oval", "thesis.deep_convex_oval", "thesis.caplet",
-                                          "thesis.flat_faced_round", "thesis.oblong", "thesis.rod"):
+    if land is None and tablet.family in NO_LAND:  # the thesis's shapes say so in the catalogue
         land = 0.0
     bulge = found.bulge if found is not None else 0.0
     return TabletFrame(tablet, shape, (float(band_z[0]), float(band_z[1])), bulge, float(lo[2]), float(hi[2]), wire, kind,
