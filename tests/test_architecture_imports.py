@@ -221,3 +221,50 @@ def test_the_family_catalogue_is_static():
 def test_every_layer_names_modules_that_exist(layer):
     for key in LAYERS[layer]:
         assert key in MODULES, key
+
+
+BLOCKED = r"""
+import importlib, pkgutil, sys
+sys.path.insert(0, {root!r})
+BLOCK = ("OCP", "build123d", "cadquery", "manifold3d", "trimesh")
+
+
+class Blocker:
+    def find_spec(self, name, path=None, target=None):
+        if name.split(".")[0] in BLOCK:
+            raise ImportError(f"{{name}} is blocked")
+        return None
+
+
+sys.meta_path.insert(0, Blocker())
+import tabletcad
+
+core = sorted(m.name for m in pkgutil.walk_packages(tabletcad.__path__, "tabletcad.")
+              if m.name != "tabletcad.__main__"  # (runs the command line)
+              and (not m.name.startswith(("tabletcad.cad", "tabletcad.tooling"))
+                   or m.name in ("tabletcad.tooling.spec", "tabletcad.tooling.standards")))
+for name in core:
+    importlib.import_module(name)
+from tabletcad.pipeline.build import build_design
+from tabletcad.pipeline.design import Design
+
+d = Design.from_toml({sample!r})
+report = build_design(d, {out!r}, cad=False, progress=False)
+assert not any(k.split(".")[0] in BLOCK for k in sys.modules), "a CAD library was imported"
+print(len(core), round(report["volume_mm3"], 6), ",".join(report["outputs"]))
+"""
+
+
+def test_the_numerical_core_imports_and_builds_with_every_cad_library_blocked(tmp_path):
+    """Every module outside cad/ and tooling/ (the [tooling] table's parser included) imports, and a
+    design with a [tooling] table builds its report and picture, while OCP, build123d, cadquery,
+    manifold3d and trimesh cannot be imported: what FreeCAD's Python and the core-only install rely on."""
+    sample = ROOT / "samples" / "tooling" / "tsm_b_round.toml"
+    code = BLOCKED.format(root=str(ROOT), sample=str(sample), out=str(tmp_path / "out"))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600, cwd="/")
+    assert out.returncode == 0, out.stderr[-3000:]
+    n, volume, outputs = out.stdout.splitlines()[-1].split()
+    from tabletcad.pipeline.design import load_design
+
+    assert int(n) > 80 and float(volume) == pytest.approx(load_design(sample).volume(), rel=1e-9)
+    assert outputs == "report.json,tablet.png"
