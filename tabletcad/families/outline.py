@@ -80,7 +80,7 @@ class PlanOutline:
         for i, s in enumerate(segs):
             prev = segs[i - 1]
             gap = math.hypot(prev.p1[0] - s.p0[0], prev.p1[1] - s.p0[1])
-            if gap > 1e-7 * scale:
+            if gap > DEFAULT.seam_gap * scale:
                 raise DesignError(parameter, f"gap of {gap:.3g} mm before segment {i}", "segments must join end to start")
             t_prev, t_next = prev.tangent(1), s.tangent(0)
             ang = math.degrees(math.atan2(abs(float(t_prev[0] * t_next[1] - t_prev[1] * t_next[0])), float(np.dot(t_prev, t_next))))

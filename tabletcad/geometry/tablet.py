@@ -366,14 +366,15 @@ class Tablet:
         within 1 % of that height of its end curve in plan (a side wall, not a dome).
         """
         v = np.linspace(0.0, math.tau, 96, endpoint=False)
+        gap = self.tol.seam_gap  # the end curves are the design's own: flat and identical to round-off
         for i, p in enumerate(self.patches):
             x0, x1 = p.evaluate(0.0, v), p.evaluate(1.0, v)
-            if float(np.ptp(x0[:, 2])) > 1e-9 or float(np.ptp(x1[:, 2])) > 1e-9:
+            if float(np.ptp(x0[:, 2])) > gap or float(np.ptp(x1[:, 2])) > gap:
                 continue
-            if float(np.max(np.abs(x1[:, :2] - x0[:, :2]))) > 1e-9:
+            if float(np.max(np.abs(x1[:, :2] - x0[:, :2]))) > gap:
                 continue
             z0, z1 = float(x0[0, 2]), float(x1[0, 2])
-            if abs(z1 - z0) <= 1e-6:
+            if abs(z1 - z0) <= gap:
                 continue
             X = p.evaluate_grid(np.linspace(0.0, 1.0, 65), v)
             dev = X[..., :2] - x0[None, :, :2]
