@@ -101,7 +101,7 @@ def test_solved_weight_matches_the_python_api(capsys):
     (["--csv", "OUT/r.txt"], "--csv"),
     ([str(FAM / "missing.toml"), "--csv", "OUT/r.csv"], "DESIGN"),
     ([str(ROOT / "samples" / "spherical.toml"), "--solve-for", "band", "--target-volume", "300", "--csv", "OUT/r.csv"],
-     "tablet.family"),  # the thesis's shapes have a report but no inverse calculation
+     "--solve-for"),  # the thesis's sphere has no band (nor any dimension the inverse solves for)
     (["--solve-for", "thickness", "--target-volume", "300"], "--solve-for"),  # concave_round takes no thickness
     (["--solve-for", "band", "--target-weight", "300", "--solid-fraction", "1.5"], "[report].solid_fraction"),
 ])
@@ -126,13 +126,20 @@ def test_xlsx_without_openpyxl_names_the_extra(tmp_path, capsys, monkeypatch):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_solve_for_refuses_a_design_whose_smoothing_or_reshape_it_would_drop(tmp_path, capsys):
+def test_solve_for_carries_the_smoothing_and_refuses_a_reshape_or_trim_it_would_drop(tmp_path, capsys):
+    from tabletcad.cli.report import _solved, load_family_design
+
     d = tmp_path / "a.toml"
     d.write_text((FAM / "concave_round.toml").read_text().replace("[tablet]\n", "[tablet]\na = 0.05\n", 1))
-    assert main(["report", str(d), "--solve-for", "band", "--target-volume", "280"]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith("error: --solve-for = 'band' is not allowed: the design sets a,") or \
-        err.startswith("error: --solve-for = band is not allowed: the design sets a,"), err
+    tablet, design = load_family_design(d)
+    solved, inv = _solved(tablet, design, design.report_options, "band", None, 280.0)
+    assert {p.a for p in solved.patches} == {0.05} and {p.a for p in tablet.patches} == {0.05}
+    assert inv["nominal_volume_mm3"] == pytest.approx(280.0, rel=1e-9)
+    for table in ("[reshape]\nradius = 1.1\n", "[trim]\nu = [0.0, 0.5]\n"):
+        d.write_text((FAM / "concave_round.toml").read_text().split("[report]")[0] + table)
+        assert main(["report", str(d), "--solve-for", "band", "--target-volume", "280"]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"error: --solve-for = 'band' is not allowed: the design sets {table.split()[0]},"), err
 
 
 def test_solve_for_a_custom_outline_keeps_its_outline(capsys):

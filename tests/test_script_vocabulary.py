@@ -134,7 +134,12 @@ def test_report_solve_for_names_the_families_it_serves(capsys):
 
     rc = main(["report", str(ROOT / "samples" / "spherical.toml"), "--solve-for", "band", "--target-volume", "100"])
     err = capsys.readouterr().err
-    assert rc == 2 and err.count("\n") == 1 and err.startswith("error: tablet.family = 'thesis.spherical'")
+    assert rc == 2 and err.count("\n") == 1 and err.startswith("error: --solve-for = 'band' is not allowed: thesis.spherical ")
+    rc = main(["report", str(ROOT / "samples" / "oblate_spheroid.toml"), "--solve-for", "band", "--target-volume", "100"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.strip().endswith("thesis.oblate_spheroid can solve for height")
+    assert main(["report", str(ROOT / "samples" / "oblate_spheroid.toml"), "--solve-for", "height", "--target-volume", "100"]) == 0
+    assert capsys.readouterr().out.startswith("oblate_spheroid: height = ")
 
 
 def test_report_compares_designs_of_any_family(capsys):

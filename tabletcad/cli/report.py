@@ -5,8 +5,8 @@ tensile strength, FDA size flag, nominal certificate and seams), or one line
 per design for several designs; ``--json`` prints the report as JSON instead,
 ``--json-file``, ``--csv`` and ``--xlsx`` write it (CSV and workbook: one row
 per design, every scalar of the report).  ``--solve-for`` with a target
-weight or volume first solves for the band, thickness or cup depth
-(:func:`tabletcad.families.inverse.solve_for`).  Options not given on the command line
+weight or volume first solves for the band, thickness, cup depth, height or
+dome of any family that has it (:func:`tabletcad.families.inverse.solve_for`).  Options not given on the command line
 are read from the design file's ``[report]`` table.  Bad input: one line on
 stderr, exit status 2, nothing written.
 """
@@ -129,25 +129,37 @@ def _table(name: str, sec: dict[str, Any]) -> str:
     return "\n".join(f"{k:<{w}}  {v}" for k, v in rows)
 
 
-_SOLVABLE = ("band", "thickness", "cup_depth")
+#: The dimensions --solve-for takes: :data:`tabletcad.families.inverse.VARY` (not imported here, to keep
+#: the command line's start light; tests/test_inverse_all_families.py checks that they agree).
+_SOLVABLE = ("band", "thickness", "cup_depth", "height", "dome")
 
 
-def _solved(tablet, opts, vary: str, target_weight: float | None, target_volume: float | None):
-    """``tablet`` with ``vary`` solved for the target weight or volume; ``(tablet, inverse section)``."""
+def _solved(tablet, design, opts, vary: str, target_weight: float | None, target_volume: float | None):
+    """``tablet`` with ``vary`` solved for the target weight or volume; ``(tablet, inverse section)``.
+
+    The family is rebuilt from the design's own ``[tablet]`` dimensions (mm, deg) and its
+    smoothing parameter ``a``; a custom outline keeps its outline.  Errors name the command's
+    options (``--solve-for``, ``--target-volume``...) or the design's keys (``tablet.band``).
+    """
     import functools
-    import inspect
 
-    from tabletcad.families.inverse import _family_function, solve_for
+    from tabletcad.families.inverse import VARY, _family_function, solve_for
 
+    if tablet.family == "free_form":
+        raise DesignError("--solve-for", vary, f"free_form designs have none of the dimensions that can be solved for "
+                          f"({', '.join(VARY)}): their patches are given curve by curve")
+    given = {k: v for k, v in design.tablet.items() if k not in ("family", "name")}
     try:
         if tablet.family == "custom_outline":  # its outline stays, its cup dimensions vary
             from tabletcad.families import outline_tablet
 
             family = functools.partial(outline_tablet, tablet.nominal.outline)
+            dims = {k: v for k, v in tablet.params.items() if k in given}
         else:
             family = _family_function(tablet.family)
-        takes = inspect.signature(family).parameters
-        dims = {k: v for k, v in tablet.params.items() if k in takes}
+            dims = {k: v for k, v in given.items() if k != "a"}
+        if given.get("a") is not None:
+            dims["a"] = given["a"]
         r = solve_for(family, target_weight_mg=target_weight, target_volume_mm3=target_volume, vary=vary,
                       solid_fraction=opts.solid_fraction if target_weight is not None else None,
                       true_density_mg_mm3=opts.true_density_mg_mm3 if target_weight is not None else None, **dims)
@@ -155,12 +167,13 @@ def _solved(tablet, opts, vary: str, target_weight: float | None, target_volume:
         option = {"target_volume_mm3": "--target-volume", "target_weight_mg": "--target-weight", "vary": "--solve-for",
                   vary: "--solve-for", "family": "tablet.family", "solid_fraction": "--solid-fraction",
                   "true_density_mg_mm3": "--true-density",
-                  "solid_fraction, true_density_mg_mm3": "--solid-fraction/--true-density"}.get(exc.parameter)
+                  "solid_fraction, true_density_mg_mm3": "--solid-fraction/--true-density",
+                  **{k: f"tablet.{k}" for k in given if k != vary}}.get(exc.parameter)
         raise exc.renamed(option or one_token(exc.parameter)) from None
     from dataclasses import replace
 
     solved = replace(r.tablet, name=tablet.name) if hasattr(r.tablet, "name") else r.tablet
-    section = dict(solved_for=vary, value_mm=r.value, given_mm=dims.get(vary), target_weight_mg=target_weight,
+    section = dict(solved_for=vary, value_mm=r.value, given_mm=given.get(vary), target_weight_mg=target_weight,
                    target_volume_mm3=target_volume, nominal_volume_mm3=r.volume_mm3, weight_mg=r.weight_mg,
                    evaluations=r.evaluations)
     return solved, section
@@ -231,7 +244,8 @@ def _write_tables(payloads: list[dict[str, Any]], csv_out: Path | None, xlsx_out
 @click.option("--max-punch-force", type=float, default=None, help="Punch-tip force limit, kN (user-given).")
 @click.option("--max-punch-pressure", type=float, default=None, help="Punch-tip pressure limit, MPa (user-given).")
 @click.option("--solve-for", "solve_for", type=click.Choice(_SOLVABLE), default=None,
-              help="Solve for this dimension (mm) to reach --target-weight or --target-volume; the others stay.")
+              help="Solve for this dimension (mm) to reach --target-weight or --target-volume; the others stay "
+                   "(height, dome: the thesis's spheroids, caplet, oblong and rod).")
 @click.option("--target-weight", type=float, default=None, help="Target weight, mg (needs solid fraction and true density).")
 @click.option("--target-volume", type=float, default=None, help="Target volume, mm3.")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON on stdout (a list for several designs).")
@@ -244,7 +258,8 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
     """Design report of one or more DESIGN.toml (any family): volumes, cup, weight, checks.
 
     One design prints its report; several print one line each.  --solve-for finds the band,
-    thickness or cup depth that gives --target-weight or --target-volume, then reports that design.
+    thickness, cup depth, height or dome that gives --target-weight or --target-volume (any
+    family that has it), then reports that design.
     """
     from tabletcad.cli.outputs import check_output, staged
     from tabletcad.pipeline.designreport import design_report, shape_report
@@ -281,14 +296,11 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
             raise exc.renamed(one_token(exc.parameter)) from None
         inverse = None
         if solve_for is not None:
-            from tabletcad.pipeline.design import read_design_file
-
-            data = read_design_file(design)
-            carried = [k for k in ("a",) if k in data.get("tablet", {})] + (["[reshape]"] if "reshape" in data else [])
+            carried = [f"[{k}]" for k in ("trim", "reshape") if getattr(spec, k) is not None and tablet.family != "free_form"]
             if carried:
                 raise DesignError("--solve-for", solve_for, f"the design sets {', '.join(carried)}, which the inverse "
                                   "calculation does not carry (it rebuilds the family from its dimensions)")
-            tablet, inverse = _solved(tablet, opts, solve_for, target_weight, target_volume)
+            tablet, inverse = _solved(tablet, spec, opts, solve_for, target_weight, target_volume)
         # industry families: the certified report; the thesis's shapes and free-form designs:
         # the same figures from their own geometry, without a certificate
         sec = design_report(tablet, opts) if isinstance(tablet.nominal, SweepNominal) else shape_report(tablet, opts)

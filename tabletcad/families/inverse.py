@@ -1,10 +1,37 @@
-"""Inverse design: the band, thickness or cup depth that gives a target volume or weight.
+"""Inverse design: the band, thickness, cup depth (or, for the thesis's shapes, height or dome)
+that gives a target volume or weight.
 
-The volume is the family's exact nominal volume (:func:`tabletcad.families.sweep.nominal_volume`,
-independent of the PDE patches), and the root is found by
-:func:`scipy.optimize.brentq` on a bracket found by growing the parameter from its
-given (or default) value.  Weight (mg) = volume (mm³) × solid fraction × true
-density (mg/mm³).
+Any family of :data:`tabletcad.families.FAMILIES` (the industry families and the thesis's
+shapes ``thesis.*``) and any custom outline (``functools.partial(outline_tablet, outline)``)
+can be solved for each of its dimensions in :data:`VARY`; the other dimensions stay fixed.
+
+Method
+------
+1. The volume: for a family with an exact nominal (:class:`~tabletcad.families.sweep.SweepNominal`:
+   the industry families, custom outlines) the closed-form/quadrature
+   :func:`~tabletcad.families.sweep.nominal_volume`; the family is only built as far as its
+   nominal while searching (its PDE patches are made once, for the answer).  The thesis's
+   shapes have no such nominal: their own :meth:`Tablet.volume() <tabletcad.geometry.tablet.Tablet.volume>`.
+2. The feasible interval of the solved dimension: the families' constructors raise
+   :class:`~tabletcad.errors.DesignError` on dimensions they cannot build, and with the
+   other dimensions fixed the buildable values form one interval inside
+   ``[0, tol.max_length]`` mm.  From a buildable start (the given value, else the family
+   default, else the first buildable value of a logarithmic scan) its ends are found by
+   doubling and then bisection on buildability, to ``1e-9`` relative (industry families,
+   cheap) or ``1e-7`` relative (the thesis's shapes, whose every build makes patches).
+   An open end (``band > 0``, ``thickness > 2 edge_radius``) is approached to that
+   tolerance, so the reachable range is exact to it.
+3. Monotonicity: the volume is sampled at 17 points across the interval.  Every family
+   here is monotone in these dimensions (increasing, or decreasing for an oblong's dome);
+   if the samples are not, the reachable range is the samples' span and the root is taken
+   in the sampled sub-interval nearest the start.
+4. :func:`scipy.optimize.brentq` on the bracket (``xtol`` 1e-12 mm), then one full build.
+
+Steps 2-3 are remembered for the 32 latest (family, dimensions) requests, so solving several
+targets for one design searches once.  A custom outline's inscribed radius is computed once
+per request instead of on every build.
+
+Weight (mg) = volume (mm³) × solid fraction × true density (mg/mm³).
 
 ::
 
@@ -18,23 +45,33 @@ density (mg/mm³).
 
 from __future__ import annotations
 
+import contextvars
+import functools
 import inspect
 import math
+import threading
+from contextlib import contextmanager
+from collections import OrderedDict
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
+import numpy as np
 from scipy.optimize import brentq
 
-from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.errors import DesignError, GeometryError, check_positive, check_range
+from tabletcad.families import sweep as _sweep
 from tabletcad.families.sweep import SweepNominal, nominal_volume
 from tabletcad.geometry.tablet import Tablet
+from tabletcad.tolerance import DEFAULT
 
-__all__ = ["InverseResult", "solve_for", "VARY"]
+__all__ = ["InverseResult", "Reach", "reachable", "solve_for", "solvable", "VARY"]
 
-#: Parameters that can be solved for (each family takes some of them).
-VARY = ("band", "thickness", "cup_depth")
-_XTOL_MM = 1e-9
-_LO_MM = 1e-3  # the thinnest band / cup depth tried (mm)
+#: Dimensions that can be solved for (each family takes some of them): the ones along the
+#: tablet's axis, which a formulator changes at fixed tooling.  ``height`` (a spheroid's or
+#: caplet's overall height) and ``dome`` (an oblong's or rod's dome) are the thesis's names.
+VARY = ("band", "thickness", "cup_depth", "height", "dome")
+_XTOL_MM = 1e-12  # brentq on the volume equation (mm)
+_N_SAMPLES = 17  # volume samples across the feasible interval (monotonicity check)
 
 
 @dataclass(frozen=True)
@@ -49,11 +86,15 @@ class InverseResult:
     params : dict
         All dimensions passed to the family (mm, deg), the solved one included.
     volume_mm3 : float
-        Exact nominal volume of the result.
+        Volume of the result (mm³): the exact nominal volume, or the tablet's own volume for a
+        family without one (the thesis's shapes).
     weight_mg : float or None
-        Weight at the given solid fraction and true density.
+        Weight at the given solid fraction and true density (mg).
     evaluations : int
-        Family builds used (bracket + Brent).
+        Family builds used (interval search, Brent and the final build; the interval search
+        counts 0 when it was remembered from an earlier call with the same family and dimensions).
+    tablet : Tablet
+        The tablet built with the solved value.
     """
 
     family: str
@@ -66,15 +107,322 @@ class InverseResult:
     tablet: Tablet = field(repr=False, compare=False)
 
 
-def _family_function(family: str | Callable[..., Tablet]) -> Callable[..., Tablet]:
-    from tabletcad.families import FAMILY_FUNCTIONS
+@dataclass(frozen=True)
+class Reach:
+    """The buildable interval of one dimension and the volumes it spans (the others fixed).
 
-    by_name = {f.__name__: f for f in FAMILY_FUNCTIONS}
+    Attributes
+    ----------
+    family, vary : str
+    lo_mm, hi_mm : float
+        Ends of the buildable interval (mm), within the search tolerance of an open end.
+    volume_lo_mm3, volume_hi_mm3 : float
+        Smallest and largest volume reached on the interval (mm³).
+    monotone : bool
+        Whether the sampled volumes are strictly monotone in the dimension.
+    exact_nominal : bool
+        Whether the volume is the exact nominal volume (else the tablet's own volume).
+    """
+
+    family: str
+    vary: str
+    lo_mm: float
+    hi_mm: float
+    volume_lo_mm3: float
+    volume_hi_mm3: float
+    monotone: bool
+    exact_nominal: bool
+
+
+# ---------------------------------------------------------------------------- families
+
+def _family_function(family: str | Callable[..., Tablet]) -> Callable[..., Tablet]:
+    """The constructor of a family name (any :data:`~tabletcad.families.FAMILIES` name, or an
+    old name with its warning), or ``family`` itself if it is callable."""
     if callable(family):
         return family
-    if family not in by_name:
-        raise DesignError("family", family, f"must be one of {', '.join(by_name)} (the industry families)")
-    return by_name[family]
+    from tabletcad.families import family as lookup
+
+    return lookup(family, parameter="family").func
+
+
+def _family_name(family: str | Callable[..., Tablet], func: Callable[..., Tablet]) -> str:
+    if isinstance(family, str):
+        from tabletcad.families import RENAMED
+
+        return RENAMED.get(family, family)
+    inner = func.func if isinstance(func, functools.partial) else func
+    name = getattr(inner, "__name__", "family")
+    if name == "outline_tablet":
+        return "custom_outline"
+    from tabletcad.families import FAMILIES
+
+    for key, fam in FAMILIES.items():  # a thesis function: its catalogue name
+        if fam.func is inner:
+            return key
+    return name
+
+
+def _takes(func: Callable[..., Tablet]) -> list[str]:
+    params = inspect.signature(func).parameters
+    return [k for k, p in params.items() if p.kind is p.POSITIONAL_OR_KEYWORD]
+
+
+def solvable(family: str | Callable[..., Tablet]) -> tuple[str, ...]:
+    """The dimensions of :data:`VARY` that ``family`` takes (what :func:`solve_for` can solve for).
+
+    Parameters
+    ----------
+    family : str or callable
+        A family name of :data:`tabletcad.families.FAMILIES` or a constructor.
+    """
+    takes = _takes(_family_function(family))
+    return tuple(v for v in VARY if v in takes)
+
+
+# ---------------------------------------------------------------------------- nominal-only builds
+
+class _NominalReady(Exception):
+    """Raised inside :func:`~tabletcad.families.sweep.build_sweep_tablet` once the nominal exists."""
+
+    def __init__(self, nominal: SweepNominal) -> None:
+        super().__init__("nominal built")
+        self.nominal = nominal
+
+
+_NOMINAL_ONLY: contextvars.ContextVar[bool] = contextvars.ContextVar("tabletcad_inverse_nominal_only", default=False)
+_SWAP_LOCK = threading.Lock()
+_SWAP_USERS = 0
+
+
+class _StopAtNominal(SweepNominal):
+    """A :class:`SweepNominal` that, in a :func:`_nominal_only` context, stops the build at itself."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        if _NOMINAL_ONLY.get():
+            raise _NominalReady(self)
+
+
+@contextmanager
+def _nominal_only() -> Iterator[None]:
+    """Swept families built in this context stop once their exact nominal is made (every
+    dimension check has run by then; the PDE patches are not made).  Other threads and
+    contexts build as usual: the stop is keyed on a context variable."""
+    global _SWAP_USERS
+    with _SWAP_LOCK:
+        if _SWAP_USERS == 0:
+            _sweep.SweepNominal = _StopAtNominal
+        _SWAP_USERS += 1
+    token = _NOMINAL_ONLY.set(True)
+    try:
+        yield
+    finally:
+        _NOMINAL_ONLY.reset(token)
+        with _SWAP_LOCK:
+            _SWAP_USERS -= 1
+            if _SWAP_USERS == 0:
+                _sweep.SweepNominal = SweepNominal
+
+
+class _Probe:
+    """Builds of ``func`` with one dimension varied: buildability and volume, cached by value."""
+
+    def __init__(self, func: Callable[..., Tablet], dims: dict, vary: str) -> None:
+        self.func, self.dims, self.vary = func, dims, vary
+        self.builds = 0
+        self._cache: dict[float, tuple[bool, Any]] = {}
+        self.exact_nominal: bool | None = None
+
+    def _build(self, x: float) -> tuple[bool, Any]:
+        if x not in self._cache:
+            self.builds += 1
+            try:
+                with _nominal_only():
+                    t = self.func(**self.dims, **{self.vary: x})
+            except _NominalReady as ready:
+                self._cache[x] = (True, ready.nominal)
+            except (DesignError, GeometryError):
+                self._cache[x] = (False, None)
+            else:
+                self._cache[x] = (True, t)
+        return self._cache[x]
+
+    def ok(self, x: float) -> bool:
+        return self._build(x)[0]
+
+    def volume(self, x: float) -> float:
+        ok, obj = self._build(x)
+        if not ok:  # pragma: no cover - only called inside the feasible interval
+            raise DesignError(self.vary, x, "cannot be built with these dimensions", "mm")
+        if isinstance(obj, SweepNominal):
+            self.exact_nominal = True
+            return nominal_volume(obj)
+        if isinstance(obj.nominal, SweepNominal):  # pragma: no cover - built without the stop
+            self.exact_nominal = True
+            return nominal_volume(obj.nominal)
+        self.exact_nominal = False
+        return float(obj.volume())
+
+
+def _start(probe: _Probe, x0: float, x_max: float) -> float:
+    """A buildable value: ``x0`` if it is, else the one nearest it on a logarithmic scan."""
+    if x0 > 0 and probe.ok(x0):
+        return x0
+    grid = np.geomspace(1e-6, x_max, 91)
+    if x0 > 0:
+        grid = grid[np.argsort(np.abs(np.log(grid / x0)))]
+    for x in grid:
+        if probe.ok(float(x)):
+            return float(x)
+    raise DesignError(probe.vary, x0, f"no {probe.vary} in (0, {x_max:g}] mm builds with these dimensions "
+                      "(the other dimensions are infeasible together)", "mm")
+
+
+def _ends(probe: _Probe, x0: float, x_max: float, rel: float) -> tuple[float, float]:
+    """The buildable interval ``[lo, hi]`` around the buildable ``x0`` within ``[0, x_max]``."""
+    # lower end: bisection between 0 and x0; 0 itself only if the values down to it build
+    # (a compound cup builds flat at 0 but not below its least depth: {0} is not part of the interval)
+    bad, good = 0.0, x0
+    while good - bad > rel * x0:
+        mid = 0.5 * (bad + good)
+        if probe.ok(mid):
+            good = mid
+        else:
+            bad = mid
+    lo = 0.0 if bad == 0.0 and probe.ok(0.0) else good
+    # upper end: doubling, then bisection
+    good, bad = x0, None
+    while good < x_max:
+        nxt = min(2.0 * good, x_max)
+        if probe.ok(nxt):
+            good = nxt
+        else:
+            bad = nxt
+            break
+    if bad is not None:
+        while bad - good > rel * max(good, x0):
+            mid = 0.5 * (good + bad)
+            if probe.ok(mid):
+                good = mid
+            else:
+                bad = mid
+    return lo, good
+
+
+def _samples(lo: float, hi: float, x0: float) -> np.ndarray:
+    """Points across ``[lo, hi]``: linear, plus logarithmic ones near ``lo`` for wide intervals."""
+    xs = np.linspace(lo, hi, _N_SAMPLES)
+    if hi > 0 and hi / max(lo, 1e-300) > 100.0:
+        xs = np.concatenate([xs, np.geomspace(max(lo, hi * 1e-6), hi, _N_SAMPLES)])
+    return np.unique(np.clip(np.append(xs, x0), lo, hi))
+
+
+def _reach(probe: _Probe, name: str, x0: float, x_max: float, rel: float):
+    x0 = _start(probe, x0, x_max)
+    lo, hi = _ends(probe, x0, x_max, rel)
+    xs = _samples(lo, hi, x0)
+    vs = np.array([probe.volume(float(x)) for x in xs])
+    dv = np.diff(vs)
+    monotone = bool(np.all(dv > 0) or np.all(dv < 0)) if len(vs) > 1 else True
+    reach = Reach(family=name, vary=probe.vary, lo_mm=lo, hi_mm=hi, volume_lo_mm3=float(vs.min()),
+                  volume_hi_mm3=float(vs.max()), monotone=monotone, exact_nominal=bool(probe.exact_nominal))
+    return reach, x0, xs, vs
+
+
+# ---------------------------------------------------------------------------- API
+
+def _interval(reach: Reach) -> str:
+    """``[lo, hi]``, or ``(0, hi]`` when the lower end is a value > 0 approached down to 0."""
+    if 0.0 < reach.lo_mm <= 1e-6 * reach.hi_mm:
+        return f"(0, {reach.hi_mm:.6g}]"
+    return f"[{reach.lo_mm:.6g}, {reach.hi_mm:.6g}]"
+
+
+def _prepare(family, vary, dims):
+    func = _family_function(family)
+    name = _family_name(family, func)
+    takes = _takes(func)
+    kw_only = {k for k, p in inspect.signature(func).parameters.items() if p.kind is p.KEYWORD_ONLY}
+    if vary not in VARY or vary not in takes:
+        allowed = [v for v in VARY if v in takes]
+        raise DesignError("vary", vary, f"{name} can solve for {', '.join(allowed)}" if allowed else
+                          f"{name} has none of the dimensions that can be solved for ({', '.join(VARY)})")
+    for k in dims:
+        if k not in takes and not (k in ("a", "tol") and k in kw_only):
+            raise DesignError(k, dims[k], f"{name} takes {', '.join(takes)}")
+    dims = dict(dims)
+    default = inspect.signature(func).parameters[vary].default
+    x0 = dims.pop(vary, default)
+    x0 = float(x0) if isinstance(x0, (int, float)) and not isinstance(x0, bool) and math.isfinite(x0) else 0.0
+    x_max = float(getattr(dims.get("tol", DEFAULT), "max_length", DEFAULT.max_length))
+    return func, name, dims, x0, x_max
+
+
+def _with_reach(func: Callable[..., Tablet]) -> Callable[..., Tablet]:
+    """``functools.partial(outline_tablet, outline)`` with the outline's inscribed radius given
+    (``reach=``): what the family would compute on every build (a minimisation), computed once."""
+    from tabletcad.families.shaped import as_outline, outline_tablet
+
+    if isinstance(func, functools.partial) and func.func is outline_tablet and len(func.args) == 1 \
+            and "reach" not in func.keywords:
+        try:
+            outline = as_outline(func.args[0])
+        except DesignError:  # the family's own build reports it
+            return func
+        return functools.partial(outline_tablet, outline, reach=outline.inscribed_radius(), **func.keywords)
+    return func
+
+
+_CACHE: OrderedDict = OrderedDict()
+_CACHE_SIZE = 32
+
+
+def _search(func: Callable[..., Tablet], name: str, dims: dict, vary: str, x0: float, x_max: float):
+    """``(reach, start, samples, volumes, builds)``, remembered for the 32 latest hashable requests
+    (the families are pure functions of their dimensions: solving several targets searches once)."""
+    try:
+        key = (func, name, vary, x0, x_max, tuple(sorted(dims.items())))
+        hash(key)
+    except TypeError:
+        key = None
+    if key is not None and key in _CACHE:
+        _CACHE.move_to_end(key)
+        return _CACHE[key][:4] + (0,)
+    probe = _Probe(_with_reach(func), dims, vary)
+    rel = 1e-9 if _is_swept(probe, x0, x_max) else 1e-7
+    found = _reach(probe, name, x0, x_max, rel)
+    if key is not None:
+        _CACHE[key] = found
+        while len(_CACHE) > _CACHE_SIZE:
+            _CACHE.popitem(last=False)
+    return found + (probe.builds,)
+
+
+def reachable(family: str | Callable[..., Tablet], vary: str = "band", **dims: Any) -> Reach:
+    """The buildable interval of ``vary`` (mm) and the volumes (mm³) it spans, the other dimensions fixed.
+
+    Parameters
+    ----------
+    family : str or callable
+        As for :func:`solve_for`.
+    vary : str
+        One of the family's dimensions in :data:`VARY`.
+    **dims
+        The other dimensions (mm, deg; the family's defaults otherwise), ``a`` and ``tol``.
+
+    Returns
+    -------
+    Reach
+    """
+    func, name, dims, x0, x_max = _prepare(family, vary, dims)
+    return _search(func, name, dims, vary, x0, x_max)[0]
+
+
+def _is_swept(probe: _Probe, x0: float, x_max: float) -> bool:
+    """Whether the family stops at an exact nominal (cheap builds), seen from one buildable value."""
+    x = _start(probe, x0, x_max)
+    return isinstance(probe._build(x)[1], SweepNominal)
 
 
 def solve_for(
@@ -92,31 +440,45 @@ def solve_for(
     Parameters
     ----------
     family : str or callable
-        An industry family name (``tabletcad shapes``) or its function; for any other plan
-        outline, ``functools.partial(outline_tablet, outline)`` (a custom_outline design).
-    target_volume_mm3, target_weight_mg : float
-        Exactly one target; a weight needs ``solid_fraction`` (0, 1] and ``true_density_mg_mm3``.
-    vary : {"band", "thickness", "cup_depth"}
-        The dimension to solve for; the family must take it.
+        A family name of :data:`tabletcad.families.FAMILIES` (an industry family such as
+        ``"capsule"``, or a thesis shape such as ``"thesis.shallow_convex_round"``) or its
+        constructor; for any other plan outline, ``functools.partial(outline_tablet, outline)``
+        (a custom_outline design).
+    target_volume_mm3 : float, optional
+        Target volume, mm³.
+    target_weight_mg : float, optional
+        Target weight, mg; needs ``solid_fraction`` (0, 1] and ``true_density_mg_mm3`` (mg/mm³).
+        Give exactly one of the two targets.
+    vary : {"band", "thickness", "cup_depth", "height", "dome"}
+        The dimension to solve for (mm); the family must take it (:func:`solvable`).
+    solid_fraction : float, optional
+        1 - porosity, in (0, 1].
+    true_density_mg_mm3 : float, optional
+        True density of the material, mg/mm³ (= g/cm³).
     **dims
-        The other dimensions (mm; the family's defaults otherwise).  A value given for
-        ``vary`` is the starting point of the bracket search.
+        The other dimensions (mm, deg; the family's defaults otherwise), and ``a`` (the
+        smoothing parameter) or ``tol`` if the constructor takes them.  A value given for
+        ``vary`` is the start of the search (and, if the volume were not monotone, picks
+        the root nearest it).
+
+    Returns
+    -------
+    InverseResult
+        The solved value (mm), all dimensions, the volume (mm³: exact nominal volume for the
+        industry families and custom outlines, :meth:`Tablet.volume` for the thesis's shapes),
+        the weight (mg) and the tablet built with the value.
 
     Raises
     ------
     DesignError
-        Bad targets, a parameter the family does not take, or a target outside the volumes
-        the family can reach by changing ``vary`` alone (the message gives that range).
+        Bad targets (``target_volume_mm3``, ``target_weight_mg``, ``solid_fraction``...), a
+        ``vary`` the family does not take (``"vary"``; the message lists those it can solve
+        for), an unknown dimension, or a target outside the volumes or weights the family can
+        reach by changing ``vary`` alone: the message gives that range and the interval of
+        ``vary`` (``target_volume_mm3 = 5 mm3 is not allowed: must be within 87.3 to 512.9
+        mm3 for thickness in [1.6, 1000] mm ...``).
     """
-    func = _family_function(family)
-    name = getattr(func, "__name__", None) or getattr(getattr(func, "func", None), "__name__", "family")
-    takes = [k for k, p in inspect.signature(func).parameters.items() if p.kind is p.POSITIONAL_OR_KEYWORD]
-    if vary not in VARY or vary not in takes:
-        allowed = [v for v in VARY if v in takes]
-        raise DesignError("vary", vary, f"{name} can solve for {', '.join(allowed) or 'none of ' + ', '.join(VARY)}")
-    for k in dims:
-        if k not in takes:
-            raise DesignError(k, dims[k], f"{name} takes {', '.join(takes)}")
+    func, name, dims, x0, x_max = _prepare(family, vary, dims)
     if (target_volume_mm3 is None) == (target_weight_mg is None):
         raise DesignError("target", "both" if target_volume_mm3 is not None else "none",
                           "give exactly one of target_volume_mm3 and target_weight_mg")
@@ -130,54 +492,33 @@ def solve_for(
         target = check_positive("target_volume_mm3", target_volume_mm3, "mm3")
     else:
         target = check_positive("target_weight_mg", target_weight_mg, "mg") / mg_per_mm3
-    x0 = float(dims.pop(vary, inspect.signature(func).parameters[vary].default))
-    n = 0
 
-    def volume(x: float) -> float:
-        nonlocal n
-        n += 1
-        t = func(**dims, **{vary: x})
-        if not isinstance(t.nominal, SweepNominal):  # pragma: no cover - every industry family sweeps
-            raise DesignError("family", name, "has no exact nominal volume")
-        return nominal_volume(t.nominal)
-
-    def valid(x: float) -> float | None:
-        try:
-            return volume(x)
-        except DesignError:
-            return None
-
-    lo = _LO_MM
-    v_lo = valid(lo)
-    if v_lo is None:
-        raise DesignError(vary, lo, f"{name} cannot be built with {vary} = {lo} mm and these dimensions", "mm")
-    hi, v_hi, bad = max(x0, 2 * lo), valid(max(x0, 2 * lo)), math.inf
-    while v_hi is not None and v_hi < target and hi < 1e3:  # grow until the target is passed
-        lo, v_lo = hi, v_hi
-        hi *= 2.0
-        v_hi = valid(hi)
-    if v_hi is None:  # invalid: the largest buildable value lies between lo and hi
-        bad = hi
-        good, v_good = lo, v_lo
-        for _ in range(40):
-            mid = 0.5 * (good + bad)
-            v = valid(mid)
-            if v is None:
-                bad = mid
-            else:
-                good, v_good = mid, v
-                if v >= target:
-                    break
-        hi, v_hi = good, v_good
-    if not (min(v_lo, v_hi) <= target <= max(v_lo, v_hi)):
-        vmin = valid(_LO_MM)
-        what = "volume_mm3" if target_weight_mg is None else "weight_mg"
-        scale, unit = (1.0, "mm3") if target_weight_mg is None else (mg_per_mm3, "mg")
-        raise DesignError(f"target_{what}", target_volume_mm3 if target_weight_mg is None else target_weight_mg,
-                          f"{name} reaches {vmin * scale:.6g}-{v_hi * scale:.6g} {unit} by changing {vary} "
-                          f"(the other dimensions fixed)", unit)
-    x = brentq(lambda x: volume(x) - target, lo, hi, xtol=_XTOL_MM, rtol=1e-12)
-    t = func(**dims, **{vary: x})
-    v = nominal_volume(t.nominal)
-    return InverseResult(family=name, vary=vary, value=float(x), params={**dims, vary: float(x)}, volume_mm3=v,
-                         weight_mg=None if mg_per_mm3 is None else v * mg_per_mm3, evaluations=n + 1, tablet=t)
+    reach, x_start, xs, vs, builds = _search(func, name, dims, vary, x0, x_max)
+    probe = _Probe(_with_reach(func), dims, vary)
+    if target_weight_mg is None:
+        param, given, unit, scale = "target_volume_mm3", target_volume_mm3, "mm3", 1.0
+    else:
+        param, given, unit, scale = "target_weight_mg", target_weight_mg, "mg", mg_per_mm3
+    if not reach.volume_lo_mm3 <= target <= reach.volume_hi_mm3:
+        basis = "" if reach.monotone else " (sampled: the volume is not monotone in it)"
+        raise DesignError(param, given, f"must be within {reach.volume_lo_mm3 * scale:.6g} to "
+                          f"{reach.volume_hi_mm3 * scale:.6g} {unit} for {vary} in {_interval(reach)} mm{basis} ({name}, the other dimensions fixed)", unit)
+    # a bracket: consecutive samples around the target (the one nearest the start if several)
+    f = vs - target
+    exact = np.flatnonzero(f == 0.0)
+    if exact.size:
+        x = float(xs[exact[np.argmin(np.abs(xs[exact] - x_start))]])
+    else:
+        brackets = np.flatnonzero(np.sign(f[:-1]) != np.sign(f[1:]))
+        if brackets.size == 0:  # pragma: no cover - a non-monotone volume peaking between samples
+            raise DesignError(param, given, f"no {vary} found for it: the volume of {name} is not monotone in {vary}",
+                              unit)
+        mids = 0.5 * (xs[brackets] + xs[brackets + 1])
+        k = int(brackets[np.argmin(np.abs(mids - x_start))])
+        x = float(brentq(lambda x: probe.volume(x) - target, float(xs[k]), float(xs[k + 1]),
+                         xtol=_XTOL_MM, rtol=4 * np.finfo(float).eps))
+    t = func(**dims, **{vary: x})  # the full build: patches (and, for the industry families, their certificate)
+    v = nominal_volume(t.nominal) if isinstance(t.nominal, SweepNominal) else float(t.volume())
+    return InverseResult(family=name, vary=vary, value=x, params={**{k: d for k, d in dims.items() if k not in ("a", "tol")}, vary: x},
+                         volume_mm3=v, weight_mg=None if mg_per_mm3 is None else v * mg_per_mm3,
+                         evaluations=builds + probe.builds + 1, tablet=t)
