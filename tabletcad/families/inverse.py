@@ -45,22 +45,18 @@ Weight (mg) = volume (mm³) × solid fraction × true density (mg/mm³).
 
 from __future__ import annotations
 
-import contextvars
 import functools
 import inspect
 import math
-import threading
-from contextlib import contextmanager
 from collections import OrderedDict
 from dataclasses import dataclass, field
-from typing import Any, Callable, Iterator
+from typing import Any, Callable
 
 import numpy as np
 from scipy.optimize import brentq
 
 from tabletcad.errors import DesignError, GeometryError, check_positive, check_range
-from tabletcad.families import sweep as _sweep
-from tabletcad.families.sweep import SweepNominal, nominal_volume
+from tabletcad.families.sweep import NominalBuilt, SweepNominal, nominal_only, nominal_volume
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT
 
@@ -182,49 +178,6 @@ def solvable(family: str | Callable[..., Tablet]) -> tuple[str, ...]:
 
 # ---------------------------------------------------------------------------- nominal-only builds
 
-class _NominalReady(Exception):
-    """Raised inside :func:`~tabletcad.families.sweep.build_sweep_tablet` once the nominal exists."""
-
-    def __init__(self, nominal: SweepNominal) -> None:
-        super().__init__("nominal built")
-        self.nominal = nominal
-
-
-_NOMINAL_ONLY: contextvars.ContextVar[bool] = contextvars.ContextVar("tabletcad_inverse_nominal_only", default=False)
-_SWAP_LOCK = threading.Lock()
-_SWAP_USERS = 0
-
-
-class _StopAtNominal(SweepNominal):
-    """A :class:`SweepNominal` that, in a :func:`_nominal_only` context, stops the build at itself."""
-
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        super().__init__(*args, **kwargs)
-        if _NOMINAL_ONLY.get():
-            raise _NominalReady(self)
-
-
-@contextmanager
-def _nominal_only() -> Iterator[None]:
-    """Swept families built in this context stop once their exact nominal is made (every
-    dimension check has run by then; the PDE patches are not made).  Other threads and
-    contexts build as usual: the stop is keyed on a context variable."""
-    global _SWAP_USERS
-    with _SWAP_LOCK:
-        if _SWAP_USERS == 0:
-            _sweep.SweepNominal = _StopAtNominal
-        _SWAP_USERS += 1
-    token = _NOMINAL_ONLY.set(True)
-    try:
-        yield
-    finally:
-        _NOMINAL_ONLY.reset(token)
-        with _SWAP_LOCK:
-            _SWAP_USERS -= 1
-            if _SWAP_USERS == 0:
-                _sweep.SweepNominal = SweepNominal
-
-
 class _Probe:
     """Builds of ``func`` with one dimension varied: buildability and volume, cached by value."""
 
@@ -238,9 +191,9 @@ class _Probe:
         if x not in self._cache:
             self.builds += 1
             try:
-                with _nominal_only():
+                with nominal_only():
                     t = self.func(**self.dims, **{self.vary: x})
-            except _NominalReady as ready:
+            except NominalBuilt as ready:
                 self._cache[x] = (True, ready.nominal)
             except (DesignError, GeometryError):
                 self._cache[x] = (False, None)
