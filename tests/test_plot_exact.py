@@ -7,7 +7,7 @@
   stadium of the thesis's shapes): no spike or notch.
 * The side profile of the sphere and the spheroids is their closed-form ellipse, reaching
   its extreme x, by both silhouette methods (meridian, and crossings of a dense sample).
-* ``plot_tablets`` takes Tablets and TabletModels.
+* ``plot_tablets`` takes Tablets and TabletModels; ``tabletcad report --plot``.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 import tabletcad
+from tabletcad.cli import main
 from tabletcad.pipeline import plot
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -211,3 +212,36 @@ def test_plot_tablets_takes_tablets_and_models(tmp_path):
     assert [a.get_title().splitlines()[0] for a in fig.axes[:2]] == [m.tablet.name] * 2
     with pytest.raises(TypeError, match="TabletModel"):
         plot.tablets_figure(["concave_round"])
+
+
+def test_report_plot_many_side_by_side_and_one_picture(tmp_path, capsys):
+    designs = [ROOT / "samples" / "families" / "concave_round.toml", ROOT / "samples" / "families" / "capsule.toml",
+               ROOT / "samples" / "spherical.toml"]
+    many, one = tmp_path / "many.png", tmp_path / "one.png"
+    assert main(["report", *map(str, designs), "--plot", str(many)]) == 0
+    assert f"plot -> {many}" in capsys.readouterr().out
+    assert main(["report", str(designs[1]), "--plot", str(one)]) == 0
+    # the side-by-side figure is (2.6 k + 0.6) × 5 in, the single picture 11 × 4 in, at 110 dpi
+    assert _png_size(many) == (round((2.6 * 3 + 0.6) * 110), 5 * 110)
+    assert _png_size(one) == (11 * 110, 4 * 110)
+
+
+@pytest.mark.parametrize("value, why", [
+    ("OUT/r.jpg", "must end in .png"),
+    ("OUT/r", "must end in .png"),
+    ("OUT/d.png", "is a folder"),
+    ("OUT/f.txt/r.png", "cannot be created"),
+])
+def test_report_plot_bad_output_is_one_line_and_writes_nothing(tmp_path, capsys, value, why):
+    out = tmp_path / "OUT"
+    out.mkdir()
+    (out / "d.png").mkdir()
+    (out / "f.txt").write_text("x")
+    before = sorted(out.rglob("*"))
+    argv = ["report", str(ROOT / "samples" / "families" / "concave_round.toml"), "--csv", str(out / "r.csv"),
+            "--plot", value.replace("OUT", str(out))]
+    assert main(argv) == 2
+    cap = capsys.readouterr()
+    assert cap.out == "" and cap.err.splitlines() == [cap.err.strip()]
+    assert cap.err.startswith("error: --plot = ") and " is not allowed: " in cap.err and why in cap.err
+    assert sorted(out.rglob("*")) == before
