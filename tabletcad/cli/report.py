@@ -4,7 +4,8 @@ Prints a readable table (volume, area, cup, plan, weight, punch-tip check,
 tensile strength, FDA size flag, nominal certificate and seams), or one line
 per design for several designs; ``--json`` prints the report as JSON instead,
 ``--json-file``, ``--csv`` and ``--xlsx`` write it (CSV and workbook: one row
-per design, every scalar of the report).  ``--solve-for`` with a target
+per design, every scalar of the report); ``--plot`` draws the design's picture, or several
+designs side by side at one scale (PNG).  ``--solve-for`` with a target
 weight or volume first solves for the band, thickness, cup depth, height or
 dome of any family that has it (:func:`tabletcad.families.inverse.solve_for`).  Options not given on the command line
 are read from the design file's ``[report]`` table.  Bad input: one line on
@@ -235,6 +236,17 @@ def _write_tables(payloads: list[dict[str, Any]], csv_out: Path | None, xlsx_out
         wb.save(staged["xlsx"])
 
 
+def _write_plot(tablets: list, path: Path) -> None:
+    """One design: its picture (:func:`~tabletcad.pipeline.plot.plot_tablet`); several: their
+    profiles and plans side by side at one scale (:func:`~tabletcad.pipeline.plot.plot_tablets`)."""
+    from tabletcad.pipeline.plot import plot_tablet, plot_tablets
+
+    if len(tablets) == 1:
+        plot_tablet(tablets[0], path)
+    else:
+        plot_tablets(tablets, path)
+
+
 @click.command("report")
 @click.argument("designs", metavar="DESIGN.toml...", nargs=-1, required=True, type=click.Path(path_type=Path))
 @click.option("--solid-fraction", type=float, default=None, help="Solid fraction (1 - porosity), 0-1.")
@@ -252,9 +264,11 @@ def _write_tables(payloads: list[dict[str, Any]], csv_out: Path | None, xlsx_out
 @click.option("--json-file", type=click.Path(path_type=Path), default=None, help="Write the report as JSON to this file.")
 @click.option("--csv", "csv_out", type=click.Path(path_type=Path), default=None, help="Write one row per design (every scalar of the report) as CSV.")
 @click.option("--xlsx", "xlsx_out", type=click.Path(path_type=Path), default=None, help="The same table as an Excel workbook (needs openpyxl).")
+@click.option("--plot", "plot_out", type=click.Path(path_type=Path), default=None,
+              help="Write a picture (PNG): the design's, or several designs side by side at one scale.")
 def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking_force, compaction_force, max_punch_force,
                max_punch_pressure, solve_for, target_weight, target_volume, as_json: bool, json_file: Path | None,
-               csv_out: Path | None, xlsx_out: Path | None) -> None:
+               csv_out: Path | None, xlsx_out: Path | None, plot_out: Path | None = None) -> None:
     """Design report of one or more DESIGN.toml (any family): volumes, cup, weight, checks.
 
     One design prints its report; several print one line each.  --solve-for finds the band,
@@ -274,6 +288,7 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
     check_output("--json-file", json_file, (".json",))
     check_output("--csv", csv_out, (".csv",))
     check_output("--xlsx", xlsx_out, (".xlsx",))
+    check_output("--plot", plot_out, (".png",))
     if xlsx_out is not None:
         try:
             import openpyxl  # noqa: F401
@@ -285,7 +300,7 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
         raise DesignError("--target-weight/--target-volume", "both" if target_weight is not None else "none",
                           "give exactly one target for --solve-for")
 
-    payloads, shown = [], []
+    payloads, shown, tablets = [], [], []
     for design in designs:
         tablet, spec = load_family_design(design)
         try:
@@ -311,15 +326,18 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
         json.loads(to_json(payload))  # fail before writing if not serialisable
         payloads.append(payload)
         shown.append((tablet.name, sec))
+        tablets.append(tablet)
 
     document = payloads[0] if len(payloads) == 1 else payloads
-    with staged(json=json_file, csv=csv_out, xlsx=xlsx_out) as st:
+    with staged(json=json_file, csv=csv_out, xlsx=xlsx_out, plot=plot_out) as st:
         if json_file is not None:
             st["json"].write_text(to_json(document) if isinstance(document, dict)
                                   else "[\n" + ",\n".join(to_json(p).rstrip("\n") for p in payloads) + "\n]\n",
                                   encoding="utf-8")
         if csv_out is not None or xlsx_out is not None:
             _write_tables(payloads, csv_out, xlsx_out, st)
+        if plot_out is not None:
+            _write_plot(tablets, st["plot"])
     if as_json:
         click.echo(to_json(document).rstrip("\n") if isinstance(document, dict)
                    else "[\n" + ",\n".join(to_json(p).rstrip("\n") for p in payloads) + "\n]")
@@ -332,7 +350,7 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
             click.echo(f"{p['design']['name']}: {inv['solved_for']} = {inv['value_mm']:.6g} mm gives {target}"
                        + (f" (was {inv['given_mm']:.6g} mm)" if inv["given_mm"] is not None else ""))
     click.echo(_table(*shown[0]) if len(shown) == 1 else _comparison(shown))
-    for option, path in (("json", json_file), ("csv", csv_out), ("xlsx", xlsx_out)):
+    for option, path in (("json", json_file), ("csv", csv_out), ("xlsx", xlsx_out), ("plot", plot_out)):
         if path is not None:
             click.echo(f"{option} -> {path}")
 

@@ -14,6 +14,7 @@ No global matplotlib backend is set: every figure is a
 from __future__ import annotations
 
 import io
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
@@ -34,23 +35,34 @@ def _quads(Y: np.ndarray) -> np.ndarray:
     return np.stack([Y[:-1, :-1], Y[1:, :-1], Y[1:, 1:], Y[:-1, 1:]], axis=-2).reshape(-1, 4, 3)
 
 
-def _face_grids(tablet: Tablet, nu: int, nv: int) -> list[tuple[object, np.ndarray]]:
+def _face_grids(tablet: Tablet, nu: int, nv: int, faces: list | None = None) -> list[tuple[object, np.ndarray]]:
     out = []
-    for face in tablet.faces():
+    for face in tablet.faces() if faces is None else faces:
         s = np.linspace(face.s_range[0], face.s_range[1], nu)
         t = np.linspace(face.t_range[0], face.t_range[1], nv)
         out.append((face, face.evaluate_grid(tablet, s, t)))
     return out
 
 
+def _as_tablet(obj) -> Tablet:
+    """``obj`` itself when it is a :class:`Tablet`, else its ``.tablet`` (a :class:`TabletModel`...)."""
+    t = obj if isinstance(obj, Tablet) else getattr(obj, "tablet", None)
+    if not isinstance(t, Tablet):
+        raise TypeError(f"expected a Tablet or an object with a .tablet (a TabletModel), got {type(obj).__name__}")
+    return t
+
+
 @dataclass(frozen=True)
 class TabletOutline:
     """Side profile and plan outline of a tablet (mm).
 
-    ``x``: bin centres along x; ``z_low``/``z_high``: the silhouette seen along y
-    (lowest and highest surface point over each x bin); ``plan``: closed outline
-    (k, 2) seen from above; ``band``, ``thickness``, ``cup_depth`` (top face), ``length``,
-    ``width``: the main dimensions.
+    ``x``: abscissae along x (from the least to the greatest x of the tablet, denser towards
+    both ends); ``z_low``/``z_high``: the silhouette seen along y (lowest and highest point of
+    the tablet over each x); ``plan``: closed outline (k, 2) seen from above, ``plan_holes``
+    the closed outlines of see-through holes (a ring); ``band``, ``thickness``, ``cup_depth``
+    (top face), ``cup_depth_bottom``, ``length``, ``width``: the main dimensions;
+    ``has_band``: False for a tablet without a band (a sphere: ``band`` and the cup depths are
+    then only the silhouette's height at its ends and the heights beyond it, and are not drawn).
     """
 
     x: np.ndarray
@@ -63,59 +75,221 @@ class TabletOutline:
     length: float
     width: float
     round: bool
+    cup_depth_bottom: float = 0.0
+    plan_holes: tuple = ()
+    has_band: bool = True
+
+
+def _revolution_axis(tablet: Tablet) -> np.ndarray | None:
+    """The plan point ``(x, y)`` of the vertical axis the (untrimmed in u and v) tablet is a
+    surface of revolution about, or None: every ``u`` ring of every patch is a horizontal circle
+    about one axis (within 1e-9 of the size)."""
+    t = tablet.trim
+    if t.u != (0.0, 1.0) or not t.full_v:
+        return None
+    segs = getattr(getattr(tablet.nominal, "outline", None), "segs", None)
+    if segs is not None and not (len(segs) == 1 and segs[0].kind == "arc"):
+        return None  # an industry family's outline that is not a circle
+    u = np.linspace(0.0, 1.0, 9)
+    v = np.linspace(0.0, math.tau, 24, endpoint=False)
+    c = None
+    for p in tablet.patches:  # patch by patch: a shaped tablet fails at its first patch
+        X = p.evaluate_grid(u, v)  # (9, 24, 3)
+        if c is None:
+            c = 0.5 * (X[..., :2].min(axis=(0, 1)) + X[..., :2].max(axis=(0, 1)))
+        r = np.hypot(X[..., 0] - c[0], X[..., 1] - c[1])
+        tol = 1e-9 * max(1.0, float(np.max(np.abs(X))))
+        if float(np.max(np.ptp(r, axis=-1))) > tol or float(np.max(np.ptp(X[..., 2], axis=-1))) > tol:
+            return None
+    return c
+
+
+def _abscissae(x0: float, x1: float, n: int) -> np.ndarray:
+    """``n`` abscissae from ``x0`` to ``x1`` (both reached), Chebyshev-spaced: dense where a
+    rounded end's silhouette turns vertical."""
+    return x0 + (x1 - x0) * 0.5 * (1.0 - np.cos(np.linspace(0.0, math.pi, n)))
+
+
+def _crossings(lines: list[np.ndarray], xs: np.ndarray, eps: float) -> tuple[np.ndarray, np.ndarray]:
+    """Lowest and highest ``z`` where the polylines ``lines`` (arrays (..., m, 2) of (x, z)) cross
+    each vertical ``x = xs[k]`` (``xs`` increasing; linear between points; a segment along the
+    vertical gives both its ends); ``±inf`` where none does."""
+    zl = np.full(xs.size, np.inf)
+    zh = np.full(xs.size, -np.inf)
+    for L in lines:
+        xa, za = L[..., :-1, 0].ravel(), L[..., :-1, 1].ravel()
+        xb, zb = L[..., 1:, 0].ravel(), L[..., 1:, 1].ravel()
+        k0 = np.searchsorted(xs, np.minimum(xa, xb) - eps, side="left")
+        cnt = np.searchsorted(xs, np.maximum(xa, xb) + eps, side="right") - k0
+        sel = np.flatnonzero(cnt > 0)  # most short segments cross no vertical
+        if sel.size == 0:
+            continue
+        cnt = cnt[sel]
+        seg = np.repeat(sel, cnt)
+        k = np.repeat(k0[sel] - (np.cumsum(cnt) - cnt), cnt) + np.arange(seg.size)
+        xa, za, xb, zb = xa[seg], za[seg], xb[seg], zb[seg]
+        dx = xb - xa
+        along = np.abs(dx) <= 2.0 * eps
+        t = np.clip((xs[k] - xa) / np.where(along, 1.0, dx), 0.0, 1.0)
+        z = za + t * (zb - za)
+        np.minimum.at(zl, k, np.where(along, np.minimum(za, zb), z))
+        np.maximum.at(zh, k, np.where(along, np.maximum(za, zb), z))
+    return zl, zh
+
+
+def _seg_points(outline) -> np.ndarray:
+    """Closed polyline (k, 2) of a chain of lines and arcs (``outline.segs``), arcs every ≤ 0.25°
+    and at their points of greatest and least x and y (the outline's extents are exact)."""
+    pts = []
+    for s in outline.segs:
+        if s.kind == "line":
+            pts.append(np.asarray([s.p0], float))
+            continue
+        m = max(2, int(math.ceil(abs(s.sweep) / math.radians(0.25))))
+        t = np.linspace(0.0, 1.0, m, endpoint=False)
+        lo, hi = sorted((s.theta0, s.theta0 + s.sweep))
+        quad = np.arange(math.ceil(lo / (0.5 * math.pi)), math.floor(hi / (0.5 * math.pi)) + 1) * (0.5 * math.pi)
+        tq = (quad - s.theta0) / s.sweep
+        t = np.unique(np.r_[t, tq[(tq > 0.0) & (tq < 1.0)]])
+        pts.append(s.point(t))
+    P = np.vstack(pts)
+    return np.vstack([P, P[:1]])
+
+
+def _plan(tablet: Tablet, band, axis: np.ndarray | None = None, radius: float = 0.0) -> tuple[np.ndarray, tuple]:
+    """The plan outline (closed, (k, 2)) and the outlines of see-through holes.
+
+    Exact where the tablet has one: an industry family's nominal outline (lines and arcs);
+    else the band patch's edge curve (the band is the side wall the die forms: its edge is the
+    outline, the PDE band bulging beyond it by at most :attr:`Band.bulge`); else, with no band,
+    for a tablet of revolution about ``axis`` (a sphere, a spheroid) the circle of its greatest
+    ``radius``, and for any other, per ``v`` the point of greatest plan radius over ``u`` and the
+    patches on a dense grid (exact for coaxial patches star-shaped about the axis).  A tablet
+    trimmed in ``v`` (a cut-away view) adds the cut faces, which run to the axis.
+    """
+    t = tablet.trim
+    segs = getattr(getattr(tablet.nominal, "outline", None), "segs", None)
+    if segs is not None and t.u == (0.0, 1.0) and t.full_v and t.w[0] == 0.0:
+        return _seg_points(tablet.nominal.outline), ()
+    nv = 1441
+    v = np.linspace(t.v[0], t.v[1], nv)
+    if band is not None and t.u == (0.0, 1.0):
+        p = tablet.patches[band.patch]
+        X = p.evaluate(0.0, v)[:, :2]
+        axis = p.spine(np.array([0.5]))[0, :2]
+    elif axis is not None:
+        X = axis + radius * np.c_[np.cos(v), np.sin(v)]
+    else:
+        u = np.linspace(t.u[0], t.u[1], 257)
+        G = np.stack([p.evaluate_grid(u, v)[..., :2] for p in tablet.patches])  # (patches, nu, nv, 2)
+        axis = tablet.patches[0].spine(np.array([0.5]))[0, :2]
+        c = 0.5 * (G.min(axis=(0, 1, 2)) + G.max(axis=(0, 1, 2))) if t.full_v else axis
+        r = np.hypot(G[..., 0] - c[0], G[..., 1] - c[1]).reshape(-1, nv)
+        X = G.reshape(-1, nv, 2)[np.argmax(r, axis=0), np.arange(nv)]
+    if not t.full_v:
+        X = np.vstack([axis, X, axis])
+    holes = ()
+    if t.w[0] > 0.0:  # a hollow solid (ring): the inner wall, nearest the axis over u and the patches
+        u = np.linspace(t.u[0], t.u[1], 129)
+        inner = []
+        for p in tablet.patches:
+            A = p.spine(u)[:, None, :2]
+            inner.append(A + t.w[0] * (p.evaluate_grid(u, v)[..., :2] - A))
+        inner = np.concatenate(inner)  # (patches·nu, nv, 2)
+        r = np.hypot(inner[..., 0] - axis[0], inner[..., 1] - axis[1])
+        holes = (inner[np.argmin(r, axis=0), np.arange(nv)],)
+    return X, holes
 
 
 def side_profile(tablet: Tablet, n: int = 121, *, nu: int = 65, nv: int = 257,
                  grids: list | None = None) -> TabletOutline:
     """The side profile (silhouette along y), the plan outline and the main dimensions (mm).
 
-    The band is the nominal's ``band_z`` when the family has one, else the silhouette's
-    height at the rim; the cup depth is the top's height above the band's top.  Length, width
-    and thickness are an industry family's exact nominal dimensions (its surface is certified
-    within 1 µm of them), else the surface's polished extremes (:meth:`Tablet.bounds`).
+    ``tablet``: a :class:`Tablet` or anything with a ``.tablet``.  The silhouette is the tablet's
+    true outline seen along y, from its least to its greatest x (``n`` abscissae, denser
+    towards the ends): for a tablet of revolution, from its meridian (513 points a patch: at
+    each ``x``, the highest and lowest meridian point at least ``|x|`` from the axis); else
+    where the grid lines of a dense sample of its faces (``nu`` × ``nv`` each, or ``grids``)
+    cross each vertical ``x = const`` (linear between grid points), its ends from the sample's
+    extreme points.  The plan outline: see :func:`_plan`.  The band is the nominal's ``band_z``
+    when the family has one, else the band patch's heights (:meth:`Tablet.band`), else (no band:
+    a sphere) the silhouette's height at its ends; the cup depths are the top's height above the
+    band and the band's height above the bottom.  Length, width and thickness are an industry
+    family's exact nominal dimensions (its surface is certified within 1 µm of them), else the
+    surface's polished extremes (:meth:`Tablet.bounds`), as the reports give them.
     """
-    grids = grids if grids is not None else _face_grids(tablet, nu, nv)
-    P = np.vstack([Y.reshape(-1, 3) for _, Y in grids])
-    lo, hi = P.min(axis=0), P.max(axis=0)
-    edges = np.linspace(lo[0], hi[0], n + 1)
-    k = np.clip(np.searchsorted(edges, P[:, 0], side="right") - 1, 0, n - 1)
-    zl = np.full(n, np.inf)
-    zh = np.full(n, -np.inf)
-    np.minimum.at(zl, k, P[:, 2])
-    np.maximum.at(zh, k, P[:, 2])
-    x = 0.5 * (edges[:-1] + edges[1:])
-    ok = np.isfinite(zl)
-    x, zl, zh = x[ok], zl[ok], zh[ok]
-    c = 0.5 * (lo[:2] + hi[:2])
-    ang = np.arctan2(P[:, 1] - c[1], P[:, 0] - c[0])
-    rad = np.hypot(P[:, 0] - c[0], P[:, 1] - c[1])
-    m = 180  # outline: farthest point from the centre per 2 degrees (nv = 257 puts samples in each)
-    ka = np.clip(((ang + np.pi) / (2 * np.pi) * m).astype(int), 0, m - 1)
-    rmax = np.zeros(m)
-    np.maximum.at(rmax, ka, rad)
-    amid = np.linspace(-np.pi, np.pi, m, endpoint=False) + np.pi / m
-    keep = rmax > 0
-    plan = c + rmax[keep, None] * np.c_[np.cos(amid[keep]), np.sin(amid[keep])]
-    plan = np.vstack([plan, plan[:1]])
-    band_z = getattr(tablet.nominal, "band_z", None)
-    if band_z is None:
-        rim = slice(0, max(1, len(x) // 50))
-        band_z = (float(np.max(zl[rim])), float(np.min(zh[rim])))
-    band = float(band_z[1] - band_z[0])
-    info = getattr(tablet.nominal, "info", None) or {}
-    T = getattr(tablet.nominal, "thickness", None)
+    return _side_profile(_as_tablet(tablet), n, nu, nv, grids, None)
+
+
+def _side_profile(tablet: Tablet, n: int, nu: int, nv: int, grids: list | None, faces: list | None) -> TabletOutline:
+    nominal = tablet.nominal
+    band_z = getattr(nominal, "band_z", None)
+    exact_outline = getattr(getattr(nominal, "outline", None), "segs", None) is not None
+    # an industry family has its band and outline exactly: no need to look for the band patch
+    band = None if band_z is not None and exact_outline else tablet.band()
+    info = getattr(nominal, "info", None) or {}
+    T = getattr(nominal, "thickness", None)
+    axis = _revolution_axis(tablet)
+    M = None
+    if axis is not None:  # the meridian (the surfaces w = 1 at v = 0)
+        u = np.linspace(0.0, 1.0, 513)
+        M = np.stack([p.evaluate(u, np.zeros_like(u)) for p in tablet.patches])  # (patches, 513, 3)
+        rho = np.hypot(M[..., 0] - axis[0], M[..., 1] - axis[1])
+    plan, holes = _plan(tablet, band, axis, float(rho.max()) if M is not None else 0.0)
     if "length_mm" in info and "width_mm" in info and T is not None:
         # an industry family: its exact nominal dimensions (the surface is certified within 1 µm of
         # them), which a dimensioned drawing shows; standing on z = 0
         ext = np.array([info["length_mm"], info["width_mm"], T], dtype=float)
-        top = float(T)
+        top, bottom = float(T), 0.0
+        xr = (float(plan[:, 0].min()), float(plan[:, 0].max()))
     else:
         blo, bhi = tablet.bounds()  # extremes polished on the surface, not just sampled
         ext = np.asarray(bhi) - np.asarray(blo)
-        top = float(bhi[2])
-    return TabletOutline(x=x, z_low=zl, z_high=zh, plan=plan, band=band, thickness=float(ext[2]),
-                         cup_depth=max(0.0, top - float(band_z[1])), length=float(ext[0]), width=float(ext[1]),
-                         round=abs(ext[0] - ext[1]) <= 1e-3 * max(ext[0], ext[1]))
+        top, bottom = float(bhi[2]), float(blo[2])
+        xr = (float(blo[0]), float(bhi[0]))
+    scale = max(1.0, float(np.max(np.abs(plan))), abs(top), abs(bottom))
+    eps = 1e-9 * scale
+    if M is not None:
+        R = float(rho.max())
+        x = _abscissae(axis[0] - R, axis[0] + R, n)
+        lines = [np.stack([axis[0] + rho, M[..., 2]], -1), np.stack([axis[0] - rho, M[..., 2]], -1)]
+        zl, zh = _crossings(lines, x, eps)
+        # the section seen along y: z is covered at x where the meridian reaches |x| from the axis
+        # at that height, so its extremes also come from meridian points beyond |x| (a flat top, a ring)
+        order = np.argsort(-rho, axis=None)
+        rs, zs = rho.reshape(-1)[order], M[..., 2].reshape(-1)[order]
+        cnt = np.searchsorted(-rs, -(np.abs(x - axis[0]) - eps), side="right")
+        hit = cnt > 0
+        zl[hit] = np.minimum(zl[hit], np.minimum.accumulate(zs)[cnt[hit] - 1])
+        zh[hit] = np.maximum(zh[hit], np.maximum.accumulate(zs)[cnt[hit] - 1])
+    else:
+        if grids is None:
+            grids = _face_grids(tablet, nu, nv, faces)
+        x = _abscissae(xr[0], xr[1], n)
+        lines = []
+        for _, Y in grids:
+            xz = Y[..., [0, 2]]
+            lines += [np.swapaxes(xz, 0, 1), xz]  # lines along s (one per t), along t (one per s)
+        zl, zh = _crossings(lines, x, eps)
+        # the ends: the sample's points at its least and greatest x (a band's wall)
+        P = np.vstack([Y.reshape(-1, 3) for _, Y in grids])
+        tol = (band.bulge if band is not None else 0.0) + 1e-6 * scale
+        for k, sel in ((0, P[:, 0] <= P[:, 0].min() + tol), (-1, P[:, 0] >= P[:, 0].max() - tol)):
+            zl[k] = min(zl[k], float(P[sel, 2].min()))
+            zh[k] = max(zh[k], float(P[sel, 2].max()))
+    ok = np.isfinite(zl) & np.isfinite(zh)
+    x, zl, zh = x[ok], zl[ok], zh[ok]
+    if band_z is None and band is not None:
+        band_z = (band.z0, band.z1)
+    has_band = band_z is not None
+    if band_z is None:  # no band patch: the silhouette's height at its ends
+        rim = slice(0, max(1, len(x) // 50))
+        lo_, hi_ = float(np.max(zl[rim])), float(np.min(zh[rim]))
+        band_z = (lo_, max(lo_, hi_))
+    return TabletOutline(x=x, z_low=zl, z_high=zh, plan=plan, band=float(band_z[1] - band_z[0]),
+                         thickness=float(ext[2]), cup_depth=max(0.0, top - float(band_z[1])), length=float(ext[0]),
+                         width=float(ext[1]), round=abs(ext[0] - ext[1]) <= 1e-3 * max(ext[0], ext[1]),
+                         cup_depth_bottom=max(0.0, float(band_z[0]) - bottom), plan_holes=holes, has_band=has_band)
 
 
 def _dim(ax, p0, p1, text: str, *, offset=(0.0, 0.0), rotation: float = 0.0, fontsize: float = 7.0) -> None:
@@ -144,11 +318,16 @@ def _draw_profile(ax, o: TabletOutline, colour="#4e79a7", dims: bool = True) -> 
     rim_top = ztop - o.cup_depth
     pad = 0.06 * max(o.length, o.thickness)
     _dim(ax, (x0, ztop), (x0, zbot), f"{o.thickness:.3g}", offset=(-pad, 0), rotation=90)
-    _dim(ax, (x1, rim_top), (x1, rim_top - o.band), f"band {o.band:.3g}", offset=(pad, 0), rotation=90)
-    if o.cup_depth > 1e-6:
-        xc = float(o.x[np.argmax(o.z_high)])
-        ax.plot([x0, x1], [rim_top, rim_top], color="0.5", lw=0.4, ls=":")
-        _dim(ax, (xc, rim_top), (xc, ztop), f"cup {o.cup_depth:.3g}", offset=(0, 0))
+    if o.has_band:  # a sphere or spheroid has no band, and no cups
+        _dim(ax, (x1, rim_top), (x1, rim_top - o.band), f"band {o.band:.3g}", offset=(pad, 0), rotation=90)
+        if o.cup_depth > 1e-6:
+            xc = float(o.x[np.argmax(o.z_high)])
+            ax.plot([x0, x1], [rim_top, rim_top], color="0.5", lw=0.4, ls=":")
+            _dim(ax, (xc, rim_top), (xc, ztop), f"cup {o.cup_depth:.3g}", offset=(0, 0))
+        if o.cup_depth_bottom > 1e-6 and f"{o.cup_depth_bottom:.3g}" != f"{o.cup_depth:.3g}":
+            xc, rim_bot = float(o.x[np.argmin(o.z_low)]), rim_top - o.band
+            ax.plot([x0, x1], [rim_bot, rim_bot], color="0.5", lw=0.4, ls=":")
+            _dim(ax, (xc, zbot), (xc, rim_bot), f"cup {o.cup_depth_bottom:.3g}", offset=(0, 0))
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("z (mm)")
     ax.set_title("side profile", fontsize=9)
@@ -175,7 +354,8 @@ def _draw_plan(ax, tablet: Tablet, o: TabletOutline, grids, colour="#4e79a7", di
         order = np.argsort(np.concatenate(depth), kind="stable")  # painter: the top face drawn last
         ax.add_collection(PolyCollection(np.concatenate(polys)[order], facecolors=np.concatenate(cols)[order],
                                          linewidths=0, antialiased=False))
-    ax.plot(o.plan[:, 0], o.plan[:, 1], color="k", lw=0.8)
+    for loop in (o.plan, *o.plan_holes):
+        ax.plot(loop[:, 0], loop[:, 1], color="k", lw=0.8)
     ax.set_aspect("equal")
     ax.autoscale_view()
     if not dims:
@@ -205,6 +385,7 @@ def tablet_figure(
 ):
     """A :class:`matplotlib.figure.Figure`: shaded 3-D view, dimensioned side profile and plan, to scale.
 
+    ``tablet``: a :class:`Tablet` or anything with a ``.tablet`` (a :class:`~tabletcad.pipeline.model.TabletModel`).
     All faces of the 3-D view go into one polygon collection so that matplotlib sorts
     them by depth together (separate surfaces hide each other wrongly).
     """
@@ -213,11 +394,13 @@ def tablet_figure(
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
+    tablet = _as_tablet(tablet)
     fig = Figure(figsize=(11.0, 4.0))
     FigureCanvasAgg(fig)  # no global backend: the figure owns its Agg canvas
     ax = fig.add_subplot(131, projection="3d")
     colours = colormaps["tab10"]
-    grids = _face_grids(tablet, nu, nv)
+    faces = tablet.faces()  # once: finding the shared edges evaluates the patches
+    grids = _face_grids(tablet, nu, nv, faces)
     polys, cols, edges = [], [], []
     for face, Y in grids:
         q = _quads(Y)
@@ -244,7 +427,7 @@ def tablet_figure(
     # (and the 3-D axes' panes, grids and ticks were half the drawing time)
     ax.set_axis_off()
     ax.view_init(elev=elev, azim=azim)
-    o = side_profile(tablet)
+    o = _side_profile(tablet, 121, 65, 257, None, faces)
     _draw_profile(fig.add_subplot(132), o)
     _draw_plan(fig.add_subplot(133), tablet, o, grids)
     fig.suptitle(title or f"{tablet.name} ({tablet.family}, {len(tablet.patches)} patches), mm", fontsize=10)
@@ -253,10 +436,15 @@ def tablet_figure(
 
 
 def tablets_figure(tablets: Sequence[Tablet], *, labels: Sequence[str] | None = None, nu: int = 25, nv: int = 73):
-    """Side profiles (top row) and plans (bottom row) of several tablets at one scale (mm)."""
+    """Side profiles (top row) and plans (bottom row) of several tablets at one scale (mm).
+
+    ``tablets``: :class:`Tablet` objects or anything with a ``.tablet`` (a
+    :class:`~tabletcad.pipeline.model.TabletModel`), in any mix.
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    tablets = [_as_tablet(t) for t in tablets]
     k = len(tablets)
     if k == 0:
         raise ValueError("tablets_figure needs at least one tablet")
@@ -266,8 +454,9 @@ def tablets_figure(tablets: Sequence[Tablet], *, labels: Sequence[str] | None = 
     axes = fig.subplots(2, k, squeeze=False, sharex="row", sharey="row")
     outlines = []
     for i, t in enumerate(tablets):
-        grids = _face_grids(t, nu, nv)
-        o = side_profile(t)
+        faces = t.faces()
+        grids = _face_grids(t, nu, nv, faces)
+        o = _side_profile(t, 121, 65, 257, None, faces)
         outlines.append(o)
         colour = f"C{i % 10}"
         _draw_profile(axes[0, i], o, colour, dims=False)
@@ -313,6 +502,6 @@ def plot_tablet(tablet: Tablet, path: str | Path, *, dpi: int = 110, **kw) -> Pa
     return _save(tablet_figure(tablet, **kw), path, dpi)
 
 
-def plot_tablets(tablets: Sequence[Tablet], path: str | Path, *, dpi: int = 110, **kw) -> Path:
-    """Write :func:`tablets_figure` (several tablets at one scale) to ``path`` (PNG)."""
+def plot_tablets(tablets: Sequence, path: str | Path, *, dpi: int = 110, **kw) -> Path:
+    """Write :func:`tablets_figure` (several tablets, or models, at one scale) to ``path`` (PNG)."""
     return _save(tablets_figure(tablets, **kw), path, dpi)
