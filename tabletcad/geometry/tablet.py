@@ -364,7 +364,13 @@ class Tablet:
 
         A band patch has plan-identical horizontal end curves at different heights and stays
         within 1 % of that height of its end curve in plan (a side wall, not a dome).
+        Cached: a tablet is immutable.
         """
+        if "_band" not in self.__dict__:
+            object.__setattr__(self, "_band", self._find_band())
+        return self.__dict__["_band"]
+
+    def _find_band(self) -> Band | None:
         v = np.linspace(0.0, math.tau, 96, endpoint=False)
         gap = self.tol.seam_gap  # the end curves are the design's own: flat and identical to round-off
         for i, p in enumerate(self.patches):
