@@ -347,8 +347,8 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
             inv = p["inverse"]
             target = (f"{inv['target_weight_mg']:.6g} mg" if inv["target_weight_mg"] is not None
                       else f"{inv['target_volume_mm3']:.6g} mm3")
-            click.echo(f"{p['design']['name']}: {inv['solved_for']} = {inv['value_mm']:.6g} mm gives {target}"
-                       + (f" (was {inv['given_mm']:.6g} mm)" if inv["given_mm"] is not None else ""))
+            click.echo(f"{p['design']['name']}: {inv['solved_for']} = {inv['value_mm']:.4g} mm gives {target}"
+                       + (f" (was {inv['given_mm']:.4g} mm)" if inv["given_mm"] is not None else ""))
     click.echo(_table(*shown[0]) if len(shown) == 1 else _comparison(shown))
     for option, path in (("json", json_file), ("csv", csv_out), ("xlsx", xlsx_out), ("plot", plot_out)):
         if path is not None:
