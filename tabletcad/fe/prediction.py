@@ -2,8 +2,9 @@
 
 The diametral test of a tablet is linear elastic up to the first crack, and
 its stresses scale with the force.  With ``σ_max/P`` the largest tensile
-stress per newton of the shape (FE, :func:`tabletcad.fe.diametral.diametral`,
-away from the platens), the force at which that stress reaches the
+stress per newton of the shape (FE, :func:`tabletcad.fe.diametral.diametral`:
+the stress averaged over a ball of the strip width's radius, on the loaded
+diametral plane away from the platens; mesh-independent), the force at which that stress reaches the
 material's tensile strength ``σ_t`` is
 
     F = σ_t / (σ_max / P).
@@ -15,7 +16,7 @@ FE criterion on that reference: ``σ_t = F_ref · σ_max,ref / P``.  (On a thin
 flat disc this is ``2F/(πDt)``, thesis eq 2.4, within the Hondros factor.)
 
 The estimate is an *elastic first-crack* force: it assumes brittle fracture
-when the largest principal stress reaches ``σ_t`` (Rankine), ignores plastic
+when the largest (averaged) principal stress reaches ``σ_t`` (Rankine), ignores plastic
 flattening at the platens and crack growth after initiation, and assumes the
 tensile strength does not depend on the shape (same solid fraction).
 """

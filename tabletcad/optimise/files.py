@@ -32,6 +32,18 @@ A problem over the parameters of any tablet family (``tabletcad shapes``)::
     relative = true                  # or lower = / upper = ; optional tol, scale
 
 Quantities are computed by :meth:`Tablet.properties` and :meth:`Tablet.dimensions`.
+
+The finite-element breaking force (``fe`` extra) is the quantity
+``fe_breaking_force_N``, as the objective or in a ``[[constraint]]``, with its
+inputs in an ``[fe]`` table::
+
+    [fe]
+    tensile_strength_MPa = 2.0       # the formulation's tensile strength (required)
+    direction = "width"              # width | length | x | y
+    recheck = true                   # re-check the optimum on the default (finer) mesh
+
+Each evaluation is :func:`tabletcad.fe.objective.breaking_force` on the coarse
+mesh; the re-check's figures go to the report's ``extras``.
 """
 
 from __future__ import annotations
@@ -71,7 +83,10 @@ QUANTITIES = {
     "width_mm": ("mm", lambda t: t.dimensions()["width_mm"]),
     "height_mm": ("mm", lambda t: t.dimensions()["height_mm"]),
 }
-_TOP = {"problem", "parameters", "solver", "variables", "fixed", "constraint"}
+_TOP = {"problem", "parameters", "solver", "variables", "fixed", "constraint", "fe"}
+#: The FE quantity (needs the ``[fe]`` table and the ``fe`` extra).
+FE_QUANTITY = "fe_breaking_force_N"
+_FE_KEYS = {"tensile_strength_MPa", "direction", "recheck"}
 #: A problem's ``name`` becomes a design and file name: a plain file name, no path.
 _NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}")
 
@@ -256,8 +271,9 @@ def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
         for k in ("parameters",):
             if k in data:
                 raise DesignError(f"[{k}]", "given", "family problems take [variables], [fixed] and [[constraint]]")
-        return family_problem(prob, data.get("variables"), data.get("fixed", {}), data.get("constraint", [])), method, solver
-    for k in ("variables", "fixed", "constraint"):
+        return family_problem(prob, data.get("variables"), data.get("fixed", {}), data.get("constraint", []),
+                              data.get("fe")), method, solver
+    for k in ("variables", "fixed", "constraint", "fe"):
         if k in data:
             raise DesignError(f"[{k}]", "given", f"only family problems take it, not {kind!r}")
     for k in ("family", "sense", "objective", "name"):
@@ -276,8 +292,44 @@ def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
         raise
 
 
-def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) -> Problem:
-    """A :class:`Problem` over the parameters of a tablet family (:data:`tabletcad.families.FAMILIES`)."""
+def _fe_settings(fe: Any, used: bool) -> dict | None:
+    """The checked ``[fe]`` table (None when no FE quantity is used; refused when given unused)."""
+    if fe is None:
+        if used:
+            raise DesignError("[fe] tensile_strength_MPa", "missing",
+                              f"must be given (MPa) when {FE_QUANTITY} is the objective or a constraint")
+        return None
+    _check_keys("[fe]", fe, _FE_KEYS)
+    if not used:
+        raise DesignError("[fe]", "given", f"only problems using {FE_QUANTITY} take it")
+    if "tensile_strength_MPa" not in fe:
+        raise DesignError("[fe] tensile_strength_MPa", "missing", "must be given (MPa)")
+    return {
+        "tensile_strength_MPa": number("[fe] tensile_strength_MPa", fe["tensile_strength_MPa"], "MPa", lo=0.0,
+                                       lo_open=True, hi=LIMITS["MPa"]),
+        "direction": choice("[fe] direction", fe.get("direction", "width"), ("width", "length", "x", "y")),
+        "recheck": boolean("[fe] recheck", fe.get("recheck", True)),
+    }
+
+
+def _fe_recheck(settings: dict) -> Callable[[dict, Any], dict]:
+    """``extras``: the optimum's FE breaking force on the coarse mesh and on the default (finer) one."""
+    def extras(x: dict, design: Any) -> dict:
+        from tabletcad.fe.objective import breaking_force
+
+        st, d = settings["tensile_strength_MPa"], settings["direction"]
+        coarse = breaking_force(design, st, d)
+        fine = breaking_force(design, st, d, coarse=False)
+        return {"fe_breaking_force_coarse_N": coarse, "fe_breaking_force_fine_N": fine,
+                "fe_fine_minus_coarse_relative": fine / coarse - 1.0}
+    return extras
+
+
+def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe: Any = None) -> Problem:
+    """A :class:`Problem` over the parameters of a tablet family (:data:`tabletcad.families.FAMILIES`).
+
+    ``fe`` is the ``[fe]`` table, needed when :data:`FE_QUANTITY` is the objective or a constraint.
+    """
     from tabletcad.pipeline.design import design_to_toml
     from tabletcad.families import FAMILIES, RENAMED
     from tabletcad.families import family as lookup_family
@@ -312,10 +364,19 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) ->
         return fam.build(**fixed, **x)
 
     obj_spec = prob.get("objective")
+    used = obj_spec == FE_QUANTITY or (isinstance(constraints, list) and any(
+        isinstance(c, dict) and c.get("quantity") == FE_QUANTITY for c in constraints))
+    fe_set = _fe_settings(fe, used)
+    quantities = dict(QUANTITIES)
+    if fe_set is not None:
+        from tabletcad.optimise.strength import fe_breaking_force
+
+        quantities[FE_QUANTITY] = ("N", fe_breaking_force(fe_set["tensile_strength_MPa"], fe_set["direction"]))
     if isinstance(obj_spec, str):
-        if obj_spec not in QUANTITIES:
-            raise DesignError("[problem] objective", obj_spec, "must be one of " + ", ".join(QUANTITIES) + " or {linear = {...}}")
-        unit, f = QUANTITIES[obj_spec]
+        if obj_spec not in quantities:
+            raise DesignError("[problem] objective", obj_spec, "must be one of " + ", ".join([*QUANTITIES, FE_QUANTITY])
+                              + " or {linear = {...}}")
+        unit, f = quantities[obj_spec]
         objective = Objective(f, obj_spec, unit)
     elif isinstance(obj_spec, dict) and set(obj_spec) == {"linear"} and isinstance(obj_spec["linear"], dict):
         coef = {k: number(f"[problem] objective linear {k}", v, lo=-LIMITS[""], hi=LIMITS[""]) for k, v in obj_spec["linear"].items()}
@@ -331,8 +392,9 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) ->
     cons = []
     for k, c in enumerate(constraints):
         _check_keys(f"[[constraint]] {k}", c, {"quantity", "target", "lower", "upper", "relative", "tol", "scale", "name"})
-        q = choice(f"[[constraint]] {k} quantity", c.get("quantity"), tuple(QUANTITIES))
-        unit, f = QUANTITIES[q]
+        q = choice(f"[[constraint]] {k} quantity", c.get("quantity"), tuple(quantities) if fe_set else
+                   (*QUANTITIES, FE_QUANTITY))
+        unit, f = quantities[q]
         # every quantity is a size (>= 0): a target must be > 0, bounds >= 0
         kw = {kk: number(f"[[constraint]] {k} {kk}", c[kk], unit, lo=0.0, lo_open=kk == "target", hi=LIMITS[unit])
               for kk in ("target", "lower", "upper") if kk in c}
@@ -347,5 +409,6 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any) ->
     def to_toml(x, d):
         return design_to_toml(fam_name, {**fixed, **x}, name=name)
 
+    extras = _fe_recheck(fe_set) if fe_set is not None and fe_set["recheck"] else None
     return Problem(name=name, variables=vs, objective=objective, sense=sense, constraints=cons, build=build,
-                   to_toml=to_toml, description=f"family {fam_name}: {sense} {objective.name}")
+                   to_toml=to_toml, description=f"family {fam_name}: {sense} {objective.name}", extras=extras)

@@ -14,7 +14,7 @@ from typing import Any
 from tabletcad.errors import check_positive
 from tabletcad.optimise.problem import Constraint, Objective
 
-__all__ = ["breaking_force_objective", "breaking_force_constraint"]
+__all__ = ["breaking_force_objective", "breaking_force_constraint", "fe_breaking_force"]
 
 _NAME = "FE breaking force (elastic first crack, coarse mesh)"
 
@@ -26,6 +26,12 @@ def _force(tensile_strength_MPa: float, direction: str):
         return breaking_force(tablet, tensile_strength_MPa, direction)
 
     return force
+
+
+def fe_breaking_force(tensile_strength_MPa: float, direction: str = "width"):
+    """``f(tablet) -> N``: the coarse-mesh FE breaking force, as a quantity of a problem file."""
+    check_positive("tensile_strength_MPa", tensile_strength_MPa, "MPa")
+    return _force(tensile_strength_MPa, direction)
 
 
 def breaking_force_objective(tensile_strength_MPa: float, direction: str = "width") -> Objective:
