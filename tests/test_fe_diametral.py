@@ -235,20 +235,20 @@ def _averaged_line_pair_field(D, t, b, R, centres):
     for c in centres:
         r2 = ((P - c[:2]) ** 2).sum(axis=1)[:, None] + (zq[None, :] - c[2]) ** 2
         w = np.where(r2 < R * R, (1 - r2 / (R * R)) ** 2, 0.0)
-        w = np.trapz(w, zq, axis=1)
+        w = getattr(np, "trapezoid", None)(w, zq, axis=1) if hasattr(np, "trapezoid") else np.trapz(w, zq, axis=1)
         s = np.einsum("k,kij->ij", w, S) / w.sum()
         out.append(np.linalg.eigvalsh(s)[-1])
     return np.array(out)
 
 
 def test_largest_tensile_stress_of_a_thin_disc_against_hondros():
-    """Thin disc 10 x 1 mm: the FE largest tensile stress (averaged over a ball of radius b, on the
+    """Thin disc 10 x 1 mm: the FE largest tensile stress (averaged over a ball of radius t/6, on the
     loaded diametral plane) against the same average of Hondros' plane-stress field (Flamant +
     Michell superposition over the strip), and against Hondros' centre value."""
     t = _tablet(family="flat_face_round", diameter=10.0, thickness=1.0)
     r = diametral(t, 1.0, "x", error_estimate=False)
     D, th, b, R = r.diameter_mm, r.thickness_mm, r.strip_width_mm, r.averaging_radius_mm
-    assert R == pytest.approx(b)
+    assert R == pytest.approx(min(b, th / 6))
     loc = np.array(r.max_tensile_location_mm) - np.array(r.centre_mm)
     xs = (0.5 * D - b) * np.linspace(-1, 1, 41)
     zs = np.linspace(-0.5 * th, 0.5 * th, 9)
@@ -256,7 +256,7 @@ def test_largest_tensile_stress_of_a_thin_disc_against_hondros():
     closed = _averaged_line_pair_field(D, th, b, R, grid)
     k = int(np.argmax(closed))
     centre = hondros_centre_stress(1.0, D, th, b)
-    print(f"\nthin disc 10 x 1, b = R = {b:g} mm: FE largest averaged tensile stress {r.max_tensile_stress_MPa:.5f} MPa/N "
+    print(f"\nthin disc 10 x 1, b = {b:g} mm, R = {R:.4g} mm: FE largest averaged tensile stress {r.max_tensile_stress_MPa:.5f} MPa/N "
           f"at {np.round(loc, 2)}; Hondros field averaged the same way {closed[k]:.5f} at {np.round(grid[k], 2)}; "
           f"Hondros centre value {centre:.5f}")
     assert r.max_tensile_stress_MPa == pytest.approx(closed[k], rel=0.01)
@@ -269,7 +269,7 @@ def test_largest_tensile_stress_converges_under_refinement():
     the largest averaged tensile stress at bulk sizes 1.6, 1.2, 0.9 mm (ratio 4/3, strips b/3).
 
     The differences fall and the observed order ``log(d1/d2)/log(4/3)`` is printed and must exceed 1;
-    the values stay within 5 % of the finest one.
+    the finest value is within 5 % of the Richardson limit ``s₃ + (s₃ - s₂)/(d1/d2 - 1)``.
     """
     t = _tablet(family="concave_round", diameter=10.0, band=2.8, cup_depth=0.9, land=0.08)
     hs = [1.6, 1.2, 0.9]
@@ -280,7 +280,8 @@ def test_largest_tensile_stress_converges_under_refinement():
     print("\nh (mm), unknowns, largest averaged tensile stress (MPa per N), where:")
     for h, r in zip(hs, res):
         print(f"  {h:.3f} {r.dofs:6d} {r.max_tensile_stress_MPa:.5f} {np.round(r.max_tensile_location_mm, 2)}")
-    print(f"differences {d1:.2e}, {d2:.2e}: observed order {order:.2f}")
+    limit = s[2] + (s[2] - s[1]) / (d1 / d2 - 1)
+    print(f"differences {d1:.2e}, {d2:.2e}: observed order {order:.2f}; Richardson limit {limit:.5f}")
     assert d2 < d1
     assert order > 1.0
-    assert all(abs(v / s[-1] - 1) < 0.05 for v in s)
+    assert s[2] == pytest.approx(limit, rel=0.05)

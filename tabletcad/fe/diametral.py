@@ -32,8 +32,9 @@ largest tensile stress and where it is (below), and the shape factor
 The largest tensile stress
 --------------------------
 ``max_tensile_stress_MPa`` is the largest maximum principal stress of the
-stress *averaged over a ball of radius* ``R`` (default ``R = b``, the strip
-width: 1 mm on a 10 mm tablet), sampled on a fixed grid of the *loaded
+stress *averaged over a ball of radius* ``R`` (default ``R = min(b, t/6)``,
+``b`` the strip width, ``t`` the thickness: 0.77 mm on a 10 mm round 4.6 mm
+thick), sampled on a fixed grid of the *loaded
 diametral plane* (the plane through the centre holding the load axis and the
 tablet's axis), farther than ``b`` from the platens' planes
 (:func:`split_plane_points`: 41 points along the load, 9 from face to face,
@@ -53,8 +54,12 @@ cups at σ_t = 2 MPa, the coarse-mesh breaking force read 31, 73, 53, 74, 52,
 stress on the scale the load model resolves (how the force spreads within
 ``b`` is not modelled) and, like the critical-distance (volume) criteria of
 brittle fracture, asks for tension over a volume of material, not at a
-point.  ``R ∝ b ∝ D`` keeps the prediction self-similar: a tablet scaled by
-``k`` breaks at ``k²`` times the force, as eq 2.4 assumes.
+point.  The cap ``t/6`` keeps the ball's diameter within a third of the
+thickness, so the average still tells the faces from the mid-plane (which of
+them peaks decides where a convex tablet cracks first); on thin or elongated
+tablets ``b = D/10`` alone would average over the whole thickness.  ``R``
+scales with the tablet, so the prediction stays self-similar: a tablet scaled
+by ``k`` breaks at ``k²`` times the force, as eq 2.4 assumes.
 
 Why it converges.  The average is an integral of the stress against a fixed
 smooth weight (``(1 - r²/R²)²``) over a ball fixed in space, and the sample
@@ -107,8 +112,10 @@ STRIP_FRACTION = 0.1
 COARSENING = 1.5
 #: Radius of the centre-stress recovery, in units of the bulk element size.
 RECOVERY_RADIUS = 1.5
-#: Radius of the ball the largest tensile stress is averaged over, as a fraction of the strip width.
+#: Radius of the ball the largest tensile stress is averaged over, as a fraction of the strip width ...
 AVERAGING_FRACTION = 1.0
+#: ... and at most this fraction of the tablet's thickness (the ball's diameter at most a third of it).
+AVERAGING_THICKNESS_FRACTION = 1.0 / 6.0
 #: Sample points of the largest tensile stress along the load (see :func:`split_plane_points`).
 SAMPLES_ALONG_LOAD = 41
 #: Sample points of the largest tensile stress through the thickness, faces included.
@@ -369,7 +376,7 @@ def diametral(
         Element size within ``strip_width/2`` of the platens, mm; default ``min(mesh_size, strip_width/3)``.
     averaging_radius : float, optional
         Radius of the ball the largest tensile stress is averaged over, mm; default
-        ``strip_width`` (``AVERAGING_FRACTION`` × b), at most a quarter of the smaller plan extent.
+        ``min(strip_width, thickness/6)``; at most a quarter of the smaller plan extent.
     material : Material, optional
         E and ν (stresses do not depend on E).
     error_estimate : bool
@@ -393,7 +400,7 @@ def diametral(
                           f"({0.5 * D:.4g} mm)", "mm")
     h = min(t / 2.0, float(min(ext[0], ext[1])) / 12.0) if mesh_size is None else check_positive(
         "mesh_size", mesh_size, "mm")
-    R = AVERAGING_FRACTION * b if averaging_radius is None else check_positive("averaging_radius", averaging_radius,
+    R = min(AVERAGING_FRACTION * b, AVERAGING_THICKNESS_FRACTION * t) if averaging_radius is None else check_positive("averaging_radius", averaging_radius,
                                                                                 "mm")
     if R > 0.25 * float(min(ext[0], ext[1])):
         raise DesignError("averaging_radius", R, f"must be <= a quarter of the smaller plan extent "

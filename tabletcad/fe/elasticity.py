@@ -197,7 +197,7 @@ class ElasticSolution:
 
         The integral is a composite rule: each tetrahedron that can reach a ball is split into
         ``8^k`` sub-tetrahedra (scikit-fem's uniform refinement of the reference element, with
-        ``k`` chosen so that the sub-elements are at most ``R/2`` across) carrying scikit-fem's
+        ``k`` ≤ 2 chosen so that the sub-elements are about ``R`` across or less) carrying scikit-fem's
         degree-2 rule; the P2 stress is linear in each element, so it is evaluated exactly at
         those points from the element's vertex values.
 
@@ -224,7 +224,7 @@ class ElasticSolution:
         el = np.flatnonzero(near_q > 0)
         if el.size == 0:
             return np.zeros((len(q), 3, 3)), np.zeros(len(q))
-        k = int(np.clip(np.ceil(np.log2(max(2.0 * float(diam[el].max()) / R, 1.0))), 0, 3))
+        k = int(np.clip(np.ceil(np.log2(max(2.0 * float(diam[el].max()) / R, 1.0))), 0, 2))
         ref = skfem.MeshTet(np.array([[0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]),
                             np.array([[0], [1], [2], [3]]))  # the reference tetrahedron
         ref = ref.refined(k) if k else ref

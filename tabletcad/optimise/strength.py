@@ -1,10 +1,14 @@
 """The finite-element breaking force as an optimisation objective or constraint.
 
 Both evaluate :func:`tabletcad.fe.objective.breaking_force` (coarse mesh; needs
-the ``fe`` extra, imported on the first evaluation).  Every evaluation remeshes
-the design, so the value is not a smooth function of the variables at the scale
-of the mesh: prefer the derivative-free ``differential_evolution`` method, and
-re-check the optimum on the default mesh (``tabletcad fe strength``).
+the ``fe`` extra, imported on the first evaluation).  The predicted force rests
+on a mesh-independent stress (averaged over the strip width), but every
+evaluation remeshes the design, so neighbouring designs differ by about 1 % of
+scatter on top of the trend: use finite differences over several per cent of
+each range (``fd_step = 0.05``, ``fd_scheme = "central"``) or the
+derivative-free ``differential_evolution``, and re-check the optimum on the
+default mesh (problem files with ``[fe]`` do it and report it in ``extras``;
+``tabletcad fe strength`` prints it).
 """
 
 from __future__ import annotations
