@@ -31,6 +31,11 @@ A problem over the parameters of any tablet family (``tabletcad shapes``)::
     target = 235.0                   #   length_mm | width_mm | height_mm
     relative = true                  # or lower = / upper = ; optional tol, scale
 
+Instead of a volume constraint, ``[problem] solve_for = "band"`` (or ``thickness``,
+``cup_depth``) with ``volume_mm3 = 235.0`` builds every point with that parameter
+solved for the volume (:func:`tabletcad.families.inverse.solve_for`, the family's
+exact nominal volume): the variables then move along the designs of that volume.
+
 Quantities are computed by :meth:`Tablet.properties` and :meth:`Tablet.dimensions`.
 
 The finite-element breaking force (``fe`` extra) is the quantity
@@ -41,6 +46,8 @@ inputs in an ``[fe]`` table::
     tensile_strength_MPa = 2.0       # the formulation's tensile strength (required)
     direction = "width"              # width | length | x | y
     recheck = true                   # re-check the optimum on the default (finer) mesh
+    symmetric = false                # true: every design is mirror symmetric across the load and
+                                     # about mid-thickness (halves the coarse mesh's scatter)
 
 Each evaluation is :func:`tabletcad.fe.objective.breaking_force` on the coarse
 mesh; the re-check's figures go to the report's ``extras``.
@@ -86,7 +93,7 @@ QUANTITIES = {
 _TOP = {"problem", "parameters", "solver", "variables", "fixed", "constraint", "fe"}
 #: The FE quantity (needs the ``[fe]`` table and the ``fe`` extra).
 FE_QUANTITY = "fe_breaking_force_N"
-_FE_KEYS = {"tensile_strength_MPa", "direction", "recheck"}
+_FE_KEYS = {"tensile_strength_MPa", "direction", "recheck", "symmetric"}
 #: A problem's ``name`` becomes a design and file name: a plain file name, no path.
 _NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}")
 
@@ -254,7 +261,8 @@ def _check_keys(where: str, table: Any, allowed: set) -> dict:
 
 def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
     _check_keys("top-level", data, _TOP)
-    prob = _check_keys("[problem]", data.get("problem", {}), {"kind", "method", "family", "sense", "objective", "name"})
+    prob = _check_keys("[problem]", data.get("problem", {}), {"kind", "method", "family", "sense", "objective", "name",
+                                                              "solve_for", "volume_mm3"})
     kind = prob.get("kind")
     kinds = (*THESIS_PARAMETERS, "family")
     if kind is None:
@@ -276,7 +284,7 @@ def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
     for k in ("variables", "fixed", "constraint", "fe"):
         if k in data:
             raise DesignError(f"[{k}]", "given", f"only family problems take it, not {kind!r}")
-    for k in ("family", "sense", "objective", "name"):
+    for k in ("family", "sense", "objective", "name", "solve_for", "volume_mm3"):
         if k in prob:
             raise DesignError(f"[problem] {k}", _shown(prob[k]), f"only family problems take it, not {kind!r}")
     spec = THESIS_PARAMETERS[kind]
@@ -309,6 +317,7 @@ def _fe_settings(fe: Any, used: bool) -> dict | None:
                                        lo_open=True, hi=LIMITS["MPa"]),
         "direction": choice("[fe] direction", fe.get("direction", "width"), ("width", "length", "x", "y")),
         "recheck": boolean("[fe] recheck", fe.get("recheck", True)),
+        "symmetric": boolean("[fe] symmetric", fe.get("symmetric", False)),
     }
 
 
@@ -318,11 +327,26 @@ def _fe_recheck(settings: dict) -> Callable[[dict, Any], dict]:
         from tabletcad.fe.objective import breaking_force
 
         st, d = settings["tensile_strength_MPa"], settings["direction"]
-        coarse = breaking_force(design, st, d)
-        fine = breaking_force(design, st, d, coarse=False)
+        coarse = breaking_force(design, st, d, symmetric=settings["symmetric"])
+        fine = breaking_force(design, st, d, coarse=False, symmetric=settings["symmetric"])
         return {"fe_breaking_force_coarse_N": coarse, "fe_breaking_force_fine_N": fine,
                 "fe_fine_minus_coarse_relative": fine / coarse - 1.0}
     return extras
+
+
+def _held_volume(prob: dict, fam_name: str, fam: Any, variables: dict, fixed: dict) -> tuple[str, float] | None:
+    """``(parameter, volume mm³)`` when ``[problem] solve_for`` holds the volume by solving one parameter."""
+    if "solve_for" not in prob and "volume_mm3" not in prob:
+        return None
+    if "solve_for" not in prob or "volume_mm3" not in prob:
+        missing = "solve_for" if "solve_for" not in prob else "volume_mm3"
+        raise DesignError(f"[problem] {missing}", "missing", "solve_for and volume_mm3 go together")
+    from tabletcad.families.inverse import VARY
+
+    vary = choice("[problem] solve_for", prob["solve_for"], tuple(v for v in VARY if v in fam.params))
+    if vary in variables or vary in fixed:
+        raise DesignError("[problem] solve_for", vary, "must not be a variable or fixed: it is solved for the volume")
+    return vary, number("[problem] volume_mm3", prob["volume_mm3"], "mm3", lo=0.0, lo_open=True, hi=LIMITS["mm3"])
 
 
 def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe: Any = None) -> Problem:
@@ -359,9 +383,15 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
              for k, v in fixed.items()}
     sense = prob.get("sense", "max")
     name = prob.get("name", f"{fam_name}_optimum")
+    held = _held_volume(prob, fam_name, fam, variables, fixed)
 
     def build(x):
-        return fam.build(**fixed, **x)
+        if held is None:
+            return fam.build(**fixed, **x)
+        from tabletcad.families.inverse import solve_for
+
+        vary, volume = held
+        return solve_for(fam_name, target_volume_mm3=volume, vary=vary, **fixed, **x).tablet
 
     obj_spec = prob.get("objective")
     used = obj_spec == FE_QUANTITY or (isinstance(constraints, list) and any(
@@ -371,7 +401,8 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
     if fe_set is not None:
         from tabletcad.optimise.strength import fe_breaking_force
 
-        quantities[FE_QUANTITY] = ("N", fe_breaking_force(fe_set["tensile_strength_MPa"], fe_set["direction"]))
+        quantities[FE_QUANTITY] = ("N", fe_breaking_force(fe_set["tensile_strength_MPa"], fe_set["direction"],
+                                                          fe_set["symmetric"]))
     if isinstance(obj_spec, str):
         if obj_spec not in quantities:
             raise DesignError("[problem] objective", obj_spec, "must be one of " + ", ".join([*QUANTITIES, FE_QUANTITY])
@@ -407,7 +438,8 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
         cons.append(Constraint(cname, f, kind="eq" if "target" in c else "ineq", relative=relative, unit=unit, **kw))
 
     def to_toml(x, d):
-        return design_to_toml(fam_name, {**fixed, **x}, name=name)
+        solved = {} if held is None else {held[0]: float(d.params[held[0]])}
+        return design_to_toml(fam_name, {**fixed, **x, **solved}, name=name)
 
     extras = _fe_recheck(fe_set) if fe_set is not None and fe_set["recheck"] else None
     return Problem(name=name, variables=vs, objective=objective, sense=sense, constraints=cons, build=build,

@@ -57,6 +57,10 @@ def summary(result: Result) -> str:
         flag = "ok " if c.satisfied else "FAIL"
         cu = f" {c.unit}" if c.unit else ""
         lines.append(f"  [{flag}] {c.name}: {c.value:.10g}{cu} (slack {c.slack:.3g})")
+    ex = result.extras
+    if isinstance(ex.get("fe_breaking_force_fine_N"), float):  # the FE optimum's re-check on the default mesh
+        lines.append(f"  re-check on the default FE mesh: {ex['fe_breaking_force_fine_N']:.5g} N "
+                     f"({100 * ex['fe_fine_minus_coarse_relative']:+.1f} % from the coarse mesh)")
     if not result.success:
         lines.append("  " + result.message)
     return "\n".join(lines)

@@ -23,19 +23,22 @@ __all__ = ["breaking_force_objective", "breaking_force_constraint", "fe_breaking
 _NAME = "FE breaking force (elastic first crack, coarse mesh)"
 
 
-def _force(tensile_strength_MPa: float, direction: str):
+def _force(tensile_strength_MPa: float, direction: str, symmetric: bool = False):
     def force(tablet: Any) -> float:
         from tabletcad.fe.objective import breaking_force
 
-        return breaking_force(tablet, tensile_strength_MPa, direction)
+        return breaking_force(tablet, tensile_strength_MPa, direction, symmetric=symmetric)
 
     return force
 
 
-def fe_breaking_force(tensile_strength_MPa: float, direction: str = "width"):
-    """``f(tablet) -> N``: the coarse-mesh FE breaking force, as a quantity of a problem file."""
+def fe_breaking_force(tensile_strength_MPa: float, direction: str = "width", symmetric: bool = False):
+    """``f(tablet) -> N``: the coarse-mesh FE breaking force, as a quantity of a problem file.
+
+    ``symmetric``: the designs are mirror symmetric (see :func:`tabletcad.fe.objective.breaking_force`).
+    """
     check_positive("tensile_strength_MPa", tensile_strength_MPa, "MPa")
-    return _force(tensile_strength_MPa, direction)
+    return _force(tensile_strength_MPa, direction, symmetric)
 
 
 def breaking_force_objective(tensile_strength_MPa: float, direction: str = "width") -> Objective:
