@@ -103,7 +103,8 @@ from tabletcad.fe.elasticity import Material, PressureLoad, boundary_facets, pri
 from tabletcad.fe.mesh import CutPlane, Refinement, check_mesh_size, mesh_solid
 
 __all__ = ["DIRECTIONS", "DiametralResult", "diametral", "hondros_centre_stress", "line_load_stress",
-           "load_axis", "STRIP_FRACTION", "COARSENING", "RECOVERY_RADIUS", "contact_depth"]
+           "load_axis", "STRIP_FRACTION", "default_averaging_radius", "largest_tensile", "split_plane_points",
+           "PLANE_MESH_FACTOR", "COARSENING", "RECOVERY_RADIUS", "contact_depth"]
 
 DIRECTIONS = ("width", "length", "x", "y")
 #: Default strip width as a fraction of the extent along the load.
@@ -116,7 +117,7 @@ RECOVERY_RADIUS = 1.5
 AVERAGING_FRACTION = 1.0
 #: ... and at most this fraction of the tablet's thickness (the ball's diameter at most a third of it).
 AVERAGING_THICKNESS_FRACTION = 1.0 / 6.0
-#: Element size near the loaded diametral plane (within R + size of it), as a multiple of R (if below the bulk size).
+#: Element size near the loaded diametral plane on the optimiser's coarse mesh, as a multiple of R.
 PLANE_MESH_FACTOR = 1.5
 #: Sample points of the largest tensile stress along the load (see :func:`split_plane_points`).
 SAMPLES_ALONG_LOAD = 41
@@ -240,6 +241,11 @@ class DiametralResult:
             "coarse_centre_tensile_stress_MPa": self.coarse_centre_tensile_stress_MPa,
             "work_Nmm": self.work_Nmm,
         }
+
+
+def default_averaging_radius(strip_width: float, thickness: float) -> float:
+    """``min(b, t/6)``, mm: the default radius of the ball the largest tensile stress is averaged over."""
+    return min(AVERAGING_FRACTION * strip_width, AVERAGING_THICKNESS_FRACTION * thickness)
 
 
 def contact_depth(D: float, b: float) -> float:
@@ -372,6 +378,7 @@ def diametral(
     mesh_size: float | None = None,
     strip_mesh_size: float | None = None,
     averaging_radius: float | None = None,
+    plane_mesh_size: float | None = None,
     symmetric: bool = False,
     material: Material | None = None,
     error_estimate: bool = True,
@@ -391,13 +398,16 @@ def diametral(
         Width of each loaded strip, mm; default ``D/10`` (``D`` = extent along the load).
     mesh_size : float, optional
         Element size away from the strips, mm; default ``min(t/2, min(plan extents)/12)``.
-        Near the centre the size is ``mesh_size/1.5``, and within ``R + size`` of the loaded
-        diametral plane at most ``1.5 R`` (``R`` the averaging radius).
+        Near the centre the size is ``mesh_size/1.5``.
     strip_mesh_size : float, optional
         Element size within ``strip_width/2`` of the platens, mm; default ``min(mesh_size, strip_width/3)``.
     averaging_radius : float, optional
         Radius of the ball the largest tensile stress is averaged over, mm; default
         ``min(strip_width, thickness/6)``; at most a quarter of the smaller plan extent.
+    plane_mesh_size : float, optional
+        Element size within ``R + plane_mesh_size`` of the loaded diametral plane, mm (where the
+        averaging balls reach); default: ``mesh_size``.  The coarse mesh of
+        :func:`tabletcad.fe.objective.breaking_force` uses ``PLANE_MESH_FACTOR · R``.
     symmetric : bool
         Declare the tablet mirror symmetric about the plane across the load and about its
         mid-thickness plane (every round and capsule family without one-sided embossing or
@@ -427,7 +437,7 @@ def diametral(
                           f"({0.5 * D:.4g} mm)", "mm")
     h = min(t / 2.0, float(min(ext[0], ext[1])) / 12.0) if mesh_size is None else check_positive(
         "mesh_size", mesh_size, "mm")
-    R = min(AVERAGING_FRACTION * b, AVERAGING_THICKNESS_FRACTION * t) if averaging_radius is None else check_positive("averaging_radius", averaging_radius,
+    R = default_averaging_radius(b, t) if averaging_radius is None else check_positive("averaging_radius", averaging_radius,
                                                                                 "mm")
     if R > 0.25 * float(min(ext[0], ext[1])):
         raise DesignError("averaging_radius", R, f"must be <= a quarter of the smaller plan extent "
@@ -440,7 +450,7 @@ def diametral(
         from tabletcad.cad.tablet_solid import tablet_solid
 
         solid = tablet_solid(tablet)
-    hp = min(h, PLANE_MESH_FACTOR * R)
+    hp = h if plane_mesh_size is None else min(h, check_positive("plane_mesh_size", plane_mesh_size, "mm"))
     sol, s_c, m, bf = _solve_once(solid, lo, hi, ax, P, b, h, hs, material, R, hp)
     s_max, loc, _ = largest_tensile(sol, bf, lo, hi, ax, b, R, symmetric)
     s_t, s_l = float(s_c[px, px]), float(s_c[ax, ax])

@@ -2,8 +2,9 @@
 
 :func:`breaking_force` evaluates :func:`tabletcad.fe.prediction.predict_breaking_force`
 on a coarse mesh (element size = smallest plan extent / 6, strips at plan / 10,
-no error estimate: about 5 000 unknowns and under 2 s for a round tablet, see
-``benchmarks/bench_fe.py``); :mod:`tabletcad.optimise.strength` wraps it as an
+``1.5 R`` within ``R`` of the loaded diametral plane where the largest tensile
+stress is averaged over balls of radius ``R``; no error estimate: about
+6 000 unknowns and under 2 s for a round tablet, see ``benchmarks/bench_fe.py``); :mod:`tabletcad.optimise.strength` wraps it as an
 objective or constraint of :class:`tabletcad.optimise.Problem`, and problem
 files use it as the quantity ``fe_breaking_force_N``.
 
@@ -22,14 +23,29 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
+from tabletcad.fe.diametral import PLANE_MESH_FACTOR, STRIP_FRACTION, default_averaging_radius, load_axis
 from tabletcad.fe.prediction import StrengthInputs, predict_breaking_force
 
-__all__ = ["COARSE_MESH_FRACTION", "COARSE_STRIP_FRACTION", "breaking_force"]
+__all__ = ["COARSE_MESH_FRACTION", "COARSE_STRIP_FRACTION", "breaking_force", "coarse_mesh"]
 
 #: Coarse element size as a fraction of the smallest plan extent.
 COARSE_MESH_FRACTION = 1.0 / 6.0
 #: Coarse element size at the platens as a fraction of the smallest plan extent.
 COARSE_STRIP_FRACTION = 1.0 / 10.0
+
+
+def coarse_mesh(tablet: Any, direction: str = "width") -> dict[str, float]:
+    """The coarse mesh's sizes (mm) for ``tablet``: ``mesh_size``, ``strip_mesh_size``, ``plane_mesh_size``
+    (keyword arguments of :func:`tabletcad.fe.diametral.diametral`)."""
+    lo, hi = (np.asarray(a, float) for a in tablet.bounds())
+    ext = hi - lo
+    plan = float(min(ext[0], ext[1]))
+    D = float(ext[load_axis(direction, ext)])
+    R = default_averaging_radius(STRIP_FRACTION * D, float(ext[2]))
+    return {"mesh_size": plan * COARSE_MESH_FRACTION, "strip_mesh_size": plan * COARSE_STRIP_FRACTION,
+            "plane_mesh_size": PLANE_MESH_FACTOR * R}
 
 
 def breaking_force(tablet: Any, tensile_strength_MPa: float, direction: str = "width", *, coarse: bool = True,
@@ -42,8 +58,6 @@ def breaking_force(tablet: Any, tensile_strength_MPa: float, direction: str = "w
     """
     fe: dict[str, Any] = {"error_estimate": False, "symmetric": symmetric}
     if coarse:
-        lo, hi = tablet.bounds()
-        plan = float(min(hi[0] - lo[0], hi[1] - lo[1]))
-        fe.update(mesh_size=plan * COARSE_MESH_FRACTION, strip_mesh_size=plan * COARSE_STRIP_FRACTION)
+        fe.update(coarse_mesh(tablet, direction))
     return predict_breaking_force(tablet, StrengthInputs(tensile_strength_MPa=tensile_strength_MPa), direction,
                                   **fe).breaking_force_N
