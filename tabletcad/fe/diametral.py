@@ -50,7 +50,7 @@ jumps at the strip's edges, so the elastic stress near the platens is set by
 the idealised contact, grows under refinement there, and the vertex value of
 the largest stress jumps with the mesh (on a 10 mm concave round with 0.9 mm
 cups at σ_t = 2 MPa, the coarse-mesh breaking force read 31, 73, 53, 74, 52,
-71 N for bands 1.5-4 mm).  Averaging over the strip width ``b`` gives the
+71 N for bands 1.5-4 mm).  Averaging over a ball no wider than the strip ``b`` gives the
 stress on the scale the load model resolves (how the force spreads within
 ``b`` is not modelled) and, like the critical-distance (volume) criteria of
 brittle fracture, asks for tension over a volume of material, not at a
@@ -65,10 +65,14 @@ Why it converges.  The average is an integral of the stress against a fixed
 smooth weight (``(1 - r²/R²)²``) over a ball fixed in space, and the sample
 points are fixed in coordinates normalised by the tablet's extent and its
 faces' heights; only the quadrature of that integral depends on the mesh.
-Measured on that concave round (band 2.8 mm, ``b = R = 1`` mm, meshes 1.6,
-1.2, 0.9, 0.675 mm): 0.01534, 0.01471, 0.01452, 0.01445 MPa per N, differences
-falling by 3.3 and 2.7 per refinement (observed order 3.5-4); the vertex
+Measured on that concave round (band 2.8 mm, ``R`` = 0.767 mm, meshes 1.6,
+1.2, 0.9 mm): 0.01658, 0.01555, 0.01508 MPa per N, differences falling by 2.2
+(observed order 2.8), Richardson limit 0.01470; with ``R = b`` = 1 mm the
+differences fall by about 3 per 4/3 refinement (order 3.5-4).  The vertex
 maximum of the old definition never settled (``tests/test_fe_diametral.py``).
+Symmetric designs may declare it (``symmetric=True``): the four mirror images
+of every sample point are then averaged, which cancels the part of the error
+an unsymmetric mesh puts on them.
 
 Hondros' solution
 -----------------
