@@ -102,10 +102,10 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
         f"{tablet.name}: {force:g} N along {res.axis} ({direction}), strip {res.strip_width_mm:.4g} mm, "
         f"D = {res.diameter_mm:.4g} mm, t = {res.thickness_mm:.4g} mm",
         f"mesh: {res.nodes} nodes, {res.elements} quadratic tetrahedra, {res.dofs} unknowns (size {res.mesh_size_mm:.3g} mm)",
-        f"centre tensile stress {res.centre_tensile_stress_MPa:.5g} MPa"
+        f"centre tensile stress {res.centre_tensile_stress_MPa:.4g} MPa"
         + (f" (± {abs(err):.2g} MPa estimated)" if err is not None else ""),
-        f"2P/(πDt) = {res.line_load_MPa:.5g} MPa, shape factor {res.shape_factor:.4f}",
-        f"largest tensile stress {res.max_tensile_stress_MPa:.5g} MPa at "
+        f"2P/(πDt) = {res.line_load_MPa:.4g} MPa, shape factor {res.shape_factor:.4f}",
+        f"largest tensile stress {res.max_tensile_stress_MPa:.4g} MPa at "
         + "(" + ", ".join(f"{v:.3g}" for v in res.max_tensile_location_mm) + ") mm",
     ] + [f"-> {f}" for f in files])
 
@@ -147,7 +147,7 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
         f"{tablet.name}: predicted breaking force {pred.breaking_force_N:.4g} N across {direction} "
         f"(elastic first-crack estimate; {pred.breaking_force_centre_N:.4g} N if the crack starts at the centre)",
         f"tensile strength {pred.tensile_strength_MPa:.4g} MPa ({pred.tensile_strength_basis})",
-        f"largest tensile stress {pred.max_tensile_per_N:.5g} MPa per N at "
+        f"largest tensile stress {pred.max_tensile_per_N:.4g} MPa per N at "
         + "(" + ", ".join(f"{v:.3g}" for v in d["first_crack_location_mm"]) + ") mm; shape factor "
         f"{d['shape_factor']:.4f}",
     ])
@@ -220,8 +220,8 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
     _echo(payload, as_json, [
         f"{tablet.name}: {which} punch tip, {force:g} kN over the cup face ({res.loaded_area_mm2:.4g} mm2)",
         f"mesh: {res.nodes} nodes, {res.elements} quadratic tetrahedra, {res.dofs} unknowns",
-        f"largest von Mises stress {res.max_von_mises_MPa:.5g} MPa at ("
-        + ", ".join(f"{v:.3g}" for v in res.max_von_mises_location_mm) + f") mm; F/A = {res.uniform_stress_MPa:.5g} MPa",
+        f"largest von Mises stress {res.max_von_mises_MPa:.4g} MPa at ("
+        + ", ".join(f"{v:.3g}" for v in res.max_von_mises_location_mm) + f") mm; F/A = {res.uniform_stress_MPa:.4g} MPa",
         f"allowed force {res.allowed_force_kN:.4g} kN (yield {yield_stress:g} MPa / {safety_factor:g}"
         + (f"; {b['method']} buckling {b['critical_force_kN']:.4g} kN at slenderness {b['slenderness']:.3g}" if b else "")
         + ")",
