@@ -10,7 +10,7 @@ pytest.importorskip("manifold3d")
 
 from scipy.integrate import quad  # noqa: E402
 
-from tabletcad.pipeline.design import load_design  # noqa: E402
+from tabletcad.pipeline.design import Design, load_design  # noqa: E402
 from tabletcad.errors import DesignError  # noqa: E402
 from tabletcad.tooling.spec import ScoreSpec, ToolingSpec, parse_tooling  # noqa: E402
 from tabletcad.tooling.split import split_directions  # noqa: E402
@@ -36,8 +36,9 @@ def flat():
 
 def test_cut_through_bisect_splits_into_equal_halves_with_the_closed_form_break_surface(flat):
     d = 0.3
+    # the design's [report] table gives the density of the parts' masses
     ts = make_tooling(flat, ToolingSpec(scores=(ScoreSpec(depth_mm=d, cut_through=True),)), check=False,
-                      interference_check=False)
+                      interference_check=False, options=Design.from_toml(FLAT).report_options)
     sp = ts.report["split"]
     half = 0.5 * (math.pi * R * R * H - _groove_volume(d))
     assert sp["n_parts"] == 2
