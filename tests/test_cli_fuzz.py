@@ -22,7 +22,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, event, given, settings
+from hypothesis import HealthCheck, event, example, given, settings
 from hypothesis import strategies as st
 
 from tabletcad.cli import main
@@ -118,13 +118,20 @@ raw_text = st.lists(st.one_of(st.sampled_from(FRAGMENTS), texts(8)), max_size=25
 
 
 def _fake_build_design(design, out_dir, *, progress=True):
-    """Everything ``build`` does before its CAD stages: read and validate the design, build the PDE tablet."""
+    """Everything ``build`` does before its CAD stages: read and validate the design, build the PDE tablet;
+    the report keys the command prints."""
     from tabletcad.pipeline.design import load_design
 
     t = load_design(design)
     Path(out_dir).mkdir(parents=True, exist_ok=True)
     dims = t.dimensions()
-    return dict(design=dict(name=t.name), volume_mm3=t.volume(), surface_area_mm2=t.surface_area(), outputs=[], **dims)
+    return dict(design=dict(name=t.name, family=t.family, params=dict(t.params)), volume_mm3=t.volume(),
+                surface_area_mm2=t.surface_area(), outputs=[], **dims)
+
+
+VALID = '[tablet]\nfamily = "concave_round"\ndiameter = 8.0\nband = 2.0\ncup_depth = 0.8\n'
+VALID_THESIS = '[tablet]\nfamily = "thesis.flat_faced_round"\ndiameter = 10.0\nthickness = 6.0\n'
+
 
 
 def _check_contract(rc: int, err: str, context) -> None:
@@ -138,6 +145,8 @@ def _check_contract(rc: int, err: str, context) -> None:
 @settings(max_examples=50, suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow], deadline=None)
 @given(doc=st.one_of(designs.map(_toml), designs.map(_toml), designs.map(_toml), raw_text),
        command=st.sampled_from(["build", "report", "mesh"]))
+@example(doc=VALID, command="build")  # the success path always runs, whatever the draw
+@example(doc=VALID_THESIS, command="build")
 def test_fuzzed_design_files_keep_the_one_line_contract(tmp_path_factory, capsys, monkeypatch, doc, command):
     import tabletcad.pipeline.build
 
@@ -151,6 +160,8 @@ def test_fuzzed_design_files_keep_the_one_line_contract(tmp_path_factory, capsys
     out, err = capsys.readouterr()
     event(f"{command} exit {rc}: {err[:90]}")
     _check_contract(rc, err, (command, doc))
+    if doc in (VALID, VALID_THESIS):
+        assert rc == 0 and err == "" and ("PDE surface; nominal 10 x 10 x 6 mm" in out) == (doc == VALID_THESIS), out
     if rc == 2:  # nothing written beside the design
         assert sorted(p.name for p in folder.iterdir()) == ["design.toml"], doc
 

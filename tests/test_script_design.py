@@ -110,3 +110,21 @@ def test_writer_takes_numpy_scalars_and_refuses_what_toml_cannot_hold():
         toml_text({"tablet": {1: 2.0}})
     with pytest.raises(DesignError):
         toml_text({"tablet": {"x": object()}})
+
+
+def test_an_emboss_svg_is_found_beside_the_design_file(tmp_path, monkeypatch):
+    """A relative svg path starts in the design file's folder, whatever the current folder; the file
+    keeps the relative name (the design round-trips unchanged)."""
+    folder = tmp_path / "designs"
+    folder.mkdir()
+    (folder / "logo.svg").write_text('<svg xmlns="http://www.w3.org/2000/svg"><rect width="1" height="1"/></svg>')
+    text = ('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 2.0\ncup_depth = 0.8\n\n'
+            '[[tooling.emboss]]\nsvg = "logo.svg"\nheight_mm = 3.0\n')
+    (folder / "d.toml").write_text(text, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    d = Design.from_toml(folder / "d.toml")
+    assert d.tooling_spec.emboss[0].svg == str(folder / "logo.svg")
+    assert d.tooling["emboss"][0]["svg"] == "logo.svg" and Design.from_dict(d.to_dict(), folder=folder) == d
+    (folder / "logo.svg").unlink()
+    with pytest.raises(DesignError, match=r"svg = 'logo.svg' is not allowed: .*relative paths start in the design's folder"):
+        Design.from_toml(folder / "d.toml")

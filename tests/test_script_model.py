@@ -176,3 +176,59 @@ def test_interop_hints_name_the_pinned_versions():
     for name in ("cadquery", "cadquery-ocp"):
         assert pins[name] in interop._CQ_HINT
     assert "0.13" not in interop._BD_HINT + interop._CQ_HINT
+
+
+_SCORED = """[tablet]
+family = "flat_face_round"
+diameter = 8.0
+thickness = 3.0
+
+[report]
+solid_fraction = 0.8
+true_density_mg_mm3 = 1.5
+compaction_force_kN = 12.0
+
+[tooling]
+clearance_mm = 0.02
+allowed_tip_pressure_MPa = 300.0
+allowed_tip_pressure_source = "test value"
+
+[[tooling.score]]
+kind = "bisect"
+cut_through = true
+depth_mm = 0.3
+"""
+
+
+@pytest.mark.slow
+def test_the_designs_report_options_reach_the_tooling(tmp_path):
+    """[report] gives the split parts their masses and the tip rating its compaction force, through
+    tabletcad.load(...).tooling() and through the build (Tablet.extras is gone: the Design carries them)."""
+    import json
+
+    from tabletcad.cli import main
+
+    path = tmp_path / "scored.toml"
+    path.write_text(_SCORED, encoding="utf-8")
+    rep = tabletcad.load(path).tooling().report
+    rho = 0.8 * 1.5
+    assert rep["split"]["density_mg_mm3"] == pytest.approx(rho, rel=1e-12)
+    for part in rep["split"]["parts"]:
+        assert part["mass_mg"] == pytest.approx(part["volume_mm3"] * rho, rel=1e-12)
+    tip = rep["tip_rating"]
+    assert tip["compaction_force_kN"] == 12.0
+    assert tip["utilisation"] == pytest.approx(12.0 / (0.3 * tip["tip_projected_area_mm2"]), rel=1e-9)
+    assert main(["build", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    built = json.loads((tmp_path / "out" / "report.json").read_text())["tooling"]
+    assert built["tip_rating"]["utilisation"] == pytest.approx(tip["utilisation"], rel=1e-9)
+    assert [p["mass_mg"] for p in built["split"]["parts"]] == pytest.approx([p["mass_mg"] for p in rep["split"]["parts"]])
+
+
+def test_tooling_keywords_are_checked_like_the_table(tmp_path):
+    path = tmp_path / "scored.toml"
+    path.write_text(_SCORED, encoding="utf-8")
+    m = tabletcad.load(path)
+    with pytest.raises(DesignError, match=r"clearance_mm = -1 mm is not allowed"):
+        m.tooling(clearance_mm=-1)  # refused before any geometry, as in the design file
+    with pytest.raises(DesignError, match="standard"):
+        m.tooling(standard="XYZ", type="B")

@@ -352,7 +352,7 @@ def fit_patches(
 
 class PatchFunction:
     """``f(u, v) = patch.evaluate(u, v)``; keeps the patch's ``evaluate_grid`` (tensor grids by
-    matrix products), which :func:`tabletcad.bspline.fit_surface` uses when present."""
+    matrix products), which :func:`fit_surface` uses when present."""
 
     def __init__(self, patch) -> None:
         self.patch = patch

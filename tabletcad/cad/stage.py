@@ -138,7 +138,7 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
     half-planes (``BRepAlgoAPI_Common``).  Otherwise (shaped outlines, whose cut faces are
     ruled surfaces between the spine and the section curve) the cut-away of a full solid
     is fitted and sewn directly as one closed chain
-    (:func:`~tabletcad.cad.tablet_solid.cutaway_surface_functions`).  Its volume must agree
+    (:func:`~tabletcad.brep.surfaces.cutaway_surface_functions`).  Its volume must agree
     with the core's quadrature over the trimmed domain within ``AGREEMENT_REL`` and its mesh
     must pass the checks.
     """

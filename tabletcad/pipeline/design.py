@@ -198,6 +198,9 @@ class Design:
         The optional tables of the same names.
     comment : str
         Lines written as ``#`` comments at the top of :meth:`to_toml` (not part of the value).
+    folder : Path or None
+        The folder relative file names in the design (an emboss ``svg``) start in: the design
+        file's (:meth:`from_toml`), else the current folder (not part of the value).
     report_options : ReportOptions
         The ``[report]`` table, checked (derived; not an argument).
     tooling_spec : ToolingSpec or None
@@ -214,12 +217,14 @@ class Design:
     report: dict | None = None
     tooling: dict | None = None
     comment: str = field(default="", compare=False, repr=False)
+    folder: Path | None = field(default=None, compare=False, repr=False)
     report_options: ReportOptions = field(init=False, compare=False, repr=False)
     tooling_spec: ToolingSpec | None = field(init=False, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "report_options", ReportOptions.from_table(self.report))
-        object.__setattr__(self, "tooling_spec", None if self.tooling is None else parse_tooling(self.tooling))
+        object.__setattr__(self, "tooling_spec",
+                           None if self.tooling is None else parse_tooling(self.tooling, base=self.folder))
 
     @property
     def name(self) -> str:
@@ -230,21 +235,22 @@ class Design:
         return self.tablet["family"]
 
     @classmethod
-    def from_dict(cls, data: Any, default_name: str = "tablet", *, comment: str = "") -> Design:
+    def from_dict(cls, data: Any, default_name: str = "tablet", *, comment: str = "",
+                  folder: str | Path | None = None) -> Design:
         """A design from its dictionary (the TOML structure above); the name defaults to ``default_name``.
 
         Checks what needs no geometry: the top-level tables, the name, the family.  The
         dimensions are checked by :meth:`build`, before any geometry is built.
         """
         try:
-            return cls._from_dict(data, default_name, comment)
+            return cls._from_dict(data, default_name, comment, None if folder is None else Path(folder))
         except DesignError as exc:
             if len(exc.parameter.split()) > 1:
                 raise exc.renamed(one_token(exc.parameter)) from None
             raise
 
     @classmethod
-    def _from_dict(cls, data: Any, default_name: str, comment: str) -> Design:
+    def _from_dict(cls, data: Any, default_name: str, comment: str, folder: Path | None) -> Design:
         if not isinstance(data, dict):
             raise DesignError("design", type(data).__name__, "must be a TOML table")
         _check_keys("", data, set(TOP_LEVEL_KEYS))
@@ -270,13 +276,13 @@ class Design:
                 raise DesignError("tablet.family", family, f"must be one of {families}")
             family = lookup_family(family).name  # an old name: one warning, then its new family
         tablet = {"family": family, "name": name, **{k: v for k, v in tab.items() if k not in ("family", "name")}}
-        return cls(tablet, data.get("patch"), **{t: data.get(t) for t in _TABLES}, comment=comment)
+        return cls(tablet, data.get("patch"), **{t: data.get(t) for t in _TABLES}, comment=comment, folder=folder)
 
     @classmethod
     def from_toml(cls, path: str | Path) -> Design:
         """The design of a TOML file; its name defaults to the file's stem."""
         path = Path(path)
-        return cls.from_dict(read_design_file(path), default_name=path.stem)
+        return cls.from_dict(read_design_file(path), default_name=path.stem, folder=path.parent)
 
     def to_dict(self) -> dict[str, Any]:
         """The design as a plain dictionary (a copy; :meth:`from_dict` reads it back)."""

@@ -208,10 +208,13 @@ class TabletModel(_Shaped):
         from tabletcad.tooling.spec import ToolingSpec, parse_tooling
         from tabletcad.tooling.toolset import make_tooling
 
-        if spec is None:
-            spec = ToolingSpec() if self.design is None or self.design.tooling_spec is None else self.design.tooling_spec
+        folder = None if self.design is None else self.design.folder
+        if spec is None and not kw and self.design is not None and self.design.tooling_spec is not None:
+            spec = self.design.tooling_spec  # parsed and checked when the design was read
+        elif spec is None:  # the design's table with the keywords in it, parsed and checked again
+            spec = {} if self.design is None or self.design.tooling is None else self.design.tooling
         if isinstance(spec, dict):
-            spec = parse_tooling({**spec, **kw})
+            spec = parse_tooling({**spec, **kw}, base=folder)
         elif isinstance(spec, ToolingSpec):
             spec = spec.with_(**kw) if kw else spec
         else:

@@ -229,7 +229,7 @@ def _score(i: int, t: Any) -> ScoreSpec:
                      check_finite(f"{w} direction_deg", t.get("direction_deg", d.direction_deg), "deg"), slot, length)
 
 
-def _emboss(i: int, t: Any) -> EmbossSpec:
+def _emboss(i: int, t: Any, base: Path | None = None) -> EmbossSpec:
     w = f"[[tooling.emboss]] {i}"
     d = EmbossSpec()
     t = _keys(w, t, set(EmbossSpec.__dataclass_fields__) | {"stroke_angle_deg"})
@@ -237,8 +237,14 @@ def _emboss(i: int, t: Any) -> EmbossSpec:
     if sum(x is not None for x in (text, outline, svg)) != 1:
         raise DesignError(f"{w} text", text, "give exactly one of text, outline (a closed polyline [[x, y], ...]) or svg "
                           "(a logo file)")
-    if svg is not None and not (isinstance(svg, str) and Path(svg).suffix.lower() == ".svg" and Path(svg).is_file()):
-        raise DesignError(f"{w} svg", svg, "must be the path of an existing .svg file")
+    if svg is not None:
+        path = Path(svg) if isinstance(svg, str) else None
+        if path is not None and base is not None and not path.is_absolute():
+            path = base / path  # relative to the design file's folder
+        if path is None or path.suffix.lower() != ".svg" or not path.is_file():
+            raise DesignError(f"{w} svg", svg, "must be the path of an existing .svg file"
+                              + (f" (relative paths start in the design's folder, {base})" if base is not None else ""))
+        svg = str(path)
     if "stroke_angle_deg" in t and "draft_deg" in t:
         raise DesignError(f"{w} draft_deg", t["draft_deg"], "give stroke_angle_deg or draft_deg, not both", "deg")
     stroke = t.get("stroke_angle_deg", t.get("draft_deg", d.draft_deg))
@@ -270,8 +276,12 @@ def _emboss(i: int, t: Any) -> EmbossSpec:
     )
 
 
-def parse_tooling(table: Any) -> ToolingSpec:
-    """A :class:`ToolingSpec` from the ``[tooling]`` table (raises :class:`DesignError`)."""
+def parse_tooling(table: Any, base: Path | None = None) -> ToolingSpec:
+    """A :class:`ToolingSpec` from the ``[tooling]`` table (raises :class:`DesignError`).
+
+    ``base``: the folder relative file names (an emboss ``svg``) start in, the design file's
+    (default: the current folder).
+    """
     d = ToolingSpec()
     keys = {"clearance_mm", "tip_length_mm", "die_outer_diameter_mm", "die_height_mm", "taper_deg", "gap_mm", "score", "emboss",
             "standard", "type", "punch", "lower_tip_length_mm", "drawing", "allowed_tip_pressure_MPa",
@@ -321,5 +331,5 @@ def parse_tooling(table: Any) -> ToolingSpec:
             raise DesignError(f"[tooling] {skey}", t[skey], f"give it together with {key}")
     return ToolingSpec(clearance, tip, od, height, taper, gap,
                        tuple(_score(i, s) for i, s in enumerate(scores)),
-                       tuple(_emboss(i, e) for i, e in enumerate(emb)), body=body, lower_tip_length_mm=lower,
+                       tuple(_emboss(i, e, base) for i, e in enumerate(emb)), body=body, lower_tip_length_mm=lower,
                        drawing=_drawing(t.get("drawing", {})), **sourced)
