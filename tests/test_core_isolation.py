@@ -12,7 +12,7 @@ import pytest
 REPO = str(Path(__file__).resolve().parents[1])
 BLOCKED = ["OCP", "build123d", "cadquery", "manifold3d", "trimesh"]
 
-SCRIPT = r"""
+BLOCKER = r"""
 import sys
 sys.path.insert(0, {repo!r})
 BLOCKED = {blocked!r}
@@ -24,6 +24,9 @@ class Block:
         return None
 
 sys.meta_path.insert(0, Block())
+"""
+
+SCRIPT = BLOCKER + r"""
 for b in BLOCKED:
     try:
         __import__(b)
@@ -83,3 +86,37 @@ def test_same_volume_on_debian_numpy_124(family):
         pytest.skip(info)
     old = _run(exe, family)
     assert old == pytest.approx(_volume_here(family), rel=1e-12), info
+
+
+EVERY_MODULE = BLOCKER + r"""
+import importlib, pkgutil
+import tabletcad
+
+core = sorted(m.name for m in pkgutil.walk_packages(tabletcad.__path__, "tabletcad.")
+              if m.name != "tabletcad.__main__"  # (runs the command line)
+              and (not m.name.startswith(("tabletcad.cad", "tabletcad.tooling"))
+                   or m.name in ("tabletcad.tooling.spec", "tabletcad.tooling.standards")))
+for name in core:
+    importlib.import_module(name)
+from tabletcad.pipeline.build import build_design
+from tabletcad.pipeline.design import Design
+
+report = build_design(Design.from_toml({sample!r}), {out!r}, cad=False, progress=False)
+assert not any(k.split(".")[0] in BLOCKED for k in sys.modules), "a CAD library was imported"
+print(len(core), repr(report["volume_mm3"]), ",".join(report["outputs"]))
+"""
+
+
+def test_every_core_module_imports_and_a_tooling_design_builds_with_cad_blocked(tmp_path):
+    """Every module outside cad/ and tooling/ (the [tooling] table's parser included) imports, and a
+    design with a [tooling] table builds its report and picture, while the CAD libraries cannot be
+    imported: what FreeCAD's Python and the core-only install rely on."""
+    sample = Path(REPO) / "samples" / "tooling" / "tsm_b_round.toml"
+    code = EVERY_MODULE.format(repo=REPO, blocked=BLOCKED, sample=str(sample), out=str(tmp_path / "out"))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600, cwd="/")
+    assert out.returncode == 0, out.stderr[-3000:]
+    n, volume, outputs = out.stdout.splitlines()[-1].split()
+    from tabletcad.pipeline.design import load_design
+
+    assert int(n) > 80 and float(volume) == pytest.approx(load_design(sample).volume(), rel=1e-9)
+    assert outputs == "report.json,tablet.png"
