@@ -61,6 +61,17 @@ def test_figure_is_to_scale_and_dimensioned(pair):
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def test_the_drawn_side_profile_is_a_closed_outline(pair):
+    """The profile's outline line comes back to its start: the band on the left is drawn too."""
+    fig = tablet_figure(pair[0])
+    prof = fig.axes[1]
+    outline = max(prof.lines, key=lambda ln: len(ln.get_xdata()))
+    xy = np.c_[outline.get_xdata(), outline.get_ydata()]
+    assert np.array_equal(xy[0], xy[-1])
+    left = xy[np.isclose(xy[:, 0], xy[:, 0].min())]
+    assert np.ptp(left[:, 1]) == pytest.approx(BAND, abs=1e-6)  # the left band edge, bottom to top
+
+
 def test_several_tablets_share_one_scale(pair):
     t3 = capsule(length=18, width=8, band=3, cup_depth=1.2)
     fig = tablets_figure([*pair, t3])

@@ -134,3 +134,25 @@ def test_shapes_json_gives_no_default_for_a_required_dimension(capsys):
     d = json.loads(out)["concave_round"]
     assert d["defaults"] == {"diameter": None, "band": None, "cup_depth": None, "land": 0.0}
     assert d["required"] == ["diameter", "band", "cup_depth"] and d["optional"] == ["land"]
+
+
+@pytest.mark.parametrize("command", ["kawakita", "walker"])
+def test_a_press_record_is_fitted_on_its_loading_branch(capsys, tmp_path, command):
+    """Rows after the peak pressure (unloading, reloading) are left out, as heckel does, and said so."""
+    h = H0 * (1 - A * B * P / (1 + B * P))
+    load = _write(tmp_path / "load.csv", "pressure_MPa,thickness_mm", (P, h))
+    back = np.array([150.0, 90.0, 30.0, 5.0, 60.0, 180.0])  # unloading, then reloading the compact
+    h_back = h[-1] + 0.02 * (1 - back / P[-1])  # elastic recovery: thicker than on the way up
+    record = _write(tmp_path / "record.csv", "pressure_MPa,thickness_mm", (np.r_[P, back], np.r_[h, h_back]))
+    rc, out, err = run(capsys, command, load, "--json")
+    assert rc == 0, err
+    alone = json.loads(out)
+    rc, out, err = run(capsys, command, record, "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    assert d["loading_rows"] == [1, len(P)] and d["n_points"] == alone["n_points"]
+    keys = ("a", "b_per_MPa") if command == "kawakita" else ("W_percent_per_decade", "intercept_percent")
+    assert [d[k] for k in keys] == pytest.approx([alone[k] for k in keys], rel=1e-12)
+    rc, out, err = run(capsys, command, record)
+    assert out.splitlines()[0] == (f"record.csv: loading rows 1-{len(P)} of {len(P) + len(back)} used (up to the peak "
+                                   "pressure; the rows after it unload or reload the compact)")

@@ -238,11 +238,11 @@ def _compression_options(f):
 
 
 def _kawakita_line(fit) -> str:
-    return f"a = {fit.a:.4g}, b = {fit.b_per_MPa:.4g} 1/MPa (1/b = {fit.inv_b_MPa:.4g} MPa), R² = {fit.r2:.5f}"
+    return f"a = {fit.a:.4g}, b = {fit.b_per_MPa:.4g} 1/MPa (1/b = {fit.inv_b_MPa:.4g} MPa), R² = {fit.r2:.4f}"
 
 
 def _walker_line(fit) -> str:
-    return f"W = {fit.W_percent_per_decade:.4g} % per decade, c = {fit.intercept_percent:.4g} %, R² = {fit.r2:.5f}"
+    return f"W = {fit.W_percent_per_decade:.4g} % per decade, c = {fit.intercept_percent:.4g} %, R² = {fit.r2:.4f}"
 
 
 def _compression_command(name: str, fit_name: str, describe, doc: str):
@@ -254,12 +254,20 @@ def _compression_command(name: str, fit_name: str, describe, doc: str):
                 window: tuple[float, float] | None, as_json: bool, json_file: Path | None) -> None:
         from tabletcad.mechanics import kawakita
 
+        from tabletcad.mechanics.compaction import split_branches
+
         t = _compression_table(data, pressure_column, thickness_column, h0, window, json_file)
+        # the loading branch only (as heckel): a press record goes on past its peak pressure into
+        # unloading and reloading rows, whose thickness follows the elastic recovery instead
+        a, b = split_branches(t["P"]).loading
+        lines = [] if (a, b) == (0, len(t["P"])) else [
+            f"{data.name}: loading rows {a + 1}-{b} of {len(t['P'])} used (up to the peak pressure; "
+            f"the rows after it unload or reload the compact)"]
         with _collect() as msgs:
-            fit = getattr(kawakita, fit_name)(t["P"], t["h"], window=window, h0=h0)
+            fit = getattr(kawakita, fit_name)(t["P"][a:b], t["h"][a:b], window=window, h0=h0)
         lo, hi = fit.window_MPa
-        _finish(fit.to_dict() | {"data": str(data), "warnings": msgs}, as_json, json_file, [
-            f"{name} over {lo:.4g}-{hi:.4g} MPa (n = {fit.n_points}, h0 = {fit.h0:.4g} mm): {describe(fit)}"])
+        _finish(fit.to_dict() | {"data": str(data), "loading_rows": [a + 1, b], "warnings": msgs}, as_json, json_file,
+                lines + [f"{name} over {lo:.4g}-{hi:.4g} MPa (n = {fit.n_points}, h0 = {fit.h0:.4g} mm): {describe(fit)}"])
 
     return command
 
@@ -313,7 +321,7 @@ def profiles_cmd(data: Path, pressure_column: str, solid_fraction_column: str, s
              f"compressibility: {'porosity' if porosity else 'solid fraction'} {comp.y.min():.4g}-{comp.y.max():.4g}"]
     if rd is not None:
         lines.append(f"Ryshkewitch-Duckworth (eq 2.6): sigma0 = {rd.sigma0_MPa:.4g} MPa, k = {rd.k:.4g}, "
-                     f"R² = {rd.r2:.5f}")
+                     f"R² = {rd.r2:.4f}")
     _finish(payload, as_json, json_file, lines, (plot_file, lambda p: plot_profiles(profs, p)))
 
 
