@@ -118,6 +118,17 @@ def test_bad_use_is_one_line_and_writes_nothing(tmp_path, capsys, extra, paramet
     assert list(out.iterdir()) == []
 
 
+def test_a_bad_design_among_several_is_named(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[tablet]\nfamily = "concave_round"\ndiameter = 10\nband = 2\ncup_depth = -1\n', encoding="utf-8")
+    assert main(["report", str(FAM / "ffre.toml"), str(bad), "--csv", str(tmp_path / "r.csv")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: tablet.cup_depth = -1 mm is not allowed: ") and err.endswith(f" (in {bad})\n")
+    assert err.count("\n") == 1 and sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
+    assert main(["report", str(bad)]) == 2  # one design: the line needs no file name
+    assert "(in " not in capsys.readouterr().err
+
+
 def test_xlsx_without_openpyxl_names_the_extra(tmp_path, capsys, monkeypatch):
     monkeypatch.setitem(sys.modules, "openpyxl", None)
     assert main(["report", str(FAM / "concave_round.toml"), "--xlsx", str(tmp_path / "r.xlsx")]) == 2

@@ -302,7 +302,12 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
 
     payloads, shown, tablets = [], [], []
     for design in designs:
-        tablet, spec = load_family_design(design)
+        try:
+            tablet, spec = load_family_design(design)
+        except DesignError as exc:  # with several designs, say which file it is
+            if len(designs) == 1:
+                raise
+            raise DesignError(exc.parameter, exc.value, f"{exc.allowed} (in {design})", exc.unit) from None
         try:
             opts = spec.report_options.merged(
                 solid_fraction=solid_fraction, true_density_mg_mm3=true_density, breaking_force_N=breaking_force,
