@@ -141,3 +141,16 @@ def test_diametral_refuses_a_ring_fast(capsys):
     ring = Path(__file__).resolve().parents[1] / "samples" / "ring.toml"
     rc, so, err = run(capsys, "fe", "diametral", ring, "--force", 10)
     assert rc == 2 and err.startswith("error: [trim] w = [0.5, 1.0] is not allowed: the diametral test needs a solid")
+
+
+def test_json_file_writes_what_json_prints(capsys, tmp_path, thin):
+    args = ["fe", "strength", thin, "--tensile-strength", "2.0", "--mesh-size", "1.5"]
+    rc, out, err = run(capsys, *args, "--json")
+    assert rc == 0, err
+    printed = json.loads(out)
+    target = tmp_path / "r.json"
+    rc, out, err = run(capsys, *args, "--json-file", target)
+    assert rc == 0, err
+    assert out.rstrip().endswith(f"json -> {target}") and json.loads(target.read_text()) == printed
+    rc, out, err = run(capsys, *args, "--json-file", tmp_path / "r.txt")
+    assert rc == 2 and err.startswith("error: --json-file = ") and not (tmp_path / "r.txt").exists()

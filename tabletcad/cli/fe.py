@@ -27,12 +27,24 @@ def _require_fe() -> None:
         raise DesignError("tabletcad fe", exc.name, "needs the fe extra: pip install 'tabletcad[fe]'") from None
 
 
-def _echo(payload: dict[str, Any], as_json: bool, lines: list[str]) -> None:
+def _echo(payload: dict[str, Any], as_json: bool, lines: list[str], json_file: Path | None = None) -> None:
+    """Write ``--json-file`` (all-or-nothing), then print the JSON or the lines."""
+    if json_file is not None:
+        from tabletcad.cli.outputs import staged
+
+        with staged(json=json_file) as out:
+            out["json"].write_text(json.dumps(payload, indent=2) + "\n", encoding="utf-8")
     if as_json:
         click.echo(json.dumps(payload, indent=2))
     else:
-        for ln in lines:
+        for ln in lines + ([f"json -> {json_file}"] if json_file is not None else []):
             click.echo(ln)
+
+
+def _check_json_file(json_file: Path | None) -> None:
+    from tabletcad.cli.outputs import check_output
+
+    check_output("--json-file", json_file, (".json",))
 
 
 def _check_out(out: Path | None) -> None:
@@ -58,9 +70,11 @@ def fe_group() -> None:
 @click.option("--no-error-estimate", is_flag=True, help="Skip the second (coarser) mesh of the error estimate.")
 @click.option("--out", type=click.Path(file_okay=True, path_type=Path), default=None,
               help="Folder for stress.vtu and section.png (tensile stress on the mid-thickness section).")
-@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout.")
+@click.option("--json-file", type=click.Path(path_type=Path), default=None, help="Write the result as JSON to this file.")
 def diametral_cmd(design: Path, force: float, direction: str, strip_width: float | None, mesh_size: float | None,
-                  E: float, nu: float, no_error_estimate: bool, out: Path | None, as_json: bool) -> None:
+                  E: float, nu: float, no_error_estimate: bool, out: Path | None, as_json: bool,
+                  json_file: Path | None) -> None:
     """Diametral compression of DESIGN.toml by FE: centre and largest tensile stress, shape factor."""
     from tabletcad.cli.report import load_family_design
     from tabletcad.errors import check_positive
@@ -70,6 +84,7 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
     if direction not in DIRECTIONS:
         raise DesignError("--direction", direction, "must be one of " + ", ".join(DIRECTIONS))
     _check_out(out)
+    _check_json_file(json_file)
     _require_fe()
     from tabletcad.fe.diametral import diametral
     from tabletcad.fe.elasticity import Material
@@ -107,7 +122,7 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
         f"2P/(πDt) = {res.line_load_MPa:.4g} MPa, shape factor {res.shape_factor:.4f}",
         f"largest tensile stress {res.max_tensile_stress_MPa:.4g} MPa at "
         + "(" + ", ".join(f"{v:.3g}" for v in res.max_tensile_location_mm) + ") mm",
-    ] + [f"-> {f}" for f in files])
+    ] + [f"-> {f}" for f in files], json_file=json_file)
 
 
 @fe_group.command("strength")
@@ -119,10 +134,11 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
 @click.option("--reference-thickness", type=float, default=None, help="Reference compact thickness, mm.")
 @click.option("--direction", default="width", show_default=True, help="Load direction in plan: width|length|x|y.")
 @click.option("--mesh-size", type=float, default=None, help="Element size, mm [default as fe diametral].")
-@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout.")
+@click.option("--json-file", type=click.Path(path_type=Path), default=None, help="Write the result as JSON to this file.")
 def strength_cmd(design: Path, tensile_strength: float | None, reference_force: float | None,
                  reference_diameter: float | None, reference_thickness: float | None, direction: str,
-                 mesh_size: float | None, as_json: bool) -> None:
+                 mesh_size: float | None, as_json: bool, json_file: Path | None) -> None:
     """Breaking force of DESIGN.toml predicted by FE (elastic first-crack estimate).
 
     Inputs from the options or the design file's [report] table: tensile_strength_MPa, or
@@ -133,6 +149,7 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
 
     if direction not in DIRECTIONS:
         raise DesignError("--direction", direction, "must be one of " + ", ".join(DIRECTIONS))
+    _check_json_file(json_file)
     _require_fe()
     from tabletcad.fe.prediction import StrengthInputs, predict_breaking_force
 
@@ -150,7 +167,7 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
         f"largest tensile stress {pred.max_tensile_per_N:.4g} MPa per N at "
         + "(" + ", ".join(f"{v:.3g}" for v in d["first_crack_location_mm"]) + ") mm; shape factor "
         f"{d['shape_factor']:.4f}",
-    ])
+    ], json_file=json_file)
 
 
 @fe_group.command("punch")
@@ -166,10 +183,11 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
 @click.option("--mesh-size", type=float, default=None, help="Element size, mm [default: tip width/8].")
 @click.option("--out", type=click.Path(file_okay=True, path_type=Path), default=None,
               help="Folder for stress.vtu and section.png (von Mises stress on the tip's axial section).")
-@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout.")
+@click.option("--json-file", type=click.Path(path_type=Path), default=None, help="Write the result as JSON to this file.")
 def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_stress: float | None, E: float | None,
               safety_factor: float, effective_length_factor: float, mesh_size: float | None, out: Path | None,
-              as_json: bool) -> None:
+              as_json: bool, json_file: Path | None) -> None:
     """Punch-tip stress under the compaction force spread over the cup, and the allowed force."""
     from tabletcad.cli.report import load_family_design
     from tabletcad.errors import check_positive
@@ -178,6 +196,7 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
     check_positive("--safety-factor", safety_factor)
     check_positive("--effective-length-factor", effective_length_factor)
     _check_out(out)
+    _check_json_file(json_file)
     from tabletcad.fe.punch import tool_steels
 
     steels = tool_steels()
@@ -225,7 +244,7 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
         f"allowed force {res.allowed_force_kN:.4g} kN (yield {yield_stress:g} MPa / {safety_factor:g}"
         + (f"; {b['method']} buckling {b['critical_force_kN']:.4g} kN at slenderness {b['slenderness']:.3g}" if b else "")
         + ")",
-    ] + [f"-> {f}" for f in files])
+    ] + [f"-> {f}" for f in files], json_file=json_file)
 
 
 COMMANDS = [fe_group]
