@@ -245,3 +245,18 @@ def test_report_plot_bad_output_is_one_line_and_writes_nothing(tmp_path, capsys,
     assert cap.out == "" and cap.err.splitlines() == [cap.err.strip()]
     assert cap.err.startswith("error: --plot = ") and " is not allowed: " in cap.err and why in cap.err
     assert sorted(out.rglob("*")) == before
+
+
+def test_an_outline_through_points_is_drawn_from_its_band_edge(tmp_path):
+    """A custom outline through points (a spline, no line/arc segments) draws its plan from the band's
+    edge curve: the drawn outline's area is the tablet's plan area (the build's picture had crashed)."""
+    from tabletcad.pipeline.design import Design
+
+    th = np.linspace(0.0, math.tau, 21)[:-1]
+    pts = [[float(4.5 * math.cos(a)), float(3.0 * math.sin(a))] for a in th]
+    t = Design.from_dict({"tablet": {"family": "custom_outline", "outline": pts, "band": 2.5,
+                                     "cup_depth": 0.19}}).build()
+    o = plot.side_profile(t)
+    perimeter = float(np.sum(np.linalg.norm(np.diff(o.plan, axis=0), axis=1)))
+    assert abs(_polyline_area(o.plan) - t.plan_area()) <= 2e-5 * t.plan_area() + perimeter * 4e-3
+    assert plot.plot_tablet(t, tmp_path / "t.png").stat().st_size > 10_000

@@ -169,7 +169,7 @@ def _plan(tablet: Tablet, band, axis: np.ndarray | None = None, radius: float = 
     """
     t = tablet.trim
     segs = getattr(getattr(tablet.nominal, "outline", None), "segs", None)
-    if segs is not None and t.u == (0.0, 1.0) and t.full_v and t.w[0] == 0.0:
+    if segs and t.u == (0.0, 1.0) and t.full_v and t.w[0] == 0.0:  # (an outline through points has no segs)
         return _seg_points(tablet.nominal.outline), ()
     nv = 1441
     v = np.linspace(t.v[0], t.v[1], nv)
