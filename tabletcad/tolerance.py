@@ -83,6 +83,11 @@ class Tolerances:
     brep_agreement : float
         Largest relative difference allowed between a B-rep solid's volume or area
         (OCC mass properties) and the core's quadrature of the same tablet.
+    revolution : float
+        Largest Fourier coefficient (mm) that may break a patch's symmetry about the z
+        axis for the patch to be treated as an exact surface of revolution (its
+        extents, plan area and CAD faces then come from its profile; see
+        :mod:`tabletcad.geometry.revolution`).  Round-off of exact circles is ~1e-15 mm.
     mesh_volume : float
         Relative difference between a hexahedral mesh's volume and the solid's exact
         volume above which ``tabletcad mesh`` warns (straight-edged cells cut the
@@ -110,6 +115,7 @@ class Tolerances:
     mesh_angle: float = 0.2
     brep_agreement: float = 1e-6
     mesh_volume: float = 1e-2
+    revolution: float = 1e-11
 
 
 DEFAULT = Tolerances()

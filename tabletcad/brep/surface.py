@@ -221,16 +221,23 @@ def segment_v(data: BSplineSurfaceData, a: float, b: float) -> BSplineSurfaceDat
     return replace(data, poles=poles, v_knots=new_knots, v_mults=new_mults, v_periodic=False)
 
 
-def enclosed_volume(surfaces: Sequence[BSplineSurfaceData]) -> float:
+def enclosed_volume(surfaces: Sequence) -> float:
     """Signed volume enclosed by a closed chain of B-spline patches (divergence theorem).
 
     ``V = 1/3 sum_k  integral S . (S_u x S_v) du dv``; the integrand is a
     polynomial on every knot span, so Gauss-Legendre with ``ceil(3p/2)`` points
     per span and direction is exact up to round-off.  The sign follows the
-    parametrisation (positive when ``S_u x S_v`` points outward).
+    parametrisation (positive when ``S_u x S_v`` points outward).  Faces of revolution
+    (:class:`~tabletcad.brep.revolved.RevolvedSurfaceData`) contribute
+    :func:`~tabletcad.brep.revolved.revolved_volume`.
     """
+    from tabletcad.brep.revolved import RevolvedSurfaceData, revolved_volume
+
     total = 0.0
     for s in surfaces:
+        if isinstance(s, RevolvedSurfaceData):
+            total += revolved_volume([s])
+            continue
         rules = []
         for knots, deg in ((s.u_knots, s.u_degree), (s.v_knots, s.v_degree)):
             n = int(math.ceil(3 * deg / 2)) + 1

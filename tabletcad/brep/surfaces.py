@@ -18,8 +18,8 @@ import numpy as np
 from tabletcad.errors import GeometryError
 from tabletcad.geometry.tablet import Tablet, solid_map
 
-__all__ = ["SurfaceFunction", "tablet_surface_functions", "cutaway_surface_functions", "tablet_breakpoints",
-           "fit_options"]
+__all__ = ["SurfaceFunction", "tablet_surface_functions", "tablet_profiles", "cutaway_surface_functions",
+           "tablet_breakpoints", "fit_options"]
 
 SurfaceFunction = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
@@ -122,3 +122,26 @@ def fit_options(tablet: Tablet, **kwargs: Any) -> dict[str, Any]:
     kwargs.setdefault("v_break_mult", kwargs["v_degree"])
     kwargs.setdefault("v_breaks", tablet_breakpoints(tablet))
     return kwargs
+
+
+def tablet_profiles(tablet: Tablet) -> tuple[list, list[str]] | None:
+    """The profiles ``f(s) -> (R, Z)`` (mm) of the faces of a tablet of revolution, or None.
+
+    Each face of :func:`tablet_surface_functions` (the patches, or the walls and end faces
+    of a hollow tablet) is then a surface of revolution about the z axis
+    (:attr:`Tablet.revolution <tabletcad.geometry.tablet.Tablet.revolution>`); its profile is
+    its meridian at plan angle 0, where ``y = 0`` and ``x = R``.  None for a tablet that is
+    not of revolution; raises like :func:`tablet_surface_functions` for trimmed ones.
+    """
+    revs = tablet.revolution
+    if revs is None:
+        return None
+    funcs, names = tablet_surface_functions(tablet)
+    v0 = [r.v_of_angle(0.0) for r in revs]
+    if len(funcs) != len(revs):  # the walls and ends of a hollow one-patch tablet
+        v0 = v0[:1] * len(funcs)
+
+    def meridian(f, v):
+        return lambda s: np.asarray(f(np.asarray(s, dtype=float), np.full(np.shape(s), v)))[..., [0, 2]]
+
+    return [meridian(f, v) for f, v in zip(funcs, v0)], names

@@ -9,13 +9,15 @@ from OCP.TopoDS import TopoDS, TopoDS_Shape
 try:  # OCP >= 8.0
     from OCP.collections import Array1_double as Array1OfReal
     from OCP.collections import Array1_int as Array1OfInteger
+    from OCP.collections import Array1_gp_Pnt as Array1OfPnt
     from OCP.collections import Array2_gp_Pnt as Array2OfPnt
 except ImportError:  # pragma: no cover - OCP 7.x
+    from OCP.TColgp import TColgp_Array1OfPnt as Array1OfPnt
     from OCP.TColgp import TColgp_Array2OfPnt as Array2OfPnt
     from OCP.TColStd import TColStd_Array1OfInteger as Array1OfInteger
     from OCP.TColStd import TColStd_Array1OfReal as Array1OfReal
 
-__all__ = ["Array1OfReal", "Array1OfInteger", "Array2OfPnt", "cast", "shape_type"]
+__all__ = ["Array1OfPnt", "Array1OfReal", "Array1OfInteger", "Array2OfPnt", "cast", "shape_type"]
 
 _NAMES = {
     TopAbs_ShapeEnum.TopAbs_VERTEX: "Vertex",

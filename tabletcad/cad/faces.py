@@ -44,9 +44,9 @@ import numpy as np
 from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
 from OCP.BRepCheck import BRepCheck_Analyzer
-from OCP.Geom import Geom_BSplineSurface
+from OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface, Geom_SurfaceOfRevolution
 from OCP.Geom2d import Geom2d_BSplineCurve
-from OCP.gp import gp_Pnt, gp_Pnt2d
+from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt, gp_Pnt2d
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 
 try:  # OCP >= 8.0
@@ -54,11 +54,12 @@ try:  # OCP >= 8.0
 except ImportError:  # pragma: no cover - OCP 7.x
     from OCP.TColgp import TColgp_Array1OfPnt2d as Array1OfPnt2d
 
+from tabletcad.brep.revolved import RevolvedSurfaceData
 from tabletcad.brep.surface import BSplineSurfaceData
-from tabletcad.cad._occ import Array1OfInteger, Array1OfReal, Array2OfPnt
+from tabletcad.cad._occ import Array1OfInteger, Array1OfPnt, Array1OfReal, Array2OfPnt
 from tabletcad.errors import GeometryError
 
-__all__ = ["knot_boundary_pcurves", "make_face", "make_geom_surface", "surface_data_from_geom"]
+__all__ = ["knot_boundary_pcurves", "make_face", "make_geom_surface", "make_revolved_face", "surface_data_from_geom"]
 
 
 def _real_array(values) -> Array1OfReal:
@@ -114,6 +115,28 @@ def make_face(data: BSplineSurfaceData, *, tol_degen: float = 1e-7, name: str = 
         raise GeometryError(f"BRepBuilderAPI_MakeFace failed for {name} (error {maker.Error()})", data)
     face = maker.Face()
     knot_boundary_pcurves(face)
+    if not BRepCheck_Analyzer(face).IsValid():
+        raise GeometryError(f"face of {name} is not valid (BRepCheck_Analyzer)", data)
+    return face
+
+
+def make_revolved_face(data: RevolvedSurfaceData, *, tol_degen: float = 1e-7, name: str = "surface") -> TopoDS_Face:
+    """The full turn about the z axis of the profile ``data`` (a ``Geom_BSplineCurve`` in the
+    plane ``y = 0``, ``x = R``) as a ``Geom_SurfaceOfRevolution`` face; checked with
+    ``BRepCheck_Analyzer``.  A profile end on the axis becomes a degenerated edge (a pole)."""
+    n = data.poles.shape[0]
+    poles = Array1OfPnt(1, n)
+    for i, (r, z) in enumerate(data.poles, start=1):
+        poles.SetValue(i, gp_Pnt(float(r), 0.0, float(z)))
+    try:
+        curve = Geom_BSplineCurve(poles, _real_array(data.knots), _int_array(data.mults), data.degree, False)
+    except Exception as exc:  # Standard_ConstructionError
+        raise GeometryError(f"OCCT rejected the profile of {name}: {exc}", data) from exc
+    surf = Geom_SurfaceOfRevolution(curve, gp_Ax1(gp_Pnt(0.0, 0.0, 0.0), gp_Dir(0.0, 0.0, 1.0)))
+    maker = BRepBuilderAPI_MakeFace(surf, float(tol_degen))
+    if not maker.IsDone():
+        raise GeometryError(f"BRepBuilderAPI_MakeFace failed for {name} (error {maker.Error()})", data)
+    face = maker.Face()
     if not BRepCheck_Analyzer(face).IsValid():
         raise GeometryError(f"face of {name} is not valid (BRepCheck_Analyzer)", data)
     return face

@@ -27,7 +27,7 @@ from tabletcad.cad._occ import explore
 from tabletcad.errors import GeometryError
 from tabletcad.tolerance import DEFAULT
 
-__all__ = ["MeshResult", "tessellate", "triangulate", "MESH_ALGOS"]
+__all__ = ["MeshResult", "mesh_result", "tessellate", "tessellate_solid", "triangulate", "MESH_ALGOS"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -212,6 +212,26 @@ def tessellate(
 ) -> MeshResult:
     """Triangulate ``shape`` (deflections in mm and rad) and run the manifold3d / trimesh checks."""
     V, T = triangulate(shape, linear_deflection, angular_deflection, relative=relative, weld_tol=weld_tol, algo=algo)
+    return mesh_result(V, T, linear_deflection, angular_deflection, check=check)
+
+
+def tessellate_solid(solid, linear_deflection: float = DEFAULT.mesh_deflection,
+                     angular_deflection: float = DEFAULT.mesh_angle, *, check: bool = True) -> MeshResult:
+    """:func:`tessellate` a :class:`~tabletcad.cad.solid.TabletSolid`; a solid whose faces are all
+    surfaces of revolution is meshed from their profiles instead
+    (:func:`tabletcad.brep.revolved.revolved_mesh`: rings of exact circle points, its
+    deflection measured against the faces), with the same checks."""
+    from tabletcad.brep.revolved import RevolvedSurfaceData, revolved_mesh
+
+    if solid.surfaces and all(isinstance(sd, RevolvedSurfaceData) for sd in solid.surfaces):
+        V, T, _ = revolved_mesh(solid.surfaces, linear_deflection, angular_deflection)
+        return mesh_result(V, T, linear_deflection, angular_deflection, check=check)
+    return tessellate(solid.shape, linear_deflection, angular_deflection, check=check)
+
+
+def mesh_result(V: np.ndarray, T: np.ndarray, linear_deflection: float, angular_deflection: float, *,
+                check: bool = True) -> MeshResult:
+    """A :class:`MeshResult` of the welded mesh ``(V, T)``, with the manifold3d / trimesh checks."""
     vol, area = _signed_volume_area(V, T)
     status, genus, mvol = ("unchecked", None, None)
     watertight = winding = None

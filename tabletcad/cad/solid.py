@@ -11,8 +11,8 @@ free edge) that failed.
    of its length (:func:`tabletcad.brep.slit.chain_face_surfaces`);
 3. ``BRepBuilderAPI_Sewing`` with tolerance ``max(2 tol, 1e-6)`` mm - no free
    or multiple edges allowed, exactly one closed shell;
-4. ``BRepBuilderAPI_MakeSolid`` + ``BRepLib::OrientClosedSolid`` (matter
-   inside, positive volume) + ``BRepCheck_Analyzer``;
+4. ``BRepBuilderAPI_MakeSolid``, reversed if its volume is negative (matter
+   inside) + ``BRepCheck_Analyzer``;
 5. volume/area/centroid by *adaptive* Gauss integration
    (``BRepGProp::VolumeProperties(shape, props, eps)``, ``eps`` = 1e-9): the
    default integration was measured up to ~1e-3 relative off on dense B-spline faces;
@@ -34,7 +34,6 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepGProp import BRepGProp
-from OCP.BRepLib import BRepLib
 from OCP.GProp import GProp_GProps
 from OCP.TopoDS import TopoDS_Shape, TopoDS_Solid
 
@@ -52,6 +51,7 @@ __all__ = [
     "build_solid",
     "solid_from_surfaces",
     "solid_from_tablet",
+    "revolved_solid",
     "sew_faces",
     "check_solid",
     "chain_breakpoints",
@@ -216,8 +216,15 @@ def _make_solid(shell, name: str) -> TopoDS_Solid:
     if not maker.IsDone():
         raise GeometryError(f"BRepBuilderAPI_MakeSolid failed for {name}", shell)
     solid = cast(maker.Solid(), "Solid")
-    if not BRepLib.OrientClosedSolid_s(solid):
-        raise GeometryError(f"{name}: the sewn shell cannot be oriented (open or incoherent)", solid)
+    # orient the matter inside: the sewn shell's faces are coherent, so the sign of its volume
+    # says which side is inside (BRepLib::OrientClosedSolid classifies a point instead, which
+    # took 46 ms of a 60 ms solid of revolution)
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(solid, props)
+    if not math.isfinite(props.Mass()) or props.Mass() == 0.0:
+        raise GeometryError(f"{name}: the sewn shell cannot be oriented (volume {props.Mass():.3g} mm^3)", solid)
+    if props.Mass() < 0.0:
+        solid = cast(solid.Reversed(), "Solid")
     check_solid(solid, name)
     return solid
 
@@ -245,7 +252,12 @@ def solid_from_surfaces(
     for pieces, n in zip(chain_face_surfaces(surfaces, tol_degen, names), names):
         faces_l.extend(make_face(p, tol_degen=tol_degen, name=n) for p in pieces)
         face_names.extend([n] if len(pieces) == 1 else [f"{n} (piece {k + 1})" for k in range(len(pieces))])
-    faces = tuple(faces_l)
+    return _solid_from_faces(tuple(faces_l), face_names, surfaces, names, fits, sew_tolerance, eps, name, t0)
+
+
+def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequence, names: Sequence[str],
+                      fits: Sequence, sew_tolerance: float, eps: float, name: str, t0: float) -> TabletSolid:
+    """Sew ``faces`` into one closed shell, make the outward solid, check it, integrate it."""
     t1 = time.perf_counter()
     shell = sew_faces(faces, face_names, sew_tolerance)
     # sewing may rebuild p-curves: make sure the boundary p-curves still carry the C0/C1
@@ -305,6 +317,52 @@ def build_solid(
     result = solid_from_surfaces(
         [f.surface for f in fits], name=name, names=names, sew_tolerance=sew_tol, eps=eps, fits=fits
     )
+    timings = {"fit": t1 - t0, **result.timings}
+    timings["total"] = time.perf_counter() - t0
+    object.__setattr__(result, "timings", timings)
+    return result
+
+
+def revolved_solid(
+    profiles: Sequence[Callable[[np.ndarray], np.ndarray]],
+    tol: float = 1e-4,
+    *,
+    name: str = "tablet",
+    names: Sequence[str] | None = None,
+    sew_tolerance: float | None = None,
+    eps: float | None = None,
+    degree: int = 5,
+) -> TabletSolid:
+    """The solid bounded by a chain of faces of revolution about the z axis.
+
+    Each profile ``f(u) -> (R, Z)`` (mm, ``u`` in [0, 1]; profile ``j`` ends where ``j+1``
+    starts) is fitted within ``tol`` by a clamped B-spline of ``degree``
+    (:func:`tabletcad.brep.revolved.fit_profile`, chained so that neighbours share their end
+    points bit for bit) and revolved exactly (:func:`tabletcad.cad.faces.make_revolved_face`);
+    then sewing, validation and mass properties as in :func:`solid_from_surfaces`.
+    ``sew_tolerance`` defaults to ``max(2 tol, 1e-6)`` mm.
+
+    ``eps`` defaults to OCCT's non-adaptive integration (``None``), which splits at the
+    profile's knots: on these faces it reproduces the exact volume of the revolved
+    B-splines (:func:`tabletcad.brep.revolved.revolved_volume`) to ~1e-11 relative, while
+    the adaptive one with ``eps = 1e-9`` was measured 3.4e-7 low with an error estimate
+    of 2e-15 (concave round sample).
+    """
+    from tabletcad.brep.revolved import fit_profile
+    from tabletcad.cad.faces import make_revolved_face
+
+    t0 = time.perf_counter()
+    names = list(names) if names is not None else [f"patch {j}" for j in range(len(profiles))]
+    fits, start = [], None
+    for f, n in zip(profiles, names):
+        fit = fit_profile(f, tol, degree=degree, start=start, name=n)
+        fits.append(fit)
+        start = fit.surface.poles[-1]
+    t1 = time.perf_counter()
+    surfaces = [f.surface for f in fits]
+    faces = tuple(make_revolved_face(sd, name=n) for sd, n in zip(surfaces, names))
+    sew_tol = float(sew_tolerance) if sew_tolerance is not None else max(2.0 * tol, 1e-6)
+    result = _solid_from_faces(faces, names, surfaces, names, fits, sew_tol, eps, name, t1)
     timings = {"fit": t1 - t0, **result.timings}
     timings["total"] = time.perf_counter() - t0
     object.__setattr__(result, "timings", timings)

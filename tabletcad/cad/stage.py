@@ -32,13 +32,16 @@ MESH_ANGULAR_RAD = DEFAULT.mesh_angle
 AGREEMENT_REL = DEFAULT.brep_agreement
 
 
-def check_tablet_solid(tablet: Tablet, report: dict[str, Any] | None = None):
-    """Build the solid and its mesh and cross-check them; return ``(solid, mesh, sections)``."""
-    from tabletcad.cad.mesh import tessellate
+def check_tablet_solid(tablet: Tablet, report: dict[str, Any] | None = None, *, revolved: bool | None = None):
+    """Build the solid and its mesh and cross-check them; return ``(solid, mesh, sections)``.
+
+    ``revolved``: faces of revolution for a tablet of revolution (None: whenever it is one; see
+    :func:`~tabletcad.cad.tablet_solid.tablet_solid`)."""
+    from tabletcad.cad.mesh import tessellate_solid
     from tabletcad.cad.tablet_solid import tablet_solid
 
     t0 = time.perf_counter()
-    solid = tablet_solid(tablet)
+    solid = tablet_solid(tablet, revolved=revolved)
     t1 = time.perf_counter()
     v_q = report["volume_mm3"] if report else tablet.volume()
     a_q = report["surface_area_mm2"] if report else tablet.surface_area()
@@ -51,7 +54,7 @@ def check_tablet_solid(tablet: Tablet, report: dict[str, Any] | None = None):
             f"(allowed {AGREEMENT_REL:g}; largest fit deviation {dev:.2e} mm)",
             solid,
         )
-    mesh = tessellate(solid.shape, MESH_LINEAR_MM, MESH_ANGULAR_RAD)
+    mesh = tessellate_solid(solid, MESH_LINEAR_MM, MESH_ANGULAR_RAD)
     t2 = time.perf_counter()
     genus_expected = 1 if tablet.trim.w[0] > 0 else 0
     sections = dict(
@@ -216,8 +219,10 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
     return shape, mesh, sections
 
 
-def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any]):
+def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any], revolved: bool | None = None):
     """Write ``tablet.step``, ``tablet.stl`` and ``tablet.glb`` into ``out`` and extend ``report``.
+
+    ``revolved=False`` gives a tablet of revolution B-spline faces (the tooling needs them).
 
     Returns the ``TopoDS_Shape`` written (the solid, or its cut-away), or None when no solid
     is built (a cut-away of a kind the CAD layer does not make: the report says why).
@@ -232,7 +237,7 @@ def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any]):
             return None
         shape, mesh, sections = cut
     else:
-        solid, mesh, sections = check_tablet_solid(tablet, report)
+        solid, mesh, sections = check_tablet_solid(tablet, report, revolved=revolved)
         shape = solid.shape
     t0 = time.perf_counter()
     export(shape, out / "tablet.step", name=tablet.name)

@@ -114,6 +114,12 @@ class PlanOutline:
         return self.breaks[:-1]
 
     @property
+    def is_circle(self) -> bool:
+        """True when the outline is one full circle (then, parametrised by arc length, its
+        points and offsets are Fourier mode 1 only)."""
+        return len(self.segs) == 1 and self.segs[0].kind == "arc" and abs(abs(self.segs[0].sweep) - math.tau) <= 1e-12
+
+    @property
     def min_convex_radius(self) -> float:
         """Smallest radius of a convex arc (inf without arcs), mm."""
         r = [s.radius for s in self.segs if s.kind == "arc" and s.sweep > 0]

@@ -134,6 +134,10 @@ class SweepCurve(Curve):
     def is_point(self) -> bool:
         return self.alpha == 0.0 and self.beta == 0.0
 
+    def band_limit(self) -> int | None:
+        """1 on a circular outline (an offset circle, or a constant), else None."""
+        return 1 if getattr(self.outline, "is_circle", False) else None
+
     def breakpoints(self) -> np.ndarray:
         """``v`` of the outline's segment joins (where the offset is only piecewise smooth)."""
         if self.is_point:
@@ -202,6 +206,14 @@ class SweepNominal:
         # face heights as functions of d (the faces are graphs over d)
         self._dz_top = _graph(self.top, d_far)
         self._dz_bot = _graph(self.bottom[::-1], d_far, reverse=True)
+
+    @property
+    def axisymmetric(self) -> bool:
+        """True when the nominal is a solid of revolution about the z axis: its outline is one
+        full circle about the origin (then its distance to a point depends only on the
+        point's radius and height)."""
+        o = self.outline
+        return bool(getattr(o, "is_circle", False)) and max(map(abs, o.segs[0].center)) <= 1e-12 * o.segs[0].radius
 
     def planar(self, points: np.ndarray) -> np.ndarray:
         """``(δ, z)`` of 3-D points: signed inward plan distance to the outline and height."""
@@ -446,6 +458,12 @@ def _v_samples(outline, nv: int) -> np.ndarray:
     return np.unique(np.concatenate([v, b, np.mod(b - eps, math.tau), b + eps]))
 
 
+def _axisymmetric_nv(tablet: Tablet, nv: int) -> int:
+    """``v`` samples for a distance to the nominal: 4 when the surface and the nominal are both
+    of revolution about the z axis (the distance is then the same on every meridian), else ``nv``."""
+    return 4 if tablet.revolution is not None and getattr(tablet.nominal, "axisymmetric", False) else nv
+
+
 def certify(tablet: Tablet, nu: int = 33, nv: int = 512) -> Certificate:
     """Measure the largest distance from the PDE surface to the exact nominal.
 
@@ -459,7 +477,7 @@ def certify(tablet: Tablet, nu: int = 33, nv: int = 512) -> Certificate:
     if not isinstance(nom, SweepNominal):
         raise DesignError("tablet", tablet.name, "has no swept nominal to certify against")
     u = np.linspace(0.0, 1.0, nu)
-    v = _v_samples(nom.outline, nv)
+    v = _v_samples(nom.outline, _axisymmetric_nv(tablet, nv))
     per = []
     for p in tablet.patches:
         X = p.evaluate_grid(u, v).reshape(-1, 3)

@@ -668,11 +668,13 @@ def _modes_needed(curve: CurveLike, tol: float, max_modes: int, m: int) -> int:
     if start is None:
         return max_modes + 1
     approx = a0 + cos[:, :start] @ a[:start] + sin[:, :start] @ b[:start]
-    for k0 in range(start, max_modes, 16):
-        k1 = min(k0 + 16, max_modes)
+    k0 = start
+    while k0 < max_modes:  # the subset's answer usually holds: try it alone, then blocks of 16
+        k1 = min(k0 + (1 if k0 == start else 16), max_modes)
         err = _truncation_errors(pts, approx, a, b, cos, sin, k0, k1)
         hit = np.flatnonzero(err <= tol)
         if hit.size:
             return k0 + int(hit[0]) + 1
         approx = approx + cos[:, k0:k1] @ a[k0:k1] + sin[:, k0:k1] @ b[k0:k1]
+        k0 = k1
     return max_modes + 1

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tabletcad.geometry.basis import cardinal, cardinal_coefficients, cardinals
+from tabletcad.geometry.revolution import Revolution, detect_revolution
 from tabletcad.geometry.curves import CurveLike, fourier_coefficients, modes_needed, sample_v
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
@@ -181,6 +182,9 @@ class PDEPatch:
             amp[1:] = np.maximum(np.max(np.abs(ac), axis=(0, 2)), np.max(np.abs(bc), axis=(0, 2)))
         zero = 1e-15 * scale
         object.__setattr__(self, "_active", [n for n in range(1, N + 1) if amp[n] > zero])
+        lam1 = float(self._lams[1]) if N else 0.0
+        object.__setattr__(self, "_revolution", detect_revolution(
+            a0, ac, bc, self._active, self._has_remainder, lam1, self.u_nodes, self.form, self.tol.revolution))
         if self.check:
             self._check_amplification(amp, zero)
 
@@ -231,6 +235,12 @@ class PDEPatch:
     def beta_value(self) -> float:
         """Decay rate ``β`` of the remainder term actually used."""
         return self._beta
+
+    @property
+    def revolution(self) -> Revolution | None:
+        """The patch's profile when it is a surface of revolution about the z axis, else None
+        (see :mod:`tabletcad.geometry.revolution`)."""
+        return self._revolution
 
     @property
     def has_remainder(self) -> bool:
@@ -451,7 +461,10 @@ class PDEPatch:
     def _stray(self, nu: int, nv: int | None) -> float:
         # every datum's design content counts (in the Hermite form the derivative
         # curves X_u(0), X_u(1) carry design modes of their own)
-        n_design = max(modes_needed(self.data[k], self.tol.stray / 4, self.modes) for k in range(4))
+        if self._revolution is not None:  # one mode: a datum needs it unless it is a point within tol
+            n_design = int(float(np.max(np.abs(self._revolution.radius))) > self.tol.stray / 4)
+        else:
+            n_design = max(modes_needed(self.data[k], self.tol.stray / 4, self.modes) for k in range(4))
         if n_design >= self.modes and not self._has_remainder:
             return 0.0
         n_design = min(n_design, self.modes)
@@ -486,9 +499,12 @@ class PDEPatch:
     def _check_nv(self) -> int:
         """``v`` samples for the fold checks: 128, or fewer for a surface that is a trigonometric
         polynomial of low degree ``N`` in ``v`` (no remainder term): 16 (N + 1), at least 32, so
-        that the checks' products of three such factors (degree 3N) get five samples per period."""
+        that the checks' products of three such factors (degree 3N) get five samples per period;
+        4 for a surface of revolution (:attr:`revolution`), whose checks do not depend on ``v``."""
         if self._has_remainder or not self._active:
             return 128 if self._has_remainder else 32
+        if self._revolution is not None:
+            return 4  # a surface of revolution: every meridian is the same, so are the checks
         return int(min(128, max(32, 16 * (max(self._active) + 1))))
 
     def fold_depth(self, nu: int = 257, nv: int | None = None) -> float:
@@ -500,9 +516,11 @@ class PDEPatch:
         ``u``-intervals; 0 when the map does not fold.  The thesis's domes fold
         slightly at their poles: the spine, a cubic through the curves' centres,
         runs backwards for ``u`` below ~0.015 (0.8 µm for the 5 mm sphere).
-        ``nv`` defaults to the fold checks' sampling in ``v`` (``_check_nv``).
+        ``nv`` defaults to the fold checks' sampling in ``v`` (``_check_nv``); a surface of
+        revolution is always measured on that sampling's few meridians.
         """
-        nv = self._check_nv() if nv is None else nv
+        if nv is None or self._revolution is not None:  # a surface of revolution folds alike on every meridian
+            nv = self._check_nv()
         key = ("fold", nu, nv)
         if key not in self.__dict__.get("_checks", {}):
             self.__dict__.setdefault("_checks", {})[key] = self._fold_depth_of(nu, nv)

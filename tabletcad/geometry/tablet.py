@@ -19,6 +19,11 @@ import numpy as np
 
 from tabletcad.errors import DesignError, check_range
 from tabletcad.geometry.patch import PDEPatch
+from tabletcad.geometry.revolution import profile_extreme
+
+#: Trapezoidal points in ``v`` for the integrals of a surface of revolution, whose integrands
+#: (``X·n``, ``|n|``, the solid map's Jacobian) are the same on every meridian.
+_REVOLUTION_NV = 4
 from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = ["Band", "Trim", "Tablet", "Face", "solid_map"]
@@ -284,6 +289,8 @@ class Tablet:
     # ------------------------------------------------------------------ quadrature
     def _rules(self, face: Face, nu: int | None = None, nv: int | None = None):
         nu = nu or self.tol.quad_u
+        if nv is None and face.periodic_t and self.patches[face.patch].revolution is not None:
+            nv = _REVOLUTION_NV  # the integrands do not depend on v: any trapezoidal rule is exact
         nv = nv or self.tol.quad_v
         xs, ws = np.polynomial.legendre.leggauss(nu)
         s0, s1 = face.s_range
@@ -327,7 +334,8 @@ class Tablet:
         """Area and volume by quadrature (eqs 4.8, 4.9), per face and in total.
 
         Gauss-Legendre in ``u`` (and ``w``) and the trapezoidal rule in periodic
-        ``v`` (spectrally accurate for these smooth periodic integrands).
+        ``v`` (spectrally accurate for these smooth periodic integrands; four points on a
+        patch of revolution, whose integrands do not depend on ``v``).
 
         Returns
         -------
@@ -402,8 +410,16 @@ class Tablet:
         of these points (polar angle, radius) is integrated as ``½∮ r² dφ``.
         Exact in the limit for the round, oval, capsule and shaped outlines
         tabletcad builds (~1e-12 relative from the polish, ~1e-9 from the
-        ``v`` sampling of the default).
+        ``v`` sampling of the default).  A tablet of revolution (:attr:`revolution`,
+        untrimmed in ``v`` and ``w``) is the disc of its largest profile radius,
+        ``π R_max²``, with ``R_max`` polished to ~1e-12 in ``u``.
         """
+        if self.revolution is not None and self.trim.full_v and self.trim.w[0] == 0.0:
+            return math.pi * self._largest_radius() ** 2
+        return self._plan_area_sampled(nu, nv)
+
+    def _plan_area_sampled(self, nu: int = 129, nv: int = 2048) -> float:
+        """:meth:`plan_area` from samples of every patch (any star-shaped plan)."""
         u, v = self._grid(nu, nv)
         pts = self.sample(nu, nv)  # (patches, nu, nv, 3)
         c = 0.5 * (pts[..., :2].min(axis=(0, 1, 2)) + pts[..., :2].max(axis=(0, 1, 2)))
@@ -479,6 +495,8 @@ class Tablet:
         quadratic in ``w``)."""
         t = self.trim
         nu = nu or self.tol.quad_u
+        if nv is None and t.full_v and self.revolution is not None:
+            nv = _REVOLUTION_NV  # the Jacobian does not depend on v: any trapezoidal rule is exact
         nv = nv or self.tol.quad_v
         xu, wu = np.polynomial.legendre.leggauss(nu)
         xw, ww = np.polynomial.legendre.leggauss(nw)
@@ -532,6 +550,8 @@ class Tablet:
         polished by zooming: a 17 × 17 grid around the best point, each round four
         times finer, until the grid step is below ~1e-10 in ``u`` and ``v``
         (the extreme's error falls with the square of the step, to ~1e-18 mm).
+        A tablet of revolution untrimmed in ``v`` takes its extents from its profile
+        (:attr:`revolution`), polished the same way in ``u`` alone.
         Cached: a tablet is immutable.
         """
         hit = self.__dict__.get("_bounds")
@@ -540,7 +560,35 @@ class Tablet:
             object.__setattr__(self, "_bounds", hit)
         return hit[0].copy(), hit[1].copy()
 
+    @property
+    def revolution(self) -> tuple | None:
+        """Every patch's :class:`~tabletcad.geometry.revolution.Revolution` when all of them are
+        surfaces of revolution about the z axis, else None."""
+        revs = tuple(p.revolution for p in self.patches)
+        return None if any(r is None for r in revs) else revs
+
+    def _profile_extreme(self, value: Callable[[Any, np.ndarray], np.ndarray]) -> float:
+        """Largest ``value(revolution, u)`` over every patch's profile and the trimmed ``u`` range."""
+        lo, hi = self.trim.u
+        return max(profile_extreme(lambda u, r=r: value(r, u), lo, hi)[1] for r in self.revolution)
+
+    def _largest_radius(self) -> float:
+        """Largest distance (mm) of a tablet of revolution's surface from the z axis (cached)."""
+        hit = self.__dict__.get("_rmax")
+        if hit is None:
+            hit = self._profile_extreme(lambda r, u: np.abs(r.profile(u)[:, 0]))
+            object.__setattr__(self, "_rmax", hit)
+        return hit
+
     def _bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        if self.revolution is not None and self.trim.full_v:
+            rmax = self._largest_radius()
+            ztop = self._profile_extreme(lambda r, u: r.profile(u)[:, 1])
+            zbot = -self._profile_extreme(lambda r, u: -r.profile(u)[:, 1])
+            return np.array([-rmax, -rmax, zbot]), np.array([rmax, rmax, ztop])
+        return self._bounds_sampled()
+
+    def _bounds_sampled(self) -> tuple[np.ndarray, np.ndarray]:
         pts = self.sample(97, 256)
         lo = pts.reshape(-1, 3).min(axis=0)
         hi = pts.reshape(-1, 3).max(axis=0)
@@ -618,9 +666,16 @@ class Tablet:
         return out
 
     def nominal_deviation(self, nu: int = 129, nv: int = 256) -> float | None:
-        """Largest distance (mm) of the surface from the nominal shape, or None."""
+        """Largest distance (mm) of the surface from the nominal shape, or None.
+
+        Sampled on ``nu × nv`` points of every patch; a surface of revolution measured against
+        a nominal of revolution (``nominal.axisymmetric``) on ``nu × 4``, since every meridian
+        gives the same distances.
+        """
         if self.nominal is None:
             return None
+        if self.revolution is not None and self.trim.full_v and getattr(self.nominal, "axisymmetric", False):
+            nv = 4  # surface and nominal of revolution: the distance is the same on every meridian
         pts = self.sample(nu, nv).reshape(-1, 3)
         return float(np.max(np.abs(self.nominal(pts))))
 

@@ -78,7 +78,10 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
             if cad:
                 from tabletcad.cad.stage import cad_stage
 
-                shape = cad_stage(tablet=tablet, out=staging, report=report)
+                # a tooling build cuts scores and letters into the solid: B-spline faces for it
+                # (see tabletcad.tooling.outline.tablet_frame)
+                shape = cad_stage(tablet=tablet, out=staging, report=report,
+                                  revolved=False if tooling is not None else None)
                 bar.update()
                 if tooling is not None:
                     from tabletcad.tooling.stage import tooling_stage

@@ -206,8 +206,16 @@ def _section_wire(shape, z: float) -> Any:
     return translated(cast(wires.Value(1), "Wire"), dz=-z)
 
 
+def _has_faces_of_revolution(shape: TopoDS_Shape) -> bool:
+    from OCP.BRep import BRep_Tool
+    from OCP.Geom import Geom_SurfaceOfRevolution
+
+    return any(isinstance(BRep_Tool.Surface_s(cast(f, "Face")), Geom_SurfaceOfRevolution) for f in explore(shape, "Face"))
+
+
 def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFrame:
-    """Band, outline and heights of ``tablet`` (its solid is built unless ``shape`` is given).
+    """Band, outline and heights of ``tablet`` (its solid is built unless ``shape`` is given; a
+    solid with faces of revolution is rebuilt with B-spline faces).
 
     Raises :class:`DesignError` for tablets a pair of punches in a die cannot
     make: no band (spheres, spheroids), hollow (ring) or cut-away tablets.
@@ -226,10 +234,13 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
     if band_z is None or not band_z[1] - band_z[0] > 1e-6:
         raise DesignError("[tooling]", tablet.family,
                           "tooling needs a tablet with a band (a cylindrical side wall the die forms); this one has none")
-    if shape is None:
+    if shape is None or _has_faces_of_revolution(shape):
+        # the tooling cuts scores and letters into the tablet: it works on B-spline faces, since a
+        # Boolean-trimmed face of revolution written to STEP read back invalid (BRepCheck_Analyzer,
+        # OCCT 7.9: the concave round bisect sample's score)
         from tabletcad.cad.tablet_solid import tablet_solid
 
-        shape = tablet_solid(tablet).shape
+        shape = tablet_solid(tablet, revolved=False).shape
     lo, hi = tablet.bounds()
     info = dict(getattr(nom, "info", {}) or {})
     round_radius = None

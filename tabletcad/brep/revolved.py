@@ -1,0 +1,344 @@
+"""Surfaces of revolution about the z axis with a B-spline profile (numpy only).
+
+A PDE patch of revolution (:mod:`tabletcad.geometry.revolution`) is its profile
+``(R(u), Z(u))`` turned a full circle about the z axis.  Its CAD face is exactly
+that: a clamped cubic B-spline profile in the half-plane ``y = 0`` (``x = R``)
+revolved about z, which OCCT (``Geom_SurfaceOfRevolution``) and STEP
+(``SURFACE_OF_REVOLUTION``) represent exactly.  Only the profile is fitted, so
+the fit is one-dimensional and its deviation at equal parameters *is* the
+surface's deviation at equal ``(u, angle)``: the circles are exact.
+
+:func:`fit_profile` interpolates the profile at its own parameters and refines
+until the deviation measured on a denser grid is within the tolerance, like
+:func:`tabletcad.brep.fit.fit_surface` in ``u``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tabletcad.brep.knots import basis_derivatives, clamped_interp_knots, flat_knots
+from tabletcad.errors import GeometryError
+
+__all__ = ["RevolvedSurfaceData", "ProfileFit", "fit_profile", "revolved_volume"]
+
+ProfileFunction = Callable[[np.ndarray], np.ndarray]
+
+
+def _frozen(a, dtype=float) -> np.ndarray:
+    a = np.array(a, dtype=dtype, copy=True)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True, eq=False)
+class RevolvedSurfaceData:
+    """A clamped B-spline profile ``(R, Z)`` (mm) revolved a full turn about the z axis.
+
+    ``poles`` has shape ``(n, 2)``: ``(R, Z)`` of each pole in the half-plane
+    ``y = 0``; ``knots`` are the distinct knot values and ``mults`` their
+    multiplicities (``sum(mults) == n + degree + 1``), as for
+    :class:`~tabletcad.brep.surface.BSplineSurfaceData`.  The surface point at
+    ``(u, θ)`` is ``(R(u) cos θ, R(u) sin θ, Z(u))``.
+    """
+
+    poles: np.ndarray
+    knots: np.ndarray
+    mults: np.ndarray
+    degree: int = 3
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "poles", _frozen(self.poles))
+        object.__setattr__(self, "knots", _frozen(self.knots))
+        object.__setattr__(self, "mults", _frozen(self.mults, int))
+        object.__setattr__(self, "degree", int(self.degree))
+        if self.poles.ndim != 2 or self.poles.shape[1] != 2:
+            raise GeometryError(f"profile poles must have shape (n, 2), got {self.poles.shape}", self)
+        if not np.all(np.isfinite(self.poles)):
+            raise GeometryError("profile poles contain non-finite values", self)
+        if self.degree < 1 or self.knots.ndim != 1 or self.knots.shape != self.mults.shape or self.knots.size < 2:
+            raise GeometryError("profile knots/mults must be 1-D of equal length >= 2 and degree >= 1", self)
+        if np.any(np.diff(self.knots) <= 0):
+            raise GeometryError("profile knots must be strictly increasing", self)
+        if int(self.mults.sum()) - self.degree - 1 != self.poles.shape[0]:
+            raise GeometryError("profile knots/mults do not match the number of poles", self)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """``(n, 1)``: the profile's poles, revolved (one meridian; the circles are exact)."""
+        return self.poles.shape[0], 1
+
+    @property
+    def u_range(self) -> tuple[float, float]:
+        return float(self.knots[0]), float(self.knots[-1])
+
+    def _basis(self, u: np.ndarray, order: int):
+        t = flat_knots(self.knots, self.mults, self.degree, False)
+        span, N = basis_derivatives(t, self.degree, self.poles.shape[0], u, order)
+        return span[..., None] - self.degree + np.arange(self.degree + 1), N
+
+    def profile(self, u, du: int = 0) -> np.ndarray:
+        """``(R, Z)`` (or its first ``u``-derivative) at ``u``; shape ``u.shape + (2,)``."""
+        u = np.asarray(u, dtype=float)
+        idx, N = self._basis(u, du)
+        return np.einsum("...i,...ik->...k", N, self.poles[idx])
+
+    def evaluate_grid(self, u, theta) -> np.ndarray:
+        """Points on the grid ``u × θ`` (θ the plan angle, rad): shape ``(len(u), len(θ), 3)``."""
+        P = self.profile(np.asarray(u, dtype=float).reshape(-1))
+        th = np.asarray(theta, dtype=float).reshape(-1)
+        return np.stack([np.outer(P[:, 0], np.cos(th)), np.outer(P[:, 0], np.sin(th)),
+                         np.repeat(P[:, 1:2], th.size, axis=1)], axis=-1)
+
+    def as_dict(self) -> dict:
+        """Plain-Python representation (lists), e.g. for JSON or FreeCAD's Python."""
+        return {"poles": self.poles.tolist(), "knots": self.knots.tolist(), "mults": self.mults.tolist(),
+                "degree": self.degree}
+
+
+def revolved_volume(surfaces) -> float:
+    """Signed volume (mm³) enclosed by a closed chain of revolved profiles (divergence theorem).
+
+    For ``S(u, θ) = (R cos θ, R sin θ, Z)``, ``S · (S_u × S_θ) = Z R R' - R² Z'``, so each
+    face contributes ``(2π/3) ∫ (Z R R' - R² Z') du``: a polynomial of degree ``3p - 1`` on every
+    knot span, integrated exactly by Gauss-Legendre with ``ceil(3p/2)`` points per span.
+    The sign follows the parametrisation ``(u, θ)``.
+    """
+    total = 0.0
+    for s in surfaces:
+        x, w = np.polynomial.legendre.leggauss(int(math.ceil(3 * s.degree / 2)) + 1)
+        a, b = s.knots[:-1, None], s.knots[1:, None]
+        u = (((b - a) * x + (a + b)) / 2).ravel()
+        wu = (((b - a) / 2) * w).ravel()
+        (R, Z), (dR, dZ) = s.profile(u).T, s.profile(u, 1).T
+        total += (math.tau / 3.0) * float(np.sum(wu * (Z * R * dR - R * R * dZ)))
+    return total
+
+
+@dataclass(frozen=True)
+class ProfileFit:
+    """Result of :func:`fit_profile`: the revolved surface and its measured deviation (mm).
+
+    ``max_deviation`` is the largest ``|C(u) - P(u)|`` (same ``u``) on a grid
+    ``check_factor`` times denser than the interpolation points, midpoints included;
+    it is also the surface's deviation at equal ``(u, angle)``.
+    """
+
+    surface: RevolvedSurfaceData
+    max_deviation: float
+    tol: float
+    n: int
+    iterations: int
+    seconds: float
+    u_samples: np.ndarray = field(repr=False)
+
+    @property
+    def ok(self) -> bool:
+        return self.max_deviation <= self.tol
+
+    @property
+    def poles(self) -> tuple[int, int]:
+        return self.surface.shape
+
+
+def _interpolate(D: np.ndarray, u: np.ndarray, degree: int) -> RevolvedSurfaceData:
+    knots, mults = clamped_interp_knots(u, degree)
+    proto_t = flat_knots(knots, mults, degree, False)
+    span, N = basis_derivatives(proto_t, degree, u.size, u, 0)
+    B = np.zeros((u.size, u.size))
+    rows = np.repeat(np.arange(u.size), degree + 1)
+    np.add.at(B, (rows, (span[:, None] - degree + np.arange(degree + 1)).ravel()), N.ravel())
+    P = np.empty_like(D)
+    P[0], P[-1] = D[0], D[-1]  # a clamped interpolant passes through its end data exactly
+    if u.size > 2:
+        P[1:-1] = np.linalg.solve(B[1:-1, 1:-1], D[1:-1] - np.outer(B[1:-1, 0], D[0]) - np.outer(B[1:-1, -1], D[-1]))
+    return RevolvedSurfaceData(P, knots, mults, degree)
+
+
+def fit_profile(
+    f: ProfileFunction,
+    tol: float = 1e-4,
+    *,
+    n: int = 17,
+    degree: int = 3,
+    max_n: int = 2000,
+    max_iterations: int = 12,
+    check_factor: int = 8,
+    pole_tol: float = 1e-9,
+    start: np.ndarray | None = None,
+    name: str = "profile",
+) -> ProfileFit:
+    """Interpolate a profile ``f(u) -> (m, 2)`` (``(R, Z)``, mm, ``u`` in [0, 1]) within ``tol``.
+
+    The profile is sampled at ``n`` equally spaced ``u`` and interpolated by a clamped
+    B-spline of ``degree``; ``n`` grows with the ``h^(p+1)`` rate until the deviation on
+    the check grid is ``<= tol``.  An end whose radius is within ``pole_tol`` of the axis
+    is put exactly on it (the face's pole); ``start`` replaces the first sample (so that a
+    chain of profiles shares its end points bit for bit).  Raises :class:`GeometryError`
+    naming ``name`` when ``max_n``/``max_iterations`` do not reach ``tol``.
+    """
+    if tol <= 0 or not math.isfinite(tol):
+        raise ValueError(f"tol = {tol} is not allowed: must be > 0")
+    t0 = time.perf_counter()
+    n = max(int(n), degree + 1)
+    best = None
+    for it in range(1, max_iterations + 1):
+        u = np.linspace(0.0, 1.0, n)
+        D = np.array(f(u), dtype=float).reshape(n, 2)
+        if start is not None:
+            D[0] = start
+        for k in (0, -1):
+            if abs(D[k, 0]) <= pole_tol:
+                D[k, 0] = 0.0
+        if not np.all(np.isfinite(D)):
+            raise GeometryError(f"profile of {name} has non-finite values", f)
+        surf = _interpolate(D, u, degree)
+        uc = np.linspace(0.0, 1.0, check_factor * (n - 1) + 1)
+        dev = float(np.max(np.linalg.norm(surf.profile(uc) - np.asarray(f(uc), dtype=float), axis=-1)))
+        best = ProfileFit(surf, dev, float(tol), n, it, time.perf_counter() - t0, u)
+        if dev <= tol:
+            return best
+        ratio = dev / (0.4 * tol)
+        new_n = min(int(math.ceil((n - 1) * min(max(ratio ** (1.0 / (degree + 1)), 1.25), 3.0))) + 1, max_n)
+        if new_n == n:
+            break
+        n = new_n
+    assert best is not None
+    raise GeometryError(
+        f"B-spline fit of {name} misses tolerance: max deviation {best.max_deviation:.3g} mm > tol {tol:.3g} mm "
+        f"with {best.n} profile poles", best)
+
+
+def _profile_nodes(s: RevolvedSurfaceData, deflection: float, angle: float, density: float,
+                   samples: int = 2049) -> np.ndarray:
+    """Parameters ``u`` of the mesh nodes on one profile: both ends plus nodes equidistributed in
+    ``max(sqrt(κ / (8 δ)), κ / angle)`` per unit length (``δ`` = half the deflection; κ the
+    curvature measured on ``samples`` points), times ``density``."""
+    lo, hi = s.u_range
+    u = np.linspace(lo, hi, samples)
+    P, D = s.profile(u), s.profile(u, 1)
+    seg = np.linalg.norm(np.diff(P, axis=0), axis=1)
+    phi = np.unwrap(np.arctan2(D[:, 1], D[:, 0]))
+    kappa = np.abs(np.diff(phi)) / np.maximum(seg, 1e-300)  # curvature of each sample interval
+    rate = np.maximum(np.sqrt(kappa / (8.0 * 0.5 * deflection)), kappa / angle) * density
+    count = np.concatenate([[0.0], np.cumsum(rate * seg)])
+    n = max(1, int(math.ceil(count[-1])))
+    return np.interp(np.linspace(0.0, count[-1], n + 1), count, u) if count[-1] > 0 else np.array([lo, hi])
+
+
+def revolved_mesh(surfaces, deflection: float, angle: float, *, max_rounds: int = 4):
+    """A closed, welded triangle mesh of a chain of revolved faces (numpy only).
+
+    Profile nodes follow each face's curvature (:func:`_profile_nodes`); every node off the
+    axis becomes a ring of ``m`` vertices, ``m`` set by the widest ring's sagitta
+    (``R (1 - cos(π/m)) <= deflection / 2``) and by ``2π/m <= angle``; a node on the axis
+    is one vertex (a pole, closed by a fan).  Triangles are wound outward.
+
+    The deflection is then *measured*: every band of cells between two rings is congruent
+    under rotation, so one cell per band is compared with the surface at the same
+    parameters ``(u, θ)`` (a bound on the distance to the surface) on 15 points of each
+    triangle (corners, edge midpoints, centroid and points between them); until it is
+    ``<= deflection`` the node densities are doubled (at most ``max_rounds`` times, else
+    :class:`GeometryError`).
+
+    Returns
+    -------
+    V : ndarray (n, 3), T : ndarray (t, 3) int, measured : float (mm)
+    """
+    density, measured = 1.0, math.inf
+    for _ in range(max_rounds + 1):
+        P, bands = [], []
+        for f, s in enumerate(surfaces):
+            u = _profile_nodes(s, deflection, angle, density)
+            pts = s.profile(u)
+            start = len(P) - 1 if P else None  # the previous face's last node is this face's first
+            if start is None:
+                P.append(pts[0])
+                start = 0
+            idx = [start] + list(range(len(P), len(P) + len(u) - 1))
+            P.extend(pts[1:])
+            bands.extend((f, u[t], u[t + 1], idx[t], idx[t + 1]) for t in range(len(u) - 1))
+        P = np.array(P)
+        if P[0, 0] > 0.0 and np.max(np.abs(P[-1] - P[0])) <= 1e-6 * (1.0 + np.max(np.abs(P))):
+            last = len(P) - 1  # a ring: the chain returns to its start
+            P = P[:-1]
+            bands = [(f, ua, ub, ia, 0 if ib == last else ib) for f, ua, ub, ia, ib in bands]
+        rmax = float(np.max(P[:, 0]))
+        half = 0.5 * deflection
+        m = max(8, int(math.ceil(math.tau / angle)),
+                int(math.ceil(math.pi / math.acos(1.0 - half / rmax))) if rmax > half else 8)
+        m = 4 * int(math.ceil(m * math.sqrt(density) / 4))
+        V, T, measured = _mesh_rings(surfaces, P, bands, m)
+        if measured <= deflection:
+            return V, T, measured
+        density *= 2.0
+    raise GeometryError(f"revolved mesh misses the deflection {deflection:g} mm: measured {measured:.3g} mm")
+
+
+def _mesh_rings(surfaces, P: np.ndarray, bands, m: int):
+    th = np.arange(m) * (math.tau / m)
+    pole = P[:, 0] <= 0.0
+    first = np.zeros(len(P) + 1, dtype=np.int64)  # index of each node's first vertex
+    first[1:] = np.cumsum(np.where(pole, 1, m))
+    V = np.concatenate([np.array([[0.0, 0.0, z]]) if p else
+                        np.column_stack([r * np.cos(th), r * np.sin(th), np.full(m, z)])
+                        for (r, z), p in zip(P, pole)])
+    j, j1 = np.arange(m), (np.arange(m) + 1) % m
+    tris = []
+    for f, ua, ub, ia, ib in bands:
+        a, b = first[ia], first[ib]
+        if pole[ia] and pole[ib]:
+            continue
+        if pole[ia]:
+            tris.append(np.column_stack([np.full(m, a), b + j1, b + j]))
+        elif pole[ib]:
+            tris.append(np.column_stack([a + j, a + j1, np.full(m, b)]))
+        else:
+            tris.extend([np.column_stack([a + j, a + j1, b + j]), np.column_stack([a + j1, b + j1, b + j])])
+    T = np.concatenate(tris)
+    a, b, c = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
+    if float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum()) < 0.0:  # wind outward (positive volume)
+        T = T[:, ::-1]
+    return V, np.ascontiguousarray(T), _mesh_deviation(surfaces, P, bands, th[1])
+
+
+# barycentric sample points of a triangle: corners, edge midpoints, centroid, and between them
+_BARY = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [.5, .5, 0], [0, .5, .5], [.5, 0, .5], [1 / 3, 1 / 3, 1 / 3],
+                  [.75, .25, 0], [.25, .75, 0], [0, .75, .25], [0, .25, .75], [.25, 0, .75], [.75, 0, .25],
+                  [2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6]], dtype=float)
+
+
+def _mesh_deviation(surfaces, P: np.ndarray, bands, dth: float, n_seg: int = 64) -> float:
+    """Largest distance (mm) from the triangles to the surface, measured on one cell per band
+    (the cells of a band are congruent under rotation): 15 points of each of its two
+    triangles, each point's distance to the band's stretch of profile in its own meridian
+    plane, the profile taken as ``n_seg`` chords (whose own sagitta, ~``δ/n_seg²``, is
+    negligible)."""
+    fs = np.array([b[0] for b in bands])
+    ua = np.array([b[1] for b in bands])
+    ub = np.array([b[2] for b in bands])
+    A, B = P[[b[3] for b in bands]], P[[b[4] for b in bands]]
+    c, s = math.cos(dth), math.sin(dth)
+
+    def corner(p, rot):
+        return np.column_stack([p[:, 0] * (c if rot else 1.0), p[:, 0] * (s if rot else 0.0), p[:, 1]])
+
+    A0, A1, B0, B1 = corner(A, False), corner(A, True), corner(B, False), corner(B, True)
+    q = np.concatenate([np.einsum("pk,bkc->bpc", _BARY, np.stack([A0, A1, B0], axis=1)),
+                        np.einsum("pk,bkc->bpc", _BARY, np.stack([A1, B1, B0], axis=1))], axis=1)
+    rz = np.stack([np.hypot(q[..., 0], q[..., 1]), q[..., 2]], axis=-1)  # (bands, 30, 2)
+    t = np.linspace(0.0, 1.0, n_seg + 1)
+    C = np.empty((len(bands), n_seg + 1, 2))
+    for f in np.unique(fs):
+        k = fs == f
+        C[k] = surfaces[f].profile(ua[k, None] + (ub - ua)[k, None] * t)
+    s0, d = C[:, None, :-1], np.diff(C, axis=1)[:, None]  # chords (bands, 1, n_seg, 2)
+    w = rz[:, :, None] - s0
+    lam = np.clip(np.sum(w * d, axis=-1) / np.maximum(np.sum(d * d, axis=-1), 1e-300), 0.0, 1.0)
+    dist = np.linalg.norm(w - lam[..., None] * d, axis=-1).min(axis=2)
+    return float(dist.max())
