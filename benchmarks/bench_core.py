@@ -24,9 +24,15 @@ Run: ``python benchmarks/bench_core.py`` (no assertions on time).
 from __future__ import annotations
 
 import math
+import os
 import sys
 import time
 from pathlib import Path
+
+# one core, as the figures are per core (and as the command line runs: see tabletcad.cli.main)
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("MKL_NUM_THREADS", "1")
 
 import numpy as np
 
