@@ -25,7 +25,7 @@ import numpy as np
 from tabletcad.brep.knots import basis_derivatives, clamped_interp_knots, flat_knots
 from tabletcad.errors import GeometryError
 
-__all__ = ["RevolvedSurfaceData", "ProfileFit", "fit_profile", "revolved_volume"]
+__all__ = ["RevolvedSurfaceData", "ProfileFit", "fit_profile", "fit_profiles", "revolved_mesh", "revolved_volume"]
 
 ProfileFunction = Callable[[np.ndarray], np.ndarray]
 
@@ -214,6 +214,19 @@ def fit_profile(
         f"with {best.n} profile poles", best)
 
 
+def fit_profiles(profiles, tol: float = 1e-4, *, names=None, degree: int = 5) -> list[ProfileFit]:
+    """:func:`fit_profile` of a chain of profiles (profile ``j`` ends where ``j+1`` starts), each
+    starting at the previous fit's last pole, so that neighbours share their end points bit
+    for bit; ``names`` name them in errors."""
+    names = list(names) if names is not None else [f"profile {j}" for j in range(len(profiles))]
+    fits, start = [], None
+    for f, n in zip(profiles, names):
+        fit = fit_profile(f, tol, degree=degree, start=start, name=n)
+        fits.append(fit)
+        start = fit.surface.poles[-1]
+    return fits
+
+
 def _profile_nodes(s: RevolvedSurfaceData, deflection: float, angle: float, density: float,
                    samples: int = 2049) -> np.ndarray:
     """Parameters ``u`` of the mesh nodes on one profile: both ends plus nodes equidistributed in
@@ -228,7 +241,11 @@ def _profile_nodes(s: RevolvedSurfaceData, deflection: float, angle: float, dens
     rate = np.maximum(np.sqrt(kappa / (8.0 * 0.5 * deflection)), kappa / angle) * density
     count = np.concatenate([[0.0], np.cumsum(rate * seg)])
     n = max(1, int(math.ceil(count[-1])))
-    return np.interp(np.linspace(0.0, count[-1], n + 1), count, u) if count[-1] > 0 else np.array([lo, hi])
+    if n == 1:
+        return np.array([lo, hi])
+    nodes = np.interp(np.linspace(0.0, count[-1], n + 1), count, u)
+    nodes[0], nodes[-1] = lo, hi  # the ends exactly (count may stand still at either end)
+    return nodes
 
 
 def revolved_mesh(surfaces, deflection: float, angle: float, *, max_rounds: int = 4):

@@ -337,8 +337,8 @@ def revolved_solid(
 
     Each profile ``f(u) -> (R, Z)`` (mm, ``u`` in [0, 1]; profile ``j`` ends where ``j+1``
     starts) is fitted within ``tol`` by a clamped B-spline of ``degree``
-    (:func:`tabletcad.brep.revolved.fit_profile`, chained so that neighbours share their end
-    points bit for bit) and revolved exactly (:func:`tabletcad.cad.faces.make_revolved_face`);
+    (:func:`tabletcad.brep.revolved.fit_profiles`: neighbours share their end points bit for bit)
+    and revolved exactly (:func:`tabletcad.cad.faces.make_revolved_face`);
     then sewing, validation and mass properties as in :func:`solid_from_surfaces`.
     ``sew_tolerance`` defaults to ``max(2 tol, 1e-6)`` mm.
 
@@ -348,16 +348,12 @@ def revolved_solid(
     the adaptive one with ``eps = 1e-9`` was measured 3.4e-7 low with an error estimate
     of 2e-15 (concave round sample).
     """
-    from tabletcad.brep.revolved import fit_profile
+    from tabletcad.brep.revolved import fit_profiles
     from tabletcad.cad.faces import make_revolved_face
 
     t0 = time.perf_counter()
     names = list(names) if names is not None else [f"patch {j}" for j in range(len(profiles))]
-    fits, start = [], None
-    for f, n in zip(profiles, names):
-        fit = fit_profile(f, tol, degree=degree, start=start, name=n)
-        fits.append(fit)
-        start = fit.surface.poles[-1]
+    fits = fit_profiles(profiles, tol, names=names, degree=degree)
     t1 = time.perf_counter()
     surfaces = [f.surface for f in fits]
     faces = tuple(make_revolved_face(sd, name=n) for sd, n in zip(surfaces, names))

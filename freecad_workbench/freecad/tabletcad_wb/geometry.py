@@ -7,7 +7,9 @@ The chain is the one of :mod:`tabletcad.cad.tablet_solid` without OCP:
    the union of their ``v`` breakpoints;
 2. :func:`tabletcad.brep.fit.fit_patches` (quintic in ``u`` and ``v``, like
    ``tablet_solid``) -> kernel-neutral :class:`~tabletcad.brep.surface.BSplineSurfaceData`;
-3. ``Part.BSplineSurface().buildFromPolesMultsKnots`` -> faces -> sewn
+   for a tablet of revolution only the profiles (:func:`tabletcad.brep.revolved.fit_profiles`);
+3. ``Part.BSplineSurface().buildFromPolesMultsKnots`` (or ``Part.SurfaceOfRevolution`` of a
+   ``Part.BSplineCurve``) -> faces -> sewn
    ``Part.Shell`` -> ``Part.Solid`` (outward, ``isValid()``, exactly one solid).
 
 Tooling is made with Part Booleans from the tablet's *rims* (the boundary rows
@@ -186,26 +188,71 @@ def solid_from_faces(faces, sew_tolerance, what="tablet"):
     return solid
 
 
+def revolved_face(data):
+    """``Part.Face`` of a kernel-neutral RevolvedSurfaceData: its B-spline profile (plane y = 0,
+    x = R) turned a full circle about the z axis (a surface of revolution, exact in the angle)."""
+    import FreeCAD
+    import Part
+
+    c = Part.BSplineCurve()
+    c.buildFromPolesMultsKnots([FreeCAD.Vector(float(r), 0.0, float(z)) for r, z in np.asarray(data.poles)],
+                               [int(m) for m in data.mults], [float(k) for k in data.knots], False, int(data.degree))
+    return Part.Face(Part.SurfaceOfRevolution(c, FreeCAD.Vector(0, 0, 0), FreeCAD.Vector(0, 0, 1)))
+
+
+def _revolved_rims(surfaces, hollow):
+    """Rims of a chain of faces of revolution: the profile ends on the silhouette (as far from
+    the axis as the profiles get), each an exact circle ``{z, inner, radius}``; for a hollow
+    tablet also the ends of the inner wall."""
+    u = np.linspace(0.0, 1.0, 257)
+    rho = max(float(np.max(s.profile(u)[:, 0])) for s in surfaces)
+    out, seen = [], []
+    for k, s in enumerate(surfaces):
+        for r, z in np.asarray(s.poles)[[0, -1]]:
+            if r < 1e-6 * rho:  # a pole
+                continue
+            outer = bool(r >= rho - 2e-3 * rho)
+            inner = bool(hollow and k == 2)
+            key = (round(float(z), 9), round(float(r), 9))
+            if not (outer or inner) or key in seen:
+                continue
+            seen.append(key)
+            out.append(dict(z=float(z), inner=inner and not outer, radius=float(r)))
+    return out if any(not r["inner"] for r in out) else []
+
+
 def build_tablet(tablet, tol=None):
-    """Fit the tablet's chain, build the Part solid, compute the core's figures."""
+    """Fit the tablet's chain, build the Part solid, compute the core's figures.
+
+    A tablet of revolution gets faces of revolution of its fitted profiles
+    (:func:`tabletcad.brep.revolved.fit_profiles`, as ``tablet_solid`` does), any other
+    B-spline faces (:func:`tabletcad.brep.fit.fit_patches`)."""
     from tabletcad.brep.fit import fit_patches
+    from tabletcad.brep.revolved import fit_profiles
     from tabletcad.brep.surface import enclosed_volume
-    from tabletcad.brep.surfaces import fit_options
+    from tabletcad.brep.surfaces import fit_options, tablet_profiles
     from tabletcad.brep.slit import chain_face_surfaces
 
     t0 = time.perf_counter()
-    funcs, names, breaks = tablet_chain(tablet)
     tol = float(tablet.tol.fit if tol is None else tol)
-    fits = fit_patches(funcs, tol, names=names, **fit_options(tablet, v_breaks=breaks))
-    t1 = time.perf_counter()
-    # cut alike where a boundary row stands still over part of its length (tabletcad.brep.slit)
-    pieces = chain_face_surfaces([f.surface for f in fits], 1e-7, names)
-    faces = [bspline_face(p) for ps in pieces for p in ps]
+    profiles = tablet_profiles(tablet) if tablet.trim.u == (0.0, 1.0) and tablet.trim.full_v else None
+    if profiles is not None:
+        fits = fit_profiles(profiles[0], tol, names=profiles[1], degree=fit_options(tablet)["u_degree"])
+        t1 = time.perf_counter()
+        faces = [revolved_face(f.surface) for f in fits]
+    else:
+        funcs, names, breaks = tablet_chain(tablet)
+        fits = fit_patches(funcs, tol, names=names, **fit_options(tablet, v_breaks=breaks))
+        t1 = time.perf_counter()
+        # cut alike where a boundary row stands still over part of its length (tabletcad.brep.slit)
+        pieces = chain_face_surfaces([f.surface for f in fits], 1e-7, names)
+        faces = [bspline_face(p) for ps in pieces for p in ps]
     solid = solid_from_faces(faces, max(2.0 * tol, 1e-6), tablet.name)
     t2 = time.perf_counter()
     props = tablet.properties()
     t3 = time.perf_counter()
-    rims = _rims([f.surface for f in fits], hollow=tablet.trim.w[0] > 0.0)
+    hollow = tablet.trim.w[0] > 0.0
+    rims = (_revolved_rims if profiles is not None else _rims)([f.surface for f in fits], hollow=hollow)
     outline = outline_segments(tablet)
     if outline:  # the die bore follows the exact outline (lines and arcs), not the fitted rim
         for r in rims:
@@ -272,6 +319,9 @@ def _rim_wire(rim, dz=0.0):
     import FreeCAD
     import Part
 
+    if "radius" in rim:  # an exact circle (a tablet of revolution)
+        circle = Part.Circle(FreeCAD.Vector(0, 0, rim["z"] + dz), FreeCAD.Vector(0, 0, 1), rim["radius"])
+        return Part.Wire([circle.toShape()])
     c = Part.BSplineCurve()
     c.buildFromPolesMultsKnots(
         [FreeCAD.Vector(x, y, z + dz) for x, y, z in rim["poles"]],
@@ -376,12 +426,14 @@ def die_shape(rims, clearance=0.05, height=22.22, outer_diameter=38.1):
     z_lo, z_hi = lo["z"], max(r["z"] for r in outer)
     if lo.get("outline"):
         bore_wire = offset_outline_wire(lo["outline"], float(clearance), z_lo)
+    elif "radius" in lo:  # a circle: the bore is the concentric circle
+        bore_wire = _rim_wire(dict(lo, radius=lo["radius"] + float(clearance)))
     else:
         bore_wire = _rim_wire(lo).makeOffset2D(float(clearance), 0, False, False, False)
         # offset curves as B-splines: FreeCAD 1.0's STEP writer drops extrusions of offset
         # curves (the die came back as an open shell of 3 of its 5 faces)
         bore_wire = Part.Wire([e.toNurbs().Edges[0] for e in bore_wire.OrderedEdges])
-    reach = float(np.max(np.hypot(*np.asarray(lo["poles"])[:, :2].T))) + clearance
+    reach = (lo["radius"] if "radius" in lo else float(np.max(np.hypot(*np.asarray(lo["poles"])[:, :2].T)))) + clearance
     if not outer_diameter / 2.0 > reach + 0.5:
         raise DesignError(
             "die outer diameter",
