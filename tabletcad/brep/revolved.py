@@ -228,7 +228,7 @@ def fit_profiles(profiles, tol: float = 1e-4, *, names=None, degree: int = 5) ->
 
 
 def _profile_nodes(s: RevolvedSurfaceData, deflection: float, angle: float, density: float,
-                   samples: int = 2049) -> np.ndarray:
+                   samples: int = 513) -> np.ndarray:
     """Parameters ``u`` of the mesh nodes on one profile: both ends plus nodes equidistributed in
     ``max(sqrt(κ / (8 δ)), κ / angle)`` per unit length (``δ`` = half the deflection; κ the
     curvature measured on ``samples`` points), times ``density``."""
