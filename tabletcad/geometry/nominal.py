@@ -2,7 +2,9 @@
 
 Each function returns ``f(points (m, 3)) -> (m,)``, negative inside.  Used to
 certify how far a PDE surface lies from the shape it stands for
-(:meth:`tabletcad.geometry.tablet.Tablet.nominal_deviation`).
+(:meth:`tabletcad.geometry.tablet.Tablet.nominal_deviation`).  A function whose shape
+is a solid of revolution about the z axis carries ``f.axisymmetric = True`` (the
+deviation of a PDE surface of revolution is then measured on a few meridians).
 """
 
 from __future__ import annotations
@@ -16,6 +18,15 @@ __all__ = ["cylinder", "sphere", "spheroid", "convex_round", "capsule_z", "inter
 SDF = Callable[[np.ndarray], np.ndarray]
 
 
+def _about_z(f: SDF, axisymmetric: bool = True) -> SDF:
+    f.axisymmetric = bool(axisymmetric)  # type: ignore[attr-defined]
+    return f
+
+
+def _on_axis(center) -> bool:
+    return float(np.hypot(center[0], center[1])) == 0.0
+
+
 def cylinder(radius: float, z0: float, z1: float) -> SDF:
     """Solid cylinder of ``radius`` about the z axis between ``z0`` and ``z1``."""
 
@@ -27,12 +38,12 @@ def cylinder(radius: float, z0: float, z1: float) -> SDF:
         out[both] = np.hypot(dr[both], dz[both])
         return out
 
-    return f
+    return _about_z(f)
 
 
 def sphere(radius: float, center=(0.0, 0.0, 0.0)) -> SDF:
     c = np.asarray(center, dtype=float)
-    return lambda p: np.linalg.norm(p - c, axis=1) - radius
+    return _about_z(lambda p: np.linalg.norm(p - c, axis=1) - radius, _on_axis(c))
 
 
 def spheroid(a: float, c: float, center=(0.0, 0.0, 0.0)) -> SDF:
@@ -45,11 +56,12 @@ def spheroid(a: float, c: float, center=(0.0, 0.0, 0.0)) -> SDF:
         grad = 2.0 * np.column_stack([q[:, 0] / a**2, q[:, 1] / a**2, q[:, 2] / c**2])
         return g / np.maximum(np.linalg.norm(grad, axis=1), 1e-300)
 
-    return f
+    return _about_z(f, _on_axis(c0))
 
 
 def intersection(*fs: SDF) -> SDF:
-    return lambda p: np.max(np.stack([f(p) for f in fs]), axis=0)
+    return _about_z(lambda p: np.max(np.stack([f(p) for f in fs]), axis=0),
+                    all(getattr(f, "axisymmetric", False) for f in fs))
 
 
 def convex_round(radius: float, band_z0: float, band_z1: float, cup_depth: float) -> SDF:
@@ -68,7 +80,7 @@ def convex_round(radius: float, band_z0: float, band_z1: float, cup_depth: float
         b = np.minimum(bot(p), band_z0 - p[:, 2])
         return np.maximum(cyl(p), np.maximum(t, b))
 
-    return f
+    return _about_z(f)
 
 
 def capsule_z(radius: float, z0: float, z1: float) -> SDF:
@@ -78,4 +90,4 @@ def capsule_z(radius: float, z0: float, z1: float) -> SDF:
         zc = np.clip(p[:, 2], z0, z1)
         return np.sqrt(p[:, 0] ** 2 + p[:, 1] ** 2 + (p[:, 2] - zc) ** 2) - radius
 
-    return f
+    return _about_z(f)

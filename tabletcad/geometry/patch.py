@@ -170,11 +170,15 @@ class PDEPatch:
         object.__setattr__(self, "_a0", a0)
         object.__setattr__(self, "_ac", ac)
         object.__setattr__(self, "_bc", bc)
-        # is there anything above mode N?  (residual at dense samples)
-        v = sample_v(4 * samples)
-        res = float(np.max(np.abs(self._residuals(v, 0))))
+        # is there anything above mode N?  Not for curves band-limited to N modes (circles,
+        # ellipses: the FFT of 8 N + 8 samples is exact); else the residual at dense samples
         scale = max(1.0, float(np.max(np.abs(a0))), float(np.max(np.abs(ac))) if N else 0.0)
-        object.__setattr__(self, "_has_remainder", res > 1e-14 * scale)
+        limits = [getattr(c, "band_limit", lambda: None)() for c in self.data]
+        if all(lim is not None and lim <= N for lim in limits):
+            object.__setattr__(self, "_has_remainder", False)
+        else:
+            res = float(np.max(np.abs(self._residuals(sample_v(4 * samples), 0))))
+            object.__setattr__(self, "_has_remainder", res > 1e-14 * scale)
         object.__setattr__(self, "_lams", self.a * np.arange(N + 1))
         # modes with any non-zero coefficient; the others are skipped in every sum
         amp = np.zeros(N + 1)
