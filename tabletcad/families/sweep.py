@@ -510,7 +510,8 @@ def sweep_properties(tablet: Tablet, nu: int = 24, nv_per: int = 48) -> dict[str
     sweep is only piecewise smooth in ``v``), so the figures converge to
     rounding; :meth:`Tablet.properties` uses a periodic rule in ``v``, which is
     spectrally accurate for circles but only first order across the joins of
-    a lines-and-arcs outline.
+    a lines-and-arcs outline.  A tablet of revolution on a round outline takes four
+    meridians (its integrands do not depend on ``v``).
 
     Returns
     -------
@@ -523,7 +524,10 @@ def sweep_properties(tablet: Tablet, nu: int = 24, nv_per: int = 48) -> dict[str
     xu, wu = np.polynomial.legendre.leggauss(nu)
     u = 0.5 * (xu + 1)
     wu = 0.5 * wu
-    v, wv = _rule_v(nom.outline, nv_per)
+    if tablet.revolution is not None and nom.axisymmetric:  # integrands the same on every meridian
+        v, wv = np.arange(4) * (math.tau / 4), np.full(4, math.tau / 4)
+    else:
+        v, wv = _rule_v(nom.outline, nv_per)
     W = np.outer(wu, wv)
     area = vol = 0.0
     top_area = plan = cup = 0.0

@@ -577,24 +577,41 @@ class Tablet:
         revs = tuple(p.revolution for p in self.patches)
         return None if any(r is None for r in revs) else revs
 
-    def _profile_extreme(self, value: Callable[[Any, np.ndarray], np.ndarray]) -> float:
-        """Largest ``value(revolution, u)`` over every patch's profile and the trimmed ``u`` range."""
+    def _profile_extents(self) -> tuple[float, float, float]:
+        """``(R_max, Z_min, Z_max)`` (mm) of a tablet of revolution's profiles over the trimmed ``u``
+        range (cached).
+
+        Every profile is sampled once (513 points); a quantity is then polished
+        (:func:`~tabletcad.geometry.revolution.profile_extreme`) on each profile whose best
+        sample comes within ``max |Δ²g|`` (the samples' largest second difference, a bound on
+        what lies between samples) of the best sample of all, so no profile that could hold
+        the extreme is skipped.
+        """
+        hit = self.__dict__.get("_extents")
+        if hit is not None:
+            return hit
         lo, hi = self.trim.u
-        return max(profile_extreme(lambda u, r=r: value(r, u), lo, hi)[1] for r in self.revolution)
+        u = np.linspace(lo, hi, 513)
+        prof = [r.profile(u) for r in self.revolution]
+        quantities = (lambda P: np.abs(P[..., 0]), lambda P: -P[..., 1], lambda P: P[..., 1])
+        out = []
+        for g in quantities:
+            samples = [g(P) for P in prof]
+            best = max(float(x.max()) for x in samples)
+            slack = max(float(np.max(np.abs(np.diff(x, 2)))) for x in samples)
+            out.append(max(profile_extreme(lambda uu, r=r, g=g: g(r.profile(uu)), lo, hi)[1]
+                           for r, x in zip(self.revolution, samples) if float(x.max()) >= best - slack))
+        hit = (out[0], -out[1], out[2])
+        object.__setattr__(self, "_extents", hit)
+        return hit
 
     def _largest_radius(self) -> float:
-        """Largest distance (mm) of a tablet of revolution's surface from the z axis (cached)."""
-        hit = self.__dict__.get("_rmax")
-        if hit is None:
-            hit = self._profile_extreme(lambda r, u: np.abs(r.profile(u)[:, 0]))
-            object.__setattr__(self, "_rmax", hit)
-        return hit
+        """Largest distance (mm) of a tablet of revolution's surface from the z axis."""
+        return self._profile_extents()[0]
 
     def _bounds(self) -> tuple[np.ndarray, np.ndarray]:
         if self.revolution is not None and self.trim.full_v:
-            rmax = self._largest_radius()
-            ztop = self._profile_extreme(lambda r, u: r.profile(u)[:, 1])
-            zbot = -self._profile_extreme(lambda r, u: -r.profile(u)[:, 1])
+            rmax, zbot, ztop = self._profile_extents()
             return np.array([-rmax, -rmax, zbot]), np.array([rmax, rmax, ztop])
         return self._bounds_sampled()
 
@@ -648,8 +665,11 @@ class Tablet:
 
     def seams(self, nv: int = 720) -> list[dict[str, Any]]:
         """For every curve shared by consecutive patches: largest gap (mm) and
-        largest angle (deg) between the two patches' normals."""
+        largest angle (deg) between the two patches' normals (on ``nv`` meridians; 4 for a
+        tablet of revolution, whose meridians are all alike)."""
         out = []
+        if self.revolution is not None:  # every meridian meets its neighbour patch alike
+            nv = 4
         v = np.linspace(0.0, math.tau, nv, endpoint=False)
         for i in range(len(self.patches) - 1):
             a, b = self.patches[i], self.patches[i + 1]

@@ -124,10 +124,13 @@ def family_seams(tablet: Tablet, nv: int = 720) -> list[dict[str, Any]]:
     Like :meth:`Tablet.seams` but (1) normals are ``X_u × X_v`` of each patch at
     the shared curve and (2) points where the shared curve is degenerate
     (``|X_v| ≈ 0``: a corner arc collapsed by the offset, where the seam is a
-    single point and one side has no surface) are skipped and counted.
+    single point and one side has no surface) are skipped and counted.  A tablet of
+    revolution is measured on 4 meridians.
     """
     nom = tablet.nominal
     expected = list(getattr(nom, "expected_sharp", []))
+    if tablet.revolution is not None:  # every meridian meets its neighbour patch alike
+        nv = 4
     v = np.linspace(0.0, 2 * math.pi, nv, endpoint=False)
     if isinstance(nom, SweepNominal):
         b = np.asarray(nom.outline.breaks)[:-1]
