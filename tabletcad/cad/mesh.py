@@ -21,7 +21,6 @@ from OCP.BRepTools import BRepTools
 from OCP.TopAbs import TopAbs_Orientation
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS_Shape
-from scipy.spatial import cKDTree
 
 from tabletcad.cad._occ import explore
 from tabletcad.errors import GeometryError
@@ -151,6 +150,8 @@ def _weld(V: np.ndarray, T: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndar
     from scipy.sparse.csgraph import connected_components
 
     n = len(V)
+    from scipy.spatial import cKDTree
+
     pairs = cKDTree(V).query_pairs(tol, output_type="ndarray")
     if len(pairs):
         graph = coo_matrix((np.ones(len(pairs), dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n))

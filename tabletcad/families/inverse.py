@@ -53,7 +53,6 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import numpy as np
-from scipy.optimize import brentq
 
 from tabletcad.errors import DesignError, GeometryError, check_positive, check_range
 from tabletcad.families.sweep import NominalBuilt, SweepNominal, nominal_only, nominal_volume
@@ -431,6 +430,8 @@ def solve_for(
         ``vary`` (``target_volume_mm3 = 5 mm3 is not allowed: must be within 87.3 to 512.9
         mm3 for thickness in [1.6, 1000] mm ...``).
     """
+    from scipy.optimize import brentq  # here: scipy.optimize takes ~0.4 s to import
+
     func, name, dims, x0, x_max = _prepare(family, vary, dims)
     if (target_volume_mm3 is None) == (target_weight_mg is None):
         raise DesignError("target", "both" if target_volume_mm3 is not None else "none",

@@ -25,7 +25,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from tabletcad.geometry.curves import Seg, signed_area
 from tabletcad.errors import DesignError, check_positive, check_range
@@ -348,6 +347,8 @@ class SplineOutline(PlanOutline):
         _check_polyline_simple(p, parameter)
         t = np.concatenate([[0.0], np.cumsum(seg)]) * (math.tau / float(np.sum(seg)))
         self.points = p
+        from scipy.interpolate import CubicSpline  # here: scipy.interpolate takes ~0.3 s to import
+
         self._sp = CubicSpline(t, np.vstack([p, p[:1]]), bc_type="periodic", axis=0)
         self.name = name
         self.parameter = parameter

@@ -22,7 +22,6 @@ from functools import lru_cache
 from typing import Protocol, runtime_checkable
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from tabletcad.errors import DesignError, check_finite, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
@@ -497,6 +496,8 @@ class PointCurve(Curve):
         t = t * (math.tau / t[-1])
         self.points = p
         self._knots = t[:-1]
+        from scipy.interpolate import CubicSpline  # here: scipy.interpolate takes ~0.3 s to import
+
         self._spline = CubicSpline(t, np.vstack([p, p[:1]]), bc_type="periodic", axis=0)
 
     def breakpoints(self) -> np.ndarray:

@@ -36,7 +36,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.optimize import brentq
 
 from tabletcad.errors import DesignError, check_positive, check_range
 from tabletcad.mechanics.materials import Material, get_material
@@ -169,6 +168,8 @@ def elastic_plastic_displacement(F, r_s: float, s_y: float, omega_y: float) -> n
     ``F(ω)`` is increasing for ``ω >= ω'``, and ``F(ω) >= π s_y r_s ω / 3``
     there, so the root is bracketed by ``[ω', max(ω', 3F/(π s_y r_s))]``.
     """
+    from scipy.optimize import brentq  # here: scipy.optimize takes ~0.4 s to import
+
     F = _check_force_above_yield(F, r_s, s_y, omega_y)
     k = math.pi * s_y * r_s / 2.0
     out = np.empty(F.shape, dtype=float)
