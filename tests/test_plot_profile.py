@@ -50,11 +50,19 @@ def test_main_dimensions(pair):
 
 
 def test_figure_is_to_scale_and_dimensioned(pair):
-    fig = tablet_figure(pair[0])
-    ax3d, prof, plan = fig.axes
-    box = np.asarray(ax3d.get_box_aspect(), float)
-    assert box / box[0] == pytest.approx([1.0, 1.0, (BAND + 2 * CUP) / D], rel=1e-6)
-    assert prof.get_aspect() == 1.0 and plan.get_aspect() == 1.0
+    fig = tablet_figure(pair[1], elev=18.0, azim=-60.0)
+    view, prof, plan = fig.axes
+    assert view.get_aspect() == prof.get_aspect() == plan.get_aspect() == 1.0
+    # the 3-D view is an orthographic projection to scale: the flat-faced round (a cylinder
+    # D x T) spans D across and T cos(elev) + D sin(elev) up (its 72-gon rims: within 0.1 %)
+    xy = np.concatenate([p.vertices for p in view.collections[0].get_paths()])
+    width, height = np.ptp(xy, axis=0)
+    e = np.radians(18.0)
+    assert width == pytest.approx(D, rel=1e-3)
+    assert height == pytest.approx((BAND + 2 * CUP) * np.cos(e) + D * np.sin(e), rel=1e-3)
+    # only faces turned towards the viewer are drawn: the bottom face of the cylinder is not
+    assert len(view.collections[0].get_paths()) < 0.75 * 3 * 24 * 72
+    _, prof, plan = tablet_figure(pair[0]).axes
     texts = {t.get_text() for a in (prof, plan) for t in a.texts}
     assert {"band 2", "cup 1", "4", "⌀ 10"} <= texts
     png = tablet_png(pair[1])

@@ -47,7 +47,7 @@ def from_any(obj: Any) -> TopoDS_Shape:
     if isinstance(obj, Tablet):
         from tabletcad.cad.tablet_solid import tablet_solid
 
-        return tablet_solid(obj).shape
+        return tablet_solid(obj, revolved=False).shape  # B-spline faces: see TabletModel.solid
     to_occ = getattr(obj, "to_occ", None)
     if callable(to_occ):
         return from_any(to_occ())

@@ -183,10 +183,15 @@ class TabletModel(_Shaped):
 
     @cached_property
     def solid(self):
-        """The validated :class:`~tabletcad.cad.solid.TabletSolid` (B-spline faces, sewn)."""
+        """The validated :class:`~tabletcad.cad.solid.TabletSolid` (B-spline faces, sewn).
+
+        B-spline faces even for a tablet of revolution (whose ``tabletcad build`` STEP has exact
+        surfaces of revolution): a surface of revolution has no normal at its pole, where
+        cadquery's ``faces(">Z").workplane()`` asks for one (the face's centre projects onto it).
+        """
         from tabletcad.cad.tablet_solid import tablet_solid
 
-        return tablet_solid(self.tablet)
+        return tablet_solid(self.tablet, revolved=False)
 
     def to_occ(self):
         """The tablet's ``TopoDS_Solid``."""
