@@ -36,8 +36,8 @@ ROOT = Path(__file__).resolve().parent
 
 #: the README's statements: largest |relative difference| per column (PDE/nominal, B-rep/quad,
 #: OCC default rule, mesh/B-rep), and the sphere's smallest and largest ``|p| - R`` (mm)
-README_BOUNDS = dict(columns=(1.3e-6, 1.1e-7, 9e-4, 2.1e-3), sphere_inside=(-6.4e-3, -6.2e-3),
-                     sphere_outside=(1.22e-2, 1.24e-2), mesh_below=(4.8e-5, 2.1e-3), default_rule_same=1e-8)
+README_BOUNDS = dict(columns=(1.3e-6, 1.1e-7, 9e-4, 3.3e-3), sphere_inside=(-6.4e-3, -6.2e-3),
+                     sphere_outside=(1.22e-2, 1.24e-2), mesh_below=(2.5e-4, 3.3e-3), default_rule_same=1e-8)
 
 
 def _default_rule_volume(shape) -> float:
@@ -94,7 +94,7 @@ def main() -> int:
     # OCC's default rule gives the eps 1e-9 figure except on the stadium (free_form_stadium)
     ok &= all(abs(r[3] - r[2]) <= README_BOUNDS["default_rule_same"] for r in table if "stadium" not in r[0])
     lo_m, hi_m = README_BOUNDS["mesh_below"]
-    ok &= all(lo_m <= -r[4] <= hi_m for r in table)  # every mesh lies below its B-rep, by 4.9e-5 to 2.0e-3
+    ok &= all(lo_m <= -r[4] <= hi_m for r in table)  # every mesh lies below its B-rep, by 2.6e-4 to 3.3e-3
     ok &= README_BOUNDS["sphere_inside"][0] <= lo <= README_BOUNDS["sphere_inside"][1]
     ok &= README_BOUNDS["sphere_outside"][0] <= hi <= README_BOUNDS["sphere_outside"][1]
     print("within the README's bounds" if ok else f"NOT within the README's bounds {README_BOUNDS}")
