@@ -453,7 +453,7 @@ def diametral(
     if solid is None:
         from tabletcad.cad.tablet_solid import tablet_solid
 
-        solid = tablet_solid(tablet)
+        solid = tablet_solid(tablet, revolved=False)  # the faces the FE results were validated on
     hp = h if plane_mesh_size is None else min(h, check_positive("plane_mesh_size", plane_mesh_size, "mm"))
     sol, s_c, m, bf = _solve_once(solid, lo, hi, ax, P, b, h, hs, material, R, hp)
     s_max, loc, _ = largest_tensile(sol, bf, lo, hi, ax, b, R, symmetric)
