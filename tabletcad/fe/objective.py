@@ -3,8 +3,13 @@
 :func:`breaking_force` evaluates :func:`tabletcad.fe.prediction.predict_breaking_force`
 on a coarse mesh (element size = smallest plan extent / 6, strips at plan / 10,
 ``1.5 R`` within ``R`` of the loaded diametral plane where the largest tensile
-stress is averaged over balls of radius ``R``; no error estimate: about
-6 000 unknowns and under 2 s for a round tablet, see ``benchmarks/bench_fe.py``); :mod:`tabletcad.optimise.strength` wraps it as an
+stress is averaged over balls of radius ``R``, size / 2 within ``1.5`` sizes of
+the centre where the centre stress is recovered; no error estimate).  With
+``symmetric=True`` only the quarter of the tablet is solved (see
+:func:`tabletcad.fe.diametral.diametral`): about 3 000 unknowns for a 10 mm
+round and 7 500 for an 18 x 8 mm capsule, and under a second of FE per
+evaluation on an unloaded machine (``benchmarks/bench_fe.py``; the whole
+tablet costs 2-7 times as much).  :mod:`tabletcad.optimise.strength` wraps it as an
 objective or constraint of :class:`tabletcad.optimise.Problem`, and problem
 files use it as the quantity ``fe_breaking_force_N``.
 
@@ -45,7 +50,7 @@ def coarse_mesh(tablet: Any, direction: str = "width") -> dict[str, float]:
     D = float(ext[load_axis(direction, ext)])
     R = default_averaging_radius(STRIP_FRACTION * D, float(ext[2]))
     return {"mesh_size": plan * COARSE_MESH_FRACTION, "strip_mesh_size": plan * COARSE_STRIP_FRACTION,
-            "plane_mesh_size": PLANE_MESH_FACTOR * R}
+            "plane_mesh_size": PLANE_MESH_FACTOR * R, "centre_mesh_size": plan * COARSE_MESH_FRACTION / 2.0}
 
 
 def breaking_force(tablet: Any, tensile_strength_MPa: float, direction: str = "width", *, coarse: bool = True,
