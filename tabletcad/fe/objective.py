@@ -7,9 +7,9 @@ stress is averaged over balls of radius ``R``, size / 2 within ``1.5`` sizes of
 the centre where the centre stress is recovered; no error estimate).  With
 ``symmetric=True`` only the quarter of the tablet is solved (see
 :func:`tabletcad.fe.diametral.diametral`): about 3 000 unknowns for a 10 mm
-round and 7 500 for an 18 x 8 mm capsule, and under a second of FE per
-evaluation on an unloaded machine (``benchmarks/bench_fe.py``; the whole
-tablet costs 2-7 times as much).  :mod:`tabletcad.optimise.strength` wraps it as an
+round and 7 500 for an 18 x 8 mm capsule, and under a second of CPU for the
+FE of one evaluation (``benchmarks/bench_fe.py``; the whole
+tablet costs 1.8-6 times as much).  :mod:`tabletcad.optimise.strength` wraps it as an
 objective or constraint of :class:`tabletcad.optimise.Problem`, and problem
 files use it as the quantity ``fe_breaking_force_N``.
 
@@ -60,7 +60,7 @@ def breaking_force(tablet: Any, tensile_strength_MPa: float, direction: str = "w
 
     ``symmetric`` declares the tablet mirror symmetric about the plane across the load and its
     mid-thickness plane (see :func:`tabletcad.fe.diametral.diametral`): only its quarter is meshed
-    and solved, and the unfolded field is exactly symmetric (2-6 times faster than the whole tablet).
+    and solved, and the unfolded field is exactly symmetric (1.8-6 times faster than the whole tablet).
     """
     fe: dict[str, Any] = {"error_estimate": False, "symmetric": symmetric}
     if coarse:
