@@ -31,10 +31,12 @@ from typing import Any
 
 import numpy as np
 
+from tabletcad.errors import DesignError
 from tabletcad.fe.diametral import PLANE_MESH_FACTOR, STRIP_FRACTION, default_averaging_radius, load_axis
-from tabletcad.fe.prediction import StrengthInputs, predict_breaking_force
+from tabletcad.fe.prediction import STRENGTH_KEYS, StrengthInputs, StrengthPrediction, predict_breaking_force
 
-__all__ = ["COARSE_MESH_FRACTION", "COARSE_STRIP_FRACTION", "breaking_force", "coarse_mesh"]
+__all__ = ["COARSE_MESH_FRACTION", "COARSE_STRIP_FRACTION", "breaking_force", "coarse_mesh", "coarse_prediction",
+           "report_breaking_force"]
 
 #: Coarse element size as a fraction of the smallest plan extent.
 COARSE_MESH_FRACTION = 1.0 / 6.0
@@ -67,3 +69,24 @@ def breaking_force(tablet: Any, tensile_strength_MPa: float, direction: str = "w
         fe.update(coarse_mesh(tablet, direction))
     return predict_breaking_force(tablet, StrengthInputs(tensile_strength_MPa=tensile_strength_MPa), direction,
                                   **fe).breaking_force_N
+
+
+def coarse_prediction(tablet: Any, inputs: StrengthInputs, direction: str = "width") -> StrengthPrediction:
+    """:func:`tabletcad.fe.prediction.predict_breaking_force` on the coarse mesh (whole tablet, no error
+    estimate): what ``tabletcad fe strength --coarse`` prints and the design report shows."""
+    return predict_breaking_force(tablet, inputs, direction, **coarse_mesh(tablet, direction), error_estimate=False)
+
+
+def report_breaking_force(tablet: Any, options: Any) -> dict[str, Any]:
+    """The design report's FE breaking force (``[report] fe_breaking_force = true``): :func:`coarse_prediction`
+    across the width from the ``[report]`` strength inputs of ``options`` (a
+    :class:`~tabletcad.pipeline.designreport.ReportOptions`); an elastic first-crack estimate."""
+    try:
+        import gmsh  # noqa: F401
+        import skfem  # noqa: F401
+    except ImportError as exc:
+        raise DesignError("[report] fe_breaking_force", True, f"needs the fe extra ({exc.name} is missing): "
+                          "pip install 'tabletcad[fe]'") from None
+    inputs = StrengthInputs(**{k: getattr(options, k) for k in STRENGTH_KEYS})
+    pred = coarse_prediction(tablet, inputs, "width")
+    return {**pred.to_dict(), "mesh": "coarse (tabletcad fe strength --coarse)", "dofs": pred.result.dofs}
