@@ -4,7 +4,6 @@ and the build run ``tabletcad fe strength --coarse`` on the design (an elastic f
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import pytest
 
@@ -37,15 +36,11 @@ def run(capsys, *args):
     return rc, out, err
 
 
-@pytest.fixture
-def design(tmp_path) -> Path:
-    p = tmp_path / "round.toml"
-    p.write_text(DESIGN)
-    return p
-
-
-def test_report_and_build_run_the_coarse_fe_strength(capsys, tmp_path, design):
+def test_report_and_build_run_the_coarse_fe_strength(capsys, tmp_path):
     from tabletcad.pipeline.build import build_design
+
+    design = tmp_path / "round.toml"
+    design.write_text(DESIGN)
 
     rc, so, err = run(capsys, "report", design, "--json")
     assert rc == 0, err
