@@ -445,9 +445,10 @@ def diametral(
         solved, with the normal displacement held on the two planes and one platen carrying
         ``P/2``, and the solution is unfolded to the whole tablet
         (:func:`tabletcad.fe.elasticity.unfold`), an exactly symmetric field read like the full
-        model's (see :func:`largest_tensile`).  About a third of the unknowns and a tenth of the
-        solve time of the full model; ``dofs`` counts the quarter's unknowns, ``nodes`` and
-        ``elements`` the unfolded mesh's.  The optimiser's coarse evaluations use it.
+        model's (see :func:`largest_tensile`).  About a third of the unknowns of the whole tablet
+        with the same sizes and 1.8-6 times less time (``benchmarks/bench_fe.py``); ``dofs``
+        counts the quarter's unknowns, ``nodes`` and ``elements`` the unfolded mesh's.  The
+        optimiser's coarse evaluations use it.
     material : Material, optional
         E and ν (stresses do not depend on E).
     error_estimate : bool
@@ -487,6 +488,7 @@ def diametral(
 
         solid = tablet_solid(tablet)
     hp = h if plane_mesh_size is None else min(h, check_positive("plane_mesh_size", plane_mesh_size, "mm"))
+
     def centre_ball(h: float, hc: float | None) -> tuple[float, float]:
         return (h / 1.5, D / 8.0) if hc is None else (min(h, hc), max(D / 8.0, RECOVERY_RADIUS * h))
 
