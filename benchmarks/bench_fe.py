@@ -2,7 +2,7 @@
 
 For a few tablets, one coarse-mesh evaluation as the optimiser makes it
 (:func:`tabletcad.fe.objective.coarse_mesh`: ``mesh_size`` = plan extent / 6,
-strips plan / 10, ``1.5 R`` about the loaded diametral plane, ``mesh_size / 2``
+strips plan / 10, ``1.2 R`` about the loaded diametral plane, ``mesh_size / 2``
 about the centre; mirror symmetry declared, so the quarter model is solved and
 unfolded; no error estimate) is timed after the B-rep solid (CAD layer, built
 once per tablet and timed apart; an optimiser pays both, "eval s" is their

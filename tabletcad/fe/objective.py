@@ -2,12 +2,12 @@
 
 :func:`breaking_force` evaluates :func:`tabletcad.fe.prediction.predict_breaking_force`
 on a coarse mesh (element size = smallest plan extent / 6, strips at plan / 10,
-``1.5 R`` within ``R`` of the loaded diametral plane where the largest tensile
+``1.2 R`` within ``R`` of the loaded diametral plane where the largest tensile
 stress is averaged over balls of radius ``R``, size / 2 within ``1.5`` sizes of
 the centre where the centre stress is recovered; no error estimate).  With
 ``symmetric=True`` only the quarter of the tablet is solved (see
-:func:`tabletcad.fe.diametral.diametral`): about 3 000 unknowns for a 10 mm
-round and 7 500 for an 18 x 8 mm capsule, and under a second of CPU for the
+:func:`tabletcad.fe.diametral.diametral`): about 3 500 unknowns for a 10 mm
+round and 7 900 for an 18 x 8 mm capsule, and under a second of CPU for the
 FE of one evaluation (``benchmarks/bench_fe.py``; the whole
 tablet costs 1.8-6 times as much).  :mod:`tabletcad.optimise.strength` wraps it as an
 objective or constraint of :class:`tabletcad.optimise.Problem`, and problem
@@ -17,7 +17,7 @@ The figure rests on the largest tensile stress averaged over a ball of the
 strip width's radius on the loaded diametral plane (see
 :mod:`tabletcad.fe.diametral`), which converges under refinement: the coarse
 mesh only adds a small, slowly varying bias (on ten 10 mm concave rounds of
-289.1 mm³, cup depths 0.5-1.5 mm, symmetric: 1.3 % rms and at most 2.4 % above
+289.1 mm³, cup depths 0.5-1.5 mm, symmetric: 0.9 % rms and at most 2.2 % off
 a mesh twice finer than the default) and a scatter of about 1 % between
 neighbouring designs, because each evaluation remeshes.  Finite differences
 for gradients must therefore step over several per cent of a variable's range
