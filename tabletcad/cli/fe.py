@@ -134,11 +134,12 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
 @click.option("--reference-thickness", type=float, default=None, help="Reference compact thickness, mm.")
 @click.option("--direction", default="width", show_default=True, help="Load direction in plan: width|length|x|y.")
 @click.option("--mesh-size", type=float, default=None, help="Element size, mm [default as fe diametral].")
+@click.option("--coarse", is_flag=True, help="The optimiser's coarse mesh (as the design report's FE breaking force).")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout.")
 @click.option("--json-file", type=click.Path(path_type=Path), default=None, help="Write the result as JSON to this file.")
 def strength_cmd(design: Path, tensile_strength: float | None, reference_force: float | None,
                  reference_diameter: float | None, reference_thickness: float | None, direction: str,
-                 mesh_size: float | None, as_json: bool, json_file: Path | None) -> None:
+                 mesh_size: float | None, as_json: bool, json_file: Path | None, coarse: bool = False) -> None:
     """Breaking force of DESIGN.toml predicted by FE (elastic first-crack estimate).
 
     Inputs from the options or the design file's [report] table: tensile_strength_MPa, or
@@ -149,8 +150,11 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
 
     if direction not in DIRECTIONS:
         raise DesignError("--direction", direction, "must be one of " + ", ".join(DIRECTIONS))
+    if coarse and mesh_size is not None:
+        raise DesignError("--mesh-size", mesh_size, "give either --mesh-size or --coarse", "mm")
     _check_json_file(json_file)
     _require_fe()
+    from tabletcad.fe.objective import coarse_prediction
     from tabletcad.fe.prediction import StrengthInputs, predict_breaking_force
 
     tablet, spec = load_family_design(design)
@@ -158,7 +162,8 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
                                        reference_breaking_force_N=reference_force,
                                        reference_diameter_mm=reference_diameter,
                                        reference_thickness_mm=reference_thickness)
-    pred = predict_breaking_force(tablet, inputs, direction, mesh_size=mesh_size, error_estimate=False)
+    pred = (coarse_prediction(tablet, inputs, direction) if coarse
+            else predict_breaking_force(tablet, inputs, direction, mesh_size=mesh_size, error_estimate=False))
     d = pred.to_dict()
     _echo({"design": str(design), **d}, as_json, [
         f"{tablet.name}: predicted breaking force {pred.breaking_force_N:.4g} N across {direction} "

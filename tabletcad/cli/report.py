@@ -113,6 +113,10 @@ def _table(name: str, sec: dict[str, Any]) -> str:
     else:
         rows.append(("punch-tip check", f"{'OK' if pc['ok'] else 'OVER LIMIT'}: {pc['compaction_force_kN']:g} kN of {pc['allowed_force_kN']:.4g} kN "
                      f"({pc['compaction_pressure_MPa']:.4g} MPa on {pc['tip_face_area_mm2']:.4g} mm2; {pc['limit_basis']})"))
+    fe = sec.get("fe_breaking_force")
+    if fe is not None:
+        rows.append(("FE breaking force", f"{fe['breaking_force_N']:.4g} N across the width (elastic first-crack "
+                                          f"estimate, coarse mesh; σ_t {fe['tensile_strength_MPa']:.4g} MPa)"))
     fda = r["fda_size"]
     rows.append(("FDA size (largest <= 22 mm)", f"{'OK' if fda['ok'] else 'TOO LARGE'} ({fda['largest_dimension_mm']:.4g} mm)"))
     if sec["nominal_certified"] is not None:
@@ -324,6 +328,13 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
         # industry families: the certified report; the thesis's shapes and free-form designs:
         # the same figures from their own geometry, without a certificate
         sec = design_report(tablet, opts) if isinstance(tablet.nominal, SweepNominal) else shape_report(tablet, opts)
+        if opts.fe_breaking_force:  # [report] fe_breaking_force = true: the coarse-mesh FE prediction
+            from tabletcad.fe.objective import report_breaking_force
+
+            try:
+                sec["fe_breaking_force"] = report_breaking_force(tablet, opts)
+            except DesignError as exc:  # a missing [report] input: one token, as above
+                raise exc.renamed(one_token(exc.parameter)) from None
         payload = dict(design=dict(name=tablet.name, file=str(design), family=tablet.family, params=dict(tablet.params)),
                        units=dict(length="mm", area="mm2", volume="mm3", angle="deg", force="N (kN where named)",
                                   stress="MPa", mass="mg"),

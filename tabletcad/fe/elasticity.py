@@ -14,6 +14,13 @@ reactions are zero up to round-off (they are returned and checked), so the
 stresses are those of the free body; weak springs would instead load the body
 slightly everywhere.  For traction loads the stresses do not depend on E (and
 scale linearly with the load); E only scales the displacements.
+
+Mirror-symmetric problems can be solved on the part of the body on one side of
+two or three coordinate mirror planes (``symmetry=``): the normal displacement
+vanishes on each plane (the tangential traction vanishes there naturally), one
+unknown fixes the translation the planes leave free, and the solution is
+unfolded to the whole body by reflection (:func:`unfold`), so that stresses are
+read from a full, exactly symmetric field.
 """
 
 from __future__ import annotations
@@ -28,7 +35,7 @@ from tabletcad.errors import DesignError, GeometryError, check_positive
 from tabletcad.fe.mesh import TetMesh
 
 __all__ = ["Material", "PressureLoad", "ElasticSolution", "boundary_facets", "solve_elasticity",
-           "principal_stresses", "von_mises"]
+           "principal_stresses", "von_mises", "unfold"]
 
 
 @dataclass(frozen=True)
@@ -180,7 +187,8 @@ class ElasticSolution:
         vals = np.concatenate([self.vertex_stress[near].reshape(-1, 9), self.vertex_stress[near].mean(axis=1).reshape(-1, 9)])
         X, Y, Z = (pts / radius).T
         A = np.column_stack([np.ones_like(X), X, Y, Z, X * X, Y * Y, Z * Z, X * Y, Y * Z, Z * X])
-        coef, *_ = np.linalg.lstsq(A, vals, rcond=None)
+        q_, r_ = np.linalg.qr(A)  # least squares by a thin QR: the same fit as lstsq's SVD, several times faster
+        coef = np.linalg.solve(r_, q_.T @ vals)
         s = coef[0].reshape(3, 3)
         return 0.5 * (s + s.T)
 
@@ -296,6 +304,67 @@ def _supports(m: Any, basis: Any, centre: np.ndarray, arm: float) -> np.ndarray:
     return np.array([nd[0, a], nd[1, a], nd[2, a], nd[1, b], nd[2, b], nd[2, c]])
 
 
+def unfold(points: np.ndarray, tets: np.ndarray, displacement: np.ndarray, vertex_stress: np.ndarray,
+           planes: Sequence[tuple[int, float]], tol: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Reflect a mesh and its fields across coordinate mirror planes, one after the other.
+
+    Parameters
+    ----------
+    points : ndarray, shape (n, 3)
+        Vertices, mm; ``tets`` (m, 4) their tetrahedra.
+    displacement : ndarray, shape (n, 3)
+        Vertex displacements, mm.
+    vertex_stress : ndarray, shape (m, 4, 3, 3)
+        Stress (MPa) at the vertices of every element.
+    planes : sequence of (axis, coordinate)
+        Mirror planes ``x[axis] = coordinate`` (mm).
+    tol : float
+        Vertices within ``tol`` mm of a plane lie on it and are shared by the two halves.
+
+    Returns
+    -------
+    The unfolded ``points``, ``tets``, ``displacement`` and ``vertex_stress``: each plane doubles
+    the elements; a reflection ``Q`` maps the displacement to ``Q u`` and the stress to ``Q σ Q``;
+    the reflected tetrahedra keep a positive orientation (two vertices swapped).
+    """
+    p, t, u, s = points, tets, displacement, vertex_stress
+    for ax, c in planes:
+        on = np.abs(p[:, ax] - c) <= tol
+        new = np.flatnonzero(~on)
+        idx = np.arange(len(p))
+        idx[new] = len(p) + np.arange(len(new))
+        q = p[new].copy()
+        q[:, ax] = 2.0 * c - q[:, ax]
+        sign = np.ones(3)
+        sign[ax] = -1.0
+        v = u[new] * sign
+        swap = [1, 0, 2, 3]
+        p = np.concatenate([p, q])
+        u = np.concatenate([u, v])
+        t = np.concatenate([t, idx[t][:, swap]])
+        s = np.concatenate([s, (s * np.outer(sign, sign))[:, swap]])
+    return p, t, u, s
+
+
+def _symmetry_dofs(basis: Any, planes: Sequence[tuple[int, float]], centre: np.ndarray, tol: float) -> np.ndarray:
+    """Unknowns fixed on mirror planes: the normal displacement of every node on each plane, and the
+    translation along the one axis two planes leave free (at the vertex nearest ``centre``)."""
+    axes = sorted({int(a) for a, _ in planes})
+    if len(axes) != len(planes) or len(axes) < 2:
+        raise ValueError(f"symmetry: need two or three mirror planes normal to different axes, got {list(planes)}")
+    comp = np.zeros(basis.N, dtype=np.int64)
+    for k, idx in enumerate(basis.split_indices()):
+        comp[idx] = k
+    x = basis.doflocs
+    fixed = [np.flatnonzero((comp == a) & (np.abs(x[a] - c) <= tol)) for a, c in planes]
+    if len(axes) == 2:
+        free_axis = ({0, 1, 2} - set(axes)).pop()
+        m = basis.mesh
+        v = int(np.argmin(((m.p.T - centre) ** 2).sum(axis=1)))
+        fixed.append(np.array([basis.nodal_dofs[free_axis, v]]))
+    return np.unique(np.concatenate(fixed))
+
+
 def solve_elasticity(
     mesh: TetMesh,
     material: Material,
@@ -305,6 +374,7 @@ def solve_elasticity(
     support_arm: float,
     facets: BoundaryFacets | None = None,
     skmesh: Any = None,
+    symmetry: Sequence[tuple[int, float]] = (),
 ) -> ElasticSolution:
     """Solve linear elasticity with pressure loads and a 3-2-1 support.
 
@@ -320,6 +390,13 @@ def solve_elasticity(
         Where the 3-2-1 support sits (mm) and the spacing of its three vertices (mm).
     facets, skmesh
         The :func:`boundary_facets` and skfem mesh the loads were selected on.
+    symmetry : sequence of (axis, coordinate)
+        Two or three mirror planes ``x[axis] = coordinate`` (mm) bounding ``mesh``, a part of a
+        mirror-symmetric body under a mirror-symmetric load: they replace the 3-2-1 support
+        (see :func:`_symmetry_dofs`; ``support_centre`` places the one fixed translation), and the
+        returned solution is unfolded to the whole body (:func:`unfold`): its mesh, displacement,
+        stresses and ``work`` are the whole body's, ``dofs`` the unknowns solved, ``reaction`` that
+        of the fixed translation.
     """
     import scipy.sparse.linalg as spla
     import skfem
@@ -343,7 +420,11 @@ def solve_elasticity(
         fb = skfem.FacetBasis(m, elem, facets=bf.ids[ld.facets], intorder=2)
         f += ld.pressure * pressure.assemble(fb)
         scale = max(scale, float(np.abs(bf.resultant(ld)).max()))
-    D = _supports(m, basis, np.asarray(support_centre, float), float(support_arm))
+    tol = 1e-9 * float(np.ptp(m.p, axis=1).max())
+    if symmetry:
+        D = _symmetry_dofs(basis, symmetry, np.asarray(support_centre, float), tol)
+    else:
+        D = _supports(m, basis, np.asarray(support_centre, float), float(support_arm))
     free = np.setdiff1d(np.arange(basis.N), D)
     Kf = K[free][:, free].tocsc()
     lu = spla.splu(Kf, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
@@ -357,5 +438,10 @@ def solve_elasticity(
     vertex_stress = np.ascontiguousarray(np.transpose(sig, (2, 3, 0, 1)))
     # vertex displacements (P2 nodal dofs at the vertices)
     disp = u[basis.nodal_dofs].T
+    work = float(f @ u)
+    if symmetry:
+        p, t, disp, vertex_stress = unfold(m.p.T, m.t.T, disp, vertex_stress, symmetry, tol)
+        m = skfem.MeshTet(np.ascontiguousarray(p.T), np.ascontiguousarray(t.T))
+        work *= 2 ** len(symmetry)
     return ElasticSolution(mesh=m, displacement=disp, vertex_stress=vertex_stress, dofs=int(basis.N),
-                           reaction=reaction, load_scale=scale, work=float(f @ u))
+                           reaction=reaction, load_scale=scale, work=work)

@@ -143,6 +143,13 @@ def _add_plane(gmsh: Any, plane: CutPlane, lo: np.ndarray, hi: np.ndarray) -> tu
     return (2, occ.addPlaneSurface([loop]))
 
 
+def _box_centre(occ: Any, dimtag: tuple[int, int]) -> np.ndarray:
+    """Centre of an entity's bounding box (mm): on the side of a cutting plane normal to an axis
+    where the piece lies (and much cheaper than the centre of mass of a B-spline piece)."""
+    b = np.asarray(occ.getBoundingBox(*dimtag), float)
+    return 0.5 * (b[:3] + b[3:])
+
+
 #: What :func:`mesh_solid` changes, in order, when gmsh fails to mesh a solid: a surface mesh that
 #: follows the curvature (a coarse one can leave facets of the curved cup crossing the band's, "PLC
 #: Error: A segment and a facet intersect"), then the Frontal-Delaunay surface and HXT volume algorithms.
@@ -172,6 +179,7 @@ def mesh_solid(
     *,
     refinements: Sequence[Refinement] = (),
     cuts: Sequence[CutPlane] = (),
+    keep: Sequence[CutPlane] = (),
 ) -> TetMesh:
     """Mesh a B-rep solid (TopoDS_Shape / TabletSolid / build123d or cadquery solid) with tetrahedra.
 
@@ -185,6 +193,10 @@ def mesh_solid(
         Finer regions (box or ball size fields, combined by their minimum).
     cuts : sequence of CutPlane
         Planes splitting the solid before meshing (conforming pieces).
+    keep : sequence of CutPlane
+        Half-spaces ``normal · x >= offset`` to keep, ``normal`` a coordinate axis: the solid is
+        also split by these planes and only the pieces inside all of them are meshed (a
+        symmetric part of the solid, e.g. the quarter of a tablet cut by two mirror planes).
     """
     from tabletcad.cad.export import export_brep
 
@@ -200,10 +212,17 @@ def mesh_solid(
                 raise GeometryError(f"mesh: expected one solid, gmsh read {len(vols)}", solid)
             lo = np.array(gmsh.model.getBoundingBox(-1, -1)[:3])
             hi = np.array(gmsh.model.getBoundingBox(-1, -1)[3:])
-            if cuts:
-                tools = [_add_plane(gmsh, c, lo, hi) for c in cuts]
+            if cuts or keep:
+                tools = [_add_plane(gmsh, c, lo, hi) for c in (*cuts, *keep)]
                 occ.fragment(vols, tools)
                 occ.synchronize()
+                out = [v for v in gmsh.model.getEntities(3) if any(np.dot(k.normal, _box_centre(occ, v)) < k.offset
+                                                                    for k in keep)]
+                if out:
+                    occ.remove(out, recursive=True)
+                    occ.synchronize()
+                if not gmsh.model.getEntities(3):
+                    raise GeometryError("mesh: no part of the solid is inside the kept half-spaces", solid)
                 keep = {f[1] for v in gmsh.model.getEntities(3)
                         for f in gmsh.model.getBoundary([v], oriented=False)}
                 loose = [e for e in gmsh.model.getEntities(2) if e[1] not in keep]

@@ -47,7 +47,7 @@ inputs in an ``[fe]`` table::
     direction = "width"              # width | length | x | y
     recheck = true                   # re-check the optimum on the default (finer) mesh
     symmetric = false                # true: every design is mirror symmetric across the load and
-                                     # about mid-thickness (halves the coarse mesh's scatter)
+                                     # about mid-thickness (only its quarter is solved: faster, exactly symmetric)
 
 Each evaluation is :func:`tabletcad.fe.objective.breaking_force` on the coarse
 mesh; the re-check's figures go to the report's ``extras``.

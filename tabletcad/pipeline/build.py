@@ -50,7 +50,9 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
     with the report ``options``); with ``cad`` (default: :func:`cad_available`) the solid, its
     checks and ``tablet.step/.stl/.glb`` (:func:`tabletcad.cad.stage.cad_stage`), then, with a
     ``tooling`` specification, the punches, die and drawings made from that solid
-    (:func:`tabletcad.tooling.stage.tooling_stage`); last the picture.  Whether the tablet can
+    (:func:`tabletcad.tooling.stage.tooling_stage`); when the options ask for it
+    (``[report] fe_breaking_force = true``), the FE breaking force on the coarse mesh
+    (:func:`tabletcad.fe.objective.report_breaking_force`); last the picture.  Whether the tablet can
     have tooling is checked before any geometry is built.  :func:`build_design` takes both
     from a design.
 
@@ -88,6 +90,14 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
 
                     tooling_stage(tablet=tablet, spec=tooling, shape=shape, out=staging, report=report, options=options)
                     bar.update()
+            if options is not None and options.fe_breaking_force:  # [report] fe_breaking_force = true
+                if cad:
+                    from tabletcad.fe.objective import report_breaking_force
+
+                    report["fe_breaking_force"] = report_breaking_force(tablet, options)
+                else:
+                    report["fe_breaking_force"] = {"breaking_force_N": None,
+                                                   "note": "not computed: this build made no CAD solid"}
             plot_tablet(tablet, staging / "tablet.png")
             bar.update()
         names = sorted(p.name for p in staging.iterdir() if p.name != STAGING_MARKER) + ["report.json"]

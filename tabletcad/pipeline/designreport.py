@@ -54,6 +54,8 @@ REPORT_KEYS = {
     "reference_breaking_force_N": "N",
     "reference_diameter_mm": "mm",
     "reference_thickness_mm": "mm",
+    # true: `tabletcad report` and `build` run that prediction on the coarse mesh (tabletcad.fe.objective)
+    "fe_breaking_force": "true or false",
 }
 
 
@@ -75,6 +77,9 @@ class ReportOptions:
         User-given punch-tip limits (no public rating table is bundled).
     tensile_strength_MPa, reference_breaking_force_N, reference_diameter_mm, reference_thickness_mm : float
         Inputs of the FE breaking-force prediction (``tabletcad fe strength``).
+    fe_breaking_force : bool
+        Run that prediction (across the width, coarse mesh: ``tabletcad fe strength --coarse``) in the
+        design report and the build (an elastic first-crack estimate; needs the CAD layer and FE).
     """
 
     solid_fraction: float | None = None
@@ -87,6 +92,7 @@ class ReportOptions:
     reference_breaking_force_N: float | None = None
     reference_diameter_mm: float | None = None
     reference_thickness_mm: float | None = None
+    fe_breaking_force: bool = False
 
     def __post_init__(self) -> None:
         if self.solid_fraction is not None:
@@ -105,7 +111,11 @@ class ReportOptions:
         for k in table:
             if k not in REPORT_KEYS:
                 raise DesignError(f"[report] key {k!r}", table[k], f"allowed keys are {', '.join(REPORT_KEYS)}")
-        return cls(**{k: float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else _bad(k, v) for k, v in table.items()})
+        flag = table.get("fe_breaking_force", False)
+        if not isinstance(flag, bool):
+            raise DesignError("[report] fe_breaking_force", flag, "must be a TOML boolean (true or false)")
+        return cls(fe_breaking_force=flag, **{k: float(v) if isinstance(v, (int, float)) and not isinstance(v, bool)
+                                              else _bad(k, v) for k, v in table.items() if k != "fe_breaking_force"})
 
     def merged(self, **kw) -> "ReportOptions":
         d = asdict(self)

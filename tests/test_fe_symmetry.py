@@ -1,0 +1,106 @@
+"""Mirror symmetry in FE: a quarter of the body solved with symmetry planes and unfolded must give the
+whole body's solution (closed forms on a box; the full model and Hondros on a thin disc)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.fe
+pytest.importorskip("skfem")
+pytest.importorskip("gmsh")
+build123d = pytest.importorskip("build123d")
+
+from tabletcad.fe.diametral import diametral, hondros_centre_stress  # noqa: E402
+from tabletcad.fe.elasticity import Material, PressureLoad, _skfem_mesh, boundary_facets, solve_elasticity  # noqa: E402
+from tabletcad.fe.mesh import CutPlane, mesh_solid  # noqa: E402
+from tabletcad.pipeline.design import design_from_dict  # noqa: E402
+
+SIGMA = 3.0  # MPa, the uniaxial compression of the box
+QUARTER = ((0, 0.0), (2, 0.0))  # mirror planes x = 0 and z = 0
+
+
+@pytest.fixture(scope="module")
+def box():
+    return build123d.Box(4.0, 3.0, 2.0).wrapped  # centred at the origin
+
+
+def _uniaxial(mesh, material, symmetry=()):
+    m = _skfem_mesh(mesh)
+    bf = boundary_facets(m)
+    ends = [PressureLoad(np.flatnonzero(s * bf.normals[:, 0] > 0.999), SIGMA) for s in (-1.0, 1.0)]
+    loads = [ld for ld in ends if ld.facets.size]  # the quarter has only the x = +2 end
+    return solve_elasticity(mesh, material, loads, support_centre=(0, 0, 0), support_arm=1.0, facets=bf, skmesh=m,
+                            symmetry=symmetry)
+
+
+def test_keep_meshes_only_the_quarter(box):
+    q = mesh_solid(box, 1.0, keep=[CutPlane((1.0, 0.0, 0.0), 0.0), CutPlane((0.0, 0.0, 1.0), 0.0)])
+    assert q.volume() == pytest.approx(6.0, rel=1e-12)
+    assert q.points.min(axis=0) == pytest.approx([0.0, -1.5, 0.0], abs=1e-12)
+    assert q.points.max(axis=0) == pytest.approx([2.0, 1.5, 1.0], abs=1e-12)
+
+
+def test_quarter_box_in_uniaxial_compression_unfolds_to_the_exact_whole(box):
+    """σ_xx = -3 MPa everywhere, the strain (-σ/E, νσ/E, νσ/E) and the load work σ²V/E = 2U of the whole box,
+    from the quarter x, z >= 0 with the normal displacement held on x = 0 and z = 0."""
+    mat = Material(E=1000.0, nu=0.25)
+    quarter = mesh_solid(box, 1.0, keep=[CutPlane((1.0, 0.0, 0.0), 0.0), CutPlane((0.0, 0.0, 1.0), 0.0)])
+    sol = _uniaxial(quarter, mat, QUARTER)
+    expect = np.zeros((3, 3))
+    expect[0, 0] = -SIGMA
+    assert np.abs(sol.vertex_stress - expect).max() < 1e-8
+    # the unfolded mesh is the whole box, four times the quarter, no vertex doubled on the planes
+    p = sol.mesh.p.T
+    assert sol.elements == 4 * quarter.elements
+    assert len(np.unique(np.round(p, 9), axis=0)) == len(p)
+    assert p.min(axis=0) == pytest.approx([-2.0, -1.5, -1.0], abs=1e-12)
+    assert p.max(axis=0) == pytest.approx([2.0, 1.5, 1.0], abs=1e-12)
+    xv = p[sol.mesh.t.T]  # (m, 4, 3)
+    vol6 = np.linalg.det(xv[:, 1:] - xv[:, :1])
+    assert np.abs(vol6).sum() / 6.0 == pytest.approx(24.0, rel=1e-12)
+    assert np.sign(vol6).min() == np.sign(vol6).max()  # reflected tetrahedra keep the orientation
+    # the displacement is the affine field u = ε x (+ a translation along y), mirrored with the mesh
+    X = np.hstack([p, np.ones((len(p), 1))])
+    coef, *_ = np.linalg.lstsq(X, sol.displacement, rcond=None)
+    assert np.abs(X @ coef - sol.displacement).max() < 1e-10 * np.abs(sol.displacement).max()
+    G = coef[:3].T
+    eps = np.diag([-SIGMA / mat.E, mat.nu * SIGMA / mat.E, mat.nu * SIGMA / mat.E])
+    assert 0.5 * (G + G.T) == pytest.approx(eps, abs=1e-10)
+    assert sol.work == pytest.approx(SIGMA**2 * 24.0 / mat.E, rel=1e-9)
+    assert sol.reaction < 1e-9 * SIGMA * 6.0
+    full = _uniaxial(mesh_solid(box, 1.0), mat)
+    assert full.work == pytest.approx(sol.work, rel=1e-9)
+
+
+def test_symmetry_needs_two_or_three_distinct_planes(box):
+    quarter = mesh_solid(box, 1.0, keep=[CutPlane((1.0, 0.0, 0.0), 0.0), CutPlane((0.0, 0.0, 1.0), 0.0)])
+    for bad in (((0, 0.0),), ((0, 0.0), (0, 0.0))):
+        with pytest.raises(ValueError, match="two or three mirror planes"):
+            _uniaxial(quarter, Material(), bad)
+
+
+def test_quarter_model_of_a_thin_disc_matches_the_full_model_and_hondros():
+    """Thin flat disc 10 x 1 mm across x, default mesh: the quarter model (``symmetric=True``) against
+    the whole disc and Hondros' centre stress; the unfolded field is exactly mirror symmetric."""
+    t = design_from_dict({"tablet": {"family": "flat_face_round", "diameter": 10.0, "thickness": 1.0}})
+    q = diametral(t, 100.0, "x", symmetric=True, error_estimate=False)
+    f = diametral(t, 100.0, "x", error_estimate=False)
+    h = hondros_centre_stress(100.0, q.diameter_mm, q.thickness_mm, q.strip_width_mm)
+    print(f"\nthin disc 10 x 1, 100 N: centre {q.centre_tensile_stress_MPa:.4f} MPa (quarter, {q.dofs} unknowns), "
+          f"{f.centre_tensile_stress_MPa:.4f} (whole, {f.dofs}), Hondros {h:.4f}; largest "
+          f"{q.max_tensile_stress_MPa:.4f} / {f.max_tensile_stress_MPa:.4f}")
+    assert q.centre_tensile_stress_MPa == pytest.approx(h, rel=0.02)
+    assert q.centre_tensile_stress_MPa == pytest.approx(f.centre_tensile_stress_MPa, rel=0.01)
+    assert q.max_tensile_stress_MPa == pytest.approx(f.max_tensile_stress_MPa, rel=0.01)
+    assert q.work_Nmm == pytest.approx(f.work_Nmm, rel=0.01)
+    assert q.dofs < 0.5 * f.dofs
+    # mirror images across x = 0 and z = mid-thickness: σ(Qx) = Q σ(x) Q
+    sol, c = q.solution, np.array(q.centre_mm)
+    x = c + np.array([2.1, 0.7, 0.3])
+    for ax in (0, 2):
+        y = x.copy()
+        y[ax] = 2.0 * c[ax] - x[ax]
+        Q = np.eye(3)
+        Q[ax, ax] = -1.0
+        assert sol.stress_at(y) == pytest.approx(Q @ sol.stress_at(x) @ Q, abs=1e-9 * q.centre_tensile_stress_MPa)
