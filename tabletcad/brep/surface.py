@@ -135,16 +135,18 @@ class BSplineSurfaceData:
         P = self.poles[iu[..., :, None], iv[..., None, :]]  # (..., pu+1, pv+1, 3)
         return np.einsum("...i,...j,...ijk->...k", Nu, Nv, P)
 
-    def evaluate_grid(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """Points on the tensor grid ``u x v`` (1-D arrays); returns ``(len(u), len(v), 3)``."""
-        Bu = self.collocation("u", u)
-        Bv = self.collocation("v", v)
+    def evaluate_grid(self, u: np.ndarray, v: np.ndarray, du: int = 0, dv: int = 0) -> np.ndarray:
+        """Points (or first partial derivatives) on the tensor grid ``u x v`` (1-D arrays);
+        returns ``(len(u), len(v), 3)``."""
+        Bu = self.collocation("u", u, du)
+        Bv = self.collocation("v", v, dv)
         return np.einsum("ai,ijk,bj->abk", Bu, self.poles, Bv, optimize=True)
 
-    def collocation(self, which: str, x: np.ndarray) -> np.ndarray:
-        """Dense matrix ``B[a, i]`` = value of the B-spline attached to pole ``i`` at ``x[a]``."""
+    def collocation(self, which: str, x: np.ndarray, order: int = 0) -> np.ndarray:
+        """Dense matrix ``B[a, i]`` = value (``order`` 0) or first derivative (``order`` 1) of the
+        B-spline attached to pole ``i`` at ``x[a]``."""
         x = np.asarray(x, dtype=float).ravel()
-        idx, N = self._basis(which, x, 0)
+        idx, N = self._basis(which, x, order)
         n = self.shape[0] if which == "u" else self.shape[1]
         B = np.zeros((x.size, n))
         rows = np.repeat(np.arange(x.size), idx.shape[1])
@@ -245,10 +247,9 @@ def enclosed_volume(surfaces: Sequence) -> float:
             a, b = knots[:-1, None], knots[1:, None]
             rules.append(((((b - a) * x + (a + b)) / 2).ravel(), (((b - a) / 2) * w).ravel()))
         (uq, uw), (vq, vw) = rules
-        U, V = np.meshgrid(uq, vq, indexing="ij")
-        S = s.evaluate(U, V)
-        Su = s.evaluate(U, V, du=1)
-        Sv = s.evaluate(U, V, dv=1)
+        S = s.evaluate_grid(uq, vq)
+        Su = s.evaluate_grid(uq, vq, du=1)
+        Sv = s.evaluate_grid(uq, vq, dv=1)
         integrand = np.einsum("...k,...k->...", S, np.cross(Su, Sv))
         total += float(np.einsum("i,j,ij->", uw, vw, integrand)) / 3.0
     return total
