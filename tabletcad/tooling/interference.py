@@ -112,14 +112,18 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
 
     ``tris`` (n, 3, 3) with ``values`` (n, 3), ``f`` at their corners.  Every point of a
     triangle with longest edge ``L`` lies within ``L / √3`` of a corner, so ``f`` there is
-    at most ``max(corner values) + L / √3``: triangles whose bound does not exceed the
-    largest value found are dropped, the others split at the midpoint of their longest
-    edge (``f`` measured there) until their edges are ``<= spacing``.  A value larger than
-    every one returned can then only hide within ``spacing / √3`` of a measured point, as
-    with uniformly refined triangles, at a fraction of the points.
+    at most ``max(corner values) + L / √3``.  A triangle is split at the midpoint of its
+    longest edge (``f`` measured there) while that bound exceeds the largest value found by
+    more than ``spacing / √3``; the others are dropped.  A triangle whose edges are
+    ``<= spacing`` is always dropped (its bound is within ``spacing / √3`` of a corner), so
+    no value exceeds every one returned by more than ``spacing / √3``, as with uniformly
+    refined triangles of edge ``spacing``, at a fraction of the points: where ``f`` is
+    nearly flat at its peak (the gap over a land: clearance / 2 all round) the triangles
+    stop splitting as soon as their bound is within the resolution of the peak.
 
     Returns the measured points (m, 3) and their values (m,).
     """
+    slack = spacing / math.sqrt(3.0)
     pts, vals = [], []
     for _ in range(200):
         if not len(tris):
@@ -127,7 +131,7 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
         e = np.stack([np.linalg.norm(tris[:, 1] - tris[:, 0], axis=1), np.linalg.norm(tris[:, 2] - tris[:, 1], axis=1),
                       np.linalg.norm(tris[:, 0] - tris[:, 2], axis=1)], axis=1)
         L = e.max(axis=1)
-        live = (values.max(axis=1) + L / math.sqrt(3.0) > best) & (L > spacing)
+        live = values.max(axis=1) + L / math.sqrt(3.0) > best + slack
         tris, values, e = tris[live], values[live], e[live]
         if not len(tris):
             break
