@@ -53,10 +53,7 @@ def _transform(shape: TopoDS_Shape, trsf: gp_Trsf) -> TopoDS_Shape:
 def figure_faces(e: EmbossSpec) -> TopoDS_Shape:
     """Plan faces (a compound at ``z = 0``) of the text or outline, placed and, for the bottom, mirrored."""
     if e.text is not None:
-        import build123d as bd
-
-        txt = bd.Text(e.text, font_size=e.height_mm, font_path=str(font_path(e.font)))
-        shape = txt.wrapped
+        shape = text_faces(e.text, e.height_mm, font_path(e.font))
     elif e.svg is not None:
         shape = svg_faces(e.svg, e.height_mm)
     else:
@@ -72,6 +69,25 @@ def figure_faces(e: EmbossSpec) -> TopoDS_Shape:
     if not explore(shape, "Face"):
         raise DesignError("[[tooling.emboss]] text", e.text, "gives no glyphs in this font")
     return shape
+
+
+def text_faces(text: str, size: float, path) -> TopoDS_Shape:
+    """The glyph faces of ``text`` in the font file ``path`` at ``size`` mm, centred on the origin both ways.
+
+    OCC's ``StdPrs_BRepTextBuilder`` with the font loaded from the file, as build123d's ``Text`` does
+    (``Graphic3d_HTA_CENTER``/``VTA_CENTER`` at the origin; its faces gathered in one compound) without
+    importing build123d (2 s): the same vertices and areas for the DejaVu fonts."""
+    from OCP.gp import gp_Ax3
+    from OCP.Graphic3d import Graphic3d_HTA_CENTER, Graphic3d_VTA_CENTER
+    from OCP.NCollection import NCollection_Utf8String
+    from OCP.StdPrs import StdPrs_BRepFont, StdPrs_BRepTextBuilder
+
+    font = StdPrs_BRepFont()
+    if not font.Init(NCollection_Utf8String(str(path)), float(size), 0):
+        raise DesignError("[[tooling.emboss]] font", str(path), "must be a TrueType/OpenType font file OCC can read")
+    shape = StdPrs_BRepTextBuilder().Perform(font, NCollection_Utf8String(text), gp_Ax3(), Graphic3d_HTA_CENTER,
+                                             Graphic3d_VTA_CENTER)
+    return _compound(explore(shape, "Face"))
 
 
 def svg_faces(path: str, height: float) -> TopoDS_Shape:
@@ -281,11 +297,14 @@ def _z_range(shape) -> tuple[float, float]:
 
 
 def apply_emboss(frame: TabletFrame, shape, items, clearance: float, *, check: bool = True,
-                 deflection: float = 0.005, a_manifold=None) -> tuple[Any, list, list[dict]]:
-    """Emboss/deboss every item on ``shape``; returns ``(solid, Boolean checks, per-item info)``."""
+                 deflection: float = 0.005, a_manifold=None, checked=None) -> tuple[Any, list, list[dict]]:
+    """Emboss/deboss every item on ``shape``; returns ``(solid, Boolean checks, per-item info)``.
+
+    ``checked``: what :func:`check_emboss` returned for each item, when the caller has checked them."""
     checks, infos = [], []
     for i, e in enumerate(items):
-        figure, info = check_emboss(frame, e, clearance, i)
+        figure, info = checked[i] if checked is not None else check_emboss(frame, e, clearance, i)
+        info = dict(info)
         top = e.face == "top"
         sg = 1.0 if top else -1.0
         # short prisms (OCC's surface intersections cost grows with the walls' height): from just

@@ -90,8 +90,7 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
         raise DesignError("[tooling] gap_mm", spec.gap_mm, f"must be >= the band {gap_closed:.4g} mm (the closed position)", "mm")
     for i, s in enumerate(spec.scores):  # fail on bad input before any Boolean
         check_score(frame, s, i)
-    for i, e in enumerate(spec.emboss):
-        check_emboss(frame, e, spec.clearance_mm, i)
+    emb_checked = [check_emboss(frame, e, spec.clearance_mm, i) for i, e in enumerate(spec.emboss)]
     if spec.body is not None:
         _check_complete_punches(frame, spec)
     solid = frame.shape
@@ -99,7 +98,8 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     a_man = to_manifold(solid, deflection) if check and (spec.scores or spec.emboss) else None
     solid, score_checks, score_info = apply_scores(frame, solid, spec.scores, check=check, deflection=deflection, a_manifold=a_man)
     a_man = None
-    solid, emb_checks, emb_info = apply_emboss(frame, solid, spec.emboss, spec.clearance_mm, check=check, deflection=deflection)
+    solid, emb_checks, emb_info = apply_emboss(frame, solid, spec.emboss, spec.clearance_mm, check=check, deflection=deflection,
+                                               checked=emb_checked)
     split = None
     if spec.scores:  # the finished tablet (scores and figures) split along its score planes
         from tabletcad.tooling.split import split_parts
