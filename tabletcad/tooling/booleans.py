@@ -33,7 +33,7 @@ try:  # OCP >= 8.0
 except ImportError:  # pragma: no cover - OCP 7.x
     from OCP.TopTools import TopTools_ListOfShape as _ShapeList
 
-__all__ = ["boolean", "split_cells", "checked_boolean", "BooleanCheck", "to_manifold", "manifold_volume", "translated",
+__all__ = ["boolean", "split_cells", "split_solid", "compound", "checked_boolean", "BooleanCheck", "to_manifold", "manifold_volume", "translated",
            "volume", "area", "TIMER", "CACHE"]
 
 _ALGOS = {"cut": BRepAlgoAPI_Cut, "fuse": BRepAlgoAPI_Fuse, "common": BRepAlgoAPI_Common}
@@ -157,12 +157,23 @@ def split_cells(a: TopoDS_Shape, faces, keep, *, what: str = "result") -> TopoDS
     outline split by the tablet's cup faces only, not by its band, which runs parallel to the prism's
     wall a clearance away and is the costly part of the full Boolean).  Raises :class:`GeometryError`
     unless exactly one cell is kept."""
+    shape, cells = _split(a, [compound(faces)], what)  # one tool: OCC does not intersect its faces with each other
+    return _one_solid([c for c in cells if keep(c)], shape, what=what, how="the split")
+
+
+def split_solid(a: TopoDS_Shape, tools, *, what: str = "result") -> list:
+    """The cells (solids) of solid ``a`` cut apart by the ``tools`` (faces or shells, intersected with
+    each other too: ``BRepAlgoAPI_Splitter``)."""
+    return _split(a, list(tools), what)[1]
+
+
+def _split(a: TopoDS_Shape, tools: list, what: str):
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Splitter
 
     t0 = time.perf_counter()
     algo = BRepAlgoAPI_Splitter()
     algo.SetArguments(_list(a))
-    algo.SetTools(_list(compound(faces)))  # one tool: OCC does not intersect its faces with each other
+    algo.SetTools(_list(*tools))
     algo.SetRunParallel(True)
     algo.SetNonDestructive(True)
     algo.Build()
@@ -171,7 +182,7 @@ def split_cells(a: TopoDS_Shape, faces, keep, *, what: str = "result") -> TopoDS
     if not algo.IsDone() or (hasattr(algo, "HasErrors") and algo.HasErrors()):
         raise GeometryError(f"{what}: OCC splitter failed", a)
     shape = algo.Shape()
-    return _one_solid([c for c in explore(shape, "Solid") if keep(c)], shape, what=what, how="the split")
+    return shape, explore(shape, "Solid")
 
 
 def translated(shape: TopoDS_Shape, dx: float = 0.0, dy: float = 0.0, dz: float = 0.0) -> TopoDS_Shape:
