@@ -209,9 +209,16 @@ def tessellate(
     weld_tol: float = 1e-7,
     check: bool = True,
     algo: str = "delabella",
+    arrays: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> MeshResult:
-    """Triangulate ``shape`` (deflections in mm and rad) and run the manifold3d / trimesh checks."""
-    V, T = triangulate(shape, linear_deflection, angular_deflection, relative=relative, weld_tol=weld_tol, algo=algo)
+    """Triangulate ``shape`` (deflections in mm and rad) and run the manifold3d / trimesh checks.
+
+    ``arrays``: ``(V, T)`` of a triangulation of ``shape`` already made with these deflections
+    (by :func:`triangulate`), checked instead of meshing again."""
+    if arrays is not None:
+        V, T = (np.array(a) for a in arrays)
+    else:
+        V, T = triangulate(shape, linear_deflection, angular_deflection, relative=relative, weld_tol=weld_tol, algo=algo)
     vol, area = _signed_volume_area(V, T)
     status, genus, mvol = ("unchecked", None, None)
     watertight = winding = None

@@ -99,6 +99,7 @@ class MeshDistance:
         if len(near):
             d2 = self.tree.squared_distance(self.V, self.T, np.ascontiguousarray(P[near]))[0]
             out[near] = np.sqrt(np.maximum(d2, 0.0))
+        out[out > self.reach] = np.inf  # the same answer whatever the triangles' size
         return out
 
 
@@ -265,10 +266,14 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
     # land against chords of 5 µm would be outranked by chord artefacts on the cups)
     tool_deflection = min(deflection, max(0.1 * clearance, 1e-3))
     # each tool's triangles near the tablet, long ones split (slivers of a die's flat faces
-    # make an AABB tree slow): distances are unchanged, only the search is cheaper
-    h_split = max(4.0 * clearance, 0.05)
-    lo, hi = V.min(axis=0) - 4 * h_split, V.max(axis=0) + 4 * h_split
-    tools = [MeshDistance(*refine_triangles(*mesh_arrays(s, tool_deflection, 0.2), h_split, lo, hi), reach=2 * h_split)
+    # make an AABB tree slow): distances are unchanged, only the search is cheaper.  Distances
+    # beyond ``reach`` are not needed (the gap is a fraction of it); triangles of 16 clearances
+    # (0.32 mm at 0.02 mm) search fastest: at 0.08 mm a die's bore had 440,000 triangles and
+    # its tree took 4 times as long to build and ask
+    reach = 2.0 * max(4.0 * clearance, 0.05)
+    h_split = max(16.0 * clearance, 0.2)
+    lo, hi = V.min(axis=0) - 2 * reach, V.max(axis=0) + 2 * reach
+    tools = [MeshDistance(*refine_triangles(*mesh_arrays(s, tool_deflection, 0.2), h_split, lo, hi), reach=reach)
              for s in parts.values()]
 
     def measure(P):
