@@ -194,12 +194,23 @@ def translated(shape: TopoDS_Shape, dx: float = 0.0, dy: float = 0.0, dz: float 
 
 def volume(shape: TopoDS_Shape, eps: float = 1e-9) -> float:
     """Volume (mm^3) by OCC's adaptive integration (once per shape: :data:`CACHE`)."""
-    return CACHE.get(shape, ("volume", eps), lambda: mass_properties(shape, eps).volume)
+    return CACHE.get(shape, ("volume", eps), lambda: _integral(shape, eps, "Volume"))
 
 
 def area(shape: TopoDS_Shape, eps: float = 1e-6) -> float:
     """Surface area (mm^2) by OCC's adaptive integration (once per shape: :data:`CACHE`)."""
-    return CACHE.get(shape, ("area", eps), lambda: mass_properties(shape, eps).area)
+    return CACHE.get(shape, ("area", eps), lambda: _integral(shape, eps, "Surface"))
+
+
+def _integral(shape: TopoDS_Shape, eps: float, kind: str) -> float:
+    """``BRepGProp.VolumeProperties`` or ``SurfaceProperties`` alone (what :func:`mass_properties` computes,
+    without the other one), adaptive to ``eps``."""
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    props = GProp_GProps()
+    getattr(BRepGProp, f"{kind}Properties_s")(shape, props, Eps=float(eps))
+    return float(props.Mass())
 
 
 # ----------------------------------------------------------------------------- manifold3d
