@@ -249,14 +249,9 @@ def _to_manifold(shape: TopoDS_Shape, deflection: float, angular: float):
 
 
 def manifold_volume(m) -> float:
-    """Volume (mm^3) of a manifold, summed in float64 from its ``Mesh64``."""
-    mesh = m.to_mesh64()
-    V = np.asarray(mesh.vert_properties, dtype=float)[:, :3]
-    T = np.asarray(mesh.tri_verts, dtype=np.int64)
-    if len(T) == 0:
-        return 0.0
-    a, b, c = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
-    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+    """Volume (mm^3) of a manifold, by manifold3d (float64 vertices since manifold3d 3.0: the same sum as
+    the signed tetrahedra of its ``Mesh64`` to 2e-16 relative, without copying the mesh out)."""
+    return 0.0 if m.is_empty() else float(m.volume())
 
 
 def manifold_op(op: str, ma, mb):
