@@ -40,6 +40,7 @@ from OCP.TopoDS import TopoDS_Shape
 from tabletcad.cad._occ import explore
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.tooling.booleans import checked_boolean, translated
+from tabletcad.tooling.booleans import compound as _compound
 from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, polyline_wire
 from tabletcad.tooling.spec import EmbossSpec, font_path
 
@@ -228,17 +229,7 @@ def figure_prism(figure: TopoDS_Shape, z0: float, z1: float, draft_deg: float = 
     else:
         zn = z0 if z_nominal is None else z_nominal
         solids = [_drafted(f, zn, abs(z1 - zn), abs(zn - z0), draft_deg, up=z1 > z0) for f in faces]
-    if len(solids) == 1:
-        return solids[0]
-    from OCP.BRep import BRep_Builder
-    from OCP.TopoDS import TopoDS_Compound
-
-    comp = TopoDS_Compound()
-    b = BRep_Builder()
-    b.MakeCompound(comp)
-    for s in solids:
-        b.Add(comp, s)
-    return comp
+    return solids[0] if len(solids) == 1 else _compound(solids)
 
 
 def _mirror_z(shape):
@@ -365,18 +356,6 @@ def face_heights(shape, figure, top: bool) -> list[float]:
     if not out:
         raise GeometryError("the figure does not lie over the tablet", figure)
     return out
-
-
-def _compound(shapes):
-    from OCP.BRep import BRep_Builder
-    from OCP.TopoDS import TopoDS_Compound
-
-    comp = TopoDS_Compound()
-    b = BRep_Builder()
-    b.MakeCompound(comp)
-    for s in shapes:
-        b.Add(comp, s)
-    return comp
 
 
 def _cut_each(prism, shifted, i):
