@@ -277,7 +277,7 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
     V, T = mesh_arrays(tablet, deflection, 0.2)
     if tablet_model is not None:
         S = _surface_samples(tablet_model)
-        keep = mesh_distance(S, V, T) <= 2.0 * deflection
+        keep = mesh_distance(S, V, T, reach=2.0 * deflection) <= 2.0 * deflection  # farther: inf, dropped as before
         V = np.vstack([V, S[keep]])
     n_mesh = len(V)
     V = np.vstack([V, face_samples(tablet, spacing=max(0.25 * clearance, 0.005))])  # inside every B-rep face
