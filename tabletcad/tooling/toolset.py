@@ -14,7 +14,7 @@ from typing import Any
 from tabletcad.errors import DesignError
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.designreport import ReportOptions
-from tabletcad.tooling.booleans import TIMER, to_manifold, volume
+from tabletcad.tooling.booleans import CACHE, TIMER, to_manifold, volume
 from tabletcad.tolerance import DEFAULT
 from tabletcad.tooling.spec import ToolingSpec
 
@@ -84,6 +84,7 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     spec = spec or ToolingSpec()
     t0 = time.perf_counter()
     b0 = dict(TIMER)
+    CACHE.clear()  # meshes and volumes of the previous build's solids are not asked for again
     frame = tablet_frame(tablet, shape)
     gap_closed = frame.band
     if spec.gap_mm is not None and spec.gap_mm < gap_closed - 1e-9:
