@@ -8,6 +8,9 @@ on manifold3d meshes (``Mesh64``, tessellated by :func:`tabletcad.cad.mesh.trian
 and compares the volume removed or added: a triangulation with chord height
 ``d`` misplaces each surface by at most ``d``, so the two volume changes may
 differ by about ``d`` times the area of the tool's surface (``bound_mm3``).
+:func:`split_cells` gets one piece of such a result from ``BRepAlgoAPI_Splitter`` with only the
+faces that bound it (a punch tip: the prism split by the tablet's face, not by its band).
+Meshes, manifolds, volumes and areas are computed once per shape (:data:`CACHE`).
 """
 
 from __future__ import annotations
