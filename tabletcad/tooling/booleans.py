@@ -8,6 +8,9 @@ on manifold3d meshes (``Mesh64``, tessellated by :func:`tabletcad.cad.mesh.trian
 and compares the volume removed or added: a triangulation with chord height
 ``d`` misplaces each surface by at most ``d``, so the two volume changes may
 differ by about ``d`` times the area of the tool's surface (``bound_mm3``).
+:func:`split_cells` gets one piece of such a result from ``BRepAlgoAPI_Splitter`` with only the
+faces that bound it (a punch tip: the prism split by the tablet's face, not by its band).
+Meshes, manifolds, volumes and areas are computed once per shape (:data:`CACHE`).
 """
 
 from __future__ import annotations
@@ -26,18 +29,23 @@ from OCP.TopoDS import TopoDS_Shape
 from tabletcad.cad._occ import explore
 from tabletcad.cad.solid import check_solid, mass_properties
 from tabletcad.errors import GeometryError
+from tabletcad.tooling.shape_cache import ShapeCache, frozen
 
 try:  # OCP >= 8.0
     from OCP.collections import List_TopoDS_Shape as _ShapeList
 except ImportError:  # pragma: no cover - OCP 7.x
     from OCP.TopTools import TopTools_ListOfShape as _ShapeList
 
-__all__ = ["boolean", "checked_boolean", "BooleanCheck", "to_manifold", "manifold_volume", "translated", "volume", "TIMER"]
+__all__ = ["boolean", "split_cells", "split_solid", "compound", "checked_boolean", "BooleanCheck", "to_manifold", "manifold_volume", "translated",
+           "volume", "area", "TIMER", "CACHE"]
 
 _ALGOS = {"cut": BRepAlgoAPI_Cut, "fuse": BRepAlgoAPI_Fuse, "common": BRepAlgoAPI_Common}
 
 #: seconds spent in OCC Booleans and in manifold3d (meshing + Booleans), for the benchmarks
 TIMER = {"occ_boolean_s": 0.0, "manifold_s": 0.0, "occ_booleans": 0, "manifold_booleans": 0}
+
+#: meshes, manifolds, volumes and areas of the shapes a build asks about more than once
+CACHE = ShapeCache()
 
 
 def _list(*shapes: TopoDS_Shape):
@@ -104,13 +112,18 @@ def boolean(op: str, a: TopoDS_Shape, b: TopoDS_Shape, *, what: str = "result", 
         # retry with a sub-micrometre fuzzy tolerance: B-spline faces that meet a tool
         # exactly along a seam (e.g. a score across a capsule's centre-line seam) need it
         shape = raw_boolean(op, a, b, 1e-5)
-    solids = explore(shape, "Solid")
+    return _one_solid(explore(shape, "Solid"), shape, what=what, how=f"the {op}", sliver=sliver)
+
+
+def _one_solid(solids: list, shape, *, what: str, how: str, sliver: float = 0.0) -> TopoDS_Shape:
+    """The one solid of ``solids`` (those below ``sliver`` times the largest dropped), faces on one
+    surface merged, checked by ``BRepCheck_Analyzer``."""
     if sliver > 0 and len(solids) > 1:
         vols = [mass_properties(s, 1e-7).volume for s in solids]
         solids = [s for s, v in zip(solids, vols) if v >= sliver * max(vols)]
     if len(solids) != 1:
         vols = ", ".join(f"{mass_properties(s, 1e-7).volume:.4g}" for s in solids[:6])
-        raise GeometryError(f"{what}: the {op} gave {len(solids)} solids (volumes {vols} mm^3), expected one", shape)
+        raise GeometryError(f"{what}: {how} gave {len(solids)} solids (volumes {vols} mm^3), expected one", shape)
     unify = ShapeUpgrade_UnifySameDomain(solids[0], True, True, False)
     unify.KeepShapes(_bspline_face_edges(solids[0]))
     unify.Build()
@@ -124,6 +137,57 @@ def boolean(op: str, a: TopoDS_Shape, b: TopoDS_Shape, *, what: str = "result", 
     return solid
 
 
+def compound(shapes) -> TopoDS_Shape:
+    """The shapes as one ``TopoDS_Compound``."""
+    from OCP.BRep import BRep_Builder
+    from OCP.TopoDS import TopoDS_Compound
+
+    comp = TopoDS_Compound()
+    b = BRep_Builder()
+    b.MakeCompound(comp)
+    for s in shapes:
+        b.Add(comp, s)
+    return comp
+
+
+def split_cells(a: TopoDS_Shape, faces, keep, *, what: str = "result") -> TopoDS_Shape:
+    """The cell of solid ``a`` cut apart by ``faces`` (``BRepAlgoAPI_Splitter``) for which ``keep`` holds,
+    as one valid solid (faces on one surface merged).
+
+    ``keep(cell)`` gets each cell (a solid).  When the faces are the only part of a solid ``b``'s
+    boundary that lies inside ``a`` near the kept cell, that cell is a piece of ``a - b`` computed
+    without intersecting ``a`` with the rest of ``b`` (e.g. a punch tip: the prism on the tablet's
+    outline split by the tablet's cup faces only, not by its band, which runs parallel to the prism's
+    wall a clearance away and is the costly part of the full Boolean).  Raises :class:`GeometryError`
+    unless exactly one cell is kept."""
+    shape, cells = _split(a, [compound(faces)], what)  # one tool: OCC does not intersect its faces with each other
+    return _one_solid([c for c in cells if keep(c)], shape, what=what, how="the split")
+
+
+def split_solid(a: TopoDS_Shape, tools, *, what: str = "result") -> list:
+    """The cells (solids) of solid ``a`` cut apart by the ``tools`` (faces or shells, intersected with
+    each other too: ``BRepAlgoAPI_Splitter``)."""
+    return _split(a, list(tools), what)[1]
+
+
+def _split(a: TopoDS_Shape, tools: list, what: str):
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Splitter
+
+    t0 = time.perf_counter()
+    algo = BRepAlgoAPI_Splitter()
+    algo.SetArguments(_list(a))
+    algo.SetTools(_list(*tools))
+    algo.SetRunParallel(True)
+    algo.SetNonDestructive(True)
+    algo.Build()
+    TIMER["occ_boolean_s"] += time.perf_counter() - t0
+    TIMER["occ_booleans"] += 1
+    if not algo.IsDone() or (hasattr(algo, "HasErrors") and algo.HasErrors()):
+        raise GeometryError(f"{what}: OCC splitter failed", a)
+    shape = algo.Shape()
+    return shape, explore(shape, "Solid")
+
+
 def translated(shape: TopoDS_Shape, dx: float = 0.0, dy: float = 0.0, dz: float = 0.0) -> TopoDS_Shape:
     """A copy of ``shape`` moved by ``(dx, dy, dz)`` mm (geometry copied, no location)."""
     tr = gp_Trsf()
@@ -132,29 +196,54 @@ def translated(shape: TopoDS_Shape, dx: float = 0.0, dy: float = 0.0, dz: float 
 
 
 def volume(shape: TopoDS_Shape, eps: float = 1e-9) -> float:
-    """Volume (mm^3) by OCC's adaptive integration."""
-    return mass_properties(shape, eps).volume
+    """Volume (mm^3) by OCC's adaptive integration (once per shape: :data:`CACHE`)."""
+    return CACHE.get(shape, ("volume", eps), lambda: _integral(shape, eps, "Volume"))
+
+
+def area(shape: TopoDS_Shape, eps: float = 1e-6) -> float:
+    """Surface area (mm^2) by OCC's adaptive integration (once per shape: :data:`CACHE`)."""
+    return CACHE.get(shape, ("area", eps), lambda: _integral(shape, eps, "Surface"))
+
+
+def _integral(shape: TopoDS_Shape, eps: float, kind: str) -> float:
+    """``BRepGProp.VolumeProperties`` or ``SurfaceProperties`` alone (what :func:`mass_properties` computes,
+    without the other one), adaptive to ``eps``."""
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    props = GProp_GProps()
+    getattr(BRepGProp, f"{kind}Properties_s")(shape, props, Eps=float(eps))
+    return float(props.Mass())
 
 
 # ----------------------------------------------------------------------------- manifold3d
 def mesh_arrays(shape: TopoDS_Shape, deflection: float = 0.005, angular: float = 0.2):
-    """``(V, T)`` of the tessellation (Delabella, falling back to Watson for faces it leaves empty)."""
+    """``(V, T)`` of the tessellation (Delabella, falling back to Watson for faces it leaves empty),
+    read-only and computed once per shape and deflections (:data:`CACHE`)."""
     from tabletcad.cad.mesh import triangulate
 
-    try:
-        return triangulate(shape, deflection, angular)
-    except GeometryError:  # Delabella leaves some trimmed faces (letter counters) untriangulated
-        return triangulate(shape, deflection, angular, algo="watson")
+    def compute():
+        try:
+            return frozen(*triangulate(shape, deflection, angular))
+        except GeometryError:  # Delabella leaves some trimmed faces (letter counters) untriangulated
+            return frozen(*triangulate(shape, deflection, angular, algo="watson"))
+
+    return CACHE.get(shape, ("mesh", float(deflection), float(angular)), compute)
 
 
 def to_manifold(shape: TopoDS_Shape, deflection: float = 0.005, angular: float = 0.2):
-    """A ``manifold3d.Manifold`` from the OCC tessellation of ``shape`` (double precision)."""
+    """A ``manifold3d.Manifold`` from the OCC tessellation of ``shape`` (double precision; once per
+    shape and deflections, :data:`CACHE`)."""
+    return CACHE.get(shape, ("manifold", float(deflection), float(angular)), lambda: _to_manifold(shape, deflection, angular))
+
+
+def _to_manifold(shape: TopoDS_Shape, deflection: float, angular: float):
     import manifold3d
 
     t0 = time.perf_counter()
     V, T = mesh_arrays(shape, deflection, angular)
-    m = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=np.ascontiguousarray(V, dtype=np.float64),
-                                              tri_verts=np.ascontiguousarray(T, dtype=np.uint32)))
+    m = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=np.array(V, dtype=np.float64, order="C"),  # writable copies
+                                              tri_verts=np.array(T, dtype=np.uint32, order="C")))
     status = getattr(m.status(), "name", str(m.status()))
     TIMER["manifold_s"] += time.perf_counter() - t0
     if not str(status).endswith("NoError"):
@@ -163,14 +252,9 @@ def to_manifold(shape: TopoDS_Shape, deflection: float = 0.005, angular: float =
 
 
 def manifold_volume(m) -> float:
-    """Volume (mm^3) of a manifold, summed in float64 from its ``Mesh64``."""
-    mesh = m.to_mesh64()
-    V = np.asarray(mesh.vert_properties, dtype=float)[:, :3]
-    T = np.asarray(mesh.tri_verts, dtype=np.int64)
-    if len(T) == 0:
-        return 0.0
-    a, b, c = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
-    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+    """Volume (mm^3) of a manifold, by manifold3d (float64 vertices since manifold3d 3.0: the same sum as
+    the signed tetrahedra of its ``Mesh64`` to 2e-16 relative, without copying the mesh out)."""
+    return 0.0 if m.is_empty() else float(m.volume())
 
 
 def manifold_op(op: str, ma, mb):
@@ -211,12 +295,15 @@ def checked_boolean(
     a_manifold=None,
     fuzzy: float = 0.0,
     sliver: float = 0.0,
+    exact=None,
 ) -> tuple[TopoDS_Shape, BooleanCheck | None]:
     """:func:`boolean` plus the manifold3d check; raises :class:`GeometryError` if they disagree.
 
-    The "change" is the volume removed (cut), added (fuse) or kept (common).
+    The "change" is the volume removed (cut), added (fuse) or kept (common).  ``exact``: a function
+    that returns the exact result another way (e.g. :func:`split_cells`); the manifold3d check
+    still runs the whole ``a op b`` on the meshes of ``a`` and ``b``.
     """
-    result = boolean(op, a, b, what=what, fuzzy=fuzzy, sliver=sliver)
+    result = boolean(op, a, b, what=what, fuzzy=fuzzy, sliver=sliver) if exact is None else exact()
     if not check:
         return result, None
     va, vr = volume(a), volume(result)
@@ -226,8 +313,7 @@ def checked_boolean(
     mr = manifold_op(op, ma, mb)
     mva, mvr = manifold_volume(ma), manifold_volume(mr)
     mesh_change = {"cut": mva - mvr, "fuse": mvr - mva, "common": mvr}[op]
-    area_b = mass_properties(b, 1e-6).area
-    bound = deflection * area_b
+    bound = deflection * area(b)
     diff = abs(occ_change - mesh_change)
     chk = BooleanCheck(what, op, occ_change, mesh_change, diff, diff / max(abs(occ_change), 1e-300), bound,
                        deflection, True, diff <= bound)

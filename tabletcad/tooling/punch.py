@@ -20,7 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tabletcad.tooling.booleans import checked_boolean, volume
+from tabletcad.errors import GeometryError
+from tabletcad.tooling.booleans import boolean, checked_boolean, split_cells, volume
 from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, prism, wire_length
 
 __all__ = ["PunchTip", "punch_tip", "cup_volume_within", "punch_volume_quadrature"]
@@ -54,7 +55,8 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
     body = prism(tip_wire, z0, z1)
     # the manifold check is on "prism minus tablet": the removed volume is the tablet inside the prism
     shape, chk = checked_boolean("cut", body, tablet_shape, what=f"{which} punch tip", deflection=deflection,
-                                 check=check, a_manifold=None, sliver=1e-4)
+                                 check=check, a_manifold=None, sliver=1e-4,
+                                 exact=lambda: tip_cell(body, tablet_shape, z_mid, z0, z1, which))
     vol = volume(shape)
     land = None if frame.land is None else frame.land - clearance
     quad = punch_volume_quadrature(frame, clearance, tip_length, which)
@@ -81,6 +83,45 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
         volume_rel_diff_vs_quadrature=None if quad is None else (vol - quad) / quad,
     )
     return PunchTip(f"{which}_punch", shape, vol, info), chk
+
+
+def _z_range(shape) -> tuple[float, float]:
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    box = Bnd_Box()
+    BRepBndLib.Add_s(shape, box, False)
+    return box.CornerMin().Z(), box.CornerMax().Z()
+
+
+def tip_cell(body, tablet_shape, z_mid: float, z0: float, z1: float, which: str):
+    """``body - tablet_shape`` for the tip prism ``body`` (``z0`` to ``z1``, its inner end ``z_mid`` inside the
+    tablet): the prism split by the tablet's faces beyond the band's middle only, the cell at the tip's far
+    end kept (:func:`~tabletcad.tooling.booleans.split_cells`).
+
+    Inside the prism the tablet's boundary is its face (cup, scores, figures): the band lies on the
+    outline, outside the prism inset by the clearance (or on its wall), and is left out, so OCC never
+    intersects the band with the prism's wall running parallel to it (the full Boolean took 0.5-2 s, the
+    split ~0.1 s, with the same volume to 1e-12).  A cell that reaches the prism's inner end would have
+    leaked into the tablet past a missing face: it is refused and the full Boolean is done instead, as
+    when the split does not give one such cell."""
+    from tabletcad.cad._occ import explore
+
+    up = which == "upper"
+    faces = [f for f in explore(tablet_shape, "Face") if (_z_range(f)[0] > z_mid if up else _z_range(f)[1] < z_mid)]
+    far, near = (z1, z0) if up else (z0, z1)
+    tol = 1e-6
+
+    def keep(cell) -> bool:
+        lo, hi = _z_range(cell)
+        reaches_far = hi > far - tol if up else lo < far + tol
+        reaches_near = lo < near + tol if up else hi > near - tol
+        return reaches_far and not reaches_near
+
+    try:
+        return split_cells(body, faces, keep, what=f"{which} punch tip")
+    except GeometryError:
+        return boolean("cut", body, tablet_shape, what=f"{which} punch tip", sliver=1e-4)
 
 
 # ----------------------------------------------------------------------------- quadrature

@@ -83,8 +83,11 @@ def write_finished_tablet(ts, out: Path) -> list[Path]:
     import os
 
     from tabletcad.cad.export import export
-    from tabletcad.cad.mesh import tessellate
+    import numpy as np
+
+    from tabletcad.cad.mesh import mesh_result
     from tabletcad.cad.stage import MESH_ANGULAR_RAD, MESH_LINEAR_MM
+    from tabletcad.tooling.booleans import mesh_arrays
 
     out = Path(out)
     name = ts.tablet.name
@@ -95,10 +98,10 @@ def write_finished_tablet(ts, out: Path) -> list[Path]:
         export(ts.frame.shape, out / "tablet_plain.step", name=f"{name}_plain")
     files.append(out / "tablet_plain.step")
     finished = ts.parts["tablet"]
-    try:
-        mesh = tessellate(finished, MESH_LINEAR_MM, MESH_ANGULAR_RAD)
-    except GeometryError:  # Delabella leaves some trimmed faces (letter counters) empty: as mesh_arrays
-        mesh = tessellate(finished, MESH_LINEAR_MM, MESH_ANGULAR_RAD, algo="watson")
+    # the triangulation the tooling checks made (Delabella, or Watson where Delabella leaves some
+    # trimmed faces such as letter counters empty), meshed once per solid
+    V, T = mesh_arrays(finished, MESH_LINEAR_MM, MESH_ANGULAR_RAD)
+    mesh = mesh_result(np.array(V), np.array(T), MESH_LINEAR_MM, MESH_ANGULAR_RAD)
     if not mesh.ok:
         raise GeometryError(
             f"{name}: mesh check of the finished tablet failed (manifold3d {mesh.manifold_status}, "

@@ -14,7 +14,7 @@ from typing import Any
 from tabletcad.errors import DesignError
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.designreport import ReportOptions
-from tabletcad.tooling.booleans import TIMER, to_manifold, volume
+from tabletcad.tooling.booleans import CACHE, TIMER, to_manifold, volume
 from tabletcad.tolerance import DEFAULT
 from tabletcad.tooling.spec import ToolingSpec
 
@@ -84,14 +84,14 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     spec = spec or ToolingSpec()
     t0 = time.perf_counter()
     b0 = dict(TIMER)
+    CACHE.clear()  # meshes and volumes of the previous build's solids are not asked for again
     frame = tablet_frame(tablet, shape)
     gap_closed = frame.band
     if spec.gap_mm is not None and spec.gap_mm < gap_closed - 1e-9:
         raise DesignError("[tooling] gap_mm", spec.gap_mm, f"must be >= the band {gap_closed:.4g} mm (the closed position)", "mm")
     for i, s in enumerate(spec.scores):  # fail on bad input before any Boolean
         check_score(frame, s, i)
-    for i, e in enumerate(spec.emboss):
-        check_emboss(frame, e, spec.clearance_mm, i)
+    emb_checked = [check_emboss(frame, e, spec.clearance_mm, i) for i, e in enumerate(spec.emboss)]
     if spec.body is not None:
         _check_complete_punches(frame, spec)
     solid = frame.shape
@@ -99,7 +99,8 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     a_man = to_manifold(solid, deflection) if check and (spec.scores or spec.emboss) else None
     solid, score_checks, score_info = apply_scores(frame, solid, spec.scores, check=check, deflection=deflection, a_manifold=a_man)
     a_man = None
-    solid, emb_checks, emb_info = apply_emboss(frame, solid, spec.emboss, spec.clearance_mm, check=check, deflection=deflection)
+    solid, emb_checks, emb_info = apply_emboss(frame, solid, spec.emboss, spec.clearance_mm, check=check, deflection=deflection,
+                                               checked=emb_checked)
     split = None
     if spec.scores:  # the finished tablet (scores and figures) split along its score planes
         from tabletcad.tooling.split import split_parts

@@ -1,0 +1,55 @@
+"""Results computed from an OCC shape, kept while the shape lives in the build (meshes, volumes, areas).
+
+A tooling build asks for the same facts of the same solid many times: the finished tablet is
+meshed for every Boolean's manifold3d check, for the overlap check, for the gap check and for its
+STL; its volume is integrated before and after every Boolean.  :class:`ShapeCache` keeps one
+result per (shape, key): shapes are matched by ``IsEqual`` (same topology, location and
+orientation), the newest ``size`` entries are kept, and each entry holds a reference to its shape
+so that its topology cannot be freed and its address reused while the entry exists.  A cached
+result is the same object as the first one, so results are returned read-only (numpy arrays are
+frozen by :func:`frozen`).
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from typing import Any, Callable
+
+import numpy as np
+
+__all__ = ["ShapeCache", "frozen"]
+
+
+class ShapeCache:
+    """The ``size`` most recently used results ``compute()`` of ``(shape, key)``."""
+
+    def __init__(self, size: int = 48) -> None:
+        self.size = int(size)
+        self._entries: OrderedDict = OrderedDict()
+        self.hits = 0
+        self.misses = 0
+
+    def get(self, shape, key: Any, compute: Callable[[], Any]) -> Any:
+        slot = (hash(shape), key)
+        for i, (s, value) in enumerate(self._entries.get(slot, ())):
+            if s.IsEqual(shape):
+                self._entries.move_to_end(slot)
+                self.hits += 1
+                return value
+        value = compute()
+        self.misses += 1
+        self._entries.setdefault(slot, []).append((shape, value))
+        self._entries.move_to_end(slot)
+        while len(self._entries) > self.size:
+            self._entries.popitem(last=False)
+        return value
+
+    def clear(self) -> None:
+        self._entries.clear()
+
+
+def frozen(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The arrays made read-only (a cached result must not be changed by one of its users)."""
+    for a in arrays:
+        a.setflags(write=False)
+    return arrays
