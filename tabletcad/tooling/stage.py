@@ -82,9 +82,9 @@ def write_finished_tablet(ts, out: Path) -> list[Path]:
     """``tablet.step/.stl/.glb`` of the finished tablet (mesh checked), ``tablet_plain.step`` of the plain one."""
     import os
 
-    from tabletcad.cad.export import export
     import numpy as np
 
+    from tabletcad.cad.export import export
     from tabletcad.cad.mesh import mesh_result
     from tabletcad.cad.stage import MESH_ANGULAR_RAD, MESH_LINEAR_MM
     from tabletcad.tooling.booleans import mesh_arrays
