@@ -121,8 +121,9 @@ RECOVERY_RADIUS = 1.5
 AVERAGING_FRACTION = 1.0
 #: ... and at most this fraction of the tablet's thickness (the ball's diameter at most a third of it).
 AVERAGING_THICKNESS_FRACTION = 1.0 / 6.0
-#: Element size near the loaded diametral plane on the optimiser's coarse mesh, as a multiple of R.
-PLANE_MESH_FACTOR = 1.2
+#: Element size near the loaded diametral plane on the optimiser's coarse mesh, as a multiple of R
+#: (1.2 fitted concave rounds better, 0.91 % against 1.34 % rms, but read a thin 8 x 2 mm disc 11 % high).
+PLANE_MESH_FACTOR = 1.5
 #: Sample points of the largest tensile stress along the load (see :func:`split_plane_points`).
 SAMPLES_ALONG_LOAD = 41
 #: Sample points of the largest tensile stress through the thickness, faces included.
