@@ -25,18 +25,22 @@ __all__ = [
 
 
 def reraise_interrupt(exc: BaseException) -> None:
-    """Raise :class:`KeyboardInterrupt` if ``exc`` was caused by one.
+    """Raise :class:`KeyboardInterrupt` (or the :class:`SystemExit` of a SIGTERM) if ``exc`` was
+    caused by one.
 
     A Ctrl-C while an extension module initialises (OCP, gmsh) surfaces as
     ``ImportError: initialization failed`` caused by the KeyboardInterrupt;
-    code that treats an ImportError as "optional library absent" must not
-    swallow the user's interrupt.
+    so does a SIGTERM, whose handler raises SystemExit (see
+    :mod:`tabletcad.io.outputs`); code that treats an ImportError as
+    "optional library absent" must not swallow the user's interrupt.
     """
     seen: set[int] = set()
     e: BaseException | None = exc
     while e is not None and id(e) not in seen:
         if isinstance(e, KeyboardInterrupt):
             raise KeyboardInterrupt from exc
+        if isinstance(e, SystemExit) and e is not exc:
+            raise SystemExit(e.code) from exc
         seen.add(id(e))
         e = e.__cause__ or e.__context__
 

@@ -385,3 +385,32 @@ def test_ctrl_c_while_an_extension_initialises_is_an_interrupt(tmp_path, capsys,
     rc, _, err = run(capsys, "build", str(ROOT / "samples" / "spherical.toml"), "--out", str(out))
     assert (rc, err) == (130, "interrupted\n") and not out.exists()
     assert not (tmp_path / "cache").exists()  # no internal-error log
+
+
+def test_sigterm_while_an_extension_initialises_is_a_termination(tmp_path, capsys, monkeypatch):
+    """A SIGTERM during an extension module's initialisation (its handler raises SystemExit(143)
+    inside the build's staging block) surfaces as ``ImportError: initialization failed`` caused by
+    the SystemExit; the build ends with status 143 and nothing written, not as an internal error
+    (found by the killed-build test once the build reached the OCP import within 0.1 s)."""
+    def terminated_import():
+        try:
+            raise SystemExit(143)
+        except SystemExit as exc:
+            raise ImportError("initialization failed") from exc
+
+    class TerminatedFinder:
+        def find_spec(self, name, path=None, target=None):
+            if name == "tabletcad.cad.stage":
+                terminated_import()
+            return None
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    monkeypatch.setenv("TABLETCAD_REQUIRE_CAD", "1")
+    monkeypatch.delitem(sys.modules, "tabletcad.cad.stage", raising=False)
+    monkeypatch.setattr(sys, "meta_path", [TerminatedFinder(), *sys.meta_path])
+    out = tmp_path / "out"
+    with pytest.raises(SystemExit) as info:
+        run(capsys, "build", str(ROOT / "samples" / "spherical.toml"), "--out", str(out))
+    assert info.value.code == 143
+    assert not out.exists() and not [q for q in tmp_path.iterdir() if q.name.startswith(".out.")]
+    assert not (tmp_path / "cache").exists()  # no internal-error log
