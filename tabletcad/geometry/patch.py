@@ -331,14 +331,17 @@ class PDEPatch:
         out = np.zeros((uf.size, 3))
         if nmin == 0 and dv == 0:
             out += cardinal(uf, 0.0, self.u_nodes, self.form, du) @ self._a0
-        for n in self._active:
-            if n < nmin:
-                continue
-            L = cardinal(uf, self._lams[n], self.u_nodes, self.form, du)  # (M, 4)
-            A = L @ self._ac[:, n - 1]  # (M, 3)
-            B = L @ self._bc[:, n - 1]
-            c, s = _trig(vf, np.array([n]), dv)
-            out += A * c + B * s
+        n = np.array([m for m in self._active if m >= nmin], dtype=int)
+        if n.size:
+            # every mode at once: A_n(u) = L(u; λ_n) @ a_n, then Σ_n A_n cos(nv) + B_n sin(nv),
+            # in chunks of points that keep the (modes, points, 4) arrays near 1 MB
+            ac, bc = self._ac[:, n - 1].transpose(1, 0, 2), self._bc[:, n - 1].transpose(1, 0, 2)
+            step = max(1, 32768 // n.size)
+            for i in range(0, uf.size, step):
+                L = cardinals(uf[i : i + step], self._lams[n], self.u_nodes, self.form, du)  # (n, m, 4)
+                c, s = _trig(vf[i : i + step], n, dv)  # (m, n)
+                out[i : i + step] += np.einsum("mn,nmc->mc", c, np.matmul(L, ac))
+                out[i : i + step] += np.einsum("mn,nmc->mc", s, np.matmul(L, bc))
         if remainder and self._has_remainder:
             L = cardinal(uf, self._beta, self.u_nodes, self.form, du)
             r = self._residuals(vf, dv)

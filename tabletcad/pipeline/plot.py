@@ -292,13 +292,23 @@ def _side_profile(tablet: Tablet, n: int, nu: int, nv: int, grids: list | None, 
                          cup_depth_bottom=max(0.0, float(band_z[0]) - bottom), plan_holes=holes, has_band=has_band)
 
 
-def _few_ticks(ax) -> None:
-    """At most five round ticks per axis: the drawings are dimensioned, the ticks only give the
-    scale (and matplotlib's tick objects were a third of a picture's drawing time)."""
-    from matplotlib.ticker import MaxNLocator
+def _scale_bar(ax, x0: float, y0: float, span: float) -> None:
+    """A scale bar of a round length (1, 2 or 5 × 10^k mm, about a quarter of ``span``) from
+    ``(x0, y0)`` (mm) to the right, labelled in mm.  The panels are dimensioned; the bar
+    gives the scale in place of axis ticks (matplotlib's tick objects cost about half the
+    picture's time, ``benchmarks/bench_plot.py``)."""
+    target = 0.25 * span
+    k = 10.0 ** math.floor(math.log10(target))
+    bar = max(m * k for m in (1.0, 2.0, 5.0) if m * k <= target)
+    ax.plot([x0, x0 + bar], [y0, y0], color="k", lw=1.6, solid_capstyle="butt")
+    ax.annotate(f"{bar:g} mm", (x0 + 0.5 * bar, y0), xytext=(0.0, -2.0), textcoords="offset points",
+                fontsize=7, ha="center", va="top")
 
-    for axis in (ax.xaxis, ax.yaxis):
-        axis.set_major_locator(MaxNLocator(nbins=4, steps=[1, 2, 5, 10]))
+
+def _panel_title(ax, text: str) -> None:
+    """A panel's title as plain text above it (``Axes.set_title`` positions itself from the axis
+    ticks, which the panels do not draw but matplotlib would build to ask)."""
+    ax.text(0.5, 1.02, text, transform=ax.transAxes, fontsize=9, ha="center", va="bottom")
 
 
 def _dim(ax, p0, p1, text: str, *, offset=(0.0, 0.0), rotation: float = 0.0, fontsize: float = 7.0) -> None:
@@ -337,11 +347,10 @@ def _draw_profile(ax, o: TabletOutline, colour="#4e79a7", dims: bool = True) -> 
             xc, rim_bot = float(o.x[np.argmin(o.z_low)]), rim_top - o.band
             ax.plot([x0, x1], [rim_bot, rim_bot], color="0.5", lw=0.4, ls=":")
             _dim(ax, (xc, zbot), (xc, rim_bot), f"cup {o.cup_depth_bottom:.3g}", offset=(0, 0))
-    ax.set_xlabel("x (mm)")
-    ax.set_ylabel("z (mm)")
-    _few_ticks(ax)
-    ax.set_title("side profile", fontsize=9)
+    _scale_bar(ax, x0, zbot - 2.0 * pad, o.length)
+    _panel_title(ax, "side profile")
     ax.margins(0.2)
+    ax.set_axis_off()
 
 
 def _draw_plan(ax, tablet: Tablet, o: TabletOutline, grids, colour="#4e79a7", dims: bool = True) -> None:
@@ -362,8 +371,9 @@ def _draw_plan(ax, tablet: Tablet, o: TabletOutline, grids, colour="#4e79a7", di
         depth.append(q[seen][:, :, 2].mean(axis=1))
     if polys:
         order = np.argsort(np.concatenate(depth), kind="stable")  # painter: the top face drawn last
+        # no data limits from the polygons: the plan outline drawn next spans the same extent
         ax.add_collection(PolyCollection(np.concatenate(polys)[order], facecolors=np.concatenate(cols)[order],
-                                         linewidths=0, antialiased=False))
+                                         linewidths=0, antialiased=False), autolim=False)
     for loop in (o.plan, *o.plan_holes):
         ax.plot(loop[:, 0], loop[:, 1], color="k", lw=0.8)
     ax.set_aspect("equal")
@@ -378,11 +388,10 @@ def _draw_plan(ax, tablet: Tablet, o: TabletOutline, grids, colour="#4e79a7", di
     else:
         _dim(ax, (lo[0], lo[1]), (hi[0], lo[1]), f"{o.length:.3g}", offset=(0, -pad))
         _dim(ax, (hi[0], lo[1]), (hi[0], hi[1]), f"{o.width:.3g}", offset=(pad, 0), rotation=90)
-    ax.set_xlabel("x (mm)")
-    ax.set_ylabel("y (mm)")
-    _few_ticks(ax)
-    ax.set_title("plan", fontsize=9)
+    _scale_bar(ax, float(lo[0]), float(lo[1]) - 2.5 * pad, max(o.length, o.width))
+    _panel_title(ax, "plan")
     ax.margins(0.2)
+    ax.set_axis_off()
 
 
 def view_axes(elev: float, azim: float) -> np.ndarray:
@@ -431,8 +440,8 @@ def _draw_view(ax, tablet: Tablet, grids, elev: float, azim: float) -> None:
                 lines.append(seg[grid_seen[k]])
     order = np.argsort(np.concatenate(depth))  # far to near
     ax.add_collection(PolyCollection(np.concatenate(polys)[order], facecolors=np.concatenate(cols)[order],
-                                     edgecolors="none", linewidths=0.0, antialiased=False))
-    ax.add_collection(LineCollection(np.concatenate(lines), colors="k", linewidths=0.5))
+                                     edgecolors="none", linewidths=0.0, antialiased=False), autolim=False)
+    ax.add_collection(LineCollection(np.concatenate(lines), colors="k", linewidths=0.5), autolim=False)
     pts = np.vstack([Y.reshape(-1, 3) for _, Y in grids]) @ R[:2].T
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     pad = 0.03 * float(np.max(hi - lo))
