@@ -8,8 +8,8 @@ cut-aways left out) it prints, as relative differences:
 * ``PDE/nominal``: the PDE tablet's volume (the core's quadrature) against the family's exact
   nominal volume (:func:`tabletcad.families.nominal_volume`, Steiner's offset areas integrated
   along the lines-and-arcs profile: a closed form to rounding); families only;
-* ``B-rep/quad``: the B-spline solid's volume (OCC's adaptive integration, eps 1e-9) against
-  the quadrature;
+* ``B-rep/quad``: the solid's volume (Gauss-Legendre on its faces' B-spline or profile data,
+  :func:`tabletcad.brep.surface.volume_and_area`, exact to rounding) against the quadrature;
 * ``OCC default``: the same solid's volume by OCC's default rule (``BRepGProp`` without an eps,
   which is what FreeCAD's ``Shape.Volume`` uses) against the quadrature;
 * ``mesh/B-rep``: the STL mesh's volume (0.005 mm, 0.2 rad) against the B-rep's.

