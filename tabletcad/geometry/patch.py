@@ -305,6 +305,22 @@ class PDEPatch:
     def _cardinals(self, u: np.ndarray, du: int, lams) -> list[np.ndarray]:
         return [cardinal(u, lam, self.u_nodes, self.form, du) for lam in lams]
 
+    def _u_tables(self, u: np.ndarray, du: int) -> tuple[np.ndarray | None, np.ndarray, np.ndarray | None]:
+        """The cardinal functions at ``u`` (or their ``u``-derivative) of every active mode
+        ``(modes, len(u), 4)``, of the spine ``(len(u), 4)`` and of the remainder term, read-only;
+        cached for short ``u`` arrays, which the checks evaluate again and again (seams at
+        ``u = 0, 1``, the same lines for a point and its derivatives)."""
+
+        def make():
+            n = np.array(self._active, dtype=int)
+            modes = cardinals(u, self._lams[n], self.u_nodes, self.form, du) if n.size else np.zeros((0, u.size, 4))
+            rem = cardinal(u, self._beta, self.u_nodes, self.form, du) if self._has_remainder else np.zeros((0, 4))
+            return modes, cardinal(u, 0.0, self.u_nodes, self.form, du), rem
+
+        if u.size > 1024:
+            return make()
+        return self._memo(("u", du, u.tobytes()), make)
+
     # ------------------------------------------------------------------ evaluation
     def evaluate(self, u, v, du: int = 0, dv: int = 0, *, nmin: int = 0, remainder: bool = True) -> np.ndarray:
         """Surface point or partial derivative ``∂^{du+dv} X / ∂u^{du} ∂v^{dv}``.
@@ -328,6 +344,11 @@ class PDEPatch:
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
         shape = u.shape
         uf, vf = u.reshape(-1), v.reshape(-1)
+        if nmin == 0 and remainder and uf.size > 1:  # points along one u or one v line: a grid of one row
+            if uf[0] == uf[-1] and np.all(uf == uf[0]):
+                return self.evaluate_grid(uf[:1], vf, du, dv)[0].reshape(shape + (3,))
+            if vf[0] == vf[-1] and np.all(vf == vf[0]):
+                return self.evaluate_grid(uf, vf[:1], du, dv)[:, 0].reshape(shape + (3,))
         out = np.zeros((uf.size, 3))
         if nmin == 0 and dv == 0:
             out += cardinal(uf, 0.0, self.u_nodes, self.form, du) @ self._a0
@@ -357,9 +378,9 @@ class PDEPatch:
         """
         u = np.asarray(u, dtype=float).reshape(-1)
         v = np.asarray(v, dtype=float).reshape(-1)
+        L, L0, Lr = self._u_tables(u, du)  # (n, nu, 4), (nu, 4), (nu, 4)
         if self._active:
             n = np.array(self._active)
-            L = cardinals(u, self._lams[n], self.u_nodes, self.form, du)  # (n, nu, 4)
             A = np.matmul(L, self._ac[:, n - 1].transpose(1, 0, 2))  # (n, nu, 3)
             B = np.matmul(L, self._bc[:, n - 1].transpose(1, 0, 2))
             if v.size < 64:
@@ -372,12 +393,10 @@ class PDEPatch:
         else:
             out = np.zeros((u.size, v.size, 3))
         if dv == 0:
-            L0 = cardinal(u, 0.0, self.u_nodes, self.form, du)
             out += (L0 @ self._a0)[:, None, :]
         if self._has_remainder:
-            L = cardinal(u, self._beta, self.u_nodes, self.form, du)  # (nu, 4)
             r = self._residuals(v, dv)  # (4, nv, 3)
-            out += (L @ r.reshape(4, -1)).reshape(u.size, v.size, 3)
+            out += (Lr @ r.reshape(4, -1)).reshape(u.size, v.size, 3)
         return out
 
     def spine(self, u, du: int = 0) -> np.ndarray:
