@@ -4,10 +4,11 @@ Run:  .venv/bin/python benchmarks/bench_cad.py [--repeat 3] [samples/x.toml ...]
 
 For every sample design that is not a cut-away, prints (best of ``--repeat`` runs, one core):
 
-* ``solid``: :func:`tabletcad.cad.tablet_solid.tablet_solid` - B-spline fit of every
-  face, OCCT faces, sewing, ``BRepCheck_Analyzer``, adaptive mass properties;
-* ``check``: the stage's cross-checks (volume/area vs the core's quadrature, taken as
-  given - the quadrature itself is core work and not timed) and the tessellation
+* ``solid``: :func:`tabletcad.cad.tablet_solid.tablet_solid` - B-spline (or profile) fit of
+  every face, OCCT faces, sewing, orientation, ``BRepCheck_Analyzer``;
+* ``check``: the stage's cross-checks (the faces' volume and area by Gauss-Legendre on their
+  B-spline data against the core's quadrature, taken as given - the quadrature itself is core
+  work and not timed) and the tessellation
   with its manifold3d/trimesh checks (:func:`tabletcad.cad.stage.check_tablet_solid`
   minus the solid, which it rebuilds: ``check = stage total - solid``);
 * ``export``: tablet.step + tablet.stl + tablet.glb (:func:`tabletcad.cad.export.export`);
