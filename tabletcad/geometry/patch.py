@@ -41,6 +41,11 @@ from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = ["PDEPatch", "AUTO_A_LADDER"]
 
+#: ``v`` arrays of these sizes have their trigonometric tables and residuals cached per patch
+#: (:meth:`PDEPatch._memo`): shorter ones are cheap to recompute, longer ones (scattered
+#: points, not grid lines) would hold megabytes each.
+_CACHED_V = (64, 8192)
+
 #: Smoothing parameters tried, in order, when ``a="auto"``.
 AUTO_A_LADDER = (1.0, 0.5, 0.25, 0.1, 0.05, 0.02, 0.01)
 
@@ -288,7 +293,7 @@ class PDEPatch:
 
     def _trig_cached(self, v: np.ndarray, N: int, dv: int) -> tuple[np.ndarray, np.ndarray]:
         """``_trig(v, 1..N, dv)`` (read-only), cached for repeated ``v``."""
-        if v.size < 64:
+        if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
             return _trig(v, np.arange(1, N + 1), dv)
         return self._memo(("trig", N, dv, v.tobytes()), lambda: _trig(v, np.arange(1, N + 1), dv))
 
@@ -298,7 +303,7 @@ class PDEPatch:
         def make() -> np.ndarray:
             return np.stack([self.data[k].evaluate(v, dv) - self._series(k, v, dv) for k in range(4)])
 
-        if v.size < 64:
+        if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
             return make()
         return self._memo(("res", dv, v.tobytes()), make)
 
@@ -383,7 +388,7 @@ class PDEPatch:
             n = np.array(self._active)
             A = np.matmul(L, self._ac[:, n - 1].transpose(1, 0, 2))  # (n, nu, 3)
             B = np.matmul(L, self._bc[:, n - 1].transpose(1, 0, 2))
-            if v.size < 64:
+            if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
                 c, s = _trig(v, n, dv)  # (nv, n)
             else:
                 c, s = self._memo(("active", dv, v.tobytes()), lambda: _trig(v, n, dv))
