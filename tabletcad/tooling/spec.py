@@ -41,7 +41,8 @@
     mode = "deboss"                # "deboss" | "emboss"
     face = "top"                   # "top" | "bottom"
     height_mm = 2.0                # font size (text)
-    depth_mm = 0.15                # depth (deboss) or height (emboss), along the axis
+    depth_mm = 0.15                # depth (deboss) or height (emboss), along the face normal
+    projection = "normal"          # "normal": depth along the local face normal | "axial": along the axis
     stroke_angle_deg = 0.0         # stroke angle: draft of the letter walls from the axis, 0 <= . < 60
                                    # (``draft_deg`` is accepted as the same key)
     font = "DejaVuSans-Bold"       # a DejaVu font name or a .ttf path
@@ -97,6 +98,7 @@ class EmbossSpec:
     rotation_deg: float = 0.0
     margin_mm: float = 0.2
     svg: str | None = None
+    projection: str = "normal"
 
 
 #: general +- tolerance (mm) printed on the drawings when the design gives none: 0.003 in, stated on the sheet
@@ -273,6 +275,7 @@ def _emboss(i: int, t: Any, base: Path | None = None) -> EmbossSpec:
         check_finite(f"{w} rotation_deg", t.get("rotation_deg", d.rotation_deg), "deg"),
         check_range(f"{w} margin_mm", t.get("margin_mm", d.margin_mm), 0.0, None, "mm"),
         svg,
+        _choice(f"{w} projection", t.get("projection", d.projection), ("normal", "axial")),
     )
 
 
