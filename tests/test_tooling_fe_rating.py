@@ -125,3 +125,33 @@ def test_fe_rating_spec():
                                      "punch": "both"}}).fe_rating
     assert r.punches == ("upper", "lower") and r.safety_factor == 1.5 and r.steel is None
     assert parse_tooling({}).fe_rating is None
+
+
+def test_fe_rating_note_stays_inside_the_sheet(built, design):
+    """The longer rating notes still fit the title block: every text inside the sheet, none on another."""
+    import matplotlib.pyplot as plt
+
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling import make_tooling
+    from tabletcad.tooling.drawing import drawing_model, sheet_figure
+
+    _, rep = built
+    d = Design.from_toml(design)
+    ts = make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False, options=d.report_options)
+    ts.report["tip_rating"]["fe"] = rep["tooling"]["tip_rating"]["fe"]
+    dr = drawing_model(ts)
+    assert any("FE punch analysis" in n for n in dr.notes)
+    fig = sheet_figure(dr, rep["tooling"]["drawing"]["paper"])
+    try:
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        texts = [t for t in fig.texts + fig.axes[0].texts if t.get_text()]
+        boxes = [(t.get_text(), t.get_window_extent(renderer)) for t in texts]
+        assert any("FE punch analysis" in s for s, _ in boxes)
+        for s, bb in boxes:
+            assert fig.bbox.x0 <= bb.x0 and bb.x1 <= fig.bbox.x1 and fig.bbox.y0 <= bb.y0 and bb.y1 <= fig.bbox.y1, s
+        for k, (sa, a) in enumerate(boxes):
+            for sb, b in boxes[k + 1:]:
+                assert not a.expanded(0.98, 0.9).overlaps(b.expanded(0.98, 0.9)), (sa, sb)
+    finally:
+        plt.close(fig)
