@@ -50,7 +50,8 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
     with the report ``options``); with ``cad`` (default: :func:`cad_available`) the solid, its
     checks and ``tablet.step/.stl/.glb`` (:func:`tabletcad.cad.stage.cad_stage`), then, with a
     ``tooling`` specification, the punches, die and drawings made from that solid
-    (:func:`tabletcad.tooling.stage.tooling_stage`); when the options ask for it
+    (:func:`tabletcad.tooling.stage.tooling_stage`; with ``[tooling.fe_rating]`` the FE tip-force
+    rating, :func:`fe_tip_rating`, before the drawings); when the options ask for it
     (``[report] fe_breaking_force = true``), the FE breaking force on the coarse mesh
     (:func:`tabletcad.fe.objective.report_breaking_force`); last the picture.  Whether the tablet can
     have tooling is checked before any geometry is built.  :func:`build_design` takes both
