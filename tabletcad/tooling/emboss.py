@@ -418,10 +418,15 @@ def offset_solid(shape, d: float):
     from OCP.BRepCheck import BRepCheck_Analyzer
     from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeOffsetShape
     from OCP.ShapeCustom import ShapeCustom
+    from OCP.ShapeFix import ShapeFix_Shape
 
     mk = BRepOffsetAPI_MakeOffsetShape()
     mk.PerformBySimple(shape, float(d))
     out = ShapeCustom.ConvertToBSpline_s(mk.Shape(), False, False, True, False) if mk.IsDone() else None
+    if out is not None and not BRepCheck_Analyzer(out).IsValid():  # (the almond: one face's wire, at its tip)
+        fix = ShapeFix_Shape(out)
+        fix.Perform()
+        out = fix.Shape()
     solids = [] if out is None else explore(out, "Solid")
     if len(solids) != 1 or not BRepCheck_Analyzer(solids[0]).IsValid():
         raise GeometryError(f"normal offset of the tablet by {d:g} mm failed ({len(solids)} solids)", shape)
