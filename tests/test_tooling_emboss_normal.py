@@ -138,3 +138,33 @@ def test_projection_key():
     with pytest.raises(DesignError) as e:
         parse_tooling({"emboss": [{"text": "A", "projection": "radial"}]})
     assert "projection" in e.value.parameter and "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize("family", ["almond", "capsule", "oval", "rounded_triangle", "compound_cup"])
+def test_offset_solid_is_valid_and_at_the_normal_distance(family):
+    """The plain tablet's simple offset (ShapeFix-ed where OCC leaves it invalid: the almond's tip) is one
+    valid solid, and points of the top face near the axis lie exactly ``d`` from it (BRepExtrema)."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+    from OCP.gp import gp_Pnt
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.cad.solid import check_solid
+    from tabletcad.tooling.emboss import offset_solid
+    from tabletcad.tooling.outline import tablet_frame
+
+    frame = tablet_frame(load_design(ROOT / "samples" / "families" / f"{family}.toml"))
+    from OCP.gp import gp_Dir, gp_Lin
+    from OCP.IntCurvesFace import IntCurvesFace_ShapeIntersector
+
+    inter = IntCurvesFace_ShapeIntersector()
+    inter.Load(frame.shape, 1e-7)
+    for d in (-0.12, 0.12):
+        off = offset_solid(frame.shape, d)
+        check_solid(off)
+        (shell,) = explore(off, "Shell")  # the distance to the boundary (a point inside a solid is at 0)
+        for x, y in [(-1.0, -1.0), (1.0, 0.5), (0.0, 1.2)]:
+            inter.Perform(gp_Lin(gp_Pnt(x, y, -1e3), gp_Dir(0, 0, 1)), -1e9, 1e9)
+            z = max(inter.Pnt(k).Z() for k in range(1, inter.NbPnt() + 1))
+            dist = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(x, y, z)).Vertex(), shell)
+            assert dist.Value() == pytest.approx(abs(d), abs=2e-6), (family, d, x, y)
