@@ -24,6 +24,9 @@ layer of the face the engraving occupies:
   ``depth`` along the axis instead of offset (on a face sloping at ``θ`` the
   layer is ``depth·cos θ`` thick along the normal).
 
+The offset is of the plain tablet (before scores and earlier figures), so a
+figure crossing a score groove keeps the cup's layer; OCC leaves an invalid
+face on some offsets (the almond's tip), which ``ShapeFix_Shape`` repairs.
 Then tablet − cutter or tablet ∪ adder.  The plan figure is placed on the
 face by projection along the axis (a vertical line through each point of the
 figure meets the face once, the cups being graphs over the plan).  The stroke
