@@ -155,3 +155,26 @@ def test_fe_rating_note_stays_inside_the_sheet(built, design):
                 assert not a.expanded(0.98, 0.9).overlaps(b.expanded(0.98, 0.9)), (sa, sb)
     finally:
         plt.close(fig)
+
+
+def test_complete_punches_are_rated_on_their_tips():
+    """With complete punches (TSM B) the analysis takes the tip alone, the solid fused to the barrel:
+    its volume is the report's tip volume, and its rating is the tips-only tooling's for the same tablet."""
+    from tabletcad.fe.punch import fe_tip_rating, tool_set_tip
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling import make_tooling
+    from tabletcad.tooling.booleans import volume
+    from tabletcad.tooling.spec import FeRatingSpec
+
+    sample = Path(__file__).resolve().parents[1] / "samples" / "tooling" / "tsm_b_round.toml"
+    d = Design.from_toml(sample)
+    tablet, spec = d.build(), d.tooling_spec
+    assert spec.body is not None
+    rating = FeRatingSpec(steel=STEEL, mesh_size_mm=1.0)
+    ts = make_tooling(tablet, spec, check=False, interference_check=False)
+    shape, info = tool_set_tip(ts, "upper")
+    assert volume(shape) == pytest.approx(ts.report["upper_punch"]["tip_volume_mm3"], rel=1e-9)
+    tips_only = make_tooling(tablet, spec.with_(body=None), check=False, interference_check=False)
+    full, alone = fe_tip_rating(ts, rating, 10.0), fe_tip_rating(tips_only, rating, 10.0)
+    assert full["allowed_force_kN"] == pytest.approx(alone["allowed_force_kN"], rel=1e-9)
+    assert 0.0 < full["allowed_force_kN"] < 1450.0 / 1.5 * info["tip_plan_area_mm2"] / 1000.0

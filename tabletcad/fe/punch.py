@@ -47,7 +47,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["ToolSteel", "tool_steels", "PunchResult", "punch_stress", "punch_tip_solid", "column_buckling", "fe_tip_rating"]
+__all__ = ["ToolSteel", "tool_steels", "PunchResult", "punch_stress", "punch_tip_solid", "column_buckling", "fe_tip_rating", "tool_set_tip"]
 
 #: Cosine below which a facet's outward normal counts as facing the tablet (loaded by the powder):
 #: the cup and land (cup walls up to 72° steep); chordal triangles of the side wall tilt far less.
@@ -159,7 +159,21 @@ def punch_tip_solid(tablet: Any, spec: Any, which: str = "upper") -> tuple[Any, 
 
     check_tooling(tablet, spec)
     ts = make_tooling(tablet, spec, check=False, interference_check=False)
-    return ts.parts[f"{which}_punch"], ts.report[f"{which}_punch"]
+    return tool_set_tip(ts, which)
+
+
+def tool_set_tip(ts: Any, which: str) -> tuple[Any, dict[str, Any]]:
+    """The ``which`` tip's solid and info of a built tool set: the punch part itself when the tooling is
+    punch tips; with complete punches (``[tooling] standard``) the tip alone, as the tips-only tooling
+    makes it (prism minus the finished tablet, up to ``tip_length_mm``), so that its back face is the
+    datum plane the analysis loads; the tip relief behind ``tip_straight_mm`` is not modelled."""
+    if ts.spec.body is None:
+        return ts.parts[f"{which}_punch"], ts.report[f"{which}_punch"]
+    from tabletcad.tooling.punch import punch_tip
+
+    length = ts.spec.tip_length_mm if which == "upper" else ts.spec.lower_tip
+    tip, _ = punch_tip(ts.frame, ts.parts["tablet"], which, ts.spec.clearance_mm, length, check=False)
+    return tip.shape, tip.info
 
 
 def punch_stress(
@@ -262,7 +276,7 @@ REFERENCE_FORCE_KN = 10.0
 def fe_tip_rating(ts: Any, rating: Any, force_kN: float | None = None) -> dict[str, Any]:
     """The FE tip-force rating of a built tool set, for ``tooling.tip_rating.fe`` and the drawing.
 
-    ``ts``: a :class:`tabletcad.tooling.toolset.ToolSet` (its punch solids and their info, the same
+    ``ts``: a :class:`tabletcad.tooling.toolset.ToolSet` (its tips, :func:`tool_set_tip`, the same
     as :func:`punch_tip_solid` makes); ``rating``: the design's ``[tooling.fe_rating]``
     (:class:`tabletcad.tooling.spec.FeRatingSpec`); ``force_kN``: the design's compaction force, kN
     (default :data:`REFERENCE_FORCE_KN`).  Each tip is analysed by :func:`punch_stress` with the
@@ -278,7 +292,7 @@ def fe_tip_rating(ts: Any, rating: Any, force_kN: float | None = None) -> dict[s
     force = REFERENCE_FORCE_KN if force_kN is None else force_kN
     tips = {}
     for which in rating.punches:
-        res = punch_stress(ts.parts[f"{which}_punch"], ts.report[f"{which}_punch"], force, which, yield_MPa=y,
+        res = punch_stress(*tool_set_tip(ts, which), force, which, yield_MPa=y,
                            safety_factor=rating.safety_factor, E=E, mesh_size=rating.mesh_size_mm)
         tips[which] = {k: v for k, v in res.to_dict().items() if k != "buckling"}
         tips[which]["buckling"] = res.buckling
