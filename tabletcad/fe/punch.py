@@ -47,7 +47,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["ToolSteel", "tool_steels", "PunchResult", "punch_stress", "punch_tip_solid", "column_buckling"]
+__all__ = ["ToolSteel", "tool_steels", "PunchResult", "punch_stress", "punch_tip_solid", "column_buckling", "fe_tip_rating", "tool_set_tip"]
 
 #: Cosine below which a facet's outward normal counts as facing the tablet (loaded by the powder):
 #: the cup and land (cup walls up to 72° steep); chordal triangles of the side wall tilt far less.
@@ -159,7 +159,21 @@ def punch_tip_solid(tablet: Any, spec: Any, which: str = "upper") -> tuple[Any, 
 
     check_tooling(tablet, spec)
     ts = make_tooling(tablet, spec, check=False, interference_check=False)
-    return ts.parts[f"{which}_punch"], ts.report[f"{which}_punch"]
+    return tool_set_tip(ts, which)
+
+
+def tool_set_tip(ts: Any, which: str) -> tuple[Any, dict[str, Any]]:
+    """The ``which`` tip's solid and info of a built tool set: the punch part itself when the tooling is
+    punch tips; with complete punches (``[tooling] standard``) the tip alone, as the tips-only tooling
+    makes it (prism minus the finished tablet, up to ``tip_length_mm``), so that its back face is the
+    datum plane the analysis loads; the tip relief behind ``tip_straight_mm`` is not modelled."""
+    if ts.spec.body is None:
+        return ts.parts[f"{which}_punch"], ts.report[f"{which}_punch"]
+    from tabletcad.tooling.punch import punch_tip
+
+    length = ts.spec.tip_length_mm if which == "upper" else ts.spec.lower_tip
+    tip, _ = punch_tip(ts.frame, ts.parts["tablet"], which, ts.spec.clearance_mm, length, check=False)
+    return tip.shape, tip.info
 
 
 def punch_stress(
@@ -252,3 +266,42 @@ def punch_stress(
         axial_area_mm2=push, back_area_mm2=A_back, uniform_stress_MPa=F / A_back, nodes=sol.nodes,
         elements=sol.elements, dofs=sol.dofs, reaction_N=sol.reaction, yield_MPa=yield_MPa, safety_factor=S,
         buckling=buck, tip=tip, solution=sol)
+
+
+#: compaction force (kN) the FE rating loads the tips with when the design gives none; the analysis is
+#: linear, so the rating (stress per newton) does not depend on it
+REFERENCE_FORCE_KN = 10.0
+
+
+def fe_tip_rating(ts: Any, rating: Any, force_kN: float | None = None) -> dict[str, Any]:
+    """The FE tip-force rating of a built tool set, for ``tooling.tip_rating.fe`` and the drawing.
+
+    ``ts``: a :class:`tabletcad.tooling.toolset.ToolSet` (its tips, :func:`tool_set_tip`, the same
+    as :func:`punch_tip_solid` makes); ``rating``: the design's ``[tooling.fe_rating]``
+    (:class:`tabletcad.tooling.spec.FeRatingSpec`); ``force_kN``: the design's compaction force, kN
+    (default :data:`REFERENCE_FORCE_KN`).  Each tip is analysed by :func:`punch_stress` with the
+    steel's yield stress and Young's modulus; ``allowed_force_kN`` is the smaller of the tips'.
+    """
+    if rating.steel is not None:
+        steel = tool_steels()[rating.steel]
+        y, E, src, e_src = steel.yield_MPa, steel.E_MPa, steel.yield_source, steel.E_source
+        what = f"steel {steel.name}: {steel.description}"
+    else:
+        y, E, src = rating.yield_stress_MPa, 206000.0, rating.yield_stress_source
+        e_src, what = "tabletcad fe punch's default (206000 MPa)", "user-given yield stress"
+    force = REFERENCE_FORCE_KN if force_kN is None else force_kN
+    tips = {}
+    for which in rating.punches:
+        res = punch_stress(*tool_set_tip(ts, which), force, which, yield_MPa=y,
+                           safety_factor=rating.safety_factor, E=E, mesh_size=rating.mesh_size_mm)
+        tips[which] = {k: v for k, v in res.to_dict().items() if k != "buckling"}
+        tips[which]["buckling"] = res.buckling
+    allowed = min(t["allowed_force_kN"] for t in tips.values())
+    return dict(method="FE punch analysis (tabletcad.fe.punch.punch_stress, as tabletcad fe punch): the largest von "
+                       "Mises stress per newton of the compaction force spread over the cup face; allowed force = "
+                       "yield / safety factor / (stress per N), or the buckling force / safety factor if lower",
+                allowed_force_kN=allowed, yield_MPa=y, yield_source=src, youngs_modulus_MPa=E, youngs_modulus_source=e_src,
+                material=what, steel=rating.steel, safety_factor=rating.safety_factor, force_kN=force,
+                force_source="the design's [report] compaction_force_kN" if force_kN is not None else
+                f"reference load {REFERENCE_FORCE_KN:g} kN (linear analysis: the rating does not depend on it)",
+                utilisation=None if force_kN is None else force_kN / allowed, tips=tips)

@@ -50,7 +50,8 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
     with the report ``options``); with ``cad`` (default: :func:`cad_available`) the solid, its
     checks and ``tablet.step/.stl/.glb`` (:func:`tabletcad.cad.stage.cad_stage`), then, with a
     ``tooling`` specification, the punches, die and drawings made from that solid
-    (:func:`tabletcad.tooling.stage.tooling_stage`); when the options ask for it
+    (:func:`tabletcad.tooling.stage.tooling_stage`; with ``[tooling.fe_rating]`` the FE tip-force
+    rating, :func:`fe_tip_rating`, before the drawings); when the options ask for it
     (``[report] fe_breaking_force = true``), the FE breaking force on the coarse mesh
     (:func:`tabletcad.fe.objective.report_breaking_force`); last the picture.  Whether the tablet can
     have tooling is checked before any geometry is built.  :func:`build_design` takes both
@@ -88,7 +89,9 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
                 if tooling is not None:
                     from tabletcad.tooling.stage import tooling_stage
 
-                    tooling_stage(tablet=tablet, spec=tooling, shape=shape, out=staging, report=report, options=options)
+                    fe = None if tooling.fe_rating is None else (lambda ts: fe_tip_rating(ts, options))
+                    tooling_stage(tablet=tablet, spec=tooling, shape=shape, out=staging, report=report, options=options,
+                                  fe_rating=fe)
                     bar.update()
             if options is not None and options.fe_breaking_force:  # [report] fe_breaking_force = true
                 if cad:
@@ -105,6 +108,19 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
         (staging / "report.json").write_text(to_json(report), encoding="utf-8")
         publish(staging, out_dir)
         return report
+
+
+def fe_tip_rating(ts: Any, options: ReportOptions | None) -> dict[str, Any]:
+    """``tooling.tip_rating.fe`` of a tooling build (``[tooling.fe_rating]``): the FE punch analysis
+    (:func:`tabletcad.fe.punch.fe_tip_rating`) at the design's compaction force, or a note saying why
+    not (the fe extra missing): the drawing then states the pressure rule's rating alone."""
+    missing = [m for m in ("gmsh", "skfem") if importlib.util.find_spec(m) is None]
+    if missing:
+        return dict(allowed_force_kN=None, note=f"not computed: the FE punch analysis needs the fe extra ({missing[0]} "
+                                                "is missing: pip install 'tabletcad[fe]')")
+    from tabletcad.fe.punch import fe_tip_rating as rate
+
+    return rate(ts, ts.spec.fe_rating, None if options is None else options.compaction_force_kN)
 
 
 def build_design(design: str | Path | Design, out_dir: str | Path, *, cad: bool | None = None,

@@ -201,9 +201,7 @@ def drawing_model(ts) -> Drawing:
     for e in ts.report.get("emboss", []):
         notes.append(f"{e['mode']} '{e['text'] or 'outline'}' {_fmt(e['depth_mm'])} mm on the {e['face']} face")
     r = ts.report.get("tip_rating") or {}
-    if r.get("rated_force_kN") is not None:
-        notes.append(f"tip force rating {r['rated_force_kN']:.3g} kN = {r['allowed_pressure_MPa']:g} MPa x "
-                     f"{r['tip_projected_area_mm2']:.4g} mm2 tip area (allowed pressure: {r['allowed_pressure_source']})")
+    notes += rating_notes(r)
     for k, b in ((r.get("buckling") or {}).get("tips") or {}).items():
         if b["buckling_load_kN"] is not None:
             notes.append(f"{k} tip Euler buckling load {b['buckling_load_kN']:.3g} kN (K = 2, free length "
@@ -230,6 +228,22 @@ def drawing_model(ts) -> Drawing:
     notes.append(f"section A-A through the axis across {th:g} deg{' (the score)' if scores else ''}; "
                  f"detail B: band edge and land, {k:g}:1")
     return Drawing(views, origins, _toleranced(dims, ts), notes, title=_title(ts), title_block=title_block(ts))
+
+
+def rating_notes(r: dict) -> list[str]:
+    """The tip-force rating lines of the drawing from ``tooling.tip_rating``: the FE punch analysis's
+    (``fe``, when it was computed) first, then the projected-area pressure rule's."""
+    notes = []
+    fe = r.get("fe") or {}
+    if fe.get("allowed_force_kN") is not None:
+        tips = ", ".join(f"{k} {t['allowed_force_kN']:.4g} kN" for k, t in fe["tips"].items())
+        notes.append(f"tip force rating {fe['allowed_force_kN']:.4g} kN (FE punch analysis: {tips}; allowed stress "
+                     f"{fe['yield_MPa']:g} MPa yield / safety factor {fe['safety_factor']:g}, from {fe['yield_source']})")
+    if r.get("rated_force_kN") is not None:
+        lead = "pressure-rule rating" if notes else "tip force rating"
+        notes.append(f"{lead} {r['rated_force_kN']:.3g} kN = {r['allowed_pressure_MPa']:g} MPa x "
+                     f"{r['tip_projected_area_mm2']:.4g} mm2 tip area (allowed pressure: {r['allowed_pressure_source']})")
+    return notes
 
 
 _DIM_KEYS = {"Ø": "diameter", "L": "length", "W": "width", "band": "band", "cup": "cup_depth", "T": "thickness",

@@ -6,13 +6,35 @@ polyline, or a logo's filled outlines from an SVG file (build123d's
 ``import_svg``, centred and scaled to ``height_mm`` tall) —
 rotated, moved to ``position_mm`` and, on the bottom face, mirrored so that
 it reads correctly when the tablet is turned over.  It is extruded along the
-axis into a prism (with ``draft_deg`` on its walls when asked) and made to
-follow the face at a constant axial depth, the way a punch is engraved:
+axis into a prism (with ``draft_deg`` on its walls when asked) and cut to the
+layer of the face the engraving occupies:
 
-* deboss: cutter = prism − (tablet moved by ``depth`` into itself);
-  tablet − cutter;
-* emboss: adder = prism ∩ (tablet moved by ``depth`` out of itself);
-  tablet ∪ adder.
+* ``projection = "normal"`` (default): the layer between the face and its
+  normal offset by ``depth`` (OCC's simple offset,
+  ``BRepOffsetAPI_MakeOffsetShape.PerformBySimple``: every face of the plain
+  tablet replaced by its ``Geom_OffsetSurface``), so a deboss floor lies at
+  normal distance ``depth`` below the cup and an emboss stands ``depth`` proud
+  along the normal everywhere — on a spherical cup of radius ``R`` the floor
+  is the concentric sphere ``R - depth``:
+
+  - deboss: cutter = prism − (plain tablet offset inwards by ``depth``);
+  - emboss: adder = prism ∩ (plain tablet offset outwards by ``depth``);
+
+* ``projection = "axial"``: a constant axial depth, the tablet moved by
+  ``depth`` along the axis instead of offset (on a face sloping at ``θ`` the
+  layer is ``depth·cos θ`` thick along the normal).
+
+The offset is of the plain tablet (before scores and earlier figures), so a
+figure crossing a score groove keeps the cup's layer; OCC leaves an invalid
+face on some offsets (the almond's tip), which ``ShapeFix_Shape`` repairs.
+Then tablet − cutter or tablet ∪ adder.  The plan figure is placed on the
+face by projection along the axis (a vertical line through each point of the
+figure meets the face once, the cups being graphs over the plan).  The stroke
+walls keep their stroke angle to the axis; where the face is tilted by ``θ``
+to the axis, a wall's angle to the local normal lies within ``stroke angle ±
+θ``: the largest ``θ`` over the figure's footprint is reported
+(``max_normal_tilt_deg``), with the deepest axial reach of the normal layer
+(``depth / cos θ``).
 
 Figures must lie inside the punch tip (outline inset by the clearance, the
 tablet's land and ``margin_mm``), else :class:`DesignError`.
@@ -32,6 +54,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from OCP.BRepAdaptor import BRepAdaptor_Surface
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
 from OCP.BRepBuilderAPI import BRepBuilderAPI_Transform
 from OCP.gp import gp_Ax1, gp_Ax2, gp_Dir, gp_Pnt, gp_Trsf, gp_Vec
@@ -44,7 +67,7 @@ from tabletcad.tooling.booleans import compound as _compound
 from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, polyline_wire
 from tabletcad.tooling.spec import EmbossSpec, font_path
 
-__all__ = ["figure_faces", "figure_prism", "apply_emboss", "check_fit", "check_emboss", "face_heights"]
+__all__ = ["figure_faces", "figure_prism", "apply_emboss", "check_fit", "check_emboss", "face_heights", "offset_solid"]
 
 
 def _transform(shape: TopoDS_Shape, trsf: gp_Trsf) -> TopoDS_Shape:
@@ -293,6 +316,7 @@ def apply_emboss(frame: TabletFrame, shape, items, clearance: float, *, check: b
 
     ``checked``: what :func:`check_emboss` returned for each item, when the caller has checked them."""
     checks, infos = [], []
+    offsets = _Offsets(frame.shape)
     for i, e in enumerate(items):
         figure, info = checked[i] if checked is not None else check_emboss(frame, e, clearance, i)
         info = dict(info)
@@ -300,26 +324,32 @@ def apply_emboss(frame: TabletFrame, shape, items, clearance: float, *, check: b
         sg = 1.0 if top else -1.0
         # short prisms (OCC's surface intersections cost grows with the walls' height): from just
         # inside the tablet under the figure to just beyond the face's highest point
-        zs = face_heights(shape, figure, top)
+        zs, tilts = _footprint(shape, figure, top)
+        tilt = max(tilts)
+        normal = e.projection == "normal"
+        reach = e.depth_mm / math.cos(tilt) if normal else e.depth_mm  # axial extent of the layer
         near = min(zs) if top else max(zs)
         far = frame.z_max if top else frame.z_min
-        inner = near - sg * ((e.depth_mm if e.mode == "deboss" else 0.0) + 0.05)
-        outer = far + sg * ((e.depth_mm if e.mode == "emboss" else 0.0) + 0.05)
+        inner = near - sg * ((reach if e.mode == "deboss" else 0.0) + 0.05)
+        outer = far + sg * ((reach if e.mode == "emboss" else 0.0) + 0.05)
         # stroke angle: the figure is nominal at the mean height of the face under it (exact on a flat
         # face; on a cup its width at the face varies by +-spread/2 * tan(angle), reported)
         z_face = sum(zs) / len(zs)
+        info["projection"] = e.projection
+        info["max_normal_tilt_deg"] = math.degrees(tilt)
+        info["max_axial_depth_mm"] = reach
         info["face_height_spread_mm"] = max(zs) - min(zs)
         info["width_variation_at_face_mm"] = 0.5 * (max(zs) - min(zs)) * math.tan(math.radians(e.draft_deg))
         if e.mode == "deboss":
             # narrower towards the letter bottom, wider out of the tablet
             prism = figure_prism(figure, outer, inner, e.draft_deg, z_nominal=z_face)
-            shifted = translated(shape, dz=-sg * e.depth_mm)
-            tool = _cut_each(prism, shifted, i)
+            floor = offsets.get(-e.depth_mm) if normal else translated(shape, dz=-sg * e.depth_mm)
+            tool = _cut_each(prism, floor, i)
             op = "cut"
         else:
             prism = figure_prism(figure, inner, outer, e.draft_deg, z_nominal=z_face)
-            shifted = translated(shape, dz=sg * e.depth_mm)
-            tool = _common_each(prism, shifted, i)
+            roof = offsets.get(e.depth_mm) if normal else translated(shape, dz=sg * e.depth_mm)
+            tool = _common_each(prism, roof, i)
             op = "fuse"
         shape, chk = checked_boolean(op, shape, tool, what=f"{e.mode} {i} ({e.text or e.svg or 'outline'}, {e.face})",
                                      deflection=deflection, check=check, a_manifold=a_manifold)
@@ -335,27 +365,75 @@ def apply_emboss(frame: TabletFrame, shape, items, clearance: float, *, check: b
 
 def face_heights(shape, figure, top: bool) -> list[float]:
     """Heights (mm) where vertical lines through the figure's vertices meet the top (bottom) face of ``shape``."""
+    return _footprint(shape, figure, top)[0]
+
+
+def _footprint(shape, figure, top: bool) -> tuple[list[float], list[float]]:
+    """Heights (mm) and tilts of the face normal from the axis (rad) where vertical lines through points
+    of the figure's edges (7 per edge) meet the top (bottom) face of ``shape``."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.BRepLProp import BRepLProp_SLProps
     from OCP.gp import gp_Lin
     from OCP.IntCurvesFace import IntCurvesFace_ShapeIntersector
 
     inter = IntCurvesFace_ShapeIntersector()
     inter.Load(shape, 1e-7)
-    from OCP.BRepAdaptor import BRepAdaptor_Curve
-
     pts = []
     for edge in explore(figure, "Edge"):
         c = BRepAdaptor_Curve(edge)
         a, b = c.FirstParameter(), c.LastParameter()
         pts.extend(c.Value(a + (b - a) * k / 6.0) for k in range(7))
-    out = []
+    zs, tilts = [], []
     for p in pts:
         inter.Perform(gp_Lin(gp_Pnt(p.X(), p.Y(), -1e3), gp_Dir(0, 0, 1)), -1e9, 1e9)
-        zs = [inter.Pnt(k).Z() for k in range(1, inter.NbPnt() + 1)]
-        if zs:
-            out.append(max(zs) if top else min(zs))
-    if not out:
+        hits = [(inter.Pnt(k).Z(), k) for k in range(1, inter.NbPnt() + 1)]
+        if not hits:
+            continue
+        z, k = max(hits) if top else min(hits)
+        zs.append(z)
+        props = BRepLProp_SLProps(BRepAdaptor_Surface(inter.Face(k)), inter.UParameter(k), inter.VParameter(k), 1, 1e-9)
+        tilts.append(math.acos(min(1.0, abs(props.Normal().Z()))) if props.IsNormalDefined() else 0.0)
+    if not zs:
         raise GeometryError("the figure does not lie over the tablet", figure)
-    return out
+    return zs, tilts
+
+
+class _Offsets:
+    """The plain tablet offset along its normals by ``d`` mm (outwards > 0), built once per depth."""
+
+    def __init__(self, plain):
+        self.plain, self.done = plain, {}
+
+    def get(self, d: float):
+        if d not in self.done:
+            self.done[d] = offset_solid(self.plain, d)
+        return self.done[d]
+
+
+def offset_solid(shape, d: float):
+    """``shape`` with every face replaced by its offset surface at ``d`` mm along the outward normal
+    (``d < 0``: inwards), by OCC's simple offset (no intersections: exact on smooth faces; where faces
+    meet at an angle the offset edges take the gap as tolerance, which the figures, inset from the
+    tablet's edges by land and margin, never reach).  The offset surfaces are then approximated by
+    B-splines (``ShapeCustom.ConvertToBSpline``, to ``Precision::Approximation``, 1e-6 mm): OCC's
+    meshers leave trimmed faces on ``Geom_OffsetSurface`` untriangulated, and the Booleans are
+    cross-checked on meshes.  A single valid solid or :class:`GeometryError`."""
+    from OCP.BRepCheck import BRepCheck_Analyzer
+    from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeOffsetShape
+    from OCP.ShapeCustom import ShapeCustom
+    from OCP.ShapeFix import ShapeFix_Shape
+
+    mk = BRepOffsetAPI_MakeOffsetShape()
+    mk.PerformBySimple(shape, float(d))
+    out = ShapeCustom.ConvertToBSpline_s(mk.Shape(), False, False, True, False) if mk.IsDone() else None
+    if out is not None and not BRepCheck_Analyzer(out).IsValid():  # (the almond: one face's wire, at its tip)
+        fix = ShapeFix_Shape(out)
+        fix.Perform()
+        out = fix.Shape()
+    solids = [] if out is None else explore(out, "Solid")
+    if len(solids) != 1 or not BRepCheck_Analyzer(solids[0]).IsValid():
+        raise GeometryError(f"normal offset of the tablet by {d:g} mm failed ({len(solids)} solids)", shape)
+    return solids[0]
 
 
 def _cut_each(prism, shifted, i):

@@ -6,7 +6,10 @@
   it comes from ``[tooling] allowed_tip_pressure_MPa`` with its
   ``allowed_tip_pressure_source``, else from the design's ``[report]
   max_punch_pressure_MPa`` (reported as user-given).  The finite-element punch analysis
-  belongs to :mod:`tabletcad.fe`; this is the rule of thumb beside the drawing.
+  belongs to :mod:`tabletcad.fe`: with ``[tooling.fe_rating]`` the build
+  (:func:`tabletcad.pipeline.build.fe_tip_rating`) adds its rating as ``fe`` and the drawing
+  states it first (:func:`tabletcad.tooling.drawing.rating_notes`); this is the rule of thumb
+  beside it, and alone when the FE analysis is not asked for or not installed.
 * **Buckling** (what limits mini-tablet tips): the tip as an Euler column fixed at the barrel
   and free at the face, ``P_cr = π² E I_min / (K L)²`` with ``K = 2`` (the conservative end
   condition), ``L`` the tip length and ``I_min`` the smaller principal second moment of the

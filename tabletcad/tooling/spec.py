@@ -17,6 +17,13 @@
     punch_youngs_modulus_MPa = 210000.0       # tip buckling (Euler); needs its source:
     punch_youngs_modulus_source = "..."
 
+    [tooling.fe_rating]            # tip-force rating by the FE punch analysis as well (tabletcad.fe.punch;
+    steel = "S7_tempered_205C"     # needs the fe extra): a steel of tabletcad/data/tool_steels.toml, or
+                                   # yield_stress_MPa = 1450.0 with yield_stress_source = "..."
+    safety_factor = 1.5            # divides the yield stress and the buckling force
+    punch = "upper"                # "upper" | "lower" | "both"
+    mesh_size_mm = 0.5             # element size (default: tip width/8, as tabletcad fe punch)
+
     [tooling.drawing]              # title block and tolerances of the drawings
     name = "Example 10 mm"         # name, number, revision, material, date, author: strings
     tolerance_mm = 0.076           # general +- tolerance (default 0.076 mm, stated on the sheet)
@@ -41,7 +48,8 @@
     mode = "deboss"                # "deboss" | "emboss"
     face = "top"                   # "top" | "bottom"
     height_mm = 2.0                # font size (text)
-    depth_mm = 0.15                # depth (deboss) or height (emboss), along the axis
+    depth_mm = 0.15                # depth (deboss) or height (emboss), along the face normal
+    projection = "normal"          # "normal": depth along the local face normal | "axial": along the axis
     stroke_angle_deg = 0.0         # stroke angle: draft of the letter walls from the axis, 0 <= . < 60
                                    # (``draft_deg`` is accepted as the same key)
     font = "DejaVuSans-Bold"       # a DejaVu font name or a .ttf path
@@ -60,7 +68,7 @@ from typing import Any
 from tabletcad.errors import DesignError, check_finite, check_positive, check_range
 from tabletcad.tooling.standards import PunchBody, resolve_body
 
-__all__ = ["ToolingSpec", "ScoreSpec", "EmbossSpec", "parse_tooling", "FONT_DIR", "font_path"]
+__all__ = ["ToolingSpec", "ScoreSpec", "EmbossSpec", "FeRatingSpec", "parse_tooling", "FONT_DIR", "font_path"]
 
 FONT_DIR = Path("/usr/share/fonts/truetype/dejavu")
 
@@ -97,6 +105,66 @@ class EmbossSpec:
     rotation_deg: float = 0.0
     margin_mm: float = 0.2
     svg: str | None = None
+    projection: str = "normal"
+
+
+@dataclass(frozen=True)
+class FeRatingSpec:
+    """``[tooling.fe_rating]``: rate the tips by the FE punch analysis too (:mod:`tabletcad.fe.punch`, the
+    same computation as ``tabletcad fe punch``).  The yield stress (MPa) and Young's modulus (MPa) come
+    from ``steel`` (tabletcad/data/tool_steels.toml, each with its source) or from ``yield_stress_MPa``
+    with its ``yield_stress_source`` (E then 206000 MPa, as ``tabletcad fe punch``)."""
+
+    steel: str | None = None
+    yield_stress_MPa: float | None = None
+    yield_stress_source: str | None = None
+    safety_factor: float = 1.5
+    punch: str = "upper"
+    mesh_size_mm: float | None = None
+
+    @property
+    def punches(self) -> tuple[str, ...]:
+        return ("upper", "lower") if self.punch == "both" else (self.punch,)
+
+
+def steel_names() -> list[str]:
+    """The steels of ``tabletcad/data/tool_steels.toml`` (read as data: the FE layer owns their use)."""
+    import sys
+    from importlib import resources
+
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # pragma: no cover
+        import tomli as tomllib
+    text = resources.files("tabletcad").joinpath("data/tool_steels.toml").read_text(encoding="utf-8")
+    return list(tomllib.loads(text).get("steel", {}))
+
+
+def _fe_rating(t: Any) -> FeRatingSpec | None:
+    w = "[tooling.fe_rating]"
+    if t is None:
+        return None
+    t = _keys(w, t, set(FeRatingSpec.__dataclass_fields__))
+    d = FeRatingSpec()
+    steel, y = t.get("steel"), t.get("yield_stress_MPa")
+    if (steel is None) == (y is None):
+        raise DesignError(f"{w} steel", steel if steel is not None else "missing",
+                          "give steel (one of " + ", ".join(steel_names()) + ") or yield_stress_MPa with its "
+                          "yield_stress_source: no allowed stress is invented")
+    src = t.get("yield_stress_source")
+    if steel is not None:
+        _choice(f"{w} steel", steel, tuple(steel_names()))
+        if src is not None:
+            raise DesignError(f"{w} yield_stress_source", src, "give it with yield_stress_MPa (a steel has its own)")
+    else:
+        y = check_positive(f"{w} yield_stress_MPa", y, "MPa")
+        if not (isinstance(src, str) and src.strip()):
+            raise DesignError(f"{w} yield_stress_source", src if src is not None else "missing",
+                              "must name the source of yield_stress_MPa (a non-empty string)")
+    mesh = t.get("mesh_size_mm")
+    return FeRatingSpec(steel, y, src, check_positive(f"{w} safety_factor", t.get("safety_factor", d.safety_factor)),
+                        _choice(f"{w} punch", t.get("punch", d.punch), ("upper", "lower", "both")),
+                        None if mesh is None else check_positive(f"{w} mesh_size_mm", mesh, "mm"))
 
 
 #: general +- tolerance (mm) printed on the drawings when the design gives none: 0.003 in, stated on the sheet
@@ -161,6 +229,7 @@ class ToolingSpec:
     allowed_tip_pressure_source: str | None = None
     punch_youngs_modulus_MPa: float | None = None
     punch_youngs_modulus_source: str | None = None
+    fe_rating: FeRatingSpec | None = None
 
     @property
     def lower_tip(self) -> float:
@@ -273,6 +342,7 @@ def _emboss(i: int, t: Any, base: Path | None = None) -> EmbossSpec:
         check_finite(f"{w} rotation_deg", t.get("rotation_deg", d.rotation_deg), "deg"),
         check_range(f"{w} margin_mm", t.get("margin_mm", d.margin_mm), 0.0, None, "mm"),
         svg,
+        _choice(f"{w} projection", t.get("projection", d.projection), ("normal", "axial")),
     )
 
 
@@ -285,7 +355,7 @@ def parse_tooling(table: Any, base: Path | None = None) -> ToolingSpec:
     d = ToolingSpec()
     keys = {"clearance_mm", "tip_length_mm", "die_outer_diameter_mm", "die_height_mm", "taper_deg", "gap_mm", "score", "emboss",
             "standard", "type", "punch", "lower_tip_length_mm", "drawing", "allowed_tip_pressure_MPa",
-            "allowed_tip_pressure_source", "punch_youngs_modulus_MPa", "punch_youngs_modulus_source"}
+            "allowed_tip_pressure_source", "punch_youngs_modulus_MPa", "punch_youngs_modulus_source", "fe_rating"}
     t = _keys("[tooling]", table, keys)
     clearance = check_range("[tooling] clearance_mm", t.get("clearance_mm", d.clearance_mm), 0.0, 1.0, "mm")
     tip = check_positive("[tooling] tip_length_mm", t.get("tip_length_mm", d.tip_length_mm), "mm")
@@ -332,4 +402,4 @@ def parse_tooling(table: Any, base: Path | None = None) -> ToolingSpec:
     return ToolingSpec(clearance, tip, od, height, taper, gap,
                        tuple(_score(i, s) for i, s in enumerate(scores)),
                        tuple(_emboss(i, e, base) for i, e in enumerate(emb)), body=body, lower_tip_length_mm=lower,
-                       drawing=_drawing(t.get("drawing", {})), **sourced)
+                       drawing=_drawing(t.get("drawing", {})), fe_rating=_fe_rating(t.get("fe_rating")), **sourced)

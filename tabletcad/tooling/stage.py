@@ -16,7 +16,7 @@ exits with status 2 and the build writes nothing).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.geometry.tablet import Tablet
@@ -53,14 +53,17 @@ def write_tooling(ts, out: Path, *, drawing: bool = True) -> list[Path]:
 
 
 def tooling_stage(*, tablet: Tablet, spec: ToolingSpec, shape, out: Path, report: dict[str, Any],
-                  options: ReportOptions | None = None) -> None:
+                  options: ReportOptions | None = None, fe_rating: Callable[[Any], dict] | None = None) -> None:
     """Tooling files of ``spec`` (the design's checked ``[tooling]`` table); the finished tablet as ``tablet.*``.
 
     ``shape`` is the tablet's solid (``TopoDS_Shape``) that the CAD stage built and wrote as
     ``tablet.step/.stl/.glb``; when scores or embossing change it, the plain STEP is kept as
     ``tablet_plain.step`` and ``tablet.*`` become the finished (scored, embossed) tablet, the
     one the punches fit.  ``options`` (the design's ``[report]`` table) gives the density for the
-    masses of the split parts.
+    masses of the split parts.  ``fe_rating``: called with the built
+    :class:`~tabletcad.tooling.toolset.ToolSet` before the drawings are written, it returns the FE
+    tip-force rating (``tooling.tip_rating.fe``, printed on the drawing beside the pressure rule's);
+    the layer above passes it (:mod:`tabletcad.fe` may not be imported here).
     """
     from tabletcad.tooling.toolset import make_tooling
 
@@ -70,6 +73,8 @@ def tooling_stage(*, tablet: Tablet, spec: ToolingSpec, shape, out: Path, report
         raise GeometryError(
             f"{tablet.name}: tooling check failed: overlap {res['interference_mm3']:.3g} mm^3, largest gap "
             f"{res['max_gap_mm']:.4g} mm (clearance {spec.clearance_mm} mm)", ts)
+    if fe_rating is not None:
+        res["tip_rating"]["fe"] = fe_rating(ts)
     out = Path(out)
     files = write_tooling(ts, out)
     if spec.scores or spec.emboss:
