@@ -21,6 +21,7 @@ pytest.importorskip("OCP")
 pytest.importorskip("manifold3d")
 pytest.importorskip("trimesh")
 
+from support.family_tablets import family_tablet  # noqa: E402
 from tabletcad.cli.report import load_family_design  # noqa: E402
 from tabletcad.tooling import ToolingSpec, make_tooling  # noqa: E402
 
@@ -49,9 +50,9 @@ def test_tapered_bore_volume_is_steiner(deg):
 @pytest.mark.slow
 @pytest.mark.parametrize("path", FAMILY_SAMPLES, ids=[p.stem for p in FAMILY_SAMPLES])
 def test_every_family_builds_a_die_tapered_1_degree(path):
-    t, _ = load_family_design(path)
+    t, shape = family_tablet(path)  # shared with tests/test_tooling_parts.py
     spec = ToolingSpec(clearance_mm=0.02, taper_deg=1.0)
-    r = make_tooling(t, spec, check=False).report
+    r = make_tooling(t, spec, shape=shape, check=False).report
     assert r["interference_mm3"] == pytest.approx(0.0, abs=1e-9)
     assert 0.0 < r["max_gap_mm"] <= spec.clearance_mm
     assert r["die"]["bore_growth_at_top_mm"] == pytest.approx(r["die"]["punch_entry_mm"] * math.tan(math.radians(1.0)))
@@ -62,8 +63,8 @@ def test_largest_gap_on_a_flat_land_is_half_the_clearance():
     """Rounded triangle (0.1 mm land) at 0.035 mm clearance: a land point ``s`` in from the outline
     is ``s`` from the die bore and ``0.035 - s`` from the punch tip's edge, so the largest gap is
     0.0175 mm (the earlier measure, at mesh vertices only, reported 4.7e-11 mm)."""
-    t, _ = load_family_design(ROOT / "samples" / "families" / "rounded_triangle.toml")
-    r = make_tooling(t, ToolingSpec(clearance_mm=0.035), check=False).report
+    t, shape = family_tablet(ROOT / "samples" / "families" / "rounded_triangle.toml")
+    r = make_tooling(t, ToolingSpec(clearance_mm=0.035), shape=shape, check=False).report
     assert r["tablet"]["land_mm"] > 0.035
     assert r["max_gap_mm"] == pytest.approx(0.0175, abs=2e-3)
     assert r["max_gap_mm"] <= 0.0175 + 1e-9  # exact distances of surface points cannot exceed the peak
@@ -74,14 +75,13 @@ def test_largest_gap_on_a_flat_land_is_half_the_clearance():
 def test_largest_gap_agrees_with_an_independent_dense_sampling():
     """Rounded triangle with raised "A1" on the top cup, 0.035 mm clearance (issue 13 item 10: the
     letters' side walls were missed).  Independently of the report's method: 400,000 random points
-    on a 1e-4 mm tessellation of the finished tablet; an upper bound of every point's distance to the
-    tools from points on them (a k-d tree: each tool's 1e-4 mm mesh nodes, which lie on its B-rep,
-    then, for the points whose bound still reaches 80 % of the reported gap, a random cloud of about
-    one point per 25 µm² on the tool's triangles within 0.1 mm of them), and every point whose bound
-    reaches 80 % of the reported gap is measured exactly (BRepExtrema, :class:`ExactDistance`).  No
-    sampled point (letter walls included) lies farther from the tools than the reported gap plus its
-    stated resolution, and the sampling finds the land's closed-form peak.  (The random points are
-    about 20 µm apart, coarser than the report's refined 4.4 µm: the check is independent, not finer.)"""
+    on a 1e-4 mm tessellation of the finished tablet; a random cloud on each tool (about one point
+    per 25 µm²) gives an upper bound of every point's distance, and every point whose bound reaches
+    80 % of the reported gap is measured exactly (BRepExtrema's point-to-face and point-to-edge
+    extrema, :class:`~tabletcad.tooling.interference.ExactDistance`).  No sampled point (letter
+    walls included) lies farther from the tools than the reported gap plus its stated resolution,
+    and the sampling finds the land's closed-form peak.  (The random points are about 20 µm apart,
+    coarser than the report's refined 4.4 µm: the check is independent, not finer.)"""
     import numpy as np
     import trimesh
     from scipy.spatial import cKDTree
@@ -90,10 +90,10 @@ def test_largest_gap_agrees_with_an_independent_dense_sampling():
     from tabletcad.tooling.interference import ExactDistance
     from tabletcad.tooling.spec import EmbossSpec
 
-    t, _ = load_family_design(ROOT / "samples" / "families" / "rounded_triangle.toml")
+    t, shape = family_tablet(ROOT / "samples" / "families" / "rounded_triangle.toml")
     spec = ToolingSpec(clearance_mm=0.035, emboss=(EmbossSpec(text="A1", mode="emboss", face="top", height_mm=2.5,
                                                               depth_mm=0.12),))
-    ts = make_tooling(t, spec, check=False)
+    ts = make_tooling(t, spec, shape=shape, check=False)
     gap, res = ts.report["max_gap_mm"], ts.report["interference"]["max_gap_resolution_mm"]
     tools = {k: s for k, s in ts.parts.items() if k != "tablet"}
 
@@ -101,26 +101,15 @@ def test_largest_gap_agrees_with_an_independent_dense_sampling():
     surface = trimesh.Trimesh(V, T, process=False)
     P, _ = trimesh.sample.sample_surface(surface, 400_000, seed=1)
     lo, hi = P.min(axis=0) - 0.05, P.max(axis=0) + 0.05
-    meshes = {k: mesh_arrays(s, 1e-4, 0.05) for k, s in tools.items()}
     bound = np.full(len(P), np.inf)
-    for Vs, _ in meshes.values():  # mesh nodes lie on the tool's B-rep: their distance bounds the tool's
-        Vs = Vs[np.all((Vs >= lo) & (Vs <= hi), axis=1)]
-        bound = np.minimum(bound, cKDTree(Vs).query(P, distance_upper_bound=0.1)[0])
-    open_ = np.flatnonzero(bound >= 0.8 * gap)  # not yet below 80 %: a dense cloud on the tools near them
-    near_pts = cKDTree(P[open_])
-    for Vs, Ts in meshes.values():
+    for s in tools.values():
+        Vs, Ts = mesh_arrays(s, 1e-4, 0.05)
         tri = Vs[Ts]
-        box = np.all(tri.max(axis=1) >= lo, axis=1) & np.all(tri.min(axis=1) <= hi, axis=1)
-        tri, Tn = tri[box], Ts[box]
-        centre = tri.mean(axis=1)
-        radius = np.linalg.norm(tri - centre[:, None, :], axis=2).max(axis=1)
-        d, _ = near_pts.query(centre, distance_upper_bound=0.1 + radius.max())
-        keep = d <= 0.1 + radius  # a triangle farther than 0.1 mm from every open point cannot give its bound
-        if not np.any(keep):
-            continue
-        part = trimesh.Trimesh(Vs, Tn[keep], process=False)
+        near = np.all(tri.max(axis=1) >= lo, axis=1) & np.all(tri.min(axis=1) <= hi, axis=1)
+        part = trimesh.Trimesh(Vs, Ts[near], process=False)
         Q, _ = trimesh.sample.sample_surface(part, int(part.area / 2.5e-5), seed=2)
-        bound[open_] = np.minimum(bound[open_], cKDTree(Q).query(P[open_], distance_upper_bound=0.1)[0])
+        Q = Q[np.all((Q >= lo) & (Q <= hi), axis=1)]
+        bound = np.minimum(bound, cKDTree(Q).query(P, distance_upper_bound=0.1)[0])
     candidates = np.flatnonzero(bound >= 0.8 * gap)
     assert 0 < len(candidates) < 5000
     exact_to = [ExactDistance(s) for s in tools.values()]
