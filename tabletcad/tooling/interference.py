@@ -156,7 +156,7 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
 
 
 class ExactDistance:
-    """Exact distance (mm) from points to the boundary of one OCC shape, asked for many points.
+    """Exact distance (mm) from points to one OCC shape (0 inside a solid), asked for many points.
 
     What ``BRepExtrema_DistShapeShape`` computes for a vertex and the shape - the least of the
     point's distances to every vertex, its extrema on every edge (``BRepExtrema_ExtPC``) and its
@@ -262,16 +262,6 @@ def _box_corners(shape) -> tuple[tuple[float, float, float], tuple[float, float,
     box = _box(shape)
     lo, hi = box.CornerMin(), box.CornerMax()
     return (lo.X(), lo.Y(), lo.Z()), (hi.X(), hi.Y(), hi.Z())
-
-
-def _occ_point_distance(p, shape) -> float:
-    """``BRepExtrema_DistShapeShape`` of the point ``p`` and ``shape`` (one point; see :class:`ExactDistance`)."""
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
-    from OCP.gp import gp_Pnt
-
-    v = BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex()
-    d = BRepExtrema_DistShapeShape(v, shape)
-    return float(d.Value()) if d.IsDone() else float("inf")
 
 
 def _box(shape):
