@@ -109,7 +109,8 @@ def test_largest_gap_agrees_with_an_independent_dense_sampling():
         part = trimesh.Trimesh(Vs, Ts[near], process=False)
         Q, _ = trimesh.sample.sample_surface(part, int(part.area / 2.5e-5), seed=2)
         Q = Q[np.all((Q >= lo) & (Q <= hi), axis=1)]
-        bound = np.minimum(bound, cKDTree(Q).query(P, distance_upper_bound=0.1)[0])
+        tree = cKDTree(Q, balanced_tree=False, compact_nodes=False)  # the same answers, built 3 times faster
+        bound = np.minimum(bound, tree.query(P, distance_upper_bound=0.1)[0])
     candidates = np.flatnonzero(bound >= 0.8 * gap)
     assert 0 < len(candidates) < 5000
     exact_to = [ExactDistance(s) for s in tools.values()]
