@@ -44,3 +44,47 @@ def test_mesh_distance_of_points_on_the_mesh_and_of_nothing():
     assert centre[0] == pytest.approx(1.0, abs=1e-15)  # the nearest face is x = ±1
     assert mesh_distance(np.zeros((0, 3)), V, T).shape == (0,)
     assert np.isinf(mesh_distance(np.zeros((2, 3)), V, T[:0])).all()
+
+
+def test_exact_distance_matches_closed_forms_and_brepextrema():
+    """:class:`ExactDistance` (each face's extremum solver set up once) against closed forms - a box's
+    boundary, a sphere converted to a NURBS face (0 inside both solids, as OCC's distance of a point
+    and a solid) - and against ``BRepExtrema_DistShapeShape`` of a vertex and the thesis tablet's
+    B-spline solid and its shell (its boundary only): never above it, below it by less than OCC's
+    confusion precision (1e-7 mm)."""
+    pytest.importorskip("OCP")
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex, BRepBuilderAPI_NurbsConvert
+    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeSphere
+    from OCP.gp import gp_Pnt
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.cad.tablet_solid import tablet_solid
+    from tabletcad.families.thesis import shallow_convex_round
+    from tabletcad.tooling.interference import ExactDistance
+
+    rng = np.random.default_rng(7)
+    h = np.array([1.0, 1.5, 2.0])
+    solid = BRepPrimAPI_MakeBox(gp_Pnt(*-h), gp_Pnt(*h)).Shape()
+    box, box_shell = ExactDistance(solid), ExactDistance(explore(solid, "Shell")[0])
+    P = rng.uniform(-3.0, 3.0, (60, 3))
+    q = np.abs(P) - h
+    inside = np.all(q <= 0, axis=1)
+    closed = np.where(inside, -q.max(axis=1), np.linalg.norm(np.maximum(q, 0.0), axis=1))
+    assert 5 < inside.sum() < 50
+    assert np.allclose([box_shell(p) for p in P], closed, rtol=0, atol=1e-12)
+    assert np.allclose([box(p) for p in P], np.where(inside, 0.0, closed), rtol=0, atol=1e-12)
+    sphere = ExactDistance(BRepBuilderAPI_NurbsConvert(BRepPrimAPI_MakeSphere(2.0).Shape(), True).Shape())
+    P = rng.normal(size=(40, 3)) * 2.0
+    r = np.linalg.norm(P, axis=1)
+    got = [sphere.nearest(p) for p in P]
+    assert 5 < np.sum(r < 2.0) < 35
+    assert np.allclose([d for d, _ in got], np.maximum(r - 2.0, 0.0), rtol=0, atol=1e-7)
+    assert np.allclose([np.linalg.norm(x) for (_, x), ri in zip(got, r) if ri > 2.0], 2.0, rtol=0, atol=1e-7)
+    shape = tablet_solid(shallow_convex_round(), revolved=False).shape
+    P = rng.uniform(-6.0, 6.0, (30, 3)) * np.array([1.0, 1.0, 0.5])
+    for s in (shape, explore(shape, "Shell")[0]):
+        ext = ExactDistance(s)
+        for p in P:
+            dss = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*p)).Vertex(), s)
+            assert dss.Value() - 1e-7 <= ext(p) <= dss.Value() + 1e-12

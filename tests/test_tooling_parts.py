@@ -246,11 +246,11 @@ def test_every_family_sample_gets_valid_tooling(path):
     """Punches and die for every family sample: single valid solids; at the closed position no
     overlap between any two parts (OCC) and no point of the tablet farther than the clearance
     from a tool; a bisect score across the width (it crosses a capsule's centre line)."""
-    from tabletcad.cli.report import load_family_design
+    from support.family_tablets import family_tablet
 
-    t, _ = load_family_design(path)
+    t, shape = family_tablet(path)  # shared with tests/test_tooling_taper_gap.py
     spec = ToolingSpec(clearance_mm=0.02)
-    ts = make_tooling(t, spec, check=False)
+    ts = make_tooling(t, spec, shape=shape, check=False)
     for name, shape in ts.parts.items():
         check_solid(shape, name)
     r = ts.report
