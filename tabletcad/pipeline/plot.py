@@ -358,13 +358,16 @@ def _draw_plan(ax, tablet: Tablet, o: TabletOutline, grids, colour="#4e79a7", di
     from matplotlib.colors import to_rgb
 
     base = np.array(to_rgb(colour))
+    outward = tablet.orientation
     polys, cols, depth = [], [], []
     for face, Y in grids:
         q = _quads(Y)
-        n = np.cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 1])
+        n = np.cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 1]) * (face.sign * outward)
         n /= np.maximum(np.linalg.norm(n, axis=-1), 1e-300)[:, None]
-        seen = np.abs(n[:, 2]) > 1e-3  # walls are edge-on from above
-        n = n[seen] * np.sign(n[seen, 2])[:, None]  # the normal facing the viewer
+        # seen from above: the faces turned up (outward normals; walls are edge-on, the
+        # bottom lies under the top, whatever the grid's orientation)
+        seen = n[:, 2] > 1e-3
+        n = n[seen]
         lam = np.clip(n @ _LIGHT, 0.0, 1.0)
         polys.append(q[seen][:, :, :2])
         cols.append(np.clip(base[None, :] * (0.2 + 1.0 * lam[:, None] ** 2) + 0.05, 0, 1))
