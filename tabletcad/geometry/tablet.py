@@ -336,9 +336,13 @@ class Tablet:
 
     @property
     def orientation(self) -> float:
-        """+1 if the patches' ``X_u × X_v`` points out of the solid, -1 if inward."""
-        vol = sum(self._face_integrals(f, 24, 64)[1] for f in self.faces())
-        return 1.0 if vol >= 0.0 else -1.0
+        """+1 if the patches' ``X_u × X_v`` points out of the solid, -1 if inward (computed once)."""
+        hit = self.__dict__.get("_orientation")
+        if hit is None:
+            vol = sum(self._face_integrals(f, 24, 64)[1] for f in self.faces())
+            hit = 1.0 if vol >= 0.0 else -1.0
+            object.__setattr__(self, "_orientation", hit)
+        return hit
 
     def properties(self, nu: int | None = None, nv: int | None = None) -> dict[str, Any]:
         """Area and volume by quadrature (eqs 4.8, 4.9), per face and in total.
