@@ -64,7 +64,7 @@ from tabletcad.cad._occ import explore
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.tooling.booleans import checked_boolean, translated
 from tabletcad.tooling.booleans import compound as _compound
-from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, polyline_wire
+from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, polyline_wire, wire_length
 from tabletcad.tooling.spec import EmbossSpec, font_path
 
 __all__ = ["figure_faces", "figure_prism", "apply_emboss", "check_fit", "check_emboss", "face_heights", "offset_solid"]
@@ -346,8 +346,10 @@ def _section_to(wire, d: float, steps: int = 8):
 def _ruled_draft(wire, narrow: float, wide: float, t: float, grow: float):
     """Ruled solid through ``wire``'s offsets: at ``z = narrow`` offset by ``-grow*narrow*t``, at
     ``z = -wide`` by ``+grow*wide*t`` (nominal at 0), axial beyond where an offset ceases to exist.
-    Where OCC cannot loft two sections (a nearly closed hole has fewer edges than its other end) the
-    drafted part of that end is shortened (1/2, 1/4, 0 of it) until it can."""
+    Where OCC cannot loft the sections as they are (their edges do not pair up: OCC's offsets split
+    Bézier edges differently at the two ends) they are replaced by polygons through paired points
+    (:func:`_paired`, 0.04 mm apart); where that fails too the drafted part is
+    shortened (to 1/2, 1/4, 0 at one end or both) until it lofts."""
     d_hi, d_lo = -grow * narrow * t, grow * wide * t
     w_hi, f_hi = _section_to(wire, d_hi)
     w_lo, f_lo = _section_to(wire, d_lo)
@@ -356,15 +358,87 @@ def _ruled_draft(wire, narrow: float, wide: float, t: float, grow: float):
         hi = w_hi if s_hi == 1.0 else _offset_section(wire, s_hi * f_hi * d_hi)
         if lo is None or hi is None:
             continue
-        solid = _loft([(lo, -wide), (lo, -s_lo * f_lo * wide), (hi, s_hi * f_hi * narrow), (hi, narrow)])
+        sections = [(lo, -wide), (lo, -s_lo * f_lo * wide), (hi, s_hi * f_hi * narrow), (hi, narrow)]
+        solid = _loft(sections)
+        if solid is None:
+            a, b = _paired(lo, hi) if wire_length(lo) >= wire_length(hi) else _paired(hi, lo)[::-1]
+            solid = _loft([(a if w is lo else b, z) for w, z in sections])
         if solid is not None:
             return solid
     raise GeometryError("ruled drafted prism of a glyph wire failed", wire)
 
 
+def _wire_points(wire, spacing: float):
+    """Points (n, 2) about ``spacing`` mm apart along the planar closed ``wire``, counter-clockwise."""
+    import numpy as np
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.BRepTools import BRepTools_WireExplorer
+    from OCP.GCPnts import GCPnts_AbscissaPoint, GCPnts_UniformAbscissa
+    from OCP.TopAbs import TopAbs_REVERSED
+
+    pts = []
+    ex = BRepTools_WireExplorer(wire)
+    while ex.More():  # the edges in the wire's order, each along the wire's direction
+        edge = ex.Current()
+        curve = BRepAdaptor_Curve(edge)
+        u0, u1 = curve.FirstParameter(), curve.LastParameter()
+        n = max(2, int(math.ceil(GCPnts_AbscissaPoint.Length_s(curve) / spacing)))
+        ua = GCPnts_UniformAbscissa(curve, n + 1, u0, u1)
+        us = [ua.Parameter(i) for i in range(1, ua.NbPoints() + 1)] if ua.IsDone() else list(np.linspace(u0, u1, n + 1))
+        if edge.Orientation() == TopAbs_REVERSED:
+            us = us[::-1]
+        pts += [(curve.Value(u).X(), curve.Value(u).Y()) for u in us[:-1]]
+        ex.Next()
+    pts = np.array(pts)
+    keep = np.linalg.norm(pts - np.roll(pts, 1, axis=0), axis=1) > 0.1 * spacing  # OCC's offsets have 0-length edges
+    pts = pts[keep]
+    x, y = pts[:, 0], pts[:, 1]
+    return pts if np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) > 0.0 else pts[::-1]
+
+
+def _paired(wa, wb, spacing: float = 0.04):
+    """Two closed polygons: through ``wa``'s points (``spacing`` apart) and through the nearest points
+    of ``wb`` to them, vertex for vertex, so that a ruled loft between them joins
+    each point of one offset to its counterpart along the normal on the other (OCC's offsets of one
+    outline split its edges differently, and pairing by arc length drifts where a feature vanishes).
+    The positions along ``wb`` are kept in order (a step back becomes a step of 1e-3 spacing)."""
+    import numpy as np
+
+    pa, pb = _wire_points(wa, spacing), _wire_points(wb, 0.25 * spacing)
+    seg = np.roll(pb, -1, axis=0) - pb
+    slen = np.linalg.norm(seg, axis=1)
+    cum = np.concatenate([[0.0], np.cumsum(slen)])
+    per = cum[-1]
+    rel = pa[:, None, :] - pb[None, :, :]
+    u = np.clip(np.einsum("ijk,jk->ij", rel, seg) / np.maximum(slen * slen, 1e-30), 0.0, 1.0)
+    dist = np.linalg.norm(rel - u[..., None] * seg[None], axis=2)
+    j = np.argmin(dist, axis=1)
+    sig = cum[j] + u[np.arange(len(pa)), j] * slen[j]  # arc-length position on wb of each point of wa
+    steps = np.mod(np.diff(np.concatenate([sig, sig[:1]])) + 0.5 * per, per) - 0.5 * per
+    steps = np.maximum(steps, 1e-3 * spacing)  # distinct vertices
+    steps *= per / steps.sum()  # once round wb
+    sig = np.mod(sig[0] + np.concatenate([[0.0], np.cumsum(steps[:-1])]), per)
+    k = np.searchsorted(cum, sig, side="right") - 1
+    k = np.clip(k, 0, len(pb) - 1)
+    pbq = pb[k] + ((sig - cum[k]) / np.maximum(slen[k], 1e-30))[:, None] * seg[k]
+    return _polygon(pa), _polygon(pbq)
+
+
+def _polygon(pts):
+    """The closed polygon wire through the points (n, 2) at z = 0."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakePolygon
+
+    mk = BRepBuilderAPI_MakePolygon()
+    for px, py in pts:
+        mk.Add(gp_Pnt(float(px), float(py), 0.0))
+    mk.Close()
+    return mk.Wire()
+
+
 def _loft(sections):
     """One ruled solid (``BRepOffsetAPI_ThruSections``) through the planar ``(wire, z)`` sections
-    (a section repeating its neighbour's height is dropped), or ``None``."""
+    (a section repeating its neighbour's height is dropped), or ``None`` (failed or invalid)."""
+    from OCP.BRepCheck import BRepCheck_Analyzer
     from OCP.BRepOffsetAPI import BRepOffsetAPI_ThruSections
     from OCP.TopoDS import TopoDS
 
@@ -380,7 +454,7 @@ def _loft(sections):
         solids = explore(loft.Shape(), "Solid") if loft.IsDone() else []
     except Exception:  # StdFail_NotDone
         return None
-    return solids[0] if len(solids) == 1 else None
+    return solids[0] if len(solids) == 1 and BRepCheck_Analyzer(solids[0]).IsValid() else None
 
 
 def _z_range(shape) -> tuple[float, float]:
