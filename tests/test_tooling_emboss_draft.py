@@ -9,10 +9,11 @@ A(s) = A + P s + K s² (s the outward offset; P the perimeter, K the corner term
     V = A h - P t (n² - w²) / 2 + K t² (n³ + w³) / 3,   h = n + w,
 
 exact for a disc (the frustum π h (R₁² + R₁R₂ + R₂²) / 3) and a square (the pyramid frustum
-h (A₁ + A₂ + √(A₁A₂)) / 3).  For glyphs (Bézier outlines whose offsets OCC approximates) the volume
-lies between the straight prisms of the narrow and the wide end sections and within
-0.25 · P h² t / 2 of the linear part ``A h - P t (n² - w²) / 2`` (|K| t² (n³ + w³) / 3 for the
-turning of the glyph outlines, measured below 0.13 of P h² t / 2 for DejaVu Sans Bold).
+h (A₁ + A₂ + √(A₁A₂)) / 3).  For glyphs (Bézier outlines whose offsets OCC approximates, lofted
+through paired polygons where the two ends' edges do not pair up) the volume lies between the
+straight prisms of the narrow and the wide end sections and within 0.15 · P h² t / 2 of the linear
+part ``A h - P t (n² - w²) / 2`` (the corner term |K| t² (n³ + w³) / 3 of the glyphs' sharp corners:
+measured at most 0.033 of P h² t / 2 at 15° ("X") and 0.099 at 30° ("M") for DejaVu Sans Bold).
 
 ``LocOpe_DPrism``, used before, segfaulted the process on "6", "8" and "9"."""
 
@@ -158,7 +159,7 @@ def test_every_glyph_gives_one_valid_drafted_solid(a, text):
             assert narrow_end * h < V < wide_end * h, ch
             assert narrow_end < A < wide_end, ch
             linear = A * h - P * t * (N * N - W * W) / 2.0
-            assert abs(V - linear) <= 0.25 * P * h * h * t / 2.0, (ch, V, linear)
+            assert abs(V - linear) <= 0.15 * P * h * h * t / 2.0, (ch, V, linear)
 
 
 @pytest.mark.parametrize("family", ["concave_round", "capsule"])
