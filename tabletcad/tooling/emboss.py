@@ -348,7 +348,7 @@ def _ruled_draft(wire, narrow: float, wide: float, t: float, grow: float):
     ``z = -wide`` by ``+grow*wide*t`` (nominal at 0), axial beyond where an offset ceases to exist.
     Where the two ends have different numbers of edges (OCC's offsets split Bézier edges
     differently at the two ends) or OCC cannot loft them as they are they are replaced by polygons through paired points
-    (:func:`_paired`, 0.04 mm apart); where that fails too the drafted part is
+    (:func:`_paired`, 0.08 mm apart); where that fails too the drafted part is
     shortened (to 1/2, 1/4, 0 at one end or both) until it lofts."""
     d_hi, d_lo = -grow * narrow * t, grow * wide * t
     w_hi, f_hi = _section_to(wire, d_hi)
@@ -398,7 +398,7 @@ def _wire_points(wire, spacing: float):
     return pts if np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) > 0.0 else pts[::-1]
 
 
-def _paired(wa, wb, spacing: float = 0.04):
+def _paired(wa, wb, spacing: float = 0.08):
     """Two closed polygons: through ``wa``'s points (``spacing`` apart) and through the nearest points
     of ``wb`` to them, vertex for vertex, so that a ruled loft between them joins
     each point of one offset to its counterpart along the normal on the other (OCC's offsets of one
