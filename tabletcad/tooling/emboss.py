@@ -6,8 +6,9 @@ polyline, or a logo's filled outlines from an SVG file (build123d's
 ``import_svg``, centred and scaled to ``height_mm`` tall) —
 rotated, moved to ``position_mm`` and, on the bottom face, mirrored so that
 it reads correctly when the tablet is turned over.  It is extruded along the
-axis into a prism (with ``draft_deg`` on its walls when asked) and cut to the
-layer of the face the engraving occupies:
+axis into a prism (with ``draft_deg`` on its walls when asked: a ruled loft of
+each outline's in-plane offsets, narrower towards the letter floor) and cut to
+the layer of the face the engraving occupies:
 
 * ``projection = "normal"`` (default): the layer between the face and its
   normal offset by ``depth`` (OCC's simple offset,
