@@ -424,18 +424,7 @@ def _paired(wa, wb, spacing: float = 0.08):
     k = np.searchsorted(cum, sig, side="right") - 1
     k = np.clip(k, 0, len(pb) - 1)
     pbq = pb[k] + ((sig - cum[k]) / np.maximum(slen[k], 1e-30))[:, None] * seg[k]
-    return _polygon(pa), _polygon(pbq)
-
-
-def _polygon(pts):
-    """The closed polygon wire through the points (n, 2) at z = 0."""
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakePolygon
-
-    mk = BRepBuilderAPI_MakePolygon()
-    for px, py in pts:
-        mk.Add(gp_Pnt(float(px), float(py), 0.0))
-    mk.Close()
-    return mk.Wire()
+    return polyline_wire(pa), polyline_wire(pbq)
 
 
 def _loft(sections):

@@ -137,8 +137,17 @@ def segments_wire(segs) -> Any:
 
 
 def polyline_wire(points) -> Any:
-    pts = [gp_Pnt(float(x), float(y), 0.0) for x, y in points]
-    return _wire([BRepBuilderAPI_MakeEdge(pts[i], pts[(i + 1) % len(pts)]).Edge() for i in range(len(pts))])
+    """The closed polygon wire through the plan points (n, 2) at z = 0 (shared vertices; a point
+    equal to the one before it is skipped)."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakePolygon
+
+    mk = BRepBuilderAPI_MakePolygon()
+    for x, y in points:
+        mk.Add(gp_Pnt(float(x), float(y), 0.0))
+    mk.Close()
+    if not mk.IsDone():
+        raise GeometryError("polyline points do not form a closed wire", points)
+    return mk.Wire()
 
 
 def plan_face(wire) -> Any:
