@@ -266,13 +266,16 @@ def test_largest_tensile_stress_of_a_thin_disc_against_hondros():
 
 def test_largest_tensile_stress_converges_under_refinement():
     """Concave round 10 mm, band 2.8, cup 0.9 (the shape whose vertex maximum jumped with the mesh):
-    the largest averaged tensile stress at bulk sizes 1.6, 1.2, 0.9 mm (ratio 4/3, strips b/3).
+    the largest averaged tensile stress at bulk sizes 1.2, 0.9, 0.675 mm (ratio 4/3, strips b/3).
 
     The differences fall and the observed order ``log(d1/d2)/log(4/3)`` is printed and must exceed 1;
     the finest value is within 5 % of the Richardson limit ``s₃ + (s₃ - s₂)/(d1/d2 - 1)``.
+    1.6 mm is not in the asymptotic range: with gmsh 4.15.2 it read 0.01633 MPa per N (on the face),
+    then 0.01579, 0.01497, 0.01486 and 0.01483 at 0.506 mm (62,433 unknowns), so 1.6, 1.2, 0.9
+    had growing differences with that release and falling ones with the one before.
     """
     t = _tablet(family="concave_round", diameter=10.0, band=2.8, cup_depth=0.9, land=0.08)
-    hs = [1.6, 1.2, 0.9]
+    hs = [1.2, 0.9, 0.675]
     res = [diametral(t, 1.0, "x", mesh_size=h, error_estimate=False) for h in hs]
     s = [r.max_tensile_stress_MPa for r in res]
     d1, d2 = abs(s[1] - s[0]), abs(s[2] - s[1])

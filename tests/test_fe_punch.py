@@ -38,7 +38,9 @@ def test_flat_tip_carries_the_uniform_stress(flat_tip):
     r = punch_stress(shape, info, 20.0, yield_MPa=1450.0, safety_factor=1.5, mesh_size=1.0, face_refinement=1.0)
     A = math.pi * (4.0 - 0.02) ** 2
     assert r.back_area_mm2 == pytest.approx(A, rel=0.015)  # inscribed polygon of ~25 sides: -(2π/25)²/6
-    assert r.axial_area_mm2 == pytest.approx(r.back_area_mm2, rel=1e-9)
+    # the two faces' boundary circles are meshed as separate curves: gmsh 4.15.2 puts their nodes 1e-9
+    # (relative) apart, so the two polygons' areas agree to that, against a 1 % polygon error
+    assert r.axial_area_mm2 == pytest.approx(r.back_area_mm2, rel=1e-6)
     assert r.uniform_stress_MPa == pytest.approx(20000.0 / r.back_area_mm2)
     assert r.max_von_mises_MPa == pytest.approx(r.uniform_stress_MPa, rel=0.01)
     vm = von_mises(r.solution.vertex_stress)

@@ -5,7 +5,8 @@
   ``samples`` link to the repository's samples; every command must exit 0.
 * Transcript blocks (no language, lines starting with ``$ ``): each command runs the same
   way, and every line the README shows under it must appear among the lines it printed
-  (white space folded; ``...`` in a shown line stands for anything, e.g. a time),
+  (white space folded; ``...`` in a shown line stands for anything, e.g. a time; in a line
+  that ends ``# numbers within P %`` each number may differ by P %: an FE figure on gmsh's mesh),
   so the figures quoted in the README are the figures the command
   prints today.
 * ```` ```python ```` blocks run as scripts in such a folder.
@@ -66,9 +67,37 @@ def _strip_comment(cmd: str) -> str:
     return re.sub(r"(^|\s+)#.*$", "", cmd).strip()
 
 
+_NUMBER = r"[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
+_WITHIN = re.compile(r"\s+#\s*numbers within (\d+(?:\.\d+)?) %\s*$")
+
+
 def _pattern(shown: str) -> re.Pattern:
-    """A README output line as a pattern: white space folded, ``...`` stands for anything."""
-    return re.compile(".*".join(re.escape(part) for part in _fold(shown).split("...")))
+    """A README output line as a pattern: white space folded, ``...`` stands for anything; in a
+    line marked ``# numbers within P %`` every number is a number (compared by :func:`_matches`)."""
+    m = _WITHIN.search(shown)
+    if m:
+        shown = shown[: m.start()]
+    parts = []
+    for part in _fold(shown).split("..."):
+        if m:
+            pieces = re.split(f"({_NUMBER})", part)
+            parts.append("".join(f"({_NUMBER})" if k % 2 else re.escape(x) for k, x in enumerate(pieces)))
+        else:
+            parts.append(re.escape(part))
+    return re.compile(".*".join(parts))
+
+
+def _matches(shown: str, printed: str) -> bool:
+    """``printed`` is the README's ``shown`` line; a line marked ``# numbers within P %`` (a figure
+    that moves with a library's release, e.g. an FE result on gmsh's mesh) matches when every number
+    printed lies within P % of the one shown."""
+    found = _pattern(shown).fullmatch(printed)
+    m = _WITHIN.search(shown)
+    if not found or not m:
+        return bool(found)
+    want = re.findall(_NUMBER, _fold(shown[: m.start()]).replace("...", " "))
+    tol = float(m.group(1)) / 100.0
+    return all(abs(float(g) - float(w)) <= tol * abs(float(w)) for g, w in zip(found.groups(), want))
 
 
 def _workdir(tmp_path: Path) -> Path:
@@ -128,7 +157,7 @@ def test_transcript_prints_what_the_readme_shows(text: str, tmp_path: Path) -> N
         want = 2 if refused else 0
         assert r.returncode == want, f"{cmd!r} exited {r.returncode}, not {want}:\n{r.stderr[-2000:]}"
         printed = [_fold(s) for s in (r.stderr if refused else r.stdout).splitlines()]
-        missing = [s for s in expected if not any(_pattern(s).fullmatch(p) for p in printed)]
+        missing = [s for s in expected if not any(_matches(s, p) for p in printed)]
         assert not missing, f"{cmd!r} no longer prints:\n" + "\n".join(missing) + f"\n--- it printed:\n{r.stdout}"
 
     for line in text.splitlines():

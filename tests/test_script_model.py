@@ -152,7 +152,9 @@ def test_tooling_parts_have_the_same_vocabulary(model):
     assert tools.report["keys"]["clearance_mm"] == 0.03
     up = tools.upper_punch
     assert isinstance(up.to_build123d(), bd.Solid)
-    assert up.to_build123d().volume == pytest.approx(up.volume, rel=1e-9)
+    # build123d's volume is OCC's default integration (no eps: 1.4e-9 off on the punch's B-spline cup with
+    # build123d 0.12), ours the adaptive one to 1e-9
+    assert up.to_build123d().volume == pytest.approx(up.volume, rel=1e-8)
     assert tools["tablet"].volume == pytest.approx(model.occ_volume, rel=1e-6)
     assert not re.search(r"https?://", tools._repr_html_())
     import struct
