@@ -74,7 +74,9 @@ def _mesh_parameters(linear_deflection: float, angular_deflection: float, relati
     p.Deflection = float(linear_deflection)
     p.Angle = float(angular_deflection)
     p.Relative = bool(relative)
-    p.InParallel = False  # a tablet has 2-4 faces; threads cost more than they save
+    # faces meshed on every core (the same triangles, bit for bit): the plain tooling tablet's five B-spline
+    # faces at 0.005 mm 0.90 -> 0.51 s on two cores, the lettered tablet 0.70 -> 0.46 s
+    p.InParallel = True
     p.ControlSurfaceDeflection = True  # needed: without it the chord error is not bounded inside faces
     p.MeshAlgo = {
         "delabella": IMeshTools_MeshAlgoType.IMeshTools_MeshAlgoType_Delabella,
