@@ -88,3 +88,33 @@ def test_exact_distance_matches_closed_forms_and_brepextrema():
         for p in P:
             dss = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*p)).Vertex(), s)
             assert dss.Value() - 1e-7 <= ext(p) <= dss.Value() + 1e-12
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), flat=st.floats(0.0, 1.0))
+def test_covering_radius_is_the_largest_distance_to_the_nearest_corner(seed, flat):
+    """:func:`covering_radius` (the branch and bound's bound on a triangle) against a dense barycentric
+    grid: no grid point lies farther from its nearest corner, for an acute triangle the grid's worst
+    comes within the grid's spacing of it (an obtuse one gets half its longest edge, an upper bound),
+    and it never exceeds ``L / √3``; closed forms for the equilateral and the right isosceles triangle."""
+    from tabletcad.tooling.interference import covering_radius
+
+    rng = np.random.default_rng(seed)
+    tri = rng.normal(size=(3, 3))
+    tri[2] = tri[0] + flat * (tri[2] - tri[0]) + (1 - flat) * 0.5 * (tri[1] - tri[0])  # down to nearly flat
+    r = float(covering_radius(tri[None])[0])
+    n = 120
+    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+    keep = i + j <= n
+    w = np.stack([i[keep], j[keep], n - i[keep] - j[keep]], axis=1) / n
+    P = w @ tri
+    worst = float(np.max(np.min(np.linalg.norm(P[:, None, :] - tri[None], axis=2), axis=1)))
+    L = max(np.linalg.norm(tri[a] - tri[b]) for a, b in ((0, 1), (1, 2), (2, 0)))
+    assert worst <= r * (1 + 1e-12) + 1e-15
+    e = np.sort([np.linalg.norm(tri[a] - tri[b]) for a, b in ((0, 1), (1, 2), (2, 0))])
+    if e[0] ** 2 + e[1] ** 2 > e[2] ** 2 * (1 + 1e-9):  # acute: the circumcentre, a tight bound
+        assert worst >= r - 2.0 * L / n
+    assert r <= L / np.sqrt(3.0) * (1 + 1e-12)
+    eq = np.array([[[0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0]]])
+    assert covering_radius(eq)[0] == pytest.approx(1 / np.sqrt(3), rel=1e-12)
+    assert covering_radius(np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float))[0] == pytest.approx(np.sqrt(2) / 2, rel=1e-12)

@@ -114,8 +114,8 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
     """Points where the 1-Lipschitz function ``f`` may exceed ``best`` inside triangles, by branch and bound.
 
     ``tris`` (n, 3, 3) with ``values`` (n, 3), ``f`` at their corners.  Every point of a
-    triangle with longest edge ``L`` lies within ``L / √3`` of a corner, so ``f`` there is
-    at most ``max(corner values) + L / √3``.  A triangle is split at the midpoint of its
+    triangle lies within its :func:`covering_radius` ``r <= L / √3`` (longest edge ``L``) of a
+    corner, so ``f`` there is at most ``max(corner values) + r``.  A triangle is split at the midpoint of its
     longest edge (``f`` measured there) while that bound exceeds the largest value found by
     more than ``spacing / √3``; the others are dropped.  A triangle whose edges are
     ``<= spacing`` is always dropped (its bound is within ``spacing / √3`` of a corner), so
@@ -133,8 +133,7 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
             break
         e = np.stack([np.linalg.norm(tris[:, 1] - tris[:, 0], axis=1), np.linalg.norm(tris[:, 2] - tris[:, 1], axis=1),
                       np.linalg.norm(tris[:, 0] - tris[:, 2], axis=1)], axis=1)
-        L = e.max(axis=1)
-        live = values.max(axis=1) + L / math.sqrt(3.0) > best + slack
+        live = values.max(axis=1) + covering_radius(tris, e) > best + slack
         tris, values, e = tris[live], values[live], e[live]
         if not len(tris):
             break
@@ -153,6 +152,29 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
     if not pts:
         return np.zeros((0, 3)), np.zeros(0)
     return np.concatenate(pts), np.concatenate(vals)
+
+
+def covering_radius(tris: np.ndarray, e: np.ndarray | None = None) -> np.ndarray:
+    """The largest distance from a point of each triangle to its nearest corner (mm).
+
+    The circumradius ``abc / 4A`` when the triangle is acute (its circumcentre lies inside), else half
+    its longest edge: with the longest edge ``AB`` on the x axis, an angle at ``C`` of 90° or more puts
+    ``C`` in the circle on ``AB`` (``|AC|² <= |AB| x_C``), so the points of ``AB`` equidistant from ``C``
+    and ``A`` (or ``B``) lie within ``|AB| / 2`` of them.  Never above ``L / √3`` (the equilateral
+    triangle); a right isosceles triangle, as longest-edge bisection makes, has ``L / 2``.
+    """
+    if e is None:
+        e = np.stack([np.linalg.norm(tris[:, 1] - tris[:, 0], axis=1), np.linalg.norm(tris[:, 2] - tris[:, 1], axis=1),
+                      np.linalg.norm(tris[:, 0] - tris[:, 2], axis=1)], axis=1)
+    es = np.sort(e, axis=1)
+    a, b, c = es[:, 0], es[:, 1], es[:, 2]
+    half = 0.5 * c
+    acute = a * a + b * b > c * c
+    area2 = np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1)  # twice the area
+    with np.errstate(divide="ignore", invalid="ignore"):
+        R = a * b * c / (2.0 * area2)
+    # rounding: never below half the longest edge (any triangle's bound) nor above L / √3
+    return np.where(acute & np.isfinite(R), np.clip(R, half, c / math.sqrt(3.0)), half)
 
 
 class ExactDistance:
