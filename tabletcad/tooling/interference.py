@@ -157,11 +157,15 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
 def covering_radius(tris: np.ndarray, e: np.ndarray | None = None) -> np.ndarray:
     """The largest distance from a point of each triangle to its nearest corner (mm).
 
-    The circumradius ``abc / 4A`` when the triangle is acute (its circumcentre lies inside), else half
-    its longest edge: with the longest edge ``AB`` on the x axis, an angle at ``C`` of 90° or more puts
-    ``C`` in the circle on ``AB`` (``|AC|² <= |AB| x_C``), so the points of ``AB`` equidistant from ``C``
-    and ``A`` (or ``B``) lie within ``|AB| / 2`` of them.  Never above ``L / √3`` (the equilateral
-    triangle); a right isosceles triangle, as longest-edge bisection makes, has ``L / 2``.
+    The distance to the nearest corner is convex inside each corner's Voronoi cell and along each
+    bisector, so its maximum over the triangle lies at the circumcentre (when inside) or where a
+    bisector of two corners meets an edge.  Acute triangle: the circumradius ``abc / 4A``.  Otherwise
+    half the longest edge ``AB``: with ``AB`` on the x axis, an angle at ``C`` of 90° or more puts ``C``
+    in the circle on ``AB`` (``|AC|² <= |AB| x_C``), so the bisector of ``AC`` meets ``AB`` at
+    ``|AC|² / 2 x_C <= |AB| / 2`` from ``A`` (that of ``BC`` likewise from ``B``), the midpoint of ``AB`` is
+    no farther from ``C`` than from ``A``, and the other edges' midpoints are nearer still.  Never above
+    ``L / √3`` (the equilateral triangle); a right isosceles triangle, as longest-edge bisection makes,
+    has ``L / 2``.
     """
     if e is None:
         e = np.stack([np.linalg.norm(tris[:, 1] - tris[:, 0], axis=1), np.linalg.norm(tris[:, 2] - tris[:, 1], axis=1),
