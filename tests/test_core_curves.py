@@ -250,3 +250,82 @@ def test_band_limited_curves_need_the_modes_the_general_scan_finds(rx, ry, tol, 
                               np.array([1.0, 2.0, 3.0]))):
         assert curve.band_limit() == 1
         assert modes_needed(curve, tol, 64) == modes_needed(_Plain(curve), tol, 64)
+
+
+# ------------------------------------------------------------------ exact distances to arcs and outlines
+def _arc_distance_by_angle(seg, q: np.ndarray) -> np.ndarray:
+    """The textbook form: the polar angle of each point decides arc or nearer end."""
+    r = q - np.asarray(seg.center)
+    rel = np.mod((np.arctan2(r[:, 1], r[:, 0]) - seg.theta0) * math.copysign(1.0, seg.sweep), TWO_PI)
+    ends = np.minimum(*(np.hypot(*(q - seg.point(t)).T) for t in (0.0, 1.0)))
+    return np.where(rel <= abs(seg.sweep), np.abs(np.hypot(r[:, 0], r[:, 1]) - seg.radius), ends)
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(
+    r=st.floats(0.05, 20.0),
+    t0=st.floats(-7.0, 7.0),
+    sweep=st.floats(0.01, TWO_PI).flatmap(lambda s: st.sampled_from([s, -s])),
+    seed=st.integers(0, 2**16),
+)
+def test_arc_distance_agrees_with_the_polar_angle_form(r, t0, sweep, seed):
+    """``Seg.distance`` tests the angular span without an arctangent (half-sweep about the middle
+    direction); it must give the polar-angle form's distance everywhere, including near the
+    span's ends, where the two branches meet."""
+    from tabletcad.geometry.curves import Seg
+
+    seg = Seg.arc((0.3, -1.1), r, t0, sweep)
+    rng = np.random.default_rng(seed)
+    q = np.asarray(seg.center) + rng.normal(scale=1.5 * r, size=(400, 2))
+    ang = t0 + sweep * rng.choice([0.0, 1.0], size=100) + rng.normal(scale=1e-9, size=100)  # at the ends
+    q = np.vstack([q, np.asarray(seg.center) + (r * rng.uniform(0.2, 2.0, 100))[:, None] * np.column_stack([np.cos(ang), np.sin(ang)])])
+    np.testing.assert_allclose(seg.distance(q), _arc_distance_by_angle(seg, q), rtol=0, atol=1e-12 * max(1.0, r))
+
+
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(L=st.floats(6.0, 22.0), W_frac=st.floats(0.2, 0.95), seed=st.integers(0, 2**16))
+def test_outline_signed_distance_against_a_dense_polygon(L, W_frac, seed):
+    """Exact signed distance of a stadium and a rounded rectangle against a polygon of 200,000
+    outline points: magnitudes agree to the polygon's chord error, signs to a point-in-polygon test."""
+    from matplotlib.path import Path
+
+    from tabletcad.families.outline import rounded_rectangle_outline, stadium_outline
+
+    W = W_frac * L
+    rng = np.random.default_rng(seed)
+    for ol in (stadium_outline(L, W), rounded_rectangle_outline(L, W, 0.3 * W)):
+        poly = ol.frame(np.linspace(0.0, TWO_PI, 200_000, endpoint=False))[0]
+        q = rng.uniform(-0.8 * L, 0.8 * L, size=(300, 2))
+        sd = ol.signed_distance(q)
+        tree = __import__("scipy.spatial", fromlist=["cKDTree"]).cKDTree(poly)
+        near = tree.query(q)[0]
+        h = ol.perimeter / 200_000
+        assert np.all(near >= np.abs(sd) - 1e-12) and np.all(near <= np.abs(sd) + h)
+        inside = Path(poly).contains_points(q)
+        clear = near > 2 * h
+        assert np.array_equal((sd > 0)[clear], inside[clear])
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(seed=st.integers(0, 2**16), n=st.integers(1, 8))
+def test_chain_distance_is_the_minimum_over_every_element(seed, n):
+    """``distance_to_chain`` skips elements whose bounding circle is farther than the best so
+    far; the result must equal the plain minimum over all elements, and every element's
+    bounding circle must hold the element."""
+    from tabletcad.families.profile import distance_to_chain
+    from tabletcad.geometry.curves import Seg
+
+    rng = np.random.default_rng(seed)
+    els = []
+    for _ in range(n):
+        if rng.random() < 0.5:
+            els.append(Seg.line(rng.normal(size=2) * 3, rng.normal(size=2) * 3))
+        else:
+            els.append(Seg.arc(rng.normal(size=2) * 3, rng.uniform(0.1, 4.0), rng.uniform(-7, 7), rng.uniform(-TWO_PI, TWO_PI)))
+    for e in els:
+        cx, cy, r = e.bounding_circle()
+        pts = e.point(np.linspace(0.0, 1.0, 2001))
+        assert np.max(np.hypot(pts[:, 0] - cx, pts[:, 1] - cy)) <= r * (1 + 1e-12) + 1e-12
+    q = rng.normal(size=(3000, 2)) * rng.uniform(0.5, 6.0)
+    plain = np.min([e.distance(q) for e in els], axis=0)
+    np.testing.assert_array_equal(distance_to_chain(els, q), plain)

@@ -47,6 +47,9 @@ __all__ = [
 
 _line, _arc = Seg.line, Seg.arc
 
+#: How many ``v`` sample arrays an outline remembers the frames of (:meth:`PlanOutline.frame`).
+_FRAME_MEMO = 16
+
 
 class PlanOutline:
     """Closed CCW G1 chain of lines and arcs in the plane (mm).
@@ -131,8 +134,28 @@ class PlanOutline:
 
     def frame(self, v) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Point ``O``, unit tangent ``T``, inward normal ``N`` (each (m, 2)) and
-        signed curvature ``κ`` (m,) (1/mm, > 0 on convex arcs) at ``v``."""
+        signed curvature ``κ`` (m,) (1/mm, > 0 on convex arcs) at ``v``; read-only arrays.
+
+        A swept tablet's patches evaluate their boundary data (offsets of this outline) on
+        the same ``v`` samples again and again, so frames of grid-sized ``v`` arrays are
+        remembered (the last :data:`_FRAME_MEMO` of them, keyed on the samples' bytes).
+        """
         v = np.asarray(v, dtype=float).reshape(-1)
+        if not 64 <= v.size <= 8192:
+            return self._frame(v)
+        memo = self.__dict__.setdefault("_frame_memo", {})
+        key = v.tobytes()
+        hit = memo.get(key)
+        if hit is None:
+            hit = self._frame(v)
+            for a in hit:
+                a.setflags(write=False)
+            if len(memo) >= _FRAME_MEMO:
+                memo.pop(next(iter(memo)))
+            memo[key] = hit
+        return hit
+
+    def _frame(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         s, idx = self._locate(v)
         O = np.zeros((v.size, 2))
         T = np.zeros((v.size, 2))
@@ -226,39 +249,32 @@ class PlanOutline:
     def signed_distance(self, xy) -> np.ndarray:
         """Exact distance (mm) from plan points ``xy`` (m, 2) to the outline, > 0 inside."""
         p = np.asarray(xy, dtype=float).reshape(-1, 2)
+        px, py = np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1])
         best = np.full(len(p), np.inf)
         sign = np.ones(len(p))
+
+        def side(x0: float, y0: float, t) -> np.ndarray:  # +1 left of the direction t through (x0, y0)
+            return np.where((px - x0) * -t[1] + (py - y0) * t[0] >= 0.0, 1.0, -1.0)
+
         for s in self.segs:
             if s.kind == "line":
-                a = np.asarray(s.p0)
-                d = np.subtract(s.p1, s.p0)
-                L2 = float(d @ d)
-                t = np.clip(((p - a) @ d) / L2, 0.0, 1.0)
-                foot = a + t[:, None] * d
-                n = np.array([-d[1], d[0]]) / math.sqrt(L2)
-                q = p - foot
-                dist = np.hypot(q[:, 0], q[:, 1])
-                sg = np.where(q @ n >= 0.0, 1.0, -1.0)
+                (ax, ay), (bx, by) = s.p0, s.p1
+                dx, dy = bx - ax, by - ay
+                t = np.clip(((px - ax) * dx + (py - ay) * dy) / (dx * dx + dy * dy), 0.0, 1.0)
+                qx, qy = px - (ax + t * dx), py - (ay + t * dy)
+                dist = np.hypot(qx, qy)
+                sg = np.where(qx * -dy + qy * dx >= 0.0, 1.0, -1.0)
             else:
-                c = np.asarray(s.center)
-                q = p - c
-                rho = np.hypot(q[:, 0], q[:, 1])
-                ang = np.arctan2(q[:, 1], q[:, 0])
-                sw = s.sweep
-                rel = np.mod((ang - s.theta0) * math.copysign(1.0, sw), math.tau)
-                inside_arc = rel <= abs(sw)
+                rx, ry = px - s.center[0], py - s.center[1]
+                rho = np.hypot(rx, ry)
+                inside_arc = s.within_sweep(rx, ry, rho)
                 d_arc = np.abs(rho - s.radius)
                 # inward normal of a convex (ccw) arc points to the centre
-                sg_arc = np.where((s.radius - rho) * math.copysign(1.0, sw) >= 0.0, 1.0, -1.0)
-                e0 = np.hypot(p[:, 0] - s.p0[0], p[:, 1] - s.p0[1])
-                e1 = np.hypot(p[:, 0] - s.p1[0], p[:, 1] - s.p1[1])
-                t0, t1 = s.tangent(0), s.tangent(1)
-                n0 = np.array([-t0[1], t0[0]])
-                n1 = np.array([-t1[1], t1[0]])
-                sg0 = np.where((p - np.asarray(s.p0)) @ n0 >= 0.0, 1.0, -1.0)
-                sg1 = np.where((p - np.asarray(s.p1)) @ n1 >= 0.0, 1.0, -1.0)
+                sg_arc = np.where((s.radius - rho) * math.copysign(1.0, s.sweep) >= 0.0, 1.0, -1.0)
+                e0 = np.hypot(px - s.p0[0], py - s.p0[1])
+                e1 = np.hypot(px - s.p1[0], py - s.p1[1])
                 dist = np.where(inside_arc, d_arc, np.minimum(e0, e1))
-                sg = np.where(inside_arc, sg_arc, np.where(e0 <= e1, sg0, sg1))
+                sg = np.where(inside_arc, sg_arc, np.where(e0 <= e1, side(*s.p0, s.tangent(0)), side(*s.p1, s.tangent(1))))
             better = dist < best
             best = np.where(better, dist, best)
             sign = np.where(better, sg, sign)
@@ -410,8 +426,8 @@ class SplineOutline(PlanOutline):
         kmax = self.max_curvature
         return (1.0 - DEFAULT.offset_regularity) / kmax if kmax > 0 else math.inf
 
-    def frame(self, v):
-        v = np.mod(np.asarray(v, dtype=float).reshape(-1), math.tau)
+    def _frame(self, v):
+        v = np.mod(v, math.tau)
         O = self._sp(v)
         d1 = self._sp(v, 1)
         d2 = self._sp(v, 2)

@@ -90,11 +90,23 @@ def pieces_for(element: Seg, target: float, max_angle: float = math.radians(45.0
 
 
 def distance_to_chain(elements, q: np.ndarray) -> np.ndarray:
-    """Exact distance (mm) from points ``q`` (m, 2) to a chain of elements."""
+    """Exact distance (mm) from points ``q`` (m, 2) to a chain of elements.
+
+    The smallest of the distances to every element; an element is measured only at the points
+    where it could be nearer than the best so far (its bounding circle,
+    :meth:`~tabletcad.geometry.curves.Seg.bounding_circle`, gives ``|q - c| - r`` as a lower
+    bound), so each point usually meets only the elements around it.
+    """
     q = np.asarray(q, dtype=float).reshape(-1, 2)
+    qx, qy = np.ascontiguousarray(q[:, 0]), np.ascontiguousarray(q[:, 1])
     out = np.full(len(q), np.inf)
     for e in elements:
-        out = np.minimum(out, e.distance(q))
+        cx, cy, r = e.bounding_circle()
+        idx = np.flatnonzero(np.hypot(qx - cx, qy - cy) - r * (1.0 + 1e-9) < out)  # (slack for rounding)
+        if idx.size == len(q):
+            out = np.minimum(out, e.distance(q))
+        elif idx.size:
+            out[idx] = np.minimum(out[idx], e.distance(q[idx]))
     return out
 
 

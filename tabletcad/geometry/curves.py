@@ -256,14 +256,31 @@ class Seg:
             t = np.clip(((q - a) @ d) / float(d @ d), 0.0, 1.0)
             r = q - (a + t[:, None] * d)
             return np.hypot(r[:, 0], r[:, 1])
-        r = q - np.asarray(self.center)
-        rho = np.hypot(r[:, 0], r[:, 1])
-        ang = np.arctan2(r[:, 1], r[:, 0])
-        rel = np.mod((ang - self.theta0) * math.copysign(1.0, self.sweep), 2 * math.pi)
-        on = rel <= abs(self.sweep)
-        e0 = np.linalg.norm(q - self.point(0.0), axis=1)
-        e1 = np.linalg.norm(q - self.point(1.0), axis=1)
-        return np.where(on, np.abs(rho - self.radius), np.minimum(e0, e1))
+        rx, ry = q[:, 0] - self.center[0], q[:, 1] - self.center[1]
+        rho = np.hypot(rx, ry)
+        on = self.within_sweep(rx, ry, rho)
+        (x0, y0), (x1, y1) = self.point(0.0), self.point(1.0)
+        ends = np.minimum(np.hypot(q[:, 0] - x0, q[:, 1] - y0), np.hypot(q[:, 0] - x1, q[:, 1] - y1))
+        return np.where(on, np.abs(rho - self.radius), ends)
+
+    def bounding_circle(self) -> tuple[float, float, float]:
+        """``(x, y, r)``: a circle holding the whole segment (mm), about its middle point.
+
+        A line's middle and half length.  On an arc the distance from its middle point,
+        ``2 ρ sin(Δθ / 2)``, grows with the angle ``Δθ <= |sweep| / 2 <= π`` to it, so the ends
+        are farthest: ``r = 2 ρ sin(|sweep| / 4)``.
+        """
+        mx, my = (float(c) for c in self.point(0.5))
+        if self.kind == "line":
+            return mx, my, 0.5 * self.length
+        return mx, my, 2.0 * self.radius * math.sin(0.25 * abs(self.sweep))
+
+    def within_sweep(self, rx: np.ndarray, ry: np.ndarray, rho: np.ndarray) -> np.ndarray:
+        """Whether directions ``(rx, ry)`` from an arc's centre (of lengths ``rho``) fall inside
+        its angular span: within half the sweep of the arc's middle direction, i.e.
+        ``r · m >= |r| cos(|sweep| / 2)`` (no arctangent; right for any sweep up to 2π)."""
+        mid = self.theta0 + 0.5 * self.sweep
+        return rx * math.cos(mid) + ry * math.sin(mid) >= rho * math.cos(0.5 * abs(self.sweep))
 
     def mirrored(self, ym: float) -> Seg:
         """The mirror image in the line ``y = ym``, run the other way (so a chain stays a chain)."""

@@ -29,6 +29,7 @@ curves is refused with :class:`~tabletcad.errors.DesignError`; pass a smaller
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -63,6 +64,34 @@ def _trig(v: np.ndarray, n: np.ndarray, dv: int) -> tuple[np.ndarray, np.ndarray
     if k == 2:
         return -c * fac, -s * fac
     return s * fac, -c * fac
+
+
+#: How many trigonometric tables :func:`_trig_shared` keeps (all patches together).
+_TRIG_TABLES = 16
+_trig_tables: dict = {}
+_trig_lock = threading.Lock()
+
+
+def _trig_shared(v: np.ndarray, n: np.ndarray, dv: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_trig` (read-only), remembered across patches for grid-sized ``v``.
+
+    The patches of one tablet are evaluated on the same ``v`` samples with the same modes
+    (a swept tablet's nine patches, the checks' grids), so one table serves them all.  Keyed
+    on the bytes of ``v`` and ``n``: equal samples hit, nothing is shared between different ones.
+    """
+    if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
+        return _trig(v, n, dv)
+    key = (dv, n.tobytes(), v.tobytes())
+    hit = _trig_tables.get(key)
+    if hit is None:
+        hit = _trig(v, n, dv)
+        for a in hit:
+            a.setflags(write=False)
+        with _trig_lock:
+            while len(_trig_tables) >= _TRIG_TABLES:
+                _trig_tables.pop(next(iter(_trig_tables)))
+            _trig_tables[key] = hit
+    return hit
 
 
 @dataclass(frozen=True, eq=False)
@@ -293,9 +322,7 @@ class PDEPatch:
 
     def _trig_cached(self, v: np.ndarray, N: int, dv: int) -> tuple[np.ndarray, np.ndarray]:
         """``_trig(v, 1..N, dv)`` (read-only), cached for repeated ``v``."""
-        if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
-            return _trig(v, np.arange(1, N + 1), dv)
-        return self._memo(("trig", N, dv, v.tobytes()), lambda: _trig(v, np.arange(1, N + 1), dv))
+        return _trig_shared(v, np.arange(1, N + 1), dv)
 
     def _residuals(self, v: np.ndarray, dv: int) -> np.ndarray:
         """Every datum's part above mode ``N`` (or its v-derivative) at ``v``: (4, len(v), 3) mm, read-only."""
@@ -388,10 +415,7 @@ class PDEPatch:
             n = np.array(self._active)
             A = np.matmul(L, self._ac[:, n - 1].transpose(1, 0, 2))  # (n, nu, 3)
             B = np.matmul(L, self._bc[:, n - 1].transpose(1, 0, 2))
-            if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
-                c, s = _trig(v, n, dv)  # (nv, n)
-            else:
-                c, s = self._memo(("active", dv, v.tobytes()), lambda: _trig(v, n, dv))
+            c, s = _trig_shared(v, n, dv)  # (nv, n)
             # one batched product per u: (nv, 2n) @ (2n, 3), written straight into the (nu, nv, 3)
             # layout (4x faster than one big product followed by a transposing copy)
             out = np.matmul(np.concatenate([c, s], axis=1), np.concatenate([A, B]).transpose(1, 0, 2))

@@ -31,6 +31,17 @@ __all__ = ["Band", "Trim", "Tablet", "Face", "solid_map"]
 
 
 
+def _coordinate_range(arrays, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Smallest and largest of each of the first ``k`` coordinates over point arrays ``(..., 3)``.
+
+    One strided reduction per coordinate: some 30 times faster than ``min(axis=0)`` over an
+    ``(m, 3)`` view, which numpy runs three elements at a time.
+    """
+    lo = np.array([min(float(a[..., j].min()) for a in arrays) for j in range(k)])
+    hi = np.array([max(float(a[..., j].max()) for a in arrays) for j in range(k)])
+    return lo, hi
+
+
 @lru_cache(maxsize=32)
 def _leggauss(n: int) -> tuple[np.ndarray, np.ndarray]:
     """Gauss-Legendre nodes and weights on [-1, 1] (cached: numpy solves an eigenproblem)."""
@@ -435,24 +446,29 @@ class Tablet:
     def _plan_area_sampled(self, nu: int = 129, nv: int = 2048) -> float:
         """:meth:`plan_area` from samples of every patch (any star-shaped plan)."""
         u, v = self._grid(nu, nv)
-        pts = self.sample(nu, nv)  # (patches, nu, nv, 3)
-        c = 0.5 * (pts[..., :2].min(axis=(0, 1, 2)) + pts[..., :2].max(axis=(0, 1, 2)))
-        d = pts[..., :2] - c
-        r = np.hypot(d[..., 0], d[..., 1])
-        i = np.argmax(r, axis=1)  # farthest point along each v line: (patches, nv)
+        pts = [p.evaluate_grid(u, v) for p in self.patches]  # each (nu, nv, 3); no stacked copy
+        lo, hi = _coordinate_range(pts, 2)
+        c = 0.5 * (lo + hi)
         m = 4 * nv
         grid = (np.arange(m) + 0.5) * (math.tau / m) - math.pi
         env_full = np.zeros(m)
         cols = np.arange(nv)
-        for j, p in enumerate(self.patches):  # each patch's outer curve r_j(φ), then the envelope over patches
-            rr = r[j, i[j], cols]
-            dd = d[j, i[j], cols]
-            inner = (i[j] > 0) & (i[j] < nu - 1)
+        r_max = 0.0
+        outer = []
+        for X in pts:  # the farthest point along each v line of each patch
+            dx, dy = X[..., 0] - c[0], X[..., 1] - c[1]
+            r2 = dx * dx + dy * dy
+            i = np.argmax(r2, axis=0)
+            rr = np.sqrt(r2[i, cols])
+            r_max = max(r_max, float(rr.max()))
+            outer.append((i, rr, np.column_stack([dx[i, cols], dy[i, cols]])))
+        for p, (i, rr, dd) in zip(self.patches, outer):  # each patch's outer curve r_j(φ), then the envelope
+            inner = (i > 0) & (i < nu - 1)
             if np.any(inner):
                 k = np.flatnonzero(inner)
-                _, r2, dk = self._farthest_along_u(p, c, u[i[j, k]], v[k], rr[k] ** 2, u[1] - u[0])
+                _, r2, dk = self._farthest_along_u(p, c, u[i[k]], v[k], rr[k] ** 2, u[1] - u[0])
                 rr[k], dd[k] = np.sqrt(r2), dk
-            keep = rr > 1e-9 * max(float(r.max()), 1.0)
+            keep = rr > 1e-9 * max(r_max, 1.0)
             if np.count_nonzero(keep) < 8:
                 continue
             phi = np.arctan2(dd[keep, 1], dd[keep, 0])
@@ -461,7 +477,7 @@ class Tablet:
         hole = 0.0
         if self.trim.w[0] > 0.0:  # hollow solid (ring): subtract the see-through hole
             A = np.stack([p.spine(np.linspace(self.trim.u[0], self.trim.u[1], nu)) for p in self.patches])
-            inner = A[:, :, None, :] + self.trim.w[0] * (pts - A[:, :, None, :])
+            inner = A[:, :, None, :] + self.trim.w[0] * (np.stack(pts) - A[:, :, None, :])
             ri = np.hypot(inner[..., 0] - c[0], inner[..., 1] - c[1]).min(axis=(0, 1))
             di = inner[0, 0, :, :2] - c
             phi = np.arctan2(di[:, 1], di[:, 0])
@@ -621,8 +637,7 @@ class Tablet:
 
     def _bounds_sampled(self) -> tuple[np.ndarray, np.ndarray]:
         pts = self.sample(97, 256)
-        lo = pts.reshape(-1, 3).min(axis=0)
-        hi = pts.reshape(-1, 3).max(axis=0)
+        lo, hi = _coordinate_range([pts], 3)
         u, v = self._grid(97, 256)
         for axis in range(3):
             for sign, store in ((-1.0, lo), (1.0, hi)):
