@@ -72,20 +72,30 @@ _trig_tables: dict = {}
 _trig_lock = threading.Lock()
 
 
-def _trig_shared(v: np.ndarray, n: np.ndarray, dv: int) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_trig` (read-only), remembered across patches for grid-sized ``v``.
+_EYE3 = np.eye(3)
+
+
+def _trig_rows(v: np.ndarray, n: np.ndarray, dv: int) -> np.ndarray:
+    c, s = _trig(v, n, dv)
+    return np.ascontiguousarray(np.concatenate([c, s], axis=1).T)
+
+
+def _trig_shared(v: np.ndarray, n: np.ndarray, dv: int, rows: bool = False):
+    """:func:`_trig` (read-only), remembered across patches for grid-sized ``v``; with
+    ``rows`` the table ``(2 len(n), len(v))`` of the cosines' rows over the sines' rows.
 
     The patches of one tablet are evaluated on the same ``v`` samples with the same modes
     (a swept tablet's nine patches, the checks' grids), so one table serves them all.  Keyed
     on the bytes of ``v`` and ``n``: equal samples hit, nothing is shared between different ones.
     """
+    make = _trig_rows if rows else _trig
     if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
-        return _trig(v, n, dv)
-    key = (dv, n.tobytes(), v.tobytes())
+        return make(v, n, dv)
+    key = (rows, dv, n.tobytes(), v.tobytes())
     hit = _trig_tables.get(key)
     if hit is None:
-        hit = _trig(v, n, dv)
-        for a in hit:
+        hit = make(v, n, dv)
+        for a in (hit,) if rows else hit:
             a.setflags(write=False)
         with _trig_lock:
             while len(_trig_tables) >= _TRIG_TABLES:
@@ -411,22 +421,27 @@ class PDEPatch:
         u = np.asarray(u, dtype=float).reshape(-1)
         v = np.asarray(v, dtype=float).reshape(-1)
         L, L0, Lr = self._u_tables(u, du)  # (n, nu, 4), (nu, 4), (nu, 4)
+        # X[i, j, c] = Σ_k U[i, c, k] V[k, j]: the modes (cos and sin rows of V, their u-profiles
+        # in U), the spine (a row of ones) and the remainder (rows r_k,c'(v), with U = L_β δ_cc')
+        # in one matrix product of (3 nu, K) by (K, nv), the shape BLAS runs fastest
+        left, right = [], []
         if self._active:
             n = np.array(self._active)
-            A = np.matmul(L, self._ac[:, n - 1].transpose(1, 0, 2))  # (n, nu, 3)
-            B = np.matmul(L, self._bc[:, n - 1].transpose(1, 0, 2))
-            c, s = _trig_shared(v, n, dv)  # (nv, n)
-            # one batched product per u: (nv, 2n) @ (2n, 3), written straight into the (nu, nv, 3)
-            # layout (4x faster than one big product followed by a transposing copy)
-            out = np.matmul(np.concatenate([c, s], axis=1), np.concatenate([A, B]).transpose(1, 0, 2))
-        else:
-            out = np.zeros((u.size, v.size, 3))
+            left.append(np.matmul(L, self._ac[:, n - 1].transpose(1, 0, 2)).transpose(1, 2, 0))  # (nu, 3, n)
+            left.append(np.matmul(L, self._bc[:, n - 1].transpose(1, 0, 2)).transpose(1, 2, 0))
+            right.append(_trig_shared(v, n, dv, rows=True))  # (2n, nv)
         if dv == 0:
-            out += (L0 @ self._a0)[:, None, :]
+            left.append((L0 @ self._a0)[:, :, None])
+            right.append(np.ones((1, v.size)))
         if self._has_remainder:
             r = self._residuals(v, dv)  # (4, nv, 3)
-            out += (Lr @ r.reshape(4, -1)).reshape(u.size, v.size, 3)
-        return out
+            left.append((Lr[:, None, :, None] * _EYE3[None, :, None, :]).reshape(u.size, 3, 12))
+            right.append(r.transpose(0, 2, 1).reshape(12, v.size))
+        if not left:
+            return np.zeros((u.size, v.size, 3))
+        U = np.concatenate(left, axis=2).reshape(3 * u.size, -1)
+        X = U @ (right[0] if len(right) == 1 else np.concatenate(right))
+        return np.ascontiguousarray(X.reshape(u.size, 3, v.size).transpose(0, 2, 1))
 
     def spine(self, u, du: int = 0) -> np.ndarray:
         """The spine ``A0(u)`` (eq 3.13, mm), the ``n = 0`` term; shape ``u.shape + (3,)``."""
