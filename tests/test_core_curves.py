@@ -329,3 +329,23 @@ def test_chain_distance_is_the_minimum_over_every_element(seed, n):
     q = rng.normal(size=(3000, 2)) * rng.uniform(0.5, 6.0)
     plain = np.min([e.distance(q) for e in els], axis=0)
     np.testing.assert_array_equal(distance_to_chain(els, q), plain)
+
+
+@pytest.mark.parametrize("der", [0, 1, 2])
+def test_outline_offset_is_the_weighted_point_and_normal(der):
+    """``offset`` (one frame) equals ``alpha O + beta N`` from ``point`` and ``normal`` for every
+    derivative order, and both agree with central differences of the order below."""
+    from tabletcad.families.outline import rounded_rectangle_outline, stadium_outline
+
+    v = np.linspace(0.0, TWO_PI, 997, endpoint=False) + 1e-3
+    for ol in (stadium_outline(14.0, 6.0), rounded_rectangle_outline(12.0, 7.0, 2.0)):
+        for alpha, beta in ((1.0, 0.0), (0.0, 1.0), (1.0, 0.7), (0.3, -2.0)):
+            got = ol.offset(v, der, alpha, beta)
+            want = alpha * ol.point(v, der) + beta * ol.normal(v, der)
+            np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
+            if der:  # away from the joins, where the curvature jumps
+                h = 1e-6
+                fd = (ol.offset(v + h, der - 1, alpha, beta) - ol.offset(v - h, der - 1, alpha, beta)) / (2 * h)
+                b = np.asarray(ol.breaks)
+                far = np.min(np.abs(np.mod(v[:, None] - b[None, :] + math.pi, TWO_PI) - math.pi), axis=1) > 1e-4
+                np.testing.assert_allclose(got[far], fd[far], rtol=0, atol=1e-6 * max(1.0, float(np.max(np.abs(got)))))

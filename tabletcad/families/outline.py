@@ -210,6 +210,19 @@ class PlanOutline:
             return -(k * k * g * g)[:, None] * N
         raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
 
+    def offset(self, v, der: int, alpha: float, beta: float) -> np.ndarray:
+        """``d^der/dv^der (alpha O + beta N)`` (mm), shape (m, 2): :meth:`point` and
+        :meth:`normal` combined from one :meth:`frame` (a swept tablet's boundary data)."""
+        if der not in (0, 1, 2):
+            raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
+        O, T, N, k = self.frame(v)
+        g = self.speed
+        if der == 0:
+            return alpha * O + beta * N
+        if der == 1:
+            return (g * (alpha - beta * k))[:, None] * T
+        return ((alpha * k - beta * k * k) * g * g)[:, None] * N
+
     def centroid(self) -> np.ndarray:
         """Area centroid (mm), exact for lines and arcs."""
         sx = sy = 0.0
@@ -454,6 +467,9 @@ class SplineOutline(PlanOutline):
             h = 1e-5
             return (self.normal(v + h, 1) - self.normal(v - h, 1)) / (2 * h)
         raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
+
+    def offset(self, v, der: int, alpha: float, beta: float) -> np.ndarray:
+        return alpha * self.point(v, der) + beta * self.normal(v, der)
 
     def centroid(self) -> np.ndarray:
         p, d1 = self._ps, self._sp(self._vs, 1)

@@ -120,10 +120,8 @@ class SweepCurve(Curve):
     def evaluate(self, v, der: int = 0) -> np.ndarray:
         v = np.asarray(v, dtype=float).reshape(-1)
         out = np.zeros((v.size, 3))
-        if self.alpha:
-            out[:, :2] += self.alpha * self.outline.point(v, der)
-        if self.beta:
-            out[:, :2] += self.beta * self.outline.normal(v, der)
+        if self.alpha or self.beta:
+            out[:, :2] = self.outline.offset(v, der, self.alpha, self.beta)
         if der == 0:
             out += np.asarray(self.const, dtype=float)
         elif der not in (1, 2):

@@ -295,14 +295,15 @@ class PDEPatch:
         """True when some datum has content above mode ``N`` (so ``R != 0``)."""
         return self._has_remainder
 
-    def _series(self, k: int, v: np.ndarray, dv: int) -> np.ndarray:
-        """Truncated Fourier series of datum ``k`` (or its v-derivative) at ``v``."""
+    def _series(self, k: int, v: np.ndarray, dv: int, cs: tuple | None = None) -> np.ndarray:
+        """Truncated Fourier series of datum ``k`` (or its v-derivative) at ``v``; ``cs``: the
+        table ``_trig(v, 1..N, dv)`` if already made."""
         N = self.modes
         out = np.zeros((v.size, 3))
         if dv == 0:
             out += self._a0[k]
         if N:
-            c, s = self._trig_cached(v, N, dv)
+            c, s = cs if cs is not None else self._trig_cached(v, N, dv)
             out += c @ self._ac[k, :N] + s @ self._bc[k, :N]
         return out
 
@@ -338,7 +339,12 @@ class PDEPatch:
         """Every datum's part above mode ``N`` (or its v-derivative) at ``v``: (4, len(v), 3) mm, read-only."""
 
         def make() -> np.ndarray:
-            return np.stack([self.data[k].evaluate(v, dv) - self._series(k, v, dv) for k in range(4)])
+            N = self.modes
+            cs = self._trig_cached(v, N, dv) if N else None  # one table for the four data
+            out = np.stack([self.data[k].evaluate(v, dv) for k in range(4)])
+            for k in range(4):
+                out[k] -= self._series(k, v, dv, cs)
+            return out
 
         if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
             return make()
