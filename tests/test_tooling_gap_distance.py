@@ -36,6 +36,31 @@ def test_mesh_distance_is_the_exact_minimum_over_all_triangles(seed, noise, spre
     assert np.allclose(mesh_distance(P, V, T), _brute_force(P, V, T), rtol=0, atol=1e-12)
 
 
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), reach=st.floats(0.05, 2.0), spread=st.floats(0.2, 3.0))
+def test_mesh_distance_with_a_reach_and_per_point_bounds(seed, reach, spread):
+    """Beyond ``reach`` a point is ``inf`` (its box and its nearest triangle centre rule it out
+    without the tree), within it the brute-force minimum; with ``below`` a point is measured
+    where its distance could be below its bound, and every finite value is still exact."""
+    from tabletcad.tooling.interference import MeshDistance
+
+    rng = np.random.default_rng(seed)
+    mesh = trimesh.creation.icosphere(subdivisions=2)
+    V, T = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    P = rng.normal(size=(80, 3)) * spread
+    exact = _brute_force(P, V, T)
+    md = MeshDistance(V, T, reach=reach)
+    d = md(P)
+    assert np.allclose(d[exact <= reach * (1 - 1e-9)], exact[exact <= reach * (1 - 1e-9)], rtol=0, atol=1e-12)
+    assert np.all(np.isinf(d[exact > reach * (1 + 1e-9)]))
+    below = rng.uniform(0.0, 1.5, size=len(P))
+    db = md(P, below=below)
+    fin = np.isfinite(db)
+    assert np.allclose(db[fin], exact[fin], rtol=0, atol=1e-12)
+    need = (exact < below) & (exact <= reach * (1 - 1e-9))  # could beat its bound: must be measured
+    assert np.all(fin[need])
+
+
 def test_mesh_distance_of_points_on_the_mesh_and_of_nothing():
     mesh = trimesh.creation.box(extents=(2.0, 3.0, 4.0))
     V, T = np.asarray(mesh.vertices), np.asarray(mesh.faces)

@@ -88,16 +88,28 @@ class MeshDistance:
                 centres = tri.mean(axis=1)
                 self.radius = float(np.max(np.linalg.norm(tri - centres[:, None, :], axis=2)))
                 self.centres = cKDTree(centres)
+                used = self.V[np.unique(self.T)]
+                self.box = (used.min(axis=0) - self.reach, used.max(axis=0) + self.reach)
 
-    def __call__(self, points: np.ndarray) -> np.ndarray:
+    def __call__(self, points: np.ndarray, below: np.ndarray | None = None) -> np.ndarray:
+        """Distances (mm) of ``points`` (``inf`` beyond ``reach``).  With ``below`` (one bound per
+        point), a point whose distance cannot be below its bound (its nearest triangle centre is
+        farther than the bound plus the centre-to-corner radius) is left at ``inf``: every finite
+        value returned is exact."""
         P = np.ascontiguousarray(points, dtype=float).reshape(-1, 3)
         out = np.full(len(P), np.inf)
         if not len(P) or self.tree is None:
             return out
         near = np.arange(len(P))
         if self.centres is not None:
-            d, _ = self.centres.query(P, k=1, distance_upper_bound=self.reach + self.radius)
-            near = np.flatnonzero(np.isfinite(d))
+            lo, hi = self.box  # farther than reach from the triangles' box: farther from every triangle
+            near = np.flatnonzero((P[:, 0] >= lo[0]) & (P[:, 0] <= hi[0]) & (P[:, 1] >= lo[1]) & (P[:, 1] <= hi[1])
+                                  & (P[:, 2] >= lo[2]) & (P[:, 2] <= hi[2]))
+            d, _ = self.centres.query(P[near], k=1, distance_upper_bound=self.reach + self.radius, workers=-1)
+            ok = np.isfinite(d)
+            if below is not None:
+                ok &= d - self.radius * (1.0 + 1e-9) < below[near]  # (slack for rounding)
+            near = near[ok]
         if len(near):
             d2 = self.tree.squared_distance(self.V, self.T, np.ascontiguousarray(P[near]))[0]
             out[near] = np.sqrt(np.maximum(d2, 0.0))
@@ -342,6 +354,17 @@ def face_samples(shape, spacing: float = 0.05, max_per_face: int = 2500) -> np.n
     return np.asarray(out, dtype=float).reshape(-1, 3)
 
 
+def _distance_shapes(a, b) -> BRepExtrema_DistShapeShape:
+    """``BRepExtrema_DistShapeShape`` of two shapes, its sub-shape pairs on every core
+    (``SetMultiThread``: the same distance; tablet to die 0.34 -> 0.18 s on two cores)."""
+    dss = BRepExtrema_DistShapeShape()
+    dss.SetMultiThread(True)
+    dss.LoadS1(a)
+    dss.LoadS2(b)
+    dss.Perform()
+    return dss
+
+
 def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0.005, refine: int = 40,
                  tablet_model=None) -> dict:
     """Overlaps (mm^3) between all pairs of ``{"tablet": shape, **parts}`` and the tablet's largest gap (mm).
@@ -365,7 +388,7 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
                 # proves the zero overlap (BRepExtrema took 2 s on two punches carrying letters)
                 entry["min_distance_lower_bound_mm"] = float(gap)
             else:
-                dss = BRepExtrema_DistShapeShape(shapes[a], shapes[b])
+                dss = _distance_shapes(shapes[a], shapes[b])
                 entry["min_distance_mm"] = float(dss.Value()) if dss.IsDone() else None
         if entry.get("min_distance_lower_bound_mm") is not None:
             occ, how = 0.0, "disjoint (bounding boxes apart, Bnd_Box)"
@@ -406,13 +429,19 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
     # its tree took 4 times as long to build and ask
     reach = 2.0 * max(4.0 * clearance, 0.05)
     h_split = max(16.0 * clearance, 0.2)
-    lo, hi = V.min(axis=0) - 2 * reach, V.max(axis=0) + 2 * reach
+    lo = np.array([V[:, k].min() for k in range(3)]) - 2 * reach  # (column by column: 30x faster than axis=0)
+    hi = np.array([V[:, k].max() for k in range(3)]) + 2 * reach
     tools = [MeshDistance(*refine_triangles(*mesh_arrays(s, tool_deflection, 0.2), h_split, lo, hi), reach=reach)
              for s in parts.values()]
 
     def measure(P):
-        d = np.stack([tool(P) for tool in tools])
-        return d.min(axis=0), d.argmin(axis=0)
+        # the nearest tool and its distance; a tool is asked only where it could beat the best so far
+        best, which = np.full(len(P), np.inf), np.zeros(len(P), dtype=np.int64)
+        for j, tool in enumerate(tools):
+            d = tool(P, below=best)
+            nearer = d < best
+            best[nearer], which[nearer] = d[nearer], j
+        return best, which
 
     dist, near = measure(V)
     # tablet triangles whose corners are nearest to different tools (the land between a punch tip and
