@@ -27,6 +27,7 @@ from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from scipy.spatial import cKDTree
 
 from tabletcad.cad._occ import explore
+from tabletcad.geometry.tablet import coordinate_range
 from tabletcad.tooling.booleans import area, mesh_arrays, manifold_op, manifold_volume, raw_boolean, to_manifold, volume
 from tabletcad.tooling.die import MIN_BORE_OFFSET_MM
 
@@ -88,8 +89,8 @@ class MeshDistance:
                 centres = tri.mean(axis=1)
                 self.radius = float(np.max(np.linalg.norm(tri - centres[:, None, :], axis=2)))
                 self.centres = cKDTree(centres)
-                used = self.V[np.unique(self.T)]
-                self.box = (used.min(axis=0) - self.reach, used.max(axis=0) + self.reach)
+                lo, hi = coordinate_range([self.V[np.unique(self.T)]], 3)
+                self.box = (lo - self.reach, hi + self.reach)
 
     def __call__(self, points: np.ndarray, below: np.ndarray | None = None) -> np.ndarray:
         """Distances (mm) of ``points`` (``inf`` beyond ``reach``).  With ``below`` (one bound per
@@ -429,8 +430,8 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
     # its tree took 4 times as long to build and ask
     reach = 2.0 * max(4.0 * clearance, 0.05)
     h_split = max(16.0 * clearance, 0.2)
-    lo = np.array([V[:, k].min() for k in range(3)]) - 2 * reach  # (column by column: 30x faster than axis=0)
-    hi = np.array([V[:, k].max() for k in range(3)]) + 2 * reach
+    lo, hi = coordinate_range([V], 3)
+    lo, hi = lo - 2 * reach, hi + 2 * reach
     tools = [MeshDistance(*refine_triangles(*mesh_arrays(s, tool_deflection, 0.2), h_split, lo, hi), reach=reach)
              for s in parts.values()]
 
