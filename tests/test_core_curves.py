@@ -249,6 +249,11 @@ def test_band_limited_curves_need_the_modes_the_general_scan_finds(rx, ry, tol, 
                   Transformed(Ellipse(rx, ry, (0.5, 0.0, 1.0)), np.array([[c, -s, 0], [s, c, 0], [0.3, 0.1, zscale]]),
                               np.array([1.0, 2.0, 3.0]))):
         assert curve.band_limit() == 1
+        # the fast path measures the exact largest distance from the mean, the scan 4096 samples:
+        # they may round apart only when that distance equals tol to the last bits
+        pts = curve.evaluate(np.linspace(0.0, TWO_PI, 4096, endpoint=False))
+        if abs(float(np.max(np.linalg.norm(pts - pts.mean(axis=0), axis=1))) - tol) <= 1e-9 * tol:
+            continue
         assert modes_needed(curve, tol, 64) == modes_needed(_Plain(curve), tol, 64)
 
 

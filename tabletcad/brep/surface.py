@@ -30,6 +30,7 @@ import numpy as np
 
 from tabletcad.brep.knots import basis_derivatives, flat_knots
 from tabletcad.errors import GeometryError
+from tabletcad.geometry.vectors import cross
 
 __all__ = ["BSplineSurfaceData", "enclosed_volume", "volume_and_area", "segment_v"]
 
@@ -250,7 +251,7 @@ def enclosed_volume(surfaces: Sequence) -> float:
         S = s.evaluate_grid(uq, vq)
         Su = s.evaluate_grid(uq, vq, du=1)
         Sv = s.evaluate_grid(uq, vq, dv=1)
-        integrand = np.einsum("...k,...k->...", S, np.cross(Su, Sv))
+        integrand = np.einsum("...k,...k->...", S, cross(Su, Sv))
         total += float(np.einsum("i,j,ij->", uw, vw, integrand)) / 3.0
     return total
 
@@ -289,7 +290,7 @@ def volume_and_area(surfaces: Sequence) -> tuple[float, float]:
             continue
         (uq, uw), (vq, vw) = (_span_rule(k, max(int(math.ceil(3 * d / 2)) + 1, d + 4))
                               for k, d in ((s.u_knots, s.u_degree), (s.v_knots, s.v_degree)))
-        n = np.cross(s.evaluate_grid(uq, vq, du=1), s.evaluate_grid(uq, vq, dv=1))
+        n = cross(s.evaluate_grid(uq, vq, du=1), s.evaluate_grid(uq, vq, dv=1))
         W = np.outer(uw, vw)
         volume += float(np.sum(W * np.einsum("...k,...k->...", s.evaluate_grid(uq, vq), n))) / 3.0
         area += float(np.sum(W * np.linalg.norm(n, axis=-1)))

@@ -50,6 +50,7 @@ from tabletcad.families.profile import Piece, profile_line, distance_to_chain, j
 from tabletcad.geometry.patch import PDEPatch
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT, Tolerances
+from tabletcad.geometry.vectors import cross
 
 __all__ = [
     "SweepCurve",
@@ -343,8 +344,9 @@ def build_sweep_tablet(
         # certificate below bounds the real deviation from the nominal instead; the fold depth
         # of the solid map (a surface crossing its spine) is still checked.
         patch = PDEPatch(tuple(data), a=a, form="hermite", tol=tol, name=f"{name}[{len(patches)}:{label}]", check=False)
-        # the patches are cubic-like in u: a coarser u grid than the core default suffices
-        depth = patch.fold_depth(nu=65, nv=128)
+        # the patches are cubic-like in u: a coarser u grid than the core default suffices; a
+        # patch of revolution is measured on a few meridians at the default (the report's) u grid
+        depth = patch.fold_depth(nu=65 if patch.revolution is None else 257, nv=128)
         if depth > tol.fold:
             raise DesignError(f"patch {patch.name} curves", f"a fold {depth:.3g} mm deep",
                               f"the surface must not cross its spine by more than {tol.fold:g} mm "
@@ -533,7 +535,7 @@ def sweep_properties(tablet: Tablet, nu: int = 24, nv_per: int = 48) -> dict[str
     t0, t1 = nom.top_patch_range
     for i, p in enumerate(tablet.patches):
         X = p.evaluate_grid(u, v)
-        n = np.cross(p.evaluate_grid(u, v, du=1), p.evaluate_grid(u, v, dv=1))
+        n = cross(p.evaluate_grid(u, v, du=1), p.evaluate_grid(u, v, dv=1))
         dA = np.linalg.norm(n, axis=-1)
         a = float(np.sum(W * dA))
         area += a

@@ -662,11 +662,17 @@ def _truncation_errors(pts, approx, a, b, cos, sin, k0: int, k1: int) -> np.ndar
 
 
 def _modes_needed(curve: CurveLike, tol: float, max_modes: int, m: int) -> int:
-    pts = curve.evaluate(sample_v(m))
     limit = curve.band_limit() if isinstance(curve, Curve) else None
     if limit is not None and limit <= 1 and limit <= max_modes:
-        # a0 is the mean of the samples for a trigonometric sum of degree < m: N = 0 or the whole curve
-        return 0 if np.max(np.linalg.norm(pts - pts.mean(axis=0), axis=1)) <= tol else limit
+        # c(v) = a0 + a cos v + b sin v exactly (eight samples give a0, a, b): N = 0 when its
+        # largest distance from a0, max |a cos v + b sin v| (the larger singular value of [a b]),
+        # is within tol, else the whole curve
+        f = np.fft.rfft(curve.evaluate(sample_v(8)), axis=0) / 8.0
+        a, b = 2.0 * f[1].real, -2.0 * f[1].imag
+        aa, bb, ab = float(a @ a), float(b @ b), float(a @ b)
+        amplitude = math.sqrt(max(0.5 * (aa + bb) + math.hypot(0.5 * (aa - bb), ab), 0.0))
+        return 0 if amplitude <= tol else limit
+    pts = curve.evaluate(sample_v(m))
     a0, a, b = fourier_coefficients(curve, max_modes, samples=max(4 * max_modes + 8, 1024))
     cos, sin = _trig_table(m, max_modes)
     if np.max(np.linalg.norm(pts - a0, axis=1)) <= tol:

@@ -29,22 +29,23 @@ curves is refused with :class:`~tabletcad.errors.DesignError`; pass a smaller
 from __future__ import annotations
 
 import math
-import threading
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from tabletcad.geometry.basis import cardinal, cardinal_coefficients, cardinals
 from tabletcad.geometry.revolution import Revolution, detect_revolution
+from tabletcad.geometry.tables import CARDINAL, TRIG
 from tabletcad.geometry.curves import CurveLike, fourier_coefficients, modes_needed, sample_v
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
+from tabletcad.geometry.vectors import cross
 
 __all__ = ["PDEPatch", "AUTO_A_LADDER"]
 
-#: ``v`` arrays of these sizes have their trigonometric tables and residuals cached per patch
-#: (:meth:`PDEPatch._memo`): shorter ones are cheap to recompute, longer ones (scattered
-#: points, not grid lines) would hold megabytes each.
+#: ``v`` arrays of these sizes have their residuals cached per patch (:meth:`PDEPatch._memo`), and
+#: of up to the larger their trigonometric tables shared by all patches (:func:`_trig_shared`):
+#: longer ones (scattered points, not grid lines) would hold megabytes each.
 _CACHED_V = (64, 8192)
 
 #: Smoothing parameters tried, in order, when ``a="auto"``.
@@ -66,14 +67,6 @@ def _trig(v: np.ndarray, n: np.ndarray, dv: int) -> tuple[np.ndarray, np.ndarray
     return s * fac, -c * fac
 
 
-#: How many trigonometric tables :func:`_trig_shared` keeps (all patches together), and the largest
-#: it keeps (bytes: 8192 samples of 48 modes are 6.3 MB; 512 modes on 2048 samples, 16.8 MB, are not kept).
-_TRIG_TABLES = 16
-_TRIG_TABLE_BYTES = 8_000_000
-_trig_tables: dict = {}
-_trig_lock = threading.Lock()
-
-
 _EYE3 = np.eye(3)
 
 
@@ -91,19 +84,9 @@ def _trig_shared(v: np.ndarray, n: np.ndarray, dv: int, rows: bool = False):
     on the bytes of ``v`` and ``n``: equal samples hit, nothing is shared between different ones.
     """
     make = _trig_rows if rows else _trig
-    if not _CACHED_V[0] <= v.size <= _CACHED_V[1] or 16 * v.size * n.size > _TRIG_TABLE_BYTES:
+    if v.size > _CACHED_V[1] or 16 * v.size * n.size > TRIG.max_bytes:
         return make(v, n, dv)
-    key = (rows, dv, n.tobytes(), v.tobytes())
-    hit = _trig_tables.get(key)
-    if hit is None:
-        hit = make(v, n, dv)
-        for a in (hit,) if rows else hit:
-            a.setflags(write=False)
-        with _trig_lock:
-            while len(_trig_tables) >= _TRIG_TABLES:
-                _trig_tables.pop(next(iter(_trig_tables)))
-            _trig_tables[key] = hit
-    return hit
+    return TRIG.get((rows, dv, n.tobytes(), v.tobytes()), lambda: make(v, n, dv))
 
 
 @dataclass(frozen=True, eq=False)
@@ -232,6 +215,15 @@ class PDEPatch:
             amp[1:] = np.maximum(np.max(np.abs(ac), axis=(0, 2)), np.max(np.abs(bc), axis=(0, 2)))
         zero = 1e-15 * scale
         object.__setattr__(self, "_active", [n for n in range(1, N + 1) if amp[n] > zero])
+        # the active modes' cosine and sine coefficients side by side, (modes, 4 data, 6): one
+        # product with the cardinal functions gives both halves of every mode's u-profile
+        act = np.array(self._active, dtype=int)
+        object.__setattr__(self, "_n_active", act)
+        object.__setattr__(self, "_abT", np.ascontiguousarray(
+            np.concatenate([ac[:, act - 1], bc[:, act - 1]], axis=2).transpose(1, 0, 2)))
+        # what the cardinal tables in u depend on besides u (patches alike in these share them)
+        object.__setattr__(self, "_u_key", (self._lams[self._active].tobytes(),
+                                            self._beta if self._has_remainder else None, self.u_nodes, self.form))
         lam1 = float(self._lams[1]) if N else 0.0
         object.__setattr__(self, "_revolution", detect_revolution(
             a0, ac, bc, self._active, self._has_remainder, lam1, self.u_nodes, self.form, self.tol.revolution))
@@ -359,7 +351,9 @@ class PDEPatch:
         """The cardinal functions at ``u`` (or their ``u``-derivative) of every active mode
         ``(modes, len(u), 4)``, of the spine ``(len(u), 4)`` and of the remainder term, read-only;
         cached for short ``u`` arrays, which the checks evaluate again and again (seams at
-        ``u = 0, 1``, the same lines for a point and its derivatives)."""
+        ``u = 0, 1``, the same lines for a point and its derivatives), and shared with every
+        patch alike in ``λ`` of its active modes, remainder rate, nodes and form
+        (:data:`~tabletcad.geometry.tables.CARDINAL`)."""
 
         def make():
             n = np.array(self._active, dtype=int)
@@ -369,7 +363,7 @@ class PDEPatch:
 
         if u.size > 1024:
             return make()
-        return self._memo(("u", du, u.tobytes()), make)
+        return CARDINAL.get((du, u.tobytes()) + self._u_key, make)
 
     # ------------------------------------------------------------------ evaluation
     def evaluate(self, u, v, du: int = 0, dv: int = 0, *, nmin: int = 0, remainder: bool = True) -> np.ndarray:
@@ -434,10 +428,10 @@ class PDEPatch:
         # in one matrix product of (3 nu, K) by (K, nv), the shape BLAS runs fastest
         left, right = [], []
         if self._active:
-            n = np.array(self._active)
-            left.append(np.matmul(L, self._ac[:, n - 1].transpose(1, 0, 2)).transpose(1, 2, 0))  # (nu, 3, n)
-            left.append(np.matmul(L, self._bc[:, n - 1].transpose(1, 0, 2)).transpose(1, 2, 0))
-            right.append(_trig_shared(v, n, dv, rows=True))  # (2n, nv)
+            AB = np.matmul(L, self._abT)  # (n, nu, 6): each mode's cosine and sine profiles
+            left.append(AB[:, :, :3].transpose(1, 2, 0))  # (nu, 3, n)
+            left.append(AB[:, :, 3:].transpose(1, 2, 0))
+            right.append(_trig_shared(v, self._n_active, dv, rows=True))  # (2n, nv)
         if dv == 0:
             left.append((L0 @ self._a0)[:, :, None])
             right.append(np.ones((1, v.size)))
@@ -454,7 +448,8 @@ class PDEPatch:
     def spine(self, u, du: int = 0) -> np.ndarray:
         """The spine ``A0(u)`` (eq 3.13, mm), the ``n = 0`` term; shape ``u.shape + (3,)``."""
         u = np.asarray(u, dtype=float)
-        L = cardinal(u.reshape(-1), 0.0, self.u_nodes, self.form, du)
+        uf = u.reshape(-1)
+        L = self._u_tables(uf, du)[1] if uf.size <= 1024 else cardinal(uf, 0.0, self.u_nodes, self.form, du)
         return (L @ self._a0).reshape(u.shape + (3,))
 
     def normal(self, u, v, *, eps: float = 1e-7) -> np.ndarray:
@@ -463,14 +458,14 @@ class PDEPatch:
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
         xu = self.evaluate(u, v, du=1)
         xv = self.evaluate(u, v, dv=1)
-        n = np.cross(xu, xv)
+        n = cross(xu, xv)
         norm = np.linalg.norm(n, axis=-1)
         scale = np.max(np.linalg.norm(xu, axis=-1)) + 1e-300
         bad = norm <= 1e-9 * scale * scale
         if np.any(bad):
             ub = u[bad]
             ush = np.where(ub > 0.5, ub - 1e-5, ub + 1e-5)
-            nb = np.cross(self.evaluate(ush, v[bad], du=1), self.evaluate(ush, v[bad], dv=1))
+            nb = cross(self.evaluate(ush, v[bad], du=1), self.evaluate(ush, v[bad], dv=1))
             n[bad] = nb
             norm[bad] = np.linalg.norm(nb, axis=-1)
         return n / np.maximum(norm, 1e-300)[..., None]
@@ -612,7 +607,7 @@ class PDEPatch:
         Xu = self.evaluate_grid(u, v, du=1)
         Xv = self.evaluate_grid(u, v, dv=1)
         D = X - self.spine(u)[:, None, :]
-        m = np.cross(Xv, D)
+        m = cross(Xv, D)
         det = np.einsum("uvc,uvc->uv", Xu, m)
         mag = lambda a: float(np.max(np.linalg.norm(a, axis=-1)))  # noqa: E731
         scale = mag(Xu) * mag(Xv) * mag(D)
@@ -662,7 +657,7 @@ class PDEPatch:
         # (b) the surface itself must not fold back (normal reversing between neighbours)
         Xu = self.evaluate_grid(u, v, du=1)
         Xv = self.evaluate_grid(u, v, dv=1)
-        n = np.cross(Xu, Xv)
+        n = cross(Xu, Xv)
         nn = np.linalg.norm(n, axis=-1)
         big = nn > 1e-6 * float(np.max(nn))
         dots = np.einsum("uvc,uvc->uv", n[1:], n[:-1])

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tabletcad.geometry.basis import cardinal
+from tabletcad.geometry.tables import CARDINAL
 
 __all__ = ["Revolution", "detect_revolution", "profile_extreme"]
 
@@ -67,9 +68,17 @@ class Revolution:
         """
         u = np.asarray(u, dtype=float)
         uf = u.reshape(-1)
-        R = cardinal(uf, self.lam, self.u_nodes, self.form, du) @ self.radius
-        Z = cardinal(uf, 0.0, self.u_nodes, self.form, du) @ self.height
+        R = self._cardinal(uf, self.lam, du) @ self.radius
+        Z = self._cardinal(uf, 0.0, du) @ self.height
         return np.stack([R, Z], axis=-1).reshape(u.shape + (2,))
+
+    def _cardinal(self, u: np.ndarray, lam: float, du: int) -> np.ndarray:
+        """:func:`~tabletcad.geometry.basis.cardinal`, shared by every profile of the same
+        ``λ``, nodes and form on sample lines of up to 1024 points."""
+        make = lambda: cardinal(u, lam, self.u_nodes, self.form, du)  # noqa: E731
+        if u.size > 1024:
+            return make()
+        return CARDINAL.get(("profile", du, u.tobytes(), lam, self.u_nodes, self.form), make)
 
     def v_of_angle(self, angle: float) -> float:
         """The parameter ``v`` (rad) of the meridian at plan angle ``angle``."""

@@ -26,6 +26,7 @@ from tabletcad.geometry.revolution import profile_extreme
 #: (``X·n``, ``|n|``, the solid map's Jacobian) are the same on every meridian.
 _REVOLUTION_NV = 4
 from tabletcad.tolerance import DEFAULT, Tolerances
+from tabletcad.geometry.vectors import cross
 
 __all__ = ["Band", "Trim", "Tablet", "Face", "solid_map"]
 
@@ -338,7 +339,7 @@ class Tablet:
         X = face.evaluate_grid(self, s, t)
         Xs = face.evaluate_grid(self, s, t, "s")
         Xt = face.evaluate_grid(self, s, t, "t")
-        n = np.cross(Xs, Xt) * face.sign
+        n = cross(Xs, Xt) * face.sign
         W = np.outer(sw, tw)
         dA = np.linalg.norm(n, axis=-1)
         area = float(np.sum(W * dA))
@@ -558,7 +559,7 @@ class Tablet:
             D = X - A
             Du = Xu - Au
             for wk, wq in zip(w, wwt):
-                J = np.einsum("uvc,uvc->uv", Au + wk * Du, np.cross(wk * Xv, D))
+                J = np.einsum("uvc,uvc->uv", Au + wk * Du, cross(wk * Xv, D))
                 total += wq * float(np.sum(np.outer(uw, vw) * J))
         return abs(total)
 

@@ -28,6 +28,7 @@ import numpy as np
 from tabletcad.errors import DesignError, check_range
 from tabletcad.families.sweep import SweepNominal, certify, sweep_properties
 from tabletcad.geometry.tablet import Tablet
+from tabletcad.geometry.vectors import cross
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -153,8 +154,8 @@ def family_seams(tablet: Tablet, nv: int = 720) -> list[dict[str, Any]]:
         xv = pa.evaluate(1.0, v, dv=1)
         scale = max(1e-300, float(np.max(np.linalg.norm(xv, axis=1))))
         good = np.linalg.norm(xv, axis=1) > 1e-6 * scale
-        na = np.cross(pa.evaluate(1.0, v, du=1), xv)
-        nb = np.cross(pb.evaluate(0.0, v, du=1), pb.evaluate(0.0, v, dv=1))
+        na = cross(pa.evaluate(1.0, v, du=1), xv)
+        nb = cross(pb.evaluate(0.0, v, du=1), pb.evaluate(0.0, v, dv=1))
         la, lb = np.linalg.norm(na, axis=1), np.linalg.norm(nb, axis=1)
         good &= (la > 1e-9 * la.max()) & (lb > 1e-9 * lb.max())
         if np.any(good):

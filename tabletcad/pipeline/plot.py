@@ -23,6 +23,7 @@ import numpy as np
 
 from tabletcad.io.atomic import atomic_path
 from tabletcad.geometry.tablet import Tablet
+from tabletcad.geometry.vectors import cross
 
 __all__ = ["plot_tablet", "plot_tablets", "tablet_figure", "tablets_figure", "tablet_png", "side_profile",
            "TabletOutline", "view_axes"]
@@ -362,7 +363,7 @@ def _draw_plan(ax, tablet: Tablet, o: TabletOutline, grids, colour="#4e79a7", di
     polys, cols, depth = [], [], []
     for face, Y in grids:
         q = _quads(Y)
-        n = np.cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 1]) * (face.sign * outward)
+        n = cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 1]) * (face.sign * outward)
         n /= np.maximum(np.linalg.norm(n, axis=-1), 1e-300)[:, None]
         # seen from above: the faces turned up (outward normals; walls are edge-on, the
         # bottom lies under the top, whatever the grid's orientation)
@@ -404,7 +405,7 @@ def view_axes(elev: float, azim: float) -> np.ndarray:
     e, a = np.radians(elev), np.radians(azim)
     towards = np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
     right = np.array([-np.sin(a), np.cos(a), 0.0])
-    return np.stack([right, np.cross(towards, right), towards])
+    return np.stack([right, cross(towards, right), towards])
 
 
 def _draw_view(ax, tablet: Tablet, grids, elev: float, azim: float) -> None:
@@ -422,7 +423,7 @@ def _draw_view(ax, tablet: Tablet, grids, elev: float, azim: float) -> None:
     polys, cols, depth, lines = [], [], [], []
     for face, Y in grids:
         q = _quads(Y)
-        n = np.cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 1]) * (face.sign * outward)
+        n = cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 1]) * (face.sign * outward)
         n /= np.maximum(np.linalg.norm(n, axis=-1), 1e-300)[:, None]
         seen = n @ R[2] > 0.0
         lam = np.abs(n @ _LIGHT)  # two-sided Lambert, light low from the upper left
