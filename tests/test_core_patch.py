@@ -474,3 +474,25 @@ def test_replace_data_keeps_settings():
     assert (q.a, q.u_nodes, q.form, q.name) == (p.a, p.u_nodes, p.form, p.name)
     u = np.linspace(0, 1, 5)[:, None]
     np.testing.assert_allclose(q.evaluate(u, V[None]), p.evaluate(u, V[None]) + (1.0, 2.0, 3.0), atol=1e-11)
+
+
+@pytest.mark.parametrize("family", ["capsule", "concave_round"])
+def test_grid_components_layout_holds_the_same_values(family):
+    """``evaluate_grid(..., components=True, axes=...)`` is the point layout's values, coordinate by
+    coordinate (all three bit for bit: the same matrix product, without the transposed copy; a
+    subset from a product with fewer rows, which BLAS may block differently)."""
+    from tabletcad.families import FAMILIES
+
+    t = FAMILIES[family].build()
+    u, v = np.linspace(0.0, 1.0, 23), np.linspace(0.0, 6.0, 71)
+    for p in t.patches[:3]:
+        for du, dv in ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)):
+            X = p.evaluate_grid(u, v, du, dv)
+            np.testing.assert_array_equal(p.evaluate_grid(u, v, du, dv, components=True), X.transpose(2, 0, 1))
+            tol = 1e-14 * max(1.0, float(np.abs(X).max()))
+            np.testing.assert_allclose(p.evaluate_grid(u, v, du, dv, components=True, axes=(0, 1))[1], X[..., 1],
+                                       rtol=0, atol=tol)
+            np.testing.assert_allclose(p.evaluate_grid(u, v, du, dv, components=True, axes=(2,))[0], X[..., 2],
+                                       rtol=0, atol=tol)
+    with pytest.raises(ValueError):
+        t.patches[0].evaluate_grid(u, v, axes=(0, 1))

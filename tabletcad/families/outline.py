@@ -137,13 +137,15 @@ class PlanOutline:
         signed curvature ``κ`` (m,) (1/mm, > 0 on convex arcs) at ``v``; read-only arrays.
 
         A swept tablet's patches evaluate their boundary data (offsets of this outline) on
-        the same ``v`` samples again and again, so frames of grid-sized ``v`` arrays are
-        remembered (the last :data:`_FRAME_MEMO` of them, keyed on the samples' bytes).
+        the same ``v`` samples again and again, so frames of ``v`` arrays up to 8192 samples
+        are remembered (the last :data:`_FRAME_MEMO` of them, keyed on the samples' bytes;
+        grid-sized arrays and short ones, such as a polish's few samples that a patch's four
+        data ask for in turn, in two memos, so that the short ones never push out the grids).
         """
         v = np.asarray(v, dtype=float).reshape(-1)
-        if not 64 <= v.size <= 8192:
+        if v.size > 8192:
             return self._frame(v)
-        memo = self.__dict__.setdefault("_frame_memo", {})
+        memo = self.__dict__.setdefault("_frame_memo" if v.size >= 64 else "_frame_memo_short", {})
         key = v.tobytes()
         hit = memo.get(key)
         if hit is None:

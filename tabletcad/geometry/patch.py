@@ -199,6 +199,8 @@ class PDEPatch:
         object.__setattr__(self, "_a0", a0)
         object.__setattr__(self, "_ac", ac)
         object.__setattr__(self, "_bc", bc)
+        object.__setattr__(self, "_ac_rows", np.ascontiguousarray(ac.transpose(1, 0, 2).reshape(N, 12)))
+        object.__setattr__(self, "_bc_rows", np.ascontiguousarray(bc.transpose(1, 0, 2).reshape(N, 12)))
         # is there anything above mode N?  Not for curves band-limited to N modes (circles,
         # ellipses: the FFT of 8 N + 8 samples is exact); else the residual at dense samples
         scale = max(1.0, float(np.max(np.abs(a0))), float(np.max(np.abs(ac))) if N else 0.0)
@@ -334,10 +336,15 @@ class PDEPatch:
 
         def make() -> np.ndarray:
             N = self.modes
-            cs = self._trig_cached(v, N, dv) if N else None  # one table for the four data
-            out = np.stack([self.data[k].evaluate(v, dv) for k in range(4)])
-            for k in range(4):
-                out[k] -= self._series(k, v, dv, cs)
+            out = np.empty((4, v.size, 3))
+            for k, c in enumerate(self.data):  # a datum repeated (a fan's two equal derivatives) is evaluated once
+                j = next(j for j in range(k + 1) if self.data[j] is c)
+                out[k] = out[j] if j < k else c.evaluate(v, dv)
+            if dv == 0:
+                out -= self._a0[:, None, :]
+            if N:  # the four truncated series in two products: (m, N) by (N, 4·3)
+                c, s = self._trig_cached(v, N, dv)
+                out -= (c @ self._ac_rows + s @ self._bc_rows).reshape(v.size, 4, 3).transpose(1, 0, 2)
             return out
 
         if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
@@ -404,7 +411,7 @@ class PDEPatch:
             step = max(1, 32768 // n.size)
             for i in range(0, uf.size, step):
                 L = cardinals(uf[i : i + step], self._lams[n], self.u_nodes, self.form, du)  # (n, m, 4)
-                c, s = _trig(vf[i : i + step], n, dv)  # (m, n)
+                c, s = _trig_shared(vf[i : i + step], n, dv)  # (m, n); the same v again for other du
                 out[i : i + step] += np.einsum("mn,nmc->mc", c, np.matmul(L, ac))
                 out[i : i + step] += np.einsum("mn,nmc->mc", s, np.matmul(L, bc))
         if remainder and self._has_remainder:
@@ -414,36 +421,46 @@ class PDEPatch:
                 out += L[:, k : k + 1] * r[k]
         return out.reshape(shape + (3,))
 
-    def evaluate_grid(self, u, v, du: int = 0, dv: int = 0) -> np.ndarray:
+    def evaluate_grid(self, u, v, du: int = 0, dv: int = 0, *, components: bool = False,
+                      axes: tuple[int, ...] = (0, 1, 2)) -> np.ndarray:
         """Tensor-grid evaluation: ``X[i, j] = ∂X(u[i], v[j])``, shape (len(u), len(v), 3).
 
         Uses matrix products (cost ~ (nu + nv)·N + nu·nv·N), the fast path
-        for pictures, meshes and quadrature.
+        for pictures, meshes and quadrature.  With ``components`` the same values
+        come as ``(len(axes), len(u), len(v))`` (``X[c, i, j]`` for the coordinates ``axes``),
+        the layout the product makes: no transposed copy, each coordinate one contiguous
+        block (for reductions over the grid, such as extents and the plan's silhouette), and
+        only the coordinates asked for are computed.
         """
+        if tuple(axes) != (0, 1, 2) and not components:
+            raise ValueError(f"axes = {axes} is not allowed: only with components=True")
         u = np.asarray(u, dtype=float).reshape(-1)
         v = np.asarray(v, dtype=float).reshape(-1)
         L, L0, Lr = self._u_tables(u, du)  # (n, nu, 4), (nu, 4), (nu, 4)
-        # X[i, j, c] = Σ_k U[i, c, k] V[k, j]: the modes (cos and sin rows of V, their u-profiles
+        # X[c, i, j] = Σ_k U[c, i, k] V[k, j]: the modes (cos and sin rows of V, their u-profiles
         # in U), the spine (a row of ones) and the remainder (rows r_k,c'(v), with U = L_β δ_cc')
         # in one matrix product of (3 nu, K) by (K, nv), the shape BLAS runs fastest
         left, right = [], []
         if self._active:
             AB = np.matmul(L, self._abT)  # (n, nu, 6): each mode's cosine and sine profiles
-            left.append(AB[:, :, :3].transpose(1, 2, 0))  # (nu, 3, n)
-            left.append(AB[:, :, 3:].transpose(1, 2, 0))
+            left.append(AB[:, :, :3].transpose(2, 1, 0))  # (3, nu, n)
+            left.append(AB[:, :, 3:].transpose(2, 1, 0))
             right.append(_trig_shared(v, self._n_active, dv, rows=True))  # (2n, nv)
         if dv == 0:
-            left.append((L0 @ self._a0)[:, :, None])
+            left.append((L0 @ self._a0).T[:, :, None])
             right.append(np.ones((1, v.size)))
         if self._has_remainder:
             r = self._residuals(v, dv)  # (4, nv, 3)
-            left.append((Lr[:, None, :, None] * _EYE3[None, :, None, :]).reshape(u.size, 3, 12))
+            left.append((_EYE3[:, None, None, :] * Lr[None, :, :, None]).reshape(3, u.size, 12))
             right.append(r.transpose(0, 2, 1).reshape(12, v.size))
         if not left:
-            return np.zeros((u.size, v.size, 3))
-        U = np.concatenate(left, axis=2).reshape(3 * u.size, -1)
-        X = U @ (right[0] if len(right) == 1 else np.concatenate(right))
-        return np.ascontiguousarray(X.reshape(u.size, 3, v.size).transpose(0, 2, 1))
+            return np.zeros((len(axes), u.size, v.size) if components else (u.size, v.size, 3))
+        U = np.concatenate(left, axis=2)  # (3, nu, K)
+        if components and tuple(axes) != (0, 1, 2):
+            U = U[list(axes)]
+        X = (U.reshape(-1, U.shape[2]) @ (right[0] if len(right) == 1 else np.concatenate(right)))
+        X = X.reshape(-1, u.size, v.size)
+        return X if components else np.ascontiguousarray(X.transpose(1, 2, 0))
 
     def spine(self, u, du: int = 0) -> np.ndarray:
         """The spine ``A0(u)`` (eq 3.13, mm), the ``n = 0`` term; shape ``u.shape + (3,)``."""

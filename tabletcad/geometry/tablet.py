@@ -447,8 +447,10 @@ class Tablet:
     def _plan_area_sampled(self, nu: int = 129, nv: int = 2048) -> float:
         """:meth:`plan_area` from samples of every patch (any star-shaped plan)."""
         u, v = self._grid(nu, nv)
-        pts = [p.evaluate_grid(u, v) for p in self.patches]  # each (nu, nv, 3); no stacked copy
-        lo, hi = coordinate_range(pts, 2)
+        # each (2, nu, nv): x and y as contiguous blocks, no stacked copy
+        pts = [p.evaluate_grid(u, v, components=True, axes=(0, 1)) for p in self.patches]
+        lo = np.array([min(float(X[j].min()) for X in pts) for j in range(2)])
+        hi = np.array([max(float(X[j].max()) for X in pts) for j in range(2)])
         c = 0.5 * (lo + hi)
         m = 4 * nv
         grid = (np.arange(m) + 0.5) * (math.tau / m) - math.pi
@@ -457,7 +459,7 @@ class Tablet:
         r_max = 0.0
         outer = []
         for X in pts:  # the farthest point along each v line of each patch
-            dx, dy = X[..., 0] - c[0], X[..., 1] - c[1]
+            dx, dy = X[0] - c[0], X[1] - c[1]
             r2 = dx * dx + dy * dy
             i = np.argmax(r2, axis=0)
             rr = np.sqrt(r2[i, cols])
@@ -478,7 +480,7 @@ class Tablet:
         hole = 0.0
         if self.trim.w[0] > 0.0:  # hollow solid (ring): subtract the see-through hole
             A = np.stack([p.spine(np.linspace(self.trim.u[0], self.trim.u[1], nu)) for p in self.patches])
-            inner = A[:, :, None, :] + self.trim.w[0] * (np.stack(pts) - A[:, :, None, :])
+            inner = A[:, :, None, :2] + self.trim.w[0] * (np.stack(pts).transpose(0, 2, 3, 1) - A[:, :, None, :2])
             ri = np.hypot(inner[..., 0] - c[0], inner[..., 1] - c[1]).min(axis=(0, 1))
             di = inner[0, 0, :, :2] - c
             phi = np.arctan2(di[:, 1], di[:, 0])
@@ -495,22 +497,32 @@ class Tablet:
         """
         lo, hi = self.trim.u
         ub, best = u0.copy(), best.copy()
+
+        def jet(uu, vv):  # X - c, X_u, X_uu in the plan at the points (uu, vv)
+            return (p.evaluate(uu, vv)[:, :2] - c, p.evaluate(uu, vv, du=1)[:, :2], p.evaluate(uu, vv, du=2)[:, :2])
+
+        X, Xu, Xuu = jet(ub, v)
+        live = np.arange(ub.size)  # points whose last step gained (one that did not would only repeat it)
         for _ in range(6):
-            X = p.evaluate(ub, v)[:, :2] - c
-            Xu = p.evaluate(ub, v, du=1)[:, :2]
-            Xuu = p.evaluate(ub, v, du=2)[:, :2]
-            g1 = 2.0 * np.einsum("ij,ij->i", X, Xu)
-            g2 = 2.0 * (np.einsum("ij,ij->i", Xu, Xu) + np.einsum("ij,ij->i", X, Xuu))
+            x, xu, xuu = X[live], Xu[live], Xuu[live]
+            g1 = 2.0 * np.einsum("ij,ij->i", x, xu)
+            g2 = 2.0 * (np.einsum("ij,ij->i", xu, xu) + np.einsum("ij,ij->i", x, xuu))
             with np.errstate(divide="ignore", invalid="ignore"):
                 step = np.where(g2 < 0.0, -g1 / g2, 0.0)
-            un = np.clip(ub + np.clip(step, -h, h), lo, hi)
-            Xn = p.evaluate(un, v)[:, :2] - c
-            r2 = np.einsum("ij,ij->i", Xn, Xn)
-            better = r2 > best
-            if not np.any(better):
+            un = np.clip(ub[live] + np.clip(step, -h, h), lo, hi)
+            moved = un != ub[live]
+            live, un = live[moved], un[moved]
+            if not live.size:
                 break
-            ub, best = np.where(better, un, ub), np.where(better, r2, best)
-        return ub, best, p.evaluate(ub, v)[:, :2] - c
+            xn, xun, xuun = jet(un, v[live])
+            r2 = np.einsum("ij,ij->i", xn, xn)
+            better = r2 > best[live]
+            live = live[better]
+            if not live.size:
+                break
+            ub[live], best[live] = un[better], r2[better]
+            X[live], Xu[live], Xuu[live] = xn[better], xun[better], xuun[better]
+        return ub, best, X
 
     def volume(self) -> float:
         """Enclosed volume (mm³) by the divergence theorem (eq 4.9)."""
@@ -653,17 +665,20 @@ class Tablet:
 
         Two passes of: a dense line over the whole ``u`` range at ``v0`` (the
         extreme of a band is nearly flat along ``u``, so its best ``u`` may lie
-        far from the sample's), then grids zooming four times per round.
+        far from the sample's), then grids zooming four times per round; the
+        second pass only when its line beats the first zoom's point.
         """
         t = self.trim
         best = sign * float(p.evaluate(u0, v0)[axis])
         n = 17
-        for _ in range(2):
+        for round_ in range(2):
             line = np.linspace(t.u[0], t.u[1], 513)
             g = sign * p.evaluate(line, np.full(line.shape, v0))[:, axis]
             i = int(np.argmax(g))
-            if g[i] >= best:
+            if g[i] > best or (round_ == 0 and g[i] == best):
                 best, u0 = float(g[i]), float(line[i])
+            elif round_:  # the second line found nothing better: the first zoom's point stands
+                break
             a, b = max(hu, line[1] - line[0]), hv
             while a > 1e-9 or b > 1e-9:
                 uu = np.clip(u0 + np.linspace(-a, a, n), t.u[0], t.u[1])
