@@ -336,6 +336,36 @@ def test_chain_distance_is_the_minimum_over_every_element(seed, n):
     np.testing.assert_array_equal(distance_to_chain(els, q), plain)
 
 
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(seed=st.integers(0, 2**16), n=st.integers(1, 8), grid=st.booleans())
+def test_nearest_of_is_the_plain_scan(seed, n, grid):
+    """``nearest_of`` measures each element only where its bounding circle allows: its least
+    value, winning element (the first of equals, ties included: points on a coarse lattice and
+    repeated elements) and that element's extra must be the plain scan's in element order."""
+    from tabletcad.geometry.curves import Seg, nearest_of
+
+    rng = np.random.default_rng(seed)
+    els = []
+    for _ in range(n):
+        if rng.random() < 0.5:
+            els.append(Seg.line(*np.round(rng.normal(size=(2, 2)) * 3)))
+        else:
+            els.append(Seg.arc(np.round(rng.normal(size=2) * 3), float(rng.integers(1, 4)), rng.uniform(-7, 7),
+                               rng.uniform(-TWO_PI, TWO_PI)))
+    els += els[: rng.integers(0, 2)]  # a repeated element: equal distances everywhere
+    q = np.round(rng.normal(size=(2000, 2)) * 3) if grid else rng.normal(size=(2000, 2)) * rng.uniform(0.5, 6.0)
+
+    def measure(e, p):
+        return e.distance(p), np.full(len(p), float(id(e) % 1000003))
+
+    d_all = np.array([e.distance(q) for e in els])
+    which = np.argmin(d_all, axis=0)
+    best, got_which, extra = nearest_of(els, q, measure)
+    np.testing.assert_array_equal(best, d_all[which, np.arange(len(q))])
+    np.testing.assert_array_equal(got_which, which)
+    np.testing.assert_array_equal(extra, [id(els[k]) % 1000003 for k in which])
+
+
 @pytest.mark.parametrize("der", [0, 1, 2])
 def test_outline_offset_is_the_weighted_point_and_normal(der):
     """``offset`` (one frame) equals ``alpha O + beta N`` from ``point`` and ``normal`` for every

@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-from tabletcad.geometry.curves import Seg, signed_area
+from tabletcad.geometry.curves import NEAREST_CHUNK, Seg, nearest_of, signed_area
 from tabletcad.errors import DesignError, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
 
@@ -262,38 +262,18 @@ class PlanOutline:
 
     # ------------------------------------------------------------------ distances
     def signed_distance(self, xy) -> np.ndarray:
-        """Exact distance (mm) from plan points ``xy`` (m, 2) to the outline, > 0 inside."""
+        """Exact distance (mm) from plan points ``xy`` (m, 2) to the outline, > 0 inside.
+
+        The distance and side of the nearest segment (the first of equals in the chain's
+        order), each segment measured only where its bounding circle allows it to be the
+        nearest (:func:`~tabletcad.geometry.curves.nearest_of`).
+        """
         p = np.asarray(xy, dtype=float).reshape(-1, 2)
-        px, py = np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1])
-        best = np.full(len(p), np.inf)
-        sign = np.ones(len(p))
-
-        def side(x0: float, y0: float, t) -> np.ndarray:  # +1 left of the direction t through (x0, y0)
-            return np.where((px - x0) * -t[1] + (py - y0) * t[0] >= 0.0, 1.0, -1.0)
-
-        for s in self.segs:
-            if s.kind == "line":
-                (ax, ay), (bx, by) = s.p0, s.p1
-                dx, dy = bx - ax, by - ay
-                t = np.clip(((px - ax) * dx + (py - ay) * dy) / (dx * dx + dy * dy), 0.0, 1.0)
-                qx, qy = px - (ax + t * dx), py - (ay + t * dy)
-                dist = np.hypot(qx, qy)
-                sg = np.where(qx * -dy + qy * dx >= 0.0, 1.0, -1.0)
-            else:
-                rx, ry = px - s.center[0], py - s.center[1]
-                rho = np.hypot(rx, ry)
-                inside_arc = s.within_sweep(rx, ry, rho)
-                d_arc = np.abs(rho - s.radius)
-                # inward normal of a convex (ccw) arc points to the centre
-                sg_arc = np.where((s.radius - rho) * math.copysign(1.0, s.sweep) >= 0.0, 1.0, -1.0)
-                e0 = np.hypot(px - s.p0[0], py - s.p0[1])
-                e1 = np.hypot(px - s.p1[0], py - s.p1[1])
-                dist = np.where(inside_arc, d_arc, np.minimum(e0, e1))
-                sg = np.where(inside_arc, sg_arc, np.where(e0 <= e1, side(*s.p0, s.tangent(0)), side(*s.p1, s.tangent(1))))
-            better = dist < best
-            best = np.where(better, dist, best)
-            sign = np.where(better, sg, sign)
-        return sign * best
+        out = np.empty(len(p))
+        for i in range(0, len(p), NEAREST_CHUNK):
+            best, _, sign = nearest_of(self.segs, p[i : i + NEAREST_CHUNK], _signed_to_segment)
+            out[i : i + NEAREST_CHUNK] = sign * best
+        return out
 
     def inscribed_radius(self) -> float:
         """Largest inward distance reached inside the outline (mm), to ~1e-9 mm."""
@@ -504,6 +484,34 @@ class SplineOutline(PlanOutline):
 
     def _check_simple(self) -> None:  # pragma: no cover - done in __init__
         pass
+
+
+def _signed_to_segment(s, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distance (mm) from plan points ``p`` (m, 2) to one segment of a CCW outline, and the side
+    (+1 inward, -1 outward) it puts them on: the inward normal at the nearest point of a line or
+    an arc's span, and the side of the end's tangent at an arc's nearer end."""
+    px, py = p[:, 0], p[:, 1]
+    if s.kind == "line":
+        (ax, ay), (bx, by) = s.p0, s.p1
+        dx, dy = bx - ax, by - ay
+        t = np.clip(((px - ax) * dx + (py - ay) * dy) / (dx * dx + dy * dy), 0.0, 1.0)
+        qx, qy = px - (ax + t * dx), py - (ay + t * dy)
+        return np.hypot(qx, qy), np.where(qx * -dy + qy * dx >= 0.0, 1.0, -1.0)
+
+    def side(x0: float, y0: float, t) -> np.ndarray:  # +1 left of the direction t through (x0, y0)
+        return np.where((px - x0) * -t[1] + (py - y0) * t[0] >= 0.0, 1.0, -1.0)
+
+    rx, ry = px - s.center[0], py - s.center[1]
+    rho = np.hypot(rx, ry)
+    inside_arc = s.within_sweep(rx, ry, rho)
+    d_arc = np.abs(rho - s.radius)
+    # inward normal of a convex (ccw) arc points to the centre
+    sg_arc = np.where((s.radius - rho) * math.copysign(1.0, s.sweep) >= 0.0, 1.0, -1.0)
+    e0 = np.hypot(px - s.p0[0], py - s.p0[1])
+    e1 = np.hypot(px - s.p1[0], py - s.p1[1])
+    dist = np.where(inside_arc, d_arc, np.minimum(e0, e1))
+    sg = np.where(inside_arc, sg_arc, np.where(e0 <= e1, side(*s.p0, s.tangent(0)), side(*s.p1, s.tangent(1))))
+    return dist, sg
 
 
 def _check_polyline_simple(p: np.ndarray, parameter: str) -> None:

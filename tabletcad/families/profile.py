@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tabletcad.geometry.curves import Seg
+from tabletcad.geometry.curves import NEAREST_CHUNK, Seg, nearest_of
 
 __all__ = ["profile_line", "profile_arc", "Piece", "hermite_points", "pieces_for", "distance_to_chain",
            "joint_is_smooth"]
@@ -92,21 +92,17 @@ def pieces_for(element: Seg, target: float, max_angle: float = math.radians(45.0
 def distance_to_chain(elements, q: np.ndarray) -> np.ndarray:
     """Exact distance (mm) from points ``q`` (m, 2) to a chain of elements.
 
-    The smallest of the distances to every element; an element is measured only at the points
-    where it could be nearer than the best so far (its bounding circle,
-    :meth:`~tabletcad.geometry.curves.Seg.bounding_circle`, gives ``|q - c| - r`` as a lower
-    bound), so each point usually meets only the elements around it.
+    The smallest of the distances to every element, each measured only where it could win:
+    every element's bounding circle (:meth:`~tabletcad.geometry.curves.Seg.bounding_circle`)
+    gives the lower bound ``|q - c| - r`` of its distance; each point is first measured to
+    the element of least bound (nearly always the nearest), then to the others whose bound
+    is below that distance (near the joints), so a point usually meets one element or two.
     """
     q = np.asarray(q, dtype=float).reshape(-1, 2)
-    qx, qy = np.ascontiguousarray(q[:, 0]), np.ascontiguousarray(q[:, 1])
-    out = np.full(len(q), np.inf)
-    for e in elements:
-        cx, cy, r = e.bounding_circle()
-        idx = np.flatnonzero(np.hypot(qx - cx, qy - cy) - r * (1.0 + 1e-9) < out)  # (slack for rounding)
-        if idx.size == len(q):
-            out = np.minimum(out, e.distance(q))
-        elif idx.size:
-            out[idx] = np.minimum(out[idx], e.distance(q[idx]))
+    elements = list(elements)
+    out = np.empty(len(q))
+    for i in range(0, len(q), NEAREST_CHUNK):  # chunks keep the (elements, points) bounds near a few MB
+        out[i : i + NEAREST_CHUNK] = nearest_of(elements, q[i : i + NEAREST_CHUNK], lambda e, p: e.distance(p))[0]
     return out
 
 

@@ -41,6 +41,7 @@ __all__ = [
     "fourier_coefficients",
     "modes_needed",
     "sample_v",
+    "nearest_of",
 ]
 
 
@@ -702,3 +703,69 @@ def _modes_needed(curve: CurveLike, tol: float, max_modes: int, m: int) -> int:
         approx = approx + cos[:, k0:k1] @ a[k0:k1] + sin[:, k0:k1] @ b[k0:k1]
         k0 = k1
     return max_modes + 1
+
+
+#: Points per chunk for :func:`nearest_of`'s callers (its bounds are an (elements, points) array).
+NEAREST_CHUNK = 65536
+
+
+def nearest_of(elements, q: np.ndarray, measure):
+    """``(best, which, extra)``: the least ``measure(e, q)`` over ``elements`` (segments with a
+    ``bounding_circle``) at each point of ``q`` (m, 2), the index of the element giving it (the
+    first of equals, as a plain scan in order would pick) and that element's ``extra``.
+
+    Each element is measured only where its bounding circle's lower bound ``|q - c| - r`` is not
+    above the best so far, starting at each point from the element of least bound (nearly
+    always the nearest), so a point usually meets one element or two, not all of them.
+    ``measure(e, points)`` returns distances (mm) to ``e``, or ``(distances, extra)`` with a
+    per-point ``extra`` such as a side (then ``extra`` is returned, else None).
+    """
+    m, n = len(q), len(elements)
+    if n == 0:
+        return np.full(m, np.inf), np.full(m, -1, dtype=np.intp), None
+    qx, qy = np.ascontiguousarray(q[:, 0]), np.ascontiguousarray(q[:, 1])
+    lb = np.empty((n, m))
+    t = np.empty(m)
+    least = np.full(m, np.inf)  # the least bound so far, and its element (running: an argmin over
+    first = np.zeros(m, dtype=np.intp)  # the first axis would copy the bounds transposed)
+    mask = np.empty(m, dtype=bool)
+    for j, e in enumerate(elements):
+        cx, cy, r = e.bounding_circle()
+        row = lb[j]
+        np.subtract(qx, cx, out=row)
+        np.multiply(row, row, out=row)
+        np.subtract(qy, cy, out=t)
+        np.multiply(t, t, out=t)
+        row += t
+        np.sqrt(row, out=row)
+        row -= r * (1.0 + 1e-9) + 1e-12 * r  # (slack for rounding)
+        np.less(row, least, out=mask)
+        np.copyto(least, row, where=mask)
+        np.copyto(first, j, where=mask)
+    best = np.empty(m)
+    which = first.copy()
+    extra = None
+    for j, e in enumerate(elements):
+        idx = np.flatnonzero(first == j)
+        if idx.size:
+            res = measure(e, q[idx])
+            if isinstance(res, tuple):
+                if extra is None:
+                    extra = np.empty(m)
+                best[idx], extra[idx] = res
+            else:
+                best[idx] = res
+    for j, e in enumerate(elements):
+        idx = np.flatnonzero(lb[j] <= best)
+        idx = idx[first[idx] != j]
+        if not idx.size:
+            continue
+        res = measure(e, q[idx])
+        d, x = res if isinstance(res, tuple) else (res, None)
+        # the first element of equal distance wins, as in a plain scan in chain order
+        win = (d < best[idx]) | ((d == best[idx]) & (j < which[idx]))
+        k = idx[win]
+        best[k], which[k] = d[win], j
+        if x is not None:
+            extra[k] = x[win]
+    return best, which, extra
