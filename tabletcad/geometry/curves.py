@@ -673,25 +673,29 @@ def _modes_needed(curve: CurveLike, tol: float, max_modes: int, m: int) -> int:
         aa, bb, ab = float(a @ a), float(b @ b), float(a @ b)
         amplitude = math.sqrt(max(0.5 * (aa + bb) + math.hypot(0.5 * (aa - bb), ab), 0.0))
         return 0 if amplitude <= tol else limit
-    pts = curve.evaluate(sample_v(m))
     a0, a, b = fourier_coefficients(curve, max_modes, samples=max(4 * max_modes + 8, 1024))
-    cos, sin = _trig_table(m, max_modes)
-    if np.max(np.linalg.norm(pts - a0, axis=1)) <= tol:
-        return 0
     # The error at a subset of the samples is a lower bound of the error at all of them:
     # every N failing on the subset fails, so the full scan starts at the subset's first pass.
-    step = max(1, m // 256)
-    sub, sc, ss = pts[::step], cos[::step], sin[::step]
-    approx, start = np.broadcast_to(a0, sub.shape), None
-    for k0 in range(0, max_modes, 32):
-        k1 = min(k0 + 32, max_modes)
-        ok = np.flatnonzero(_truncation_errors(sub, approx, a, b, sc, ss, k0, k1) <= tol)
-        if ok.size:
-            start = k0 + int(ok[0])  # modes 1..start fail; the full scan resumes after mode `start`
-            break
-        approx = approx + sc[:, k0:k1] @ a[k0:k1] + ss[:, k0:k1] @ b[k0:k1]
-    if start is None:
+    memo = _memo(curve)
+    key = ("subset_errors", int(max_modes), m)
+    errs = memo.get(key) if memo is not None else None
+    if errs is None:
+        errs = _subset_errors(curve, a0, a, b, max_modes, m)
+        if memo is not None:
+            memo[key] = errs
+    passing = np.flatnonzero(errs <= tol)
+    if not passing.size:
         return max_modes + 1
+    pts = curve.evaluate(sample_v(m))
+    first = int(passing[0])
+    if first == 0:
+        if np.max(np.linalg.norm(pts - a0, axis=1)) <= tol:
+            return 0
+        if passing.size == 1:
+            return max_modes + 1
+        first = int(passing[1])
+    cos, sin = _trig_table(m, max_modes)
+    start = first - 1  # modes 1..start fail; the full scan resumes after mode `start`
     approx = a0 + cos[:, :start] @ a[:start] + sin[:, :start] @ b[:start]
     k0 = start
     while k0 < max_modes:  # the subset's answer usually holds: try it alone, then blocks of 16
@@ -703,6 +707,23 @@ def _modes_needed(curve: CurveLike, tol: float, max_modes: int, m: int) -> int:
         approx = approx + cos[:, k0:k1] @ a[k0:k1] + sin[:, k0:k1] @ b[k0:k1]
         k0 = k1
     return max_modes + 1
+
+
+def _subset_errors(curve: CurveLike, a0, a, b, max_modes: int, m: int) -> np.ndarray:
+    """Largest distance (mm), over every ``(m // 256)``-th of ``m`` equally spaced samples, of the
+    curve from its Fourier series truncated after ``N`` modes, for ``N = 0 .. max_modes``
+    (one array, read-only: :func:`modes_needed` asks it once per curve for every tolerance)."""
+    step = max(1, m // 256)
+    pts = curve.evaluate(sample_v(m)[::step])
+    cos, sin = _trig_table(m, max_modes)
+    run = np.empty((pts.shape[0], max_modes + 1, 3))
+    run[:, 0] = a0
+    run[:, 1:] = cos[::step, :, None] * a[None] + sin[::step, :, None] * b[None]
+    np.cumsum(run, axis=1, out=run)  # the partial sums: a0 plus modes 1..N
+    d = pts[:, None, :] - run
+    errs = np.sqrt(np.max(np.einsum("knc,knc->kn", d, d), axis=0))
+    errs.setflags(write=False)
+    return errs
 
 
 #: Points per chunk for :func:`nearest_of`'s callers (its bounds are an (elements, points) array).

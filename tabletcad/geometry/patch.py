@@ -620,13 +620,13 @@ class PDEPatch:
         ends = np.geomspace(1e-6, 0.05, 48)
         u = np.unique(np.concatenate([ends, np.linspace(0.0, 1.0, nu)[1:-1], 1.0 - ends]))
         v = sample_v(nv)
-        X = self.evaluate_grid(u, v)
-        Xu = self.evaluate_grid(u, v, du=1)
-        Xv = self.evaluate_grid(u, v, dv=1)
-        D = X - self.spine(u)[:, None, :]
-        m = cross(Xv, D)
-        det = np.einsum("uvc,uvc->uv", Xu, m)
-        mag = lambda a: float(np.max(np.linalg.norm(a, axis=-1)))  # noqa: E731
+        # coordinates as contiguous (nu, nv) blocks (evaluate_grid's components layout)
+        Xu = self.evaluate_grid(u, v, du=1, components=True)
+        Xv = self.evaluate_grid(u, v, dv=1, components=True)
+        D = self.evaluate_grid(u, v, components=True) - self.spine(u).T[:, :, None]
+        m = (Xv[1] * D[2] - Xv[2] * D[1], Xv[2] * D[0] - Xv[0] * D[2], Xv[0] * D[1] - Xv[1] * D[0])  # Xv × D
+        det = Xu[0] * m[0] + Xu[1] * m[1] + Xu[2] * m[2]
+        mag = lambda a: math.sqrt(float(np.max(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])))  # noqa: E731
         scale = mag(Xu) * mag(Xv) * mag(D)
         if scale == 0.0:
             return 0.0
@@ -634,8 +634,7 @@ class PDEPatch:
         folded = det * ref < -1e-9 * scale
         if not np.any(folded):
             return 0.0
-        n = m / np.maximum(np.linalg.norm(m, axis=-1), 1e-300)[..., None]
-        speed = np.abs(np.einsum("uvc,uvc->uv", Xu, n)) * folded
+        speed = np.abs(det) / np.maximum(np.sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]), 1e-300) * folded
         du = np.diff(u)[:, None]
         back = np.sum(0.5 * (speed[1:] + speed[:-1]) * du, axis=0)
         return float(np.max(back))
