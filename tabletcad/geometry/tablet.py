@@ -590,9 +590,10 @@ class Tablet:
         """Axis-aligned bounding box (mm) of the surface, refined to ~1e-9 mm.
 
         Each extreme is taken from a 97 × 256 sample of every patch and then
-        polished by zooming: a 17 × 17 grid around the best point, each round four
-        times finer, until the grid step is below ~1e-10 in ``u`` and ``v``
-        (the extreme's error falls with the square of the step, to ~1e-18 mm).
+        polished by zooming: a 33 × 33 grid around the best point, each round eight
+        times finer (the next round's grid still spans two of this one's steps each
+        side), until the grid step is below ~1e-10 in ``u`` and ``v`` (the extreme's
+        error falls with the square of the step, to ~1e-18 mm).
         A tablet of revolution untrimmed in ``v`` takes its extents from its profile
         (:attr:`revolution`), polished the same way in ``u`` alone.
         Cached: a tablet is immutable.
@@ -665,12 +666,12 @@ class Tablet:
 
         Two passes of: a dense line over the whole ``u`` range at ``v0`` (the
         extreme of a band is nearly flat along ``u``, so its best ``u`` may lie
-        far from the sample's), then grids zooming four times per round; the
+        far from the sample's), then grids zooming eight times per round; the
         second pass only when its line beats the first zoom's point.
         """
         t = self.trim
         best = sign * float(p.evaluate(u0, v0)[axis])
-        n = 17
+        n = 33
         for round_ in range(2):
             line = np.linspace(t.u[0], t.u[1], 513)
             g = sign * p.evaluate(line, np.full(line.shape, v0))[:, axis]
@@ -689,7 +690,7 @@ class Tablet:
                 i, j = np.unravel_index(int(np.argmax(g)), g.shape)
                 if g[i, j] >= best:
                     best, u0, v0 = float(g[i, j]), float(uu[i]), float(vv[j])
-                a, b = a / 4.0, b / 4.0
+                a, b = a / 8.0, b / 8.0
         return sign * best
 
     def dimensions(self) -> dict[str, float]:
