@@ -278,14 +278,19 @@ class Tablet:
             return False
         a = self.patches[i]
         b = self.patches[j]
-        v = np.linspace(0.0, math.tau, 64, endpoint=False)
+        v = self._edge_v()
         xa = a.evaluate(float(end), v)
         xb = b.evaluate(float(1 - end), v)
         scale = max(1.0, float(np.max(np.abs(xa))))
         return float(np.max(np.linalg.norm(xa - xb, axis=1))) <= 1e-9 * scale
 
+    def _edge_v(self) -> np.ndarray:
+        """``v`` samples of the topology checks: 64 around, or 4 meridians on a tablet of revolution
+        (every meridian of a patch of revolution meets its neighbour and the axis alike)."""
+        return np.linspace(0.0, math.tau, 4 if self.revolution is not None else 64, endpoint=False)
+
     def _end_is_point(self, i: int, end: int) -> bool:
-        v = np.linspace(0.0, math.tau, 64, endpoint=False)
+        v = self._edge_v()
         x = self.patches[i].evaluate(float(end), v)
         return float(np.max(np.ptp(x, axis=0))) <= 1e-12 * max(1.0, float(np.max(np.abs(x))))
 
