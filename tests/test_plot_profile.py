@@ -55,18 +55,89 @@ def test_figure_is_to_scale_and_dimensioned(pair):
     assert view.get_aspect() == prof.get_aspect() == plan.get_aspect() == 1.0
     # the 3-D view is an orthographic projection to scale: the flat-faced round (a cylinder
     # D x T) spans D across and T cos(elev) + D sin(elev) up (its 72-gon rims: within 0.1 %)
-    xy = np.concatenate([p.vertices for p in view.collections[0].get_paths()])
-    width, height = np.ptp(xy, axis=0)
+    quads = _drawn_quads(view)
+    width, height = np.ptp(quads.reshape(-1, 2), axis=0)
     e = np.radians(18.0)
     assert width == pytest.approx(D, rel=1e-3)
     assert height == pytest.approx((BAND + 2 * CUP) * np.cos(e) + D * np.sin(e), rel=1e-3)
     # only faces turned towards the viewer are drawn: the bottom face of the cylinder is not
-    assert len(view.collections[0].get_paths()) < 0.75 * 3 * 24 * 72
+    assert len(quads) < 0.75 * 3 * 24 * 72
     _, prof, plan = tablet_figure(pair[0]).axes
     texts = {t.get_text() for a in (prof, plan) for t in a.texts}
     assert {"band 2", "cup 1", "4", "⌀ 10"} <= texts
     png = tablet_png(pair[1])
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def _drawn_quads(ax) -> np.ndarray:
+    """The shaded quads an axes draws, (k, 4, 2): a PolyCollection's polygons, or a QuadMesh's
+    cells that are not transparent (a convex tablet's faces, one mesh each)."""
+    from matplotlib.collections import PolyCollection, QuadMesh
+
+    out = []
+    for c in ax.collections:
+        if isinstance(c, QuadMesh):
+            C = c.get_coordinates()
+            cells = np.stack([C[:-1, :-1], C[1:, :-1], C[1:, 1:], C[:-1, 1:]], axis=2).reshape(-1, 4, 2)
+            out.append(cells[c.get_facecolor()[:, 3] > 0.0])
+        elif isinstance(c, PolyCollection):
+            out.append(np.stack([p.vertices[:4] for p in c.get_paths()]))
+    return np.concatenate(out)
+
+
+def test_only_convex_tablets_are_drawn_as_meshes():
+    """``_convex`` decides from the exact nominal: a concave round without a land is convex, with
+    a land its cup rises from the land (a re-entrant edge) and it is not; a capsule with a land
+    is not, but its faces turned up still never overlap in plan (``_graph_from_above``)."""
+    from tabletcad.pipeline import plot
+
+    assert plot._convex(concave_round(diameter=D, band=BAND, cup_depth=CUP))
+    assert not plot._convex(concave_round(diameter=D, band=BAND, cup_depth=CUP, land=0.08))
+    c = capsule(length=14.0, width=6.0, band=2.5, cup_depth=0.8, land=0.1)
+    assert not plot._convex(c) and plot._graph_from_above(c)
+    assert plot._convex(flat_face_round(diameter=D, thickness=3.0))
+
+
+def _cover(quads: np.ndarray) -> float:
+    """Summed area of the quads (k, 4, 2) over the area of their convex hull."""
+    from scipy.spatial import ConvexHull
+
+    x, y = quads[..., 0], quads[..., 1]  # shoelace area of every quad
+    areas = 0.5 * np.abs(np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1))
+    return float(areas.sum() / ConvexHull(quads.reshape(-1, 2)).volume)
+
+
+@pytest.mark.parametrize("factory", [flat_face_round, concave_round])
+def test_meshes_of_a_convex_tablet_paint_what_the_depth_sorted_polygons_paint(monkeypatch, factory):
+    """A convex tablet's faces are drawn as one mesh each in any order (``_convex``), the others
+    as polygons sorted far to near.  For a convex tablet both draw the same quads, and those
+    quads do not overlap on screen (their areas add up to the area of their convex hull, the
+    silhouette, but for slivers along it), so the order cannot matter: the two pictures differ
+    only in which of two neighbouring quads owns the pixels along their edges."""
+    from tabletcad.pipeline import plot
+
+    t = factory(diameter=D, thickness=BAND + 2 * CUP) if factory is flat_face_round else factory(
+        diameter=D, band=BAND, cup_depth=CUP)
+    assert plot._convex(t)
+
+    def picture():
+        fig = tablet_figure(t)
+        fig.canvas.draw()
+        return np.asarray(fig.canvas.buffer_rgba())[..., :3].astype(int), _drawn_quads(fig.axes[0])
+
+    img, quads = picture()
+    monkeypatch.setattr(plot, "_convex", lambda tablet: False)
+    monkeypatch.setattr(plot, "_graph_from_above", lambda tablet: False)
+    ref, ref_quads = picture()
+    assert len(quads) == len(ref_quads)
+    np.testing.assert_allclose(np.sort(quads.reshape(-1, 8), axis=0), np.sort(ref_quads.reshape(-1, 8), axis=0),
+                               atol=1e-12)
+    assert _cover(quads) == pytest.approx(1.0, abs=1e-6)
+    # where quads do overlap (a cup rising from a land hides part of the land) the sum exceeds the hull
+    landed = tablet_figure(concave_round(diameter=D, band=BAND, cup_depth=1.5, land=0.5))
+    assert _cover(_drawn_quads(landed.axes[0])) > 1.01
+    differ = np.any(np.abs(img - ref) > 8, axis=-1)
+    assert differ.mean() < 5e-3, f"{differ.sum()} pixels differ"
 
 
 def test_the_drawn_side_profile_is_a_closed_outline(pair):

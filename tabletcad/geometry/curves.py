@@ -271,10 +271,12 @@ class Seg:
         ``2 ρ sin(Δθ / 2)``, grows with the angle ``Δθ <= |sweep| / 2 <= π`` to it, so the ends
         are farthest: ``r = 2 ρ sin(|sweep| / 4)``.
         """
-        mx, my = (float(c) for c in self.point(0.5))
         if self.kind == "line":
-            return mx, my, 0.5 * self.length
-        return mx, my, 2.0 * self.radius * math.sin(0.25 * abs(self.sweep))
+            (x0, y0), (x1, y1) = self.p0, self.p1
+            return 0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * math.hypot(x1 - x0, y1 - y0)
+        mid = self.theta0 + 0.5 * self.sweep
+        return (self.center[0] + self.radius * math.cos(mid), self.center[1] + self.radius * math.sin(mid),
+                2.0 * self.radius * math.sin(0.25 * abs(self.sweep)))
 
     def within_sweep(self, rx: np.ndarray, ry: np.ndarray, rho: np.ndarray) -> np.ndarray:
         """Whether directions ``(rx, ry)`` from an arc's centre (of lengths ``rho``) fall inside

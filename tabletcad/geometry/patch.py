@@ -190,7 +190,10 @@ class PDEPatch:
             beta = check_positive("beta", beta)
         object.__setattr__(self, "_beta", float(beta))
         # Fourier coefficients of every datum: a0 (4,3), a (4,N,3), b (4,N,3)
-        samples = max(self.tol.samples, 8 * N + 8)
+        limits = [getattr(c, "band_limit", lambda: None)() for c in self.data]
+        band_limited = all(lim is not None and lim <= N for lim in limits)
+        # 8 N + 8 samples give a band-limited curve's coefficients exactly; others get dense ones
+        samples = 8 * N + 8 if band_limited else max(self.tol.samples, 8 * N + 8)
         a0 = np.zeros((4, 3))
         ac = np.zeros((4, N, 3))
         bc = np.zeros((4, N, 3))
@@ -204,8 +207,7 @@ class PDEPatch:
         # is there anything above mode N?  Not for curves band-limited to N modes (circles,
         # ellipses: the FFT of 8 N + 8 samples is exact); else the residual at dense samples
         scale = max(1.0, float(np.max(np.abs(a0))), float(np.max(np.abs(ac))) if N else 0.0)
-        limits = [getattr(c, "band_limit", lambda: None)() for c in self.data]
-        if all(lim is not None and lim <= N for lim in limits):
+        if band_limited:
             object.__setattr__(self, "_has_remainder", False)
         else:
             res = float(np.max(np.abs(self._residuals(sample_v(4 * samples), 0))))

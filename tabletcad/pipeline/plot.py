@@ -354,13 +354,97 @@ def _draw_profile(ax, o: TabletOutline, colour="#4e79a7", dims: bool = True) -> 
     ax.set_axis_off()
 
 
+def _convex(tablet: Tablet) -> bool:
+    """Whether the (untrimmed) tablet is known to be convex, so that no two quads of its faces
+    turned towards a viewer overlap on screen and every face can be drawn as one mesh in any
+    order (:func:`_draw_view`, :func:`_draw_plan`).  Decided on exact data, not on samples:
+
+    * an industry family (:class:`~tabletcad.families.sweep.SweepNominal`) whose outline turns
+      one way only (no concave arc) and whose faces, as heights over the inward distance ``d``
+      from the outline, are concave and rising inward on top, convex and falling at the bottom
+      (then the solid ``{z_bottom(d) <= z <= z_top(d)}`` is convex, ``d`` being concave inside
+      a convex outline); its surface lies within 1 µm of that nominal;
+    * a tablet of revolution whose meridian section (its profiles through every patch, both
+      sides of the axis) lies on the boundary of its convex hull to 1e-3 of its size (so any
+      overlap is a sliver of a fraction of a pixel).
+    """
+    t = tablet.trim
+    if t.u != (0.0, 1.0) or not t.full_v or t.w[0] != 0.0:
+        return False
+    nominal = tablet.nominal
+    segs = getattr(getattr(nominal, "outline", None), "segs", None)
+    graphs = (getattr(nominal, "_dz_top", None), getattr(nominal, "_dz_bot", None))
+    if segs is not None and graphs[0] is not None and graphs[1] is not None:
+        if any(s.kind == "arc" and s.sweep < 0.0 for s in segs):
+            return False
+        (dt, zt), (db, zb) = graphs
+        return _rising_concave(dt, zt) and _rising_concave(db, -zb)
+    revs = tablet.revolution
+    if revs is None:
+        return False
+    from scipy.spatial import ConvexHull
+
+    u = np.linspace(0.0, 1.0, 129)
+    M = np.concatenate([r.profile(u) for r in revs])  # (R, Z) along the chain of patches
+    section = np.concatenate([M, M * [-1.0, 1.0]])  # the meridian section through the axis
+    size = float(np.ptp(section, axis=0).max())
+    hull = ConvexHull(section)
+    # every point on the hull's boundary, to a thousandth of the size: the thesis's PDE shapes dip
+    # a few micrometres inside theirs where their patches meet (a fraction of a pixel, whose
+    # slivers of overlap no picture shows); a land that a cup rises from does not pass
+    inside = -np.max(section @ hull.equations[:, :2].T + hull.equations[:, 2], axis=1)
+    return bool(np.max(inside) <= 1e-3 * size)
+
+
+def _graph_from_above(tablet: Tablet) -> bool:
+    """Whether the faces turned up of the (untrimmed) tablet never overlap seen from above, so the
+    plan can draw every face as one mesh: an industry family (its top face is a height over the
+    inward distance from the outline, which every plan point has one of; its band's upward-turned
+    strip, where it bulges, lies outside the rim), or a convex tablet (:func:`_convex`)."""
+    t = tablet.trim
+    if t.u != (0.0, 1.0) or not t.full_v or t.w[0] != 0.0:
+        return False
+    if getattr(getattr(tablet.nominal, "outline", None), "segs", None) is not None and \
+            getattr(tablet.nominal, "_dz_top", None) is not None:
+        return True
+    return _convex(tablet)
+
+
+def _rising_concave(d: np.ndarray, z: np.ndarray) -> bool:
+    """Whether the graph ``z(d)`` (``d`` increasing, dense samples) never falls and bends down only."""
+    dd = np.diff(d)
+    keep = dd > 1e-12 * max(1.0, float(np.max(np.abs(d))))
+    slope = np.diff(z)[keep] / dd[keep]
+    tol = 1e-7 * max(1.0, float(np.max(np.abs(slope))))
+    return bool(np.all(slope >= -tol) and np.all(np.diff(slope) <= tol))
+
+
+def _meshes(ax, items) -> None:
+    """Add ``(key, coordinates (ns, nt, 2), rgba (cells, 4))`` as one QuadMesh each, in order of key
+    (matplotlib draws a mesh's cells in C, without a Path per quad)."""
+    from matplotlib.collections import QuadMesh
+
+    for _, xy, rgba in sorted(items, key=lambda it: it[0]):
+        m = QuadMesh(xy, antialiased=False, linewidths=0.0, edgecolors="none")
+        m.set_facecolor(rgba)
+        ax.add_collection(m, autolim=False)
+
+
+def _rgba(rgb: np.ndarray, seen: np.ndarray) -> np.ndarray:
+    out = np.zeros((len(seen), 4))
+    out[seen, :3] = rgb
+    out[seen, 3] = 1.0
+    return out
+
+
 def _draw_plan(ax, tablet: Tablet, o: TabletOutline, grids, colour="#4e79a7", dims: bool = True) -> None:
     from matplotlib.collections import PolyCollection
     from matplotlib.colors import to_rgb
 
     base = np.array(to_rgb(colour))
     outward = tablet.orientation
-    polys, cols, depth = [], [], []
+    graph = _graph_from_above(tablet)
+    polys, cols, depth, meshes = [], [], [], []
     for face, Y in grids:
         q = _quads(Y)
         n = cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 1]) * (face.sign * outward)
@@ -368,11 +452,17 @@ def _draw_plan(ax, tablet: Tablet, o: TabletOutline, grids, colour="#4e79a7", di
         # seen from above: the faces turned up (outward normals; walls are edge-on, the
         # bottom lies under the top, whatever the grid's orientation)
         seen = n[:, 2] > 1e-3
-        n = n[seen]
-        lam = np.clip(n @ _LIGHT, 0.0, 1.0)
+        if not np.any(seen):
+            continue
+        lam = np.clip(n[seen] @ _LIGHT, 0.0, 1.0)
+        rgb = np.clip(base[None, :] * (0.2 + 1.0 * lam[:, None] ** 2) + 0.05, 0, 1)
+        if graph:  # the faces turned up never overlap in plan: one mesh each, lowest first
+            meshes.append((float(q[seen][:, :, 2].mean()), Y[..., :2], _rgba(rgb, seen)))
+            continue
         polys.append(q[seen][:, :, :2])
-        cols.append(np.clip(base[None, :] * (0.2 + 1.0 * lam[:, None] ** 2) + 0.05, 0, 1))
+        cols.append(rgb)
         depth.append(q[seen][:, :, 2].mean(axis=1))
+    _meshes(ax, meshes)
     if polys:
         order = np.argsort(np.concatenate(depth), kind="stable")  # painter: the top face drawn last
         # no data limits from the polygons: the plan outline drawn next spans the same extent
@@ -420,7 +510,8 @@ def _draw_view(ax, tablet: Tablet, grids, elev: float, azim: float) -> None:
     colours = colormaps["tab10"]
     outward = tablet.orientation
     hollow = tablet.trim.w[0] > 0.0
-    polys, cols, depth, lines = [], [], [], []
+    convex = _convex(tablet)
+    polys, cols, depth, lines, meshes = [], [], [], [], []
     for face, Y in grids:
         q = _quads(Y)
         n = cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 1]) * (face.sign * outward)
@@ -428,11 +519,17 @@ def _draw_view(ax, tablet: Tablet, grids, elev: float, azim: float) -> None:
         seen = n @ R[2] > 0.0
         lam = np.abs(n @ _LIGHT)  # two-sided Lambert, light low from the upper left
         base = np.array(colours(face.patch % 10)[:3]) if face.kind == "w" else np.array([0.72, 0.72, 0.72])
-        P = q[seen] @ R.T  # (k, 4, 3): screen x, screen y, depth
-        polys.append(P[..., :2])
-        depth.append(P[..., 2].mean(axis=1))
         # squared Lambert: the few degrees a cup tilts its faces show as a clear gradient
-        cols.append(np.clip(base[None, :] * (0.2 + 1.0 * lam[seen, None] ** 2), 0.0, 1.0))
+        rgb = np.clip(base[None, :] * (0.2 + 1.0 * lam[seen, None] ** 2), 0.0, 1.0)
+        if convex:  # the quads turned towards the viewer never overlap: one mesh a face, far to near
+            if np.any(seen):
+                S = Y @ R.T
+                meshes.append((-float(S[..., 2].mean()), S[..., :2], _rgba(rgb, seen)))
+        else:
+            P = q[seen] @ R.T  # (k, 4, 3): screen x, screen y, depth
+            polys.append(P[..., :2])
+            depth.append(P[..., 2].mean(axis=1))
+            cols.append(rgb)
         # the outer surface's edge rows (seams, rims): segment j where quad j beside it is seen,
         # which on a convex tablet is exactly where it is visible (a ring's inner wall, which
         # its outer wall may hide, gets none)
@@ -442,9 +539,11 @@ def _draw_view(ax, tablet: Tablet, grids, elev: float, azim: float) -> None:
                 E = row[:, None, :] @ R[:2].T
                 seg = np.concatenate([E[:-1], E[1:]], axis=1)
                 lines.append(seg[grid_seen[k]])
-    order = np.argsort(np.concatenate(depth))  # far to near
-    ax.add_collection(PolyCollection(np.concatenate(polys)[order], facecolors=np.concatenate(cols)[order],
-                                     edgecolors="none", linewidths=0.0, antialiased=False), autolim=False)
+    _meshes(ax, meshes)
+    if polys:
+        order = np.argsort(np.concatenate(depth))  # far to near
+        ax.add_collection(PolyCollection(np.concatenate(polys)[order], facecolors=np.concatenate(cols)[order],
+                                         edgecolors="none", linewidths=0.0, antialiased=False), autolim=False)
     ax.add_collection(LineCollection(np.concatenate(lines), colors="k", linewidths=0.5), autolim=False)
     pts = np.vstack([Y.reshape(-1, 3) for _, Y in grids]) @ R[:2].T
     lo, hi = pts.min(axis=0), pts.max(axis=0)
@@ -481,7 +580,7 @@ def tablet_figure(
     faces = tablet.faces()  # once: finding the shared edges evaluates the patches
     grids = _face_grids(tablet, nu, nv, faces)
     _draw_view(fig.add_subplot(131), tablet, grids, elev, azim)
-    o = _side_profile(tablet, 121, 65, 257, None, faces)
+    o = _side_profile(tablet, 121, 65, 257, grids, faces)  # the view's grids: to a fraction of a pixel
     _draw_profile(fig.add_subplot(132), o)
     _draw_plan(fig.add_subplot(133), tablet, o, grids)
     fig.suptitle(title or f"{tablet.name} ({tablet.family}, {len(tablet.patches)} patches), mm", fontsize=10)
