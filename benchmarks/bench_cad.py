@@ -134,8 +134,13 @@ def nominal_build123d(tablet):
         items = [("line", (ri, 0.0), (ro, 0.0)), ("line", (ro, 0.0), (ro, T)), ("line", (ro, T), (ri, T)),
                  ("line", (ri, T), (ri, 0.0))]
         return _revolve_profile(items), "revolve"
-    # free form (the stadium sample): its bounding plan extruded
+    if {"diameter", "band", "cup_depth"} <= p.keys():  # other round families (compound cup, bevels)
+        R, b, d = p["diameter"] / 2, p["band"], p["cup_depth"]
+        return _band_tablet(R, d, d + b, d, d), "~revolve (spherical cups)"
     bb = tablet_bbox(tablet)
+    if abs((bb[3] - bb[0]) - (bb[4] - bb[1])) <= 1e-6 * (bb[3] - bb[0]):  # round plan: a cylinder
+        return _band_tablet(0.5 * (bb[3] - bb[0]), bb[2], bb[5], 0.0, 0.0), "~revolve (cylinder of its size)"
+    # free form (the stadium sample): its bounding plan extruded
     sk = bd.SlotOverall(bb[3] - bb[0], bb[4] - bb[1])
     return bd.extrude(sk, amount=bb[5] - bb[2]).solids()[0], "~extruded SlotOverall plan"
 
