@@ -48,6 +48,44 @@ def test_rebuild_removes_only_unchanged_files_of_the_earlier_build(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging folder left
 
 
+def test_a_build_never_replaces_a_file_it_did_not_write(tmp_path):
+    """A file of a name the build writes that no build wrote there (or that was edited since the
+    build that did) is refused before anything in the folder changes; an unchanged one is replaced."""
+    from tabletcad.errors import DesignError
+
+    out = tmp_path / "out"
+    _stage(tmp_path, out, {"a.step": "A", "b.stl": "B"})
+    (out / "mine.step").write_text("the user's own")
+    (out / "b.stl").write_text("edited after the build")
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    for clash in ({"mine.step": "M"}, {"b.stl": "B2"}, {"a.step": "A2", "mine.step": "M"}):
+        with pytest.raises(DesignError) as exc:
+            _stage(tmp_path, out, clash)
+        assert exc.value.parameter == "--out" and ("mine.step" in str(exc.value) or "b.stl" in str(exc.value))
+        assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging folder left
+    assert _stage(tmp_path, out, {"a.step": "A3"}) == ["a.step"]  # unchanged since its build: replaced
+    assert (out / "a.step").read_text() == "A3" and (out / "mine.step").read_text() == "the user's own"
+
+
+def test_cli_build_refuses_a_folder_holding_the_users_file_of_an_output_name(tmp_path):
+    """``tabletcad build`` into a folder where the user keeps a file named like an output: exit 2,
+    one line naming ``--out``, the file untouched, nothing else written; report.json (which every
+    build writes) is refused before any geometry is built."""
+    sample = ROOT / "samples" / "families" / "flat_face_round.toml"
+    for name in ("tablet.step", "report.json"):
+        out = tmp_path / name.replace(".", "_")
+        out.mkdir()
+        (out / name).write_text("MY OWN")
+        r = subprocess.run([sys.executable, "-m", "tabletcad", "build", str(sample), "--out", str(out)],
+                           capture_output=True, text=True, cwd=tmp_path)
+        assert r.returncode == 2, r.stderr
+        lines = r.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("error: --out = ") and name in lines[0], r.stderr
+        assert sorted(p.name for p in out.iterdir()) == [name] and (out / name).read_text() == "MY OWN"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report_json", "tablet_step"]
+
+
 def test_manifest_cannot_remove_files_outside_the_folder(tmp_path):
     out = tmp_path / "out"
     out.mkdir()

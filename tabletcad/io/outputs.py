@@ -7,7 +7,9 @@ place with :func:`publish`.  The output folder then holds a manifest,
 The next build into the same folder removes the files of the earlier build
 that it does not write itself, but only those listed by the earlier manifest
 *and unchanged since* (same hash): files that tabletcad did not write, or that
-someone edited after the build, are never touched.
+someone edited after the build, are never touched, and a build that would write a
+file of the same name as one of them is refused (:class:`~tabletcad.errors.DesignError`
+for ``--out``) before anything in the folder changes.
 
 A staging folder carries a marker (``.tabletcad-staging.json``: process id,
 host, start time).  :func:`staging_folder` removes the current staging folder
@@ -32,10 +34,11 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
+from tabletcad.errors import DesignError
 from tabletcad.io.atomic import atomic_write_text
 
 __all__ = ["MANIFEST", "STAGING_MARKER", "STALE_AFTER_S", "staging_folder", "publish", "read_manifest",
-           "clean_stale_staging", "file_sha256"]
+           "clean_stale_staging", "file_sha256", "check_replaceable"]
 
 MANIFEST = ".tabletcad-build.json"
 
@@ -180,15 +183,48 @@ def publish(staging: str | os.PathLike[str], out_dir: str | os.PathLike[str]) ->
     Files of the earlier build in ``out_dir`` (its manifest) that this build did
     not write are removed if they are unchanged since that build; nothing else
     in ``out_dir`` is touched.  Returns the published names (relative, sorted).
+
+    Raises
+    ------
+    DesignError
+        ``--out``: the folder holds a file of a name this build writes that is not an
+        unchanged file of the earlier build (someone else's, or edited); nothing is moved.
     """
     staging, out_dir = Path(staging), Path(out_dir)
     files = sorted(p.relative_to(staging) for p in staging.rglob("*") if p.is_file() and p.name != STAGING_MARKER)
     hashes = {p.as_posix(): file_sha256(staging / p) for p in files}
     earlier = read_manifest(out_dir)
+    check_replaceable(out_dir, [rel.as_posix() for rel in files], earlier)
     with _signals_deferred():  # Ctrl-C or SIGTERM now would leave half a build in out_dir
         _move_in(staging, out_dir, files, hashes, earlier)
         published.append(out_dir)
     return sorted(hashes)
+
+
+def check_replaceable(out_dir: str | os.PathLike[str], names, earlier: dict[str, str] | None = None) -> None:
+    """Refuse (:class:`~tabletcad.errors.DesignError` for ``--out``) when ``out_dir`` holds a file of
+    one of ``names`` (relative paths a build writes) that a build may not replace: one that no
+    tabletcad build wrote there, or one edited since (its hash is not the manifest's)."""
+    out_dir = Path(out_dir)
+    earlier = read_manifest(out_dir) if earlier is None else earlier
+    theirs = [n for n in names if not _ours(out_dir / n, earlier.get(n))]
+    if theirs:  # replacing them would lose what someone else put there
+        shown = ", ".join(theirs[:3]) + (f" and {len(theirs) - 3} more" if len(theirs) > 3 else "")
+        raise DesignError("--out", str(out_dir), f"must not hold files this build writes that no tabletcad build "
+                          f"wrote there or that were edited since ({shown}): move them or build into another folder")
+
+
+def _ours(path: Path, digest: str | None) -> bool:
+    """Whether a build may replace ``path``: nothing is there, or the file an earlier build wrote,
+    unchanged since (its manifest's ``digest``)."""
+    if not os.path.lexists(path):
+        return True
+    if digest is None or path.is_symlink() or not path.is_file():
+        return False
+    try:
+        return file_sha256(path) == digest
+    except OSError:
+        return False
 
 
 def _move_in(staging: Path, out_dir: Path, files: list[Path], hashes: dict[str, str], earlier: dict[str, str]) -> None:

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from tabletcad.geometry.tablet import Tablet
-from tabletcad.io.outputs import STAGING_MARKER, publish, staging_folder
+from tabletcad.io.outputs import STAGING_MARKER, check_replaceable, publish, staging_folder
 from tabletcad.pipeline.design import Design
 from tabletcad.pipeline.designreport import ReportOptions
 from tabletcad.pipeline.plot import plot_tablet
@@ -70,6 +70,7 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
         from tabletcad.tooling.stage import check_tooling
 
         check_tooling(tablet, tooling)  # refused before the (slow) geometry
+    check_replaceable(out_dir, ["report.json", "tablet.png"])  # written by every build: refused before the geometry
     steps = 2 + cad + (tooling is not None)
     with staging_folder(out_dir) as staging:
         from tqdm import tqdm
