@@ -62,6 +62,10 @@ class Tolerances:
         ``[-max_length, max_length]`` (1 m; the largest pharmaceutical and
         veterinary boluses are a few cm).  Beyond it the numbers stop being a
         tablet and rounding errors exceed the nanometre tolerances above.
+    min_length : float
+        Smallest length (mm) other than 0 that a design may give (a band, land, cup
+        depth, diameter...): the tolerance ``nominal`` the surfaces are certified to; a
+        smaller feature would be lost in it (and closes up when the faces are sewn).
     memory_fraction : float
         Share of the memory the system reports available (Linux ``MemAvailable``)
         that one command may plan to use; a mesh estimated larger is refused
@@ -108,6 +112,7 @@ class Tolerances:
     fit: float = 1e-4
     nominal: float = 1e-3
     max_length: float = 1000.0
+    min_length: float = 1e-3
     memory_fraction: float = 0.5
     mesh_bytes_per_node: int = 200
     offset_regularity: float = 1e-2

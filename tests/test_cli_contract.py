@@ -64,6 +64,14 @@ FLAT = '[tablet]\nfamily = "thesis.flat_faced_round"\nthickness = 6.0\n'
         (FLAT + "diameter = true\n", "tablet.diameter", "true and false are not numbers"),
         (FLAT + 'diameter = "10"\n', "tablet.diameter", "must be a number"),
         (FLAT + "diameter = -1e-300\n", "tablet.diameter", "> 0"),
+        # features below the 1 µm the surfaces are certified to: refused before any geometry
+        # (a 1e-9 mm band used to reach the CAD stage and fail there, a 1 nm tablet to build)
+        ('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\ncup_depth = 1.0\nband = 1e-9\n', "tablet.band",
+         "at least 0.001 mm"),
+        ('[tablet]\nfamily = "concave_round"\ndiameter = 1e-6\ncup_depth = 1e-7\nband = 1e-7\n', "tablet.diameter",
+         "at least 0.001 mm"),
+        ('[tablet]\nfamily = "capsule"\nlength = 18.0\nwidth = 8.0\nband = 3.0\ncup_depth = 1.2\nland = 5e-4\n',
+         "tablet.land", "must be 0 or at least 0.001 mm"),
         (FLAT, "tablet.diameter", "needs diameter, thickness"),
         ('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\ncup_depth = 1.0\nband = 1e300\n', "tablet.band", "within ±1000 mm"),
         ('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 3.0\n', "tablet.cup_depth", "optional: land"),

@@ -102,9 +102,10 @@ def load_design(path: str | Path) -> Tablet:
     return Design.from_toml(path).build()
 
 
-def _number(where: str, value: Any, unit: str = "", *, tol: Tolerances = DEFAULT) -> float:
+def _number(where: str, value: Any, unit: str = "", *, tol: Tolerances = DEFAULT, coordinate: bool = False) -> float:
     """A number read from a design: an int or float (never a boolean or a string), finite,
-    and for lengths (``unit == "mm"``) within ``±tol.max_length``."""
+    and for lengths and coordinates (``unit == "mm"``) within ``±tol.max_length``; a length
+    (not a ``coordinate``) is 0 or at least ``tol.min_length``."""
     if isinstance(value, bool):
         raise DesignError(where, value, "must be a number (true and false are not numbers)", unit)
     if not isinstance(value, (int, float)):
@@ -112,6 +113,9 @@ def _number(where: str, value: Any, unit: str = "", *, tol: Tolerances = DEFAULT
     x = check_finite(where, value, unit)
     if unit == "mm" and abs(x) > tol.max_length:
         raise DesignError(where, value, f"must be within ±{tol.max_length:g} mm (size limit, Tolerances.max_length)", unit)
+    if unit == "mm" and not coordinate and 0.0 < x < tol.min_length:
+        raise DesignError(where, value, f"must be 0 or at least {tol.min_length:g} mm (Tolerances.min_length: a "
+                          "smaller feature is below the tolerance the surface is certified to)", unit)
     return x
 
 
@@ -122,7 +126,7 @@ def _lengths(where: str, value: Any, *, tol: Tolerances = DEFAULT) -> None:
         for i, item in enumerate(value):
             _lengths(f"{where}[{i}]", item, tol=tol)
     elif not isinstance(value, str):
-        _number(where, value, "mm", tol=tol)
+        _number(where, value, "mm", tol=tol, coordinate=True)
 
 
 def _check_keys(where: str, table: dict, allowed: set[str]) -> None:
@@ -151,7 +155,7 @@ def _curve(spec: Any, where: str, previous: Curve | None) -> Curve:
     center = spec.get("center", (0.0, 0.0, spec.get("z", 0.0)))
     if not (isinstance(center, (list, tuple)) and len(center) == 3):
         raise DesignError(f"{where}.center", center, "must be [x, y, z] in mm")
-    center = tuple(_number(f"{where}.center", c, "mm") for c in center)
+    center = tuple(_number(f"{where}.center", c, "mm", coordinate=True) for c in center)
     num = {k: _number(f"{where}.{k}", spec[k], "mm") for k in _CURVE_KEYS[kind] if k != "points"}
     try:
         if kind == "circle":
