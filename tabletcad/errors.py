@@ -58,7 +58,7 @@ class DesignError(TabletcadError, ValueError):
         self.allowed = allowed
         self.unit = unit
         shown = _fmt(value)
-        if unit:
+        if unit and not isinstance(value, (str, bool)):  # not after a string ('10 mm') or true/false
             shown = f"{shown} {unit}"
         super().__init__(f"{parameter} = {shown} is not allowed: {allowed}")
 

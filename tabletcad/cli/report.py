@@ -83,7 +83,9 @@ def _table(name: str, sec: dict[str, Any]) -> str:
     r = sec["design_report"]
     kind = f"{r['shape']}, {r['face']} face" if r["shape"] is not None else "no shape formulas"
     rows = [
-        ("design", f"{name} ({r['family']}, {kind})"),
+        ("design", f"{name} ({r['family']}, {kind})"
+                   + ("; a cut-away view: the figures below are the uncut design's"
+                      if r.get("cut_away") and r["shape"] is not None else "")),
         ("length x width x thickness", f"{r['length_mm']:.4g} x {r['width_mm']:.4g} x {r['overall_thickness_mm']:.4g} mm"
                                        + _nominal_note(r)),
         ("band (wall) height", _fmt(r["band_mm"], "mm")),

@@ -545,11 +545,14 @@ def sweep_properties(tablet: Tablet, nu: int = 24, nv_per: int = 48) -> dict[str
             plan += float(np.sum(W * n[..., 2]))
             cup += float(np.sum(W * (X[..., 2] - z0) * n[..., 2]))
     sgn = 1.0 if vol >= 0 else -1.0
+    # a flat face's cup is 0: its integrand (X_z - z0) vanishes but for rounding, which would
+    # show as a negative -3e-15 mm3
+    cup = 0.0 if abs(cup) <= 1e-13 * abs(vol) else sgn * cup
     return dict(
         surface_area_mm2=area,
         volume_mm3=abs(vol),
         plan_area_mm2=abs(plan),
-        cup_volume_mm3=sgn * cup,
+        cup_volume_mm3=cup,
         cup_surface_area_mm2=top_area,
     )
 

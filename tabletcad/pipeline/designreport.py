@@ -321,6 +321,9 @@ def design_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str
         family=tablet.family,
         shape=info.get("shape"),
         face=info.get("face"),
+        # a cut-away view ([trim]) of a family tablet: these are the uncut design's figures; the
+        # geometry report's volume, area and extents are the cut-away's
+        cut_away=not (tablet.trim.u == (0.0, 1.0) and tablet.trim.full_v and tablet.trim.w == (0.0, 1.0)),
         volume_mm3=V,
         surface_area_mm2=A,
         sa_to_volume_per_mm=A / V,
@@ -411,7 +414,8 @@ def shape_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str,
     band = float(band_of(p)) if band_of is not None else None
     cup = None if band is None else (0.0 if face == "flat" else (float(p["thickness"]) - band) / 2.0)
     rep: dict[str, Any] = dict(
-        family=tablet.family, shape=shape, face=face, volume_mm3=V, surface_area_mm2=A, sa_to_volume_per_mm=A / V,
+        family=tablet.family, shape=shape, face=face, cut_away=not whole, volume_mm3=V, surface_area_mm2=A,
+        sa_to_volume_per_mm=A / V,
         cup_volume_mm3=None, cup_surface_area_mm2=None, cup_depth_mm=cup, overall_thickness_mm=T, band_mm=band,
         land_mm=0.0 if shape is not None else None, length_mm=Ln, width_mm=W, plan_area_mm2=tablet.plan_area(),
         plan_area_exact_mm2=None, plan_perimeter_mm=None, shape_factor=None if cup is None else cup / W,

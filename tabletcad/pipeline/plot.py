@@ -217,7 +217,8 @@ def side_profile(tablet: Tablet, n: int = 121, *, nu: int = 65, nv: int = 257,
     a sphere) the silhouette's height at its ends; the cup depths are the top's height above the
     band and the band's height above the bottom.  Length, width and thickness are an industry
     family's exact nominal dimensions (its surface is certified within 1 µm of them), else the
-    surface's polished extremes (:meth:`Tablet.bounds`), as the reports give them.
+    surface's polished extremes (:meth:`Tablet.bounds`), as the reports give them (also for a
+    cut-away view of a family tablet: its own extents, not the whole tablet's).
     """
     return _side_profile(_as_tablet(tablet), n, nu, nv, grids, None)
 
@@ -237,7 +238,8 @@ def _side_profile(tablet: Tablet, n: int, nu: int, nv: int, grids: list | None, 
         M = np.stack([p.evaluate(u, np.zeros_like(u)) for p in tablet.patches])  # (patches, 513, 3)
         rho = np.hypot(M[..., 0] - axis[0], M[..., 1] - axis[1])
     plan, holes = _plan(tablet, band, axis, float(rho.max()) if M is not None else 0.0)
-    if "length_mm" in info and "width_mm" in info and T is not None:
+    whole = tablet.trim.u == (0.0, 1.0) and tablet.trim.full_v and tablet.trim.w == (0.0, 1.0)
+    if whole and "length_mm" in info and "width_mm" in info and T is not None:
         # an industry family: its exact nominal dimensions (the surface is certified within 1 µm of
         # them), which a dimensioned drawing shows; standing on z = 0
         ext = np.array([info["length_mm"], info["width_mm"], T], dtype=float)
