@@ -42,7 +42,11 @@ def test_flat_tip_carries_the_uniform_stress(flat_tip):
     # (relative) apart, so the two polygons' areas agree to that, against a 1 % polygon error
     assert r.axial_area_mm2 == pytest.approx(r.back_area_mm2, rel=1e-6)
     assert r.uniform_stress_MPa == pytest.approx(20000.0 / r.back_area_mm2)
-    assert r.max_von_mises_MPa == pytest.approx(r.uniform_stress_MPa, rel=0.01)
+    # the largest stress is where a section of the faceted wall falls short of the back face's polygon,
+    # by at most an inscribed polygon's error, (2π/n)²/6 for n = perimeter / element size sides (1.05 %
+    # here; a rounding-level change of the tablet moves gmsh's nodes and the peak within it)
+    polygon = (2.0 * math.pi / (math.tau * (4.0 - 0.02) / 1.0)) ** 2 / 6.0
+    assert r.uniform_stress_MPa * (1.0 - 0.01) <= r.max_von_mises_MPa <= r.uniform_stress_MPa * (1.0 + polygon + 2e-3)
     vm = von_mises(r.solution.vertex_stress)
     assert np.median(vm) == pytest.approx(r.uniform_stress_MPa, rel=0.003)
     assert r.reaction_N < 1e-7 * 20000.0
@@ -50,7 +54,8 @@ def test_flat_tip_carries_the_uniform_stress(flat_tip):
     d = r.to_dict()
     assert r.buckling["method"] == "Johnson"
     assert r.allowed_force_kN == pytest.approx(min(d["allowed_force_yield_kN"], r.buckling["critical_force_kN"] / 1.5))
-    assert d["allowed_force_yield_kN"] == pytest.approx(1450.0 / 1.5 * A / 1000.0, rel=0.02)
+    # against the true circle's area: the back polygon's shortfall plus the wall's, each at most `polygon`
+    assert d["allowed_force_yield_kN"] == pytest.approx(1450.0 / 1.5 * A / 1000.0, rel=2.0 * polygon + 2e-3)
 
 
 def test_cup_depth_lowers_the_rating(flat_tip):
