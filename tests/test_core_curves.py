@@ -366,6 +366,21 @@ def test_nearest_of_is_the_plain_scan(seed, n, grid):
     np.testing.assert_array_equal(extra, [id(els[k]) % 1000003 for k in which])
 
 
+def test_nearest_of_in_chunks_is_the_same(monkeypatch):
+    """Points beyond one chunk are measured chunk by chunk: the same values, elements and sides."""
+    from tabletcad.families.outline import rounded_rectangle_outline
+    from tabletcad.geometry import curves
+
+    ol = rounded_rectangle_outline(12.0, 7.0, 2.0)
+    q = np.random.default_rng(3).uniform(-9.0, 9.0, size=(2500, 2))
+    whole = ol.signed_distance(q)
+    one = curves.nearest_of(ol.segs, q, lambda e, p: e.distance(p))
+    monkeypatch.setattr(curves, "_NEAREST_CHUNK", 300)
+    np.testing.assert_array_equal(ol.signed_distance(q), whole)
+    for a, b in zip(curves.nearest_of(ol.segs, q, lambda e, p: e.distance(p))[:2], one[:2]):
+        np.testing.assert_array_equal(a, b)
+
+
 @pytest.mark.parametrize("der", [0, 1, 2])
 def test_outline_offset_is_the_weighted_point_and_normal(der):
     """``offset`` (one frame) equals ``alpha O + beta N`` from ``point`` and ``normal`` for every

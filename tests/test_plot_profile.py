@@ -127,7 +127,7 @@ def test_meshes_of_a_convex_tablet_paint_what_the_depth_sorted_polygons_paint(mo
 
     img, quads = picture()
     monkeypatch.setattr(plot, "_convex", lambda tablet: False)
-    monkeypatch.setattr(plot, "_graph_from_above", lambda tablet: False)
+    monkeypatch.setattr(plot, "_graph_from_above", lambda tablet, convex=None: False)
     ref, ref_quads = picture()
     assert len(quads) == len(ref_quads)
     np.testing.assert_allclose(np.sort(quads.reshape(-1, 8), axis=0), np.sort(ref_quads.reshape(-1, 8), axis=0),

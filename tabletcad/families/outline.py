@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-from tabletcad.geometry.curves import NEAREST_CHUNK, Seg, nearest_of, signed_area
+from tabletcad.geometry.curves import Seg, nearest_of, signed_area
 from tabletcad.errors import DesignError, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
 
@@ -268,12 +268,8 @@ class PlanOutline:
         order), each segment measured only where its bounding circle allows it to be the
         nearest (:func:`~tabletcad.geometry.curves.nearest_of`).
         """
-        p = np.asarray(xy, dtype=float).reshape(-1, 2)
-        out = np.empty(len(p))
-        for i in range(0, len(p), NEAREST_CHUNK):
-            best, _, sign = nearest_of(self.segs, p[i : i + NEAREST_CHUNK], _signed_to_segment)
-            out[i : i + NEAREST_CHUNK] = sign * best
-        return out
+        best, _, sign = nearest_of(self.segs, xy, _signed_to_segment)
+        return sign * best
 
     def inscribed_radius(self) -> float:
         """Largest inward distance reached inside the outline (mm), to ~1e-9 mm."""

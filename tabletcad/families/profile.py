@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tabletcad.geometry.curves import NEAREST_CHUNK, Seg, nearest_of
+from tabletcad.geometry.curves import Seg, nearest_of
 
 __all__ = ["profile_line", "profile_arc", "Piece", "hermite_points", "pieces_for", "distance_to_chain",
            "joint_is_smooth"]
@@ -99,11 +99,7 @@ def distance_to_chain(elements, q: np.ndarray) -> np.ndarray:
     is below that distance (near the joints), so a point usually meets one element or two.
     """
     q = np.asarray(q, dtype=float).reshape(-1, 2)
-    elements = list(elements)
-    out = np.empty(len(q))
-    for i in range(0, len(q), NEAREST_CHUNK):  # chunks keep the (elements, points) bounds near a few MB
-        out[i : i + NEAREST_CHUNK] = nearest_of(elements, q[i : i + NEAREST_CHUNK], lambda e, p: e.distance(p))[0]
-    return out
+    return nearest_of(elements, q, lambda e, p: e.distance(p))[0]
 
 
 def _unit_tangent(e, t: float) -> np.ndarray:

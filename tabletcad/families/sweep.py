@@ -214,6 +214,23 @@ class SweepNominal:
         o = self.outline
         return bool(getattr(o, "is_circle", False)) and max(map(abs, o.segs[0].center)) <= 1e-12 * o.segs[0].radius
 
+    @property
+    def convex(self) -> bool | None:
+        """Whether the nominal solid is convex, or None when its outline is not lines and arcs.
+
+        Convex when the outline turns one way only (a G1 chain with no concave arc) and the faces,
+        as heights over the inward distance ``d`` from the outline, rise and bend down on top and
+        fall and bend up at the bottom: then ``{z_bottom(d) <= z <= z_top(d)}`` is convex, ``d``
+        being concave inside a convex outline.  A cup rising from a land is not (a kink upward).
+        """
+        segs = getattr(self.outline, "segs", None)
+        if segs is None:
+            return None
+        if any(s.kind == "arc" and s.sweep < 0.0 for s in segs):
+            return False
+        (dt, zt), (db, zb) = self._dz_top, self._dz_bot
+        return _rising_concave(dt, zt) and _rising_concave(db, -zb)
+
     def planar(self, points: np.ndarray) -> np.ndarray:
         """``(δ, z)`` of 3-D points: signed inward plan distance to the outline and height."""
         p = np.asarray(points, dtype=float).reshape(-1, 3)
@@ -231,6 +248,15 @@ class SweepNominal:
         zb = np.interp(np.maximum(d, 0.0), *self._dz_bot)
         inside = (d > 0.0) & (z > zb) & (z < zt)
         return np.where(inside, -dist, dist)
+
+
+def _rising_concave(d: np.ndarray, z: np.ndarray) -> bool:
+    """Whether the graph ``z(d)`` (``d`` increasing, dense samples) never falls and bends down only."""
+    dd = np.diff(d)
+    keep = dd > 1e-12 * max(1.0, float(np.max(np.abs(d))))
+    slope = np.diff(z)[keep] / dd[keep]
+    tol = 1e-7 * max(1.0, float(np.max(np.abs(slope))))
+    return bool(np.all(slope >= -tol) and np.all(np.diff(slope) <= tol))
 
 
 def _graph(elements, d_far: float, reverse: bool = False):

@@ -728,8 +728,8 @@ def _subset_errors(curve: CurveLike, a0, a, b, max_modes: int, m: int) -> np.nda
     return errs
 
 
-#: Points per chunk for :func:`nearest_of`'s callers (its bounds are an (elements, points) array).
-NEAREST_CHUNK = 65536
+#: Points per chunk of :func:`nearest_of` (its bounds are an (elements, points) array: a few MB).
+_NEAREST_CHUNK = 65536
 
 
 def nearest_of(elements, q: np.ndarray, measure):
@@ -743,6 +743,15 @@ def nearest_of(elements, q: np.ndarray, measure):
     ``measure(e, points)`` returns distances (mm) to ``e``, or ``(distances, extra)`` with a
     per-point ``extra`` such as a side (then ``extra`` is returned, else None).
     """
+    q = np.asarray(q, dtype=float).reshape(-1, 2)
+    if len(q) <= _NEAREST_CHUNK:
+        return _nearest_of(list(elements), q, measure)
+    parts = [_nearest_of(list(elements), q[i : i + _NEAREST_CHUNK], measure) for i in range(0, len(q), _NEAREST_CHUNK)]
+    extra = None if parts[0][2] is None else np.concatenate([x for _, _, x in parts])
+    return np.concatenate([b for b, _, _ in parts]), np.concatenate([w for _, w, _ in parts]), extra
+
+
+def _nearest_of(elements: list, q: np.ndarray, measure):
     m, n = len(q), len(elements)
     if n == 0:
         return np.full(m, np.inf), np.full(m, -1, dtype=np.intp), None

@@ -293,20 +293,8 @@ class PDEPatch:
         """True when some datum has content above mode ``N`` (so ``R != 0``)."""
         return self._has_remainder
 
-    def _series(self, k: int, v: np.ndarray, dv: int, cs: tuple | None = None) -> np.ndarray:
-        """Truncated Fourier series of datum ``k`` (or its v-derivative) at ``v``; ``cs``: the
-        table ``_trig(v, 1..N, dv)`` if already made."""
-        N = self.modes
-        out = np.zeros((v.size, 3))
-        if dv == 0:
-            out += self._a0[k]
-        if N:
-            c, s = cs if cs is not None else self._trig_cached(v, N, dv)
-            out += c @ self._ac[k, :N] + s @ self._bc[k, :N]
-        return out
-
     def _memo(self, key: tuple, make):
-        """Small per-patch cache of arrays that depend only on ``v`` (trig tables, residuals).
+        """Small per-patch cache of arrays that depend only on ``v`` (the data's residuals).
 
         The same ``v`` samples are evaluated many times (the surface and its
         derivatives, every datum's residual); keys hold the samples' bytes, so
@@ -352,9 +340,6 @@ class PDEPatch:
         if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
             return make()
         return self._memo(("res", dv, v.tobytes()), make)
-
-    def _cardinals(self, u: np.ndarray, du: int, lams) -> list[np.ndarray]:
-        return [cardinal(u, lam, self.u_nodes, self.form, du) for lam in lams]
 
     def _u_tables(self, u: np.ndarray, du: int) -> tuple[np.ndarray | None, np.ndarray, np.ndarray | None]:
         """The cardinal functions at ``u`` (or their ``u``-derivative) of every active mode

@@ -123,6 +123,11 @@ class Trim:
     def full_v(self) -> bool:
         return self.v[1] - self.v[0] >= math.tau - 1e-12
 
+    @property
+    def whole(self) -> bool:
+        """True when nothing is trimmed: the whole solid of every patch (no cut-away, not hollow)."""
+        return self.u == (0.0, 1.0) and self.full_v and self.w == (0.0, 1.0)
+
 
 def solid_map(patch: PDEPatch, u, v, w, du: int = 0, dv: int = 0, dw: int = 0) -> np.ndarray:
     """``X(u, v, w) = A0(u) + w (X(u, v) - A0(u))`` (eq 4.12) and first partials.
@@ -454,8 +459,7 @@ class Tablet:
         u, v = self._grid(nu, nv)
         # each (2, nu, nv): x and y as contiguous blocks, no stacked copy
         pts = [p.evaluate_grid(u, v, components=True, axes=(0, 1)) for p in self.patches]
-        lo = np.array([min(float(X[j].min()) for X in pts) for j in range(2)])
-        hi = np.array([max(float(X[j].max()) for X in pts) for j in range(2)])
+        lo, hi = coordinate_range([X.transpose(1, 2, 0) for X in pts], 2)  # views: X[..., j] is the block X[j]
         c = 0.5 * (lo + hi)
         m = 4 * nv
         grid = (np.arange(m) + 0.5) * (math.tau / m) - math.pi

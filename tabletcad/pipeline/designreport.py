@@ -323,7 +323,7 @@ def design_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str
         face=info.get("face"),
         # a cut-away view ([trim]) of a family tablet: these are the uncut design's figures; the
         # geometry report's volume, area and extents are the cut-away's
-        cut_away=not (tablet.trim.u == (0.0, 1.0) and tablet.trim.full_v and tablet.trim.w == (0.0, 1.0)),
+        cut_away=not tablet.trim.whole,
         volume_mm3=V,
         surface_area_mm2=A,
         sa_to_volume_per_mm=A / V,
@@ -407,7 +407,7 @@ def shape_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str,
     V, A = props["volume_mm3"], props["surface_area_mm2"]
     Ln, W, T = dims["length_mm"], dims["width_mm"], dims["height_mm"]
     p = dict(tablet.params)
-    whole = tablet.trim.u == (0.0, 1.0) and tablet.trim.full_v and tablet.trim.w == (0.0, 1.0)
+    whole = tablet.trim.whole
     # a cut-away view, or a reshaped tablet (its family's dimensions no longer describe it): no formula
     known = whole and bool(p)
     shape, face, band_of = _THESIS_SHAPES.get(tablet.family, (None, None, None)) if known else (None, None, None)

@@ -238,8 +238,7 @@ def _side_profile(tablet: Tablet, n: int, nu: int, nv: int, grids: list | None, 
         M = np.stack([p.evaluate(u, np.zeros_like(u)) for p in tablet.patches])  # (patches, 513, 3)
         rho = np.hypot(M[..., 0] - axis[0], M[..., 1] - axis[1])
     plan, holes = _plan(tablet, band, axis, float(rho.max()) if M is not None else 0.0)
-    whole = tablet.trim.u == (0.0, 1.0) and tablet.trim.full_v and tablet.trim.w == (0.0, 1.0)
-    if whole and "length_mm" in info and "width_mm" in info and T is not None:
+    if tablet.trim.whole and "length_mm" in info and "width_mm" in info and T is not None:
         # an industry family: its exact nominal dimensions (the surface is certified within 1 µm of
         # them), which a dimensioned drawing shows; standing on z = 0
         ext = np.array([info["length_mm"], info["width_mm"], T], dtype=float)
@@ -361,26 +360,17 @@ def _convex(tablet: Tablet) -> bool:
     turned towards a viewer overlap on screen and every face can be drawn as one mesh in any
     order (:func:`_draw_view`, :func:`_draw_plan`).  Decided on exact data, not on samples:
 
-    * an industry family (:class:`~tabletcad.families.sweep.SweepNominal`) whose outline turns
-      one way only (no concave arc) and whose faces, as heights over the inward distance ``d``
-      from the outline, are concave and rising inward on top, convex and falling at the bottom
-      (then the solid ``{z_bottom(d) <= z <= z_top(d)}`` is convex, ``d`` being concave inside
-      a convex outline); its surface lies within 1 µm of that nominal;
+    * an industry family: its nominal's :attr:`~tabletcad.families.sweep.SweepNominal.convex`
+      (its surface lies within 1 µm of that nominal);
     * a tablet of revolution whose meridian section (its profiles through every patch, both
       sides of the axis) lies on the boundary of its convex hull to 1e-3 of its size (so any
       overlap is a sliver of a fraction of a pixel).
     """
-    t = tablet.trim
-    if t.u != (0.0, 1.0) or not t.full_v or t.w[0] != 0.0:
+    if not tablet.trim.whole:
         return False
-    nominal = tablet.nominal
-    segs = getattr(getattr(nominal, "outline", None), "segs", None)
-    graphs = (getattr(nominal, "_dz_top", None), getattr(nominal, "_dz_bot", None))
-    if segs is not None and graphs[0] is not None and graphs[1] is not None:
-        if any(s.kind == "arc" and s.sweep < 0.0 for s in segs):
-            return False
-        (dt, zt), (db, zb) = graphs
-        return _rising_concave(dt, zt) and _rising_concave(db, -zb)
+    family_convex = getattr(tablet.nominal, "convex", None)  # a family's nominal knows (SweepNominal.convex)
+    if family_convex is not None:
+        return bool(family_convex)
     revs = tablet.revolution
     if revs is None:
         return False
@@ -398,27 +388,17 @@ def _convex(tablet: Tablet) -> bool:
     return bool(np.max(inside) <= 1e-3 * size)
 
 
-def _graph_from_above(tablet: Tablet) -> bool:
+def _graph_from_above(tablet: Tablet, convex: bool | None = None) -> bool:
     """Whether the faces turned up of the (untrimmed) tablet never overlap seen from above, so the
-    plan can draw every face as one mesh: an industry family (its top face is a height over the
-    inward distance from the outline, which every plan point has one of; its band's upward-turned
-    strip, where it bulges, lies outside the rim), or a convex tablet (:func:`_convex`)."""
-    t = tablet.trim
-    if t.u != (0.0, 1.0) or not t.full_v or t.w[0] != 0.0:
+    plan can draw every face as one mesh: an industry family (a :class:`~tabletcad.families.sweep.SweepNominal`
+    with lines and arcs, whose top face is a height over the inward distance from the outline,
+    which every plan point has one of; its band's upward-turned strip, where it bulges, lies
+    outside the rim), or a convex tablet (:func:`_convex`, or ``convex`` when already known)."""
+    if not tablet.trim.whole:
         return False
-    if getattr(getattr(tablet.nominal, "outline", None), "segs", None) is not None and \
-            getattr(tablet.nominal, "_dz_top", None) is not None:
+    if getattr(tablet.nominal, "convex", None) is not None:
         return True
-    return _convex(tablet)
-
-
-def _rising_concave(d: np.ndarray, z: np.ndarray) -> bool:
-    """Whether the graph ``z(d)`` (``d`` increasing, dense samples) never falls and bends down only."""
-    dd = np.diff(d)
-    keep = dd > 1e-12 * max(1.0, float(np.max(np.abs(d))))
-    slope = np.diff(z)[keep] / dd[keep]
-    tol = 1e-7 * max(1.0, float(np.max(np.abs(slope))))
-    return bool(np.all(slope >= -tol) and np.all(np.diff(slope) <= tol))
+    return _convex(tablet) if convex is None else convex
 
 
 def _meshes(ax, items) -> None:
@@ -439,13 +419,14 @@ def _rgba(rgb: np.ndarray, seen: np.ndarray) -> np.ndarray:
     return out
 
 
-def _draw_plan(ax, tablet: Tablet, o: TabletOutline, grids, colour="#4e79a7", dims: bool = True) -> None:
+def _draw_plan(ax, tablet: Tablet, o: TabletOutline, grids, colour="#4e79a7", dims: bool = True,
+               convex: bool | None = None) -> None:
     from matplotlib.collections import PolyCollection
     from matplotlib.colors import to_rgb
 
     base = np.array(to_rgb(colour))
     outward = tablet.orientation
-    graph = _graph_from_above(tablet)
+    graph = _graph_from_above(tablet, convex)
     polys, cols, depth, meshes = [], [], [], []
     for face, Y in grids:
         q = _quads(Y)
@@ -500,7 +481,7 @@ def view_axes(elev: float, azim: float) -> np.ndarray:
     return np.stack([right, cross(towards, right), towards])
 
 
-def _draw_view(ax, tablet: Tablet, grids, elev: float, azim: float) -> None:
+def _draw_view(ax, tablet: Tablet, grids, elev: float, azim: float, convex: bool | None = None) -> None:
     """The shaded view of the closed surface, drawn as 2-D polygons to scale: every quad of the
     face grids projected orthographically, those facing away culled (outward normals from
     the faces' orientation), the rest painted far to near, each with a two-sided Lambert
@@ -512,7 +493,7 @@ def _draw_view(ax, tablet: Tablet, grids, elev: float, azim: float) -> None:
     colours = colormaps["tab10"]
     outward = tablet.orientation
     hollow = tablet.trim.w[0] > 0.0
-    convex = _convex(tablet)
+    convex = _convex(tablet) if convex is None else convex
     polys, cols, depth, lines, meshes = [], [], [], [], []
     for face, Y in grids:
         q = _quads(Y)
@@ -581,10 +562,11 @@ def tablet_figure(
     FigureCanvasAgg(fig)  # no global backend: the figure owns its Agg canvas
     faces = tablet.faces()  # once: finding the shared edges evaluates the patches
     grids = _face_grids(tablet, nu, nv, faces)
-    _draw_view(fig.add_subplot(131), tablet, grids, elev, azim)
+    convex = _convex(tablet)  # once for both panels
+    _draw_view(fig.add_subplot(131), tablet, grids, elev, azim, convex)
     o = _side_profile(tablet, 121, 65, 257, grids, faces)  # the view's grids: to a fraction of a pixel
     _draw_profile(fig.add_subplot(132), o)
-    _draw_plan(fig.add_subplot(133), tablet, o, grids)
+    _draw_plan(fig.add_subplot(133), tablet, o, grids, convex=convex)
     fig.suptitle(title or f"{tablet.name} ({tablet.family}, {len(tablet.patches)} patches), mm", fontsize=10)
     fig.subplots_adjust(left=0.02, right=0.98, wspace=0.3)
     return fig
