@@ -24,6 +24,7 @@ import numpy as np
 
 from tabletcad.brep.knots import basis_derivatives, clamped_interp_knots, flat_knots
 from tabletcad.errors import GeometryError
+from tabletcad.geometry.quadrature import gauss_legendre
 
 __all__ = ["RevolvedSurfaceData", "ProfileFit", "fit_profile", "fit_profiles", "revolved_mesh", "revolved_volume"]
 
@@ -111,7 +112,7 @@ def revolved_volume(surfaces) -> float:
     """
     total = 0.0
     for s in surfaces:
-        x, w = np.polynomial.legendre.leggauss(int(math.ceil(3 * s.degree / 2)) + 1)
+        x, w = gauss_legendre(int(math.ceil(3 * s.degree / 2)) + 1)
         a, b = s.knots[:-1, None], s.knots[1:, None]
         u = (((b - a) * x + (a + b)) / 2).ravel()
         wu = (((b - a) / 2) * w).ravel()

@@ -31,6 +31,7 @@ import numpy as np
 from tabletcad.brep.knots import basis_derivatives, flat_knots
 from tabletcad.errors import GeometryError
 from tabletcad.geometry.vectors import cross
+from tabletcad.geometry.quadrature import gauss_legendre
 
 __all__ = ["BSplineSurfaceData", "enclosed_volume", "volume_and_area", "segment_v"]
 
@@ -244,7 +245,7 @@ def enclosed_volume(surfaces: Sequence) -> float:
         rules = []
         for knots, deg in ((s.u_knots, s.u_degree), (s.v_knots, s.v_degree)):
             n = int(math.ceil(3 * deg / 2)) + 1
-            x, w = np.polynomial.legendre.leggauss(n)
+            x, w = gauss_legendre(n)
             a, b = knots[:-1, None], knots[1:, None]
             rules.append(((((b - a) * x + (a + b)) / 2).ravel(), (((b - a) / 2) * w).ravel()))
         (uq, uw), (vq, vw) = rules
@@ -259,7 +260,7 @@ def enclosed_volume(surfaces: Sequence) -> float:
 
 def _span_rule(knots: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Gauss-Legendre nodes and weights, ``n`` per knot span."""
-    x, w = np.polynomial.legendre.leggauss(n)
+    x, w = gauss_legendre(n)
     a, b = knots[:-1, None], knots[1:, None]
     return (((b - a) * x + (a + b)) / 2).ravel(), (((b - a) / 2) * w).ravel()
 

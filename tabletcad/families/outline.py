@@ -29,6 +29,7 @@ import numpy as np
 from tabletcad.geometry.curves import Seg, nearest_of, signed_area
 from tabletcad.errors import DesignError, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
+from tabletcad.geometry.quadrature import gauss_legendre
 
 __all__ = [
     "Seg",
@@ -236,7 +237,7 @@ class PlanOutline:
                 sy += (y0 + y1) * cr / 6.0
             else:
                 # ∮ x² dy / 2 and -∮ y² dx / 2 over the arc, by Gauss-Legendre (exact to rounding)
-                xg, wg = np.polynomial.legendre.leggauss(24)
+                xg, wg = gauss_legendre(24)
                 th = s.theta0 + 0.5 * s.sweep * (xg + 1)
                 w = 0.5 * s.sweep * wg
                 x = s.center[0] + s.radius * np.cos(th)

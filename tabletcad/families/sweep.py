@@ -51,6 +51,7 @@ from tabletcad.geometry.patch import PDEPatch
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT, Tolerances
 from tabletcad.geometry.vectors import cross
+from tabletcad.geometry.quadrature import gauss_legendre
 
 __all__ = [
     "SweepCurve",
@@ -504,10 +505,9 @@ def certify(tablet: Tablet, nu: int = 33, nv: int = 512) -> Certificate:
         raise DesignError("tablet", tablet.name, "has no swept nominal to certify against")
     u = np.linspace(0.0, 1.0, nu)
     v = _v_samples(nom.outline, _axisymmetric_nv(tablet, nv))
-    per = []
-    for p in tablet.patches:
-        X = p.evaluate_grid(u, v).reshape(-1, 3)
-        per.append(float(np.max(nom.distance(X))))
+    X = [p.evaluate_grid(u, v).reshape(-1, 3) for p in tablet.patches]
+    d = nom.distance(np.concatenate(X))  # one call for all patches: each point's distance is its own
+    per = [float(np.max(part)) for part in np.split(d, np.cumsum([len(x) for x in X])[:-1])]
     cert = Certificate(max(per), tuple(per), tablet.tol.nominal, (nu, len(v)), max(per) <= tablet.tol.nominal)
     nom.certificate = cert
     nom.patch_ids = tuple(id(p) for p in tablet.patches)
@@ -521,7 +521,7 @@ def _rule_v(outline, n_per: int):
     if len(b) == 2:
         m = 4 * n_per
         return np.arange(m) * (math.tau / m), np.full(m, math.tau / m)
-    x, w = np.polynomial.legendre.leggauss(n_per)
+    x, w = gauss_legendre(n_per)
     vs, ws = [], []
     for lo, hi in zip(b[:-1], b[1:]):
         vs.append(0.5 * (hi - lo) * (x + 1) + lo)
@@ -547,7 +547,7 @@ def sweep_properties(tablet: Tablet, nu: int = 24, nv_per: int = 48) -> dict[str
     ``cup_surface_area_mm2``.
     """
     nom = tablet.nominal
-    xu, wu = np.polynomial.legendre.leggauss(nu)
+    xu, wu = gauss_legendre(nu)
     u = 0.5 * (xu + 1)
     wu = 0.5 * wu
     if tablet.revolution is not None and nom.axisymmetric:  # integrands the same on every meridian
@@ -595,7 +595,7 @@ def nominal_volume(nominal: SweepNominal, n: int = 64) -> float:
     """
     ol = nominal.outline
     A0, P = float(ol.area), float(ol.perimeter)
-    x, w = np.polynomial.legendre.leggauss(n)
+    x, w = gauss_legendre(n)
     t = 0.5 * (x + 1.0)
     cup = 0.0
     for e in nominal.top:

@@ -29,6 +29,7 @@ curves is refused with :class:`~tabletcad.errors.DesignError`; pass a smaller
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -36,7 +37,7 @@ import numpy as np
 from tabletcad.geometry.basis import cardinal, cardinal_coefficients, cardinals
 from tabletcad.geometry.revolution import Revolution, detect_revolution
 from tabletcad.geometry.tables import CARDINAL, TRIG
-from tabletcad.geometry.curves import CurveLike, fourier_coefficients, modes_needed, sample_v
+from tabletcad.geometry.curves import fourier_coefficients, modes_needed, sample_v
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
 from tabletcad.geometry.vectors import cross
@@ -68,6 +69,16 @@ def _trig(v: np.ndarray, n: np.ndarray, dv: int) -> tuple[np.ndarray, np.ndarray
 
 
 _EYE3 = np.eye(3)
+
+
+@lru_cache(maxsize=8)
+def _fold_u(nu: int, n_ends: int) -> np.ndarray:
+    """The fold checks' ``u`` samples: ``nu`` equally spaced and ``n_ends`` geometrically
+    closer to each end (from 1e-6 to 0.05), where a dome's spine may run backwards (read-only)."""
+    ends = np.geomspace(1e-6, 0.05, n_ends)
+    u = np.unique(np.concatenate([ends, np.linspace(0.0, 1.0, nu)[1:-1], 1.0 - ends]))
+    u.setflags(write=False)
+    return u
 
 
 def _trig_rows(v: np.ndarray, n: np.ndarray, dv: int) -> np.ndarray:
@@ -133,7 +144,7 @@ class PDEPatch:
         if len(data) != 4:
             raise DesignError("curves", len(data), "a patch needs exactly 4 boundary data")
         for i, c in enumerate(data):
-            if not isinstance(c, CurveLike):
+            if not callable(getattr(c, "evaluate", None)):  # CurveLike (isinstance on a Protocol is slow)
                 raise DesignError(f"curve {i}", type(c).__name__, "must be a curve with evaluate(v, der)")
         object.__setattr__(self, "data", data)
         if self.form not in ("curves", "hermite"):
@@ -379,7 +390,10 @@ class PDEPatch:
         ndarray, shape ``broadcast(u, v).shape + (3,)`` in mm (per unit parameter
         for derivatives).
         """
-        u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
+        u, v = np.asarray(u, dtype=float), np.asarray(v, dtype=float)
+        if u.ndim == 0 and v.ndim == 1 and v.size > 1 and nmin == 0 and remainder:  # one u line: as below
+            return self.evaluate_grid(u.reshape(1), v, du, dv)[0]
+        u, v = np.broadcast_arrays(u, v)
         shape = u.shape
         uf, vf = u.reshape(-1), v.reshape(-1)
         if nmin == 0 and remainder and uf.size > 1:  # points along one u or one v line: a grid of one row
@@ -604,8 +618,7 @@ class PDEPatch:
         return self._checks[key]
 
     def _fold_depth_of(self, nu: int, nv: int) -> float:
-        ends = np.geomspace(1e-6, 0.05, 48)
-        u = np.unique(np.concatenate([ends, np.linspace(0.0, 1.0, nu)[1:-1], 1.0 - ends]))
+        u = _fold_u(nu, 48)
         v = sample_v(nv)
         # coordinates as contiguous (nu, nv) blocks (evaluate_grid's components layout)
         Xu = self.evaluate_grid(u, v, du=1, components=True)
@@ -638,8 +651,7 @@ class PDEPatch:
                 f"the surface must not cross its spine by more than {self.tol.fold:g} mm "
                 "(a radius would turn negative or the surface self-intersects)",
             )
-        ends = np.geomspace(1e-6, 0.05, 24)
-        u = np.unique(np.concatenate([ends, np.linspace(0.0, 1.0, 401)[1:-1], 1.0 - ends]))
+        u = _fold_u(401, 24)
         v = sample_v(self._check_nv())
         X = self.evaluate_grid(u, v)
         D = X - self.spine(u)[:, None, :]

@@ -12,7 +12,6 @@ the union of the patch solids.  A :class:`Trim` restricts ``u``, ``v`` and
 from __future__ import annotations
 
 import math
-from functools import lru_cache
 from dataclasses import dataclass, field, replace
 from typing import Any, Callable
 
@@ -27,6 +26,7 @@ from tabletcad.geometry.revolution import profile_extreme
 _REVOLUTION_NV = 4
 from tabletcad.tolerance import DEFAULT, Tolerances
 from tabletcad.geometry.vectors import cross
+from tabletcad.geometry.quadrature import gauss_legendre
 
 __all__ = ["Band", "Trim", "Tablet", "Face", "solid_map"]
 
@@ -43,15 +43,6 @@ def coordinate_range(arrays, k: int) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
-@lru_cache(maxsize=32)
-def _leggauss(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre nodes and weights on [-1, 1] (cached: numpy solves an eigenproblem)."""
-    x, w = np.polynomial.legendre.leggauss(n)
-    x.setflags(write=False)
-    w.setflags(write=False)
-    return x, w
-
-
 def _composite_gauss(breaks: np.ndarray, n_total: int) -> tuple[np.ndarray, np.ndarray]:
     """Gauss-Legendre nodes and weights over the periodic intervals between ``breaks``.
 
@@ -61,7 +52,7 @@ def _composite_gauss(breaks: np.ndarray, n_total: int) -> tuple[np.ndarray, np.n
     b = np.sort(np.mod(breaks, math.tau))
     edges = np.concatenate([b, [b[0] + math.tau]])
     k = max(12, int(math.ceil(n_total / len(b))))
-    x, w = _leggauss(k)
+    x, w = gauss_legendre(k)
     lo, hi = edges[:-1, None], edges[1:, None]
     nodes = 0.5 * (hi - lo) * (x + 1.0) + lo
     weights = 0.5 * (hi - lo) * w
@@ -83,7 +74,7 @@ def _split_gauss(t0: float, t1: float, breaks: np.ndarray, n_total: int) -> tupl
     inner = inner[(inner > t0 + 1e-12 * span) & (inner < t1 - 1e-12 * span)]
     edges = np.concatenate([[t0], inner, [t1]])
     k = max(12, int(math.ceil(n_total / (len(edges) - 1))))
-    x, w = _leggauss(k)
+    x, w = gauss_legendre(k)
     lo, hi = edges[:-1, None], edges[1:, None]
     return (0.5 * (hi - lo) * (x + 1.0) + lo).ravel(), (0.5 * (hi - lo) * w).ravel()
 
@@ -324,7 +315,7 @@ class Tablet:
         if nv is None and face.periodic_t and self.patches[face.patch].revolution is not None:
             nv = _REVOLUTION_NV  # the integrands do not depend on v: any trapezoidal rule is exact
         nv = nv or self.tol.quad_v
-        xs, ws = _leggauss(nu)
+        xs, ws = gauss_legendre(nu)
         s0, s1 = face.s_range
         s = 0.5 * (s1 - s0) * (xs + 1.0) + s0
         sw = 0.5 * (s1 - s0) * ws
@@ -338,7 +329,7 @@ class Tablet:
         elif bps.size:  # a trimmed v range: Gauss-Legendre per smooth piece between the outline's joins
             t, tw = _split_gauss(t0, t1, bps, nv if face.kind == "w" else max(nv // 4, 32))
         else:
-            xt, wt = _leggauss(nv if face.kind == "w" else max(nv // 4, 32))
+            xt, wt = gauss_legendre(nv if face.kind == "w" else max(nv // 4, 32))
             t = 0.5 * (t1 - t0) * (xt + 1.0) + t0
             tw = 0.5 * (t1 - t0) * wt
         return s, sw, t, tw
@@ -550,8 +541,8 @@ class Tablet:
         if nv is None and t.full_v and self.revolution is not None:
             nv = _REVOLUTION_NV  # the Jacobian does not depend on v: any trapezoidal rule is exact
         nv = nv or self.tol.quad_v
-        xu, wu = _leggauss(nu)
-        xw, ww = _leggauss(nw)
+        xu, wu = gauss_legendre(nu)
+        xw, ww = gauss_legendre(nw)
         u = 0.5 * (t.u[1] - t.u[0]) * (xu + 1) + t.u[0]
         uw = 0.5 * (t.u[1] - t.u[0]) * wu
         w = 0.5 * (t.w[1] - t.w[0]) * (xw + 1) + t.w[0]
@@ -560,7 +551,7 @@ class Tablet:
             v = np.arange(nv) * (math.tau / nv) + t.v[0]
             vw = np.full(nv, math.tau / nv)
         else:
-            xv, wv = _leggauss(nv)
+            xv, wv = gauss_legendre(nv)
             v = 0.5 * (t.v[1] - t.v[0]) * (xv + 1) + t.v[0]
             vw = 0.5 * (t.v[1] - t.v[0]) * wv
         total = 0.0
