@@ -347,12 +347,38 @@ def face_samples(shape, spacing: float = 0.05, max_per_face: int = 2500) -> np.n
         lv = float(np.max(np.sum(np.linalg.norm(np.diff(P, axis=1), axis=2), axis=1)))
         nu = int(np.clip(np.ceil(lu / spacing) + 1, 3, max_per_face // 3))
         nv = int(np.clip(np.ceil(lv / spacing) + 1, 3, max(3, max_per_face // nu)))
+        us, vs = np.linspace(u0, u1, nu).tolist(), np.linspace(v0, v1, nv).tolist()
+        if _fills_uv_box(face, u0, u1, v0, v1):  # every grid point lies inside the face or on its edges
+            out.extend(surf.Value(u, v).Coord() for u in us for v in vs)
+            continue
         cls = BRepTopAdaptor_FClass2d(face, 1e-9)
-        for u in np.linspace(u0, u1, nu):
-            for v in np.linspace(v0, v1, nv):
-                if cls.Perform(gp_Pnt2d(float(u), float(v))) in keep_states:
-                    out.append(surf.Value(float(u), float(v)).Coord())
+        for u in us:
+            for v in vs:
+                if cls.Perform(gp_Pnt2d(u, v)) in keep_states:
+                    out.append(surf.Value(u, v).Coord())
     return np.asarray(out, dtype=float).reshape(-1, 3)
+
+
+def _fills_uv_box(face, u0: float, u1: float, v0: float, v1: float) -> bool:
+    """Whether ``face`` is the whole of its ``(u, v)`` box: one wire, every edge a straight
+    p-curve along a side of the box (a closed wire on the box's sides is its whole boundary),
+    as the faces of an untrimmed patch are.  False whenever in doubt."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+    from OCP.GeomAbs import GeomAbs_CurveType
+
+    wires = explore(face, "Wire")
+    if len(wires) != 1:
+        return False
+    eps = 1e-9 * max(1.0, abs(u0), abs(u1), abs(v0), abs(v1))
+    for e in explore(wires[0], "Edge"):
+        c = BRepAdaptor_Curve2d(e, face)
+        if c.GetType() != GeomAbs_CurveType.GeomAbs_Line:
+            return False
+        p, q = c.Value(c.FirstParameter()), c.Value(c.LastParameter())
+        if not (any(abs(p.X() - x) <= eps and abs(q.X() - x) <= eps for x in (u0, u1))
+                or any(abs(p.Y() - y) <= eps and abs(q.Y() - y) <= eps for y in (v0, v1))):
+            return False
+    return True
 
 
 def _distance_shapes(a, b) -> BRepExtrema_DistShapeShape:
