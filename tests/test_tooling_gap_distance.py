@@ -143,3 +143,79 @@ def test_covering_radius_is_the_largest_distance_to_the_nearest_corner(seed, fla
     eq = np.array([[[0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0]]])
     assert covering_radius(eq)[0] == pytest.approx(1 / np.sqrt(3), rel=1e-12)
     assert covering_radius(np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float))[0] == pytest.approx(np.sqrt(2) / 2, rel=1e-12)
+
+
+def test_mesh_distance_closest_points_lie_on_the_mesh_at_the_distance():
+    """With ``closest``, each finite distance comes with a point of the mesh that far away (the
+    branch and bound's anchors); NaN where the distance is ``inf``."""
+    from tabletcad.tooling.interference import MeshDistance
+
+    rng = np.random.default_rng(7)
+    mesh = trimesh.creation.icosphere(subdivisions=2)
+    V, T = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    P = rng.normal(size=(200, 3)) * 1.5
+    d, Q = MeshDistance(V, T, reach=0.8)(P, closest=True)
+    fin = np.isfinite(d)
+    assert 20 < np.count_nonzero(fin) < len(P)
+    assert np.allclose(np.linalg.norm(P[fin] - Q[fin], axis=1), d[fin], rtol=0, atol=1e-12)
+    assert np.max(_brute_force(Q[fin], V, T)) < 1e-12  # the points lie on the mesh (a second library's distance)
+    assert np.all(np.isnan(Q[~fin]))
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), anchored=st.booleans(), height=st.floats(0.0, 0.05))
+def test_branch_and_bound_misses_no_peak_by_more_than_its_resolution(seed, anchored, height):
+    """``largest_inside`` of the distance to a set of points (a ridge between two rows of them,
+    as a land lies between a punch tip and a die wall): no point of any triangle, sampled densely,
+    is farther from the set than the largest value found plus ``spacing / √3`` - with the
+    Lipschitz bound alone and with the anchored bound (each corner's nearest point), which
+    refines fewer points along the ridge."""
+    from scipy.spatial import cKDTree
+
+    from tabletcad.tooling.interference import largest_inside
+
+    rng = np.random.default_rng(seed)
+    xs = np.linspace(-1.0, 1.0, 400)
+    S = np.concatenate([np.column_stack([xs, np.full_like(xs, -0.1), np.zeros_like(xs)]),
+                        np.column_stack([xs, np.full_like(xs, 0.1 + 0.05 * rng.uniform()), np.zeros_like(xs)])])
+    tree = cKDTree(S)
+
+    def f(P):
+        d, i = tree.query(P)
+        return (d, S[i]) if anchored else d
+
+    corners = rng.uniform([-0.9, -0.2, height - 0.01], [0.9, 0.25, height + 0.01], size=(12, 3, 3))
+    d0, i0 = tree.query(corners.reshape(-1, 3))
+    values = d0.reshape(-1, 3)
+    spacing = 0.005
+    best = float(values.max())
+    anchors = S[i0].reshape(-1, 3, 3) if anchored else None
+    Vs, ds = largest_inside(corners, values, f, spacing, best, anchors=anchors)
+    found = max(best, float(ds.max()) if len(ds) else best)
+    assert np.allclose(tree.query(Vs)[0], ds, rtol=0, atol=0) if len(Vs) else True
+    w = rng.dirichlet(np.ones(3), size=4000)  # dense random points of every triangle
+    inside = np.einsum("sk,tkc->tsc", w, corners).reshape(-1, 3)
+    assert float(tree.query(inside)[0].max()) <= found + spacing / np.sqrt(3.0) + 1e-12
+
+
+def test_anchored_bound_refines_fewer_points_along_a_ridge():
+    """Along a straight ridge the anchored bound is second order (``sqrt(f² + h²)``), the Lipschitz
+    one first order (``f + h``): the same guarantee with fewer refined points."""
+    from scipy.spatial import cKDTree
+
+    from tabletcad.tooling.interference import largest_inside
+
+    xs = np.linspace(-2.0, 2.0, 4001)
+    S = np.concatenate([np.column_stack([xs, np.full_like(xs, -0.1), np.zeros_like(xs)]),
+                        np.column_stack([xs, np.full_like(xs, 0.1), np.zeros_like(xs)])])
+    tree = cKDTree(S)
+    g = np.linspace(-1.0, 1.0, 41)
+    corners = np.array([[[a, -0.1, 0.0], [b, -0.1, 0.0], [a, 0.1, 0.0]] for a, b in zip(g[:-1], g[1:])]
+                       + [[[b, -0.1, 0.0], [b, 0.1, 0.0], [a, 0.1, 0.0]] for a, b in zip(g[:-1], g[1:])])
+    d0, i0 = tree.query(corners.reshape(-1, 3))
+    values, best = d0.reshape(-1, 3), float(d0.max())
+    plain, dp = largest_inside(corners, values, lambda P: tree.query(P)[0], 0.004, best)
+    anch, da = largest_inside(corners, values, lambda P: (tree.query(P)[0], S[tree.query(P)[1]]), 0.004, best,
+                              anchors=S[i0].reshape(-1, 3, 3))
+    assert dp.max() == pytest.approx(0.1, abs=0.004 / np.sqrt(3)) and da.max() == pytest.approx(0.1, abs=0.004 / np.sqrt(3))
+    assert len(anch) < 0.7 * len(plain)

@@ -92,15 +92,17 @@ class MeshDistance:
                 lo, hi = coordinate_range([self.V[np.unique(self.T)]], 3)
                 self.box = (lo - self.reach, hi + self.reach)
 
-    def __call__(self, points: np.ndarray, below: np.ndarray | None = None) -> np.ndarray:
+    def __call__(self, points: np.ndarray, below: np.ndarray | None = None, closest: bool = False):
         """Distances (mm) of ``points`` (``inf`` beyond ``reach``).  With ``below`` (one bound per
         point), a point whose distance cannot be below its bound (its nearest triangle centre is
         farther than the bound plus the centre-to-corner radius) is left at ``inf``: every finite
-        value returned is exact."""
+        value returned is exact.  With ``closest``, also the mesh's point nearest to each point
+        (NaN where the distance is ``inf``)."""
         P = np.ascontiguousarray(points, dtype=float).reshape(-1, 3)
         out = np.full(len(P), np.inf)
+        Q = np.full((len(P), 3), np.nan) if closest else None
         if not len(P) or self.tree is None:
-            return out
+            return (out, Q) if closest else out
         near = np.arange(len(P))
         if self.centres is not None:
             lo, hi = self.box  # farther than reach from the triangles' box: farther from every triangle
@@ -112,9 +114,15 @@ class MeshDistance:
                 ok &= d - self.radius * (1.0 + 1e-9) < below[near]  # (slack for rounding)
             near = near[ok]
         if len(near):
-            d2 = self.tree.squared_distance(self.V, self.T, np.ascontiguousarray(P[near]))[0]
+            d2, _, C = self.tree.squared_distance(self.V, self.T, np.ascontiguousarray(P[near]))
             out[near] = np.sqrt(np.maximum(d2, 0.0))
-        out[out > self.reach] = np.inf  # the same answer whatever the triangles' size
+            if closest:
+                Q[near] = C
+        far = out > self.reach
+        out[far] = np.inf  # the same answer whatever the triangles' size
+        if closest:
+            Q[far] = np.nan
+            return out, Q
         return out
 
 
@@ -123,7 +131,8 @@ def mesh_distance(points: np.ndarray, V: np.ndarray, T: np.ndarray, reach: float
     return MeshDistance(V, T, reach)(points)
 
 
-def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best: float):
+def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best: float,
+                   anchors: np.ndarray | None = None):
     """Points where the 1-Lipschitz function ``f`` may exceed ``best`` inside triangles, by branch and bound.
 
     ``tris`` (n, 3, 3) with ``values`` (n, 3), ``f`` at their corners.  Every point of a
@@ -137,6 +146,13 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
     nearly flat at its peak (the gap over a land: clearance / 2 all round) the triangles
     stop splitting as soon as their bound is within the resolution of the peak.
 
+    With ``anchors`` (n, 3, 3), ``f`` is a distance to a set and each corner's nearest point of
+    that set is known (``f`` then returns ``(values, nearest points)``, NaN where there is none):
+    ``f(y) <= |y - q|`` for every point ``q`` of the set, and ``|y - q|`` is convex, so over a
+    triangle it is at most its largest value at the corners.  The bound taken is the smaller of
+    the two, ``min_c max_k |v_k - q_c|`` being second order where the triangle runs along the set
+    (along a land's ridge: ``sqrt(f² + h²)``) where the first is ``f + h``; the guarantee is the same.
+
     Returns the measured points (m, 3) and their values (m,).
     """
     slack = spacing / math.sqrt(3.0)
@@ -146,8 +162,15 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
             break
         e = np.stack([np.linalg.norm(tris[:, 1] - tris[:, 0], axis=1), np.linalg.norm(tris[:, 2] - tris[:, 1], axis=1),
                       np.linalg.norm(tris[:, 0] - tris[:, 2], axis=1)], axis=1)
-        live = values.max(axis=1) + covering_radius(tris, e) > best + slack
+        bound = values.max(axis=1) + covering_radius(tris, e)
+        if anchors is not None:  # D[n, c, k] = |corner k - corner c's nearest point|
+            D = np.sqrt(np.sum((tris[:, None, :, :] - anchors[:, :, None, :]) ** 2, axis=3))
+            np.copyto(D, np.inf, where=np.isnan(D))
+            bound = np.minimum(bound, D.max(axis=2).min(axis=1))
+        live = bound > best + slack
         tris, values, e = tris[live], values[live], e[live]
+        if anchors is not None:
+            anchors = anchors[live]
         if not len(tris):
             break
         k = np.argmax(e, axis=1)  # edge k joins corner k and k + 1
@@ -156,7 +179,12 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
         a, b, c = tris[r, i0], tris[r, i1], tris[r, i2]
         fa, fb, fc = values[r, i0], values[r, i1], values[r, i2]
         m = 0.5 * (a + b)
-        fm = f(m)
+        if anchors is None:
+            fm = f(m)
+        else:
+            fm, qm = f(m)
+            qa, qb, qc = anchors[r, i0], anchors[r, i1], anchors[r, i2]
+            anchors = np.concatenate([np.stack([qa, qm, qc], axis=1), np.stack([qm, qb, qc], axis=1)])
         pts.append(m)
         vals.append(fm)
         best = max(best, float(np.max(fm)))
@@ -463,15 +491,17 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
              for s in parts.values()]
 
     def measure(P):
-        # the nearest tool and its distance; a tool is asked only where it could beat the best so far
+        # the nearest tool, its distance and its point nearest to P; a tool is asked only where it
+        # could beat the best so far
         best, which = np.full(len(P), np.inf), np.zeros(len(P), dtype=np.int64)
+        q = np.full((len(P), 3), np.nan)
         for j, tool in enumerate(tools):
-            d = tool(P, below=best)
+            d, c = tool(P, below=best, closest=True)
             nearer = d < best
-            best[nearer], which[nearer] = d[nearer], j
-        return best, which
+            best[nearer], which[nearer], q[nearer] = d[nearer], j, c[nearer]
+        return best, which, q
 
-    dist, near = measure(V)
+    dist, near, nearest = measure(V)
     # tablet triangles whose corners are nearest to different tools (the land between a punch tip and
     # the die bore): the gap peaks inside such triangles, away from every vertex - search them
     n_t = int(T.max()) + 1 if len(T) else 0
@@ -482,8 +512,8 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
     # h / sqrt(3) of a corner, so a peak inside a searched triangle is missed by at most that much
     refined_spacing = max(0.125 * clearance, 1e-3)
     if np.any(sel):
-        Vs, ds = largest_inside(V[:n_t][T[sel]], dist[:n_t][T[sel]], lambda P: measure(P)[0], refined_spacing,
-                                float(np.max(dist)))
+        Vs, ds = largest_inside(V[:n_t][T[sel]], dist[:n_t][T[sel]], lambda P: measure(P)[::2], refined_spacing,
+                                float(np.max(dist)), anchors=nearest[:n_t][T[sel]])
         V, dist = np.vstack([V, Vs]), np.concatenate([dist, ds])
         n_refined = len(Vs)
     order = np.argsort(dist)[::-1][:refine]
