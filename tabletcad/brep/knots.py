@@ -51,6 +51,9 @@ def _find_span(t: np.ndarray, degree: int, n_basis: int, x: np.ndarray) -> np.nd
 
 def _basis_on_span(t: np.ndarray, degree: int, x: np.ndarray, span: np.ndarray) -> np.ndarray:
     """Cox-de Boor: values of B-splines ``span-degree ... span`` at ``x`` (vectorised)."""
+    lo, hi = t[span], t[span + 1]
+    if x.size and np.all(lo < hi) and np.all((lo <= x) & (x <= hi)):
+        return _basis_inside(t, degree, x.reshape(-1), span.reshape(-1)).reshape(x.shape + (degree + 1,))
     N = np.zeros(x.shape + (degree + 1,))
     N[..., 0] = 1.0
     left = np.zeros(x.shape + (degree + 1,))
@@ -67,6 +70,27 @@ def _basis_on_span(t: np.ndarray, degree: int, x: np.ndarray, span: np.ndarray) 
             saved = left[..., j - r] * temp
         N[..., j] = saved
     return N
+
+
+def _basis_inside(t: np.ndarray, degree: int, x: np.ndarray, span: np.ndarray) -> np.ndarray:
+    """:func:`_basis_on_span` where every ``x`` lies in its non-empty span: there no denominator
+    ``(t[span+r+1] - x) + (x - t[span+1-j+r])`` can vanish (one term is at least
+    ``t[span+1] - t[span] > 0`` when the other is 0), so the same operations run unguarded, all
+    ``r`` of one degree ``j`` at once on rows of a ``(degree + 1, len(x))`` table - the same
+    values, bit for bit, in a few array passes per degree."""
+    J = np.arange(degree + 1)[:, None]
+    left = x - t[span + 1 - J]  # row j: x - t[span+1-j] (row 0 unused)
+    right = t[span + J] - x  # row j: t[span+j] - x
+    N = np.empty((degree + 1, x.size))
+    N[0] = 1.0
+    for j in range(1, degree + 1):
+        L = left[j:0:-1]  # rows j - r for r = 0 .. j-1
+        temp = N[:j] / (right[1 : j + 1] + L)
+        saved = L * temp  # the next r's "saved"
+        N[:j] = right[1 : j + 1] * temp
+        N[1:j] += saved[:-1]
+        N[j] = saved[-1]
+    return np.ascontiguousarray(N.T)
 
 
 def basis_functions(t: np.ndarray, degree: int, n_basis: int, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
