@@ -228,17 +228,26 @@ def fit_profiles(profiles, tol: float = 1e-4, *, names=None, degree: int = 5) ->
     return fits
 
 
-def _profile_nodes(s: RevolvedSurfaceData, deflection: float, angle: float, density: float,
-                   samples: int = 513) -> np.ndarray:
-    """Parameters ``u`` of the mesh nodes on one profile: both ends plus nodes equidistributed in
-    ``max(sqrt(κ / (8 δ)), κ / angle)`` per unit length (``δ`` = half the deflection; κ the
-    curvature measured on ``samples`` points), times ``density``."""
+def _curvature_samples(s: RevolvedSurfaceData, samples: int = 513) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``u`` on ``samples`` points of one profile, the length of each interval between them and its
+    curvature (the turn of the tangent over the length), for :func:`_profile_nodes`."""
     lo, hi = s.u_range
     u = np.linspace(lo, hi, samples)
     P, D = s.profile(u), s.profile(u, 1)
     seg = np.linalg.norm(np.diff(P, axis=0), axis=1)
     phi = np.unwrap(np.arctan2(D[:, 1], D[:, 0]))
     kappa = np.abs(np.diff(phi)) / np.maximum(seg, 1e-300)  # curvature of each sample interval
+    return u, seg, kappa
+
+
+def _profile_nodes(s: RevolvedSurfaceData, deflection: float, angle: float, density: float,
+                   samples: int = 513, curvature=None) -> np.ndarray:
+    """Parameters ``u`` of the mesh nodes on one profile: both ends plus nodes equidistributed in
+    ``max(sqrt(κ / (8 δ)), κ / angle)`` per unit length (``δ`` = half the deflection; κ the
+    curvature measured on ``samples`` points), times ``density``.  ``curvature``: the profile's
+    :func:`_curvature_samples`, when already measured."""
+    lo, hi = s.u_range
+    u, seg, kappa = curvature if curvature is not None else _curvature_samples(s, samples)
     rate = np.maximum(np.sqrt(kappa / (8.0 * 0.5 * deflection)), kappa / angle) * density
     count = np.concatenate([[0.0], np.cumsum(rate * seg)])
     n = max(1, int(math.ceil(count[-1])))
@@ -269,10 +278,11 @@ def revolved_mesh(surfaces, deflection: float, angle: float, *, max_rounds: int 
     V : ndarray (n, 3), T : ndarray (t, 3) int, measured : float (mm)
     """
     density, measured = 1.0, math.inf
+    curvature = [_curvature_samples(s) for s in surfaces]  # the same in every round
     for _ in range(max_rounds + 1):
         P, bands = [], []
         for f, s in enumerate(surfaces):
-            u = _profile_nodes(s, deflection, angle, density)
+            u = _profile_nodes(s, deflection, angle, density, curvature=curvature[f])
             pts = s.profile(u)
             start = len(P) - 1 if P else None  # the previous face's last node is this face's first
             if start is None:
