@@ -162,12 +162,10 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
             break
         e = np.stack([np.linalg.norm(tris[:, 1] - tris[:, 0], axis=1), np.linalg.norm(tris[:, 2] - tris[:, 1], axis=1),
                       np.linalg.norm(tris[:, 0] - tris[:, 2], axis=1)], axis=1)
-        bound = values.max(axis=1) + covering_radius(tris, e)
-        if anchors is not None:  # D[n, c, k] = |corner k - corner c's nearest point|
-            D = np.sqrt(np.sum((tris[:, None, :, :] - anchors[:, :, None, :]) ** 2, axis=3))
-            np.copyto(D, np.inf, where=np.isnan(D))
-            bound = np.minimum(bound, D.max(axis=2).min(axis=1))
-        live = bound > best + slack
+        live = values.max(axis=1) + covering_radius(tris, e) > best + slack
+        if anchors is not None and np.any(live):  # the anchored bound, where the first did not prune
+            k = np.flatnonzero(live)
+            live[k] = _anchored_bound(tris[k], anchors[k]) > best + slack
         tris, values, e = tris[live], values[live], e[live]
         if anchors is not None:
             anchors = anchors[live]
@@ -193,6 +191,19 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
     if not pts:
         return np.zeros((0, 3)), np.zeros(0)
     return np.concatenate(pts), np.concatenate(vals)
+
+
+def _anchored_bound(tris: np.ndarray, anchors: np.ndarray) -> np.ndarray:
+    """``min_c max_k |corner k - anchor c|`` per triangle (``inf`` where every anchor is NaN)."""
+    out = np.full(len(tris), np.inf)
+    for c in range(3):
+        q = anchors[:, c]
+        far = np.zeros(len(tris))
+        for k in range(3):
+            d = tris[:, k] - q
+            np.maximum(far, np.einsum("ij,ij->i", d, d), out=far)
+        np.fmin(out, np.sqrt(far), out=out)  # NaN (no anchor) never wins
+    return out
 
 
 def covering_radius(tris: np.ndarray, e: np.ndarray | None = None) -> np.ndarray:
