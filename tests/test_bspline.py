@@ -50,6 +50,14 @@ def test_grid_evaluation_matches_pointwise():
     u, v = np.linspace(0, 1, 7), np.linspace(0, 2 * np.pi, 11)
     U, V = np.meshgrid(u, v, indexing="ij")
     np.testing.assert_allclose(S.evaluate_grid(u, v), S.evaluate(U, V), atol=1e-14)
+    # derivatives too, on a surface whose poles are not square (the grid's two matrix products
+    # against the point-by-point sum)
+    S = fit_surface(sphere(2.5).patches[0], tol=TOL).surface
+    assert S.poles.shape[0] != S.poles.shape[1]
+    u, v = np.linspace(0, 1, 13), np.linspace(0, 2 * np.pi, 29)
+    U, V = np.meshgrid(u, v, indexing="ij")
+    for du, dv in ((0, 0), (1, 0), (0, 1)):
+        np.testing.assert_allclose(S.evaluate_grid(u, v, du, dv), S.evaluate(U, V, du, dv), atol=1e-12)
 
 
 def test_refinement_reaches_tight_tolerance():
