@@ -77,7 +77,8 @@ def _basis_inside(t: np.ndarray, degree: int, x: np.ndarray, span: np.ndarray) -
     ``(t[span+r+1] - x) + (x - t[span+1-j+r])`` can vanish (one term is at least
     ``t[span+1] - t[span] > 0`` when the other is 0), so the same operations run unguarded, all
     ``r`` of one degree ``j`` at once on rows of a ``(degree + 1, len(x))`` table - the same
-    values, bit for bit, in a few array passes per degree."""
+    values (equal everywhere; a zero may keep a minus sign the guarded sum's ``0.0 +`` drops,
+    with a ``-0.0`` knot), in a few array passes per degree."""
     J = np.arange(degree + 1)[:, None]
     left = x - t[span + 1 - J]  # row j: x - t[span+1-j] (row 0 unused)
     right = t[span + J] - x  # row j: t[span+j] - x

@@ -37,11 +37,12 @@ from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepGProp import BRepGProp
 from OCP.BRepLib import BRepLib
 from OCP.GProp import GProp_GProps
+from OCP.TopAbs import TopAbs_Orientation
 from OCP.TopoDS import TopoDS_Shape, TopoDS_Solid
 
 from tabletcad.brep.revolved import RevolvedSurfaceData
 from tabletcad.brep.fit import PatchFunction, SurfaceFit, chain_breakpoints, fit_patches
-from tabletcad.brep.surface import BSplineSurfaceData
+from tabletcad.brep.surface import BSplineSurfaceData, volume_and_area
 from tabletcad.cad._occ import cast, explore, shape_type
 from tabletcad.cad.faces import knot_boundary_pcurves, make_face
 from tabletcad.errors import GeometryError
@@ -126,6 +127,17 @@ class TabletSolid:
             hit = mass_properties(self.shape, self.eps)
             object.__setattr__(self, "_mass", hit)
             self.timings["mass_properties"] = time.perf_counter() - t0
+        return hit
+
+    @property
+    def data_volume_area(self) -> tuple[float, float]:
+        """Signed volume (mm³, positive when the surfaces' ``S_u × S_v`` points outward) and area
+        (mm²) of the faces' own surface data by Gauss-Legendre
+        (:func:`~tabletcad.brep.surface.volume_and_area`), computed once."""
+        hit = self.__dict__.get("_data_volume_area")
+        if hit is None:
+            hit = volume_and_area(self.surfaces)
+            object.__setattr__(self, "_data_volume_area", hit)
         return hit
 
     @property
@@ -226,12 +238,20 @@ def check_solid(solid: TopoDS_Shape, what: str = "solid") -> None:
         raise GeometryError(f"{what} fails BRepCheck_Analyzer", solid)
 
 
-def _make_solid(shell, name: str, by_volume: bool = False) -> TopoDS_Solid:
+def _make_solid(shell, name: str, by_volume: bool = False, data_volume: float | None = None) -> TopoDS_Solid:
     maker = BRepBuilderAPI_MakeSolid(shell)
     if not maker.IsDone():
         raise GeometryError(f"BRepBuilderAPI_MakeSolid failed for {name}", shell)
     solid = cast(maker.Solid(), "Solid")
-    if by_volume:
+    if (data_volume is not None and math.isfinite(data_volume) and data_volume != 0.0
+            and all(f.Orientation() == TopAbs_Orientation.TopAbs_FORWARD for f in explore(shell, "Face"))):
+        # every face as made (sewing turned none), so the shell encloses the surfaces' own signed
+        # volume (Gauss-Legendre on their data, which the stage's check needs anyway): its sign says
+        # which side is inside, where BRepLib::OrientClosedSolid's point classification took 49 ms
+        # of the capsule's 0.47 s stage
+        if data_volume < 0.0:
+            solid = cast(solid.Reversed(), "Solid")
+    elif by_volume:
         # the sewn shell's faces are coherent, so the sign of its volume says which side is
         # inside: on faces of revolution OCC's default integration is exact and takes ~2 ms,
         # where BRepLib::OrientClosedSolid's point classification took 46 ms of a 60 ms solid
@@ -283,9 +303,11 @@ def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequenc
     # sewing may rebuild p-curves: make sure the boundary p-curves still carry the C0/C1
     # v knots that BRepGProp needs to integrate across them (see tabletcad.cad.faces)
     knot_boundary_pcurves(shell)
-    solid = _make_solid(shell, name, by_volume=all(isinstance(sd, RevolvedSurfaceData) for sd in surfaces))
+    revolved = all(isinstance(sd, RevolvedSurfaceData) for sd in surfaces)
+    va = None if revolved else volume_and_area(surfaces)
+    solid = _make_solid(shell, name, by_volume=revolved, data_volume=None if va is None else va[0])
     t2 = time.perf_counter()
-    return TabletSolid(
+    out = TabletSolid(
         name=name,
         shape=solid,
         faces=faces,
@@ -296,6 +318,9 @@ def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequenc
         eps=eps,
         timings={"faces": t1 - t0, "sew_and_check": t2 - t1},
     )
+    if va is not None:
+        object.__setattr__(out, "_data_volume_area", va)
+    return out
 
 
 def build_solid(
