@@ -118,3 +118,36 @@ def test_random_sizes(kind, r, h):
     ts = build_solid(s.patches, TOL)
     assert abs(ts.volume - s.volume) <= ts.max_fit_deviation * s.area
     assert math.isclose(ts.area, s.area, rel_tol=1e-4)
+
+
+@pytest.mark.parametrize("turn", [None, 0, 1])
+def test_solid_is_outward_whichever_way_its_faces_come(turn, monkeypatch):
+    """The solid is turned outward by the sign of its faces' own Gauss-Legendre volume when
+    sewing kept every face as made (no point classification), and by OCC's classification
+    (``BRepLib::OrientClosedSolid``) when a face comes turned: the cylinder's faces enclose a
+    negative volume as parametrised, and OCC's volume of the result is positive and equals the
+    closed form (to the fit's deviation times the area) either way."""
+    import tabletcad.cad.solid as solid_module
+    from tabletcad.cad._occ import cast
+
+    calls, orient = [], solid_module.BRepLib.OrientClosedSolid_s
+
+    class Spy:
+        @staticmethod
+        def OrientClosedSolid_s(shape):
+            calls.append(shape)
+            return orient(shape)
+
+    ts = build_solid(cylinder(radius=2.0, height=3.0).patches)
+    faces = tuple(cast(f.Reversed(), "Face") if k == turn else f for k, f in enumerate(ts.faces))
+    monkeypatch.setattr(solid_module, "BRepLib", Spy)
+    s = solid_module._solid_from_faces(faces, [f"f{k}" for k in range(len(faces))], ts.surfaces, ts.patch_names,
+                                       ts.fits, ts.sew_tolerance, 1e-9, "cylinder", 0.0)
+    # the first face leads the sewing: turned, the shell comes turned against the data (classified);
+    # a later face turned is turned back by the sewing (the data's sign serves)
+    assert len(calls) == (1 if turn == 0 else 0)
+    assert s.data_volume_area[0] < 0.0  # the data's own sign: the solid had to be turned
+    v = mass_properties(s.shape, 1e-9).volume
+    assert v > 0.0 and abs(v + s.data_volume_area[0]) <= 1e-8 * v  # the faces' own volume, outward
+    area = 2 * math.pi * 2.0 * 2.0 + 2 * math.pi * 2.0 * 3.0
+    assert abs(v - math.pi * 4.0 * 3.0) <= ts.max_fit_deviation * area  # the closed form, to the fit

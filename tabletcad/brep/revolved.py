@@ -240,14 +240,12 @@ def _curvature_samples(s: RevolvedSurfaceData, samples: int = 513) -> tuple[np.n
     return u, seg, kappa
 
 
-def _profile_nodes(s: RevolvedSurfaceData, deflection: float, angle: float, density: float,
-                   samples: int = 513, curvature=None) -> np.ndarray:
+def _profile_nodes(s: RevolvedSurfaceData, curvature, deflection: float, angle: float, density: float) -> np.ndarray:
     """Parameters ``u`` of the mesh nodes on one profile: both ends plus nodes equidistributed in
     ``max(sqrt(κ / (8 δ)), κ / angle)`` per unit length (``δ`` = half the deflection; κ the
-    curvature measured on ``samples`` points), times ``density``.  ``curvature``: the profile's
-    :func:`_curvature_samples`, when already measured."""
+    curvature, ``curvature`` the profile's :func:`_curvature_samples`), times ``density``."""
     lo, hi = s.u_range
-    u, seg, kappa = curvature if curvature is not None else _curvature_samples(s, samples)
+    u, seg, kappa = curvature
     rate = np.maximum(np.sqrt(kappa / (8.0 * 0.5 * deflection)), kappa / angle) * density
     count = np.concatenate([[0.0], np.cumsum(rate * seg)])
     n = max(1, int(math.ceil(count[-1])))
@@ -282,7 +280,7 @@ def revolved_mesh(surfaces, deflection: float, angle: float, *, max_rounds: int 
     for _ in range(max_rounds + 1):
         P, bands = [], []
         for f, s in enumerate(surfaces):
-            u = _profile_nodes(s, deflection, angle, density, curvature=curvature[f])
+            u = _profile_nodes(s, curvature[f], deflection, angle, density)
             pts = s.profile(u)
             start = len(P) - 1 if P else None  # the previous face's last node is this face's first
             if start is None:
