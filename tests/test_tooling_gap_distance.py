@@ -219,3 +219,34 @@ def test_anchored_bound_refines_fewer_points_along_a_ridge():
                               anchors=S[i0].reshape(-1, 3, 3))
     assert dp.max() == pytest.approx(0.1, abs=0.004 / np.sqrt(3)) and da.max() == pytest.approx(0.1, abs=0.004 / np.sqrt(3))
     assert len(anch) < 0.7 * len(plain)
+
+
+def test_faces_that_fill_their_box_keep_the_same_samples_unclassified(monkeypatch):
+    """``face_samples`` keeps the whole grid of a face that is its entire (u, v) box without
+    classifying each point: on a tablet's B-spline faces the points are the classified ones to
+    the last bit; a face with a hole, or a trimmed one, is never taken for a whole box."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
+    from OCP.BRepTools import BRepTools
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+
+    import tabletcad.tooling.interference as I
+    from tabletcad.cad._occ import explore
+    from tabletcad.cad.tablet_solid import tablet_solid
+    from tabletcad.families import FAMILIES
+
+    shape = tablet_solid(FAMILIES["concave_round"].build(diameter=8.0, band=2.0, cup_depth=0.8), revolved=False).shape
+    assert all(I._fills_uv_box(f, *BRepTools.UVBounds_s(f)) for f in explore(shape, "Face"))
+    fast = I.face_samples(shape, spacing=0.05)
+    monkeypatch.setattr(I, "_fills_uv_box", lambda *a: False)
+    assert np.array_equal(fast, I.face_samples(shape, spacing=0.05))
+    monkeypatch.undo()
+    plate = BRepPrimAPI_MakeBox(4.0, 4.0, 1.0).Shape()
+    holed = BRepAlgoAPI_Cut(plate, BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(2, 2, -1), gp_Dir(0, 0, 1)), 0.5, 3.0).Shape()).Shape()
+    whole = [I._fills_uv_box(f, *BRepTools.UVBounds_s(f)) for f in explore(plate, "Face")]
+    assert all(whole) and len(whole) == 6
+    holed_faces = explore(holed, "Face")
+    flags = [I._fills_uv_box(f, *BRepTools.UVBounds_s(f)) for f in holed_faces]
+    assert flags.count(False) >= 2  # the top and bottom with their holes (and the bore, not a line-bounded box)
+    P = I.face_samples(holed, spacing=0.1)
+    assert np.all(np.hypot(P[:, 0] - 2.0, P[:, 1] - 2.0) >= 0.5 - 1e-9)  # no sample inside the hole
