@@ -109,8 +109,41 @@ def test_removed_and_added_volumes(built):
     for v in (removed, added):
         assert D * AREA < v < D * AREA / math.cos(tilt)
         assert v > 1.02 * D * AREA  # 2.4 % more than the axial layer on this slope
-    assert -vol["axial", "deboss"] == pytest.approx(D * AREA, rel=1e-6)
-    assert vol["axial", "emboss"] == pytest.approx(D * AREA, rel=1e-6)
+    # axial: d·A up to what the Boolean's own trimming allows - where a face's p-curve leaves the 3-D
+    # edge by delta, the faces bounding the volume miss each other by a strip of that width, whose
+    # flux (x · n) / 3 about the origin is at most delta |x| / 3 per unit length of edge (measured:
+    # delta 2e-7 mm, the difference from d·A 5e-7 mm^3 = 1.2e-6 relative on the rational B-spline
+    # cup, 6e-8 mm^3 on the earlier B-spline fit of it)
+    for mode, sign in (("deboss", -1.0), ("emboss", 1.0)):
+        slack = _trim_flux_bound(built["axial", mode].parts["tablet"])
+        assert 0.0 < slack < 1e-5 * D * AREA
+        assert abs(sign * vol["axial", mode] - D * AREA) <= slack
+
+
+def _trim_flux_bound(shape, n=64):
+    """``sum over edges of max |S(p(t)) - C(t)| * length * max |x| / 3`` (mm^3) for the edges over the
+    bar: the largest change of the divergence-theorem volume the faces' mismatch along them allows."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_Surface
+
+    from tabletcad.cad._occ import explore
+
+    total = 0.0
+    for face in explore(shape, "Face"):
+        surface = BRepAdaptor_Surface(face)
+        for edge in explore(face, "Edge"):
+            if BRep_Tool.Degenerated_s(edge):
+                continue
+            c, pc = BRepAdaptor_Curve(edge), BRepAdaptor_Curve2d(edge, face)
+            ts = np.linspace(c.FirstParameter(), c.LastParameter(), n + 1)
+            P = np.array([c.Value(t).Coord() for t in ts])
+            if not (np.all((P[:, 0] >= X0 - 0.01) & (P[:, 0] <= X1 + 0.01)) and np.all(np.abs(P[:, 1]) <= Y + 0.01)):
+                continue
+            S = np.array([surface.Value(*pc.Value(t).Coord()).Coord() for t in ts])
+            delta = np.linalg.norm(S - P, axis=1).max()
+            length = np.linalg.norm(np.diff(P, axis=0), axis=1).sum()
+            total += delta * length * np.linalg.norm(P, axis=1).max() / 3.0
+    return total
 
 
 def test_normal_projection_reports_and_checks(built):

@@ -228,7 +228,7 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
 def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any], revolved: bool | None = None):
     """Write ``tablet.step``, ``tablet.stl`` and ``tablet.glb`` into ``out`` and extend ``report``.
 
-    ``revolved=False`` gives a tablet of revolution B-spline faces (the tooling needs them).
+    ``revolved=False`` gives a tablet of revolution B-spline faces fitted to its PDE surfaces.
 
     Returns the ``TopoDS_Shape`` written (the solid, or its cut-away), or None when no solid
     is built (a cut-away of a kind the CAD layer does not make: the report says why).

@@ -82,10 +82,9 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
             if cad:
                 from tabletcad.cad.stage import cad_stage
 
-                # a tooling build cuts scores and letters into the solid: B-spline faces for it
+                # a tooling build converts faces of revolution to rational B-splines
                 # (see tabletcad.tooling.outline.tablet_frame)
-                shape = cad_stage(tablet=tablet, out=staging, report=report,
-                                  revolved=False if tooling is not None else None)
+                shape = cad_stage(tablet=tablet, out=staging, report=report)
                 bar.update()
                 if tooling is not None:
                     from tabletcad.tooling.stage import tooling_stage
