@@ -250,3 +250,39 @@ def test_faces_that_fill_their_box_keep_the_same_samples_unclassified(monkeypatc
     assert flags.count(False) >= 2  # the top and bottom with their holes (and the bore, not a line-bounded box)
     P = I.face_samples(holed, spacing=0.1)
     assert np.all(np.hypot(P[:, 0] - 2.0, P[:, 1] - 2.0) >= 0.5 - 1e-9)  # no sample inside the hole
+
+
+def test_trimmed_faces_classified_by_their_polygons_keep_the_classifier_samples(monkeypatch):
+    """``face_samples`` of trimmed faces decides points away from the wires by the even-odd rule on
+    the wires' (u, v) polygons and asks ``BRepTopAdaptor_FClass2d`` only near them: on a debossed,
+    scored tablet (letter floors and walls, a cup with holes, a periodic cup cut by a score) the
+    samples are the classifier's to the last bit; a polygon with its parity flipped fails it."""
+    from pathlib import Path
+
+    import tabletcad.tooling.interference as I
+    from tabletcad.cad._occ import explore
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.toolset import make_tooling
+
+    d = Design.from_toml(Path(__file__).resolve().parents[1] / "samples" / "tooling" / "concave_round_bisect.toml")
+    shape = make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False).parts["tablet"]
+    fast = I.face_samples(shape, spacing=0.02)
+    polygons = I._polygon_classes
+    classes = [polygons(f, np.linspace(0, 1, 5), np.linspace(0, 1, 5), 0.01) for f in explore(shape, "Face")[:1]]
+    assert classes and classes[0][0].shape == (5, 5)
+    asked = []
+
+    def every_point_near(face, us, vs, margin):
+        asked.append(len(us) * len(vs))
+        return np.zeros((len(us), len(vs)), dtype=bool), np.ones((len(us), len(vs)), dtype=bool)
+
+    monkeypatch.setattr(I, "_polygon_classes", every_point_near)
+    slow = I.face_samples(shape, spacing=0.02)
+    assert len(asked) >= 10 and np.array_equal(fast, slow)
+
+    def flipped(face, us, vs, margin):
+        inside, near = polygons(face, us, vs, margin)
+        return ~inside, near
+
+    monkeypatch.setattr(I, "_polygon_classes", flipped)
+    assert not np.array_equal(I.face_samples(shape, spacing=0.02), slow)

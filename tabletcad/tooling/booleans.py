@@ -47,6 +47,11 @@ TIMER = {"occ_boolean_s": 0.0, "manifold_s": 0.0, "occ_booleans": 0, "manifold_b
 #: meshes, manifolds, volumes and areas of the shapes a build asks about more than once
 CACHE = ShapeCache()
 
+#: relative accuracy of the areas that only scale the manifold3d bounds (``deflection x area``): OCC's
+#: adaptive integration to 1e-3 came within 1e-7 of eps = 1e-6 on every shape of the concave round
+#: sample's tooling, at a third of the time (0.5 -> 0.17 s over the build)
+BOUND_AREA_EPS = 1e-3
+
 
 def _list(*shapes: TopoDS_Shape):
     lst = _ShapeList()
@@ -317,7 +322,7 @@ def checked_boolean(
     mr = manifold_op(op, ma, mb)
     mva, mvr = manifold_volume(ma), manifold_volume(mr)
     mesh_change = {"cut": mva - mvr, "fuse": mvr - mva, "common": mvr}[op]
-    bound = deflection * area(b)
+    bound = deflection * area(b, BOUND_AREA_EPS)
     diff = abs(occ_change - mesh_change)
     chk = BooleanCheck(what, op, occ_change, mesh_change, diff, diff / max(abs(occ_change), 1e-300), bound,
                        deflection, True, diff <= bound)

@@ -28,7 +28,8 @@ from scipy.spatial import cKDTree
 
 from tabletcad.cad._occ import explore
 from tabletcad.geometry.tablet import coordinate_range
-from tabletcad.tooling.booleans import area, mesh_arrays, manifold_op, manifold_volume, raw_boolean, to_manifold, volume
+from tabletcad.tooling.booleans import (BOUND_AREA_EPS, area, mesh_arrays, manifold_op, manifold_volume, raw_boolean, to_manifold,
+                                        volume)
 from tabletcad.tooling.die import MIN_BORE_OFFSET_MM
 
 __all__ = ["interference", "MeshDistance", "mesh_distance", "largest_inside", "ExactDistance"]
@@ -390,12 +391,100 @@ def face_samples(shape, spacing: float = 0.05, max_per_face: int = 2500) -> np.n
         if _fills_uv_box(face, u0, u1, v0, v1):  # every grid point lies inside the face or on its edges
             out.extend(surf.Value(u, v).Coord() for u in us for v in vs)
             continue
-        cls = BRepTopAdaptor_FClass2d(face, 1e-9)
-        for u in us:
-            for v in vs:
-                if cls.Perform(gp_Pnt2d(u, v)) in keep_states:
-                    out.append(surf.Value(u, v).Coord())
+        U, V = (a.ravel() for a in np.meshgrid(us, vs, indexing="ij"))
+        # the face's wires as (u, v) polygons decide every point farther from them than a twentieth of
+        # the grid's step; nearer ones (and every point of a face whose polygons cannot be made) go to
+        # the classifier
+        margin = 0.05 * min((u1 - u0) / (nu - 1), (v1 - v0) / (nv - 1))
+        inside, near = _polygon_classes(face, us, vs, margin)
+        cls = None
+        for u, v, keep, ask in zip(U.tolist(), V.tolist(), inside.ravel().tolist(), near.ravel().tolist()):
+            if ask:
+                cls = cls or BRepTopAdaptor_FClass2d(face, 1e-9)
+                keep = cls.Perform(gp_Pnt2d(u, v)) in keep_states
+            if keep:
+                out.append(surf.Value(u, v).Coord())
     return np.asarray(out, dtype=float).reshape(-1, 3)
+
+
+def _wire_polygons(face, tol: float, max_points: int = 4097) -> list[np.ndarray] | None:
+    """Each wire of ``face`` as a closed ``(u, v)`` polygon (m, 2) through its edges' p-curves in
+    wire order, every edge sampled until no chord leaves its p-curve by more than ``tol`` (checked at
+    the chords' midpoints); None when an edge needs more than ``max_points``."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+    from OCP.BRepTools import BRepTools_WireExplorer
+    from OCP.TopAbs import TopAbs_Orientation
+
+    polygons = []
+    for wire in explore(face, "Wire"):
+        pts = []
+        ex = BRepTools_WireExplorer(wire, face)
+        while ex.More():
+            edge = ex.Current()
+            c = BRepAdaptor_Curve2d(edge, face)
+            a, b = c.FirstParameter(), c.LastParameter()
+            n = 9
+            while True:
+                t = np.linspace(a, b, 2 * n - 1)
+                P = np.array([c.Value(x).Coord() for x in t.tolist()])
+                chord = 0.5 * (P[:-2:2] + P[2::2])
+                if np.max(np.linalg.norm(P[1::2] - chord, axis=1), initial=0.0) <= tol:
+                    break
+                if 2 * n - 1 > max_points:
+                    return None
+                n = 2 * n - 1
+            if edge.Orientation() == TopAbs_Orientation.TopAbs_REVERSED:
+                P = P[::-1]
+            pts.append(P)
+            ex.Next()
+        if not pts:
+            return None
+        poly = np.concatenate(pts)
+        polygons.append(np.vstack([poly, poly[:1]]))
+    return polygons or None
+
+
+def _polygon_classes(face, us, vs, margin: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(inside, near)`` masks (nu, nv) of the grid ``us x vs`` on ``face``: inside by the even-odd rule
+    on the wires' polygons (:func:`_wire_polygons`, within ``margin / 4`` of the p-curves: a ray along
+    ``+u`` on each grid line ``v = const`` counts the crossings), near (a superset) where a grid point
+    lies within ``margin`` of a polygon's segment's box, where the polygon may disagree with the
+    face; every point near when the polygons cannot be made."""
+    us, vs = np.asarray(us, dtype=float), np.asarray(vs, dtype=float)
+    shape = (len(us), len(vs))
+    polygons = _wire_polygons(face, 0.25 * margin) if margin > 0.0 else None
+    if polygons is None:
+        return np.zeros(shape, dtype=bool), np.ones(shape, dtype=bool)
+    du, dv = us[1] - us[0], vs[1] - vs[0]
+    # segments no longer than four grid steps, so that their boxes stay close to them
+    A, B = [], []
+    for poly in polygons:
+        a, b = poly[:-1], poly[1:]
+        k = np.maximum(1, np.ceil(np.max(np.abs(b - a) / (4.0 * np.array([du, dv])), axis=1))).astype(int)
+        t = np.concatenate([np.arange(n) / n for n in k])
+        i = np.repeat(np.arange(len(a)), k)
+        A.append(a[i] + t[:, None] * (b[i] - a[i]))
+        B.append(a[i] + np.minimum(t + 1.0 / k[i], 1.0)[:, None] * (b[i] - a[i]))
+    A, B = np.concatenate(A), np.concatenate(B)
+    near = np.zeros(shape, dtype=bool)
+    lo, hi = np.minimum(A, B) - margin, np.maximum(A, B) + margin
+    i0 = np.clip(np.ceil((lo[:, 0] - us[0]) / du), 0, shape[0]).astype(int)
+    i1 = np.clip(np.floor((hi[:, 0] - us[0]) / du) + 1, 0, shape[0]).astype(int)
+    j0 = np.clip(np.ceil((lo[:, 1] - vs[0]) / dv), 0, shape[1]).astype(int)
+    j1 = np.clip(np.floor((hi[:, 1] - vs[0]) / dv) + 1, 0, shape[1]).astype(int)
+    for a0, a1, b0, b1 in zip(i0.tolist(), i1.tolist(), j0.tolist(), j1.tolist()):
+        if a0 < a1 and b0 < b1:
+            near[a0:a1, b0:b1] = True
+    inside = np.zeros(shape, dtype=bool)
+    ay, by = A[:, 1], B[:, 1]
+    for j, v in enumerate(vs.tolist()):
+        c = (ay > v) != (by > v)
+        if not c.any():
+            continue
+        ax, bx, cy, dy = A[c, 0], B[c, 0], ay[c], by[c]
+        x = np.sort(ax + (v - cy) * (bx - ax) / (dy - cy))
+        inside[:, j] = (len(x) - np.searchsorted(x, us, side="right")) % 2 == 1
+    return inside, near
 
 
 def _fills_uv_box(face, u0: float, u1: float, v0: float, v1: float) -> bool:
@@ -439,7 +528,7 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
     t0 = time.perf_counter()
     shapes = {"tablet": tablet, **parts}
     manifolds = {k: to_manifold(s, deflection) for k, s in shapes.items()}
-    areas = {k: area(s, 1e-6) for k, s in shapes.items()}
+    areas = {k: area(s, BOUND_AREA_EPS) for k, s in shapes.items()}  # for the manifold3d bounds only
     pairs = []
     for a, b in itertools.combinations(shapes, 2):
         entry = dict(parts=[a, b])
