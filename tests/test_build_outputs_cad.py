@@ -56,7 +56,9 @@ def test_tooling_build_then_cutaway_then_plain_rebuild(tmp_path, capsys):
     assert fin["volume"] == pytest.approx(rep["tooling"]["tablet"]["volume_mm3"], rel=1e-6)
     assert plain["volume"] == pytest.approx(rep["volume_mm3"], rel=1e-6)
     removed = rep["tooling"]["tablet"]["volume_plain_mm3"] - rep["tooling"]["tablet"]["volume_mm3"]
-    assert plain["volume"] - fin["volume"] == pytest.approx(removed, rel=1e-5) and removed > 0.05
+    # tablet_plain.step has faces of revolution: OCC's adaptive integration is 3e-7 low on them, its
+    # non-adaptive one splits at the profile's knots and is exact (README, "CAD solids")
+    assert plain["volume_default"] - fin["volume"] == pytest.approx(removed, rel=1e-5) and removed > 0.05
     assert fin["n_faces"] > plain["n_faces"]
 
     (out / "notes.txt").write_text("mine")

@@ -548,23 +548,12 @@ def _footprint(shape, figure, top: bool) -> tuple[list[float], list[float]]:
 
 def _offset_base(frame: TabletFrame):
     """The solid whose normal offsets are the floors (deboss) and tops (emboss): the tablet's own,
-    except when its faces are the rational B-spline forms of faces of revolution
-    (:func:`~tabletcad.tooling.outline.tablet_frame`), whose offsets OCC approximates at degree 15 with
-    46 poles around (a 10 mm concave round's cup; its letters' Booleans and volumes then took 30 %
-    longer): the B-spline fit of the same PDE surfaces then (within the fit tolerance of them), whose
-    offsets have 6 x 15 poles."""
-    from OCP.BRep import BRep_Tool
-    from OCP.Geom import Geom_BSplineSurface
-
-    def rational(f):
-        s = BRep_Tool.Surface_s(f)
-        return isinstance(s, Geom_BSplineSurface) and (s.IsURational() or s.IsVRational())
-
-    if not any(rational(f) for f in explore(frame.shape, "Face")):
-        return frame.shape
-    from tabletcad.cad.tablet_solid import tablet_solid
-
-    return tablet_solid(frame.tablet, revolved=False).shape
+    except for a tablet of revolution, whose faces of revolution (``frame.revolved``) are offset rather
+    than their rational B-spline form (``frame.shape``, the same surfaces), because OCC approximates
+    the offsets of the rational faces at degree 15 with 46 poles around (a 10 mm concave round's cup;
+    its letters' Booleans and volumes then took 30 % longer), those of the faces of revolution with
+    15 x 6 poles."""
+    return frame.revolved if frame.revolved is not None else frame.shape
 
 
 class _Offsets:

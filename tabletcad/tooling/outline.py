@@ -50,7 +50,8 @@ class TabletFrame:
     tablet's lowest and highest points, ``cup_depth`` the top cup's depth above
     the band (``z_max - band_z[1]``; the bottom one is ``band_z[0] - z_min``),
     ``outline`` a closed OCC wire at ``z = 0``, ``shape`` the tablet solid;
-    ``band_bulge`` how far the band's PDE surface leaves the outline (mm).
+    ``band_bulge`` how far the band's PDE surface leaves the outline (mm); ``revolved`` the solid with
+    faces of revolution whose rational B-spline form ``shape`` is (None when it had none).
     """
 
     tablet: Tablet
@@ -66,6 +67,7 @@ class TabletFrame:
     length: float
     width: float
     info: dict = field(default_factory=dict)
+    revolved: TopoDS_Shape | None = None
 
     @property
     def band(self) -> float:
@@ -265,11 +267,12 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
         from tabletcad.cad.tablet_solid import tablet_solid
 
         shape = tablet_solid(tablet).shape
+    revolved = None
     if _has_faces_of_revolution(shape):
         # the tooling cuts scores and letters into the tablet: it works on B-spline faces, since a
         # Boolean-trimmed face of revolution written to STEP read back invalid (BRepCheck_Analyzer,
         # OCCT 7.9: the concave round bisect sample's score)
-        shape = _rational_bspline_solid(shape)
+        revolved, shape = shape, _rational_bspline_solid(shape)
     lo, hi = tablet.bounds()
     info = dict(getattr(nom, "info", {}) or {})
     round_radius = None
@@ -297,4 +300,5 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
         land = 0.0
     bulge = found.bulge if found is not None else 0.0
     return TabletFrame(tablet, shape, (float(band_z[0]), float(band_z[1])), bulge, float(lo[2]), float(hi[2]), wire, kind,
-                       round_radius, None if land is None else float(land), float(hi[0] - lo[0]), float(hi[1] - lo[1]), info)
+                       round_radius, None if land is None else float(land), float(hi[0] - lo[0]), float(hi[1] - lo[1]), info,
+                       revolved)
