@@ -395,7 +395,7 @@ def face_samples(shape, spacing: float = 0.05, max_per_face: int = 2500) -> np.n
         # the face's wires as (u, v) polygons decide every point farther from them than a twentieth of
         # the grid's step; nearer ones (and every point of a face whose polygons cannot be made) go to
         # the classifier
-        margin = 0.05 * min((u1 - u0) / (nu - 1), (v1 - v0) / (nv - 1))
+        margin = 0.05 * min((u1 - u0) / (nu - 1), (v1 - v0) / (nv - 1)) if min(nu, nv) > 1 else 0.0
         inside, near = _polygon_classes(face, us, vs, margin)
         cls = None
         for u, v, keep, ask in zip(U.tolist(), V.tolist(), inside.ravel().tolist(), near.ravel().tolist()):
@@ -410,18 +410,29 @@ def face_samples(shape, spacing: float = 0.05, max_per_face: int = 2500) -> np.n
 def _wire_polygons(face, tol: float, max_points: int = 4097) -> list[np.ndarray] | None:
     """Each wire of ``face`` as a closed ``(u, v)`` polygon (m, 2) through its edges' p-curves in
     wire order, every edge sampled until no chord leaves its p-curve by more than ``tol`` (checked at
-    the chords' midpoints); None when an edge needs more than ``max_points``."""
+    the chords' midpoints); None when an edge needs more than ``max_points``, has no p-curve, or the
+    wire explorer does not visit every edge of a wire (it stops at a wire not closed in 2-D; the
+    classifier then falls back on its own)."""
     from OCP.BRepAdaptor import BRepAdaptor_Curve2d
     from OCP.BRepTools import BRepTools_WireExplorer
     from OCP.TopAbs import TopAbs_Orientation
+    from OCP.TopoDS import TopoDS_Iterator
 
+    bounding = (TopAbs_Orientation.TopAbs_FORWARD, TopAbs_Orientation.TopAbs_REVERSED)
     polygons = []
     for wire in explore(face, "Wire"):
+        n_edges, it = 0, TopoDS_Iterator(wire)
+        while it.More():
+            n_edges += it.Value().Orientation() in bounding
+            it.Next()
         pts = []
         ex = BRepTools_WireExplorer(wire, face)
         while ex.More():
             edge = ex.Current()
-            c = BRepAdaptor_Curve2d(edge, face)
+            try:
+                c = BRepAdaptor_Curve2d(edge, face)
+            except Exception:  # Standard_Failure: no p-curve on this face
+                return None
             a, b = c.FirstParameter(), c.LastParameter()
             n = 9
             while True:
@@ -437,7 +448,7 @@ def _wire_polygons(face, tol: float, max_points: int = 4097) -> list[np.ndarray]
                 P = P[::-1]
             pts.append(P)
             ex.Next()
-        if not pts:
+        if not pts or len(pts) != n_edges:
             return None
         poly = np.concatenate(pts)
         polygons.append(np.vstack([poly, poly[:1]]))
@@ -461,10 +472,11 @@ def _polygon_classes(face, us, vs, margin: float) -> tuple[np.ndarray, np.ndarra
     for poly in polygons:
         a, b = poly[:-1], poly[1:]
         k = np.maximum(1, np.ceil(np.max(np.abs(b - a) / (4.0 * np.array([du, dv])), axis=1))).astype(int)
-        t = np.concatenate([np.arange(n) / n for n in k])
+        j = np.concatenate([np.arange(n) for n in k])
         i = np.repeat(np.arange(len(a)), k)
-        A.append(a[i] + t[:, None] * (b[i] - a[i]))
-        B.append(a[i] + np.minimum(t + 1.0 / k[i], 1.0)[:, None] * (b[i] - a[i]))
+        A.append(a[i] + (j / k[i])[:, None] * (b[i] - a[i]))
+        last = (j == k[i] - 1)[:, None]  # the last piece ends exactly at b: no rounding gap at a vertex
+        B.append(np.where(last, b[i], a[i] + ((j + 1) / k[i])[:, None] * (b[i] - a[i])))
     A, B = np.concatenate(A), np.concatenate(B)
     near = np.zeros(shape, dtype=bool)
     lo, hi = np.minimum(A, B) - margin, np.maximum(A, B) + margin
