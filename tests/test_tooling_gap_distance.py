@@ -260,7 +260,6 @@ def test_trimmed_faces_classified_by_their_polygons_keep_the_classifier_samples(
     from pathlib import Path
 
     import tabletcad.tooling.interference as I
-    from tabletcad.cad._occ import explore
     from tabletcad.pipeline.design import Design
     from tabletcad.tooling.toolset import make_tooling
 
@@ -268,8 +267,6 @@ def test_trimmed_faces_classified_by_their_polygons_keep_the_classifier_samples(
     shape = make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False).parts["tablet"]
     fast = I.face_samples(shape, spacing=0.02)
     polygons = I._polygon_classes
-    classes = [polygons(f, np.linspace(0, 1, 5), np.linspace(0, 1, 5), 0.01) for f in explore(shape, "Face")[:1]]
-    assert classes and classes[0][0].shape == (5, 5)
     asked = []
 
     def every_point_near(face, us, vs, margin):

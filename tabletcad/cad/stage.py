@@ -33,16 +33,15 @@ MESH_ANGULAR_RAD = DEFAULT.mesh_angle
 AGREEMENT_REL = DEFAULT.brep_agreement
 
 
-def check_tablet_solid(tablet: Tablet, report: dict[str, Any] | None = None, *, revolved: bool | None = None):
+def check_tablet_solid(tablet: Tablet, report: dict[str, Any] | None = None):
     """Build the solid and its mesh and cross-check them; return ``(solid, mesh, sections)``.
 
-    ``revolved``: faces of revolution for a tablet of revolution (None: whenever it is one; see
-    :func:`~tabletcad.cad.tablet_solid.tablet_solid`)."""
+    A tablet of revolution gets faces of revolution (:func:`~tabletcad.cad.tablet_solid.tablet_solid`)."""
     from tabletcad.cad.mesh import tessellate_solid
     from tabletcad.cad.tablet_solid import tablet_solid
 
     t0 = time.perf_counter()
-    solid = tablet_solid(tablet, revolved=revolved)
+    solid = tablet_solid(tablet)
     # the B-rep's own surfaces (poles, knots) integrated by Gauss-Legendre: exact for the volume,
     # within ~1e-9 for the area, and 5-25x cheaper than OCC's adaptive integration of the faces
     volume, area = solid.data_volume_area
@@ -225,10 +224,8 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
     return shape, mesh, sections
 
 
-def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any], revolved: bool | None = None):
+def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any]):
     """Write ``tablet.step``, ``tablet.stl`` and ``tablet.glb`` into ``out`` and extend ``report``.
-
-    ``revolved=False`` gives a tablet of revolution B-spline faces fitted to its PDE surfaces.
 
     Returns the ``TopoDS_Shape`` written (the solid, or its cut-away), or None when no solid
     is built (a cut-away of a kind the CAD layer does not make: the report says why).
@@ -243,7 +240,7 @@ def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any], revolved: bo
             return None
         shape, mesh, sections = cut
     else:
-        solid, mesh, sections = check_tablet_solid(tablet, report, revolved=revolved)
+        solid, mesh, sections = check_tablet_solid(tablet, report)
         shape = solid.shape
     t0 = time.perf_counter()
     export(shape, out / "tablet.step", name=tablet.name)
