@@ -52,10 +52,16 @@ def row_pieces(data: BSplineSurfaceData, row: int, tol: float = 1e-7):
     if len(cuts) < 3:
         return None
     t = np.linspace(0.0, 1.0, 17)
+    spans = list(zip(cuts[:-1], cuts[1:]))
+    v = np.concatenate([a + (b - a) * t for a, b in spans])
+    clamped = data.u_mults[0 if row == 0 else -1] == data.u_degree + 1
+    if clamped:  # the row is the curve of the boundary pole row: one product for every piece
+        rows = data.collocation("v", v) @ np.asarray(data.poles[0 if row == 0 else -1])
+    else:
+        rows = np.asarray(data.evaluate(np.full_like(v, u_row), v), dtype=float)
     pts, pieces = [], []
-    for a, b in zip(cuts[:-1], cuts[1:]):
-        v = a + (b - a) * t
-        p = np.asarray(data.evaluate(np.full_like(v, u_row), v), dtype=float)
+    for k, (a, b) in enumerate(spans):
+        p = rows[k * t.size:(k + 1) * t.size]
         pts.append(p)
         pieces.append((a, b, "point" if float(np.max(np.linalg.norm(p - p[0], axis=-1))) <= tol else "run"))
     return pieces, pts, u_row

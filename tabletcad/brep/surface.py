@@ -144,6 +144,17 @@ class BSplineSurfaceData:
         Bv = self.collocation("v", v, dv)
         return np.einsum("ai,ijk,bj->abk", Bu, self.poles, Bv, optimize=True)
 
+    def grid_components(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Points, ``S_u`` and ``S_v`` on the tensor grid ``u x v``, components first: each
+        ``(3, len(u), len(v))``, C-contiguous.  One collocation matrix per direction and order,
+        and two matrix products per component (``B_u P_c B_v^T``)."""
+        u, v = np.asarray(u, dtype=float).ravel(), np.asarray(v, dtype=float).ravel()
+        Bu, Bu1 = self.collocation("u", u), self.collocation("u", u, 1)
+        BvT, Bv1T = self.collocation("v", v).T, self.collocation("v", v, 1).T
+        P = np.ascontiguousarray(self.poles.transpose(2, 0, 1))  # (3, u poles, v poles)
+        A, A1 = Bu @ P, Bu1 @ P  # (3, len(u), v poles)
+        return A @ BvT, A1 @ BvT, A @ Bv1T
+
     def collocation(self, which: str, x: np.ndarray, order: int = 0) -> np.ndarray:
         """Dense matrix ``B[a, i]`` = value (``order`` 0) or first derivative (``order`` 1) of the
         B-spline attached to pole ``i`` at ``x[a]``."""
@@ -291,8 +302,8 @@ def volume_and_area(surfaces: Sequence) -> tuple[float, float]:
             continue
         (uq, uw), (vq, vw) = (_span_rule(k, max(int(math.ceil(3 * d / 2)) + 1, d + 4))
                               for k, d in ((s.u_knots, s.u_degree), (s.v_knots, s.v_degree)))
-        n = cross(s.evaluate_grid(uq, vq, du=1), s.evaluate_grid(uq, vq, dv=1))
-        W = np.outer(uw, vw)
-        volume += float(np.sum(W * np.einsum("...k,...k->...", s.evaluate_grid(uq, vq), n))) / 3.0
-        area += float(np.sum(W * np.linalg.norm(n, axis=-1)))
+        (x, y, z), (xu, yu, zu), (xv, yv, zv) = s.grid_components(uq, vq)
+        nx, ny, nz = yu * zv - zu * yv, zu * xv - xu * zv, xu * yv - yu * xv
+        volume += float(uw @ (x * nx + y * ny + z * nz) @ vw) / 3.0
+        area += float(uw @ np.sqrt(nx * nx + ny * ny + nz * nz) @ vw)
     return volume, area

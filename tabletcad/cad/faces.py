@@ -63,18 +63,18 @@ __all__ = ["knot_boundary_pcurves", "make_face", "make_geom_surface", "make_revo
 
 
 def _real_array(values) -> Array1OfReal:
-    values = np.asarray(values, dtype=float)
-    arr = Array1OfReal(1, values.size)
+    values = np.asarray(values, dtype=float).tolist()
+    arr = Array1OfReal(1, len(values))
     for i, x in enumerate(values, start=1):
-        arr.SetValue(i, float(x))
+        arr.SetValue(i, x)
     return arr
 
 
 def _int_array(values) -> Array1OfInteger:
-    values = np.asarray(values, dtype=int)
-    arr = Array1OfInteger(1, values.size)
+    values = np.asarray(values, dtype=int).tolist()
+    arr = Array1OfInteger(1, len(values))
     for i, x in enumerate(values, start=1):
-        arr.SetValue(i, int(x))
+        arr.SetValue(i, x)
     return arr
 
 
@@ -82,11 +82,9 @@ def make_geom_surface(data: BSplineSurfaceData) -> Geom_BSplineSurface:
     """Build the OCCT surface with exactly the poles, knots and multiplicities of ``data``."""
     nu, nv = data.shape
     poles = Array2OfPnt(1, nu, 1, nv)
-    P = data.poles
-    for i in range(nu):
-        for j in range(nv):
-            x, y, z = P[i, j]
-            poles.SetValue(i + 1, j + 1, gp_Pnt(float(x), float(y), float(z)))
+    for i, row in enumerate(data.poles.tolist(), start=1):  # Python floats: no numpy scalar per value
+        for j, (x, y, z) in enumerate(row, start=1):
+            poles.SetValue(i, j, gp_Pnt(x, y, z))
     try:
         return Geom_BSplineSurface(
             poles,

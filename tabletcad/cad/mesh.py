@@ -22,6 +22,7 @@ from OCP.TopAbs import TopAbs_Orientation
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS_Shape
 
+from tabletcad.brep.weld import weld
 from tabletcad.cad._occ import explore
 from tabletcad.errors import GeometryError
 from tabletcad.tolerance import DEFAULT
@@ -143,35 +144,7 @@ def triangulate(
         raise GeometryError("shape has no faces to mesh", shape)
     V = np.concatenate(verts)
     T = np.concatenate(tris)
-    return _weld(V, T, weld_tol)
-
-
-def _weld(V: np.ndarray, T: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
-    """Merge nodes closer than ``tol`` (transitively: connected components of the pair graph)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    n = len(V)
-    from scipy.spatial import cKDTree
-
-    pairs = cKDTree(V).query_pairs(tol, output_type="ndarray")
-    if len(pairs):
-        graph = coo_matrix((np.ones(len(pairs), dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
-        _, labels = connected_components(graph, directed=False)
-    else:
-        labels = np.arange(n)
-    # representative of each component: its smallest node index (keeps the first face's node)
-    first = np.full(labels.max() + 1, n, dtype=np.int64)
-    np.minimum.at(first, labels, np.arange(n))
-    roots = first[labels]
-    uniq, inverse = np.unique(roots, return_inverse=True)
-    T = inverse[T]
-    keep = (T[:, 0] != T[:, 1]) & (T[:, 1] != T[:, 2]) & (T[:, 0] != T[:, 2])
-    T = T[keep]
-    used = np.unique(T)
-    remap = -np.ones(len(uniq), dtype=np.int64)
-    remap[used] = np.arange(used.size)
-    return np.ascontiguousarray(V[uniq[used]]), np.ascontiguousarray(remap[T])
+    return weld(V, T, weld_tol)
 
 
 def _signed_volume_area(V: np.ndarray, T: np.ndarray) -> tuple[float, float]:
@@ -220,15 +193,21 @@ def tessellate(
 
 def tessellate_solid(solid, linear_deflection: float = DEFAULT.mesh_deflection,
                      angular_deflection: float = DEFAULT.mesh_angle, *, check: bool = True) -> MeshResult:
-    """:func:`tessellate` a :class:`~tabletcad.cad.solid.TabletSolid`; a solid whose faces are all
-    surfaces of revolution is meshed from their profiles instead
-    (:func:`tabletcad.brep.revolved.revolved_mesh`: rings of exact circle points, its
-    deflection measured against the faces), with the same checks."""
+    """:func:`tessellate` a :class:`~tabletcad.cad.solid.TabletSolid`, meshing its faces' own data
+    where it can, with the same checks: a solid whose faces are all surfaces of revolution from
+    their profiles (:func:`tabletcad.brep.revolved.revolved_mesh`: rings of exact circle points),
+    a chain of B-spline faces by a grid of their parameter lines
+    (:func:`tabletcad.brep.grid_mesh.grid_mesh`); the deflection is measured against the faces
+    either way.  Anything else, or a grid that does not close, goes to BRepMesh."""
+    from tabletcad.brep.grid_mesh import grid_mesh
     from tabletcad.brep.revolved import RevolvedSurfaceData, revolved_mesh
 
     if solid.surfaces and all(isinstance(sd, RevolvedSurfaceData) for sd in solid.surfaces):
         V, T, _ = revolved_mesh(solid.surfaces, linear_deflection, angular_deflection)
         return mesh_result(V, T, linear_deflection, angular_deflection, check=check)
+    grid = grid_mesh(solid.surfaces, linear_deflection, angular_deflection)
+    if grid is not None:
+        return mesh_result(grid[0], grid[1], linear_deflection, angular_deflection, check=check)
     return tessellate(solid.shape, linear_deflection, angular_deflection, check=check)
 
 

@@ -1,0 +1,58 @@
+"""Welding a triangle soup into an indexed mesh, and whether the result is closed (numpy and scipy only).
+
+Face triangulations meet on shared edges, seams and collapsed pole rows with nodes that
+coincide up to rounding: :func:`weld` merges them and drops the triangles the merge
+made degenerate; :func:`is_closed` tells whether every edge then has exactly two
+triangles, wound opposite ways (a closed, oriented 2-manifold without boundary).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["is_closed", "weld"]
+
+
+def weld(V: np.ndarray, T: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """Merge nodes closer than ``tol`` (mm; transitively: connected components of the pair graph)
+    and drop the triangles left with a repeated node; unused nodes are removed.
+
+    Each merged node keeps the position of its lowest-numbered member (the first face's node).
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    n = len(V)
+    pairs = cKDTree(V).query_pairs(tol, output_type="ndarray")
+    if len(pairs):
+        graph = coo_matrix((np.ones(len(pairs), dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+        _, labels = connected_components(graph, directed=False)
+    else:
+        labels = np.arange(n)
+    first = np.full(labels.max() + 1, n, dtype=np.int64)
+    np.minimum.at(first, labels, np.arange(n))
+    roots = first[labels]
+    uniq, inverse = np.unique(roots, return_inverse=True)
+    T = inverse[T]
+    keep = (T[:, 0] != T[:, 1]) & (T[:, 1] != T[:, 2]) & (T[:, 0] != T[:, 2])
+    T = T[keep]
+    used = np.unique(T)
+    remap = -np.ones(len(uniq), dtype=np.int64)
+    remap[used] = np.arange(used.size)
+    return np.ascontiguousarray(V[uniq[used]]), np.ascontiguousarray(remap[T])
+
+
+def is_closed(T: np.ndarray) -> bool:
+    """Whether every directed edge of the triangles ``T`` (m, 3) occurs once and its reverse once
+    (each edge between exactly two triangles of opposite winding: no boundary, no fin)."""
+    T = np.asarray(T, dtype=np.int64)
+    if T.size == 0:
+        return False
+    a = T.ravel()
+    b = T[:, [1, 2, 0]].ravel()
+    n = int(T.max()) + 1
+    fwd = np.sort(a * n + b)
+    if np.any(fwd[1:] == fwd[:-1]):
+        return False
+    return bool(np.array_equal(fwd, np.sort(b * n + a)))

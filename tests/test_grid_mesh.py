@@ -1,0 +1,134 @@
+"""The structured mesh of a chain of B-spline faces (tabletcad.brep.grid_mesh) and the weld.
+
+numpy only: the chains are fitted here from the family samples' PDE patches
+(``tabletcad.brep.fit.fit_patches``, as the CAD stage does).  Checked against the exact
+volume and area of the B-spline faces (Gauss-Legendre, ``volume_and_area``): a closed
+mesh within chord height ``δ`` of surfaces of area ``A`` encloses a volume within
+``δ A`` of theirs, and its error falls in proportion to ``δ`` (chords of length
+``h ∝ sqrt(δ)`` miss by ``O(h²)``).  The distances to the faces measured by OpenCascade
+are in ``tests/test_grid_mesh_cad.py``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tabletcad.brep.fit import fit_patches
+from tabletcad.brep.grid_mesh import grid_mesh
+from tabletcad.brep.surface import volume_and_area
+from tabletcad.brep.surfaces import fit_options, tablet_surface_functions
+from tabletcad.brep.weld import is_closed, weld
+from tabletcad.pipeline.design import load_design
+
+FAMILIES = Path(__file__).resolve().parents[1] / "samples" / "families"
+SHAPED = ["capsule", "rounded_rectangle", "rounded_triangle", "custom_outline", "almond", "oval"]
+
+
+@lru_cache(maxsize=None)
+def chain(name: str):
+    """The fitted B-spline surfaces of a family sample's solid (the CAD stage's fit)."""
+    tablet = load_design(FAMILIES / f"{name}.toml")
+    funcs, names = tablet_surface_functions(tablet)
+    fits = fit_patches(funcs, tablet.tol.fit, names=names, **fit_options(tablet))
+    return tuple(f.surface for f in fits)
+
+
+def signed_volume_area(V, T):
+    a, b, c = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6), float(0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum())
+
+
+# ------------------------------------------------------------------------------------------- weld
+
+
+def octahedron():
+    V = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=float)
+    T = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+    return V, T
+
+
+def test_weld_merges_coincident_nodes_and_is_closed_tells_a_closed_surface():
+    V, T = octahedron()
+    assert is_closed(T)
+    # every triangle with its own three nodes (a soup), nodes moved by less than the tolerance
+    soup = V[T].reshape(-1, 3) + 1e-9 * np.random.default_rng(1).standard_normal((24, 3))
+    Vw, Tw = weld(soup, np.arange(24).reshape(8, 3), 1e-7)
+    assert Vw.shape == (6, 3) and is_closed(Tw)
+    assert signed_volume_area(Vw, Tw)[0] == pytest.approx(4 / 3, rel=1e-7)
+    assert not is_closed(T[1:])  # a hole
+    assert not is_closed(np.vstack([T, T[:1]]))  # a fin: one edge in three triangles
+    flipped = T.copy()
+    flipped[0] = flipped[0, ::-1]
+    assert not is_closed(flipped)  # one triangle wound the wrong way
+    # a triangle whose nodes merge is dropped
+    V2 = np.vstack([V, V[0] + 1e-9])
+    Vw, Tw = weld(V2, np.vstack([T, [[0, 6, 2]]]), 1e-7)
+    assert len(Tw) == 8 and is_closed(Tw)
+
+
+# ------------------------------------------------------------------------------------------- mesh
+
+
+@pytest.mark.parametrize("name", SHAPED)
+def test_shaped_family_mesh_is_closed_outward_and_within_its_deflection(name):
+    surfaces = chain(name)
+    deflection, angle = 0.005, 0.2
+    V, T, measured = grid_mesh(surfaces, deflection, angle)
+    assert is_closed(T)
+    assert 0.0 < measured <= deflection
+    vol = signed_volume_area(V, T)[0]
+    exact_vol, exact_area = volume_and_area(surfaces)
+    assert vol > 0.0
+    # chords lie inside a convex surface: within δ·A below its volume
+    assert abs(vol - abs(exact_vol)) <= deflection * exact_area
+    # every vertex lies on its surface: the rows of shared boundaries appear once
+    assert len(np.unique(np.round(V / 1e-7).astype(np.int64), axis=0)) == len(V)
+
+
+def test_volume_error_falls_in_proportion_to_the_deflection():
+    surfaces = chain("oval")
+    exact = abs(volume_and_area(surfaces)[0])
+    errors = []
+    for d in (0.04, 0.01, 0.0025):
+        V, T, _ = grid_mesh(surfaces, d, 1.0)  # the chord height alone sets the nodes
+        errors.append(exact - signed_volume_area(V, T)[0])
+    assert all(e > 0 for e in errors)  # chords inside the convex oval
+    rates = [errors[k] / errors[k + 1] for k in range(2)]
+    # quartering the chord height quarters the error (second order in the node spacing)
+    assert all(2.5 <= r <= 6.5 for r in rates), rates
+
+
+@settings(max_examples=12)
+@given(deflection=st.floats(0.002, 0.05), angle=st.floats(0.1, 0.8), name=st.sampled_from(["oval", "capsule", "rounded_triangle"]))
+def test_any_deflection_is_met_and_bounds_the_volume(deflection, angle, name):
+    surfaces = chain(name)
+    V, T, measured = grid_mesh(surfaces, deflection, angle)
+    assert is_closed(T) and measured <= deflection
+    exact_vol, exact_area = volume_and_area(surfaces)
+    assert 0.0 <= abs(exact_vol) - signed_volume_area(V, T)[0] <= deflection * exact_area
+
+
+def test_an_edge_turns_the_tangent_by_at_most_the_angle():
+    surfaces = chain("oval")
+    n_fine = len(grid_mesh(surfaces, 0.05, 0.05)[1])
+    n_coarse = len(grid_mesh(surfaces, 0.05, 1.0)[1])
+    assert n_fine > 4 * n_coarse  # the angle, not the chord height, sets the nodes at 0.05 rad
+
+
+def test_surfaces_that_are_not_one_chain_are_left_to_the_caller():
+    surfaces = chain("oval")
+    assert grid_mesh(surfaces[:2], 0.005, 0.2) is None  # ends on an open row: the weld leaves a hole
+    k = surfaces[1].v_knots
+    shifted = replace(surfaces[1], v_knots=np.concatenate([k[:1], k[1:-1] + 1e-6, k[-1:]]))
+    assert grid_mesh((surfaces[0], shifted, *surfaces[2:]), 0.005, 0.2) is None  # v knots differ
+    moved = replace(surfaces[1], poles=surfaces[1].poles + np.array([0.0, 0.0, 1e-12]))
+    assert grid_mesh((surfaces[0], moved, *surfaces[2:]), 0.005, 0.2) is None  # rows not shared bit for bit
+    with pytest.raises(ValueError):
+        grid_mesh(surfaces, 0.0, 0.2)
