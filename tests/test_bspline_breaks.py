@@ -85,3 +85,27 @@ def test_unreachable_tolerance_raises_with_name():
 def test_bad_break_multiplicity():
     with pytest.raises(ValueError):
         periodic_knots(10, 3, [1.0], 4)
+
+
+@pytest.mark.parametrize("name", ["capsule", "rounded_rectangle", "custom_outline"])
+def test_shared_rows_put_into_the_first_fit_give_the_refit_poles_and_a_bound_on_its_deviation(name, monkeypatch):
+    """``fit_patches`` solves a patch again with its neighbour's boundary row without sampling
+    it again: the poles are those of a full refit, bit for bit, and the deviation it reports
+    (the first fit's plus the largest pole change) is at least what a fresh measurement finds."""
+    from pathlib import Path
+
+    import tabletcad.brep.fit as fit_module
+    from tabletcad.brep.fit import _deviation
+    from tabletcad.brep.surfaces import fit_options, tablet_surface_functions
+    from tabletcad.pipeline.design import load_design
+
+    tablet = load_design(Path(__file__).resolve().parents[1] / "samples" / "families" / f"{name}.toml")
+    funcs, names = tablet_surface_functions(tablet)
+    quick = fit_patches(funcs, tablet.tol.fit, names=names, **fit_options(tablet))
+    monkeypatch.setattr(fit_module, "_with_rows", lambda *a, **k: None)  # the full refit of every patch
+    full = fit_patches(funcs, tablet.tol.fit, names=names, **fit_options(tablet))
+    for f, q, r in zip(funcs, quick, full):
+        assert np.array_equal(q.surface.poles, r.surface.poles)
+        measured = _deviation(f, q.surface, q.u_samples, q.v_samples, 4)[0]
+        assert measured <= q.max_deviation <= q.tol
+        assert q.max_deviation - measured <= 1e-8  # the bound is tight: the rows moved by ~1e-9

@@ -151,3 +151,28 @@ def test_solid_is_outward_whichever_way_its_faces_come(turn, monkeypatch):
     assert v > 0.0 and abs(v + s.data_volume_area[0]) <= 1e-8 * v  # the faces' own volume, outward
     area = 2 * math.pi * 2.0 * 2.0 + 2 * math.pi * 2.0 * 3.0
     assert abs(v - math.pi * 4.0 * 3.0) <= ts.max_fit_deviation * area  # the closed form, to the fit
+
+
+def test_a_solid_that_fails_its_check_names_the_invalid_face(monkeypatch):
+    """Faces are checked once, as part of the solid; when that check fails, each face is
+    checked on its own and the first invalid one is named (spied: OCC makes valid faces of
+    every B-spline it accepts)."""
+    import tabletcad.cad.solid as solid_module
+
+    def fail(*args, **kwargs):
+        raise GeometryError("solid fails BRepCheck_Analyzer")
+
+    class Analyzer:
+        def __init__(self, face):
+            self.face = face
+
+        def IsValid(self):
+            return not self.face.IsSame(made[1])
+
+    made = []
+    real_make_face = solid_module.make_face
+    monkeypatch.setattr(solid_module, "make_face", lambda *a, **k: made.append(real_make_face(*a, **k)) or made[-1])
+    monkeypatch.setattr(solid_module, "_solid_from_faces", fail)
+    monkeypatch.setattr(solid_module, "BRepCheck_Analyzer", Analyzer)
+    with pytest.raises(GeometryError, match=r"^face of patch 1 is not valid"):
+        build_solid(cylinder(2.0, 3.0).patches, 1e-4, names=["patch 0", "patch 1", "patch 2"])

@@ -33,7 +33,9 @@ class SurfaceFit:
 
     ``max_deviation`` is the largest distance |S(u, v) - f(u, v)| (same
     parameters) over a check grid ``check_factor`` times denser than the fit
-    grid in each direction, which includes the points midway between samples.
+    grid in each direction, which includes the points midway between samples;
+    for a fit that :func:`fit_patches` solved again with a neighbour's boundary
+    row, that figure of the first fit plus the largest pole change (a bound).
     ``u_samples``/``v_samples`` are the interpolation parameters.
     """
 
@@ -51,6 +53,7 @@ class SurfaceFit:
     u_samples: np.ndarray = field(repr=False)
     v_samples: np.ndarray = field(repr=False)
     v_breaks: tuple[float, ...] = ()
+    samples: np.ndarray | None = field(default=None, repr=False)  # f on the u x v samples, as evaluated
 
     @property
     def poles(self) -> tuple[int, int]:
@@ -136,6 +139,13 @@ def _build(
     u = np.linspace(u_range[0], u_range[1], nu)
     v_knots, v_mults, v = periodic_knots(nv, v_degree, v_breaks, break_mult)
     D = _eval_f(f, u, v)
+    data, flags, D = _interpolate(D.copy(), D, u, v, u_degree, v_degree, pole_tol, boundary_rows, v_knots, v_mults)
+    return data, u, v, flags, D
+
+
+def _interpolate(D, raw, u, v, u_degree, v_degree, pole_tol, boundary_rows, v_knots, v_mults):
+    """The B-spline interpolating the samples ``D`` (modified: shared boundary rows put in,
+    collapsed rows made one point); returns ``(data, pole flags, raw)``."""
     poles_flags = []
     for k, r in ((0, 0), (-1, 1)):
         if boundary_rows[r] is not None:
@@ -150,7 +160,7 @@ def _build(
         if flag:
             P[k] = D[k][0]
     data = BSplineSurfaceData(P, u_knots, u_mults, v_knots, v_mults, u_degree, v_degree, False, True)
-    return data, u, v, poles_flags, D
+    return data, poles_flags, raw
 
 
 def _deviation(f: SurfaceFunction, data: BSplineSurfaceData, u: np.ndarray, v: np.ndarray, factor: int):
@@ -226,13 +236,13 @@ def fit_surface(
     breaks = normalise_breaks(v_breaks)
     best = None
     for it in range(1, max_iterations + 1):
-        data, u, v, flags, _ = _build(
+        data, u, v, flags, raw = _build(
             f, nu, nv, u_degree, v_degree, pole_tol, u_range, boundary_rows, breaks, v_break_mult
         )
         dmax, drms, err_u, err_v, npts = _deviation(f, data, u, v, check_factor)
         best = SurfaceFit(
             data, dmax, drms, tol, nu, nv, it, npts, flags[0], flags[1], time.perf_counter() - t0, u, v,
-            tuple(float(b) for b in breaks),
+            tuple(float(b) for b in breaks), raw,
         )
         if dmax <= tol:
             return best
@@ -322,6 +332,10 @@ def fit_patches(
         if first[j].nv == nv_common and all(r is None for r in shared[j]):
             fits.append(first[j])
             continue
+        again = _with_rows(first[j], shared[j], v, u_degree, v_degree, kwargs.get("pole_tol", 1e-9))
+        if again is not None:
+            fits.append(again)
+            continue
         fits.append(
             fit_surface(
                 fj,
@@ -348,6 +362,30 @@ def fit_patches(
         poles[0] = pa[-1]
         fits[b] = replace(fits[b], surface=replace(fits[b].surface, poles=poles))
     return fits
+
+
+def _with_rows(fit: SurfaceFit, rows, v: np.ndarray, u_degree: int, v_degree: int, pole_tol: float):
+    """``fit`` interpolated again with its shared boundary ``rows`` put into its own samples,
+    without evaluating the surface again, or None if that cannot be certified within the
+    tolerance (then :func:`fit_surface` refits and measures).
+
+    The poles are those :func:`fit_surface` computes from the same samples, bit for bit.  Its
+    deviation is bounded by the first fit's measured one plus the largest pole change: a
+    B-spline surface's basis functions are non-negative and sum to one, so the surfaces of
+    two pole sets differ nowhere by more than their poles do."""
+    if fit.samples is None or fit.v_samples.shape != v.shape or not np.array_equal(fit.v_samples, v):
+        return None
+    s = fit.surface
+    data, flags, _ = _interpolate(fit.samples.copy(), fit.samples, fit.u_samples, v, u_degree, v_degree, pole_tol,
+                                  tuple(rows), s.v_knots, s.v_mults)
+    if data.shape != s.shape:
+        return None
+    moved = float(np.max(np.linalg.norm(data.poles - s.poles, axis=-1)))
+    bound = fit.max_deviation + moved
+    if bound > fit.tol:
+        return None
+    return replace(fit, surface=data, max_deviation=bound, rms_deviation=fit.rms_deviation + moved,
+                   pole_u0=flags[0], pole_u1=flags[1])
 
 
 class PatchFunction:

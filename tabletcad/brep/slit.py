@@ -94,12 +94,14 @@ def _pieces(data: BSplineSurfaceData, cuts: list[float], tol: float) -> tuple[BS
     for a, b in spans:
         piece = segment_v(data, a, b)
         poles = np.array(piece.poles)
+        snapped = False
         for k in (0, -1):
             r = poles[k]
             spread = float(np.max(np.linalg.norm(r - r[0], axis=-1)))
             if 0.0 < spread <= 10.0 * tol:  # a collapsed row: one pole, so every kernel makes it degenerate
                 poles[k] = r.mean(axis=0)
-        out.append(replace(piece, poles=poles))
+                snapped = True
+        out.append(replace(piece, poles=poles) if snapped else piece)
     return tuple(out)
 
 

@@ -227,12 +227,12 @@ def segment_v(data: BSplineSurfaceData, a: float, b: float) -> BSplineSurfaceDat
         if int(np.sum(np.abs(t - x) <= 1e-12 * scale)) < p and not (not data.v_periodic and x in (knots[0], knots[-1])):
             raise GeometryError(f"segment_v: v = {x} is not a knot of multiplicity >= {p}", data)
     n_basis = t.size - p - 1
-    active = [k for k in range(n_basis) if t[k] < b - 1e-12 * scale and t[k + p + 1] > a + 1e-12 * scale]
+    active = np.flatnonzero((t[:n_basis] < b - 1e-12 * scale) & (t[p + 1:p + 1 + n_basis] > a + 1e-12 * scale))
     inner = t[(t > a + 1e-12 * scale) & (t < b - 1e-12 * scale)]
     vals, counts = np.unique(inner, return_counts=True)
     new_knots = np.concatenate([[a], vals, [b]])
     new_mults = np.concatenate([[p + 1], counts, [p + 1]]).astype(int)
-    poles = np.asarray(data.poles)[:, [(k + shift) % n for k in active], :]
+    poles = np.asarray(data.poles)[:, (active + shift) % n, :]
     return replace(data, poles=poles, v_knots=new_knots, v_mults=new_mults, v_periodic=False)
 
 

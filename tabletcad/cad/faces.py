@@ -101,8 +101,11 @@ def make_geom_surface(data: BSplineSurfaceData) -> Geom_BSplineSurface:
         raise GeometryError(f"OCCT rejected the B-spline surface data: {exc}", data) from exc
 
 
-def make_face(data: BSplineSurfaceData, *, tol_degen: float = 1e-7, name: str = "surface") -> TopoDS_Face:
-    """A ``TopoDS_Face`` bounded by the natural limits of the surface; checked with ``BRepCheck_Analyzer``.
+def make_face(data: BSplineSurfaceData, *, tol_degen: float = 1e-7, name: str = "surface",
+              check: bool = True) -> TopoDS_Face:
+    """A ``TopoDS_Face`` bounded by the natural limits of the surface; checked with
+    ``BRepCheck_Analyzer`` unless ``check`` is false (a caller that checks the solid the
+    faces make, which checks every face again).
 
     ``tol_degen`` is the length below which a boundary iso-curve becomes a
     degenerated edge (a pole of the patch).
@@ -113,7 +116,7 @@ def make_face(data: BSplineSurfaceData, *, tol_degen: float = 1e-7, name: str = 
         raise GeometryError(f"BRepBuilderAPI_MakeFace failed for {name} (error {maker.Error()})", data)
     face = maker.Face()
     knot_boundary_pcurves(face)
-    if not BRepCheck_Analyzer(face).IsValid():
+    if check and not BRepCheck_Analyzer(face).IsValid():
         raise GeometryError(f"face of {name} is not valid (BRepCheck_Analyzer)", data)
     return face
 

@@ -280,9 +280,17 @@ def solid_from_surfaces(
     faces_l: list = []
     face_names: list[str] = []
     for pieces, n in zip(chain_face_surfaces(surfaces, tol_degen, names), names):
-        faces_l.extend(make_face(p, tol_degen=tol_degen, name=n) for p in pieces)
+        # each face is checked as part of the solid (BRepCheck_Analyzer of the solid checks its
+        # faces); only when that fails are they checked one by one, to name the bad one
+        faces_l.extend(make_face(p, tol_degen=tol_degen, name=n, check=False) for p in pieces)
         face_names.extend([n] if len(pieces) == 1 else [f"{n} (piece {k + 1})" for k in range(len(pieces))])
-    return _solid_from_faces(tuple(faces_l), face_names, surfaces, names, fits, sew_tolerance, eps, name, t0)
+    try:
+        return _solid_from_faces(tuple(faces_l), face_names, surfaces, names, fits, sew_tolerance, eps, name, t0)
+    except GeometryError as exc:
+        for face, n in zip(faces_l, face_names):
+            if not BRepCheck_Analyzer(face).IsValid():
+                raise GeometryError(f"face of {n} is not valid (BRepCheck_Analyzer)", face) from exc
+        raise
 
 
 def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequence, names: Sequence[str],
