@@ -116,10 +116,11 @@ def test_cutaway_with_curved_cut_faces_is_a_solid(tmp_path, capsys, design, trim
     assert rep["brep"]["valid"] and "ruled cut faces" in rep["brep"]["cutaway"]
     assert rep["volume_mm3"] == pytest.approx(t.volume(), rel=1e-12)
     assert abs(rep["brep"]["volume_rel_diff_vs_quadrature"]) < 1e-7
-    if design == "almond":  # OCC's tessellation of this cut-away leaves cracks: STEP only, said in the report
-        assert "not a closed mesh" in rep["mesh"]["skipped"] and "tablet.stl" not in rep["outputs"]
-    else:
-        assert rep["mesh"]["watertight"] and rep["mesh"]["genus"] == 0 and "tablet.stl" in rep["outputs"]
+    # meshed on the chain's parameter grids where they close (the almond's and the triangle's; OCC's
+    # BRepMesh left cracks in the almond's), else by BRepMesh (the capsule's slit)
+    assert rep["mesh"]["watertight"] and rep["mesh"]["genus"] == 0 and "tablet.stl" in rep["outputs"]
+    brep = rep["brep"]
+    assert abs(rep["mesh"]["volume_rel_diff_vs_brep"]) * brep["volume_mm3"] <= 0.005 * brep["surface_area_mm2"]
     (cut,) = ocp_read_steps([tmp_path / "out" / "tablet.step"])
     assert cut["valid"] and cut["n_solids"] == 1
     assert cut["volume"] == pytest.approx(rep["volume_mm3"], rel=1e-6)

@@ -32,7 +32,7 @@ from OCP.TopoDS import TopoDS_Shape
 from OCP.XCAFDoc import XCAFDoc_DocumentTool
 
 from tabletcad.cad._occ import quiet
-from tabletcad.cad.mesh import MeshResult, tessellate
+from tabletcad.cad.mesh import MeshResult, tessellate, tessellate_solid
 from tabletcad.errors import GeometryError
 from tabletcad.io import atomic_path
 from tabletcad.tolerance import DEFAULT
@@ -102,7 +102,10 @@ def _mesh_of(obj: Any, mesh: MeshResult | None, **kw: Any) -> MeshResult:
     if mesh is not None:
         return mesh
     opts = {**MESH_DEFAULTS, **kw}
-    m = tessellate(_shape_of(obj), opts["linear_deflection"], opts["angular_deflection"])
+    if hasattr(obj, "surfaces") and hasattr(obj, "shape"):  # a TabletSolid: meshed from its faces' data, as the CAD stage does
+        m = tessellate_solid(obj, opts["linear_deflection"], opts["angular_deflection"])
+    else:
+        m = tessellate(_shape_of(obj), opts["linear_deflection"], opts["angular_deflection"])
     if not m.ok:
         raise GeometryError(
             f"tessellation is not a closed manifold (manifold3d: {m.manifold_status}, "

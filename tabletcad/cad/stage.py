@@ -154,7 +154,7 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
 
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
 
-    from tabletcad.cad.mesh import tessellate
+    from tabletcad.cad.mesh import tessellate, tessellate_solid
     from tabletcad.cad.solid import check_solid, mass_properties
     from tabletcad.cad.tablet_solid import tablet_solid
     from tabletcad.geometry.tablet import Trim
@@ -167,6 +167,7 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
 
     phi0, phi1 = _cut_plane_angle(tablet, v0), _cut_plane_angle(tablet, v1)
     t0 = time.perf_counter()
+    chain = None
     if phi0 is None or phi1 is None:
         if t.w != (0.0, 1.0):
             return "hollow ([trim] w) with cut faces that are not planes through the axis"
@@ -175,8 +176,9 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
 
         funcs, breaks = cutaway_surface_functions(tablet)
         names = [f"{p.name or f'patch {j}'} cut-away" for j, p in enumerate(tablet.patches)]
-        shape = build_solid(funcs, tablet.tol.fit, name=f"{tablet.name} cut-away", names=names,
-                            **fit_options(tablet, v_breaks=breaks)).shape
+        chain = build_solid(funcs, tablet.tol.fit, name=f"{tablet.name} cut-away", names=names,
+                            **fit_options(tablet, v_breaks=breaks))
+        shape = chain.shape
         how = ("fitted and sewn as one chain: the outer surface between the cuts and the ruled cut faces "
                f"A0(u) + w (X(u, v) - A0(u)) at v = {v0:.6g} and {v1:.6g}")
     else:
@@ -201,7 +203,10 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
     if abs(dv) > AGREEMENT_REL:
         raise GeometryError(f"{tablet.name}: cut-away B-rep volume differs from the quadrature by {dv:.2e} relative "
                             f"(allowed {AGREEMENT_REL:g})", shape)
-    mesh = tessellate(shape, MESH_LINEAR_MM, MESH_ANGULAR_RAD)
+    # the sewn chain is meshed on its faces' parameter grids (BRepMesh left cracks in the almond's
+    # ruled cut faces), the wedge-cut solid by BRepMesh
+    mesh = (tessellate_solid(chain, MESH_LINEAR_MM, MESH_ANGULAR_RAD) if chain is not None
+            else tessellate(shape, MESH_LINEAR_MM, MESH_ANGULAR_RAD))
     genus_expected = 0
     brep = dict(valid=True, volume_mm3=mass.volume, surface_area_mm2=mass.area, faces=len(explore(shape, "Face")),
                 volume_rel_diff_vs_quadrature=dv, cutaway=how, seconds=t1 - t0)
@@ -209,8 +214,9 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
         failed = (f"manifold3d {mesh.manifold_status}, genus {mesh.manifold_genus}, watertight {mesh.watertight}, "
                   f"winding {mesh.winding_consistent}")
         if phi0 is None or phi1 is None:
-            # the directly sewn cut-away is a valid B-rep of the right volume, but OCC's tessellation of
-            # its ruled cut faces can leave cracks (seen on the almond): the STEP is written, no STL/GLB
+            # the directly sewn cut-away is a valid B-rep of the right volume, but where its grid does not
+            # close, OCC's tessellation of its ruled cut faces can leave cracks (it did on the almond):
+            # the STEP is written, no STL/GLB
             return shape, None, dict(brep=brep, mesh=dict(skipped=f"the tessellation is not a closed mesh ({failed}): "
                                                                  "tablet.step only, no tablet.stl/.glb"))
         raise GeometryError(f"{tablet.name}: cut-away mesh check failed ({failed})", mesh)
