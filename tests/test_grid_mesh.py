@@ -33,7 +33,8 @@ SHAPED = ["capsule", "rounded_rectangle", "rounded_triangle", "custom_outline", 
 
 @lru_cache(maxsize=None)
 def chain(name: str):
-    """The fitted B-spline surfaces of a family sample's solid (the CAD stage's fit)."""
+    """The fitted B-spline surfaces of a family sample's solid (the CAD stage's fit); ``name``
+    relative to ``samples/families``."""
     tablet = load_design(FAMILIES / f"{name}.toml")
     funcs, names = tablet_surface_functions(tablet)
     fits = fit_patches(funcs, tablet.tol.fit, names=names, **fit_options(tablet))
@@ -120,6 +121,16 @@ def test_an_edge_turns_the_tangent_by_at_most_the_angle():
     n_fine = len(grid_mesh(surfaces, 0.05, 0.05)[1])
     n_coarse = len(grid_mesh(surfaces, 0.05, 1.0)[1])
     assert n_fine > 4 * n_coarse  # the angle, not the chord height, sets the nodes at 0.05 rad
+
+
+def test_a_ring_of_faces_closes_on_itself_with_genus_one():
+    surfaces = chain("../ring")  # the hollow ring tablet as four B-spline faces: walls and end faces
+    V, T, measured = grid_mesh(surfaces, 0.005, 0.2)
+    assert len(surfaces) == 4 and is_closed(T) and measured <= 0.005
+    edges = {tuple(sorted(e)) for e in np.vstack([T[:, [0, 1]], T[:, [1, 2]], T[:, [2, 0]]]).tolist()}
+    assert len(V) - len(edges) + len(T) == 0  # Euler characteristic 2 - 2g with g = 1
+    exact_vol, exact_area = volume_and_area(surfaces)
+    assert 0.0 <= abs(exact_vol) - signed_volume_area(V, T)[0] <= 0.005 * exact_area
 
 
 def test_surfaces_that_are_not_one_chain_are_left_to_the_caller():
