@@ -22,8 +22,10 @@ lattice: the corners, edge midpoints and 9 interior points of both triangles): w
 ``Δ`` from the surface point to the triangle point of the same parameters, ``n`` the
 surface normal there and ``κ`` the surface's largest principal curvature, the distance
 from that point of the mesh to the surface is at most about ``|n·Δ| + κ |Δ - (n·Δ) n|² / 2``
-(the surface leaves its tangent plane by ``κ r² / 2`` at distance ``r``), or ``|Δ|`` where
-the normal is undefined (a collapsed row).  Until it is within the deflection the
+(the surface leaves its tangent plane by ``κ r² / 2`` at distance ``r``) while that
+tangential step ``r`` is at most half the radius ``1/κ``; ``|Δ|`` itself (a distance to a
+point of the surface, so a bound) where it is longer or the normal is undefined (a collapsed
+row).  Until it is within the deflection the
 densities grow by half (at most ``max_rounds`` times).
 
 Arrays are components first, ``(3, nu, nv)``: dot and cross products are then sums of
@@ -301,7 +303,11 @@ def _cell_deviation(s: BSplineSurfaceData, u: np.ndarray, v: np.ndarray, V: np.n
     D = M - S[:, rows, cols]
     h = _dot(D, Nrm[:, rows, cols])
     dd = _dot(D, D)
-    est = np.where(ok[rows, cols], np.abs(h) + 0.5 * curvature * np.maximum(dd - h * h, 0.0), np.sqrt(dd))
+    tang = np.maximum(dd - h * h, 0.0)
+    # the tangent-plane estimate holds while the step along the surface is small against its radius
+    # of curvature; beyond that (very coarse deflections on a distorted parametrisation) |Δ| itself
+    near = ok[rows, cols] & (curvature * curvature * tang <= 0.25)
+    est = np.where(near, np.abs(h) + 0.5 * curvature * tang, np.sqrt(dd))
     return est.max(axis=0)
 
 
