@@ -101,7 +101,11 @@ def test_shared_rows_put_into_the_first_fit_give_the_refit_poles_and_a_bound_on_
 
     tablet = load_design(Path(__file__).resolve().parents[1] / "samples" / "families" / f"{name}.toml")
     funcs, names = tablet_surface_functions(tablet)
+    used = []
+    real = fit_module._with_rows
+    monkeypatch.setattr(fit_module, "_with_rows", lambda *a, **k: used.append(real(*a, **k)) or used[-1])
     quick = fit_patches(funcs, tablet.tol.fit, names=names, **fit_options(tablet))
+    assert used and all(u is not None for u in used)  # every patch with a shared row took the quick path
     monkeypatch.setattr(fit_module, "_with_rows", lambda *a, **k: None)  # the full refit of every patch
     full = fit_patches(funcs, tablet.tol.fit, names=names, **fit_options(tablet))
     for f, q, r in zip(funcs, quick, full):
