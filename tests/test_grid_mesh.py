@@ -139,6 +139,11 @@ def test_surfaces_that_are_not_one_chain_are_left_to_the_caller():
     assert grid_mesh((surfaces[0], shifted, *surfaces[2:]), 0.005, 0.2) is None  # v knots differ
     moved = replace(surfaces[1], poles=surfaces[1].poles + np.array([0.0, 0.0, 1e-12]))
     assert grid_mesh((surfaces[0], moved, *surfaces[2:]), 0.005, 0.2) is None  # rows not shared bit for bit
+    # unclamped in u: the end pole rows are not the boundary rows
+    knots, mults = surfaces[1].u_knots, surfaces[1].u_mults
+    unclamped = replace(surfaces[1], u_knots=np.concatenate([[knots[0] - 0.1], knots, [knots[-1] + 0.1]]),
+                        u_mults=np.concatenate([[1], mults - np.eye(len(mults), dtype=int)[[0, -1]].sum(0), [1]]))
+    assert grid_mesh((surfaces[0], unclamped, *surfaces[2:]), 0.005, 0.2) is None
     with pytest.raises(ValueError):
         grid_mesh(surfaces, 0.0, 0.2)
 

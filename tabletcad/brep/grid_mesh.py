@@ -80,6 +80,8 @@ def _is_chain(surfaces: Sequence) -> bool | None:
     for s in surfaces:
         if s.u_periodic or not s.v_periodic or s.v_degree != s0.v_degree:
             return None
+        if s.u_mults[0] != s.u_degree + 1 or s.u_mults[-1] != s.u_degree + 1:
+            return None  # not clamped in u: a shared end pole row is not a shared boundary row
         if not (np.array_equal(s.v_knots, s0.v_knots) and np.array_equal(s.v_mults, s0.v_mults)):
             return None
     for a, b in zip(surfaces[:-1], surfaces[1:]):
@@ -110,10 +112,7 @@ class _Collocation:
 def _points_normals(s: BSplineSurfaceData, u: np.ndarray, v: np.ndarray, col: _Collocation):
     """Points and unit normals ``S_u × S_v`` on the grid ``u × v``, each ``(3, len(u), len(v))``,
     and where the normal is defined (not on a collapsed row, where the cross product vanishes)."""
-    (Bu, Bu1), (Bv, Bv1) = col(s, "u", u), col(s, "v", v)
-    P = np.ascontiguousarray(s.poles.transpose(2, 0, 1))  # (3, u poles, v poles)
-    A, A1 = Bu @ P, Bu1 @ P
-    S, Su, Sv = A @ Bv.T, A1 @ Bv.T, A @ Bv1.T
+    S, Su, Sv = s.grid_components(u, v, lambda which, x: col(s, which, x))
     N = np.stack([Su[1] * Sv[2] - Su[2] * Sv[1], Su[2] * Sv[0] - Su[0] * Sv[2], Su[0] * Sv[1] - Su[1] * Sv[0]])
     size = np.sqrt(_dot(N, N))
     ok = size > 1e-9 * np.maximum(_dot(Su, Su), _dot(Sv, Sv))

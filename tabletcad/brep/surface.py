@@ -144,13 +144,19 @@ class BSplineSurfaceData:
         Bv = self.collocation("v", v, dv)
         return np.einsum("ai,ijk,bj->abk", Bu, self.poles, Bv, optimize=True)
 
-    def grid_components(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def grid_components(self, u: np.ndarray, v: np.ndarray, collocation=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Points, ``S_u`` and ``S_v`` on the tensor grid ``u x v``, components first: each
         ``(3, len(u), len(v))``, C-contiguous.  One collocation matrix per direction and order,
-        and two matrix products per component (``B_u P_c B_v^T``)."""
+        and two matrix products per component (``B_u P_c B_v^T``).  ``collocation(which, x)``,
+        if given, supplies ``(values, first derivatives)`` matrices (e.g. shared by surfaces
+        with the same knots)."""
         u, v = np.asarray(u, dtype=float).ravel(), np.asarray(v, dtype=float).ravel()
-        Bu, Bu1 = self.collocation("u", u), self.collocation("u", u, 1)
-        BvT, Bv1T = self.collocation("v", v).T, self.collocation("v", v, 1).T
+        if collocation is None:
+            def collocation(which, x):
+                return self.collocation(which, x), self.collocation(which, x, 1)
+        Bu, Bu1 = collocation("u", u)
+        Bv, Bv1 = collocation("v", v)
+        BvT, Bv1T = Bv.T, Bv1.T
         P = np.ascontiguousarray(self.poles.transpose(2, 0, 1))  # (3, u poles, v poles)
         A, A1 = Bu @ P, Bu1 @ P  # (3, len(u), v poles)
         return A @ BvT, A1 @ BvT, A @ Bv1T
