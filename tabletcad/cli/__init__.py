@@ -261,7 +261,12 @@ def main(argv: list[str] | None = None) -> int:
                 # a command (Python hides them outside __main__ too; pytest would show them)
                 warnings.simplefilter("ignore", DeprecationWarning)
                 warnings.simplefilter("ignore", PendingDeprecationWarning)
-                return _run(argv)
+                status = _run(argv)
+            if argv is None:  # the program's outcome is decided: a Ctrl-C now would only break its exit
+                import signal
+
+                signal.signal(signal.SIGINT, signal.SIG_IGN)
+            return status
         except (KeyboardInterrupt, SystemExit):
             raise
         except BrokenPipeError:  # the reader of stdout went away (``| head``): stop quietly
