@@ -283,3 +283,51 @@ def test_trimmed_faces_classified_by_their_polygons_keep_the_classifier_samples(
 
     monkeypatch.setattr(I, "_polygon_classes", flipped)
     assert not np.array_equal(I.face_samples(shape, spacing=0.02), slow)
+
+
+def test_grid_points_on_straight_boundary_sides_are_the_classifiers_on_points():
+    """``_on_straight_sides`` marks grid points that lie on an edge running along a side of the face's
+    (u, v) box (the lettered cup's rim and seam, B-spline p-curves after the Boolean): every one is
+    ON (or IN) by ``BRepTopAdaptor_FClass2d``, there are over a thousand of them on the sample, and a
+    point one step inside the box is never marked."""
+    from pathlib import Path
+
+    from OCP.BRepTools import BRepTools
+    from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
+    from OCP.gp import gp_Pnt2d
+    from OCP.TopAbs import TopAbs_State
+
+    import tabletcad.tooling.interference as I
+    from tabletcad.cad._occ import explore
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.toolset import make_tooling
+
+    d = Design.from_toml(Path(__file__).resolve().parents[1] / "samples" / "tooling" / "concave_round_bisect.toml")
+    shape = make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False).parts["tablet"]
+    marked = 0
+    for face in explore(shape, "Face"):
+        u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
+        us, vs = np.linspace(u0, u1, 61), np.linspace(v0, v1, 41)
+        on = I._on_straight_sides(face, us, vs)
+        assert not on[1:-1, 1:-1].any()
+        cls = BRepTopAdaptor_FClass2d(face, 1e-9)
+        for i, j in zip(*np.nonzero(on)):
+            assert cls.Perform(gp_Pnt2d(us[i], vs[j])) in (TopAbs_State.TopAbs_ON, TopAbs_State.TopAbs_IN)
+        marked += int(on.sum())
+    assert marked > 1000
+
+
+@pytest.mark.parametrize("radius, height", [(5.0, 3.0), (0.8, 12.0), (15.0, 0.5)])
+def test_bound_area_is_at_least_the_exact_area_and_close_to_it(radius, height):
+    """``bound_area`` (the mesh's area over ``cos(angle)``, scaling the manifold3d bounds) is at least a
+    cylinder's closed-form area and within the cosine's 2.03 % of it; a box's planar faces mesh exactly."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
+
+    from tabletcad.tooling.booleans import CACHE, bound_area
+
+    CACHE.clear()
+    cyl = BRepPrimAPI_MakeCylinder(radius, height).Shape()
+    exact = 2.0 * np.pi * radius * (radius + height)
+    assert exact <= bound_area(cyl, 0.005) <= exact / np.cos(0.2) * (1 + 1e-12)
+    box = BRepPrimAPI_MakeBox(radius, height, 2.0).Shape()
+    assert bound_area(box, 0.005) == pytest.approx(2 * (radius * height + 2 * radius + 2 * height) / np.cos(0.2), rel=1e-12)

@@ -15,6 +15,7 @@ Meshes, manifolds, volumes and areas are computed once per shape (:data:`CACHE`)
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import asdict, dataclass
 from typing import Any
@@ -36,7 +37,7 @@ try:  # OCP >= 8.0
 except ImportError:  # pragma: no cover - OCP 7.x
     from OCP.TopTools import TopTools_ListOfShape as _ShapeList
 
-__all__ = ["boolean", "split_cells", "split_solid", "compound", "checked_boolean", "BooleanCheck", "to_manifold", "manifold_volume", "translated",
+__all__ = ["boolean", "bound_area", "split_cells", "split_solid", "compound", "checked_boolean", "BooleanCheck", "to_manifold", "manifold_volume", "translated",
            "volume", "area", "TIMER", "CACHE"]
 
 _ALGOS = {"cut": BRepAlgoAPI_Cut, "fuse": BRepAlgoAPI_Fuse, "common": BRepAlgoAPI_Common}
@@ -47,11 +48,6 @@ TIMER = {"occ_boolean_s": 0.0, "manifold_s": 0.0, "occ_booleans": 0, "manifold_b
 #: meshes, manifolds, volumes and areas of the shapes a build asks about more than once
 CACHE = ShapeCache()
 
-#: relative accuracy of the areas that only scale the manifold3d bounds (``deflection x area``): OCC's
-#: adaptive integration to 5e-4 (below 1e-3, where ``BRepGProp_Gauss`` stops estimating its error and
-#: subdividing) instead of 1e-6: 0.36 -> 0.25 s over the concave round sample's tooling, every area
-#: within 1e-7 of the finer one
-BOUND_AREA_EPS = 5e-4
 
 
 def _list(*shapes: TopoDS_Shape):
@@ -211,6 +207,17 @@ def area(shape: TopoDS_Shape, eps: float = 1e-6) -> float:
     return CACHE.get(shape, ("area", eps), lambda: _integral(shape, eps, "Surface"))
 
 
+def bound_area(shape: TopoDS_Shape, deflection: float = 0.005, angular: float = 0.2) -> float:
+    """An upper estimate of the surface area (mm^2) that scales the manifold3d bounds (``deflection x
+    area``): the area of the tessellation the manifold is made of (:func:`mesh_arrays`, already computed)
+    over ``cos(angular)``.  A face whose normals stay within ``angular`` of its triangle's normal has at
+    most the triangle's area over that cosine.  On the parts of the five tooling samples this is 1.0198
+    to 1.0203 times OCC's adaptive integration to 1e-6, which cost 0.3 s a tooling build."""
+    V, T = mesh_arrays(shape, deflection, angular)
+    a, b, c = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
+    return float(0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum() / math.cos(angular))
+
+
 def _integral(shape: TopoDS_Shape, eps: float, kind: str) -> float:
     """``BRepGProp.VolumeProperties`` or ``SurfaceProperties`` alone (what :func:`mass_properties` computes,
     without the other one), adaptive to ``eps``."""
@@ -323,7 +330,7 @@ def checked_boolean(
     mr = manifold_op(op, ma, mb)
     mva, mvr = manifold_volume(ma), manifold_volume(mr)
     mesh_change = {"cut": mva - mvr, "fuse": mvr - mva, "common": mvr}[op]
-    bound = deflection * area(b, BOUND_AREA_EPS)
+    bound = deflection * bound_area(b, deflection)
     diff = abs(occ_change - mesh_change)
     chk = BooleanCheck(what, op, occ_change, mesh_change, diff, diff / max(abs(occ_change), 1e-300), bound,
                        deflection, True, diff <= bound)

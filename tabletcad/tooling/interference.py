@@ -28,7 +28,7 @@ from scipy.spatial import cKDTree
 
 from tabletcad.cad._occ import explore
 from tabletcad.geometry.tablet import coordinate_range
-from tabletcad.tooling.booleans import (BOUND_AREA_EPS, area, mesh_arrays, manifold_op, manifold_volume, raw_boolean, to_manifold,
+from tabletcad.tooling.booleans import (bound_area, mesh_arrays, manifold_op, manifold_volume, raw_boolean, to_manifold,
                                         volume)
 from tabletcad.tooling.die import MIN_BORE_OFFSET_MM
 
@@ -459,8 +459,9 @@ def _polygon_classes(face, us, vs, margin: float) -> tuple[np.ndarray, np.ndarra
     """``(inside, near)`` masks (nu, nv) of the grid ``us x vs`` on ``face``: inside by the even-odd rule
     on the wires' polygons (:func:`_wire_polygons`, within ``margin / 4`` of the p-curves: a ray along
     ``+u`` on each grid line ``v = const`` counts the crossings), near (a superset) where a grid point
-    lies within ``margin`` of a polygon's segment's box, where the polygon may disagree with the
-    face; every point near when the polygons cannot be made."""
+    lies within ``margin`` of a polygon's segment (Euclidean in ``(u, v)``), where the polygon may
+    disagree with the face (a point farther than ``margin`` from the polygon is farther than
+    ``3 margin / 4`` from the p-curves, on the same side of both); every point near when the polygons cannot be made."""
     us, vs = np.asarray(us, dtype=float), np.asarray(vs, dtype=float)
     shape = (len(us), len(vs))
     polygons = _wire_polygons(face, 0.25 * margin) if margin > 0.0 else None
@@ -484,9 +485,22 @@ def _polygon_classes(face, us, vs, margin: float) -> tuple[np.ndarray, np.ndarra
     i1 = np.clip(np.floor((hi[:, 0] - us[0]) / du) + 1, 0, shape[0]).astype(int)
     j0 = np.clip(np.ceil((lo[:, 1] - vs[0]) / dv), 0, shape[1]).astype(int)
     j1 = np.clip(np.floor((hi[:, 1] - vs[0]) / dv) + 1, 0, shape[1]).astype(int)
-    for a0, a1, b0, b1 in zip(i0.tolist(), i1.tolist(), j0.tolist(), j1.tolist()):
-        if a0 < a1 and b0 < b1:
-            near[a0:a1, b0:b1] = True
+    # the grid points in each segment's box grown by the margin, kept where they lie within the margin
+    # of the segment itself (a diagonal segment's box holds many points far from it)
+    ni, nj = np.maximum(i1 - i0, 0), np.maximum(j1 - j0, 0)
+    count = ni * nj
+    seg = np.repeat(np.arange(len(A)), count)
+    if len(seg):
+        k = np.arange(len(seg)) - np.repeat(np.cumsum(count) - count, count)  # index inside the segment's box
+        gi, gj = i0[seg] + k // nj[seg], j0[seg] + k % nj[seg]
+        P = np.stack([us[gi], vs[gj]], axis=1)
+        a, ab = A[seg], B[seg] - A[seg]
+        L2 = np.einsum("ij,ij->i", ab, ab)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.clip(np.where(L2 > 0.0, np.einsum("ij,ij->i", P - a, ab) / L2, 0.0), 0.0, 1.0)
+        d = P - (a + t[:, None] * ab)
+        close = np.einsum("ij,ij->i", d, d) <= margin * margin
+        near[gi[close], gj[close]] = True
     inside = np.zeros(shape, dtype=bool)
     ay, by = A[:, 1], B[:, 1]
     for j, v in enumerate(vs.tolist()):
@@ -496,7 +510,47 @@ def _polygon_classes(face, us, vs, margin: float) -> tuple[np.ndarray, np.ndarra
         ax, bx, cy, dy = A[c, 0], B[c, 0], ay[c], by[c]
         x = np.sort(ax + (v - cy) * (bx - ax) / (dy - cy))
         inside[:, j] = (len(x) - np.searchsorted(x, us, side="right")) % 2 == 1
-    return inside, near
+    on = _on_straight_sides(face, us, vs)  # on the boundary: kept, as the classifier keeps them
+    return inside | on, near & ~on
+
+
+def _on_straight_sides(face, us, vs) -> np.ndarray:
+    """Mask (nu, nv) of the grid points on the first or last row or column of the grid ``us x vs``
+    that lie on an edge of ``face`` whose p-curve runs along that side of the grid: a line, or a
+    B-spline whose poles all lie on it (the curve lies in their convex hull), with both ends on it
+    to ``1e-12`` of the parameter range and the point between its ends (the curve passes every value
+    between them).  Those are points of the face's boundary, which the classifier puts ON the face
+    (a cup's rim and seam after the Boolean that cut letters into it: 1,668 points a face)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+    from OCP.GeomAbs import GeomAbs_CurveType
+
+    on = np.zeros((len(us), len(vs)), dtype=bool)
+    eps = (1e-12 * max(1.0, abs(us[0]), abs(us[-1])), 1e-12 * max(1.0, abs(vs[0]), abs(vs[-1])))
+    sides = ((0, us[0]), (0, us[-1]), (1, vs[0]), (1, vs[-1]))
+    for e in explore(face, "Edge"):
+        try:
+            c = BRepAdaptor_Curve2d(e, face)
+        except Exception:  # no p-curve on this face: the classifier decides
+            continue
+        kind = c.GetType()
+        if kind == GeomAbs_CurveType.GeomAbs_Line:
+            pts = np.array([c.Value(c.FirstParameter()).Coord(), c.Value(c.LastParameter()).Coord()])
+        elif kind == GeomAbs_CurveType.GeomAbs_BSplineCurve:
+            b = c.BSpline()
+            pts = np.array([b.Pole(i).Coord() for i in range(1, b.NbPoles() + 1)]
+                           + [c.Value(c.FirstParameter()).Coord(), c.Value(c.LastParameter()).Coord()])
+        else:
+            continue
+        p, q = pts[-2], pts[-1]
+        for axis, x in sides:
+            if np.all(np.abs(pts[:, axis] - x) <= eps[axis]):
+                other = 1 - axis
+                lo, hi = min(p[other], q[other]) - eps[other], max(p[other], q[other]) + eps[other]
+                if axis == 0:
+                    on[0 if x == us[0] else -1] |= (vs >= lo) & (vs <= hi)
+                else:
+                    on[:, 0 if x == vs[0] else -1] |= (us >= lo) & (us <= hi)
+    return on
 
 
 def _fills_uv_box(face, u0: float, u1: float, v0: float, v1: float) -> bool:
@@ -540,7 +594,7 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
     t0 = time.perf_counter()
     shapes = {"tablet": tablet, **parts}
     manifolds = {k: to_manifold(s, deflection) for k, s in shapes.items()}
-    areas = {k: area(s, BOUND_AREA_EPS) for k, s in shapes.items()}  # for the manifold3d bounds only
+    areas = {k: bound_area(s, deflection) for k, s in shapes.items()}  # for the manifold3d bounds only
     pairs = []
     for a, b in itertools.combinations(shapes, 2):
         entry = dict(parts=[a, b])
