@@ -37,7 +37,7 @@ try:  # OCP >= 8.0
 except ImportError:  # pragma: no cover - OCP 7.x
     from OCP.TopTools import TopTools_ListOfShape as _ShapeList
 
-__all__ = ["boolean", "bound_area", "split_cells", "split_solid", "compound", "checked_boolean", "BooleanCheck", "to_manifold", "manifold_volume", "translated",
+__all__ = ["boolean", "bound_area", "volume_centroid", "split_cells", "split_solid", "compound", "checked_boolean", "BooleanCheck", "to_manifold", "manifold_volume", "translated",
            "volume", "area", "TIMER", "CACHE"]
 
 _ALGOS = {"cut": BRepAlgoAPI_Cut, "fuse": BRepAlgoAPI_Fuse, "common": BRepAlgoAPI_Common}
@@ -199,7 +199,13 @@ def translated(shape: TopoDS_Shape, dx: float = 0.0, dy: float = 0.0, dz: float 
 
 def volume(shape: TopoDS_Shape, eps: float = 1e-9) -> float:
     """Volume (mm^3) by OCC's adaptive integration (once per shape: :data:`CACHE`)."""
-    return CACHE.get(shape, ("volume", eps), lambda: _integral(shape, eps, "Volume"))
+    return volume_centroid(shape, eps)[0]
+
+
+def volume_centroid(shape: TopoDS_Shape, eps: float = 1e-9) -> tuple[float, tuple[float, float, float]]:
+    """Volume (mm^3) and centroid (mm) from one adaptive ``BRepGProp.VolumeProperties`` (once per
+    shape: :data:`CACHE`; :func:`volume` reads the same entry)."""
+    return CACHE.get(shape, ("volume", eps), lambda: _integral(shape, eps, "Volume", centroid=True))
 
 
 def area(shape: TopoDS_Shape, eps: float = 1e-6) -> float:
@@ -218,15 +224,18 @@ def bound_area(shape: TopoDS_Shape, deflection: float = 0.005, angular: float = 
     return float(0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum() / math.cos(angular))
 
 
-def _integral(shape: TopoDS_Shape, eps: float, kind: str) -> float:
+def _integral(shape: TopoDS_Shape, eps: float, kind: str, centroid: bool = False):
     """``BRepGProp.VolumeProperties`` or ``SurfaceProperties`` alone (what :func:`mass_properties` computes,
-    without the other one), adaptive to ``eps``."""
+    without the other one), adaptive to ``eps``: the mass, or with ``centroid`` the mass and the centre."""
     from OCP.BRepGProp import BRepGProp
     from OCP.GProp import GProp_GProps
 
     props = GProp_GProps()
     getattr(BRepGProp, f"{kind}Properties_s")(shape, props, Eps=float(eps))
-    return float(props.Mass())
+    if not centroid:
+        return float(props.Mass())
+    c = props.CentreOfMass()
+    return float(props.Mass()), (c.X(), c.Y(), c.Z())
 
 
 # ----------------------------------------------------------------------------- manifold3d

@@ -22,9 +22,8 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolyg
 from OCP.gp import gp_Pnt
 
 from tabletcad.cad._occ import explore
-from tabletcad.cad.solid import mass_properties
 from tabletcad.errors import GeometryError
-from tabletcad.tooling.booleans import split_solid, volume
+from tabletcad.tooling.booleans import split_solid, volume_centroid
 from tabletcad.tooling.outline import TabletFrame, face_area
 
 __all__ = ["split_directions", "split_parts", "SPLIT_LOSS_LIMIT_PERCENT", "SPLIT_LOSS_SOURCE"]
@@ -88,10 +87,10 @@ def split_parts(frame: TabletFrame, solid, scores, *, density_mg_mm3: float | No
     parts = [dict(from_deg=a, to_deg=rays[(k + 1) % len(rays)], volume_mm3=0.0, cells=0) for k, a in enumerate(rays)]
     for cell in cells:
         # a part lies in a convex sector (at most 180 degrees): its centroid is inside it
-        cx, cy, _ = mass_properties(cell, 1e-9).centroid
+        vol, (cx, cy, _) = volume_centroid(cell)
         ang = math.degrees(math.atan2(cy, cx)) % 360.0
         k = max(j for j, a in enumerate(rays) if a <= ang) if ang >= rays[0] else len(rays) - 1
-        parts[k]["volume_mm3"] += volume(cell)
+        parts[k]["volume_mm3"] += vol
         parts[k]["cells"] += 1
     if any(p["cells"] != 1 for p in parts):
         raise GeometryError(f"splitting the tablet along its scores gave {[p['cells'] for p in parts]} pieces per part, "
