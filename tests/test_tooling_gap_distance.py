@@ -331,3 +331,59 @@ def test_bound_area_is_at_least_the_exact_area_and_close_to_it(radius, height):
     assert exact <= bound_area(cyl, 0.005) <= exact / np.cos(0.2) * (1 + 1e-12)
     box = BRepPrimAPI_MakeBox(radius, height, 2.0).Shape()
     assert bound_area(box, 0.005) == pytest.approx(2 * (radius * height + 2 * radius + 2 * height) / np.cos(0.2), rel=1e-12)
+
+
+@pytest.mark.parametrize("nurbs", [False, True])
+def test_exact_distance_signs_points_nearest_to_edges_without_the_classifier(monkeypatch, nurbs):
+    """Inside or outside, for a point whose nearest boundary point lies on an edge, follows from the
+    edge's two face normals (the solid's normal cone there): on an L-shaped solid (a concave edge
+    along which inside points are nearest, convex edges for outside ones), plain and converted to
+    B-spline faces (where a face's extremum on its boundary ties with the edge's), ``ExactDistance``
+    gives ``BRepExtrema_DistShapeShape``'s distance (0 inside) to 1e-7 mm and asks the solid
+    classifier for few points (those nearest to a vertex)."""
+    import OCP.BRepClass3d as C
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex, BRepBuilderAPI_NurbsConvert
+    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.gp import gp_Pnt
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.interference import ExactDistance
+
+    L = BRepAlgoAPI_Cut(BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), gp_Pnt(2, 2, 1)).Shape(),
+                        BRepPrimAPI_MakeBox(gp_Pnt(1, 1, -1), gp_Pnt(3, 3, 2)).Shape()).Shape()
+    if nurbs:
+        L = BRepBuilderAPI_NurbsConvert(L, True).Shape()
+    solid = explore(L, "Solid")[0]
+    calls = []
+    real = C.BRepClass3d_SolidClassifier
+
+    class Spy:
+        def __init__(self, *a):
+            self.c = real(*a)
+
+        def Perform(self, *a):
+            calls.append(a)
+            return self.c.Perform(*a)
+
+        def State(self):
+            return self.c.State()
+
+    monkeypatch.setattr(C, "BRepClass3d_SolidClassifier", Spy)
+    rng = np.random.default_rng(3)
+    # points near the concave edge (x = y = 1) and the convex edges, inside and out
+    P = np.concatenate([np.array([1.0, 1.0, 0.0]) + rng.uniform(-0.15, 0.15, (60, 3)) * [1, 1, 0] + [0, 0, 0.5],
+                        np.array([2.0, 0.5, 1.0]) + rng.uniform(-0.15, 0.15, (60, 3)) * [1, 0, 1],
+                        rng.uniform(-0.3, 2.3, (80, 3)) * [1, 1, 0.6]])
+    ext = ExactDistance(solid)
+    got = np.array([ext(p) for p in P])
+    want = np.array([BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*p)).Vertex(), solid).Value() for p in P])
+    assert np.allclose(got, want, rtol=0, atol=1e-7)
+    concave = np.hypot(*(P[:60, :2] - 1.0).T)
+    inside_near_concave = (P[:60, 0] < 1.0) & (P[:60, 1] < 1.0)
+    assert inside_near_concave.sum() > 5 and np.all(got[:60][inside_near_concave] == 0.0)
+    assert np.all(concave[inside_near_concave] > 0.0)
+    outside = want > 1e-3
+    assert outside.sum() > 20 and (want == 0.0).sum() > 20
+    assert len(calls) <= 0.1 * len(P)

@@ -245,7 +245,8 @@ class ExactDistance:
     whose bounding box (``BRepBndLib``: never nearer than its shape) is no nearer than the best
     distance found skipped.  As there, a point inside a solid is at distance 0: when its nearest
     boundary point lies inside a face, the side of the face's outward normal it lies on decides
-    (the segment to it crosses no other boundary), else ``BRepClass3d_SolidClassifier``.  It agrees
+    (the segment to it crosses no other boundary), when it lies inside an edge the sum of the edge's
+    two face normals (see :meth:`_inside`), else ``BRepClass3d_SolidClassifier``.  It agrees
     with ``BRepExtrema_DistShapeShape`` to 1e-7 mm, never above it (that one keeps a solution
     within ``Precision::Confusion`` of a nearer one); see ``tests/test_tooling_gap_distance.py``.
     """
@@ -258,6 +259,7 @@ class ExactDistance:
         self.vertices = np.array([BRep_Tool.Pnt_s(v).Coord() for v in explore(shape, "Vertex")], dtype=float).reshape(-1, 3)
         self.solid = shape if explore(shape, "Solid") else None
         self._classifier = None
+        self._edge_faces = None  # edge -> its faces, made when first asked
         self.items = []  # (kind, sub-shape, solver)
         boxes = []
         for e in explore(shape, "Edge"):
@@ -287,7 +289,7 @@ class ExactDistance:
             k = int(np.argmin(dv))
             best, point = float(dv[k]), self.vertices[k]
         box_d = np.linalg.norm(np.maximum(np.maximum(self.lo - p, p - self.hi), 0.0), axis=1)
-        vertex = None
+        vertex, edge_best, edge_hit = None, math.inf, None
         for i in np.argsort(box_d, kind="stable"):
             if box_d[i] >= best:
                 break  # this box and every later one are no nearer than the best distance found
@@ -302,35 +304,102 @@ class ExactDistance:
                 continue
             for k in range(1, ext.NbExt() + 1):
                 d = math.sqrt(max(ext.SquareDistance(k), 0.0))
-                if d < best:
+                if d < best or (kind == "edge" and d < edge_best):
                     q = ext.Point(k)
-                    best, point = d, np.array((q.Value() if hasattr(q, "Value") else q).Coord())
-                    where = (sub, ext.Parameter(k)) if kind == "face" else None
-        if self.solid is not None and best > 0.0 and self._inside(p, point, where):
-            return 0.0, p
+                    qk = np.array((q.Value() if hasattr(q, "Value") else q).Coord())
+                    if kind == "edge" and d < edge_best:
+                        edge_best, edge_hit = d, (kind, sub, ext.Parameter(k), qk)
+                    if d < best:
+                        best, point, where = d, qk, (kind, sub, ext.Parameter(k), qk)
+        if self.solid is not None and best > 0.0:
+            # a face's extremum on its boundary (p - q along the face): the edge there, if one was found as
+            # near to within the edge's tolerance (its curve and the face's boundary differ by that much)
+            tie = None
+            if edge_hit is not None:
+                from OCP.BRep import BRep_Tool
+
+                if edge_best <= best + max(1e-9 * max(1.0, best), BRep_Tool.Tolerance_s(edge_hit[1])):
+                    tie = edge_hit
+            if self._inside(p, where, tie):
+                return 0.0, p
         return best, np.asarray(point, dtype=float)
 
-    def _inside(self, p: np.ndarray, q: np.ndarray, where) -> bool:
-        """Whether ``p`` (nearest boundary point ``q``) lies inside the solid."""
-        from OCP.BRepAdaptor import BRepAdaptor_Surface
-        from OCP.BRepClass3d import BRepClass3d_SolidClassifier
-        from OCP.gp import gp_Pnt, gp_Vec
-        from OCP.TopAbs import TopAbs_Orientation, TopAbs_State
+    def _inside(self, p: np.ndarray, where, tie=None) -> bool:
+        """Whether ``p`` lies inside the solid; ``where`` = ``(kind, sub-shape, parameter, q)`` of its
+        nearest boundary point ``q`` (None: a vertex), ``tie`` the same of an edge point as near.
 
-        if where is not None:  # nearest point inside a face: p - q lies along the face's normal there
-            face, (u, v) = where
-            pt, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
-            BRepAdaptor_Surface(face).D1(u, v, pt, du, dv)
-            n = np.cross(du.Coord(), dv.Coord())
-            if face.Orientation() == TopAbs_Orientation.TopAbs_REVERSED:
-                n = -n
-            side = float(np.dot(n, p - q))
-            if abs(side) > 1e-3 * np.linalg.norm(n) * np.linalg.norm(p - q):
-                return side < 0.0
+        ``q`` inside a face: ``p - q`` lies along the face's normal there, whose side decides.  ``q``
+        inside an edge: ``p - q`` lies in the solid's normal cone there, spanned by the two faces'
+        outward normals at ``q`` (outside, at a convex edge) or by their opposites (inside, at a
+        concave one: the nearest boundary point of a point on the other side cannot lie on such an
+        edge), so the sign of ``(p - q) . (n1 + n2)`` decides (the pseudo-normal of Bærentzen and
+        Aanæs, 2005); this is also asked of ``tie`` when ``p - q`` runs along the face (its extremum
+        on an edge).  Otherwise (a vertex, a seam, a knife edge) ``BRepClass3d_SolidClassifier``
+        decides (8 ms a point on a punch)."""
+        from OCP.BRepClass3d import BRepClass3d_SolidClassifier
+        from OCP.gp import gp_Pnt
+        from OCP.TopAbs import TopAbs_State
+
+        for hit in (where, tie):
+            if hit is None:
+                continue
+            kind, sub, t, q = hit
+            n = self._face_normal(sub, *t) if kind == "face" else self._edge_pseudo_normal(sub, t)
+            if n is not None:
+                side = float(np.dot(n, p - q))
+                if abs(side) > 1e-3 * np.linalg.norm(n) * np.linalg.norm(p - q):
+                    return side < 0.0
         if self._classifier is None:
             self._classifier = BRepClass3d_SolidClassifier(self.solid)
         self._classifier.Perform(gp_Pnt(*map(float, p)), 1e-7)
         return self._classifier.State() == TopAbs_State.TopAbs_IN
+
+    @staticmethod
+    def _face_normal(face, u: float, v: float) -> np.ndarray | None:
+        """The outward (for the face's orientation) normal of ``face`` at ``(u, v)``, not unit."""
+        from OCP.BRepAdaptor import BRepAdaptor_Surface
+        from OCP.gp import gp_Pnt, gp_Vec
+        from OCP.TopAbs import TopAbs_Orientation
+
+        pt, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
+        BRepAdaptor_Surface(face).D1(u, v, pt, du, dv)
+        n = np.cross(du.Coord(), dv.Coord())
+        if face.Orientation() == TopAbs_Orientation.TopAbs_REVERSED:
+            n = -n
+        return n
+
+    def _edge_pseudo_normal(self, edge, t: float) -> np.ndarray | None:
+        """``n1 + n2`` (unit outward normals of the edge's two faces at parameter ``t``), or None when
+        ``t`` is at the edge's end, the edge is a seam or does not bound exactly two faces, its
+        p-curves may not share its parameter, or a normal vanishes."""
+        from OCP.BRep import BRep_Tool
+        from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+        from OCP.TopAbs import TopAbs_ShapeEnum
+        from OCP.TopExp import TopExp
+        from OCP.TopoDS import TopoDS
+        from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+
+        a, b = BRep_Tool.Range_s(edge)
+        if not BRep_Tool.SameParameter_s(edge) or not a + 1e-9 * (b - a) < t < b - 1e-9 * (b - a):
+            return None
+        if self._edge_faces is None:
+            self._edge_faces = TopTools_IndexedDataMapOfShapeListOfShape()
+            TopExp.MapShapesAndAncestors_s(self.solid, TopAbs_ShapeEnum.TopAbs_EDGE, TopAbs_ShapeEnum.TopAbs_FACE,
+                                           self._edge_faces)
+        if not self._edge_faces.Contains(edge):
+            return None
+        faces = [TopoDS.Face_s(f) for f in self._edge_faces.FindFromKey(edge)]
+        if len(faces) != 2 or faces[0].IsSame(faces[1]):
+            return None
+        total = np.zeros(3)
+        for f in faces:
+            u, v = BRepAdaptor_Curve2d(edge, f).Value(t).Coord()
+            n = self._face_normal(f, u, v)
+            size = float(np.linalg.norm(n))
+            if not size > 0.0:
+                return None
+            total += n / size
+        return total
 
     def __call__(self, p) -> float:
         """The distance (mm) from ``p`` to the shape."""
