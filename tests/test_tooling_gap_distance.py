@@ -333,31 +333,11 @@ def test_bound_area_is_at_least_the_exact_area_and_close_to_it(radius, height):
     assert bound_area(box, 0.005) == pytest.approx(2 * (radius * height + 2 * radius + 2 * height) / np.cos(0.2), rel=1e-12)
 
 
-@pytest.mark.parametrize("nurbs", [False, True])
-def test_exact_distance_signs_points_nearest_to_edges_without_the_classifier(monkeypatch, nurbs):
-    """Inside or outside, for a point whose nearest boundary point lies on an edge, follows from the
-    edge's two face normals (the solid's normal cone there): on an L-shaped solid (a concave edge
-    along which inside points are nearest, convex edges for outside ones), plain and converted to
-    B-spline faces (where a face's extremum on its boundary ties with the edge's), ``ExactDistance``
-    gives ``BRepExtrema_DistShapeShape``'s distance (0 inside) to 1e-7 mm and asks the solid
-    classifier for few points (those nearest to a vertex)."""
+def _classifier_spy(monkeypatch):
+    """Count ``BRepClass3d_SolidClassifier.Perform`` calls (the classifier ``ExactDistance`` falls back on)."""
     import OCP.BRepClass3d as C
-    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex, BRepBuilderAPI_NurbsConvert
-    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
-    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
-    from OCP.gp import gp_Pnt
 
-    from tabletcad.cad._occ import explore
-    from tabletcad.tooling.interference import ExactDistance
-
-    L = BRepAlgoAPI_Cut(BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), gp_Pnt(2, 2, 1)).Shape(),
-                        BRepPrimAPI_MakeBox(gp_Pnt(1, 1, -1), gp_Pnt(3, 3, 2)).Shape()).Shape()
-    if nurbs:
-        L = BRepBuilderAPI_NurbsConvert(L, True).Shape()
-    solid = explore(L, "Solid")[0]
-    calls = []
-    real = C.BRepClass3d_SolidClassifier
+    calls, real = [], C.BRepClass3d_SolidClassifier
 
     class Spy:
         def __init__(self, *a):
@@ -371,19 +351,117 @@ def test_exact_distance_signs_points_nearest_to_edges_without_the_classifier(mon
             return self.c.State()
 
     monkeypatch.setattr(C, "BRepClass3d_SolidClassifier", Spy)
+    return calls
+
+
+def _box_distance(P, lo, hi):
+    return np.linalg.norm(np.maximum(np.maximum(np.asarray(lo) - P, P - np.asarray(hi)), 0.0), axis=1)
+
+
+@pytest.mark.parametrize("nurbs", [False, True])
+def test_exact_distance_signs_points_nearest_to_edges_without_the_classifier(monkeypatch, nurbs):
+    """Inside or outside, for a point whose nearest boundary point lies on an edge, follows from the
+    edge's two face normals (the solid's normal cone there): on an L-shaped solid (a concave edge
+    along which inside points are nearest, convex edges for outside ones), plain and converted to
+    B-spline faces (where a face's extremum on its boundary ties with the edge's), ``ExactDistance``
+    gives the closed form (0 inside; outside, the nearer of the two boxes' distances) to 1e-7 mm
+    and asks the solid classifier for few points (those nearest to a vertex)."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.gp import gp_Pnt
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.interference import ExactDistance
+
+    L = BRepAlgoAPI_Cut(BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), gp_Pnt(2, 2, 1)).Shape(),
+                        BRepPrimAPI_MakeBox(gp_Pnt(1, 1, -1), gp_Pnt(3, 3, 2)).Shape()).Shape()
+    if nurbs:
+        L = BRepBuilderAPI_NurbsConvert(L, True).Shape()
+    calls = _classifier_spy(monkeypatch)
     rng = np.random.default_rng(3)
-    # points near the concave edge (x = y = 1) and the convex edges, inside and out
-    P = np.concatenate([np.array([1.0, 1.0, 0.0]) + rng.uniform(-0.15, 0.15, (60, 3)) * [1, 1, 0] + [0, 0, 0.5],
+    # points near the concave edge (x = y = 1) and a convex edge, inside and out, and anywhere
+    P = np.concatenate([np.array([1.0, 1.0, 0.5]) + rng.uniform(-0.15, 0.15, (60, 3)) * [1, 1, 0],
                         np.array([2.0, 0.5, 1.0]) + rng.uniform(-0.15, 0.15, (60, 3)) * [1, 0, 1],
                         rng.uniform(-0.3, 2.3, (80, 3)) * [1, 1, 0.6]])
-    ext = ExactDistance(solid)
-    got = np.array([ext(p) for p in P])
-    want = np.array([BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*p)).Vertex(), solid).Value() for p in P])
-    assert np.allclose(got, want, rtol=0, atol=1e-7)
-    concave = np.hypot(*(P[:60, :2] - 1.0).T)
-    inside_near_concave = (P[:60, 0] < 1.0) & (P[:60, 1] < 1.0)
-    assert inside_near_concave.sum() > 5 and np.all(got[:60][inside_near_concave] == 0.0)
-    assert np.all(concave[inside_near_concave] > 0.0)
-    outside = want > 1e-3
-    assert outside.sum() > 20 and (want == 0.0).sum() > 20
+    a = _box_distance(P, (0, 0, 0), (2, 1, 1))  # the L is the union of two boxes
+    b = _box_distance(P, (0, 0, 0), (1, 2, 1))
+    closed = np.minimum(a, b)  # 0 inside either box
+    got = np.array([ExactDistance(explore(L, "Solid")[0])(p) for p in P])
+    assert np.allclose(got, closed, rtol=0, atol=1e-7)
+    near_concave = (P[:60, 0] < 1.0) & (P[:60, 1] < 1.0)  # inside, nearest to the concave edge
+    assert near_concave.sum() > 5 and np.all(got[:60][near_concave] == 0.0)
+    assert (closed > 1e-3).sum() > 20 and (closed == 0.0).sum() > 20
     assert len(calls) <= 0.1 * len(P)
+
+
+def test_exact_distance_at_a_sharp_bspline_edge_asks_the_edge_not_the_face():
+    """Near a 20° edge of a prism converted to B-spline faces, ``BRepExtrema_ExtPF`` returns points on a
+    face's boundary, off its normal, where the face's normal points the wrong way: the edge (as near,
+    within its tolerance) decides, and every point gets 0 inside the wedge (its three half-planes
+    and two heights) and ``BRepExtrema_DistShapeShape``'s distance outside."""
+    from OCP.BRepBuilderAPI import (BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon, BRepBuilderAPI_MakeVertex,
+                                    BRepBuilderAPI_NurbsConvert)
+    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
+    from OCP.gp import gp_Pnt, gp_Vec
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.interference import ExactDistance
+
+    tan = np.tan(np.radians(20.0))
+    poly = BRepBuilderAPI_MakePolygon(gp_Pnt(0, 0, 0), gp_Pnt(3, 0, 0), gp_Pnt(3, 3 * tan, 0), True)
+    wedge = BRepPrimAPI_MakePrism(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), gp_Vec(0, 0, 1)).Shape()
+    solid = explore(BRepBuilderAPI_NurbsConvert(wedge, True).Shape(), "Solid")[0]
+    ext = ExactDistance(solid)
+    rng = np.random.default_rng(11)
+    P = np.concatenate([[[-0.025170148887782406, -0.07608190636709793, 0.9518072884633912]],  # outside, 0.0801
+                        rng.uniform(-0.1, 0.1, (150, 3)) + [0.1, 0.02, 0.5],  # around the sharp edge on the z axis
+                        rng.uniform(-0.2, 0.2, (100, 3)) + [3.0, 0.5, 0.5]])
+    inside = (P[:, 1] >= 0) & (P[:, 0] <= 3) & (P[:, 1] <= P[:, 0] * tan) & (P[:, 2] >= 0) & (P[:, 2] <= 1)
+    got = np.array([ext(p) for p in P])
+    assert 20 < inside.sum() < len(P) - 20
+    assert np.all(got[inside] == 0.0)
+    for p, d in zip(P[~inside], got[~inside]):
+        dss = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*p)).Vertex(), solid).Value()
+        assert d == pytest.approx(dss, abs=1e-7)
+    assert got[0] == pytest.approx(0.0801373375617, abs=1e-9)
+
+
+def test_grid_points_on_an_external_edge_are_not_kept_as_boundary():
+    """An EXTERNAL edge of a face (not part of its boundary, though ``UVBounds`` counts it) along a
+    side of the (u, v) box marks no grid point ON: the square face's samples stay inside it."""
+    from OCP.BRep import BRep_Builder, BRep_Tool
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeVertex
+    from OCP.BRepLib import BRepLib
+    from OCP.BRepTools import BRepTools
+    from OCP.Geom import Geom_Plane
+    from OCP.Geom2d import Geom2d_Line
+    from OCP.gp import gp_Dir, gp_Dir2d, gp_Pln, gp_Pnt, gp_Pnt2d
+    from OCP.TopAbs import TopAbs_Orientation
+    from OCP.TopoDS import TopoDS, TopoDS_Iterator, TopoDS_Wire
+
+    import tabletcad.tooling.interference as I
+    from tabletcad.cad._occ import explore
+
+    plane = Geom_Plane(gp_Pln(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)))
+    face = BRepBuilderAPI_MakeFace(plane, 0.0, 1.0, 0.0, 1.0, 1e-7).Face()
+    corner = next(v for v in explore(face, "Vertex") if BRep_Tool.Pnt_s(v).Distance(gp_Pnt(0, 0, 0)) < 1e-9)
+    start = BRepBuilderAPI_MakeVertex(gp_Pnt(0, -0.5, 0)).Vertex()
+    edge = BRepBuilderAPI_MakeEdge(Geom2d_Line(gp_Pnt2d(0, -0.5), gp_Dir2d(0, 1)), plane, start, corner, 0.0, 0.5).Edge()
+    BRepLib.BuildCurves3d_s(edge)
+    b, w = BRep_Builder(), TopoDS_Wire()
+    b.MakeWire(w)
+    it = TopoDS_Iterator(BRepTools.OuterWire_s(face))
+    while it.More():
+        b.Add(w, it.Value())
+        it.Next()
+    b.Add(w, edge.Oriented(TopAbs_Orientation.TopAbs_EXTERNAL))
+    f2 = TopoDS.Face_s(face.EmptyCopied())
+    b.Add(f2, w)
+    assert BRepTools.UVBounds_s(f2)[2] == pytest.approx(-0.5)
+    u0, u1, v0, v1 = BRepTools.UVBounds_s(f2)
+    on = I._on_straight_sides(f2, np.linspace(u0, u1, 11), np.linspace(v0, v1, 13))
+    assert on.any() and not on[:, np.linspace(v0, v1, 13) < -1e-9].any()
+    P = I.face_samples(f2, spacing=0.1)
+    assert len(P) > 50 and P[:, 1].min() >= -1e-9

@@ -328,26 +328,28 @@ class ExactDistance:
         """Whether ``p`` lies inside the solid; ``where`` = ``(kind, sub-shape, parameter, q)`` of its
         nearest boundary point ``q`` (None: a vertex), ``tie`` the same of an edge point as near.
 
-        ``q`` inside a face: ``p - q`` lies along the face's normal there, whose side decides.  ``q``
+        ``q`` inside a face: ``p - q`` lies along the face's normal there, whose side decides (only
+        then: ``BRepExtrema_ExtPF`` may return a point on the face's boundary, off the normal).  ``q``
         inside an edge: ``p - q`` lies in the solid's normal cone there, spanned by the two faces'
         outward normals at ``q`` (outside, at a convex edge) or by their opposites (inside, at a
         concave one: the nearest boundary point of a point on the other side cannot lie on such an
         edge), so the sign of ``(p - q) . (n1 + n2)`` decides (the pseudo-normal of Bærentzen and
-        Aanæs, 2005); this is also asked of ``tie`` when ``p - q`` runs along the face (its extremum
-        on an edge).  Otherwise (a vertex, a seam, a knife edge) ``BRepClass3d_SolidClassifier``
+        Aanæs, 2005); ``tie`` is asked first.  Otherwise (a vertex, a seam, a knife edge) ``BRepClass3d_SolidClassifier``
         decides (8 ms a point on a punch)."""
         from OCP.BRepClass3d import BRepClass3d_SolidClassifier
         from OCP.gp import gp_Pnt
         from OCP.TopAbs import TopAbs_State
 
-        for hit in (where, tie):
+        for hit in (tie, where):  # an edge as near first: a face's extremum may lie on its boundary
             if hit is None:
                 continue
             kind, sub, t, q = hit
             n = self._face_normal(sub, *t) if kind == "face" else self._edge_pseudo_normal(sub, t)
             if n is not None:
-                side = float(np.dot(n, p - q))
-                if abs(side) > 1e-3 * np.linalg.norm(n) * np.linalg.norm(p - q):
+                side = float(np.dot(n, p - q)) / max(float(np.linalg.norm(n) * np.linalg.norm(p - q)), 1e-300)
+                # a face decides only at a true projection (p - q along its normal: not an extremum
+                # on its boundary, where the normal can point either way at a sharp edge)
+                if abs(side) > (1.0 - 1e-6 if kind == "face" else 1e-3):
                     return side < 0.0
         if self._classifier is None:
             self._classifier = BRepClass3d_SolidClassifier(self.solid)
@@ -592,11 +594,15 @@ def _on_straight_sides(face, us, vs) -> np.ndarray:
     (a cup's rim and seam after the Boolean that cut letters into it: 1,668 points a face)."""
     from OCP.BRepAdaptor import BRepAdaptor_Curve2d
     from OCP.GeomAbs import GeomAbs_CurveType
+    from OCP.TopAbs import TopAbs_Orientation
 
     on = np.zeros((len(us), len(vs)), dtype=bool)
     eps = (1e-12 * max(1.0, abs(us[0]), abs(us[-1])), 1e-12 * max(1.0, abs(vs[0]), abs(vs[-1])))
     sides = ((0, us[0]), (0, us[-1]), (1, vs[0]), (1, vs[-1]))
+    bounding = (TopAbs_Orientation.TopAbs_FORWARD, TopAbs_Orientation.TopAbs_REVERSED)
     for e in explore(face, "Edge"):
+        if e.Orientation() not in bounding:  # an INTERNAL or EXTERNAL edge bounds nothing
+            continue
         try:
             c = BRepAdaptor_Curve2d(e, face)
         except Exception:  # no p-curve on this face: the classifier decides
