@@ -248,7 +248,10 @@ class ExactDistance:
     (the segment to it crosses no other boundary), when it lies inside an edge the sum of the edge's
     two face normals (see :meth:`_inside`), else ``BRepClass3d_SolidClassifier``.  It agrees
     with ``BRepExtrema_DistShapeShape`` to 1e-7 mm, never above it (that one keeps a solution
-    within ``Precision::Confusion`` of a nearer one); see ``tests/test_tooling_gap_distance.py``.
+    within ``Precision::Confusion`` of a nearer one), except that ``DistShapeShape`` sometimes gives
+    a point just inside a solid its distance to the boundary where this gives 0 (a review found it
+    within about 1e-3 mm of the boundary); see ``tests/test_tooling_gap_distance.py``, which checks
+    inside points against closed-form inside tests.
     """
 
     def __init__(self, shape) -> None:
