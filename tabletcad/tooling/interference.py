@@ -360,7 +360,7 @@ class ExactDistance:
         return self._classifier.State() == TopAbs_State.TopAbs_IN
 
     @staticmethod
-    def _face_normal(face, u: float, v: float) -> np.ndarray | None:
+    def _face_normal(face, u: float, v: float) -> np.ndarray:
         """The outward (for the face's orientation) normal of ``face`` at ``(u, v)``, not unit."""
         from OCP.BRepAdaptor import BRepAdaptor_Surface
         from OCP.gp import gp_Pnt, gp_Vec
