@@ -15,8 +15,10 @@ For every sample design that is not a cut-away, prints (best of ``--repeat`` run
 * ``b123d``: the same *nominal* shape made directly in build123d from exact arcs -
   a revolve of its profile (band, spherical caps / elliptic domes, sphere, spheroid,
   ring rectangle) - with ``is_valid()``, its volume, and its own ``export_step`` and
-  ``export_stl`` at the same deflections (0.005 mm, 0.2 rad) as the tablet's STL;
-  oval tablets (not solids of revolution) use the round tablet of equal width and
+  ``export_stl`` at the same deflections (0.005 mm, 0.2 rad) as the tablet's STL; a round
+  family (flat face, bevel or radius edge, concave with a land, compound cup, concave bevel)
+  revolves its own face profile, every line and arc of it (the peer's volume is printed
+  against the B-rep's); oval tablets (not solids of revolution) use the round tablet of equal width and
   the stadium an extruded ``SlotOverall`` plan (marked ``~``);
 * the ratio ``(solid + check + export) / b123d``.
 
@@ -33,6 +35,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+import numpy as np
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -101,10 +105,31 @@ def _band_tablet(R: float, z0: float, z1: float, d0: float, d1: float):
     return _revolve_profile(items)
 
 
+def _round_family_items(tablet):
+    """Profile items of a round family's exact nominal (every line and arc of its face profile,
+    land, bevel, compound radii and band, at radius ``R - d``), or None for other tablets."""
+    nom = tablet.nominal
+    outline, chain = getattr(nom, "outline", None), getattr(nom, "chain", None)
+    if outline is None or chain is None or getattr(outline, "name", "") != "circle":
+        return None
+    R = outline.segs[0].radius
+    items = []
+    for e in chain:  # bottom centre -> band -> top centre, each element in (d, z) with d inward from the rim
+        a, m, b = ((R - float(q[0]), float(q[1])) for q in e.point(np.array([0.0, 0.5, 1.0])))
+        if math.dist(a, b) <= 1e-12 * R:
+            continue
+        items.append(("line", a, b) if e.kind == "line" else ("arc3", a, m, b))
+    items.append(("line", items[-1][-1], items[0][1]))  # the axis, top centre to bottom centre
+    return items
+
+
 def nominal_build123d(tablet):
     """(build123d solid, kind) for the nominal shape of a sample tablet; kind '~' marks a stand-in."""
     import build123d as bd
 
+    items = _round_family_items(tablet)
+    if items is not None:  # a round family: its own face profile, exactly
+        return _revolve_profile(items), "revolve (the family's profile)"
     f, p = tablet.family.removeprefix("thesis."), dict(getattr(tablet, "params", {}) or {})
     if f in ("shallow_convex_round", "deep_convex_round"):
         T, b, D = p["thickness"], p["band"], p["diameter"]
@@ -233,7 +258,8 @@ def main(argv=None) -> None:
             print(
                 f"{Path(path).stem:24s} {load_s:6.2f} {solid_s:6.3f} {check_s:6.3f} {export_s:6.3f} {total:6.3f} "
                 f"{ref[0]:6.3f} {total / ref[0]:5.1f}  {poles:>10s} {solid.max_fit_deviation:8.1e} "
-                f"{len(mesh.triangles):6d} {rel:9.1e} {bound:8.1e}  {ref[1]}{'' if ref[2] else ' (INVALID)'}",
+                f"{len(mesh.triangles):6d} {rel:9.1e} {bound:8.1e}  {ref[1]}{'' if ref[2] else ' (INVALID)'}"
+                f"{'' if ref[1].startswith('~') else f', volume {(ref[3] - solid.volume) / solid.volume:+.0e}'}",
                 flush=True,
             )
     if totals:
