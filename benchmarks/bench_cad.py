@@ -17,9 +17,11 @@ For every sample design that is not a cut-away, prints (best of ``--repeat`` run
   ring rectangle) - with ``is_valid()``, its volume, and its own ``export_step`` and
   ``export_stl`` at the same deflections (0.005 mm, 0.2 rad) as the tablet's STL; a round
   family (flat face, bevel or radius edge, concave with a land, compound cup, concave bevel)
-  revolves its own face profile, every line and arc of it (the peer's volume is printed
-  against the B-rep's); oval tablets (not solids of revolution) use the round tablet of equal width and
-  the stadium an extruded ``SlotOverall`` plan (marked ``~``);
+  revolves its own face profile, every line and arc of it, and a capsule has its profile revolved
+  about each end's centre and extruded along each side, the faces made one shell (the peer's
+  volume is printed against the B-rep's); oval tablets (not solids of revolution) use the round tablet of equal width and
+  the other shaped outlines (whose corners collapse inside the cup) and the stadium an extruded
+  ``SlotOverall`` of their plan's extents (marked ``~``: stand-ins, not the same shape);
 * the ratio ``(solid + check + export) / b123d``.
 
 Figures only; nothing is asserted.  The design load (PDE solve) is printed apart.
@@ -123,6 +125,53 @@ def _round_family_items(tablet):
     return items
 
 
+def _profile_items(chain, to_3d):
+    """build123d edges of a profile chain, each point ``(d, z)`` placed by ``to_3d``."""
+    import build123d as bd
+
+    edges = []
+    for e in chain:
+        a, m, b = (tuple(float(x) for x in q) for q in e.point(np.array([0.0, 0.5, 1.0])))
+        if math.dist(a, b) <= 1e-12 * max(1.0, abs(a[0]), abs(a[1])):
+            continue
+        if e.kind == "line":
+            edges.append(bd.Edge.make_line(to_3d(a), to_3d(b)))
+        else:
+            edges.append(bd.Edge.make_three_point_arc(to_3d(a), to_3d(m), to_3d(b)))
+    return edges
+
+
+def _swept_outline_peer(tablet):
+    """The exact nominal of a tablet whose face profile is swept along an outline of lines and
+    arcs none of which collapses (every arc's radius at least the profile's inward reach; the
+    capsule): each profile edge revolved about an arc's centre through its angle, or extruded
+    along a line, the faces made one shell.  None for other tablets."""
+    import build123d as bd
+
+    nom = tablet.nominal
+    outline, chain = getattr(nom, "outline", None), getattr(nom, "chain", None)
+    if outline is None or chain is None or getattr(outline, "name", "") == "circle":
+        return None
+    reach = max(float(np.max(e.point(np.linspace(0.0, 1.0, 65))[:, 0])) for e in chain)
+    faces = []
+    for s in outline.segs:
+        if s.kind == "arc":
+            if s.radius < reach * (1.0 - 1e-12):
+                return None  # the arc's offsets collapse: not a plain sweep
+            c, rho, th = s.center, s.radius, s.theta0
+            axis = bd.Axis((c[0], c[1], 0.0), (0.0, 0.0, 1.0))
+            for e in _profile_items(chain, lambda q: bd.Vector(c[0] + (rho - q[0]) * math.cos(th),
+                                                                c[1] + (rho - q[0]) * math.sin(th), q[1])):
+                faces.append(bd.Face.revolve(e, math.degrees(s.sweep), axis))
+        else:
+            p0, p1 = np.asarray(s.p0), np.asarray(s.p1)
+            t = (p1 - p0) / np.linalg.norm(p1 - p0)
+            n = np.array([t[1], -t[0]])  # outward for the counter-clockwise outline
+            for e in _profile_items(chain, lambda q: bd.Vector(*(p0 - q[0] * n), q[1])):
+                faces.append(bd.Face.extrude(e, bd.Vector(*(p1 - p0), 0.0)))
+    return bd.Solid(bd.Shell(faces))
+
+
 def nominal_build123d(tablet):
     """(build123d solid, kind) for the nominal shape of a sample tablet; kind '~' marks a stand-in."""
     import build123d as bd
@@ -130,6 +179,9 @@ def nominal_build123d(tablet):
     items = _round_family_items(tablet)
     if items is not None:  # a round family: its own face profile, exactly
         return _revolve_profile(items), "revolve (the family's profile)"
+    swept = _swept_outline_peer(tablet)
+    if swept is not None:  # a capsule: its profile around the outline, exactly
+        return swept, "revolve/extrude (the family's profile around the outline)"
     f, p = tablet.family.removeprefix("thesis."), dict(getattr(tablet, "params", {}) or {})
     if f in ("shallow_convex_round", "deep_convex_round"):
         T, b, D = p["thickness"], p["band"], p["diameter"]

@@ -2,7 +2,8 @@
 
 ``benchmarks/bench_cad.py`` times the CAD stage against a hand-made build123d solid of the same
 nominal shape; a round family's peer revolves the family's own face profile (every line and arc:
-land, bevel, compound radii, edge radius).  A peer that left a feature out would flatter or
+land, bevel, compound radii, edge radius), and a capsule's peer revolves it about each end's centre
+and extrudes it along each side.  A peer that left a feature out would flatter or
 penalise the ratio, so each round family sample's peer is checked here: a valid solid whose
 volume differs from the PDE tablet's by at most its area times the tablet's measured distance
 from the same nominal (``nominal_deviation``, 1e-10 to 3.4e-6 mm on these samples; the
@@ -36,12 +37,13 @@ def _bench_cad():
     return mod
 
 
-@pytest.mark.parametrize("name", ROUND)
-def test_a_round_familys_peer_is_its_own_profile_revolved(name):
+@pytest.mark.parametrize("name", ROUND + ("capsule",))
+def test_a_familys_peer_is_its_own_profile_revolved(name):
     bench = _bench_cad()
     tablet = load_design(ROOT / "samples" / "families" / f"{name}.toml")
     shape, kind = bench.nominal_build123d(tablet)
-    assert kind == "revolve (the family's profile)"
+    assert kind == ("revolve (the family's profile)" if name in ROUND
+                    else "revolve/extrude (the family's profile around the outline)")
     assert shape.is_valid
     assert abs(shape.volume - tablet.volume()) <= tablet.surface_area() * tablet.nominal_deviation()
     assert shape.area == pytest.approx(tablet.surface_area(), rel=2e-6)
