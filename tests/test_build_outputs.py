@@ -48,6 +48,75 @@ def test_rebuild_removes_only_unchanged_files_of_the_earlier_build(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging folder left
 
 
+def test_an_output_folder_on_its_own_file_system_is_built_into(tmp_path, monkeypatch):
+    """An existing output folder that is a mount point (or a link to another disk): renames across
+    its boundary fail (EXDEV, simulated here for every ``os.replace``), so the build stages inside it.
+    A rebuild, a foreign file kept, no staging folder left inside or beside it."""
+    import errno
+
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "mine.txt").write_text("the user's")
+    real = os.replace
+
+    def replace(src, dst):
+        inside = [out in Path(x).parents for x in (src, dst)]
+        if inside[0] != inside[1]:
+            raise OSError(errno.EXDEV, "Invalid cross-device link", str(src), None, str(dst))
+        return real(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace)
+    assert _stage(tmp_path, out, {"a.step": "A", "sub/b.svg": "B"}) == ["a.step", "sub/b.svg"]
+    assert _stage(tmp_path, out, {"a.step": "A2"}) == ["a.step"]
+    assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*")) == [MANIFEST, "a.step", "mine.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
+def test_a_killed_builds_staging_folder_inside_the_output_folder_is_cleaned(tmp_path):
+    from tabletcad.io.outputs import INNER_PREFIX
+
+    out = tmp_path / "out"
+    _stage(tmp_path, out, {"a.step": "A"})
+    child = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    dead = out / f"{INNER_PREFIX}dead"
+    dead.mkdir()
+    import socket
+
+    (dead / STAGING_MARKER).write_text(json.dumps(dict(pid=int(child.stdout), host=socket.gethostname(),
+                                                       started=time.time())))
+    (out / ".tabletcad-staging.notours").mkdir()  # no marker: left alone
+    assert _stage(tmp_path, out, {"a.step": "A2"}) == ["a.step"]
+    assert not dead.exists() and (out / ".tabletcad-staging.notours").is_dir()
+
+
+def test_build_into_a_link_to_another_file_system(tmp_path):
+    """``tabletcad build --out LINK`` where LINK points at a folder on another file system than its
+    own parent (/dev/shm, a tmpfs, when the machine has one apart from the tests' folder; else the
+    link's target is a folder beside it, still a link to follow)."""
+    import shutil
+    import uuid
+
+    shm = Path("/dev/shm")
+    other = shm.is_dir() and os.access(shm, os.W_OK) and os.stat(shm).st_dev != os.stat(tmp_path).st_dev
+    target = (shm if other else tmp_path) / f"tabletcad-test-{uuid.uuid4().hex}"
+    target.mkdir()
+    try:
+        link = tmp_path / "link"
+        link.symlink_to(target, target_is_directory=True)
+        design = ROOT / "samples" / "flat_faced_round.toml"
+        env = {**os.environ, "PYTHONPATH": str(ROOT)}
+        for _ in range(2):  # a first build and a rebuild
+            p = subprocess.run([sys.executable, "-m", "tabletcad", "build", str(design), "--out", str(link), "--quiet"],
+                               capture_output=True, text=True, env=env, timeout=300)
+            assert p.returncode == 0, p.stderr
+        names = sorted(q.name for q in target.iterdir())
+        assert "report.json" in names and MANIFEST in names
+        assert not any(n.startswith(".tabletcad-staging.") for n in names)
+        assert sorted(q.name for q in tmp_path.iterdir()) == ["link"] + ([] if other else [target.name])
+    finally:
+        shutil.rmtree(target, ignore_errors=True)
+
+
 def test_a_build_never_replaces_a_file_it_did_not_write(tmp_path):
     """A file of a name the build writes that no build wrote there (or that was edited since the
     build that did) is refused before anything in the folder changes; an unchanged one is replaced."""

@@ -135,9 +135,27 @@ def test_a_directory_as_design_file(capsys, tmp_path):
 def test_out_naming_an_existing_file(capsys, tmp_path):
     (tmp_path / "taken").write_text("keep me")
     rc, _, err = run(capsys, "build", ROOT / "samples" / "spherical.toml", "--out", tmp_path / "taken")
-    assert "not an existing file" in assert_refused(rc, err, "--out")
+    assert "a file of that name exists" in assert_refused(rc, err, "--out")
     assert (tmp_path / "taken").read_text() == "keep me"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["taken"]
+
+
+@pytest.mark.parametrize("command", ["build", "optimise", "sweep"])
+def test_out_that_cannot_be_a_folder_is_refused_before_any_work(capsys, tmp_path, monkeypatch, command):
+    """An empty --out (an unset shell variable: it would build into the current folder), a folder
+    under a file, a folder of a virtual file system: one line for --out, nothing written."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "afile").write_text("x")
+    arg = {"build": ROOT / "samples" / "spherical.toml",
+           "optimise": ROOT / "samples" / "optimise" / "cylinder_min_area.toml",
+           "sweep": ROOT / "samples" / "sweep" / "concave_round_grid.toml"}[command]
+    cases = [("", "must name a folder"), (tmp_path / "afile" / "sub", "is a file, not a folder")]
+    if command == "build" and Path("/proc/self").is_dir():
+        cases.append(("/proc/tabletcad-out", "cannot be written"))
+    for out, fragment in cases:
+        rc, _, err = run(capsys, command, arg, "--out", out)
+        assert fragment in assert_refused(rc, err, "--out"), (out, err)
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
 
 
 @pytest.mark.parametrize(

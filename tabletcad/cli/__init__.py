@@ -232,7 +232,7 @@ def _run(argv: list[str] | None) -> int:
     except OSError as exc:
         if exc.filename is None:
             raise
-        _say(str(DesignError("path", str(exc.filename), (exc.strerror or type(exc).__name__).lower())))
+        _say("error: " + str(DesignError("path", str(exc.filename), (exc.strerror or type(exc).__name__).lower())))
         return 2
     return 0
 

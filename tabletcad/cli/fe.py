@@ -14,6 +14,7 @@ from typing import Any
 
 import click
 
+from tabletcad.cli.outputs import out_folder
 from tabletcad.errors import DesignError
 
 __all__ = ["COMMANDS"]
@@ -68,7 +69,7 @@ def fe_group() -> None:
 @click.option("--E", "E", type=float, default=5000.0, show_default=True, help="Young's modulus, MPa (stresses do not depend on it).")
 @click.option("--nu", type=float, default=0.3, show_default=True, help="Poisson's ratio.")
 @click.option("--no-error-estimate", is_flag=True, help="Skip the second (coarser) mesh of the error estimate.")
-@click.option("--out", type=click.Path(file_okay=True, path_type=Path), default=None,
+@click.option("--out", type=out_folder(), default=None,
               help="Folder for stress.vtu and section.png (tensile stress on the mid-thickness section).")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout.")
 @click.option("--json-file", type=click.Path(path_type=Path), default=None, help="Write the result as JSON to this file.")
@@ -186,7 +187,7 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
 @click.option("--effective-length-factor", type=float, default=2.0, show_default=True,
               help="Buckling: K of the tip column (2 = fixed at the barrel, free at the tip).")
 @click.option("--mesh-size", type=float, default=None, help="Element size, mm [default: tip width/8].")
-@click.option("--out", type=click.Path(file_okay=True, path_type=Path), default=None,
+@click.option("--out", type=out_folder(), default=None,
               help="Folder for stress.vtu and section.png (von Mises stress on the tip's axial section).")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout.")
 @click.option("--json-file", type=click.Path(path_type=Path), default=None, help="Write the result as JSON to this file.")

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import click
 
+from tabletcad.cli.outputs import out_folder
 from tabletcad.errors import DesignError
 from tabletcad.tolerance import DEFAULT, Tolerances
 
@@ -62,7 +63,7 @@ def shapes_cmd(as_json: bool, json_file: Path | None) -> None:
 
 @click.command("build")
 @click.argument("design", type=click.Path(dir_okay=False, path_type=Path))
-@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path), help="Output folder.")
+@click.option("--out", "out_dir", required=True, type=out_folder(), help="Output folder.")
 @click.option("--quiet", is_flag=True, help="No progress display.")
 def build_cmd(design: Path, out_dir: Path, quiet: bool) -> None:
     """Build DESIGN.toml: report.json, tablet.png and CAD files in OUT."""

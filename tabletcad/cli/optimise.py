@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import os
-import shutil
-import tempfile
 from pathlib import Path
 
 import click
+
+from tabletcad.cli.outputs import out_folder
 
 __all__ = ["COMMANDS"]
 
@@ -22,7 +21,7 @@ class OptimisationFailed(click.ClickException):
 
 @click.command("optimise")
 @click.argument("problem_file", metavar="PROBLEM.toml", type=click.Path(path_type=Path))
-@click.option("--out", "out_dir", required=True, type=click.Path(path_type=Path), help="Output folder.")
+@click.option("--out", "out_dir", required=True, type=out_folder(), help="Output folder.")
 @click.option("--method", default=None,
               help="Solver: SLSQP, trust-constr, multistart or differential_evolution (default: the file's "
                    "[problem] method, else SLSQP).")
@@ -36,7 +35,6 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
     Exit status 0 on a converged feasible optimum, 3 when the run fails (report.json
     says which constraint failed and by how much), 2 on bad input (nothing written).
     """
-    from tabletcad.errors import DesignError
     from tabletcad.optimise.files import SOLVER_KEYS, choice, load_problem
     from tabletcad.optimise.problem import METHODS
 
@@ -44,11 +42,6 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
     if method is not None:
         choice("--method", method, METHODS)
 
-    for folder in (out_dir, *out_dir.parents):
-        if folder.exists():
-            if not folder.is_dir():
-                raise DesignError("--out", str(out_dir), f"must be a folder path ({str(folder)!r} is a file)")
-            break
     problem, default_method, opts = load_problem(problem_file)
     for key, value in (("starts", starts), ("maxiter", maxiter)):
         if value is not None:  # the same limits as the file's [solver] table
@@ -66,9 +59,9 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
     build_error = ""
     result = solve(problem, method, progress=not quiet, **opts)
 
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
-    try:
+    from tabletcad.io.outputs import publish, staging_folder
+
+    with staging_folder(out_dir) as staging:  # all or nothing, on out_dir's file system; the folder's manifest
         report = result_report(result, problem)
         report["problem_file"] = str(problem_file)
         written = []
@@ -96,14 +89,7 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
         written.append("convergence.png")
         atomic_write_text(staging / "report.json", to_json(report))
         written.append("report.json")
-        out_dir.mkdir(parents=True, exist_ok=True)
-        for f in sorted(staging.iterdir()):
-            target = out_dir / f.name
-            if target.is_dir() and f.is_dir():
-                shutil.rmtree(target)
-            os.replace(f, target)
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
+        publish(staging, out_dir)  # replaces only an earlier build's unchanged files; refuses anyone else's
     click.echo(summary(result))
     click.echo(f"-> {out_dir}/ ({', '.join(written)})")
     if not result.success:

@@ -8,9 +8,11 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+import click
+
 from tabletcad.errors import DesignError
 
-__all__ = ["check_output", "staged"]
+__all__ = ["check_output", "check_out_folder", "out_folder", "staged"]
 
 
 def check_output(option: str, path: Path | None, suffixes: tuple[str, ...] = (".png", ".svg", ".pdf")) -> None:
@@ -30,6 +32,37 @@ def check_output(option: str, path: Path | None, suffixes: tuple[str, ...] = (".
     if not os.access(folder, os.W_OK | os.X_OK):
         raise DesignError(option, str(path), f"cannot be created: folder {folder} is not writable")
 
+
+
+def check_out_folder(option: str, raw: str | os.PathLike[str]) -> Path:
+    """The output folder ``raw`` as a path, or :class:`DesignError` for ``option`` before anything is
+    computed: an empty name (an unset shell variable would build into the current folder), an
+    existing file, or a folder that cannot be made or written."""
+    if not str(raw).strip():
+        raise DesignError(option, str(raw), "must name a folder (give . for the current one)")
+    path = Path(raw)
+    if path.exists() and not path.is_dir():
+        raise DesignError(option, str(path), "must be a folder (a file of that name exists)")
+    folder = path.absolute()
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise DesignError(option, str(path), f"cannot be created: {folder} is a file, not a folder")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise DesignError(option, str(path), f"cannot be written: folder {folder} is not writable")
+    return path
+
+
+def out_folder(option: str = "--out") -> click.ParamType:
+    """click type of an output folder option: :func:`check_out_folder` on the text as given."""
+
+    class OutFolder(click.ParamType):
+        name = "folder"
+
+        def convert(self, value, param, ctx):  # noqa: ARG002
+            return value if isinstance(value, Path) else check_out_folder(option, value)
+
+    return OutFolder()
 
 
 @contextlib.contextmanager

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import click
 
+from tabletcad.cli.outputs import out_folder
 from tabletcad.errors import DesignError
 
 __all__ = ["COMMANDS"]
@@ -22,7 +23,7 @@ def _require_sweep() -> None:
 
 @click.command("sweep")
 @click.argument("sweep_file", metavar="SWEEP.toml", type=click.Path(dir_okay=False, path_type=Path))
-@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path),
+@click.option("--out", "out_dir", required=True, type=out_folder(),
               help="Output folder: results.csv, files of file outputs, plots.")
 @click.option("--workers", type=int, default=None, help="Worker processes of a local Dask cluster (default: one per CPU).")
 @click.option("--scheduler", default=None, help="Address of an existing Dask scheduler (tcp://host:port).")

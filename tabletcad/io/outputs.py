@@ -1,8 +1,11 @@
 """Output folders that a build owns: staging, publishing and the build manifest.
 
-A build writes everything into a staging folder ``.<name>.<random>`` beside the
-output folder ``<name>`` and, when every output succeeded, moves the files into
-place with :func:`publish`.  The output folder then holds a manifest,
+A build writes everything into a staging folder and, when every output succeeded,
+moves the files into place with :func:`publish`.  The staging folder lies on the
+output folder's own file system, so that every move is a rename: inside the output
+folder (``<name>/.tabletcad-staging.<random>``) when it exists (a mount point, a
+link to another disk, a folder in a parent the user cannot write), else beside it
+(``.<name>.<random>``, where the output folder will be made).  The output folder then holds a manifest,
 ``.tabletcad-build.json``, naming every file of that build with its SHA-256.
 The next build into the same folder removes the files of the earlier build
 that it does not write itself, but only those listed by the earlier manifest
@@ -15,7 +18,7 @@ A staging folder carries a marker (``.tabletcad-staging.json``: process id,
 host, start time).  :func:`staging_folder` removes the current staging folder
 on any exception, on Ctrl-C and on SIGTERM; a build killed outright (SIGKILL,
 power loss) leaves its staging folder, and the next build into the same
-parent removes it once the process named in its marker is gone (or, on
+folder removes it once the process named in its marker is gone (or, on
 another host, once it is older than :data:`STALE_AFTER_S`).
 """
 
@@ -96,16 +99,22 @@ def _is_stale(folder: Path, now: float) -> bool:
     return isinstance(started, (int, float)) and now - started > STALE_AFTER_S
 
 
+#: prefix of a staging folder inside an existing output folder
+INNER_PREFIX = ".tabletcad-staging."
+
+
 def clean_stale_staging(out_dir: str | os.PathLike[str]) -> list[Path]:
-    """Remove staging folders ``.<name>.*`` of ``out_dir`` left by killed builds; return them."""
+    """Remove staging folders of ``out_dir`` left by killed builds (``.<name>.*`` beside it and
+    ``.tabletcad-staging.*`` inside it, each with its marker); return them."""
     out_dir = Path(out_dir)
     removed = []
     now = time.time()
-    with contextlib.suppress(OSError):
-        for p in out_dir.parent.glob(f".{out_dir.name}.*"):
-            if p.is_dir() and not p.is_symlink() and _is_stale(p, now):
-                shutil.rmtree(p, ignore_errors=True)
-                removed.append(p)
+    for folder, pattern in ((out_dir.parent, f".{out_dir.name}.*"), (out_dir, f"{INNER_PREFIX}*")):
+        with contextlib.suppress(OSError):
+            for p in folder.glob(pattern):
+                if p.is_dir() and not p.is_symlink() and _is_stale(p, now):
+                    shutil.rmtree(p, ignore_errors=True)
+                    removed.append(p)
     return removed
 
 
@@ -128,16 +137,23 @@ def _sigterm_raises() -> Iterator[None]:
 
 @contextlib.contextmanager
 def staging_folder(out_dir: str | os.PathLike[str]) -> Iterator[Path]:
-    """A fresh staging folder beside ``out_dir``, removed on exit whatever happens.
+    """A fresh staging folder on ``out_dir``'s file system, removed on exit whatever happens: inside
+    ``out_dir`` when it is an existing folder (or a link to one), else beside it.
 
     Stale staging folders of earlier, killed builds into ``out_dir`` are removed
     first.  SIGTERM and Ctrl-C inside the block remove the folder too.
     """
     out_dir = Path(out_dir)
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    clean_stale_staging(out_dir)
+    inside = out_dir.is_dir()
     with _sigterm_raises():
-        staging = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+        try:
+            if not inside:
+                out_dir.parent.mkdir(parents=True, exist_ok=True)
+            clean_stale_staging(out_dir)
+            staging = Path(tempfile.mkdtemp(prefix=INNER_PREFIX, dir=out_dir) if inside
+                           else tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+        except OSError as exc:  # e.g. a folder of a read-only or virtual file system (/proc)
+            raise DesignError("--out", str(out_dir), f"cannot be written: {(exc.strerror or str(exc)).lower()}") from None
         try:
             marker = dict(pid=os.getpid(), host=socket.gethostname(), started=time.time(), target=out_dir.name)
             (staging / STAGING_MARKER).write_text(json.dumps(marker), encoding="utf-8")

@@ -1,6 +1,6 @@
 """``tabletcad build``: every output of a design, written all-or-nothing into a folder.
 
-Outputs are produced in a staging folder beside the target and moved into
+Outputs are produced in a staging folder on the target's file system (inside it when it exists) and moved into
 place only when all of them succeeded, so a failure leaves no partial file;
 the folder then holds exactly this build's files besides any files tabletcad
 did not write (:mod:`tabletcad.io.outputs`).
