@@ -99,10 +99,13 @@ def check_finite(name: str, value: float, unit: str = "") -> float:
     """Return ``float(value)`` or raise :class:`DesignError` if it is not a finite number.
 
     Booleans are refused although Python's ``bool`` is a subclass of ``int``
-    (a TOML ``true`` is never a length), and so are integers too large for a float.
+    (a TOML ``true`` is never a length), and so are text (``"10"``) and integers too large
+    for a float.
     """
     if isinstance(value, bool):
         raise DesignError(name, value, "must be a finite number, not a boolean", unit)
+    if isinstance(value, (str, bytes)):  # a quoted "10" in a file, or "10" in a script: never a number here
+        raise DesignError(name, value, "must be a finite number, not text", unit)
     try:
         x = float(value)
     except (TypeError, ValueError, OverflowError):

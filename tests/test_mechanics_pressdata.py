@@ -340,3 +340,43 @@ def test_utf16_without_bom_and_tensile_forces(tmp_path):
     neg = _write(tmp_path, "force,displacement\n-1,5\n-2,4.5\n-3,4\n", "neg.csv")
     with pytest.raises(DesignError, match=r"force \(row 1\) = -1 N is not allowed: has no loading branch"):
         compaction_curves(read_press_data(neg, **META))
+
+
+# ----------------------------------------------------------------------------- metadata is read strictly
+_META = ROOT / "samples" / "press" / "lactose_appendix_b.toml"
+
+
+@pytest.mark.parametrize("edit, parameter, fragment", [
+    (lambda t: t.replace("compensation_line", "compensation_lin"), "compliance", "exactly one form"),
+    (lambda t: t.replace("[compliance]", "[complience]"), "complience", "not a metadata key"),
+    (lambda t: t.replace("mass_mg = 300.0", "mass_g = 0.3"), "mass_g", "not a metadata key"),
+    (lambda t: t.replace("mass_mg = 300.0", 'mass_mg = "300"'), "mass", "not text"),
+    (lambda t: t.replace("diameter = 10.0", "diameter = 1e308"), "diameter", "<= 1000 mm"),
+    (lambda t: t.replace("true_density = 1.3", "true_density = 130"), "true density", "<= 25"),
+    (lambda t: t.replace("[0.00002, -0.0267]", "[0.00002]"), "compliance compensation_line", "list of 2 numbers"),
+])
+def test_a_metadata_file_that_would_be_misread_is_refused(tmp_path, edit, parameter, fragment):
+    """A misspelled key used to be ignored: without the compensation line the lactose record's K moved
+    from 0.008557 to 0.00988 1/MPa with no word; a quoted number, an absurd size: refused as well."""
+    from tabletcad.errors import DesignError
+    from tabletcad.mechanics.pressdata import read_metadata
+
+    p = tmp_path / "m.toml"
+    p.write_text(edit(_META.read_text(encoding="utf-8")), encoding="utf-8")
+    with pytest.raises(DesignError) as exc:
+        read_metadata(p)
+    assert exc.value.parameter == parameter and fragment in str(exc.value), str(exc.value)
+
+
+def test_metadata_overrides_binary_files_and_a_byte_order_mark(tmp_path):
+    from tabletcad.errors import DesignError
+    from tabletcad.mechanics.pressdata import read_metadata
+
+    with pytest.raises(DesignError, match="diameter = 1e.200 mm is not allowed"):
+        read_metadata(_META, diameter=1e200)  # the --diameter option: was an OverflowError in the area
+    p = tmp_path / "m.toml"
+    p.write_bytes(b"mass_mg = 300\n\xff\xfe")
+    with pytest.raises(DesignError, match="UTF-8"):
+        read_metadata(p)
+    p.write_bytes(b"\xef\xbb\xbf" + _META.read_bytes())  # as some editors save it: the same metadata
+    assert read_metadata(p) == read_metadata(_META)

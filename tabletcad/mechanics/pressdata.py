@@ -63,7 +63,7 @@ from typing import Any
 import numpy as np
 import tomllib
 
-from tabletcad.errors import DesignError, check_finite, check_positive
+from tabletcad.errors import DesignError, check_finite, check_range
 from tabletcad.mechanics.units import DIMENSIONS, header_unit, strip_unit, unit_factor
 from tabletcad.mechanics.validity import DataWarning, warn
 
@@ -188,14 +188,17 @@ class PressMetadata:
     notes: str = ""
 
     def __post_init__(self) -> None:
-        check_positive("mass", self.mass_mg, "mg")
-        check_positive("true density", self.true_density, "mg/mm³")
+        # generous physical limits: a compact of up to 1 kg, any solid's density, a die up to 1 m
+        check_range("mass", self.mass_mg, 0.0, 1e6, "mg", lo_open=True)
+        check_range("true density", self.true_density, 0.0, 25.0, "mg/mm³", lo_open=True)
         if self.diameter is None and self.face_area is None:
             raise DesignError("diameter", None, "give the die diameter (mm) or the punch face area (mm²)", "mm")
         if self.diameter is not None:
-            check_positive("diameter", self.diameter, "mm")
+            check_range("diameter", self.diameter, 0.0, 1000.0, "mm", lo_open=True)
         if self.face_area is not None:
-            check_positive("face area", self.face_area, "mm²")
+            check_range("face area", self.face_area, 0.0, 1e6, "mm²", lo_open=True)
+        if not isinstance(self.notes, str):
+            raise DesignError("notes", self.notes, "must be text")
         if self.displacement_sign not in ("auto", 1, -1):
             raise DesignError("displacement_sign", self.displacement_sign, "must be 'auto', 1 or -1")
         check_finite("displacement_zero", self.displacement_zero, "mm")
@@ -609,34 +612,28 @@ def read_metadata(source: str | Path | Mapping[str, Any], **overrides: Any) -> P
     if isinstance(source, (str, Path)):
         p = Path(source)
         try:
-            raw = tomllib.loads(p.read_text(encoding="utf-8"))
+            raw = tomllib.loads(p.read_text(encoding="utf-8-sig"))
         except tomllib.TOMLDecodeError as exc:
             raise DesignError("metadata", p.name, f"is not valid TOML ({exc})") from None
+        except UnicodeDecodeError:
+            raise DesignError("metadata", p.name, "must be a UTF-8 text file (TOML)") from None
+        except IsADirectoryError:
+            raise DesignError("metadata", str(p), "must be a file, not a folder") from None
     else:
         raw = dict(source)
-    raw = dict(raw.get("press", raw))  # allow a [press] table
+    if set(raw) == {"press"}:  # allow a [press] table
+        raw = raw["press"]
+        if not isinstance(raw, Mapping):
+            raise DesignError("press", raw, "must be a table")
+    raw = dict(raw)
+    unknown = sorted(set(raw) - set(METADATA_KEYS))
+    if unknown:  # a misspelled key would silently change the results (an ignored compliance moves K by 15 %)
+        raise DesignError(unknown[0], raw[unknown[0]], "is not a metadata key (misspelled?): the keys are "
+                          + ", ".join(METADATA_KEYS))
     for k, v in overrides.items():
         if v is not None:
             raw[k] = v
-    comp = raw.get("compliance")
-    compliance: MachineCompliance | None
-    if comp is None or isinstance(comp, MachineCompliance):
-        compliance = comp
-    elif isinstance(comp, (tuple, list)) and len(comp) == 2:
-        compliance = MachineCompliance(slope=float(comp[0]), offset=float(comp[1]))
-    elif isinstance(comp, Mapping):
-        if "compensation_line" in comp:
-            s, b = comp["compensation_line"]
-            compliance = MachineCompliance.from_compensation_line(float(s), float(b))
-        elif "force" in comp:
-            compliance = MachineCompliance(
-                table_force=tuple(float(x) for x in comp["force"]),
-                table_deflection=tuple(float(x) for x in comp["deflection"]),
-            )
-        else:
-            compliance = MachineCompliance(slope=float(comp.get("slope", 0.0)), offset=float(comp.get("offset", 0.0)))
-    else:
-        raise DesignError("compliance", comp, "must be a (slope, offset) pair or a table")
+    compliance = _compliance(raw.get("compliance"))
     missing = [k for k in ("mass_mg", "true_density") if k not in raw]
     if missing:
         raise DesignError(missing[0], None, "is required (metadata file or command-line option)")
@@ -650,9 +647,48 @@ def read_metadata(source: str | Path | Mapping[str, Any], **overrides: Any) -> P
         face_area=raw.get("face_area"),
         compliance=compliance,
         displacement_sign=sign,
-        displacement_zero=float(raw.get("displacement_zero", 0.0)),
-        notes=str(raw.get("notes", "")),
+        displacement_zero=check_finite("displacement_zero", raw.get("displacement_zero", 0.0), "mm"),
+        notes=raw.get("notes", ""),
     )
+
+
+#: the keys of a press record's metadata (file or mapping; a ``[press]`` table may hold them)
+METADATA_KEYS = ("notes", "mass_mg", "true_density", "diameter", "face_area", "compliance", "displacement_sign",
+                 "displacement_zero")
+#: the forms of a ``[compliance]`` table: exactly one of them
+COMPLIANCE_FORMS = (("compensation_line",), ("force", "deflection"), ("slope", "offset"))
+
+
+def _numbers(name: str, values: Any, unit: str, n: int | None = None) -> tuple[float, ...]:
+    """A list of finite numbers (of length ``n`` if given), else :class:`DesignError`."""
+    if not isinstance(values, (list, tuple)) or (n is not None and len(values) != n):
+        raise DesignError(name, values, f"must be a list of {n or 'several'} numbers", unit)
+    return tuple(check_finite(name, x, unit) for x in values)
+
+
+def _compliance(comp: Any) -> MachineCompliance | None:
+    """The machine compliance of a metadata entry: None, a (slope, offset) pair or a ``[compliance]`` table."""
+    if comp is None or isinstance(comp, MachineCompliance):
+        return comp
+    if isinstance(comp, (tuple, list)):
+        slope, offset = _numbers("compliance", comp, "", 2)
+        return MachineCompliance(slope=slope, offset=offset)
+    if not isinstance(comp, Mapping):
+        raise DesignError("compliance", comp, "must be a (slope, offset) pair or a table")
+    keys = set(comp)
+    form = next((f for f in COMPLIANCE_FORMS if keys and keys <= set(f)), None)
+    if form is None or (form != ("slope", "offset") and keys != set(form)):
+        allowed = "; ".join(" and ".join(f) for f in COMPLIANCE_FORMS)
+        raise DesignError("compliance", ", ".join(sorted(keys)) or "an empty table",
+                          f"must hold exactly one form of keys: {allowed}")
+    if form == ("compensation_line",):
+        s, b = _numbers("compliance compensation_line", comp["compensation_line"], "", 2)
+        return MachineCompliance.from_compensation_line(s, b)
+    if form == ("force", "deflection"):
+        return MachineCompliance(table_force=_numbers("compliance force", comp["force"], "N"),
+                                 table_deflection=_numbers("compliance deflection", comp["deflection"], "mm"))
+    return MachineCompliance(slope=check_finite("compliance slope", comp.get("slope", 0.0), "mm/N"),
+                             offset=check_finite("compliance offset", comp.get("offset", 0.0), "mm"))
 
 
 def _resolve_metadata(path: Path, meta, overrides: Mapping[str, Any]) -> PressMetadata:
