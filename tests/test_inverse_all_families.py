@@ -175,7 +175,7 @@ def test_reviewer_commands_succeed(tmp_path, capsys, monkeypatch, sample, vary, 
     (["families/capsule.toml", "--solve-for", "cup_depth", "--target-volume", "5000"], "--target-volume",
      r"must be within \S+ to \S+ mm3 for cup_depth in \["),
     (["families/concave_round.toml", "--solve-for", "band", "--target-weight", "1", "--solid-fraction", "0.8",
-      "--true-density", "1.4"], "--target-weight", r"must be within \S+ to \S+ mg for band in \(0, 1000\] mm"),
+      "--true-density", "1.4"], "--target-weight", r"must be within \S+ to \S+ mg for band in \[0.001, 1000\] mm"),
     (["families/concave_round.toml", "--solve-for", "thickness", "--target-volume", "300"], "--solve-for",
      r"concave_round can solve for band, cup_depth$"),
     (["spherical.toml", "--solve-for", "band", "--target-volume", "300"], "--solve-for",
@@ -205,4 +205,24 @@ def test_a_weight_range_is_the_volume_range_times_the_density(capsys):
     err = capsys.readouterr().err
     lo, hi = (float(x) for x in re.search(r"within (\S+) to (\S+) mg", err).groups())
     assert lo == pytest.approx(reach.volume_lo_mm3 * 1.12, rel=1e-5) and hi == pytest.approx(reach.volume_hi_mm3 * 1.12, rel=1e-5)
-    assert 0.0 < reach.lo_mm < 1e-8 and reach.hi_mm == 1000.0  # band > 0 (open end, approached to 1e-9 relative)
+    assert reach.lo_mm == 1e-3 and reach.hi_mm == 1000.0  # band >= Tolerances.min_length, as a design file allows
+
+
+def test_a_solved_length_is_one_a_design_file_accepts(tmp_path):
+    """The band of a concave round approaches 0 but a design file takes 0 or at least
+    ``Tolerances.min_length`` (1 µm): a volume reached only by a thinner band is out of reach
+    (it gave band = 1.393e-06 mm, which the written design could not build again); the least
+    band's volume is reached exactly."""
+    from tabletcad.errors import DesignError
+    from tabletcad.families.inverse import solve_for
+    from tabletcad.pipeline.design import Design
+
+    dims = dict(diameter=10.0, cup_depth=0.9, land=0.08)
+    reach = reachable("concave_round", "band", **dims)
+    with pytest.raises(DesignError, match=r"\[0.001, 1000\] mm"):
+        solve_for("concave_round", vary="band", target_volume_mm3=69.2055, **dims)
+    band = solve_for("concave_round", vary="band", target_volume_mm3=reach.volume_lo_mm3 * (1 + 1e-6), **dims).value
+    assert 1e-3 <= band < 2e-3
+    p = tmp_path / "d.toml"
+    p.write_text(f'[tablet]\nfamily = "concave_round"\ndiameter = 10.0\ncup_depth = 0.9\nland = 0.08\nband = {band!r}\n')
+    assert Design.from_toml(p).build().params["band"] == band

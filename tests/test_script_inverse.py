@@ -53,7 +53,7 @@ def test_bad_requests(kw, param):
 
 
 def test_unreachable_target_names_the_range():
-    with pytest.raises(DesignError, match=r"must be within \S+ to \S+ mm3 for band in \(0, 1000\] mm"):
+    with pytest.raises(DesignError, match=r"must be within \S+ to \S+ mm3 for band in \[0.001, 1000\] mm"):
         solve_for("concave_round", target_volume_mm3=10.0, vary="band", diameter=10.0, cup_depth=1.0)
 
 

@@ -182,11 +182,16 @@ class _Probe:
 
     def __init__(self, func: Callable[..., Tablet], dims: dict, vary: str) -> None:
         self.func, self.dims, self.vary = func, dims, vary
+        # a length between 0 and min_length is refused by a design file (tabletcad.pipeline.design):
+        # the answer must be one that the written design builds again
+        self.min_length = float(getattr(dims.get("tol", DEFAULT), "min_length", DEFAULT.min_length))
         self.builds = 0
         self._cache: dict[float, tuple[bool, Any]] = {}
         self.exact_nominal: bool | None = None
 
     def _build(self, x: float) -> tuple[bool, Any]:
+        if 0.0 < x < self.min_length:
+            return (False, None)
         if x not in self._cache:
             self.builds += 1
             try:
@@ -243,6 +248,8 @@ def _ends(probe: _Probe, x0: float, x_max: float, rel: float) -> tuple[float, fl
         else:
             bad = mid
     lo = 0.0 if bad == 0.0 and probe.ok(0.0) else good
+    if bad < probe.min_length <= lo and probe.ok(probe.min_length):  # the end is the design files' least length
+        lo = probe.min_length
     # upper end: doubling, then bisection
     good, bad = x0, None
     while good < x_max:
@@ -285,9 +292,7 @@ def _reach(probe: _Probe, name: str, x0: float, x_max: float, rel: float):
 # ---------------------------------------------------------------------------- API
 
 def _interval(reach: Reach) -> str:
-    """``[lo, hi]``, or ``(0, hi]`` when the lower end is a value > 0 approached down to 0."""
-    if 0.0 < reach.lo_mm <= 1e-6 * reach.hi_mm:
-        return f"(0, {reach.hi_mm:.6g}]"
+    """``[lo, hi]`` (a lower end > 0 is at least ``Tolerances.min_length``, a design file's least length)."""
     return f"[{reach.lo_mm:.6g}, {reach.hi_mm:.6g}]"
 
 
