@@ -145,6 +145,18 @@ def test_make_unknown_family():
         tabletcad.make("no_such_family")
 
 
+@pytest.mark.parametrize("family, dims, parameter", [
+    ("capsule", dict(length=18.0), "tablet.width"),  # was built at the family's default width, band and cup
+    ("concave_round", dict(diameter=10.0), "tablet.band"),
+    ("concave_round", dict(diameter="10", band=2.0, cup_depth=1.0), "tablet.diameter"),  # text is not a number
+    ("concave_round", dict(diameter=10.0, band=1e-6, cup_depth=1.0), "tablet.band"),  # below min_length
+])
+def test_make_checks_dimensions_as_a_design_file_does(family, dims, parameter):
+    with pytest.raises(DesignError) as exc:
+        tabletcad.make(family, **dims)
+    assert exc.value.parameter == parameter
+
+
 @pytest.mark.slow
 def test_tooling_parts_have_the_same_vocabulary(model):
     tools = model.tooling(clearance_mm=0.03)

@@ -237,10 +237,17 @@ class TabletModel(_Shaped):
 
 
 def make(family: str, **dims: Any) -> TabletModel:
-    """A tablet of a named family (``tabletcad shapes`` lists them) with dimensions in mm."""
+    """A tablet of a named family (``tabletcad shapes`` lists them) with dimensions in mm.
+
+    Checked as a design file's ``[tablet]`` table is (:class:`~tabletcad.pipeline.design.Design`):
+    every required dimension given, numbers only (no ``"10"``), lengths within ±1000 mm and 0
+    or at least ``Tolerances.min_length``; ``a`` (the smoothing parameter) may be given.
+    """
     from tabletcad.families import family as lookup_family
 
-    return TabletModel(lookup_family(family, parameter="family").build(**dims))
+    lookup_family(family, parameter="family")  # an unknown family: the one-line error naming "family"
+    design = Design.from_dict({"tablet": {"family": family, **dims}}, default_name=str(family).split(".")[-1])
+    return TabletModel(design.build(), design)
 
 
 def load(path: str | Path) -> TabletModel:
