@@ -20,7 +20,11 @@ pytestmark = pytest.mark.sweep
 pytest.importorskip("distributed")
 pd = pytest.importorskip("pandas")
 
+from pathlib import Path  # noqa: E402
+
 from tabletcad.cli import main  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
 from tabletcad.pipeline.design import design_from_dict  # noqa: E402
 from tabletcad.errors import DesignError  # noqa: E402
 from tabletcad.sweep import design_hash, parse_sweep, run_sweep  # noqa: E402
@@ -243,3 +247,26 @@ def test_a_lost_worker_is_a_failed_row_not_the_end():
         with pytest.raises(KilledWorker):
             map_tasks(os._exit, [3], client=client, progress=False)
         assert map_tasks(abs, [-2, 5], client=client, progress=False) == [2, 5]
+
+
+def test_a_plot_of_no_column_is_refused_before_any_design_is_built(tmp_path, capsys):
+    """``--plot`` of a column the reports do not have: one line, exit 2, no folder, no cluster
+    started (it used to run the whole sweep, then stop and leave results.csv, which a corrected
+    rerun then refused); a right column of the report is accepted."""
+    import time
+
+    from tabletcad.sweep.run import _check_plot_columns
+
+    sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
+    t0 = time.perf_counter()
+    rc = main(["sweep", str(sweep), "--out", str(tmp_path / "sw"), "--workers", "1", "--plot", "nonexistent_col"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.startswith("error: --plot = 'nonexistent_col' is not allowed: must be a report column")
+    assert len(err.splitlines()) == 1 and "volume_mm3" in err
+    assert list(tmp_path.iterdir()) == []
+    spec = parse_sweep(__import__("tomllib").loads(sweep.read_text()), name="g")
+    design = spec.designs()[0]
+    _check_plot_columns(("volume_mm3", "design_report.weight_mg"), design, spec)  # columns of the report
+    for bad in ("tablet.band", "status", "nonexistent_col"):  # a varied key, the status, no column
+        with pytest.raises(DesignError):
+            _check_plot_columns((bad,), design, spec)

@@ -71,6 +71,8 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
     elif out.exists() and not out.is_dir():
         raise DesignError("--out", str(out), "must be a folder")
     designs = spec.designs()
+    if plot and out is not None:
+        _check_plot_columns(plot, designs[0], spec)
     hashes = [design_hash(d) for d in designs]
     done: dict[str, dict[str, Any]] = {}
     if out is not None and out.is_dir() and ((out / RESULTS_CSV).exists() or (out / JOURNAL).exists()):
@@ -126,6 +128,28 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
         if plot:
             plot_results(df, spec.keys, plot, out)
     return df
+
+
+def _check_plot_columns(plot: tuple[str, ...], design: dict[str, Any], spec) -> None:
+    """Refuse a ``--plot`` column before any design is built: the first design's report (built here,
+    in this process, without files) names the columns.  A column of what only a build with files
+    adds (``brep``, ``mesh``, ``tooling``...) is left to the end when the sweep asks for files; a
+    first design that does not build leaves the check to the end as well."""
+    from tabletcad.errors import TabletcadError
+    from tabletcad.pipeline.design import Design
+    from tabletcad.pipeline.report import flatten_report, geometry_report
+
+    try:
+        d = Design.from_dict(design, default_name=spec.name)
+        cols = flatten_report(geometry_report(d.build(), d.report_options))
+    except TabletcadError:
+        return
+    files = any(o != "report" for o in spec.outputs)
+    sections = {c.split(".")[0] for c in cols}
+    allowed = [c for c in cols if c not in spec.keys and c not in TAIL_COLUMNS]
+    for o in plot:
+        if o in spec.keys or o in TAIL_COLUMNS or (o not in cols and (not files or o.split(".")[0] in sections)):
+            raise DesignError("--plot", o, "must be a report column of results.csv: " + ", ".join(allowed))
 
 
 def _restored(row: dict[str, Any], keys: tuple[str, ...], values: tuple[Any, ...]) -> dict[str, Any]:
