@@ -13,6 +13,7 @@ import math
 import socket
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -20,16 +21,14 @@ pytestmark = pytest.mark.sweep
 pytest.importorskip("distributed")
 pd = pytest.importorskip("pandas")
 
-from pathlib import Path  # noqa: E402
-
 from tabletcad.cli import main  # noqa: E402
-
-ROOT = Path(__file__).resolve().parents[1]
 from tabletcad.pipeline.design import design_from_dict  # noqa: E402
 from tabletcad.errors import DesignError  # noqa: E402
 from tabletcad.sweep import design_hash, parse_sweep, run_sweep  # noqa: E402
 from tabletcad.sweep.engine import flatten_report  # noqa: E402
 from tabletcad.sweep.results import JOURNAL, read_results  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
 
 TABLET = {"family": "concave_round", "diameter": 8.0, "band": 2.6, "cup_depth": 0.8, "land": 0.08}
 REPORT = {"solid_fraction": 0.85, "true_density_mg_mm3": 1.5, "breaking_force_N": 90.0}
@@ -253,12 +252,9 @@ def test_a_plot_of_no_column_is_refused_before_any_design_is_built(tmp_path, cap
     """``--plot`` of a column the reports do not have: one line, exit 2, no folder, no cluster
     started (it used to run the whole sweep, then stop and leave results.csv, which a corrected
     rerun then refused); a right column of the report is accepted."""
-    import time
-
     from tabletcad.sweep.run import _check_plot_columns
 
     sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
-    t0 = time.perf_counter()
     rc = main(["sweep", str(sweep), "--out", str(tmp_path / "sw"), "--workers", "1", "--plot", "nonexistent_col"])
     err = capsys.readouterr().err
     assert rc == 2 and err.startswith("error: --plot = 'nonexistent_col' is not allowed: must be a report column")
