@@ -112,3 +112,30 @@ def test_unknown_suffix_and_atomicity(tmp_path):
         export(ts, tmp_path / "x.obj")
     export(ts, tmp_path / "x.step")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["x.step"]  # no temporary left behind
+
+
+def test_a_name_beyond_ascii_reads_back_as_written(tmp_path):
+    """A design name in any script (design files allow it) is the STEP PRODUCT's name, read back the
+    same by STEPControl (fresh process) and by STEPCAFControl's document; it came back double-encoded
+    ('Ã\\x98' for 'Ø') when the name was handed to OCC as bytes of Latin-1."""
+    from OCP.STEPCAFControl import STEPCAFControl_Reader
+    from OCP.TCollection import TCollection_ExtendedString
+    from OCP.TDataStd import TDataStd_Name
+    from OCP.TDF import TDF_LabelSequence
+    from OCP.TDocStd import TDocStd_Document
+    from OCP.XCAFDoc import XCAFDoc_DocumentTool
+
+    name = "Tablette Ø10 – «test» 日本"
+    ts = build_solid(STANDINS[0].patches, 1e-4, name="standin")
+    path = export(ts, tmp_path / "u.step", name=name)
+    assert ocp_read_step(path)["products"] == [name]
+    doc = TDocStd_Document(TCollection_ExtendedString("XmlOcaf"))
+    reader = STEPCAFControl_Reader()
+    reader.SetNameMode(True)
+    reader.ReadFile(str(path))
+    assert reader.Transfer(doc)
+    labels = TDF_LabelSequence()
+    XCAFDoc_DocumentTool.ShapeTool_s(doc.Main()).GetFreeShapes(labels)
+    attr = TDataStd_Name()
+    assert labels.Length() == 1 and labels.Value(1).FindAttribute(TDataStd_Name.GetID_s(), attr)
+    assert attr.Get().ToExtString() == name

@@ -94,7 +94,7 @@ def export_step(obj: Any, path: str | os.PathLike[str], *, name: str = "tablet",
     shape = _shape_of(obj)
     doc, tool = step_document(schema)
     label = tool.AddShape(shape, False)
-    TDataStd_Name.Set_s(label, TCollection_ExtendedString(str(name)))
+    TDataStd_Name.Set_s(label, TCollection_ExtendedString(str(name), True))  # UTF-8 (multibyte), not bytes as Latin-1
     return write_step_document(doc, path, what=str(name), obj=shape)
 
 

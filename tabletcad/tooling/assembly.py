@@ -56,7 +56,7 @@ def write_assembly(parts: dict, path, *, name: str = "tooling", offsets: dict | 
         dz = float(offsets.get(part, 0.0))
         builder.Add(comp, parts[part].Moved(TopLoc_Location(tr)) if dz else parts[part])
     top = tool.AddShape(comp, True)  # an assembly: one component (and one part) per sub-shape
-    TDataStd_Name.Set_s(top, TCollection_ExtendedString(str(name)))
+    TDataStd_Name.Set_s(top, TCollection_ExtendedString(str(name), True))  # UTF-8
     colours = XCAFDoc_DocumentTool.ColorTool_s(doc.Main())
     labels = TDF_LabelSequence()
     XCAFDoc_ShapeTool.GetComponents_s(top, labels, False)
@@ -64,10 +64,10 @@ def write_assembly(parts: dict, path, *, name: str = "tooling", offsets: dict | 
         raise GeometryError(f"the assembly has {labels.Length()} components, expected {len(names)}", parts)
     for k, part in enumerate(names):
         comp_label = labels.Value(k + 1)
-        TDataStd_Name.Set_s(comp_label, TCollection_ExtendedString(part))
+        TDataStd_Name.Set_s(comp_label, TCollection_ExtendedString(part, True))
         ref = TDF_Label()
         if XCAFDoc_ShapeTool.GetReferredShape_s(comp_label, ref):
-            TDataStd_Name.Set_s(ref, TCollection_ExtendedString(part))
+            TDataStd_Name.Set_s(ref, TCollection_ExtendedString(part, True))
             r, g, b = PART_COLOURS[part]
             colours.SetColor(ref, Quantity_Color(r, g, b, Quantity_TypeOfColor.Quantity_TOC_sRGB),
                              XCAFDoc_ColorType.XCAFDoc_ColorSurf)
