@@ -193,3 +193,22 @@ def test_bad_tooling_table_is_refused_before_any_geometry(tmp_path, capsys, monk
     cap = capsys.readouterr()
     assert cap.out == "" and len(cap.err.strip().splitlines()) == 1 and cap.err.startswith("error: [")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
+
+
+def test_a_hollow_tablet_of_several_patches_writes_its_report_and_picture(tmp_path, capsys):
+    """The README's ``[trim] w`` on the thesis's flat-faced round (three patches): the report (its
+    volume, by quadrature, the solid's minus the hollow core's) and the picture, with ``brep.skipped``
+    saying why there is no solid; it stopped the build with a geometry error after the report."""
+    design = tmp_path / "hollow.toml"
+    design.write_text('[tablet]\nfamily = "thesis.flat_faced_round"\ndiameter = 10.0\nthickness = 6.0\n'
+                      "[trim]\nw = [0.5, 1.0]\n")
+    assert main(["build", str(design), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    rep = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert sorted(read_manifest(tmp_path / "out")) == ["report.json", "tablet.png"]
+    assert "one-patch tablets only" in rep["brep"]["skipped"] and rep["brep"]["valid"] is None
+    from tabletcad.pipeline.design import load_design
+
+    v_full = load_design(ROOT / "samples" / "flat_faced_round.toml").volume()
+    # every patch's spine lies on the axis, so w scales the sections about it in x and y only:
+    # the core with w < 1/2 holds (1/2)² of the volume
+    assert rep["volume_mm3"] == pytest.approx(0.75 * v_full, rel=1e-12)

@@ -239,6 +239,10 @@ def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any]):
     from tabletcad.cad.export import export
 
     t = tablet.trim
+    if t.w != (0.0, 1.0) and len(tablet.patches) != 1:  # (tabletcad.brep.surfaces makes one-patch ones)
+        report["brep"] = dict(valid=None, skipped=f"hollow ([trim] w) tablet of {len(tablet.patches)} patches: "
+                              "hollow solids are made of one-patch tablets only; picture only")
+        return None
     if t.u != (0.0, 1.0) or not t.full_v:
         cut = cutaway_solid(tablet, report)
         if isinstance(cut, str):
