@@ -177,3 +177,24 @@ def test_thesis_tables_sample_runs():
                        env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=300)
     assert r.returncode == 0, r.stderr
     assert "| flat_faced_round | 345.604 | 345.062 | 345.575 | 471.382 |" in r.stdout
+
+
+def test_a_free_form_chain_with_a_gap_is_refused():
+    """Patches that do not meet make no solid: the report gave a volume for the open surface (and
+    called the seam 'gap 1000 um, an edge'), the build failed late in the B-spline fit.  Now one
+    line for the patch's first curve; the sample (every seam "previous") still loads."""
+    import tomllib
+
+    from tabletcad.errors import DesignError
+    from tabletcad.pipeline.design import design_from_dict
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "samples" / "free_form_stadium.toml").read_text()
+    assert design_from_dict(tomllib.loads(text)).volume() > 0
+    gapped = text.replace('curves = [\n  "previous",\n  { type = "stadium", length = 12.0, width = 6.0, z = 1.0 },',
+                          'curves = [\n  { type = "stadium", length = 12.0, width = 6.0, z = 0.5 },\n'
+                          '  { type = "stadium", length = 12.0, width = 6.0, z = 1.0 },', 1)
+    assert gapped != text
+    with pytest.raises(DesignError) as exc:
+        design_from_dict(tomllib.loads(gapped))
+    assert exc.value.parameter == "patch[1].curves[0]" and "a gap of 0.5 mm" in str(exc.value)
