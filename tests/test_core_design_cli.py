@@ -198,3 +198,32 @@ def test_a_free_form_chain_with_a_gap_is_refused():
     with pytest.raises(DesignError) as exc:
         design_from_dict(tomllib.loads(gapped))
     assert exc.value.parameter == "patch[1].curves[0]" and "a gap of 0.5 mm" in str(exc.value)
+
+
+def test_toml_files_with_a_byte_order_mark_load_and_binary_ones_are_refused(tmp_path, capsys):
+    """Some editors save UTF-8 with a byte-order mark: design, sweep and problem files read the same
+    with it.  A binary file is one line for the file, not an internal error."""
+    from tabletcad.cli import main
+
+    for rel in ("samples/families/concave_round.toml", "samples/sweep/concave_round_grid.toml",
+                "samples/optimise/cylinder_min_area.toml"):
+        src = ROOT / rel
+        bom = tmp_path / f"bom_{src.name}"
+        bom.write_bytes(b"\xef\xbb\xbf" + src.read_bytes())
+        if "families" in rel:
+            assert load_design(bom).volume() == load_design(src).volume()
+        elif "sweep" in rel:
+            from tabletcad.sweep.spec import load_sweep
+
+            assert load_sweep(bom).designs() == load_sweep(src).designs()
+        else:
+            from tabletcad.optimise.files import load_problem
+
+            assert load_problem(bom)[1:] == load_problem(src)[1:]
+    junk = tmp_path / "junk.toml"
+    junk.write_bytes(b"\x89PNG\r\n\x1a\n\xff\xfe\x00")
+    for args, parameter in ((["report", str(junk)], "design_file"),
+                            (["optimise", str(junk), "--out", str(tmp_path / "o")], "problem file")):
+        assert main(args) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"error: {parameter} = ") and "UTF-8" in err and len(err.splitlines()) == 1

@@ -66,7 +66,7 @@ class Material:
 def load_materials(path: str | None = None) -> dict[str, Material]:
     """Read the material table; keys and aliases are lower-case."""
     p = Path(path) if path else MATERIALS_FILE
-    raw = tomllib.loads(p.read_text(encoding="utf-8"))
+    raw = tomllib.loads(p.read_text(encoding="utf-8-sig"))
     out: dict[str, Material] = {}
     for key, d in raw.items():
         m = Material(

@@ -243,9 +243,11 @@ def load_problem(path: str | Path) -> tuple[Problem, str, dict]:
     if not path.is_file():
         raise DesignError("problem file", str(path), "must be an existing TOML file")
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
     except tomllib.TOMLDecodeError as exc:
         raise DesignError("problem file", path.name, f"must be valid TOML ({exc})") from None
+    except UnicodeDecodeError:
+        raise DesignError("problem file", path.name, "must be UTF-8 text (TOML)") from None
     return problem_from_dict(data)
 
 

@@ -82,7 +82,7 @@ def read_design_file(path: str | Path) -> dict[str, Any]:
     if not path.is_file():
         raise DesignError("design_file", str(path), "must be an existing TOML file")
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark, as some editors write it, is not TOML
     except UnicodeDecodeError:
         raise DesignError("design_file", str(path), "must be UTF-8 text (TOML)") from None
     except OSError as exc:

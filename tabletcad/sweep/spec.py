@@ -141,9 +141,11 @@ def load_sweep(path: str | Path) -> SweepSpec:
     if not path.is_file():
         raise DesignError("sweep file", str(path), "must be an existing TOML file")
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
     except tomllib.TOMLDecodeError as exc:
         raise DesignError("sweep file", path.name, f"must be valid TOML ({exc})") from None
+    except UnicodeDecodeError:
+        raise DesignError("sweep file", path.name, "must be UTF-8 text (TOML)") from None
     return parse_sweep(data, name=path.stem)
 
 
