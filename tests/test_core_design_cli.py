@@ -227,3 +227,32 @@ def test_toml_files_with_a_byte_order_mark_load_and_binary_ones_are_refused(tmp_
         assert main(args) == 2
         err = capsys.readouterr().err
         assert err.startswith(f"error: {parameter} = ") and "UTF-8" in err and len(err.splitlines()) == 1
+
+
+@pytest.mark.parametrize("table, parameter, fragment", [
+    ('family = "thesis.caplet"\nwidth = 3.5\nlength = 7.0\nheight = 15.0\nband = 20.0', "tablet.band",
+     "<= height = 15 mm"),  # the caplet's key is height (the oval it is made from says thickness)
+    ('family = "concave_round"\ndiameter = 10\nband = 3\ncup_depth = 1\na = "autox"', "tablet.a", 'or "auto"'),
+    ('family = "concave_round"\nname = ""\ndiameter = 10\nband = 3\ncup_depth = 1', "tablet.name", "non-empty"),
+])
+def test_messages_name_the_keys_and_values_a_design_takes(tmp_path, capsys, table, parameter, fragment):
+    from tabletcad.cli import main
+
+    p = tmp_path / "d.toml"
+    p.write_text(f"[tablet]\n{table}\n")
+    assert main(["report", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {parameter} = ") and fragment in err and len(err.splitlines()) == 1, err
+
+
+def test_heckel_input_that_would_be_misread(tmp_path, capsys):
+    from tabletcad.cli import main
+
+    data = ROOT / "samples" / "press" / "lactose_appendix_b.csv"
+    for args, parameter, fragment in (
+            ([str(data), "--diameter", "12", "--face-area", "78.54"], "--face-area", "not both"),  # one was ignored
+            (["/dev/null"], "DATA", "must be a file"),  # it said "does not exist"
+            ([str(data), "--diameter", "1e200"], "diameter", "<= 1000 mm")):  # an OverflowError, exit 1
+        assert main(["heckel", *args]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"error: {parameter} = ") and fragment in err and len(err.splitlines()) == 1, err

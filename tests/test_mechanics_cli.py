@@ -241,7 +241,7 @@ def test_outputs_are_written_only_when_all_succeed(capsys, tmp_path, monkeypatch
         (["shell", "--outer", "2.5", "--inner", "2", "--E", "100", "--nu", "0.3", "--p-ext", "nan"], ["--p-ext = nan"]),
         (["contact", "--force", "nan"], ["--force = nan"]),
         (["heckel", SAMPLE, "--window", "nan", "50"], ["--window = nan"]),
-        (["heckel", "missing.csv"], ["DATA = 'missing.csv'", "does not exist"]),
+        (["heckel", "missing.csv"], ["DATA = 'missing.csv'", "must be an existing file"]),
         (["heckel", SAMPLE, "--meta", "."], ["--meta = '.'", "is a folder"]),
         (["heckel", SAMPLE, "--plot", "out.txt"], ["--plot = 'out.txt'"]),
     ],

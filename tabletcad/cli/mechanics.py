@@ -61,7 +61,8 @@ def _jsonable(o: Any) -> Any:
 
 def _check_input(name: str, path: Path | None) -> None:
     if path is not None and not path.is_file():
-        raise DesignError(name, str(path), "is a folder, not a file" if path.is_dir() else "does not exist")
+        raise DesignError(name, str(path), "must be a file: it is a folder" if path.is_dir() else
+                          "must be a file: it is not one" if path.exists() else "must be an existing file")
 
 
 _JSON_OPTS = [
@@ -117,6 +118,8 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
 
     _check_input("DATA", data)
     _check_input("--meta", meta)
+    if diameter is not None and face_area is not None:  # one would be ignored without a word
+        raise DesignError("--face-area", face_area, "give --diameter or --face-area, not both", "mm²")
     _check_output("--plot", plot_file)
     _check_json_file(json_file, plot=plot_file)
     if window is not None:

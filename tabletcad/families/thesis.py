@@ -275,7 +275,12 @@ def rod(diameter: float = 3.0, length: float = 7.5, dome: float = 0.2, *, a=1.0,
 
 def caplet(width: float = 3.5, length: float = 7.0, height: float = 15.0, band: float = 10.0, *, a=1.0, tol=DEFAULT) -> Tablet:
     """Caplet: an oval tablet stretched along its axis (Table 4.5: 3.5 × 7 × 15 mm)."""
-    t = shallow_convex_oval(width, length, height, band, a=a, tol=tol)
+    try:
+        t = shallow_convex_oval(width, length, height, band, a=a, tol=tol)
+    except DesignError as exc:  # the oval's "thickness" is the caplet's "height"
+        if exc.parameter == "thickness":
+            raise exc.renamed("height") from None
+        raise DesignError(exc.parameter, exc.value, exc.allowed.replace("thickness", "height"), exc.unit) from None
     from dataclasses import replace
 
     return replace(t, name="caplet", family="thesis.caplet")

@@ -109,7 +109,8 @@ def _number(where: str, value: Any, unit: str = "", *, tol: Tolerances = DEFAULT
     if isinstance(value, bool):
         raise DesignError(where, value, "must be a number (true and false are not numbers)", unit)
     if not isinstance(value, (int, float)):
-        raise DesignError(where, value, "must be a number", unit)
+        auto = where.split(".")[-1] == "a"  # the smoothing parameter also takes "auto"
+        raise DesignError(where, value, 'must be a number or "auto"' if auto else "must be a number", unit)
     x = check_finite(where, value, unit)
     if unit == "mm" and abs(x) > tol.max_length:
         raise DesignError(where, value, f"must be within ±{tol.max_length:g} mm (size limit, Tolerances.max_length)", unit)
@@ -263,7 +264,7 @@ class Design:
                               "a design needs a [tablet] table with a family")
         data = copy.deepcopy(data)
         tab = data["tablet"]
-        name = tab.get("name") or default_name
+        name = tab.get("name", default_name)  # given empty, it is refused (not replaced by the default)
         if not isinstance(name, str) or not name.strip() or any(ch in name for ch in '/\\"\n') or len(name) > 200:
             raise DesignError("tablet.name", name, "must be a plain non-empty name (no / \\ or quotes, at most 200 characters)")
         family = tab.get("family")
