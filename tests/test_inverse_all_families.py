@@ -226,3 +226,17 @@ def test_a_solved_length_is_one_a_design_file_accepts(tmp_path):
     p = tmp_path / "d.toml"
     p.write_text(f'[tablet]\nfamily = "concave_round"\ndiameter = 10.0\ncup_depth = 0.9\nland = 0.08\nband = {band!r}\n')
     assert Design.from_toml(p).build().params["band"] == band
+
+
+def test_a_flat_face_stays_reachable_and_a_root_below_the_least_length_is_refused():
+    """An oval's cup depth builds at 0 (a flat face) and from Tolerances.min_length up: its interval keeps 0,
+    the flat design's volume is solved to 0 exactly, and a volume only reached between 0 and 1 µm is refused."""
+    from tabletcad.errors import DesignError
+    from tabletcad.families.inverse import solve_for
+
+    dims = dict(length=14.0, width=8.0, end_radius=3.0, band=3.0)
+    r = reachable("oval", vary="cup_depth", **dims)
+    assert r.lo_mm == 0.0 and r.hi_mm == 3.0
+    assert solve_for("oval", vary="cup_depth", target_volume_mm3=r.volume_lo_mm3, **dims).value == 0.0
+    with pytest.raises(DesignError, match="reached only with cup_depth = .* mm, which a design file refuses"):
+        solve_for("oval", vary="cup_depth", target_volume_mm3=r.volume_lo_mm3 + 1e-4, **dims)

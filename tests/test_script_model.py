@@ -145,6 +145,14 @@ def test_make_unknown_family():
         tabletcad.make("no_such_family")
 
 
+def test_make_takes_numpy_scalars():
+    import numpy as np
+
+    a = tabletcad.make("concave_round", diameter=np.int64(10), band=np.float32(2.5), cup_depth=np.float64(1.0))
+    b = tabletcad.make("concave_round", diameter=10, band=2.5, cup_depth=1.0)
+    assert a.volume == b.volume
+
+
 @pytest.mark.parametrize("family, dims, parameter", [
     ("capsule", dict(length=18.0), "tablet.width"),  # was built at the family's default width, band and cup
     ("concave_round", dict(diameter=10.0), "tablet.band"),

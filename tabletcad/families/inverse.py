@@ -183,15 +183,13 @@ class _Probe:
     def __init__(self, func: Callable[..., Tablet], dims: dict, vary: str) -> None:
         self.func, self.dims, self.vary = func, dims, vary
         # a length between 0 and min_length is refused by a design file (tabletcad.pipeline.design):
-        # the answer must be one that the written design builds again
+        # an approached lower end is raised to it, and a root between them is refused (solve_for)
         self.min_length = float(getattr(dims.get("tol", DEFAULT), "min_length", DEFAULT.min_length))
         self.builds = 0
         self._cache: dict[float, tuple[bool, Any]] = {}
         self.exact_nominal: bool | None = None
 
     def _build(self, x: float) -> tuple[bool, Any]:
-        if 0.0 < x < self.min_length:
-            return (False, None)
         if x not in self._cache:
             self.builds += 1
             try:
@@ -248,7 +246,7 @@ def _ends(probe: _Probe, x0: float, x_max: float, rel: float) -> tuple[float, fl
         else:
             bad = mid
     lo = 0.0 if bad == 0.0 and probe.ok(0.0) else good
-    if bad < probe.min_length <= lo and probe.ok(probe.min_length):  # the end is the design files' least length
+    if 0.0 < lo < probe.min_length and probe.ok(probe.min_length):  # approached: the design files' least length
         lo = probe.min_length
     # upper end: doubling, then bisection
     good, bad = x0, None
@@ -476,6 +474,9 @@ def solve_for(
         k = int(brackets[np.argmin(np.abs(mids - x_start))])
         x = float(brentq(lambda x: probe.volume(x) - target, float(xs[k]), float(xs[k + 1]),
                          xtol=_XTOL_MM, rtol=4 * np.finfo(float).eps))
+    if 0.0 < x < probe.min_length:  # between 0 (the flat face, where it builds) and a design file's least length
+        raise DesignError(param, given, f"is reached only with {vary} = {x:.4g} mm, which a design file refuses "
+                          f"(0 or at least {probe.min_length:g} mm, Tolerances.min_length)", unit)
     t = func(**dims, **{vary: x})  # the full build: patches (and, for the industry families, their certificate)
     v = nominal_volume(t.nominal) if isinstance(t.nominal, SweepNominal) else float(t.volume())
     return InverseResult(family=name, vary=vary, value=x, params={**{k: d for k, d in dims.items() if k not in ("a", "tol")}, vary: x},

@@ -243,9 +243,10 @@ def make(family: str, **dims: Any) -> TabletModel:
     every required dimension given, numbers only (no ``"10"``), lengths within ±1000 mm and 0
     or at least ``Tolerances.min_length``; ``a`` (the smoothing parameter) may be given.
     """
-    from tabletcad.families import family as lookup_family
+    import numpy as np
 
-    lookup_family(family, parameter="family")  # an unknown family: the one-line error naming "family"
+    # numpy's scalars (np.arange(...)[i], np.float32) are the numbers they hold; arrays are not numbers
+    dims = {k: v.item() if isinstance(v, np.generic) else v for k, v in dims.items()}
     design = Design.from_dict({"tablet": {"family": family, **dims}}, default_name=str(family).split(".")[-1])
     return TabletModel(design.build(), design)
 
