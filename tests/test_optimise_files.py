@@ -247,3 +247,31 @@ def test_fuzz_bad_cli_options_one_line(tmp_path_factory, capsys, bad, data):
     assert rc == 2 and len(err) == 1 and ONE_LINE.match(err[0]), (args, err)
     assert any(err[0].startswith(f"error: {opt} = ") for opt in bad), err
     assert not out.exists()
+
+
+def test_an_optimisation_folder_and_a_build_folder_keep_each_others_files(tmp_path, capsys, monkeypatch):
+    """``optimise`` records its files in its own manifest: a rerun replaces them, but a ``build`` into
+    the folder never takes them for an earlier build's (a build of ``res/optimum.toml`` into ``res``
+    would otherwise delete the optimum it is building), and an optimisation into a build's folder is
+    refused before the solve, the folder unchanged."""
+    monkeypatch.chdir(tmp_path)
+    problem = SAMPLES / "spherical_tablet_a.toml"
+    res = tmp_path / "res"
+    assert main(["optimise", str(problem), "--out", str(res), "--quiet"]) == 0
+    capsys.readouterr()
+    files = {p.relative_to(res).as_posix(): p.read_bytes() for p in res.rglob("*") if p.is_file()}
+    assert {"optimum.toml", "report.json", "convergence.png", ".tabletcad-optimise.json"} <= set(files)
+    assert main(["build", str(res / "optimum.toml"), "--out", str(res), "--quiet"]) == 2
+    assert "error: --out = " in capsys.readouterr().err
+    assert {p.relative_to(res).as_posix(): p.read_bytes() for p in res.rglob("*") if p.is_file()} == files
+    assert main(["optimise", str(problem), "--out", str(res), "--quiet"]) == 0  # its own earlier run: replaced
+    capsys.readouterr()
+    assert main(["build", str(res / "optimum.toml"), "--out", str(tmp_path / "b"), "--quiet"]) == 0
+    capsys.readouterr()
+    before = {p.name: p.read_bytes() for p in (tmp_path / "b").iterdir()}
+    import tabletcad.optimise.solvers as solvers
+
+    monkeypatch.setattr(solvers, "solve", lambda *a, **k: pytest.fail("the solve ran"))
+    assert main(["optimise", str(problem), "--out", str(tmp_path / "b"), "--quiet"]) == 2
+    assert "error: --out = " in capsys.readouterr().err
+    assert {p.name: p.read_bytes() for p in (tmp_path / "b").iterdir()} == before

@@ -55,11 +55,15 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
     from tabletcad.optimise.solvers import solve
     from tabletcad.geometry.tablet import Tablet
 
+    from tabletcad.io.outputs import OPTIMISE_MANIFEST, check_replaceable, publish, staging_folder
+
+    # the folder may hold only this command's earlier, unchanged results where it writes: checked before the
+    # solve (minutes for an FE problem); a build's files or anyone else's are never replaced
+    check_replaceable(out_dir, ["report.json", "convergence.png", "optimum.toml", "last_point.toml",
+                                "tablet/report.json", "tablet/tablet.png"], manifest=OPTIMISE_MANIFEST)
     method = method or default_method
     build_error = ""
     result = solve(problem, method, progress=not quiet, **opts)
-
-    from tabletcad.io.outputs import publish, staging_folder
 
     with staging_folder(out_dir) as staging:  # all or nothing, on out_dir's file system; the folder's manifest
         report = result_report(result, problem)
@@ -89,7 +93,7 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
         written.append("convergence.png")
         atomic_write_text(staging / "report.json", to_json(report))
         written.append("report.json")
-        publish(staging, out_dir)  # replaces only an earlier build's unchanged files; refuses anyone else's
+        publish(staging, out_dir, OPTIMISE_MANIFEST)  # replaces only its earlier run's unchanged files
     click.echo(summary(result))
     click.echo(f"-> {out_dir}/ ({', '.join(written)})")
     if not result.success:

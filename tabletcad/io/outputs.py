@@ -40,10 +40,13 @@ from pathlib import Path
 from tabletcad.errors import DesignError
 from tabletcad.io.atomic import atomic_write_text
 
-__all__ = ["MANIFEST", "STAGING_MARKER", "STALE_AFTER_S", "staging_folder", "publish", "read_manifest",
+__all__ = ["MANIFEST", "OPTIMISE_MANIFEST", "STAGING_MARKER", "STALE_AFTER_S", "staging_folder", "publish", "read_manifest",
            "clean_stale_staging", "file_sha256", "check_replaceable"]
 
 MANIFEST = ".tabletcad-build.json"
+#: the manifest of ``tabletcad optimise``'s folder: a command owns the files of its own manifest only, so a
+#: build into an optimisation's folder never takes its results (optimum.toml, report.json) for its own
+OPTIMISE_MANIFEST = ".tabletcad-optimise.json"
 
 #: Output folders that :func:`publish` completed in this process.  The command line reads it: a
 #: Ctrl-C that reaches a build after its outputs are in place is too late to undo it, and the
@@ -63,10 +66,10 @@ def file_sha256(path: Path) -> str:
     return h.hexdigest()
 
 
-def read_manifest(out_dir: str | os.PathLike[str]) -> dict[str, str]:
+def read_manifest(out_dir: str | os.PathLike[str], manifest: str = MANIFEST) -> dict[str, str]:
     """``{relative file name: sha256}`` of the build recorded in ``out_dir`` (empty if none or unreadable)."""
     try:
-        data = json.loads((Path(out_dir) / MANIFEST).read_text(encoding="utf-8"))
+        data = json.loads((Path(out_dir) / manifest).read_text(encoding="utf-8"))
         files = data["files"]
         return {str(k): str(v) for k, v in files.items()} if isinstance(files, dict) else {}
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
@@ -193,7 +196,7 @@ def _signals_deferred() -> Iterator[None]:
                 os.kill(os.getpid(), s)
 
 
-def publish(staging: str | os.PathLike[str], out_dir: str | os.PathLike[str]) -> list[str]:
+def publish(staging: str | os.PathLike[str], out_dir: str | os.PathLike[str], manifest: str = MANIFEST) -> list[str]:
     """Move the files of ``staging`` into ``out_dir`` and record them in its manifest.
 
     Files of the earlier build in ``out_dir`` (its manifest) that this build did
@@ -209,20 +212,21 @@ def publish(staging: str | os.PathLike[str], out_dir: str | os.PathLike[str]) ->
     staging, out_dir = Path(staging), Path(out_dir)
     files = sorted(p.relative_to(staging) for p in staging.rglob("*") if p.is_file() and p.name != STAGING_MARKER)
     hashes = {p.as_posix(): file_sha256(staging / p) for p in files}
-    earlier = read_manifest(out_dir)
-    check_replaceable(out_dir, [rel.as_posix() for rel in files], earlier)
+    earlier = read_manifest(out_dir, manifest)
+    check_replaceable(out_dir, [rel.as_posix() for rel in files], earlier, manifest)
     with _signals_deferred():  # Ctrl-C or SIGTERM now would leave half a build in out_dir
-        _move_in(staging, out_dir, files, hashes, earlier)
+        _move_in(staging, out_dir, files, hashes, earlier, manifest)
         published.append(out_dir)
     return sorted(hashes)
 
 
-def check_replaceable(out_dir: str | os.PathLike[str], names, earlier: dict[str, str] | None = None) -> None:
+def check_replaceable(out_dir: str | os.PathLike[str], names, earlier: dict[str, str] | None = None,
+                      manifest: str = MANIFEST) -> None:
     """Refuse (:class:`~tabletcad.errors.DesignError` for ``--out``) when ``out_dir`` holds a file of
     one of ``names`` (relative paths a build writes) that a build may not replace: one that no
     tabletcad build wrote there, or one edited since (its hash is not the manifest's)."""
     out_dir = Path(out_dir)
-    earlier = read_manifest(out_dir) if earlier is None else earlier
+    earlier = read_manifest(out_dir, manifest) if earlier is None else earlier
     theirs = [n for n in names if not _ours(out_dir / n, earlier.get(n))]
     if theirs:  # replacing them would lose what someone else put there
         shown = ", ".join(theirs[:3]) + (f" and {len(theirs) - 3} more" if len(theirs) > 3 else "")
@@ -243,7 +247,8 @@ def _ours(path: Path, digest: str | None) -> bool:
         return False
 
 
-def _move_in(staging: Path, out_dir: Path, files: list[Path], hashes: dict[str, str], earlier: dict[str, str]) -> None:
+def _move_in(staging: Path, out_dir: Path, files: list[Path], hashes: dict[str, str], earlier: dict[str, str],
+             manifest: str = MANIFEST) -> None:
     out_dir.mkdir(parents=True, exist_ok=True)
     umask = os.umask(0)
     os.umask(umask)
@@ -265,4 +270,4 @@ def _move_in(staging: Path, out_dir: Path, files: list[Path], hashes: dict[str, 
                 while parent != out_dir and not any(parent.iterdir()):  # folders the old build made
                     parent.rmdir()
                     parent = parent.parent
-    atomic_write_text(out_dir / MANIFEST, json.dumps(dict(tool="tabletcad", files=hashes), indent=1) + "\n")
+    atomic_write_text(out_dir / manifest, json.dumps(dict(tool="tabletcad", files=hashes), indent=1) + "\n")
