@@ -263,6 +263,8 @@ def test_a_plot_of_no_column_is_refused_before_any_design_is_built(tmp_path, cap
     spec = parse_sweep(__import__("tomllib").loads(sweep.read_text()), name="g")
     design = spec.designs()[0]
     _check_plot_columns(("volume_mm3", "design_report.weight_mg"), design, spec)  # columns of the report
+    # a column of a section that another design may have (a flat face has no cup radius): left to the end
+    _check_plot_columns(("design_report.cup_radii_mm.central",), design, spec)
     for bad in ("tablet.band", "status", "nonexistent_col"):  # a varied key, the status, no column
         with pytest.raises(DesignError):
             _check_plot_columns((bad,), design, spec)

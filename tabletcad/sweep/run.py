@@ -131,24 +131,26 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
 
 
 def _check_plot_columns(plot: tuple[str, ...], design: dict[str, Any], spec) -> None:
-    """Refuse a ``--plot`` column before any design is built: the first design's report (built here,
-    in this process, without files) names the columns.  A column of what only a build with files
-    adds (``brep``, ``mesh``, ``tooling``...) is left to the end when the sweep asks for files; a
-    first design that does not build leaves the check to the end as well."""
-    from tabletcad.errors import TabletcadError
+    """Refuse a ``--plot`` name before any design is built when no design's report can have it: a
+    varied key, a status column, or a name outside every section of the first design's report (built
+    here, in this process, without files).  Within a section the columns differ between designs (a
+    flat face has no cup radius), so such a name is left to the end, as are the sections only a build
+    with files adds (``brep``, ``mesh``, ``tooling``...) when the sweep asks for files, and every name
+    when the first design does not build."""
     from tabletcad.pipeline.design import Design
     from tabletcad.pipeline.report import flatten_report, geometry_report
 
     try:
         d = Design.from_dict(design, default_name=spec.name)
         cols = flatten_report(geometry_report(d.build(), d.report_options))
-    except TabletcadError:
+    except Exception:  # noqa: BLE001 - a design that fails is the sweep's row, not a reason to stop here
         return
     files = any(o != "report" for o in spec.outputs)
     sections = {c.split(".")[0] for c in cols}
     allowed = [c for c in cols if c not in spec.keys and c not in TAIL_COLUMNS]
     for o in plot:
-        if o in spec.keys or o in TAIL_COLUMNS or (o not in cols and (not files or o.split(".")[0] in sections)):
+        unknown = o not in cols and o.split(".")[0] not in sections and not files
+        if o in spec.keys or o in TAIL_COLUMNS or unknown:
             raise DesignError("--plot", o, "must be a report column of results.csv: " + ", ".join(allowed))
 
 
