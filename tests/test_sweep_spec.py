@@ -167,3 +167,23 @@ def test_sample_sweep_files():
     assert pts.shape == (40, 3) and pts[:, 0].min() >= 8.0 and pts[:, 0].max() < 12.0
     assert sorted(np.floor((pts[:, 2] - 0.5) / 0.9 * 40).astype(int)) == list(range(40))
     assert len({design_hash(d) for d in lhs.designs()}) == 40
+
+
+def test_a_sweep_of_more_than_a_million_designs_is_refused_up_front():
+    """Two axes of 1e8 values each filled the memory (1.2 GB after 25 s) before any design was built."""
+    from tabletcad.errors import DesignError
+    from tabletcad.sweep import parse_sweep
+
+    design = {"tablet": {"family": "concave_round", "diameter": 10.0, "band": 2.8, "cup_depth": 0.9}}
+
+    def sweep(vary, **sw):
+        return parse_sweep({"design": design, "sweep": {"vary": vary, **sw}})
+
+    with pytest.raises(DesignError, match="num = 100000000 is not allowed: must be an integer from 1 to 1,000,000"):
+        sweep({"tablet.band": {"min": 2.0, "max": 3.0, "num": 100_000_000}})
+    with pytest.raises(DesignError, match=r"'1000 x 1001' is not allowed: must give at most 1,000,000"):
+        sweep({"tablet.band": {"min": 2.0, "max": 3.0, "num": 1000}, "tablet.cup_depth": {"min": 0.5, "max": 1.0, "num": 1001}})
+    with pytest.raises(DesignError, match="samples"):
+        sweep({"tablet.band": {"min": 2.0, "max": 3.0}}, method="lhs", samples=10**9, seed=1)
+    assert len(sweep({"tablet.band": {"min": 2.0, "max": 3.0, "num": 1000},
+                      "tablet.cup_depth": {"min": 0.5, "max": 1.0, "num": 1000}}).points()) == 1_000_000

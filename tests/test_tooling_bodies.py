@@ -91,6 +91,11 @@ def test_user_defined_set_needs_every_dimension():
     (_with(punch_tip_straight_mm=9.0), "[tooling.punch] tip_straight_mm"),
     (_with(punch_key=True), "[tooling.punch] key_width_mm"),
     (_with(punch_bogus=1), "[tooling.punch] key 'bogus'"),
+    (_with(punch_key=True, punch_key_width_mm=25.0, punch_key_length_mm=20.0, punch_key_height_mm=2.0,
+           punch_key_offset_mm=10.0), "[tooling.punch] key_width_mm"),  # wider than the barrel: was built
+    (_with(tip_length_mm=1e300), "[tooling] tip_length_mm"),  # reached OCC as a zero vector (exit 1)
+    (_with(gap_mm=1e308), "[tooling] gap_mm"),  # an assembly of volume 0
+    (_with(die_height_mm=1e7), "[tooling] die_height_mm"),
 ])
 def test_bad_complete_tooling_is_one_design_error(table, parameter):
     if "punch" in table:
@@ -197,3 +202,12 @@ def test_cli_bad_complete_tooling_exits_2_with_one_line_and_writes_nothing(tmp_p
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error: [tooling")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
+
+
+def test_a_given_die_height_is_kept_whatever_its_value():
+    """22.22 mm given was taken for the default and replaced by the die table's height (23.81 mm for a
+    D die): the spec now keeps None for "not given"."""
+    from tabletcad.tooling.spec import ToolingSpec
+
+    assert parse_tooling({"die_height_mm": 22.22}).die_height_mm == 22.22
+    assert parse_tooling({}).die_height_mm is None and ToolingSpec().die_height_mm is None

@@ -48,6 +48,16 @@ def _check_json_file(json_file: Path | None) -> None:
     check_output("--json-file", json_file, (".json",))
 
 
+def _warn_plain(design) -> None:
+    """One warning line when the design's [tooling] scores or embosses a tablet the FE leaves plain."""
+    spec = getattr(design, "tooling_spec", None)
+    if spec is not None and (spec.scores or spec.emboss):
+        import warnings
+
+        warnings.warn("the FE meshes the plain tablet: the design's [tooling] scores and embossing are not in it",
+                      stacklevel=2)
+
+
 def _check_out(out: Path | None) -> None:
     if out is not None and out.exists() and not out.is_dir():
         raise DesignError("--out", str(out), "must be a folder (it is a file)")
@@ -91,7 +101,8 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
     from tabletcad.fe.elasticity import Material
 
     material = Material(E=E, nu=nu)
-    tablet, _ = load_family_design(design)
+    tablet, spec = load_family_design(design)
+    _warn_plain(spec)
     res = diametral(tablet, force, direction, strip_width=strip_width, mesh_size=mesh_size, material=material,
                     error_estimate=not no_error_estimate)
     payload = {"design": str(design), **res.to_dict()}
@@ -159,6 +170,7 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
     from tabletcad.fe.prediction import StrengthInputs, predict_breaking_force
 
     tablet, spec = load_family_design(design)
+    _warn_plain(spec)
     inputs = StrengthInputs.from_table(spec.report, tensile_strength_MPa=tensile_strength,
                                        reference_breaking_force_N=reference_force,
                                        reference_diameter_mm=reference_diameter,

@@ -61,6 +61,10 @@ OUTPUTS = {
 _SWEEP_KEYS = {"method", "samples", "seed", "outputs", "vary", "store"}
 
 
+#: most designs one sweep file may give (a million reports take hours; a grid of 1e8 x 1e8 filled memory)
+MAX_DESIGNS = 1_000_000
+
+
 @dataclass(frozen=True)
 class Axis:
     """One varied key: the dotted ``key`` of the design and its ``values`` (grid) or range (lhs).
@@ -211,8 +215,8 @@ def _axis(key: str, spec: Any, method: str) -> Axis:
     if "num" not in spec:
         raise DesignError(f"{where} num", "missing", "a grid range needs num (the number of values, >= 1)")
     num = spec["num"]
-    if isinstance(num, bool) or not isinstance(num, int) or num <= 0:
-        raise DesignError(f"{where} num", num, "must be an integer >= 1")
+    if isinstance(num, bool) or not isinstance(num, int) or not 0 < num <= MAX_DESIGNS:
+        raise DesignError(f"{where} num", num, f"must be an integer from 1 to {MAX_DESIGNS:,}")
     if num == 1:
         values: tuple[float, ...] = (lo,) if lo == hi else ()
         if not values:
@@ -251,8 +255,8 @@ def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
         if "samples" not in sw:
             raise DesignError("[sweep] samples", "missing", "a Latin hypercube needs samples (an integer >= 1)")
         samples = sw["samples"]
-        if isinstance(samples, bool) or not isinstance(samples, int) or samples <= 0:
-            raise DesignError("[sweep] samples", samples, "must be an integer >= 1")
+        if isinstance(samples, bool) or not isinstance(samples, int) or not 0 < samples <= MAX_DESIGNS:
+            raise DesignError("[sweep] samples", samples, f"must be an integer from 1 to {MAX_DESIGNS:,}")
         if "seed" not in sw:
             raise DesignError("[sweep] seed", "missing", "samples need a seed (an integer >= 0) so that the sweep can be repeated")
         seed = sw["seed"]
@@ -283,5 +287,8 @@ def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
             raise DesignError("[sweep.vary] key", key, "must name a value of [design] or a parameter of its family "
                               "(e.g. 'tablet.cup_depth'); known: " + ", ".join(sorted(known)))
         axes.append(_axis(key, spec, method))
+    if method == "grid" and math.prod(len(a.values) for a in axes) > MAX_DESIGNS:
+        raise DesignError("[sweep.vary]", " x ".join(str(len(a.values)) for a in axes),
+                          f"must give at most {MAX_DESIGNS:,} designs (the grid's product)")
     return SweepSpec(design=design, axes=tuple(axes), method=method, samples=samples, seed=seed,
                      outputs=tuple(dict.fromkeys(["report", *outputs])), store=store, name=name)

@@ -66,6 +66,7 @@ from pathlib import Path
 from typing import Any
 
 from tabletcad.errors import DesignError, check_finite, check_positive, check_range
+from tabletcad.tolerance import DEFAULT
 from tabletcad.tooling.standards import PunchBody, resolve_body
 
 __all__ = ["ToolingSpec", "ScoreSpec", "EmbossSpec", "FeRatingSpec", "parse_tooling", "FONT_DIR", "font_path"]
@@ -216,7 +217,7 @@ class ToolingSpec:
     clearance_mm: float = 0.025
     tip_length_mm: float = 8.0
     die_outer_diameter_mm: float | None = None
-    die_height_mm: float = 22.22
+    die_height_mm: float | None = None  # None: 22.22 mm, or the TSM die table's when no outer diameter is given
     taper_deg: float = 0.0
     gap_mm: float | None = None
     scores: tuple[ScoreSpec, ...] = ()
@@ -358,13 +359,15 @@ def parse_tooling(table: Any, base: Path | None = None) -> ToolingSpec:
             "allowed_tip_pressure_source", "punch_youngs_modulus_MPa", "punch_youngs_modulus_source", "fe_rating"}
     t = _keys("[tooling]", table, keys)
     clearance = check_range("[tooling] clearance_mm", t.get("clearance_mm", d.clearance_mm), 0.0, 1.0, "mm")
-    tip = check_positive("[tooling] tip_length_mm", t.get("tip_length_mm", d.tip_length_mm), "mm")
+    big = DEFAULT.max_length  # steel longer than a metre is no tablet tooling (1e300 reached OCC as a zero vector)
+    tip = check_range("[tooling] tip_length_mm", t.get("tip_length_mm", d.tip_length_mm), 0.0, big, "mm", lo_open=True)
     od = t.get("die_outer_diameter_mm")
-    od = None if od is None else check_positive("[tooling] die_outer_diameter_mm", od, "mm")
-    height = check_positive("[tooling] die_height_mm", t.get("die_height_mm", d.die_height_mm), "mm")
+    od = None if od is None else check_range("[tooling] die_outer_diameter_mm", od, 0.0, big, "mm", lo_open=True)
+    height = t.get("die_height_mm")  # given, it is kept (22.22 given was taken for the default and replaced)
+    height = None if height is None else check_range("[tooling] die_height_mm", height, 0.0, big, "mm", lo_open=True)
     taper = check_range("[tooling] taper_deg", t.get("taper_deg", d.taper_deg), 0.0, 10.0, "deg", hi_open=True)
     gap = t.get("gap_mm")
-    gap = None if gap is None else check_positive("[tooling] gap_mm", gap, "mm")
+    gap = None if gap is None else check_range("[tooling] gap_mm", gap, 0.0, big, "mm", lo_open=True)
     scores = t.get("score", [])
     emb = t.get("emboss", [])
     if not isinstance(scores, list):
@@ -372,7 +375,7 @@ def parse_tooling(table: Any, base: Path | None = None) -> ToolingSpec:
     if not isinstance(emb, list):
         raise DesignError("[[tooling.emboss]]", emb, "must be an array of tables")
     lower = t.get("lower_tip_length_mm")
-    lower = None if lower is None else check_positive("[tooling] lower_tip_length_mm", lower, "mm")
+    lower = None if lower is None else check_range("[tooling] lower_tip_length_mm", lower, 0.0, big, "mm", lo_open=True)
     body = None
     if "standard" in t or "type" in t or "punch" in t:
         std = _choice("[tooling] standard", t.get("standard", "missing"), ("TSM", "EU", "custom"))

@@ -178,6 +178,8 @@ def resolve_body(standard: str, kind: str | None, table: Any, tip_length: float,
     if key:
         for k in _KEY_KEYS:
             kv[k] = _num(w, t, k, {}, src, zero_ok=k == "key_offset_mm")
+    if key and not kv["key_width_mm"] < Db:  # a key sits in a slot of the barrel
+        raise DesignError(f"{w} key_width_mm", kv["key_width_mm"], f"must be < barrel_diameter_mm {Db:.4g} mm", "mm")
     key_angle = float(check_range(f"{w} key_angle_deg", t.get("key_angle_deg", 0.0), -360.0, 360.0, "deg"))
     ext = {k: entry[k]["value"] for k in ("max_round_tablet_mm", "max_shaped_tablet_mm", "die_outer_diameter_mm")
            if k in entry}

@@ -45,6 +45,20 @@ class ToolSet:
         return out
 
 
+#: die height (mm) when only the outer diameter is given
+DEFAULT_DIE_HEIGHT_MM = 22.22
+
+
+def die_height(frame, spec: ToolingSpec) -> float:
+    """The die height (mm) a build uses: the given one, else 22.22 mm beside a given outer diameter, else the
+    TSM die table's for the tablet's size (:func:`tabletcad.tooling.die.default_die_size`)."""
+    from tabletcad.tooling.die import default_die_size
+
+    if spec.die_height_mm is not None:
+        return spec.die_height_mm
+    return DEFAULT_DIE_HEIGHT_MM if spec.die_outer_diameter_mm is not None else default_die_size(frame)[1]
+
+
 def _check_complete_punches(frame, spec: ToolingSpec) -> None:
     """Bad complete-punch input (tablet larger than the barrel or the standard, a tip too short to keep
     the barrel out of the die) as a DesignError, before any tooling geometry is built."""
@@ -52,7 +66,7 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
     from tabletcad.tooling.punch_body import check_body_fits
 
     check_body_fits(frame, spec.body, _max_radius(frame.outline))
-    _, top, bottom = die_position(frame, spec.die_height_mm)
+    _, top, bottom = die_position(frame, die_height(frame, spec))
     need_up = top - frame.band_z[1]
     if spec.tip_length_mm <= need_up:
         raise DesignError("[tooling] tip_length_mm", spec.tip_length_mm,
@@ -118,8 +132,8 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
             shape_, info_ = complete_punch(frame, tip.shape, which, spec.body, spec.clearance_mm, tl)
             tip.info.update(tip_volume_mm3=tip.volume_mm3, body=info_)
             tip.shape, tip.volume_mm3 = shape_, info_["volume_mm3"]
-    die_shape, die_info = die(frame, spec.die_outer_diameter_mm, None if spec.die_outer_diameter_mm is None and
-                              spec.die_height_mm == ToolingSpec().die_height_mm else spec.die_height_mm, spec.taper_deg)
+    die_shape, die_info = die(frame, spec.die_outer_diameter_mm, spec.die_height_mm if spec.die_height_mm is not None
+                              else None if spec.die_outer_diameter_mm is None else DEFAULT_DIE_HEIGHT_MM, spec.taper_deg)
     t2 = time.perf_counter()
     parts = {"tablet": solid, "upper_punch": upper.shape, "lower_punch": lower.shape, "die": die_shape}
     gap = gap_closed if spec.gap_mm is None else spec.gap_mm
