@@ -58,11 +58,6 @@ def _warn_plain(design) -> None:
                       stacklevel=2)
 
 
-def _check_out(out: Path | None) -> None:
-    if out is not None and out.exists() and not out.is_dir():
-        raise DesignError("--out", str(out), "must be a folder (it is a file)")
-
-
 @click.group("fe")
 def fe_group() -> None:
     """Finite-element stresses on the real shape (scikit-fem, quadratic tetrahedra; gmsh meshes)."""
@@ -94,7 +89,6 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
     check_positive("--force", force, "N")
     if direction not in DIRECTIONS:
         raise DesignError("--direction", direction, "must be one of " + ", ".join(DIRECTIONS))
-    _check_out(out)
     _check_json_file(json_file)
     _require_fe()
     from tabletcad.fe.diametral import diametral
@@ -213,7 +207,6 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
     check_positive("--force", force, "kN")
     check_positive("--safety-factor", safety_factor)
     check_positive("--effective-length-factor", effective_length_factor)
-    _check_out(out)
     _check_json_file(json_file)
     from tabletcad.fe.punch import tool_steels
 

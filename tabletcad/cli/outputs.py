@@ -24,14 +24,18 @@ def check_output(option: str, path: Path | None, suffixes: tuple[str, ...] = (".
         raise DesignError(option, str(path), f"must end in {allowed}")
     if path.is_dir():
         raise DesignError(option, str(path), "is a folder; give a file name")
-    folder = path.absolute().parent
+    _check_writable_from(option, path, path.absolute().parent)
+
+
+def _check_writable_from(option: str, path: Path, start: Path) -> None:
+    """Refuse ``path`` unless the nearest existing folder at or above ``start`` is a writable folder."""
+    folder = start
     while not folder.exists() and folder != folder.parent:
         folder = folder.parent
     if not folder.is_dir():
         raise DesignError(option, str(path), f"cannot be created: {folder} is a file, not a folder")
     if not os.access(folder, os.W_OK | os.X_OK):
-        raise DesignError(option, str(path), f"cannot be created: folder {folder} is not writable")
-
+        raise DesignError(option, str(path), f"cannot be written: folder {folder} is not writable")
 
 
 def check_out_folder(option: str, raw: str | os.PathLike[str]) -> Path:
@@ -43,13 +47,7 @@ def check_out_folder(option: str, raw: str | os.PathLike[str]) -> Path:
     path = Path(raw)
     if path.exists() and not path.is_dir():
         raise DesignError(option, str(path), "must be a folder (a file of that name exists)")
-    folder = path.absolute()
-    while not folder.exists() and folder != folder.parent:
-        folder = folder.parent
-    if not folder.is_dir():
-        raise DesignError(option, str(path), f"cannot be created: {folder} is a file, not a folder")
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise DesignError(option, str(path), f"cannot be written: folder {folder} is not writable")
+    _check_writable_from(option, path, path.absolute())
     return path
 
 

@@ -64,6 +64,7 @@ import numpy as np
 import tomllib
 
 from tabletcad.errors import DesignError, check_finite, check_range
+from tabletcad.tolerance import DEFAULT
 from tabletcad.mechanics.units import DIMENSIONS, header_unit, strip_unit, unit_factor
 from tabletcad.mechanics.validity import DataWarning, warn
 
@@ -194,7 +195,7 @@ class PressMetadata:
         if self.diameter is None and self.face_area is None:
             raise DesignError("diameter", None, "give the die diameter (mm) or the punch face area (mm²)", "mm")
         if self.diameter is not None:
-            check_range("diameter", self.diameter, 0.0, 1000.0, "mm", lo_open=True)
+            check_range("diameter", self.diameter, 0.0, DEFAULT.max_length, "mm", lo_open=True)
         if self.face_area is not None:
             check_range("face area", self.face_area, 0.0, 1e6, "mm²", lo_open=True)
         if not isinstance(self.notes, str):

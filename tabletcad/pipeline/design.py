@@ -448,23 +448,21 @@ def _free_form(patches: Any, name: str, a) -> Tablet:
             key = last if last in ("a", "modes", "u_nodes", "form", "curves") else exc.parameter
             raise exc.renamed(one_token(f"{where}.{key}")) from None
         prev = cs[3]
-    _check_joined(out)
-    return Tablet(tuple(out), name=name, family="free_form")
+    return _check_joined(Tablet(tuple(out), name=name, family="free_form"))
 
 
-def _check_joined(patches: list[PDEPatch], n: int = 64) -> None:
-    """Each patch of a free-form chain starts where the previous one ends (within ``seam_gap`` mm at
-    ``n`` points around), else :class:`DesignError` for the patch's first curve: a gap is no solid."""
-    v = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
-    for j in range(1, len(patches)):
-        end = patches[j - 1].evaluate(np.ones(n), v)
-        start = patches[j].evaluate(np.zeros(n), v)
-        gap = float(np.max(np.linalg.norm(end - start, axis=1)))
-        tol = patches[j].tol.seam_gap
-        if not gap <= tol:
-            raise DesignError(f"patch[{j}].curves[0]", f"a gap of {gap:.4g} mm to patch[{j - 1}]'s end",
-                              f"must start where patch[{j - 1}] ends (within {tol:g} mm; \"previous\" repeats its "
+def _check_joined(tablet: Tablet) -> Tablet:
+    """``tablet`` if each patch of its free-form chain starts where the previous one ends (the report's
+    seam gaps, :meth:`Tablet.seams`, within ``seam_gap`` mm), else :class:`DesignError` for the patch's
+    first curve: a gap is no solid."""
+    tol = tablet.tol.seam_gap
+    for seam in tablet.seams():
+        i, j = seam["patches"]
+        if not seam["max_gap_mm"] <= tol:
+            raise DesignError(f"patch[{j}].curves[0]", f"a gap of {seam['max_gap_mm']:.4g} mm to patch[{i}]'s end",
+                              f"must start where patch[{i}] ends (within {tol:g} mm; \"previous\" repeats its "
                               "last curve)")
+    return tablet
 
 
 def _pair(where: str, val: Any) -> tuple[float, float]:

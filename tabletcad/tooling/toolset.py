@@ -132,8 +132,7 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
             shape_, info_ = complete_punch(frame, tip.shape, which, spec.body, spec.clearance_mm, tl)
             tip.info.update(tip_volume_mm3=tip.volume_mm3, body=info_)
             tip.shape, tip.volume_mm3 = shape_, info_["volume_mm3"]
-    die_shape, die_info = die(frame, spec.die_outer_diameter_mm, spec.die_height_mm if spec.die_height_mm is not None
-                              else None if spec.die_outer_diameter_mm is None else DEFAULT_DIE_HEIGHT_MM, spec.taper_deg)
+    die_shape, die_info = die(frame, spec.die_outer_diameter_mm, die_height(frame, spec), spec.taper_deg)
     t2 = time.perf_counter()
     parts = {"tablet": solid, "upper_punch": upper.shape, "lower_punch": lower.shape, "die": die_shape}
     gap = gap_closed if spec.gap_mm is None else spec.gap_mm
