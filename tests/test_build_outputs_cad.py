@@ -60,6 +60,14 @@ def test_tooling_build_then_cutaway_then_plain_rebuild(tmp_path, capsys):
     # non-adaptive one splits at the profile's knots and is exact (README, "CAD solids")
     assert plain["volume_default"] - fin["volume"] == pytest.approx(removed, rel=1e-5) and removed > 0.05
     assert fin["n_faces"] > plain["n_faces"]
+    # weights at the sample's [report] density (0.85 x 1.5 mg/mm^3): design_report's is the plain
+    # tablet's, tooling.tablet's the finished one's, which the halves share and the summary prints
+    tab, rho = rep["tooling"]["tablet"], 0.85 * 1.5
+    assert rep["design_report"]["weight_mg"] == pytest.approx(plain["volume"] * rho, rel=1e-6)
+    assert tab["weight_plain_mg"] == pytest.approx(plain["volume"] * rho, rel=1e-6)
+    assert tab["weight_mg"] == pytest.approx(fin["volume"] * rho, rel=1e-6)
+    assert sum(p["mass_mg"] for p in rep["tooling"]["split"]["parts"]) == pytest.approx(tab["weight_mg"], rel=1e-6)
+    assert f"finished (scored/embossed) tablet: volume {fin['volume']:.4g} mm3, weight {fin['volume'] * rho:.4g} mg" in line
 
     (out / "notes.txt").write_text("mine")
     (out / "drawing.svg").write_text((out / "drawing.svg").read_text() + "<!-- edited -->")

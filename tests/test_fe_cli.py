@@ -68,9 +68,12 @@ def test_diametral_json_and_files(capsys, tmp_path, thin):
         (["--force", "0"], "--force = 0 N is not allowed: must be > 0"),
         (["--force", "-5"], "--force = -5 N is not allowed: must be > 0"),
         (["--force", "10", "--direction", "diagonal"], "--direction = 'diagonal' is not allowed"),
-        (["--force", "10", "--strip-width", "5"], "strip_width = 5 mm is not allowed"),
-        (["--force", "10", "--mesh-size", "0.001"], "mesh_size = 0.001 mm is not allowed: must be >= "),
-        (["--force", "10", "--nu", "0.5"], "nu = 0.5 is not allowed"),
+        # the FE functions' keyword arguments are named as the options that set them
+        (["--force", "10", "--strip-width", "5"], "error: --strip-width = 5 mm is not allowed"),
+        (["--force", "10", "--mesh-size", "0.001"], "error: --mesh-size = 0.001 mm is not allowed: must be >= "),
+        (["--force", "10", "--mesh-size", "0"], "error: --mesh-size = 0 mm is not allowed: must be > 0"),
+        (["--force", "10", "--nu", "0.5"], "error: --nu = 0.5 is not allowed"),
+        (["--force", "10", "--E", "-1"], "error: --E = -1 MPa is not allowed: must be > 0"),
     ],
 )
 def test_diametral_bad_input_one_line_exit_2_nothing_written(capsys, tmp_path, thin, extra, match):

@@ -211,3 +211,59 @@ def test_a_given_die_height_is_kept_whatever_its_value():
 
     assert parse_tooling({"die_height_mm": 22.22}).die_height_mm == 22.22
     assert parse_tooling({}).die_height_mm is None and ToolingSpec().die_height_mm is None
+
+
+@pytest.mark.cad
+def test_a_tip_relief_leaving_no_tip_names_tip_relief_mm():
+    """``tip_relief_mm = 6`` on a 10 mm tablet stopped with "offsetting the outline by -6.025 mm failed"
+    after the tablet was built; the relief is now refused by name before any tooling geometry, and a
+    relief that leaves a tip passes."""
+    pytest.importorskip("OCP")
+    from dataclasses import replace
+
+    from tabletcad.families.thesis import shallow_convex_round
+    from tabletcad.tooling.outline import tablet_frame
+    from tabletcad.tooling.toolset import _check_relief, make_tooling
+
+    tablet = shallow_convex_round()
+    with pytest.raises(DesignError) as e:
+        make_tooling(tablet, parse_tooling(_with(punch_tip_relief_mm=6.0)), check=False)
+    assert str(e.value).startswith("[tooling.punch] tip_relief_mm = 6 mm is not allowed: must leave a relieved tip")
+    frame = tablet_frame(tablet)
+    spec = parse_tooling(EU_B)
+    R = 0.5 * frame.width  # the round's radius: the tip's outline is R - clearance
+    for relief, ok in ((R - 0.025 - 0.05, True), (R - 0.025 + 1e-3, False), (R, False)):
+        s = replace(spec, body=replace(spec.body, tip_relief_mm=relief))
+        if ok:
+            _check_relief(frame, s)
+        else:
+            with pytest.raises(DesignError, match="tip_relief_mm"):
+                _check_relief(frame, s)
+
+
+@pytest.mark.cad
+def test_cupped_tips_without_a_land_warn_of_a_knife_edge():
+    """The EU D oval sample's tablet has no land: its tips' land is -0.02 mm (0 - the clearance),
+    which was reported without a word; a cupped tablet with a land wider than the clearance is quiet,
+    and so is a flat face (it meets the tip's wall square)."""
+    pytest.importorskip("OCP")
+    import warnings
+
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.outline import tablet_frame
+    from tabletcad.tooling.toolset import _warn_knife_edge
+
+    def warned(tablet: dict, clearance: float) -> list[str]:
+        frame = tablet_frame(Design.from_dict({"tablet": tablet}).build())
+        with warnings.catch_warnings(record=True) as w:
+            warnings.simplefilter("always")
+            _warn_knife_edge(frame, clearance)
+        return [str(x.message) for x in w]
+
+    oval = dict(family="oval", length=14.0, width=8.0, end_radius=3.0, band=3.0, cup_depth=0.9)
+    (msg,) = warned(oval, 0.02)
+    assert "no land (0 mm tablet land - 0.02 mm clearance = -0.02 mm)" in msg and "knife edge" in msg
+    landed = dict(family="concave_round", diameter=10.0, band=2.8, cup_depth=0.9, land=0.08)
+    assert warned(landed, 0.02) == [] and len(warned(landed, 0.1)) == 1
+    flat = dict(family="flat_face_round", diameter=10.0, thickness=3.0)
+    assert warned(flat, 0.02) == []

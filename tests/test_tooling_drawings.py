@@ -43,7 +43,12 @@ def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
     td = ts.report["tooling_drawing"]
     assert td["paper"] in ("A3", "A2") and td["scale"] >= 1.0
     tsvg = (out / "tooling.svg").read_text(encoding="utf-8")
-    for text in ("overall 133.35 ±0.076", "Ø19.00", "Ø25.40", "tip 8.00", "tip 19.00", "Ø30.16 ±0.076", "H 22.22 ±0.076",
+    # the cup's sphere through the land's inner edge (4.92 mm from the axis) and 0.9 mm deep; the land
+    cup_r = (4.92 ** 2 + 0.9 ** 2) / (2 * 0.9)
+    for text in (f"R{cup_r:.2f} ±0.076", "land 0.080 ±0.076"):
+        assert text in svg, text
+    for text in ("overall 133.35 ±0.076", "Ø19.00 ±0.076", "Ø25.40 ±0.076", "tip 8.00 ±0.076", "tip 19.00 ±0.076",
+                 "Ø30.16 ±0.076", "H 22.22 ±0.076",
                  "UPPER PUNCH", "LOWER PUNCH", "DIE", "drawing no. TC-0001-T", "TSM B tooling, angled heads"):
         assert text in tsvg, text
     dxf = (out / "tooling.dxf").read_text(encoding="utf-8", errors="replace")
@@ -104,3 +109,35 @@ def test_no_text_leaves_the_sheet_or_lies_on_the_views(drawn, capsule, which):
                 assert not a.overlaps(b), (ta, tb)
     finally:
         plt.close(fig)
+
+
+def test_every_dimension_takes_its_own_tolerance():
+    """Each dimension key of ``[tooling.drawing] tolerances`` reaches its dimension on the sheets, and
+    the radius and land dimensions measure the drawn geometry (the detail is enlarged 10 times)."""
+    import math
+    from dataclasses import replace
+
+    from tabletcad.tooling.drawing import _dim_geometry
+    from tabletcad.tooling.spec import TOLERANCE_KEYS
+
+    design = Design.from_toml(SAMPLE)
+    spec = design.tooling_spec
+    # a distinct tolerance per key: 0.001, 0.002, ... (none is the general 0.076)
+    tols = {k: round(0.001 * (i + 1), 3) for i, k in enumerate(TOLERANCE_KEYS)}
+    spec = replace(spec, drawing=replace(spec.drawing, tolerances=tuple(tols.items())))
+    ts = make_tooling(load_design(SAMPLE), spec, check=False, interference_check=False)
+    dr, tr = drawing_model(ts), tooling_model(ts)
+    texts = [d.text for d in dr.dims] + [d.text for d in tr.dims]
+    assert all("±" in t for t in texts) and not any("±0.076" in t for t in texts)
+    shown = {t.rsplit("±", 1)[1] for t in texts}
+    # every key the tablet and punch sheets dimension (a round: no length or width) appears
+    expected = {k for k in TOLERANCE_KEYS if k not in ("length", "width", "score_depth")}
+    assert {f"{tols[k]:.3f}" for k in expected} <= shown
+    radius = [d for d in dr.dims if d.radius]
+    assert len(radius) == 1
+    (cx, cy), (px, py) = radius[0].p1, radius[0].p2
+    assert math.hypot(px - cx, py - cy) == pytest.approx((4.92 ** 2 + 0.9 ** 2) / 1.8, rel=1e-12)
+    a, b, ext = _dim_geometry(radius[0])
+    assert a == (px, py) and ext == [] and math.hypot(b[0] - a[0], b[1] - a[1]) == pytest.approx(3.0)
+    (land,) = [d for d in dr.dims if d.text.startswith("land")]
+    assert abs(land.p2[0] - land.p1[0]) == pytest.approx(10.0 * 0.08, rel=1e-12)

@@ -58,7 +58,24 @@ def _warn_plain(design) -> None:
                       stacklevel=2)
 
 
-@click.group("fe")
+# the keyword names tabletcad.fe's functions give their arguments, and the options that set them
+OPTION_NAMES = {"force": "--force", "direction": "--direction", "strip_width": "--strip-width",
+                "mesh_size": "--mesh-size", "E": "--E", "nu": "--nu"}
+
+
+class _FEGroup(click.Group):
+    """The ``fe`` group: a refusal of an argument the command line set names the option."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except DesignError as exc:
+            if exc.parameter in OPTION_NAMES:
+                raise exc.renamed(OPTION_NAMES[exc.parameter]) from None
+            raise
+
+
+@click.group("fe", cls=_FEGroup)
 def fe_group() -> None:
     """Finite-element stresses on the real shape (scikit-fem, quadratic tetrahedra; gmsh meshes)."""
 

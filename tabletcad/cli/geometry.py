@@ -77,9 +77,22 @@ def build_cmd(design: Path, out_dir: Path, quiet: bool) -> None:
     size = f"{rep['length_mm']:.4g} x {rep['width_mm']:.4g} x {rep['height_mm']:.4g} mm"
     click.echo(
         f"{d['name']}: volume {rep['volume_mm3']:.4g} mm3, area {rep['surface_area_mm2']:.4g} mm2, {size}"
-        f"{nominal_note(d['family'], d['params'], rep['length_mm'], rep['width_mm'], rep['height_mm'])} "
-        f"-> {out_dir}/ ({', '.join(written)})"
+        f"{nominal_note(d['family'], d['params'], rep['length_mm'], rep['width_mm'], rep['height_mm'])}"
+        f"{_finished_note(rep)} -> {out_dir}/ ({', '.join(written)})"
     )
+
+
+def _finished_note(rep: dict) -> str:
+    """``; finished tablet ...`` when scores or embossing changed the tablet (``tablet.*`` is that one).
+
+    The summary's volume and area, and ``design_report``, are the plain PDE tablet's; the finished
+    tablet's volume and weight are in ``tooling.tablet``.
+    """
+    tab = (rep.get("tooling") or {}).get("tablet")
+    if not tab or tab["volume_mm3"] == tab["volume_plain_mm3"]:
+        return ""
+    weight = "" if tab.get("weight_mg") is None else f", weight {tab['weight_mg']:.4g} mg"
+    return f"; finished (scored/embossed) tablet: volume {tab['volume_mm3']:.4g} mm3{weight}"
 
 
 @click.command("mesh")

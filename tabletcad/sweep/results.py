@@ -119,6 +119,13 @@ def _safe(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", name)
 
 
+def plot_column_error(name: str, columns: Sequence[str], keys: Sequence[str]) -> DesignError:
+    """The refusal of ``--plot name``, listing the report ``columns`` that can be plotted (not the
+    varied ``keys``, not the status columns)."""
+    allowed = [c for c in columns if c not in keys and c not in TAIL_COLUMNS]
+    return DesignError("--plot", name, "must be a report column of results.csv: " + ", ".join(allowed))
+
+
 def plot_results(df, keys: Sequence[str], outputs: Sequence[str], out_dir: str | Path) -> list[Path]:
     """``plot_<output>.png``: each chosen output against each varied key (designs with status ok).
 
@@ -133,8 +140,7 @@ def plot_results(df, keys: Sequence[str], outputs: Sequence[str], out_dir: str |
 
     for o in outputs:
         if o not in df.columns or o in keys or o in TAIL_COLUMNS:
-            cols = [c for c in df.columns if c not in keys and c not in TAIL_COLUMNS]
-            raise DesignError("--plot", o, "must be a report column of results.csv: " + ", ".join(cols))
+            raise plot_column_error(o, df.columns, keys)
     ok = df[df["status"] == "ok"]
     paths = []
     for o in outputs:

@@ -9,8 +9,8 @@ from typing import Any
 
 from tabletcad.errors import DesignError
 from tabletcad.sweep.engine import CONNECT_TIMEOUT_S, failed_design, map_tasks, open_client, sweep_task
-from tabletcad.sweep.results import (JOURNAL, RESULTS_CSV, TAIL_COLUMNS, append_journal, plot_results, read_done,
-                                     results_frame, write_results)
+from tabletcad.sweep.results import (JOURNAL, RESULTS_CSV, TAIL_COLUMNS, append_journal, plot_column_error,
+                                     plot_results, read_done, results_frame, write_results)
 from tabletcad.sweep.spec import SweepSpec, design_hash, load_sweep, parse_sweep
 
 __all__ = ["run_sweep"]
@@ -147,11 +147,10 @@ def _check_plot_columns(plot: tuple[str, ...], design: dict[str, Any], spec) -> 
         return
     files = any(o != "report" for o in spec.outputs)
     sections = {c.split(".")[0] for c in cols}
-    allowed = [c for c in cols if c not in spec.keys and c not in TAIL_COLUMNS]
     for o in plot:
         unknown = o not in cols and o.split(".")[0] not in sections and not files
         if o in spec.keys or o in TAIL_COLUMNS or unknown:
-            raise DesignError("--plot", o, "must be a report column of results.csv: " + ", ".join(allowed))
+            raise plot_column_error(o, list(cols), spec.keys)
 
 
 def _restored(row: dict[str, Any], keys: tuple[str, ...], values: tuple[Any, ...]) -> dict[str, Any]:

@@ -6,7 +6,8 @@ silhouettes drawn solid, hidden sharp edges dashed.  Third-angle layout: the
 front elevation (looking along +y), the plan above it (looking down -z) and
 the side elevation (looking along -x) to its right.  Dimensions state the
 design's numbers: diameter (or length and width), band, cup depth, overall
-thickness, cup/edge radii and land, each with its ± tolerance (the design's
+thickness, a round's spherical cup radius (section A-A) and land (detail B), each
+with its ± tolerance (compound, shaped and edge radii are in the notes; the design's
 ``[tooling.drawing] tolerances``, else its ``tolerance_mm``, else 0.076 mm stated
 on the sheet as this program's default).  The title block carries name,
 drawing number, revision, material, date and author from ``[tooling.drawing]``
@@ -14,8 +15,8 @@ and the scale the views were drawn at.  Written as ``drawing.svg`` and
 ``drawing.pdf`` (matplotlib, text kept as text) and ``drawing.dxf`` (ezdxf,
 DIMENSION entities with the same texts).  With complete punches a second sheet,
 ``tooling.svg``/``.pdf``/``.dxf``, shows the upper punch, lower punch and die
-in elevation with overall length, tip length, barrel, neck and head
-diameters, die diameter and height, and the die bore.
+in elevation with overall length, tip length, barrel and head diameters, die
+diameter and height, each with its ± tolerance (neck, relief and bore in the notes).
 """
 
 from __future__ import annotations
@@ -129,13 +130,18 @@ def detail_view(view: dict, centre: tuple[float, float], half: float, k: float) 
 
 @dataclass
 class Dim:
-    """A linear dimension between two sheet points, drawn ``offset`` mm aside, with its text."""
+    """A linear dimension between two sheet points, drawn ``offset`` mm aside, with its text.
+
+    ``radius``: a radius dimension instead; ``p1`` is the arc's centre, ``p2`` a point on the arc,
+    and the leader runs from ``p2`` outwards (away from the centre) ``offset`` mm to the text.
+    """
 
     p1: tuple[float, float]
     p2: tuple[float, float]
     offset: float
     text: str
     vertical: bool = False
+    radius: bool = False
 
 
 @dataclass
@@ -225,9 +231,27 @@ def drawing_model(ts) -> Drawing:
         sc = ts.report["scores"][0]
         dims.append(Dim((sx_, sy_ + fr.z_max - sc["depth_mm"]), (sx_, sy_ + fr.z_max), 2.0 + half_w,
                         f"score {_fmt(sc['depth_mm'])}", vertical=True))
+    cup_r = _single_cup_radius(fr, radii)
+    if cup_r is not None:  # on the section's left half, away from a score at the centre
+        x = -0.6 * (fr.round_radius - (fr.land or 0.0))
+        zc = fr.z_max - cup_r  # the cup's sphere is centred on the axis
+        dims.append(Dim((sx_, sy_ + zc), (sx_ + x, sy_ + zc + math.sqrt(cup_r * cup_r - x * x)), 3.0,
+                        f"R{_fmt(cup_r)}", radius=True))
+    if fr.land and fr.edge_land("top") > 0:  # the land in detail B: from the cup's edge to the outline
+        dx, dy = origins[f"detail B {k:g}:1"]
+        dims.append(Dim((dx - k * fr.land, dy), (dx, dy), 0.25 * k * half, f"land {_fmt(fr.land)}"))
     notes.append(f"section A-A through the axis across {th:g} deg{' (the score)' if scores else ''}; "
                  f"detail B: band edge and land, {k:g}:1")
     return Drawing(views, origins, _toleranced(dims, ts), notes, title=_title(ts), title_block=title_block(ts))
+
+
+def _single_cup_radius(fr, radii: dict) -> float | None:
+    """The cup radius to dimension (mm): a round tablet's spherical cup (one radius), else None
+    (compound cups, shaped tablets and edge radii stay in the notes)."""
+    if fr.round_radius is None or fr.cup_depth_top <= 1e-6 or set(radii) != {"cup_radius_mm"}:
+        return None
+    r = float(radii["cup_radius_mm"])
+    return r if r > fr.round_radius else None
 
 
 def rating_notes(r: dict) -> list[str]:
@@ -247,7 +271,7 @@ def rating_notes(r: dict) -> list[str]:
 
 
 _DIM_KEYS = {"Ø": "diameter", "L": "length", "W": "width", "band": "band", "cup": "cup_depth", "T": "thickness",
-             "score": "score_depth"}
+             "score": "score_depth", "R": "cup_radius", "land": "land"}
 
 
 def _toleranced(dims: list, ts) -> list:
@@ -288,7 +312,12 @@ def _sheet_lines(dr: Drawing):
 
 
 def _dim_geometry(d: Dim):
+    """``(a, b, extension lines)``: the dimension line from ``a`` to ``b`` (a radius: the leader, from
+    the arc outwards) and the lines joining it to the measured points."""
     (x1, y1), (x2, y2) = d.p1, d.p2
+    if d.radius:
+        r = math.hypot(x2 - x1, y2 - y1)
+        return (x2, y2), (x2 + d.offset * (x2 - x1) / r, y2 + d.offset * (y2 - y1) / r), []
     if d.vertical:
         x = max(x1, x2) + d.offset if d.offset > 0 else min(x1, x2) + d.offset
         return (x, y1), (x, y2), [((x1, y1), (x, y1)), ((x2, y2), (x, y2))]
@@ -340,7 +369,12 @@ def sheet_figure(dr: Drawing, paper: str = "A4"):
                                      linewidths=0.3))
     for d in dr.dims:
         a, b, _ = _dim_geometry(d)
-        ax.annotate("", xy=a, xytext=b, arrowprops=dict(arrowstyle="<|-|>", lw=0.4, color="0.2", shrinkA=0, shrinkB=0))
+        ax.annotate("", xy=a, xytext=b, arrowprops=dict(arrowstyle="-|>" if d.radius else "<|-|>", lw=0.4,
+                                                        color="0.2", shrinkA=0, shrinkB=0))
+        if d.radius:  # the text beyond the leader's end, on its side
+            ax.text(b[0], b[1], d.text, fontsize=7, ha="left" if b[0] >= a[0] else "right",
+                    va="bottom" if b[1] >= a[1] else "top")
+            continue
         mx, my = 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])
         ax.text(mx + (0.4 if d.vertical else 0), my + (0 if d.vertical else 0.4), d.text, fontsize=7,
                 rotation=90 if d.vertical else 0, ha="center" if not d.vertical else "left",
@@ -410,6 +444,13 @@ def _write_dxf(dr: Drawing, path: Path) -> None:
         msp.add_lwpolyline([tuple(map(float, q)) for q in p], dxfattribs={"layer": kind.upper()})
     for d in dr.dims:
         a, b, _ = _dim_geometry(d)
+        if d.radius:
+            (cx, cy), (px, py) = d.p1, d.p2
+            dim = msp.add_radius_dim(center=(cx, cy), radius=math.hypot(px - cx, py - cy),
+                                     angle=math.degrees(math.atan2(py - cy, px - cx)), text=d.text,
+                                     dimstyle="EZDXF", dxfattribs={"layer": "DIMENSIONS"})
+            dim.render()
+            continue
         base = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)
         dim = msp.add_linear_dim(base=base, p1=d.p1, p2=d.p2, angle=90 if d.vertical else 0, text=d.text,
                                  dimstyle="EZDXF", dxfattribs={"layer": "DIMENSIONS"})
@@ -454,25 +495,27 @@ def tooling_model(ts) -> Drawing:
     origins = {"upper punch": (0.0, -fr.band_z[1]), "lower punch": (Dh + 25.0, lo["overall_length_mm"] - fr.band_z[0]),
                "die": (Dh + 25.0 + gap, -die["bottom_z_mm"])}
     dims: list[Dim] = []
-    tol = ts.spec.drawing.tolerance_mm
+    tol = ts.spec.drawing.tolerance
     for name, b, edge, sgn in (("upper punch", up, fr.band_z[1], 1.0), ("lower punch", lo, fr.band_z[0], -1.0)):
         ox, oy = origins[name]
         z_tip, z_head = oy + edge, oy + b["head_flat_z_mm"]
         z_shoulder = z_tip + sgn * b["tip_length_mm"]
         rb, rh = 0.5 * b["barrel_diameter_mm"], 0.5 * b["head_diameter_mm"]
         dims.append(Dim((ox - rh, min(z_tip, z_head)), (ox - rh, max(z_tip, z_head)), -4.0,
-                        f"overall {_fmt(b['overall_length_mm'])} ±{_fmt(tol)}", vertical=True))
+                        f"overall {_fmt(b['overall_length_mm'])} ±{_fmt(tol('overall_length'))}", vertical=True))
         dims.append(Dim((ox + rb, min(z_tip, z_shoulder)), (ox + rb, max(z_tip, z_shoulder)), 3.0,
-                        f"tip {_fmt(b['tip_length_mm'])}", vertical=True))
+                        f"tip {_fmt(b['tip_length_mm'])} ±{_fmt(tol('tip_length'))}", vertical=True))
         zb = z_shoulder + sgn * 0.5 * b["barrel_length_mm"]
-        dims.append(Dim((ox - rb, zb), (ox + rb, zb), 0.0, f"Ø{_fmt(b['barrel_diameter_mm'])}"))
+        dims.append(Dim((ox - rb, zb), (ox + rb, zb), 0.0,
+                        f"Ø{_fmt(b['barrel_diameter_mm'])} ±{_fmt(tol('barrel_diameter'))}"))
         zh = z_head - sgn * 0.5 * b["head_height_mm"]
-        dims.append(Dim((ox - rh, zh), (ox + rh, zh), sgn * (b["head_height_mm"] + 3.0), f"Ø{_fmt(b['head_diameter_mm'])}"))
+        dims.append(Dim((ox - rh, zh), (ox + rh, zh), sgn * (b["head_height_mm"] + 3.0),
+                        f"Ø{_fmt(b['head_diameter_mm'])} ±{_fmt(tol('head_diameter'))}"))
     ox, oy = origins["die"]
     R = 0.5 * die["outer_diameter_mm"]
     zb, zt = oy + die["bottom_z_mm"], oy + die["top_z_mm"]
-    dims.append(Dim((ox - R, zt), (ox + R, zt), 4.0, f"Ø{_fmt(die['outer_diameter_mm'])} ±{_fmt(tol)}"))
-    dims.append(Dim((ox + R, zb), (ox + R, zt), 3.0, f"H {_fmt(die['height_mm'])} ±{_fmt(tol)}", vertical=True))
+    dims.append(Dim((ox - R, zt), (ox + R, zt), 4.0, f"Ø{_fmt(die['outer_diameter_mm'])} ±{_fmt(tol('die_diameter'))}"))
+    dims.append(Dim((ox + R, zb), (ox + R, zt), 3.0, f"H {_fmt(die['height_mm'])} ±{_fmt(tol('die_height'))}", vertical=True))
     notes = [f"{ts.tablet.name}: {up['standard']} {up['type'] or 'user-defined'} tooling, {up['head']} heads",
              f"barrel Ø{_fmt(up['barrel_diameter_mm'])}, neck Ø{_fmt(up['neck_diameter_mm'])} x {_fmt(up['neck_length_mm'])}, "
              f"head Ø{_fmt(up['head_diameter_mm'])} (flat Ø{_fmt(up['head_flat_diameter_mm'])})",

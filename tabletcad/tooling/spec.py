@@ -27,7 +27,9 @@
     [tooling.drawing]              # title block and tolerances of the drawings
     name = "Example 10 mm"         # name, number, revision, material, date, author: strings
     tolerance_mm = 0.076           # general +- tolerance (default 0.076 mm, stated on the sheet)
-    tolerances = { cup_depth = 0.05 }   # per dimension: diameter, length, width, band, cup_depth, thickness
+    tolerances = { cup_depth = 0.05 }   # per dimension: diameter, length, width, band, cup_depth, thickness,
+                                   # land, score_depth, cup_radius; overall_length, tip_length,
+                                   # barrel_diameter, head_diameter, die_diameter, die_height
 
     [tooling.punch]                # body dimensions the standard file does not hold (see standards.py)
     head_diameter_mm = 25.4        # ... every key of tabletcad.tooling.standards.BODY_KEYS
@@ -171,7 +173,9 @@ def _fe_rating(t: Any) -> FeRatingSpec | None:
 #: general +- tolerance (mm) printed on the drawings when the design gives none: 0.003 in, stated on the sheet
 #: as this program's default, not as a standard's value
 DEFAULT_TOLERANCE_MM = 0.076
-TOLERANCE_KEYS = ("diameter", "length", "width", "band", "cup_depth", "thickness", "land", "score_depth")
+TOLERANCE_KEYS = ("diameter", "length", "width", "band", "cup_depth", "thickness", "land", "score_depth", "cup_radius",
+                  # the punches and die sheet (complete punches)
+                  "overall_length", "tip_length", "barrel_diameter", "head_diameter", "die_diameter", "die_height")
 TITLE_KEYS = ("name", "number", "revision", "material", "date", "author")
 
 
@@ -250,6 +254,52 @@ def _keys(where: str, table: Any, allowed: set[str]) -> dict:
     return table
 
 
+def polygon_problem(points) -> str | None:
+    """Why the closed polyline through ``points`` (mm) is not a simple polygon, or None.
+
+    A repeated point (the closing one too) is dropped; what is left must have three points and an
+    area, and no two of its edges may meet except adjacent ones at their shared point (a bow-tie's
+    crossing, an edge doubling back over the one before it).
+    """
+    pts: list[tuple[float, float]] = []
+    for p in points:
+        if not pts or p != pts[-1]:
+            pts.append(p)
+    if len(pts) > 1 and pts[0] == pts[-1]:
+        pts.pop()
+    n = len(pts)
+    if n < 3:
+        return "fewer than 3 distinct points"
+    def orient(a, b, c) -> float:
+        return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
+    def on(a, b, c) -> bool:  # c on the segment ab, given that the three are collinear
+        return min(a[0], b[0]) <= c[0] <= max(a[0], b[0]) and min(a[1], b[1]) <= c[1] <= max(a[1], b[1])
+
+    def meet(a, b, c, d) -> bool:
+        o1, o2, o3, o4 = orient(a, b, c), orient(a, b, d), orient(c, d, a), orient(c, d, b)
+        if ((o1 > 0 > o2) or (o1 < 0 < o2)) and ((o3 > 0 > o4) or (o3 < 0 < o4)):
+            return True
+        return (o1 == 0 and on(a, b, c)) or (o2 == 0 and on(a, b, d)) or (o3 == 0 and on(c, d, a)) or \
+            (o4 == 0 and on(c, d, b))
+
+    for i in range(n):
+        a, b = pts[i], pts[(i + 1) % n]
+        c = pts[(i + 2) % n]  # the next edge b-c may touch a-b only at b: not fold back over it
+        if orient(a, b, c) == 0 and (on(a, b, c) or on(b, c, a)):
+            return f"the edges at point {(i + 1) % n} ({b[0]:g}, {b[1]:g}) double back over each other"
+        for j in range(i + 2, n):
+            if i == 0 and j == n - 1:
+                continue  # adjacent through the closing edge
+            if meet(a, b, pts[j], pts[(j + 1) % n]):
+                return f"edges {i} and {j} cross or touch"
+    area2 = sum(pts[i][0] * pts[(i + 1) % n][1] - pts[(i + 1) % n][0] * pts[i][1] for i in range(n))
+    size = max(max(abs(x), abs(y)) for x, y in pts) or 1.0
+    if abs(area2) <= 1e-12 * size * size:
+        return "it encloses no area"
+    return None
+
+
 def _choice(where: str, value: Any, options: tuple[str, ...]) -> str:
     if value not in options:
         raise DesignError(where, value, f"must be one of {', '.join(repr(o) for o in options)}")
@@ -325,6 +375,9 @@ def _emboss(i: int, t: Any, base: Path | None = None) -> EmbossSpec:
         if not ok:
             raise DesignError(f"{w} outline", outline, "must be a list of at least 3 [x, y] points (mm)")
         outline = tuple((check_finite(f"{w} outline", p[0], "mm"), check_finite(f"{w} outline", p[1], "mm")) for p in outline)
+        problem = polygon_problem(outline)
+        if problem:
+            raise DesignError(f"{w} outline", [list(p) for p in outline], f"must be a simple closed polygon: {problem}")
     pos = t.get("position_mm", list(d.position_mm))
     if not (isinstance(pos, list) and len(pos) == 2):
         raise DesignError(f"{w} position_mm", pos, "must be [x, y] in mm")

@@ -66,6 +66,7 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
     from tabletcad.tooling.punch_body import check_body_fits
 
     check_body_fits(frame, spec.body, _max_radius(frame.outline))
+    _check_relief(frame, spec)
     _, top, bottom = die_position(frame, die_height(frame, spec))
     need_up = top - frame.band_z[1]
     if spec.tip_length_mm <= need_up:
@@ -76,6 +77,38 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
         raise DesignError("[tooling] lower_tip_length_mm", spec.lower_tip,
                           f"must be > {need_low:.4g} mm: from the lower tip edge to the die's bottom face at the "
                           f"closed position (the barrel stays out of the die)", "mm")
+
+
+def _warn_knife_edge(frame, clearance: float) -> None:
+    """One warning when cupped punch tips have no land: the tablet's land (0 without one) is narrower than
+    the clearance, so the tip outline cuts the cup surface and the tip's edge is a knife edge."""
+    cupped = max(frame.cup_depth_top, frame.cup_depth_bottom) > 1e-9  # a flat face meets the wall square
+    if cupped and frame.land is not None and frame.land - clearance < 0.0:
+        import warnings
+
+        warnings.warn(f"the punch tips have no land ({frame.land:.4g} mm tablet land - {clearance:.4g} mm clearance "
+                      f"= {frame.land - clearance:.4g} mm): the tip's edge is a knife edge, which chips in service; "
+                      "give the tablet a land wider than the clearance", stacklevel=3)
+
+
+def _check_relief(frame, spec: ToolingSpec) -> None:
+    """A tip relief that leaves no relieved outline (the tip's outline offset inwards by the clearance
+    and the relief is empty or falls apart) as a DesignError naming ``tip_relief_mm``."""
+    from tabletcad.errors import GeometryError
+    from tabletcad.tooling.outline import face_area, offset_wire, plan_face
+
+    b = spec.body
+    if b.tip_relief_mm <= 0:
+        return
+    d = spec.clearance_mm + b.tip_relief_mm
+    try:
+        relieved = face_area(plan_face(offset_wire(frame.outline, -d)))
+    except GeometryError:
+        relieved = 0.0
+    if not relieved > 0.0:
+        raise DesignError("[tooling.punch] tip_relief_mm", b.tip_relief_mm,
+                          f"must leave a relieved tip: the outline offset inwards by the clearance and the relief "
+                          f"({d:.4g} mm) has no area left (tablet width {frame.width:.4g} mm)", "mm")
 
 
 def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None, check: bool = True,
@@ -106,6 +139,7 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     for i, s in enumerate(spec.scores):  # fail on bad input before any Boolean
         check_score(frame, s, i)
     emb_checked = [check_emboss(frame, e, spec.clearance_mm, i) for i, e in enumerate(spec.emboss)]
+    _warn_knife_edge(frame, spec.clearance_mm)
     if spec.body is not None:
         _check_complete_punches(frame, spec)
     solid = frame.shape
@@ -115,12 +149,13 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     a_man = None
     solid, emb_checks, emb_info = apply_emboss(frame, solid, spec.emboss, spec.clearance_mm, check=check, deflection=deflection,
                                                checked=emb_checked)
+    sf, rho = (None, None) if options is None else (options.solid_fraction, options.true_density_mg_mm3)
+    density = None if sf is None or rho is None else sf * rho  # mg/mm^3 of the compact
     split = None
     if spec.scores:  # the finished tablet (scores and figures) split along its score planes
         from tabletcad.tooling.split import split_parts
 
-        sf, rho = (None, None) if options is None else (options.solid_fraction, options.true_density_mg_mm3)
-        split = split_parts(frame, solid, spec.scores, density_mg_mm3=None if sf is None or rho is None else sf * rho)
+        split = split_parts(frame, solid, spec.scores, density_mg_mm3=density)
     t1 = time.perf_counter()
     upper, chk_u = punch_tip(frame, solid, "upper", spec.clearance_mm, spec.tip_length_mm, check=check, deflection=deflection)
     lower, chk_l = punch_tip(frame, solid, "lower", spec.clearance_mm, spec.lower_tip, check=check, deflection=deflection)
@@ -134,6 +169,7 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
             tip.shape, tip.volume_mm3 = shape_, info_["volume_mm3"]
     die_shape, die_info = die(frame, spec.die_outer_diameter_mm, die_height(frame, spec), spec.taper_deg)
     t2 = time.perf_counter()
+    v1 = volume(solid)  # the finished (scored, embossed) tablet's
     parts = {"tablet": solid, "upper_punch": upper.shape, "lower_punch": lower.shape, "die": die_shape}
     gap = gap_closed if spec.gap_mm is None else spec.gap_mm
     checks = [c for c in [*score_checks, *emb_checks, chk_u, chk_l] if c is not None]
@@ -141,7 +177,8 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
         keys=dict(clearance_mm=spec.clearance_mm, tip_length_mm=spec.tip_length_mm,
                   die_outer_diameter_mm=die_info["outer_diameter_mm"], die_height_mm=die_info["height_mm"],
                   taper_deg=spec.taper_deg, gap_mm=gap),
-        tablet=dict(volume_plain_mm3=v0, volume_mm3=volume(solid), band_mm=frame.band, band_z_mm=list(frame.band_z),
+        tablet=dict(volume_plain_mm3=v0, volume_mm3=v1, weight_plain_mg=None if density is None else v0 * density,
+                    weight_mg=None if density is None else v1 * density, band_mm=frame.band, band_z_mm=list(frame.band_z),
                     band_bulge_mm=frame.band_bulge, cup_depth_top_mm=frame.cup_depth_top,
                     cup_depth_bottom_mm=frame.cup_depth_bottom, thickness_mm=frame.thickness,
                     land_mm=frame.land, outline=frame.outline_kind, length_mm=frame.length, width_mm=frame.width),
