@@ -85,14 +85,28 @@ def test_bad_fe_report_input_is_one_line_and_writes_nothing(capsys, tmp_path, re
     assert not out.exists()
 
 
-def test_the_diametral_and_strength_commands_say_when_the_design_is_scored(recwarn):
-    """They mesh the plain tablet: a design whose [tooling] scores or embosses it gets a warning line
-    (a new user compared the bisect sample with the unscored one: 1.343 against 1.355 MPa, no word)."""
-    from tabletcad.cli.fe import _warn_plain
-    from tabletcad.pipeline.design import Design
+def test_diametral_meshes_the_scored_tablet_and_finds_the_score_root(capsys):
+    """A design whose [tooling] scores it is meshed with its score (they meshed the plain tablet, with
+    a warning, before).  Loaded along the bisect's line (y), the split opens the score: the largest
+    tensile stress sits at the score's root, 0.5 mm below the cup's apex on the axis, and is a third
+    above the unscored tablet's, which sits on the cup 2.8 mm from a platen."""
+    import json
+
+    from tabletcad.cli import main
 
     root = Path(__file__).resolve().parents[1]
-    with pytest.warns(UserWarning, match="plain tablet"):
-        _warn_plain(Design.from_toml(root / "samples" / "tooling" / "concave_round_bisect.toml"))
-    _warn_plain(Design.from_toml(root / "samples" / "families" / "concave_round.toml"))
-    assert not [w for w in recwarn if "plain tablet" in str(w.message)]
+    results = {}
+    for name, path in (("scored", root / "samples" / "tooling" / "concave_round_bisect.toml"),
+                       ("plain", root / "samples" / "families" / "concave_round.toml")):
+        assert main(["fe", "diametral", str(path), "--force", "100", "--direction", "y", "--no-error-estimate",
+                     "--json"]) == 0
+        out = capsys.readouterr()
+        results[name] = json.loads(out.out)
+        assert "warning" not in out.err
+    scored, plain = results["scored"], results["plain"]
+    assert scored["tablet_meshed"].startswith("finished") and plain["tablet_meshed"] == "plain"
+    assert scored["thickness_mm"] == plain["thickness_mm"] == pytest.approx(4.6)
+    x, y, z = scored["max_tensile_location_mm"]
+    assert abs(x) < 1e-9 and abs(y) < 1.0 and z == pytest.approx(4.6 - 0.5, abs=0.05)  # the score's root
+    assert scored["max_tensile_stress_MPa"] > 1.2 * plain["max_tensile_stress_MPa"]
+    assert abs(plain["max_tensile_location_mm"][1]) > 2.0  # plain: near a platen, on a cup face

@@ -48,14 +48,16 @@ def _check_json_file(json_file: Path | None) -> None:
     check_output("--json-file", json_file, (".json",))
 
 
-def _warn_plain(design) -> None:
-    """One warning line when the design's [tooling] scores or embosses a tablet the FE leaves plain."""
+def _finished(design, tablet) -> tuple[Any, str]:
+    """``(solid, what)``: the finished (scored, embossed) tablet's B-rep when the design's ``[tooling]``
+    scores or embosses it (:func:`tabletcad.tooling.toolset.finished_solid`), else None (the FE
+    builds the plain tablet's); ``what`` says which tablet is meshed: ``"finished"`` or ``"plain"``."""
     spec = getattr(design, "tooling_spec", None)
-    if spec is not None and (spec.scores or spec.emboss):
-        import warnings
+    if spec is None or not (spec.scores or spec.emboss):
+        return None, "plain"
+    from tabletcad.tooling.toolset import finished_solid
 
-        warnings.warn("the FE meshes the plain tablet: the design's [tooling] scores and embossing are not in it",
-                      stacklevel=2)
+    return finished_solid(tablet, spec)[0], "finished"
 
 
 # the keyword names tabletcad.fe's functions give their arguments, and the options that set them
@@ -113,10 +115,10 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
 
     material = Material(E=E, nu=nu)
     tablet, spec = load_family_design(design)
-    _warn_plain(spec)
+    solid, meshed = _finished(spec, tablet)
     res = diametral(tablet, force, direction, strip_width=strip_width, mesh_size=mesh_size, material=material,
-                    error_estimate=not no_error_estimate)
-    payload = {"design": str(design), **res.to_dict()}
+                    error_estimate=not no_error_estimate, solid=solid)
+    payload = {"design": str(design), "tablet_meshed": meshed, **res.to_dict()}
     files: list[str] = []
     if out is not None:
         from tabletcad.fe.output import plot_section, write_vtu
@@ -139,7 +141,8 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
     _echo(payload, as_json, [
         f"{tablet.name}: {force:g} N along {res.axis} ({direction}), strip {res.strip_width_mm:.4g} mm, "
         f"D = {res.diameter_mm:.4g} mm, t = {res.thickness_mm:.4g} mm",
-        f"mesh: {res.nodes} nodes, {res.elements} quadratic tetrahedra, {res.dofs} unknowns (size {res.mesh_size_mm:.3g} mm)",
+        f"mesh of the {meshed} tablet: {res.nodes} nodes, {res.elements} quadratic tetrahedra, {res.dofs} unknowns "
+        f"(size {res.mesh_size_mm:.3g} mm)",
         f"centre tensile stress {res.centre_tensile_stress_MPa:.4g} MPa"
         + (f" (± {abs(err):.2g} MPa estimated)" if err is not None else ""),
         f"2P/(πDt) = {res.line_load_MPa:.4g} MPa, shape factor {res.shape_factor:.4f}",
@@ -181,21 +184,23 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
     from tabletcad.fe.prediction import StrengthInputs, predict_breaking_force
 
     tablet, spec = load_family_design(design)
-    _warn_plain(spec)
+    solid, meshed = _finished(spec, tablet)
     inputs = StrengthInputs.from_table(spec.report, tensile_strength_MPa=tensile_strength,
                                        reference_breaking_force_N=reference_force,
                                        reference_diameter_mm=reference_diameter,
                                        reference_thickness_mm=reference_thickness)
-    pred = (coarse_prediction(tablet, inputs, direction) if coarse
-            else predict_breaking_force(tablet, inputs, direction, mesh_size=mesh_size, error_estimate=False))
+    pred = (coarse_prediction(tablet, inputs, direction, solid=solid) if coarse
+            else predict_breaking_force(tablet, inputs, direction, solid=solid, mesh_size=mesh_size,
+                                        error_estimate=False))
     d = pred.to_dict()
-    _echo({"design": str(design), **d}, as_json, [
+    _echo({"design": str(design), "tablet_meshed": meshed, **d}, as_json, [
         f"{tablet.name}: predicted breaking force {pred.breaking_force_N:.4g} N across {direction} "
         f"(elastic first-crack estimate; {pred.breaking_force_centre_N:.4g} N if the crack starts at the centre)",
         f"tensile strength {pred.tensile_strength_MPa:.4g} MPa ({pred.tensile_strength_basis})",
         f"largest tensile stress {pred.max_tensile_per_N:.4g} MPa per N at "
         + "(" + ", ".join(f"{v:.3g}" for v in d["first_crack_location_mm"]) + ") mm; shape factor "
         f"{d['shape_factor']:.4f}",
+        f"meshed: the {meshed} tablet",
     ], json_file=json_file)
 
 

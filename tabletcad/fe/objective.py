@@ -71,10 +71,13 @@ def breaking_force(tablet: Any, tensile_strength_MPa: float, direction: str = "w
                                   **fe).breaking_force_N
 
 
-def coarse_prediction(tablet: Any, inputs: StrengthInputs, direction: str = "width") -> StrengthPrediction:
+def coarse_prediction(tablet: Any, inputs: StrengthInputs, direction: str = "width", *,
+                      solid: Any = None) -> StrengthPrediction:
     """:func:`tabletcad.fe.prediction.predict_breaking_force` on the coarse mesh (whole tablet, no error
-    estimate): what ``tabletcad fe strength --coarse`` prints and the design report shows."""
-    return predict_breaking_force(tablet, inputs, direction, **coarse_mesh(tablet, direction), error_estimate=False)
+    estimate): what ``tabletcad fe strength --coarse`` prints and the design report shows.  ``solid``:
+    the tablet's B-rep when it is not the plain one (scored, embossed)."""
+    return predict_breaking_force(tablet, inputs, direction, solid=solid, **coarse_mesh(tablet, direction),
+                                  error_estimate=False)
 
 
 def report_breaking_force(tablet: Any, options: Any) -> dict[str, Any]:

@@ -120,9 +120,11 @@ def reference_tensile_strength(inputs: StrengthInputs, **fe: Any) -> tuple[float
     return inputs.reference_breaking_force_N * r.max_tensile_stress_MPa, r
 
 
-def predict_breaking_force(tablet: Any, inputs: StrengthInputs, direction: str = "width",
+def predict_breaking_force(tablet: Any, inputs: StrengthInputs, direction: str = "width", *, solid: Any = None,
                            **fe: Any) -> StrengthPrediction:
-    """Breaking force (N) of ``tablet`` loaded across ``direction``; ``fe`` goes to :func:`diametral`."""
+    """Breaking force (N) of ``tablet`` loaded across ``direction``; ``fe`` goes to :func:`diametral`
+    (for the tablet and the reference compact), ``solid`` (the tablet's B-rep, e.g. the scored one)
+    to the tablet's alone."""
     ref = None
     if inputs.tensile_strength_MPa is not None:
         st, basis = inputs.tensile_strength_MPa, "given"
@@ -130,7 +132,7 @@ def predict_breaking_force(tablet: Any, inputs: StrengthInputs, direction: str =
         st, ref = reference_tensile_strength(inputs, **fe)
         basis = (f"FE on a {inputs.reference_diameter_mm:g} x {inputs.reference_thickness_mm:g} mm flat-faced "
                  f"round reference broken at {inputs.reference_breaking_force_N:g} N")
-    r = diametral(tablet, 1.0, direction, **fe)
+    r = diametral(tablet, 1.0, direction, solid=solid, **fe)
     if r.max_tensile_stress_MPa <= 0 or r.centre_tensile_stress_MPa <= 0:
         raise DesignError("direction", direction, "loads this shape without tension at its centre; choose another")
     return StrengthPrediction(

@@ -18,7 +18,7 @@ from tabletcad.tooling.booleans import CACHE, TIMER, to_manifold, volume
 from tabletcad.tolerance import DEFAULT
 from tabletcad.tooling.spec import ToolingSpec
 
-__all__ = ["ToolSet", "make_tooling", "DEFLECTION_MM"]
+__all__ = ["ToolSet", "make_tooling", "finished_solid", "DEFLECTION_MM"]
 
 DEFLECTION_MM = DEFAULT.mesh_deflection
 
@@ -109,6 +109,28 @@ def _check_relief(frame, spec: ToolingSpec) -> None:
         raise DesignError("[tooling.punch] tip_relief_mm", b.tip_relief_mm,
                           f"must leave a relieved tip: the outline offset inwards by the clearance and the relief "
                           f"({d:.4g} mm) has no area left (tablet width {frame.width:.4g} mm)", "mm")
+
+
+def finished_solid(tablet: Tablet, spec: ToolingSpec, *, shape=None, deflection: float = DEFLECTION_MM):
+    """The finished tablet of ``spec`` alone: the solid with its scores and embossing, no tools.
+
+    The same checks and the same Booleans as :func:`make_tooling` (which also cross-checks each with
+    manifold3d); for analyses of the finished shape such as ``tabletcad fe diametral``.  Returns
+    ``(solid, frame)``; the frame's solid is the plain tablet.  Raises :class:`DesignError` for
+    scores and figures that do not fit, :class:`GeometryError` when a Boolean fails.
+    """
+    from tabletcad.tooling.emboss import apply_emboss, check_emboss
+    from tabletcad.tooling.outline import tablet_frame
+    from tabletcad.tooling.scores import apply_scores, check_score
+
+    frame = tablet_frame(tablet, shape)
+    for i, s in enumerate(spec.scores):
+        check_score(frame, s, i)
+    checked = [check_emboss(frame, e, spec.clearance_mm, i) for i, e in enumerate(spec.emboss)]
+    solid, _, _ = apply_scores(frame, frame.shape, spec.scores, check=False, deflection=deflection)
+    solid, _, _ = apply_emboss(frame, solid, spec.emboss, spec.clearance_mm, check=False, deflection=deflection,
+                               checked=checked)
+    return solid, frame
 
 
 def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None, check: bool = True,
