@@ -242,28 +242,30 @@ def test_a_tip_relief_leaving_no_tip_names_tip_relief_mm():
 
 
 @pytest.mark.cad
-def test_cupped_tips_without_a_land_warn_of_a_knife_edge():
+def test_cupped_tips_without_a_land_warn_of_a_sharp_edge():
     """The EU D oval sample's tablet has no land: its tips' land is -0.02 mm (0 - the clearance),
     which was reported without a word; a cupped tablet with a land wider than the clearance is quiet,
-    and so is a flat face (it meets the tip's wall square)."""
+    and so are a flat face (it meets the tip's wall square) and a bevel (the edge's own design)."""
     pytest.importorskip("OCP")
     import warnings
 
     from tabletcad.pipeline.design import Design
     from tabletcad.tooling.outline import tablet_frame
-    from tabletcad.tooling.toolset import _warn_knife_edge
+    from tabletcad.tooling.toolset import _warn_sharp_edge
 
     def warned(tablet: dict, clearance: float) -> list[str]:
         frame = tablet_frame(Design.from_dict({"tablet": tablet}).build())
         with warnings.catch_warnings(record=True) as w:
             warnings.simplefilter("always")
-            _warn_knife_edge(frame, clearance)
+            _warn_sharp_edge(frame, clearance)
         return [str(x.message) for x in w]
 
     oval = dict(family="oval", length=14.0, width=8.0, end_radius=3.0, band=3.0, cup_depth=0.9)
     (msg,) = warned(oval, 0.02)
-    assert "no land (0 mm tablet land - 0.02 mm clearance = -0.02 mm)" in msg and "knife edge" in msg
+    assert "no land (0 mm tablet land - 0.02 mm clearance = -0.02 mm)" in msg and "sharp edge" in msg
     landed = dict(family="concave_round", diameter=10.0, band=2.8, cup_depth=0.9, land=0.08)
     assert warned(landed, 0.02) == [] and len(warned(landed, 0.1)) == 1
     flat = dict(family="flat_face_round", diameter=10.0, thickness=3.0)
     assert warned(flat, 0.02) == []
+    bevel = dict(family="concave_bevel", diameter=10.0, band=2.5, cup_depth=0.8, bevel_angle=30.0, bevel_width=0.5)
+    assert warned(bevel, 0.02) == []

@@ -53,6 +53,13 @@ def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
         assert text in tsvg, text
     dxf = (out / "tooling.dxf").read_text(encoding="utf-8", errors="replace")
     assert "overall 133.35" in dxf and "TC-0001" in dxf
+    # read back by ezdxf: the cup radius is a radius DIMENSION measuring the sphere's radius
+    import ezdxf
+
+    dims = ezdxf.readfile(out / "drawing.dxf").modelspace().query("DIMENSION")
+    (radius,) = [d for d in dims if d.dimtype == 4]  # 4: radius
+    assert radius.get_measurement() == pytest.approx(cup_r, rel=1e-9) and radius.dxf.text == f"R{cup_r:.2f} ±0.076"
+    assert sum(d.dimtype in (0, 1) for d in dims) == len(ts.report["drawing"]["dimension_texts"]) - 1  # linear
 
 
 @pytest.fixture(scope="module")
@@ -131,7 +138,7 @@ def test_every_dimension_takes_its_own_tolerance():
     assert all("±" in t for t in texts) and not any("±0.076" in t for t in texts)
     shown = {t.rsplit("±", 1)[1] for t in texts}
     # every key the tablet and punch sheets dimension (a round: no length or width) appears
-    expected = {k for k in TOLERANCE_KEYS if k not in ("length", "width", "score_depth")}
+    expected = {k for k in TOLERANCE_KEYS if k not in ("length", "width", "score_depth", "bevel_width", "bevel_angle")}
     assert {f"{tols[k]:.3f}" for k in expected} <= shown
     radius = [d for d in dr.dims if d.radius]
     assert len(radius) == 1
@@ -141,3 +148,25 @@ def test_every_dimension_takes_its_own_tolerance():
     assert a == (px, py) and ext == [] and math.hypot(b[0] - a[0], b[1] - a[1]) == pytest.approx(3.0)
     (land,) = [d for d in dr.dims if d.text.startswith("land")]
     assert abs(land.p2[0] - land.p1[0]) == pytest.approx(10.0 * 0.08, rel=1e-12)
+    assert f"cup radius R{(4.92 ** 2 + 0.81) / 1.8:.2f} ±{tols['cup_radius']:.3f} mm" in dr.notes
+    assert f"land 0.080 ±{tols['land']:.3f} mm" in dr.notes
+
+
+def test_bevel_and_radii_notes_carry_tolerances():
+    """A bevelled concave round: the cup radius is dimensioned on the section at a point of the sphere
+    (inside the bevel), and the bevel's width and angle are noted with their tolerances (the angle's
+    default is ISO 2768-m's for legs up to 10 mm)."""
+    import math
+
+    d = Design.from_dict({"tablet": dict(family="concave_bevel", diameter=10.0, band=2.5, cup_depth=0.8,
+                                         bevel_angle=30.0, bevel_width=0.5),
+                          "tooling": {"clearance_mm": 0.02, "drawing": {"tolerances": {"bevel_width": 0.02}}}})
+    ts = make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False)
+    dr = drawing_model(ts)
+    assert "bevel 0.50 ±0.020 mm wide at 30 deg ±1 deg (ISO 2768-m, legs up to 10 mm)" in dr.notes
+    assert "no land" in dr.notes
+    (radius,) = [x for x in dr.dims if x.radius]
+    r = (4.5 ** 2 + 0.8 ** 2) / 1.6  # the sphere through the bevel's inner edge, 0.8 mm below the apex
+    assert radius.text == f"R{r:.2f} ±0.076"
+    (cx, cy), (px, py) = radius.p1, radius.p2
+    assert math.hypot(px - cx, py - cy) == pytest.approx(r, rel=1e-12) and abs(px - cx) < 4.5

@@ -152,7 +152,7 @@ def test_drawing_states_the_design_numbers(built):
     dxf = (out / "drawing.dxf").read_text(encoding="utf-8", errors="replace")
     for text in ("Ø10.00", "band 2.80", "cup 0.90", "T 4.60", "land 0.080", "R13.90"):
         assert text in svg, text
-    for text in ("band 2.80", "cup 0.90", "T 4.60"):
+    for text in ("band 2.80", "cup 0.90", "T 4.60", "R13.90", "land 0.080"):  # (the radius: a DIMENSION entity)
         assert text in dxf, text
     assert "10.00" in dxf
 

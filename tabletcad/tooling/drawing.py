@@ -194,14 +194,23 @@ def drawing_model(ts) -> Drawing:
         notes.insert(1, f"diameter Ø{_fmt(2 * fr.round_radius)} mm")
     else:
         notes.insert(1, f"length {_fmt(L)} mm x width {_fmt(W)} mm")
+    tol = ts.spec.drawing.tolerance
     radii = {k: v for k, v in fr.info.items() if k.endswith("radius_mm") and isinstance(v, (int, float)) and v > 0}
-    if not radii and fr.round_radius is not None and fr.cup_depth_top > 1e-6 and not fr.info:
-        R, d = fr.round_radius, fr.cup_depth_top
-        radii["cup_radius_mm"] = (R * R + d * d) / (2 * d)
     for k, v in radii.items():
-        notes.append(f"{k[:-3].replace('_', ' ')} R{_fmt(v)} mm")
-    if fr.land is not None:
-        notes.append(f"land {_fmt(fr.land)} mm")
+        notes.append(f"{k[:-3].replace('_', ' ')} R{_fmt(v)} ±{_fmt(tol('cup_radius'))} mm")
+    if not radii and fr.round_radius is not None and fr.cup_depth_top > 1e-6 and not fr.info:
+        R, d = fr.round_radius, fr.cup_depth_top  # a thesis shape: its PDE cup is not a sphere
+        notes.append(f"sphere through the cup's rim and apex R{_fmt((R * R + d * d) / (2 * d))} mm (reference: "
+                     "the cup is the PDE surface of the STEP file)")
+    if fr.land:
+        notes.append(f"land {_fmt(fr.land)} ±{_fmt(tol('land'))} mm")
+    elif fr.land is not None:
+        notes.append("no land")
+    if fr.info.get("bevel_width_mm"):
+        ang = dict(ts.spec.drawing.tolerances).get("bevel_angle")
+        notes.append(f"bevel {_fmt(fr.info['bevel_width_mm'])} ±{_fmt(tol('bevel_width'))} mm wide at "
+                     f"{fr.info['bevel_angle_deg']:g} deg " + (f"±{ang:g} deg" if ang is not None else
+                                                               "±1 deg (ISO 2768-m, legs up to 10 mm)"))
     for s in ts.report.get("scores", []):
         notes.append(f"{s['kind']} score {s['profile']} {_fmt(s['depth_mm'])} mm deep on the {s['face']} face")
     for e in ts.report.get("emboss", []):
@@ -232,8 +241,8 @@ def drawing_model(ts) -> Drawing:
         dims.append(Dim((sx_, sy_ + fr.z_max - sc["depth_mm"]), (sx_, sy_ + fr.z_max), 2.0 + half_w,
                         f"score {_fmt(sc['depth_mm'])}", vertical=True))
     cup_r = _single_cup_radius(fr, radii)
-    if cup_r is not None:  # on the section's left half, away from a score at the centre
-        x = -0.6 * (fr.round_radius - (fr.land or 0.0))
+    if cup_r is not None:  # on the section's left half, away from a score at the centre, inside the sphere
+        x = -0.6 * (fr.round_radius - (fr.land or 0.0) - fr.info.get("bevel_width_mm", 0.0))
         zc = fr.z_max - cup_r  # the cup's sphere is centred on the axis
         dims.append(Dim((sx_, sy_ + zc), (sx_ + x, sy_ + zc + math.sqrt(cup_r * cup_r - x * x)), 3.0,
                         f"R{_fmt(cup_r)}", radius=True))
@@ -246,9 +255,11 @@ def drawing_model(ts) -> Drawing:
 
 
 def _single_cup_radius(fr, radii: dict) -> float | None:
-    """The cup radius to dimension (mm): a round tablet's spherical cup (one radius), else None
-    (compound cups, shaped tablets and edge radii stay in the notes)."""
-    if fr.round_radius is None or fr.cup_depth_top <= 1e-6 or set(radii) != {"cup_radius_mm"}:
+    """The cup radius to dimension (mm): a round family's spherical cup (one radius, from the family's
+    nominal geometry), else None (compound cups, shaped tablets and edge radii stay in the notes, as does
+    the sphere through a thesis shape's PDE cup, which is not a sphere)."""
+    if fr.round_radius is None or fr.cup_depth_top <= 1e-6 or set(radii) != {"cup_radius_mm"} \
+            or "cup_radius_mm" not in fr.info:
         return None
     r = float(radii["cup_radius_mm"])
     return r if r > fr.round_radius else None

@@ -28,7 +28,8 @@
     name = "Example 10 mm"         # name, number, revision, material, date, author: strings
     tolerance_mm = 0.076           # general +- tolerance (default 0.076 mm, stated on the sheet)
     tolerances = { cup_depth = 0.05 }   # per dimension: diameter, length, width, band, cup_depth, thickness,
-                                   # land, score_depth, cup_radius; overall_length, tip_length,
+                                   # land, score_depth, cup_radius, bevel_width, bevel_angle (deg);
+                                   # overall_length, tip_length,
                                    # barrel_diameter, head_diameter, die_diameter, die_height
 
     [tooling.punch]                # body dimensions the standard file does not hold (see standards.py)
@@ -174,6 +175,7 @@ def _fe_rating(t: Any) -> FeRatingSpec | None:
 #: as this program's default, not as a standard's value
 DEFAULT_TOLERANCE_MM = 0.076
 TOLERANCE_KEYS = ("diameter", "length", "width", "band", "cup_depth", "thickness", "land", "score_depth", "cup_radius",
+                  "bevel_width", "bevel_angle",  # bevel_angle in degrees, the others mm
                   # the punches and die sheet (complete punches)
                   "overall_length", "tip_length", "barrel_diameter", "head_diameter", "die_diameter", "die_height")
 TITLE_KEYS = ("name", "number", "revision", "material", "date", "author")
@@ -212,7 +214,8 @@ def _drawing(t: Any) -> DrawingSpec:
         kw["tolerance_mm"] = check_positive(f"{w} tolerance_mm", t["tolerance_mm"], "mm")
         kw["tolerance_given"] = True
     tol = _keys(f"{w} tolerances", t.get("tolerances", {}), set(TOLERANCE_KEYS))
-    kw["tolerances"] = tuple((k, check_positive(f"{w} tolerances.{k}", v, "mm")) for k, v in tol.items())
+    kw["tolerances"] = tuple((k, check_positive(f"{w} tolerances.{k}", v, "deg" if k == "bevel_angle" else "mm"))
+                             for k, v in tol.items())
     return DrawingSpec(**kw)
 
 

@@ -79,16 +79,18 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
                           f"closed position (the barrel stays out of the die)", "mm")
 
 
-def _warn_knife_edge(frame, clearance: float) -> None:
+def _warn_sharp_edge(frame, clearance: float) -> None:
     """One warning when cupped punch tips have no land: the tablet's land (0 without one) is narrower than
-    the clearance, so the tip outline cuts the cup surface and the tip's edge is a knife edge."""
-    cupped = max(frame.cup_depth_top, frame.cup_depth_bottom) > 1e-9  # a flat face meets the wall square
-    if cupped and frame.land is not None and frame.land - clearance < 0.0:
+    the clearance, so the tip's outline cuts the cup surface and the cup runs into the tip's wall at a
+    sharp edge.  A flat face meets the wall square, and a bevel is the edge's own design: neither warns."""
+    cupped = max(frame.cup_depth_top, frame.cup_depth_bottom) > 1e-9
+    bevelled = bool(frame.info.get("bevel_width_mm"))
+    if cupped and not bevelled and frame.land is not None and frame.land - clearance < 0.0:
         import warnings
 
         warnings.warn(f"the punch tips have no land ({frame.land:.4g} mm tablet land - {clearance:.4g} mm clearance "
-                      f"= {frame.land - clearance:.4g} mm): the tip's edge is a knife edge, which chips in service; "
-                      "give the tablet a land wider than the clearance", stacklevel=3)
+                      f"= {frame.land - clearance:.4g} mm): the cup runs into the tip's wall at a sharp edge, which "
+                      "chips in service; give the tablet a land wider than the clearance", stacklevel=3)
 
 
 def _check_relief(frame, spec: ToolingSpec) -> None:
@@ -161,7 +163,7 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     for i, s in enumerate(spec.scores):  # fail on bad input before any Boolean
         check_score(frame, s, i)
     emb_checked = [check_emboss(frame, e, spec.clearance_mm, i) for i, e in enumerate(spec.emboss)]
-    _warn_knife_edge(frame, spec.clearance_mm)
+    _warn_sharp_edge(frame, spec.clearance_mm)
     if spec.body is not None:
         _check_complete_punches(frame, spec)
     solid = frame.shape
