@@ -72,6 +72,9 @@ def test_diametral_json_and_files(capsys, tmp_path, thin):
         (["--force", "10", "--strip-width", "5"], "error: --strip-width = 5 mm is not allowed"),
         (["--force", "10", "--mesh-size", "0.001"], "error: --mesh-size = 0.001 mm is not allowed: must be >= "),
         (["--force", "10", "--mesh-size", "0"], "error: --mesh-size = 0 mm is not allowed: must be > 0"),
+        # the strip's own width, not its mesh size b/3 (which was shown as --strip-width's value)
+        (["--force", "10", "--strip-width", "0.02"], "error: --strip-width = 0.02 mm is not allowed: meshes its strips "
+                                                     "at b/3 = 0.00667 mm, a size that must be >= "),
         (["--force", "10", "--nu", "0.5"], "error: --nu = 0.5 is not allowed"),
         (["--force", "10", "--E", "-1"], "error: --E = -1 MPa is not allowed: must be > 0"),
     ],
@@ -119,7 +122,7 @@ def test_punch_json_and_files(capsys, tmp_path):
 @pytest.mark.parametrize(
     "extra, match",
     [
-        (["--force", "5"], "--yield-stress = None is not allowed: give --yield-stress (MPa) or --steel"),
+        (["--force", "5"], "--yield-stress = 'missing' is not allowed: give --yield-stress (MPa) or --steel"),
         (["--force", "5", "--steel", "unobtainium"], "--steel = 'unobtainium' is not allowed: must be one of"),
         (["--force", "0", "--yield-stress", "1000"], "--force = 0 kN is not allowed: must be > 0"),
         (["--force", "5", "--yield-stress", "1000", "--steel", "S7_tempered_205C"], "not both"),
@@ -137,7 +140,7 @@ def test_punch_bad_input(capsys, tmp_path, extra, match):
 def test_strength_needs_its_inputs(capsys, thin):
     rc, so, err = run(capsys, "fe", "strength", thin)
     assert rc == 2 and err.count("\n") == 1
-    assert err.startswith("error: [report] tensile_strength_MPa = None is not allowed: give it, or all of"), err
+    assert err.startswith("error: [report] tensile_strength_MPa = 'missing' is not allowed: give it, or all of"), err
 
 
 def test_diametral_refuses_a_ring_fast(capsys):

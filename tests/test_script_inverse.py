@@ -37,12 +37,16 @@ def test_concave_round_band_and_cup_depth():
     assert r.params == {"diameter": 10.0, "band": band, "cup_depth": hh}
 
 
+DIMS = dict(diameter=10.0, cup_depth=1.0)  # what a concave round needs besides its band
+
+
 @pytest.mark.parametrize("kw, param", [
     (dict(family="flat_face_round", vary="band", target_volume_mm3=100.0), "vary"),
-    (dict(family="concave_round", vary="band"), "target"),
-    (dict(family="concave_round", vary="band", target_volume_mm3=1.0, target_weight_mg=1.0), "target"),
-    (dict(family="concave_round", vary="band", target_weight_mg=100.0, solid_fraction=0.9), "solid_fraction"),
-    (dict(family="concave_round", vary="band", target_volume_mm3=-5.0), "target_volume_mm3"),
+    (dict(family="concave_round", vary="band", **DIMS), "target"),
+    (dict(family="concave_round", vary="band", target_volume_mm3=1.0, target_weight_mg=1.0, **DIMS), "target"),
+    (dict(family="concave_round", vary="band", target_weight_mg=100.0, solid_fraction=0.9, **DIMS), "solid_fraction"),
+    (dict(family="concave_round", vary="band", target_volume_mm3=-5.0, **DIMS), "target_volume_mm3"),
+    (dict(family="concave_round", vary="band", target_volume_mm3=300.0, diameter=10.0), "cup_depth"),  # a default stood in
     (dict(family="no_such", vary="band", target_volume_mm3=5.0), "family"),
     (dict(family="concave_round", vary="band", target_volume_mm3=5.0, length=3.0), "length"),
 ])

@@ -245,7 +245,7 @@ def test_a_tip_relief_leaving_no_tip_names_tip_relief_mm():
 def test_cupped_tips_without_a_land_warn_of_a_sharp_edge():
     """The EU D oval sample's tablet has no land: its tips' land is -0.02 mm (0 - the clearance),
     which was reported without a word; a cupped tablet with a land wider than the clearance is quiet,
-    and so are a flat face (it meets the tip's wall square) and a bevel (the edge's own design)."""
+    and so are a flat face (it meets the tip's wall square) and a designed edge (bevels, FFRE's radius)."""
     pytest.importorskip("OCP")
     import warnings
 
@@ -267,5 +267,8 @@ def test_cupped_tips_without_a_land_warn_of_a_sharp_edge():
     assert warned(landed, 0.02) == [] and len(warned(landed, 0.1)) == 1
     flat = dict(family="flat_face_round", diameter=10.0, thickness=3.0)
     assert warned(flat, 0.02) == []
-    bevel = dict(family="concave_bevel", diameter=10.0, band=2.5, cup_depth=0.8, bevel_angle=30.0, bevel_width=0.5)
-    assert warned(bevel, 0.02) == []
+    assert len(warned(landed, 0.08)) == 1  # a land equal to the clearance leaves the tip none
+    for edge in (dict(family="concave_bevel", diameter=10.0, band=2.5, cup_depth=0.8, bevel_angle=30.0, bevel_width=0.5),
+                 dict(family="ffbe", diameter=10.0, thickness=3.5, bevel_angle=30.0, bevel_width=0.5),
+                 dict(family="ffre", diameter=10.0, thickness=3.5, edge_radius=0.8)):
+        assert warned(edge, 0.02) == [], edge["family"]

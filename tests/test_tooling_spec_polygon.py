@@ -11,7 +11,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tabletcad.errors import DesignError
-from tabletcad.tooling.spec import parse_tooling, polygon_problem
+from tabletcad.tooling.polygon import polygon_problem
+from tabletcad.tooling.spec import parse_tooling
 
 
 def _convex(n: int, phase: float) -> list[tuple[float, float]]:
@@ -49,7 +50,20 @@ def test_star_shaped_polygons_are_simple(radii, twist):
     assert polygon_problem(pts + [pts[0]]) is None  # the closing point repeated
 
 
+def test_float_round_off_is_not_a_defect():
+    """Lengths compare within 1e-7 mm: a scripted outline that repeats its first point closes on
+    sin(2 pi) = -2.4e-16 (42 of the ellipses below were refused when points were compared exactly),
+    and a closing point 1e-9 mm off is the first point."""
+    for n in range(3, 120):
+        ellipse = [(1.5 * math.cos(2 * math.pi * k / n), math.sin(2 * math.pi * k / n)) for k in range(n + 1)]
+        assert polygon_problem(ellipse) is None, n
+    assert polygon_problem([(0, 0), (1, 0), (1, 1), (0, 1), (1e-9, 0)]) is None
+
+
 @pytest.mark.parametrize("points, fragment", [
+    ([(0, 0), (1.5, 0.15), (0.5, 0.05), (0, 2.5)], "double back"),            # 0.15 is no binary fraction
+    ([(0, 0), (2, 0), (2, 2), (1, 1e-17), (0, 2)], "cross or touch"),         # a vertex 1e-17 from an edge
+    ([(0, 0), (0, 0), (1, 1), (1, 0), (0, 1)], "edges 1 and 3 cross"),        # numbered as given
     ([(0, 0), (1, 1), (1, 0), (0, 1)], "edges 0 and 2 cross"),                # the bow-tie
     ([(0, 0), (2, 0), (2, 2), (1, 0), (0, 2)], "cross or touch"),              # a vertex on an edge
     ([(0, 0), (2, 0), (1, 0), (1, 1)], "double back"),                         # an edge folding back

@@ -14,6 +14,7 @@ from typing import Any
 
 import click
 
+from tabletcad.cli.options import option_names
 from tabletcad.cli.outputs import out_folder
 from tabletcad.errors import DesignError
 
@@ -69,12 +70,8 @@ class _FEGroup(click.Group):
     """The ``fe`` group: a refusal of an argument the command line set names the option."""
 
     def invoke(self, ctx: click.Context) -> Any:
-        try:
+        with option_names(OPTION_NAMES):
             return super().invoke(ctx)
-        except DesignError as exc:
-            if exc.parameter in OPTION_NAMES:
-                raise exc.renamed(OPTION_NAMES[exc.parameter]) from None
-            raise
 
 
 @click.group("fe", cls=_FEGroup)
@@ -160,7 +157,8 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
 @click.option("--reference-thickness", type=float, default=None, help="Reference compact thickness, mm.")
 @click.option("--direction", default="width", show_default=True, help="Load direction in plan: width|length|x|y.")
 @click.option("--mesh-size", type=float, default=None, help="Element size, mm [default as fe diametral].")
-@click.option("--coarse", is_flag=True, help="The optimiser's coarse mesh (as the design report's FE breaking force).")
+@click.option("--coarse", is_flag=True, help="The optimiser's coarse mesh (as the design report's FE breaking force, which is the plain "
+                   "tablet's for a scored or embossed design).")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout.")
 @click.option("--json-file", type=click.Path(path_type=Path), default=None, help="Write the result as JSON to this file.")
 def strength_cmd(design: Path, tensile_strength: float | None, reference_force: float | None,
@@ -241,7 +239,7 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
         yield_stress = steels[steel].yield_MPa
         E = steels[steel].E_MPa if E is None else E
     if yield_stress is None:
-        raise DesignError("--yield-stress", None, "give --yield-stress (MPa) or --steel " + "|".join(steels)
+        raise DesignError("--yield-stress", "missing", "give --yield-stress (MPa) or --steel " + "|".join(steels)
                           + ": no rating is invented")
     check_positive("--yield-stress", yield_stress, "MPa")
     E = 206000.0 if E is None else check_positive("--E", E, "MPa")

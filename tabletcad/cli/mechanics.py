@@ -20,6 +20,7 @@ from typing import Any
 import click
 import numpy as np
 
+from tabletcad.cli.options import option_names
 from tabletcad.cli.outputs import check_output as _check_output
 from tabletcad.cli.outputs import staged as _staged
 from tabletcad.errors import DesignError, check_finite, check_positive, check_range
@@ -355,10 +356,14 @@ def strength_cmd(method: str, F: float, D, t, W, L, R, material, E, nu, radius, 
 
     def need(name: str, v):
         if v is None:
-            raise DesignError(name, None, f"is required for method {method!r}")
+            raise DesignError(name, "missing", f"is required for method {method!r}")
         return v
 
-    with _collect() as msgs:
+    # the formulas name their arguments; here they are options
+    names = {"force": "--force", "diameter": "--diameter", "width": "--diameter", "thickness": "--thickness",
+             "band thickness": "--band", "length": "--length", "face radius": "--face-radius", "E": "--E",
+             "nu": "--nu", "radius": "--radius", "s_y": "--s-y"}
+    with _collect() as msgs, option_names(names):
         if method == "diametral":
             sigma, eq = st.diametral_flat(F, need("--diameter", D), need("--thickness", t)), "2.4"
         elif method == "axial":

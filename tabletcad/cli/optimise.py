@@ -14,9 +14,19 @@ EXIT_FAILED = 3
 
 
 class OptimisationFailed(click.ClickException):
-    """The run finished without a certified feasible optimum (exit status 3)."""
+    """The run finished without a certified feasible optimum (exit status 3): one ``error:`` line."""
 
     exit_code = EXIT_FAILED
+
+    def show(self, file=None) -> None:
+        click.echo(f"error: {self.format_message()}", err=True)
+
+
+def raise_starts(starts: str, method: str) -> None:
+    """``--starts`` with a single-start method: refused rather than ignored."""
+    from tabletcad.errors import DesignError
+
+    raise DesignError("--starts", starts, f"is read by --method multistart only (this run: {method})")
 
 
 @click.command("optimise")
@@ -62,6 +72,8 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
     check_replaceable(out_dir, ["report.json", "convergence.png", "optimum.toml", "last_point.toml",
                                 "tablet/report.json", "tablet/tablet.png"], manifest=OPTIMISE_MANIFEST)
     method = method or default_method
+    if starts is not None and method != "multistart":
+        raise_starts(starts, method)
     build_error = ""
     result = solve(problem, method, progress=not quiet, **opts)
 
@@ -96,8 +108,9 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
         publish(staging, out_dir, OPTIMISE_MANIFEST)  # replaces only its earlier run's unchanged files
     click.echo(summary(result))
     click.echo(f"-> {out_dir}/ ({', '.join(written)})")
-    if not result.success:
-        raise OptimisationFailed(f"optimisation {result.status}: {result.message}")
+    if not result.success:  # the reason is the summary's last line
+        raise OptimisationFailed(f"optimisation {result.status}: no certified optimum (see above; report.json "
+                                 "holds every constraint's value)")
     if build_error:
         raise OptimisationFailed(f"optimum found but its tablet outputs failed: {build_error}")
 

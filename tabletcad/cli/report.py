@@ -318,8 +318,13 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
             opts = spec.report_options.merged(
                 solid_fraction=solid_fraction, true_density_mg_mm3=true_density, breaking_force_N=breaking_force,
                 compaction_force_kN=compaction_force, max_punch_force_kN=max_punch_force, max_punch_pressure_MPa=max_punch_pressure)
-        except DesignError as exc:  # "[report] solid_fraction" -> "[report].solid_fraction": one token
-            raise exc.renamed(one_token(exc.parameter)) from None
+        except DesignError as exc:  # named as given: the option, else "[report].solid_fraction" (one token)
+            options = {"solid_fraction": ("--solid-fraction", solid_fraction), "true_density_mg_mm3": (
+                "--true-density", true_density), "breaking_force_N": ("--breaking-force", breaking_force),
+                "compaction_force_kN": ("--compaction-force", compaction_force), "max_punch_force_kN": (
+                "--max-punch-force", max_punch_force), "max_punch_pressure_MPa": ("--max-punch-pressure", max_punch_pressure)}
+            option, value = options.get(exc.parameter.removeprefix("[report] "), (None, None))
+            raise exc.renamed(option if value is not None else one_token(exc.parameter)) from None
         inverse = None
         if solve_for is not None:
             carried = [f"[{k}]" for k in ("trim", "reshape") if getattr(spec, k) is not None and tablet.family != "free_form"]

@@ -58,6 +58,7 @@ from tabletcad.errors import DesignError, GeometryError, check_positive, check_r
 from tabletcad.families.sweep import NominalBuilt, SweepNominal, nominal_only, nominal_volume
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT
+from tabletcad.mechanics.units import MAX_TRUE_DENSITY_MG_MM3
 
 __all__ = ["InverseResult", "Reach", "reachable", "solve_for", "solvable", "VARY"]
 
@@ -306,6 +307,14 @@ def _prepare(family, vary, dims):
     for k in dims:
         if k not in takes and not (k in ("a", "tol") and k in kw_only):
             raise DesignError(k, dims[k], f"{name} takes {', '.join(takes)}")
+    if isinstance(family, str):  # a named family needs what its design file needs (a callable: its defaults)
+        from tabletcad.families import family as lookup
+
+        required = lookup(family, parameter="family").required
+        missing = [k for k in required if k != vary and k not in dims]
+        if missing:
+            raise DesignError(missing[0], "missing", f"{name} needs {', '.join(k for k in required if k != vary)} "
+                              f"besides {vary}")
     dims = dict(dims)
     default = inspect.signature(func).parameters[vary].default
     x0 = dims.pop(vary, default)
@@ -411,7 +420,8 @@ def solve_for(
     true_density_mg_mm3 : float, optional
         True density of the material, mg/mm³ (= g/cm³).
     **dims
-        The other dimensions (mm, deg; the family's defaults otherwise), and ``a`` (the
+        The other dimensions (mm, deg): every one a named family's design file needs (a
+        constructor passed as ``family`` uses its defaults for those not given), and ``a`` (the
         smoothing parameter) or ``tol`` if the constructor takes them.  A value given for
         ``vary`` is the start of the search (and, if the volume were not monotone, picks
         the root nearest it).
@@ -444,7 +454,7 @@ def solve_for(
         if solid_fraction is None or true_density_mg_mm3 is None:
             raise DesignError("solid_fraction, true_density_mg_mm3", "missing", "both are needed for a weight")
         mg_per_mm3 = check_range("solid_fraction", solid_fraction, 0.0, 1.0, lo_open=True) * \
-            check_positive("true_density_mg_mm3", true_density_mg_mm3, "mg/mm3")
+            check_range("true_density_mg_mm3", true_density_mg_mm3, 0.0, MAX_TRUE_DENSITY_MG_MM3, "mg/mm3", lo_open=True)
     if target_volume_mm3 is not None:
         target = check_positive("target_volume_mm3", target_volume_mm3, "mm3")
     else:

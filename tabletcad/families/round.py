@@ -41,7 +41,7 @@ def flat_face_round(diameter: float = 10.0, thickness: float = 4.0, *, a=DEFAULT
     T = check_positive("thickness", thickness, "mm")
     face = [profile_line((0.0, 0.0), (D / 2.0, 0.0), "flat face")]
     return _round("flat_face_round", D, face, T, dict(diameter=D, thickness=T),
-                  dict(face="flat", cup_depth_mm=0.0, land_mm=D / 2.0), a, tol)
+                  dict(face="flat", cup_depth_mm=0.0, land_mm=0.0), a, tol)  # a flat face: no land
 
 
 def _bevel_dims(R: float, T: float, angle: float, width: float, depth: float) -> tuple[float, float]:

@@ -483,7 +483,13 @@ def diametral(
     if max(estimated_dofs(box, h), estimated_dofs(box * min(1.0, b / D), hs)) > MAX_DOFS:
         vol = float(tablet.volume())
         check_mesh_size(vol, h)
-        check_mesh_size(vol * min(1.0, b / D), hs, "strip_width")
+        try:
+            check_mesh_size(vol * min(1.0, b / D), hs, "strip_mesh_size")
+        except DesignError as exc:  # named by what was given: the strip width, unless its mesh size was
+            if strip_mesh_size is not None or hs == h:
+                raise
+            raise DesignError("strip_width", b, f"meshes its strips at b/3 = {hs:.3g} mm, a size that "
+                              f"{exc.allowed}", "mm") from None
     if solid is None:
         from tabletcad.cad.tablet_solid import tablet_solid
 

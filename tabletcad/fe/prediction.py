@@ -58,7 +58,7 @@ class StrengthInputs:
         ref = [self.reference_breaking_force_N, self.reference_diameter_mm, self.reference_thickness_mm]
         given = sum(v is not None for v in ref)
         if self.tensile_strength_MPa is None and given != 3:
-            raise DesignError("[report] tensile_strength_MPa", None,
+            raise DesignError("[report] tensile_strength_MPa", "missing",
                               "give it, or all of reference_breaking_force_N, reference_diameter_mm, "
                               "reference_thickness_mm")
         if self.tensile_strength_MPa is not None and given:

@@ -316,7 +316,7 @@ def fit_heckel_arrays(
     P = np.asarray(pressure, dtype=float).ravel()
     if heckel is None:
         if relative_density is None:
-            raise DesignError("relative_density", None, "give relative_density or heckel")
+            raise DesignError("relative_density", "missing", "give relative_density or heckel")
         D = np.asarray(relative_density, dtype=float).ravel()
         with np.errstate(divide="ignore", invalid="ignore"):
             H = np.where(D < 1.0, -np.log1p(-np.minimum(D, 1.0 - 1e-300)), np.nan)
@@ -326,6 +326,9 @@ def fit_heckel_arrays(
         raise DesignError("data", f"{P.size} pressures, {H.size} densities", "must have equal length")
     idx = np.arange(P.size) if rows is None else np.asarray(rows, dtype=int).ravel()
     good = np.isfinite(P) & np.isfinite(H) & (P > 0)
+    n_dense = int(np.sum(np.isfinite(P) & (P > 0) & ~np.isfinite(H)))  # relative density >= 1: no Heckel term
+    why = (f" ({n_dense} loaded row(s) have relative density >= 1 and no Heckel term: check mass, true density, "
+           "compliance)") if n_dense else ""
     order = np.argsort(P[good], kind="stable")
     Pg, Hg, ig = P[good][order], H[good][order], idx[good][order]
     if window is not None:
@@ -335,7 +338,7 @@ def fit_heckel_arrays(
             raise DesignError("window", (lo, hi), "must be two increasing pressures", "MPa")
         sel = (Pg >= lo) & (Pg <= hi)
         if sel.sum() < 3:
-            raise DesignError("window", f"{lo:g}-{hi:g}", f"holds {int(sel.sum())} loading points; need >= 3", "MPa")
+            raise DesignError("window", f"{lo:g}-{hi:g}", f"holds {int(sel.sum())} loading points; need >= 3{why}", "MPa")
         x, y, used = Pg[sel], Hg[sel], ig[sel]
         method = "window"
         requested = (lo, hi)
@@ -344,7 +347,7 @@ def fit_heckel_arrays(
         if min_points < 3:
             raise DesignError("min_points", min_points, "must be >= 3")
         if Pg.size < min_points:
-            raise DesignError("data", f"{Pg.size} loading points", f"need >= {min_points} for automatic window")
+            raise DesignError("data", f"{Pg.size} loading points", f"need >= {min_points} for automatic window{why}")
         if noise_sd is None:
             # the floor is the double-precision resolution of the Heckel term (exact, noise-free data)
             sigma = max(heckel_noise_sd(Pg, Hg), 16.0 * np.finfo(float).eps * float(np.max(np.abs(Hg))))

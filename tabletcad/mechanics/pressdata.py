@@ -65,7 +65,7 @@ import tomllib
 
 from tabletcad.errors import DesignError, check_finite, check_range
 from tabletcad.tolerance import DEFAULT
-from tabletcad.mechanics.units import DIMENSIONS, header_unit, strip_unit, unit_factor
+from tabletcad.mechanics.units import DIMENSIONS, MAX_TRUE_DENSITY_MG_MM3, header_unit, strip_unit, unit_factor
 from tabletcad.mechanics.validity import DataWarning, warn
 
 __all__ = [
@@ -191,9 +191,9 @@ class PressMetadata:
     def __post_init__(self) -> None:
         # generous physical limits: a compact of up to 1 kg, any solid's density, a die up to 1 m
         check_range("mass", self.mass_mg, 0.0, 1e6, "mg", lo_open=True)
-        check_range("true density", self.true_density, 0.0, 25.0, "mg/mm³", lo_open=True)
+        check_range("true density", self.true_density, 0.0, MAX_TRUE_DENSITY_MG_MM3, "mg/mm³", lo_open=True)
         if self.diameter is None and self.face_area is None:
-            raise DesignError("diameter", None, "give the die diameter (mm) or the punch face area (mm²)", "mm")
+            raise DesignError("diameter", "missing", "give the die diameter (mm) or the punch face area (mm²)", "mm")
         if self.diameter is not None:
             check_range("diameter", self.diameter, 0.0, DEFAULT.max_length, "mm", lo_open=True)
         if self.face_area is not None:
@@ -637,7 +637,7 @@ def read_metadata(source: str | Path | Mapping[str, Any], **overrides: Any) -> P
     compliance = _compliance(raw.get("compliance"))
     missing = [k for k in ("mass_mg", "true_density") if k not in raw]
     if missing:
-        raise DesignError(missing[0], None, "is required (metadata file or command-line option)")
+        raise DesignError(missing[0], "missing", "is required (metadata file or command-line option)")
     sign = raw.get("displacement_sign", "auto")
     if isinstance(sign, float) and sign in (1.0, -1.0):
         sign = int(sign)

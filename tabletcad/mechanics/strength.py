@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 
-from tabletcad.errors import check_positive, check_range
+from tabletcad.errors import DesignError, check_positive, check_range
 from tabletcad.mechanics.contact import contact_radius_at_yield
 from tabletcad.mechanics.validity import ValidityWarning, warn
 
@@ -90,7 +90,13 @@ def axial_flat(F: float, D: float) -> float:
 
 
 def _pitt_denominator(D: float, t: float, W: float) -> float:
-    return 2.84 * t / D - 0.126 * t / W + 3.15 * W / D + 0.01
+    """``2.84 t/D - 0.126 t/W + 3.15 W/D + 0.01`` of eq 2.7; a band so thin that it is <= 0 (the fit
+    would give a negative or infinite strength) is refused: the formula has no value there."""
+    den = 2.84 * t / D - 0.126 * t / W + 3.15 * W / D + 0.01
+    if not den > 0:
+        raise DesignError("band thickness", W, f"makes eq 2.7's denominator 2.84 t/D - 0.126 t/W + 3.15 W/D + 0.01 "
+                          f"= {den:.3g} <= 0 (D = {D:g}, t = {t:g} mm): the fit has no value for so thin a band", "mm")
+    return den
 
 
 def _check_convex(name: str, D: float, t: float, W: float, wd: tuple[float, float]) -> None:
@@ -122,10 +128,7 @@ def pitt_convex(F: float, D: float, t: float, W: float) -> float:
     t = check_positive("thickness", t, "mm")
     W = check_positive("band thickness", W, "mm")
     _check_convex("eq 2.7 (Pitt 1988)", D, t, W, (0.06, 0.3))
-    den = _pitt_denominator(D, t, W)
-    if den <= 0:
-        warn(ValidityWarning, f"eq 2.7: denominator {den:.3g} <= 0; geometry far outside the fitted range")
-    return 10.0 * F / (math.pi * D * D * den)
+    return 10.0 * F / (math.pi * D * D * _pitt_denominator(D, t, W))
 
 
 def _check_elongation(name: str, D: float, length: float | None) -> None:

@@ -351,6 +351,28 @@ def _held_volume(prob: dict, fam_name: str, fam: Any, variables: dict, fixed: di
     return vary, number("[problem] volume_mm3", prob["volume_mm3"], "mm3", lo=0.0, lo_open=True, hi=LIMITS["mm3"])
 
 
+def _check_lower_lengths(fam_name: str, fam: Any, vs: list, fixed: dict) -> None:
+    """Refuse a length variable's lower bound that no design file takes: between 0 and
+    ``Tolerances.min_length`` (a solver ending on it wrote an optimum that could not be built), or 0
+    where the family refuses 0 for it (a band); checked by building at that bound, the other variables
+    at their starting values or mid-range."""
+    from tabletcad.tolerance import DEFAULT as TOL
+
+    start = {v.name: v.initial if v.initial is not None else 0.5 * (v.lower + v.upper) for v in vs}
+    for v in vs:
+        if v.unit != "mm" or v.lower >= TOL.min_length:
+            continue
+        if v.lower > 0.0:
+            raise DesignError(f"[variables] {v.name} lower", v.lower, f"must be 0 or at least {TOL.min_length:g} mm "
+                              "(Tolerances.min_length, the least length a design takes)", "mm")
+        try:
+            fam.build(**fixed, **{**start, v.name: 0.0})
+        except DesignError as exc:
+            if exc.parameter == v.name:
+                raise DesignError(f"[variables] {v.name} lower", 0.0, f"family {fam_name!r} refuses {v.name} = 0 "
+                                  f"({exc.allowed}): give a lower bound of at least {TOL.min_length:g} mm", "mm") from None
+
+
 def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe: Any = None) -> Problem:
     """A :class:`Problem` over the parameters of a tablet family (:data:`tabletcad.families.FAMILIES`).
 
@@ -358,6 +380,7 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
     """
     from tabletcad.pipeline.design import design_to_toml
     from tabletcad.families import FAMILIES, RENAMED
+    from tabletcad.tolerance import DEFAULT as TOL
     from tabletcad.families import family as lookup_family
 
     fam_name = prob.get("family")
@@ -379,13 +402,19 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
         lo = number(f"[variables] {name} lower", spec["lower"], unit, lo=0.0, hi=lim)
         hi = number(f"[variables] {name} upper", spec["upper"], unit, lo=0.0, hi=lim)
         x0 = None if "initial" not in spec else number(f"[variables] {name} initial", spec["initial"], unit, lo=0.0, hi=lim)
-        vs.append(Variable(name, lo, hi, x0, unit))
+        vs.append(Variable(name, lo, hi, x0, unit, least=TOL.min_length if unit == "mm" else None))
     _check_keys("[fixed]", fixed, set(fam.params) - set(variables))
     fixed = {k: number(f"[fixed] {k}", v, fam.params[k], lo=0.0, hi=LIMITS.get(fam.params[k], LIMITS[""]))
              for k, v in fixed.items()}
     sense = prob.get("sense", "max")
     name = prob.get("name", f"{fam_name}_optimum")
     held = _held_volume(prob, fam_name, fam, variables, fixed)
+    _check_lower_lengths(fam_name, fam, vs, fixed)
+    given = set(variables) | set(fixed) | ({held[0]} if held else set())
+    missing = [k for k in fam.required if k not in given]
+    if missing:  # the family's default would stand in for it, unseen, and the optimum would not build
+        raise DesignError(f"[fixed] {missing[0]}", "missing", f"family {fam_name!r} needs {', '.join(fam.required)}: "
+                          "give each as a variable, in [fixed] or as [problem] solve_for")
 
     def build(x):
         if held is None:

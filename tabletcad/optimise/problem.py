@@ -61,7 +61,9 @@ FD_STEP = 1e-6
 class Variable:
     """A design variable with bounds ``lower <= x <= upper`` and a starting value.
 
-    ``unit`` is only used in reports.  ``lower == upper`` fixes the variable.
+    ``unit`` is only used in reports.  ``lower == upper`` fixes the variable.  ``least``: the
+    smallest non-zero value a design takes (a family's lengths: ``Tolerances.min_length``); a
+    solver's end point between 0 and it is moved to whichever of the two is feasible and better.
     """
 
     name: str
@@ -69,6 +71,7 @@ class Variable:
     upper: float
     initial: float | None = None
     unit: str = ""
+    least: float | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:

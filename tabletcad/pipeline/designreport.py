@@ -16,9 +16,11 @@ from the design file's ``[report]`` table or its command-line options.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import sys
 import warnings
+from collections.abc import Iterator
 from dataclasses import asdict, dataclass
 from importlib import resources
 from typing import Any
@@ -29,6 +31,7 @@ from tabletcad.errors import DesignError, check_range
 from tabletcad.families.sweep import SweepNominal, certify, sweep_properties
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.geometry.vectors import cross
+from tabletcad.mechanics.units import MAX_TRUE_DENSITY_MG_MM3
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -101,7 +104,8 @@ class ReportOptions:
         for k in ("true_density_mg_mm3", "breaking_force_N", "compaction_force_kN", "max_punch_force_kN", "max_punch_pressure_MPa"):
             v = getattr(self, k)
             if v is not None:
-                check_range(f"[report] {k}", v, 0.0, None, REPORT_KEYS[k], lo_open=True)
+                hi = MAX_TRUE_DENSITY_MG_MM3 if k == "true_density_mg_mm3" else None  # (not kg/m³)
+                check_range(f"[report] {k}", v, 0.0, hi, REPORT_KEYS[k], lo_open=True)
 
     @classmethod
     def from_table(cls, table: Any) -> "ReportOptions":
@@ -231,7 +235,7 @@ def tensile_strength(info: dict, thickness: float, F: float) -> dict[str, Any]:
     D = info.get("width_mm")
     Ln = info.get("length_mm")
     flags: list[str] = []
-    with warnings.catch_warnings(record=True) as rec:
+    with warnings.catch_warnings(record=True) as rec, _no_value(F) as refused:
         warnings.simplefilter("always")
         if shape == "round":
             if flat:
@@ -248,9 +252,23 @@ def tensile_strength(info: dict, thickness: float, F: float) -> dict[str, Any]:
         else:
             return dict(tensile_strength_MPa=None, formula=None, breaking_force_N=F,
                         range_flags=[f"no published tensile-strength formula for a {shape} plan"])
+    if refused:
+        return refused[0]
     flags += [str(w.message) for w in rec]
     return dict(tensile_strength_MPa=float(val), formula=formula, breaking_force_N=F, range_flags=flags,
                 within_range=not any(True for w in rec))
+
+
+@contextlib.contextmanager
+def _no_value(F: float) -> Iterator[list[dict[str, Any]]]:
+    """Turn a formula's refusal of the geometry (eq 2.7 with a band so thin that its denominator is <= 0)
+    into a tensile strength of None with the reason, in the list it yields."""
+    out: list[dict[str, Any]] = []
+    try:
+        yield out
+    except DesignError as exc:
+        out.append(dict(tensile_strength_MPa=None, formula=None, breaking_force_N=F,
+                        range_flags=[f"{exc.parameter} = {exc.value:g} mm {exc.allowed}"], within_range=False))
 
 
 def _punch_check(plan_area: float, opts: ReportOptions) -> dict[str, Any]:

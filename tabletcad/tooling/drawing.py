@@ -241,8 +241,10 @@ def drawing_model(ts) -> Drawing:
         dims.append(Dim((sx_, sy_ + fr.z_max - sc["depth_mm"]), (sx_, sy_ + fr.z_max), 2.0 + half_w,
                         f"score {_fmt(sc['depth_mm'])}", vertical=True))
     cup_r = _single_cup_radius(fr, radii)
-    if cup_r is not None:  # on the section's left half, away from a score at the centre, inside the sphere
-        x = -0.6 * (fr.round_radius - (fr.land or 0.0) - fr.info.get("bevel_width_mm", 0.0))
+    # the section shows the cup only where no score runs along it: not across a quadrisect or crossing bisects
+    along = any(sc.kind == "quadrisect" or abs(((sc.direction_deg - th) + 90.0) % 180.0 - 90.0) > 1e-9 for sc in scores)
+    if cup_r is not None and not along:  # on the section's left half, away from a score at the centre
+        x = -0.6 * _cup_edge_radius(fr)
         zc = fr.z_max - cup_r  # the cup's sphere is centred on the axis
         dims.append(Dim((sx_, sy_ + zc), (sx_ + x, sy_ + zc + math.sqrt(cup_r * cup_r - x * x)), 3.0,
                         f"R{_fmt(cup_r)}", radius=True))
@@ -262,7 +264,12 @@ def _single_cup_radius(fr, radii: dict) -> float | None:
             or "cup_radius_mm" not in fr.info:
         return None
     r = float(radii["cup_radius_mm"])
-    return r if r > fr.round_radius else None
+    return r if r >= _cup_edge_radius(fr) else None  # the sphere reaches the cup's edge (a hemisphere too)
+
+
+def _cup_edge_radius(fr) -> float:
+    """Distance from the axis to the cup's edge (mm): the outline's radius less the land and a bevel."""
+    return fr.round_radius - (fr.land or 0.0) - float(fr.info.get("bevel_width_mm", 0.0))
 
 
 def rating_notes(r: dict) -> list[str]:

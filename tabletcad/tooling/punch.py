@@ -58,7 +58,8 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
                                  check=check, a_manifold=None, sliver=1e-4,
                                  exact=lambda: tip_cell(body, tablet_shape, z_mid, z0, z1, which))
     vol = volume(shape)
-    land = None if frame.land is None else frame.land - clearance
+    cup = frame.cup_depth_top if which == "upper" else frame.cup_depth_bottom
+    land = None if frame.land is None or cup < 1e-9 else frame.land - clearance  # a flat tip has no land
     quad = punch_volume_quadrature(frame, clearance, tip_length, which)
     info = dict(
         tip_outline=frame.outline_kind,

@@ -70,6 +70,7 @@ from typing import Any
 
 from tabletcad.errors import DesignError, check_finite, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
+from tabletcad.tooling.polygon import polygon_problem
 from tabletcad.tooling.standards import PunchBody, resolve_body
 
 __all__ = ["ToolingSpec", "ScoreSpec", "EmbossSpec", "FeRatingSpec", "parse_tooling", "FONT_DIR", "font_path"]
@@ -255,52 +256,6 @@ def _keys(where: str, table: Any, allowed: set[str]) -> dict:
         if k not in allowed:
             raise DesignError(f"{where} key {k!r}", table[k], f"allowed keys are {', '.join(sorted(allowed))}")
     return table
-
-
-def polygon_problem(points) -> str | None:
-    """Why the closed polyline through ``points`` (mm) is not a simple polygon, or None.
-
-    A repeated point (the closing one too) is dropped; what is left must have three points and an
-    area, and no two of its edges may meet except adjacent ones at their shared point (a bow-tie's
-    crossing, an edge doubling back over the one before it).
-    """
-    pts: list[tuple[float, float]] = []
-    for p in points:
-        if not pts or p != pts[-1]:
-            pts.append(p)
-    if len(pts) > 1 and pts[0] == pts[-1]:
-        pts.pop()
-    n = len(pts)
-    if n < 3:
-        return "fewer than 3 distinct points"
-    def orient(a, b, c) -> float:
-        return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-
-    def on(a, b, c) -> bool:  # c on the segment ab, given that the three are collinear
-        return min(a[0], b[0]) <= c[0] <= max(a[0], b[0]) and min(a[1], b[1]) <= c[1] <= max(a[1], b[1])
-
-    def meet(a, b, c, d) -> bool:
-        o1, o2, o3, o4 = orient(a, b, c), orient(a, b, d), orient(c, d, a), orient(c, d, b)
-        if ((o1 > 0 > o2) or (o1 < 0 < o2)) and ((o3 > 0 > o4) or (o3 < 0 < o4)):
-            return True
-        return (o1 == 0 and on(a, b, c)) or (o2 == 0 and on(a, b, d)) or (o3 == 0 and on(c, d, a)) or \
-            (o4 == 0 and on(c, d, b))
-
-    for i in range(n):
-        a, b = pts[i], pts[(i + 1) % n]
-        c = pts[(i + 2) % n]  # the next edge b-c may touch a-b only at b: not fold back over it
-        if orient(a, b, c) == 0 and (on(a, b, c) or on(b, c, a)):
-            return f"the edges at point {(i + 1) % n} ({b[0]:g}, {b[1]:g}) double back over each other"
-        for j in range(i + 2, n):
-            if i == 0 and j == n - 1:
-                continue  # adjacent through the closing edge
-            if meet(a, b, pts[j], pts[(j + 1) % n]):
-                return f"edges {i} and {j} cross or touch"
-    area2 = sum(pts[i][0] * pts[(i + 1) % n][1] - pts[(i + 1) % n][0] * pts[i][1] for i in range(n))
-    size = max(max(abs(x), abs(y)) for x, y in pts) or 1.0
-    if abs(area2) <= 1e-12 * size * size:
-        return "it encloses no area"
-    return None
 
 
 def _choice(where: str, value: Any, options: tuple[str, ...]) -> str:

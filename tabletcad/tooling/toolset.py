@@ -81,11 +81,12 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
 
 def _warn_sharp_edge(frame, clearance: float) -> None:
     """One warning when cupped punch tips have no land: the tablet's land (0 without one) is narrower than
-    the clearance, so the tip's outline cuts the cup surface and the cup runs into the tip's wall at a
-    sharp edge.  A flat face meets the wall square, and a bevel is the edge's own design: neither warns."""
+    the clearance (or equal to it), so the tip's outline meets the cup surface and the cup runs into the
+    tip's wall at a sharp edge.  A flat face meets the wall square, and a flat face's bevel or edge radius
+    (FFBE, FFRE) and a concave face's bevel are the edge's own design: none of them warns."""
     cupped = max(frame.cup_depth_top, frame.cup_depth_bottom) > 1e-9
-    bevelled = bool(frame.info.get("bevel_width_mm"))
-    if cupped and not bevelled and frame.land is not None and frame.land - clearance < 0.0:
+    edge_designed = frame.info.get("face") == "flat" or bool(frame.info.get("bevel_width_mm"))
+    if cupped and not edge_designed and frame.land is not None and frame.land - clearance <= 1e-9:
         import warnings
 
         warnings.warn(f"the punch tips have no land ({frame.land:.4g} mm tablet land - {clearance:.4g} mm clearance "
@@ -100,8 +101,8 @@ def _check_relief(frame, spec: ToolingSpec) -> None:
     from tabletcad.tooling.outline import face_area, offset_wire, plan_face
 
     b = spec.body
-    if b.tip_relief_mm <= 0:
-        return
+    if b.tip_relief_mm <= 0 or max(spec.tip_length_mm, spec.lower_tip) <= b.tip_straight_mm:
+        return  # no relief is cut
     d = spec.clearance_mm + b.tip_relief_mm
     try:
         relieved = face_area(plan_face(offset_wire(frame.outline, -d)))
@@ -110,7 +111,7 @@ def _check_relief(frame, spec: ToolingSpec) -> None:
     if not relieved > 0.0:
         raise DesignError("[tooling.punch] tip_relief_mm", b.tip_relief_mm,
                           f"must leave a relieved tip: the outline offset inwards by the clearance and the relief "
-                          f"({d:.4g} mm) has no area left (tablet width {frame.width:.4g} mm)", "mm")
+                          f"({d:.4g} mm) leaves no single outline (tablet width {frame.width:.4g} mm)", "mm")
 
 
 def finished_solid(tablet: Tablet, spec: ToolingSpec, *, shape=None, deflection: float = DEFLECTION_MM):
@@ -123,13 +124,12 @@ def finished_solid(tablet: Tablet, spec: ToolingSpec, *, shape=None, deflection:
     """
     from tabletcad.tooling.emboss import apply_emboss, check_emboss
     from tabletcad.tooling.outline import tablet_frame
-    from tabletcad.tooling.scores import apply_scores, check_score
+    from tabletcad.tooling.scores import apply_scores
 
+    CACHE.clear()  # as make_tooling: the previous build's meshes and volumes are not asked for again
     frame = tablet_frame(tablet, shape)
-    for i, s in enumerate(spec.scores):
-        check_score(frame, s, i)
     checked = [check_emboss(frame, e, spec.clearance_mm, i) for i, e in enumerate(spec.emboss)]
-    solid, _, _ = apply_scores(frame, frame.shape, spec.scores, check=False, deflection=deflection)
+    solid, _, _ = apply_scores(frame, frame.shape, spec.scores, check=False, deflection=deflection)  # (checks each)
     solid, _, _ = apply_emboss(frame, solid, spec.emboss, spec.clearance_mm, check=False, deflection=deflection,
                                checked=checked)
     return solid, frame

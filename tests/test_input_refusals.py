@@ -1,0 +1,181 @@
+"""Inputs a new user gave that were taken silently or refused under another name (second trial).
+
+Each case: the exact ``error: <parameter> = <value> is not allowed: <range>`` line with the name the
+user wrote (the option, the file key), exit status 2, nothing written; or, where the input is valid, the
+value it must give.  Core only (numpy, scipy): the optimiser runs without the CAD stage.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from tabletcad.cli import main
+from tabletcad.errors import DesignError
+
+CONCAVE = """[problem]
+kind = "family"
+family = "concave_round"
+sense = "{sense}"
+objective = "volume_mm3"
+
+[variables]
+{variables}
+
+[fixed]
+{fixed}
+"""
+
+
+def _optimise(tmp_path, capsys, text: str, *extra: str) -> tuple[int, list[str], list[str]]:
+    f = tmp_path / "problem.toml"
+    f.write_text(text, encoding="utf-8")
+    rc = main(["optimise", str(f), "--out", str(tmp_path / "out"), "--quiet", *extra])
+    cap = capsys.readouterr()
+    return rc, cap.out.strip().splitlines(), cap.err.strip().splitlines()
+
+
+@pytest.mark.parametrize("variables, fixed, line", [
+    # cup_depth neither varied nor fixed: the constructor's default 1.0 mm stood in for it, and the
+    # optimum file (without it) could not be built
+    ("diameter = { lower = 6.0, upper = 12.0 }", "band = 2.8",
+     "error: [fixed] cup_depth = 'missing' is not allowed: family 'concave_round' needs diameter, band, cup_depth"),
+    # band from 0: the solver stopped at 9.1e-12 mm, which no design takes
+    ("band = { lower = 0.0, upper = 3.0, initial = 1.0 }", "diameter = 10.0\ncup_depth = 0.9",
+     "error: [variables] band lower = 0 mm is not allowed: family 'concave_round' refuses band = 0 (must be > 0)"),
+    ("band = { lower = 0.0005, upper = 3.0 }", "diameter = 10.0\ncup_depth = 0.9",
+     "error: [variables] band lower = 0.0005 mm is not allowed: must be 0 or at least 0.001 mm"),
+])
+def test_family_problem_refused_before_the_solve(tmp_path, capsys, variables, fixed, line):
+    rc, out, err = _optimise(tmp_path, capsys, CONCAVE.format(sense="min", variables=variables, fixed=fixed))
+    assert rc == 2 and len(err) == 1 and err[0].startswith(line), err
+    assert out == [] and sorted(p.name for p in tmp_path.iterdir()) == ["problem.toml"]
+
+
+@pytest.mark.parametrize("method", ["SLSQP", "trust-constr", "differential_evolution"])
+def test_a_length_ending_below_the_least_length_is_put_on_zero(method):
+    """Volume grows as the land shrinks: the optimum is land = 0 exactly, whatever the solver.  The
+    interior-point solver stopped at 3.3e-4 mm and differential evolution at 6e-9 mm before, lengths no
+    design file takes (0 or at least Tolerances.min_length)."""
+    from tabletcad.families import concave_round
+    import tomllib
+
+    from tabletcad.optimise.files import problem_from_dict
+    from tabletcad.optimise.solvers import solve
+    from tabletcad.pipeline.design import Design
+
+    text = CONCAVE.format(sense="max", variables="land = { lower = 0.0, upper = 0.3, initial = 0.1 }",
+                          fixed="diameter = 10.0\nband = 2.5\ncup_depth = 0.8")
+    problem, _, opts = problem_from_dict(tomllib.loads(text))
+    r = solve(problem, method, progress=False, **opts)
+    assert r.success and r.x["land"] == 0.0
+    assert r.objective == pytest.approx(concave_round(diameter=10.0, band=2.5, cup_depth=0.8, land=0.0).volume(),
+                                        rel=1e-9)
+    d = Design.from_dict({"tablet": dict(family="concave_round", diameter=10.0, band=2.5, cup_depth=0.8,
+                                         land=r.x["land"])})
+    assert d.build().volume() == pytest.approx(r.objective, rel=1e-12)
+
+
+def test_starts_with_a_single_start_method_is_refused(tmp_path, capsys):
+    text = CONCAVE.format(sense="max", variables="land = { lower = 0.0, upper = 0.3 }",
+                          fixed="diameter = 10.0\nband = 2.5\ncup_depth = 0.8")
+    rc, out, err = _optimise(tmp_path, capsys, text, "--starts", "3")
+    assert rc == 2 and err == ["error: --starts = '3' is not allowed: is read by --method multistart only "
+                               "(this run: SLSQP)"]
+
+
+def test_solve_for_needs_every_dimension_of_a_named_family():
+    from tabletcad.families import concave_round
+    from tabletcad.families.inverse import solve_for
+
+    with pytest.raises(DesignError) as e:
+        solve_for("concave_round", target_volume_mm3=300, vary="band", diameter=10)
+    assert str(e.value) == "cup_depth = 'missing' is not allowed: concave_round needs diameter, cup_depth besides band"
+    # a constructor passed in keeps its defaults (documented)
+    r = solve_for(concave_round, target_volume_mm3=300, vary="band", diameter=10)
+    assert r.volume_mm3 == pytest.approx(300, rel=1e-9)
+    with pytest.raises(DesignError, match=r"true_density_mg_mm3 = 1540 mg/mm3 is not allowed: must be > 0 and <= 25"):
+        solve_for("concave_round", target_weight_mg=300, vary="band", diameter=10, cup_depth=1,
+                  solid_fraction=0.8, true_density_mg_mm3=1540)
+
+
+@pytest.mark.parametrize("args, line", [
+    # Pitt's eq 2.7 with so thin a band that its denominator is negative: a negative strength was printed
+    (["strength", "pitt", "--force", "100", "--diameter", "10", "--thickness", "4.6", "--band", "0.01"],
+     "error: --band = 0.01 mm is not allowed: makes eq 2.7's denominator"),
+    (["strength", "pitt", "--force", "-100", "--diameter", "10", "--thickness", "4.6", "--band", "1"],
+     "error: --force = -100 N is not allowed: must be > 0"),
+    (["strength", "pitt", "--force", "100", "--thickness", "4.6", "--band", "1"],
+     "error: --diameter = 'missing' is not allowed: is required for method 'pitt'"),
+    (["strength", "elongated-convex", "--force", "100", "--diameter", "0", "--thickness", "4", "--band", "1"],
+     "error: --diameter = 0 mm is not allowed: must be > 0"),
+])
+def test_strength_options_named_as_given(capsys, args, line):
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(line), err
+
+
+def test_pitt_denominator_is_the_edge_of_the_formula():
+    """eq 2.7 has a value while its denominator is positive and none at or beyond zero."""
+    from tabletcad.mechanics.strength import pitt_convex
+
+    D, t, F = 10.0, 4.6, 100.0
+    # the denominator's root in W: 3.15 W²/D + (2.84 t/D + 0.01) W - 0.126 t = 0
+    a, b, c = 3.15 / D, 2.84 * t / D + 0.01, -0.126 * t
+    W0 = (-b + math.sqrt(b * b - 4 * a * c)) / (2 * a)
+    assert pitt_convex(F, D, t, W0 * 1.001) > 0
+    with pytest.raises(DesignError, match="band thickness"):
+        pitt_convex(F, D, t, W0 * 0.999)
+
+
+def test_design_report_gives_no_strength_where_the_formula_has_none(capsys, tmp_path):
+    rc = main(["report", "samples/families/concave_round.toml", "--solve-for", "band", "--target-volume", "70",
+               "--json"])
+    assert rc == 0
+    import json
+
+    ts = json.loads(capsys.readouterr().out)
+    ts = ts[0] if isinstance(ts, list) else ts
+    strength = ts["design_report"]["tensile_strength"]
+    assert strength["tensile_strength_MPa"] is None and "eq 2.7's denominator" in strength["range_flags"][0]
+
+
+@pytest.mark.parametrize("args, line", [
+    (["--true-density", "1540"], "error: --true-density = 1540 mg/mm3 is not allowed: must be > 0 and <= 25 mg/mm3"),
+    (["--solid-fraction", "1.2"], "error: --solid-fraction = 1.2 is not allowed: must be > 0 and <= 1"),
+    (["--breaking-force", "inf"], "error: --breaking-force = inf N is not allowed"),
+])
+def test_report_options_named_as_given(capsys, args, line):
+    assert main(["report", "samples/families/concave_round.toml", *args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(line), err
+
+
+def test_a_density_in_kg_per_m3_in_the_design_file(tmp_path, capsys):
+    d = tmp_path / "d.toml"
+    d.write_text('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 3.0\ncup_depth = 1.0\n\n'
+                 '[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1540\n')
+    assert main(["report", str(d)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["error: [report].true_density_mg_mm3 = 1540 mg/mm3 is not allowed: must be > 0 and <= 25 mg/mm3"]
+
+
+def test_heckel_says_why_no_row_is_left(tmp_path, capsys):
+    """A mass far too large makes every row denser than the solid: the refusal says so (it said only
+    '0 loading points')."""
+    import numpy as np
+
+    P = np.linspace(5.0, 200.0, 60)  # MPa on a 10 mm die
+    F = P * math.pi * 25.0
+    D = 1.0 - 0.5 * np.exp(-0.01 * P)
+    h = 300.0 / (1.5 * math.pi * 25.0 * D)  # 300 mg at 1.5 mg/mm³
+    csv = tmp_path / "run.csv"
+    csv.write_text("force_N,thickness_mm\n" + "".join(f"{float(f)!r},{float(x)!r}\n" for f, x in zip(F, h)))
+    (tmp_path / "run.toml").write_text("mass_mg = 300\ntrue_density = 1.5\ndiameter = 10\n")
+    assert main(["heckel", str(csv)]) == 0
+    capsys.readouterr()
+    assert main(["heckel", str(csv), "--mass", "3000"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "60 loaded row(s) have relative density >= 1" in err[0], err
