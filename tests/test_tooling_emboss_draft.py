@@ -210,3 +210,36 @@ def test_debossed_text_on_a_flat_face_narrows_towards_the_floor():
     removed = ts.report["tablet"]["volume_plain_mm3"] - ts.report["tablet"]["volume_mm3"]
     assert abs(removed - (A * d - P * tn * d * d / 2.0)) < 0.15 * P * tn * d * d / 2.0
     assert removed < A * d
+
+
+def test_a_vanishing_offset_is_not_paired():
+    """A wire too short to hold three points 0.008 mm apart (an offset of a stroke about to vanish) has
+    no polygon to pair: None, and the draft is shortened instead (it stopped the build with numpy's
+    "argmin of an empty sequence")."""
+    from tabletcad.tooling.emboss import _paired
+    from tabletcad.tooling.outline import polyline_wire
+
+    square = lambda s: polyline_wire([(-s, -s), (s, -s), (s, s), (-s, s)])  # noqa: E731
+    assert _paired(square(1.0), square(0.0005)) is None and _paired(square(0.0005), square(1.0)) is None
+    a, b = _paired(square(1.0), square(0.9))
+    assert a is not None and b is not None
+
+
+def test_drafted_digits_on_a_scored_radius_edge_face():
+    """Found by a random sweep of tooling designs: "10" debossed at 30 deg beside a 37 deg bisect on a
+    flat-faced radius-edged round.  The finished tablet is one valid solid, every Boolean agreeing with
+    manifold3d, the punches leave no gap beyond the clearance."""
+    from tabletcad.cad._occ import explore
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.toolset import make_tooling
+
+    d = Design.from_dict({"tablet": dict(family="ffre", diameter=10.96, thickness=3.55, edge_radius=0.934),
+                          "tooling": {"clearance_mm": 0.02,
+                                      "score": [dict(kind="bisect", profile="v", depth_mm=0.549, direction_deg=37.0)],
+                                      "emboss": [dict(text="10", mode="deboss", face="top", height_mm=1.947,
+                                                      depth_mm=0.1588, stroke_angle_deg=30.0)]}})
+    ts = make_tooling(d.build(), d.tooling_spec, check=True, interference_check=True)
+    tablet = ts.parts["tablet"]
+    assert len(explore(tablet, "Solid")) == 1 and _valid(tablet)
+    assert all(c["ok"] for c in ts.report["booleans"])
+    assert ts.report["interference_mm3"] <= 1e-6 and ts.report["interference"]["gap_within_clearance"]

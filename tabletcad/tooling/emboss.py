@@ -364,8 +364,10 @@ def _ruled_draft(wire, narrow: float, wide: float, t: float, grow: float):
         # at 15 deg lost 4 % of its volume) and slowly (seconds): paired polygons then
         solid = _loft(sections) if len(explore(lo, "Edge")) == len(explore(hi, "Edge")) else None
         if solid is None:
-            a, b = _paired(lo, hi) if wire_length(lo) >= wire_length(hi) else _paired(hi, lo)[::-1]
-            solid = _loft([(a if w is lo else b, z) for w, z in sections])
+            pair = _paired(lo, hi) if wire_length(lo) >= wire_length(hi) else _paired(hi, lo)
+            if pair is not None:  # (None: an offset too small to hold a polygon; a shorter draft next)
+                a, b = pair if wire_length(lo) >= wire_length(hi) else pair[::-1]
+                solid = _loft([(a if w is lo else b, z) for w, z in sections])
         if solid is not None:
             return solid
     raise GeometryError("ruled drafted prism of a glyph wire failed", wire)
@@ -400,7 +402,7 @@ def _wire_points(wire, spacing: float):
 
 
 def _paired(wa, wb, spacing: float = 0.08):
-    """Two closed polygons: through ``wa``'s points (``spacing`` apart) and through the nearest points
+    """Two closed polygons (None where either wire holds fewer than three points): through ``wa``'s points (``spacing`` apart) and through the nearest points
     of ``wb`` to them, vertex for vertex, so that a ruled loft between them joins
     each point of one offset to its counterpart along the normal on the other (OCC's offsets of one
     outline split its edges differently, and pairing by arc length drifts where a feature vanishes).
@@ -408,6 +410,8 @@ def _paired(wa, wb, spacing: float = 0.08):
     import numpy as np
 
     pa, pb = _wire_points(wa, spacing), _wire_points(wb, 0.25 * spacing)
+    if len(pa) < 3 or len(pb) < 3:  # a wire shorter than a few spacings (a vanishing stroke's offset)
+        return None
     seg = np.roll(pb, -1, axis=0) - pb
     slen = np.linalg.norm(seg, axis=1)
     cum = np.concatenate([[0.0], np.cumsum(slen)])
