@@ -179,3 +179,13 @@ def test_heckel_says_why_no_row_is_left(tmp_path, capsys):
     assert main(["heckel", str(csv), "--mass", "3000"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "60 loaded row(s) have relative density >= 1" in err[0], err
+
+
+def test_a_thesis_shapes_smoothing_parameter_is_named_as_written(tmp_path, capsys):
+    """``a = 50`` in [tablet] of a thesis shape was reported as
+    ``patch.flat_faced_round[0].smoothing.parameter.a``; the file says ``tablet.a``."""
+    d = tmp_path / "d.toml"
+    d.write_text('[tablet]\nfamily = "thesis.flat_faced_round"\ndiameter = 10\nthickness = 3\na = 50\n')
+    assert main(["report", str(d)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: tablet.a = 50 is not allowed: mode 1"), err

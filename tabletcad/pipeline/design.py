@@ -355,6 +355,8 @@ class Design:
             except DesignError as exc:  # the constructor names its parameter: the design file says tablet.<name>
                 if exc.parameter in fam.params or exc.parameter == "a":
                     raise exc.renamed(f"tablet.{exc.parameter}") from None
+                if a is not None and exc.parameter.endswith("smoothing parameter a"):  # a patch's: the file's a
+                    raise exc.renamed("tablet.a") from None
                 raise
             tablet = replace(built, name=name)
         if self.reshape is not None:
