@@ -189,3 +189,17 @@ def test_a_thesis_shapes_smoothing_parameter_is_named_as_written(tmp_path, capsy
     assert main(["report", str(d)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error: tablet.a = 50 is not allowed: mode 1"), err
+
+
+def test_optimise_names_itself_when_it_will_not_replace_a_file(tmp_path, capsys):
+    """The refusal said "no tabletcad build wrote there" for an optimise run (and a build may well have)."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "report.json").write_text("{}")
+    text = CONCAVE.format(sense="max", variables="land = { lower = 0.0, upper = 0.3 }",
+                          fixed="diameter = 10.0\nband = 2.5\ncup_depth = 0.8")
+    rc, _, err = _optimise(tmp_path, capsys, text)
+    assert rc == 2 and err == [f"error: --out = '{out}' is not allowed: must not hold files this run writes that no "
+                               "earlier tabletcad optimise run wrote there or that were edited since (report.json): "
+                               "move them or write into another folder"]
+    assert (out / "report.json").read_text() == "{}"

@@ -230,8 +230,10 @@ def check_replaceable(out_dir: str | os.PathLike[str], names, earlier: dict[str,
     theirs = [n for n in names if not _ours(out_dir / n, earlier.get(n))]
     if theirs:  # replacing them would lose what someone else put there
         shown = ", ".join(theirs[:3]) + (f" and {len(theirs) - 3} more" if len(theirs) > 3 else "")
-        raise DesignError("--out", str(out_dir), f"must not hold files this build writes that no tabletcad build "
-                          f"wrote there or that were edited since ({shown}): move them or build into another folder")
+        who = ("run", "tabletcad optimise run") if manifest == OPTIMISE_MANIFEST else ("build", "tabletcad build")
+        raise DesignError("--out", str(out_dir), f"must not hold files this {who[0]} writes that no earlier "
+                          f"{who[1]} wrote there or that were edited since ({shown}): move them or write into another "
+                          "folder")
 
 
 def _ours(path: Path, digest: str | None) -> bool:
