@@ -203,3 +203,16 @@ def test_optimise_names_itself_when_it_will_not_replace_a_file(tmp_path, capsys)
                                "earlier tabletcad optimise run wrote there or that were edited since (report.json): "
                                "move them or write into another folder"]
     assert (out / "report.json").read_text() == "{}"
+
+
+@pytest.mark.parametrize("force, pressure, expected", [(20.0, 100.0, "pressure"), (5.0, 100.0, "force")])
+def test_two_punch_limits_use_the_stricter_and_say_so(capsys, force, pressure, expected):
+    import json
+
+    assert main(["report", "samples/families/concave_round.toml", "--max-punch-force", str(force),
+                 "--max-punch-pressure", str(pressure), "--compaction-force", "5", "--json"]) == 0
+    rep = json.loads(capsys.readouterr().out)
+    pc = (rep[0] if isinstance(rep, list) else rep)["design_report"]["punch_tip_check"]
+    area = math.pi * 25.0  # the 10 mm round's tip face, mm2
+    assert pc["allowed_force_kN"] == pytest.approx(min(force, pressure * area / 1000.0), rel=1e-9)
+    assert f"max_punch_{expected}" in pc["limit_basis"] and "the stricter of the two limits given" in pc["limit_basis"]

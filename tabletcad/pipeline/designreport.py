@@ -289,6 +289,8 @@ def _punch_check(plan_area: float, opts: ReportOptions) -> dict[str, Any]:
         f = opts.max_punch_pressure_MPa * plan_area / 1000.0
         if lim_force is None or f < lim_force:
             lim_force, basis = f, "user-given max_punch_pressure_MPa x tip face area"
+    if basis and opts.max_punch_force_kN is not None and opts.max_punch_pressure_MPa is not None:
+        basis += " (the stricter of the two limits given)"
     out["allowed_force_kN"] = lim_force
     out["limit_basis"] = basis or ("no limit given (no citable public punch-tip rating table is bundled: "
                                     "give [report] max_punch_force_kN or max_punch_pressure_MPa)")
