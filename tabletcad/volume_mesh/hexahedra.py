@@ -24,9 +24,17 @@ vectorised, and turns it into a *conforming* finite-element mesh:
   - consecutive patches: patch ``j`` at ``u = 1`` and patch ``j + 1`` at
     ``u = 0`` (same ``v`` and ``w``) share their nodes (untrimmed ``u`` only);
 
+  and then every other pair of nodes within that distance is merged too
+  (:func:`_geometric_merge`): a shaped cup folds onto its centre line or its
+  corner arcs, where nodes of mirror ``v`` meet;
+
 * a cell whose eight corners are not distinct is written as the lower-order
   cell it is: a wedge next to the spine (6 distinct nodes), a pyramid next to
-  a pole (5), a tetrahedron where both meet (4); cells with fewer nodes, and
+  a pole (5), a tetrahedron where both meet (4), and likewise for the same
+  collapses in any orientation (:data:`_DEGENERATE`); a cell next to both the
+  spine and a shaped cup's fold, whose sides are bilinear quads sharing two
+  edges, is no standard cell and stays a degenerate hexahedron (repeated
+  nodes, shared with its neighbours); cells with fewer nodes, and
   all cells of a flat patch (a zero-volume solid, such as the flat faces of
   a flat-faced round tablet, whose volume the band patch's solid fills), are
   dropped;
@@ -108,6 +116,45 @@ _AS_HEX: dict[str, list[int]] = {
     "pyramid": [0, 1, 2, 3, 4, 4, 4, 4],
     "tetra": [0, 1, 2, 2, 3, 3, 3, 3],
 }
+
+
+def _rotations() -> list[np.ndarray]:
+    """The 24 rotations of the reference cube as permutations of its 8 corners (``c[σ]`` is the
+    rotated cell's corner array)."""
+    import itertools
+
+    centred = 2 * _HEX_OFFSETS - 1
+    index = {tuple(c): i for i, c in enumerate(centred)}
+    out = []
+    for perm in itertools.permutations(range(3)):
+        for signs in itertools.product((1, -1), repeat=3):
+            m = np.zeros((3, 3), dtype=np.intp)
+            for r, (c, sg) in enumerate(zip(perm, signs)):
+                m[r, c] = sg
+            if round(np.linalg.det(m)) == 1:
+                out.append(np.array([index[tuple(m @ c)] for c in centred], dtype=np.intp))
+    return out
+
+
+def _signature(pairs) -> frozenset:
+    """The classes of coincident corners (of two or more) that the corner ``pairs`` make."""
+    cls = {i: {i} for i in range(8)}
+    for a, b in pairs:
+        if cls[a] is not cls[b]:
+            merged = cls[a] | cls[b]
+            for i in merged:
+                cls[i] = merged
+    return frozenset(frozenset(c) for c in cls.values() if len(c) > 1)
+
+
+# every collapse of a positively oriented hexahedron into a wedge, pyramid or tetrahedron: the templates
+# above in each of the cube's 24 rotations, keyed by the classes of coincident corners; the value is the
+# written cell's type and its columns of the hexahedron's corners (rotations keep the orientation)
+_DEGENERATE: dict[frozenset, tuple[str, np.ndarray]] = {}
+for _sigma in _rotations():
+    for _name in ("wedge", "pyramid0", "pyramid1", "tetra0", "tetra1"):
+        _key = _signature([(_sigma[a], _sigma[b]) for a, b in _COLLAPSED[_name]])
+        _DEGENERATE.setdefault(_key, (_name.rstrip("01"), _sigma[_TEMPLATES[_name]]))
 
 #: A patch's solid is flat (zero volume, all its cells dropped) when the sum of
 #: its cells' signed volumes is at most FLAT × (bounding-box diagonal)³.
@@ -371,6 +418,7 @@ def hex_mesh(tablet: "Tablet", nodes: tuple[int, int, int] = (11, 21, 5), *, che
     raw, rep = _merged_nodes(tablet, grids, offsets)
     if check:
         _check_merge(tablet, raw, rep, offsets)
+    rep = _geometric_merge(tablet, raw, rep)
     blocks: dict[str, list[np.ndarray]] = {k: [] for k in CELL_TYPES}
     pids: dict[str, list[np.ndarray]] = {k: [] for k in CELL_TYPES}
     dropped = 0
@@ -518,7 +566,8 @@ def _patch_cells(tablet: "Tablet", p: int, g: _Grid, offset: int, rep: np.ndarra
         "tetra0": keep & spine & at0,
         "tetra1": keep & spine & at1,
     }
-    out = []
+    out: list[tuple[str, np.ndarray]] = []
+    dropped = 0
     for name, mask in kinds.items():
         if not np.any(mask):
             continue
@@ -528,12 +577,65 @@ def _patch_cells(tablet: "Tablet", p: int, g: _Grid, offset: int, rep: np.ndarra
                 if not np.array_equal(cc[:, x], cc[:, y]):  # pragma: no cover - index logic
                     raise GeometryError(f"patch {p}: {name} cells with corners {x}, {y} not merged")
         conn = cc[:, _TEMPLATES[name]]
-        if check:
-            srt = np.sort(conn, axis=1)
-            if np.any(srt[:, 1:] == srt[:, :-1]):  # pragma: no cover - index logic
-                raise GeometryError(f"patch {p}: {name} cells with repeated nodes")
-        out.append((name.rstrip("01"), conn))
-    return out, int(np.sum(~keep))
+        srt = np.sort(conn, axis=1)
+        more = np.any(srt[:, 1:] == srt[:, :-1], axis=1)  # collapsed further than the index logic knows
+        out.append((name.rstrip("01"), conn[~more]))
+        if np.any(more):
+            extra, n_gone = _collapsed_cells(tablet, p, cc[more])
+            out += extra
+            dropped += n_gone
+    return [(k, c) for k, c in out if len(c)], int(np.sum(~keep)) + dropped
+
+
+def _collapsed_cells(tablet: "Tablet", p: int, corners: np.ndarray) -> tuple[list[tuple[str, np.ndarray]], int]:
+    """Hexahedra (rows of 8 corner node indices) whose corners coincide in a way the index logic does
+    not know (a shaped cup's centre line, where the surface folds onto a segment and nodes of mirror
+    ``v`` meet): each written as the wedge, pyramid or tetrahedron its classes of coincident corners
+    make (:data:`_DEGENERATE`), or dropped with fewer than four distinct corners; one that none of
+    them describes (next to both the spine and a collapsed corner: two bilinear sides share two edges)
+    is kept as the degenerate hexahedron it is, its repeated nodes shared with its neighbours (the mesh
+    stays conforming; its corner Jacobians vanish there).  Returns the blocks and the number dropped."""
+    blocks: dict[str, list[np.ndarray]] = {}
+    gone = 0
+    for row in corners:
+        if len(set(row.tolist())) < 4:
+            gone += 1
+            continue
+        pairs = [(a, b) for a in range(8) for b in range(a + 1, 8) if row[a] == row[b]]
+        hit = _DEGENERATE.get(_signature(pairs))
+        if hit is None:  # (a pyramid-like cell whose sides are bilinear quads: a degenerate hexahedron)
+            blocks.setdefault("hexahedron", []).append(row)
+        else:
+            blocks.setdefault(hit[0], []).append(row[hit[1]])
+    return [(k, np.array(v, dtype=np.intp)) for k, v in blocks.items()], gone
+
+
+def _geometric_merge(tablet: "Tablet", raw: np.ndarray, rep: np.ndarray) -> np.ndarray:
+    """``rep`` with representatives that lie within ``tablet.tol.seam_gap`` (relative to the size, at
+    least 1 mm) of each other merged too: coincidences the index logic does not know, such as the two
+    sides of a shaped cup's centre line, where the surface folds onto a segment."""
+    from scipy.spatial import cKDTree
+
+    reps = np.unique(rep)
+    scale = max(1.0, float(np.max(np.abs(raw))))
+    pairs = cKDTree(raw[reps]).query_pairs(float(tablet.tol.seam_gap) * scale, output_type="ndarray")
+    if len(pairs) == 0:
+        return rep
+    parent = np.arange(reps.size)
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for a, b in pairs:
+        ra, rb = root(int(a)), root(int(b))
+        if ra != rb:
+            parent[max(ra, rb)] = min(ra, rb)
+    final = np.empty(raw.shape[0], dtype=np.intp)
+    final[reps] = reps[[root(i) for i in range(reps.size)]]
+    return final[rep]
 
 
 # ---------------------------------------------------------------------------- output
