@@ -216,3 +216,25 @@ def test_two_punch_limits_use_the_stricter_and_say_so(capsys, force, pressure, e
     area = math.pi * 25.0  # the 10 mm round's tip face, mm2
     assert pc["allowed_force_kN"] == pytest.approx(min(force, pressure * area / 1000.0), rel=1e-9)
     assert f"max_punch_{expected}" in pc["limit_basis"] and "the stricter of the two limits given" in pc["limit_basis"]
+
+
+def test_extents_and_plan_area_of_a_w_trim_are_the_solid_s():
+    """``[trim] w = [w0, w1]`` with w1 < 1 keeps the solid between the spine's w0 and w1 (eq 4.12);
+    the report gave the whole surface's extents (12.01 mm for a ring whose STEP is 10.81 mm wide) and
+    plan area.  The ring's spine is on the axis, so its plan scales exactly: outer radius by w1, the
+    hole's by w0 / 0.5 (the design's own w0); the sphere's by w1 alone."""
+    from tabletcad.pipeline.design import Design
+
+    def build(tablet: dict, w=None):
+        return Design.from_dict({"tablet": tablet, **({"trim": {"w": w}} if w else {})}).build()
+
+    ring = dict(family="thesis.ring", outer_diameter=12.0, inner_diameter=6.0, thickness=4.5)
+    full, cut = build(ring), build(ring, [0.2, 0.9])
+    R = full.dimensions()["length_mm"] / 2.0
+    Rh2 = R * R - full.plan_area() / math.pi  # the hole's radius², at w0 = 0.5
+    assert cut.dimensions()["length_mm"] == pytest.approx(0.9 * 2.0 * R, rel=1e-9)
+    assert cut.plan_area() == pytest.approx(math.pi * ((0.9 * R) ** 2 - (0.2 / 0.5) ** 2 * Rh2), rel=1e-7)
+    sphere = dict(family="thesis.spherical", diameter=5.0)
+    full, cut = build(sphere), build(sphere, [0.0, 0.5])
+    assert cut.dimensions()["width_mm"] == pytest.approx(0.5 * full.dimensions()["width_mm"], rel=1e-9)
+    assert cut.plan_area() == pytest.approx(0.25 * full.plan_area(), rel=1e-7)

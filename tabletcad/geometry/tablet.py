@@ -443,7 +443,7 @@ class Tablet:
         untrimmed in ``v`` and ``w``) is the disc of its largest profile radius,
         ``π R_max²``, with ``R_max`` polished to ~1e-12 in ``u``.
         """
-        if self.revolution is not None and self.trim.full_v and self.trim.w[0] == 0.0:
+        if self.revolution is not None and self.trim.full_v and self.trim.w == (0.0, 1.0):
             return math.pi * self._largest_radius() ** 2
         return self._plan_area_sampled(nu, nv)
 
@@ -451,7 +451,7 @@ class Tablet:
         """:meth:`plan_area` from samples of every patch (any star-shaped plan)."""
         u, v = self._grid(nu, nv)
         # each (2, nu, nv): x and y as contiguous blocks, no stacked copy
-        pts = [p.evaluate_grid(u, v, components=True, axes=(0, 1)) for p in self.patches]
+        pts = [self._outer_grid(p, u, v, axes=(0, 1)) for p in self.patches]
         lo, hi = coordinate_range([X.transpose(1, 2, 0) for X in pts], 2)  # views: X[..., j] is the block X[j]
         c = 0.5 * (lo + hi)
         m = 4 * nv
@@ -482,7 +482,9 @@ class Tablet:
         hole = 0.0
         if self.trim.w[0] > 0.0:  # hollow solid (ring): subtract the see-through hole
             A = np.stack([p.spine(np.linspace(self.trim.u[0], self.trim.u[1], nu)) for p in self.patches])
-            inner = A[:, :, None, :2] + self.trim.w[0] * (np.stack(pts).transpose(0, 2, 3, 1) - A[:, :, None, :2])
+            # pts are the outer surface w = w1: the inner one is w0 / w1 of the way from the spine to it
+            k = self.trim.w[0] / self.trim.w[1]
+            inner = A[:, :, None, :2] + k * (np.stack(pts).transpose(0, 2, 3, 1) - A[:, :, None, :2])
             ri = np.hypot(inner[..., 0] - c[0], inner[..., 1] - c[1]).min(axis=(0, 1))
             di = inner[0, 0, :, :2] - c
             phi = np.arctan2(di[:, 1], di[:, 0])
@@ -500,8 +502,9 @@ class Tablet:
         lo, hi = self.trim.u
         ub, best = u0.copy(), best.copy()
 
-        def jet(uu, vv):  # X - c, X_u, X_uu in the plan at the points (uu, vv)
-            return (p.evaluate(uu, vv)[:, :2] - c, p.evaluate(uu, vv, du=1)[:, :2], p.evaluate(uu, vv, du=2)[:, :2])
+        def jet(uu, vv):  # X - c, X_u, X_uu in the plan at the points (uu, vv) of the outer surface
+            return (self._outer(p, uu, vv)[:, :2] - c, self._outer(p, uu, vv, 1)[:, :2],
+                    self._outer(p, uu, vv, 2)[:, :2])
 
         X, Xu, Xuu = jet(ub, v)
         live = np.arange(ub.size)  # points whose last step gained (one that did not would only repeat it)
@@ -589,7 +592,8 @@ class Tablet:
         return np.linspace(t.u[0], t.u[1], nu), np.linspace(t.v[0], t.v[1], nv, endpoint=not t.full_v)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """Axis-aligned bounding box (mm) of the surface, refined to ~1e-9 mm.
+        """Axis-aligned bounding box (mm) of the surface (the outer one, ``w = w1``, when ``[trim] w``
+        ends before 1), refined to ~1e-9 mm.
 
         Each extreme is taken from a 97 × 256 sample of every patch and then
         polished by zooming: a 33 × 33 grid around the best point, each round eight
@@ -645,16 +649,42 @@ class Tablet:
         """Largest distance (mm) of a tablet of revolution's surface from the z axis."""
         return self._profile_extents()[0]
 
+    def _outer(self, p: PDEPatch, u, v, du: int = 0) -> np.ndarray:
+        """The solid's outer surface at points ``(u, v)`` (or its ``u`` derivative): the patch's
+        surface, or ``A0(u) + w1 (X(u, v) - A0(u))`` when ``[trim] w`` ends at ``w1 < 1`` (eq 4.12)."""
+        X = p.evaluate(u, v, du=du)
+        w1 = self.trim.w[1]
+        if w1 == 1.0:
+            return X
+        A = p.spine(np.asarray(u, float), du=du)
+        return A + w1 * (X - A)
+
+    def _outer_grid(self, p: PDEPatch, u, v, axes: tuple[int, ...] | None = None) -> np.ndarray:
+        """:meth:`_outer` on the grid ``u × v``: (len(u), len(v), 3), or with ``axes`` the coordinates
+        ``axes`` as contiguous blocks ``(len(axes), len(u), len(v))`` (``evaluate_grid``'s layout)."""
+        w1 = self.trim.w[1]
+        if axes is None:
+            X = p.evaluate_grid(u, v)
+            if w1 == 1.0:
+                return X
+            A = p.spine(np.asarray(u, float))[:, None, :]
+            return A + w1 * (X - A)
+        X = p.evaluate_grid(u, v, components=True, axes=axes)
+        if w1 == 1.0:
+            return X
+        A = p.spine(np.asarray(u, float))[:, list(axes)].T[:, :, None]
+        return A + w1 * (X - A)
+
     def _bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        if self.revolution is not None and self.trim.full_v:
+        if self.revolution is not None and self.trim.full_v and self.trim.w[1] == 1.0:
             rmax, zbot, ztop = self._profile_extents()
             return np.array([-rmax, -rmax, zbot]), np.array([rmax, rmax, ztop])
         return self._bounds_sampled()
 
     def _bounds_sampled(self) -> tuple[np.ndarray, np.ndarray]:
-        pts = self.sample(97, 256)
-        lo, hi = coordinate_range([pts], 3)
         u, v = self._grid(97, 256)
+        pts = np.stack([self._outer_grid(p, u, v) for p in self.patches])
+        lo, hi = coordinate_range([pts], 3)
         for axis in range(3):
             for sign, store in ((-1.0, lo), (1.0, hi)):
                 k = int(np.argmax(sign * pts[..., axis]))
@@ -672,11 +702,11 @@ class Tablet:
         second pass only when its line beats the first zoom's point.
         """
         t = self.trim
-        best = sign * float(p.evaluate(u0, v0)[axis])
+        best = sign * float(self._outer(p, u0, v0)[axis])
         n = 33
         for round_ in range(2):
             line = np.linspace(t.u[0], t.u[1], 513)
-            g = sign * p.evaluate(line, np.full(line.shape, v0))[:, axis]
+            g = sign * self._outer(p, line, np.full(line.shape, v0))[:, axis]
             i = int(np.argmax(g))
             if g[i] > best or (round_ == 0 and g[i] == best):
                 best, u0 = float(g[i]), float(line[i])
@@ -688,7 +718,7 @@ class Tablet:
                 vv = v0 + np.linspace(-b, b, n)
                 if not t.full_v:
                     vv = np.clip(vv, t.v[0], t.v[1])
-                g = sign * p.evaluate_grid(uu, vv)[..., axis]
+                g = sign * self._outer_grid(p, uu, vv)[..., axis]
                 i, j = np.unravel_index(int(np.argmax(g)), g.shape)
                 if g[i, j] >= best:
                     best, u0, v0 = float(g[i, j]), float(uu[i]), float(vv[j])
