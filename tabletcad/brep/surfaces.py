@@ -32,8 +32,9 @@ def tablet_surface_functions(tablet: Tablet) -> tuple[list[SurfaceFunction], lis
     t = tablet.trim
     if t.u != (0.0, 1.0) or not t.full_v:
         raise GeometryError(
-            f"{tablet.name}: tablets trimmed in u or v (cut-away views) are not exported as solids; "
-            "remove [trim] u/v to export, or use the picture and mesh outputs",
+            f"{tablet.name}: a tablet trimmed in u or v (a cut-away view) is not a chain of patch faces: "
+            "its solid is made by tabletcad build and TabletModel.to_occ (tabletcad.cad.stage.cutaway_solid), "
+            "not by the FreeCAD workbench",
             tablet,
         )
     w0, w1 = t.w

@@ -194,8 +194,22 @@ class TabletModel(_Shaped):
         return tablet_solid(self.tablet, revolved=False)
 
     def to_occ(self):
-        """The tablet's ``TopoDS_Solid``."""
-        return self.solid.shape
+        """The tablet's ``TopoDS_Solid``; for a cut-away view (``[trim] u`` or ``v``) the cut-away's,
+        made and checked as ``tabletcad build`` makes it (:func:`tabletcad.cad.stage.cutaway_solid`)."""
+        t = self.tablet.trim
+        if t.u == (0.0, 1.0) and t.full_v:
+            return self.solid.shape
+        return self._cutaway
+
+    @cached_property
+    def _cutaway(self):
+        from tabletcad.cad.stage import cutaway_solid
+        from tabletcad.errors import GeometryError
+
+        cut = cutaway_solid(self.tablet, {"volume_mm3": self.tablet.volume()})
+        if isinstance(cut, str):
+            raise GeometryError(f"{self.name}: no solid for this cut-away view: {cut}", self.tablet)
+        return cut[0]
 
     def report(self) -> dict[str, Any]:
         """The geometry and design report (the content of ``report.json``)."""
