@@ -238,3 +238,26 @@ def test_extents_and_plan_area_of_a_w_trim_are_the_solid_s():
     full, cut = build(sphere), build(sphere, [0.0, 0.5])
     assert cut.dimensions()["width_mm"] == pytest.approx(0.5 * full.dimensions()["width_mm"], rel=1e-9)
     assert cut.plan_area() == pytest.approx(0.25 * full.plan_area(), rel=1e-7)
+
+
+@pytest.mark.parametrize("reshape, line", [
+    ("spine = [1.0, 2.0]", "error: reshape.spine = [1.0, 2.0] is not allowed: need one per patch (3)"),
+    ("spine = [1.0, -2.0, 1.0]", "error: reshape.spine[1] = -2 is not allowed"),
+    ("radius = 1000.0", "error: reshape = {'radius': 1000.0} is not allowed: must keep the tablet within ±1000 mm"),
+])
+def test_reshape_refusals_name_the_key(tmp_path, capsys, reshape, line):
+    """They said ``spine.factors = 2`` and ``reshape = 'factors'``."""
+    d = tmp_path / "d.toml"
+    d.write_text(f'[tablet]\nfamily = "thesis.flat_faced_round"\ndiameter = 10\nthickness = 3\n[reshape]\n{reshape}\n')
+    assert main(["report", str(d)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(line), err
+
+
+def test_mesh_nodes_named_as_the_option(tmp_path, capsys):
+    d = tmp_path / "d.toml"
+    d.write_text('[tablet]\nfamily = "thesis.flat_faced_round"\ndiameter = 10\nthickness = 3\n')
+    assert main(["mesh", str(d), "--nodes", "2", "2", "2", "--out", str(tmp_path / "m.vtu")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: --nodes = (2, 2, 2) is not allowed: must be integers"), err
+    assert not (tmp_path / "m.vtu").exists()

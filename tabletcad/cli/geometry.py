@@ -119,7 +119,10 @@ def mesh_cmd(design: Path, nodes: tuple[int, int, int], out_file: Path) -> None:
         raise DesignError("--out", str(out_file), "must end in .vtu, .xdmf, .msh or .vtk")
     tablet = load_design(design)
     _check_mesh_memory(nodes, len(tablet.patches))
-    mesh = hex_mesh(tablet, nodes=nodes)
+    from tabletcad.cli.options import option_names
+
+    with option_names({"nodes": "--nodes"}):
+        mesh = hex_mesh(tablet, nodes=nodes)
     write_mesh(mesh, out_file)
     counts = ", ".join(f"{len(c)} {k}" for k, c in mesh.cells.items() if len(c))
     v_mesh, v_exact = mesh_volume(mesh), tablet.solid_volume()

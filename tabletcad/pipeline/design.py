@@ -361,7 +361,7 @@ class Design:
             tablet = replace(built, name=name)
         if self.reshape is not None:
             tablet = _reshape(tablet, self.reshape)
-            _check_size(tablet)
+            _check_size(tablet, what=self.reshape)
         if self.trim is not None:
             tablet = _trim(tablet, self.trim)
         return tablet
@@ -372,12 +372,14 @@ def design_from_dict(data: dict, default_name: str = "tablet") -> Tablet:
     return Design.from_dict(data, default_name).build()
 
 
-def _check_size(tablet: Tablet, tol: Tolerances = DEFAULT) -> None:
-    """Refuse a tablet (e.g. reshaped) whose overall size leaves ``±tol.max_length``."""
+def _check_size(tablet: Tablet, tol: Tolerances = DEFAULT, *, what: dict | None = None) -> None:
+    """Refuse a reshaped tablet whose overall size leaves ``±tol.max_length`` (``what``: the
+    ``[reshape]`` table, named in the refusal)."""
     lo, hi = tablet.bounds()
     big = float(max(np.max(np.abs(lo)), np.max(np.abs(hi))))
     if not big <= tol.max_length:
-        raise DesignError("reshape", "factors", f"must keep the tablet within ±{tol.max_length:g} mm "
+        raise DesignError("reshape", what if what is not None else "factors",
+                          f"must keep the tablet within ±{tol.max_length:g} mm "
                           f"(size limit, Tolerances.max_length; it reaches {big:.6g} mm)")
 
 
@@ -500,7 +502,11 @@ def _reshape(tablet: Tablet, r: dict) -> Tablet:
     if "spine" in r:
         if not isinstance(r["spine"], list):
             raise DesignError("reshape.spine", r["spine"], "must be a list with one factor per patch")
-        tablet = reshape.scale_heights(tablet, [_factor(f"reshape.spine[{j}]", f) for j, f in enumerate(r["spine"])])
+        factors = [_factor(f"reshape.spine[{j}]", f) for j, f in enumerate(r["spine"])]
+        try:
+            tablet = reshape.scale_heights(tablet, factors)
+        except DesignError as exc:  # the function's own name for it: the file's key
+            raise DesignError("reshape.spine", r["spine"], exc.allowed) from None
     if "radius" in r:
         tablet = reshape.scale_radius(tablet, _factor("reshape.radius", r["radius"]))
     return tablet
