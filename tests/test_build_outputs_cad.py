@@ -203,6 +203,25 @@ def test_bad_tooling_table_is_refused_before_any_geometry(tmp_path, capsys, monk
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
 
 
+def test_a_free_form_band_without_caps_writes_its_report_and_picture(tmp_path, capsys):
+    """One free-form patch of four equal circles, no caps: the core closes it with the solid map's flat
+    end faces (nearly the cylinder's volume), the CAD chain of patch surfaces cannot; the build
+    stopped with "sewing ... left 2 free edges" (not the one-line form).  Now report and picture,
+    ``brep.skipped`` saying which end is open; a capped chain is unaffected (every sample builds)."""
+    design = tmp_path / "band.toml"
+    circles = ", ".join(f'{{ type = "circle", radius = 5.0, z = {z:.1f} }}' for z in (0, 1, 2, 3))
+    design.write_text(f'[tablet]\nfamily = "free_form"\n[[patch]]\ncurves = [ {circles} ]\n')
+    assert main(["build", str(design), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    rep = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert sorted(read_manifest(tmp_path / "out")) == ["report.json", "tablet.png"]
+    assert "the chain's first curve encloses an area" in rep["brep"]["skipped"] and rep["brep"]["valid"] is None
+    from tabletcad.pipeline.design import load_design
+
+    # the divergence theorem over band and end faces = the triple integral of the solid map's Jacobian
+    assert rep["volume_mm3"] == pytest.approx(load_design(design).solid_volume(), rel=1e-9)
+    assert rep["volume_mm3"] == pytest.approx(math.pi * 25.0 * 3.0, rel=1e-3)  # nearly the cylinder
+
+
 def test_a_hollow_tablet_of_several_patches_writes_its_report_and_picture(tmp_path, capsys):
     """The README's ``[trim] w`` on the thesis's flat-faced round (three patches): the report (its
     volume, by quadrature, the solid's minus the hollow core's) and the picture, with ``brep.skipped``

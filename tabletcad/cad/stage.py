@@ -230,6 +230,20 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
     return shape, mesh, sections
 
 
+def _open_end(tablet: Tablet) -> str | None:
+    """``"first"`` or ``"last"`` when the chain's first or last boundary curve encloses an area (a
+    free-form band without caps): the core closes it with the solid map's flat end face, the fitted
+    chain of patch surfaces does not.  A pole and a cup folded onto a segment enclose none."""
+    for name, patch, u in (("first", tablet.patches[0], 0.0), ("last", tablet.patches[-1], 1.0)):
+        v = np.linspace(0.0, 2.0 * np.pi, 257)
+        x = patch.evaluate(np.full(v.shape, u), v)
+        area = 0.5 * np.sum(np.cross(x[:-1], x[1:] - x[:-1]), axis=0)  # the curve's vector area
+        size = float(np.ptp(x, axis=0).max())
+        if float(np.linalg.norm(area)) > 1e-6 * max(size * size, 1e-12):
+            return name
+    return None
+
+
 def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any]):
     """Write ``tablet.step``, ``tablet.stl`` and ``tablet.glb`` into ``out`` and extend ``report``.
 
@@ -242,6 +256,12 @@ def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any]):
     if t.w != (0.0, 1.0) and len(tablet.patches) != 1:  # (tabletcad.brep.surfaces makes one-patch ones)
         report["brep"] = dict(valid=None, skipped=f"hollow ([trim] w) tablet of {len(tablet.patches)} patches: "
                               "hollow solids are made of one-patch tablets only; picture only")
+        return None
+    open_end = _open_end(tablet) if t.w == (0.0, 1.0) and t.u == (0.0, 1.0) else None
+    if open_end is not None:
+        report["brep"] = dict(valid=None, skipped=f"the chain's {open_end} curve encloses an area: its solid "
+                              "would need a flat end face, which the CAD layer does not add (give the chain a "
+                              "pole or a cap patch there); picture only")
         return None
     if t.u != (0.0, 1.0) or not t.full_v:
         cut = cutaway_solid(tablet, report)
