@@ -124,3 +124,7 @@ class Tolerances:
 
 
 DEFAULT = Tolerances()
+
+#: the largest true density taken, mg/mm³ (= g/cm³): above every solid's (osmium 22.6); a density in
+#: kg/m³ (lactose 1540) is 1000 times too large and refused (press data, design reports, inverse design)
+MAX_TRUE_DENSITY_MG_MM3 = 25.0

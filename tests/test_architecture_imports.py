@@ -29,7 +29,8 @@ LAYERS: list[tuple[str, ...]] = [
     ("tabletcad.mechanics",),  # compaction and strength formulas (they read dimensions)
     ("tabletcad.brep",),  # kernel-neutral B-spline data of the solid's faces
     ("tabletcad.volume_mesh",),  # hexahedral meshes from the PDE solid map
-    ("tabletcad.tooling.spec", "tabletcad.tooling.standards"),  # the [tooling] table as data (no kernel):
+    ("tabletcad.tooling.spec", "tabletcad.tooling.standards", "tabletcad.tooling.polygon"),  # the [tooling]
+    # table as data (no kernel):
     # a Design holds it parsed
     ("tabletcad.pipeline.design", "tabletcad.pipeline.designreport", "tabletcad.pipeline.report",
      "tabletcad.pipeline.plot"),  # design files, the design and geometry reports, pictures

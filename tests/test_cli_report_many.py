@@ -105,7 +105,7 @@ def test_solved_weight_matches_the_python_api(capsys):
     ([str(ROOT / "samples" / "spherical.toml"), "--solve-for", "band", "--target-volume", "300", "--csv", "OUT/r.csv"],
      "--solve-for"),  # the thesis's sphere has no band (nor any dimension the inverse solves for)
     (["--solve-for", "thickness", "--target-volume", "300"], "--solve-for"),  # concave_round takes no thickness
-    (["--solve-for", "band", "--target-weight", "300", "--solid-fraction", "1.5"], "[report].solid_fraction"),
+    (["--solve-for", "band", "--target-weight", "300", "--solid-fraction", "1.5"], "--solid-fraction"),
 ])
 def test_bad_use_is_one_line_and_writes_nothing(tmp_path, capsys, extra, parameter):
     out = tmp_path / "OUT"

@@ -261,3 +261,14 @@ def test_mesh_nodes_named_as_the_option(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error: --nodes = (2, 2, 2) is not allowed: must be integers"), err
     assert not (tmp_path / "m.vtu").exists()
+
+
+def test_a_cut_away_s_extents_reach_its_cut_faces():
+    """The cut faces run in to the spine (eq 4.12): a capsule cut to v = [0, 1] spans x from its axis,
+    0, to its end, L/2 (4.0 mm was reported for this 9 mm wide solid: the outer surface's span)."""
+    from tabletcad.pipeline.design import Design
+
+    d = Design.from_dict({"tablet": dict(family="capsule", length=18.0, width=8.0, band=3.0, cup_depth=1.2),
+                          "trim": {"v": [0.0, 1.0]}})
+    lo, hi = d.build().bounds()
+    assert lo[0] == pytest.approx(0.0, abs=1e-9) and hi[0] == pytest.approx(9.0, abs=1e-6)

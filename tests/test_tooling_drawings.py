@@ -175,11 +175,13 @@ def test_bevel_and_radii_notes_carry_tolerances():
 @pytest.mark.parametrize("scores, dimensioned", [
     ([{"kind": "bisect", "direction_deg": 90.0}], True),
     ([{"kind": "quadrisect", "direction_deg": 90.0}], False),  # the second groove runs along the section
-    ([{"kind": "bisect", "direction_deg": 90.0}, {"kind": "bisect", "direction_deg": 0.0, "faces": "bottom"}], False),
+    ([{"kind": "bisect", "direction_deg": 90.0}, {"kind": "bisect", "direction_deg": 0.0, "faces": "both"}], False),
+    ([{"kind": "bisect", "direction_deg": 90.0}, {"kind": "bisect", "direction_deg": 0.0, "faces": "bottom"}], True),
 ])
 def test_the_cup_radius_is_dimensioned_only_where_the_section_shows_the_cup(scores, dimensioned):
-    """Section A-A runs across the first score: a groove along it (a quadrisect's, a crossing bisect's)
-    replaces the cup's arc there, and a radius dimension would point into empty space."""
+    """Section A-A runs across the first score: a groove along it on the top face (a quadrisect's, a
+    crossing bisect's) replaces the top cup's arc there, and a radius dimension would point into empty
+    space; a crossing groove on the bottom face alone leaves the top cup's arc, where R is drawn."""
     d = Design.from_dict({"tablet": dict(family="concave_round", diameter=10.0, band=2.8, cup_depth=0.9, land=0.08),
                           "tooling": {"clearance_mm": 0.02, "score": [dict(s, profile="v", depth_mm=0.3) for s in scores]}})
     ts = make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False)

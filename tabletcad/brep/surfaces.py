@@ -32,9 +32,9 @@ def tablet_surface_functions(tablet: Tablet) -> tuple[list[SurfaceFunction], lis
     t = tablet.trim
     if t.u != (0.0, 1.0) or not t.full_v:
         raise GeometryError(
-            f"{tablet.name}: a tablet trimmed in u or v (a cut-away view) is not a chain of patch faces: "
-            "its solid is made by tabletcad build and TabletModel.to_occ (tabletcad.cad.stage.cutaway_solid), "
-            "not by the FreeCAD workbench",
+            f"{tablet.name}: a tablet trimmed in u or v (a cut-away view) is not a chain of patch faces; "
+            "tabletcad build and TabletModel.to_occ make its solid (tabletcad.cad.stage.cutaway_solid), "
+            "the FreeCAD workbench and the FE commands do not",
             tablet,
         )
     w0, w1 = t.w

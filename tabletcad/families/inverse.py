@@ -58,7 +58,7 @@ from tabletcad.errors import DesignError, GeometryError, check_positive, check_r
 from tabletcad.families.sweep import NominalBuilt, SweepNominal, nominal_only, nominal_volume
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT
-from tabletcad.mechanics.units import MAX_TRUE_DENSITY_MG_MM3
+from tabletcad.tolerance import MAX_TRUE_DENSITY_MG_MM3
 
 __all__ = ["InverseResult", "Reach", "reachable", "solve_for", "solvable", "VARY"]
 

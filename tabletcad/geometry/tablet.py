@@ -685,6 +685,11 @@ class Tablet:
         u, v = self._grid(97, 256)
         pts = np.stack([self._outer_grid(p, u, v) for p in self.patches])
         lo, hi = coordinate_range([pts], 3)
+        t = self.trim
+        if not t.full_v or t.u != (0.0, 1.0):  # a cut-away's cut faces run in to the spine A0(u) (eq 4.12)
+            line = np.linspace(t.u[0], t.u[1], 1025)
+            spine = np.concatenate([p.spine(line) for p in self.patches])
+            lo, hi = np.minimum(lo, spine.min(axis=0)), np.maximum(hi, spine.max(axis=0))
         for axis in range(3):
             for sign, store in ((-1.0, lo), (1.0, hi)):
                 k = int(np.argmax(sign * pts[..., axis]))

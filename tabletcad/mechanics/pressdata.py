@@ -65,7 +65,8 @@ import tomllib
 
 from tabletcad.errors import DesignError, check_finite, check_range
 from tabletcad.tolerance import DEFAULT
-from tabletcad.mechanics.units import DIMENSIONS, MAX_TRUE_DENSITY_MG_MM3, header_unit, strip_unit, unit_factor
+from tabletcad.mechanics.units import DIMENSIONS, header_unit, strip_unit, unit_factor
+from tabletcad.tolerance import MAX_TRUE_DENSITY_MG_MM3
 from tabletcad.mechanics.validity import DataWarning, warn
 
 __all__ = [

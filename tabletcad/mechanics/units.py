@@ -21,11 +21,7 @@ import re
 
 from tabletcad.errors import DesignError
 
-__all__ = ["DIMENSIONS", "UNITS", "MAX_TRUE_DENSITY_MG_MM3", "header_unit", "strip_unit", "unit_factor"]
-
-#: the largest true density taken, mg/mm³ (= g/cm³): above every solid's (osmium 22.6); a density in
-#: kg/m³ (lactose 1540) is 1000 times too large and refused
-MAX_TRUE_DENSITY_MG_MM3 = 25.0
+__all__ = ["DIMENSIONS", "UNITS", "header_unit", "strip_unit", "unit_factor"]
 
 #: Quantity each column role is measured in.
 DIMENSIONS = {"force": "force", "displacement": "length", "thickness": "length", "time": "time"}

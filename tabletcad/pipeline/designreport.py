@@ -31,7 +31,7 @@ from tabletcad.errors import DesignError, check_range
 from tabletcad.families.sweep import SweepNominal, certify, sweep_properties
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.geometry.vectors import cross
-from tabletcad.mechanics.units import MAX_TRUE_DENSITY_MG_MM3
+from tabletcad.tolerance import MAX_TRUE_DENSITY_MG_MM3
 
 if sys.version_info >= (3, 11):
     import tomllib

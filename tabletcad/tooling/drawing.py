@@ -242,7 +242,8 @@ def drawing_model(ts) -> Drawing:
                         f"score {_fmt(sc['depth_mm'])}", vertical=True))
     cup_r = _single_cup_radius(fr, radii)
     # the section shows the cup only where no score runs along it: not across a quadrisect or crossing bisects
-    along = any(sc.kind == "quadrisect" or abs(((sc.direction_deg - th) + 90.0) % 180.0 - 90.0) > 1e-9 for sc in scores)
+    along = any((sc.kind == "quadrisect" or abs(((sc.direction_deg - th) + 90.0) % 180.0 - 90.0) > 1e-9)
+                and "top" in sc.face_list for sc in scores)  # (the radius is drawn on the top cup)
     if cup_r is not None and not along:  # on the section's left half, away from a score at the centre
         x = -0.6 * _cup_edge_radius(fr)
         zc = fr.z_max - cup_r  # the cup's sphere is centred on the axis

@@ -593,8 +593,10 @@ def _collapsed_cells(tablet: "Tablet", p: int, corners: np.ndarray) -> tuple[lis
     ``v`` meet): each written as the wedge, pyramid or tetrahedron its classes of coincident corners
     make (:data:`_DEGENERATE`), or dropped with fewer than four distinct corners; one that none of
     them describes (next to both the spine and a collapsed corner: two bilinear sides share two edges)
-    is kept as the degenerate hexahedron it is, its repeated nodes shared with its neighbours (the mesh
-    stays conforming; its corner Jacobians vanish there).  Returns the blocks and the number dropped."""
+    is kept as the degenerate hexahedron it is, its repeated nodes shared with its neighbours (conforming
+    as a map: its collapsed quads interpolate linearly and match the neighbouring triangles; tools that
+    match faces by node lists, VTK's surface filter and gmsh, see them as extra faces, and its corner
+    Jacobians vanish there).  Returns the blocks and the number dropped."""
     blocks: dict[str, list[np.ndarray]] = {}
     gone = 0
     for row in corners:
@@ -613,28 +615,24 @@ def _collapsed_cells(tablet: "Tablet", p: int, corners: np.ndarray) -> tuple[lis
 def _geometric_merge(tablet: "Tablet", raw: np.ndarray, rep: np.ndarray) -> np.ndarray:
     """``rep`` with representatives that lie within ``tablet.tol.seam_gap`` (relative to the size, at
     least 1 mm) of each other merged too: coincidences the index logic does not know, such as the two
-    sides of a shaped cup's centre line, where the surface folds onto a segment."""
+    sides of a shaped cup's centre line, where the surface folds onto a segment.  Each group of such
+    nodes takes its lowest index (connected components of the pairs, scipy.sparse.csgraph)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
     from scipy.spatial import cKDTree
 
-    reps = np.unique(rep)
+    reps = np.flatnonzero(rep == np.arange(rep.size))  # the representatives (rep is idempotent)
     scale = max(1.0, float(np.max(np.abs(raw))))
     pairs = cKDTree(raw[reps]).query_pairs(float(tablet.tol.seam_gap) * scale, output_type="ndarray")
     if len(pairs) == 0:
         return rep
-    parent = np.arange(reps.size)
-
-    def root(i: int) -> int:
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    for a, b in pairs:
-        ra, rb = root(int(a)), root(int(b))
-        if ra != rb:
-            parent[max(ra, rb)] = min(ra, rb)
+    n = reps.size
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    lowest = np.full(label.max() + 1, n, dtype=np.intp)
+    np.minimum.at(lowest, label, np.arange(n))
     final = np.empty(raw.shape[0], dtype=np.intp)
-    final[reps] = reps[[root(i) for i in range(reps.size)]]
+    final[reps] = reps[lowest[label]]
     return final[rep]
 
 
