@@ -62,6 +62,9 @@ class DesignError(TabletcadError, ValueError):
             shown = f"{shown} {unit}"
         super().__init__(f"{parameter} = {shown} is not allowed: {allowed}")
 
+    def __reduce__(self):  # pickled with its own arguments (a forked helper sends it back to the parent)
+        return DesignError, (self.parameter, self.value, self.allowed, self.unit)
+
     def renamed(self, parameter: str) -> "DesignError":
         """The same error for another parameter name (e.g. with the design-file table it came from)."""
         return DesignError(parameter, self.value, self.allowed, self.unit)
@@ -73,6 +76,9 @@ class GeometryError(TabletcadError):
     def __init__(self, message: str, obj: Any = None) -> None:
         self.obj = obj
         super().__init__(message)
+
+    def __reduce__(self):  # pickled without ``obj`` (an OCC shape cannot be): its message stays
+        return GeometryError, (str(self),)
 
 
 def one_token(parameter: str) -> str:

@@ -286,6 +286,32 @@ def test_ctrl_c_during_a_build_subprocess(tmp_path):
         assert not out.exists() and not any(q.name.startswith(f".{out.name}") for q in tmp_path.iterdir())
 
 
+_SWALLOWED = """
+import os, signal, sys
+import tabletcad.pipeline.build as g
+from tabletcad.cli import main
+
+def build(*a, **k):  # a library that catches the Ctrl-C and then fails over it (trimesh's lazy imports)
+    try:
+        os.kill(os.getpid(), signal.SIGINT)
+    except BaseException:
+        pass
+    raise TypeError("unsupported operand type(s) for |: 'ExceptionWrapper' and 'NoneType'")
+
+g.build_design = build
+sys.argv = ["tabletcad", "build", sys.argv[1], "--out", sys.argv[2]]
+sys.exit(main())
+"""
+
+
+def test_a_ctrl_c_that_a_library_swallowed_is_still_an_interruption(tmp_path):
+    p = subprocess.run([sys.executable, "-c", _SWALLOWED, str(ROOT / "samples" / "families" / "capsule.toml"),
+                        str(tmp_path / "out")], cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)},
+                       capture_output=True, text=True, timeout=120)
+    assert (p.returncode, p.stderr) == (130, "interrupted\n")
+    assert os.listdir(tmp_path) == []
+
+
 def test_readme_says_how_to_reach_the_commands():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     after = text[text.index("## Two commands on a fresh machine"):]

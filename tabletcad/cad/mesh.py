@@ -25,6 +25,7 @@ from OCP.TopoDS import TopoDS_Shape
 from tabletcad.brep.weld import weld
 from tabletcad.cad._occ import explore
 from tabletcad.errors import GeometryError
+from tabletcad.io.forked import OCC_PARALLEL
 from tabletcad.tolerance import DEFAULT
 
 __all__ = ["MeshResult", "mesh_result", "tessellate", "tessellate_solid", "triangulate", "MESH_ALGOS"]
@@ -77,7 +78,7 @@ def _mesh_parameters(linear_deflection: float, angular_deflection: float, relati
     p.Relative = bool(relative)
     # faces meshed on every core (the same triangles, bit for bit): the plain tooling tablet's five B-spline
     # faces at 0.005 mm 0.90 -> 0.51 s on two cores, the lettered tablet 0.70 -> 0.46 s
-    p.InParallel = True
+    p.InParallel = OCC_PARALLEL[0]  # (not in a forked helper: OCC's thread pool lives in the parent)
     p.ControlSurfaceDeflection = True  # needed: without it the chord error is not bounded inside faces
     p.MeshAlgo = {
         "delabella": IMeshTools_MeshAlgoType.IMeshTools_MeshAlgoType_Delabella,

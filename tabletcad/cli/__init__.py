@@ -253,6 +253,11 @@ def main(argv: list[str] | None = None) -> int:
     for var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")
 
+    if argv is None:  # run as the program: remember a Ctrl-C even if a library catches its KeyboardInterrupt
+        import signal
+
+        _SIGINT_SEEN[0] = False
+        signal.signal(signal.SIGINT, _on_sigint)
     try:
         try:
             with warnings.catch_warnings():
@@ -285,6 +290,8 @@ def main(argv: list[str] | None = None) -> int:
             from tabletcad.errors import reraise_interrupt
 
             reraise_interrupt(exc)  # e.g. ImportError "initialization failed" from a Ctrl-C in OCP's import
+            if _SIGINT_SEEN[0]:  # a library swallowed the Ctrl-C and failed over it (trimesh's lazy imports)
+                raise KeyboardInterrupt from exc
             path = _log_internal(exc)
             msg = " ".join(str(exc).split())
             if len(msg) > 120:
@@ -296,6 +303,16 @@ def main(argv: list[str] | None = None) -> int:
         if argv is None:  # run as the program: end here
             _exit_now(status)
         return status
+
+
+#: Whether this program has received a SIGINT (Ctrl-C): an internal error after one is an interruption.
+_SIGINT_SEEN = [False]
+
+
+def _on_sigint(signum, frame) -> None:
+    """Python's own Ctrl-C (a :class:`KeyboardInterrupt`), remembered in :data:`_SIGINT_SEEN`."""
+    _SIGINT_SEEN[0] = True
+    raise KeyboardInterrupt
 
 
 def _published() -> list:

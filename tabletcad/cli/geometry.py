@@ -71,7 +71,7 @@ def build_cmd(design: Path, out_dir: Path, quiet: bool) -> None:
 
     from tabletcad.cli.report import nominal_note
 
-    rep = build_design(design, out_dir, progress=not quiet)
+    rep = build_design(design, out_dir, progress=not quiet, parallel=True)
     written = rep["outputs"]  # this build's files only (the folder may hold files tabletcad did not write)
     d = rep["design"]
     size = f"{rep['length_mm']:.4g} x {rep['width_mm']:.4g} x {rep['height_mm']:.4g} mm"

@@ -94,7 +94,7 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
                     from tabletcad.pipeline.build import build_design
 
                     try:
-                        rep = build_design(written_design, staging / "tablet", progress=not quiet)
+                        rep = build_design(written_design, staging / "tablet", progress=not quiet, parallel=True)
                         report["built_design"] = dict(folder="tablet", volume_mm3=rep.get("volume_mm3"),
                                                       surface_area_mm2=rep.get("surface_area_mm2"))
                         written.append("tablet/")

@@ -10,12 +10,14 @@ is installed (:func:`cad_available`).
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import os
 from pathlib import Path
 from typing import Any
 
 from tabletcad.geometry.tablet import Tablet
+from tabletcad.io.forked import Forked, can_fork
 from tabletcad.io.outputs import STAGING_MARKER, check_replaceable, publish, staging_folder
 from tabletcad.pipeline.design import Design
 from tabletcad.pipeline.designreport import ReportOptions
@@ -43,7 +45,8 @@ def cad_available() -> bool:
 
 
 def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | None = None,
-                 options: ReportOptions | None = None, cad: bool | None = None, progress: bool = True) -> dict[str, Any]:
+                 options: ReportOptions | None = None, cad: bool | None = None, progress: bool = True,
+                 parallel: bool = False) -> dict[str, Any]:
     """Write ``report.json``, ``tablet.png``, the CAD files and the tooling of ``tablet`` into ``out_dir``.
 
     The steps, in order: the geometry report (:func:`~tabletcad.pipeline.report.geometry_report`,
@@ -55,7 +58,10 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
     (``[report] fe_breaking_force = true``), the FE breaking force on the coarse mesh
     (:func:`tabletcad.fe.objective.report_breaking_force`); last the picture.  Whether the tablet can
     have tooling is checked before any geometry is built.  :func:`build_design` takes both
-    from a design.
+    from a design.  ``parallel``: the picture is drawn by a forked process beside the CAD stage, and the
+    tooling's files are written by another beside the closed-position check (the command line's
+    ``build``; for a process of its own, not a Dask worker or FreeCAD: see
+    :func:`~tabletcad.tooling.stage.tooling_stage`); the files are the same.
 
     Returns the report; ``report["outputs"]`` names the files this build wrote.
     Nothing in ``out_dir`` changes if any step fails.  The folder is owned by
@@ -76,9 +82,13 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
         from tqdm import tqdm
 
         # the bar shows on a terminal only (disable=None), never in a log or a pipe
-        with tqdm(total=steps, desc="build", unit="step", disable=None if progress else True, leave=False) as bar:
+        with tqdm(total=steps, desc="build", unit="step", disable=None if progress else True, leave=False) as bar, \
+                contextlib.ExitStack() as helpers:
             report = geometry_report(tablet, options)
             bar.update()
+            # the picture needs only the tablet: drawn by a forked process beside the CAD stage
+            picture = (helpers.enter_context(Forked(lambda: plot_tablet(tablet, staging / "tablet.png")))
+                       if parallel and can_fork() else None)
             if cad:
                 from tabletcad.cad.stage import cad_stage
 
@@ -91,7 +101,7 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
 
                     fe = None if tooling.fe_rating is None else (lambda ts: fe_tip_rating(ts, options))
                     tooling_stage(tablet=tablet, spec=tooling, shape=shape, out=staging, report=report, options=options,
-                                  fe_rating=fe)
+                                  fe_rating=fe, parallel=parallel)
                     bar.update()
             if options is not None and options.fe_breaking_force:  # [report] fe_breaking_force = true
                 if cad:
@@ -101,7 +111,10 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
                 else:
                     report["fe_breaking_force"] = {"breaking_force_N": None,
                                                    "note": "not computed: this build made no CAD solid"}
-            plot_tablet(tablet, staging / "tablet.png")
+            if picture is None:
+                plot_tablet(tablet, staging / "tablet.png")
+            else:
+                picture.result()
             bar.update()
         names = sorted(p.name for p in staging.iterdir() if p.name != STAGING_MARKER) + ["report.json"]
         report["outputs"] = sorted(names)
@@ -124,10 +137,10 @@ def fe_tip_rating(ts: Any, options: ReportOptions | None) -> dict[str, Any]:
 
 
 def build_design(design: str | Path | Design, out_dir: str | Path, *, cad: bool | None = None,
-                 progress: bool = True) -> dict[str, Any]:
+                 progress: bool = True, parallel: bool = False) -> dict[str, Any]:
     """:func:`build_tablet` of a design (a :class:`~tabletcad.pipeline.design.Design` or a design file):
     its tablet, its ``[tooling]`` specification and its ``[report]`` options."""
     if not isinstance(design, Design):
         design = Design.from_toml(design)
     return build_tablet(design.build(), out_dir, tooling=design.tooling_spec, options=design.report_options,
-                        cad=cad, progress=progress)
+                        cad=cad, progress=progress, parallel=parallel)

@@ -30,6 +30,7 @@ from OCP.TopoDS import TopoDS_Shape
 from tabletcad.cad._occ import explore
 from tabletcad.cad.solid import check_solid, mass_properties
 from tabletcad.errors import GeometryError
+from tabletcad.io.forked import OCC_PARALLEL
 from tabletcad.tooling.shape_cache import ShapeCache, frozen
 
 try:  # OCP >= 8.0
@@ -65,7 +66,7 @@ def raw_boolean(op: str, a: TopoDS_Shape, b: TopoDS_Shape, fuzzy: float = 0.0, g
     algo = _ALGOS[op]()
     algo.SetArguments(_list(a))
     algo.SetTools(_list(b))
-    algo.SetRunParallel(True)
+    algo.SetRunParallel(OCC_PARALLEL[0])
     algo.SetNonDestructive(True)
     if fuzzy > 0:
         algo.SetFuzzyValue(float(fuzzy))
@@ -179,7 +180,7 @@ def _split(a: TopoDS_Shape, tools: list, what: str):
     algo = BRepAlgoAPI_Splitter()
     algo.SetArguments(_list(a))
     algo.SetTools(_list(*tools))
-    algo.SetRunParallel(True)
+    algo.SetRunParallel(OCC_PARALLEL[0])
     algo.SetNonDestructive(True)
     algo.Build()
     TIMER["occ_boolean_s"] += time.perf_counter() - t0

@@ -53,7 +53,8 @@ def write_tooling(ts, out: Path, *, drawing: bool = True) -> list[Path]:
 
 
 def tooling_stage(*, tablet: Tablet, spec: ToolingSpec, shape, out: Path, report: dict[str, Any],
-                  options: ReportOptions | None = None, fe_rating: Callable[[Any], dict] | None = None) -> None:
+                  options: ReportOptions | None = None, fe_rating: Callable[[Any], dict] | None = None,
+                  parallel: bool = False) -> None:
     """Tooling files of ``spec`` (the design's checked ``[tooling]`` table); the finished tablet as ``tablet.*``.
 
     ``shape`` is the tablet's solid (``TopoDS_Shape``) that the CAD stage built and wrote as
@@ -64,23 +65,54 @@ def tooling_stage(*, tablet: Tablet, spec: ToolingSpec, shape, out: Path, report
     :class:`~tabletcad.tooling.toolset.ToolSet` before the drawings are written, it returns the FE
     tip-force rating (``tooling.tip_rating.fe``, printed on the drawing beside the pressure rule's);
     the layer above passes it (:mod:`tabletcad.fe` may not be imported here).
+
+    ``parallel``: on Linux with two or more cores, the parts' STEP files and the drawings are
+    written by a forked process (:class:`tabletcad.io.forked.Forked`) while this one runs the
+    closed-position check; the files and the report are the same.  For a process of its own (the
+    command line), not for a Dask worker or FreeCAD.  Nothing is left running when a step fails.
     """
+    from tabletcad.io.forked import Forked, can_fork
     from tabletcad.tooling.toolset import make_tooling
 
-    ts = make_tooling(tablet, spec, shape=shape, options=options)
+    out = Path(out)
+    ts = make_tooling(tablet, spec, shape=shape, options=options, interference_check=False)
+    if not (parallel and can_fork()):
+        _check_gap(ts, tablet.name, spec)
+        if fe_rating is not None:
+            ts.report["tip_rating"]["fe"] = fe_rating(ts)
+        files = write_tooling(ts, out)
+    else:
+        # the FE rating goes on the drawing, so it comes first; the closed-position check (this process)
+        # and the writers (the child) are independent
+        if fe_rating is not None:
+            ts.report["tip_rating"]["fe"] = fe_rating(ts)
+        before = set(ts.report)
+
+        def write():
+            names = write_tooling(ts, out)
+            return names, {k: v for k, v in ts.report.items() if k not in before}
+
+        with Forked(write) as child:
+            _check_gap(ts, tablet.name, spec)
+            files, added = child.result()
+        ts.report.update(added)
+    if spec.scores or spec.emboss:
+        files += write_finished_tablet(ts, out)
+    res = ts.report
+    res["files"] = sorted(p.name for p in files)
+    report["tooling"] = res
+
+
+def _check_gap(ts, name: str, spec: ToolingSpec) -> None:
+    """The closed-position check; a :class:`GeometryError` for an overlap or a gap above the clearance."""
+    from tabletcad.tooling.toolset import check_closed_position
+
+    check_closed_position(ts)
     res = ts.report
     if res.get("interference_mm3", 0.0) > 1e-6 or not res["interference"]["gap_within_clearance"]:
         raise GeometryError(
-            f"{tablet.name}: tooling check failed: overlap {res['interference_mm3']:.3g} mm^3, largest gap "
+            f"{name}: tooling check failed: overlap {res['interference_mm3']:.3g} mm^3, largest gap "
             f"{res['max_gap_mm']:.4g} mm (clearance {spec.clearance_mm} mm)", ts)
-    if fe_rating is not None:
-        res["tip_rating"]["fe"] = fe_rating(ts)
-    out = Path(out)
-    files = write_tooling(ts, out)
-    if spec.scores or spec.emboss:
-        files += write_finished_tablet(ts, out)
-    res["files"] = sorted(p.name for p in files)
-    report["tooling"] = res
 
 
 def write_finished_tablet(ts, out: Path) -> list[Path]:

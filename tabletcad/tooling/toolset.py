@@ -18,7 +18,7 @@ from tabletcad.tooling.booleans import CACHE, TIMER, to_manifold, volume
 from tabletcad.tolerance import DEFAULT
 from tabletcad.tooling.spec import ToolingSpec
 
-__all__ = ["ToolSet", "make_tooling", "finished_solid", "DEFLECTION_MM"]
+__all__ = ["ToolSet", "make_tooling", "check_closed_position", "finished_solid", "DEFLECTION_MM"]
 
 DEFLECTION_MM = DEFAULT.mesh_deflection
 
@@ -221,14 +221,34 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
 
     report["tip_rating"] = tip_rating(frame, spec, options)
     ts = ToolSet(tablet, spec, frame, parts, gap - gap_closed, report)
-    if interference_check:
-        from tabletcad.tooling.interference import interference
-
-        res = interference(solid, {k: v for k, v in parts.items() if k != "tablet"}, spec.clearance_mm, deflection=deflection,
-                           tablet_model=tablet)
-        report.update(interference_mm3=res["interference_mm3"], max_gap_mm=res["max_gap_mm"], interference=res)
-    t3 = time.perf_counter()
-    report["seconds"] = dict(features=t1 - t0, parts=t2 - t1, interference=t3 - t2, total=t3 - t0,
+    report["seconds"] = dict(features=t1 - t0, parts=t2 - t1, interference=0.0, total=t2 - t0,
                              occ_booleans=TIMER["occ_boolean_s"] - b0["occ_boolean_s"],
                              manifold3d=TIMER["manifold_s"] - b0["manifold_s"])
+    if interference_check:
+        check_closed_position(ts, deflection=deflection)
     return ts
+
+
+def check_closed_position(ts: ToolSet, *, deflection: float = DEFLECTION_MM) -> dict[str, Any]:
+    """The closed-position check of a tool set made with ``interference_check=False``: overlaps of
+    every pair of parts and the tablet's largest gap (:func:`tabletcad.tooling.interference.interference`).
+
+    Adds ``interference_mm3``, ``max_gap_mm`` and ``interference`` to ``ts.report`` (and the
+    check's seconds to ``seconds``) and returns the check's result.
+    """
+    from tabletcad.tooling.interference import interference
+
+    t0 = time.perf_counter()
+    b0 = dict(TIMER)
+    parts = ts.parts
+    res = interference(parts["tablet"], {k: v for k, v in parts.items() if k != "tablet"}, ts.spec.clearance_mm,
+                       deflection=deflection, tablet_model=ts.tablet)
+    report = ts.report
+    seconds = report.pop("seconds")  # kept last, as the sum of the steps
+    report.update(interference_mm3=res["interference_mm3"], max_gap_mm=res["max_gap_mm"], interference=res)
+    dt = time.perf_counter() - t0
+    seconds.update(interference=dt, total=seconds["total"] + dt,
+                   occ_booleans=seconds["occ_booleans"] + TIMER["occ_boolean_s"] - b0["occ_boolean_s"],
+                   manifold3d=seconds["manifold3d"] + TIMER["manifold_s"] - b0["manifold_s"])
+    report["seconds"] = seconds
+    return res
