@@ -1,7 +1,7 @@
 """The command line's parallel build (:mod:`tabletcad.io.forked`): a forked child returns its value or
 its exception, is stopped by ``cancel``, and never uses OCC's thread pool; a parallel tooling build
-writes the same files and report as the sequential one; a failure in the child or in the parent
-leaves no file and no process behind."""
+(picture, writers and the gap in three children) writes the same files and report as the sequential
+one; a failure in a child or in the parent leaves no file and no process behind."""
 
 import json
 import os
@@ -121,7 +121,8 @@ def test_a_parallel_tooling_build_writes_what_the_sequential_one_writes(tmp_path
     seq = build_design(SAMPLE, tmp_path / "seq", progress=False, parallel=False)
     assert recorded == []
     par = build_design(SAMPLE, tmp_path / "par", progress=False, parallel=True)
-    assert len(recorded) == 2 and all(_gone(p) for p in recorded)  # the picture and the tooling's writers
+    # the picture, the tooling's writers and the closed-position check's gap
+    assert len(recorded) == 3 and all(_gone(p) for p in recorded)
     assert sorted(os.listdir(tmp_path / "par")) == sorted(os.listdir(tmp_path / "seq"))
     assert _without_seconds(par) == _without_seconds(seq)
     assert par["tooling"]["drawing"]["dimension_texts"] and par["tooling"]["files"] == seq["tooling"]["files"]
@@ -132,10 +133,11 @@ def test_a_parallel_tooling_build_writes_what_the_sequential_one_writes(tmp_path
 
 
 @pytest.mark.cad
-@pytest.mark.parametrize("where", ["drawing", "picture", "closed_position"])
+@pytest.mark.parametrize("where", ["drawing", "picture", "closed_position", "gap"])
 def test_a_failure_in_either_process_leaves_nothing(tmp_path, recorded, monkeypatch, where):
     import tabletcad.pipeline.build as build
     import tabletcad.tooling.drawing as drawing
+    import tabletcad.tooling.interference as interference
     import tabletcad.tooling.toolset as toolset
     from tabletcad.pipeline.build import build_design
 
@@ -143,7 +145,7 @@ def test_a_failure_in_either_process_leaves_nothing(tmp_path, recorded, monkeypa
         raise DesignError("test", where, "fails here on purpose")
 
     target = {"drawing": (drawing, "write_drawing"), "picture": (build, "plot_tablet"),
-              "closed_position": (toolset, "check_closed_position")}[where]
+              "closed_position": (toolset, "check_closed_position"), "gap": (interference, "_largest_gap")}[where]
     monkeypatch.setattr(*target, fail)
     out = tmp_path / "out"
     with pytest.raises(DesignError, match=f"test = '{where}' is not allowed: fails here on purpose"):

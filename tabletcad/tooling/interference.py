@@ -666,11 +666,48 @@ def _distance_shapes(a, b) -> BRepExtrema_DistShapeShape:
 
 
 def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0.005, refine: int = 40,
-                 tablet_model=None) -> dict:
+                 tablet_model=None, forked: bool = False) -> dict:
     """Overlaps (mm^3) between all pairs of ``{"tablet": shape, **parts}`` and the tablet's largest gap (mm).
 
-    ``tablet_model``: the :class:`~tabletcad.geometry.tablet.Tablet`, whose patches add surface samples."""
+    ``tablet_model``: the :class:`~tabletcad.geometry.tablet.Tablet`, whose patches add surface samples.
+    ``forked``: the gap is measured by a forked process (:class:`tabletcad.io.forked.Forked`) while this
+    one checks the overlaps; the same result (the gap uses neither manifold3d nor OCC's thread pool)."""
     t0 = time.perf_counter()
+    gap_args = (tablet, parts, clearance, deflection, refine, tablet_model)
+    if forked:
+        from tabletcad.io.forked import Forked
+
+        mesh_arrays(tablet, deflection, 0.2)  # meshed here on every core, before the child, which needs it too
+        with Forked(lambda: _largest_gap(*gap_args)) as child:
+            pairs = _overlaps(tablet, parts, deflection)
+            t1 = time.perf_counter()
+            gap = child.result()
+    else:
+        pairs = _overlaps(tablet, parts, deflection)
+        t1 = time.perf_counter()
+        gap = _largest_gap(*gap_args)
+    gap_s = gap.pop("_seconds")  # its own time (beside the overlaps' when forked)
+    occ_max = max(p["occ_mm3"] for p in pairs)
+    man_max = max(p["manifold3d_mm3"] for p in pairs)
+    return dict(
+        interference_mm3=occ_max,
+        interference_method="OCC, largest over all pairs of parts: BRepAlgoAPI_Common with the tablet "
+                            "(BOPAlgo_GlueFull for the punches, which share its faces), exact distance between tools "
+                            "(or their bounding boxes' distance when the boxes are apart)",
+        interference_manifold3d_mm3=man_max,
+        interference_manifold3d_bound_mm3=max(p["manifold3d_bound_mm3"] for p in pairs),
+        **gap,
+        punch_die_clearance_mm=min(p["min_distance_mm"] for p in pairs if p["parts"][1] == "die" and p["parts"][0].endswith("punch")),
+        clearance_mm=clearance,
+        gap_within_clearance=bool(gap["max_gap_mm"] <= clearance * (1 + 1e-6) + 1e-7),
+        pairs=pairs,
+        deflection_mm=deflection,
+        seconds=dict(overlap=t1 - t0, gap=gap_s),
+    )
+
+
+def _overlaps(tablet, parts: dict, deflection: float) -> list[dict]:
+    """Every pair of ``{"tablet": tablet, **parts}``: its overlap by OCC (or a proof that it is 0) and by manifold3d."""
     shapes = {"tablet": tablet, **parts}
     manifolds = {k: to_manifold(s, deflection) for k, s in shapes.items()}
     areas = {k: bound_area(s, deflection) for k, s in shapes.items()}  # for the manifold3d bounds only
@@ -709,6 +746,11 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
         entry.update(occ_mm3=occ, occ_method=how, manifold3d_mm3=mv,
                      manifold3d_bound_mm3=deflection * min(areas[a], areas[b]))
         pairs.append(entry)
+    return pairs
+
+
+def _largest_gap(tablet, parts: dict, clearance: float, deflection: float, refine: int, tablet_model) -> dict:
+    """The tablet's largest gap to the tools (mm), where it is and how it was found (the ``max_gap_*`` keys)."""
     t1 = time.perf_counter()
     # gap: points on the tablet's surface (its mesh vertices, plus its PDE patches sampled densely
     # towards their edges, kept where they lie on the featured solid) against the parts' meshes
@@ -773,19 +815,9 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
                  if d_mesh[j, i] <= d_mesh[:, i].min() + 10.0 * tool_deflection + 1e-9)
              for i, q in enumerate(on_surface)]
     i_max = int(np.argmax(exact)) if exact else 0
-    t2 = time.perf_counter()
-    occ_max = max(p["occ_mm3"] for p in pairs)
-    man_max = max(p["manifold3d_mm3"] for p in pairs)
     return dict(
-        interference_mm3=occ_max,
-        interference_method="OCC, largest over all pairs of parts: BRepAlgoAPI_Common with the tablet "
-                            "(BOPAlgo_GlueFull for the punches, which share its faces), exact distance between tools "
-                            "(or their bounding boxes' distance when the boxes are apart)",
-        interference_manifold3d_mm3=man_max,
-        interference_manifold3d_bound_mm3=max(p["manifold3d_bound_mm3"] for p in pairs),
         max_gap_mm=float(exact[i_max]) if exact else float(np.max(dist)),
         max_gap_point_mm=[float(x) for x in on_surface[i_max]] if exact else None,
-        punch_die_clearance_mm=min(p["min_distance_mm"] for p in pairs if p["parts"][1] == "die" and p["parts"][0].endswith("punch")),
         max_gap_method=f"tablet surface points ({len(V)}: {n_mesh} mesh vertices and PDE samples, "
                        f"{len(V) - n_mesh - n_refined} on a (u, v) grid in every B-rep face, {n_refined} by branch and bound in "
                        f"triangles between tools) vs part meshes at {tool_deflection:.3g} mm (exact point-to-mesh distances, libigl; largest {float(np.max(dist)):.6g} mm), "
@@ -793,9 +825,5 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
                        f"face and edge, as BRepExtrema_DistShapeShape)",
         max_gap_mesh_mm=float(np.max(dist)),
         max_gap_resolution_mm=refined_spacing / math.sqrt(3.0) if n_refined else None,
-        clearance_mm=clearance,
-        gap_within_clearance=bool((float(exact[i_max]) if exact else float(np.max(dist))) <= clearance * (1 + 1e-6) + 1e-7),
-        pairs=pairs,
-        deflection_mm=deflection,
-        seconds=dict(overlap=t1 - t0, gap=t2 - t1),
+        _seconds=time.perf_counter() - t1,
     )

@@ -68,7 +68,8 @@ def tooling_stage(*, tablet: Tablet, spec: ToolingSpec, shape, out: Path, report
 
     ``parallel``: on Linux with two or more cores, the parts' STEP files and the drawings are
     written by a forked process (:class:`tabletcad.io.forked.Forked`) while this one runs the
-    closed-position check; the files and the report are the same.  For a process of its own (the
+    closed-position check, whose gap another forked process measures beside the overlaps; the
+    files and the report are the same.  For a process of its own (the
     command line), not for a Dask worker or FreeCAD.  Nothing is left running when a step fails.
     """
     from tabletcad.io.forked import Forked, can_fork
@@ -93,7 +94,7 @@ def tooling_stage(*, tablet: Tablet, spec: ToolingSpec, shape, out: Path, report
             return names, {k: v for k, v in ts.report.items() if k not in before}
 
         with Forked(write) as child:
-            _check_gap(ts, tablet.name, spec)
+            _check_gap(ts, tablet.name, spec, forked=True)
             files, added = child.result()
         ts.report.update(added)
     if spec.scores or spec.emboss:
@@ -103,11 +104,11 @@ def tooling_stage(*, tablet: Tablet, spec: ToolingSpec, shape, out: Path, report
     report["tooling"] = res
 
 
-def _check_gap(ts, name: str, spec: ToolingSpec) -> None:
+def _check_gap(ts, name: str, spec: ToolingSpec, forked: bool = False) -> None:
     """The closed-position check; a :class:`GeometryError` for an overlap or a gap above the clearance."""
     from tabletcad.tooling.toolset import check_closed_position
 
-    check_closed_position(ts)
+    check_closed_position(ts, forked=forked)
     res = ts.report
     if res.get("interference_mm3", 0.0) > 1e-6 or not res["interference"]["gap_within_clearance"]:
         raise GeometryError(

@@ -229,12 +229,14 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     return ts
 
 
-def check_closed_position(ts: ToolSet, *, deflection: float = DEFLECTION_MM) -> dict[str, Any]:
+def check_closed_position(ts: ToolSet, *, deflection: float = DEFLECTION_MM, forked: bool = False) -> dict[str, Any]:
     """The closed-position check of a tool set made with ``interference_check=False``: overlaps of
     every pair of parts and the tablet's largest gap (:func:`tabletcad.tooling.interference.interference`).
 
     Adds ``interference_mm3``, ``max_gap_mm`` and ``interference`` to ``ts.report`` (and the
-    check's seconds to ``seconds``) and returns the check's result.
+    check's seconds to ``seconds``) and returns the check's result.  ``forked``: the gap is measured
+    by a forked process beside the overlaps (the command line's build, see
+    :func:`tabletcad.tooling.interference.interference`).
     """
     from tabletcad.tooling.interference import interference
 
@@ -242,7 +244,7 @@ def check_closed_position(ts: ToolSet, *, deflection: float = DEFLECTION_MM) -> 
     b0 = dict(TIMER)
     parts = ts.parts
     res = interference(parts["tablet"], {k: v for k, v in parts.items() if k != "tablet"}, ts.spec.clearance_mm,
-                       deflection=deflection, tablet_model=ts.tablet)
+                       deflection=deflection, tablet_model=ts.tablet, forked=forked)
     report = ts.report
     seconds = report.pop("seconds")  # kept last, as the sum of the steps
     report.update(interference_mm3=res["interference_mm3"], max_gap_mm=res["max_gap_mm"], interference=res)
