@@ -29,8 +29,9 @@ def _gone(pid: int) -> bool:
 
 
 class _Unpicklable(Exception):
-    def __init__(self, a, b):  # pickle rebuilds exceptions from .args: this one cannot be
+    def __init__(self, a, b):  # an attribute pickle cannot take (with or without tblib's exception pickling)
         super().__init__(f"{a} and {b}")
+        self.callback = lambda: None
 
 
 def test_the_child_returns_its_value_and_runs_occ_without_its_thread_pool():

@@ -117,7 +117,7 @@ FRAGMENTS = ["[tablet]", "[[patch]]", "family = ", '"thesis.flat_faced_round"', 
 raw_text = st.lists(st.one_of(st.sampled_from(FRAGMENTS), texts(8)), max_size=25).map("".join)
 
 
-def _fake_build_design(design, out_dir, *, progress=True):
+def _fake_build_design(design, out_dir, *, progress=True, parallel=False):
     """Everything ``build`` does before its CAD stages: read and validate the design, build the PDE tablet;
     the report keys the command prints."""
     from tabletcad.pipeline.design import load_design
