@@ -399,3 +399,42 @@ def test_outline_offset_is_the_weighted_point_and_normal(der):
                 b = np.asarray(ol.breaks)
                 far = np.min(np.abs(np.mod(v[:, None] - b[None, :] + math.pi, TWO_PI) - math.pi), axis=1) > 1e-4
                 np.testing.assert_allclose(got[far], fd[far], rtol=0, atol=1e-6 * max(1.0, float(np.max(np.abs(got)))))
+
+
+def _sample_curves():
+    from pathlib import Path
+
+    from tabletcad.pipeline.design import Design
+
+    root = Path(__file__).resolve().parents[1] / "samples"
+    out = []
+    for name in ("families/capsule", "families/rounded_triangle", "flat_faced_round"):
+        out += [c for p in Design.from_toml(root / f"{name}.toml").build().patches for c in p.data]
+    return out
+
+
+def test_fourier_tail_is_the_rms_of_the_truncated_series_at_the_samples():
+    """Discrete Parseval: the tail from the FFT equals the root mean square of curve minus series."""
+    import tabletcad.geometry.curves as C
+
+    for c in _sample_curves()[::5]:
+        for modes, m in ((8, 1024), (48, 1024), (5, 77)):
+            a0, a, b = C.fourier_coefficients(c, modes, samples=m)
+            v = C.sample_v(m)
+            n = np.arange(1, modes + 1)
+            S = a0 + np.cos(np.outer(v, n)) @ a + np.sin(np.outer(v, n)) @ b
+            rms = float(np.sqrt(np.mean(np.sum((c.evaluate(v) - S) ** 2, axis=1))))
+            assert C.fourier_tail(c, modes, m) == pytest.approx(rms, rel=1e-9, abs=1e-13)
+
+
+def test_modes_needed_gives_the_same_answer_without_the_tail_shortcut(monkeypatch):
+    """A curve whose series after max_modes is still off by more than tol in the mean square is
+    answered max_modes + 1 at once; the full scan gives the same answer for every curve and tol."""
+    import tabletcad.geometry.curves as C
+
+    curves = _sample_curves()
+    fast = [[C._modes_needed(c, tol, mm, 4096) for tol in (1e-9, 1e-6, 1e-3) for mm in (8, 48)] for c in curves]
+    monkeypatch.setattr(C, "fourier_tail", lambda *a: 0.0)
+    C._MEMO.clear()
+    slow = [[C._modes_needed(c, tol, mm, 4096) for tol in (1e-9, 1e-6, 1e-3) for mm in (8, 48)] for c in curves]
+    assert fast == slow and any(49 in row for row in fast) and any(0 < x < 49 for row in fast for x in row)

@@ -618,6 +618,13 @@ def fourier_coefficients(curve: CurveLike, modes: int, samples: int | None = Non
 
 
 def _fourier(curve: CurveLike, modes: int, m: int):
+    return _fourier_and_tail(curve, modes, m)[:3]
+
+
+def _fourier_and_tail(curve: CurveLike, modes: int, m: int):
+    """``(a0, a, b, tail)``: the coefficients of :func:`fourier_coefficients` and ``tail``, the
+    root mean square (mm) over the ``m`` samples of the curve minus its series truncated after
+    ``modes`` modes (by discrete Parseval, from the coefficients above ``modes``)."""
     pts = curve.evaluate(sample_v(m))
     f = np.fft.rfft(pts, axis=0) / m
     a0 = f[0].real
@@ -626,7 +633,25 @@ def _fourier(curve: CurveLike, modes: int, m: int):
     b = np.zeros((modes, 3))
     a[:n] = 2.0 * f[1 : n + 1].real
     b[:n] = -2.0 * f[1 : n + 1].imag
-    return a0, a, b
+    power = np.sum(np.abs(f) ** 2, axis=1)  # |f_k|² summed over x, y, z
+    top = m // 2 if m % 2 == 0 else m // 2 + 1  # the Nyquist term (even m) counts once
+    tail = 2.0 * float(np.sum(power[n + 1 : top])) + (float(power[m // 2]) if m % 2 == 0 and n < m // 2 else 0.0)
+    return a0, a, b, math.sqrt(tail)
+
+
+def fourier_tail(curve: CurveLike, modes: int, samples: int) -> float:
+    """Root mean square (mm), over ``samples`` equally spaced samples, of the curve's distance from
+    its Fourier series truncated after ``modes`` modes: a lower bound of the largest distance at
+    those samples (shares the samples of :func:`fourier_coefficients`)."""
+    memo = _memo(curve)
+    if memo is None:
+        return _fourier_and_tail(curve, modes, samples)[3]
+    key = ("fourier_tail", modes, samples)
+    if key not in memo:
+        a0, a, b, tail = _fourier_and_tail(curve, modes, samples)
+        memo.setdefault(("fourier", modes, samples), (a0, a, b))
+        memo[key] = tail
+    return memo[key]
 
 
 @lru_cache(maxsize=8)
@@ -675,7 +700,12 @@ def _modes_needed(curve: CurveLike, tol: float, max_modes: int, m: int) -> int:
         aa, bb, ab = float(a @ a), float(b @ b), float(a @ b)
         amplitude = math.sqrt(max(0.5 * (aa + bb) + math.hypot(0.5 * (aa - bb), ab), 0.0))
         return 0 if amplitude <= tol else limit
-    a0, a, b = fourier_coefficients(curve, max_modes, samples=max(4 * max_modes + 8, 1024))
+    n_fft = max(4 * max_modes + 8, 1024)
+    if m % n_fft == 0 and fourier_tail(curve, max_modes, n_fft) > tol * (1.0 + 1e-6) + 1e-15:
+        # even max_modes leaves a root-mean-square error above tol at the FFT's samples, which are
+        # among the m checked below: every N <= max_modes would fail there (the answer below, sooner)
+        return max_modes + 1
+    a0, a, b = fourier_coefficients(curve, max_modes, samples=n_fft)
     # The error at a subset of the samples is a lower bound of the error at all of them:
     # every N failing on the subset fails, so the full scan starts at the subset's first pass.
     memo = _memo(curve)
