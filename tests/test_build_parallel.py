@@ -51,18 +51,79 @@ def test_the_childs_exception_is_raised_in_the_parent():
         child.result()
     assert str(e.value) == str(DesignError("[tooling] clearance_mm", -1.0, "must be > 0"))
     assert _gone(child.pid)
+    if hasattr(e.value, "__notes__"):  # Python >= 3.11: the child's traceback comes along
+        assert "in bad" in e.value.__notes__[-1] and "forked helper" in e.value.__notes__[-1]
 
     def geometry():
         raise GeometryError("sewing left 2 free edges", object())
 
-    with pytest.raises(GeometryError, match="^sewing left 2 free edges$"):
+    with pytest.raises(GeometryError, match="^sewing left 2 free edges"):
         Forked(geometry).result()
+    assert str(pytest.raises(GeometryError, lambda: Forked(geometry).result()).value) == "sewing left 2 free edges"
 
     def unpicklable():
         raise _Unpicklable("left", "right")
 
     with pytest.raises(RuntimeError, match="_Unpicklable: left and right"):
         Forked(unpicklable).result()
+
+
+def test_a_refused_fork_runs_the_work_here_and_closed_output_streams_do_not_matter(monkeypatch):
+    import sys
+
+    def refuse():
+        raise OSError(11, "Resource temporarily unavailable")
+
+    before = len(os.listdir("/proc/self/fd"))
+    with monkeypatch.context() as m:
+        m.setattr(os, "fork", refuse)
+        child = Forked(lambda: os.getpid())
+    assert child.pid is None and child.result() == os.getpid()  # run in this process, when asked
+    assert len(os.listdir("/proc/self/fd")) == before  # the pipe was closed
+    monkeypatch.setattr(sys, "stdout", None)  # `tabletcad build ... >&-`
+    assert Forked(lambda: 7).result() == 7
+
+
+def test_an_interrupted_wait_leaves_no_child_and_no_descriptor():
+    """Ctrl-C while the parent waits (here: the child's read raises) ends in cancel without a second close."""
+    import signal
+
+    before = len(os.listdir("/proc/self/fd"))
+    old = signal.signal(signal.SIGALRM, lambda *a: (_ for _ in ()).throw(KeyboardInterrupt()))
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 0.3)
+        with pytest.raises(KeyboardInterrupt):
+            with Forked(lambda: time.sleep(30)) as child:
+                child.result()
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    assert _gone(child.pid) and len(os.listdir("/proc/self/fd")) == before
+
+
+def test_the_child_dies_with_its_parent(tmp_path):
+    """A parent killed outright (SIGKILL) takes its helper with it: no writer goes on alone."""
+    import subprocess
+    import sys
+
+    code = ("import os, sys, time\n"
+            "from tabletcad.io.forked import Forked\n"
+            "c = Forked(lambda: time.sleep(60))\n"
+            "print(c.pid, flush=True)\n"
+            "time.sleep(60)\n")
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
+                         env={**os.environ, "PYTHONPATH": str(ROOT)})
+    pid = int(p.stdout.readline())
+    p.kill()
+    p.wait(timeout=30)
+    for _ in range(100):  # the orphan is killed by the kernel and reaped by init
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            break
+        time.sleep(0.1)
+    else:
+        raise AssertionError(f"helper {pid} outlived its parent")
 
 
 def test_a_child_that_dies_is_an_error_and_cancel_stops_a_running_one():

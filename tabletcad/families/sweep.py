@@ -158,7 +158,8 @@ class Certificate:
     tolerance_mm : float
         The tolerance it was certified against (``tol.nominal``).
     samples : tuple of int
-        ``(nu, nv)`` grid per patch (plus the outline's joins in ``v``).
+        ``(nu, nv)``: the grid sampled on every patch, the outline's joins included in ``v``
+        (then polished around its peaks, :func:`certify`).
     passed : bool
     """
 
@@ -515,7 +516,7 @@ def certify(tablet: Tablet, nu: int = 33, nv: int = 512) -> Certificate:
     else:  # a grid half as fine each way, polished around its peaks
         u, v = u[::2] if nu % 2 else np.linspace(0.0, 1.0, nu // 2 + 1), _v_samples(nom.outline, max(nv // 2, 4))
         per = [float(x) for x in tablet.deviation_peaks(u, v, math.tau / max(nv // 2, 4))]
-    cert = Certificate(max(per), tuple(per), tablet.tol.nominal, (nu, len(v)), max(per) <= tablet.tol.nominal)
+    cert = Certificate(max(per), tuple(per), tablet.tol.nominal, (len(u), len(v)), max(per) <= tablet.tol.nominal)
     nom.certificate = cert
     nom.patch_ids = tuple(id(p) for p in tablet.patches)
     return cert

@@ -36,34 +36,75 @@ def can_fork() -> bool:
 
 
 def _payload(ok: bool, value: Any) -> bytes:
+    """``(ok, value, traceback text)`` pickled; what cannot be pickled travels as text."""
+    text = "" if ok else "".join(traceback.format_exception(type(value), value, value.__traceback__))
     try:
-        data = pickle.dumps((ok, value))
+        data = pickle.dumps((ok, value, text))
         pickle.loads(data)  # an exception whose __init__ takes other arguments than its args fails here
         return data
     except Exception:  # noqa: BLE001 - anything unpicklable travels as text
         if ok:
             value = RuntimeError(f"the helper process's result could not be sent back: {value!r:.200}")
         else:
-            text = "".join(traceback.format_exception(type(value), value, value.__traceback__))
             value = RuntimeError(f"in the helper process: {type(value).__name__}: {value}\n{text}")
-        return pickle.dumps((False, value))
+        return pickle.dumps((False, value, text))
+
+
+def _flush() -> None:
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (AttributeError, OSError, ValueError):  # None, or closed (``>&-``)
+            pass
+
+
+def _die_with_parent(parent: int) -> None:
+    """Linux: SIGKILL this process when its parent ends (a parent killed outright leaves no writer)."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # pragma: no cover - not Linux
+        pass
+    if os.getppid() != parent:  # the parent ended before the request took effect
+        os._exit(1)
 
 
 class Forked:
     """``work()`` running in a forked child; :meth:`result` waits for it, :meth:`cancel` stops it.
 
-    The parent must call one of the two (``with`` calls :meth:`cancel` if neither was).
+    The parent must call one of the two (``with`` calls :meth:`cancel` if neither was).  The child
+    ignores Ctrl-C (the parent, which gets it too, cancels the child) and dies with its parent.
+    When the system refuses the fork (memory, process limits), :meth:`result` runs ``work()`` in
+    this process instead: the same result, one step after the other.
     """
 
     def __init__(self, work: Callable[[], Any]) -> None:
-        sys.stdout.flush()
-        sys.stderr.flush()
+        self.pid: int | None = None  #: the child's process id (None when the fork was refused)
+        self._pid: int | None = None
+        self._r: int | None = None
+        self._work: Callable[[], Any] | None = None
+        _flush()
+        parent = os.getpid()
         r, w = os.pipe()
-        with warnings.catch_warnings():  # Python >= 3.12 warns about fork() in a process with threads
-            warnings.simplefilter("ignore", DeprecationWarning)
-            pid = os.fork()
+        held = {signal.SIGINT, signal.SIGTERM}
+        old_mask = signal.pthread_sigmask(signal.SIG_BLOCK, held)  # no handler runs between fork and set-up
+        try:
+            with warnings.catch_warnings():  # Python >= 3.12 warns about fork() in a process with threads
+                warnings.simplefilter("ignore", DeprecationWarning)
+                pid = os.fork()
+        except OSError:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
+            os.close(r)
+            os.close(w)
+            self._work = work
+            return
         if pid == 0:  # the child
             try:
+                signal.signal(signal.SIGINT, signal.SIG_IGN)
+                signal.signal(signal.SIGTERM, signal.SIG_DFL)
+                _die_with_parent(parent)
+                signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
                 os.close(r)
                 OCC_PARALLEL[0] = False
                 try:
@@ -72,31 +113,42 @@ class Forked:
                     data = _payload(False, e)
                 with os.fdopen(w, "wb") as f:
                     f.write(data)
-                sys.stdout.flush()
-                sys.stderr.flush()
+                _flush()
             finally:
                 os._exit(0)
+        signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
         os.close(w)
-        self.pid = pid  #: the child's process id
-        self._pid, self._r = pid, r
+        self.pid = self._pid = pid
+        self._r = r
 
     def result(self) -> Any:
-        """The child's return value (waits for it); its exception is raised here."""
+        """The child's return value (waits for it); its exception is raised here, with the child's
+        traceback as a note."""
+        if self._work is not None:  # the fork was refused: the work runs here
+            work, self._work = self._work, None
+            return work()
         if self._pid is None:
             raise RuntimeError("the helper process was already waited for")
-        with os.fdopen(self._r, "rb") as f:
+        r, self._r = self._r, None  # closed by the read below, whatever happens to it
+        with os.fdopen(r, "rb") as f:
             data = f.read()
         _, status = os.waitpid(self._pid, 0)
         self._pid = None
         if not data:
             raise RuntimeError(f"the helper process ended without a result (wait status {status})")
-        ok, value = pickle.loads(data)
+        ok, value, text = pickle.loads(data)
         if not ok:
+            if text and hasattr(value, "add_note"):
+                value.add_note("raised in a forked helper process (tabletcad.io.forked):\n" + text.rstrip())
             raise value
         return value
 
     def cancel(self) -> None:
         """Stop the child (if still running) and wait for it."""
+        self._work = None
+        if self._r is not None:
+            os.close(self._r)
+            self._r = None
         if self._pid is None:
             return
         try:
@@ -104,7 +156,6 @@ class Forked:
         except ProcessLookupError:  # pragma: no cover - already gone
             pass
         os.waitpid(self._pid, 0)
-        os.close(self._r)
         self._pid = None
 
     def __enter__(self) -> "Forked":
