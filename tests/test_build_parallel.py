@@ -1,9 +1,7 @@
 """The command line's parallel build (:mod:`tabletcad.io.forked`): a forked child returns its value or
-its exception, is stopped by ``cancel``, and never uses OCC's thread pool; a parallel tooling build
-(picture, writers and the gap in three children) writes the same files and report as the sequential
-one; a failure in a child or in the parent leaves no file and no process behind."""
+its exception, is stopped by ``cancel``, dies with its parent and never uses OCC's thread pool; a
+refused fork runs the work in the parent.  The builds themselves: ``test_build_parallel_cad.py``."""
 
-import json
 import os
 import time
 from pathlib import Path
@@ -11,7 +9,6 @@ from pathlib import Path
 import pytest
 
 from tabletcad.errors import DesignError, GeometryError
-from tabletcad.io import forked
 from tabletcad.io.forked import OCC_PARALLEL, Forked
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="os.fork is POSIX only")
@@ -135,82 +132,3 @@ def test_a_child_that_dies_is_an_error_and_cancel_stops_a_running_one():
         pass  # leaving the block without a result cancels it
     assert time.perf_counter() - t0 < 10.0
     assert _gone(sleeper.pid)
-
-
-# ----------------------------------------------------------------------------- builds
-pytest.importorskip("OCP")
-pytest.importorskip("manifold3d")
-
-SAMPLE = ROOT / "samples" / "tooling" / "shallow_convex_round.toml"
-
-
-class _Recording(Forked):
-    made: list = []
-
-    def __init__(self, work):
-        super().__init__(work)
-        _Recording.made.append(self.pid)
-
-
-@pytest.fixture
-def recorded(monkeypatch):
-    """Every Forked child of the build, recorded; the parallel path taken on any machine."""
-    import tabletcad.pipeline.build as build
-
-    _Recording.made = []
-    monkeypatch.setattr(forked, "Forked", _Recording)
-    monkeypatch.setattr(build, "Forked", _Recording)
-    monkeypatch.setattr(forked, "can_fork", lambda: True)
-    monkeypatch.setattr(build, "can_fork", lambda: True)
-    return _Recording.made
-
-
-def _without_seconds(report: dict) -> dict:
-    def clean(o):
-        if isinstance(o, dict):
-            return {k: clean(v) for k, v in o.items() if "seconds" not in k}
-        if isinstance(o, list):
-            return [clean(v) for v in o]
-        return o
-
-    return clean(report)
-
-
-@pytest.mark.cad
-def test_a_parallel_tooling_build_writes_what_the_sequential_one_writes(tmp_path, recorded):
-    from tabletcad.pipeline.build import build_design
-
-    seq = build_design(SAMPLE, tmp_path / "seq", progress=False, parallel=False)
-    assert recorded == []
-    par = build_design(SAMPLE, tmp_path / "par", progress=False, parallel=True)
-    # the picture, the tooling's writers and the closed-position check's gap
-    assert len(recorded) == 3 and all(_gone(p) for p in recorded)
-    assert sorted(os.listdir(tmp_path / "par")) == sorted(os.listdir(tmp_path / "seq"))
-    assert _without_seconds(par) == _without_seconds(seq)
-    assert par["tooling"]["drawing"]["dimension_texts"] and par["tooling"]["files"] == seq["tooling"]["files"]
-    on_disk = json.loads((tmp_path / "par" / "report.json").read_text())
-    assert list(on_disk["tooling"]) == list(json.loads((tmp_path / "seq" / "report.json").read_text())["tooling"])
-    for name in ("upper_punch.step", "die.step", "drawing.dxf", "tablet.png"):  # the children's files are whole
-        assert (tmp_path / "par" / name).stat().st_size > 1000
-
-
-@pytest.mark.cad
-@pytest.mark.parametrize("where", ["drawing", "picture", "closed_position", "gap"])
-def test_a_failure_in_either_process_leaves_nothing(tmp_path, recorded, monkeypatch, where):
-    import tabletcad.pipeline.build as build
-    import tabletcad.tooling.drawing as drawing
-    import tabletcad.tooling.interference as interference
-    import tabletcad.tooling.toolset as toolset
-    from tabletcad.pipeline.build import build_design
-
-    def fail(*a, **k):
-        raise DesignError("test", where, "fails here on purpose")
-
-    target = {"drawing": (drawing, "write_drawing"), "picture": (build, "plot_tablet"),
-              "closed_position": (toolset, "check_closed_position"), "gap": (interference, "_largest_gap")}[where]
-    monkeypatch.setattr(*target, fail)
-    out = tmp_path / "out"
-    with pytest.raises(DesignError, match=f"test = '{where}' is not allowed: fails here on purpose"):
-        build_design(SAMPLE, out, progress=False, parallel=True)
-    assert not out.exists() and os.listdir(tmp_path) == []
-    assert recorded and all(_gone(p) for p in recorded)
