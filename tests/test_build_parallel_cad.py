@@ -102,3 +102,25 @@ def test_a_failure_in_either_process_leaves_nothing(tmp_path, recorded, monkeypa
         build_design(SAMPLE, out, progress=False, parallel=True)
     assert not out.exists() and os.listdir(tmp_path) == []
     assert recorded and all(_gone(p) for p in recorded)
+
+
+@pytest.mark.cad
+def test_an_fe_rating_waits_for_the_closed_position_check(tmp_path, recorded, monkeypatch):
+    """With ``[tooling.fe_rating]`` the parallel build keeps the one-process order: the check, then the
+    FE rating (none for tooling that fails the check), then the files."""
+    import tabletcad.tooling.toolset as toolset
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.stage import tooling_stage
+
+    calls = []
+
+    def fail(*a, **k):
+        calls.append("check")
+        raise DesignError("test", "check", "fails here on purpose")
+
+    monkeypatch.setattr(toolset, "check_closed_position", fail)
+    d = Design.from_toml(SAMPLE)
+    with pytest.raises(DesignError, match="fails here on purpose"):
+        tooling_stage(tablet=d.build(), spec=d.tooling_spec, shape=None, out=tmp_path, report={},
+                      fe_rating=lambda ts: calls.append("fe") or {}, parallel=True)
+    assert calls == ["check"] and os.listdir(tmp_path) == [] and recorded == []

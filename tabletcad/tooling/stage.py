@@ -69,7 +69,8 @@ def tooling_stage(*, tablet: Tablet, spec: ToolingSpec, shape, out: Path, report
     ``parallel``: on Linux with two or more cores, the parts' STEP files and the drawings are
     written by a forked process (:class:`tabletcad.io.forked.Forked`) while this one runs the
     closed-position check, whose gap another forked process measures beside the overlaps; the
-    files and the report are the same.  For a process of its own (the
+    files and the report are the same.  With ``fe_rating`` the files wait for the check and the
+    rating, as in one process.  For a process of its own (the
     command line), not for a Dask worker or FreeCAD.  Nothing is left running when a step fails.
     """
     from tabletcad.io.forked import Forked, can_fork
@@ -77,16 +78,14 @@ def tooling_stage(*, tablet: Tablet, spec: ToolingSpec, shape, out: Path, report
 
     out = Path(out)
     ts = make_tooling(tablet, spec, shape=shape, options=options, interference_check=False)
-    if not (parallel and can_fork()):
-        _check_gap(ts, tablet.name, spec)
+    if not (parallel and can_fork()) or fe_rating is not None:
+        # with an FE rating, which the drawing prints, the check comes first as in one process (no FE
+        # solve for tooling that then fails it), then the rating, then the files
+        _check_gap(ts, tablet.name, spec, forked=parallel and can_fork())
         if fe_rating is not None:
             ts.report["tip_rating"]["fe"] = fe_rating(ts)
         files = write_tooling(ts, out)
-    else:
-        # the FE rating goes on the drawing, so it comes first; the closed-position check (this process)
-        # and the writers (the child) are independent
-        if fe_rating is not None:
-            ts.report["tip_rating"]["fe"] = fe_rating(ts)
+    else:  # the closed-position check (this process) and the writers (the child) are independent
         before = set(ts.report)
 
         def write():
