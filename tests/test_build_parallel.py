@@ -8,21 +8,13 @@ from pathlib import Path
 
 import pytest
 
+from support.processes import gone
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.io.forked import OCC_PARALLEL, Forked
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="os.fork is POSIX only")
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def _gone(pid: int) -> bool:
-    """True when ``pid`` is no child of this process any more (reaped: no zombie left)."""
-    try:
-        os.waitpid(pid, os.WNOHANG)
-    except ChildProcessError:
-        return True
-    return False
 
 
 class _Unpicklable(Exception):
@@ -36,7 +28,7 @@ def test_the_child_returns_its_value_and_runs_occ_without_its_thread_pool():
     total, occ_parallel, pid = child.result()
     assert total == 45 and occ_parallel is False and pid == child.pid != os.getpid()
     assert OCC_PARALLEL[0] is True  # the parent's is left alone
-    assert _gone(child.pid)
+    assert gone(child.pid)
 
 
 def test_the_childs_exception_is_raised_in_the_parent():
@@ -47,7 +39,7 @@ def test_the_childs_exception_is_raised_in_the_parent():
     with pytest.raises(DesignError) as e:
         child.result()
     assert str(e.value) == str(DesignError("[tooling] clearance_mm", -1.0, "must be > 0"))
-    assert _gone(child.pid)
+    assert gone(child.pid)
     if hasattr(e.value, "__notes__"):  # Python >= 3.11: the child's traceback comes along
         assert "in bad" in e.value.__notes__[-1] and "forked helper" in e.value.__notes__[-1]
 
@@ -95,7 +87,7 @@ def test_an_interrupted_wait_leaves_no_child_and_no_descriptor():
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)
-    assert _gone(child.pid) and len(os.listdir("/proc/self/fd")) == before
+    assert gone(child.pid) and len(os.listdir("/proc/self/fd")) == before
 
 
 def test_the_child_dies_with_its_parent(tmp_path):
@@ -131,4 +123,4 @@ def test_a_child_that_dies_is_an_error_and_cancel_stops_a_running_one():
     with Forked(lambda: time.sleep(60)) as sleeper:
         pass  # leaving the block without a result cancels it
     assert time.perf_counter() - t0 < 10.0
-    assert _gone(sleeper.pid)
+    assert gone(sleeper.pid)

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+from support.processes import gone
 from tabletcad.errors import DesignError
 from tabletcad.io import forked
 from tabletcad.io.forked import Forked
@@ -18,15 +19,6 @@ pytest.importorskip("manifold3d")
 pytestmark = [pytest.mark.cad]
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def _gone(pid: int) -> bool:
-    """True when ``pid`` is no child of this process any more (reaped: no zombie left)."""
-    try:
-        os.waitpid(pid, os.WNOHANG)
-    except ChildProcessError:
-        return True
-    return False
 
 
 SAMPLE = ROOT / "samples" / "tooling" / "shallow_convex_round.toml"
@@ -72,7 +64,7 @@ def test_a_parallel_tooling_build_writes_what_the_sequential_one_writes(tmp_path
     assert recorded == []
     par = build_design(SAMPLE, tmp_path / "par", progress=False, parallel=True)
     # the picture, the tooling's writers and the closed-position check's gap
-    assert len(recorded) == 3 and all(_gone(p) for p in recorded)
+    assert len(recorded) == 3 and all(gone(p) for p in recorded)
     assert sorted(os.listdir(tmp_path / "par")) == sorted(os.listdir(tmp_path / "seq"))
     assert _without_seconds(par) == _without_seconds(seq)
     assert par["tooling"]["drawing"]["dimension_texts"] and par["tooling"]["files"] == seq["tooling"]["files"]
@@ -101,7 +93,7 @@ def test_a_failure_in_either_process_leaves_nothing(tmp_path, recorded, monkeypa
     with pytest.raises(DesignError, match=f"test = '{where}' is not allowed: fails here on purpose"):
         build_design(SAMPLE, out, progress=False, parallel=True)
     assert not out.exists() and os.listdir(tmp_path) == []
-    assert recorded and all(_gone(p) for p in recorded)
+    assert recorded and all(gone(p) for p in recorded)
 
 
 @pytest.mark.cad
