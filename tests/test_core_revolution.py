@@ -18,6 +18,7 @@ from tabletcad.brep.surface import enclosed_volume
 from tabletcad.families import FAMILIES
 from tabletcad.geometry.curves import Circle, Ellipse
 from tabletcad.geometry.patch import PDEPatch
+from tabletcad.geometry.tablet import solid_map
 
 
 def _stack(radii, heights, ellipse_b=None):
@@ -144,3 +145,167 @@ def test_mesh_of_a_hollow_cylinder_is_a_closed_torus():
     vol = np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0
     exact = math.pi * (36 - 9) * 4
     assert 0.0 < exact - vol <= 0.005 * (2 * math.pi * 9 * 4 + 2 * math.pi * (36 - 9))
+
+
+# ----------------------------------------------------------------------------- one plan ellipse
+class _Section:
+    """``ρ (p cos v + q sin v) + (0, 0, z)``: a scaled copy of one centred plan ellipse, any orientation."""
+
+    def __init__(self, rho, p, q, z):
+        self.rho, self.p, self.q, self.z = rho, np.asarray(p, float), np.asarray(q, float), z
+
+    def evaluate(self, v, der=0):
+        v = np.asarray(v, float).reshape(-1)
+        c, s = [(np.cos(v), np.sin(v)), (-np.sin(v), np.cos(v)), (-np.cos(v), -np.sin(v)), (np.sin(v), -np.cos(v))][der % 4]
+        out = np.zeros((v.size, 3))
+        out[:, :2] = self.rho * (np.outer(c, self.p) + np.outer(s, self.q))
+        if der == 0:
+            out[:, 2] = self.z
+        return out
+
+
+def _plan_vectors(angle, aspect):
+    """An ellipse of semi-axes ``aspect`` and 1 turned by ``angle``, started at a quarter of its own way round."""
+    rot = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
+    p, q = rot @ np.array([aspect, 0.0]), rot @ np.array([0.0, 1.0])
+    return math.cos(0.7) * p + math.sin(0.7) * q, -math.sin(0.7) * p + math.cos(0.7) * q
+
+
+@settings(max_examples=25, deadline=None)
+@given(rho=st.lists(st.floats(-1.0, 5.0).filter(lambda x: abs(x) > 0.05), min_size=4, max_size=4),
+       z=st.lists(st.floats(0.0, 3.0), min_size=4, max_size=4), angle=st.floats(0.0, math.pi),
+       aspect=st.floats(0.3, 3.0), form=st.sampled_from(["curves", "hermite"]))
+def test_scaled_copies_of_one_ellipse_are_a_section_whose_profile_is_the_surface(rho, z, angle, aspect, form):
+    """Every point of the patch lies on its section's ellipse ``xᵀ S⁻¹ x = R(u)²`` at height Z(u), and
+    ``det S = 1`` (so the section's area is ``π R²``): a datum of another aspect, or off centre, is no section."""
+    p, q = _plan_vectors(angle, aspect)
+    patch = PDEPatch(tuple(_Section(r, p, q, zz) for r, zz in zip(rho, z)), a=0.7, form=form, check=False)
+    sec = patch.section
+    assert sec is not None
+    assert np.linalg.det(sec.shape) == pytest.approx(1.0, rel=1e-12)
+    u = np.linspace(0.0, 1.0, 33)
+    X = patch.evaluate_grid(u, np.linspace(0.0, math.tau, 29))
+    R, Z = sec.profile(u).T
+    lhs = np.einsum("uvi,ij,uvj->uv", X[..., :2], np.linalg.inv(sec.shape), X[..., :2])
+    np.testing.assert_allclose(lhs, np.repeat(R[:, None] ** 2, 29, 1), atol=1e-11 * max(1.0, max(rho)) ** 2)
+    np.testing.assert_allclose(X[..., 2], np.repeat(Z[:, None], 29, 1), atol=1e-12)
+    np.testing.assert_allclose(sec.reach(), np.sqrt(np.diag(sec.shape)))
+    other = [_Section(r, p, q, zz) for r, zz in zip(rho, z)]
+    other[1] = _Section(rho[1], p, 1.1 * q, z[1])
+    assert PDEPatch(tuple(other), a=0.7, form=form, check=False).section is None
+    other[1] = _Section(rho[1], p, q, z[1])
+    other[2] = _Section(rho[2], p, q, z[2])
+    other[2].evaluate = lambda v, der=0, c=other[2]: _Section.evaluate(c, v, der) + (0.01 * (der == 0)) * np.array([1.0, 0.0, 0.0])
+    assert PDEPatch(tuple(other), a=0.7, form=form, check=False).section is None
+
+
+def _oval_tablet(angle, aspect, band=2.0, cup=0.8, r=3.0):
+    """A convex oval of one plan ellipse turned by ``angle`` (three coaxial patches, as the thesis's ovals)."""
+    from tabletcad.geometry.tablet import Tablet
+
+    from tabletcad.families.thesis import _band, _cap
+
+    p, q = _plan_vectors(angle, aspect)
+    secs = [_cap(r, cup, cup, up=False), _band(r, cup, cup + band), _cap(r, cup + band, cup, up=True)]
+    curves, patches = {}, []
+    for sec in secs:
+        data = tuple(curves.setdefault((rr, zz), _Section(rr, p, q, zz)) for rr, zz in sec)
+        patches.append(PDEPatch(data, a=1.0))
+    return Tablet(tuple(patches), name="oval")
+
+
+@settings(max_examples=10, deadline=None)
+@given(angle=st.floats(0.0, math.pi), aspect=st.floats(1.05, 3.0))
+def test_section_figures_equal_the_sampled_ones(angle, aspect):
+    """A tablet of one plan ellipse, turned by any angle: extents from the profile (``R_max √S_xx``)
+    equal the polished samples of every patch to 1e-12 mm; the plan area ``π R_max²`` is what the
+    sampled plan comes within 2e-8 of at 2048 meridians; the solid map's
+    volume on 4 meridians equals that on 256 (its Jacobian does not depend on v); each patch's fold
+    depth on its 4 principal meridians is that on 37 more."""
+    t = _oval_tablet(angle, aspect)
+    assert t.section is not None and t.revolution is None
+    lo, hi = t.bounds()
+    lo2, hi2 = t._bounds_sampled()
+    np.testing.assert_allclose(lo, lo2, atol=1e-12 * 10)
+    np.testing.assert_allclose(hi, hi2, atol=1e-12 * 10)
+    exact = t.plan_area()
+    assert abs(t._plan_area_sampled(33, 2048) - exact) <= 2e-8 * exact
+    assert t.solid_volume() == pytest.approx(t.solid_volume(nv=256), rel=1e-13)
+    assert t.solid_volume() == pytest.approx(t.volume(), rel=1e-12)
+    for patch in t.patches:  # with the principal meridians, which set the round-off threshold's scale
+        v = np.concatenate([patch._principal_v(), np.linspace(0.0, math.tau, 37)])
+        assert patch.fold_depth() == pytest.approx(patch._fold_depth_of(257, 0, v), abs=1e-15)
+
+
+def test_the_thesis_ovals_plan_is_their_widest_ellipse():
+    """The caplet and the ovals (Table 4.1, 4.5): bounds from the profile equal the polished samples;
+    the plan area is π a b of the widest section (a = R_max √S_xx, b = R_max √S_yy); the sampled plan
+    with twice the meridians is four times nearer or better."""
+    for name, kw in (("caplet", {}), ("shallow_convex_oval", {}), ("deep_convex_oval", {})):
+        t = FAMILIES[f"thesis.{name}"].build(**kw)
+        assert t.section is not None
+        lo, hi = t.bounds()
+        lo2, hi2 = t._bounds_sampled()
+        np.testing.assert_allclose(np.concatenate([lo, hi]), np.concatenate([lo2, hi2]), atol=1e-12)
+        a, b = hi[0], hi[1]
+        assert t.plan_area() == pytest.approx(math.pi * a * b, rel=1e-14)
+        e1, e2 = (abs(t._plan_area_sampled(33, nv) / t.plan_area() - 1.0) for nv in (1024, 2048))
+        assert e2 <= 1e-8 and e2 <= e1 / 3
+
+
+@settings(max_examples=40, deadline=None)
+@given(rho=st.lists(st.floats(-5.0, 5.0).filter(lambda x: abs(x) > 0.05), min_size=4, max_size=4),
+       z=st.lists(st.floats(0.0, 3.0), min_size=4, max_size=4), angle=st.floats(0.0, math.pi),
+       aspect=st.floats(0.3, 3.0), a=st.floats(0.2, 2.0), form=st.sampled_from(["curves", "hermite"]))
+def test_fold_checks_of_a_section_decide_as_the_sampled_ones(rho, z, angle, aspect, a, form):
+    """The radius and fold-back checks from the profile refuse exactly the patches the sampled grid
+    refuses, with the same reason, and never a smaller negative radius (they add the ellipse's
+    principal meridians)."""
+    from tabletcad.errors import DesignError
+
+    p, q = _plan_vectors(angle, aspect)
+    patch = PDEPatch(tuple(_Section(r, pp, p, zz) for r, zz, pp in zip(rho, z, [q] * 4)), a=a, form=form, check=False)
+    assert patch.section is not None
+    outcome = []
+    for section in (patch.section, None):
+        object.__setattr__(patch, "_section", section)
+        u, v = np.linspace(0.0, 1.0, 201), np.linspace(0.0, math.tau, 32, endpoint=False)
+        try:
+            (patch._check_fold_section if section is not None else patch._check_fold_sampled)(u, v)
+            outcome.append(("ok", 0.0))
+        except DesignError as exc:
+            what = str(exc).split("'")[1]
+            outcome.append((what.split()[0], float(what.split()[1]) if what.startswith("radius") else 0.0))
+    assert outcome[0][0] == outcome[1][0]
+    assert outcome[0][1] <= outcome[1][1] + 1e-12
+
+
+@settings(max_examples=15, deadline=None)
+@given(v0=st.floats(-3.0, 3.0), dv=st.floats(0.2, 6.2), u0=st.sampled_from([0.0, 0.1]), w=st.sampled_from([(0.0, 1.0), (0.0, 0.7), (0.4, 1.0)]))
+def test_trimmed_section_bounds_equal_the_sampled_ones_and_a_cut_away_plan_is_a_sector(v0, dv, u0, w):
+    """Any trim of the caplet and of a concave round (cut-aways, shells, cut ends): extents from the
+    profiles and the plan vectors' closed-form spans hold every point of the solid map on a dense grid
+    and come within 1e-3 mm of the outermost, and equal the polished samples of every patch plus
+    the cut faces' inner edges to 1e-12 mm.  The plan of a solid cut-away (w from 0) is the sector
+    of its widest section: ``(v1 - v0) / 2π`` of the whole plan, ``½ (D/2)² (v1 - v0)`` for the round."""
+    caplet = FAMILIES["thesis.caplet"].build()
+    d = 10.0
+    rnd = FAMILIES["concave_round"].build(diameter=d, band=3.0, cup_depth=1.0, land=0.08)
+    for t in (caplet, rnd):
+        cut = t.trimmed(u=(u0, 1.0 - u0), v=(v0, v0 + dv), w=w)
+        assert cut.section is not None
+        lo, hi = cut.bounds()
+        # every point of the solid map on a dense (u, v, w) grid lies inside, the nearest within 1e-3 mm
+        uu, vv, ww = np.linspace(*cut.trim.u, 161), np.linspace(*cut.trim.v, 321), np.linspace(*cut.trim.w, 3)
+        pts = np.concatenate([solid_map(p, uu[:, None, None], vv[None, :, None], ww[None, None, :]).reshape(-1, 3)
+                              for p in cut.patches])
+        assert np.all(pts.min(axis=0) >= lo - 1e-12) and np.all(pts.max(axis=0) <= hi + 1e-12)
+        assert np.all(pts.min(axis=0) - lo <= 1e-3) and np.all(hi - pts.max(axis=0) <= 1e-3)
+        # the polished samples of every patch plus the cut faces' inner edges (the spine from w = 0)
+        lo2, hi2 = cut._bounds_sampled()
+        np.testing.assert_allclose(np.concatenate([lo, hi]), np.concatenate([lo2, hi2]), atol=1e-12)
+        if w[0] == 0.0 and u0 == 0.0:
+            whole = t.trimmed(w=w).plan_area()
+            assert cut.plan_area() == pytest.approx(whole * dv / math.tau, rel=1e-13)
+            if t is rnd:
+                assert cut.plan_area() == pytest.approx(0.5 * (w[1] * d / 2) ** 2 * dv, rel=1e-13)

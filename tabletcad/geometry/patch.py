@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tabletcad.geometry.basis import cardinal, cardinal_coefficients, cardinals
-from tabletcad.geometry.revolution import Revolution, detect_revolution
+from tabletcad.geometry.revolution import Revolution, Section, detect_revolution, detect_section
 from tabletcad.geometry.tables import CARDINAL, TRIG
 from tabletcad.geometry.curves import fourier_coefficients, modes_needed, sample_v
 from tabletcad.errors import DesignError, check_positive
@@ -240,8 +240,9 @@ class PDEPatch:
         object.__setattr__(self, "_u_key", (self._lams[self._active].tobytes(),
                                             self._beta if self._has_remainder else None, self.u_nodes, self.form))
         lam1 = float(self._lams[1]) if N else 0.0
-        object.__setattr__(self, "_revolution", detect_revolution(
-            a0, ac, bc, self._active, self._has_remainder, lam1, self.u_nodes, self.form, self.tol.revolution))
+        coeffs = (a0, ac, bc, self._active, self._has_remainder, lam1, self.u_nodes, self.form, self.tol.revolution)
+        object.__setattr__(self, "_revolution", detect_revolution(*coeffs))
+        object.__setattr__(self, "_section", detect_section(*coeffs))
         if self.check:
             self._check_amplification(amp, zero)
 
@@ -298,6 +299,12 @@ class PDEPatch:
         """The patch's profile when it is a surface of revolution about the z axis, else None
         (see :mod:`tabletcad.geometry.revolution`)."""
         return self._revolution
+
+    @property
+    def section(self) -> Section | None:
+        """The patch's profile when its data are scaled copies of one centred plan ellipse (a
+        circle included), else None (see :mod:`tabletcad.geometry.revolution`)."""
+        return self._section
 
     @property
     def has_remainder(self) -> bool:
@@ -608,18 +615,36 @@ class PDEPatch:
         slightly at their poles: the spine, a cubic through the curves' centres,
         runs backwards for ``u`` below ~0.015 (0.8 µm for the 5 mm sphere).
         ``nv`` defaults to the fold checks' sampling in ``v`` (``_check_nv``); a surface of
-        revolution is always measured on that sampling's few meridians.
+        revolution, or of scaled copies of one plan ellipse (:attr:`section`), whose depth is the
+        same on every meridian, is always measured on four.
         """
-        if nv is None or self._revolution is not None:  # a surface of revolution folds alike on every meridian
+        v = None
+        if self._section is not None:
+            # a surface of revolution, or of one plan ellipse (x, y) = R(u) M e(v), z = Z(u), M = [p q], folds
+            # alike on every meridian: D = X - A0 = (R M e, 0), X_v × D = (0, 0, -R² det M) and the Jacobian
+            # X_u · (X_v × D) = -Z' R² det M, so the speed |Jacobian| / |X_v × D| is |Z'(u)| on every v.  The
+            # four principal meridians also give the largest |X_u|, |X_v| and |D| of any, the scale of the
+            # threshold below which a sign change is round-off
+            nv, v = "principal", self._principal_v()
+        elif nv is None:
             nv = self._check_nv()
         key = ("fold", nu, nv)
         if key not in self.__dict__.get("_checks", {}):
-            self.__dict__.setdefault("_checks", {})[key] = self._fold_depth_of(nu, nv)
+            self.__dict__.setdefault("_checks", {})[key] = self._fold_depth_of(nu, nv, v)
         return self._checks[key]
 
-    def _fold_depth_of(self, nu: int, nv: int) -> float:
+    def _principal_v(self) -> np.ndarray:
+        """The four meridians of a :attr:`section` patch where ``|M e(v)|`` and ``|M e'(v)|`` are extreme
+        (``M e(v) = p cos v + q sin v``, its plan vectors): ``e(v)`` along the eigenvectors of ``MᵀM``."""
+        sec = self._section
+        k = int(np.argmax(np.abs(sec.radius)))
+        pq = np.stack([self._ac[k, 0, :2], self._bc[k, 0, :2]]) / sec.radius[k]  # rows p, q
+        V = np.linalg.eigh(pq @ pq.T)[1]  # MᵀM = [p·p p·q; p·q q·q]
+        return float(np.arctan2(V[1, 0], V[0, 0])) + 0.5 * math.pi * np.arange(4)
+
+    def _fold_depth_of(self, nu: int, nv: int, v: np.ndarray | None = None) -> float:
         u = _fold_u(nu, 48)
-        v = sample_v(nv)
+        v = sample_v(nv) if v is None else v
         # coordinates as contiguous (nu, nv) blocks (evaluate_grid's components layout)
         Xu = self.evaluate_grid(u, v, du=1, components=True)
         Xv = self.evaluate_grid(u, v, dv=1, components=True)
@@ -653,6 +678,13 @@ class PDEPatch:
             )
         u = _fold_u(401, 24)
         v = sample_v(self._check_nv())
+        if self._section is not None:
+            self._check_fold_section(u, v)
+        else:
+            self._check_fold_sampled(u, v)
+
+    def _check_fold_sampled(self, u: np.ndarray, v: np.ndarray) -> None:
+        """:meth:`_check_fold`'s radius and fold-back checks on the grid ``u × v``."""
         X = self.evaluate_grid(u, v)
         D = X - self.spine(u)[:, None, :]
         # (a) the radius must not turn negative: the radial vector may not point
@@ -661,6 +693,45 @@ class PDEPatch:
         k = int(np.argmax(Dn.max(axis=1)))
         ref = D[k] / np.maximum(Dn[k], 1e-300)[:, None]
         along = np.einsum("uvc,vc->uv", D, ref)
+        self._refuse_negative_radius(along, u, v)
+        # (b) the surface itself must not fold back (normal reversing between neighbours)
+        Xu = self.evaluate_grid(u, v, du=1)
+        Xv = self.evaluate_grid(u, v, dv=1)
+        n = cross(Xu, Xv)
+        nn = np.linalg.norm(n, axis=-1)
+        dots = np.einsum("uvc,uvc->uv", n[1:], n[:-1])
+        self._refuse_fold_back(dots, nn, u, v)
+
+    def _check_fold_section(self, u: np.ndarray, v: np.ndarray) -> None:
+        """:meth:`_check_fold`'s radius and fold-back checks of a patch of one plan ellipse
+        (:attr:`section`) from its profile, on the meridians ``v`` and the four where ``|M e(v)|``
+        and ``|M e'(v)|`` are extreme (``M = [p q]``, ``e(v) = (cos v, sin v)``).
+
+        With ``P = M e``, ``Q = M e'``: ``X - A0 = (R P, 0)``, so the radius along the widest curve's
+        direction is ``sign(R_k) R(u) |P|``; and ``X_u × X_v = (Z' R J Q, R R' det M)``
+        (``J`` a quarter turn), so the normals of one meridian lie in the plane of ``J Q`` and z,
+        at ``(Z' R |Q|, R R' det M)``: the same figures the sampled check forms, without the grid.
+        """
+        sec = self._section
+        # the patch's own plan vectors: M e(v) = p cos v + q sin v (the datum k is ρ_k times them)
+        k = int(np.argmax(np.abs(sec.radius)))
+        pq = np.stack([self._ac[k, 0, :2], self._bc[k, 0, :2]]) / sec.radius[k]
+        v = np.concatenate([v, self._principal_v()])
+        P = np.outer(np.cos(v), pq[0]) + np.outer(np.sin(v), pq[1])
+        Q = np.outer(-np.sin(v), pq[0]) + np.outer(np.cos(v), pq[1])
+        Pn, Qn = np.hypot(P[:, 0], P[:, 1]), np.hypot(Q[:, 0], Q[:, 1])
+        det = float(pq[0, 0] * pq[1, 1] - pq[0, 1] * pq[1, 0])
+        R, Z = sec.profile(u).T
+        R1, Z1 = sec.profile(u, 1).T
+        kk = int(np.argmax(np.abs(R)))
+        along = np.outer(np.sign(R[kk]) * R, Pn)
+        self._refuse_negative_radius(along, u, v)
+        a, b = np.outer(Z1 * R, Qn), (R * R1 * det)[:, None]
+        nn = np.sqrt(a * a + b * b)
+        dots = a[1:] * a[:-1] + b[1:] * b[:-1]
+        self._refuse_fold_back(dots, nn, u, v)
+
+    def _refuse_negative_radius(self, along: np.ndarray, u: np.ndarray, v: np.ndarray) -> None:
         worst = float(-np.min(along))
         if worst > self.tol.fold:
             i, j = np.unravel_index(int(np.argmin(along)), along.shape)
@@ -669,13 +740,11 @@ class PDEPatch:
                 f"radius {-worst:.3g} mm at u = {u[i]:.3f}, v = {v[j]:.3f}",
                 "the radius about the spine must stay positive (the surface would pass through its spine)",
             )
-        # (b) the surface itself must not fold back (normal reversing between neighbours)
-        Xu = self.evaluate_grid(u, v, du=1)
-        Xv = self.evaluate_grid(u, v, dv=1)
-        n = cross(Xu, Xv)
-        nn = np.linalg.norm(n, axis=-1)
+
+    def _refuse_fold_back(self, dots: np.ndarray, nn: np.ndarray, u: np.ndarray, v: np.ndarray) -> None:
+        """Refuse normals (lengths ``nn`` on the grid ``u × v``) turning by more than 120° between
+        neighbouring ``u`` rows (``dots``: their dot products)."""
         big = nn > 1e-6 * float(np.max(nn))
-        dots = np.einsum("uvc,uvc->uv", n[1:], n[:-1])
         rev = (dots < -0.5 * nn[1:] * nn[:-1]) & big[1:] & big[:-1]
         if np.any(rev):
             i, j = np.argwhere(rev)[0]

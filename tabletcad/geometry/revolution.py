@@ -18,6 +18,18 @@ Detection reads the patch's own Fourier coefficients (the ones it evaluates
 with), so the profile *is* the patch's surface, not an approximation of it: the
 coefficients that would break the symmetry must be below
 :attr:`Tolerances.revolution` (mm).
+
+More generally, a patch whose data are scaled copies of one centred plan ellipse
+(the thesis's ovals and caplet, eqs 4.3-4.4: ellipses of one aspect about the z axis)
+is the linear image of a surface of revolution: its mode-1 coefficients are
+``ρ_k p`` (cosine) and ``ρ_k q`` (sine) for two fixed plan vectors ``p, q``, so
+
+    ``(x, y) = R(u) (p cos v + q sin v)``,  ``z = Z(u)``,
+
+with the same profile ``R(u) = Σ_k L_k(u; a) ρ_k``.  Its :class:`Section` holds
+``R, Z`` and the ellipse's shape ``S = p pᵀ + q qᵀ`` scaled to ``det S = 1``: the
+section at ``u`` is the ellipse ``xᵀ S⁻¹ x = R(u)²`` of area ``π R(u)²``, reaching
+``± R(u) √S_xx`` in x and ``± R(u) √S_yy`` in y.  A circle is the case ``S = I``.
 """
 
 from __future__ import annotations
@@ -30,11 +42,41 @@ import numpy as np
 from tabletcad.geometry.basis import cardinal
 from tabletcad.geometry.tables import CARDINAL
 
-__all__ = ["Revolution", "detect_revolution", "profile_extreme"]
+__all__ = ["Revolution", "Section", "detect_revolution", "detect_section", "profile_extreme"]
+
+
+class _Profile:
+    """``profile(u, du)``: ``(R(u), Z(u))`` from the fields ``radius``, ``height``, ``lam``,
+    ``u_nodes`` and ``form`` of the dataclasses below."""
+
+    radius: np.ndarray
+    height: np.ndarray
+    lam: float
+    u_nodes: tuple[float, float, float, float]
+    form: str
+
+    def profile(self, u, du: int = 0) -> np.ndarray:
+        """``(R, Z)`` (mm, or their ``du``-th derivatives) at ``u``; shape ``u.shape + (2,)``.
+
+        ``R`` is signed: a profile that crossed the axis would turn negative.
+        """
+        u = np.asarray(u, dtype=float)
+        uf = u.reshape(-1)
+        R = self._cardinal(uf, self.lam, du) @ self.radius
+        Z = self._cardinal(uf, 0.0, du) @ self.height
+        return np.stack([R, Z], axis=-1).reshape(u.shape + (2,))
+
+    def _cardinal(self, u: np.ndarray, lam: float, du: int) -> np.ndarray:
+        """:func:`~tabletcad.geometry.basis.cardinal`, shared by every profile of the same
+        ``λ``, nodes and form on sample lines of up to 1024 points."""
+        make = lambda: cardinal(u, lam, self.u_nodes, self.form, du)  # noqa: E731
+        if u.size > 1024:
+            return make()
+        return CARDINAL.get(("profile", du, u.tobytes(), lam, self.u_nodes, self.form), make)
 
 
 @dataclass(frozen=True, eq=False)
-class Revolution:
+class Revolution(_Profile):
     """The profile of a PDE patch of revolution about the z axis.
 
     Parameters
@@ -61,28 +103,101 @@ class Revolution:
     u_nodes: tuple[float, float, float, float]
     form: str
 
-    def profile(self, u, du: int = 0) -> np.ndarray:
-        """``(R, Z)`` (mm, or their ``du``-th derivatives) at ``u``; shape ``u.shape + (2,)``.
-
-        ``R`` is signed: a profile that crossed the axis would turn negative.
-        """
-        u = np.asarray(u, dtype=float)
-        uf = u.reshape(-1)
-        R = self._cardinal(uf, self.lam, du) @ self.radius
-        Z = self._cardinal(uf, 0.0, du) @ self.height
-        return np.stack([R, Z], axis=-1).reshape(u.shape + (2,))
-
-    def _cardinal(self, u: np.ndarray, lam: float, du: int) -> np.ndarray:
-        """:func:`~tabletcad.geometry.basis.cardinal`, shared by every profile of the same
-        ``λ``, nodes and form on sample lines of up to 1024 points."""
-        make = lambda: cardinal(u, lam, self.u_nodes, self.form, du)  # noqa: E731
-        if u.size > 1024:
-            return make()
-        return CARDINAL.get(("profile", du, u.tobytes(), lam, self.u_nodes, self.form), make)
-
     def v_of_angle(self, angle: float) -> float:
         """The parameter ``v`` (rad) of the meridian at plan angle ``angle``."""
         return float(np.mod(self.sense * (angle - self.phase), math.tau))
+
+
+@dataclass(frozen=True, eq=False)
+class Section(_Profile):
+    """The profile of a PDE patch whose data are scaled copies of one centred plan ellipse
+    in planes ``z = const`` (see the module's text): ``(x, y) = R(u) (p cos v + q sin v)``.
+
+    Parameters
+    ----------
+    shape : ndarray (2, 2)
+        ``S = p pᵀ + q qᵀ`` with ``det S = 1``: the section at ``u`` is ``xᵀ S⁻¹ x = R(u)²``.
+    radius : ndarray (4,)
+        Signed scale ``ρ_k`` (mm) of each datum: the radius of the circle of the same area.
+    height : ndarray (4,)
+        Height ``z_k`` (mm) of each datum.
+    lam : float
+        ``λ = a·1`` of mode 1 (eq 3.9).
+    u_nodes : tuple of 4 floats
+    form : {"curves", "hermite"}
+    plan : ndarray (2, 2)
+        Rows ``p, q`` (``|det| = 1``) with the patch's own phase: its point at ``(u, v)`` is
+        ``R(u) (p cos v + q sin v)`` in plan.
+    """
+
+    shape: np.ndarray
+    radius: np.ndarray
+    height: np.ndarray
+    lam: float
+    u_nodes: tuple[float, float, float, float]
+    form: str
+
+    plan: np.ndarray = None  # (2, 2): rows p, q (det ±1), the patch's own phase: M e(v) = p cos v + q sin v
+
+    def reach(self) -> np.ndarray:
+        """``(√S_xx, √S_yy)``: the section's half extents in x and y per unit ``R``."""
+        return np.sqrt(np.diag(self.shape))
+
+    def span(self, v0: float, v1: float) -> tuple[np.ndarray, np.ndarray]:
+        """Least and largest x and y of ``p cos v + q sin v`` for ``v`` in ``[v0, v1]`` (closed form:
+        each coordinate is ``A cos(v - φ)``, extreme at the ends or where ``v - φ`` is a multiple of π)."""
+        lo, hi = np.empty(2), np.empty(2)
+        for i in range(2):
+            a, b = float(self.plan[0, i]), float(self.plan[1, i])
+            amp, phi = math.hypot(a, b), math.atan2(b, a)
+            vals = [a * math.cos(v0) + b * math.sin(v0), a * math.cos(v1) + b * math.sin(v1)]
+            k = math.ceil((v0 - phi) / math.pi)
+            while phi + k * math.pi <= v1:
+                vals.append(amp if k % 2 == 0 else -amp)
+                k += 1
+            lo[i], hi[i] = min(vals), max(vals)
+        return lo, hi
+
+
+def detect_section(a0: np.ndarray, ac: np.ndarray, bc: np.ndarray, active, has_remainder: bool,
+                   lam1: float, u_nodes, form: str, tol: float) -> Section | None:
+    """The :class:`Section` of a patch from its Fourier coefficients, or None (the arguments
+    as for :func:`detect_revolution`).
+
+    Every datum's mode-1 coefficients must be ``ρ_k`` times those of the widest position
+    datum (``p`` for the cosines, ``q`` for the sines), within ``tol`` (mm), and ``p, q`` must span
+    the plan (an ellipse, not a segment).
+    """
+    if has_remainder or list(active) != [1]:
+        return None
+    c, s = ac[:, 0], bc[:, 0]
+    if max(np.max(np.abs(a0[:, :2])), np.max(np.abs(c[:, 2])), np.max(np.abs(s[:, 2]))) > tol:
+        return None
+    cxy, sxy = c[:, :2], s[:, :2]
+    positions = 2 if form == "hermite" else 4
+    size = np.sqrt(np.sum(cxy * cxy, axis=1) + np.sum(sxy * sxy, axis=1))
+    k = int(np.argmax(size[:positions]))
+    if size[k] <= tol:
+        return None
+    p, q = cxy[k], sxy[k]
+    n2 = float(p @ p + q @ q)
+    rho = (cxy @ p + sxy @ q) / n2
+    if max(np.max(np.abs(cxy - np.outer(rho, p))), np.max(np.abs(sxy - np.outer(rho, q)))) > tol:
+        return None
+    det = float(p[0] * q[1] - p[1] * q[0])
+    if abs(det) <= 1e-9 * n2:  # a flat ellipse: no plan area to speak of, the sampled path decides
+        return None
+    scale = math.sqrt(abs(det))
+    p, q = p / scale, q / scale
+    return Section(
+        shape=np.outer(p, p) + np.outer(q, q),
+        plan=np.stack([p, q]),
+        radius=np.ascontiguousarray(rho * scale),
+        height=np.ascontiguousarray(a0[:, 2]),
+        lam=float(lam1),
+        u_nodes=tuple(u_nodes),
+        form=form,
+    )
 
 
 def detect_revolution(a0: np.ndarray, ac: np.ndarray, bc: np.ndarray, active, has_remainder: bool,
