@@ -13,12 +13,14 @@ import numpy as np
 __all__ = ["is_closed", "weld"]
 
 
-def weld(V: np.ndarray, T: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+def weld(V: np.ndarray, T: np.ndarray, tol: float, labels: np.ndarray | None = None):
     """Merge nodes closer than ``tol`` (mm; transitively: connected components of the pair graph)
     and drop the triangles left with a repeated node; unused nodes are removed.
 
     Each merged node keeps the position of its lowest-numbered member (the first face's node).
+    With ``labels`` (one per triangle, e.g. its face) returns ``(V, T, labels of the kept triangles)``.
     """
+    tri_labels = labels
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
     from scipy.spatial import cKDTree
@@ -40,7 +42,8 @@ def weld(V: np.ndarray, T: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarr
     used = np.unique(T)
     remap = -np.ones(len(uniq), dtype=np.int64)
     remap[used] = np.arange(used.size)
-    return np.ascontiguousarray(V[uniq[used]]), np.ascontiguousarray(remap[T])
+    out = np.ascontiguousarray(V[uniq[used]]), np.ascontiguousarray(remap[T])
+    return out if tri_labels is None else (*out, np.asarray(tri_labels)[keep])
 
 
 def is_closed(T: np.ndarray) -> bool:

@@ -119,12 +119,14 @@ def triangulate(
     relative: bool = False,
     weld_tol: float = 1e-7,
     algo: str = "delabella",
-) -> tuple[np.ndarray, np.ndarray]:
+    face_ids: bool = False,
+):
     """Mesh ``shape`` and return welded ``(vertices (n, 3) float64, triangles (m, 3) int64)``, outward-wound.
 
     ``algo``: ``"delabella"`` (default; OCCT's Delabella 2-D Delaunay, ~3x faster than
     ``"watson"``, OCCT's default Bowyer-Watson, for the same deflections and a
-    comparable triangle count; both with surface deflection control).
+    comparable triangle count; both with surface deflection control).  ``face_ids``: also
+    return each triangle's face, its index in ``explore(shape, "Face")`` (m,).
     """
     if linear_deflection <= 0 or angular_deflection <= 0:
         raise ValueError("linear_deflection and angular_deflection must be > 0")
@@ -135,17 +137,18 @@ def triangulate(
     mesher = BRepMesh_IncrementalMesh(shape, params)
     if not mesher.IsDone():
         raise GeometryError("BRepMesh_IncrementalMesh failed", shape)
-    verts, tris, offset = [], [], 0
-    for face in explore(shape, "Face"):
+    verts, tris, ids, offset = [], [], [], 0
+    for k, face in enumerate(explore(shape, "Face")):
         nodes, t = _face_arrays(face)
         verts.append(nodes)
         tris.append(t + offset)
+        ids.append(np.full(len(t), k, dtype=np.int64))
         offset += nodes.shape[0]
     if not verts:
         raise GeometryError("shape has no faces to mesh", shape)
     V = np.concatenate(verts)
     T = np.concatenate(tris)
-    return weld(V, T, weld_tol)
+    return weld(V, T, weld_tol, np.concatenate(ids)) if face_ids else weld(V, T, weld_tol)
 
 
 def _signed_volume_area(V: np.ndarray, T: np.ndarray) -> tuple[float, float]:

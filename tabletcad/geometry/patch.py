@@ -712,24 +712,36 @@ class PDEPatch:
         (``J`` a quarter turn), so the normals of one meridian lie in the plane of ``J Q`` and z,
         at ``(Z' R |Q|, R R' det M)``: the same figures the sampled check forms, without the grid.
         """
+        v = np.concatenate([v, self._principal_v()])
+        R, (radial, a, b) = self._section_profile(u)[0], self._section_normals(u, v)
+        kk = int(np.argmax(np.abs(R)))
+        along = np.sign(R[kk]) * radial
+        self._refuse_negative_radius(along, u, v)
+        nn = np.sqrt(a * a + b * b)
+        dots = a[1:] * a[:-1] + b[1:] * b[:-1]
+        self._refuse_fold_back(dots, nn, u, v)
+
+    def _section_profile(self, u: np.ndarray) -> tuple[np.ndarray, ...]:
+        """``R, Z, R', Z'`` of a :attr:`section` patch at ``u``."""
+        R, Z = self._section.profile(u).T
+        R1, Z1 = self._section.profile(u, 1).T
+        return R, Z, R1, Z1
+
+    def _section_normals(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Of a :attr:`section` patch on the grid ``u × v``: the signed radius ``R(u) |P(v)|`` (the plan
+        distance of ``X - A0``, along ``P``), and ``X_u × X_v = (a J Q / |Q|, b)``: the in-plane part's
+        signed length ``a = Z' R |Q|`` and the z part ``b = R R' det M`` (``P = M e(v)``, ``Q = M e'(v)``,
+        ``M = [p q]``, ``J`` a quarter turn)."""
         sec = self._section
         # the patch's own plan vectors: M e(v) = p cos v + q sin v (the datum k is ρ_k times them)
         k = int(np.argmax(np.abs(sec.radius)))
         pq = np.stack([self._ac[k, 0, :2], self._bc[k, 0, :2]]) / sec.radius[k]
-        v = np.concatenate([v, self._principal_v()])
         P = np.outer(np.cos(v), pq[0]) + np.outer(np.sin(v), pq[1])
         Q = np.outer(-np.sin(v), pq[0]) + np.outer(np.cos(v), pq[1])
-        Pn, Qn = np.hypot(P[:, 0], P[:, 1]), np.hypot(Q[:, 0], Q[:, 1])
         det = float(pq[0, 0] * pq[1, 1] - pq[0, 1] * pq[1, 0])
-        R, Z = sec.profile(u).T
-        R1, Z1 = sec.profile(u, 1).T
-        kk = int(np.argmax(np.abs(R)))
-        along = np.outer(np.sign(R[kk]) * R, Pn)
-        self._refuse_negative_radius(along, u, v)
-        a, b = np.outer(Z1 * R, Qn), (R * R1 * det)[:, None]
-        nn = np.sqrt(a * a + b * b)
-        dots = a[1:] * a[:-1] + b[1:] * b[:-1]
-        self._refuse_fold_back(dots, nn, u, v)
+        R, _, R1, Z1 = self._section_profile(u)
+        return (np.outer(R, np.hypot(P[:, 0], P[:, 1])), np.outer(Z1 * R, np.hypot(Q[:, 0], Q[:, 1])),
+                np.repeat((R * R1 * det)[:, None], v.size, axis=1))
 
     def _refuse_negative_radius(self, along: np.ndarray, u: np.ndarray, v: np.ndarray) -> None:
         worst = float(-np.min(along))

@@ -312,8 +312,10 @@ class Tablet:
     # ------------------------------------------------------------------ quadrature
     def _rules(self, face: Face, nu: int | None = None, nv: int | None = None):
         nu = nu or self.tol.quad_u
-        if nv is None and face.periodic_t and self.patches[face.patch].revolution is not None:
-            nv = _REVOLUTION_NV  # the integrands do not depend on v: any trapezoidal rule is exact
+        if nv is None and face.kind in ("w", "u") and self.patches[face.patch].revolution is not None:
+            # the integrands do not depend on v: any trapezoidal rule (or Gauss rule, on a cut-away's
+            # v range) is exact
+            nv = _REVOLUTION_NV
         nv = nv or self.tol.quad_v
         xs, ws = gauss_legendre(nu)
         s0, s1 = face.s_range
@@ -329,7 +331,7 @@ class Tablet:
         elif bps.size:  # a trimmed v range: Gauss-Legendre per smooth piece between the outline's joins
             t, tw = _split_gauss(t0, t1, bps, nv if face.kind == "w" else max(nv // 4, 32))
         else:
-            xt, wt = gauss_legendre(nv if face.kind == "w" else max(nv // 4, 32))
+            xt, wt = gauss_legendre(nv if face.kind == "w" or nv == _REVOLUTION_NV else max(nv // 4, 32))
             t = 0.5 * (t1 - t0) * (xt + 1.0) + t0
             tw = 0.5 * (t1 - t0) * wt
         return s, sw, t, tw
@@ -447,21 +449,31 @@ class Tablet:
         A tablet of revolution (:attr:`revolution`) is the disc of its largest profile radius,
         ``π R_max²``, with ``R_max`` polished to ~1e-12 in ``u``; so is a tablet of scaled copies
         of one centred plan ellipse (:attr:`section`: the thesis's ovals and caplet), whose plan is
-        its widest section, of area ``π R_max²`` with ``R`` its equal-area radius.  Trimmed to
-        ``w ∈ [0, w1]`` the radius is ``w1 R_max``; a cut-away (``v ∈ [v0, v1]``, radii ``R >= 0``)
-        is the sector ``½ (w1 R_max)² (v1 - v0)``, which holds its cut faces.  The sampled plan
-        interpolates across a cut-away's gap (the whole plan of a shaped cut-away is reported).
+        its widest section, of area ``π R_max²`` with ``R`` its equal-area radius.  Trimmed in ``w``
+        and ``v`` (radii ``R >= 0``) it is the annular sector ``½ ((w1 R_max)² - (w0 R_min)²) (v1 - v0)``
+        (the union of each patch's radii ``w0 R`` to ``w1 R``), which holds a cut-away's cut faces.
+        Known limit: a shaped cut-away's sampled plan is measured about its box centre and bridges
+        the cut with a chord, which is not its plan.
         """
         t = self.trim
-        if self.section is not None and t.w[0] == 0.0:
-            if t.full_v:  # the widest section's area (det S = 1)
+        if self.section is not None:
+            if t.full_v and t.w[0] == 0.0:  # the widest section's area (det S = 1)
                 return math.pi * (t.w[1] * self._largest_radius()) ** 2
             radii = self._section_radii()
             plan = self.section[0].plan
             if (min(r[0] for r in radii) >= -self.tol.revolution  # R >= 0 but for round-off at a pole
                     and all(np.max(np.abs(x.plan - plan)) <= 1e-12 for x in self.section)):
-                # a cut-away: the sector v0..v1 of the widest section (its cut faces lie inside it)
-                return 0.5 * (t.w[1] * max(r[1] for r in radii)) ** 2 * (t.v[1] - t.v[0])
+                # the solid at (u, v) covers the radii w0 R(u) to w1 R(u) along P(v): each patch the band
+                # w0 R_min to w1 R_max, and their union the annular sector(s) over v0..v1 (det S = 1)
+                bands = sorted((t.w[0] * max(lo, 0.0), t.w[1] * hi) for lo, hi in radii)
+                area, (a, b) = 0.0, bands[0]
+                for lo, hi in bands[1:] + [(math.inf, math.inf)]:
+                    if lo > b:
+                        area += b * b - a * a
+                        a, b = lo, hi
+                    else:
+                        b = max(b, hi)
+                return 0.5 * area * (t.v[1] - t.v[0])
         return self._plan_area_sampled(nu, nv)
 
     def _plan_area_sampled(self, nu: int = 33, nv: int = 2048) -> float:
@@ -514,7 +526,7 @@ class Tablet:
             order = np.argsort(phi)
             hole = 0.5 * float(np.sum(np.interp(grid, phi[order], ri[order], period=math.tau) ** 2)) * (math.tau / m)
         full = 0.5 * float(np.sum(env_full**2)) * (math.tau / m)
-        if nv % 2 or not np.all(env_half > 0.0):
+        if nv % 2 or not self.trim.full_v or not np.all(env_half > 0.0):
             return full - hole
         # the envelope interpolates r(φ) linearly between the v lines' points: an error of order
         # (2π / nv)², which the same envelope from every other line has four times over
@@ -571,7 +583,7 @@ class Tablet:
         quadratic in ``w``)."""
         t = self.trim
         nu = nu or self.tol.quad_u
-        if nv is None and t.full_v and self.section is not None:
+        if nv is None and self.section is not None:
             # the Jacobian does not depend on v: any trapezoidal rule is exact.  On a tablet of one plan
             # ellipse (a circle included) the solid map is (w R(u) M e(v), Z(u)), M = [p q], whose
             # Jacobian is -w R² Z' det M
@@ -868,13 +880,13 @@ class Tablet:
         distance is then polished around the largest local maxima of those samples
         (:meth:`_polish_deviation`), which resolves each peak more finely than the whole
         ``nu × nv`` grid would, at a quarter of its cost.  A surface of revolution measured
-        against a nominal of revolution (``nominal.axisymmetric``) takes ``nu × 4`` samples,
-        since every meridian gives the same distances.
+        against a nominal of revolution (``nominal.axisymmetric``) takes ``nu × 4`` samples
+        (in its trimmed ``v`` range), since every meridian gives the same distances.
         """
         if self.nominal is None:
             return None
-        if self.revolution is not None and self.trim.full_v and getattr(self.nominal, "axisymmetric", False):
-            pts = self.sample(nu, 4).reshape(-1, 3)  # every meridian gives the same distances
+        if self.revolution is not None and getattr(self.nominal, "axisymmetric", False):
+            pts = self.sample(nu, 4).reshape(-1, 3)  # every meridian gives the same distances (a cut-away's too)
             return float(np.max(np.abs(self.nominal(pts))))
         nu_c, nv_c = max((nu - 1) // 2 + 1, 3), max(nv // 2, 4)
         u, v = self._grid(nu_c, nv_c)

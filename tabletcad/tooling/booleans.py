@@ -243,6 +243,16 @@ def _integral(shape: TopoDS_Shape, eps: float, kind: str, centroid: bool = False
 def mesh_arrays(shape: TopoDS_Shape, deflection: float = 0.005, angular: float = 0.2):
     """``(V, T)`` of the tessellation (Delabella, falling back to Watson for faces it leaves empty),
     read-only and computed once per shape and deflections (:data:`CACHE`)."""
+    return _mesh_with_faces(shape, deflection, angular)[:2]
+
+
+def mesh_face_ids(shape: TopoDS_Shape, deflection: float = 0.005, angular: float = 0.2) -> np.ndarray:
+    """Each triangle's face in :func:`mesh_arrays` ``(shape, deflection, angular)``: its index in
+    ``explore(shape, "Face")`` (read-only, computed with the mesh)."""
+    return _mesh_with_faces(shape, deflection, angular)[2]
+
+
+def _mesh_with_faces(shape: TopoDS_Shape, deflection: float, angular: float):
     from tabletcad.cad.mesh import triangulate
 
     def compute():
@@ -250,10 +260,10 @@ def mesh_arrays(shape: TopoDS_Shape, deflection: float = 0.005, angular: float =
         # straight away at the shape's other deflections (a failed Delabella pass cost 0.3-0.5 s)
         if not CACHE.get(shape, ("delabella_fails",), lambda: [False])[0]:
             try:
-                return frozen(*triangulate(shape, deflection, angular))
+                return frozen(*triangulate(shape, deflection, angular, face_ids=True))
             except GeometryError:
                 CACHE.get(shape, ("delabella_fails",), lambda: [False])[0] = True
-        return frozen(*triangulate(shape, deflection, angular, algo="watson"))
+        return frozen(*triangulate(shape, deflection, angular, algo="watson", face_ids=True))
 
     return CACHE.get(shape, ("mesh", float(deflection), float(angular)), compute)
 

@@ -27,9 +27,10 @@ from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from scipy.spatial import cKDTree
 
 from tabletcad.cad._occ import explore
+from tabletcad.errors import GeometryError
 from tabletcad.geometry.tablet import coordinate_range
 from tabletcad.io.forked import OCC_PARALLEL
-from tabletcad.tooling.booleans import (bound_area, mesh_arrays, manifold_op, manifold_volume, raw_boolean, to_manifold,
+from tabletcad.tooling.booleans import (bound_area, mesh_arrays, mesh_face_ids, manifold_op, manifold_volume, raw_boolean, to_manifold,
                                         volume)
 from tabletcad.tooling.die import MIN_BORE_OFFSET_MM
 
@@ -412,6 +413,43 @@ class ExactDistance:
         return self.nearest(p)[0]
 
 
+def _mesh_near(shape, boxes: list, margin: float, deflection: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`~tabletcad.tooling.booleans.mesh_arrays` of the faces of ``shape`` whose boxes come within
+    ``margin`` (mm) of one of ``boxes`` (``Bnd_Box``: never smaller than a face, so no face that near is
+    left out); the whole shape's (cached) when every face is that near."""
+    from OCP.BRep import BRep_Builder
+    from OCP.TopoDS import TopoDS_Compound
+
+    from tabletcad.cad.mesh import triangulate
+
+    faces = explore(shape, "Face")
+    near = [f for f in faces if min(_box(f).Distance(b) for b in boxes) <= margin]
+    if len(near) == len(faces):
+        return mesh_arrays(shape, deflection, 0.2)
+    if not near:
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
+    comp = TopoDS_Compound()
+    builder = BRep_Builder()
+    builder.MakeCompound(comp)
+    for f in near:
+        builder.Add(comp, f)
+    try:  # as mesh_arrays: Delabella, Watson where it leaves a trimmed face empty
+        return triangulate(comp, deflection, 0.2)
+    except GeometryError:
+        return triangulate(comp, deflection, 0.2, algo="watson")
+
+
+def _contact_faces(faces: list, parts: dict) -> set[int]:
+    """Indices of ``faces`` that are also faces of one of ``parts`` (``IsSame``: the same face, either way round)."""
+    from OCP.TopTools import TopTools_IndexedMapOfShape
+
+    tool_faces = TopTools_IndexedMapOfShape()
+    for s in parts.values():
+        for f in explore(s, "Face"):
+            tool_faces.Add(f)
+    return {k for k, f in enumerate(faces) if tool_faces.Contains(f)}
+
+
 def _box_corners(shape) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
     box = _box(shape)
     lo, hi = box.CornerMin(), box.CornerMax()
@@ -437,8 +475,8 @@ def _surface_samples(tablet, nu: int = 49, nv: int = 384) -> np.ndarray:
     return np.concatenate([p.evaluate_grid(u, v).reshape(-1, 3) for p in tablet.patches])
 
 
-def face_samples(shape, spacing: float = 0.05, max_per_face: int = 2500) -> np.ndarray:
-    """Points (n, 3) on every face of ``shape`` (mm): a grid in each face's ``(u, v)`` box about
+def face_samples(shape, spacing: float = 0.05, max_per_face: int = 2500, faces=None) -> np.ndarray:
+    """Points (n, 3) on every face of ``shape`` (mm; or on ``faces`` of it): a grid in each face's ``(u, v)`` box about
     ``spacing`` mm apart on the surface (at most ``max_per_face`` per face), kept where
     ``BRepTopAdaptor_FClass2d`` puts them inside the face or on its boundary.
 
@@ -453,7 +491,7 @@ def face_samples(shape, spacing: float = 0.05, max_per_face: int = 2500) -> np.n
 
     keep_states = (TopAbs_State.TopAbs_IN, TopAbs_State.TopAbs_ON)
     out = []
-    for face in explore(shape, "Face"):
+    for face in explore(shape, "Face") if faces is None else faces:
         surf = BRepAdaptor_Surface(face)
         u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
         g = np.linspace(0.0, 1.0, 9)
@@ -753,14 +791,24 @@ def _largest_gap(tablet, parts: dict, clearance: float, deflection: float, refin
     """The tablet's largest gap to the tools (mm), where it is and how it was found (the ``max_gap_*`` keys)."""
     t1 = time.perf_counter()
     # gap: points on the tablet's surface (its mesh vertices, plus its PDE patches sampled densely
-    # towards their edges, kept where they lie on the featured solid) against the parts' meshes
+    # towards their edges, kept where they lie on the featured solid) against the parts' meshes.
+    # A face of the tablet that is also a face of a tool (IsSame: a punch's tip is cut from the
+    # tablet and keeps its cup, score and letter faces) lies on that tool's boundary, at distance 0
+    # from it everywhere: only the others (the lands, the band) can hold the largest gap
+    faces = explore(tablet, "Face")
+    contact = _contact_faces(faces, parts)
+    free = [f for k, f in enumerate(faces) if k not in contact]
     V, T = mesh_arrays(tablet, deflection, 0.2)
+    if contact and free:
+        T = T[~np.isin(mesh_face_ids(tablet, deflection, 0.2), sorted(contact))]
+        used = np.unique(T)
+        V, T = V[used], np.searchsorted(used, T)
     if tablet_model is not None:
         S = _surface_samples(tablet_model)
         keep = mesh_distance(S, V, T, reach=2.0 * deflection) <= 2.0 * deflection  # farther: inf, dropped as before
         V = np.vstack([V, S[keep]])
     n_mesh = len(V)
-    V = np.vstack([V, face_samples(tablet, spacing=max(0.25 * clearance, 0.005))])  # inside every B-rep face
+    V = np.vstack([V, face_samples(tablet, spacing=max(0.25 * clearance, 0.005), faces=free)])  # inside every B-rep face
     # the tools' chord heights must be well below the gaps to be ranked (a gap of clearance/2 on a
     # land against chords of 5 µm would be outranked by chord artefacts on the cups)
     tool_deflection = min(deflection, max(0.1 * clearance, 1e-3))
@@ -774,8 +822,10 @@ def _largest_gap(tablet, parts: dict, clearance: float, deflection: float, refin
     h_split = max(50.0 * clearance, 1.0)
     lo, hi = coordinate_range([V], 3)
     lo, hi = lo - 2 * reach, hi + 2 * reach
-    tools = [MeshDistance(*refine_triangles(*mesh_arrays(s, tool_deflection, 0.2), h_split, lo, hi), reach=reach)
-             for s in parts.values()]
+    # each tool meshed where it can be within reach of those faces (a punch's letters and head are not)
+    boxes = [_box(f) for f in (free if contact and free else [tablet])]
+    tools = [MeshDistance(*refine_triangles(*_mesh_near(s, boxes, 2.0 * reach, tool_deflection), h_split, lo, hi),
+                          reach=reach) for s in parts.values()]
 
     def measure(P):
         # the nearest tool, its distance and its point nearest to P; a tool is asked only where it
@@ -818,7 +868,8 @@ def _largest_gap(tablet, parts: dict, clearance: float, deflection: float, refin
     return dict(
         max_gap_mm=float(exact[i_max]) if exact else float(np.max(dist)),
         max_gap_point_mm=[float(x) for x in on_surface[i_max]] if exact else None,
-        max_gap_method=f"tablet surface points ({len(V)}: {n_mesh} mesh vertices and PDE samples, "
+        max_gap_method=f"{len(contact)} of the tablet's {len(faces)} faces are faces of a tool (distance 0); "
+                       f"on the others, tablet surface points ({len(V)}: {n_mesh} mesh vertices and PDE samples, "
                        f"{len(V) - n_mesh - n_refined} on a (u, v) grid in every B-rep face, {n_refined} by branch and bound in "
                        f"triangles between tools) vs part meshes at {tool_deflection:.3g} mm (exact point-to-mesh distances, libigl; largest {float(np.max(dist)):.6g} mm), "
                        f"worst {len(order)} moved onto the tablet's B-rep and re-measured exactly (BRepExtrema_ExtPF/ExtPC on every "
