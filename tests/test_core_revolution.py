@@ -300,7 +300,8 @@ def test_trimmed_section_bounds_equal_the_sampled_ones_and_a_cut_away_plan_is_a_
     profiles and the plan vectors' closed-form spans hold every point of the solid map on a dense grid
     and come within 1e-3 mm of the outermost, and equal the polished samples of every patch plus
     the cut faces' inner edges to 1e-12 mm.  The plan of a solid cut-away (w from 0) is the sector
-    of its widest section: ``(v1 - v0) / 2π`` of the whole plan, ``½ (D/2)² (v1 - v0)`` for the round.
+    of its widest section: ``(v1 - v0) / 2π`` of the whole plan, ``½ (D/2)² (v1 - v0)`` for the round
+    (with or without a shell: both reach the axis).
     The solid map's volume (and the round's area and volume) on four points in v equal 256."""
     caplet = FAMILIES["thesis.caplet"].build()
     d = 10.0
@@ -325,8 +326,19 @@ def test_trimmed_section_bounds_equal_the_sampled_ones_and_a_cut_away_plan_is_a_
             a, b = cut.properties(), cut.properties(nv=256)
             assert a["volume_mm3"] == pytest.approx(b["volume_mm3"], rel=1e-13)
             assert a["surface_area_mm2"] == pytest.approx(b["surface_area_mm2"], rel=1e-13)
-        if w[0] == 0.0 and u0 == 0.0:
-            whole = t.trimmed(w=w).plan_area()
+        if u0 == 0.0:  # both reach the axis (R = 0 at the poles): a shell's plan has no hole
+            whole = t.trimmed(w=(0.0, w[1])).plan_area()
             assert cut.plan_area() == pytest.approx(whole * dv / math.tau, rel=1e-13)
             if t is rnd:
                 assert cut.plan_area() == pytest.approx(0.5 * (w[1] * d / 2) ** 2 * dv, rel=1e-13)
+
+
+def test_the_ring_s_plan_is_its_annulus():
+    """The ring (w from 0.5): the plan from its profiles, π ((w1 R_max)² - (w0 R_min)²), equals the
+    sampled plan (outer envelope minus the see-through hole) to 1e-12, and a quarter cut of it a quarter."""
+    from tabletcad.families.thesis import ring
+
+    t = ring()
+    assert t.trim.w[0] > 0.0 and t.section is not None
+    assert t.plan_area() == pytest.approx(t._plan_area_sampled(), rel=1e-12)
+    assert t.trimmed(v=(0.0, 0.5 * math.pi), w=t.trim.w).plan_area() == pytest.approx(0.25 * t.plan_area(), rel=1e-13)

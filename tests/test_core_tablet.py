@@ -134,11 +134,12 @@ def test_nominal_deviation_small_and_curves_on_nominal(name, diam, bound, family
 
 
 @pytest.mark.parametrize("sample", ["families/capsule", "families/rounded_triangle", "families/almond", "ring",
-                                    "cutaway_convex_round"])
+                                    "cutaway_convex_round", "families/concave_round", "families/ffre", "spherical"])
 def test_nominal_deviation_polished_reaches_the_dense_grids_largest(sample):
     """The coarse samples and their polished peaks reach at least the largest distance on the dense
     129 x 256 grid (which a half-as-fine grid alone misses), and no more than a peak's true height:
-    a 4x finer grid around every sample of the dense grid's best patch finds no more."""
+    a 4x finer grid around every sample of the dense grid's best patch finds no more.  Tablets of
+    revolution (one meridian polished in u) likewise, and a round family's certificate is that figure."""
     from tabletcad.pipeline.design import Design
 
     t = Design.from_toml(Path(__file__).resolve().parents[1] / "samples" / f"{sample}.toml").build()
@@ -149,6 +150,10 @@ def test_nominal_deviation_polished_reaches_the_dense_grids_largest(sample):
     u, v = t._grid(513, 1024)
     finest = float(np.max(np.abs(t.nominal(t.patches[p].evaluate_grid(u, v).reshape(-1, 3)))))
     assert finest * (1 - 1e-9) <= dev <= finest * 1.01
+    if t.revolution is not None and getattr(t.nominal, "axisymmetric", False) and hasattr(t.nominal, "outline"):
+        from tabletcad.families.sweep import certify  # a round family's certificate: the same polished peaks
+
+        assert certify(t).max_deviation_mm == dev
 
 
 def test_spherical_and_flat_round_close_to_formulae(family_tablet):

@@ -499,8 +499,9 @@ def certify(tablet: Tablet, nu: int = 33, nv: int = 512) -> Certificate:
     included) times ``nv / 2`` values of ``v`` plus the outline's joins, and the
     distance is polished around the largest local maxima of those samples
     (:meth:`~tabletcad.geometry.tablet.Tablet.deviation_peaks`: each peak resolved
-    32 times finer than ``nu × nv``); a surface and nominal of revolution on ``nu``
-    samples of four meridians.  The distance of each point to the nominal is exact
+    32 times finer than ``nu × nv``); a surface and nominal of revolution on ``4 nu - 3``
+    samples of one meridian, every peak polished in ``u``
+    (:meth:`~tabletcad.geometry.tablet.Tablet.meridian_peaks`).  The distance of each point to the nominal is exact
     (planar distance to the profile's lines and arcs at the point's exact plan
     offset).  The result is stored on the nominal (``tablet.nominal.certificate``).
     """
@@ -509,10 +510,9 @@ def certify(tablet: Tablet, nu: int = 33, nv: int = 512) -> Certificate:
         raise DesignError("tablet", tablet.name, "has no swept nominal to certify against")
     u = np.linspace(0.0, 1.0, nu)
     if _axisymmetric_nv(tablet, nv) == 4:  # of revolution: every meridian gives the same distances
-        v = _v_samples(nom.outline, 4)
-        X = [p.evaluate_grid(u, v).reshape(-1, 3) for p in tablet.patches]
-        d = nom.distance(np.concatenate(X))  # one call for all patches: each point's distance is its own
-        per = [float(np.max(part)) for part in np.split(d, np.cumsum([len(x) for x in X])[:-1])]
+        # one meridian at 4 nu - 3 points, each peak polished in u (shared with Tablet.nominal_deviation)
+        u, v = np.linspace(0.0, 1.0, 4 * nu - 3), np.zeros(1)
+        per = [float(x) for x in tablet.meridian_peaks(len(u))]
     else:  # a grid half as fine each way, polished around its peaks
         u, v = u[::2] if nu % 2 else np.linspace(0.0, 1.0, nu // 2 + 1), _v_samples(nom.outline, max(nv // 2, 4))
         per = [float(x) for x in tablet.deviation_peaks(u, v, math.tau / max(nv // 2, 4))]
