@@ -267,8 +267,12 @@ class PlanOutline:
 
         The distance and side of the nearest segment (the first of equals in the chain's
         order), each segment measured only where its bounding circle allows it to be the
-        nearest (:func:`~tabletcad.geometry.curves.nearest_of`).
+        nearest (:func:`~tabletcad.geometry.curves.nearest_of`); a circle's is ``R - |xy - c|``.
         """
+        if self.is_circle:
+            s = self.segs[0]
+            p = np.asarray(xy, dtype=float).reshape(-1, 2)
+            return s.radius - np.hypot(p[:, 0] - s.center[0], p[:, 1] - s.center[1])
         best, _, sign = nearest_of(self.segs, xy, _signed_to_segment)
         return sign * best
 

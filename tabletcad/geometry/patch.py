@@ -241,8 +241,9 @@ class PDEPatch:
                                             self._beta if self._has_remainder else None, self.u_nodes, self.form))
         lam1 = float(self._lams[1]) if N else 0.0
         coeffs = (a0, ac, bc, self._active, self._has_remainder, lam1, self.u_nodes, self.form, self.tol.revolution)
-        object.__setattr__(self, "_revolution", detect_revolution(*coeffs))
-        object.__setattr__(self, "_section", detect_section(*coeffs))
+        rev = detect_revolution(*coeffs)
+        object.__setattr__(self, "_revolution", rev)
+        object.__setattr__(self, "_section", detect_section(*coeffs) if rev is None else rev.section())
         if self.check:
             self._check_amplification(amp, zero)
 
@@ -619,7 +620,9 @@ class PDEPatch:
         same on every meridian, is always measured on four.
         """
         v = None
-        if self._section is not None:
+        if self._revolution is not None:  # every meridian alike (the section's argument, M a rotation)
+            nv = self._check_nv()
+        elif self._section is not None:
             # a surface of revolution, or of one plan ellipse (x, y) = R(u) M e(v), z = Z(u), M = [p q], folds
             # alike on every meridian: D = X - A0 = (R M e, 0), X_v × D = (0, 0, -R² det M) and the Jacobian
             # X_u · (X_v × D) = -Z' R² det M, so the speed |Jacobian| / |X_v × D| is |Z'(u)| on every v.  The
@@ -678,7 +681,7 @@ class PDEPatch:
             )
         u = _fold_u(401, 24)
         v = sample_v(self._check_nv())
-        if self._section is not None:
+        if self._section is not None and self._revolution is None:  # (of revolution: four meridians suffice)
             self._check_fold_section(u, v)
         else:
             self._check_fold_sampled(u, v)

@@ -103,6 +103,13 @@ class Revolution(_Profile):
     u_nodes: tuple[float, float, float, float]
     form: str
 
+    def section(self) -> "Section":
+        """The same profile as a :class:`Section` (``S = I``; ``p = e_φ``, ``q = sense · e_φ+90°``)."""
+        c, s = math.cos(self.phase), math.sin(self.phase)
+        return Section(shape=np.eye(2), radius=self.radius, height=self.height, lam=self.lam,
+                       u_nodes=self.u_nodes, form=self.form,
+                       plan=np.array([[c, s], [-self.sense * s, self.sense * c]]))
+
     def v_of_angle(self, angle: float) -> float:
         """The parameter ``v`` (rad) of the meridian at plan angle ``angle``."""
         return float(np.mod(self.sense * (angle - self.phase), math.tau))

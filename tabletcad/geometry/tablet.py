@@ -769,9 +769,11 @@ class Tablet:
         return A + w1 * (X - A)
 
     def _bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        if self.revolution is not None and self.trim.full_v and self.trim.w[1] == 1.0:
+        t = self.trim
+        if self.section is not None and t.full_v:  # ± w1 R_max √S_xx (the largest |R| alone: none missed)
             rmax, zbot, ztop = self._profile_extents()
-            return np.array([-rmax, -rmax, zbot]), np.array([rmax, rmax, ztop])
+            rx, ry = t.w[1] * rmax * (np.ones(2) if self.revolution is not None else self.section[0].reach())
+            return np.array([-rx, -ry, zbot]), np.array([rx, ry, ztop])
         if self.section is not None:
             return self._section_bounds()
         return self._bounds_sampled()
@@ -901,9 +903,9 @@ class Tablet:
 
         Every meridian gives the same distances (a cut-away's too), so one is sampled at ``nu``
         values of ``u`` per patch, and every local maximum within ``max |Δ²g|`` of the best sample
-        (a bound on what lies between samples) is polished in ``u``: 17 points over one sample step
-        each side, eight times finer each round, to ~1e-7 of ``u`` (all peaks of a round in one
-        evaluation per patch and one distance call).  The result is at least each patch's largest sample.
+        (a bound on what lies between samples) is polished in ``u``: 65 points over one sample step
+        each side, 32 times finer each of two rounds, to a step of ``1 / (1024 (nu - 1))`` in ``u`` (all
+        peaks of a round in one evaluation per patch and one distance call).  The result is at least each patch's largest sample.
         """
         key = f"_meridian_peaks_{nu}"
         hit = self.__dict__.get(key)
@@ -918,8 +920,8 @@ class Tablet:
         slack = float(np.max(np.abs(np.diff(D, 2, axis=1)))) if nu > 2 else math.inf
         E = np.pad(D, ((0, 0), (1, 1)), mode="edge")
         js, cs = np.nonzero((D >= E[:, :-2]) & (D >= E[:, 2:]) & (D >= float(per.max()) - slack))
-        cu, h, m = u[cs], u[1] - u[0], 17
-        for _ in range(5):
+        cu, h, m = u[cs], u[1] - u[0], 65
+        for _ in range(2):
             grid = np.clip(cu[:, None] + np.linspace(-h, h, m), lo, hi)  # (candidates, m)
             pts = np.empty((len(js), m, 3))
             for j in np.unique(js):
@@ -929,7 +931,7 @@ class Tablet:
             best = np.argmax(vals, axis=1)
             cu = grid[np.arange(len(js)), best]
             np.maximum.at(per, js, vals[np.arange(len(js)), best])
-            h /= 8.0
+            h /= 32.0
         per.setflags(write=False)
         self.__dict__[key] = per
         return per.copy()
