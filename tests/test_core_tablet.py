@@ -195,3 +195,17 @@ def test_trim_validation():
         Trim(v=(0.0, 7.0))
     with pytest.raises(DesignError):
         Trim(w=(-0.1, 1.0))
+
+
+def test_report_fold_depth_is_the_figure_each_patch_was_checked_with():
+    """The report's ``fold_depth_mm`` is what the build compared with ``tol.fold``: a thesis patch's
+    own check (the default grid), a swept family's builder's (65 rows of u, 128 meridians)."""
+    from tabletcad.families import FAMILIES
+    from tabletcad.pipeline.report import geometry_report
+
+    for name, nu in (("thesis.spherical", 257), ("capsule", 65), ("concave_round", 257)):
+        t = FAMILIES[name].build()
+        rep = geometry_report(t)
+        for p, row in zip(t.patches, rep["patches"]):
+            assert row["fold_depth_mm"] == p.fold_depth(nu=nu, nv=128 if nu == 65 else None)
+            assert row["fold_depth_mm"] <= t.tol.fold

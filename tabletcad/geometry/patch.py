@@ -636,6 +636,14 @@ class PDEPatch:
             self.__dict__.setdefault("_checks", {})[key] = self._fold_depth_of(nu, nv, v)
         return self._checks[key]
 
+    @property
+    def checked_fold_depth(self) -> float:
+        """The fold depth (mm) the patch was checked with: its own check's (:meth:`fold_depth` at the
+        defaults), or the builder's that checked it instead (a swept family's, on 65 rows of ``u``);
+        :meth:`fold_depth` when it was never checked."""
+        hit = self.__dict__.get("_fold_depth")
+        return self.fold_depth() if hit is None else hit
+
     def _principal_v(self) -> np.ndarray:
         """The four meridians of a :attr:`section` patch where ``|M e(v)|`` and ``|M e'(v)|`` are extreme
         (``M e(v) = p cos v + q sin v``, its plan vectors): ``e(v)`` along the eigenvectors of ``MᵀM``."""

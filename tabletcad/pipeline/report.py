@@ -42,7 +42,7 @@ def geometry_report(tablet: Tablet, options: ReportOptions | None = None) -> dic
                 u_nodes=list(p.u_nodes),
                 spine_height_mm=float(s[1, 2] - s[0, 2]),
                 stray_mm=p.stray(),
-                fold_depth_mm=p.fold_depth(),
+                fold_depth_mm=p.checked_fold_depth,  # the figure its check compared with tol.fold
             )
         )
     v = props["volume_mm3"]
