@@ -904,9 +904,10 @@ class Tablet:
 
         Every meridian gives the same distances (a cut-away's too), so one is sampled at ``nu``
         values of ``u`` per patch, and every local maximum within ``max |Δ²g|`` of the best sample
-        (a bound on what lies between samples) is polished in ``u``: 65 points over one sample step
-        each side, 32 times finer each of two rounds, to a step of ``1 / (1024 (nu - 1))`` in ``u`` (all
-        peaks of a round in one evaluation per patch and one distance call).  The result is at least each patch's largest sample.
+        (a bound on what lies between samples) and each patch's largest sample are polished in ``u``:
+        65 points over one sample step each side, 32 times finer each of two rounds, to a step of
+        ``1 / (1024 (nu - 1))`` in ``u`` (all peaks of a round in one evaluation per patch and one
+        distance call).  The result is at least each patch's largest sample.
         """
         key = f"_meridian_peaks_{nu}"
         hit = self.__dict__.get(key)
@@ -920,7 +921,9 @@ class Tablet:
         per = D.max(axis=1)
         slack = float(np.max(np.abs(np.diff(D, 2, axis=1)))) if nu > 2 else math.inf
         E = np.pad(D, ((0, 0), (1, 1)), mode="edge")
-        js, cs = np.nonzero((D >= E[:, :-2]) & (D >= E[:, 2:]) & (D >= float(per.max()) - slack))
+        cand = (D >= E[:, :-2]) & (D >= E[:, 2:]) & (D >= float(per.max()) - slack)
+        cand[np.arange(n), np.argmax(D, axis=1)] = True  # and each patch's best: its own figure polished
+        js, cs = np.nonzero(cand)
         cu, h, m = u[cs], u[1] - u[0], 65
         for _ in range(2):
             grid = np.clip(cu[:, None] + np.linspace(-h, h, m), lo, hi)  # (candidates, m)
