@@ -909,10 +909,13 @@ class Tablet:
         ``1 / (1024 (nu - 1))`` in ``u`` (all peaks of a round in one evaluation per patch and one
         distance call).  The result is at least each patch's largest sample.
         """
-        key = f"_meridian_peaks_{nu}"
-        hit = self.__dict__.get(key)
-        if hit is not None:
-            return hit.copy()
+        # kept on the nominal with the patches it measured: a renamed copy of the tablet (the same
+        # patches and nominal, as a design file's name makes) and its certificate share it
+        memo = getattr(self.nominal, "__dict__", self.__dict__).setdefault("_tabletcad_meridian_peaks", {})
+        key = (self.trim.u, nu)
+        hit = memo.get(key)
+        if hit is not None and len(hit[0]) == len(self.patches) and all(a is b for a, b in zip(hit[0], self.patches)):
+            return hit[1].copy()
         lo, hi = self.trim.u
         u = np.linspace(lo, hi, nu)
         v0 = self.trim.v[0]
@@ -937,7 +940,7 @@ class Tablet:
             np.maximum.at(per, js, vals[np.arange(len(js)), best])
             h /= 32.0
         per.setflags(write=False)
-        self.__dict__[key] = per
+        memo[key] = (self.patches, per)
         return per.copy()
 
     def deviation_peaks(self, u: np.ndarray, v: np.ndarray, hv: float, peaks: int = 8, rounds: int = 3,
