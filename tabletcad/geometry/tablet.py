@@ -459,10 +459,9 @@ class Tablet:
         if self.section is not None:
             if t.full_v and t.w[0] == 0.0:  # the widest section's area (det S = 1)
                 return math.pi * (t.w[1] * self._largest_radius()) ** 2
-            radii = self._section_radii()
-            plan = self.section[0].plan
-            if (min(r[0] for r in radii) >= -self.tol.revolution  # R >= 0 but for round-off at a pole
-                    and all(np.max(np.abs(x.plan - plan)) <= 1e-12 for x in self.section)):
+            # from w = 0 every patch's band of radii starts at the axis: the tablet's range of R suffices
+            radii = [self._radius_range()] if t.w[0] == 0.0 else self._section_radii()
+            if min(r[0] for r in radii) >= -self.tol.revolution and self._one_plan():  # R >= 0 but for round-off
                 # the solid at (u, v) covers the radii w0 R(u) to w1 R(u) along P(v): each patch the band
                 # w0 R_min to w1 R_max, and their union the annular sector(s) over v0..v1 (det S = 1)
                 bands = sorted((t.w[0] * max(lo, 0.0), t.w[1] * hi) for lo, hi in radii)
@@ -691,13 +690,28 @@ class Tablet:
         the extreme is skipped.
         """
         hit = self.__dict__.get("_extents")
-        if hit is not None:
-            return hit
+        if hit is None:
+            out = self._profile_maxima((lambda P: np.abs(P[..., 0]), lambda P: -P[..., 1], lambda P: P[..., 1]))
+            hit = (out[0], -out[1], out[2])
+            object.__setattr__(self, "_extents", hit)
+        return hit
+
+    def _radius_range(self) -> tuple[float, float]:
+        """``(R_min, R_max)`` (mm, signed) over every profile of a :attr:`section` tablet and the trimmed
+        ``u`` range, polished as :meth:`_profile_extents` (cached)."""
+        hit = self.__dict__.get("_rrange")
+        if hit is None:
+            out = self._profile_maxima((lambda P: P[..., 0], lambda P: -P[..., 0]))
+            hit = (-out[1], out[0])
+            object.__setattr__(self, "_rrange", hit)
+        return hit
+
+    def _profile_maxima(self, quantities) -> list[float]:
+        """The largest value of each ``g(profile)`` over every profile (:meth:`_profile_extents`)."""
         lo, hi = self.trim.u
         u = np.linspace(lo, hi, 513)
         profiles = self.revolution or self.section
         prof = [r.profile(u) for r in profiles]
-        quantities = (lambda P: np.abs(P[..., 0]), lambda P: -P[..., 1], lambda P: P[..., 1])
         out = []
         for g in quantities:
             samples = [g(P) for P in prof]
@@ -705,9 +719,12 @@ class Tablet:
             slack = max(float(np.max(np.abs(np.diff(x, 2)))) for x in samples)
             out.append(max(profile_extreme(lambda uu, r=r, g=g: g(r.profile(uu)), lo, hi)[1]
                            for r, x in zip(profiles, samples) if float(x.max()) >= best - slack))
-        hit = (out[0], -out[1], out[2])
-        object.__setattr__(self, "_extents", hit)
-        return hit
+        return out
+
+    def _one_plan(self) -> bool:
+        """Whether every patch of a :attr:`section` tablet has the same plan vectors ``p, q`` (to 1e-12)."""
+        plan = self.section[0].plan
+        return all(np.max(np.abs(x.plan - plan)) <= 1e-12 for x in self.section)
 
     def _section_radii(self) -> list[tuple[float, float]]:
         """``(R_min, R_max)`` (mm, signed) of each patch's :attr:`section` profile over the trimmed ``u``
@@ -730,7 +747,10 @@ class Tablet:
         """
         t = self.trim
         lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
-        for sec, (rmin, rmax) in zip(self.section, self._section_radii()):
+        # each coordinate is linear in R for fixed w and v: with one plan for all patches the corners of
+        # the tablet's whole range of R give the same extremes as each patch's own
+        ranges = [(self.section[0], self._radius_range())] if self._one_plan() else zip(self.section, self._section_radii())
+        for sec, (rmin, rmax) in ranges:
             plo, phi = sec.span(*t.v)
             for i in range(2):
                 vals = [w * r * c for w in t.w for r in (rmin, rmax) for c in (plo[i], phi[i])]
