@@ -13,14 +13,13 @@ import numpy as np
 __all__ = ["is_closed", "weld"]
 
 
-def weld(V: np.ndarray, T: np.ndarray, tol: float, labels: np.ndarray | None = None):
+def weld(V: np.ndarray, T: np.ndarray, tol: float, tri_labels: np.ndarray | None = None):
     """Merge nodes closer than ``tol`` (mm; transitively: connected components of the pair graph)
     and drop the triangles left with a repeated node; unused nodes are removed.
 
     Each merged node keeps the position of its lowest-numbered member (the first face's node).
-    With ``labels`` (one per triangle, e.g. its face) returns ``(V, T, labels of the kept triangles)``.
+    With ``tri_labels`` (one per triangle, e.g. its face) returns ``(V, T, labels of the kept triangles)``.
     """
-    tri_labels = labels
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
     from scipy.spatial import cKDTree

@@ -647,9 +647,7 @@ class PDEPatch:
     def _principal_v(self) -> np.ndarray:
         """The four meridians of a :attr:`section` patch where ``|M e(v)|`` and ``|M e'(v)|`` are extreme
         (``M e(v) = p cos v + q sin v``, its plan vectors): ``e(v)`` along the eigenvectors of ``MᵀM``."""
-        sec = self._section
-        k = int(np.argmax(np.abs(sec.radius)))
-        pq = np.stack([self._ac[k, 0, :2], self._bc[k, 0, :2]]) / sec.radius[k]  # rows p, q
+        pq = self._section.plan  # rows p, q
         V = np.linalg.eigh(pq @ pq.T)[1]  # MᵀM = [p·p p·q; p·q q·q]
         return float(np.arctan2(V[1, 0], V[0, 0])) + 0.5 * math.pi * np.arange(4)
 
@@ -743,10 +741,7 @@ class PDEPatch:
         distance of ``X - A0``, along ``P``), and ``X_u × X_v = (a J Q / |Q|, b)``: the in-plane part's
         signed length ``a = Z' R |Q|`` and the z part ``b = R R' det M`` (``P = M e(v)``, ``Q = M e'(v)``,
         ``M = [p q]``, ``J`` a quarter turn)."""
-        sec = self._section
-        # the patch's own plan vectors: M e(v) = p cos v + q sin v (the datum k is ρ_k times them)
-        k = int(np.argmax(np.abs(sec.radius)))
-        pq = np.stack([self._ac[k, 0, :2], self._bc[k, 0, :2]]) / sec.radius[k]
+        pq = self._section.plan  # the patch's own plan vectors: M e(v) = p cos v + q sin v
         P = np.outer(np.cos(v), pq[0]) + np.outer(np.sin(v), pq[1])
         Q = np.outer(-np.sin(v), pq[0]) + np.outer(np.cos(v), pq[1])
         det = float(pq[0, 0] * pq[1, 1] - pq[0, 1] * pq[1, 0])

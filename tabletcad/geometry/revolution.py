@@ -106,9 +106,8 @@ class Revolution(_Profile):
     def section(self) -> "Section":
         """The same profile as a :class:`Section` (``S = I``; ``p = e_φ``, ``q = sense · e_φ+90°``)."""
         c, s = math.cos(self.phase), math.sin(self.phase)
-        return Section(shape=np.eye(2), radius=self.radius, height=self.height, lam=self.lam,
-                       u_nodes=self.u_nodes, form=self.form,
-                       plan=np.array([[c, s], [-self.sense * s, self.sense * c]]))
+        return Section(plan=np.array([[c, s], [-self.sense * s, self.sense * c]]), radius=self.radius,
+                       height=self.height, lam=self.lam, u_nodes=self.u_nodes, form=self.form)
 
     def v_of_angle(self, angle: float) -> float:
         """The parameter ``v`` (rad) of the meridian at plan angle ``angle``."""
@@ -122,8 +121,9 @@ class Section(_Profile):
 
     Parameters
     ----------
-    shape : ndarray (2, 2)
-        ``S = p pᵀ + q qᵀ`` with ``det S = 1``: the section at ``u`` is ``xᵀ S⁻¹ x = R(u)²``.
+    plan : ndarray (2, 2)
+        Rows ``p, q`` (``|det| = 1``) with the patch's own phase: its point at ``(u, v)`` is
+        ``R(u) (p cos v + q sin v)`` in plan.
     radius : ndarray (4,)
         Signed scale ``ρ_k`` (mm) of each datum: the radius of the circle of the same area.
     height : ndarray (4,)
@@ -132,19 +132,19 @@ class Section(_Profile):
         ``λ = a·1`` of mode 1 (eq 3.9).
     u_nodes : tuple of 4 floats
     form : {"curves", "hermite"}
-    plan : ndarray (2, 2)
-        Rows ``p, q`` (``|det| = 1``) with the patch's own phase: its point at ``(u, v)`` is
-        ``R(u) (p cos v + q sin v)`` in plan.
     """
 
-    shape: np.ndarray
+    plan: np.ndarray
     radius: np.ndarray
     height: np.ndarray
     lam: float
     u_nodes: tuple[float, float, float, float]
     form: str
 
-    plan: np.ndarray = None  # (2, 2): rows p, q (det ±1), the patch's own phase: M e(v) = p cos v + q sin v
+    @property
+    def shape(self) -> np.ndarray:
+        """``S = p pᵀ + q qᵀ`` (``det S = 1``): the section at ``u`` is ``xᵀ S⁻¹ x = R(u)²``."""
+        return self.plan.T @ self.plan
 
     def reach(self) -> np.ndarray:
         """``(√S_xx, √S_yy)``: the section's half extents in x and y per unit ``R``."""
@@ -197,7 +197,6 @@ def detect_section(a0: np.ndarray, ac: np.ndarray, bc: np.ndarray, active, has_r
     scale = math.sqrt(abs(det))
     p, q = p / scale, q / scale
     return Section(
-        shape=np.outer(p, p) + np.outer(q, q),
         plan=np.stack([p, q]),
         radius=np.ascontiguousarray(rho * scale),
         height=np.ascontiguousarray(a0[:, 2]),

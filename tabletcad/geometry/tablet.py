@@ -904,20 +904,16 @@ class Tablet:
         (:meth:`_polish_deviation`), which resolves each peak more finely than the whole
         ``nu × nv`` grid would, at a quarter of its cost.  A surface of revolution measured
         against a nominal of revolution (``nominal.axisymmetric``) takes ``nu`` samples of one
-        meridian, polished in ``u`` (:meth:`_meridian_deviation`), since every meridian (in its
+        meridian, polished in ``u`` (:meth:`meridian_peaks`), since every meridian (in its
         trimmed ``v`` range) gives the same distances.
         """
         if self.nominal is None:
             return None
         if self.revolution is not None and getattr(self.nominal, "axisymmetric", False):
-            return self._meridian_deviation(nu)
+            return float(np.max(self.meridian_peaks(nu)))
         nu_c, nv_c = max((nu - 1) // 2 + 1, 3), max(nv // 2, 4)
         u, v = self._grid(nu_c, nv_c)
         return float(np.max(self.deviation_peaks(u, v, v[1] - v[0])))
-
-    def _meridian_deviation(self, nu: int) -> float:
-        """:meth:`nominal_deviation` of a tablet and nominal of revolution (:meth:`meridian_peaks`)."""
-        return float(np.max(self.meridian_peaks(nu)))
 
     def meridian_peaks(self, nu: int = 129) -> np.ndarray:
         """Largest ``|nominal|`` (mm) on each patch of a tablet and nominal of revolution (cached).
