@@ -32,6 +32,34 @@ __all__ = ["Band", "Trim", "Tablet", "Face", "solid_map"]
 
 
 
+def _cover(env: np.ndarray, grid: np.ndarray, psi: np.ndarray, x: np.ndarray, y: np.ndarray) -> None:
+    """Raise ``env`` (radii on the increasing angles ``grid``) to the fan of the polyline through the
+    points ``(x, y)`` (relative to the fans' centre, at polar angles ``psi``, continuous): the triangles
+    from the centre over its chords, on each run where the angle keeps its direction, and nothing
+    outside the angles it spans (in place)."""
+    if psi.size < 2:
+        return
+    d = np.sign(np.diff(psi))
+    turns = np.flatnonzero(d[1:] * d[:-1] < 0) + 1
+    for a, b in zip(np.r_[0, turns], np.r_[turns, d.size]):
+        q, px, py = psi[a:b + 1], x[a:b + 1], y[a:b + 1]
+        if q[-1] < q[0]:
+            q, px, py = q[::-1], px[::-1], py[::-1]
+        s = slice(int(np.searchsorted(grid, q[0], "left")), int(np.searchsorted(grid, q[-1], "right")))
+        g = grid[s]
+        if not g.size:
+            continue
+        k = np.clip(np.searchsorted(q, g, "right") - 1, 0, q.size - 2)
+        x0, y0, ex, ey = px[k], py[k], px[k + 1] - px[k], py[k + 1] - py[k]
+        cg, sg = np.cos(g), np.sin(g)
+        den = ex * sg - ey * cg  # the ray at angle g meets the chord where r (cg, sg) = P_k + s E
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = np.where(np.abs(den) > 0.0, (x0 * ey - y0 * ex) / -den, np.hypot(x0, y0))
+        # (a ray almost along a chord: a chord's points are never farther than its ends)
+        r = np.clip(r, 0.0, np.maximum(np.hypot(x0, y0), np.hypot(x0 + ex, y0 + ey)))
+        env[s] = np.maximum(env[s], r)
+
+
 def coordinate_range(arrays, k: int) -> tuple[np.ndarray, np.ndarray]:
     """Smallest and largest of each of the first ``k`` coordinates over point arrays ``(..., 3)``.
 
@@ -429,7 +457,7 @@ class Tablet:
             return Band(i, min(z0, z1), max(z0, z1), bulge)
         return None
 
-    def plan_area(self, nu: int = 33, nv: int = 2048) -> float:
+    def plan_area(self, nu: int = 33, nv: int = 2048) -> float | None:
         """Area (mm²) of the silhouette seen along z (the tablet's plan).
 
         The silhouette is taken as star-shaped about the plan centre: along
@@ -452,8 +480,9 @@ class Tablet:
         its widest section, of area ``π R_max²`` with ``R`` its equal-area radius.  Trimmed in ``w``
         and ``v`` (radii ``R >= 0``) it is the annular sector ``½ ((w1 R_max)² - (w0 R_min)²) (v1 - v0)``
         (the union of each patch's radii ``w0 R`` to ``w1 R``), which holds a cut-away's cut faces.
-        Known limit: a shaped cut-away's sampled plan is measured about its box centre and bridges
-        the cut with a chord, which is not its plan.
+        A shaped cut-away (``v`` trimmed, ``w`` from 0) whose spine stays at one plan point is
+        the union of fans from that point (:meth:`_plan_area_cut`); one whose spine moves in plan,
+        or a hollow shaped cut-away, has no plan area here (``None``).
         """
         t = self.trim
         if self.section is not None:
@@ -473,7 +502,94 @@ class Tablet:
                     else:
                         b = max(b, hi)
                 return 0.5 * area * (t.v[1] - t.v[0])
+        if not t.full_v:
+            return self._plan_area_cut(nu, nv) if t.w[0] == 0.0 else None
         return self._plan_area_sampled(nu, nv)
+
+    def _plan_area_cut(self, nu: int = 33, nv: int = 2048) -> float | None:
+        """:meth:`plan_area` of a cut-away (``v`` trimmed, ``w`` from 0) whose spine ``A0(u)`` stays at one
+        plan point ``c`` (to 1e-9 of the tablet's size; else ``None``).
+
+        The solid over a line ``u`` is the fan of segments from ``c`` to its outer curve
+        ``X(u, v0..v1)`` (eq 4.12), so the plan is star-shaped about ``c`` and its area is
+        ``½ ∫ r(φ)² dφ`` over the angles the fans cover, ``r(φ)`` the largest radius of any fan
+        at ``φ``.  The fans taken are those of the ``nu`` lines ``u`` of every patch (``nv``
+        points each), of the farthest point along each of the ``nv`` lines ``v`` (polished in
+        ``u`` as in :meth:`_plan_area_sampled`) and of the two cut faces (their edges ``X(u, v0)``,
+        ``X(u, v1)`` at 1025 ``u`` each), each the triangles from ``c`` over its chords; ``r`` is
+        their largest at the midpoints of 8 ``nv`` equal steps across the covered angles (or the
+        whole turn, where the fans reach round), with one Richardson step against the same from
+        every other line ``v`` (the chords' error is of second order).  On the shaped samples the
+        area from ``nu, nv = 65, 8192`` agrees to 1e-9 relative, and the union of the solid's
+        projected boundary (scanlines over its triangles) converges to it at second order
+        (``tests/test_core_plan_cutaway.py``).
+        """
+        t = self.trim
+        ue = np.linspace(t.u[0], t.u[1], 1025)
+        spine = np.concatenate([p.spine(ue)[:, :2] for p in self.patches])
+        c = 0.5 * (spine.min(axis=0) + spine.max(axis=0))
+        nv += nv % 2  # nv intervals: every other line keeps both ends (the Richardson step)
+        u, v = np.linspace(t.u[0], t.u[1], nu), np.linspace(t.v[0], t.v[1], nv + 1)
+        pts = [self._outer_grid(p, u, v, axes=(0, 1)) for p in self.patches]
+        size = max(float(np.max(np.hypot(X[0] - c[0], X[1] - c[1]))) for X in pts)
+        if np.max(np.abs(spine - c)) > 1e-9 * max(size, 1.0):
+            return None
+        tiny = 1e-9 * max(size, 1.0)
+        lines = []  # (x, y relative to c, index along v or None) of every polyline whose fan is in the plan
+        cols = np.arange(nv + 1)
+        for p, X in zip(self.patches, pts):
+            dx, dy = X[0] - c[0], X[1] - c[1]
+            lines += [(dx[k], dy[k], cols) for k in range(nu)]  # each line u's fan
+            r2 = dx * dx + dy * dy
+            i = np.argmax(r2, axis=0)
+            best = r2[i, cols]
+            d = np.column_stack([dx[i, cols], dy[i, cols]])
+            inner = (i > 0) & (i < nu - 1)
+            if np.any(inner):
+                k = np.flatnonzero(inner)
+                _, best[k], d[k] = self._farthest_along_u(p, c, u[i[k]], v[k], best[k], u[1] - u[0])
+            lines.append((d[:, 0], d[:, 1], cols))
+            for ve in t.v:  # the cut faces: fans over their outer edges
+                E = self._outer(p, ue, np.full(ue.shape, ve))[:, :2] - c
+                lines.append((E[:, 0], E[:, 1], None))
+        polar = []
+        for x, y, idx in lines:
+            keep = np.hypot(x, y) > tiny  # (the poles: no direction)
+            polar.append((np.arctan2(y[keep], x[keep]), x[keep], y[keep], None if idx is None else idx[keep]))
+        # angles from the middle of the widest direction no point has (the cut's gap), if any
+        phi = np.sort(np.concatenate([a for a, *_ in polar]))
+        gaps = np.diff(np.r_[phi, phi[0] + math.tau])
+        j = int(np.argmax(gaps))
+        g0 = float(phi[j] + 0.5 * gaps[j])
+        covered = gaps[j] <= 8.0 * math.tau / nv  # the fans reach round every direction
+        runs = []
+        lo, hi = math.inf, -math.inf
+        cr, sr = math.cos(g0), math.sin(g0)
+        for a, x, y, idx in polar:
+            psi = np.mod(a - g0, math.tau)
+            x, y = cr * x + sr * y, cr * y - sr * x  # in the frame of the angles psi
+            # a line through (or at round-off from) the centre turns by about π there: its fan is the
+            # two sides' fans; one across the gap's direction wraps by 2π and is unwrapped
+            cuts = np.flatnonzero(np.abs(np.abs(np.diff(psi)) - math.pi) < 0.5 * math.pi) + 1
+            for s, e in zip(np.r_[0, cuts], np.r_[cuts, psi.size]):
+                if e - s >= 2:
+                    q = np.unwrap(psi[s:e])
+                    runs.append((q, x[s:e], y[s:e], None if idx is None else idx[s:e]))
+                    lo, hi = min(lo, float(q.min())), max(hi, float(q.max()))
+        if covered:
+            lo, hi = 0.0, math.tau
+        m = 8 * nv
+        grid = lo + (np.arange(m) + 0.5) * ((hi - lo) / m)  # the midpoints: a radial edge's one angle is no cell
+
+        def area(half: bool) -> float:
+            env = np.zeros(grid.size)
+            for q, x, y, idx in runs:
+                k = slice(None) if not half or idx is None else idx % 2 == 0
+                for shift in (0.0, -math.tau, math.tau) if covered else (0.0,):
+                    _cover(env, grid, q[k] + shift, x[k], y[k])
+            return 0.5 * float(np.sum(env * env)) * ((hi - lo) / m)
+
+        return (4.0 * area(False) - area(True)) / 3.0
 
     def _plan_area_sampled(self, nu: int = 33, nv: int = 2048) -> float:
         """:meth:`plan_area` from samples of every patch (any star-shaped plan)."""

@@ -271,7 +271,9 @@ def _no_value(F: float) -> Iterator[list[dict[str, Any]]]:
                         range_flags=[f"{exc.parameter} = {exc.value:g} mm {exc.allowed}"], within_range=False))
 
 
-def _punch_check(plan_area: float, opts: ReportOptions) -> dict[str, Any]:
+def _punch_check(plan_area: float | None, opts: ReportOptions) -> dict[str, Any]:
+    """The punch-tip check against the user's limits; ``plan_area`` None (a shaped cut-away whose plan
+    area is not known, :meth:`Tablet.plan_area`): no pressure figures."""
     table = punch_rating_table()
     out: dict[str, Any] = dict(
         tip_face_area_mm2=plan_area,
@@ -285,16 +287,19 @@ def _punch_check(plan_area: float, opts: ReportOptions) -> dict[str, Any]:
     basis = None
     if opts.max_punch_force_kN is not None:
         lim_force, basis = opts.max_punch_force_kN, "user-given max_punch_force_kN"
-    if opts.max_punch_pressure_MPa is not None:
+    if opts.max_punch_pressure_MPa is not None and plan_area is not None:
         f = opts.max_punch_pressure_MPa * plan_area / 1000.0
         if lim_force is None or f < lim_force:
             lim_force, basis = f, "user-given max_punch_pressure_MPa x tip face area"
-    if basis and opts.max_punch_force_kN is not None and opts.max_punch_pressure_MPa is not None:
+    if opts.max_punch_pressure_MPa is not None and plan_area is None and basis is None:
+        basis = "max_punch_pressure_MPa given, but this cut-away's plan area is not known"
+    both = opts.max_punch_force_kN is not None and opts.max_punch_pressure_MPa is not None
+    if basis and both and plan_area is not None:
         basis += " (the stricter of the two limits given)"
     out["allowed_force_kN"] = lim_force
     out["limit_basis"] = basis or ("no limit given (no citable public punch-tip rating table is bundled: "
                                     "give [report] max_punch_force_kN or max_punch_pressure_MPa)")
-    if opts.compaction_force_kN is not None:
+    if opts.compaction_force_kN is not None and plan_area is not None:
         out["compaction_pressure_MPa"] = opts.compaction_force_kN * 1000.0 / plan_area
     if opts.compaction_force_kN is not None and lim_force is not None:
         out["ok"] = bool(opts.compaction_force_kN <= lim_force)
