@@ -285,19 +285,25 @@ FAMILY_SAMPLES = sorted((ROOT / "samples" / "families").glob("*.toml"))
 @pytest.mark.slow
 @pytest.mark.parametrize("path", FAMILY_SAMPLES, ids=[p.stem for p in FAMILY_SAMPLES])
 def test_every_family_sample_gets_valid_tooling(path):
-    """Punches and die for every family sample: single valid solids; at the closed position no
-    overlap between any two parts (OCC) and no point of the tablet farther than the clearance
-    from a tool; a bisect score across the width (it crosses a capsule's centre line)."""
+    """Punches and a die whose bore is tapered 1° above the tablet for every family sample: single
+    valid solids; at the closed position no overlap between any two parts (OCC) and no point of the
+    tablet farther than the clearance from a tool, the bore grown by its entry times tan 1° and the
+    punches the clearance inside it; a bisect score across the width (it crosses a capsule's centre
+    line).  (One build for both the parts and the taper: they were two tests of ~10 s a family.)"""
     from support.family_tablets import family_tablet
 
     t, shape = family_tablet(path)  # shared with tests/test_tooling_taper_gap.py
-    spec = ToolingSpec(clearance_mm=0.02)
+    spec = ToolingSpec(clearance_mm=0.02, taper_deg=1.0)
     ts = make_tooling(t, spec, shape=shape, check=False)
     for name, shape in ts.parts.items():
         check_solid(shape, name)
     r = ts.report
     assert r["interference_mm3"] == pytest.approx(0.0, abs=1e-9)
     assert 0.0 < r["max_gap_mm"] <= spec.clearance_mm
+    assert r["die"]["taper_deg"] == 1.0
+    assert r["die"]["bore_growth_at_top_mm"] == pytest.approx(r["die"]["punch_entry_mm"] * math.tan(math.radians(1.0)))
+    assert r["die"]["bore_growth_at_top_mm"] > 0.0
+    assert r["interference"]["punch_die_clearance_mm"] >= spec.clearance_mm - 1e-6
     # and a score across the width, half the shallower cup deep
     frame_depth = min(r["tablet"]["cup_depth_top_mm"], r["tablet"]["cup_depth_bottom_mm"])
     if frame_depth > 0.1:
