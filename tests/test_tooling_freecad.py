@@ -123,3 +123,44 @@ def test_freecad_reads_each_part(fc, files, name):
 
     assert r["volume"] == pytest.approx(mass_properties(ts.parts[name], None).volume, rel=1e-6)
     assert name in " ".join(r.get("labels", []))
+
+
+_NAME_READ = """
+import json, os
+import FreeCAD, Import
+doc = FreeCAD.newDocument("n")
+Import.insert(os.environ["TABLETCAD_FC_INPUT"], doc.Name)
+open(os.environ["TABLETCAD_FC_OUTPUT"], "w", encoding="utf-8").write(
+    json.dumps([o.Label for o in doc.Objects if o.TypeId == "Part::Feature"]))
+"""
+
+NAME = "Paracétamol 500 µg – 錠剤 O'Brien\\x 😀"
+
+
+def test_a_unicode_name_is_written_in_part21_directives_and_read_back(fc, tmp_path):
+    """OCC writes a product name outside ASCII as raw UTF-8 bytes under a header of Part 21's second
+    edition (basic alphabet only); tabletcad writes ``\\X2\\...\\X0\\`` (``\\X4\\`` beyond U+FFFF), and
+    OCC's reader and FreeCAD's importer give the name back."""
+    import json
+    import subprocess
+
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+
+    from support.readback import ocp_read_step
+    from tabletcad.cad.export import export_step
+
+    path = export_step(BRepPrimAPI_MakeBox(1.0, 2.0, 3.0).Shape(), tmp_path / "named.step", name=NAME)
+    raw = path.read_bytes()
+    assert max(raw) < 0x80  # the whole file is ASCII
+    text = raw.decode("ascii")
+    assert "'Parac\\X2\\00E9\\X0\\tamol 500 \\X2\\00B5\\X0\\g \\X2\\2013\\X0\\ \\X2\\93205264\\X0\\ O''Brien\\\\x " \
+           "\\X4\\0001F600\\X0\\'" in text
+    assert NAME in ocp_read_step(path)["products"]
+    script = tmp_path / "fc_name.py"
+    script.write_text(_NAME_READ)
+    out = tmp_path / "names.json"
+    env = freecads.clean_env()
+    env.update(FREECAD_USER_HOME=str(tmp_path), TABLETCAD_FC_INPUT=str(path), TABLETCAD_FC_OUTPUT=str(out))
+    proc = subprocess.run([*fc.cmd, str(script)], env=env, cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert out.exists(), proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert json.loads(out.read_text(encoding="utf-8")) == [NAME]

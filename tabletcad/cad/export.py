@@ -15,6 +15,7 @@ suffix     format
 from __future__ import annotations
 
 import os
+import re
 import struct
 from pathlib import Path
 from typing import Any
@@ -86,7 +87,32 @@ def write_step_document(doc, path: str | os.PathLike[str], *, what: str, obj: An
         status = writer.Write(str(tmp))
         if status != IFSelect_ReturnStatus.IFSelect_RetDone:
             raise GeometryError(f"writing STEP {path} failed: {status}", obj)
+        raw = Path(tmp).read_bytes()
+        if max(raw, default=0) > 0x7E:  # OCC writes names as raw UTF-8
+            Path(tmp).write_bytes(part21_text(raw.decode("utf-8")).encode("ascii"))
     return Path(path)
+
+
+_NON_ASCII = re.compile(r"[^\x00-\x7e]+")
+
+
+def part21_text(text: str) -> str:
+    """``text`` with every run of characters outside ASCII written as ISO 10303-21's control
+    directive ``\\X2\\hhhh...\\X0\\`` (UCS-2, four hex digits a character) or, for a run
+    holding a character beyond U+FFFF, ``\\X4\\hhhhhhhh...\\X0\\``.
+
+    The file header declares Part 21's second edition (``'2;1'``), whose strings hold only the
+    basic alphabet; OCC's writer puts a name such as "Paracétamol 500 µg" in as UTF-8 bytes,
+    which its own reader and FreeCAD take back, but which a reader of the standard need not.
+    Outside strings a STEP file is ASCII, so the runs are all inside strings."""
+
+    def directive(m: re.Match) -> str:
+        run = m.group(0)
+        if max(map(ord, run)) <= 0xFFFF:
+            return "\\X2\\" + "".join(f"{ord(c):04X}" for c in run) + "\\X0\\"
+        return "\\X4\\" + "".join(f"{ord(c):08X}" for c in run) + "\\X0\\"
+
+    return _NON_ASCII.sub(directive, text)
 
 
 def export_step(obj: Any, path: str | os.PathLike[str], *, name: str = "tablet", schema: str = "AP242") -> Path:
