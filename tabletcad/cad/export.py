@@ -88,12 +88,12 @@ def write_step_document(doc, path: str | os.PathLike[str], *, what: str, obj: An
         if status != IFSelect_ReturnStatus.IFSelect_RetDone:
             raise GeometryError(f"writing STEP {path} failed: {status}", obj)
         raw = Path(tmp).read_bytes()
-        if max(raw, default=0) > 0x7E:  # OCC writes names as raw UTF-8
+        if not raw.isascii():  # OCC writes names as raw UTF-8
             Path(tmp).write_bytes(part21_text(raw.decode("utf-8")).encode("ascii"))
     return Path(path)
 
 
-_NON_ASCII = re.compile(r"[^\x00-\x7e]+")
+_NON_ASCII = re.compile(r"[^\x00-\x7f]+")
 
 
 def part21_text(text: str) -> str:
