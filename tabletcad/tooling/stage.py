@@ -78,10 +78,11 @@ def tooling_stage(*, tablet: Tablet, spec: ToolingSpec, shape, out: Path, report
 
     out = Path(out)
     ts = make_tooling(tablet, spec, shape=shape, options=options, interference_check=False)
-    if not (parallel and can_fork()) or fe_rating is not None:
+    forks = parallel and can_fork()
+    if not forks or fe_rating is not None:
         # with an FE rating, which the drawing prints, the check comes first as in one process (no FE
         # solve for tooling that then fails it), then the rating, then the files
-        _check_gap(ts, tablet.name, spec, forked=parallel and can_fork())
+        _check_gap(ts, tablet.name, spec, forked=forks)
         if fe_rating is not None:
             ts.report["tip_rating"]["fe"] = fe_rating(ts)
         files = write_tooling(ts, out)
