@@ -113,8 +113,10 @@ def _table(name: str, sec: dict[str, Any]) -> str:
         rows.append(("punch-tip check", f"not checked: {pc['limit_basis']}" if pc.get("allowed_force_kN") is None
                      else f"limit {pc['allowed_force_kN']:.4g} kN ({pc['limit_basis']}); give compaction_force_kN"))
     else:
-        rows.append(("punch-tip check", f"{'OK' if pc['ok'] else 'OVER LIMIT'}: {pc['compaction_force_kN']:g} kN of {pc['allowed_force_kN']:.4g} kN "
-                     f"({pc['compaction_pressure_MPa']:.4g} MPa on {pc['tip_face_area_mm2']:.4g} mm2; {pc['limit_basis']})"))
+        on = ("plan area not known" if pc.get("tip_face_area_mm2") is None  # (a shaped cut-away, Tablet.plan_area)
+              else f"{pc['compaction_pressure_MPa']:.4g} MPa on {pc['tip_face_area_mm2']:.4g} mm2")
+        rows.append(("punch-tip check", f"{'OK' if pc['ok'] else 'OVER LIMIT'}: {pc['compaction_force_kN']:g} kN of "
+                     f"{pc['allowed_force_kN']:.4g} kN ({on}; {pc['limit_basis']})"))
     fe = sec.get("fe_breaking_force")
     if fe is not None:
         rows.append(("FE breaking force", f"{fe['breaking_force_N']:.4g} N across the width (elastic first-crack "
