@@ -598,11 +598,11 @@ class Tablet:
             pieces = []
             for q, x, y, idx in runs:
                 k = slice(None) if not half or idx is None else idx % 2 == 0
-                pieces += [(a + sh, b, c) for a, b, c in _monotone_pieces(q[k], x[k], y[k]) for sh in shifts]
+                pieces += [(qq + sh, xx, yy) for qq, xx, yy in _monotone_pieces(q[k], x[k], y[k]) for sh in shifts]
             sets.append(pieces)
         # midpoints of 8 nv steps across the range, each piece's ends among the steps' ends: the
         # envelope is continuous within each step (a fan ends at its ends), so the rule is of second order
-        ends = np.unique(np.clip([a[e] for pieces in sets for a, _, _ in pieces for e in (0, -1)], lo, hi))
+        ends = np.unique(np.clip([qq[e] for pieces in sets for qq, _, _ in pieces for e in (0, -1)], lo, hi))
         ends = np.unique(np.r_[lo, ends, hi])
         widths = np.diff(ends)
         n = np.maximum(np.ceil(widths * (8 * nv) / (hi - lo)).astype(int), 1)
