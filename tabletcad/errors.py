@@ -10,6 +10,7 @@ free edges) raise :class:`GeometryError`, which carries the object that failed.
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
 
 __all__ = [
@@ -53,14 +54,14 @@ class DesignError(TabletcadError, ValueError):
     """Invalid user input: the message names the parameter, value and allowed range."""
 
     def __init__(self, parameter: str, value: Any, allowed: str, unit: str = "") -> None:
-        self.parameter = parameter
+        self.parameter = one_token(parameter)
         self.value = value
         self.allowed = allowed
         self.unit = unit
         shown = _fmt(value)
         if unit and not isinstance(value, (str, bool)):  # not after a string ('10 mm') or true/false
             shown = f"{shown} {unit}"
-        super().__init__(f"{parameter} = {shown} is not allowed: {allowed}")
+        super().__init__(f"{self.parameter} = {shown} is not allowed: {allowed}")
 
     def __reduce__(self):  # pickled with its own arguments (a forked helper sends it back to the parent)
         return DesignError, (self.parameter, self.value, self.allowed, self.unit)
@@ -81,10 +82,46 @@ class GeometryError(TabletcadError):
         return GeometryError, (str(self),)
 
 
+_WORD = re.compile(r"""'[^']*'|"[^"]*"|\S+""")
+_HEADER = re.compile(r"^\[\[?([^\[\]]+)\]\]?(.*)$")  # [table] or [[array]], maybe followed by .key
+_BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
+
+
 def one_token(parameter: str) -> str:
-    """``parameter`` as one token (runs of whitespace become ``.``), as the one-line
-    error format ``error: <parameter> = <value> is not allowed: <range>`` shows it."""
-    return ".".join(parameter.split()) or "?"
+    """``parameter`` as one token, the key path of the design file, as the one-line error format
+    ``error: <parameter> = <value> is not allowed: <range>`` shows it: table headers lose their
+    brackets, words join with ``.``, an index follows its name in brackets and a quoted key keeps
+    double quotes where it is not a bare key (``[[tooling.score]] 0 depth_mm`` ->
+    ``tooling.score[0].depth_mm``, ``[report] key 'weight'`` -> ``report.weight``,
+    ``[sweep.vary] 'tablet.diameter' max`` -> ``sweep.vary."tablet.diameter".max``).  A token
+    without whitespace or brackets (``tablet.diameter``, ``patch[0].a``, ``--nodes``) is kept."""
+    text = str(parameter).strip()
+    if text.startswith("-"):  # a command-line option
+        return text
+    words = _WORD.findall(text)
+    out: list[str] = []
+    i = 0
+    while i < len(words):
+        w = words[i]
+        if w in ("key", "item", "top-level") and i + 1 < len(words):  # "key 'name'", "item 3": the name, the index
+            i += 1
+            w = words[i]
+            if w == "key" and i + 1 < len(words):  # "top-level key 'name'"
+                i += 1
+                w = words[i]
+        header = _HEADER.match(w)
+        if header:
+            w = header.group(1) + header.group(2)
+        if len(w) >= 2 and w[0] in "'\"" and w[-1] == w[0]:
+            inner = w[1:-1]
+            w = inner if _BARE_KEY.match(inner) else '"' + inner.replace('"', '\\"') + '"'
+        if w.isdigit() and out:
+            out[-1] += f"[{w}]"
+        elif w:
+            out.append(w.lstrip(".") if out else w)
+        i += 1
+    token = ".".join(out) or "?"
+    return re.sub(r"\.(\d+)(?=[.\[]|$)", r"[\1]", token)  # tooling.emboss.0.depth_mm -> tooling.emboss[0].depth_mm
 
 
 def _fmt(value: Any) -> str:

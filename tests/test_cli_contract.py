@@ -339,7 +339,7 @@ def test_a_missing_extra_is_one_line_naming_it(tmp_path, capsys, monkeypatch, ar
     assert main(argv) == 2
     cap = capsys.readouterr()
     assert cap.out == ""
-    assert cap.err.splitlines() == [cap.err.strip()] and cap.err.startswith(f"error: tabletcad {extra} = ")
+    assert cap.err.splitlines() == [cap.err.strip()] and cap.err.startswith(f"error: tabletcad.{extra} = ")
     assert f"pip install 'tabletcad[{extra}]'" in cap.err
     assert list(tmp_path.iterdir()) == []
 

@@ -223,7 +223,7 @@ def test_toml_files_with_a_byte_order_mark_load_and_binary_ones_are_refused(tmp_
     junk = tmp_path / "junk.toml"
     junk.write_bytes(b"\x89PNG\r\n\x1a\n\xff\xfe\x00")
     for args, parameter in ((["report", str(junk)], "design_file"),
-                            (["optimise", str(junk), "--out", str(tmp_path / "o")], "problem file")):
+                            (["optimise", str(junk), "--out", str(tmp_path / "o")], "problem.file")):
         assert main(args) == 2
         err = capsys.readouterr().err
         assert err.startswith(f"error: {parameter} = ") and "UTF-8" in err and len(err.splitlines()) == 1
@@ -252,7 +252,7 @@ def test_heckel_input_that_would_be_misread(tmp_path, capsys):
     for args, parameter, fragment in (
             ([str(data), "--diameter", "12", "--face-area", "78.54"], "--face-area", "not both"),  # one was ignored
             (["/dev/null"], "DATA", "must be a file"),  # it said "does not exist"
-            ([str(data), "--diameter", "1e200"], "diameter", "<= 1000 mm")):  # an OverflowError, exit 1
+            ([str(data), "--diameter", "1e200"], "--diameter", "<= 1000 mm")):  # an OverflowError, exit 1
         assert main(["heckel", *args]) == 2
         err = capsys.readouterr().err
         assert err.startswith(f"error: {parameter} = ") and fragment in err and len(err.splitlines()) == 1, err

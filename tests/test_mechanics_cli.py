@@ -53,7 +53,7 @@ def test_heckel_options_replace_metadata_file(capsys, tmp_path):
     "extra,match",
     [
         (["--mass", "-3"], "mass = -3 mg"),
-        (["--true-density", "0"], "true density"),
+        (["--true-density", "0"], "--true-density = 0"),
         (["--diameter", "0"], "diameter"),
         (["--window", "10", "10.5"], "need >= 3"),
     ],

@@ -33,15 +33,15 @@ def test_problem_file_with_the_fe_objective_is_checked():
 
     base = {"problem": {"kind": "family", "family": "concave_round", "objective": "fe_breaking_force_N"},
             "variables": {"band": {"lower": 2.0, "upper": 3.0}}, "fixed": {"diameter": 10.0, "cup_depth": 0.9}}
-    with pytest.raises(DesignError, match=r"\[fe\] tensile_strength_MPa = 'missing' is not allowed"):
+    with pytest.raises(DesignError, match=r"fe\.tensile_strength_MPa = 'missing' is not allowed"):
         problem_from_dict(base)
-    with pytest.raises(DesignError, match=r"\[fe\] tensile_strength_MPa = -2 MPa is not allowed: must be a finite number > 0"):
+    with pytest.raises(DesignError, match=r"fe\.tensile_strength_MPa = -2 MPa is not allowed: must be a finite number > 0"):
         problem_from_dict({**base, "fe": {"tensile_strength_MPa": -2}})
-    with pytest.raises(DesignError, match=r"\[fe\] direction = 'diagonal' is not allowed"):
+    with pytest.raises(DesignError, match=r"fe\.direction = 'diagonal' is not allowed"):
         problem_from_dict({**base, "fe": {"tensile_strength_MPa": 2.0, "direction": "diagonal"}})
-    with pytest.raises(DesignError, match=r"\[fe\] symmetric = 'yes' is not allowed: must be a TOML boolean"):
+    with pytest.raises(DesignError, match=r"fe\.symmetric = 'yes' is not allowed: must be a TOML boolean"):
         problem_from_dict({**base, "fe": {"tensile_strength_MPa": 2.0, "symmetric": "yes"}})
-    with pytest.raises(DesignError, match=r"\[fe\] = 'given' is not allowed: only problems using fe_breaking_force_N"):
+    with pytest.raises(DesignError, match=r"fe = 'given' is not allowed: only problems using fe_breaking_force_N"):
         problem_from_dict({**base, "problem": {**base["problem"], "objective": "volume_mm3"},
                            "fe": {"tensile_strength_MPa": 2.0}})
     with pytest.raises(DesignError, match=r"\[problem\] solve_for = 'band' is not allowed: must not be a variable"):

@@ -37,41 +37,41 @@ CAPSULE = '[problem]\nkind = "softgel_capsule"\n\n[parameters]\nmodel = "none"\n
 
 # (name, file text, text that the parameter named in the error line must contain)
 BAD = [
-    ("tol_string", FAMILY + 'tol = "loose"\n', "[[constraint]] 0 tol"),
-    ("P_bounds_one", ROUND + "P_bounds = [50.0]\n", "[parameters] P_bounds"),
-    ("P_bounds_reversed", ROUND + "P_bounds = [60.0, 20.0]\n", "[parameters] P_bounds"),
-    ("material_E_zero", SPHERE + "material = { E = 0.0 }\n", "[parameters] material E"),
-    ("material_unknown", SPHERE + "material = { G = 300.0 }\n", "[parameters] material key 'G'"),
-    ("lower_string", FAMILY.replace("lower = 4.0", 'lower = "4"'), "[variables] diameter lower"),
-    ("lower_bool", FAMILY.replace("lower = 4.0", "lower = true"), "[variables] diameter lower"),
-    ("relative_string", FAMILY.replace("relative = true", 'relative = "false"'), "[[constraint]] 0 relative"),
-    ("lower_negative", FAMILY.replace("lower = 1.0", "lower = -1.0"), "[variables] thickness lower"),
-    ("target_negative", FAMILY.replace("target = 235.0", "target = -235.0"), "[[constraint]] 0 target"),
-    ("mass_negative", ROUND.replace("300.0", "-300.0"), "[parameters] mass_mg"),
-    ("mass_huge_integer", ROUND.replace("300.0", "1" + "0" * 400), "[parameters] mass_mg"),
-    ("mass_nan", ROUND.replace("300.0", "nan"), "[parameters] mass_mg"),
-    ("volume_negative", SPHERE + "volume = -1.44\n", "[parameters] volume"),
-    ("force_negative", SPHERE + "force_bounds = [-9.9, 9.9]\n", "[parameters] force_bounds lower"),
-    ("ftol_negative", SPHERE + "\n[solver]\nftol = -1e-9\n", "[solver] ftol"),
-    ("fd_step_negative", SPHERE + "\n[solver]\nfd_step = -1e-6\n", "[solver] fd_step"),
-    ("maxiter_bool", SPHERE + "\n[solver]\nmaxiter = true\n", "[solver] maxiter"),
-    ("maxiter_float", SPHERE + "\n[solver]\nmaxiter = 2.5\n", "[solver] maxiter"),
-    ("solver_unknown", SPHERE + "\n[solver]\ntolerance = 1e-9\n", "[solver] key 'tolerance'"),
-    ("name_escape", FAMILY.replace('sense = "min"', 'sense = "min"\nname = "../../escape"'), "[problem] name"),
+    ("tol_string", FAMILY + 'tol = "loose"\n', "constraint[0].tol"),
+    ("P_bounds_one", ROUND + "P_bounds = [50.0]\n", "parameters.P_bounds"),
+    ("P_bounds_reversed", ROUND + "P_bounds = [60.0, 20.0]\n", "parameters.P_bounds"),
+    ("material_E_zero", SPHERE + "material = { E = 0.0 }\n", "parameters.material.E"),
+    ("material_unknown", SPHERE + "material = { G = 300.0 }\n", "parameters.material.G"),
+    ("lower_string", FAMILY.replace("lower = 4.0", 'lower = "4"'), "variables.diameter.lower"),
+    ("lower_bool", FAMILY.replace("lower = 4.0", "lower = true"), "variables.diameter.lower"),
+    ("relative_string", FAMILY.replace("relative = true", 'relative = "false"'), "constraint[0].relative"),
+    ("lower_negative", FAMILY.replace("lower = 1.0", "lower = -1.0"), "variables.thickness.lower"),
+    ("target_negative", FAMILY.replace("target = 235.0", "target = -235.0"), "constraint[0].target"),
+    ("mass_negative", ROUND.replace("300.0", "-300.0"), "parameters.mass_mg"),
+    ("mass_huge_integer", ROUND.replace("300.0", "1" + "0" * 400), "parameters.mass_mg"),
+    ("mass_nan", ROUND.replace("300.0", "nan"), "parameters.mass_mg"),
+    ("volume_negative", SPHERE + "volume = -1.44\n", "parameters.volume"),
+    ("force_negative", SPHERE + "force_bounds = [-9.9, 9.9]\n", "parameters.force_bounds.lower"),
+    ("ftol_negative", SPHERE + "\n[solver]\nftol = -1e-9\n", "solver.ftol"),
+    ("fd_step_negative", SPHERE + "\n[solver]\nfd_step = -1e-6\n", "solver.fd_step"),
+    ("maxiter_bool", SPHERE + "\n[solver]\nmaxiter = true\n", "solver.maxiter"),
+    ("maxiter_float", SPHERE + "\n[solver]\nmaxiter = 2.5\n", "solver.maxiter"),
+    ("solver_unknown", SPHERE + "\n[solver]\ntolerance = 1e-9\n", "solver.tolerance"),
+    ("name_escape", FAMILY.replace('sense = "min"', 'sense = "min"\nname = "../../escape"'), "problem.name"),
     ("name_on_thesis_kind", SPHERE.replace('kind = "spherical_tablet"', 'kind = "spherical_tablet"\nname = "x"'),
-     "[problem] name"),
-    ("initial_unknown", SPHERE + "initial = { r_P21 = 0.72, bogus = 1.0 }\n", "[parameters] initial bogus"),
-    ("initial_string", SPHERE + 'initial = { r_P21 = "0.72" }\n', "[parameters] initial r_P21"),
-    ("parameter_unknown", SPHERE + "diameter = 5.0\n", "[parameters] key 'diameter'"),
-    ("top_unknown", SPHERE + "\n[extra]\na = 1\n", "top-level key 'extra'"),
+     "problem.name"),
+    ("initial_unknown", SPHERE + "initial = { r_P21 = 0.72, bogus = 1.0 }\n", "parameters.initial.bogus"),
+    ("initial_string", SPHERE + 'initial = { r_P21 = "0.72" }\n', "parameters.initial.r_P21"),
+    ("parameter_unknown", SPHERE + "diameter = 5.0\n", "parameters.diameter"),
+    ("top_unknown", SPHERE + "\n[extra]\na = 1\n", "extra"),
     ("variable_key_unknown", FAMILY.replace("initial = 3.0", "initial = 3.0, step = 0.1"),
-     "[variables] thickness key 'step'"),
-    ("variant_bool", SPHERE.replace('"a"', "true"), "[parameters] variant"),
-    ("radius_constraints_string", CAPSULE.replace("false", '"false"'), "[parameters] radius_constraints"),
-    ("displacement_unknown", ROUND + 'displacement = "exact"\n', "[parameters] displacement"),
-    ("sense_unknown", FAMILY.replace('"min"', '"minimum"'), "[problem] sense"),
-    ("kind_list", SPHERE.replace('"spherical_tablet"', '["spherical_tablet"]'), "[problem] kind"),
-    ("not_toml", "[problem\nkind = 1\n", "problem file"),
+     "variables.thickness.step"),
+    ("variant_bool", SPHERE.replace('"a"', "true"), "parameters.variant"),
+    ("radius_constraints_string", CAPSULE.replace("false", '"false"'), "parameters.radius_constraints"),
+    ("displacement_unknown", ROUND + 'displacement = "exact"\n', "parameters.displacement"),
+    ("sense_unknown", FAMILY.replace('"min"', '"minimum"'), "problem.sense"),
+    ("kind_list", SPHERE.replace('"spherical_tablet"', '["spherical_tablet"]'), "problem.kind"),
+    ("not_toml", "[problem\nkind = 1\n", "problem.file"),
 ]
 
 
@@ -118,7 +118,7 @@ def test_bad_paths_one_line(tmp_path, capsys, where):
     rc = main(["optimise", str(problem), "--out", str(out), "--quiet"])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1 and ONE_LINE.match(err[0]), err
-    assert err[0].startswith("error: problem file =" if where == "problem_is_folder" else "error: --out =")
+    assert err[0].startswith("error: problem.file =" if where == "problem_is_folder" else "error: --out =")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["blocker", "problem.toml"]
     assert blocker.read_text() == "not a folder"
 
@@ -221,7 +221,7 @@ def test_bad_thesis_file_is_refused_before_the_solvers_and_the_pde_core_load(tmp
             "print(rc, sorted(m for m in ('scipy.optimize', 'tabletcad.geometry.curves', 'matplotlib') if m in sys.modules))")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False)
     assert r.stdout.split("\n")[0] == "2 []", (r.stdout, r.stderr)
-    assert r.stderr.strip().startswith("error: [parameters] P_bounds = [50.0] is not allowed:")
+    assert r.stderr.strip().startswith("error: parameters.P_bounds = [50.0] is not allowed:")
     assert not (tmp_path / "out").exists()
 
 

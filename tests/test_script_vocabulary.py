@@ -44,8 +44,8 @@ def test_an_old_name_builds_the_same_tablet_with_one_warning(old):
 
 def test_lookup_refuses_unknown_names_naming_the_parameter():
     with pytest.raises(DesignError) as e:
-        family("flat_faced_rnd", parameter="[problem] family")
-    assert e.value.parameter == "[problem] family" and "thesis.flat_faced_round" in str(e.value)
+        family("flat_faced_rnd", parameter="problem.family")
+    assert e.value.parameter == "problem.family" and "thesis.flat_faced_round" in str(e.value)
     with pytest.raises(DesignError):
         family(["capsule"])
     with warnings.catch_warnings():

@@ -84,7 +84,7 @@ def _write(tmp_path, body: str):
 
 
 BAD = {
-    "unknown key": ('[sweep.vary]\n"tablet.cup_dept" = [0.8, 0.9]\n', "[sweep.vary] key = 'tablet.cup_dept'"),
+    "unknown key": ('[sweep.vary]\n"tablet.cup_dept" = [0.8, 0.9]\n', "sweep.vary.key = 'tablet.cup_dept'"),
     "unknown table": ('[sweep.vary]\n"tooling.clearance_mm" = [0.01]\n', "'tooling.clearance_mm'"),
     "empty list": ('[sweep.vary]\n"tablet.cup_depth" = []\n', "an empty list sweeps nothing"),
     "empty range": ('[sweep.vary]\n"tablet.cup_depth" = { min = 1.0, max = 0.5, num = 3 }\n', "the range is empty"),
@@ -92,12 +92,12 @@ BAD = {
     "num negative": ('[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0, num = -2 }\n', "num = -2 is not allowed"),
     "num missing": ('[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0 }\n', "num = 'missing'"),
     "samples without seed": ('[sweep]\nmethod = "lhs"\nsamples = 10\n[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0 }\n',
-                             "[sweep] seed = 'missing'"),
+                             "sweep.seed = 'missing'"),
     "samples zero": ('[sweep]\nmethod = "lhs"\nsamples = 0\nseed = 1\n[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0 }\n',
-                     "[sweep] samples = 0"),
-    "unknown method": ('[sweep]\nmethod = "random"\n[sweep.vary]\n"tablet.cup_depth" = [0.8]\n', "[sweep] method = 'random'"),
-    "unknown output": ('[sweep]\noutputs = ["iges"]\n[sweep.vary]\n"tablet.cup_depth" = [0.8]\n', "[sweep] outputs = 'iges'"),
-    "no vary": ("[sweep]\n", "[sweep.vary] = 'missing'"),
+                     "sweep.samples = 0"),
+    "unknown method": ('[sweep]\nmethod = "random"\n[sweep.vary]\n"tablet.cup_depth" = [0.8]\n', "sweep.method = 'random'"),
+    "unknown output": ('[sweep]\noutputs = ["iges"]\n[sweep.vary]\n"tablet.cup_depth" = [0.8]\n', "sweep.outputs = 'iges'"),
+    "no vary": ("[sweep]\n", "sweep.vary = 'missing'"),
 }
 
 

@@ -75,27 +75,27 @@ def test_standard_fills_barrel_length_angle_and_die_and_records_sources():
 def test_user_defined_set_needs_every_dimension():
     with pytest.raises(DesignError) as e:
         parse_tooling(_with(standard="custom", type=None))
-    assert "[tooling.punch] head" in str(e.value) or "overall_length_mm" in str(e.value)
+    assert "tooling.punch.head" in str(e.value) or "overall_length_mm" in str(e.value)
 
 
 @pytest.mark.parametrize("table, parameter", [
-    (_with(standard="JIS"), "[tooling] standard"),
-    (_with(type="E"), "[tooling] type"),
-    (_with(type=None), "[tooling] type"),
-    (_with(tip_length_mm=120.0), "[tooling] tip_length_mm"),          # a tip longer than the punch
-    (_with(lower_tip_length_mm=130.0), "[tooling] lower_tip_length_mm"),
-    (_with(punch_head_diameter_mm=None), "[tooling.punch] head_diameter_mm"),
-    (_with(die_height_mm=None), "[tooling] die_height_mm"),
-    (_with(punch_neck_diameter_mm=20.0), "[tooling.punch] neck_diameter_mm"),
-    (_with(punch_dome_radius_mm=10.0), "[tooling.punch] dome_radius_mm"),
-    (_with(punch_tip_straight_mm=9.0), "[tooling.punch] tip_straight_mm"),
-    (_with(punch_key=True), "[tooling.punch] key_width_mm"),
-    (_with(punch_bogus=1), "[tooling.punch] key 'bogus'"),
+    (_with(standard="JIS"), "tooling.standard"),
+    (_with(type="E"), "tooling.type"),
+    (_with(type=None), "tooling.type"),
+    (_with(tip_length_mm=120.0), "tooling.tip_length_mm"),          # a tip longer than the punch
+    (_with(lower_tip_length_mm=130.0), "tooling.lower_tip_length_mm"),
+    (_with(punch_head_diameter_mm=None), "tooling.punch.head_diameter_mm"),
+    (_with(die_height_mm=None), "tooling.die_height_mm"),
+    (_with(punch_neck_diameter_mm=20.0), "tooling.punch.neck_diameter_mm"),
+    (_with(punch_dome_radius_mm=10.0), "tooling.punch.dome_radius_mm"),
+    (_with(punch_tip_straight_mm=9.0), "tooling.punch.tip_straight_mm"),
+    (_with(punch_key=True), "tooling.punch.key_width_mm"),
+    (_with(punch_bogus=1), "tooling.punch.bogus"),
     (_with(punch_key=True, punch_key_width_mm=25.0, punch_key_length_mm=20.0, punch_key_height_mm=2.0,
-           punch_key_offset_mm=10.0), "[tooling.punch] key_width_mm"),  # wider than the barrel: was built
-    (_with(tip_length_mm=1e300), "[tooling] tip_length_mm"),  # reached OCC as a zero vector (exit 1)
-    (_with(gap_mm=1e308), "[tooling] gap_mm"),  # an assembly of volume 0
-    (_with(die_height_mm=1e7), "[tooling] die_height_mm"),
+           punch_key_offset_mm=10.0), "tooling.punch.key_width_mm"),  # wider than the barrel: was built
+    (_with(tip_length_mm=1e300), "tooling.tip_length_mm"),  # reached OCC as a zero vector (exit 1)
+    (_with(gap_mm=1e308), "tooling.gap_mm"),  # an assembly of volume 0
+    (_with(die_height_mm=1e7), "tooling.die_height_mm"),
 ])
 def test_bad_complete_tooling_is_one_design_error(table, parameter):
     if "punch" in table:
@@ -200,7 +200,7 @@ def test_cli_bad_complete_tooling_exits_2_with_one_line_and_writes_nothing(tmp_p
     out = tmp_path / "out"
     assert main(["build", str(d), "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("error: [tooling")
+    assert len(err) == 1 and err[0].startswith("error: tooling")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
 
 
@@ -228,7 +228,7 @@ def test_a_tip_relief_leaving_no_tip_names_tip_relief_mm():
     tablet = shallow_convex_round()
     with pytest.raises(DesignError) as e:
         make_tooling(tablet, parse_tooling(_with(punch_tip_relief_mm=6.0)), check=False)
-    assert str(e.value).startswith("[tooling.punch] tip_relief_mm = 6 mm is not allowed: must leave a relieved tip")
+    assert str(e.value).startswith("tooling.punch.tip_relief_mm = 6 mm is not allowed: must leave a relieved tip")
     frame = tablet_frame(tablet)
     spec = parse_tooling(EU_B)
     R = 0.5 * frame.width  # the round's radius: the tip's outline is R - clearance

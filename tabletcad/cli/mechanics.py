@@ -124,11 +124,14 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
     _check_output("--plot", plot_file)
     _check_json_file(json_file, plot=plot_file)
     if window is not None:
-        check_finite("--window", window[0], "MPa")
+        check_range("--window", window[0], 0.0, None, "MPa")  # pressures: a compact is never pulled
         check_positive("--window", window[1], "MPa")
         if not window[0] < window[1]:
             raise DesignError("--window", window, "must be two increasing pressures", "MPa")
-    with _collect() as msgs:
+    given = {k: o for k, o, v in (("mass_mg", "--mass", mass), ("true_density", "--true-density", true_density),
+                                  ("diameter", "--diameter", diameter), ("face_area", "--face-area", face_area))
+             if v is not None}  # an option overrides the metadata file's key: named as given
+    with _collect() as msgs, option_names(given):
         comp = MachineCompliance(slope=compliance[0], offset=compliance[1]) if compliance else None
         rec = read_press_data(
             data, meta, mass_mg=mass, true_density=true_density, diameter=diameter, face_area=face_area,
@@ -165,7 +168,9 @@ def _read_table(path: Path, columns: dict[str, str]) -> dict[str, np.ndarray]:
     """
     import csv
 
-    text = path.read_text(encoding="utf-8-sig")
+    from tabletcad.mechanics.pressdata import decode_text
+
+    text = decode_text(path.read_bytes())  # UTF-8, UTF-16 or Windows-1252, as the press exports
     rows = [r for r in csv.reader((ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")),
                                   delimiter="\t" if "\t" in text.split("\n", 1)[0] else ",")]
     if len(rows) < 2:
@@ -181,16 +186,16 @@ def _read_table(path: Path, columns: dict[str, str]) -> dict[str, np.ndarray]:
             try:
                 v = float(r[j])
             except (IndexError, ValueError):
-                raise DesignError(f"{path.name} line {i}, column {name!r}", r[j] if j < len(r) else "missing",
+                raise DesignError(f"{path.name} line {i} {name!r}", r[j] if j < len(r) else "missing",
                                   "must be a number") from None
-            vals.append(check_finite(f"{path.name} line {i}, column {name!r}", v))
+            vals.append(check_finite(f"{path.name} line {i} {name!r}", v))
         out[key] = np.asarray(vals, dtype=float)
     return out
 
 
 def _check_window(window: tuple[float, float] | None) -> None:
     if window is not None:
-        check_finite("--window", window[0], "MPa")
+        check_range("--window", window[0], 0.0, None, "MPa")  # pressures: a compact is never pulled
         check_positive("--window", window[1], "MPa")
         if not window[0] < window[1]:
             raise DesignError("--window", window, "must be two increasing pressures", "MPa")
@@ -224,7 +229,12 @@ def _compression_table(data: Path, pressure_column: str, thickness_column: str, 
     _check_window(window)
     if h0 is not None:
         check_positive("--h0", h0, "mm")
-    return _read_table(data, {"P": pressure_column, "h": thickness_column})
+    table = _read_table(data, {"P": pressure_column, "h": thickness_column})
+    bad = np.flatnonzero(~(table["h"] > 0.0))
+    if bad.size:  # a thickness is a length: 0 or less is a misread column or a displacement
+        raise DesignError(f"{data.name} line {int(bad[0]) + 2} {thickness_column!r}", float(table["h"][bad[0]]),
+                          "must be > 0 (the compact's thickness)", "mm")
+    return table
 
 
 def _compression_options(f):

@@ -10,7 +10,7 @@ from __future__ import annotations
 import contextlib
 from collections.abc import Iterator, Mapping
 
-from tabletcad.errors import DesignError
+from tabletcad.errors import DesignError, one_token
 
 __all__ = ["option_names"]
 
@@ -21,6 +21,7 @@ def option_names(names: Mapping[str, str]) -> Iterator[None]:
     try:
         yield
     except DesignError as exc:
-        if exc.parameter in names:
-            raise exc.renamed(names[exc.parameter]) from None
+        option = {one_token(k): v for k, v in names.items()}.get(exc.parameter)  # (a DesignError's parameter is one token)
+        if option is not None:
+            raise exc.renamed(option) from None
         raise

@@ -325,7 +325,7 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
                 "--true-density", true_density), "breaking_force_N": ("--breaking-force", breaking_force),
                 "compaction_force_kN": ("--compaction-force", compaction_force), "max_punch_force_kN": (
                 "--max-punch-force", max_punch_force), "max_punch_pressure_MPa": ("--max-punch-pressure", max_punch_pressure)}
-            option, value = options.get(exc.parameter.removeprefix("[report] "), (None, None))
+            option, value = options.get(exc.parameter.removeprefix("report."), (None, None))
             raise exc.renamed(option if value is not None else one_token(exc.parameter)) from None
         inverse = None
         if solve_for is not None:

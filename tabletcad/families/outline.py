@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from tabletcad.geometry.curves import Seg, nearest_of, signed_area
-from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.errors import DesignError, check_finite, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
 from tabletcad.geometry.quadrature import gauss_legendre
 
@@ -371,6 +371,9 @@ class SplineOutline(PlanOutline):
         sp1 = self._sp(vs, 1)
         self.perimeter = float(np.sum(np.hypot(sp1[:, 0], sp1[:, 1])) * math.tau / vs.size)
         self.area = abs(0.5 * float(np.sum(self._ps[:, 0] * sp1[:, 1] - self._ps[:, 1] * sp1[:, 0])) * math.tau / vs.size)
+        if not self.area > 1e-9 * self.perimeter ** 2:  # points on one line: the spline runs there and back
+            raise DesignError(parameter, f"an outline enclosing {self.area:.3g} mm^2",
+                              "the points must enclose an area (they lie on one line)")
         _check_polyline_simple(self._ps[::4], parameter)
         from scipy.spatial import cKDTree
 
@@ -559,6 +562,19 @@ def _check_polyline_simple(p: np.ndarray, parameter: str) -> None:
 
 
 # ---------------------------------------------------------------------- constructors
+def check_numbers(parameter: str, value) -> None:
+    """Refuse text, booleans and non-finite values anywhere in nested lists of numbers (a quoted
+    ``"4.5"`` is not a coordinate, although numpy would read it as one)."""
+    if isinstance(value, np.ndarray) and value.dtype.kind in "fiu":
+        if not np.all(np.isfinite(value)):
+            raise DesignError(parameter, "a value that is not finite", "must hold finite numbers (mm)")
+    elif isinstance(value, (list, tuple, np.ndarray)):
+        for i, item in enumerate(value):
+            check_numbers(f"{parameter}[{i}]", item)
+    else:
+        check_finite(parameter, value, "mm")
+
+
 def outline_from_items(items, name: str = "outline", parameter: str = "outline") -> PlanOutline:
     """Outline from ``("line", (x0, y0), (x1, y1))`` and
     ``("arc", (cx, cy), radius, theta0, sweep)`` items (mm, rad), as in
@@ -568,6 +584,8 @@ def outline_from_items(items, name: str = "outline", parameter: str = "outline")
         if not isinstance(it, (list, tuple)) or not it:
             raise DesignError(f"{parameter} item {i}", it, "must be ('line', p0, p1) or ('arc', center, radius, theta0, sweep)")
         kind = it[0]
+        for k, part in enumerate(it[1:], start=1):  # no text where a number goes ("3" is not a radius)
+            check_numbers(f"{parameter}[{i}][{k}]", part)
         try:
             if kind == "line" and len(it) == 3:
                 segs.append(_line(it[1], it[2]))

@@ -25,6 +25,7 @@ from tabletcad.families.cups import CompoundCup, land_line, single_radius_cup
 from tabletcad.families.outline import (
     PlanOutline,
     SplineOutline,
+    check_numbers,
     four_arc_oval,
     outline_from_items,
     rounded_polygon,
@@ -45,6 +46,7 @@ def as_outline(outline) -> PlanOutline:
         return outline
     if isinstance(outline, (list, tuple)) and outline and isinstance(outline[0], (list, tuple)) and outline[0] and isinstance(outline[0][0], str):
         return outline_from_items(outline)
+    check_numbers("outline", outline)
     try:
         pts = np.asarray(outline, dtype=float)
     except (TypeError, ValueError):

@@ -90,7 +90,7 @@ def split_branches(force, drop: float = 0.02) -> Branches:
     fall = np.flatnonzero(F < (1.0 - drop) * runmax)
     end = int(fall[0]) if fall.size else n
     if end == 0:  # the first force is already a fall from itself: negative (tensile) forces
-        raise DesignError("force (row 1)", float(F[0]), "has no loading branch: compression forces must be > 0", "N")
+        raise DesignError("row 1 force", float(F[0]), "has no loading branch: compression forces must be > 0", "N")
     seg = F[:end]
     peak = int(np.flatnonzero(seg == seg.max())[-1])
     if peak < 2 or F[peak] <= 0.0 or F[peak] <= F[0]:

@@ -191,8 +191,8 @@ class PressMetadata:
 
     def __post_init__(self) -> None:
         # generous physical limits: a compact of up to 1 kg, any solid's density, a die up to 1 m
-        check_range("mass", self.mass_mg, 0.0, 1e6, "mg", lo_open=True)
-        check_range("true density", self.true_density, 0.0, MAX_TRUE_DENSITY_MG_MM3, "mg/mm³", lo_open=True)
+        check_range("mass_mg", self.mass_mg, 0.0, 1e6, "mg", lo_open=True)
+        check_range("true_density", self.true_density, 0.0, MAX_TRUE_DENSITY_MG_MM3, "mg/mm³", lo_open=True)
         if self.diameter is None and self.face_area is None:
             raise DesignError("diameter", "missing", "give the die diameter (mm) or the punch face area (mm²)", "mm")
         if self.diameter is not None:
@@ -307,7 +307,7 @@ def _assemble(F, pos, is_thickness, t, meta, extra, lines, dropped, source) -> P
     if np.any(thickness <= 0.0):
         i = int(np.flatnonzero(thickness <= 0.0)[0])
         raise DesignError(
-            f"thickness (line {int(lines[i])})", float(thickness[i]),
+            f"line {int(lines[i])} thickness", float(thickness[i]),
             "must be > 0; check displacement_sign/displacement_zero", "mm",
         )
     for arr in (F, gap, thickness):
@@ -336,7 +336,7 @@ def _role(header: str) -> str | None:
     return None
 
 
-def _decode(raw: bytes) -> str:
+def decode_text(raw: bytes) -> str:
     """UTF-8 (with or without BOM), UTF-16 (with or without BOM), else Windows-1252 (µ as the byte 0xB5)."""
     if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
         return raw.decode("utf-16")
@@ -524,7 +524,7 @@ def read_press_data(
         role: unit_factor(u, DIMENSIONS[role], f"--{'displacement' if role == 'thickness' else role}-unit")
         for role, u in units.items()
     }
-    header, line_numbers, by_column, delim = _read_table(_decode(path.read_bytes()), path.name)
+    header, line_numbers, by_column, delim = _read_table(decode_text(path.read_bytes()), path.name)
     found: dict[str, list[int]] = {r: [] for r in ROLES}
     for j, h in enumerate(header):
         r = _role(h)
@@ -564,7 +564,7 @@ def read_press_data(
             continue
         u = header_unit(header[j])
         factors[j] = (1.0, 0) if u is None else unit_factor(
-            u, DIMENSIONS[r], f"unit of column {header[j]!r} (or give --{unit_role}-unit)")
+            u, DIMENSIONS[r], f"column {header[j]!r} unit", f"; or give --{unit_role}-unit")
     used = {roles["force"], roles[pos_role]} | ({roles["time"]} if "time" in roles else set())
     nrow = len(line_numbers)
     decimal_comma = delim != "," and any("," in c for col in by_column for c in col[:50])
@@ -576,7 +576,7 @@ def read_press_data(
             values[:, j] = col
             numeric_cols.append(j)
         elif j in used:
-            raise DesignError(f"{header[j]} (line {line_numbers[col]})", by_column[j][col].strip(), "must be a number")
+            raise DesignError(f"line {line_numbers[col]} {header[j]!r}", by_column[j][col].strip(), "must be a number")
         # else: a non-numeric optional column is ignored entirely
         by_column[j] = []  # free the text as soon as it is read
     for j, (factor, exponent) in factors.items():

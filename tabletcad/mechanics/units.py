@@ -99,17 +99,17 @@ def _trailing(header: str) -> re.Match[str] | None:
     return m
 
 
-def unit_factor(symbol: str, dimension: str, parameter: str) -> tuple[float, int | None]:
+def unit_factor(symbol: str, dimension: str, parameter: str, hint: str = "") -> tuple[float, int | None]:
     """Factor (and its decimal exponent, or None) converting ``symbol`` to N, mm or s.
 
     Raises
     ------
     DesignError
         ``symbol`` is not a known unit of ``dimension``; ``parameter`` names
-        the header or option the unit came from.
+        the header or option the unit came from; ``hint`` is appended to what is allowed.
     """
     entry = UNITS.get(_normalise(symbol))
     if entry is None or entry[0] != dimension:
         known = ", ".join(k for k, v in UNITS.items() if v[0] == dimension)
-        raise DesignError(parameter, symbol, f"is not a known {dimension} unit ({known})")
+        raise DesignError(parameter, symbol, f"is not a known {dimension} unit ({known}){hint}")
     return entry[1], entry[2]

@@ -297,8 +297,8 @@ def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
     try:
         return thesis.make_problem(kind, **params), method, solver
     except DesignError as exc:
-        if exc.parameter.startswith("initial "):  # name the table the key came from
-            raise DesignError(f"[parameters] {exc.parameter}", exc.value, exc.allowed, exc.unit) from None
+        if exc.parameter.startswith("initial."):  # name the table the key came from
+            raise exc.renamed(f"parameters.{exc.parameter}") from None
         raise
 
 

@@ -120,13 +120,18 @@ def _number(where: str, value: Any, unit: str = "", *, tol: Tolerances = DEFAULT
     return x
 
 
-def _lengths(where: str, value: Any, *, tol: Tolerances = DEFAULT) -> None:
+def _lengths(where: str, value: Any, *, tol: Tolerances = DEFAULT, kinds: bool = False) -> None:
     """Check every number inside nested lists (points, outline segments) with :func:`_number`
-    as a length; strings are left to the reader of the list (segment kinds)."""
+    as a length; with ``kinds`` the first entry of each item is a segment kind (text), left to the
+    reader of the list.  Text anywhere else is refused (``"4.5"`` is not a coordinate)."""
     if isinstance(value, list):
         for i, item in enumerate(value):
-            _lengths(f"{where}[{i}]", item, tol=tol)
-    elif not isinstance(value, str):
+            if kinds and isinstance(item, list) and item and isinstance(item[0], str):
+                for k, part in enumerate(item[1:], start=1):
+                    _lengths(f"{where}[{i}][{k}]", part, tol=tol)
+            else:
+                _lengths(f"{where}[{i}]", item, tol=tol)
+    else:
         _number(where, value, "mm", tol=tol, coordinate=True)
 
 
@@ -355,7 +360,7 @@ class Design:
             except DesignError as exc:  # the constructor names its parameter: the design file says tablet.<name>
                 if exc.parameter in fam.params or exc.parameter == "a":
                     raise exc.renamed(f"tablet.{exc.parameter}") from None
-                if a is not None and exc.parameter.endswith("smoothing parameter a"):  # a patch's: the file's a
+                if a is not None and exc.parameter.endswith("smoothing.parameter.a"):  # a patch's: the file's a
                     raise exc.renamed("tablet.a") from None
                 raise
             tablet = replace(built, name=name)
@@ -409,11 +414,16 @@ def _custom_outline(tab: dict, name: str) -> Tablet:
         raise DesignError("tablet.outline", shape, "must be a list of [x, y] points in mm")
     if key == "segments" and not (isinstance(shape, list) and all(isinstance(q, list) and q and isinstance(q[0], str) for q in shape)):
         raise DesignError("tablet.segments", shape, 'must be a list of ["line", [x0, y0], [x1, y1]] or ["arc", [cx, cy], r, theta0, sweep] items')
-    _lengths(f"tablet.{key}", shape)
+    _lengths(f"tablet.{key}", shape, kinds=key == "segments")
     if key == "segments":
         shape = [tuple(item) for item in shape]
     kw = {k: _number(f"tablet.{k}", v, "mm") for k, v in tab.items() if k not in ("outline", "segments")}
-    return outline_tablet(shape, name=name, **kw)
+    try:
+        return outline_tablet(shape, name=name, **kw)
+    except DesignError as exc:  # the outline's own checks name "outline[...]": the design's key is tablet.<key>
+        if exc.parameter == "outline" or exc.parameter.startswith(("outline[", "outline.")):
+            raise exc.renamed(f"tablet.{key}{exc.parameter[len('outline'):]}") from None
+        raise
 
 
 def _free_form(patches: Any, name: str, a) -> Tablet:
@@ -447,12 +457,12 @@ def _free_form(patches: Any, name: str, a) -> Tablet:
             kw["a"] = _number(f"{where}.a", kw["a"])
         try:
             out.append(PDEPatch(tuple(cs), **kw))
-        except DesignError as exc:  # "patch NAME smoothing parameter a" -> "patch[j].a"
-            last = exc.parameter.split()[-1] if exc.parameter.split() else "?"
+        except DesignError as exc:  # "patch.NAME.smoothing.parameter.a" -> "patch[j].a"
+            last = exc.parameter.rsplit(".", 1)[-1]
             key = last if last in ("a", "modes", "u_nodes", "form", "curves") else exc.parameter
             raise exc.renamed(one_token(f"{where}.{key}")) from None
         prev = cs[3]
-    return _check_joined(Tablet(tuple(out), name=name, family="free_form"))
+    return _check_closed(_check_joined(Tablet(tuple(out), name=name, family="free_form")))
 
 
 def _check_joined(tablet: Tablet) -> Tablet:
@@ -466,6 +476,17 @@ def _check_joined(tablet: Tablet) -> Tablet:
             raise DesignError(f"patch[{j}].curves[0]", f"a gap of {seam['max_gap_mm']:.4g} mm to patch[{i}]'s end",
                               f"must start where patch[{i}] ends (within {tol:g} mm; \"previous\" repeats its "
                               "last curve)")
+    return tablet
+
+
+def _check_closed(tablet: Tablet) -> Tablet:
+    """``tablet`` if its free-form chain encloses a volume (closed by the solid map's end faces where
+    it does not end at a point) of at least ``min_length**3``, else :class:`DesignError` (one flat
+    patch, a disc, had reached the report's division by its zero volume)."""
+    volume = tablet.properties()["volume_mm3"]
+    if not volume >= tablet.tol.min_length ** 3:
+        raise DesignError("patch", f"an enclosed volume of {volume:.4g} mm^3",
+                          f"the patches must enclose a solid (volume >= {tablet.tol.min_length ** 3:g} mm^3)")
     return tablet
 
 
