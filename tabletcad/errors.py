@@ -114,7 +114,10 @@ def one_token(parameter: str) -> str:
             w = header.group(1) + header.group(2)
         if len(w) >= 2 and w[0] in "'\"" and w[-1] == w[0]:
             inner = w[1:-1]
-            w = inner if _BARE_KEY.match(inner) else '"' + inner.replace('"', '\\"') + '"'
+            if not _BARE_KEY.match(inner):  # a TOML quoted key, whitespace as \uXXXX escapes (still one token)
+                inner = re.sub(r"\s", lambda m: f"\\u{ord(m.group()):04X}", inner.replace("\\", "\\\\").replace('"', '\\"'))
+                inner = f'"{inner}"'
+            w = inner
         if w.isdigit() and out:
             out[-1] += f"[{w}]"
         elif w:

@@ -56,7 +56,6 @@ def test_podczeck_equals_flat_formula_with_total_thickness():
 @pytest.mark.parametrize(
     "call,match",
     [
-        (lambda: st.pitt_convex(10, 20, 4, 4.5), "exceeds total thickness"),
         (lambda: st.pitt_convex(10, 10, 6, 5), "W/D"),
         (lambda: st.pitt_heasley_elongated_flat(10, 8, 4, length=10), "length/width"),
         (lambda: st.podczeck_convex(10, 10, 4, W=0.3), "W/D"),
@@ -67,6 +66,14 @@ def test_podczeck_equals_flat_formula_with_total_thickness():
 def test_validity_warnings(call, match):
     with pytest.warns(ValidityWarning, match=match):
         call()
+
+
+def test_a_band_thicker_than_the_tablet_is_refused():
+    """No tablet has a band thicker than itself: refused (it was a warning and a strength)."""
+    for call in (lambda: st.pitt_convex(10, 20, 4, 4.5), lambda: st.pitt_heasley_elongated_convex(10, 8, 4, 4.5, 12)):
+        with pytest.raises(DesignError, match=r"band\.thickness = 4\.5 mm is not allowed: must be <= the total thickness t = 4 mm"):
+            call()
+    assert st.pitt_convex(10, 20, 4, 4) > 0  # a band as thick as the tablet: a flat-faced one
 
 
 def test_bad_input_raises_design_error():

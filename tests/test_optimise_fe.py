@@ -44,10 +44,10 @@ def test_problem_file_with_the_fe_objective_is_checked():
     with pytest.raises(DesignError, match=r"fe = 'given' is not allowed: only problems using fe_breaking_force_N"):
         problem_from_dict({**base, "problem": {**base["problem"], "objective": "volume_mm3"},
                            "fe": {"tensile_strength_MPa": 2.0}})
-    with pytest.raises(DesignError, match=r"\[problem\] solve_for = 'band' is not allowed: must not be a variable"):
+    with pytest.raises(DesignError, match=r"problem\.solve_for = 'band' is not allowed: must not be a variable"):
         problem_from_dict({**base, "problem": {**base["problem"], "solve_for": "band", "volume_mm3": 289.1},
                            "fe": {"tensile_strength_MPa": 2.0}})
-    with pytest.raises(DesignError, match=r"\[problem\] volume_mm3 = 'missing' is not allowed: solve_for and volume_mm3"):
+    with pytest.raises(DesignError, match=r"problem\.volume_mm3 = 'missing' is not allowed: solve_for and volume_mm3"):
         problem_from_dict({**base, "problem": {**base["problem"], "solve_for": "cup_depth"},
                            "fe": {"tensile_strength_MPa": 2.0}})
     prob, _, _ = problem_from_dict({**base, "fe": {"tensile_strength_MPa": 2.0}})

@@ -188,3 +188,47 @@ def test_the_cup_radius_is_dimensioned_only_where_the_section_shows_the_cup(scor
     dr = drawing_model(ts)
     assert any(x.radius for x in dr.dims) == dimensioned
     assert "cup radius R13.90 ±0.076 mm" in dr.notes
+
+
+@pytest.mark.parametrize("sheet", ["tablet", "tooling"])
+def test_the_longest_title_block_texts_stay_on_the_sheet_and_apart(drawn, sheet):
+    """Every title-block text at its longest (``TITLE_MAX_CHARS``) in the widest letter: the sheet's
+    texts stay inside the sheet and no two overlap (a 20,000-character name ran off the sheet)."""
+    import copy
+    from dataclasses import replace
+
+    import matplotlib.pyplot as plt
+
+    from tabletcad.tooling.spec import TITLE_MAX_CHARS, DrawingSpec
+
+    ts = copy.copy(drawn[0])
+    ts.spec = replace(ts.spec, drawing=DrawingSpec(**{k: "W" * n for k, n in TITLE_MAX_CHARS.items()}))
+    dr = drawing_model(ts) if sheet == "tablet" else tooling_model(ts)
+    fig = sheet_figure(dr, "A4")
+    try:
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        assert any(t.get_text().startswith("W" * TITLE_MAX_CHARS["name"]) for t in fig.texts)  # whole, not cut
+        boxes = [t.get_window_extent(renderer) for t in fig.texts if t.get_text()]
+        for bb in boxes:
+            assert fig.bbox.x0 <= bb.x0 and bb.x1 <= fig.bbox.x1 and fig.bbox.y0 <= bb.y0 and bb.y1 <= fig.bbox.y1
+        for k, a in enumerate(boxes):
+            for b in boxes[k + 1:]:
+                assert not a.overlaps(b)
+    finally:
+        plt.close(fig)
+
+
+@pytest.mark.parametrize("key, value, fragment", [
+    ("name", "N" * 61, "at most 60 characters"),
+    ("author", "A" * 31, "at most 30 characters"),
+    ("material", "steel\nD2", "printable text on one line"),
+    ("number", "A\x00", "printable text on one line"),
+])
+def test_title_block_texts_that_do_not_fit_are_refused_when_read(key, value, fragment):
+    from tabletcad.errors import DesignError
+    from tabletcad.tooling.spec import parse_tooling
+
+    with pytest.raises(DesignError) as e:
+        parse_tooling({"drawing": {key: value}})
+    assert e.value.parameter == f"tooling.drawing.{key}" and fragment in str(e.value)

@@ -341,6 +341,14 @@ def profiles_cmd(data: Path, pressure_column: str, solid_fraction_column: str, s
 
 # --------------------------------------------------------------------------- strength
 _METHODS = ("diametral", "axial", "pitt", "elongated-flat", "elongated-convex", "podczeck", "sphere")
+#: the options each method reads (besides --force)
+_STRENGTH_OPTIONS = {
+    "diametral": ("--diameter", "--thickness"), "axial": ("--diameter",),
+    "pitt": ("--diameter", "--thickness", "--band"), "elongated-flat": ("--diameter", "--thickness", "--length"),
+    "elongated-convex": ("--diameter", "--thickness", "--band", "--length"),
+    "podczeck": ("--diameter", "--thickness", "--band", "--face-radius"),
+    "sphere": ("--material", "--E", "--nu", "--radius", "--s-y"),
+}
 
 
 @click.command("strength")
@@ -363,6 +371,12 @@ def strength_cmd(method: str, F: float, D, t, W, L, R, material, E, nu, radius, 
     from tabletcad.mechanics import strength as st
 
     _check_json_file(json_file)
+    given = {"--diameter": D, "--thickness": t, "--band": W, "--length": L, "--face-radius": R, "--material": material,
+             "--E": E, "--nu": nu, "--radius": radius, "--s-y": s_y}
+    for option, value in given.items():  # an option the method does not read is a mistake, not a no-op
+        if value is not None and option not in _STRENGTH_OPTIONS[method]:
+            raise DesignError(option, value, f"is not used by method {method!r}, which takes "
+                              f"{', '.join(_STRENGTH_OPTIONS[method])}")
 
     def need(name: str, v):
         if v is None:

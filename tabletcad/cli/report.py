@@ -316,6 +316,15 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
             if len(designs) == 1:
                 raise
             raise DesignError(exc.parameter, exc.value, f"{exc.allowed} (in {design})", exc.unit) from None
+        if spec.tooling_spec is not None:  # refused as build refuses it (the report builds no tooling)
+            from tabletcad.tooling.stage import check_tooling
+
+            try:
+                check_tooling(tablet, spec.tooling_spec)
+            except DesignError as exc:
+                if len(designs) == 1:
+                    raise
+                raise DesignError(exc.parameter, exc.value, f"{exc.allowed} (in {design})", exc.unit) from None
         try:
             opts = spec.report_options.merged(
                 solid_fraction=solid_fraction, true_density_mg_mm3=true_density, breaking_force_N=breaking_force,

@@ -54,7 +54,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from tabletcad.errors import DesignError, GeometryError, check_positive, check_range
+from tabletcad.errors import DesignError, GeometryError, check_finite, check_positive, check_range
 from tabletcad.families.sweep import NominalBuilt, SweepNominal, nominal_only, nominal_volume
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT
@@ -315,8 +315,13 @@ def _prepare(family, vary, dims):
         if missing:
             raise DesignError(missing[0], "missing", f"{name} needs {', '.join(k for k in required if k != vary)} "
                               f"besides {vary}")
+    params = inspect.signature(func).parameters
+    for k, v in dims.items():  # a dimension is a number: "10" is refused here, not as a failed search
+        d = params[k].default if k in params else None
+        if k not in ("a", "tol") and (d is inspect.Parameter.empty or (isinstance(d, (int, float)) and not isinstance(d, bool))):
+            check_finite(k, v, "mm")
     dims = dict(dims)
-    default = inspect.signature(func).parameters[vary].default
+    default = params[vary].default
     x0 = dims.pop(vary, default)
     x0 = float(x0) if isinstance(x0, (int, float)) and not isinstance(x0, bool) and math.isfinite(x0) else 0.0
     x_max = float(getattr(dims.get("tol", DEFAULT), "max_length", DEFAULT.max_length))

@@ -100,8 +100,8 @@ def _pitt_denominator(D: float, t: float, W: float) -> float:
 
 
 def _check_convex(name: str, D: float, t: float, W: float, wd: tuple[float, float]) -> None:
-    if W > t * (1 + 1e-12):
-        warn(ValidityWarning, f"{name}: band thickness W = {W:g} mm exceeds total thickness t = {t:g} mm")
+    if W > t * (1 + 1e-12):  # the band is part of the tablet's thickness: no such tablet
+        raise DesignError("band thickness", W, f"must be <= the total thickness t = {t:g} mm ({name})", "mm")
     r = W / D
     if not wd[0] <= r <= wd[1]:
         warn(ValidityWarning, f"{name}: W/D = {r:.3g} is outside {wd[0]:g}-{wd[1]:g}")

@@ -70,12 +70,12 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
     """
     out_dir = Path(out_dir)
     cad = cad_available() if cad is None else cad
-    if not cad:
-        tooling = None
-    elif tooling is not None:
+    if tooling is not None:  # refused before the (slow) geometry, with or without the CAD stage
         from tabletcad.tooling.stage import check_tooling
 
-        check_tooling(tablet, tooling)  # refused before the (slow) geometry
+        check_tooling(tablet, tooling)
+    if not cad:
+        tooling = None
     check_replaceable(out_dir, ["report.json", "tablet.png"])  # written by every build: refused before the geometry
     steps = 2 + cad + (tooling is not None)
     with staging_folder(out_dir) as staging:

@@ -23,10 +23,11 @@ from tabletcad.cad._occ import cast, explore
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.tooling.booleans import boolean, translated, volume
 from tabletcad.tooling.outline import TabletFrame, offset_wire, plan_face, prism
+from tabletcad.tooling.spec import MIN_DIE_WALL_MM
 
 __all__ = ["die", "default_die_size", "tapered_prism", "MIN_WALL_MM"]
 
-MIN_WALL_MM = 2.0
+MIN_WALL_MM = MIN_DIE_WALL_MM  # the die's thinnest wall around the bore (mm)
 #: smallest outward offset (mm) of the bore: OCCT's planar offset returns no wire for
 #: distances near its confusion tolerance (1.1e-7 mm gave none, 5e-7 mm works), so a band
 #: bulge below this is cleared by this much instead (far below any die-bore tolerance)

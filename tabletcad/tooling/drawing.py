@@ -316,7 +316,7 @@ def title_block(ts, sheet: str = "tablet") -> list[str]:
     d = ts.spec.drawing
     number = d.number or "—"
     rows = [f"drawing no. {number}{'' if sheet == 'tablet' else '-T'}   rev. {d.revision or '—'}   sheet: {sheet}",
-            f"material: {d.material or '—'}   date: {d.date or '—'}   author: {d.author or '—'}",
+            f"material: {d.material or '—'}", f"date: {d.date or '—'}   author: {d.author or '—'}",
             f"general tolerance ±{_fmt(d.tolerance_mm)} mm" + ("" if d.tolerance_given else
                                                              " (tabletcad default, not a standard's value)")]
     return rows
@@ -420,10 +420,16 @@ def sheet_figure(dr: Drawing, paper: str = "A4"):
     # title block: frame, title, notes
     fig.add_artist(matplotlib.patches.Rectangle((0.04, 0.03), 0.92, block - 0.01, transform=fig.transFigure,
                                                 fill=False, lw=0.6, ec="0.2"))
-    fig.text(0.05, 0.03 + block - 0.025, dr.title, fontsize=10, ha="left", va="top", weight="bold")
+    title = fig.text(0.05, 0.03 + block - 0.025, dr.title, fontsize=10, ha="left", va="top", weight="bold")
     tb = list(dr.title_block) + [f"scale {_scale_text(scale)}   sheet {paper}   mm   third-angle projection"]
-    fig.text(0.95, 0.03 + block - 0.02, "\n".join(tb), fontsize=6.5, ha="right", va="top", family="DejaVu Sans",
-             linespacing=1.35)
+    right = fig.text(0.95, 0.03 + block - 0.02, "\n".join(tb), fontsize=6.5, ha="right", va="top",
+                     family="DejaVu Sans", linespacing=1.35)
+    renderer = fig.canvas.get_renderer()  # long texts (up to spec.TITLE_MAX_CHARS) in smaller type, down to 4 pt:
+    while right.get_window_extent(renderer).width > 0.45 * fig.bbox.width and right.get_fontsize() > 4.0:
+        right.set_fontsize(right.get_fontsize() - 0.25)  # the block within the right 45 % of the sheet
+    room = right.get_window_extent(renderer).x0 - 0.01 * fig.bbox.width  # the title ends left of the block
+    while title.get_window_extent(renderer).x1 > room and title.get_fontsize() > 4.0:
+        title.set_fontsize(title.get_fontsize() - 0.5)
     fs, ncols, lines = _note_layout(list(dr.notes), 0.9 * w_in * 72.0, (block - 0.07 - 0.012 * len(tb)) * h_in * 72.0)
     rows = -(-len(lines) // ncols)
     for c in range(ncols):

@@ -167,19 +167,28 @@ def _fe_rating(t: Any) -> FeRatingSpec | None:
             raise DesignError(f"{w} yield_stress_source", src if src is not None else "missing",
                               "must name the source of yield_stress_MPa (a non-empty string)")
     mesh = t.get("mesh_size_mm")
-    return FeRatingSpec(steel, y, src, check_positive(f"{w} safety_factor", t.get("safety_factor", d.safety_factor)),
+    return FeRatingSpec(steel, y, src, check_range(f"{w} safety_factor", t.get("safety_factor", d.safety_factor), 1.0, 100.0),
                         _choice(f"{w} punch", t.get("punch", d.punch), ("upper", "lower", "both")),
                         None if mesh is None else check_positive(f"{w} mesh_size_mm", mesh, "mm"))
 
 
 #: general +- tolerance (mm) printed on the drawings when the design gives none: 0.003 in, stated on the sheet
 #: as this program's default, not as a standard's value
+#: the most characters of one embossed text (a tablet face holds a few: "A8 69", a name)
+MAX_EMBOSS_CHARS = 40
+
+#: the die's thinnest wall (mm) around its bore: checked against the tablet's plan when the design is read
+MIN_DIE_WALL_MM = 2.0
+
 DEFAULT_TOLERANCE_MM = 0.076
 TOLERANCE_KEYS = ("diameter", "length", "width", "band", "cup_depth", "thickness", "land", "score_depth", "cup_radius",
                   "bevel_width", "bevel_angle",  # bevel_angle in degrees, the others mm
                   # the punches and die sheet (complete punches)
                   "overall_length", "tip_length", "barrel_diameter", "head_diameter", "die_diameter", "die_height")
 TITLE_KEYS = ("name", "number", "revision", "material", "date", "author")
+#: the most characters a title-block text may have: what fits the A4 sheet's title block in its
+#: smallest type (``tabletcad.tooling.drawing.sheet_figure`` shrinks long texts to fit)
+TITLE_MAX_CHARS = {"name": 60, "number": 30, "revision": 30, "material": 60, "date": 30, "author": 30}
 
 
 @dataclass(frozen=True)
@@ -210,6 +219,10 @@ def _drawing(t: Any) -> DrawingSpec:
             v = t[k]
             if not isinstance(v, (str, int, float)) or isinstance(v, bool) or not str(v).strip():
                 raise DesignError(f"{w} {k}", v, "must be a non-empty string")
+            if not str(v).isprintable():  # a line break or a NUL would leave its line in the title block
+                raise DesignError(f"{w} {k}", v, "must be printable text on one line (no control characters)")
+            if len(str(v)) > TITLE_MAX_CHARS[k]:
+                raise DesignError(f"{w} {k}", v, f"must be at most {TITLE_MAX_CHARS[k]} characters (the title block's room)")
             kw[k] = str(v)
     if "tolerance_mm" in t:
         kw["tolerance_mm"] = check_positive(f"{w} tolerance_mm", t["tolerance_mm"], "mm")
@@ -328,6 +341,10 @@ def _emboss(i: int, t: Any, base: Path | None = None) -> EmbossSpec:
     stroke = t.get("stroke_angle_deg", t.get("draft_deg", d.draft_deg))
     if text is not None and (not isinstance(text, str) or not text.strip()):
         raise DesignError(f"{w} text", text, "must be a non-empty string")
+    if text is not None and not text.isprintable():  # a NUL or a line break is no glyph
+        raise DesignError(f"{w} text", text, "must be printable text on one line (no control characters)")
+    if text is not None and len(text) > MAX_EMBOSS_CHARS:  # (whether it fits the face is checked on the face)
+        raise DesignError(f"{w} text", text, f"must be at most {MAX_EMBOSS_CHARS} characters")
     if outline is not None:
         ok = isinstance(outline, list) and len(outline) >= 3 and all(isinstance(p, list) and len(p) == 2 for p in outline)
         if not ok:

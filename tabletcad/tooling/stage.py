@@ -35,6 +35,19 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
     t = tablet.trim
     if t.u != (0.0, 1.0) or not t.full_v or t.w[0] > 0:
         raise DesignError("[tooling]", tablet.name, "tooling needs a whole solid tablet (no [trim], no ring)")
+    od = spec.die_outer_diameter_mm
+    if od is not None:  # the die's wall around the tablet's plan (the bore adds at most 1e-6 mm to it)
+        import numpy as np
+
+        from tabletcad.tooling.spec import MIN_DIE_WALL_MM
+
+        u, v = np.linspace(0.0, 1.0, 33), np.linspace(0.0, 2.0 * np.pi, 512, endpoint=False)
+        reach = max(float(np.max(np.hypot(*p.evaluate_grid(u, v, components=True, axes=(0, 1)))))
+                    for p in tablet.patches)
+        if od / 2.0 - reach < MIN_DIE_WALL_MM:
+            raise DesignError("[tooling] die_outer_diameter_mm", od,
+                              f"must be >= {2 * (reach + MIN_DIE_WALL_MM):.4g} mm (the tablet reaches {reach:.4g} mm "
+                              f"from the axis, the die's walls need {MIN_DIE_WALL_MM} mm)", "mm")
 
 
 def write_tooling(ts, out: Path, *, drawing: bool = True) -> list[Path]:
