@@ -82,19 +82,36 @@ class GeometryError(TabletcadError):
         return GeometryError, (str(self),)
 
 
-_WORD = re.compile(r"""'[^']*'|"[^"]*"|\S+""")
+_WORD = re.compile(r"""'(?:[^'\\]|\\.)*'|"(?:[^"\\]|\\.)*"|\S+""")  # a quoted name (maybe a repr) or a word
 _HEADER = re.compile(r"^\[\[?([^\[\]]+)\]\]?(.*)$")  # [table] or [[array]], maybe followed by .key
 _BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
+
+
+def _quoted(word: str) -> str:
+    """A quoted name (a Python ``repr`` or a plain quote) as a TOML key: bare if it can be, else in
+    double quotes with backslash, quote, whitespace and control characters escaped (one token)."""
+    import ast
+
+    try:
+        name = ast.literal_eval(word)
+    except (ValueError, SyntaxError):
+        name = word[1:-1]
+    name = str(name)
+    if _BARE_KEY.match(name):
+        return name
+    return '"' + "".join("\\\\" if c == "\\" else '\\"' if c == '"' else
+                         f"\\u{ord(c):04X}" if c.isspace() or not c.isprintable() else c for c in name) + '"'
 
 
 def one_token(parameter: str) -> str:
     """``parameter`` as one token, the key path of the design file, as the one-line error format
     ``error: <parameter> = <value> is not allowed: <range>`` shows it: table headers lose their
-    brackets, words join with ``.``, an index follows its name in brackets and a quoted key keeps
-    double quotes where it is not a bare key (``[[tooling.score]] 0 depth_mm`` ->
-    ``tooling.score[0].depth_mm``, ``[report] key 'weight'`` -> ``report.weight``,
-    ``[sweep.vary] 'tablet.diameter' max`` -> ``sweep.vary."tablet.diameter".max``).  A token
-    without whitespace or brackets (``tablet.diameter``, ``patch[0].a``, ``--nodes``) is kept."""
+    brackets (an index after them goes in brackets), words join with ``.``, a number after a name
+    becomes its index, and a quoted name is a bare key if it can be, else a TOML quoted key with its
+    whitespace escaped (``[[tooling.score]] 0 depth_mm`` -> ``tooling.score[0].depth_mm``,
+    ``[report] key 'weight'`` -> ``report.weight``, ``[sweep.vary] 'tablet.diameter' max`` ->
+    ``sweep.vary."tablet.diameter".max``).  A token (``tablet.diameter``, ``patch[0].a``,
+    ``--nodes``, ``v1.2``) is kept."""
     text = str(parameter).strip()
     if text.startswith("-"):  # a command-line option
         return text
@@ -110,21 +127,16 @@ def one_token(parameter: str) -> str:
                 i += 1
                 w = words[i]
         header = _HEADER.match(w)
-        if header:
-            w = header.group(1) + header.group(2)
-        if len(w) >= 2 and w[0] in "'\"" and w[-1] == w[0]:
-            inner = w[1:-1]
-            if not _BARE_KEY.match(inner):  # a TOML quoted key, whitespace as \uXXXX escapes (still one token)
-                inner = re.sub(r"\s", lambda m: f"\\u{ord(m.group()):04X}", inner.replace("\\", "\\\\").replace('"', '\\"'))
-                inner = f'"{inner}"'
-            w = inner
+        if header:  # [[tooling.emboss]].0.stroke_angle_deg -> tooling.emboss[0].stroke_angle_deg
+            w = header.group(1) + re.sub(r"\.(\d+)(?=[.\[]|$)", r"[\1]", header.group(2))
+        elif len(w) >= 2 and w[0] in "'\"" and w[-1] == w[0]:
+            w = _quoted(w)
         if w.isdigit() and out:
             out[-1] += f"[{w}]"
         elif w:
             out.append(w.lstrip(".") if out else w)
         i += 1
-    token = ".".join(out) or "?"
-    return re.sub(r"\.(\d+)(?=[.\[]|$)", r"[\1]", token)  # tooling.emboss.0.depth_mm -> tooling.emboss[0].depth_mm
+    return ".".join(out) or "?"
 
 
 def _fmt(value: Any) -> str:

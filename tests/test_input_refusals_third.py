@@ -36,7 +36,11 @@ def _run(capsys, tmp_path, *args: str) -> tuple[int, list[str]]:
     ("[[constraint]] 0 target", "constraint[0].target"),
     ("outline item 3", "outline[3]"),
     ("patch 2", "patch[2]"),
-    ("bad.csv line 3 'pressure_MPa'", "bad.csv.line[3].pressure_MPa"),
+    ("'bad.csv' line 3 'pressure_MPa'", '"bad.csv".line[3].pressure_MPa'),
+    ("'Run 1.csv' line 4 'Thickness (mm)'", '"Run\\u00201.csv".line[4]."Thickness\\u0020(mm)"'),
+    ("[report] key 'a\\tb'", 'report."a\\u0009b"'),
+    ("'tablet.2.x' max", '"tablet.2.x".max'),
+    ("v1.2", "v1.2"),
     ("tablet.diameter", "tablet.diameter"),
     ("patch[0].curves[1].radius", "patch[0].curves[1].radius"),
     ("--nodes", "--nodes"),
@@ -121,8 +125,8 @@ def test_compression_tables_refuse_a_thickness_that_is_no_length(tmp_path, capsy
     p = tmp_path / "p.csv"
     p.write_text(PRESS.format(h="0"), encoding="utf-8")
     rc, err = _run(capsys, tmp_path, cmd, p, "--json-file", tmp_path / "r.json")
-    assert rc == 2 and err == ["error: p.csv.line[6].thickness_mm = 0 mm is not allowed: must be > 0 (the compact's "
-                               "thickness)"]
+    assert rc == 2 and err == ['error: "p.csv".line[6].thickness_mm = 0 mm is not allowed: must be > 0 (the '
+                               "compact's thickness)"]
     assert sorted(q.name for q in tmp_path.iterdir()) == ["p.csv"]
 
 
@@ -167,3 +171,45 @@ def test_options_named_as_given(tmp_path, capsys, monkeypatch, args, line):
     (tmp_path / "x.csv").write_text("force_N,thickness_mm\n100,5\n200,4.5\n", encoding="utf-8")
     rc, err = _run(capsys, tmp_path, *args)
     assert rc == 2 and err == [line]
+
+
+def test_a_table_error_names_the_file_line_past_comments(tmp_path, capsys):
+    """The line named is the file's (comments and blank lines counted), not the row's."""
+    p = tmp_path / "Run 1.csv"
+    p.write_text("# press export\n\n# second comment\n" + PRESS.format(h="-2.8"), encoding="utf-8")
+    rc, err = _run(capsys, tmp_path, "walker", p)
+    assert rc == 2 and err == ['error: "Run\\u00201.csv".line[9].thickness_mm = -2.8 mm is not allowed: must be > 0 '
+                               "(the compact's thickness)"]
+
+
+def test_a_sweep_row_with_a_die_too_narrow_for_its_tablet_fails_as_report_refuses_it():
+    """Rows are what ``tabletcad report`` gives: a 14.5 mm die takes the 10 mm round (>= 14 mm) but not
+    the 12 mm one (>= 16 mm); both rows had come back "ok" without the tooling output."""
+    from tabletcad.sweep.engine import evaluate_design
+
+    def design(d):
+        return {"tablet": {"family": "concave_round", "diameter": d, "band": 2.8, "cup_depth": 0.9},
+                "tooling": {"die_outer_diameter_mm": 14.5, "die_height_mm": 22.0}}
+
+    ok, bad = evaluate_design(design(10.0)), evaluate_design(design(12.0))
+    assert ok["status"] == "ok" and ok["values"]["volume_mm3"] > 0
+    assert bad["status"] == "error" and bad["error"].startswith(
+        "tooling.die_outer_diameter_mm = 14.5 mm is not allowed: must be >= 16 mm"), bad["error"]
+
+
+def test_spaces_of_every_width_are_text_control_characters_are_not():
+    from tabletcad.tooling.spec import parse_tooling
+
+    spec = parse_tooling({"drawing": {"author": "J.\u2009Smith", "material": "D2\u00a0steel"},
+                          "emboss": [{"text": "10\u00a0mg", "mode": "deboss"}]})
+    assert spec.drawing.author == "J.\u2009Smith" and spec.emboss[0].text == "10\u00a0mg"
+    for bad in ("A\u200bB", "A\u2028B", "A\tB"):
+        with pytest.raises(DesignError, match="printable text on one line"):
+            parse_tooling({"emboss": [{"text": bad, "mode": "deboss"}]})
+
+
+def test_a_custom_outline_s_dimension_is_named_by_its_key(tmp_path, capsys):
+    d = tmp_path / "co.toml"
+    d.write_text(CUSTOM.replace("cup_depth = 0.3", "cup_depth = 5") + "outline = [[0,0],[6,0],[6,4],[0,4]]\n")
+    rc, err = _run(capsys, tmp_path, "report", d)
+    assert rc == 2 and err[0].startswith("error: tablet.cup_depth = 5 mm is not allowed: must be > 0 and <= 2.56")

@@ -93,7 +93,7 @@ def test_non_numeric_cell(capsys, tmp_path):
     data = tmp_path / "bad.csv"
     data.write_text("pressure_MPa,thickness_mm\n10,9.5\nx,9\n", encoding="utf-8")
     rc, out, err = run(capsys, "walker", data)
-    assert rc == 2 and err == "error: bad.csv.line[3].pressure_MPa = 'x' is not allowed: must be a number\n"
+    assert rc == 2 and err == "error: \"bad.csv\".line[3].pressure_MPa = 'x' is not allowed: must be a number\n"
 
 
 ROOT = Path(__file__).resolve().parents[1]

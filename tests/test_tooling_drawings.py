@@ -232,3 +232,32 @@ def test_title_block_texts_that_do_not_fit_are_refused_when_read(key, value, fra
     with pytest.raises(DesignError) as e:
         parse_tooling({"drawing": {key: value}})
     assert e.value.parameter == f"tooling.drawing.{key}" and fragment in str(e.value)
+
+
+def test_a_tablet_name_of_200_characters_is_cut_to_the_room_beside_the_title_block(drawn):
+    """Without ``[tooling.drawing] name`` the title is the tablet's name, up to 200 characters: it
+    overlapped the title block (and ran off the sheet in a wide letter); now cut with an ellipsis."""
+    import copy
+    from dataclasses import replace
+
+    import matplotlib.pyplot as plt
+
+    from tabletcad.tooling.spec import DrawingSpec
+
+    ts = copy.copy(drawn[0])
+    ts.spec = replace(ts.spec, drawing=DrawingSpec())
+    ts.tablet = replace(ts.tablet, name="W" * 200)
+    fig = sheet_figure(drawing_model(ts), "A4")
+    try:
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        title = next(t for t in fig.texts if t.get_text().startswith("WWW"))
+        assert title.get_text().endswith("…") and 20 < len(title.get_text()) < 200
+        boxes = [t.get_window_extent(renderer) for t in fig.texts if t.get_text()]
+        for bb in boxes:
+            assert fig.bbox.x0 <= bb.x0 and bb.x1 <= fig.bbox.x1
+        for k, a in enumerate(boxes):
+            for b in boxes[k + 1:]:
+                assert not a.overlaps(b)
+    finally:
+        plt.close(fig)

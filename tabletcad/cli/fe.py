@@ -222,10 +222,10 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
               as_json: bool, json_file: Path | None) -> None:
     """Punch-tip stress under the compaction force spread over the cup, and the allowed force."""
     from tabletcad.cli.report import load_family_design
-    from tabletcad.errors import check_positive
+    from tabletcad.errors import check_positive, check_range
 
     check_positive("--force", force, "kN")
-    check_positive("--safety-factor", safety_factor)
+    check_range("--safety-factor", safety_factor, 1.0, 100.0)  # as [tooling.fe_rating] safety_factor
     check_positive("--effective-length-factor", effective_length_factor)
     _check_json_file(json_file)
     from tabletcad.fe.punch import tool_steels

@@ -129,7 +129,9 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
         if not window[0] < window[1]:
             raise DesignError("--window", window, "must be two increasing pressures", "MPa")
     given = {k: o for k, o, v in (("mass_mg", "--mass", mass), ("true_density", "--true-density", true_density),
-                                  ("diameter", "--diameter", diameter), ("face_area", "--face-area", face_area))
+                                  ("diameter", "--diameter", diameter), ("face_area", "--face-area", face_area),
+                                  ("compliance slope", "--compliance", compliance),
+                                  ("compliance offset", "--compliance", compliance))
              if v is not None}  # an option overrides the metadata file's key: named as given
     with _collect() as msgs, option_names(given):
         comp = MachineCompliance(slope=compliance[0], offset=compliance[1]) if compliance else None
@@ -164,15 +166,17 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
 def _read_table(path: Path, columns: dict[str, str]) -> dict[str, np.ndarray]:
     """Numeric columns of a CSV/TSV file with a header row, found by (case-insensitive) header name.
 
-    ``columns`` maps a key to the header; empty lines and ``#`` comments are skipped.
+    ``columns`` maps a key to the header; empty lines and ``#`` comments are skipped.  ``_lines``:
+    each row's line number in the file (errors name it).
     """
     import csv
 
     from tabletcad.mechanics.pressdata import decode_text
 
     text = decode_text(path.read_bytes())  # UTF-8, UTF-16 or Windows-1252, as the press exports
-    rows = [r for r in csv.reader((ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")),
-                                  delimiter="\t" if "\t" in text.split("\n", 1)[0] else ",")]
+    kept = [(n, ln) for n, ln in enumerate(text.splitlines(), start=1) if ln.strip() and not ln.lstrip().startswith("#")]
+    rows = list(csv.reader((ln for _, ln in kept), delimiter="\t" if "\t" in text.split("\n", 1)[0] else ","))
+    line_of = [n for n, _ in kept]  # the file's line number of each row (comments and blank lines skipped)
     if len(rows) < 2:
         raise DesignError("DATA", str(path), "must hold a header row and at least one row of numbers")
     header = [h.strip().lower() for h in rows[0]]
@@ -182,14 +186,15 @@ def _read_table(path: Path, columns: dict[str, str]) -> dict[str, np.ndarray]:
             raise DesignError("column", name, f"must be one of the header's columns of {path.name}: {', '.join(rows[0])}")
         j = header.index(name.strip().lower())
         vals = []
-        for i, r in enumerate(rows[1:], start=2):
+        for i, r in enumerate(rows[1:], start=1):
+            where = f"{path.name!r} line {line_of[i]} {name!r}"
             try:
                 v = float(r[j])
             except (IndexError, ValueError):
-                raise DesignError(f"{path.name} line {i} {name!r}", r[j] if j < len(r) else "missing",
-                                  "must be a number") from None
-            vals.append(check_finite(f"{path.name} line {i} {name!r}", v))
+                raise DesignError(where, r[j] if j < len(r) else "missing", "must be a number") from None
+            vals.append(check_finite(where, v))
         out[key] = np.asarray(vals, dtype=float)
+    out["_lines"] = np.asarray(line_of[1:])
     return out
 
 
@@ -232,8 +237,8 @@ def _compression_table(data: Path, pressure_column: str, thickness_column: str, 
     table = _read_table(data, {"P": pressure_column, "h": thickness_column})
     bad = np.flatnonzero(~(table["h"] > 0.0))
     if bad.size:  # a thickness is a length: 0 or less is a misread column or a displacement
-        raise DesignError(f"{data.name} line {int(bad[0]) + 2} {thickness_column!r}", float(table["h"][bad[0]]),
-                          "must be > 0 (the compact's thickness)", "mm")
+        raise DesignError(f"{data.name!r} line {int(table['_lines'][bad[0]])} {thickness_column!r}",
+                          float(table["h"][bad[0]]), "must be > 0 (the compact's thickness)", "mm")
     return table
 
 

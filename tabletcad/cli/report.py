@@ -177,7 +177,8 @@ def _solved(tablet, design, opts, vary: str, target_weight: float | None, target
                   vary: "--solve-for", "family": "tablet.family", "solid_fraction": "--solid-fraction",
                   "true_density_mg_mm3": "--true-density",
                   "solid_fraction, true_density_mg_mm3": "--solid-fraction/--true-density",
-                  **{k: f"tablet.{k}" for k in given if k != vary}}.get(exc.parameter)
+                  **{k: f"tablet.{k}" for k in given if k != vary}}
+        option = {one_token(k): v for k, v in option.items()}.get(exc.parameter)  # (parameters are one token)
         raise exc.renamed(option or one_token(exc.parameter)) from None
     from dataclasses import replace
 

@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from tabletcad.errors import DesignError, GeometryError, check_positive
+from tabletcad.errors import DesignError, GeometryError, check_positive, check_range
 from tabletcad.fe.elasticity import Material, PressureLoad, _skfem_mesh, boundary_facets, solve_elasticity, von_mises
 from tabletcad.fe.mesh import Refinement, check_mesh_size, mesh_solid
 
@@ -212,7 +212,7 @@ def punch_stress(
         ``K`` of the buckling check.
     """
     F = check_positive("--force", force_kN, "kN") * 1000.0
-    S = check_positive("--safety-factor", safety_factor, "")
+    S = check_range("--safety-factor", safety_factor, 1.0, 100.0)
     if yield_MPa is not None:
         check_positive("--yield-stress", yield_MPa, "MPa")
     axis = np.array([0.0, 0.0, 1.0 if which == "upper" else -1.0])

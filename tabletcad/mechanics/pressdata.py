@@ -198,7 +198,7 @@ class PressMetadata:
         if self.diameter is not None:
             check_range("diameter", self.diameter, 0.0, DEFAULT.max_length, "mm", lo_open=True)
         if self.face_area is not None:
-            check_range("face area", self.face_area, 0.0, 1e6, "mm²", lo_open=True)
+            check_range("face_area", self.face_area, 0.0, 1e6, "mm²", lo_open=True)
         if not isinstance(self.notes, str):
             raise DesignError("notes", self.notes, "must be text")
         if self.displacement_sign not in ("auto", 1, -1):

@@ -420,9 +420,11 @@ def _custom_outline(tab: dict, name: str) -> Tablet:
     kw = {k: _number(f"tablet.{k}", v, "mm") for k, v in tab.items() if k not in ("outline", "segments")}
     try:
         return outline_tablet(shape, name=name, **kw)
-    except DesignError as exc:  # the outline's own checks name "outline[...]": the design's key is tablet.<key>
+    except DesignError as exc:  # the constructor names "outline[...]", "cup_depth": the design's keys are tablet.<key>
         if exc.parameter == "outline" or exc.parameter.startswith(("outline[", "outline.")):
             raise exc.renamed(f"tablet.{key}{exc.parameter[len('outline'):]}") from None
+        if exc.parameter in _CUSTOM_KEYS:
+            raise exc.renamed(f"tablet.{exc.parameter}") from None
         raise
 
 

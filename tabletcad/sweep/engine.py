@@ -67,6 +67,10 @@ def evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",)
 
         spec = Design.from_dict(design, default_name=name)
         tablet = spec.build()
+        if spec.tooling_spec is not None:  # refused as report and build refuse it, whatever the outputs
+            from tabletcad.tooling.stage import check_tooling
+
+            check_tooling(tablet, spec.tooling_spec)
         files: dict[str, bytes] = {}
         wanted = [f for o in outputs if o not in ("report", "tooling") for f in OUTPUTS[o]]
         with tempfile.TemporaryDirectory(prefix="tabletcad-sweep-") as tmp:

@@ -344,15 +344,15 @@ def _dim_geometry(d: Dim):
     return (x1, y), (x2, y), [((x1, y1), (x1, y)), ((x2, y2), (x2, y))]
 
 
-def _note_layout(notes: list[str], width_pt: float, height_pt: float) -> tuple[float, int, list[str]]:
+def _note_layout(notes: list[str], width_pt: float, height_pt: float, em: float = 0.62) -> tuple[float, int, list[str]]:
     """``(font size, columns, wrapped lines)`` that fit the notes into a ``width_pt`` x
-    ``height_pt`` box (DejaVu Sans: average glyph width below 0.62 em, lines 1.35 em apart)."""
+    ``height_pt`` box (glyphs ``em`` wide on average: DejaVu Sans below 0.62 em; lines 1.35 em apart)."""
     import textwrap
 
     for fs in (7.0, 6.0, 5.0, 4.5):
         rows = max(1, int(height_pt // (1.4 * fs)))
         for ncols in (1, 2, 3, 4):
-            chars = max(20, int((width_pt / ncols - 12.0) // (0.62 * fs)))
+            chars = max(20, int((width_pt / ncols - 12.0) // (em * fs)))
             lines = [w for n in notes for w in (textwrap.wrap(n, chars) or [""])]
             if len(lines) <= rows * ncols:
                 return fs, ncols, lines
@@ -430,11 +430,21 @@ def sheet_figure(dr: Drawing, paper: str = "A4"):
     room = right.get_window_extent(renderer).x0 - 0.01 * fig.bbox.width  # the title ends left of the block
     while title.get_window_extent(renderer).x1 > room and title.get_fontsize() > 4.0:
         title.set_fontsize(title.get_fontsize() - 0.5)
-    fs, ncols, lines = _note_layout(list(dr.notes), 0.9 * w_in * 72.0, (block - 0.07 - 0.012 * len(tb)) * h_in * 72.0)
-    rows = -(-len(lines) // ncols)
-    for c in range(ncols):
-        fig.text(0.05 + 0.9 * c / ncols, 0.03 + block - 0.055 - 0.012 * len(tb), "\n".join(lines[c * rows:(c + 1) * rows]), fontsize=fs,
-                 ha="left", va="top", family="DejaVu Sans", linespacing=1.35)
+    text = dr.title
+    while title.get_window_extent(renderer).x1 > room and len(text) > 1:  # a tablet name of up to 200 characters
+        text = text[:-1]  # (the drawing's own name is at most 60): cut, with an ellipsis
+        title.set_text(text.rstrip() + "…")
+    for em in (0.62, 1.0):  # DejaVu Sans averages below 0.62 em; a name of wide letters (W) needs up to 1 em
+        fs, ncols, lines = _note_layout(list(dr.notes), 0.9 * w_in * 72.0,
+                                        (block - 0.07 - 0.012 * len(tb)) * h_in * 72.0, em=em)
+        rows = -(-len(lines) // ncols)
+        cols = [fig.text(0.05 + 0.9 * c / ncols, 0.03 + block - 0.055 - 0.012 * len(tb),
+                         "\n".join(lines[c * rows:(c + 1) * rows]), fontsize=fs, ha="left", va="top",
+                         family="DejaVu Sans", linespacing=1.35) for c in range(ncols)]
+        if em == 1.0 or all(t.get_window_extent(renderer).width < (0.9 / ncols - 0.01) * fig.bbox.width for t in cols):
+            break
+        for t in cols:  # a column ran into the next: again, wrapped for wider letters
+            t.remove()
     return fig
 
 

@@ -210,6 +210,14 @@ class DrawingSpec:
         return dict(self.tolerances).get(key, self.tolerance_mm)
 
 
+def _one_line(text: str) -> bool:
+    """No control, format, private or unassigned character and no line or paragraph separator
+    (spaces of every width, such as a no-break space, are text)."""
+    import unicodedata
+
+    return not any(unicodedata.category(c)[0] == "C" or unicodedata.category(c) in ("Zl", "Zp") for c in text)
+
+
 def _drawing(t: Any) -> DrawingSpec:
     w = "[tooling.drawing]"
     t = _keys(w, t, set(TITLE_KEYS) | {"tolerance_mm", "tolerances"})
@@ -219,7 +227,7 @@ def _drawing(t: Any) -> DrawingSpec:
             v = t[k]
             if not isinstance(v, (str, int, float)) or isinstance(v, bool) or not str(v).strip():
                 raise DesignError(f"{w} {k}", v, "must be a non-empty string")
-            if not str(v).isprintable():  # a line break or a NUL would leave its line in the title block
+            if not _one_line(str(v)):  # a line break or a NUL would leave its line in the title block
                 raise DesignError(f"{w} {k}", v, "must be printable text on one line (no control characters)")
             if len(str(v)) > TITLE_MAX_CHARS[k]:
                 raise DesignError(f"{w} {k}", v, f"must be at most {TITLE_MAX_CHARS[k]} characters (the title block's room)")
@@ -341,7 +349,7 @@ def _emboss(i: int, t: Any, base: Path | None = None) -> EmbossSpec:
     stroke = t.get("stroke_angle_deg", t.get("draft_deg", d.draft_deg))
     if text is not None and (not isinstance(text, str) or not text.strip()):
         raise DesignError(f"{w} text", text, "must be a non-empty string")
-    if text is not None and not text.isprintable():  # a NUL or a line break is no glyph
+    if text is not None and not _one_line(text):  # a NUL or a line break is no glyph
         raise DesignError(f"{w} text", text, "must be printable text on one line (no control characters)")
     if text is not None and len(text) > MAX_EMBOSS_CHARS:  # (whether it fits the face is checked on the face)
         raise DesignError(f"{w} text", text, f"must be at most {MAX_EMBOSS_CHARS} characters")
