@@ -357,6 +357,11 @@ class Outline(Curve):
         self._cum = np.concatenate([[0.0], np.cumsum(lengths)])
         self.perimeter = float(self._cum[-1])
 
+    @property
+    def segs(self) -> tuple[Seg, ...]:
+        """The lines and arcs, in order (mm)."""
+        return self._segs
+
     @classmethod
     def from_segments(cls, items, z: float = 0.0, name: str = "outline") -> "Outline":
         """Outline from a list of ``("line", (x0, y0), (x1, y1))`` and

@@ -211,10 +211,11 @@ def _section_wire(shape, z: float) -> Any:
     seq = TopTools_HSequenceOfShape()
     for e in edges:
         seq.Append(e)
-    wires = ShapeAnalysis_FreeBounds.ConnectEdgesToWires_s(seq, 1e-6, False)
+    wires = TopTools_HSequenceOfShape()
+    ShapeAnalysis_FreeBounds.ConnectEdgesToWires_s(seq, 1e-6, False, wires)  # (OCP: the wires are an out-argument)
     if wires.Length() != 1:
         raise GeometryError(f"the band section gives {wires.Length()} wires, expected one", shape)
-    return translated(cast(wires.Value(1), "Wire"), dz=-z)
+    return cast(translated(wires.Value(1), dz=-z), "Wire")
 
 
 def _rational_bspline_solid(shape: TopoDS_Shape) -> TopoDS_Shape:
@@ -286,13 +287,21 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
             wire, kind = segments_wire(segs), "lines and arcs"
     else:
         curve = tablet.patches[found.patch].data[0] if found is not None else None
-        from tabletcad.geometry.curves import Circle, Ellipse
+        from tabletcad.geometry.curves import Circle, Ellipse, Outline, Transformed
 
+        shift = np.zeros(2)
+        while isinstance(curve, Transformed) and np.array_equal(curve.matrix[:2, :2], np.eye(2)) \
+                and not np.any(curve.matrix[:2, 2]):  # moved along the axis (a free-form chain's z): the same plan
+            shift, curve = shift + curve.offset[:2], curve.base
         if isinstance(curve, Circle):
             round_radius = float(curve.radius)
-            wire, kind = circle_wire(curve.radius, curve.center[:2]), "circle"
+            wire, kind = circle_wire(curve.radius, curve.center[:2] + shift), "circle"
         elif isinstance(curve, Ellipse):
-            wire, kind = ellipse_wire(curve.rx, curve.ry, curve.center[:2]), "ellipse"
+            wire, kind = ellipse_wire(curve.rx, curve.ry, curve.center[:2] + shift), "ellipse"
+        elif isinstance(curve, Outline):  # a free-form band of lines and arcs (a stadium): exact
+            wire, kind = segments_wire(curve.segs), "lines and arcs"
+            if np.any(shift):
+                wire = cast(translated(wire, float(shift[0]), float(shift[1]), 0.0), "Wire")
         else:
             wire, kind = _section_wire(shape, 0.5 * (band_z[0] + band_z[1])), "section of the band"
     land = info.get("land_mm")
