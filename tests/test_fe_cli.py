@@ -55,7 +55,7 @@ def test_diametral_json_and_files(capsys, tmp_path, thin):
     assert d["reaction_N"] < 1e-8 * 50
     assert len(d["max_tensile_location_mm"]) == 3
     assert d["max_tensile_stress_MPa"] >= d["centre_tensile_stress_MPa"] * 0.999
-    assert sorted(p.name for p in out.iterdir()) == ["section.png", "stress.vtu"]
+    assert sorted(p.name for p in out.iterdir()) == [".tabletcad-fe.json", "section.png", "stress.vtu"]
     mesh = meshio.read(out / "stress.vtu")
     assert len(mesh.points) == d["nodes"]
     assert len(mesh.cells_dict["tetra"]) == d["elements"]
@@ -116,7 +116,7 @@ def test_punch_json_and_files(capsys, tmp_path):
     assert d["max_von_mises_MPa"] == pytest.approx(d["uniform_stress_MPa"], rel=0.02)
     assert d["allowed_force_kN"] == pytest.approx(
         min(1450 / 1.5 * 5 / d["max_von_mises_MPa"], d["buckling"]["critical_force_kN"] / 1.5), rel=1e-9)
-    assert sorted(p.name for p in out.iterdir()) == ["section.png", "stress.vtu"]
+    assert sorted(p.name for p in out.iterdir()) == [".tabletcad-fe.json", "section.png", "stress.vtu"]
 
 
 @pytest.mark.parametrize(

@@ -43,6 +43,32 @@ def _echo(payload: dict[str, Any], as_json: bool, lines: list[str], json_file: P
             click.echo(ln)
 
 
+#: what ``--out`` of ``tabletcad fe diametral/punch`` holds
+FE_FILES = ("stress.vtu", "section.png")
+
+
+def _check_out(out: Path | None) -> None:
+    """Refuse, before any solve, an ``--out`` folder holding a file of :data:`FE_FILES` that no earlier
+    FE run wrote there or that was edited since (a run owns exactly the files it writes)."""
+    if out is not None:
+        from tabletcad.io.outputs import FE_MANIFEST, check_replaceable
+
+        check_replaceable(out, FE_FILES, manifest=FE_MANIFEST)
+
+
+def _write_outputs(out: Path, solution, section: dict) -> list[str]:
+    """``stress.vtu`` and ``section.png`` written to a staging folder and moved into ``out`` together,
+    recorded in its FE manifest; their paths."""
+    from tabletcad.fe.output import plot_section, write_vtu
+    from tabletcad.io.outputs import FE_MANIFEST, publish, staging_folder
+
+    with staging_folder(out) as staging:
+        write_vtu(solution, staging / "stress.vtu")
+        plot_section(solution, staging / "section.png", **section)
+        publish(staging, out, FE_MANIFEST)
+    return [str(out / n) for n in FE_FILES]
+
+
 def _check_json_file(json_file: Path | None) -> None:
     from tabletcad.cli.outputs import check_output
 
@@ -106,6 +132,7 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
     if direction not in DIRECTIONS:
         raise DesignError("--direction", direction, "must be one of " + ", ".join(DIRECTIONS))
     _check_json_file(json_file)
+    _check_out(out)
     _require_fe()
     from tabletcad.fe.diametral import diametral
     from tabletcad.fe.elasticity import Material
@@ -118,21 +145,13 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
     payload = {"design": str(design), "tablet_meshed": meshed, **res.to_dict()}
     files: list[str] = []
     if out is not None:
-        from tabletcad.fe.output import plot_section, write_vtu
-
         ax = "xy".index(res.axis)
         px = 1 - ax
         s = res.centre_tensile_stress_MPa
-        try:
-            files.append(str(write_vtu(res.solution, out / "stress.vtu")))
-            files.append(str(plot_section(
-                res.solution, out / "section.png", axis=2, level=res.centre_mm[2], component=(px, px),
-                title=f"{tablet.name}: σ_{'xy'[px]}{'xy'[px]} at mid-thickness, {force:g} N along {res.axis}",
-                label=f"σ_{'xy'[px]}{'xy'[px]} (MPa)", limits=(-3.0 * abs(s), 3.0 * abs(s)))))
-        except BaseException:
-            for f in files:
-                Path(f).unlink(missing_ok=True)
-            raise
+        files = _write_outputs(out, res.solution, dict(
+            axis=2, level=res.centre_mm[2], component=(px, px),
+            title=f"{tablet.name}: σ_{'xy'[px]}{'xy'[px]} at mid-thickness, {force:g} N along {res.axis}",
+            label=f"σ_{'xy'[px]}{'xy'[px]} (MPa)", limits=(-3.0 * abs(s), 3.0 * abs(s))))
         payload["files"] = files
     err = res.discretisation_error_MPa
     _echo(payload, as_json, [
@@ -183,10 +202,16 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
 
     tablet, spec = load_family_design(design)
     solid, meshed = _finished(spec, tablet)
-    inputs = StrengthInputs.from_table(spec.report, tensile_strength_MPa=tensile_strength,
-                                       reference_breaking_force_N=reference_force,
-                                       reference_diameter_mm=reference_diameter,
-                                       reference_thickness_mm=reference_thickness)
+    given = {f"report.{k}": o for k, o, v in (
+        ("tensile_strength_MPa", "--tensile-strength", tensile_strength),
+        ("reference_breaking_force_N", "--reference-force", reference_force),
+        ("reference_diameter_mm", "--reference-diameter", reference_diameter),
+        ("reference_thickness_mm", "--reference-thickness", reference_thickness)) if v is not None}
+    with option_names(given):  # an option given overrides the design's [report] key: named as given
+        inputs = StrengthInputs.from_table(spec.report, tensile_strength_MPa=tensile_strength,
+                                           reference_breaking_force_N=reference_force,
+                                           reference_diameter_mm=reference_diameter,
+                                           reference_thickness_mm=reference_thickness)
     pred = (coarse_prediction(tablet, inputs, direction, solid=solid) if coarse
             else predict_breaking_force(tablet, inputs, direction, solid=solid, mesh_size=mesh_size,
                                         error_estimate=False))
@@ -228,6 +253,7 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
     check_range("--safety-factor", safety_factor, 1.0, 100.0)  # as [tooling.fe_rating] safety_factor
     check_positive("--effective-length-factor", effective_length_factor)
     _check_json_file(json_file)
+    _check_out(out)
     from tabletcad.fe.punch import tool_steels
 
     steels = tool_steels()
@@ -253,18 +279,9 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
     payload = {"design": str(design), "steel": steel, **res.to_dict()}
     files: list[str] = []
     if out is not None:
-        from tabletcad.fe.output import plot_section, write_vtu
-
-        try:
-            files.append(str(write_vtu(res.solution, out / "stress.vtu")))
-            files.append(str(plot_section(
-                res.solution, out / "section.png", axis=1, level=float(res.solution.mesh.p[1].mean()),
-                component="von_mises", title=f"{tablet.name}: {which} punch tip, von Mises stress at {force:g} kN",
-                label="von Mises stress (MPa)")))
-        except BaseException:
-            for f in files:
-                Path(f).unlink(missing_ok=True)
-            raise
+        files = _write_outputs(out, res.solution, dict(
+            axis=1, level=float(res.solution.mesh.p[1].mean()), component="von_mises",
+            title=f"{tablet.name}: {which} punch tip, von Mises stress at {force:g} kN", label="von Mises stress (MPa)"))
         payload["files"] = files
     b = res.buckling
     _echo(payload, as_json, [

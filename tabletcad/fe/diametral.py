@@ -102,7 +102,8 @@ from typing import Any
 
 import numpy as np
 
-from tabletcad.errors import DesignError, GeometryError, check_positive
+from tabletcad.errors import DesignError, GeometryError, check_positive, check_range
+from tabletcad.tolerance import DEFAULT
 from tabletcad.fe.elasticity import Material, PressureLoad, boundary_facets, principal_stresses, solve_elasticity
 from tabletcad.fe.mesh import MAX_DOFS, CutPlane, Refinement, check_mesh_size, estimated_dofs, mesh_solid
 
@@ -457,22 +458,28 @@ def diametral(
         discretisation error of the centre stress by Richardson extrapolation
         with the nominal order 2 of quadratic elements: ``(σ_h - σ_1.5h)/(1.5² - 1)``.
     """
-    P = check_positive("force", force, "N")
+    P = check_range("force", force, 0.0, 1e9, "N", lo_open=True)  # (1e308 overflowed the solve)
     material = material or Material()
     trim = getattr(tablet, "trim", None)
     if trim is not None and trim.w[0] > 0:
         raise DesignError("[trim] w", list(trim.w), "the diametral test needs a solid tablet (a ring's centre is empty)")
+    if trim is not None and (trim.u != (0.0, 1.0) or not trim.full_v):
+        key = "v" if not trim.full_v else "u"
+        raise DesignError(f"[trim] {key}", list(getattr(trim, key)), "the diametral test needs the whole tablet, not a "
+                          "cut-away view")
     lo, hi = (np.asarray(a, float) for a in tablet.bounds())
     ext = hi - lo
     ax = load_axis(direction, ext)
     px = 1 - ax
     D, t = float(ext[ax]), float(ext[2])
     b = D * STRIP_FRACTION if strip_width is None else check_positive("strip_width", strip_width, "mm")
+    if b < DEFAULT.min_length:
+        raise DesignError("strip_width", b, f"must be >= {DEFAULT.min_length:g} mm (Tolerances.min_length)", "mm")
     if b > 0.5 * D:
         raise DesignError("strip_width", b, f"must be <= half the tablet's extent along the load "
                           f"({0.5 * D:.4g} mm)", "mm")
-    h = min(t / 2.0, float(min(ext[0], ext[1])) / 12.0) if mesh_size is None else check_positive(
-        "mesh_size", mesh_size, "mm")
+    h = min(t / 2.0, float(min(ext[0], ext[1])) / 12.0) if mesh_size is None else check_range(
+        "mesh_size", mesh_size, 0.0, float(max(ext)), "mm", lo_open=True)  # at most the tablet's largest extent
     R = default_averaging_radius(b, t) if averaging_radius is None else check_positive("averaging_radius", averaging_radius,
                                                                                 "mm")
     if R > 0.25 * float(min(ext[0], ext[1])):

@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from tabletcad.errors import DesignError, GeometryError, check_positive
+from tabletcad.errors import DesignError, GeometryError, check_finite, check_positive, check_range
 from tabletcad.fe.mesh import TetMesh
 
 __all__ = ["Material", "PressureLoad", "ElasticSolution", "boundary_facets", "solve_elasticity",
@@ -54,9 +54,11 @@ class Material:
     nu: float = 0.3
 
     def __post_init__(self) -> None:
-        check_positive("E", self.E, "MPa")
-        if not (-1.0 < float(self.nu) < 0.5):
-            raise DesignError("nu", self.nu, "must be > -1 and < 0.5")
+        check_range("E", self.E, 0.0, 1e7, "MPa", lo_open=True)  # (diamond: 1.2e6 MPa)
+        nu = check_finite("nu", self.nu)
+        if not (-0.9 <= nu <= 0.49):  # nearly incompressible (0.4999) stalled the direct solve for minutes
+            raise DesignError("nu", self.nu, "must be >= -0.9 and <= 0.49 (towards 0.5 the quadratic tetrahedra's "
+                              "system becomes singular)")
 
     @property
     def lame(self) -> tuple[float, float]:

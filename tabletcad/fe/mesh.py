@@ -24,9 +24,10 @@ from tabletcad.errors import DesignError, GeometryError
 
 __all__ = ["TetMesh", "Refinement", "CutPlane", "mesh_solid", "estimated_dofs", "check_mesh_size", "MAX_DOFS"]
 
-#: Largest number of quadratic-tetrahedron unknowns accepted (a sparse direct
-#: solve of 1.5 million unknowns needs of the order of 10 GB).
-MAX_DOFS = 1_500_000
+#: Largest number of quadratic-tetrahedron unknowns accepted: a sparse direct solve of about 90,000
+#: takes 2-3 GB and its fill grows about as n^(4/3), so 200,000 about 7 GB (1.5 million ran out of
+#: 22 GB in SuperLU after minutes, a new user's trial).
+MAX_DOFS = 200_000
 
 
 @dataclass(frozen=True)
@@ -103,6 +104,9 @@ def check_mesh_size(volume: float, size: float, name: str = "mesh_size") -> floa
     """Refuse (DesignError) a mesh size whose system would not fit in memory; return ``size``."""
     if not (np.isfinite(size) and size > 0):
         raise DesignError(name, size, "must be > 0", "mm")
+    largest = 10.0 * max(volume, 0.0) ** (1.0 / 3.0)  # far coarser than the solid is no mesh (1e200 overflowed)
+    if volume > 0 and size > largest:
+        raise DesignError(name, size, f"must be <= {largest:.3g} mm (10 x the cube root of the solid's volume)", "mm")
     n = estimated_dofs(volume, size)
     if n > MAX_DOFS:
         smallest = (3.0 * 8.0 * 1.4 * volume / MAX_DOFS) ** (1.0 / 3.0)

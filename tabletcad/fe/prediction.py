@@ -26,7 +26,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from tabletcad.errors import DesignError, check_positive
+from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.tolerance import DEFAULT
 from tabletcad.fe.diametral import DiametralResult, diametral
 
 __all__ = ["StrengthInputs", "StrengthPrediction", "predict_breaking_force", "reference_tensile_strength",
@@ -53,8 +54,9 @@ class StrengthInputs:
     def __post_init__(self) -> None:
         for k, unit in STRENGTH_KEYS.items():
             v = getattr(self, k)
-            if v is not None:
-                check_positive(f"[report] {k}", v, unit)
+            if v is not None:  # lengths as a design's (Tolerances: 0.001 mm to 1 m), a force or strength <= 1e9
+                lo, hi = (DEFAULT.min_length, DEFAULT.max_length) if unit == "mm" else (0.0, 1e9)
+                check_range(f"[report] {k}", v, lo, hi, unit, lo_open=unit != "mm")
         ref = [self.reference_breaking_force_N, self.reference_diameter_mm, self.reference_thickness_mm]
         given = sum(v is not None for v in ref)
         if self.tensile_strength_MPa is None and given != 3:

@@ -211,7 +211,7 @@ def punch_stress(
     effective_length_factor : float
         ``K`` of the buckling check.
     """
-    F = check_positive("--force", force_kN, "kN") * 1000.0
+    F = check_range("--force", force_kN, 0.0, 1e6, "kN", lo_open=True) * 1000.0  # (1e308 overflowed the solve)
     S = check_range("--safety-factor", safety_factor, 1.0, 100.0)
     if yield_MPa is not None:
         check_positive("--yield-stress", yield_MPa, "MPa")
@@ -219,7 +219,8 @@ def punch_stress(
     A_plan = float(tip["tip_plan_area_mm2"])
     width = 2.0 * math.sqrt(A_plan / math.pi)
     L = float(tip["tip_length_mm"])
-    h = min(width / 8.0, L / 6.0) if mesh_size is None else check_positive("--mesh-size", mesh_size, "mm")
+    h = min(width / 8.0, L / 6.0) if mesh_size is None else check_range("--mesh-size", mesh_size, 0.0, L + width, "mm",
+                                                                         lo_open=True)  # at most the tip's size
     check_mesh_size(A_plan * (L + 2.0 * width), h, "--mesh-size")
     edge = float(tip["tip_edge_z_mm"])
     cup = float(tip.get("cup_depth_mm") or 0.0)

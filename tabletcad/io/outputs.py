@@ -47,6 +47,8 @@ MANIFEST = ".tabletcad-build.json"
 #: the manifest of ``tabletcad optimise``'s folder: a command owns the files of its own manifest only, so a
 #: build into an optimisation's folder never takes its results (optimum.toml, report.json) for its own
 OPTIMISE_MANIFEST = ".tabletcad-optimise.json"
+#: the files an FE command wrote into its ``--out`` folder (``tabletcad fe diametral/punch``)
+FE_MANIFEST = ".tabletcad-fe.json"
 
 #: Output folders that :func:`publish` completed in this process.  The command line reads it: a
 #: Ctrl-C that reaches a build after its outputs are in place is too late to undo it, and the
@@ -230,7 +232,8 @@ def check_replaceable(out_dir: str | os.PathLike[str], names, earlier: dict[str,
     theirs = [n for n in names if not _ours(out_dir / n, earlier.get(n))]
     if theirs:  # replacing them would lose what someone else put there
         shown = ", ".join(theirs[:3]) + (f" and {len(theirs) - 3} more" if len(theirs) > 3 else "")
-        who = ("run", "tabletcad optimise run") if manifest == OPTIMISE_MANIFEST else ("build", "tabletcad build")
+        who = {OPTIMISE_MANIFEST: ("run", "tabletcad optimise run"), FE_MANIFEST: ("run", "tabletcad fe run")}.get(
+            manifest, ("build", "tabletcad build"))
         raise DesignError("--out", str(out_dir), f"must not hold files this {who[0]} writes that no earlier "
                           f"{who[1]} wrote there or that were edited since ({shown}): move them or write into another "
                           "folder")

@@ -61,7 +61,7 @@ import sys
 from pathlib import Path
 from typing import Any, Callable
 
-from tabletcad.errors import DesignError
+from tabletcad.errors import DesignError, one_token
 from tabletcad.optimise.problem import METHODS, Constraint, Objective, Problem, Variable
 
 if sys.version_info >= (3, 11):
@@ -402,6 +402,8 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
         lo = number(f"[variables] {name} lower", spec["lower"], unit, lo=0.0, hi=lim)
         hi = number(f"[variables] {name} upper", spec["upper"], unit, lo=0.0, hi=lim)
         x0 = None if "initial" not in spec else number(f"[variables] {name} initial", spec["initial"], unit, lo=0.0, hi=lim)
+        if hi < lo:  # named by the file's key (the Variable would say "variable NAME bounds")
+            raise DesignError(f"[variables] {name} upper", hi, f"must be >= lower = {lo:g}", unit)
         vs.append(Variable(name, lo, hi, x0, unit, least=TOL.min_length if unit == "mm" else None))
     _check_keys("[fixed]", fixed, set(fam.params) - set(variables))
     fixed = {k: number(f"[fixed] {k}", v, fam.params[k], lo=0.0, hi=LIMITS.get(fam.params[k], LIMITS[""]))
@@ -466,7 +468,10 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
         cname = c.get("name", q)
         if not isinstance(cname, str) or not cname.strip() or "\n" in cname:
             raise DesignError(f"[[constraint]] {k} name", _shown(cname), "must be a one-line text")
-        cons.append(Constraint(cname, f, kind="eq" if "target" in c else "ineq", relative=relative, unit=unit, **kw))
+        try:
+            cons.append(Constraint(cname, f, kind="eq" if "target" in c else "ineq", relative=relative, unit=unit, **kw))
+        except DesignError as exc:  # "constraint NAME lower": the file's [[constraint]] k
+            raise exc.renamed(f"constraint[{k}]" + exc.parameter[len(one_token(f"constraint {cname}")):]) from None
 
     def to_toml(x, d):
         solved = {} if held is None else {held[0]: float(d.params[held[0]])}

@@ -106,13 +106,24 @@ def read_done(out_dir: Path) -> dict[str, dict[str, Any]]:
             done[str(r["design_hash"])] = r
     journal = out_dir / JOURNAL
     if journal.is_file():
-        for line in journal.read_text(encoding="utf-8").splitlines():
+        lines = journal.read_bytes().decode("utf-8", errors="replace").splitlines()
+        for k, line in enumerate(lines):
             try:
                 r = json.loads(line)
-            except json.JSONDecodeError:  # the last line of an interrupted run may be cut short
-                continue
+            except json.JSONDecodeError:
+                if k == len(lines) - 1 and k > 0:  # the last line of an interrupted run may be cut short
+                    continue
+                r = None
+            if not (isinstance(r, dict) and "design_hash" in r):  # not a sweep's journal: never ours to delete
+                raise DesignError("--out", str(out_dir), f"holds a {JOURNAL} that no sweep wrote (line {k + 1}); "
+                                  "move it or write into another folder")
             done[str(r["design_hash"])] = r
     return done
+
+
+def plot_names(outputs: Sequence[str]) -> list[str]:
+    """The file names of :func:`plot_results`'s plots of ``outputs``."""
+    return [f"plot_{_safe(o)}.png" for o in outputs]
 
 
 def _safe(name: str) -> str:
@@ -159,7 +170,7 @@ def plot_results(df, keys: Sequence[str], outputs: Sequence[str], out_dir: str |
             ax.set_ylabel(o)
             ax.grid(alpha=0.3)
         fig.suptitle(f"{o}: {len(ok)} designs")
-        path = Path(out_dir) / f"plot_{_safe(o)}.png"
+        path = Path(out_dir) / plot_names([o])[0]
         fig.savefig(path, dpi=110)
         paths.append(path)
     return paths

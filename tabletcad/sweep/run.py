@@ -10,7 +10,7 @@ from typing import Any
 from tabletcad.errors import DesignError
 from tabletcad.sweep.engine import CONNECT_TIMEOUT_S, failed_design, map_tasks, open_client, sweep_task
 from tabletcad.sweep.results import (JOURNAL, RESULTS_CSV, TAIL_COLUMNS, append_journal, plot_column_error,
-                                     plot_results, read_done, results_frame, write_results)
+                                     plot_names, plot_results, read_done, results_frame, write_results)
 from tabletcad.sweep.spec import SweepSpec, design_hash, load_sweep, parse_sweep
 
 __all__ = ["run_sweep"]
@@ -83,6 +83,13 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
         if foreign:
             raise DesignError("--resume", str(out / RESULTS_CSV),
                               f"holds {len(foreign)} designs that are not in this sweep file; use another --out folder")
+    elif out is not None and out.is_dir():  # a first run into a used folder: it owns only what it writes
+        theirs = [n for n in plot_names(plot) if (out / n).exists()]
+        if files_wanted and (out / "designs").exists():
+            theirs.append("designs")
+        if theirs:
+            raise DesignError("--out", str(out), f"must not hold files this sweep writes that no earlier run of it "
+                              f"wrote ({', '.join(theirs)}): move them or write into another folder")
 
     todo: dict[str, dict[str, Any]] = {}
     for h, d in zip(hashes, designs):

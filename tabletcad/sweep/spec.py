@@ -159,6 +159,32 @@ def _number(where: str, v: Any) -> float:
     return float(v)
 
 
+def _family_of(design: dict):
+    """The named family of ``[design.tablet]`` (:data:`tabletcad.families.FAMILIES`), or ``None``."""
+    from tabletcad.families import FAMILIES, RENAMED
+
+    tab = design.get("tablet", {})
+    fam = tab.get("family") if isinstance(tab, dict) else None
+    fam = RENAMED.get(fam, fam) if isinstance(fam, str) else fam
+    return FAMILIES.get(fam) if isinstance(fam, str) else None
+
+
+def _dimension_keys(design: dict) -> set[str]:
+    """The dotted keys whose values are numbers in every design: the named family's parameters."""
+    fam = _family_of(design)
+    return set() if fam is None else {f"tablet.{k}" for k in fam.params}
+
+
+def _check_family_keys(design: dict) -> None:
+    """Refuse a key of ``[design.tablet]`` that the named family does not take (every row would fail)."""
+    fam = _family_of(design)
+    if fam is None:
+        return
+    for k, v in design["tablet"].items():
+        if k not in fam.params and k not in ("family", "name", "a"):
+            raise DesignError(f"design.tablet.{k}", v, f"family {fam.name!r} takes {', '.join(fam.params)}")
+
+
 def _known_keys(design: dict) -> set[str]:
     """Dotted keys that may be varied: every scalar of the base design, and the family's parameters."""
     keys: set[str] = set()
@@ -210,6 +236,8 @@ def _axis(key: str, spec: Any, method: str) -> Axis:
     lo, hi = _number(f"{where} min", spec["min"]), _number(f"{where} max", spec["max"])
     if hi < lo:
         raise DesignError(f"{where} max", hi, f"the range is empty: max must be >= min = {lo:g}")
+    if not math.isfinite(hi - lo):  # (-1.7e308 to 1.7e308 gave inf and nan values)
+        raise DesignError(f"{where} max", hi, f"the range's width from min = {lo:g} must be a finite number")
     if method == "lhs":
         return Axis(key, (), lo, hi)
     if "num" not in spec:
@@ -280,13 +308,18 @@ def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
     vary = sw.get("vary")
     if not isinstance(vary, dict) or not vary:
         raise DesignError("[sweep.vary]", "missing" if vary is None else vary, "give at least one dotted design key to vary")
+    _check_family_keys(design)
     known = _known_keys(design)
+    dims = _dimension_keys(design)
     axes = []
     for key, spec in vary.items():
         if key not in known:
             raise DesignError("[sweep.vary] key", key, "must name a value of [design] or a parameter of its family "
                               "(e.g. 'tablet.cup_depth'); known: " + ", ".join(sorted(known)))
-        axes.append(_axis(key, spec, method))
+        axis = _axis(key, spec, method)
+        for v in axis.values if key in dims else ():  # a dimension is a number in every design ("a" failed every row)
+            _number(f"[sweep.vary] {key!r}", v)
+        axes.append(axis)
     if method == "grid" and math.prod(len(a.values) for a in axes) > MAX_DESIGNS:
         raise DesignError("[sweep.vary]", " x ".join(str(len(a.values)) for a in axes),
                           f"must give at most {MAX_DESIGNS:,} designs (the grid's product)")
