@@ -30,6 +30,18 @@ IN_FLIGHT_PER_WORKER = 4
 """Tasks queued per worker thread; keeps the scheduler's memory flat for sweeps of millions of designs."""
 
 
+def check_scheduler_address(scheduler: str) -> None:
+    """Refuse (:class:`~tabletcad.errors.DesignError`) an address that is not ``[tcp|tls|ws|wss]://host:port``
+    or ``host:port``, before any connection is tried (a malformed one waited twice the timeout, and
+    Dask's half-made client printed a traceback when it was collected)."""
+    import re
+
+    m = re.fullmatch(r"(?:(tcp|tls|ws|wss)://)?(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):(\d{1,5})", str(scheduler).strip())
+    if m is None or not 0 < int(m.group(3)) < 65536:
+        raise DesignError("--scheduler", scheduler, "must be a Dask scheduler address: [tcp://]host:port "
+                          "(or tls://, ws://, wss://), the port from 1 to 65535")
+
+
 @contextlib.contextmanager
 def open_client(workers: int | None = None, scheduler: str | None = None,
                 connect_timeout: float = CONNECT_TIMEOUT_S) -> Iterator[Any]:
@@ -42,6 +54,7 @@ def open_client(workers: int | None = None, scheduler: str | None = None,
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
+        check_scheduler_address(scheduler)
         try:
             client = Client(scheduler, timeout=f"{connect_timeout}s", set_as_default=False)
         except (OSError, TimeoutError, ValueError) as exc:

@@ -161,3 +161,24 @@ def test_a_sweep_does_not_take_a_folder_s_other_files_for_its_own(tmp_path, caps
     assert [p.read_text() for p in (a / "results.partial.jsonl", b / "plot_volume_mm3.png")] == ["mine\n", "mine"]
     assert sorted(p.name for p in a.iterdir()) == ["results.partial.jsonl"]
     assert sorted(p.name for p in b.iterdir()) == ["plot_volume_mm3.png"]
+
+
+@pytest.mark.parametrize("address", ["notaurl", "", "tcp://", "http://127.0.0.1:1", "inproc://x", "tcp://127.0.0.1:99999"])
+def test_a_malformed_scheduler_address_is_refused_before_connecting(tmp_path, capsys, monkeypatch, address):
+    """These waited twice the connect timeout and printed a traceback of Dask's half-made client:
+    now no client is made."""
+    from pathlib import Path
+
+    import distributed
+
+    from tabletcad.parallel import check_scheduler_address
+
+    check_scheduler_address("tcp://127.0.0.1:8786"), check_scheduler_address("[::1]:8786")  # well formed
+    monkeypatch.setattr(distributed, "Client", lambda *a, **k: pytest.fail("a client was made"))
+    sample = Path(__file__).resolve().parents[1] / "samples" / "sweep" / "concave_round_grid.toml"
+    rc = main(["sweep", str(sample), "--out", str(tmp_path / "o"), "--scheduler", address])
+    assert rc == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"error: --scheduler = {address!r} is not allowed: must be a Dask scheduler address: [tcp://]host:port "
+        "(or tls://, ws://, wss://), the port from 1 to 65535"]
+    assert not (tmp_path / "o").exists()
