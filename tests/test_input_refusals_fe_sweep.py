@@ -182,3 +182,16 @@ def test_a_malformed_scheduler_address_is_refused_before_connecting(tmp_path, ca
         f"error: --scheduler = {address!r} is not allowed: must be a Dask scheduler address: [tcp://]host:port "
         "(or tls://, ws://, wss://), the port from 1 to 65535"]
     assert not (tmp_path / "o").exists()
+
+
+def test_an_output_that_cannot_be_written_is_named_as_its_option(capsys):
+    """``path = '/proc/.x.57zqaxab.json'`` named a temporary file, not the option."""
+    from pathlib import Path
+
+    assert main(["shapes", "--json-file", "/proc/x.json"]) == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        "error: --json-file = '/proc/x.json' is not allowed: cannot be written: no such file or directory"]
+    sample = Path(__file__).resolve().parents[1] / "samples" / "sweep" / "concave_round_grid.toml"
+    assert main(["sweep", str(sample), "--out", "/proc/sweep", "--workers", "1"]) == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        "error: --out = '/proc/sweep' is not allowed: cannot be written: no such file or directory"]

@@ -77,6 +77,7 @@ def staged(**targets: Path | None) -> Iterator[dict[str, Path]]:
         staged = {k: Path(tmp) / f"{k}{p.suffix}" for k, p in targets.items() if p is not None}
         yield staged
         created: list[Path] = []
+        k = None
         try:
             for k, src in staged.items():
                 dst = targets[k]
@@ -84,7 +85,10 @@ def staged(**targets: Path | None) -> Iterator[dict[str, Path]]:
                 atomic_write_bytes(dst, src.read_bytes())
                 if not existed:
                     created.append(dst)
-        except BaseException:
+        except BaseException as exc:
             for dst in created:
                 dst.unlink(missing_ok=True)
+            if isinstance(exc, OSError) and k is not None:  # (/proc/x.json): named as the option, not a temporary
+                raise DesignError({"json": "--json-file"}.get(k, f"--{k}"), str(targets[k]),
+                                  f"cannot be written: {(exc.strerror or str(exc)).lower()}") from None
             raise

@@ -124,7 +124,10 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
             n = None if scheduler is not None else min(workers or os.cpu_count() or 1, len(items))
             client = stack.enter_context(open_client(n, scheduler, connect_timeout))
         if out is not None:
-            out.mkdir(parents=True, exist_ok=True)
+            try:
+                out.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:  # (/proc/sweep): named as the option
+                raise DesignError("--out", str(out), f"cannot be written: {(exc.strerror or str(exc)).lower()}") from None
         map_tasks(sweep_task, items, client=client, workers=0 if client is None else None, **common)
 
     rows = [results.get(h) or _restored(done[h], spec.keys, values[h]) for h in hashes]
