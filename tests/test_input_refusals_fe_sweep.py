@@ -195,3 +195,20 @@ def test_an_output_that_cannot_be_written_is_named_as_its_option(capsys):
     assert main(["sweep", str(sample), "--out", "/proc/sweep", "--workers", "1"]) == 2
     assert capsys.readouterr().err.strip().splitlines() == [
         "error: --out = '/proc/sweep' is not allowed: cannot be written: no such file or directory"]
+
+
+@pytest.mark.parametrize("store, allowed", [
+    ("afile", "must be a folder: {tmp}/afile is a file"),
+    ("nosuchproto://x", "must be a folder or an fsspec URL (Protocol not known: nosuchproto)"),
+])
+def test_a_store_no_worker_could_write_is_refused(tmp_path, capsys, monkeypatch, store, allowed):
+    """Every row had failed (NotADirectoryError, Protocol not known) with exit 0."""
+    from pathlib import Path
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "afile").write_text("x")
+    sample = Path(__file__).resolve().parents[1] / "samples" / "sweep" / "concave_round_grid.toml"
+    assert main(["sweep", str(sample), "--out", str(tmp_path / "o"), "--workers", "1", "--store", store]) == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"error: --store = {store!r} is not allowed: " + allowed.format(tmp=tmp_path)]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]

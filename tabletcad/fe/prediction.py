@@ -26,7 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.errors import DesignError, check_range
 from tabletcad.tolerance import DEFAULT
 from tabletcad.fe.diametral import DiametralResult, diametral
 

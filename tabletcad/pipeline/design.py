@@ -252,12 +252,7 @@ class Design:
         Checks what needs no geometry: the top-level tables, the name, the family.  The
         dimensions are checked by :meth:`build`, before any geometry is built.
         """
-        try:
-            return cls._from_dict(data, default_name, comment, None if folder is None else Path(folder))
-        except DesignError as exc:
-            if len(exc.parameter.split()) > 1:
-                raise exc.renamed(one_token(exc.parameter)) from None
-            raise
+        return cls._from_dict(data, default_name, comment, None if folder is None else Path(folder))
 
     @classmethod
     def _from_dict(cls, data: Any, default_name: str, comment: str, folder: Path | None) -> Design:
@@ -317,12 +312,7 @@ class Design:
         ``Tolerances.max_length``.  Errors name the parameter as one token
         (``tablet.diameter``, ``patch[0].curves[1].radius``).
         """
-        try:
-            return self._build()
-        except DesignError as exc:
-            if len(exc.parameter.split()) > 1:
-                raise exc.renamed(one_token(exc.parameter)) from None
-            raise
+        return self._build()  # (every DesignError names its parameter as one token)
 
     def _build(self) -> Tablet:
         if not isinstance(self.tablet, dict):

@@ -58,6 +58,9 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
         raise DesignError("--workers", workers, "must be an integer >= 1 (0 runs the designs in this process)")
     if workers is not None and (scheduler is not None or client is not None):
         raise DesignError("--workers", workers, "give either --workers or --scheduler, not both")
+    if store is not None or spec.store is not None:
+        _check_store(store if store is not None else spec.store, "--store" if store is not None else "[sweep] store",
+                     local=scheduler is None)
     store = store if store is not None else spec.store
     files_wanted = any(o != "report" for o in spec.outputs)
     out = Path(out_dir) if out_dir is not None else None
@@ -161,6 +164,28 @@ def _check_plot_columns(plot: tuple[str, ...], design: dict[str, Any], spec) -> 
         unknown = o not in cols and o.split(".")[0] not in sections and not files
         if o in spec.keys or o in TAIL_COLUMNS or unknown:
             raise plot_column_error(o, list(cols), spec.keys)
+
+
+def _check_store(store: str, name: str, local: bool) -> None:
+    """Refuse a store that no worker could write (every row had failed, exit 0): an unknown fsspec
+    protocol, one whose library is missing here when the workers run here (``local``), a local path
+    that is a file or lies below one."""
+    import fsspec
+
+    try:
+        fs, root = fsspec.core.url_to_fs(store)
+    except ValueError as exc:
+        raise DesignError(name, store, f"must be a folder or an fsspec URL ({exc})") from None
+    except ImportError as exc:  # a remote cluster's workers may have the library this client lacks
+        if local:
+            raise DesignError(name, store, f"must be a folder or an fsspec URL the workers can write ({exc})") from None
+        return
+    if isinstance(fs, fsspec.implementations.local.LocalFileSystem):
+        p = Path(root)
+        while not p.exists() and p != p.parent:
+            p = p.parent
+        if not p.is_dir():
+            raise DesignError(name, store, f"must be a folder: {p} is a file")
 
 
 def _restored(row: dict[str, Any], keys: tuple[str, ...], values: tuple[Any, ...]) -> dict[str, Any]:
