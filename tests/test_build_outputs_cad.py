@@ -15,6 +15,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from tabletcad.cli import main
@@ -220,6 +221,33 @@ def test_a_free_form_band_without_caps_writes_its_report_and_picture(tmp_path, c
     # the divergence theorem over band and end faces = the triple integral of the solid map's Jacobian
     assert rep["volume_mm3"] == pytest.approx(load_design(design).solid_volume(), rel=1e-9)
     assert rep["volume_mm3"] == pytest.approx(math.pi * 25.0 * 3.0, rel=1e-3)  # nearly the cylinder
+
+
+@pytest.mark.parametrize("end, expected", [
+    ("pole", None), ("segment", None), ("circle", "last"),
+])
+def test_open_end_is_decided_by_the_curve_not_by_rounding(end, expected):
+    """A pole 1000 mm up the axis whose points differ by rounding (under 1e-11 mm, its ends at v = 0
+    and 2π too) encloses nothing: its vector area about the origin was |x| times the rounding, and it skipped the rounded triangle's
+    solid on a machine whose BLAS rounded its top pole differently.  A curve folded onto a segment
+    encloses nothing either; a 1 µm circle up there does."""
+    from types import SimpleNamespace
+
+    from tabletcad.cad.stage import _open_end
+
+    def curve(u, v):
+        v = np.asarray(v, float)
+        if end == "pole":
+            return np.column_stack([1e-13 * v, 1e-13 * v * v, np.full(v.shape, 1000.0)])  # v = 0 and 2π apart
+        if end == "segment":
+            return np.column_stack([2.0 * np.cos(v), np.zeros(v.shape), np.full(v.shape, 1000.0)])
+        return np.column_stack([1e-3 * np.cos(v), 1e-3 * np.sin(v), np.full(v.shape, 1000.0)])
+
+    def first(u, v):  # a pole at the origin: a closed bottom
+        return np.zeros((np.asarray(v).size, 3))
+
+    tablet = SimpleNamespace(patches=[SimpleNamespace(evaluate=first), SimpleNamespace(evaluate=curve)])
+    assert _open_end(tablet) == expected
 
 
 def test_a_hollow_tablet_of_several_patches_writes_its_report_and_picture(tmp_path, capsys):

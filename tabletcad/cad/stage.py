@@ -237,9 +237,12 @@ def _open_end(tablet: Tablet) -> str | None:
     for name, patch, u in (("first", tablet.patches[0], 0.0), ("last", tablet.patches[-1], 1.0)):
         v = np.linspace(0.0, 2.0 * np.pi, 257)
         x = patch.evaluate(np.full(v.shape, u), v)
-        area = 0.5 * np.sum(np.cross(x[:-1], x[1:] - x[:-1]), axis=0)  # the curve's vector area
         size = float(np.ptp(x, axis=0).max())
-        if float(np.linalg.norm(area)) > 1e-6 * max(size * size, 1e-12):
+        if size <= 1e-9 * max(1.0, float(np.max(np.abs(x)))):  # a pole, to rounding
+            continue
+        x = x - x.mean(axis=0)  # about its centre: no rounding of the position magnified into an area
+        area = 0.5 * np.sum(np.cross(x[:-1], x[1:] - x[:-1]), axis=0)  # the curve's vector area
+        if float(np.linalg.norm(area)) > 1e-6 * size * size:
             return name
     return None
 
