@@ -1,6 +1,7 @@
 """Scores of every kind and the split tablet: parts, masses and break surface against closed forms."""
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -51,21 +52,31 @@ def test_cut_through_bisect_splits_into_equal_halves_with_the_closed_form_break_
     assert sp["within_limit"] and sp["split_loss_limit_percent"] == 3.0 and "FDA" in sp["split_loss_limit_source"]
 
 
-def test_short_score_removes_its_prism_and_shortens_the_break_surface(flat):
+def test_short_score_removes_its_prism_and_breaks_nothing(flat):
+    """A short score ends on the face: decorative, no break plane (a tablet with only one is not split).
+    Beside a full bisect across it, the tablet splits in two along the bisect alone (it had been
+    counted as a second plane: four quarters), and the break plane loses the short V's section, d²."""
     d, L = 0.3, 4.0
     s = ScoreSpec(depth_mm=d, length_mm=L, direction_deg=90.0)
     ts = make_tooling(flat, ToolingSpec(scores=(s,)), check=False, interference_check=False)
     removed = ts.report["tablet"]["volume_plain_mm3"] - ts.report["tablet"]["volume_mm3"]
     # triangle d x 2d / 2 times the length (difference of two 275 mm3 B-rep volumes: abs 1e-6)
     assert removed == pytest.approx(d * d * L, abs=1e-6)
+    assert ts.report["split"] is None
+    bisect = ScoreSpec(depth_mm=d, cut_through=True, direction_deg=0.0)
+    ts = make_tooling(flat, ToolingSpec(scores=(bisect, replace(s, faces="bottom"))), check=False,
+                      interference_check=False)
     sp = ts.report["split"]
-    assert sp["break_surface_area_mm2"] == pytest.approx(2 * R * H - d * L, rel=1e-9)
+    assert sp["directions_deg"] == [0.0] and sp["n_parts"] == 2
+    assert sp["break_surface_area_mm2"] == pytest.approx(2 * R * (H - d) - d * d, rel=1e-9)
 
 
 @pytest.mark.parametrize("scores, dirs", [
     ([ScoreSpec(direction_deg=90.0)], [90.0]),
     ([ScoreSpec(kind="quadrisect", direction_deg=30.0)], [30.0, 120.0]),
     ([ScoreSpec(direction_deg=0.0, faces="both"), ScoreSpec(direction_deg=180.0)], [0.0]),
+    ([ScoreSpec(direction_deg=0.0), ScoreSpec(direction_deg=90.0, length_mm=4.0)], [0.0]),
+    ([ScoreSpec(kind="quadrisect", length_mm=3.0)], []),
 ])
 def test_split_directions(scores, dirs):
     assert split_directions(scores) == pytest.approx(dirs)

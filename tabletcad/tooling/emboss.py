@@ -75,12 +75,14 @@ def _transform(shape: TopoDS_Shape, trsf: gp_Trsf) -> TopoDS_Shape:
     return BRepBuilderAPI_Transform(shape, trsf, True).Shape()
 
 
-def figure_faces(e: EmbossSpec) -> TopoDS_Shape:
-    """Plan faces (a compound at ``z = 0``) of the text or outline, placed and, for the bottom, mirrored."""
+def figure_faces(e: EmbossSpec, i: int = 0) -> TopoDS_Shape:
+    """Plan faces (a compound at ``z = 0``) of the text or outline, placed and, for the bottom, mirrored
+    (``i``: the figure's index in ``[[tooling.emboss]]``, for errors)."""
+    w = f"[[tooling.emboss]] {i}"
     if e.text is not None:
-        shape = text_faces(e.text, e.height_mm, font_path(e.font))
+        shape = text_faces(e.text, e.height_mm, font_path(e.font, f"{w} font"), f"{w} font")
     elif e.svg is not None:
-        shape = svg_faces(e.svg, e.height_mm)
+        shape = svg_faces(e.svg, e.height_mm, f"{w} svg")
     else:
         shape = plan_face(polyline_wire(e.outline))
     trsf = gp_Trsf()
@@ -92,11 +94,11 @@ def figure_faces(e: EmbossSpec) -> TopoDS_Shape:
         m.SetMirror(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(1, 0, 0)))  # x -> -x: reads correctly from below
         shape = _transform(shape, m)
     if not explore(shape, "Face"):
-        raise DesignError("[[tooling.emboss]] text", e.text, "gives no glyphs in this font")
+        raise DesignError(f"{w} text", e.text, "gives no glyphs in this font")
     return shape
 
 
-def text_faces(text: str, size: float, path) -> TopoDS_Shape:
+def text_faces(text: str, size: float, path, where: str = "[[tooling.emboss]] font") -> TopoDS_Shape:
     """The glyph faces of ``text`` in the font file ``path`` at ``size`` mm, centred on the origin both ways.
 
     OCC's ``StdPrs_BRepTextBuilder`` with the font loaded from the file, as build123d's ``Text`` does
@@ -109,21 +111,24 @@ def text_faces(text: str, size: float, path) -> TopoDS_Shape:
 
     font = StdPrs_BRepFont()
     if not font.Init(NCollection_Utf8String(str(path)), float(size), 0):
-        raise DesignError("[[tooling.emboss]] font", str(path), "must be a TrueType/OpenType font file OCC can read")
+        raise DesignError(where, str(path), "must be a TrueType/OpenType font file OCC can read")
     shape = StdPrs_BRepTextBuilder().Perform(font, NCollection_Utf8String(text), gp_Ax3(), Graphic3d_HTA_CENTER,
                                              Graphic3d_VTA_CENTER)
     return _compound(explore(shape, "Face"))
 
 
-def svg_faces(path: str, height: float) -> TopoDS_Shape:
+def svg_faces(path: str, height: float, where: str = "[[tooling.emboss]] svg") -> TopoDS_Shape:
     """The filled outlines of an SVG logo as plan faces, centred on the origin and ``height`` mm tall."""
     import build123d as bd
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
 
-    faces = [s for s in bd.import_svg(path, align=None) if isinstance(s, bd.Face)]
+    try:
+        faces = [s for s in bd.import_svg(path, align=None) if isinstance(s, bd.Face)]
+    except (ValueError, TypeError, KeyError, IndexError, AttributeError, SyntaxError) as exc:  # the file's content
+        raise DesignError(where, path, f"must be an SVG file whose paths can be read ({type(exc).__name__}: {exc})") from None
     if not faces:
-        raise DesignError("[[tooling.emboss]] svg", path, "has no filled outline (closed, filled path) to emboss")
+        raise DesignError(where, path, "has no filled outline (closed, filled path) to emboss")
     comp = bd.Compound(faces).wrapped
     box = Bnd_Box()
     BRepBndLib.Add_s(comp, box)
@@ -225,7 +230,7 @@ def check_fit(frame: TabletFrame, e: EmbossSpec, figure: TopoDS_Shape, clearance
 
 def check_emboss(frame: TabletFrame, e: EmbossSpec, clearance: float, i: int = 0):
     """The placed figure and its fit facts; :class:`DesignError` if it does not fit or is too deep."""
-    figure = figure_faces(e)
+    figure = figure_faces(e, i)
     info = check_fit(frame, e, figure, clearance, i)
     info["legibility"] = leg = legibility(frame, e, figure, clearance)
     if e.draft_deg > 0 and e.depth_mm * math.tan(math.radians(e.draft_deg)) >= 0.5 * leg["stroke_width_mm"]:
@@ -235,7 +240,7 @@ def check_emboss(frame: TabletFrame, e: EmbossSpec, clearance: float, i: int = 0
                           f"{e.depth_mm:.3g} mm", "deg")
     cup = frame.cup_depth_top if e.face == "top" else frame.cup_depth_bottom
     limit = cup + 0.25 * frame.band
-    if e.mode == "deboss" and e.depth_mm > limit:
+    if e.depth_mm > limit:  # debossed into the tablet, or raised on it (cut as deep into the punch)
         raise DesignError(f"[[tooling.emboss]] {i} depth_mm", e.depth_mm, f"must be <= cup depth + band/4 = {limit:.4g} mm", "mm")
     return figure, info
 

@@ -107,11 +107,14 @@ def relief_volume(frame: TabletFrame, b: PunchBody, clearance: float, tip_length
     return (a - r) * (tip_length - b.tip_straight_mm)
 
 
-def check_body_fits(frame: TabletFrame, b: PunchBody, outline_radius: float) -> None:
-    """DesignError when the tablet does not fit the barrel or exceeds the standard's largest tablet."""
-    if outline_radius >= 0.5 * b.barrel_diameter_mm:
+def check_body_fits(frame: TabletFrame, b: PunchBody, tip_radius: float) -> None:
+    """DesignError when the punch tip (the tablet's outline less the clearance, reaching ``tip_radius``
+    mm from the axis) does not fit the barrel it is machined from, or the tablet exceeds the standard's
+    largest tablet (a 19 mm capsule on B tooling, whose barrel is 19 mm, fits with any clearance)."""
+    if tip_radius >= 0.5 * b.barrel_diameter_mm:
         raise DesignError("[tooling.punch] barrel_diameter_mm", b.barrel_diameter_mm,
-                          f"must be > the tablet's circumscribed diameter {2 * outline_radius:.4g} mm", "mm")
+                          f"must be > the punch tip's circumscribed diameter {2 * tip_radius:.4g} mm (the tablet's "
+                          "less twice the clearance)", "mm")
     size = max(frame.length, frame.width)
     round_ = frame.outline_kind == "circle"
     lim = b.max_round_tablet_mm if round_ else b.max_shaped_tablet_mm

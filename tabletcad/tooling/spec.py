@@ -65,6 +65,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -218,6 +219,32 @@ def _one_line(text: str) -> bool:
     return not any(unicodedata.category(c)[0] == "C" or unicodedata.category(c) in ("Zl", "Zp") for c in text)
 
 
+@lru_cache(maxsize=8)
+def _charmap(path: str) -> frozenset[int]:
+    """The code points the font file ``path`` has a glyph for."""
+    from matplotlib.ft2font import FT2Font
+
+    return frozenset(FT2Font(path).get_charmap())
+
+
+def missing_glyphs(text: str, path: str | Path, where: str = "[[tooling.emboss]] font") -> str:
+    """The characters of ``text`` (each once, in order) that the font file ``path`` has no glyph for: OCC
+    and matplotlib draw them as empty boxes (the .notdef glyph).  The plain space needs none.  A file that
+    is no font is a :class:`DesignError` of ``where``."""
+    try:
+        cmap = _charmap(str(path))
+    except (RuntimeError, OSError, ValueError):
+        raise DesignError(where, str(path), "must be a TrueType/OpenType font file that can be read") from None
+    return "".join(dict.fromkeys(c for c in text if c != " " and ord(c) not in cmap))
+
+
+def _drawing_font() -> str:
+    """The drawings' font file (matplotlib's DejaVu Sans)."""
+    from matplotlib import font_manager
+
+    return font_manager.findfont(font_manager.FontProperties(family="DejaVu Sans"), fallback_to_default=False)
+
+
 def _drawing(t: Any) -> DrawingSpec:
     w = "[tooling.drawing]"
     t = _keys(w, t, set(TITLE_KEYS) | {"tolerance_mm", "tolerances"})
@@ -231,6 +258,9 @@ def _drawing(t: Any) -> DrawingSpec:
                 raise DesignError(f"{w} {k}", v, "must be printable text on one line (no control characters)")
             if len(str(v)) > TITLE_MAX_CHARS[k]:
                 raise DesignError(f"{w} {k}", v, f"must be at most {TITLE_MAX_CHARS[k]} characters (the title block's room)")
+            missing = missing_glyphs(str(v), _drawing_font())
+            if missing:
+                raise DesignError(f"{w} {k}", v, f"has characters the drawings' font (DejaVu Sans) cannot draw: {missing!r}")
             kw[k] = str(v)
     if "tolerance_mm" in t:
         kw["tolerance_mm"] = check_positive(f"{w} tolerance_mm", t["tolerance_mm"], "mm")
@@ -291,8 +321,10 @@ def _bool(where: str, value: Any) -> bool:
     return value
 
 
-def font_path(font: str) -> Path:
-    """A ``.ttf`` file: a path, or a DejaVu font name (``"DejaVuSans-Bold"``)."""
+def font_path(font: str, where: str = "[[tooling.emboss]] font") -> Path:
+    """A ``.ttf`` file: a path, or a DejaVu font name (``"DejaVuSans-Bold"``); ``where`` names the key."""
+    if not isinstance(font, str) or not font.strip():
+        raise DesignError(where, font, "must be a font name or the path of a .ttf/.otf file (a string)")
     p = Path(font)
     if p.suffix.lower() in (".ttf", ".otf") and p.is_file():
         return p
@@ -300,7 +332,7 @@ def font_path(font: str) -> Path:
     if q.is_file():
         return q
     names = sorted(x.stem for x in FONT_DIR.glob("*.ttf")) if FONT_DIR.is_dir() else []
-    raise DesignError("[[tooling.emboss]] font", font, f"must be a .ttf path or one of {', '.join(names[:8]) or 'the DejaVu fonts (not installed)'}...")
+    raise DesignError(where, font, f"must be a .ttf path or one of {', '.join(names[:8]) or 'the DejaVu fonts (not installed)'}...")
 
 
 def _score(i: int, t: Any) -> ScoreSpec:
@@ -326,6 +358,18 @@ def _score(i: int, t: Any) -> ScoreSpec:
     return ScoreSpec(kind, profile, depth, angle, width, cut,
                      _choice(f"{w} faces", t.get("faces", d.faces), ("top", "bottom", "both")),
                      check_finite(f"{w} direction_deg", t.get("direction_deg", d.direction_deg), "deg"), slot, length)
+
+
+def _check_svg(where: str, path: str) -> None:
+    """DesignError unless ``path`` is well-formed XML with an ``svg`` root element."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.parse(path).getroot()
+    except (ET.ParseError, OSError, UnicodeError) as exc:
+        raise DesignError(where, path, f"must be a readable SVG file: {exc}") from None
+    if root.tag.rsplit("}", 1)[-1] != "svg":
+        raise DesignError(where, path, f"must be an SVG file: its root element is <{root.tag}>, not <svg>")
 
 
 def _emboss(i: int, t: Any, base: Path | None = None) -> EmbossSpec:
@@ -364,9 +408,16 @@ def _emboss(i: int, t: Any, base: Path | None = None) -> EmbossSpec:
     pos = t.get("position_mm", list(d.position_mm))
     if not (isinstance(pos, list) and len(pos) == 2):
         raise DesignError(f"{w} position_mm", pos, "must be [x, y] in mm")
+    big = DEFAULT.max_length
+    pos = tuple(check_range(f"{w} position_mm", x, -big, big, "mm") for x in pos)
     font = t.get("font", d.font)
     if text is not None:
-        font_path(font)
+        missing = missing_glyphs(text, font_path(font, f"{w} font"), f"{w} font")
+        if missing:
+            raise DesignError(f"{w} text", text, f"has characters the font {font!r} has no glyph for: {missing!r} "
+                              "(they would be cut as empty boxes); give a font that has them")
+    if svg is not None:
+        _check_svg(f"{w} svg", svg)
     return EmbossSpec(
         text, outline,
         _choice(f"{w} mode", t.get("mode", d.mode), ("deboss", "emboss")),
@@ -375,7 +426,7 @@ def _emboss(i: int, t: Any, base: Path | None = None) -> EmbossSpec:
         check_positive(f"{w} depth_mm", t.get("depth_mm", d.depth_mm), "mm"),
         check_range(f"{w} stroke_angle_deg", stroke, 0.0, 60.0, "deg", hi_open=True),
         font,
-        (check_finite(f"{w} position_mm", pos[0], "mm"), check_finite(f"{w} position_mm", pos[1], "mm")),
+        pos,
         check_finite(f"{w} rotation_deg", t.get("rotation_deg", d.rotation_deg), "deg"),
         check_range(f"{w} margin_mm", t.get("margin_mm", d.margin_mm), 0.0, None, "mm"),
         svg,

@@ -36,9 +36,12 @@ SPLIT_LOSS_SOURCE = ("FDA Guidance for Industry 'Tablet Scoring: Nomenclature, L
 
 
 def split_directions(scores) -> list[float]:
-    """The distinct break-plane directions (degrees in [0, 180)) of the scores."""
+    """The distinct break-plane directions (degrees in [0, 180)) of the scores.  A short score
+    (``length_mm`` given) ends on the face: it is decorative and breaks nothing."""
     out: list[float] = []
     for s in scores:
+        if s.length_mm is not None:
+            continue
         for d in ((s.direction_deg,) if s.kind == "bisect" else (s.direction_deg, s.direction_deg + 90.0)):
             d = d % 180.0
             if all(min(abs(d - e), 180.0 - abs(d - e)) > 1e-9 for e in out):

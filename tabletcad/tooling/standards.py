@@ -180,6 +180,9 @@ def resolve_body(standard: str, kind: str | None, table: Any, tip_length: float,
             kv[k] = _num(w, t, k, {}, src, zero_ok=k == "key_offset_mm")
     if key and not kv["key_width_mm"] < Db:  # a key sits in a slot of the barrel
         raise DesignError(f"{w} key_width_mm", kv["key_width_mm"], f"must be < barrel_diameter_mm {Db:.4g} mm", "mm")
+    if key and not kv["key_height_mm"] < 0.5 * Db:  # and stands out of it by less than the barrel's radius
+        raise DesignError(f"{w} key_height_mm", kv["key_height_mm"], f"must be < half barrel_diameter_mm, "
+                          f"{0.5 * Db:.4g} mm (the key stands out of a slot in the barrel)", "mm")
     key_angle = float(check_range(f"{w} key_angle_deg", t.get("key_angle_deg", 0.0), -360.0, 360.0, "deg"))
     ext = {k: entry[k]["value"] for k in ("max_round_tablet_mm", "max_shaped_tablet_mm", "die_outer_diameter_mm")
            if k in entry}
@@ -189,6 +192,14 @@ def resolve_body(standard: str, kind: str | None, table: Any, tip_length: float,
                      kv["key_width_mm"], kv["key_length_mm"], kv["key_height_mm"], kv["key_offset_mm"], key_angle,
                      ext.get("max_round_tablet_mm"), ext.get("max_shaped_tablet_mm"), ext.get("die_outer_diameter_mm"),
                      src)
+    parts = {"neck_length_mm": Ln, "inside_head_angle_deg": body.head_under_mm, "head_rim_mm": rim,
+             ("head_top_angle_deg" if head == "angled" else "dome_radius_mm"): body.head_top_mm}
+    if Ln + body.head_height_mm >= L:  # no barrel left: name the longest of neck and head's parts
+        k = max(parts, key=parts.get)
+        raise DesignError(f"{w} {k}", t.get(k, entry.get(k, {}).get("value")),
+                          f"leaves no barrel: the neck and head ({parts[k]:.4g} mm of it from {k}) take "
+                          f"{Ln + body.head_height_mm:.4g} mm of the {L:.4g} mm punch",
+                          "deg" if k.endswith("_deg") else "mm")
     for name, tl in (("tip_length_mm", tip_length), ("lower_tip_length_mm", lower_tip_length)):
         room = L - Ln - body.head_height_mm
         if tl >= room:

@@ -65,7 +65,7 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
     from tabletcad.tooling.die import _max_radius, die_position
     from tabletcad.tooling.punch_body import check_body_fits
 
-    check_body_fits(frame, spec.body, _max_radius(frame.outline))
+    check_body_fits(frame, spec.body, _max_radius(frame.outline) - spec.clearance_mm)
     _check_relief(frame, spec)
     _, top, bottom = die_position(frame, die_height(frame, spec))
     need_up = top - frame.band_z[1]

@@ -1,0 +1,143 @@
+"""Tooling inputs a fourth new user gave that were cut as something else, crashed, or were refused under
+the wrong name (session 23's trial).
+
+Each case: the exact ``error: <parameter> = <value> is not allowed: <range>`` line (the parameter the
+key path of the file), exit status 2, nothing written; or, where the input is valid, what it gives.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from types import SimpleNamespace
+
+import pytest
+
+pytest.importorskip("OCP")
+
+from tabletcad.cli import main  # noqa: E402
+from tabletcad.errors import DesignError  # noqa: E402
+from tabletcad.tooling.spec import FONT_DIR, missing_glyphs  # noqa: E402
+from tabletcad.tooling.standards import resolve_body  # noqa: E402
+
+pytestmark = pytest.mark.cad
+
+ONE_LINE = re.compile(r"^error: (\S+) = (.+) is not allowed: (.+)$")
+ROUND = '[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 3.0\ncup_depth = 1.0\n[tooling]\nclearance_mm = 0.02\n'
+TSM_B = ('[tooling]\nstandard = "TSM"\ntype = "B"\nclearance_mm = 0.02\ntip_length_mm = 8.0\ndie_height_mm = 22.22\n'
+         '[tooling.punch]\nhead_diameter_mm = 25.4\nhead_flat_diameter_mm = 12.0\nhead_rim_mm = 2.5\n'
+         'neck_diameter_mm = 12.7\nneck_length_mm = 12.0\ntip_straight_mm = 4.0\ntip_relief_mm = 0.1\n')
+
+
+def _refused(capsys, tmp_path: Path, design: str, command: str = "report") -> tuple[str, str]:
+    """The (parameter, reason) of the one error line; exit 2 and nothing written beside the design."""
+    before = sorted(p.name for p in tmp_path.iterdir())
+    src = tmp_path / "d.toml"
+    src.write_text(design, encoding="utf-8")
+    args = [command, str(src)] + (["--out", str(tmp_path / "out")] if command == "build" else [])
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    m = ONE_LINE.match(err[0])
+    assert m, err[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(set(before) | {"d.toml"})
+    return m.group(1), m.group(3)
+
+
+@pytest.mark.parametrize("extra, parameter, reason", [
+    # DejaVu Sans Bold has no 日 or 本: two empty boxes were debossed (0.171 mm³), exit 0
+    ('[[tooling.emboss]]\ntext = "A日本"\n', "tooling.emboss[0].text", "no glyph for: '日本'"),
+    ('[[tooling.emboss]]\ntext = "A"\nfont = 5\n', "tooling.emboss[0].font", "(a string)"),  # TypeError, exit 1
+    ('[[tooling.emboss]]\ntext = "A"\nposition_mm = [1e308, 0]\n', "tooling.emboss[0].position_mm", "<= 1000"),
+    ('[tooling.drawing]\nname = "Ibuprofène — 日本語"\n', "tooling.drawing.name", "cannot draw: '日本語'"),
+])
+def test_text_a_font_cannot_draw_and_wrong_font_values(capsys, tmp_path, extra, parameter, reason):
+    name, why = _refused(capsys, tmp_path, ROUND + extra)
+    assert name == parameter and reason in why
+
+
+def test_glyph_lookup_reads_the_fonts_own_table():
+    bold = FONT_DIR / "DejaVuSans-Bold.ttf"
+    assert missing_glyphs("Paracétamol 500 µg — ✓", bold) == ""  # all in DejaVu, the spaces need none
+    assert missing_glyphs("日本日", bold) == "日本"
+    with pytest.raises(DesignError) as e:
+        missing_glyphs("A", Path(__file__))  # no font
+    assert e.value.parameter == "tooling.emboss.font"
+
+
+@pytest.mark.parametrize("svg, reason", [
+    ("<svg", "must be a readable SVG file"),  # truncated XML: ParseError, exit 1
+    ("<html/>", "its root element is <html>"),
+])
+def test_an_svg_that_is_not_one_is_refused_by_report(capsys, tmp_path, svg, reason):
+    (tmp_path / "logo.svg").write_text(svg)
+    parameter, why = _refused(capsys, tmp_path, ROUND + '[[tooling.emboss]]\nsvg = "logo.svg"\n')
+    assert parameter == "tooling.emboss[0].svg" and reason in why
+
+
+def test_a_file_that_is_no_font_is_refused(capsys, tmp_path):
+    (tmp_path / "fake.ttf").write_bytes(b"not a font at all")
+    parameter, why = _refused(capsys, tmp_path, ROUND + f'[[tooling.emboss]]\ntext = "A"\nfont = "{tmp_path / "fake.ttf"}"\n')
+    assert parameter == "tooling.emboss[0].font" and "font file" in why
+
+
+@pytest.mark.parametrize("punch, parameter", [
+    ("head_top_angle_deg = 10.0\nkey = true\nkey_width_mm = 18\nkey_length_mm = 10\nkey_height_mm = 500\n"
+     "key_offset_mm = 5\n", "key_height_mm"),
+    # near 90° the head grows without bound: the tip length had been blamed ("must be < -3.838e+05 mm")
+    ("head_top_angle_deg = 89.999\n", "head_top_angle_deg"),
+    ("head_top_angle_deg = 10.0\ninside_head_angle_deg = 89.9999\n", "inside_head_angle_deg"),
+])
+def test_punch_body_values_are_named(capsys, tmp_path, punch, parameter):
+    design = ROUND.split("[tooling]")[0] + TSM_B + punch
+    name, why = _refused(capsys, tmp_path, design)
+    assert name == f"tooling.punch.{parameter}"
+    assert ("leaves no barrel" in why) == parameter.endswith("angle_deg")
+
+
+def test_a_head_that_leaves_a_barrel_is_accepted():
+    body = resolve_body("TSM", "B", {"head_diameter_mm": 25.4, "head_flat_diameter_mm": 12.0, "head_rim_mm": 2.5,
+                                     "head_top_angle_deg": 10.0, "neck_diameter_mm": 12.7, "neck_length_mm": 12.0,
+                                     "tip_straight_mm": 4.0, "tip_relief_mm": 0.1}, 8.0, 8.0)
+    assert 0.0 < body.head_height_mm < body.overall_length_mm - 12.0
+
+
+def test_a_tip_is_checked_against_the_barrel_less_the_clearance():
+    """B tooling takes shaped tablets up to 19 mm and its barrel is 19 mm (TSM 18.99): a 19 mm capsule's
+    tip (19 mm less twice the clearance) fits; it was refused for the tablet's own 19 mm."""
+    from tabletcad.tooling.punch_body import check_body_fits
+
+    b = SimpleNamespace(barrel_diameter_mm=19.0, max_round_tablet_mm=16.0, max_shaped_tablet_mm=19.0, standard="TSM",
+                        kind="B")
+    frame = SimpleNamespace(length=19.0, width=8.0, outline_kind="capsule")
+    check_body_fits(frame, b, 9.5 - 0.02)
+    with pytest.raises(DesignError) as e:
+        check_body_fits(frame, b, 9.5)
+    assert e.value.parameter == "tooling.punch.barrel_diameter_mm"
+
+
+def test_make_tooling_passes_the_tip_radius(monkeypatch):
+    import tabletcad.tooling.punch_body as pb
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.toolset import make_tooling
+
+    seen = []
+
+    def spy(frame, body, radius):
+        seen.append(radius)
+        raise DesignError("stop", 0, "spied")
+
+    monkeypatch.setattr(pb, "check_body_fits", spy)
+    d = Design.from_dict(dict(tablet=dict(family="capsule", length=19.0, width=8.0, band=3.0, cup_depth=1.0, land=0.05),
+                              **__import__("tomllib").loads(TSM_B + "head_top_angle_deg = 10.0\n")))
+    with pytest.raises(DesignError, match="spied"):
+        make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False)
+    assert seen == [pytest.approx(9.5 - 0.02, abs=1e-6)]
+
+
+def test_raised_figures_have_the_debossed_depth_limit(capsys, tmp_path):
+    """A raised figure 50 mm tall stopped the build with "emboss 0: the raised figure is empty" (no
+    parameter, no range); now refused like a debossed one, before any Boolean."""
+    parameter, why = _refused(capsys, tmp_path, ROUND + '[[tooling.emboss]]\ntext = "A"\nmode = "emboss"\ndepth_mm = 50.0\n',
+                              command="build")
+    assert parameter == "tooling.emboss[0].depth_mm" and "cup depth + band/4 = 1.75 mm" in why
