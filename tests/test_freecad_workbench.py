@@ -250,13 +250,15 @@ def test_tooling_valid_and_linked(headless, family):
     # punches sit on the tablet's band edges and carry its outline; the die surrounds it
     up, low, die = step["upper"], step["lower"], step["die"]
     assert up["bbox"][2] <= tab["bbox"][5] + 1e-6 and low["bbox"][5] >= tab["bbox"][2] - 1e-6
-    assert up["bbox"][5] == pytest.approx(up["bbox"][2] + 10.0, abs=1e-6)
+    assert up["bbox"][5] == pytest.approx(step["rim_z"][0] + 10.0, abs=1e-6)  # 10 mm tips from the band edges
+    assert low["bbox"][2] == pytest.approx(step["rim_z"][1] - 10.0, abs=1e-6)
     assert die["bbox"][0] == pytest.approx(-30.16 / 2, abs=1e-6)
     if family == "thesis.ring":
         import math
 
-        # annular punch: pi (R^2 - r^2) x 10 mm
-        assert up["volume"] == pytest.approx(math.pi * (36.0 - 9.0) * 10.0, rel=1e-3)
+        # annular punch inside the ring by the clearance c both ways: pi ((R - c)^2 - (r + c)^2) x 10 mm
+        c = 0.025
+        assert up["volume"] == pytest.approx(math.pi * ((6.0 - c) ** 2 - (3.0 + c) ** 2) * 10.0, rel=1e-3)
 
 
 def _outline_area_perimeter(segs):
@@ -274,17 +276,39 @@ def _outline_area_perimeter(segs):
     return abs(area), perim
 
 
-def test_capsule_die_bore_is_the_exact_outline_offset(headless):
-    """The workbench's die bore follows the capsule's exact outline (lines and arcs) offset by
-    the clearance: die volume = pi R^2 H - (A + P c + pi c^2) H (Steiner), A and P from the
-    core's outline; the punches carry the cup faces cut into four pieces each (tabletcad.brep.slit)."""
+def test_capsule_die_bore_is_the_exact_outline_and_the_tips_its_inward_offset(headless):
+    """The workbench's die bore is the capsule's exact outline (lines and arcs), as ``tabletcad build``
+    makes it: die volume = pi R^2 H - A H, A from the core's outline (the bore had been the outline
+    offset outward by the clearance: a 10 mm design got a 10.10 mm die).  The punch tips are the
+    outline offset inward by the clearance c: plan extents length - 2c by width - 2c."""
     from tabletcad import families
 
     (step,) = [s for s in _steps(headless, "tooling") if s["family"] == "capsule"]
-    A, P = _outline_area_perimeter(families.FAMILIES["capsule"].build().nominal.outline.segs)
-    c, H, OD = 0.05, 22.22, 30.16  # the Die object's defaults (TSM B)
-    expected = math.pi * (OD / 2) ** 2 * H - (A + P * c + math.pi * c * c) * H
-    assert step["die"]["volume"] == pytest.approx(expected, rel=1e-9)
+    outline = families.FAMILIES["capsule"].build().nominal.outline
+    A, _ = _outline_area_perimeter(outline.segs)
+    H, OD, c = 22.22, 30.16, 0.025  # the Die's defaults (TSM B) and the punches' clearance
+    assert step["die"]["volume"] == pytest.approx(math.pi * (OD / 2) ** 2 * H - A * H, rel=1e-9)
+    for k, extent in enumerate(outline.extent()):  # the punch's plan extents are its tip's: the outline's less 2c
+        tight = step["upper"]["tight_bbox"]
+        assert tight[3 + k] - tight[k] == pytest.approx(extent - 2 * c, abs=1e-6)
+
+
+def test_make_tooling_reads_the_design_files_tooling_table(headless):
+    """clearance 0.05, tips 8 and 12 mm, die 32 x 20 mm from ``[tooling]`` (they had been ignored:
+    clearance 0.05 on the die, 30.16 x 22.22 mm); the score, which the workbench does not build,
+    is named in a warning on the Report view."""
+    (st,) = _steps(headless, "design_tooling")
+    assert st["clearance"] == [0.05, 0.05] and st["lengths"] == [8.0, 12.0]
+    die, up, low, tab = st["die"], st["upper"], st["lower"], st["tablet"]
+    assert die["bbox"][3] - die["bbox"][0] == pytest.approx(32.0, abs=1e-6)
+    assert die["bbox"][5] - die["bbox"][2] == pytest.approx(20.0, abs=1e-6)
+    assert die["volume"] == pytest.approx(math.pi * (16.0**2 - 5.0**2) * 20.0, rel=1e-9)
+    assert up["bbox"][3] - up["bbox"][0] == pytest.approx(10.0 - 0.1, abs=1e-6)
+    assert up["bbox"][5] == pytest.approx(st["rim_z"][0] + 8.0, abs=1e-6)  # from the band edges
+    assert low["bbox"][2] == pytest.approx(st["rim_z"][1] - 12.0, abs=1e-6)
+    assert all(part["valid"] and part["n_solids"] == 1 for part in (die, up, low))
+    shown = headless["_stdout"] + headless["_stderr"]
+    assert "[[tooling.score]] of tooled.toml are built by `tabletcad build` only" in shown
 
 
 def test_change_property_tablet_and_tooling_follow(headless):
@@ -298,9 +322,9 @@ def test_change_property_tablet_and_tooling_follow(headless):
     for part in ("upper", "lower", "die"):
         assert step[part]["valid"] and step[part]["n_solids"] == 1
         assert step[part]["volume"] != pytest.approx(before[part]["volume"], rel=1e-6), part
-    # punch outline follows the 9 mm tablet
+    # punch outline follows the 9 mm tablet, inside it by the clearance
     assert step["upper"]["bbox"][3] - step["upper"]["bbox"][0] == pytest.approx(
-        t["bbox"][3] - t["bbox"][0], abs=1e-6
+        t["bbox"][3] - t["bbox"][0] - 2 * 0.025, abs=1e-6
     )
     print(
         f"recompute after Diameter change (tablet + 2 punches + die): {step['wall_s']:.2f} s; "
@@ -460,7 +484,7 @@ def test_design_files(headless):
     assert abs(t["solid_volume"] - core) <= t["fit_deviation"] * t["core_area"]
     assert t["volume"] == pytest.approx(core, rel=2e-3)  # OCCT default integration, measured 8.5e-4 off
     for part in ("die", "upper"):
-        assert ff[part]["valid"] and ff[part]["n_solids"] == 1
+        assert ff[part]["valid"] and ff[part]["n_solids"] == 1, (part, ff[part]["status"])
 
 
 def test_save_reopen_recompute(headless):

@@ -36,6 +36,10 @@ def shape_info(o):
         ]
         if not s.isNull()
         else None,
+        # from the geometry, not the poles (BoundBox holds a trimmed B-spline's whole control net)
+        "tight_bbox": (lambda b: [b.XMin, b.YMin, b.ZMin, b.XMax, b.YMax, b.ZMax])(s.optimalBoundingBox(False))
+        if not s.isNull()
+        else None,
     }
 
 
@@ -84,6 +88,7 @@ try:
         make_upper_punch,
     )
 
+    from freecad.tabletcad_wb import geometry as wb_geometry
     from freecad.tabletcad_wb import objects
 
     result["log"] = []
@@ -125,7 +130,21 @@ try:
             lower=shape_info(low),
             die=shape_info(die),
             links=[o.Tablet.Name for o in (up, low, die)],
+            rim_z=[wb_geometry._select(wb_geometry.rims_from_json(tabs[fam].RimData), w)[1] for w in ("upper", "lower")],
         )
+
+    # ---- a design file's [tooling] table: clearance, tip lengths and die as tabletcad build reads them
+    design = os.path.abspath("tooled.toml")
+    with open(design, "w") as fh:
+        fh.write('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 3.0\ncup_depth = 1.0\n'
+                 '[tooling]\nclearance_mm = 0.05\ntip_length_mm = 8.0\nlower_tip_length_mm = 12.0\n'
+                 'die_outer_diameter_mm = 32.0\ndie_height_mm = 20.0\n[[tooling.score]]\ndepth_mm = 0.3\n')
+    tooled = make_tablet(doc, design)
+    tparts = make_tooling(doc, tooled)
+    step("design_tooling", tablet=tablet_info(tooled), upper=shape_info(tparts[0]), lower=shape_info(tparts[1]),
+         rim_z=[wb_geometry._select(wb_geometry.rims_from_json(tooled.RimData), w)[1] for w in ("upper", "lower")],
+         die=shape_info(tparts[2]), clearance=[float(o.Clearance.Value) for o in tparts[:2]],
+         lengths=[float(o.Length.Value) for o in tparts[:2]])
 
     # ---- change a dimension: the solid and the linked tooling follow
     t = tabs["concave_round"]

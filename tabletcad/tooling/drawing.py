@@ -556,8 +556,9 @@ def tooling_model(ts) -> Drawing:
              f"head Ø{_fmt(up['head_diameter_mm'])} (flat Ø{_fmt(up['head_flat_diameter_mm'])})",
              f"tip: straight {_fmt(up['tip_straight_mm'])}, relief {_fmt(up['tip_relief_mm'])} per side; "
              f"upper tip {_fmt(up['tip_length_mm'])}, lower tip {_fmt(lo['tip_length_mm'])}",
-             f"die Ø{_fmt(die['outer_diameter_mm'])} x {_fmt(die['height_mm'])}, bore {die['bore']} + clearance "
-             f"{_fmt(ts.spec.clearance_mm)}, taper {die['taper_deg']:g} deg",
-             "standard dimensions: tabletcad/data/tooling_standards.toml (sources per value in report.json)"]
+             f"die Ø{_fmt(die['outer_diameter_mm'])} x {_fmt(die['height_mm'])}, bore: the tablet's {die['bore']} outline "
+             f"(tips inside it by the clearance {_fmt(ts.spec.clearance_mm)}), taper {die['taper_deg']:g} deg",
+             "standard dimensions: tabletcad/data/tooling_standards.toml (sources per value in report.json)"
+             if up["standard"] != "custom" else "user-defined set: every dimension from [tooling.punch]"]
     return Drawing(views, origins, dims, notes, title=f"{_title(ts)} — punches and die",
                    title_block=title_block(ts, "punches and die"))

@@ -78,6 +78,9 @@ __all__ = ["ToolingSpec", "ScoreSpec", "EmbossSpec", "FeRatingSpec", "parse_tool
 
 FONT_DIR = Path("/usr/share/fonts/truetype/dejavu")
 
+#: the largest radial clearance between punch tip and die bore (mm)
+MAX_CLEARANCE_MM = 1.0
+
 
 @dataclass(frozen=True)
 class ScoreSpec:
@@ -445,7 +448,7 @@ def parse_tooling(table: Any, base: Path | None = None) -> ToolingSpec:
             "standard", "type", "punch", "lower_tip_length_mm", "drawing", "allowed_tip_pressure_MPa",
             "allowed_tip_pressure_source", "punch_youngs_modulus_MPa", "punch_youngs_modulus_source", "fe_rating"}
     t = _keys("[tooling]", table, keys)
-    clearance = check_range("[tooling] clearance_mm", t.get("clearance_mm", d.clearance_mm), 0.0, 1.0, "mm")
+    clearance = check_range("[tooling] clearance_mm", t.get("clearance_mm", d.clearance_mm), 0.0, MAX_CLEARANCE_MM, "mm")
     big = DEFAULT.max_length  # steel longer than a metre is no tablet tooling (1e300 reached OCC as a zero vector)
     tip = check_range("[tooling] tip_length_mm", t.get("tip_length_mm", d.tip_length_mm), 0.0, big, "mm", lo_open=True)
     od = t.get("die_outer_diameter_mm")

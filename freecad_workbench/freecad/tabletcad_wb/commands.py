@@ -112,7 +112,7 @@ class LowerPunchCommand(_ToolCommand):
 
 class DieCommand(_ToolCommand):
     name, icon, menu = "Tabletcad_Die", "Die", "Die"
-    tip = "Die of the selected tablet: bore = outline + clearance (follows the tablet)"
+    tip = "Die of the selected tablet: the bore is its outline (follows the tablet)"
 
     def Activated(self):
         make_die(FreeCAD.ActiveDocument, _selected_tablet())

@@ -16,10 +16,12 @@ Tooling is made with Part Booleans from the tablet's *rims* (the boundary rows
 of the chain that lie on the tablet's silhouette, taken from the fitted poles,
 so the tool's edge is the very curve of the tablet's edge):
 
-* upper punch: prism on the upper rim(s), ``length`` up, minus the tablet;
-* lower punch: prism on the lower rim(s), ``length`` down, minus the tablet;
-* die: cylinder of ``outer_diameter`` and ``height`` centred on the band,
-  minus the prism on the outer rim offset outward by ``clearance``.
+* upper punch: prism on the upper rim(s) offset inward by ``clearance`` (a ring's hole
+  outward), ``length`` up, minus the tablet;
+* lower punch: the same on the lower rim(s), ``length`` down;
+* die: cylinder of ``outer_diameter`` and ``height`` centred on the band, minus the
+  prism on the outer rim: the bore is the tablet's outline, as ``tabletcad build``
+  makes it (the tablet's size is the die's; the punch tips are smaller by the clearance).
 
 Nothing here imports OCP or build123d.
 """
@@ -348,12 +350,34 @@ def _rim_wire(rim, dz=0.0):
     return Part.Wire(edges)
 
 
-def _rim_face(rims):
+def _offset_rim_wire(rim, distance):
+    """The rim's curve offset outward (away from the area it encloses) by ``distance`` mm: the exact
+    outline's offset when the rim has one, a concentric circle, else Part's 2-D offset as B-splines."""
+    import Part
+
+    if rim.get("outline"):
+        return offset_outline_wire(rim["outline"], float(distance), rim["z"])
+    if "radius" in rim:
+        return _rim_wire(dict(rim, radius=rim["radius"] + float(distance)))
+    wire = _rim_wire(rim).makeOffset2D(float(distance), 0, False, False, False)
+    # offset curves as B-splines: FreeCAD 1.0's STEP writer drops extrusions of offset
+    # curves (a die came back as an open shell of 3 of its 5 faces); an inward offset leaves
+    # zero-length edges at the rim's C0 joins, which no face takes (Geom_TrimmedCurve::U1 == U2)
+    edges = [e for e in wire.OrderedEdges if e.Length > 1e-9 * max(1.0, wire.Length)]
+    return Part.Wire([e.toNurbs().Edges[0] for e in edges])
+
+
+def _rim_face(rims, clearance=0.0):
+    """The plan face inside the rims (a ring's hole cut out); with ``clearance`` > 0 a punch tip's:
+    the outer rims offset inward and the holes outward by it."""
     import Part
 
     outer = [r for r in rims if not r["inner"]]
     inner = [r for r in rims if r["inner"]]
-    wires = [_rim_wire(r) for r in outer + inner]
+    if clearance > 0:
+        wires = [_offset_rim_wire(r, -clearance) for r in outer] + [_offset_rim_wire(r, clearance) for r in inner]
+    else:
+        wires = [_rim_wire(r) for r in outer + inner]
     if len(wires) == 1:
         return Part.Face(wires[0])
     return Part.Face(wires, "Part::FaceMakerBullseye")
@@ -381,17 +405,27 @@ def _select(rims, which):
     return [r for r in rims if abs(r["z"] - z) <= 1e-7 * max(1.0, abs(z))], z
 
 
-def punch_shape(tablet_shape, rims, which="upper", length=10.0):
-    """Punch tip: prism on the upper (lower) rims, ``length`` mm up (down), minus the tablet."""
+def punch_shape(tablet_shape, rims, which="upper", length=10.0, clearance=0.025):
+    """Punch tip: prism on the upper (lower) rims offset inward by ``clearance`` (the radial room
+    between tip and die bore), ``length`` mm up (down), minus the tablet."""
     import FreeCAD
+    import Part
 
     from tabletcad.errors import DesignError, GeometryError
+    from tabletcad.tooling.spec import MAX_CLEARANCE_MM
 
     if not length > 0:
         raise DesignError("punch length", length, "must be > 0", "mm")
+    if not 0.0 <= clearance <= MAX_CLEARANCE_MM:
+        raise DesignError("punch clearance", clearance, f"must be >= 0 and <= {MAX_CLEARANCE_MM:g}", "mm")
     sel, _ = _select(rims, which)
     sign = 1.0 if which == "upper" else -1.0
-    prism = _rim_face(sel).extrude(FreeCAD.Vector(0, 0, sign * float(length)))
+    try:
+        face = _rim_face(sel, clearance)
+    except (GeometryError, Part.OCCError) as exc:
+        raise DesignError("punch clearance", clearance, f"leaves no punch tip inside the tablet's outline ({exc})",
+                          "mm") from None
+    prism = face.extrude(FreeCAD.Vector(0, 0, sign * float(length)))
     result = prism.cut(tablet_shape)
     solids = result.Solids
     if len(solids) != 1:
@@ -404,17 +438,16 @@ def punch_shape(tablet_shape, rims, which="upper", length=10.0):
     return punch
 
 
-def die_shape(rims, clearance=0.05, height=22.22, outer_diameter=38.1):
-    """Die: cylinder (``outer_diameter``, ``height``, centred on the band) minus the bore
-    (the exact plan outline when the tablet has one, else its outer rim, offset outward by
-    ``clearance``)."""
+def die_shape(rims, height=22.22, outer_diameter=30.16):
+    """Die: cylinder (``outer_diameter``, ``height``, centred on the band) minus the bore, the
+    tablet's exact plan outline when it has one, else its outer rim (as ``tabletcad build``:
+    the punch tips take the clearance)."""
     import FreeCAD
     import Part
 
     from tabletcad.errors import DesignError, GeometryError
+    from tabletcad.tooling.spec import MIN_DIE_WALL_MM
 
-    if not clearance > 0:
-        raise DesignError("die clearance", clearance, "must be > 0", "mm")
     if not height > 0:
         raise DesignError("die height", height, "must be > 0", "mm")
     outer = [r for r in rims if not r["inner"]]
@@ -424,21 +457,14 @@ def die_shape(rims, clearance=0.05, height=22.22, outer_diameter=38.1):
         )
     lo = min(outer, key=lambda r: r["z"])
     z_lo, z_hi = lo["z"], max(r["z"] for r in outer)
-    if lo.get("outline"):
-        bore_wire = offset_outline_wire(lo["outline"], float(clearance), z_lo)
-    elif "radius" in lo:  # a circle: the bore is the concentric circle
-        bore_wire = _rim_wire(dict(lo, radius=lo["radius"] + float(clearance)))
-    else:
-        bore_wire = _rim_wire(lo).makeOffset2D(float(clearance), 0, False, False, False)
-        # offset curves as B-splines: FreeCAD 1.0's STEP writer drops extrusions of offset
-        # curves (the die came back as an open shell of 3 of its 5 faces)
-        bore_wire = Part.Wire([e.toNurbs().Edges[0] for e in bore_wire.OrderedEdges])
-    reach = (lo["radius"] if "radius" in lo else float(np.max(np.hypot(*np.asarray(lo["poles"])[:, :2].T)))) + clearance
-    if not outer_diameter / 2.0 > reach + 0.5:
+    bore_wire = offset_outline_wire(lo["outline"], 0.0, z_lo) if lo.get("outline") else _rim_wire(lo)
+    reach = lo["radius"] if "radius" in lo else float(np.max(np.hypot(*np.asarray(lo["poles"])[:, :2].T)))
+    if outer_diameter / 2.0 - reach < MIN_DIE_WALL_MM:  # tabletcad build's rule
         raise DesignError(
             "die outer diameter",
             outer_diameter,
-            f"must exceed the bore by a 0.5 mm wall: > {2 * (reach + 0.5):.3f}",
+            f"must be >= {2 * (reach + MIN_DIE_WALL_MM):.4g} mm (the tablet reaches {reach:.4g} mm from the axis, "
+            f"the die's walls need {MIN_DIE_WALL_MM} mm)",
             "mm",
         )
     zc = 0.5 * (z_lo + z_hi)

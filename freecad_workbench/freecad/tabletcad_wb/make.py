@@ -20,7 +20,7 @@ import FreeCAD
 
 from . import objects
 
-__all__ = ["make_die", "make_lower_punch", "make_tablet", "make_tooling", "make_upper_punch"]
+__all__ = ["design_tooling", "make_die", "make_lower_punch", "make_tablet", "make_tooling", "make_upper_punch"]
 
 
 def _value(v, unit="mm"):
@@ -93,11 +93,13 @@ def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, reco
     return obj
 
 
-def _punch(doc, tablet, which, length, recompute):
+def _punch(doc, tablet, which, length, clearance, recompute):
     obj = _new(doc, "UpperPunch" if which == "upper" else "LowerPunch")
     objects.PunchProxy(obj, tablet, which)
     if length is not None:
         obj.Length = _value(length)
+    if clearance is not None:
+        obj.Clearance = _value(clearance)
     obj.Label = f"{tablet.Label} {which} punch"
     objects.attach_view_provider(obj)
     if recompute:
@@ -105,21 +107,22 @@ def _punch(doc, tablet, which, length, recompute):
     return obj
 
 
-def make_upper_punch(doc, tablet, length=None, recompute=True):
-    """Upper punch tip linked to ``tablet`` (prism above the upper band edge minus the tablet)."""
-    return _punch(doc, tablet, "upper", length, recompute)
+def make_upper_punch(doc, tablet, length=None, recompute=True, clearance=None):
+    """Upper punch tip linked to ``tablet``: the prism above the upper band edge, inside the outline
+    by ``clearance`` (default 0.025 mm), minus the tablet."""
+    return _punch(doc, tablet, "upper", length, clearance, recompute)
 
 
-def make_lower_punch(doc, tablet, length=None, recompute=True):
-    """Lower punch tip linked to ``tablet`` (prism below the lower band edge minus the tablet)."""
-    return _punch(doc, tablet, "lower", length, recompute)
+def make_lower_punch(doc, tablet, length=None, recompute=True, clearance=None):
+    """Lower punch tip linked to ``tablet`` (as :func:`make_upper_punch`, below the lower band edge)."""
+    return _punch(doc, tablet, "lower", length, clearance, recompute)
 
 
-def make_die(doc, tablet, clearance=None, height=None, outer_diameter=None, recompute=True):
-    """Die linked to ``tablet``: cylinder minus the bore (tablet outline + clearance)."""
+def make_die(doc, tablet, height=None, outer_diameter=None, recompute=True):
+    """Die linked to ``tablet``: cylinder minus the bore (the tablet's outline)."""
     obj = _new(doc, "Die")
     objects.DieProxy(obj, tablet)
-    for prop, v in (("Clearance", clearance), ("Height", height), ("OuterDiameter", outer_diameter)):
+    for prop, v in (("Height", height), ("OuterDiameter", outer_diameter)):
         if v is not None:
             setattr(obj, prop, _value(v))
     obj.Label = f"{tablet.Label} die"
@@ -129,11 +132,46 @@ def make_die(doc, tablet, clearance=None, height=None, outer_diameter=None, reco
     return obj
 
 
-def make_tooling(doc, tablet, recompute=True):
-    """Upper punch, lower punch and die of ``tablet``."""
-    up = make_upper_punch(doc, tablet, recompute=False)
-    low = make_lower_punch(doc, tablet, recompute=False)
-    die = make_die(doc, tablet, recompute=False)
+def design_tooling(tablet):
+    """What the workbench takes from the ``[tooling]`` table of the tablet's design file: ``(values,
+    left)``, the keyword arguments of :func:`make_tooling` (clearance, tip lengths, die height and outer
+    diameter) and the names of what it does not build (scores, embossing, complete punch bodies: those
+    are made by ``tabletcad build``).  ``({}, [])`` for a tablet without a design file or table."""
+    path = getattr(tablet, "DesignFile", "") or ""
+    if not path:
+        return {}, []
+    from tabletcad.pipeline.design import Design
+
+    spec = Design.from_toml(path).tooling_spec
+    if spec is None:
+        return {}, []
+    values = dict(clearance=spec.clearance_mm, length=spec.tip_length_mm, lower_length=spec.lower_tip,
+                  die_height=spec.die_height_mm, die_outer_diameter=spec.die_outer_diameter_mm)
+    left = [name for name, given in (("[[tooling.score]]", spec.scores), ("[[tooling.emboss]]", spec.emboss),
+                                     ("complete punches ([tooling] standard)", spec.body)) if given]
+    return {k: v for k, v in values.items() if v is not None}, left
+
+
+def make_tooling(doc, tablet, recompute=True, **kw):
+    """Upper punch, lower punch and die of ``tablet``.
+
+    Keywords (mm): ``clearance``, ``length`` (upper tip), ``lower_length``, ``die_height``,
+    ``die_outer_diameter``; those not given come from the ``[tooling]`` table of the tablet's design
+    file, as ``tabletcad build`` reads it, else the objects' defaults.  What the table asks for that the
+    workbench does not build (scores, embossing, complete punch bodies) is named in a warning."""
+    allowed = {"clearance", "length", "lower_length", "die_height", "die_outer_diameter"}
+    unknown = sorted(set(kw) - allowed)
+    if unknown:
+        raise TypeError(f"make_tooling() got unexpected keyword arguments {unknown}; allowed: {sorted(allowed)}")
+    values, left = design_tooling(tablet)
+    values.update({k: v for k, v in kw.items() if v is not None})
+    if left:
+        FreeCAD.Console.PrintWarning(
+            f"tabletcad: {tablet.Label}: the workbench makes plain punch tips and a die; {', '.join(left)} of "
+            f"{Path(tablet.DesignFile).name} are built by `tabletcad build` only\n")
+    up = make_upper_punch(doc, tablet, values.get("length"), False, values.get("clearance"))
+    low = make_lower_punch(doc, tablet, values.get("lower_length", values.get("length")), False, values.get("clearance"))
+    die = make_die(doc, tablet, values.get("die_height"), values.get("die_outer_diameter"), recompute=False)
     if recompute:
         doc.recompute()
     return up, low, die

@@ -411,6 +411,15 @@ class PunchProxy(_Proxy):
         )
         self._add(
             obj,
+            "App::PropertyLength",
+            "Clearance",
+            "Punch",
+            "radial clearance between the punch tip and the die bore (the tablet's outline): the tip is the "
+            "outline offset inward by it",
+            _qty(0.025, "mm"),
+        )
+        self._add(
+            obj,
             "App::PropertyDistance",
             "Gap",
             "Punch",
@@ -422,7 +431,8 @@ class PunchProxy(_Proxy):
     def build(self, obj):
         tab = _tablet_of(obj)
         rims = geometry.rims_from_json(tab.RimData)
-        shape = geometry.punch_shape(_local_shape(tab), rims, obj.Which, float(obj.Length.Value))
+        shape = geometry.punch_shape(_local_shape(tab), rims, obj.Which, float(obj.Length.Value),
+                                     float(obj.Clearance.Value))
         gap = float(obj.Gap.Value)
         lift = FreeCAD.Placement(
             FreeCAD.Vector(0, 0, gap if obj.Which == "upper" else -gap), FreeCAD.Rotation()
@@ -433,7 +443,7 @@ class PunchProxy(_Proxy):
 
 
 class DieProxy(_Proxy):
-    """Die of a tablet: a cylinder with the bore (outer rim + clearance), centred on the band."""
+    """Die of a tablet: a cylinder with the bore (the tablet's outline), centred on the band."""
 
     Type = "TabletcadDie"
 
@@ -444,14 +454,8 @@ class DieProxy(_Proxy):
 
     def _setup(self, obj):
         self._add(obj, "App::PropertyLink", "Tablet", "Die", "the tablet this die forms")
-        self._add(
-            obj,
-            "App::PropertyLength",
-            "Clearance",
-            "Die",
-            "radial clearance between bore and tablet outline",
-            _qty(0.05, "mm"),
-        )
+        if "Clearance" in obj.PropertiesList:  # a document of an earlier version: the punches take it now
+            obj.removeProperty("Clearance")
         self._add(
             obj, "App::PropertyLength", "Height", "Die", "die height (TSM B die: 22.22 mm)", _qty(22.22, "mm")
         )
@@ -468,9 +472,7 @@ class DieProxy(_Proxy):
     def build(self, obj):
         tab = _tablet_of(obj)
         rims = geometry.rims_from_json(tab.RimData)
-        shape = geometry.die_shape(
-            rims, float(obj.Clearance.Value), float(obj.Height.Value), float(obj.OuterDiameter.Value)
-        )
+        shape = geometry.die_shape(rims, float(obj.Height.Value), float(obj.OuterDiameter.Value))
         obj.Shape = shape
         obj.Placement = tab.Placement
         obj.Volume = float(shape.Volume)
