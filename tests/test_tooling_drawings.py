@@ -1,5 +1,6 @@
 """Drawings a toolmaker can quote from: tolerances, title block, scale, punch and die sheet, no text on geometry."""
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -60,6 +61,26 @@ def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
     (radius,) = [d for d in dims if d.dimtype == 4]  # 4: radius
     assert radius.get_measurement() == pytest.approx(cup_r, rel=1e-9) and radius.dxf.text == f"R{cup_r:.2f} ±0.076"
     assert sum(d.dimtype in (0, 1) for d in dims) == len(ts.report["drawing"]["dimension_texts"]) - 1  # linear
+
+
+def test_dxf_dimensions_measure_what_their_texts_say(drawn):
+    """A CAD program that recomputes a DXF dimension multiplies its measured length by DIMLFAC: ezdxf's
+    EZDXF style has 100 (metre units shown in cm), so Ø10 measured 1000; and the land, drawn in the 10:1
+    detail, measured 0.80.  Now every measurement (radius, linear, both sheets) times its style's or
+    override's DIMLFAC is the number in its text, to the text's rounding."""
+    import ezdxf
+
+    _, out, _ = drawn
+    checked = 0
+    for name in ("drawing.dxf", "tooling.dxf"):
+        doc = ezdxf.readfile(out / name)
+        assert doc.header["$INSUNITS"] == 4  # millimetres
+        for d in doc.modelspace().query("DIMENSION"):
+            number = float(re.search(r"\d+(?:\.\d+)?", d.dxf.text).group())
+            lfac = d.override().get("dimlfac", 1.0)
+            assert abs(d.get_measurement() * lfac - number) <= 0.0051, (name, d.dxf.text, d.get_measurement(), lfac)
+            checked += 1
+    assert checked >= 12
 
 
 @pytest.fixture(scope="module")

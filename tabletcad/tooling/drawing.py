@@ -134,6 +134,8 @@ class Dim:
 
     ``radius``: a radius dimension instead; ``p1`` is the arc's centre, ``p2`` a point on the arc,
     and the leader runs from ``p2`` outwards (away from the centre) ``offset`` mm to the text.
+    ``scale``: the view's enlargement (a detail at 10:1 is 10): a DXF reader measures the
+    dimension as its sheet length over it.
     """
 
     p1: tuple[float, float]
@@ -142,6 +144,7 @@ class Dim:
     text: str
     vertical: bool = False
     radius: bool = False
+    scale: float = 1.0
 
 
 @dataclass
@@ -251,7 +254,7 @@ def drawing_model(ts) -> Drawing:
                         f"R{_fmt(cup_r)}", radius=True))
     if fr.land and fr.edge_land("top") > 0:  # the land in detail B: from the cup's edge to the outline
         dx, dy = origins[f"detail B {k:g}:1"]
-        dims.append(Dim((dx - k * fr.land, dy), (dx, dy), 0.25 * k * half, f"land {_fmt(fr.land)}"))
+        dims.append(Dim((dx - k * fr.land, dy), (dx, dy), 0.25 * k * half, f"land {_fmt(fr.land)}", scale=k))
     notes.append(f"section A-A through the axis across {th:g} deg{' (the score)' if scores else ''}; "
                  f"detail B: band edge and land, {k:g}:1")
     return Drawing(views, origins, _toleranced(dims, ts), notes, title=_title(ts), title_block=title_block(ts))
@@ -470,6 +473,9 @@ def _write_dxf(dr: Drawing, path: Path) -> None:
     import ezdxf
 
     doc = ezdxf.new("R2010", setup=True, units=4)  # 4 = millimetres
+    # ezdxf's EZDXF style measures in centimetres of metre drawing units (DIMLFAC 100): here 1 unit is 1 mm,
+    # so a reader that recomputes a measurement gets the model's millimetres (a detail's over its scale)
+    doc.dimstyles.get("EZDXF").dxf.dimlfac = 1.0
     doc.layers.add("VISIBLE", color=7)
     doc.layers.add("HIDDEN", color=8, linetype="DASHED")
     doc.layers.add("DIMENSIONS", color=1)
@@ -488,7 +494,8 @@ def _write_dxf(dr: Drawing, path: Path) -> None:
             continue
         base = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)
         dim = msp.add_linear_dim(base=base, p1=d.p1, p2=d.p2, angle=90 if d.vertical else 0, text=d.text,
-                                 dimstyle="EZDXF", dxfattribs={"layer": "DIMENSIONS"})
+                                 dimstyle="EZDXF", dxfattribs={"layer": "DIMENSIONS"},
+                                 override={"dimlfac": 1.0 / d.scale} if d.scale != 1.0 else None)
         dim.render()
     xs = [float(q[0]) for _, p in _sheet_lines(dr) for q in p]
     ys = [float(q[1]) for _, p in _sheet_lines(dr) for q in p]
