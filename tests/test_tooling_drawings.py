@@ -52,6 +52,14 @@ def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
                  "Ø30.16 ±0.076", "H 22.22 ±0.076",
                  "UPPER PUNCH", "LOWER PUNCH", "DIE", "drawing no. TC-0001-T", "TSM B tooling, angled heads"):
         assert text in tsvg, text
+    # what a toolmaker quotes from beyond the dimensions: the working length (overall less the 0.9 mm cup),
+    # the die bore (the tablet's 10 mm) and the tips (less the 0.02 mm clearance per side)
+    for which in ("upper_punch", "lower_punch"):
+        body = ts.report[which]["body"]
+        assert body["working_length_mm"] == pytest.approx(133.35 - 0.9, abs=1e-6)
+    for text in ("working length (head flat to cup bottom): upper 132.45, lower 132.45", "bore Ø10.00 (the tablet's",
+                 "tips Ø9.96 (the bore less the clearance 0.020 per side)"):
+        assert text in tsvg, text
     dxf = (out / "tooling.dxf").read_text(encoding="utf-8", errors="replace")
     assert "overall 133.35" in dxf and "TC-0001" in dxf
     # read back by ezdxf: the cup radius is a radius DIMENSION measuring the sphere's radius
@@ -282,3 +290,25 @@ def test_a_tablet_name_of_200_characters_is_cut_to_the_room_beside_the_title_blo
                 assert not a.overlaps(b)
     finally:
         plt.close(fig)
+
+
+@pytest.mark.parametrize("spec, text", [
+    (dict(profile="v", angle_deg=90.0), "bisect score V 90 deg, 0.30 mm deep, 0.60 mm wide at the face, at 90 deg on the "
+                                        "top face, across the face"),
+    (dict(profile="u", width_mm=0.6, cut_through=True), "bisect score U 0.60 mm wide, 0.30 mm deep, 0.60 mm wide at "
+                                                        "the face, at 90 deg on the top face, cut through the band"),
+    (dict(profile="pressure_sensitive", slot_width_mm=0.15, angle_deg=90.0),
+     "bisect score pressure-sensitive, slot 0.15 mm, flanks 90 deg, 0.30 mm deep, 0.55 mm wide at the face"),
+    (dict(length_mm=6.0, direction_deg=90.0), "at 90 deg on the top face, short, 6.00 mm long (decorative)"),
+])
+def test_score_notes_state_the_profile_and_extent(spec, text):
+    """The tablet sheet's note of a score gives what makes it: V angle, U width or slot width, depth, width
+    at the face, direction, face, and cut-through or short (it said only "bisect score v 0.30 mm deep")."""
+    from tabletcad.tooling.drawing import _score_note
+    from tabletcad.tooling.scores import groove_width
+    from tabletcad.tooling.spec import ScoreSpec
+
+    sc = ScoreSpec(depth_mm=0.3, **spec)
+    info = dict(index=0, kind=sc.kind, profile=sc.profile, face="top", depth_mm=sc.depth_mm, cut_through=sc.cut_through,
+                width_at_face_centre_mm=groove_width(sc), length_mm=sc.length_mm, direction_deg=sc.direction_deg)
+    assert text in _score_note(info, sc)

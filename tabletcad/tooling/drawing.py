@@ -215,7 +215,7 @@ def drawing_model(ts) -> Drawing:
                      f"{fr.info['bevel_angle_deg']:g} deg " + (f"±{ang:g} deg" if ang is not None else
                                                                "±1 deg (ISO 2768-m, legs up to 10 mm)"))
     for s in ts.report.get("scores", []):
-        notes.append(f"{s['kind']} score {s['profile']} {_fmt(s['depth_mm'])} mm deep on the {s['face']} face")
+        notes.append(_score_note(s, ts.spec.scores[s["index"]]))
     for e in ts.report.get("emboss", []):
         notes.append(f"{e['mode']} '{e['text'] or 'outline'}' {_fmt(e['depth_mm'])} mm on the {e['face']} face")
     r = ts.report.get("tip_rating") or {}
@@ -296,6 +296,18 @@ _DIM_KEYS = {"Ø": "diameter", "L": "length", "W": "width", "band": "band", "cup
              "score": "score_depth", "R": "cup_radius", "land": "land"}
 
 
+def _score_note(s: dict, spec) -> str:
+    """A score's defining geometry in words: kind, profile (V angle, U width, pressure-sensitive slot),
+    depth, width at the face, direction, face, and whether it is cut through or short."""
+    profile = {"v": f"V {spec.angle_deg:g} deg", "u": f"U {_fmt(spec.width_mm)} mm wide",
+               "pressure_sensitive": f"pressure-sensitive, slot {_fmt(spec.slot_width_mm)} mm, flanks "
+                                     f"{spec.angle_deg:g} deg"}[s["profile"]]
+    extent = (f"short, {_fmt(s['length_mm'])} mm long (decorative)" if s["length_mm"] is not None
+              else "cut through the band" if s["cut_through"] else "across the face")
+    return (f"{s['kind']} score {profile}, {_fmt(s['depth_mm'])} mm deep, {_fmt(s['width_at_face_centre_mm'])} mm "
+            f"wide at the face, at {s['direction_deg']:g} deg on the {s['face']} face, {extent}")
+
+
 def _toleranced(dims: list, ts) -> list:
     """``dims`` with ``±tolerance`` appended to each text (the drawing spec's value for its key)."""
     from dataclasses import replace
@@ -307,6 +319,14 @@ def _toleranced(dims: list, ts) -> list:
         key = _DIM_KEYS.get(head, _DIM_KEYS.get(head[:1], None))
         out.append(replace(d, text=f"{d.text} ±{_fmt(dspec.tolerance(key))}") if key else d)
     return out
+
+
+def _plan_size(fr, inset: float) -> str:
+    """The plan size of the outline offset inward by ``inset`` mm: ``Ø`` of a round, else length x width
+    (a convex outline's extents shrink by twice the offset)."""
+    if fr.round_radius is not None:
+        return f"Ø{_fmt(2.0 * (fr.round_radius - inset))}"
+    return f"{_fmt(fr.length - 2.0 * inset)} x {_fmt(fr.width - 2.0 * inset)}"
 
 
 def _title(ts) -> str:
@@ -563,8 +583,11 @@ def tooling_model(ts) -> Drawing:
              f"head Ø{_fmt(up['head_diameter_mm'])} (flat Ø{_fmt(up['head_flat_diameter_mm'])})",
              f"tip: straight {_fmt(up['tip_straight_mm'])}, relief {_fmt(up['tip_relief_mm'])} per side; "
              f"upper tip {_fmt(up['tip_length_mm'])}, lower tip {_fmt(lo['tip_length_mm'])}",
-             f"die Ø{_fmt(die['outer_diameter_mm'])} x {_fmt(die['height_mm'])}, bore: the tablet's {die['bore']} outline "
-             f"(tips inside it by the clearance {_fmt(ts.spec.clearance_mm)}), taper {die['taper_deg']:g} deg",
+             f"working length (head flat to cup bottom): upper {_fmt(up['working_length_mm'])}, lower "
+             f"{_fmt(lo['working_length_mm'])}",
+             f"die Ø{_fmt(die['outer_diameter_mm'])} x {_fmt(die['height_mm'])}, bore {_plan_size(fr, 0.0)} (the "
+             f"tablet's {die['bore']} outline), taper {die['taper_deg']:g} deg; tips {_plan_size(fr, ts.spec.clearance_mm)} "
+             f"(the bore less the clearance {_fmt(ts.spec.clearance_mm)} per side)",
              "standard dimensions: tabletcad/data/tooling_standards.toml (sources per value in report.json)"
              if up["standard"] != "custom" else "user-defined set: every dimension from [tooling.punch]"]
     return Drawing(views, origins, dims, notes, title=f"{_title(ts)} — punches and die",

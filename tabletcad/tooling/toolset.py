@@ -189,6 +189,9 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
         for tip, tl in ((upper, spec.tip_length_mm), (lower, spec.lower_tip)):
             which = tip.name.split("_")[0]
             shape_, info_ = complete_punch(frame, tip.shape, which, spec.body, spec.clearance_mm, tl)
+            # working length: head flat to the cup's bottom (the tip's datum note), the length a press sets
+            info_["working_length_mm"] = abs(info_["head_flat_z_mm"]
+                                             - tip.info["working_length_datum"]["cup_bottom_point_mm"][2])
             tip.info.update(tip_volume_mm3=tip.volume_mm3, body=info_)
             tip.shape, tip.volume_mm3 = shape_, info_["volume_mm3"]
     die_shape, die_info = die(frame, spec.die_outer_diameter_mm, die_height(frame, spec), spec.taper_deg)
