@@ -141,3 +141,22 @@ def test_raised_figures_have_the_debossed_depth_limit(capsys, tmp_path):
     parameter, why = _refused(capsys, tmp_path, ROUND + '[[tooling.emboss]]\ntext = "A"\nmode = "emboss"\ndepth_mm = 50.0\n',
                               command="build")
     assert parameter == "tooling.emboss[0].depth_mm" and "cup depth + band/4 = 1.75 mm" in why
+
+
+def test_a_score_wider_than_half_the_tablet_and_a_huge_direction(capsys, tmp_path):
+    """A V score of 179.9° was cut 687 mm wide on a 10 mm tablet, and direction_deg = 1e308 was taken."""
+    name, why = _refused(capsys, tmp_path, ROUND + '[[tooling.score]]\ndepth_mm = 0.3\nangle_deg = 179.9\n', command="build")
+    assert name == "tooling.score[0].angle_deg" and "687.5 mm wide" in why and "5 mm" in why
+    name, why = _refused(capsys, tmp_path, ROUND + '[[tooling.score]]\ndepth_mm = 0.3\ndirection_deg = 1e308\n')
+    assert name == "tooling.score[0].direction_deg" and "<= 360" in why
+
+
+def test_an_optimise_variable_is_named_by_its_table(capsys, tmp_path):
+    problem = ('[problem]\nkind = "family"\nfamily = "concave_round"\nsense = "min"\nobjective = "surface_area_mm2"\n'
+               '[variables]\ndiameter = { lower = 7.0, upper = 11.0, initial = 20.0 }\n[fixed]\nband = 3.0\n'
+               'cup_depth = 1.0\n')
+    (tmp_path / "p.toml").write_text(problem)
+    assert main(["optimise", str(tmp_path / "p.toml"), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: variables.diameter.initial = 20 mm is not allowed: must lie within [7, 11]"), err
+    assert not (tmp_path / "out").exists()

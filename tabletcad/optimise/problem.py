@@ -76,13 +76,13 @@ class Variable:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise DesignError("variable name", self.name, "must be a non-empty string")
-        lo = check_finite(f"variable {self.name} lower", self.lower, self.unit)
-        hi = check_finite(f"variable {self.name} upper", self.upper, self.unit)
+        lo = check_finite(f"variables.{self.name}.lower", self.lower, self.unit)
+        hi = check_finite(f"variables.{self.name}.upper", self.upper, self.unit)
         if lo > hi:
-            raise DesignError(f"variable {self.name} bounds", (lo, hi), "must have lower <= upper", self.unit)
-        x0 = 0.5 * (lo + hi) if self.initial is None else check_finite(f"variable {self.name} initial", self.initial, self.unit)
+            raise DesignError(f"variables.{self.name}.bounds", (lo, hi), "must have lower <= upper", self.unit)
+        x0 = 0.5 * (lo + hi) if self.initial is None else check_finite(f"variables.{self.name}.initial", self.initial, self.unit)
         if not lo <= x0 <= hi:
-            raise DesignError(f"variable {self.name} initial", x0, f"must lie within [{lo:g}, {hi:g}]", self.unit)
+            raise DesignError(f"variables.{self.name}.initial", x0, f"must lie within [{lo:g}, {hi:g}]", self.unit)
         object.__setattr__(self, "lower", lo)
         object.__setattr__(self, "upper", hi)
         object.__setattr__(self, "initial", x0)

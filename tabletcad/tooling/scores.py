@@ -112,6 +112,12 @@ def _check_short(frame: TabletFrame, s: ScoreSpec, i: int) -> None:
 def check_score(frame: TabletFrame, s: ScoreSpec, i: int = 0) -> None:
     """Raise :class:`DesignError` if the score is deeper than the cup (and band) allow."""
     w = f"[[tooling.score]] {i} depth_mm"
+    room = 0.5 * min(frame.length, frame.width)
+    if groove_width(s) >= room:  # a V of 179.9 deg was a 687 mm wide "score" on a 10 mm tablet
+        key = {"v": "angle_deg", "u": "width_mm", "pressure_sensitive": "slot_width_mm"}[s.profile]
+        raise DesignError(f"[[tooling.score]] {i} {key}", getattr(s, key),
+                          f"makes the groove {groove_width(s):.4g} mm wide at the face: it must be narrower than half "
+                          f"the tablet's width, {room:.4g} mm", "deg" if key == "angle_deg" else "mm")
     if s.length_mm is not None:
         _check_short(frame, s, i)
     for face in s.face_list:

@@ -360,7 +360,7 @@ def _score(i: int, t: Any) -> ScoreSpec:
             raise DesignError(f"{w} length_mm", length, "a short score cannot be cut_through (it ends on the face)", "mm")
     return ScoreSpec(kind, profile, depth, angle, width, cut,
                      _choice(f"{w} faces", t.get("faces", d.faces), ("top", "bottom", "both")),
-                     check_finite(f"{w} direction_deg", t.get("direction_deg", d.direction_deg), "deg"), slot, length)
+                     check_range(f"{w} direction_deg", t.get("direction_deg", d.direction_deg), -360.0, 360.0, "deg"), slot, length)
 
 
 def _check_svg(where: str, path: str) -> None:
