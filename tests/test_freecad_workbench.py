@@ -344,6 +344,10 @@ def test_invalid_values_keep_previous_shape(headless):
     assert neg["tablet"]["volume"] == neg["before"]["volume"]
     (ok,) = _steps(headless, "repaired")
     assert ok["tablet"]["valid_obj"] and ok["state"] == ["Up-to-date"]
+    # the size limit of tabletcad build (it had reached the fit: "PDE surface deviates 1e+303 µm")
+    (big,) = _steps(headless, "too_big")
+    assert not big["tablet"]["valid_obj"] and "tablet.band = 1e+300 mm is not allowed: must be within ±1000 mm" in \
+        big["tablet"]["status"], big["tablet"]["status"]
 
 
 def test_refused_value_is_one_line_in_the_report_traceback_in_the_log(headless):
@@ -354,7 +358,7 @@ def test_refused_value_is_one_line_in_the_report_traceback_in_the_log(headless):
     lines = [ln for ln in shown.splitlines() if "cup_depth" in ln and "hemisphere" in ln]
     # the exception's one line; FreeCAD 1.0 adds its own "<label>: <message>" after a failed recompute
     assert [ln for ln in lines if "DesignError" in ln] == lines[:1], lines
-    assert all(ln.startswith("concave_round: cup_depth = 8 mm") for ln in lines[1:]) and len(lines) <= 2, lines
+    assert all(ln.startswith("concave_round: tablet.cup_depth = 8 mm") for ln in lines[1:]) and len(lines) <= 2, lines
     (log,) = [t for t in headless["log"] if "cup_depth" in t and "hemisphere" in t]  # FreeCAD.Console.PrintLog
     assert "Traceback (most recent call last)" in log and "DesignError" in log
 

@@ -188,6 +188,12 @@ try:
     t.Diameter = 9.0
     doc.recompute()
     step("repaired", tablet=tablet_info(t), upper=shape_info(up), state=list(t.State))
+    band = t.Band
+    t.Band = "1e300 mm"  # beyond the size limit: refused as tabletcad build refuses it
+    doc.recompute()
+    step("too_big", tablet=tablet_info(t), state=list(t.State))
+    t.Band = band
+    doc.recompute()
 
     # ---- exploded view: Gap lifts the punch off the tablet
     z0 = up.Shape.BoundBox.ZMin

@@ -60,14 +60,14 @@ def tablet_chain(tablet):
 
 
 def tablet_from_spec(family=None, params=None, design=None):
-    """A core Tablet from a family name and its parameters (mm, deg), or from a design file."""
-    from tabletcad import families
+    """A core Tablet from a family name and its parameters (mm, deg), or from a design file: both
+    through :class:`tabletcad.pipeline.design.Design`, so the workbench refuses what ``tabletcad
+    build`` refuses, with the same message (a size beyond ±1000 mm, a length below the tolerance)."""
+    from tabletcad.pipeline.design import Design, load_design
 
     if design:
-        from tabletcad.pipeline.design import load_design
-
         return load_design(design)
-    return families.family(family, parameter="family").build(**(params or {}))
+    return Design.from_dict({"tablet": {"family": family, **(params or {})}}).build()
 
 
 def _rims(surfaces, hollow):
