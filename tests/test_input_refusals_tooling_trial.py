@@ -116,23 +116,38 @@ def test_a_tip_is_checked_against_the_barrel_less_the_clearance():
     assert e.value.parameter == "tooling.punch.barrel_diameter_mm"
 
 
-def test_make_tooling_passes_the_tip_radius(monkeypatch):
+def test_make_tooling_passes_the_tip_radius_and_warns_of_a_keyless_shaped_tip(monkeypatch):
+    """The barrel check gets the tip's reach (the 19 mm capsule's 9.5 mm less the 0.02 mm clearance), and a
+    shaped tip without a key is warned of (it turns in its bore); the build is stopped after the checks."""
+    import tomllib
+
     import tabletcad.tooling.punch_body as pb
+    import tabletcad.tooling.toolset as toolset
     from tabletcad.pipeline.design import Design
-    from tabletcad.tooling.toolset import make_tooling
 
     seen = []
+    monkeypatch.setattr(pb, "check_body_fits", lambda frame, body, radius: seen.append(radius))
 
-    def spy(frame, body, radius):
-        seen.append(radius)
-        raise DesignError("stop", 0, "spied")
+    def stop(*a, **k):
+        raise DesignError("stop", 0, "after the checks")
 
-    monkeypatch.setattr(pb, "check_body_fits", spy)
+    monkeypatch.setattr(toolset, "_check_relief", stop)
+    punch = TSM_B + "head_top_angle_deg = 10.0\n"
     d = Design.from_dict(dict(tablet=dict(family="capsule", length=19.0, width=8.0, band=3.0, cup_depth=1.0, land=0.05),
-                              **__import__("tomllib").loads(TSM_B + "head_top_angle_deg = 10.0\n")))
-    with pytest.raises(DesignError, match="spied"):
-        make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False)
+                              **tomllib.loads(punch)))
+    with pytest.warns(UserWarning, match="shaped punch tips have no key"), pytest.raises(DesignError, match="after"):
+        toolset.make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False)
     assert seen == [pytest.approx(9.5 - 0.02, abs=1e-6)]
+    keyed = tomllib.loads(punch + "key = true\nkey_width_mm = 4.76\nkey_length_mm = 10\nkey_height_mm = 2\n"
+                          "key_offset_mm = 5\n")
+    d = Design.from_dict(dict(tablet=dict(family="capsule", length=19.0, width=8.0, band=3.0, cup_depth=1.0, land=0.05),
+                              **keyed))
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(DesignError, match="after"):
+            toolset.make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False)
 
 
 def test_raised_figures_have_the_debossed_depth_limit(capsys, tmp_path):

@@ -312,3 +312,13 @@ def test_score_notes_state_the_profile_and_extent(spec, text):
     info = dict(index=0, kind=sc.kind, profile=sc.profile, face="top", depth_mm=sc.depth_mm, cut_through=sc.cut_through,
                 width_at_face_centre_mm=groove_width(sc), length_mm=sc.length_mm, direction_deg=sc.direction_deg)
     assert text in _score_note(info, sc)
+
+
+def test_a_flat_face_has_no_cup_dimension():
+    """A flat-faced round's sheet dimensioned "cup 0.000 ±0.076"; a face without a cup has no cup dimension."""
+    from tabletcad.tooling.spec import ToolingSpec
+
+    flat = Path(__file__).resolve().parents[1] / "samples" / "families" / "flat_face_round.toml"
+    ts = make_tooling(load_design(flat), ToolingSpec(), check=False, interference_check=False)
+    texts = [d.text for d in drawing_model(ts).dims]
+    assert not any(t.startswith("cup") for t in texts) and any(t.startswith("T 3.50") for t in texts), texts

@@ -189,7 +189,9 @@ def drawing_model(ts) -> Drawing:
         dims.append(Dim((sx - W / 2, sy + fr.z_min), (sx + W / 2, sy + fr.z_min), -2.0, f"W {_fmt(W)}"))
     b0, b1 = fr.band_z
     dims.append(Dim((fx + x1, fy + b0), (fx + x1, fy + b1), 2.0, f"band {_fmt(fr.band)}", vertical=True))
-    dims.append(Dim((fx + x1, fy + b1), (fx + x1, fy + fr.z_max), 2.0 + 4.0, f"cup {_fmt(fr.cup_depth_top)}", vertical=True))
+    if fr.cup_depth_top > 1e-6:  # a flat face has no cup to dimension
+        dims.append(Dim((fx + x1, fy + b1), (fx + x1, fy + fr.z_max), 2.0 + 4.0, f"cup {_fmt(fr.cup_depth_top)}",
+                        vertical=True))
     dims.append(Dim((fx + x0, fy + fr.z_min), (fx + x0, fy + fr.z_max), -3.0, f"T {_fmt(T)}", vertical=True))
     notes = [f"{ts.tablet.name} ({ts.tablet.family})", f"overall thickness {_fmt(T)} mm", f"band {_fmt(fr.band)} mm",
              f"cup depth {_fmt(fr.cup_depth_top)} mm (bottom {_fmt(fr.cup_depth_bottom)} mm)"]

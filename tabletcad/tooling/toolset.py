@@ -66,6 +66,11 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
     from tabletcad.tooling.punch_body import check_body_fits
 
     check_body_fits(frame, spec.body, _max_radius(frame.outline) - spec.clearance_mm)
+    if frame.round_radius is None and not spec.body.key:
+        import warnings
+
+        warnings.warn("the shaped punch tips have no key: a shaped tip turns in its die bore unless a "
+                      "key in the barrel holds it; set key = true with key_* in [tooling.punch]", stacklevel=3)
     _check_relief(frame, spec)
     _, top, bottom = die_position(frame, die_height(frame, spec))
     need_up = top - frame.band_z[1]
