@@ -2,7 +2,7 @@
 
 * :mod:`tabletcad.cad.faces`   - kernel-neutral B-spline data -> ``Geom_BSplineSurface`` -> ``TopoDS_Face``
 * :mod:`tabletcad.cad.solid`   - fit, sew and validate a closed solid; adaptive mass properties
-* :mod:`tabletcad.cad.mesh`    - tessellation + manifold3d / trimesh checks
+* :mod:`tabletcad.cad.mesh`    - tessellation + manifold3d and edge checks
 * :mod:`tabletcad.cad.export`  - STEP / STL / 3MF / GLB / BREP writers chosen by suffix
 * :mod:`tabletcad.cad.interop` - build123d / cadquery wrappers (imported lazily)
 """

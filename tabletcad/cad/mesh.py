@@ -1,4 +1,4 @@
-"""Tessellation of a B-rep solid to numpy arrays, checked with manifold3d and trimesh.
+"""Tessellation of a B-rep solid to numpy arrays, checked with manifold3d and by its edges.
 
 ``BRepMesh_IncrementalMesh`` with an explicit linear deflection (mm, chord
 height) and angular deflection (rad), OCCT's Delabella triangulator by default
@@ -37,7 +37,7 @@ class MeshResult:
 
     ``volume``/``area`` are computed from the triangles (float64);
     ``manifold_*`` come from manifold3d (float32 vertices), ``watertight`` and
-    ``winding_consistent`` from trimesh.  ``ok`` is true when every check passed.
+    ``winding_consistent`` from the triangles' edges (:func:`_edge_check`).  ``ok`` is true when every check passed.
     """
 
     vertices: np.ndarray
@@ -173,11 +173,23 @@ def _manifold_check(V: np.ndarray, T: np.ndarray) -> tuple[str, Any, Any]:
     return name, int(m.genus()), float(m.volume())
 
 
-def _trimesh_check(V: np.ndarray, T: np.ndarray) -> tuple[bool, bool]:
-    import trimesh
-
-    tm = trimesh.Trimesh(V, T, process=False)
-    return bool(tm.is_watertight), bool(tm.is_winding_consistent)
+def _edge_check(T: np.ndarray) -> tuple[bool, bool]:
+    """``(watertight, winding_consistent)`` of the triangles ``T`` from their edges alone (trimesh's
+    definitions, without importing trimesh, 0.6-0.8 s): watertight when every edge is shared by exactly
+    two triangles, consistent when each such pair runs it in opposite directions (no directed edge twice)."""
+    T = np.asarray(T, dtype=np.int64)
+    if not len(T):
+        return False, False
+    a = T.reshape(-1)
+    b = T[:, [1, 2, 0]].reshape(-1)
+    n = int(T.max()) + 1
+    directed = a * n + b
+    undirected = np.minimum(a, b) * n + np.maximum(a, b)
+    edges, uses = np.unique(undirected, return_counts=True)
+    watertight = bool(np.all(uses == 2))
+    shared = np.isin(undirected, edges[uses == 2])  # edges of two triangles: their directions must differ
+    _, runs = np.unique(directed[shared], return_counts=True)
+    return watertight, bool(np.all(runs == 1))
 
 
 def tessellate(
@@ -190,7 +202,7 @@ def tessellate(
     check: bool = True,
     algo: str = "delabella",
 ) -> MeshResult:
-    """Triangulate ``shape`` (deflections in mm and rad) and run the manifold3d / trimesh checks."""
+    """Triangulate ``shape`` (deflections in mm and rad) and run the manifold3d and edge checks."""
     V, T = triangulate(shape, linear_deflection, angular_deflection, relative=relative, weld_tol=weld_tol, algo=algo)
     return mesh_result(V, T, linear_deflection, angular_deflection, check=check)
 
@@ -217,13 +229,13 @@ def tessellate_solid(solid, linear_deflection: float = DEFAULT.mesh_deflection,
 
 def mesh_result(V: np.ndarray, T: np.ndarray, linear_deflection: float, angular_deflection: float, *,
                 check: bool = True) -> MeshResult:
-    """A :class:`MeshResult` of the welded mesh ``(V, T)``, with the manifold3d / trimesh checks."""
+    """A :class:`MeshResult` of the welded mesh ``(V, T)``, with the manifold3d and edge checks."""
     vol, area = _signed_volume_area(V, T)
     status, genus, mvol = ("unchecked", None, None)
     watertight = winding = None
     if check:
         status, genus, mvol = _manifold_check(V, T)
-        watertight, winding = _trimesh_check(V, T)
+        watertight, winding = _edge_check(T)
     V.setflags(write=False)
     T.setflags(write=False)
     return MeshResult(
