@@ -162,6 +162,9 @@ def test_a_score_wider_than_half_the_tablet_and_a_huge_direction(capsys, tmp_pat
     """A V score of 179.9° was cut 687 mm wide on a 10 mm tablet, and direction_deg = 1e308 was taken."""
     name, why = _refused(capsys, tmp_path, ROUND + '[[tooling.score]]\ndepth_mm = 0.3\nangle_deg = 179.9\n', command="build")
     assert name == "tooling.score[0].angle_deg" and "687.5 mm wide" in why and "5 mm" in why
+    # a groove too deep is named by its depth, not by the default angle that makes it wide
+    name, why = _refused(capsys, tmp_path, ROUND + '[[tooling.score]]\ndepth_mm = 5.0\n', command="build")
+    assert name == "tooling.score[0].depth_mm", why
     name, why = _refused(capsys, tmp_path, ROUND + '[[tooling.score]]\ndepth_mm = 0.3\ndirection_deg = 1e308\n')
     assert name == "tooling.score[0].direction_deg" and "<= 360" in why
 

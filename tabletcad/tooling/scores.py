@@ -112,14 +112,6 @@ def _check_short(frame: TabletFrame, s: ScoreSpec, i: int) -> None:
 def check_score(frame: TabletFrame, s: ScoreSpec, i: int = 0) -> None:
     """Raise :class:`DesignError` if the score is deeper than the cup (and band) allow."""
     w = f"[[tooling.score]] {i} depth_mm"
-    room = 0.5 * min(frame.length, frame.width)
-    if groove_width(s) >= room:  # a V of 179.9 deg was a 687 mm wide "score" on a 10 mm tablet
-        key = {"v": "angle_deg", "u": "width_mm", "pressure_sensitive": "slot_width_mm"}[s.profile]
-        raise DesignError(f"[[tooling.score]] {i} {key}", getattr(s, key),
-                          f"makes the groove {groove_width(s):.4g} mm wide at the face: it must be narrower than half "
-                          f"the tablet's width, {room:.4g} mm", "deg" if key == "angle_deg" else "mm")
-    if s.length_mm is not None:
-        _check_short(frame, s, i)
     for face in s.face_list:
         cup = frame.cup_depth_top if face == "top" else frame.cup_depth_bottom
         if s.cut_through or s.length_mm is not None:
@@ -130,6 +122,14 @@ def check_score(frame: TabletFrame, s: ScoreSpec, i: int = 0) -> None:
         elif s.depth_mm > cup - RUN_OUT_MARGIN_MM:
             raise DesignError(w, s.depth_mm, f"must be < the {face} cup depth {cup:.4g} mm minus {RUN_OUT_MARGIN_MM} mm "
                               "(a standard score runs out on the face; set cut_through = true to cut the band)", "mm")
+    room = 0.5 * min(frame.length, frame.width)
+    if groove_width(s) >= room:  # (a depth within its bounds): a V of 179.9 deg was a 687 mm wide "score"
+        key = {"v": "angle_deg", "u": "width_mm", "pressure_sensitive": "slot_width_mm"}[s.profile]
+        raise DesignError(f"[[tooling.score]] {i} {key}", getattr(s, key),
+                          f"makes the groove {groove_width(s):.4g} mm wide at the face: it must be narrower than half "
+                          f"the tablet's width, {room:.4g} mm", "deg" if key == "angle_deg" else "mm")
+    if s.length_mm is not None:
+        _check_short(frame, s, i)
 
 
 def score_cutter(frame: TabletFrame, s: ScoreSpec, face: str):
