@@ -256,3 +256,20 @@ def test_heckel_input_that_would_be_misread(tmp_path, capsys):
         assert main(["heckel", *args]) == 2
         err = capsys.readouterr().err
         assert err.startswith(f"error: {parameter} = ") and fragment in err and len(err.splitlines()) == 1, err
+
+
+def test_thesis_and_free_form_reports_carry_their_design_report():
+    """``report.json`` (the geometry report) of a thesis shape gives the design report ``tabletcad report``
+    prints (weight, strength by eq 2.7): it had none, for thesis shapes and free-form designs alike."""
+    from tabletcad.pipeline.design import Design
+    from tabletcad.pipeline.designreport import shape_report
+    from tabletcad.pipeline.report import geometry_report
+
+    d = Design.from_dict({"tablet": {"family": "thesis.shallow_convex_round", "diameter": 10.0, "thickness": 3.0, "band": 2.0},
+                          "report": {"solid_fraction": 0.85, "true_density_mg_mm3": 1.5, "breaking_force_N": 100.0}})
+    t = d.build()
+    rep = geometry_report(t, d.report_options)
+    dr = rep["design_report"]
+    assert dr == shape_report(t, d.report_options)["design_report"]
+    assert dr["weight_mg"] == pytest.approx(rep["volume_mm3"] * 0.85 * 1.5, rel=1e-12)
+    assert "eq 2.7" in dr["tensile_strength"]["formula"] and dr["tensile_strength"]["tensile_strength_MPa"] > 0

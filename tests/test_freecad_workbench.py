@@ -205,7 +205,7 @@ FAMILIES = {
     "compound_cup": {},
     "capsule": {},
 }
-TOOLING_FAMILIES = ["concave_round", "thesis.ring", "capsule"]
+TOOLING_FAMILIES = ["concave_round", "thesis.ring", "capsule", "thesis.flat_faced_round"]
 
 
 @pytest.fixture(scope="module")
@@ -252,7 +252,13 @@ def test_tooling_valid_and_linked(headless, family):
     assert up["bbox"][2] <= tab["bbox"][5] + 1e-6 and low["bbox"][5] >= tab["bbox"][2] - 1e-6
     assert up["bbox"][5] == pytest.approx(step["rim_z"][0] + 10.0, abs=1e-6)  # 10 mm tips from the band edges
     assert low["bbox"][2] == pytest.approx(step["rim_z"][1] - 10.0, abs=1e-6)
-    assert die["bbox"][0] == pytest.approx(-30.16 / 2, abs=1e-6)
+    from tabletcad.tooling.spec import standard_die_size
+
+    box = tab["tight_bbox"]
+    od, height, _ = standard_die_size(max(box[3] - box[0], box[4] - box[1]))
+    assert die["bbox"][0] == pytest.approx(-od / 2, abs=1e-6)  # the TSM die for its size, as build takes it
+    assert die["bbox"][5] - die["bbox"][2] == pytest.approx(height, abs=1e-6)
+    assert max(step["overlap"]) < 1e-9, step["overlap"]
     if family == "thesis.ring":
         import math
 
@@ -277,17 +283,24 @@ def _outline_area_perimeter(segs):
 
 
 def test_capsule_die_bore_is_the_exact_outline_and_the_tips_its_inward_offset(headless):
-    """The workbench's die bore is the capsule's exact outline (lines and arcs), as ``tabletcad build``
-    makes it: die volume = pi R^2 H - A H, A from the core's outline (the bore had been the outline
-    offset outward by the clearance: a 10 mm design got a 10.10 mm die).  The punch tips are the
-    outline offset inward by the clearance c: plan extents length - 2c by width - 2c."""
+    """The workbench's die bore is the capsule's exact outline (lines and arcs) offset by the band's
+    bulge b (at least 1e-6 mm, as ``tabletcad build`` makes it): die volume = pi R^2 H - (A + P b +
+    pi b^2) H (Steiner), A and P from the core's outline (the bore had been the outline offset outward
+    by the clearance: a 10 mm design got a 10.10 mm die).  The punch tips are the outline offset
+    inward by the clearance c: plan extents length - 2c by width - 2c."""
     from tabletcad import families
+    from tabletcad.tooling.spec import MIN_BORE_OFFSET_MM, standard_die_size
 
     (step,) = [s for s in _steps(headless, "tooling") if s["family"] == "capsule"]
-    outline = families.FAMILIES["capsule"].build().nominal.outline
-    A, _ = _outline_area_perimeter(outline.segs)
-    H, OD, c = 22.22, 30.16, 0.025  # the Die's defaults (TSM B) and the punches' clearance
-    assert step["die"]["volume"] == pytest.approx(math.pi * (OD / 2) ** 2 * H - A * H, rel=1e-9)
+    tablet = families.FAMILIES["capsule"].build()
+    outline = tablet.nominal.outline
+    A, P = _outline_area_perimeter(outline.segs)
+    b = tablet.band().bulge
+    b = max(b, MIN_BORE_OFFSET_MM) if b > 0 else 0.0
+    OD, H, _ = standard_die_size(max(outline.extent()))  # the TSM die for its size, as build takes it
+    c = 0.025  # the punches' clearance
+    expected = math.pi * (OD / 2) ** 2 * H - (A + P * b + math.pi * b * b) * H
+    assert step["die"]["volume"] == pytest.approx(expected, rel=1e-9)
     for k, extent in enumerate(outline.extent()):  # the punch's plan extents are its tip's: the outline's less 2c
         tight = step["upper"]["tight_bbox"]
         assert tight[3 + k] - tight[k] == pytest.approx(extent - 2 * c, abs=1e-6)
@@ -299,6 +312,8 @@ def test_make_tooling_reads_the_design_files_tooling_table(headless):
     is named in a warning on the Report view."""
     (st,) = _steps(headless, "design_tooling")
     assert st["clearance"] == [0.05, 0.05] and st["lengths"] == [8.0, 12.0]
+    (given,) = _steps(headless, "design_tooling_length")  # length=5 with no lower tip in the file: both 5
+    assert given["lengths"] == [5.0, 5.0]
     die, up, low, tab = st["die"], st["upper"], st["lower"], st["tablet"]
     assert die["bbox"][3] - die["bbox"][0] == pytest.approx(32.0, abs=1e-6)
     assert die["bbox"][5] - die["bbox"][2] == pytest.approx(20.0, abs=1e-6)

@@ -253,7 +253,7 @@ class Band:
         Heights (mm) of its bottom and top edges.
     bulge : float
         Largest outward plan distance (mm) of the patch from its end curve (0 when it bows
-        inward): the PDE surface between the two edges may bulge a little (the thesis's
+        inward, or leaves it by rounding only, under 1e-12 of its size): the PDE surface between the two edges may bulge a little (the thesis's
         10 mm shallow convex round: 1.4 µm), which a die bore has to clear.
     """
 
@@ -466,7 +466,10 @@ class Tablet:
                 continue
             out = x0[:, :2] - x0[:, :2].mean(axis=0)  # outward (star-shaped outlines about their centroid)
             out /= np.maximum(np.linalg.norm(out, axis=1, keepdims=True), 1e-300)
-            bulge = max(0.0, float(np.max(np.einsum("uvc,vc->uv", dev, out))))
+            bulge = float(np.max(np.einsum("uvc,vc->uv", dev, out)))
+            # rounding is no bulge: a straight band's 1e-16 mm on one machine's BLAS had the die bore
+            # offset by MIN_BORE_OFFSET_MM there and not on another
+            bulge = bulge if bulge > 1e-12 * max(1.0, float(np.max(np.abs(x0)))) else 0.0
             return Band(i, min(z0, z1), max(z0, z1), bulge)
         return None
 

@@ -38,7 +38,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["ReportOptions", "design_report", "shape_report", "family_seams",
+__all__ = ["ReportOptions", "design_report", "shape_report", "shape_design_report", "family_seams",
            "punch_rating_table", "tensile_strength", "FDA_MAX_DIMENSION_MM", "REPORT_KEYS"]
 
 #: FDA guidance "Size, Shape, and Other Physical Attributes of Generic Tablets and Capsules"
@@ -416,9 +416,25 @@ _THESIS_SHAPES = {
 
 
 def shape_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str, Any]:
+    """The design report of a tablet without a family nominal (:func:`shape_design_report`) with the
+    nominal deviation and seams, as :func:`design_report` gives them for a family tablet."""
+    dev = tablet.nominal_deviation()
+    seams = [dict(s, expected_sharp=None, as_expected=None) for s in tablet.seams()]
+    return dict(
+        nominal_max_deviation_um=None if dev is None else dev * 1000.0,
+        nominal_tolerance_um=None,
+        nominal_certified=None,
+        nominal_recertified=False,
+        seams=seams,
+        seams_as_expected=None,
+        design_report=shape_design_report(tablet, opts),
+    )
+
+
+def shape_design_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str, Any]:
     """The design report of a tablet without a family nominal: the thesis's shapes, free-form designs.
 
-    The same keys as :func:`design_report`, from the tablet's own geometry (quadrature volume and
+    The same keys as :func:`design_report`'s ``design_report``, from the tablet's own geometry (quadrature volume and
     area, plan area, overall dimensions); band and cup depth come from the family's parameters
     where it has them (the thesis's convex rounds and ovals: cup depth = (thickness - band) / 2),
     else they are None (also for a trimmed, cut-away tablet and a reshaped one).  The tensile strength uses eq 2.4 (flat round), eq 2.7 (convex round) or
@@ -451,14 +467,4 @@ def shape_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str,
         rep.update(cup_radius_mm=r_cup, cup_radii_mm={"cup": r_cup})
     _add_figures(rep, dict(shape=shape, face=face, band_mm=band, cup_depth_mm=cup or 0.0, width_mm=W, length_mm=Ln,
                            elongated=shape == "oval"), T, opts)
-    dev = tablet.nominal_deviation()
-    seams = [dict(s, expected_sharp=None, as_expected=None) for s in tablet.seams()]
-    return dict(
-        nominal_max_deviation_um=None if dev is None else dev * 1000.0,
-        nominal_tolerance_um=None,
-        nominal_certified=None,
-        nominal_recertified=False,
-        seams=seams,
-        seams_as_expected=None,
-        design_report=rep,
-    )
+    return rep

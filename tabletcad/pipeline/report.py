@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from tabletcad.pipeline.designreport import ReportOptions, design_report
+from tabletcad.pipeline.designreport import ReportOptions, design_report, shape_design_report
 from tabletcad.families.sweep import SweepNominal
 from tabletcad.geometry.tablet import Tablet
 
@@ -68,6 +68,8 @@ def geometry_report(tablet: Tablet, options: ReportOptions | None = None) -> dic
     )
     if isinstance(tablet.nominal, SweepNominal):  # the industry families' design report
         rep.update(design_report(tablet, options))
+    else:  # the thesis's shapes and free-form designs: the same report from their own geometry
+        rep["design_report"] = shape_design_report(tablet, options)
     return rep
 
 

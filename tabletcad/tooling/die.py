@@ -23,16 +23,11 @@ from tabletcad.cad._occ import cast, explore
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.tooling.booleans import boolean, translated, volume
 from tabletcad.tooling.outline import TabletFrame, offset_wire, plan_face, prism
-from tabletcad.tooling.spec import MIN_DIE_WALL_MM
+from tabletcad.tooling.spec import MIN_BORE_OFFSET_MM, MIN_DIE_WALL_MM, standard_die_size
 
 __all__ = ["die", "default_die_size", "tapered_prism", "MIN_WALL_MM"]
 
 MIN_WALL_MM = MIN_DIE_WALL_MM  # the die's thinnest wall around the bore (mm)
-#: smallest outward offset (mm) of the bore: OCCT's planar offset returns no wire for
-#: distances near its confusion tolerance (1.1e-7 mm gave none, 5e-7 mm works), so a band
-#: bulge below this is cleared by this much instead (far below any die-bore tolerance)
-MIN_BORE_OFFSET_MM = 1e-6
-TSM_DIES = ((16.0, 30.16, 22.22, "B"), (25.4, 38.10, 23.81, "D"))
 
 
 def _max_radius(wire) -> float:
@@ -68,12 +63,7 @@ def tapered_prism(wire, z0: float, z1: float, taper_deg: float):
 
 def default_die_size(frame: TabletFrame) -> tuple[float, float, str]:
     """``(outer diameter, height, TSM type)`` for the tablet's largest plan dimension."""
-    size = max(frame.length, frame.width)
-    for lim, od, h, name in TSM_DIES:
-        if size <= lim:
-            return od, h, name
-    raise DesignError("[tooling] die_outer_diameter_mm", "missing",
-                      f"give it for a tablet {size:.4g} mm long (larger than a TSM 'D' die takes, 25.4 mm)", "mm")
+    return standard_die_size(max(frame.length, frame.width))
 
 
 def die_position(frame: TabletFrame, height: float, penetration: float | None = None) -> tuple[float, float, float]:

@@ -32,7 +32,7 @@ from tabletcad.geometry.tablet import coordinate_range
 from tabletcad.io.forked import OCC_PARALLEL
 from tabletcad.tooling.booleans import (bound_area, mesh_arrays, mesh_face_ids, manifold_op, manifold_volume, raw_boolean, to_manifold,
                                         volume)
-from tabletcad.tooling.die import MIN_BORE_OFFSET_MM
+from tabletcad.tooling.spec import MIN_BORE_OFFSET_MM
 
 __all__ = ["interference", "MeshDistance", "mesh_distance", "largest_inside", "ExactDistance"]
 

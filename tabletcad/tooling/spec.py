@@ -81,6 +81,24 @@ FONT_DIR = Path("/usr/share/fonts/truetype/dejavu")
 #: the largest radial clearance between punch tip and die bore (mm)
 MAX_CLEARANCE_MM = 1.0
 
+#: smallest outward offset (mm) of a die bore: OCCT's planar offset returns no wire for distances near
+#: its confusion tolerance (1.1e-7 mm gave none, 5e-7 mm works), so a band bulge below this is cleared
+#: by this much instead (far below any die-bore tolerance)
+MIN_BORE_OFFSET_MM = 1e-6
+
+#: TSM die sizes: (largest tablet size, outer diameter, height, type), mm
+TSM_DIES = ((16.0, 30.16, 22.22, "B"), (25.4, 38.10, 23.81, "D"))
+
+
+def standard_die_size(size_mm: float) -> tuple[float, float, str]:
+    """``(outer diameter, height, TSM type)`` of the die for a tablet whose largest plan dimension is
+    ``size_mm`` (:data:`TSM_DIES`); a :class:`DesignError` for one larger than a 'D' die takes."""
+    for lim, od, h, name in TSM_DIES:
+        if size_mm <= lim:
+            return od, h, name
+    raise DesignError("[tooling] die_outer_diameter_mm", "missing",
+                      f"give it for a tablet {size_mm:.4g} mm long (larger than a TSM 'D' die takes, 25.4 mm)", "mm")
+
 
 @dataclass(frozen=True)
 class ScoreSpec:

@@ -256,10 +256,13 @@ def build_tablet(tablet, tol=None):
     hollow = tablet.trim.w[0] > 0.0
     rims = (_revolved_rims if profiles is not None else _rims)([f.surface for f in fits], hollow=hollow)
     outline = outline_segments(tablet)
-    if outline:  # the die bore follows the exact outline (lines and arcs), not the fitted rim
-        for r in rims:
-            if not r["inner"]:
+    band = tablet.band()
+    for r in rims:
+        if not r["inner"]:
+            if outline:  # the die bore follows the exact outline (lines and arcs), not the fitted rim
                 r["outline"] = outline
+            # how far the band's PDE surface leaves the outline (mm): the bore clears it, as build's does
+            r["band_bulge"] = 0.0 if band is None else float(band.bulge)
     # exact volume of the B-spline solid (FreeCAD's Shape.Volume is OCCT's default integration,
     # measured 8.5e-4 relative off on a free-form stadium tablet)
     props = dict(props, solid_volume_mm3=abs(enclosed_volume([f.surface for f in fits])))
@@ -440,13 +443,14 @@ def punch_shape(tablet_shape, rims, which="upper", length=10.0, clearance=0.025)
 
 def die_shape(rims, height=22.22, outer_diameter=30.16):
     """Die: cylinder (``outer_diameter``, ``height``, centred on the band) minus the bore, the
-    tablet's exact plan outline when it has one, else its outer rim (as ``tabletcad build``:
-    the punch tips take the clearance)."""
+    tablet's exact plan outline when it has one, else its outer rim, offset by the band's bulge
+    where its PDE surface leaves the outline (as ``tabletcad build``: the punch tips take the
+    clearance)."""
     import FreeCAD
     import Part
 
     from tabletcad.errors import DesignError, GeometryError
-    from tabletcad.tooling.spec import MIN_DIE_WALL_MM
+    from tabletcad.tooling.spec import MIN_BORE_OFFSET_MM, MIN_DIE_WALL_MM
 
     if not height > 0:
         raise DesignError("die height", height, "must be > 0", "mm")
@@ -457,8 +461,13 @@ def die_shape(rims, height=22.22, outer_diameter=30.16):
         )
     lo = min(outer, key=lambda r: r["z"])
     z_lo, z_hi = lo["z"], max(r["z"] for r in outer)
-    bore_wire = offset_outline_wire(lo["outline"], 0.0, z_lo) if lo.get("outline") else _rim_wire(lo)
-    reach = lo["radius"] if "radius" in lo else float(np.max(np.hypot(*np.asarray(lo["poles"])[:, :2].T)))
+    bulge = float(lo.get("band_bulge", 0.0))
+    bulge = max(bulge, MIN_BORE_OFFSET_MM) if bulge > 0 else 0.0  # (a thesis band bulges 2.5 µm)
+    if bulge > 0:
+        bore_wire = _offset_rim_wire(lo, bulge)
+    else:
+        bore_wire = offset_outline_wire(lo["outline"], 0.0, z_lo) if lo.get("outline") else _rim_wire(lo)
+    reach = bulge + (lo["radius"] if "radius" in lo else float(np.max(np.hypot(*np.asarray(lo["poles"])[:, :2].T))))
     if outer_diameter / 2.0 - reach < MIN_DIE_WALL_MM:  # tabletcad build's rule
         raise DesignError(
             "die outer diameter",

@@ -119,7 +119,15 @@ def make_lower_punch(doc, tablet, length=None, recompute=True, clearance=None):
 
 
 def make_die(doc, tablet, height=None, outer_diameter=None, recompute=True):
-    """Die linked to ``tablet``: cylinder minus the bore (the tablet's outline)."""
+    """Die linked to ``tablet``: cylinder minus the bore (the tablet's outline).  Without
+    ``outer_diameter``, the TSM die for the tablet's size, as ``tabletcad build`` takes it (B,
+    30.16 x 22.22 mm, up to 16 mm; D, 38.10 x 23.81 mm, up to 25.4 mm)."""
+    if outer_diameter is None:  # (an outer diameter given alone keeps the 22.22 mm height, as build does)
+        from tabletcad.tooling.spec import standard_die_size
+
+        dims = tablet.Proxy.core_tablet(tablet).dimensions()
+        outer_diameter, h, _ = standard_die_size(max(dims["length_mm"], dims["width_mm"]))
+        height = h if height is None else height
     obj = _new(doc, "Die")
     objects.DieProxy(obj, tablet)
     for prop, v in (("Height", height), ("OuterDiameter", outer_diameter)):
@@ -145,7 +153,7 @@ def design_tooling(tablet):
     spec = Design.from_toml(path).tooling_spec
     if spec is None:
         return {}, []
-    values = dict(clearance=spec.clearance_mm, length=spec.tip_length_mm, lower_length=spec.lower_tip,
+    values = dict(clearance=spec.clearance_mm, length=spec.tip_length_mm, lower_length=spec.lower_tip_length_mm,
                   die_height=spec.die_height_mm, die_outer_diameter=spec.die_outer_diameter_mm)
     left = [name for name, given in (("[[tooling.score]]", spec.scores), ("[[tooling.emboss]]", spec.emboss),
                                      ("complete punches ([tooling] standard)", spec.body)) if given]
