@@ -196,20 +196,42 @@ class TabletModel(_Shaped):
     def to_occ(self):
         """The tablet's ``TopoDS_Solid``; for a cut-away view (``[trim] u`` or ``v``) the cut-away's,
         made and checked as ``tabletcad build`` makes it (:func:`tabletcad.cad.stage.cutaway_solid`)."""
+        return self.solid.shape if self._whole else self._cutaway[0]
+
+    @property
+    def _whole(self) -> bool:
         t = self.tablet.trim
-        if t.u == (0.0, 1.0) and t.full_v:
-            return self.solid.shape
-        return self._cutaway
+        return t.u == (0.0, 1.0) and t.full_v
 
     @cached_property
     def _cutaway(self):
+        """``(shape, mesh)`` of the cut-away as ``tabletcad build`` makes and checks them (the mesh:
+        its faces' own grids; OCC's mesher leaves the folded cut faces of a shaped cut-away open)."""
         from tabletcad.cad.stage import cutaway_solid
         from tabletcad.errors import GeometryError
 
         cut = cutaway_solid(self.tablet, {"volume_mm3": self.tablet.volume()})
         if isinstance(cut, str):
             raise GeometryError(f"{self.name}: no solid for this cut-away view: {cut}", self.tablet)
-        return cut[0]
+        return cut[0], cut[1]
+
+    def mesh(self, linear_deflection: float = DEFAULT.mesh_deflection, angular_deflection: float = DEFAULT.mesh_angle,
+             check: bool = False):
+        """:class:`tabletcad.cad.mesh.MeshResult` of the solid (mm, rad); a cut-away's at the default
+        deflections is the one ``tabletcad build`` writes (checked)."""
+        if not self._whole and (linear_deflection, angular_deflection) == (DEFAULT.mesh_deflection, DEFAULT.mesh_angle) \
+                and self._cutaway[1] is not None:
+            return self._cutaway[1]
+        return super().mesh(linear_deflection, angular_deflection, check=check)
+
+    def export(self, path: str | Path, **kw: Any) -> Path:
+        """Write the solid in the format named by the suffix (.step .stl .3mf .glb .brep); a cut-away's
+        mesh formats from the mesh ``tabletcad build`` writes (unless other deflections are asked for)."""
+        mesh_kw = {"linear_deflection", "angular_deflection", "relative", "mesh"}
+        if not self._whole and Path(path).suffix.lower() in (".stl", ".3mf", ".glb") and not mesh_kw & set(kw) \
+                and self._cutaway[1] is not None:
+            kw["mesh"] = self._cutaway[1]
+        return super().export(path, **kw)
 
     def report(self) -> dict[str, Any]:
         """The geometry and design report (the content of ``report.json``)."""
