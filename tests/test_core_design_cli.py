@@ -273,3 +273,17 @@ def test_thesis_and_free_form_reports_carry_their_design_report():
     assert dr == shape_report(t, d.report_options)["design_report"]
     assert dr["weight_mg"] == pytest.approx(rep["volume_mm3"] * 0.85 * 1.5, rel=1e-12)
     assert "eq 2.7" in dr["tensile_strength"]["formula"] and dr["tensile_strength"]["tensile_strength_MPa"] > 0
+
+
+@pytest.mark.parametrize("trim, token", [("v = [0.0, 1e-9]", "trim.v"), ("w = [0.0, 1e-12]", "trim.w"),
+                                         ("u = [0.5, 0.5000001]", "trim.u")])
+def test_a_trim_thinner_than_a_thousandth_is_refused(tmp_path, capsys, trim, token):
+    """``v = [0, 1e-9]`` failed late in the CAD stage ("0 solids"), ``w = [0, 1e-12]`` built a solid 1e-11 mm
+    wide: a trim narrower than 0.001 (rad for v) is refused by the report, before any geometry."""
+    from tabletcad.cli import main
+
+    d = tmp_path / "t.toml"
+    d.write_text('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 3.0\ncup_depth = 1.0\n[trim]\n' + trim + "\n")
+    assert main(["report", str(d)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"error: {token} = ") and "at least 0.001" in err and len(err.splitlines()) == 1, err

@@ -120,6 +120,11 @@ def _split_gauss(t0: float, t1: float, breaks: np.ndarray, n_total: int) -> tupl
     return (0.5 * (hi - lo) * (x + 1.0) + lo).ravel(), (0.5 * (hi - lo) * w).ravel()
 
 
+#: the narrowest range of ``u`` or ``w`` (a fraction) and of ``v`` (rad) a :class:`Trim` keeps: a
+#: thinner slice is no solid the CAD layer can make (v = [0, 1e-9] failed late, "0 solids")
+TRIM_MIN_WIDTH = 1e-3
+
+
 @dataclass(frozen=True)
 class Trim:
     """Parameter ranges kept of every patch solid.
@@ -142,11 +147,13 @@ class Trim:
         for name, (lo, hi), top in (("u", self.u, 1.0), ("w", self.w, 1.0)):
             check_range(f"trim {name}[0]", lo, 0.0, 1.0)
             check_range(f"trim {name}[1]", hi, 0.0, 1.0)
-            if not lo < hi:
-                raise DesignError(f"trim {name}", (lo, hi), "must be an increasing pair within [0, 1]")
+            if not hi - lo >= TRIM_MIN_WIDTH:  # (w = [0, 1e-12] made a solid 1e-11 mm wide)
+                raise DesignError(f"trim {name}", (lo, hi), f"must be an increasing pair within [0, 1], at least "
+                                  f"{TRIM_MIN_WIDTH:g} apart")
         v0, v1 = (float(x) for x in self.v)
-        if not (math.isfinite(v0) and math.isfinite(v1) and 0.0 < v1 - v0 <= math.tau + 1e-12):
-            raise DesignError("trim v", self.v, "must be an increasing pair spanning at most 2π rad")
+        if not (math.isfinite(v0) and math.isfinite(v1) and TRIM_MIN_WIDTH <= v1 - v0 <= math.tau + 1e-12):
+            raise DesignError("trim v", self.v, f"must be an increasing pair spanning at most 2π rad and at least "
+                              f"{TRIM_MIN_WIDTH:g} rad")
         object.__setattr__(self, "u", tuple(float(x) for x in self.u))
         object.__setattr__(self, "v", (v0, v1))
         object.__setattr__(self, "w", tuple(float(x) for x in self.w))
