@@ -40,9 +40,10 @@ from __future__ import annotations
 
 import math
 
-from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.errors import DesignError, check_range
 from tabletcad.mechanics.contact import contact_radius_at_yield
 from tabletcad.mechanics.validity import ValidityWarning, warn
+from tabletcad.tolerance import DEFAULT
 
 __all__ = [
     "ELONGATED_FACTOR",
@@ -61,6 +62,17 @@ ELONGATED_RATIO = 1.7
 #: limiting ratio of elongated to round tablet strength (Pitt & Heasley).
 ELONGATED_FACTOR = 2.0 / 3.0
 
+#: the largest force (N) a breaking test is read with (1e308 gave an infinite strength)
+MAX_FORCE_N = 1e9
+
+
+def _force(F: float) -> float:
+    return check_range("force", F, 0.0, MAX_FORCE_N, "N", lo_open=True)
+
+
+def _length(name: str, x: float) -> float:
+    """A tablet's length (mm) as a design's: at least ``Tolerances.min_length``, at most ``max_length``."""
+    return check_range(name, x, DEFAULT.min_length, DEFAULT.max_length, "mm")
 
 def diametral_flat(F: float, D: float, t: float) -> float:
     """Diametral tensile strength of a flat-faced round tablet, eq 2.4: ``2F / (π D t)`` (MPa).
@@ -74,9 +86,9 @@ def diametral_flat(F: float, D: float, t: float) -> float:
     t : float
         Thickness, mm.
     """
-    F = check_positive("force", F, "N")
-    D = check_positive("diameter", D, "mm")
-    t = check_positive("thickness", t, "mm")
+    F = _force(F)
+    D = _length("diameter", D)
+    t = _length("thickness", t)
     if t > D:
         warn(ValidityWarning, f"eq 2.4: thickness {t:g} mm exceeds diameter {D:g} mm (outside the usual disc test range)")
     return 2.0 * F / (math.pi * D * t)
@@ -84,8 +96,8 @@ def diametral_flat(F: float, D: float, t: float) -> float:
 
 def axial_flat(F: float, D: float) -> float:
     """Axial strength of a flat-faced round tablet, eq 2.5: ``4F / (π D²)`` (MPa); F the yield force (N)."""
-    F = check_positive("force", F, "N")
-    D = check_positive("diameter", D, "mm")
+    F = _force(F)
+    D = _length("diameter", D)
     return 4.0 * F / (math.pi * D * D)
 
 
@@ -123,10 +135,10 @@ def pitt_convex(F: float, D: float, t: float, W: float) -> float:
     W : float
         Thickness of the central cylinder (band), mm.
     """
-    F = check_positive("force", F, "N")
-    D = check_positive("diameter", D, "mm")
-    t = check_positive("thickness", t, "mm")
-    W = check_positive("band thickness", W, "mm")
+    F = _force(F)
+    D = _length("diameter", D)
+    t = _length("thickness", t)
+    W = _length("band thickness", W)
     _check_convex("eq 2.7 (Pitt 1988)", D, t, W, (0.06, 0.3))
     return 10.0 * F / (math.pi * D * D * _pitt_denominator(D, t, W))
 
@@ -134,7 +146,7 @@ def pitt_convex(F: float, D: float, t: float, W: float) -> float:
 def _check_elongation(name: str, D: float, length: float | None) -> None:
     if length is None:
         return
-    L = check_positive("length", length, "mm")
+    L = _length("length", length)
     if L / D < ELONGATED_RATIO:
         warn(ValidityWarning, f"{name}: length/width = {L / D:.3g} < {ELONGATED_RATIO}; the 2/3 limit is not yet reached")
 
@@ -145,19 +157,19 @@ def pitt_heasley_elongated_flat(F: float, D: float, t: float, length: float | No
     ``D`` is the width (short axis), mm; ``length`` (mm), if given, is checked
     against the ratio ``length/width >= 1.7``.
     """
-    F = check_positive("force", F, "N")
-    D = check_positive("width", D, "mm")
-    t = check_positive("thickness", t, "mm")
+    F = _force(F)
+    D = _length("width", D)
+    t = _length("thickness", t)
     _check_elongation("eq 2.8", D, length)
     return ELONGATED_FACTOR * 2.0 * F / (math.pi * D * t)
 
 
 def pitt_heasley_elongated_convex(F: float, D: float, t: float, W: float, length: float | None = None) -> float:
     """Convex-faced elongated tablet, eq 2.9: 2/3 of eq 2.7 with ``D`` the width (MPa)."""
-    F = check_positive("force", F, "N")
-    D = check_positive("width", D, "mm")
-    t = check_positive("thickness", t, "mm")
-    W = check_positive("band thickness", W, "mm")
+    F = _force(F)
+    D = _length("width", D)
+    t = _length("thickness", t)
+    W = _length("band thickness", W)
     _check_convex("eq 2.9", D, t, W, (0.06, 0.3))
     _check_elongation("eq 2.9", D, length)
     return ELONGATED_FACTOR * 10.0 * F / (math.pi * D * D * _pitt_denominator(D, t, W))
@@ -169,13 +181,13 @@ def podczeck_convex(F: float, D: float, t: float, W: float | None = None, R: flo
     ``W`` (band thickness, mm) and ``R`` (face radius of curvature, mm), when
     given, are checked against the study's range W/D 0.06-0.50, D/R 0.25-1.85.
     """
-    F = check_positive("force", F, "N")
-    D = check_positive("diameter", D, "mm")
-    t = check_positive("thickness", t, "mm")
+    F = _force(F)
+    D = _length("diameter", D)
+    t = _length("thickness", t)
     if W is not None:
-        _check_convex("Podczeck 2013", D, t, check_positive("band thickness", W, "mm"), (0.06, 0.5))
+        _check_convex("Podczeck 2013", D, t, _length("band thickness", W), (0.06, 0.5))
     if R is not None:
-        dr = D / check_positive("face radius", R, "mm")
+        dr = D / _length("face radius", R)
         if not 0.25 <= dr <= 1.85:
             warn(ValidityWarning, f"Podczeck 2013: D/R = {dr:.3g} is outside 0.25-1.85")
     return 2.0 * F / (math.pi * D * t)
@@ -199,7 +211,7 @@ def sphere_hertz(F: float, E: float, nu: float, r_s: float, s_y: float) -> float
     s_y : float
         Micro-yield strength, MPa.
     """
-    F = check_positive("force", F, "N")
+    F = _force(F)
     nu = check_range("nu", nu, -1.0, 0.5, lo_open=True, hi_open=True)
     if nu < 0:
         warn(ValidityWarning, f"eq 2.10: negative Poisson's ratio {nu:g} is outside the granular materials it was derived for")

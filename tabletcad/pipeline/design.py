@@ -322,8 +322,11 @@ class Design:
         a = tab.pop("a", None)
         if a is not None and a != "auto":
             a = _number("tablet.a", a)
-        if family == "free_form":
-            _check_keys("tablet", tab, set())
+        if family == "free_form":  # (family, name and a were taken above: the only keys it has)
+            if tab:
+                k = next(iter(tab))
+                raise DesignError(f"tablet.{k}", tab[k], "allowed keys of tablet for free_form are a, family, name "
+                                  "(the shape is in the [[patch]] tables)")
             tablet = _free_form(self.patch, name, 1.0 if a is None else a)
         elif family == "custom_outline":
             tablet = _custom_outline(tab, name)
