@@ -47,6 +47,13 @@ def test_main_dimensions(pair):
     c = side_profile(capsule(length=18, width=8, band=3, cup_depth=1.2))
     assert not c.round and c.length == pytest.approx(18, abs=1e-6) and c.width == pytest.approx(8, abs=1e-6)
     assert c.band == pytest.approx(3, abs=1e-9) and c.cup_depth == pytest.approx(1.2, abs=1e-6)
+    # a quarter cut-away of the round is as long as wide but no circle: length and width, not "⌀ 5"
+    from dataclasses import replace
+
+    from tabletcad.geometry.tablet import Trim
+
+    q = side_profile(replace(pair[0], trim=Trim(v=(0.0, 0.5 * np.pi))))
+    assert not q.round and q.length == pytest.approx(D / 2, abs=1e-6) and q.width == pytest.approx(D / 2, abs=1e-6)
 
 
 def test_figure_is_to_scale_and_dimensioned(pair):

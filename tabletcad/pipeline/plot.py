@@ -223,6 +223,15 @@ def side_profile(tablet: Tablet, n: int = 121, *, nu: int = 65, nv: int = 257,
     return _side_profile(_as_tablet(tablet), n, nu, nv, grids, None)
 
 
+def _round(tablet: Tablet, ext: np.ndarray, plan: np.ndarray) -> bool:
+    """Whether the plan is dimensioned by a diameter: as long as wide and, for a cut-away, still
+    spanning a diameter (a quarter of a round is as long as wide, no circle: it showed "⌀ 5" on a
+    10 mm tablet; three quarters keep the diameter)."""
+    if abs(ext[0] - ext[1]) > 1e-3 * max(ext[0], ext[1]):
+        return False
+    return tablet.trim.full_v or abs(ext[0] - 2.0 * float(np.max(np.hypot(plan[:, 0], plan[:, 1])))) <= 1e-3 * ext[0]
+
+
 def _side_profile(tablet: Tablet, n: int, nu: int, nv: int, grids: list | None, faces: list | None) -> TabletOutline:
     nominal = tablet.nominal
     band_z = getattr(nominal, "band_z", None)
@@ -290,7 +299,7 @@ def _side_profile(tablet: Tablet, n: int, nu: int, nv: int, grids: list | None, 
         band_z = (lo_, max(lo_, hi_))
     return TabletOutline(x=x, z_low=zl, z_high=zh, plan=plan, band=float(band_z[1] - band_z[0]),
                          thickness=float(ext[2]), cup_depth=max(0.0, top - float(band_z[1])), length=float(ext[0]),
-                         width=float(ext[1]), round=abs(ext[0] - ext[1]) <= 1e-3 * max(ext[0], ext[1]),
+                         width=float(ext[1]), round=_round(tablet, ext, plan),
                          cup_depth_bottom=max(0.0, float(band_z[0]) - bottom), plan_holes=holes, has_band=has_band)
 
 
