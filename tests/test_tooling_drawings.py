@@ -322,3 +322,15 @@ def test_a_flat_face_has_no_cup_dimension():
     ts = make_tooling(load_design(flat), ToolingSpec(), check=False, interference_check=False)
     texts = [d.text for d in drawing_model(ts).dims]
     assert not any(t.startswith("cup") for t in texts) and any(t.startswith("T 3.50") for t in texts), texts
+
+
+def test_texts_the_sheet_font_cannot_draw_are_escaped_not_boxed():
+    """A tablet name (the default title, and the notes' first line) or an emboss text in a font of its own
+    may hold characters DejaVu Sans has no glyph for: matplotlib drew empty boxes; they are written as
+    \\uXXXX, and what the font has is kept."""
+    from tabletcad.tooling.drawing import Drawing
+
+    dr = Drawing(views={}, origins={}, notes=["錠剤10 (concave_round)", "deboss 'Paracétamol'"], title="錠剤10",
+                 title_block=["material: acier"])
+    assert dr.title == "\\u9320\\u526410" and dr.notes == ["\\u9320\\u526410 (concave_round)", "deboss 'Paracétamol'"]
+    assert dr.title_block == ["material: acier"]

@@ -158,8 +158,24 @@ class Drawing:
     scale: float | None = None
     paper: str = "A4"
 
+    def __post_init__(self) -> None:
+        # a tablet's name or an emboss text in a font of its own may hold characters the sheet's font
+        # (DejaVu Sans) has no glyph for: written as \uXXXX, not drawn as empty boxes
+        self.title = drawable(self.title)
+        self.notes = [drawable(n) for n in self.notes]
+        self.title_block = [drawable(t) for t in self.title_block]
+
     def texts(self) -> list[str]:
         return [d.text for d in self.dims] + list(self.notes)
+
+
+def drawable(text: str) -> str:
+    """``text`` with every character the drawings' font cannot draw written as ``\\uXXXX``."""
+    from tabletcad.tooling.spec import drawing_font, missing_glyphs
+
+    for c in missing_glyphs(text, drawing_font()):
+        text = text.replace(c, f"\\u{ord(c):04x}" if ord(c) <= 0xFFFF else f"\\U{ord(c):08x}")
+    return text
 
 
 def _fmt(x: float) -> str:

@@ -110,7 +110,7 @@ def relief_volume(frame: TabletFrame, b: PunchBody, clearance: float, tip_length
 def check_body_fits(frame: TabletFrame, b: PunchBody, tip_radius: float) -> None:
     """DesignError when the punch tip (the tablet's outline less the clearance, reaching ``tip_radius``
     mm from the axis) does not fit the barrel it is machined from, or the tablet exceeds the standard's
-    largest tablet (a 19 mm capsule on B tooling, whose barrel is 19 mm, fits with any clearance)."""
+    largest tablet (a 19 mm capsule on B tooling, whose barrel is 19 mm, fits with a clearance)."""
     if tip_radius >= 0.5 * b.barrel_diameter_mm:
         raise DesignError("[tooling.punch] barrel_diameter_mm", b.barrel_diameter_mm,
                           f"must be > the punch tip's circumscribed diameter {2 * tip_radius:.4g} mm (the tablet's "

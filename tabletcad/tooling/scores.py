@@ -124,12 +124,24 @@ def check_score(frame: TabletFrame, s: ScoreSpec, i: int = 0) -> None:
                               "(a standard score runs out on the face; set cut_through = true to cut the band)", "mm")
     room = 0.5 * min(frame.length, frame.width)
     if groove_width(s) >= room:  # (a depth within its bounds): a V of 179.9 deg was a 687 mm wide "score"
-        key = {"v": "angle_deg", "u": "width_mm", "pressure_sensitive": "slot_width_mm"}[s.profile]
-        raise DesignError(f"[[tooling.score]] {i} {key}", getattr(s, key),
-                          f"makes the groove {groove_width(s):.4g} mm wide at the face: it must be narrower than half "
-                          f"the tablet's width, {room:.4g} mm", "deg" if key == "angle_deg" else "mm")
+        _refuse_wide(s, i, room)
     if s.length_mm is not None:
         _check_short(frame, s, i)
+
+
+def _refuse_wide(s: ScoreSpec, i: int, room: float) -> None:
+    """DesignError naming what makes the groove at least ``room`` mm wide at the face, with its own limit:
+    a U's width, a V's angle, a pressure-sensitive groove's slot (when it alone is too wide) or angle."""
+    w = f"[[tooling.score]] {i}"
+    flank = {"v": s.depth_mm, "pressure_sensitive": 2.0 * s.depth_mm / 3.0}.get(s.profile)  # a flank's depth
+    if s.profile == "u" or (s.profile == "pressure_sensitive" and s.slot_width_mm >= room):
+        key = "width_mm" if s.profile == "u" else "slot_width_mm"
+        raise DesignError(f"{w} {key}", getattr(s, key), f"must be < {room:.4g} mm, half the tablet's width (the "
+                          "groove's width at the face)", "mm")
+    slot = s.slot_width_mm if s.profile == "pressure_sensitive" else 0.0
+    most = 2.0 * math.degrees(math.atan(0.5 * (room - slot) / flank))
+    raise DesignError(f"{w} angle_deg", s.angle_deg, f"must be < {most:.4g} deg: the groove, {groove_width(s):.4g} mm "
+                      f"wide at the face, must be narrower than half the tablet's width, {room:.4g} mm", "deg")
 
 
 def score_cutter(frame: TabletFrame, s: ScoreSpec, face: str):

@@ -259,7 +259,7 @@ def missing_glyphs(text: str, path: str | Path, where: str = "[[tooling.emboss]]
     return "".join(dict.fromkeys(c for c in text if c != " " and ord(c) not in cmap))
 
 
-def _drawing_font() -> str:
+def drawing_font() -> str:
     """The drawings' font file (matplotlib's DejaVu Sans)."""
     from matplotlib import font_manager
 
@@ -279,7 +279,7 @@ def _drawing(t: Any) -> DrawingSpec:
                 raise DesignError(f"{w} {k}", v, "must be printable text on one line (no control characters)")
             if len(str(v)) > TITLE_MAX_CHARS[k]:
                 raise DesignError(f"{w} {k}", v, f"must be at most {TITLE_MAX_CHARS[k]} characters (the title block's room)")
-            missing = missing_glyphs(str(v), _drawing_font())
+            missing = missing_glyphs(str(v), drawing_font())
             if missing:
                 raise DesignError(f"{w} {k}", v, f"has characters the drawings' font (DejaVu Sans) cannot draw: {missing!r}")
             kw[k] = str(v)

@@ -118,8 +118,9 @@ def make_lower_punch(doc, tablet, length=None, recompute=True, clearance=None):
     return _punch(doc, tablet, "lower", length, clearance, recompute)
 
 
-def make_die(doc, tablet, height=None, outer_diameter=None, recompute=True):
-    """Die linked to ``tablet``: cylinder minus the bore (the tablet's outline).  Without
+def make_die(doc, tablet, *, height=None, outer_diameter=None, recompute=True):
+    """Die linked to ``tablet``: cylinder minus the bore (the tablet's outline); keywords only (the
+    clearance that came third is the punches' now: an old positional call is a TypeError).  Without
     ``outer_diameter``, the TSM die for the tablet's size, as ``tabletcad build`` takes it (B,
     30.16 x 22.22 mm, up to 16 mm; D, 38.10 x 23.81 mm, up to 25.4 mm)."""
     if outer_diameter is None:  # (an outer diameter given alone keeps the 22.22 mm height, as build does)
@@ -179,7 +180,8 @@ def make_tooling(doc, tablet, recompute=True, **kw):
             f"{Path(tablet.DesignFile).name} are built by `tabletcad build` only\n")
     up = make_upper_punch(doc, tablet, values.get("length"), False, values.get("clearance"))
     low = make_lower_punch(doc, tablet, values.get("lower_length", values.get("length")), False, values.get("clearance"))
-    die = make_die(doc, tablet, values.get("die_height"), values.get("die_outer_diameter"), recompute=False)
+    die = make_die(doc, tablet, height=values.get("die_height"), outer_diameter=values.get("die_outer_diameter"),
+                   recompute=False)
     if recompute:
         doc.recompute()
     return up, low, die
