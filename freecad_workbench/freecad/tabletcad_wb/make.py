@@ -94,6 +94,11 @@ def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, reco
 
 
 def _punch(doc, tablet, which, length, clearance, recompute):
+    if length is None or clearance is None:  # the design file's [tooling] table, as build reads it
+        values = design_tooling(tablet)[0]
+        if length is None:
+            length = values.get("lower_length", values.get("length")) if which == "lower" else values.get("length")
+        clearance = values.get("clearance") if clearance is None else clearance
     obj = _new(doc, "UpperPunch" if which == "upper" else "LowerPunch")
     objects.PunchProxy(obj, tablet, which)
     if length is not None:
@@ -109,7 +114,8 @@ def _punch(doc, tablet, which, length, clearance, recompute):
 
 def make_upper_punch(doc, tablet, length=None, recompute=True, clearance=None):
     """Upper punch tip linked to ``tablet``: the prism above the upper band edge, inside the outline
-    by ``clearance`` (default 0.025 mm), minus the tablet."""
+    by ``clearance``, minus the tablet.  ``length`` and ``clearance`` not given come from the
+    ``[tooling]`` table of the tablet's design file, else the defaults (10 mm, 0.025 mm)."""
     return _punch(doc, tablet, "upper", length, clearance, recompute)
 
 
@@ -122,7 +128,11 @@ def make_die(doc, tablet, *, height=None, outer_diameter=None, recompute=True):
     """Die linked to ``tablet``: cylinder minus the bore (the tablet's outline); keywords only (the
     clearance that came third is the punches' now: an old positional call is a TypeError).  Without
     ``outer_diameter``, the TSM die for the tablet's size, as ``tabletcad build`` takes it (B,
-    30.16 x 22.22 mm, up to 16 mm; D, 38.10 x 23.81 mm, up to 25.4 mm)."""
+    30.16 x 22.22 mm, up to 16 mm; D, 38.10 x 23.81 mm, up to 25.4 mm); neither given, the design
+    file's ``[tooling]`` table first."""
+    if outer_diameter is None and height is None:  # the design file's [tooling] table, as build reads it
+        values = design_tooling(tablet)[0]
+        height, outer_diameter = values.get("die_height"), values.get("die_outer_diameter")
     if outer_diameter is None:  # (an outer diameter given alone keeps the 22.22 mm height, as build does)
         from tabletcad.tooling.spec import standard_die_size
 
