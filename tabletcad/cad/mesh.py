@@ -175,7 +175,7 @@ def _manifold_check(V: np.ndarray, T: np.ndarray) -> tuple[str, Any, Any]:
 
 def _edge_check(T: np.ndarray) -> tuple[bool, bool]:
     """``(watertight, winding_consistent)`` of the triangles ``T`` from their edges alone (trimesh's
-    definitions, without importing trimesh, 0.6-0.8 s): watertight when every edge is shared by exactly
+    definitions, without building a trimesh object): watertight when every edge is shared by exactly
     two triangles, consistent when each such pair runs it in opposite directions (no directed edge twice)."""
     T = np.asarray(T, dtype=np.int64)
     if not len(T):

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -247,11 +247,9 @@ def _open_end(tablet: Tablet) -> str | None:
     return None
 
 
-def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any], run: Callable[[Callable[[], Any]], Any] | None = None):
+def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any]):
     """Write ``tablet.step``, ``tablet.stl`` and ``tablet.glb`` into ``out`` and extend ``report``.
 
-    ``run(work)``: how the GLB writer runs (default: here, now); a parallel build passes one that forks
-    it (its trimesh import, 0.6-0.8 s, then leaves this process's path).
     Returns the ``TopoDS_Shape`` written (the solid, or its cut-away), or None when no solid
     is built (a cut-away of a kind the CAD layer does not make: the report says why).
     """
@@ -281,7 +279,7 @@ def cad_stage(*, tablet: Tablet, out: Path, report: dict[str, Any], run: Callabl
     export(shape, out / "tablet.step", name=tablet.name)
     if mesh is not None:  # a cut-away whose tessellation failed its checks writes the STEP only
         export(shape, out / "tablet.stl", name=tablet.name, mesh=mesh)
-        (run or (lambda work: work()))(lambda: export(shape, out / "tablet.glb", name=tablet.name, mesh=mesh))
+        export(shape, out / "tablet.glb", name=tablet.name, mesh=mesh)
     sections["brep"]["export_seconds"] = time.perf_counter() - t0
     report.update(sections)
     return shape

@@ -86,26 +86,15 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
                 contextlib.ExitStack() as helpers:
             report = geometry_report(tablet, options)
             bar.update()
-            forks = parallel and can_fork()
             # the picture needs only the tablet: drawn by a forked process beside the CAD stage
-            picture = helpers.enter_context(Forked(lambda: plot_tablet(tablet, staging / "tablet.png"))) if forks else None
-            writers: list[Forked] = []  # the CAD stage's GLB writer, beside the rest when forks
+            picture = (helpers.enter_context(Forked(lambda: plot_tablet(tablet, staging / "tablet.png")))
+                       if parallel and can_fork() else None)
             if cad:
                 from tabletcad.cad.stage import cad_stage
 
-                # a scored or embossed tablet's tooling stage writes the finished tablet over tablet.glb (and
-                # imports trimesh for it): the CAD stage's writer then runs here, before it
-                replaced = tooling is not None and bool(tooling.scores or tooling.emboss)
-
-                def run(work):
-                    if forks and not replaced:
-                        writers.append(helpers.enter_context(Forked(work)))
-                    else:
-                        work()
-
                 # a tooling build converts faces of revolution to rational B-splines
                 # (see tabletcad.tooling.outline.tablet_frame)
-                shape = cad_stage(tablet=tablet, out=staging, report=report, run=run)
+                shape = cad_stage(tablet=tablet, out=staging, report=report)
                 bar.update()
                 if tooling is not None:
                     from tabletcad.tooling.stage import tooling_stage
@@ -122,8 +111,6 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
                 else:
                     report["fe_breaking_force"] = {"breaking_force_N": None,
                                                    "note": "not computed: this build made no CAD solid"}
-            for w in writers:
-                w.result()
             if picture is None:
                 plot_tablet(tablet, staging / "tablet.png")
             else:
