@@ -171,10 +171,34 @@ def wire_length(wire) -> float:
     return p.Mass()
 
 
+#: wires smaller than this (mm, bounding-box diagonal) are offset at this size and scaled back: OCCT
+#: 7.9's planar offset crashed the process (SIGSEGV) offsetting a 1 mm circle inward by 0.02 mm (a
+#: 2 mm mini-tablet's punch tip), where a 10 mm circle by 0.2 mm works; the similarity is exact
+OFFSET_MIN_SIZE_MM = 10.0
+
+
+def _scaled(shape, factor: float):
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Transform
+    from OCP.gp import gp_Pnt, gp_Trsf
+
+    tr = gp_Trsf()
+    tr.SetScale(gp_Pnt(0.0, 0.0, 0.0), float(factor))
+    return BRepBuilderAPI_Transform(shape, tr, True).Shape()
+
+
 def offset_wire(wire, distance: float) -> Any:
     """The planar closed ``wire`` offset by ``distance`` mm (> 0 outward, arcs at corners)."""
     if distance == 0.0:
         return wire
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    box = Bnd_Box()
+    BRepBndLib.Add_s(wire, box)
+    size = box.CornerMin().Distance(box.CornerMax())
+    if size < OFFSET_MIN_SIZE_MM:  # offset a similar copy of the size OCCT handles, then scale it back
+        k = OFFSET_MIN_SIZE_MM / max(size, 1e-9)
+        return cast(_scaled(offset_wire(cast(_scaled(wire, k), "Wire"), k * distance), 1.0 / k), "Wire")
     face = plan_face(wire)
     mk = BRepOffsetAPI_MakeOffset(face, GeomAbs_JoinType.GeomAbs_Arc)
     mk.Perform(float(distance))
