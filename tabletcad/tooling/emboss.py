@@ -126,7 +126,8 @@ def svg_faces(path: str, height: float, where: str = "[[tooling.emboss]] svg") -
     try:
         faces = [s for s in bd.import_svg(path, align=None) if isinstance(s, bd.Face)]
     except (ValueError, TypeError, KeyError, IndexError, AttributeError, SyntaxError) as exc:  # the file's content
-        raise DesignError(where, path, f"must be an SVG file whose paths can be read ({type(exc).__name__}: {exc})") from None
+        why = " ".join(str(exc).split())[:200]  # the library's text, on one line
+        raise DesignError(where, path, f"must be an SVG file whose paths can be read ({type(exc).__name__}: {why})") from None
     if not faces:
         raise DesignError(where, path, "has no filled outline (closed, filled path) to emboss")
     comp = bd.Compound(faces).wrapped
