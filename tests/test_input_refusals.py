@@ -109,7 +109,7 @@ def test_solve_for_needs_every_dimension_of_a_named_family():
     (["strength", "pitt", "--force", "100", "--thickness", "4.6", "--band", "1"],
      "error: --diameter = 'missing' is not allowed: is required for method 'pitt'"),
     (["strength", "elongated-convex", "--force", "100", "--diameter", "0", "--thickness", "4", "--band", "1"],
-     "error: --diameter = 0 mm is not allowed: must be > 0"),
+     "error: --diameter = 0 mm is not allowed: must be >= 0.001 and <= 1000 mm"),
 ])
 def test_strength_options_named_as_given(capsys, args, line):
     assert main(args) == 2
