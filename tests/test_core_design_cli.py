@@ -313,3 +313,17 @@ def test_a_free_form_tablet_table_names_its_keys(tmp_path, capsys):
     assert main(["report", str(d)]) == 2
     assert capsys.readouterr().err.strip() == ("error: tablet.diameter = 3 is not allowed: allowed keys of tablet for "
                                                "free_form are a, family, name (the shape is in the [[patch]] tables)")
+
+
+def test_a_unit_for_a_column_the_record_lacks_is_refused(capsys):
+    """``heckel --time-unit ms`` on a record with no time column was ignored without a word (the README
+    promises that options a method does not read are refused)."""
+    from tabletcad.cli import main
+
+    press = Path(__file__).resolve().parents[1] / "samples" / "press"
+    args = ["heckel", str(press / "lactose_appendix_b.csv"), "--meta", str(press / "lactose_appendix_b.toml")]
+    assert main(args + ["--time-unit", "ms"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: --time-unit = 'ms' is not allowed: is for a time column, which "
+                          "lactose_appendix_b.csv has none of (columns: force_N, displacement_mm,"), err
+    assert main(args + ["--force-unit", "N"]) == 0  # a unit for a column it has is read

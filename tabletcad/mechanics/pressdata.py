@@ -553,6 +553,12 @@ def read_press_data(
         pos_role = "thickness"
     else:
         raise DesignError("columns", header, "need a displacement or thickness column")
+    for r in option_units:  # a unit for a column the record does not have would be ignored without a word
+        role = r if r != "displacement" else pos_role
+        if role not in roles:
+            shown = ", ".join(header[:8]) + (", ..." if len(header) > 8 else "")
+            raise DesignError(f"--{r}-unit", units[r], f"is for a {r} column, which {path.name} has none of "
+                              f"(columns: {shown})")
     factors: dict[int, tuple[float, int | None]] = {}
     for r in ("force", pos_role, "time"):
         if r not in roles:
