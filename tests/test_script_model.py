@@ -284,3 +284,15 @@ def test_a_cut_away_has_the_same_solid_from_python_as_from_build(tmp_path, desig
         back = trimesh.load(m.export(tmp_path / f"cut{suffix}"), force="mesh")
         scale = 1e3 if suffix == ".glb" else 1.0  # glTF is in metres
         assert back.is_watertight and back.volume * scale**3 == pytest.approx(m.volume, abs=0.005 * m.tablet.surface_area())
+
+
+def test_exporting_onto_a_folder_names_the_folder(tmp_path):
+    """``.export(folder)`` raised IsADirectoryError naming a temporary file, after the work."""
+    from tabletcad.errors import DesignError
+
+    (tmp_path / "x.step").mkdir()
+    m = tabletcad.load(ROOT / "samples" / "families" / "concave_round.toml")
+    with pytest.raises(DesignError) as e:
+        m.export(tmp_path / "x.step")
+    assert e.value.parameter == "path" and "is a folder" in str(e.value) and str(tmp_path / "x.step") in str(e.value)
+    assert [p.name for p in tmp_path.iterdir()] == ["x.step"] and not any((tmp_path / "x.step").iterdir())
