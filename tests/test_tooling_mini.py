@@ -38,3 +38,35 @@ def test_a_two_millimetre_round_gets_its_tooling():
     assert up["tip_plan_area_mm2"] == pytest.approx(math.pi * 0.98**2, rel=1e-9)
     # the tip: its cylinder minus the cup within it (the quadrature of the plain tip)
     assert up["volume_mm3"] == pytest.approx(up["volume_quadrature_mm3"], rel=1e-7)
+
+
+def test_a_figure_across_a_score_is_warned_of():
+    """Letters across a bisect are cut in two when the tablet is split and pick at the groove's edge (a
+    trade rule): a warning names the figure and the score; none for a figure clear of the groove or on
+    the other face."""
+    import warnings
+
+    from tabletcad.cad.tablet_solid import tablet_solid
+    from tabletcad.tooling.emboss import check_emboss
+    from tabletcad.tooling.outline import tablet_frame
+    from tabletcad.tooling.spec import EmbossSpec, ScoreSpec, ToolingSpec
+    from tabletcad.tooling.toolset import _warn_crossings
+
+    d = Design.from_dict({"tablet": {"family": "concave_round", "diameter": 10.0, "band": 2.8, "cup_depth": 0.9,
+                                     "land": 0.08}})
+    t = d.build()
+    frame = tablet_frame(t, tablet_solid(t).shape)
+    score = ScoreSpec(depth_mm=0.3, direction_deg=0.0)  # along x: the groove is |y| < 0.3 mm at the face
+
+    def crossings(**kw):
+        e = EmbossSpec(text="AB", height_mm=1.5, depth_mm=0.1, **kw)
+        spec = ToolingSpec(clearance_mm=0.02, scores=(score,), emboss=(e,))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            _warn_crossings(frame, spec, [check_emboss(frame, e, 0.02, 0)])
+        return [str(w.message) for w in caught]
+
+    (msg,) = crossings()
+    assert msg.startswith("emboss 0 ('AB') crosses score 0 on the top face")
+    assert crossings(position_mm=(0.0, 2.5)) == []  # clear of the groove
+    assert crossings(face="bottom") == []  # the score is on the top face

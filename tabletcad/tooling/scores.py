@@ -144,6 +144,22 @@ def _refuse_wide(s: ScoreSpec, i: int, room: float) -> None:
                       f"wide at the face, must be narrower than half the tablet's width, {room:.4g} mm", "deg")
 
 
+def score_footprints(frame: TabletFrame, s: ScoreSpec) -> list:
+    """Plan faces (z = 0) of the score's grooves at the face: each its width at the face (:func:`groove_width`)
+    across and its length along (a full score: across the whole tablet); two for a quadrisect."""
+    from tabletcad.tooling.outline import plan_face, polyline_wire
+
+    length = 2.0 * max(frame.length, frame.width) + 4.0 if s.length_mm is None else s.length_mm
+    a, b = 0.5 * length, 0.5 * groove_width(s)
+    out = []
+    for deg in (s.direction_deg,) if s.kind == "bisect" else (s.direction_deg, s.direction_deg + 90.0):
+        th = math.radians(deg)
+        d, n = (math.cos(th), math.sin(th)), (-math.sin(th), math.cos(th))
+        out.append(plan_face(polyline_wire([(sa * a * d[0] + sb * b * n[0], sa * a * d[1] + sb * b * n[1])
+                                            for sa, sb in ((-1, -1), (1, -1), (1, 1), (-1, 1))])))
+    return out
+
+
 def score_cutter(frame: TabletFrame, s: ScoreSpec, face: str):
     """The solid removed by score ``s`` on ``face`` (one groove, or two fused for a quadrisect)."""
     length = 2.0 * max(frame.length, frame.width) + 4.0 if s.length_mm is None else s.length_mm

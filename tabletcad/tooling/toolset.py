@@ -84,6 +84,35 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
                           f"closed position (the barrel stays out of the die)", "mm")
 
 
+def _warn_crossings(frame, spec: ToolingSpec, emb_checked: list) -> None:
+    """One warning for each embossed figure that crosses a score groove on its face: the letters are cut
+    in two when the tablet is split, and the narrow land between groove and stroke picks and sticks.
+    Checked in plan, on the figure's faces and the groove's width at the face
+    (:func:`~tabletcad.tooling.scores.score_footprints`), before any Boolean.
+    """
+    if not (spec.scores and spec.emboss):
+        return
+    import warnings
+
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.outline import face_area
+    from tabletcad.tooling.scores import score_footprints
+
+    feet = [(j, s, score_footprints(frame, s)) for j, s in enumerate(spec.scores)]
+    for i, (e, (figure, _)) in enumerate(zip(spec.emboss, emb_checked)):
+        for j, s, footprints in feet:
+            if e.face not in s.face_list:
+                continue
+            shared = sum(face_area(f) for fp in footprints for f in explore(BRepAlgoAPI_Common(figure, fp).Shape(), "Face"))
+            if shared > 1e-6:
+                what = repr(e.text) if e.text is not None else "svg" if e.svg is not None else "outline"
+                warnings.warn(f"emboss {i} ({what}) crosses score {j} on the {e.face} face ({shared:.3g} mm^2 of it "
+                              "lies in the groove): it is cut in two when the tablet is split and picks at the "
+                              "groove's edge; move it (position_mm) or make it smaller", stacklevel=3)
+
+
 def _warn_sharp_edge(frame, clearance: float) -> None:
     """One warning when cupped punch tips have no land: the tablet's land (0 without one) is narrower than
     the clearance (or equal to it), so the tip's outline meets the cup surface and the cup runs into the
@@ -168,6 +197,7 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     for i, s in enumerate(spec.scores):  # fail on bad input before any Boolean
         check_score(frame, s, i)
     emb_checked = [check_emboss(frame, e, spec.clearance_mm, i) for i, e in enumerate(spec.emboss)]
+    _warn_crossings(frame, spec, emb_checked)
     _warn_sharp_edge(frame, spec.clearance_mm)
     if spec.body is not None:
         _check_complete_punches(frame, spec)
