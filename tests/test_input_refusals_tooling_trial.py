@@ -93,6 +93,9 @@ def test_punch_body_values_are_named(capsys, tmp_path, punch, parameter):
     name, why = _refused(capsys, tmp_path, design)
     assert name == f"tooling.punch.{parameter}"
     assert ("leaves no barrel" in why) == parameter.endswith("angle_deg")
+    if parameter.endswith("angle_deg"):  # with the angle's own bound: its head then just fills the punch
+        bound = float(why.split("must be < ")[1].split(" deg")[0])
+        assert 80.0 < bound < 89.9
 
 
 def test_a_head_that_leaves_a_barrel_is_accepted():
@@ -178,3 +181,20 @@ def test_an_optimise_variable_is_named_by_its_table(capsys, tmp_path):
     err = capsys.readouterr().err.strip()
     assert err.startswith("error: variables.diameter.initial = 20 mm is not allowed: must lie within [7, 11]"), err
     assert not (tmp_path / "out").exists()
+
+
+def test_the_head_angle_bound_is_where_the_barrel_ends():
+    """The bound "leaves no barrel" gives for head_top_angle_deg is exact: just below it a barrel is left
+    (the tip length, not the head, then limits the punch); at it the neck and head fill the punch."""
+    table = {"head_diameter_mm": 25.4, "head_flat_diameter_mm": 12.0, "head_rim_mm": 2.5, "neck_diameter_mm": 12.7,
+             "neck_length_mm": 12.0, "tip_straight_mm": 4.0, "tip_relief_mm": 0.1, "head_top_angle_deg": 89.999}
+    with pytest.raises(DesignError) as e:
+        resolve_body("TSM", "B", table, 8.0, 8.0)
+    bound = float(str(e.value).split("must be < ")[1].split(" deg")[0])
+    for angle, barrel in ((bound - 0.01, True), (bound + 0.01, False)):
+        try:
+            resolve_body("TSM", "B", dict(table, head_top_angle_deg=angle), 1e-3, 1e-3)
+            left = True
+        except DesignError as err:
+            left = "leaves no barrel" not in str(err)
+        assert left == barrel, angle

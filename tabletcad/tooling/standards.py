@@ -196,8 +196,12 @@ def resolve_body(standard: str, kind: str | None, table: Any, tip_length: float,
              ("head_top_angle_deg" if head == "angled" else "dome_radius_mm"): body.head_top_mm}
     if Ln + body.head_height_mm >= L:  # no barrel left: name the longest of neck and head's parts
         k = max(parts, key=parts.get)
+        rest = L - (Ln + body.head_height_mm - parts[k])  # what the named part may take at most
+        run = {"inside_head_angle_deg": 0.5 * (Dh - Dn), "head_top_angle_deg": 0.5 * (Dh - Df)}.get(k)
+        bound = (f"must be < {math.degrees(math.atan(rest / run)):.4g} deg: " if run and rest > 0
+                 else f"must be < {rest:.4g} mm: " if k in ("neck_length_mm", "head_rim_mm") and rest > 0 else "")
         raise DesignError(f"{w} {k}", t.get(k, entry.get(k, {}).get("value")),
-                          f"leaves no barrel: the neck and head ({parts[k]:.4g} mm of it from {k}) take "
+                          f"{bound}leaves no barrel: the neck and head ({parts[k]:.4g} mm of it from {k}) take "
                           f"{Ln + body.head_height_mm:.4g} mm of the {L:.4g} mm punch",
                           "deg" if k.endswith("_deg") else "mm")
     for name, tl in (("tip_length_mm", tip_length), ("lower_tip_length_mm", lower_tip_length)):
