@@ -110,6 +110,11 @@ def test_solve_for_needs_every_dimension_of_a_named_family():
      "error: --diameter = 'missing' is not allowed: is required for method 'pitt'"),
     (["strength", "elongated-convex", "--force", "100", "--diameter", "0", "--thickness", "4", "--band", "1"],
      "error: --diameter = 0 mm is not allowed: must be >= 0.001 and <= 1000 mm"),
+    # an infinite strength was printed with exit 0; a 1e-9 mm tablet only warned (1.6e10 MPa)
+    (["strength", "diametral", "--force", "1e308", "--diameter", "10", "--thickness", "4"],
+     "error: --force = 1e+308 N is not allowed: must be > 0 and <= 1e+09 N"),
+    (["strength", "diametral", "--force", "100", "--diameter", "1e-9", "--thickness", "4"],
+     "error: --diameter = 1e-09 mm is not allowed: must be >= 0.001 and <= 1000 mm"),
 ])
 def test_strength_options_named_as_given(capsys, args, line):
     assert main(args) == 2

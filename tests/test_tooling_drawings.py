@@ -238,14 +238,21 @@ def test_the_longest_title_block_texts_stay_on_the_sheet_and_apart(drawn, sheet)
         fig.canvas.draw()
         renderer = fig.canvas.get_renderer()
         assert any(t.get_text().startswith("W" * TITLE_MAX_CHARS["name"]) for t in fig.texts)  # whole, not cut
-        boxes = [t.get_window_extent(renderer) for t in fig.texts if t.get_text()]
-        for bb in boxes:
-            assert fig.bbox.x0 <= bb.x0 and bb.x1 <= fig.bbox.x1 and fig.bbox.y0 <= bb.y0 and bb.y1 <= fig.bbox.y1
-        for k, a in enumerate(boxes):
-            for b in boxes[k + 1:]:
-                assert not a.overlaps(b)
+        _texts_inside_and_apart(fig, renderer, vertically=True)
     finally:
         plt.close(fig)
+
+
+def _texts_inside_and_apart(fig, renderer, vertically: bool) -> None:
+    """Every figure-level text inside the sheet (across, and up and down when ``vertically``) and no two
+    of them overlapping."""
+    boxes = [t.get_window_extent(renderer) for t in fig.texts if t.get_text()]
+    for bb in boxes:
+        assert fig.bbox.x0 <= bb.x0 and bb.x1 <= fig.bbox.x1
+        assert not vertically or (fig.bbox.y0 <= bb.y0 and bb.y1 <= fig.bbox.y1)
+    for k, a in enumerate(boxes):
+        for b in boxes[k + 1:]:
+            assert not a.overlaps(b)
 
 
 @pytest.mark.parametrize("key, value, fragment", [
@@ -282,12 +289,7 @@ def test_a_tablet_name_of_200_characters_is_cut_to_the_room_beside_the_title_blo
         renderer = fig.canvas.get_renderer()
         title = next(t for t in fig.texts if t.get_text().startswith("WWW"))
         assert title.get_text().endswith("…") and 20 < len(title.get_text()) < 200
-        boxes = [t.get_window_extent(renderer) for t in fig.texts if t.get_text()]
-        for bb in boxes:
-            assert fig.bbox.x0 <= bb.x0 and bb.x1 <= fig.bbox.x1
-        for k, a in enumerate(boxes):
-            for b in boxes[k + 1:]:
-                assert not a.overlaps(b)
+        _texts_inside_and_apart(fig, renderer, vertically=False)
     finally:
         plt.close(fig)
 
