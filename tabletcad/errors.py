@@ -20,6 +20,7 @@ __all__ = [
     "check_finite",
     "check_positive",
     "check_range",
+    "is_number",
     "one_token",
     "reraise_interrupt",
 ]
@@ -59,7 +60,7 @@ class DesignError(TabletcadError, ValueError):
         self.allowed = allowed
         self.unit = unit
         shown = _fmt(value)
-        if unit and not isinstance(value, (str, bool)):  # not after a string ('10 mm') or true/false
+        if unit and is_number(value) and not shown.startswith("an integer of"):  # not after text ('10 mm'), true/false, a list or None
             shown = f"{shown} {unit}"
         super().__init__(f"{self.parameter} = {shown} is not allowed: {allowed}")
 
@@ -137,6 +138,16 @@ def one_token(parameter: str) -> str:
             out.append(w.lstrip(".") if out else w)
         i += 1
     return ".".join(out) or "?"
+
+
+def is_number(value: Any) -> bool:
+    """Whether ``value`` is a real number that a unit can follow (an int, float, numpy scalar,
+    ``Fraction`` or ``Decimal``; never a boolean)."""
+    import decimal
+    import numbers
+
+    return isinstance(value, (numbers.Real, decimal.Decimal)) and not isinstance(value, bool) and \
+        type(value).__name__ != "bool_"
 
 
 def _fmt(value: Any) -> str:

@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from tabletcad.geometry.curves import Circle, Curve, Ellipse, PointCurve, RoundedRectangle, Stadium
-from tabletcad.errors import DesignError, check_finite, one_token
+from tabletcad.errors import DesignError, check_finite, is_number, one_token
 from tabletcad.geometry.patch import PDEPatch
 from tabletcad.families import FAMILIES, RENAMED
 from tabletcad.families import family as lookup_family
@@ -108,7 +108,7 @@ def _number(where: str, value: Any, unit: str = "", *, tol: Tolerances = DEFAULT
     (not a ``coordinate``) is 0 or at least ``tol.min_length``."""
     if isinstance(value, bool):
         raise DesignError(where, value, "must be a number (true and false are not numbers)", unit)
-    if not isinstance(value, (int, float)):
+    if not is_number(value):  # an int, float, numpy scalar, Fraction or Decimal
         auto = where.split(".")[-1] == "a"  # the smoothing parameter also takes "auto"
         raise DesignError(where, value, 'must be a number or "auto"' if auto else "must be a number", unit)
     x = check_finite(where, value, unit)

@@ -1,0 +1,54 @@
+"""Numbers of every numeric type a script may hold are numbers; a unit follows only a number.
+
+A scripting user passes numpy scalars (an element of an array), ``Fraction`` or ``Decimal``: each is
+the number it equals (the tablet is the same as with the float).  A value that is no number is
+shown as given, without the unit (``None``, ``[10]``, text), in the one-line error.  Core only.
+"""
+
+from __future__ import annotations
+
+import decimal
+import fractions
+
+import numpy as np
+import pytest
+
+from tabletcad.errors import DesignError, is_number
+from tabletcad.pipeline.design import Design
+
+
+def _design(diameter):
+    return Design.from_dict({"tablet": {"family": "concave_round", "diameter": diameter, "band": 2.8,
+                                        "cup_depth": 0.9}})
+
+
+@pytest.mark.parametrize("value", [np.int64(10), np.int32(10), np.float64(10.0), np.float32(10.0),
+                                   fractions.Fraction(10), decimal.Decimal("10"), decimal.Decimal("10.000")])
+def test_numeric_types_give_the_tablet_of_the_float(value):
+    a = _design(value).build()
+    b = _design(10.0).build()
+    assert a.volume() == pytest.approx(b.volume(), rel=1e-15, abs=0.0)
+    assert a.dimensions()["length_mm"] == b.dimensions()["length_mm"]
+
+
+@pytest.mark.parametrize("value, message", [
+    (None, "tablet.diameter = None is not allowed: must be a number"),
+    ([10], "tablet.diameter = [10] is not allowed: must be a number"),
+    ("ten", "tablet.diameter = 'ten' is not allowed: must be a number"),
+    ({"v": 10}, "tablet.diameter = {'v': 10} is not allowed: must be a number"),
+    (np.True_, "tablet.diameter = True is not allowed: must be a number"),
+    (True, "tablet.diameter = true is not allowed: must be a number (true and false are not numbers)"),
+    (float("nan"), "tablet.diameter = nan mm is not allowed: must be a finite number"),
+    (decimal.Decimal("Infinity"), "tablet.diameter = Infinity mm is not allowed: must be a finite number"),
+    (10**400, "tablet.diameter = an integer of 401 digits is not allowed: must be a finite number"),
+    (-1, "tablet.diameter = -1 mm is not allowed: must be > 0"),
+])
+def test_the_unit_follows_only_a_number(value, message):
+    with pytest.raises(DesignError) as e:
+        _design(value).build()
+    assert str(e.value) == message
+
+
+def test_is_number():
+    assert all(map(is_number, [0, 1.5, np.float16(1), np.uint8(3), fractions.Fraction(1, 3), decimal.Decimal("2")]))
+    assert not any(map(is_number, [True, np.bool_(False), "1", b"1", None, [1], np.array([1.0]), 1j]))
