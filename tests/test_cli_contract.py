@@ -312,6 +312,35 @@ def test_a_ctrl_c_that_a_library_swallowed_is_still_an_interruption(tmp_path):
     assert os.listdir(tmp_path) == []
 
 
+_EXIT_HANDLERS = """
+import atexit, sys
+from tabletcad.cli import main
+
+out = sys.argv[1]
+atexit.register(lambda: open(out, "w").write("ran"))  # a library's exit handler
+sys.argv = ["tabletcad"] + sys.argv[2:]
+sys.exit(main())
+"""
+
+
+@pytest.mark.parametrize("args, status", [(["report", "samples/spherical.toml"], 0),
+                                          (["report", "samples/spherical.toml", "--solid-fraction", "2"], 2),
+                                          (["report", "no_such_file.toml"], 2)])
+def test_the_program_ends_with_its_status_after_the_exit_handlers(tmp_path, args, status):
+    """The program ends without tearing its objects down one by one (``cli._finish``), but after the
+    exit handlers that libraries registered, with the command's status and its output flushed."""
+    flag = tmp_path / "flag"
+    p = subprocess.run([sys.executable, "-c", _EXIT_HANDLERS, str(flag), *args], cwd=ROOT,
+                       env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True, text=True, timeout=120)
+    assert p.returncode == status, p.stderr
+    assert flag.read_text() == "ran"
+    if status == 0:
+        assert "PDE surface vs exact shape" in p.stdout and p.stdout.endswith("\n"), p.stdout
+        assert p.stderr == ""
+    else:
+        assert p.stdout == "" and len(p.stderr.splitlines()) == 1 and p.stderr.startswith("error: ")
+
+
 def test_readme_says_how_to_reach_the_commands():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     after = text[text.index("## Two commands on a fresh machine"):]

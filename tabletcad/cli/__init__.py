@@ -271,6 +271,7 @@ def main(argv: list[str] | None = None) -> int:
                 import signal
 
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
+                _finish(status)
             return status
         except (KeyboardInterrupt, SystemExit):
             raise
@@ -330,6 +331,22 @@ def _interrupted() -> int:
         return 0
     _say("interrupted")
     return 130
+
+
+def _finish(status: int) -> None:
+    """End the program with ``status`` once its work is done: the exit handlers that libraries
+    registered run (``atexit``: multiprocessing's children joined, logging flushed, thread pools
+    shut down), then the process ends without tearing down its modules and objects one by one.
+    That teardown only frees memory the system frees anyway, and after a tooling build, with
+    OpenCascade's shapes and meshes alive, it took 0.5-0.6 s of the command's time (``python
+    -c`` runs of the concave round bisect, the same build: 0.55-0.63 s from ``main`` returning to
+    the process's end; 0.07 s with this)."""
+    import atexit
+
+    try:
+        atexit._run_exitfuncs()
+    finally:
+        _exit_now(status)
 
 
 def _exit_now(status: int) -> None:
