@@ -187,3 +187,30 @@ def test_a_sweep_of_more_than_a_million_designs_is_refused_up_front():
         sweep({"tablet.band": {"min": 2.0, "max": 3.0}}, method="lhs", samples=10**9, seed=1)
     assert len(sweep({"tablet.band": {"min": 2.0, "max": 3.0, "num": 1000},
                       "tablet.cup_depth": {"min": 0.5, "max": 1.0, "num": 1000}}).points()) == 1_000_000
+
+
+@pytest.mark.parametrize("land, line", [
+    (-0.08, "error: design.tablet.land = -0.08 mm is not allowed: must be >= 0 (a length of concave_round; the sweep "
+            "does not vary it, so every design would be refused)"),
+    ("0.08", "error: design.tablet.land = '0.08' is not allowed: must be a number"),
+    (1e-9, "error: design.tablet.land = 1e-09 mm is not allowed: must be 0 or at least"),
+    (2e3, "error: design.tablet.land = 2000 mm is not allowed: must be within ±1000 mm"),
+])
+def test_a_fixed_dimension_no_design_could_take_is_refused_before_the_sweep(tmp_path, capsys, land, line):
+    """A base dimension the sweep does not vary, wrong whatever the varied values are, would fail every
+    row: refused up front (one line, exit 2, no folder)."""
+    p = _write(tmp_path, f'land = {land!r}\n[sweep.vary]\n"tablet.cup_depth" = [0.8, 0.9]\n'.replace("'", '"'))
+    out = tmp_path / "out"
+    assert main(["sweep", str(p), "--out", str(out), "--workers", "1", "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(line), err
+    assert not out.exists()
+
+
+def test_a_dimension_wrong_only_with_the_varied_values_or_varied_itself_is_left_to_the_rows():
+    """Valid alone, too wide for some varied cups (land 4.5 on a 10 mm round), or varied: not refused."""
+    base = {"tablet": {**BASE["tablet"], "land": 4.5}}
+    assert len(parse_sweep({"design": base, "sweep": {"vary": {"tablet.cup_depth": [0.1, 0.9]}}}).designs()) == 2
+    base = {"tablet": {**BASE["tablet"], "land": -0.08}}
+    spec = parse_sweep({"design": base, "sweep": {"vary": {"tablet.land": [-0.08, 0.08]}}})
+    assert [d["tablet"]["land"] for d in spec.designs()] == [-0.08, 0.08]

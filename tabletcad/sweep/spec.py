@@ -185,6 +185,24 @@ def _check_family_keys(design: dict) -> None:
             raise DesignError(f"design.tablet.{k}", v, f"family {fam.name!r} takes {', '.join(fam.params)}")
 
 
+def _check_fixed_dimensions(design: dict, varied: set[str]) -> None:
+    """Refuse a dimension of ``[design.tablet]`` that the sweep does not vary and that no design could
+    take, whatever the varied values: not a number, not finite, beyond the size limit, below the
+    smallest length, or a negative length (every family's lengths are >= 0).  Every row would fail."""
+    from tabletcad.pipeline.design import _number
+
+    fam = _family_of(design)
+    if fam is None:
+        return
+    for k, v in design["tablet"].items():
+        if k in fam.params and f"tablet.{k}" not in varied:
+            where = f"design.tablet.{k}"
+            x = _number(where, v, fam.params[k])
+            if fam.params[k] == "mm" and x < 0.0:
+                raise DesignError(where, v, f"must be >= 0 (a length of {fam.name}; the sweep does not vary it, "
+                                  "so every design would be refused)", "mm")
+
+
 def _known_keys(design: dict) -> set[str]:
     """Dotted keys that may be varied: every scalar of the base design, and the family's parameters."""
     keys: set[str] = set()
@@ -309,6 +327,7 @@ def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
     if not isinstance(vary, dict) or not vary:
         raise DesignError("[sweep.vary]", "missing" if vary is None else vary, "give at least one dotted design key to vary")
     _check_family_keys(design)
+    _check_fixed_dimensions(design, set(vary))
     known = _known_keys(design)
     dims = _dimension_keys(design)
     axes = []
