@@ -78,7 +78,10 @@ def open_client(workers: int | None = None, scheduler: str | None = None,
     inherited = os.environ.pop("MALLOC_TRIM_THRESHOLD_") if os.environ.get("MALLOC_TRIM_THRESHOLD_") == "65536" else None
     try:
         with dask.config.set({"distributed.nanny.pre-spawn-environ": env, "distributed.worker.profile.enabled": False}):
+            # no dashboard; the scheduler's own HTTP server (health, metrics) on a free local port, not
+            # 8787 (taken by another sweep or notebook: "Port 8787 is already in use" on every run)
             cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
                                    silence_logs=logging.ERROR)
     finally:
         if inherited is not None:

@@ -265,6 +265,53 @@ def test_a_plot_of_no_column_is_refused_before_any_design_is_built(tmp_path, cap
     _check_plot_columns(("volume_mm3", "design_report.weight_mg"), design, spec)  # columns of the report
     # a column of a section that another design may have (a flat face has no cup radius): left to the end
     _check_plot_columns(("design_report.cup_radii_mm.central",), design, spec)
-    for bad in ("tablet.band", "status", "nonexistent_col"):  # a varied key, the status, no column
-        with pytest.raises(DesignError):
+    # a varied key, the status, no column, a table of columns, text (the same type in every row)
+    for bad in ("tablet.band", "status", "nonexistent_col", "design_report.fda_size", "design.name",
+                "design_report.tensile_strength.formula"):
+        with pytest.raises(DesignError) as e:
             _check_plot_columns((bad,), design, spec)
+        allowed = e.value.allowed.split(": ", 1)[1].split(", ")
+        assert "volume_mm3" in allowed and "design_report.fda_size.ok" in allowed  # numbers and booleans
+        assert "design.name" not in allowed and "status" not in allowed and "tablet.band" not in allowed
+
+
+def test_a_plot_column_no_design_had_keeps_the_results_and_says_where(tmp_path, capsys):
+    """A column left to the end (its section exists) that no design's report has: the sweep's results
+    stay, the one line says where they are, and ``--resume`` plots another column without rebuilding."""
+    sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
+    out = tmp_path / "sw"
+    rc = main(["sweep", str(sweep), "--out", str(out), "--workers", "1", "--quiet", "--plot",
+               "design_report.cup_radii_mm.central"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1
+    assert err[0].startswith("error: --plot = 'design_report.cup_radii_mm.central' is not allowed: must be a report "
+                             f"column of results.csv (the results are in {out / 'results.csv'}: plot one with --resume): ")
+    assert sorted(p.name for p in out.iterdir()) == ["results.csv"]
+    assert main(["sweep", str(sweep), "--out", str(out), "--workers", "1", "--quiet", "--resume", "--plot",
+                 "volume_mm3"]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["plot_volume_mm3.png", "results.csv"]
+
+
+def test_a_local_cluster_takes_no_fixed_port():
+    """With 8787 (Dask's default HTTP port) taken, as by another sweep or a notebook, a local cluster
+    starts without a warning, its scheduler's HTTP server on a free port of this machine only."""
+    import warnings
+
+    from tabletcad.sweep.engine import open_client
+
+    held = socket.socket()
+    try:
+        held.bind(("", 8787))
+        held.listen()
+    except OSError:  # taken already: the case itself
+        pass
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            with open_client(1) as client:
+                link = client.dashboard_link
+                assert client.submit(abs, -3).result() == 3
+    finally:
+        held.close()
+    assert not [w for w in caught if "already in use" in str(w.message)]
+    assert link.startswith("http://127.0.0.1:") and ":8787/" not in link

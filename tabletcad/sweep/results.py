@@ -149,10 +149,12 @@ def plot_results(df, keys: Sequence[str], outputs: Sequence[str], out_dir: str |
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    for o in outputs:
-        if o not in df.columns or o in keys or o in TAIL_COLUMNS:
-            raise plot_column_error(o, df.columns, keys)
     ok = df[df["status"] == "ok"]
+    numeric = [c for c in df.columns if c not in keys and c not in TAIL_COLUMNS
+               and pd.to_numeric(ok[c], errors="coerce").notna().any()]
+    for o in outputs:
+        if o not in numeric:
+            raise plot_column_error(o, numeric, keys)
     paths = []
     for o in outputs:
         y = pd.to_numeric(ok[o], errors="coerce")

@@ -139,7 +139,12 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
         write_results(df, out / RESULTS_CSV)
         (out / JOURNAL).unlink(missing_ok=True)
         if plot:
-            plot_results(df, spec.keys, plot, out)
+            try:
+                plot_results(df, spec.keys, plot, out)
+            except DesignError as exc:  # a column no design's report had: the results stay, and say so
+                raise DesignError(exc.parameter, exc.value, exc.allowed.replace(
+                    "of results.csv:", f"of results.csv (the results are in {out / RESULTS_CSV}: plot one with "
+                    "--resume):", 1)) from None
     return df
 
 
@@ -160,10 +165,18 @@ def _check_plot_columns(plot: tuple[str, ...], design: dict[str, Any], spec) -> 
         return
     files = any(o != "report" for o in spec.outputs)
     sections = {c.split(".")[0] for c in cols}
+    numeric = [c for c, v in cols.items() if _plottable(v)]
     for o in plot:
         unknown = o not in cols and o.split(".")[0] not in sections and not files
-        if o in spec.keys or o in TAIL_COLUMNS or unknown:
-            raise plot_column_error(o, list(cols), spec.keys)
+        table = o not in cols and any(c.startswith(o + ".") for c in cols)  # a table of columns, never one
+        text = o in cols and not _plottable(cols[o])  # (a name, a family, a formula: the same type in every row)
+        if o in spec.keys or o in TAIL_COLUMNS or unknown or table or text:
+            raise plot_column_error(o, numeric, spec.keys)
+
+
+def _plottable(value: Any) -> bool:
+    """Whether a report value can be plotted: a number or a boolean (0/1), not text or None."""
+    return isinstance(value, (int, float))
 
 
 def _check_store(store: str, name: str, local: bool) -> None:
