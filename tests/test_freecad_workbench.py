@@ -520,6 +520,15 @@ def test_save_reopen_recompute(headless):
         assert step[part]["valid"] and step[part]["n_solids"] == 1
     # the lower punch still ends at the ring's base, the upper one starts at its new top
     assert step["upper"]["bbox"][2] == pytest.approx(5.0, abs=1e-6)
+    # a document of an earlier version: the die's clearance (0.05 mm) went to its tablet's punch, whose
+    # tip is now the outline inset by it (0.025 mm more each side than the default's, the stadium's
+    # straight sides and end arcs alike)
+    old = step["old_document"]
+    assert old["punch_clearance"] == pytest.approx(0.05, abs=1e-12) and "Clearance" not in old["die_properties"]
+    (before,) = _steps(headless, "design_free_form")
+    for k in range(2):
+        span = lambda info: info["tight_bbox"][3 + k] - info["tight_bbox"][k]  # noqa: E731
+        assert span(before["upper"]) - span(old["upper"]) == pytest.approx(2 * (0.05 - 0.025), abs=1e-6)
 
 
 # ------------------------------------------------------------------------------------------- macros

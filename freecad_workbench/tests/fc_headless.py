@@ -294,6 +294,12 @@ try:
         upper=shape_info(d2up),
     )
 
+    # ---- a document of an earlier version: its die held the clearance (0.05 mm), its punch none
+    d2up.removeProperty("Clearance")
+    d2die.addProperty("App::PropertyLength", "Clearance", "Die", "radial clearance (an earlier version's)")
+    d2die.Clearance = 0.05
+    old_names = (d2up.Name, d2die.Name)
+
     # ---- save, reopen (proxies restored), change, recompute
     path = os.path.join(work, "wbtest.FCStd")
     doc.saveAs(path)
@@ -308,6 +314,10 @@ try:
     t0 = time.perf_counter()
     doc.recompute()
     rup, rlow, rdie = (doc.getObject(n) for n in tool_names)
+    old_up = doc.getObject(old_names[0])
+    old_clearance = float(old_up.Clearance.Value)
+    old_up.touch()  # as any change would: rebuilt with the clearance it took from the die
+    doc.recompute()
     step(
         "reopen",
         proxies=proxies,
@@ -318,6 +328,11 @@ try:
         lower=shape_info(rlow),
         die=shape_info(rdie),
         all_valid=all(o.isValid() for o in doc.Objects),
+        old_document=dict(
+            punch_clearance=old_clearance,
+            die_properties=list(doc.getObject(old_names[1]).PropertiesList),
+            upper=shape_info(doc.getObject(old_names[0])),
+        ),
     )
     doc.save()
     result["ok"] = True

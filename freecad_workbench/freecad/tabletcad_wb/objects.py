@@ -455,6 +455,7 @@ class DieProxy(_Proxy):
     def _setup(self, obj):
         self._add(obj, "App::PropertyLink", "Tablet", "Die", "the tablet this die forms")
         if "Clearance" in obj.PropertiesList:  # a document of an earlier version: the punches take it now
+            self._hand_clearance_to_punches(obj)
             obj.removeProperty("Clearance")
         self._add(
             obj, "App::PropertyLength", "Height", "Die", "die height (TSM B die: 22.22 mm)", _qty(22.22, "mm")
@@ -468,6 +469,19 @@ class DieProxy(_Proxy):
             _qty(30.16, "mm"),
         )
         self._add(obj, "App::PropertyFloat", "Volume", "Results (mm³)", "volume of the die, mm³", mode=_READONLY)
+
+    @staticmethod
+    def _hand_clearance_to_punches(obj):
+        """A document of an earlier version kept the radial clearance on the die (its bore the outline
+        widened by it, the punch tips the outline): its value goes to the punches of the same tablet
+        (their tips now the outline inset by it, the bore the outline: the same clearance), which
+        restored before or after the die and had none of their own then."""
+        value = obj.Clearance
+        for o in obj.Document.Objects:
+            proxy = getattr(o, "Proxy", None)
+            if getattr(proxy, "Type", None) == PunchProxy.Type and o.Tablet == obj.Tablet and obj.Tablet is not None:
+                proxy._setup(o)  # (adds Clearance if the punch has not been restored yet)
+                o.Clearance = value
 
     def build(self, obj):
         tab = _tablet_of(obj)
