@@ -380,3 +380,47 @@ def test_metadata_overrides_binary_files_and_a_byte_order_mark(tmp_path):
         read_metadata(p)
     p.write_bytes(b"\xef\xbb\xbf" + _META.read_bytes())  # as some editors save it: the same metadata
     assert read_metadata(p) == read_metadata(_META)
+
+
+def test_the_face_area_is_given_once_and_an_option_replaces_the_files(tmp_path):
+    """A file holding both ``diameter`` and ``face_area`` is refused (one of them was ignored without a
+    word); ``--diameter`` or ``--face-area`` replaces the file's area however the file gives it (a
+    ``--diameter`` beside a file's ``face_area`` was dropped: K 6.5 times too large in a trial)."""
+    import math
+
+    from tabletcad.mechanics.pressdata import read_metadata
+
+    text = _META.read_text(encoding="utf-8")
+    both = tmp_path / "both.toml"
+    both.write_text(text.replace("diameter = 10.0", "diameter = 10.0\nface_area = 50.0"), encoding="utf-8")
+    with pytest.raises(DesignError) as e:
+        read_metadata(both)
+    assert str(e.value) == ("face_area = 50 mm² is not allowed: give diameter or face_area, not both "
+                            "(the punch face area is one quantity)")
+    area = tmp_path / "area.toml"
+    area.write_text(text.replace("diameter = 10.0", "face_area = 50.0"), encoding="utf-8")
+    assert read_metadata(area).area == 50.0
+    m = read_metadata(area, diameter=10.0)
+    assert (m.diameter, m.face_area, m.area) == (10.0, None, pytest.approx(math.pi * 25.0, rel=1e-15))
+    m = read_metadata(_META, face_area=78.0)
+    assert (m.diameter, m.face_area, m.area) == (None, 78.0, 78.0)
+    with pytest.raises(DesignError, match="not both"):
+        read_metadata(_META, diameter=10.0, face_area=78.0)
+    with pytest.raises(DesignError, match="not both"):
+        PressMetadata(mass_mg=300.0, true_density=1.5, diameter=10.0, face_area=78.0)
+
+
+def test_heckel_with_diameter_beside_a_files_face_area_fits_with_the_diameter(tmp_path, capsys):
+    """The command line: the lactose record with its metadata's diameter replaced by a wrong face area
+    in the file, and ``--diameter 10`` given, fits exactly as the original metadata does."""
+    import json
+
+    from tabletcad.cli import main
+
+    meta = tmp_path / "m.toml"
+    meta.write_text(_META.read_text(encoding="utf-8").replace("diameter = 10.0", "face_area = 50.0"), encoding="utf-8")
+    assert main(["heckel", str(SAMPLE), "--json"]) == 0
+    want = json.loads(capsys.readouterr().out)
+    assert main(["heckel", str(SAMPLE), "--meta", str(meta), "--diameter", "10", "--json"]) == 0
+    got = json.loads(capsys.readouterr().out)
+    assert got["K_per_MPa"] == want["K_per_MPa"] and got["A"] == want["A"]

@@ -171,7 +171,7 @@ class PressMetadata:
     diameter : float or None
         Die diameter, mm (flat round punches).
     face_area : float or None
-        Punch face area, mm²; overrides ``diameter`` when given.
+        Punch face area, mm² (for a shaped punch); give it or ``diameter``, not both.
     compliance : MachineCompliance or None
         Machine deflection correction; ``None`` means none.
     displacement_sign : int or "auto"
@@ -195,6 +195,9 @@ class PressMetadata:
         check_range("true_density", self.true_density, 0.0, MAX_TRUE_DENSITY_MG_MM3, "mg/mm³", lo_open=True)
         if self.diameter is None and self.face_area is None:
             raise DesignError("diameter", "missing", "give the die diameter (mm) or the punch face area (mm²)", "mm")
+        if self.diameter is not None and self.face_area is not None:
+            raise DesignError("face_area", self.face_area, "give diameter or face_area, not both (the punch face "
+                              "area is one quantity)", "mm²")
         if self.diameter is not None:
             check_range("diameter", self.diameter, 0.0, DEFAULT.max_length, "mm", lo_open=True)
         if self.face_area is not None:
@@ -638,8 +641,16 @@ def read_metadata(source: str | Path | Mapping[str, Any], **overrides: Any) -> P
     if unknown:  # a misspelled key would silently change the results (an ignored compliance moves K by 15 %)
         raise DesignError(unknown[0], raw[unknown[0]], "is not a metadata key (misspelled?): the keys are "
                           + ", ".join(METADATA_KEYS))
+    if raw.get("diameter") is not None and raw.get("face_area") is not None:  # one would be ignored without a word
+        raise DesignError("face_area", raw["face_area"], "give diameter or face_area, not both (the punch face "
+                          "area is one quantity)", "mm²")
+    if overrides.get("diameter") is not None and overrides.get("face_area") is not None:
+        raise DesignError("face_area", overrides["face_area"], "give diameter or face_area, not both", "mm²")
     for k, v in overrides.items():
         if v is not None:
+            if k in ("diameter", "face_area"):  # the area given another way replaces the file's, either way
+                raw.pop("diameter", None)
+                raw.pop("face_area", None)
             raw[k] = v
     compliance = _compliance(raw.get("compliance"))
     missing = [k for k in ("mass_mg", "true_density") if k not in raw]
