@@ -158,3 +158,63 @@ def test_a_press_record_is_fitted_on_its_loading_branch(capsys, tmp_path, comman
     rc, out, err = run(capsys, command, record)
     assert out.splitlines()[0] == (f"record.csv: loading rows 1-{len(P)} of {len(P) + len(back)} used (up to the peak "
                                    "pressure; the rows after it unload or reload the compact)")
+
+
+def _write_as(path: Path, header: list[str], cols, sep: str = ",", comma: bool = False, scale=(1.0, 1.0, 1.0)) -> Path:
+    """A table with ``sep`` between cells, decimal commas if ``comma``, each column multiplied by its ``scale``."""
+    def cell(v):
+        text = f"{v:.15g}"
+        return text.replace(".", ",") if comma else text
+    rows = [sep.join(header)] + [sep.join(cell(v * f) for v, f in zip(r, scale)) for r in zip(*cols)]
+    path.write_text("\n".join(rows) + "\n", encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("header, sep, comma, scale", [
+    (["pressure_MPa", "thickness_mm"], ";", True, (1.0, 1.0)),
+    (["pressure_MPa", "thickness_mm"], "\t", False, (1.0, 1.0)),
+    (["Pressure (kPa)", "Thickness (µm)"], ",", False, (1e3, 1e3)),
+    (["Pressure (kPa)", "Thickness (µm)"], ";", True, (1e3, 1e3)),
+    (["Pressure [bar]", "Thickness [cm]"], ",", False, (10.0, 0.1)),
+    (["pressure_psi", "thickness_in"], ",", False, (1 / 0.0068947572931683625, 1 / 25.4)),
+])
+def test_kawakita_reads_separators_decimal_commas_and_the_headers_units(capsys, tmp_path, header, sep, comma, scale):
+    """Tables of compacts read as press records are: ``;``/tab, decimal commas and units in the header,
+    converted to MPa and mm, give the fit of the plain file (a table in kPa and µm had been taken as MPa
+    and mm: b 1,000 times too small, h0 8000 mm)."""
+    h = H0 * (1 - A * B * P / (1 + B * P))
+    data = _write_as(tmp_path / "k.csv", header, (P, h), sep, comma, scale)
+    rc, out, err = run(capsys, "kawakita", data, "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    assert d["a"] == pytest.approx(A, rel=1e-9) and d["b_per_MPa"] == pytest.approx(B, rel=1e-9)
+    assert d["h0_mm"] == pytest.approx(H0, rel=1e-14)
+
+
+def test_profiles_read_a_solid_fraction_in_percent_and_a_strength_in_kpa(capsys, tmp_path):
+    Pp = P[1:]
+    sf = 0.6 + 0.35 * (1 - np.exp(-Pp / 80))
+    s = SIGMA0 * np.exp(K * (sf - 1))
+    data = _write_as(tmp_path / "p.csv", ["Pressure (MPa)", "Solid fraction (%)", "Tensile strength (kPa)"],
+                     (Pp, sf, s), ";", True, (1.0, 100.0, 1e3))
+    rc, out, err = run(capsys, "profiles", data, "--json", "--pressure-column", "Pressure (MPa)",
+                       "--solid-fraction-column", "Solid fraction (%)", "--strength-column", "Tensile strength (kPa)")
+    assert rc == 0, err
+    rd = json.loads(out)["ryshkewitch_duckworth"]
+    assert rd["sigma0_MPa"] == pytest.approx(SIGMA0, rel=1e-9) and rd["k"] == pytest.approx(K, rel=1e-9)
+
+
+@pytest.mark.parametrize("header, line", [
+    ("Pressure (mm),thickness_mm", "error: column.\"Pressure\\u0020(mm)\".unit = 'mm' is not allowed: is not a known "
+                                   "pressure unit (MPa, N/mm², N/mm2, kPa, Pa, GPa, bar, psi)"),
+    ("Pressure (atm),thickness_mm", "error: column.\"Pressure\\u0020(atm)\".unit = 'atm' is not allowed: is not a known "
+                                    "pressure unit"),
+    ("pressure_MPa,Thickness (kN)", "error: column.\"Thickness\\u0020(kN)\".unit = 'kN' is not allowed: is not a known "
+                                    "length unit (mm, µm, um, cm, m, in, inch)"),
+])
+def test_a_header_unit_of_another_quantity_is_refused(capsys, tmp_path, header, line):
+    data = tmp_path / "k.csv"
+    data.write_text(header + "\n10,5\n20,4.5\n", encoding="utf-8")
+    cols = header.split(",")
+    rc, out, err = run(capsys, "kawakita", data, "--pressure-column", cols[0], "--thickness-column", cols[1])
+    assert rc == 2 and out == "" and len(err.splitlines()) == 1 and err.startswith(line), err

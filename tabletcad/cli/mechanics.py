@@ -163,39 +163,12 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
 
 
 # --------------------------------------------------------------------------- kawakita, walker, profiles
-def _read_table(path: Path, columns: dict[str, str]) -> dict[str, np.ndarray]:
-    """Numeric columns of a CSV/TSV file with a header row, found by (case-insensitive) header name.
+def _read_table(path: Path, columns: dict[str, tuple[str, str]]) -> dict[str, np.ndarray]:
+    """Numeric columns of a table, read as a press record is (:func:`tabletcad.mechanics.pressdata.read_columns`:
+    delimiter, decimal commas, encodings and the header's units)."""
+    from tabletcad.mechanics.pressdata import read_columns
 
-    ``columns`` maps a key to the header; empty lines and ``#`` comments are skipped.  ``_lines``:
-    each row's line number in the file (errors name it).
-    """
-    import csv
-
-    from tabletcad.mechanics.pressdata import decode_text
-
-    text = decode_text(path.read_bytes())  # UTF-8, UTF-16 or Windows-1252, as the press exports
-    kept = [(n, ln) for n, ln in enumerate(text.splitlines(), start=1) if ln.strip() and not ln.lstrip().startswith("#")]
-    rows = list(csv.reader((ln for _, ln in kept), delimiter="\t" if "\t" in text.split("\n", 1)[0] else ","))
-    line_of = [n for n, _ in kept]  # the file's line number of each row (comments and blank lines skipped)
-    if len(rows) < 2:
-        raise DesignError("DATA", str(path), "must hold a header row and at least one row of numbers")
-    header = [h.strip().lower() for h in rows[0]]
-    out = {}
-    for key, name in columns.items():
-        if name.strip().lower() not in header:
-            raise DesignError("column", name, f"must be one of the header's columns of {path.name}: {', '.join(rows[0])}")
-        j = header.index(name.strip().lower())
-        vals = []
-        for i, r in enumerate(rows[1:], start=1):
-            where = f"{path.name!r} line {line_of[i]} {name!r}"
-            try:
-                v = float(r[j])
-            except (IndexError, ValueError):
-                raise DesignError(where, r[j] if j < len(r) else "missing", "must be a number") from None
-            vals.append(check_finite(where, v))
-        out[key] = np.asarray(vals, dtype=float)
-    out["_lines"] = np.asarray(line_of[1:])
-    return out
+    return read_columns(path, columns)
 
 
 def _check_window(window: tuple[float, float] | None) -> None:
@@ -234,7 +207,7 @@ def _compression_table(data: Path, pressure_column: str, thickness_column: str, 
     _check_window(window)
     if h0 is not None:
         check_positive("--h0", h0, "mm")
-    table = _read_table(data, {"P": pressure_column, "h": thickness_column})
+    table = _read_table(data, {"P": (pressure_column, "pressure"), "h": (thickness_column, "length")})
     bad = np.flatnonzero(~(table["h"] > 0.0))
     if bad.size:  # a thickness is a length: 0 or less is a misread column or a displacement
         raise DesignError(f"{data.name!r} line {int(table['_lines'][bad[0]])} {thickness_column!r}",
@@ -321,7 +294,8 @@ def profiles_cmd(data: Path, pressure_column: str, solid_fraction_column: str, s
     _check_output("--plot", plot_file)
     if json_file is not None and plot_file is not None and json_file.absolute() == plot_file.absolute():
         raise DesignError("--plot", str(plot_file), "must differ from --json-file")
-    t = _read_table(data, {"P": pressure_column, "sf": solid_fraction_column, "s": strength_column})
+    t = _read_table(data, {"P": (pressure_column, "pressure"), "sf": (solid_fraction_column, "fraction"),
+                           "s": (strength_column, "pressure")})
     porosity = not as_solid_fraction
     with _collect() as msgs:
         profs = [tabletability(t["P"], t["s"]), compressibility(t["P"], t["sf"], as_porosity=porosity),

@@ -397,6 +397,60 @@ def _read_table(text: str, source: str) -> tuple[list[str], list[int], list[Sequ
     return header, [i for i, _ in numbered], columns, delim
 
 
+#: the unit a table column is read in when its header names none, by the column's dimension
+TABLE_UNITS = {"pressure": "MPa", "length": "mm", "fraction": "", "force": "N", "time": "s"}
+
+
+def read_columns(path: str | Path, columns: Mapping[str, tuple[str, str]]) -> dict[str, np.ndarray]:
+    """Numeric columns of a table of tablets or compacts (kawakita, walker, profiles), read as a press
+    record is: the delimiter sniffed (``,``, ``;``, tab), decimal commas with ``;`` or tab, UTF-8 (BOM),
+    UTF-16 or Windows-1252, ``#`` comments and blank lines skipped, and each column's unit taken from
+    its header and converted (``Pressure (kPa)``, ``thickness_um``, ``Solid fraction (%)``).
+
+    ``columns`` maps a key to ``(header, dimension)``: the header is found case-insensitively, as
+    written or by its name without the unit (``pressure_MPa`` finds ``Pressure (kPa)``); the
+    dimension (``"pressure"``, ``"length"``, ``"fraction"``) gives the units a header may state and the
+    unit taken when it states none (:data:`TABLE_UNITS`: MPa, mm, a fraction).  Returns the columns in
+    MPa, mm or as fractions, and ``_lines`` (each row's line number in the file).
+
+    Raises
+    ------
+    DesignError
+        No such column, a unit of another dimension or an unknown one, a cell that is not a number
+        (named by the file's line and the column).
+    """
+    path = Path(path)
+    header, line_numbers, by_column, delim = _read_table(decode_text(path.read_bytes()), path.name)
+    if not line_numbers:
+        raise DesignError("DATA", str(path), "must hold a header row and at least one row of numbers")
+    names = [h.lower() for h in header]
+    decimal_comma = delim != "," and any("," in c for col in by_column for c in col[:50])
+    out: dict[str, np.ndarray] = {}
+    bare = [strip_unit(h).lower() for h in header]
+    for key, (name, dimension) in columns.items():
+        want = name.strip().lower()
+        if want in names:  # the header as written, else the one header of that name in any unit
+            j = names.index(want)
+        elif bare.count(strip_unit(name).lower()) == 1:
+            j = bare.index(strip_unit(name).lower())
+        else:
+            raise DesignError("column", name, f"must be one of the header's columns of {path.name} (or its name "
+                              f"without the unit): {', '.join(header)}")
+        unit = header_unit(header[j])
+        factor, exponent = (1.0, 0) if unit is None else unit_factor(
+            unit, dimension, f"column {header[j]!r} unit",
+            f"; or no unit in the header for {TABLE_UNITS[dimension] or 'a fraction'}")
+        col = _parse_column(by_column[j], exponent, decimal_comma)
+        if isinstance(col, np.ndarray) and not np.all(np.isfinite(col)):
+            col = int(np.flatnonzero(~np.isfinite(col))[0])  # a missing value: every row is one tablet
+        if not isinstance(col, np.ndarray):
+            raise DesignError(f"{path.name!r} line {line_numbers[col]} {header[j]!r}", by_column[j][col].strip() or "missing",
+                              "must be a number")
+        out[key] = col * factor if exponent is None else col
+    out["_lines"] = np.asarray(line_numbers)
+    return out
+
+
 def _parse_column(cells: Sequence[str], exponent: int | None, decimal_comma: bool) -> np.ndarray | int:
     """A column of cells as floats (``exponent`` as in :func:`_to_float`, missing values NaN).
 

@@ -3,10 +3,10 @@
 Press exports label their columns ``Upper Punch Force (kN)``, ``Force [daN]``,
 ``Time [ms]``, ``displacement_mm``...  :func:`header_unit` finds the unit in a
 header and :func:`unit_factor` gives the factor to tabletcad's units (force N,
-length mm, time s).  The table is small and explicit on purpose: the mechanics
+length mm, time s; for tables of tablets also pressure MPa and fractions).  The table is small and explicit on purpose: the mechanics
 core must import with numpy and scipy alone (it runs inside FreeCAD's Python),
-and these 23 linear factors are all a press record needs (README, "Libraries
-and why").
+and these linear factors are all a press record and a table of tablets need
+(README, "Libraries and why").
 
 Power-of-ten factors (kN, daN, MN, mN, µm, cm, m, ms, µs) are stored as their
 decimal exponent, so that :mod:`tabletcad.mechanics.pressdata` can convert a
@@ -51,10 +51,20 @@ UNITS: dict[str, tuple[str, float, int | None]] = {
     "us": ("time", 1e-6, -6),
     "min": ("time", 60.0, None),
     "h": ("time", 3600.0, None),
+    # pressures and strengths (MPa = N/mm²) and fractions, for tables of tablets (kawakita, walker, profiles)
+    "MPa": ("pressure", 1.0, 0),
+    "N/mm²": ("pressure", 1.0, 0),
+    "N/mm2": ("pressure", 1.0, 0),
+    "kPa": ("pressure", 1e-3, -3),
+    "Pa": ("pressure", 1e-6, -6),
+    "GPa": ("pressure", 1e3, 3),
+    "bar": ("pressure", 0.1, -1),
+    "psi": ("pressure", 0.0068947572931683625, None),  # lbf/in², exact by definition
+    "%": ("fraction", 0.01, -2),
 }
 
 _BRACKET = re.compile(r"[\(\[]\s*([^\)\]]*?)\s*[\)\]]\s*$")
-_TRAILING = re.compile(r"([_\s])([A-Za-zµμ]+)\s*$")
+_TRAILING = re.compile(r"([_\s])([A-Za-zµμ]+|%)\s*$")
 #: words that are units only after an underscore (``time_h``), not after a space (``position in``)
 _NOT_AFTER_SPACE = {"in", "m", "h", "s"}
 
