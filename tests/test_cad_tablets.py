@@ -487,3 +487,21 @@ def test_cadquery_wraps_tablet_solid():
     assert solid.isValid() and solid.Volume() == pytest.approx(s.volume, rel=1e-6)
     wp = to_cadquery_workplane(s)
     assert wp.val().Volume() == pytest.approx(s.volume, rel=1e-6)
+
+
+@pytest.mark.parametrize("tablet", [
+    dict(family="ffre", diameter=10.0, thickness=3.0, edge_radius=1.5),  # no band: the pill
+    dict(family="ffre", diameter=10.0, thickness=3.001, edge_radius=1.5),  # the least band
+    dict(family="ffbe", diameter=10.0, thickness=2.001, bevel_angle=45, bevel_width=1.0),
+    dict(family="ffbe", diameter=10.0, thickness=4.0, bevel_angle=10, bevel_width=4.999),  # the least flat face
+])
+def test_what_a_design_file_leaves_at_the_least_length_builds_a_solid(tablet):
+    """The other side of ``test_left_lengths.py``: a band or face of 0 or the least length builds one
+    valid solid whose volume is the core's (a band of 1e-9 mm had failed the sewing)."""
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    t = design_from_dict({"tablet": tablet})
+    s = tablet_solid(t)
+    assert shape_type(s.shape) == "Solid" and BRepCheck_Analyzer(s.shape).IsValid()
+    assert len(explore(s.shape, "Face")) == len(t.patches)
+    assert s.volume == pytest.approx(t.volume(), rel=AGREE)

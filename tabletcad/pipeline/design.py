@@ -356,6 +356,7 @@ class Design:
                 if a is not None and exc.parameter.endswith("smoothing.parameter.a"):  # a patch's: the file's a
                     raise exc.renamed("tablet.a") from None
                 raise
+            _check_left_lengths(built, family, kw)
             tablet = replace(built, name=name)
         if self.reshape is not None:
             tablet = _reshape(tablet, self.reshape)
@@ -363,6 +364,35 @@ class Design:
         if self.trim is not None:
             tablet = _trim(tablet, self.trim)
         return tablet
+
+
+#: the parameter that leaves a part of a family's profile: (family, part) -> parameter(s), the first given
+_LEFT_BY = {("ffbe", "band"): ("bevel_depth", "bevel_width"), ("ffbe", "flat face"): ("bevel_width", "bevel_depth"),
+            ("ffre", "band"): ("edge_radius",), ("ffre", "flat face"): ("edge_radius",),
+            ("concave_bevel", "cup"): ("bevel_width",)}
+
+
+def _check_left_lengths(tablet: Tablet, family: str, kw: dict, tol: Tolerances = DEFAULT) -> None:
+    """Refuse a family tablet whose dimensions leave a band or a part of its face profile shorter than
+    ``tol.min_length`` but not 0 (a ffbe whose bevel takes the whole thickness but for 2e-16 mm of
+    rounding in ``tan 45°``): every length a design file gives is 0 or at least that, and so is every
+    length they leave, or the B-rep's sewing fails ("sewn shell has 4 faces, expected 5") where the
+    report had passed.  Named by the parameter that leaves it (:data:`_LEFT_BY`), else ``tablet``."""
+    from tabletcad.families.sweep import SweepNominal
+
+    nom = tablet.nominal
+    if not isinstance(nom, SweepNominal):
+        return
+    m = tol.min_length
+    parts = [("band", nom.band_z[1] - nom.band_z[0])] + [(e.label or e.kind, e.length) for e in nom.top]
+    for what, length in parts:
+        if 0.0 < length < m * (1.0 - 1e-9):  # (3.001 - 2 x 1.5 is 0.000999999999999889: at the least length)
+            names = [k for k in _LEFT_BY.get((family, what), ()) if kw.get(k)]
+            left = f"leaves a {what} of {length:.3g} mm: what the dimensions leave must be 0 or at least {m:g} mm " \
+                   "(Tolerances.min_length, the least length a design takes)"
+            if names:
+                raise DesignError(f"tablet.{names[0]}", kw[names[0]], left, "mm")
+            raise DesignError("tablet", family, left)
 
 
 def design_from_dict(data: dict, default_name: str = "tablet") -> Tablet:
