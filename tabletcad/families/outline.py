@@ -123,6 +123,51 @@ class PlanOutline:
         return len(self.segs) == 1 and self.segs[0].kind == "arc" and abs(abs(self.segs[0].sweep) - math.tau) <= 1e-12
 
     @property
+    def diameter(self) -> float:
+        """The largest distance (mm) between two points of the outline: its diameter (largest Feret
+        width; the diagonal of a rounded square, the length of a capsule), in closed form.
+
+        The distance from a point to a line's points is convex along it, so a line contributes only its
+        ends; the point of an arc farthest from ``p`` lies on the ray from ``p`` through its centre
+        (``|p - c| + r``) when that direction is within the arc's span; the farthest pair of points of
+        two arcs lies on the line through their centres (``|c_a - c_b| + r_a + r_b``) when both
+        directions are within their spans (an arc of at least half a turn holds a pair ``2 r`` apart).
+        The maximum over the joins' pairs, each join and arc, and each pair of arcs is the diameter."""
+        if "_diameter" not in self.__dict__:
+            ends = np.array([s.p0 for s in self.segs], dtype=float)
+            best = float(np.max(np.linalg.norm(ends[:, None, :] - ends[None, :, :], axis=2)))
+            arcs = [s for s in self.segs if s.kind == "arc"]
+
+            def within(a, u) -> bool:
+                return bool(a.within_sweep(np.float64(u[0]), np.float64(u[1]), np.float64(1.0)))
+
+            for k, a in enumerate(arcs):
+                ca = np.asarray(a.center)
+                for p in ends:  # a join and the arc: the arc's point across its centre from the join
+                    w = ca - p
+                    rho = float(np.linalg.norm(w))
+                    if rho > 0.0 and within(a, w / rho):
+                        best = max(best, rho + a.radius)
+                for b in arcs[k:]:
+                    w = ca - np.asarray(b.center)
+                    rho = float(np.linalg.norm(w))
+                    if b is a:
+                        if abs(a.sweep) >= math.pi:
+                            best = max(best, 2.0 * a.radius)
+                    elif rho > 1e-12 * max(a.radius, b.radius):
+                        u = w / rho
+                        if within(a, u) and within(b, -u):
+                            best = max(best, rho + a.radius + b.radius)
+                    else:  # concentric: a direction of a's span whose opposite is in b's
+                        ends_a = [a.theta0, a.theta0 + a.sweep]
+                        ends_b = [b.theta0, b.theta0 + b.sweep]
+                        if any(within(b, (-math.cos(t), -math.sin(t))) for t in ends_a) or \
+                                any(within(a, (-math.cos(t), -math.sin(t))) for t in ends_b):
+                            best = max(best, a.radius + b.radius)
+            self.__dict__["_diameter"] = best
+        return self.__dict__["_diameter"]
+
+    @property
     def min_convex_radius(self) -> float:
         """Smallest radius of a convex arc (inf without arcs), mm."""
         r = [s.radius for s in self.segs if s.kind == "arc" and s.sweep > 0]
@@ -383,6 +428,17 @@ class SplineOutline(PlanOutline):
     @property
     def breaks(self) -> np.ndarray:
         return np.array([0.0, math.tau])
+
+    @property
+    def diameter(self) -> float:
+        """The largest distance (mm) between two of the outline's 8,192 samples (its diameter, low by
+        at most the square of the samples' spacing over the curvature radius: ~1e-6 mm on tablets)."""
+        if "_diameter" not in self.__dict__:
+            from scipy.spatial import ConvexHull
+
+            hull = self._ps[ConvexHull(self._ps).vertices]
+            self.__dict__["_diameter"] = float(np.max(np.linalg.norm(hull[:, None, :] - hull[None, :, :], axis=2)))
+        return self.__dict__["_diameter"]
 
     @property
     def smooth_breaks(self) -> np.ndarray:

@@ -368,7 +368,7 @@ def design_report(tablet: Tablet, opts: ReportOptions | None = None) -> dict[str
         cup_radii_mm=_cup_radii(info),
         params={k: v for k, v in info.items() if k not in ("shape", "face")},
     )
-    _add_figures(rep, dict(info, width_mm=W, length_mm=Ln), T, opts)
+    _add_figures(rep, dict(info, width_mm=W, length_mm=Ln, plan_diameter_mm=float(nom.outline.diameter)), T, opts)
     seams = family_seams(tablet)
     return dict(
         nominal_max_deviation_um=cert.max_deviation_mm * 1000.0,
@@ -398,9 +398,12 @@ def _add_figures(rep: dict[str, Any], info: dict[str, Any], T: float, opts: Repo
                                        note="no published tensile-strength formula for this shape")
     else:
         rep["tensile_strength"] = tensile_strength(info, T, opts.breaking_force_N)
-    largest = max(Ln, W, T)
+    # the plan's largest extent in any direction (the diagonal of a rounded square), not along the axes
+    largest = max(Ln, W, info.get("plan_diameter_mm") or 0.0, T)
     rep["fda_size"] = dict(largest_dimension_mm=largest, limit_mm=FDA_MAX_DIMENSION_MM,
                            ok=bool(largest <= FDA_MAX_DIMENSION_MM),
+                           basis="the largest of the plan's diameter (its largest extent in any direction) "
+                                 "and the thickness",
                            source="FDA guidance for industry: Size, Shape, and Other Physical Attributes of Generic Tablets and Capsules (2015)")
 
 
@@ -466,5 +469,23 @@ def shape_design_report(tablet: Tablet, opts: ReportOptions | None = None) -> di
         r_cup = ((float(p["diameter"]) / 2.0) ** 2 + cup**2) / (2.0 * cup)
         rep.update(cup_radius_mm=r_cup, cup_radii_mm={"cup": r_cup})
     _add_figures(rep, dict(shape=shape, face=face, band_mm=band, cup_depth_mm=cup or 0.0, width_mm=W, length_mm=Ln,
-                           elongated=shape == "oval"), T, opts)
+                           elongated=shape == "oval", plan_diameter_mm=_sampled_plan_diameter(tablet)), T, opts)
     return rep
+
+
+def _sampled_plan_diameter(tablet: Tablet) -> float | None:
+    """The largest distance (mm) between two of the surface's points in plan, from a 33 x 256 sample of
+    every patch (None for a tablet of revolution, whose diameter is its extent): a free-form design need
+    not lie along the axes.  Low by at most the square of the sample step over the curvature radius."""
+    if tablet.revolution is not None:
+        return None
+    from scipy.spatial import ConvexHull
+
+    xy = tablet.sample(33, 256)[..., :2].reshape(-1, 2)
+    try:
+        xy = xy[ConvexHull(xy).vertices]
+    except Exception:  # noqa: BLE001 - a degenerate (flat) plan: every point is a candidate
+        pass
+    if len(xy) > 4000:
+        return None
+    return float(np.max(np.linalg.norm(xy[:, None, :] - xy[None, :, :], axis=2)))

@@ -1,0 +1,99 @@
+"""The plan's diameter (its largest extent in any direction) and the FDA size check that reads it.
+
+The FDA size line took the largest of length, width and thickness along the axes, so a 20 mm rounded
+square with 1 mm corners (diagonal 2 √2 x 9 + 2 = 27.46 mm) was "OK" under the 22 mm guidance.  The
+outline's diameter is now exact (lines, arcs: :attr:`PlanOutline.diameter`); checked against closed
+forms and against dense samples of random outlines.  Core only.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from tabletcad.families.outline import outline_from_items
+from tabletcad.pipeline.design import Design
+from tabletcad.pipeline.designreport import design_report
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _outline(tablet: dict):
+    return Design.from_dict({"tablet": tablet}).build().nominal.outline
+
+
+def _sampled(outline, n: int = 3000) -> float:
+    from scipy.spatial import ConvexHull
+
+    xy = outline.point(np.linspace(0.0, math.tau, n, endpoint=False))
+    xy = xy[ConvexHull(xy).vertices]
+    return float(np.max(np.linalg.norm(xy[:, None, :] - xy[None, :, :], axis=2)))
+
+
+@pytest.mark.parametrize("tablet, exact", [
+    (dict(family="rounded_square", side=20.0, corner_radius=1.0, band=3.0, cup_depth=0.5), 2 * math.hypot(9, 9) + 2),
+    (dict(family="rounded_rectangle", length=21.5, width=9.0, corner_radius=0.5, band=3.0, cup_depth=0.3),
+     2 * math.hypot(10.25, 4.0) + 1.0),
+    (dict(family="capsule", length=19.0, width=8.0, band=3.0, cup_depth=1.0), 19.0),
+    (dict(family="oval", length=12.0, width=7.0, end_radius=2.0, band=3.0, cup_depth=0.5), 12.0),
+    (dict(family="concave_round", diameter=10.0, band=3.0, cup_depth=1.0), 10.0),
+])
+def test_diameter_closed_forms(tablet, exact):
+    assert _outline(tablet).diameter == pytest.approx(exact, rel=1e-14)
+
+
+@pytest.mark.parametrize("sample", sorted((ROOT / "samples" / "families").glob("*.toml")), ids=lambda p: p.stem)
+def test_diameter_of_every_family_sample_against_dense_samples(sample):
+    o = Design.from_toml(sample).build().nominal.outline
+    d, s = o.diameter, _sampled(o)
+    assert s <= d * (1 + 1e-12) and d - s <= 2e-5 * d  # 3,000 samples: a step of ~0.02 mm
+
+
+@settings(max_examples=40, deadline=None)
+@given(side=st.floats(6.0, 20.0), r=st.floats(0.3, 0.45), stretch=st.floats(1.0, 2.5), turn=st.floats(0.0, math.pi))
+def test_diameter_of_random_rotated_rounded_rectangles(side, r, stretch, turn):
+    """A rounded rectangle turned by ``turn``: the diameter is the turned one's (2 |c| + 2 r for the
+    corner centres c), whatever the direction, and no dense sample exceeds it."""
+    L, W, rc = side * stretch, side, r * side
+    c, sn = math.cos(turn), math.sin(turn)
+    segs = []
+    corners = [(L / 2 - rc, W / 2 - rc), (-L / 2 + rc, W / 2 - rc), (-L / 2 + rc, -W / 2 + rc), (L / 2 - rc, -W / 2 + rc)]
+    rot = lambda x, y: (c * x - sn * y, sn * x + c * y)  # noqa: E731
+    for k, (cx, cy) in enumerate(corners):
+        a0 = 0.5 * math.pi * k + turn
+        segs.append(("arc", rot(cx, cy), rc, a0, 0.5 * math.pi))
+        nx, ny = corners[(k + 1) % 4]
+        a1 = a0 + 0.5 * math.pi
+        p0 = (rot(cx, cy)[0] + rc * math.cos(a1), rot(cx, cy)[1] + rc * math.sin(a1))
+        p1 = (rot(nx, ny)[0] + rc * math.cos(a1), rot(nx, ny)[1] + rc * math.sin(a1))
+        segs.append(("line", p0, p1))
+    o = outline_from_items(segs)
+    exact = 2 * math.hypot(L / 2 - rc, W / 2 - rc) + 2 * rc
+    assert o.diameter == pytest.approx(exact, rel=1e-12)
+    assert o.diameter * (1 - 1e-4) <= _sampled(o, 2000) <= o.diameter * (1 + 1e-12)
+
+
+def test_the_fda_size_line_reads_the_diagonal():
+    rep = design_report(Design.from_dict({"tablet": dict(family="rounded_square", side=20.0, corner_radius=1.0,
+                                                           band=3.0, cup_depth=0.5)}).build())["design_report"]
+    fda = rep["fda_size"]
+    assert fda["largest_dimension_mm"] == pytest.approx(2 * math.hypot(9, 9) + 2, rel=1e-14) and fda["ok"] is False
+    assert rep["length_mm"] == rep["width_mm"] == 20.0  # the extents stay what they are
+
+
+def test_a_shape_design_report_samples_the_plan_diameter():
+    """A tablet without a family outline (free-form, the thesis's shapes not of revolution) takes the
+    largest distance between its surface samples in plan: never above the extents' diagonal, and the
+    stadium's length when it lies along the axes."""
+    from tabletcad.pipeline.designreport import _sampled_plan_diameter, shape_design_report
+
+    t = Design.from_toml(ROOT / "samples" / "free_form_stadium.toml").build()
+    d = _sampled_plan_diameter(t)
+    dims = t.dimensions()
+    assert dims["length_mm"] * (1 - 1e-4) <= d <= dims["length_mm"] * (1 + 1e-12)
+    assert shape_design_report(t)["fda_size"]["largest_dimension_mm"] == dims["length_mm"]
+    assert _sampled_plan_diameter(Design.from_toml(ROOT / "samples" / "flat_faced_round.toml").build()) is None
