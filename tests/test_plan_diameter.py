@@ -97,3 +97,20 @@ def test_a_shape_design_report_samples_the_plan_diameter():
     assert dims["length_mm"] * (1 - 1e-4) <= d <= dims["length_mm"] * (1 + 1e-12)
     assert shape_design_report(t)["fda_size"]["largest_dimension_mm"] == dims["length_mm"]
     assert _sampled_plan_diameter(Design.from_toml(ROOT / "samples" / "flat_faced_round.toml").build()) is None
+
+
+@pytest.mark.parametrize("name", ["caplet", "deep_convex_oval"])
+def test_an_ellipse_section_tablets_diameter_agrees_with_its_samples(name):
+    """The thesis's ovals and caplet (scaled copies of one plan ellipse): ``2 R_max σ_max(N)`` against the
+    largest distance between 33 x 256 samples of every patch (an independent computation)."""
+    from scipy.spatial import ConvexHull
+
+    from tabletcad.pipeline.designreport import _sampled_plan_diameter
+
+    t = Design.from_toml(ROOT / "samples" / f"{name}.toml").build()
+    assert t.section is not None
+    xy = t.sample(33, 256)[..., :2].reshape(-1, 2)
+    xy = xy[ConvexHull(xy).vertices]
+    sampled = float(np.max(np.linalg.norm(xy[:, None, :] - xy[None, :, :], axis=2)))
+    d = _sampled_plan_diameter(t)
+    assert sampled <= d * (1 + 1e-12) and d - sampled <= 1e-4 * d

@@ -474,11 +474,20 @@ def shape_design_report(tablet: Tablet, opts: ReportOptions | None = None) -> di
 
 
 def _sampled_plan_diameter(tablet: Tablet) -> float | None:
-    """The largest distance (mm) between two of the surface's points in plan, from a 33 x 256 sample of
-    every patch (None for a tablet of revolution, whose diameter is its extent): a free-form design need
-    not lie along the axes.  Low by at most the square of the sample step over the curvature radius."""
-    if tablet.revolution is not None:
+    """The largest distance (mm) between two of the surface's points in plan: a free-form design need
+    not lie along the axes.  None for a tablet of revolution or a cut-away (the extents say it).  A
+    tablet whose patches are scaled copies of one centred plan ellipse (the thesis's ovals and caplet:
+    ``(x, y) = R(u) N (cos v, sin v)``) has ``2 R_max σ_max(N)``, its extent along x being ``2 R_max
+    |Nᵀ x|``; any other, a 33 x 256 sample of every patch, low by at most the square of the sample
+    step over the curvature radius."""
+    if tablet.revolution is not None or not tablet.trim.whole:
         return None
+    sec = tablet.section
+    if sec is not None:
+        N = np.asarray(sec[0].plan, dtype=float).T
+        (lo, hi) = tablet.bounds()
+        r_max = max(float(hi[k] - lo[k]) / (2.0 * float(np.linalg.norm(N[k]))) for k in (0, 1) if np.linalg.norm(N[k]) > 0)
+        return 2.0 * r_max * float(np.linalg.svd(N, compute_uv=False)[0])
     from scipy.spatial import ConvexHull
 
     xy = tablet.sample(33, 256)[..., :2].reshape(-1, 2)
