@@ -313,3 +313,23 @@ def test_a_unit_for_a_column_the_record_lacks_is_refused(capsys):
     assert err.startswith("error: --time-unit = 'ms' is not allowed: is for a time column, which "
                           "lactose_appendix_b.csv has none of (columns: force_N, displacement_mm,"), err
     assert main(args + ["--force-unit", "N"]) == 0  # a unit for a column it has is read
+
+
+def test_every_report_states_the_same_units(capsys):
+    """``report.json`` of a build and ``tabletcad report --json`` name the same units (the build's had
+    only length, area, volume and angle beside a weight in mg and a strength in MPa); the tensile
+    strength's "almond" plan takes "an"."""
+    import json as _json
+
+    from tabletcad.cli import main as _main
+    from tabletcad.pipeline.design import Design as _Design
+    from tabletcad.pipeline.report import REPORT_UNITS, geometry_report
+
+    d = _Design.from_toml(ROOT / "samples" / "families" / "almond.toml")
+    rep = geometry_report(d.build(), d.report_options)
+    assert rep["units"] == REPORT_UNITS and REPORT_UNITS["mass"] == "mg" and REPORT_UNITS["stress"] == "MPa"
+    assert _main(["report", str(ROOT / "samples" / "families" / "almond.toml"), "--json", "--breaking-force", "100"]) == 0
+    payload = _json.loads(capsys.readouterr().out)
+    assert payload["units"] == REPORT_UNITS
+    flags = payload["design_report"]["tensile_strength"]["range_flags"]
+    assert flags == ["no published tensile-strength formula for an almond plan"]

@@ -287,7 +287,7 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
     from tabletcad.cli.outputs import check_output, staged
     from tabletcad.pipeline.designreport import design_report, shape_report
     from tabletcad.families.sweep import SweepNominal
-    from tabletcad.pipeline.report import to_json
+    from tabletcad.pipeline.report import REPORT_UNITS, to_json
 
     for d in designs:
         if d.suffix.lower() == ".json":
@@ -355,8 +355,7 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
             except DesignError as exc:  # a missing [report] input: one token, as above
                 raise exc.renamed(one_token(exc.parameter)) from None
         payload = dict(design=dict(name=tablet.name, file=str(design), family=tablet.family, params=dict(tablet.params)),
-                       units=dict(length="mm", area="mm2", volume="mm3", angle="deg", force="N (kN where named)",
-                                  stress="MPa", mass="mg"),
+                       units=dict(REPORT_UNITS),
                        **({"inverse": inverse} if inverse is not None else {}), **sec)
         json.loads(to_json(payload))  # fail before writing if not serialisable
         payloads.append(payload)

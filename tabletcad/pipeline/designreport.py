@@ -251,7 +251,7 @@ def tensile_strength(info: dict, thickness: float, F: float) -> dict[str, Any]:
                 val, formula = st.pitt_heasley_elongated_convex(F, D, thickness, band, length=Ln), "eq 2.9: Pitt & Heasley (2013), convex elongated, 2/3 of eq 2.7"
         else:
             return dict(tensile_strength_MPa=None, formula=None, breaking_force_N=F,
-                        range_flags=[f"no published tensile-strength formula for a {shape} plan"])
+                        range_flags=[f"no published tensile-strength formula for {'an' if shape[:1] in 'aeiou' else 'a'} {shape} plan"])
     if refused:
         return refused[0]
     flags += [str(w.message) for w in rec]

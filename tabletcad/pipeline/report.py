@@ -14,6 +14,10 @@ from tabletcad.geometry.tablet import Tablet
 
 __all__ = ["geometry_report", "to_json", "flatten_report"]
 
+#: the units of a report's figures (its keys also carry them: ``volume_mm3``, ``weight_mg``)
+REPORT_UNITS = dict(length="mm", area="mm2", volume="mm3", angle="deg", force="N (kN where named)", stress="MPa",
+                    mass="mg")
+
 def geometry_report(tablet: Tablet, options: ReportOptions | None = None) -> dict[str, Any]:
     """Volume, area, dimensions, per-patch figures, seams and nominal deviation.
 
@@ -48,7 +52,7 @@ def geometry_report(tablet: Tablet, options: ReportOptions | None = None) -> dic
     v = props["volume_mm3"]
     a = props["surface_area_mm2"]
     rep: dict[str, Any] = dict(
-        units=dict(length="mm", area="mm2", volume="mm3", angle="deg"),
+        units=dict(REPORT_UNITS),
         design=dict(name=tablet.name, family=tablet.family, params=dict(tablet.params)),
         trim=dict(u=list(tablet.trim.u), v_rad=list(tablet.trim.v), w=list(tablet.trim.w)),
         volume_mm3=v,
