@@ -29,6 +29,9 @@ from tabletcad.families.outline import four_arc_oval, stadium_outline
         (lambda: F.rounded_triangle(10, 1.5, cup_width=2.0), "cup_width", "<= 1.5 mm"),
         (lambda: F.rounded_triangle(10, 3.5), "corner_radius", "< 2.88675"),
         (lambda: F.oval(12, 7, 4.0), "end_radius", "<= 3.5 mm"),
+        # as wide as long: a circle, whose end arcs vanish (it was refused as "outline = 'segment 0 of length 0'")
+        (lambda: F.oval(8, 8, 3.0), "width", "must be < length = 8 mm for ends of radius 3 mm"),
+        (lambda: F.almond(8, 8, 1.0), "width", "must be < length = 8 mm for ends of radius 1 mm"),
         (lambda: F.modified_capsule(18, 8, side_radius=5.0), "side_radius", "> length/2"),
         (lambda: F.outline_tablet([[0, 0], [4, 4], [4, 0], [0, 4]]), "outline", "must not cross itself"),
         (lambda: F.outline_tablet([("line", (0, 0), (4, 0)), ("line", (4, 0), (4, 4)), ("line", (4, 4), (0, 0))]), "outline", "tangent-continuous"),

@@ -695,6 +695,9 @@ def four_arc_oval(length: float, width: float, end_radius: float) -> PlanOutline
     r = check_range("end_radius", end_radius, 0.0, W / 2.0, "mm", lo_open=True)
     if abs(r - W / 2.0) <= 1e-12 * W:
         return stadium_outline(L, W)
+    if not W < L * (1.0 - 1e-12):  # the side arcs are then the circle of diameter W: no end arcs are left
+        raise DesignError("width", W, f"must be < length = {L:g} mm for ends of radius {r:g} mm (an oval as wide as it "
+                          "is long is a circle, with no end arcs; or give end_radius = width/2)", "mm")
     hx = L / 2.0 - r
     Rs = (hx * hx + W * W / 4.0 - r * r) / (W - 2.0 * r)
     if Rs <= r:
