@@ -333,3 +333,23 @@ def test_every_report_states_the_same_units(capsys):
     assert payload["units"] == REPORT_UNITS
     flags = payload["design_report"]["tensile_strength"]["range_flags"]
     assert flags == ["no published tensile-strength formula for an almond plan"]
+
+
+def test_a_concave_bevels_report_gives_both_cup_depths(capsys):
+    """Its ``cup_depth`` is measured from the bevel's inner edge; the report's cup depth from the band
+    (adding the bevel's depth ``w tan(angle)``), and it names the design's figure beside it."""
+    import tomllib
+
+    from tabletcad.cli import main as _main
+    from tabletcad.pipeline.design import Design as _Design
+    from tabletcad.pipeline.designreport import design_report
+
+    path = ROOT / "samples" / "families" / "concave_bevel.toml"
+    tab = tomllib.loads(path.read_text())["tablet"]
+    rep = design_report(_Design.from_toml(path).build())["design_report"]
+    below = tab["bevel_width"] * math.tan(math.radians(tab["bevel_angle"]))
+    assert rep["params"]["cup_depth_below_bevel_mm"] == tab["cup_depth"]
+    assert rep["cup_depth_mm"] == pytest.approx(tab["cup_depth"] + below, rel=1e-14)
+    assert _main(["report", str(path)]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("cup depth"))
+    assert line.endswith(f"(from the band; {tab['cup_depth']:g} mm below the bevel: the design's cup_depth)")

@@ -90,7 +90,9 @@ def _table(name: str, sec: dict[str, Any]) -> str:
                                        + _nominal_note(r)),
         ("band (wall) height", _fmt(r["band_mm"], "mm")),
         ("land", _fmt(r["land_mm"], "mm")),
-        ("cup depth", _fmt(r["cup_depth_mm"], "mm")),
+        ("cup depth", _fmt(r["cup_depth_mm"], "mm") + (
+            f" (from the band; {_fmt(r['params']['cup_depth_below_bevel_mm'], 'mm')} below the bevel: the design's cup_depth)"
+            if "cup_depth_below_bevel_mm" in (r.get("params") or {}) else "")),
         ("cup radius" if len(r.get("cup_radii_mm") or {}) <= 1 else "cup radii", _cup_radii(r)),
         ("shape factor (cup depth / width)", _fmt(r["shape_factor"])),
         ("volume", _fmt(r["volume_mm3"], "mm3")),

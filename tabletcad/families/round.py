@@ -145,5 +145,6 @@ def concave_bevel(diameter: float = 10.0, band: float = 2.5, cup_depth: float = 
     cup = single_radius_cup(w, R, cup_depth, z0=dep)
     return _round("concave_bevel", D, [bev, cup], b,
                   dict(diameter=D, band=b, cup_depth=float(cup_depth), bevel_angle=ang, bevel_width=w),
-                  dict(face="convex", cup_depth_mm=dep + float(cup_depth), land_mm=0.0, bevel_width_mm=w,
+                  dict(face="convex", cup_depth_mm=dep + float(cup_depth), cup_depth_below_bevel_mm=float(cup_depth),
+                       land_mm=0.0, bevel_width_mm=w,
                        bevel_depth_mm=dep, bevel_angle_deg=ang, cup_radius_mm=cup.radius), a, tol)
