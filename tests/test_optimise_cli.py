@@ -52,3 +52,27 @@ def test_bad_input_exit_2_nothing_written(tmp_path, capsys):
                    '[variables]\ndiameter = { lower = 5, upper = 4 }\n')
     assert main(["optimise", str(bad), "--out", str(out), "--quiet"]) == 2
     assert not out.exists()
+
+
+def test_a_run_cut_short_by_maxiter_is_not_called_infeasible(tmp_path, capsys):
+    """``--maxiter 1`` on a feasible problem (the smallest area of a 235 mm³ flat round, D = T = 6.6885 mm)
+    stops at an infeasible point: "not_converged", naming the limit, never "no feasible design found"."""
+    import json as _json
+
+    from tabletcad.cli import main as _main
+
+    p = tmp_path / "p.toml"
+    p.write_text('[problem]\nkind = "family"\nfamily = "flat_face_round"\nsense = "min"\nobjective = "surface_area_mm2"\n'
+                 '[variables]\ndiameter = { lower = 4.0, upper = 14.0, initial = 10.0 }\n'
+                 'thickness = { lower = 1.0, upper = 10.0, initial = 3.0 }\n'
+                 '[[constraint]]\nquantity = "volume_mm3"\ntarget = 235.0\nrelative = true\n', encoding="utf-8")
+    assert _main(["optimise", str(p), "--out", str(tmp_path / "o"), "--maxiter", "1", "--quiet"]) == 3
+    out, err = capsys.readouterr()
+    rep = _json.loads((tmp_path / "o" / "report.json").read_text())
+    assert rep["status"] == "not_converged" and "no feasible design found" not in rep["message"]
+    assert "iteration limit" in rep["message"] and "give a larger --maxiter" in rep["message"]
+    assert err.strip().splitlines()[-1].startswith("error: optimisation not_converged")
+    assert _main(["optimise", str(p), "--out", str(tmp_path / "o2"), "--quiet"]) == 0
+    capsys.readouterr()
+    rep = _json.loads((tmp_path / "o2" / "report.json").read_text())
+    assert rep["x"]["diameter"] == pytest.approx(rep["x"]["thickness"], rel=1e-4)  # an exact cylinder's optimum

@@ -91,6 +91,10 @@ class _Scaled:
         return out
 
 
+#: the solvers' default iteration limit; a run given fewer that stops there is "not_converged", not "infeasible"
+DEFAULT_MAXITER = 200
+
+
 def _slsqp(sc: _Scaled, z0, maxiter: int, ftol: float, restarts: int = 2):
     """SLSQP, warm-restarted from its own end point (at most ``restarts`` times) when it stops
     without success, with a constraint still violated (e.g. "positive directional derivative
@@ -200,7 +204,7 @@ def solve(
     method: str = "SLSQP",
     *,
     x0: dict | None = None,
-    maxiter: int = 200,
+    maxiter: int = DEFAULT_MAXITER,
     ftol: float = 1e-9,
     fd_step: float = FD_STEP,
     fd_scheme: str = "forward",
@@ -278,7 +282,8 @@ def solve(
             runner = _slsqp if method == "SLSQP" else _trust_constr
             res, ok, nit, msg = runner(sc, z0, maxiter, ftol)
             z, ok, msg = _land(ev, res.x, ok, msg)
-            return _finish(problem, ev, z, method, ok, nit, t0, sc.history, msg, starts=1, bar=bar)
+            return _finish(problem, ev, z, method, ok, nit, t0, sc.history, msg, starts=1, bar=bar,
+                           capped=maxiter < DEFAULT_MAXITER)
 
         if method == "multistart":
             from scipy.stats import qmc
@@ -301,7 +306,8 @@ def solve(
                     best = (cand, z, ok, msg, sc.history)
             (_, _, kbest), z, ok, msg, hist = best
             return _finish(problem, ev, z, method, ok, total_it, t0, hist,
-                           f"best of {len(pts)} starts (start {kbest}): {msg}", starts=len(pts), bar=bar)
+                           f"best of {len(pts)} starts (start {kbest}): {msg}", starts=len(pts), bar=bar,
+                           capped=maxiter < DEFAULT_MAXITER)
 
         # differential evolution + SLSQP polish
         from scipy.optimize import differential_evolution
@@ -323,19 +329,35 @@ def solve(
         res, ok, nit, msg = _slsqp(sc, de.x, maxiter, ftol)
         z, ok, msg = _land(ev, res.x, ok, msg)
         return _finish(problem, ev, z, method, ok, gen[0] + nit, t0, sc.history,
-                       f"differential evolution: {de.message}; SLSQP polish: {msg}", starts=1, bar=bar)
+                       f"differential evolution: {de.message}; SLSQP polish: {msg}", starts=1, bar=bar,
+                       capped=maxiter < DEFAULT_MAXITER)
     finally:
         if bar is not None:
             bar.close()
 
 
+_LIMIT_WORDS = ("iteration limit", "maximum number of iterations", "maximum number of function evaluations",
+                "maxiter", "max_nfev", "maximum number of generations")
+
+
+def _stopped_by_limit(message: str) -> bool:
+    """Whether a solver's message says it stopped at an iteration or evaluation limit (scipy's wordings)."""
+    m = message.lower()
+    return any(w in m for w in _LIMIT_WORDS)
+
+
 def _finish(problem: Problem, ev: Evaluator, z, method: str, solver_ok: bool, nit: int, t0: float,
-            history: list, solver_msg: str, *, status: str | None = None, starts: int = 1, bar=None) -> Result:
+            history: list, solver_msg: str, *, status: str | None = None, starts: int = 1, bar=None,
+            capped: bool = False) -> Result:
     r, vals = ev.assess(np.clip(np.asarray(z, float), 0.0, 1.0))
     bad = [v for v in vals if not v.satisfied]
+    # a run given fewer iterations than the default that stops at its limit: cut short by its caller
+    stopped = capped and not solver_ok and _stopped_by_limit(solver_msg)
     if status is None:
         if not r["ok"]:
             status = "build_failed"
+        elif bad and stopped:  # cut short (--maxiter): its last point says nothing of the problem's feasibility
+            status = "not_converged"
         elif bad:
             status = "infeasible"
         elif not solver_ok:
@@ -358,6 +380,11 @@ def _finish(problem: Problem, ev: Evaluator, z, method: str, solver_ok: bool, ni
         message = "no feasible design found; " + "; ".join(parts) + f" [solver: {solver_msg}]"
     elif status == "build_failed":
         message = solver_msg if solver_msg.startswith("design cannot") else f"design cannot be built: {r['error'] or ev.last_error}"
+    elif status == "not_converged" and bad:
+        worst = max(bad, key=lambda c: c.relative_violation)
+        message = (f"solver stopped at its iteration limit before converging: {solver_msg} (the last point violates "
+                   f"constraint '{worst.name}' by {worst.relative_violation:.3g} relative; not a proof that no "
+                   "feasible design exists: give a larger --maxiter)")
     elif status == "not_converged":
         message = f"solver did not converge: {solver_msg} (the last point satisfies the constraints but is not certified optimal)"
     else:
