@@ -214,3 +214,35 @@ def test_a_dimension_wrong_only_with_the_varied_values_or_varied_itself_is_left_
     base = {"tablet": {**BASE["tablet"], "land": -0.08}}
     spec = parse_sweep({"design": base, "sweep": {"vary": {"tablet.land": [-0.08, 0.08]}}})
     assert [d["tablet"]["land"] for d in spec.designs()] == [-0.08, 0.08]
+
+
+@pytest.mark.parametrize("table, line", [
+    ("[design.report]\nweigth = 1\n", "error: design.report.weigth = 1 is not allowed: allowed keys are solid_fraction"),
+    ("[design.report]\nsolid_fraction = 1.5\ntrue_density_mg_mm3 = 1.5\n",
+     "error: design.report.solid_fraction = 1.5 is not allowed: must be > 0 and <= 1"),
+    ("[design.tooling]\nclearance_mm = -1\n", "error: design.tooling.clearance_mm = -1 mm is not allowed: must be >= 0"),
+])
+def test_a_fixed_report_or_tooling_value_no_design_could_take_is_refused_before_the_sweep(tmp_path, capsys, table, line):
+    """A ``[design.report]`` or ``[design.tooling]`` key the sweep does not vary, wrong in every design
+    (a misspelled key, a solid fraction of 1.5): one line, exit 2, no folder (every row had failed, exit 0)."""
+    p = tmp_path / "s.toml"
+    p.write_text(textwrap.dedent("""
+        [design.tablet]
+        family = "concave_round"
+        diameter = 10.0
+        band = 2.8
+        cup_depth = 0.9
+        """) + table + '[sweep.vary]\n"tablet.cup_depth" = [0.8, 0.9]\n', encoding="utf-8")
+    out = tmp_path / "out"
+    assert main(["sweep", str(p), "--out", str(out), "--workers", "1", "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(line), err
+    assert not out.exists()
+
+
+def test_a_report_value_the_sweep_varies_is_left_to_its_rows():
+    base = {"tablet": BASE["tablet"], "report": {"solid_fraction": 1.5, "true_density_mg_mm3": 1.5}}
+    spec = parse_sweep({"design": base, "sweep": {"vary": {"report.solid_fraction": [0.8, 1.5]}}})
+    assert [d["report"]["solid_fraction"] for d in spec.designs()] == [0.8, 1.5]
+    spec = parse_sweep({"design": base, "sweep": {"vary": {"report.solid_fraction": [1.5, 0.8]}}})
+    assert len(spec.designs()) == 2

@@ -203,6 +203,27 @@ def _check_fixed_dimensions(design: dict, varied: set[str]) -> None:
                                   "so every design would be refused)", "mm")
 
 
+def _check_fixed_tables(design: dict, axes) -> None:
+    """Refuse what a design's ``[report]`` and ``[tooling]`` tables say wrong (an unknown key, a solid
+    fraction of 1.5) when the sweep does not vary it: every row would fail with it.  The tables are
+    read as each design reads them (:class:`~tabletcad.pipeline.design.Design`, no geometry), with
+    every varied key at its first value; an error about a varied key is left to the rows."""
+    import copy
+
+    from tabletcad.pipeline.design import Design
+
+    first = copy.deepcopy(design)
+    for a in axes:
+        set_key(first, a.key, a.values[0] if a.values else a.lo)
+    try:
+        Design.from_dict(first)
+    except DesignError as exc:
+        varied = any(exc.parameter == a.key or exc.parameter.startswith(a.key + ".") or
+                     exc.parameter.startswith(a.key + "[") for a in axes)
+        if exc.parameter.split(".")[0].split("[")[0] in ("report", "tooling") and not varied:
+            raise exc.renamed(f"design.{exc.parameter}") from None
+
+
 def _known_keys(design: dict) -> set[str]:
     """Dotted keys that may be varied: every scalar of the base design, and the family's parameters."""
     keys: set[str] = set()
@@ -342,5 +363,6 @@ def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
     if method == "grid" and math.prod(len(a.values) for a in axes) > MAX_DESIGNS:
         raise DesignError("[sweep.vary]", " x ".join(str(len(a.values)) for a in axes),
                           f"must give at most {MAX_DESIGNS:,} designs (the grid's product)")
+    _check_fixed_tables(design, axes)
     return SweepSpec(design=design, axes=tuple(axes), method=method, samples=samples, seed=seed,
                      outputs=tuple(dict.fromkeys(["report", *outputs])), store=store, name=name)
