@@ -82,7 +82,8 @@ def open_client(workers: int | None = None, scheduler: str | None = None,
             # 8787 (taken by another sweep or notebook: "Port 8787 is already in use" on every run)
             cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                                    scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
-                                   silence_logs=logging.ERROR)
+                                   silence_logs=logging.ERROR,
+                                   preload=["tabletcad.worker_setup"])  # workers ignore the terminal's Ctrl-C
     finally:
         if inherited is not None:
             os.environ["MALLOC_TRIM_THRESHOLD_"] = inherited

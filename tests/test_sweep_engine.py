@@ -315,3 +315,31 @@ def test_a_local_cluster_takes_no_fixed_port():
         held.close()
     assert not [w for w in caught if "already in use" in str(w.message)]
     assert link.startswith("http://127.0.0.1:") and ":8787/" not in link
+
+
+def test_a_ctrl_c_at_the_terminal_ends_a_sweep_with_one_line(tmp_path):
+    """A terminal's Ctrl-C reaches the whole process group: the workers ignore it (``worker_setup``) and
+    the command line stops the sweep, ``interrupted`` and 130, the journal kept; the workers' tracebacks
+    (30-45 lines after ``interrupted``) are gone.  Sent once designs are finishing."""
+    import os
+    import signal
+    import time
+
+    text = (ROOT / "samples" / "sweep" / "concave_round_lhs.toml").read_text()
+    sweep = tmp_path / "s.toml"
+    sweep.write_text(text.replace("samples = 40", "samples = 3000"), encoding="utf-8")
+    assert "samples = 3000" in sweep.read_text()
+    out = tmp_path / "out"
+    p = subprocess.Popen([sys.executable, "-m", "tabletcad", "sweep", str(sweep), "--out", str(out), "--workers", "1",
+                          "--quiet"], cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)},
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    journal = out / JOURNAL
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < 120 and not (journal.exists() and journal.stat().st_size > 0):
+        time.sleep(0.2)
+    assert journal.exists(), p.communicate(timeout=60)
+    time.sleep(1.0)
+    os.killpg(p.pid, signal.SIGINT)
+    _, err = p.communicate(timeout=120)
+    assert (p.returncode, err) == (130, "interrupted\n")
+    assert journal.stat().st_size > 0
