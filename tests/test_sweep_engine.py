@@ -343,3 +343,19 @@ def test_a_ctrl_c_at_the_terminal_ends_a_sweep_with_one_line(tmp_path):
     _, err = p.communicate(timeout=120)
     assert (p.returncode, err) == (130, "interrupted\n")
     assert journal.stat().st_size > 0
+
+
+def test_a_resume_asking_for_files_an_earlier_run_did_not_write_builds_them(tmp_path):
+    """The outputs are not part of a design's hash: a resume that adds ``stl`` to a report-only run
+    builds each finished design again for its file (it had counted them done and written none)."""
+    pytest.importorskip("OCP")
+    base = {"tablet": {"family": "flat_face_round", "diameter": 8.0, "thickness": 3.0}}
+    vary = {"tablet.thickness": [2.0, 4.0]}
+    out = tmp_path / "o"
+    run_sweep({"design": base, "sweep": {"vary": vary}}, out, workers=0, progress=False)
+    assert not (out / "designs").exists()
+    df = run_sweep({"design": base, "sweep": {"vary": vary, "outputs": ["report", "stl"]}}, out, workers=0,
+                   progress=False, resume=True)
+    stls = sorted(out.glob("designs/*/tablet.stl"))
+    assert len(stls) == 2 and sorted(p.parent.name for p in stls) == sorted(df["design_hash"])
+    assert list(df["status"]) == ["ok", "ok"]

@@ -86,6 +86,8 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
         if foreign:
             raise DesignError("--resume", str(out / RESULTS_CSV),
                               f"holds {len(foreign)} designs that are not in this sweep file; use another --out folder")
+        if files_wanted:  # outputs asked for now that an earlier run did not write: those designs run again
+            done = {h: r for h, r in done.items() if r.get("status") != "ok" or _has_files(out, store, h, spec.outputs)}
     elif out is not None and out.is_dir():  # a first run into a used folder: it owns only what it writes
         theirs = [n for n in plot_names(plot) if (out / n).exists()]
         if files_wanted and (out / "designs").exists():
@@ -146,6 +148,20 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
                     "of results.csv:", f"of results.csv (the results are in {out / RESULTS_CSV}: plot one with "
                     "--resume):", 1)) from None
     return df
+
+
+def _has_files(out: Path, store: str | None, key: str, outputs) -> bool:
+    """Whether the files of ``outputs`` of the design ``key`` are where this run would write them
+    (``out/designs/key/``, or ``store/key/``)."""
+    from tabletcad.sweep.spec import OUTPUTS
+
+    names = [f for o in outputs for f in OUTPUTS[o]]
+    if store is None:
+        return all((out / "designs" / key / n).is_file() for n in names)
+    import fsspec
+
+    fs, root = fsspec.core.url_to_fs(store)
+    return all(fs.exists(f"{root.rstrip('/')}/{key}/{n}") for n in names)
 
 
 def _check_plot_columns(plot: tuple[str, ...], design: dict[str, Any], spec) -> None:
