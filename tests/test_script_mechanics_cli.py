@@ -218,3 +218,14 @@ def test_a_header_unit_of_another_quantity_is_refused(capsys, tmp_path, header, 
     cols = header.split(",")
     rc, out, err = run(capsys, "kawakita", data, "--pressure-column", cols[0], "--thickness-column", cols[1])
     assert rc == 2 and out == "" and len(err.splitlines()) == 1 and err.startswith(line), err
+
+
+def test_an_h0_below_the_compacts_is_named_as_the_option(capsys, tmp_path):
+    """``--h0`` thinner than every compact leaves no volume reduction: the option is named (it was
+    ``data = '0 points with volume reduction'``)."""
+    h = H0 * (1 - A * B * P / (1 + B * P))
+    data = _write(tmp_path / "k.csv", "pressure_MPa,thickness_mm", (P, h))
+    rc, out, err = run(capsys, "kawakita", data, "--h0", 0.5)
+    assert rc == 2 and out == ""
+    assert err == (f"error: --h0 = 0.5 mm is not allowed: must exceed the thickness at 3 or more of the fitted "
+                   f"pressures (it exceeds 0 of them; the thinnest compact is {h.min():.6g} mm)\n")

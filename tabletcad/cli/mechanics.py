@@ -256,7 +256,12 @@ def _compression_command(name: str, fit_name: str, describe, doc: str):
             f"{data.name}: loading rows {a + 1}-{b} of {len(t['P'])} used (up to the peak pressure; "
             f"the rows after it unload or reload the compact)"]
         with _collect() as msgs:
-            fit = getattr(kawakita, fit_name)(t["P"][a:b], t["h"][a:b], window=window, h0=h0)
+            try:
+                fit = getattr(kawakita, fit_name)(t["P"][a:b], t["h"][a:b], window=window, h0=h0)
+            except DesignError as exc:  # the function's names for the options: as given
+                if exc.parameter in ("h0", "window"):
+                    raise exc.renamed(f"--{exc.parameter}") from None
+                raise
         lo, hi = fit.window_MPa
         _finish(fit.to_dict() | {"data": str(data), "loading_rows": [a + 1, b], "warnings": msgs}, as_json, json_file,
                 lines + [f"{name} over {lo:.4g}-{hi:.4g} MPa (n = {fit.n_points}, h0 = {fit.h0:.4g} mm): {describe(fit)}"])

@@ -117,11 +117,15 @@ def fit_kawakita(pressure, thickness, *, window: tuple[float, float] | None = No
 
     Points with ``C <= 0`` (no volume reduction yet) are skipped.
     """
+    given = h0 is not None
     P, h, h0 = _prepare(pressure, thickness, window, h0)
     C = (h0 - h) / h0
     keep = C > 0
     P, C = P[keep], C[keep]
     if P.size < 3:
+        if given:  # the reference thickness the user gave is below the compact's: no reduction to fit
+            raise DesignError("h0", h0, f"must exceed the thickness at 3 or more of the fitted pressures "
+                              f"(it exceeds {P.size} of them; the thinnest compact is {float(np.min(h)):.6g} mm)", "mm")
         raise DesignError("data", f"{P.size} points with volume reduction", "need >= 3")
     y = P / C
     slope, icpt = np.polyfit(P, y, 1)
