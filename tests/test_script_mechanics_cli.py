@@ -229,3 +229,15 @@ def test_an_h0_below_the_compacts_is_named_as_the_option(capsys, tmp_path):
     assert rc == 2 and out == ""
     assert err == (f"error: --h0 = 0.5 mm is not allowed: must exceed the thickness at 3 or more of the fitted "
                    f"pressures (it exceeds 0 of them; the thinnest compact is {h.min():.6g} mm)\n")
+
+
+@pytest.mark.parametrize("args, line", [
+    (["podczeck", "--force", 100, "--diameter", 10, "--thickness", 4, "--band", 2, "--face-radius", 1],
+     "error: --face-radius = 1 mm is not allowed: must be >= diameter/2 = 5 mm (a face of radius R spans at most 2R)"),
+    (["elongated-flat", "--force", 100, "--diameter", 6, "--thickness", 3, "--length", 3],
+     "error: --length = 3 mm is not allowed: must be >= the width (the diameter given, 6 mm): the width is the short axis"),
+])
+def test_strength_geometry_that_cannot_exist_is_refused(capsys, args, line):
+    """A face radius below D/2 (no sphere spans the face) or a length below the width: refused, not warned of."""
+    rc, out, err = run(capsys, "strength", *args)
+    assert (rc, out, err) == (2, "", line + "\n")

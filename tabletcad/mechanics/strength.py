@@ -147,6 +147,9 @@ def _check_elongation(name: str, D: float, length: float | None) -> None:
     if length is None:
         return
     L = _length("length", length)
+    if L < D:  # the width is the short axis: a length below it is a swapped pair, not a short tablet
+        raise DesignError("length", L, f"must be >= the width (the diameter given, {D:g} mm): the width is the "
+                          "short axis", "mm")
     if L / D < ELONGATED_RATIO:
         warn(ValidityWarning, f"{name}: length/width = {L / D:.3g} < {ELONGATED_RATIO}; the 2/3 limit is not yet reached")
 
@@ -187,6 +190,9 @@ def podczeck_convex(F: float, D: float, t: float, W: float | None = None, R: flo
     if W is not None:
         _check_convex("Podczeck 2013", D, t, _length("band thickness", W), (0.06, 0.5))
     if R is not None:
+        if _length("face radius", R) < D / 2.0:  # no sphere of that radius spans the face
+            raise DesignError("face radius", R, f"must be >= diameter/2 = {D / 2:g} mm (a face of radius R spans "
+                              "at most 2R)", "mm")
         dr = D / _length("face radius", R)
         if not 0.25 <= dr <= 1.85:
             warn(ValidityWarning, f"Podczeck 2013: D/R = {dr:.3g} is outside 0.25-1.85")
