@@ -338,9 +338,9 @@ def _finish(status: int) -> None:
     registered run (``atexit``: multiprocessing's children joined, logging flushed, thread pools
     shut down), then the process ends without tearing down its modules and objects one by one.
     That teardown only frees memory the system frees anyway, and after a tooling build, with
-    OpenCascade's shapes and meshes alive, it took 0.5-0.6 s of the command's time (``python
-    -c`` runs of the concave round bisect, the same build: 0.55-0.63 s from ``main`` returning to
-    the process's end; 0.07 s with this)."""
+    OpenCascade's shapes and meshes alive, it took 0.5-0.6 s of the command's time (runs of the
+    concave round bisect's build: 0.50-0.63 s from ``main`` returning to the process's end, on an
+    idle and on a loaded machine; 0.06-0.08 s with this)."""
     import atexit
 
     try:
