@@ -161,7 +161,8 @@ def _fmt(value: Any) -> str:
         return f"{value:.6g}" if digits < 300 else f"an integer of {digits} digits"
     text = repr(value) if isinstance(value, str) else str(value)
     text = " ".join(text.split())  # one line, whatever the value holds
-    return text if len(text) <= 80 else f"{text[:60]}...{text[-12:]}"
+    # whole up to 200 characters (a path in a temporary or nested folder), else its start and end
+    return text if len(text) <= 200 else f"{text[:150]}...{text[-40:]}"
 
 
 def check_finite(name: str, value: float, unit: str = "") -> float:

@@ -52,3 +52,13 @@ def test_the_unit_follows_only_a_number(value, message):
 def test_is_number():
     assert all(map(is_number, [0, 1.5, np.float16(1), np.uint8(3), fractions.Fraction(1, 3), decimal.Decimal("2")]))
     assert not any(map(is_number, [True, np.bool_(False), "1", b"1", None, [1], np.array([1.0]), 1j]))
+
+
+def test_a_long_value_is_shown_whole_up_to_200_characters():
+    """A path of a nested or temporary folder is shown whole (it was cut at 80 characters, which made
+    refusals naming pytest's temporary folders depend on its numbering); longer values keep their ends."""
+    path = "/tmp/" + "a" * 180 + "/out"
+    assert str(DesignError("--out", path, "must be a folder")) == f"--out = '{path}' is not allowed: must be a folder"
+    huge = list(range(1000))
+    shown = str(DesignError("x", huge, "must be short")).split(" is not allowed")[0]
+    assert shown.startswith("x = [0, 1, 2") and "..." in shown and shown.endswith("997, 998, 999]") and len(shown) < 200

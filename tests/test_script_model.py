@@ -294,8 +294,8 @@ def test_exporting_onto_a_folder_names_the_folder(tmp_path):
     m = tabletcad.load(ROOT / "samples" / "families" / "concave_round.toml")
     with pytest.raises(DesignError) as e:
         m.export(tmp_path / "x.step")
-    # the folder is the error's value; the line shows it whole up to 80 characters, else its start and end
-    # (a long temporary path made this test depend on pytest's numbering: pytest-119/popen-gw0)
+    # the folder is the error's value; the line shows it whole up to 200 characters, else its start and end
+    # (it was 80: a temporary path of pytest-119/popen-gw0 made this test depend on pytest's numbering)
     assert e.value.parameter == "path" and e.value.value == str(tmp_path / "x.step")
     assert "is a folder" in str(e.value) and "x.step' is not allowed" in str(e.value)
     assert [p.name for p in tmp_path.iterdir()] == ["x.step"] and not any((tmp_path / "x.step").iterdir())
