@@ -114,3 +114,36 @@ def test_an_ellipse_section_tablets_diameter_agrees_with_its_samples(name):
     sampled = float(np.max(np.linalg.norm(xy[:, None, :] - xy[None, :, :], axis=2)))
     d = _sampled_plan_diameter(t)
     assert sampled <= d * (1 + 1e-12) and d - sampled <= 1e-4 * d
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.floats(-50, 50), st.floats(-50, 50)), min_size=1, max_size=60), st.integers(0, 2))
+def test_rotating_calipers_agree_with_every_pair(pts, shape):
+    """The hull's diameter by rotating calipers against the largest of all pairwise distances (random
+    points, points on a circle, points on one line)."""
+    from tabletcad.families.outline import point_set_diameter
+
+    P = np.array(pts, dtype=float)
+    if shape == 1:  # on a circle: every point a hull vertex
+        t = np.linspace(0.0, math.tau, len(P), endpoint=False)
+        P = 7.0 * np.stack([np.cos(t), np.sin(t)], axis=1) + P[:1]
+    elif shape == 2:  # on one line
+        P = P[:, :1] * np.array([[1.0, 0.5]])
+    brute = float(np.max(np.linalg.norm(P[:, None, :] - P[None, :, :], axis=2)))
+    assert point_set_diameter(P) == pytest.approx(brute, rel=1e-12, abs=1e-12)
+
+
+def test_a_point_outline_s_diameter_is_cheap():
+    """A custom outline through points (a periodic spline, 8,192 samples nearly all on its hull): the
+    pairwise distances had taken 3 GB and 7 s; an ellipse's diameter is its major axis."""
+    import tracemalloc
+
+    from tabletcad.families.outline import SplineOutline
+
+    t = np.linspace(0.0, math.tau, 24, endpoint=False)
+    o = SplineOutline(np.stack([6.0 * np.cos(t), 4.0 * np.sin(t)], axis=1))
+    tracemalloc.start()
+    d = o.diameter
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert d == pytest.approx(12.0, rel=1e-3) and peak < 50e6

@@ -488,13 +488,6 @@ def _sampled_plan_diameter(tablet: Tablet) -> float | None:
         (lo, hi) = tablet.bounds()
         r_max = max(float(hi[k] - lo[k]) / (2.0 * float(np.linalg.norm(N[k]))) for k in (0, 1) if np.linalg.norm(N[k]) > 0)
         return 2.0 * r_max * float(np.linalg.svd(N, compute_uv=False)[0])
-    from scipy.spatial import ConvexHull
+    from tabletcad.families.outline import point_set_diameter
 
-    xy = tablet.sample(33, 256)[..., :2].reshape(-1, 2)
-    try:
-        xy = xy[ConvexHull(xy).vertices]
-    except Exception:  # noqa: BLE001 - a degenerate (flat) plan: every point is a candidate
-        pass
-    if len(xy) > 4000:
-        return None
-    return float(np.max(np.linalg.norm(xy[:, None, :] - xy[None, :, :], axis=2)))
+    return point_set_diameter(tablet.sample(33, 256)[..., :2].reshape(-1, 2))
