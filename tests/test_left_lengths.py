@@ -44,8 +44,8 @@ def test_a_sliver_the_dimensions_leave_is_refused_by_report_and_build(tmp_path, 
     with pytest.raises(DesignError) as e:
         Design.from_dict({"tablet": tablet}).build()
     assert str(e.value).startswith(start)
-    assert str(e.value).endswith("what the dimensions leave must be 0 or at least 0.001 mm (Tolerances.min_length, "
-                                 "the least length a design takes)")
+    assert str(e.value).endswith("a part the dimensions leave must be at least 0.001 mm (Tolerances.min_length, "
+                                 "the least length a design takes) or, where the family allows it, none")
     p = tmp_path / "d.toml"
     p.write_text("[tablet]\n" + "".join(f"{k} = {v!r}\n".replace("'", '"') for k, v in tablet.items()), encoding="utf-8")
     for cmd in (["report", str(p)], ["build", str(p), "--out", str(tmp_path / "out")]):

@@ -396,7 +396,9 @@ def test_the_face_area_is_given_once_and_an_option_replaces_the_files(tmp_path):
     with pytest.raises(DesignError) as e:
         read_metadata(both)
     assert str(e.value) == ("face_area = 50 mm² is not allowed: give diameter or face_area, not both "
-                            "(the punch face area is one quantity)")
+                            "(the punch face area is one quantity; or give --diameter or --face-area)")
+    assert read_metadata(both, diameter=10.0).area == pytest.approx(math.pi * 25.0, rel=1e-15)  # an option rescues it
+    assert read_metadata(both, face_area=60.0).area == 60.0
     area = tmp_path / "area.toml"
     area.write_text(text.replace("diameter = 10.0", "face_area = 50.0"), encoding="utf-8")
     assert read_metadata(area).area == 50.0

@@ -232,12 +232,24 @@ def test_an_h0_below_the_compacts_is_named_as_the_option(capsys, tmp_path):
 
 
 @pytest.mark.parametrize("args, line", [
-    (["podczeck", "--force", 100, "--diameter", 10, "--thickness", 4, "--band", 2, "--face-radius", 1],
-     "error: --face-radius = 1 mm is not allowed: must be >= diameter/2 = 5 mm (a face of radius R spans at most 2R)"),
     (["elongated-flat", "--force", 100, "--diameter", 6, "--thickness", 3, "--length", 3],
      "error: --length = 3 mm is not allowed: must be >= the width (the diameter given, 6 mm): the width is the short axis"),
 ])
 def test_strength_geometry_that_cannot_exist_is_refused(capsys, args, line):
-    """A face radius below D/2 (no sphere spans the face) or a length below the width: refused, not warned of."""
+    """A length below the width (the width is the short axis): refused, not warned of.  (A face radius
+    below D/2 is possible: a cup inside a land spans less than D; Podczeck's range warns of it.)"""
     rc, out, err = run(capsys, "strength", *args)
     assert (rc, out, err) == (2, "", line + "\n")
+
+
+@pytest.mark.parametrize("bracket", ["(-)", "[1]", "()", "(dimensionless)"])
+def test_a_bracket_saying_no_unit_is_no_unit(capsys, tmp_path, bracket):
+    """``solid_fraction (-)`` and the like: read as a fraction (the bracket had been refused as an unknown unit)."""
+    Pp = P[1:]
+    sf = 0.6 + 0.35 * (1 - np.exp(-Pp / 80))
+    s = SIGMA0 * np.exp(K * (sf - 1))
+    name = f"solid_fraction {bracket}"
+    data = _write(tmp_path / "p.csv", f"pressure_MPa,{name},tensile_strength_MPa", (Pp, sf, s))
+    rc, out, err = run(capsys, "profiles", data, "--json", "--solid-fraction-column", name)
+    assert rc == 0, err
+    assert json.loads(out)["ryshkewitch_duckworth"]["k"] == pytest.approx(K, rel=1e-9)

@@ -359,3 +359,16 @@ def test_a_resume_asking_for_files_an_earlier_run_did_not_write_builds_them(tmp_
     stls = sorted(out.glob("designs/*/tablet.stl"))
     assert len(stls) == 2 and sorted(p.parent.name for p in stls) == sorted(df["design_hash"])
     assert list(df["status"]) == ["ok", "ok"]
+
+
+def test_a_plot_column_none_in_the_first_design_is_left_to_the_end(tmp_path):
+    """The tensile strength is None where eq 2.7 refuses a design (a band of 0.05 mm) and a number in
+    the others: a --plot of it is not refused before the sweep, whatever the order of the rows."""
+    from tabletcad.sweep.run import _check_plot_columns
+
+    col = "design_report.tensile_strength.tensile_strength_MPa"
+    for bands in ([0.05, 2.8], [2.8, 0.05]):
+        spec = parse_sweep({"design": {"tablet": dict(family="concave_round", diameter=10.0, band=2.8, cup_depth=0.9),
+                                       "report": {"breaking_force_N": 100.0}},
+                            "sweep": {"vary": {"tablet.band": bands}}}, name="s")
+        _check_plot_columns((col,), spec.designs()[0], spec)

@@ -246,3 +246,16 @@ def test_a_report_value_the_sweep_varies_is_left_to_its_rows():
     assert [d["report"]["solid_fraction"] for d in spec.designs()] == [0.8, 1.5]
     spec = parse_sweep({"design": base, "sweep": {"vary": {"report.solid_fraction": [1.5, 0.8]}}})
     assert len(spec.designs()) == 2
+
+
+def test_a_table_the_sweep_varies_is_read_by_its_rows_whatever_the_order():
+    """A tooling standard varied between a standard set and "custom" (which needs its own sizes): the
+    first value does not decide for the whole sweep (it had refused ["custom", "EU"] and taken ["EU", "custom"])."""
+    import tomllib
+    from pathlib import Path
+
+    sample = Path(__file__).resolve().parents[1] / "samples" / "tooling" / "eu_d_oval.toml"
+    design = tomllib.loads(sample.read_text())
+    for order in (["EU", "custom"], ["custom", "EU"]):
+        spec = parse_sweep({"design": design, "sweep": {"vary": {"tooling.standard": order}}})
+        assert [d["tooling"]["standard"] for d in spec.designs()] == order

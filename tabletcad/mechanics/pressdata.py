@@ -695,11 +695,13 @@ def read_metadata(source: str | Path | Mapping[str, Any], **overrides: Any) -> P
     if unknown:  # a misspelled key would silently change the results (an ignored compliance moves K by 15 %)
         raise DesignError(unknown[0], raw[unknown[0]], "is not a metadata key (misspelled?): the keys are "
                           + ", ".join(METADATA_KEYS))
-    if raw.get("diameter") is not None and raw.get("face_area") is not None:  # one would be ignored without a word
-        raise DesignError("face_area", raw["face_area"], "give diameter or face_area, not both (the punch face "
-                          "area is one quantity)", "mm²")
     if overrides.get("diameter") is not None and overrides.get("face_area") is not None:
         raise DesignError("face_area", overrides["face_area"], "give diameter or face_area, not both", "mm²")
+    given = overrides.get("diameter") is not None or overrides.get("face_area") is not None
+    if not given and raw.get("diameter") is not None and raw.get("face_area") is not None:
+        # one would be ignored without a word (an option replaces both)
+        raise DesignError("face_area", raw["face_area"], "give diameter or face_area, not both (the punch face "
+                          "area is one quantity; or give --diameter or --face-area)", "mm²")
     for k, v in overrides.items():
         if v is not None:
             if k in ("diameter", "face_area"):  # the area given another way replaces the file's, either way

@@ -189,10 +189,7 @@ def podczeck_convex(F: float, D: float, t: float, W: float | None = None, R: flo
     t = _length("thickness", t)
     if W is not None:
         _check_convex("Podczeck 2013", D, t, _length("band thickness", W), (0.06, 0.5))
-    if R is not None:
-        if _length("face radius", R) < D / 2.0:  # no sphere of that radius spans the face
-            raise DesignError("face radius", R, f"must be >= diameter/2 = {D / 2:g} mm (a face of radius R spans "
-                              "at most 2R)", "mm")
+    if R is not None:  # (R < D/2 is possible: a cup inside a land spans less than D; the range warns)
         dr = D / _length("face radius", R)
         if not 0.25 <= dr <= 1.85:
             warn(ValidityWarning, f"Podczeck 2013: D/R = {dr:.3g} is outside 0.25-1.85")

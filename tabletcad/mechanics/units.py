@@ -67,6 +67,8 @@ _BRACKET = re.compile(r"[\(\[]\s*([^\)\]]*?)\s*[\)\]]\s*$")
 _TRAILING = re.compile(r"([_\s])([A-Za-zµμ]+|%)\s*$")
 #: words that are units only after an underscore (``time_h``), not after a space (``position in``)
 _NOT_AFTER_SPACE = {"in", "m", "h", "s"}
+#: what a bracket may hold that says "no unit" (``solid_fraction (-)``, ``Ratio [1]``)
+_NO_UNIT = {"", "-", "–", "1", "dimensionless", "unitless", "fraction"}
 
 
 def _normalise(symbol: str) -> str:
@@ -85,7 +87,8 @@ def header_unit(header: str) -> str | None:
     """
     m = _BRACKET.search(header)
     if m:
-        return _normalise(m.group(1))
+        unit = _normalise(m.group(1))
+        return None if unit.lower() in _NO_UNIT else unit
     m = _trailing(header)
     return None if m is None else _normalise(m.group(2))
 

@@ -388,8 +388,8 @@ def _check_left_lengths(tablet: Tablet, family: str, kw: dict, tol: Tolerances =
     for what, length in parts:
         if 0.0 < length < m * (1.0 - 1e-9):  # (3.001 - 2 x 1.5 is 0.000999999999999889: at the least length)
             names = [k for k in _LEFT_BY.get((family, what), ()) if kw.get(k)]
-            left = f"leaves a {what} of {length:.3g} mm: what the dimensions leave must be 0 or at least {m:g} mm " \
-                   "(Tolerances.min_length, the least length a design takes)"
+            left = f"leaves a {what} of {length:.3g} mm: a part the dimensions leave must be at least {m:g} mm " \
+                   "(Tolerances.min_length, the least length a design takes) or, where the family allows it, none"
             if names:
                 raise DesignError(f"tablet.{names[0]}", kw[names[0]], left, "mm")
             raise DesignError("tablet", family, left)

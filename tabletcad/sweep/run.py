@@ -181,11 +181,13 @@ def _check_plot_columns(plot: tuple[str, ...], design: dict[str, Any], spec) -> 
         return
     files = any(o != "report" for o in spec.outputs)
     sections = {c.split(".")[0] for c in cols}
-    numeric = [c for c, v in cols.items() if _plottable(v)]
+    numeric = [c for c, v in cols.items() if _plottable(v) or v is None]
     for o in plot:
         unknown = o not in cols and o.split(".")[0] not in sections and not files
         table = o not in cols and any(c.startswith(o + ".") for c in cols)  # a table of columns, never one
-        text = o in cols and not _plottable(cols[o])  # (a name, a family, a formula: the same type in every row)
+        # text (a name, a family, a formula: text in every row); None (a strength eq 2.7 refused for this
+        # design) may be a number in another: left to the end
+        text = o in cols and isinstance(cols[o], str)
         if o in spec.keys or o in TAIL_COLUMNS or unknown or table or text:
             raise plot_column_error(o, numeric, spec.keys)
 

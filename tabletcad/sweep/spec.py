@@ -204,24 +204,24 @@ def _check_fixed_dimensions(design: dict, varied: set[str]) -> None:
 
 
 def _check_fixed_tables(design: dict, axes) -> None:
-    """Refuse what a design's ``[report]`` and ``[tooling]`` tables say wrong (an unknown key, a solid
-    fraction of 1.5) when the sweep does not vary it: every row would fail with it.  The tables are
-    read as each design reads them (:class:`~tabletcad.pipeline.design.Design`, no geometry), with
-    every varied key at its first value; an error about a varied key is left to the rows."""
-    import copy
-
+    """Refuse what a design's ``[report]`` or ``[tooling]`` table says wrong (an unknown key, a solid
+    fraction of 1.5) when the sweep varies none of its keys: every row would fail with it.  Each table
+    is read as a design reads it (:class:`~tabletcad.pipeline.design.Design`, no geometry); a table
+    with a varied key (whose keys may depend on one another) and a tooling table naming font or SVG
+    files (which a remote scheduler's workers may hold) are left to the rows."""
     from tabletcad.pipeline.design import Design
 
-    first = copy.deepcopy(design)
-    for a in axes:
-        set_key(first, a.key, a.values[0] if a.values else a.lo)
-    try:
-        Design.from_dict(first)
-    except DesignError as exc:
-        varied = any(exc.parameter == a.key or exc.parameter.startswith(a.key + ".") or
-                     exc.parameter.startswith(a.key + "[") for a in axes)
-        if exc.parameter.split(".")[0].split("[")[0] in ("report", "tooling") and not varied:
-            raise exc.renamed(f"design.{exc.parameter}") from None
+    for table in ("report", "tooling"):
+        if table not in design or any(a.key.split(".")[0] == table for a in axes):
+            continue  # a table the sweep varies: its keys may depend on one another (a standard and its sizes)
+        if table == "tooling" and any(isinstance(e, dict) and ("svg" in e or "font" in e)
+                                      for e in (design["tooling"].get("emboss") or [] if isinstance(design["tooling"], dict) else [])):
+            continue  # files a remote scheduler's workers may hold and this machine not
+        try:
+            Design.from_dict({"tablet": design["tablet"], table: design[table]})
+        except DesignError as exc:
+            if exc.parameter.split(".")[0].split("[")[0] == table:
+                raise exc.renamed(f"design.{exc.parameter}") from None
 
 
 def _known_keys(design: dict) -> set[str]:
