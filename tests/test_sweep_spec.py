@@ -199,7 +199,13 @@ def test_a_sweep_of_more_than_a_million_designs_is_refused_up_front():
 def test_a_fixed_dimension_no_design_could_take_is_refused_before_the_sweep(tmp_path, capsys, land, line):
     """A base dimension the sweep does not vary, wrong whatever the varied values are, would fail every
     row: refused up front (one line, exit 2, no folder)."""
-    p = _write(tmp_path, f'land = {land!r}\n[sweep.vary]\n"tablet.cup_depth" = [0.8, 0.9]\n'.replace("'", '"'))
+    _refused_up_front(tmp_path, capsys, f'land = {land!r}\n'.replace("'", '"'), line)
+
+
+def _refused_up_front(tmp_path, capsys, body: str, line: str) -> None:
+    """The sample base with ``body`` added and its cup depth varied: one line starting ``line``, exit 2,
+    no output folder."""
+    p = _write(tmp_path, body + '[sweep.vary]\n"tablet.cup_depth" = [0.8, 0.9]\n')
     out = tmp_path / "out"
     assert main(["sweep", str(p), "--out", str(out), "--workers", "1", "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
@@ -225,19 +231,7 @@ def test_a_dimension_wrong_only_with_the_varied_values_or_varied_itself_is_left_
 def test_a_fixed_report_or_tooling_value_no_design_could_take_is_refused_before_the_sweep(tmp_path, capsys, table, line):
     """A ``[design.report]`` or ``[design.tooling]`` key the sweep does not vary, wrong in every design
     (a misspelled key, a solid fraction of 1.5): one line, exit 2, no folder (every row had failed, exit 0)."""
-    p = tmp_path / "s.toml"
-    p.write_text(textwrap.dedent("""
-        [design.tablet]
-        family = "concave_round"
-        diameter = 10.0
-        band = 2.8
-        cup_depth = 0.9
-        """) + table + '[sweep.vary]\n"tablet.cup_depth" = [0.8, 0.9]\n', encoding="utf-8")
-    out = tmp_path / "out"
-    assert main(["sweep", str(p), "--out", str(out), "--workers", "1", "--quiet"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith(line), err
-    assert not out.exists()
+    _refused_up_front(tmp_path, capsys, table, line)
 
 
 def test_a_report_value_the_sweep_varies_is_left_to_its_rows():
