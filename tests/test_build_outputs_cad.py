@@ -51,6 +51,13 @@ def test_tooling_build_then_cutaway_then_plain_rebuild(tmp_path, capsys):
                   "tablet_plain.step", "tablet.step", "tablet.stl", "tablet.glb"}
     assert tool_files <= set(rep["outputs"])
     assert _listed(line) == rep["outputs"] == sorted(read_manifest(out))
+    # exactly the files the build checks before its geometry (tooling_outputs)
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.stage import tooling_outputs
+
+    spec = Design.from_toml(ROOT / "samples" / "tooling" / "concave_round_bisect.toml").tooling_spec
+    assert set(rep["outputs"]) == {"report.json", "tablet.png", "tablet.step", "tablet.stl", "tablet.glb",
+                                   *tooling_outputs(spec)}
     # tablet.step is the finished (scored, debossed) tablet, tablet_plain.step the PDE tablet
     fin, plain = ocp_read_steps([out / "tablet.step", out / "tablet_plain.step"])
     assert fin["valid"] and plain["valid"] and fin["n_solids"] == plain["n_solids"] == 1
@@ -267,3 +274,27 @@ def test_a_hollow_tablet_of_several_patches_writes_its_report_and_picture(tmp_pa
     # every patch's spine lies on the axis, so w scales the sections about it in x and y only:
     # the core with w < 1/2 holds (1/2)² of the volume
     assert rep["volume_mm3"] == pytest.approx(0.75 * v_full, rel=1e-12)
+
+
+@pytest.mark.parametrize("design, theirs", [("families/concave_round.toml", ["tablet.step"]),
+                                            ("tooling/concave_round_bisect.toml", ["drawing.pdf", "die.step"])])
+def test_a_folder_holding_files_the_build_writes_is_refused_before_the_geometry(tmp_path, capsys, monkeypatch,
+                                                                               design, theirs):
+    """Every file a build may write is checked before any geometry (it was report.json and tablet.png
+    only: a user's tablet.step was found after the solid, 2-12 s later), and every clash is named."""
+    import tabletcad.pipeline.build as build
+
+    def no_geometry(*args, **kwargs):
+        raise AssertionError("the geometry was computed before the folder was checked")
+
+    monkeypatch.setattr(build, "geometry_report", no_geometry)
+    out = tmp_path / "out"
+    out.mkdir()
+    for name in theirs:
+        (out / name).write_text("mine")
+    assert main(["build", str(ROOT / "samples" / design), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"error: --out = '{out}' is not allowed: must not hold files")
+    for name in theirs:
+        assert name in err[0] and (out / name).read_text() == "mine"
+    assert sorted(p.name for p in out.iterdir()) == sorted(theirs)

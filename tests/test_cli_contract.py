@@ -165,6 +165,9 @@ def test_out_that_cannot_be_a_folder_is_refused_before_any_work(capsys, tmp_path
         (["mesh", "{sample}", "--nodes", "5", "2.5", "5", "--out", "{tmp}/m.vtu"], "--nodes", "must be an integer"),
         (["mesh", "{sample}", "--nodes", "1", "21", "5", "--out", "{tmp}/m.vtu"], "--nodes", "from 2 to 2000"),
         (["mesh", "{sample}", "--nodes", "5", "5", "5", "--out", "{tmp}/m.obj"], "--out", ".vtu"),
+        # a mesh file under a file: named as the option (it was "path = ... file exists", after the geometry)
+        (["mesh", "{sample}", "--nodes", "5", "5", "5", "--out", "{sample}/m.vtu"], "--out",
+         "cannot be created: {sample} is a file, not a folder"),
         (["optimise", "{sample}", "--out", "{tmp}/o", "--method", "newton"], "--method", "SLSQP"),
         (["report", "{sample}", "--solid-fraction", "half"], "--solid-fraction", "must be a number"),
         (["build", "{sample}", "--out", "{tmp}/o", "--colour", "red"], "option", "takes --out"),
@@ -179,7 +182,7 @@ def test_bad_arguments_one_line(capsys, tmp_path, args, parameter, fragment):
     sample = ROOT / "samples" / "spherical.toml"
     argv = [a.format(sample=sample, tmp=tmp_path) for a in args]
     rc, out, err = run(capsys, *argv)
-    assert fragment in assert_refused(rc, err, parameter)
+    assert fragment.format(sample=sample) in assert_refused(rc, err, parameter)
     assert out == "" and list(tmp_path.iterdir()) == []
 
 

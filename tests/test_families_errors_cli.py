@@ -200,3 +200,23 @@ def test_elongated_strength_uses_pitt_heasley():
     assert tri["tensile_strength"]["tensile_strength_MPa"] is None
     big = design_report(F.capsule(23, 9, 3, 1.0))["design_report"]
     assert big["fda_size"]["ok"] is False and big["weight_mg"] is None
+
+
+def test_a_smoothing_parameter_that_fails_the_certificate_is_named(tmp_path, capsys):
+    """A family's ``a`` (0.01 by default) taken so large that the PDE surface leaves the 1 µm certificate
+    is refused naming ``tablet.a`` (it was a line naming no parameter); a moderate one builds."""
+    base = '[tablet]\nfamily = "capsule"\nlength = 16.0\nwidth = 7.0\nband = 3.0\ncup_depth = 1.0\n'
+    d = tmp_path / "a1.toml"
+    d.write_text(base + "a = 1.0\n")
+    out = tmp_path / "out"
+    assert main(["build", str(d), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1
+    assert err[0].startswith("error: tablet.a = 1 is not allowed: must leave the PDE surface within 1 µm of the "
+                             "capsule's nominal (it deviates ")
+    assert not out.exists()
+    with pytest.raises(DesignError) as ei:
+        F.capsule(16, 7, 3, 1, a=1.0)
+    assert ei.value.parameter == "a"
+    t = F.capsule(16, 7, 3, 1, a=0.05)  # within the certificate
+    assert t.nominal.certificate.passed

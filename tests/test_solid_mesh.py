@@ -285,6 +285,54 @@ def test_shaped_cups_are_meshed_without_a_crack(family):
     assert mesh_volume(m) == pytest.approx(t.solid_volume(), rel=2e-2)
 
 
+@pytest.mark.fe
+@pytest.mark.parametrize("family, degenerate", [("capsule", {"hexahedron": 128, "wedge": 32}),
+                                                ("rounded_triangle", {"hexahedron": 60}),
+                                                ("concave_round", {})])
+def test_degenerate_cells_agree_with_gmsh_quality(tmp_path, family, degenerate):
+    """The cells at a shaped cup's fold whose corner Jacobian vanishes (a face collapsed onto the centre
+    line next to the spine) are counted as Gmsh's own ``minSJ`` rates them (an independent reader of the
+    written file); rounds have none."""
+    from pathlib import Path
+
+    gmsh = pytest.importorskip("gmsh")
+    from tabletcad.pipeline.design import load_design
+    from tabletcad.volume_mesh import corner_quality, degenerate_cells
+
+    t = load_design(Path(__file__).resolve().parents[1] / "samples" / "families" / f"{family}.toml")
+    m = hex_mesh(t, (9, 33 if family == "capsule" else 65, 5))
+    ours = degenerate_cells(m)
+    assert {k: n for k, n in ours.items() if n} == degenerate
+    write_mesh(m, tmp_path / "m.msh")
+    gmsh.initialize(["-noenv"], readConfigFiles=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.open(str(tmp_path / "m.msh"))
+        names = {5: "hexahedron", 6: "wedge", 7: "pyramid", 4: "tetra"}
+        types, tags, _ = gmsh.model.mesh.getElements(3)
+        for etype, etags in zip(types, tags):
+            q = np.asarray(gmsh.model.mesh.getElementQualities(etags, "minSJ"))
+            assert int(np.count_nonzero(q <= 1e-9)) == ours[names[etype]], names[etype]
+    finally:
+        gmsh.finalize()
+    low = min(float(q.min()) for q in corner_quality(m).values())
+    assert (low > 0.01) == (not degenerate)
+
+
+def test_mesh_command_warns_of_degenerate_cells(tmp_path, capsys):
+    from pathlib import Path
+
+    from tabletcad.cli import main
+
+    fam = Path(__file__).resolve().parents[1] / "samples" / "families"
+    assert main(["mesh", str(fam / "capsule.toml"), "--nodes", "9", "33", "5", "--out", str(tmp_path / "c.vtu")]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("warning: 160 of 7168 cells (128 hexahedron, 32 wedge) have a zero "
+                                               "Jacobian at a corner")
+    assert main(["mesh", str(fam / "concave_round.toml"), "--nodes", "9", "33", "5", "--out", str(tmp_path / "r.vtu")]) == 0
+    assert capsys.readouterr().err == ""
+
+
 # ---------------------------------------------------------------------------- files
 def _read_back(path):
     import meshio

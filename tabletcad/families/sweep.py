@@ -436,6 +436,10 @@ def build_sweep_tablet(
                     nominal_name=f"{family} (profile swept along outline offsets)", tol=tol)
     if certify_surface:
         cert = certify(tablet)
+        if not cert.passed and a != DEFAULT_A:  # a smoothing parameter the design chose: name it
+            raise DesignError("a", a, f"must leave the PDE surface within {tol.nominal * 1e3:.3g} µm of the {family}'s "
+                                      f"nominal (it deviates {cert.max_deviation_mm * 1e3:.3g} µm; leave a out for "
+                                      f"the family's {DEFAULT_A:g})")
         if not cert.passed:
             raise GeometryError(
                 f"{family}: PDE surface deviates {cert.max_deviation_mm * 1e3:.3g} µm from the nominal "

@@ -76,7 +76,13 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
         check_tooling(tablet, tooling)
     if not cad:
         tooling = None
-    check_replaceable(out_dir, ["report.json", "tablet.png"])  # written by every build: refused before the geometry
+    # every file this build may write, refused before the geometry if the folder holds one it may not replace
+    names = ["report.json", "tablet.png"] + (["tablet.step", "tablet.stl", "tablet.glb"] if cad else [])
+    if tooling is not None:
+        from tabletcad.tooling.stage import tooling_outputs
+
+        names += tooling_outputs(tooling)
+    check_replaceable(out_dir, names)
     steps = 2 + cad + (tooling is not None)
     with staging_folder(out_dir) as staging:
         from tqdm import tqdm

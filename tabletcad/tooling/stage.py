@@ -5,8 +5,8 @@ The design parses and checks the table (:attr:`tabletcad.pipeline.design.Design.
 tablet can have tooling before any geometry is built, then calls :func:`tooling_stage` with
 the solid the CAD stage made.
 
-Writes ``assembly.step``, ``upper_punch.step``, ``lower_punch.step``,
-``die.step``, ``drawing.svg`` and ``drawing.dxf`` into the build's staging
+Writes the files :func:`tooling_outputs` names (``assembly.step``, the parts,
+the drawings) into the build's staging
 folder and adds the ``tooling`` section to ``report.json`` (``interference_mm3``,
 ``max_gap_mm`` and the per-method details).  Bad ``[tooling]`` input raises
 :class:`~tabletcad.errors.DesignError` before anything is built (the CLI
@@ -23,7 +23,20 @@ from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.designreport import ReportOptions
 from tabletcad.tooling.spec import ToolingSpec
 
-__all__ = ["check_tooling", "tooling_stage", "write_tooling", "write_finished_tablet"]
+__all__ = ["check_tooling", "tooling_outputs", "tooling_stage", "write_tooling", "write_finished_tablet"]
+
+
+def tooling_outputs(spec: ToolingSpec) -> list[str]:
+    """The files :func:`tooling_stage` writes for ``spec`` besides ``tablet.*`` (which it may replace):
+    the assembly, the parts, the tablet's drawing, the punch and die drawing of complete tooling
+    (``[tooling.punch]``) and the plain tablet beside a scored or embossed one."""
+    names = ["assembly.step", "upper_punch.step", "lower_punch.step", "die.step",
+             "drawing.svg", "drawing.pdf", "drawing.dxf"]
+    if spec.body is not None:
+        names += ["tooling.svg", "tooling.pdf", "tooling.dxf"]
+    if spec.scores or spec.emboss:
+        names.append("tablet_plain.step")
+    return names
 
 
 def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:

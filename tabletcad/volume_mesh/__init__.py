@@ -8,6 +8,8 @@
 """
 
 from tabletcad.volume_mesh.files import write_mesh
-from tabletcad.volume_mesh.hexahedra import CELL_TYPES, THESIS_NODES, SolidMesh, cell_volumes, hex_mesh, mesh_volume
+from tabletcad.volume_mesh.hexahedra import (CELL_TYPES, THESIS_NODES, SolidMesh, cell_volumes, corner_quality,
+                                             degenerate_cells, hex_mesh, mesh_volume)
 
-__all__ = ["SolidMesh", "CELL_TYPES", "THESIS_NODES", "hex_mesh", "cell_volumes", "mesh_volume", "write_mesh"]
+__all__ = ["SolidMesh", "CELL_TYPES", "THESIS_NODES", "hex_mesh", "cell_volumes", "corner_quality", "degenerate_cells",
+           "mesh_volume", "write_mesh"]

@@ -34,7 +34,10 @@ vectorised, and turns it into a *conforming* finite-element mesh:
   collapses in any orientation (:data:`_DEGENERATE`); a cell next to both the
   spine and a shaped cup's fold, whose sides are bilinear quads sharing two
   edges, is no standard cell and stays a degenerate hexahedron (repeated
-  nodes, shared with its neighbours); cells with fewer nodes, and
+  nodes, shared with its neighbours), and cells beside a fold onto a line (a capsule's centre
+  line) keep a face whose four distinct nodes lie on that line; both have positive volumes but a
+  zero Jacobian at a corner (:func:`degenerate_cells` counts them as Gmsh's ``minSJ`` rates
+  them; ``tabletcad mesh`` warns); cells with fewer nodes, and
   all cells of a flat patch (a zero-volume solid, such as the flat faces of
   a flat-faced round tablet, whose volume the band patch's solid fills), are
   dropped;
@@ -69,6 +72,8 @@ __all__ = [
     "THESIS_NODES",
     "hex_mesh",
     "cell_volumes",
+    "corner_quality",
+    "degenerate_cells",
     "mesh_volume",
 ]
 
@@ -272,6 +277,46 @@ def cell_volumes(mesh: SolidMesh) -> dict[str, np.ndarray]:
             vols[s : s + _CHUNK] = _hex_volumes(mesh.points[c])
         out[kind] = vols
     return out
+
+
+# the three neighbours of every corner, ordered so that the edges to them form a right-handed
+# triple in a positively oriented cell (meshio order; a pyramid's apex has none of its own)
+_CORNER_EDGES: dict[str, tuple[tuple[int, int, int, int], ...]] = {
+    "hexahedron": ((0, 1, 3, 4), (1, 2, 0, 5), (2, 3, 1, 6), (3, 0, 2, 7),
+                   (4, 7, 5, 0), (5, 4, 6, 1), (6, 5, 7, 2), (7, 6, 4, 3)),
+    "wedge": ((0, 1, 2, 3), (1, 2, 0, 4), (2, 0, 1, 5), (3, 5, 4, 0), (4, 3, 5, 1), (5, 4, 3, 2)),
+    "pyramid": ((0, 1, 3, 4), (1, 2, 0, 4), (2, 3, 1, 4), (3, 0, 2, 4)),
+    "tetra": ((0, 1, 2, 3), (1, 2, 0, 3), (2, 0, 1, 3), (3, 2, 1, 0)),
+}
+
+
+def corner_quality(mesh: SolidMesh) -> dict[str, np.ndarray]:
+    """The smallest scaled Jacobian of every cell over its corners, per block of ``mesh.cells``.
+
+    At a corner with edges ``a, b, c`` to its three neighbours (a right-handed triple in a
+    positively oriented cell) the scaled Jacobian is ``det[a, b, c] / (|a| |b| |c|)``: 1 for a
+    right angle, 0 where the edges are coplanar or one has no length (a cell whose face
+    collapses onto a line, or a hexahedron with repeated nodes), negative for an inverted
+    corner.  This is the corner value of Gmsh's ``minSJ`` quality (dimensionless).
+    """
+    out = {}
+    for kind, conn in mesh.cells.items():
+        q = np.full(conn.shape[0], np.inf)
+        for corner, i, j, k in _CORNER_EDGES[kind]:
+            x = mesh.points[conn[:, corner]]
+            a, b, c = mesh.points[conn[:, i]] - x, mesh.points[conn[:, j]] - x, mesh.points[conn[:, k]] - x
+            det = np.einsum("ij,ij->i", a, np.cross(b, c))
+            size = np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1) * np.linalg.norm(c, axis=1)
+            q = np.minimum(q, np.divide(det, size, out=np.zeros_like(det), where=size > 0))
+        out[kind] = q
+    return out
+
+
+def degenerate_cells(mesh: SolidMesh, threshold: float = 1e-9) -> dict[str, int]:
+    """Cells whose smallest corner scaled Jacobian (:func:`corner_quality`) is at most ``threshold``:
+    where the solid map of eq 4.12 collapses (a shaped cup folded onto its centre line or corners,
+    next to the spine).  Their volumes are positive; a solver that checks corner Jacobians refuses them."""
+    return {k: int(np.count_nonzero(q <= threshold)) for k, q in corner_quality(mesh).items()}
 
 
 def mesh_volume(mesh: SolidMesh) -> float:
