@@ -22,7 +22,7 @@ def _design(diameter):
                                         "cup_depth": 0.9}})
 
 
-@pytest.mark.parametrize("value", [np.int64(10), np.int32(10), np.float64(10.0), np.float32(10.0),
+@pytest.mark.parametrize("value", [np.int64(10), np.int32(10), np.float64(10.0), np.float32(10.0), np.array(10.0),
                                    fractions.Fraction(10), decimal.Decimal("10"), decimal.Decimal("10.000")])
 def test_numeric_types_give_the_tablet_of_the_float(value):
     a = _design(value).build()
@@ -36,7 +36,7 @@ def test_numeric_types_give_the_tablet_of_the_float(value):
     ([10], "tablet.diameter = [10] is not allowed: must be a number"),
     ("ten", "tablet.diameter = 'ten' is not allowed: must be a number"),
     ({"v": 10}, "tablet.diameter = {'v': 10} is not allowed: must be a number"),
-    (np.True_, "tablet.diameter = True is not allowed: must be a number"),
+    (np.True_, "tablet.diameter = true is not allowed: must be a number (true and false are not numbers)"),
     (True, "tablet.diameter = true is not allowed: must be a number (true and false are not numbers)"),
     (float("nan"), "tablet.diameter = nan mm is not allowed: must be a finite number"),
     (decimal.Decimal("Infinity"), "tablet.diameter = Infinity mm is not allowed: must be a finite number"),
@@ -62,3 +62,19 @@ def test_a_long_value_is_shown_whole_up_to_200_characters():
     huge = list(range(1000))
     shown = str(DesignError("x", huge, "must be short")).split(" is not allowed")[0]
     assert shown.startswith("x = [0, 1, 2") and "..." in shown and shown.endswith("997, 998, 999]") and len(shown) < 200
+
+
+def test_an_outline_as_an_array_or_pairs_is_the_outline_as_lists():
+    """A script's custom outline may be an (n, 2) array or a list of tuples: the same tablet as the
+    lists TOML gives (an array had been refused as "must be a list of [x, y] points")."""
+    th = np.linspace(0.0, 2.0 * np.pi, 40, endpoint=False)
+    pts = np.column_stack([6.0 * np.cos(th), 4.0 * np.sin(th)])
+
+    def volume(outline):
+        return Design.from_dict({"tablet": {"family": "custom_outline", "outline": outline, "band": 2.0,
+                                            "cup_depth": 0.8}}).build().volume()
+
+    ref = volume(pts.tolist())
+    assert volume(pts) == ref and volume([tuple(p) for p in pts.tolist()]) == ref
+    with pytest.raises(DesignError, match=r"^tablet.diameter = \[10.0, 3.0\] is not allowed: must be a number$"):
+        _design(np.array([10.0, 3.0])).build()

@@ -262,7 +262,7 @@ class Design:
         if "tablet" not in data or not isinstance(data["tablet"], dict):
             raise DesignError("tablet", "missing" if "tablet" not in data else data["tablet"],
                               "a design needs a [tablet] table with a family")
-        data = copy.deepcopy(data)
+        data = _as_toml(data)
         tab = data["tablet"]
         name = tab.get("name", default_name)  # given empty, it is refused (not replaced by the default)
         if not isinstance(name, str) or not name.strip() or any(ch in name for ch in '/\\"\n') or len(name) > 200:
@@ -412,6 +412,18 @@ def _check_size(tablet: Tablet, tol: Tolerances = DEFAULT, *, what: dict | None 
 
 
 _CUSTOM_KEYS = {"outline", "segments", "band", "cup_depth", "land", "cup_width", "central_radius", "edge_radius"}
+
+
+def _as_toml(value: Any) -> Any:
+    """A copy of a design's data as TOML would give it: numpy arrays as (nested) lists, numpy scalars
+    as Python ones and tuples as lists (a Python caller's outline may be an (n, 2) array or pairs)."""
+    if isinstance(value, dict):
+        return {k: _as_toml(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_as_toml(v) for v in value]
+    if type(value).__module__ == "numpy" and hasattr(value, "tolist"):  # an array or a numpy scalar
+        return _as_toml(value.tolist())
+    return copy.deepcopy(value)
 
 
 def _custom_outline(tab: dict, name: str) -> Tablet:
