@@ -125,6 +125,9 @@ def test_build_writes_parts_assembly_drawing_and_report(built):
     out, rep = built
     for f in ("assembly.step", "upper_punch.step", "lower_punch.step", "die.step", "drawing.svg", "drawing.dxf", "drawing.pdf"):
         assert (out / f).stat().st_size > 0, f
+    # the PDF's text is in embedded TrueType fonts (searchable, accepted by PDF/A), not Type 3 glyph drawings
+    pdf = (out / "drawing.pdf").read_bytes()
+    assert b"/Type3" not in pdf and b"/FontFile2" in pdf
     tool = rep["tooling"]
     assert tool["interference_mm3"] == pytest.approx(0.0, abs=1e-9)
     assert tool["max_gap_mm"] <= tool["keys"]["clearance_mm"]

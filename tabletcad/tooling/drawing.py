@@ -496,7 +496,9 @@ def _scale_text(scale: float) -> str:
 def _write_matplotlib(dr: Drawing, svg: Path, pdf: Path) -> None:
     import matplotlib
 
-    with matplotlib.rc_context({"svg.fonttype": "none", "pdf.fonttype": 3}):
+    # TrueType (Type 42) fonts in the PDF: its text is text a reader can search and copy, and
+    # PDF/A and print workflows accept it (Type 3 fonts are glyph drawings)
+    with matplotlib.rc_context({"svg.fonttype": "none", "pdf.fonttype": 42}):
         for paper in PAPER:  # the smallest sheet that shows the views at 1:1 or larger (else the largest)
             fig = sheet_figure(dr, paper)
             if dr.scale >= 1.0 or paper == "A2":
