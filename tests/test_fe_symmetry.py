@@ -104,3 +104,52 @@ def test_quarter_model_of_a_thin_disc_matches_the_full_model_and_hondros():
         Q = np.eye(3)
         Q[ax, ax] = -1.0
         assert sol.stress_at(y) == pytest.approx(Q @ sol.stress_at(x) @ Q, abs=1e-9 * q.centre_tensile_stress_MPa)
+
+
+@pytest.mark.parametrize("design, offsets", [
+    ("families/capsule.toml", (0.0, 0.0, 0.0)),
+    ("families/oval.toml", (0.0, 0.0, 0.0)),
+    ("flat_faced_round.toml", (0.0, 0.0, 0.0)),
+    ("caplet.toml", (0.0, 0.0, 0.0)),  # no nominal: the dense sample
+    ("families/rounded_triangle.toml", (0.0, 1.76, 0.0)),  # a vertex up: not symmetric about y = centre
+    ("families/custom_outline.toml", (0.828, 0.0, 0.0)),
+])
+def test_mirror_offset_tells_a_symmetric_tablet_from_one_that_is_not(design, offsets):
+    from pathlib import Path
+
+    from tabletcad.fe.diametral import mirror_offset
+    from tabletcad.pipeline.design import load_design
+
+    t = load_design(Path(__file__).resolve().parents[1] / "samples" / design)
+    for axis, want in enumerate(offsets):
+        got = mirror_offset(t, axis)
+        if want == 0.0:
+            assert got <= 1e-8, (axis, got)  # rounding (a custom outline's points: 3e-10 mm)
+        else:
+            assert got == pytest.approx(want, abs=0.01), (axis, got)
+
+
+def test_a_quarter_model_of_an_unsymmetric_tablet_is_refused(tmp_path, capsys):
+    """symmetric = true on a rounded triangle loaded across its width had solved the quarter of another
+    shape: 107 N against the whole tablet's 128 N, without a word.  Refused before any mesh, in the
+    Python API and in an optimisation file (exit 2, nothing written)."""
+    from pathlib import Path
+
+    from tabletcad.cli import main
+    from tabletcad.errors import DesignError
+    from tabletcad.pipeline.design import load_design
+
+    t = load_design(Path(__file__).resolve().parents[1] / "samples" / "families" / "rounded_triangle.toml")
+    with pytest.raises(DesignError, match=r"^symmetric = true is not allowed: needs a tablet mirror symmetric about "
+                                          r"its centre's y plane"):
+        diametral(t, 100.0, "width", symmetric=True, solid=object())  # refused before the solid is read
+    prob = tmp_path / "tri.toml"
+    prob.write_text('[problem]\nkind = "family"\nfamily = "rounded_triangle"\nsense = "max"\n'
+                    'objective = "fe_breaking_force_N"\n[variables]\ncup_depth = { lower = 0.8, upper = 1.2 }\n'
+                    '[fixed]\nside = 10.0\ncorner_radius = 1.5\nband = 2.5\n'
+                    '[fe]\ntensile_strength_MPa = 2.0\nsymmetric = true\n')
+    out = tmp_path / "o"
+    assert main(["optimise", str(prob), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: fe.symmetric = true is not allowed: needs a tablet mirror")
+    assert not out.exists()

@@ -249,6 +249,51 @@ class DiametralResult:
         }
 
 
+#: the largest mirror offset (relative to the tablet's largest extent) that ``symmetric=True`` accepts
+MIRROR_TOLERANCE = 1e-3
+
+
+def mirror_offset(tablet: Any, axis: int) -> float:
+    """How far the tablet is from its mirror image about the plane through its centre normal to ``axis``
+    (0: x, 1: y, 2: z), mm.
+
+    The surface is sampled on every patch (17 × 128) and mirrored; the offset is the largest distance of
+    difference between a mirrored point's signed distance from the tablet's nominal shape (its closed
+    form: a family's or a thesis shape's) and the point's own, or, for a tablet without one, the distance
+    of a mirrored point from the nearest of a 4 × 4 times denser sample of the surface.  A symmetric
+    tablet gives rounding (1e-15 mm); a rounded triangle across its flat side, millimetres.
+    """
+    lo, hi = (np.asarray(a, float) for a in tablet.bounds())
+    c = 0.5 * (lo[axis] + hi[axis])
+    u, v = np.linspace(0.0, 1.0, 17), np.linspace(0.0, 2.0 * math.pi, 128, endpoint=False)
+    pts = np.concatenate([p.evaluate_grid(u, v).reshape(-1, 3) for p in tablet.patches])
+    own = None if getattr(tablet, "nominal", None) is None else tablet.nominal(pts)
+    pts[:, axis] = 2.0 * c - pts[:, axis]
+    if own is not None:  # a mirrored point is as far from a symmetric nominal as the point itself
+        return float(np.max(np.abs(tablet.nominal(pts) - own)))
+    from scipy.spatial import cKDTree
+
+    u, v = np.linspace(0.0, 1.0, 65), np.linspace(0.0, 2.0 * math.pi, 512, endpoint=False)
+    dense = np.concatenate([p.evaluate_grid(u, v).reshape(-1, 3) for p in tablet.patches])
+    return float(np.max(cKDTree(dense).query(pts)[0]))
+
+
+def check_symmetric(tablet: Any, direction: str = "width", parameter: str = "symmetric") -> None:
+    """Refuse (:class:`DesignError` for ``parameter``) a quarter model of a tablet that is not mirror
+    symmetric about the plane across the load and its mid-thickness plane: the mirrored quarter would
+    be another shape (a rounded triangle's read 16 % low)."""
+    lo, hi = (np.asarray(a, float) for a in tablet.bounds())
+    ax = load_axis(direction, hi - lo)
+    size = float(np.max(hi - lo))
+    for axis in (ax, 2):
+        off = mirror_offset(tablet, axis)
+        if off > MIRROR_TOLERANCE * size:
+            plane = ("x", "y", "z")[axis]
+            raise DesignError(parameter, True, f"needs a tablet mirror symmetric about its centre's {plane} plane "
+                              f"(across the load) and its mid-thickness: {getattr(tablet, 'name', 'the tablet')}'s mirror "
+                              f"image is {off:.3g} mm from it (at most {MIRROR_TOLERANCE * size:.3g} mm): set it false")
+
+
 def default_averaging_radius(strip_width: float, thickness: float) -> float:
     """``min(b, t/6)``, mm: the default radius of the ball the largest tensile stress is averaged over."""
     return min(AVERAGING_FRACTION * strip_width, AVERAGING_THICKNESS_FRACTION * thickness)
@@ -467,6 +512,8 @@ def diametral(
         key = "v" if not trim.full_v else "u"
         raise DesignError(f"[trim] {key}", list(getattr(trim, key)), "the diametral test needs the whole tablet, not a "
                           "cut-away view")
+    if symmetric:
+        check_symmetric(tablet, direction)
     lo, hi = (np.asarray(a, float) for a in tablet.bounds())
     ext = hi - lo
     ax = load_axis(direction, ext)
