@@ -158,6 +158,22 @@ def test_out_that_cannot_be_a_folder_is_refused_before_any_work(capsys, tmp_path
         assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
 
 
+@pytest.mark.skipif(not Path("/sys/kernel").is_dir(), reason="Linux's /sys (present on every CI machine)")
+@pytest.mark.parametrize("args, option", [
+    (["fe", "diametral", "{fam}/concave_round.toml", "--force", "100", "--out", "/sys/tabletcad-out"], "--out"),
+    (["fe", "diametral", "{fam}/concave_round.toml", "--force", "100", "--json-file", "/sys/x.json"], "--json-file"),
+    (["report", "{fam}/concave_round.toml", "--csv", "/sys/x.csv"], "--csv"),
+    (["optimise", "{root}/samples/optimise/cylinder_min_area.toml", "--out", "/sys/tabletcad-out"], "--out"),
+    (["build", "{fam}/concave_round.toml", "--out", "/sys/tabletcad-out"], "--out"),
+])
+def test_an_output_in_a_folder_that_takes_no_files_is_refused_first(capsys, args, option):
+    """/sys passes os.access for root, but takes no new file: refused before any work (fe and optimise
+    had failed only after the solve, 5-9 s later)."""
+    argv = [a.format(fam=ROOT / "samples" / "families", root=ROOT) for a in args]
+    rc, out, err = run(capsys, *argv)
+    assert "cannot be written: folder /sys is not writable" in assert_refused(rc, err, option)
+
+
 @pytest.mark.parametrize(
     "args, parameter, fragment",
     [
@@ -498,3 +514,12 @@ def test_sigterm_while_an_extension_initialises_is_a_termination(tmp_path, capsy
     assert info.value.code == 143
     assert not out.exists() and not [q for q in tmp_path.iterdir() if q.name.startswith(".out.")]
     assert not (tmp_path / "cache").exists()  # no internal-error log
+
+
+def test_a_json_file_may_not_overwrite_a_folders_ownership_record(capsys, tmp_path):
+    """--json-file out/.tabletcad-fe.json had replaced the FE run's record, and the next run into the
+    folder refused the files the first one wrote."""
+    rc, _, err = run(capsys, "fe", "diametral", ROOT / "samples" / "families" / "concave_round.toml", "--force", "100",
+                     "--out", tmp_path / "o", "--json-file", tmp_path / "o" / ".tabletcad-fe.json")
+    assert "must not be the record of the files a tabletcad run owns" in assert_refused(rc, err, "--json-file")
+    assert list(tmp_path.iterdir()) == []

@@ -15,6 +15,8 @@ pytest.importorskip("OCP")
 
 from tabletcad.cli import main  # noqa: E402
 
+ROOT = Path(__file__).resolve().parents[1]
+
 DESIGN = """
 [tablet]
 family = "concave_round"
@@ -57,6 +59,7 @@ def test_report_and_build_run_the_coarse_fe_strength(capsys, tmp_path):
               f"{strength['breaking_force_N']:.2f} N; default mesh {default['breaking_force_N']:.2f} N")
     assert fe["breaking_force_N"] == pytest.approx(strength["breaking_force_N"], rel=1e-9)
     assert fe["tensile_strength_MPa"] == 2.0 and fe["direction"] == "width"
+    assert fe["tablet_meshed"] == "plain" and "note" not in fe  # no [tooling]: the plain tablet is the tablet
     assert fe["estimate"].startswith("elastic first-crack")
     assert fe["breaking_force_N"] == pytest.approx(default["breaking_force_N"], rel=RECHECK)
     rc, so, err = run(capsys, "report", design)
@@ -110,3 +113,23 @@ def test_diametral_meshes_the_scored_tablet_and_finds_the_score_root(capsys):
     assert abs(x) < 1e-9 and abs(y) < 1.0 and z == pytest.approx(4.6 - 0.5, abs=0.05)  # the score's root
     assert scored["max_tensile_stress_MPa"] > 1.2 * plain["max_tensile_stress_MPa"]
     assert abs(plain["max_tensile_location_mm"][1]) > 2.0  # plain: near a platen, on a cup face
+
+
+def test_the_reports_fe_force_of_a_scored_design_says_it_is_the_plain_tablets(capsys, tmp_path):
+    """The report meshes the plain tablet; for a scored and embossed design it now says so, and that
+    fe strength meshes the finished one (which breaks at a lower force: the report had read as the
+    scored tablet's, 29 % above fe strength's)."""
+    text = (ROOT / "samples" / "tooling" / "concave_round_bisect.toml").read_text()
+    design = tmp_path / "bisect.toml"
+    design.write_text(text.replace("\n[report]", "\n[report]\ntensile_strength_MPa = 2.0\nfe_breaking_force = true", 1))
+    rc, so, err = run(capsys, "report", design, "--json")
+    assert rc == 0, err
+    fe = json.loads(so)["fe_breaking_force"]
+    assert fe["tablet_meshed"] == "plain"
+    assert fe["note"] == ("the plain tablet, without the design's score and embossing: tabletcad fe strength meshes "
+                          "the finished tablet")
+    rc, so, err = run(capsys, "fe", "strength", design, "--coarse", "--json")
+    assert rc == 0, err
+    finished = json.loads(so)
+    assert finished["tablet_meshed"] == "finished"
+    assert finished["breaking_force_N"] < 0.9 * fe["breaking_force_N"]  # the score's root cracks first

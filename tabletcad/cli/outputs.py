@@ -24,6 +24,11 @@ def check_output(option: str, path: Path | None, suffixes: tuple[str, ...] = (".
         raise DesignError(option, str(path), f"must end in {allowed}")
     if path.is_dir():
         raise DesignError(option, str(path), "is a folder; give a file name")
+    from tabletcad.io.outputs import FE_MANIFEST, MANIFEST, OPTIMISE_MANIFEST
+
+    if path.name in (MANIFEST, FE_MANIFEST, OPTIMISE_MANIFEST):  # overwritten, the folder's next run refuses its own files
+        raise DesignError(option, str(path), "must not be the record of the files a tabletcad run owns in a folder "
+                          "(give another name)")
     _check_writable_from(option, path, path.absolute().parent)
 
 
@@ -34,8 +39,19 @@ def _check_writable_from(option: str, path: Path, start: Path) -> None:
         folder = folder.parent
     if not folder.is_dir():
         raise DesignError(option, str(path), f"cannot be created: {folder} is a file, not a folder")
-    if not os.access(folder, os.W_OK | os.X_OK):
+    if not os.access(folder, os.W_OK | os.X_OK) or not _takes_files(folder):
         raise DesignError(option, str(path), f"cannot be written: folder {folder} is not writable")
+
+
+def _takes_files(folder: Path) -> bool:
+    """Whether a file can be made in ``folder``: a nameless temporary one is made and removed at once
+    (``os.access`` says yes to root in /sys and /proc, where writing fails after the work is done)."""
+    try:
+        with tempfile.TemporaryFile(dir=folder, prefix=".tabletcad-probe-"):
+            pass
+    except OSError:
+        return False
+    return True
 
 
 def check_out_folder(option: str, raw: str | os.PathLike[str]) -> Path:

@@ -121,8 +121,9 @@ def _table(name: str, sec: dict[str, Any]) -> str:
                      f"{pc['allowed_force_kN']:.4g} kN ({on}; {pc['limit_basis']})"))
     fe = sec.get("fe_breaking_force")
     if fe is not None:
+        plain = f"; {fe['note']}" if fe.get("note") else ""
         rows.append(("FE breaking force", f"{fe['breaking_force_N']:.4g} N across the width (elastic first-crack "
-                                          f"estimate, coarse mesh; σ_t {fe['tensile_strength_MPa']:.4g} MPa)"))
+                                          f"estimate, coarse mesh; σ_t {fe['tensile_strength_MPa']:.4g} MPa{plain})"))
     fda = r["fda_size"]
     rows.append(("FDA size (largest <= 22 mm)", f"{'OK' if fda['ok'] else 'TOO LARGE'} ({fda['largest_dimension_mm']:.4g} mm)"))
     if sec["nominal_certified"] is not None:
@@ -353,7 +354,7 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
             from tabletcad.fe.objective import report_breaking_force
 
             try:
-                sec["fe_breaking_force"] = report_breaking_force(tablet, opts)
+                sec["fe_breaking_force"] = report_breaking_force(tablet, opts, spec.tooling_spec)
             except DesignError as exc:  # a missing [report] input: one token, as above
                 raise exc.renamed(one_token(exc.parameter)) from None
         payload = dict(design=dict(name=tablet.name, file=str(design), family=tablet.family, params=dict(tablet.params)),

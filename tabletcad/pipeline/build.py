@@ -113,7 +113,7 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
                 if cad:
                     from tabletcad.fe.objective import report_breaking_force
 
-                    report["fe_breaking_force"] = report_breaking_force(tablet, options)
+                    report["fe_breaking_force"] = report_breaking_force(tablet, options, tooling)
                 else:
                     report["fe_breaking_force"] = {"breaking_force_N": None,
                                                    "note": "not computed: this build made no CAD solid"}
