@@ -46,7 +46,11 @@ def test_tensile_strength_scales_the_force_linearly():
     [
         ({}, "give it, or all of reference_breaking_force_N"),
         ({"tensile_strength_MPa": -1.0}, "tensile_strength_MPa = -1 MPa is not allowed: must be > 0"),
-        ({"reference_breaking_force_N": 50.0, "reference_diameter_mm": 10.0}, "give it, or all of"),
+        # a reference test lacking one input names it (it was "tensile_strength_MPa = 'missing'")
+        ({"reference_breaking_force_N": 50.0, "reference_diameter_mm": 10.0},
+         r"^report\.reference_thickness_mm = 'missing' is not allowed: the reference test needs"),
+        ({"reference_diameter_mm": 10.0, "reference_thickness_mm": 3.0},
+         r"^report\.reference_breaking_force_N = 'missing'"),
         ({"tensile_strength_MPa": 2.0, "reference_breaking_force_N": 50.0}, "not both"),
         ({"reference_breaking_force_N": 50.0, "reference_diameter_mm": 5.0, "reference_thickness_mm": 6.0},
          "must be <= reference_diameter_mm"),
@@ -97,3 +101,24 @@ def test_fe_objective_and_constraint_in_an_optimisation_problem():
     assert ev.n == 1
     with pytest.raises(DesignError):
         breaking_force_objective(-1.0)
+
+
+def test_a_reference_disc_too_thin_to_mesh_is_named_by_its_thickness(capsys):
+    """A 10 x 0.01 mm reference compact needs a mesh far beyond memory: the refusal named --mesh-size,
+    which was not given; it names the reference thickness now (the option, as given)."""
+    from pathlib import Path
+
+    from tabletcad.cli import main
+
+    design = Path(__file__).resolve().parents[1] / "samples" / "families" / "concave_round.toml"
+    rc = main(["fe", "strength", str(design), "--reference-force", "80", "--reference-diameter", "10",
+               "--reference-thickness", "0.01"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1
+    assert err[0].startswith("error: --reference-thickness = 0.01 mm is not allowed: makes a 10 x 0.01 mm reference "
+                             "disc that the FE cannot mesh: its mesh size 0.005 mm must be >= ")
+    rc = main(["fe", "strength", str(design), "--reference-force", "80", "--reference-diameter", "10"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and err == ["error: --reference-thickness = 'missing' is not allowed: the reference test needs "
+                               "reference_breaking_force_N, reference_diameter_mm, reference_thickness_mm (or give "
+                               "tensile_strength_MPa instead)"]

@@ -207,14 +207,19 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
         ("reference_breaking_force_N", "--reference-force", reference_force),
         ("reference_diameter_mm", "--reference-diameter", reference_diameter),
         ("reference_thickness_mm", "--reference-thickness", reference_thickness)) if v is not None}
+    if any(v is not None for v in (reference_force, reference_diameter, reference_thickness)):
+        # a reference test from the options: the one it lacks is named as its option too
+        given.update({"report.reference_breaking_force_N": "--reference-force",
+                      "report.reference_diameter_mm": "--reference-diameter",
+                      "report.reference_thickness_mm": "--reference-thickness"})
     with option_names(given):  # an option given overrides the design's [report] key: named as given
         inputs = StrengthInputs.from_table(spec.report, tensile_strength_MPa=tensile_strength,
                                            reference_breaking_force_N=reference_force,
                                            reference_diameter_mm=reference_diameter,
                                            reference_thickness_mm=reference_thickness)
-    pred = (coarse_prediction(tablet, inputs, direction, solid=solid) if coarse
-            else predict_breaking_force(tablet, inputs, direction, solid=solid, mesh_size=mesh_size,
-                                        error_estimate=False))
+        pred = (coarse_prediction(tablet, inputs, direction, solid=solid) if coarse
+                else predict_breaking_force(tablet, inputs, direction, solid=solid, mesh_size=mesh_size,
+                                            error_estimate=False))
     d = pred.to_dict()
     _echo({"design": str(design), "tablet_meshed": meshed, **d}, as_json, [
         f"{tablet.name}: predicted breaking force {pred.breaking_force_N:.4g} N across {direction} "

@@ -59,6 +59,11 @@ class StrengthInputs:
                 check_range(f"[report] {k}", v, lo, hi, unit, lo_open=unit != "mm")
         ref = [self.reference_breaking_force_N, self.reference_diameter_mm, self.reference_thickness_mm]
         given = sum(v is not None for v in ref)
+        if self.tensile_strength_MPa is None and 0 < given < 3:  # name the one the reference test lacks
+            names = ("reference_breaking_force_N", "reference_diameter_mm", "reference_thickness_mm")
+            lacking = next(k for k, v in zip(names, ref) if v is None)
+            raise DesignError(f"[report] {lacking}", "missing", "the reference test needs "
+                              f"{', '.join(names)} (or give tensile_strength_MPa instead)")
         if self.tensile_strength_MPa is None and given != 3:
             raise DesignError("[report] tensile_strength_MPa", "missing",
                               "give it, or all of reference_breaking_force_N, reference_diameter_mm, "
@@ -117,8 +122,17 @@ def reference_tensile_strength(inputs: StrengthInputs, **fe: Any) -> tuple[float
     """Tensile strength (MPa) from the reference test, with the FE result of the reference disc."""
     from tabletcad.families import flat_face_round
 
-    ref = flat_face_round(diameter=inputs.reference_diameter_mm, thickness=inputs.reference_thickness_mm)
-    r = diametral(ref, 1.0, "x", **fe)
+    D, t = inputs.reference_diameter_mm, inputs.reference_thickness_mm
+    ref = flat_face_round(diameter=D, thickness=t)
+    try:
+        r = diametral(ref, 1.0, "x", **fe)
+    except DesignError as exc:  # a size the disc's own dimensions chose: named by the reference thickness
+        if exc.parameter in fe and fe[exc.parameter] is not None:
+            raise
+        value = f"{exc.value:.4g}" if isinstance(exc.value, float) else exc.value
+        raise DesignError("[report] reference_thickness_mm", t, f"makes a {D:g} x {t:g} mm reference disc that the "
+                          f"FE cannot mesh: its {exc.parameter.replace('_', ' ')} {value} {exc.unit} {exc.allowed}",
+                          "mm") from None
     return inputs.reference_breaking_force_N * r.max_tensile_stress_MPa, r
 
 
