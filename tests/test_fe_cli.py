@@ -65,7 +65,7 @@ def test_diametral_json_and_files(capsys, tmp_path, thin):
 @pytest.mark.parametrize(
     "extra, match",
     [
-        (["--force", "0"], "--force = 0 N is not allowed: must be > 0"),
+        (["--force", "0"], "--force = 0 N is not allowed: must be > 0 and <= 1e+09 N"),  # the range 1e12 gets
         (["--force", "-5"], "--force = -5 N is not allowed: must be > 0"),
         (["--force", "10", "--direction", "diagonal"], "--direction = 'diagonal' is not allowed"),
         # the FE functions' keyword arguments are named as the options that set them
@@ -124,7 +124,7 @@ def test_punch_json_and_files(capsys, tmp_path):
     [
         (["--force", "5"], "--yield-stress = 'missing' is not allowed: give --yield-stress (MPa) or --steel"),
         (["--force", "5", "--steel", "unobtainium"], "--steel = 'unobtainium' is not allowed: must be one of"),
-        (["--force", "0", "--yield-stress", "1000"], "--force = 0 kN is not allowed: must be > 0"),
+        (["--force", "0", "--yield-stress", "1000"], "--force = 0 kN is not allowed: must be > 0 and <= 1e+06 kN"),
         (["--force", "5", "--yield-stress", "1000", "--steel", "S7_tempered_205C"], "not both"),
     ],
 )
@@ -160,3 +160,15 @@ def test_json_file_writes_what_json_prints(capsys, tmp_path, thin):
     assert out.rstrip().endswith(f"json -> {target}") and json.loads(target.read_text()) == printed
     rc, out, err = run(capsys, *args, "--json-file", tmp_path / "r.txt")
     assert rc == 2 and err.startswith("error: --json-file = ") and not (tmp_path / "r.txt").exists()
+
+
+@pytest.mark.parametrize("extra", [["--force", "1e7"], ["--force", "20", "--mesh-size", "0.001"]])
+def test_a_punch_refusal_is_one_line_even_where_the_tip_warns(capsys, tmp_path, extra):
+    """The shallow convex round's tips have no land (a warning); a refusal of the solve's inputs was printed
+    after that warning, two lines.  Now the warning waits for the solve: the refusal is the one line."""
+    from pathlib import Path
+
+    design = Path(__file__).resolve().parents[1] / "samples" / "tooling" / "shallow_convex_round.toml"
+    rc, so, err = run(capsys, "fe", "punch", design, *extra, "--steel", "S7_tempered_205C", "--out", tmp_path / "o")
+    assert rc == 2 and err.count("\n") == 1 and err.startswith(f"error: {extra[-2]} = "), err
+    assert list(tmp_path.iterdir()) == []

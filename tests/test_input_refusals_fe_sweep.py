@@ -185,16 +185,17 @@ def test_a_malformed_scheduler_address_is_refused_before_connecting(tmp_path, ca
 
 
 def test_an_output_that_cannot_be_written_is_named_as_its_option(capsys):
-    """``path = '/proc/.x.57zqaxab.json'`` named a temporary file, not the option."""
+    """``path = '/proc/.x.57zqaxab.json'`` named a temporary file, not the option; refused before any work
+    (a folder that takes no file: probed, as os.access says yes to root)."""
     from pathlib import Path
 
     assert main(["shapes", "--json-file", "/proc/x.json"]) == 2
     assert capsys.readouterr().err.strip().splitlines() == [
-        "error: --json-file = '/proc/x.json' is not allowed: cannot be written: no such file or directory"]
+        "error: --json-file = '/proc/x.json' is not allowed: cannot be written: folder /proc is not writable"]
     sample = Path(__file__).resolve().parents[1] / "samples" / "sweep" / "concave_round_grid.toml"
     assert main(["sweep", str(sample), "--out", "/proc/sweep", "--workers", "1"]) == 2
     assert capsys.readouterr().err.strip().splitlines() == [
-        "error: --out = '/proc/sweep' is not allowed: cannot be written: no such file or directory"]
+        "error: --out = '/proc/sweep' is not allowed: cannot be written: folder /proc is not writable"]
 
 
 @pytest.mark.parametrize("store, allowed", [

@@ -16,7 +16,7 @@ import click
 
 from tabletcad.cli.options import option_names
 from tabletcad.cli.outputs import out_folder
-from tabletcad.errors import DesignError
+from tabletcad.errors import DesignError, check_range
 
 __all__ = ["COMMANDS"]
 
@@ -125,10 +125,9 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
                   json_file: Path | None) -> None:
     """Diametral compression of DESIGN.toml by FE: centre and largest tensile stress, shape factor."""
     from tabletcad.cli.report import load_family_design
-    from tabletcad.errors import check_positive
     from tabletcad.fe.diametral import DIRECTIONS
 
-    check_positive("--force", force, "N")
+    check_range("--force", force, 0.0, 1e9, "N", lo_open=True)  # the whole range, as diametral states it
     if direction not in DIRECTIONS:
         raise DesignError("--direction", direction, "must be one of " + ", ".join(DIRECTIONS))
     _check_json_file(json_file)
@@ -254,7 +253,7 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
     from tabletcad.cli.report import load_family_design
     from tabletcad.errors import check_positive, check_range
 
-    check_positive("--force", force, "kN")
+    check_range("--force", force, 0.0, 1e6, "kN", lo_open=True)  # the whole range, as punch_stress states it
     check_range("--safety-factor", safety_factor, 1.0, 100.0)  # as [tooling.fe_rating] safety_factor
     check_positive("--effective-length-factor", effective_length_factor)
     _check_json_file(json_file)
@@ -278,9 +277,16 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
     from tabletcad.fe.punch import punch_stress, punch_tip_solid
 
     tablet, spec = load_family_design(design)
-    shape, tip = punch_tip_solid(tablet, spec.tooling_spec, which)
-    res = punch_stress(shape, tip, force, which, yield_MPa=yield_stress, safety_factor=safety_factor, E=E,
-                       mesh_size=mesh_size, effective_length_factor=effective_length_factor)
+    import warnings
+
+    # the tip's warnings (no land, ...) are shown once the solve has taken its inputs: a refusal stays one line
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        shape, tip = punch_tip_solid(tablet, spec.tooling_spec, which)
+        res = punch_stress(shape, tip, force, which, yield_MPa=yield_stress, safety_factor=safety_factor, E=E,
+                           mesh_size=mesh_size, effective_length_factor=effective_length_factor)
+    for w in said:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     payload = {"design": str(design), "steel": steel, **res.to_dict()}
     files: list[str] = []
     if out is not None:
