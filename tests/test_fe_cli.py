@@ -52,6 +52,9 @@ def test_diametral_json_and_files(capsys, tmp_path, thin):
     assert d["strip_width_mm"] == pytest.approx(0.8, rel=1e-12)  # D/10
     assert d["centre_tensile_stress_MPa"] == pytest.approx(0.988 * ref, rel=0.03)
     assert abs(d["discretisation_error_relative"]) < 0.03
+    # the same signed estimate, relative to the centre stress (it was its magnitude beside a signed MPa)
+    assert d["discretisation_error_relative"] * d["centre_tensile_stress_MPa"] == pytest.approx(
+        d["discretisation_error_MPa"], rel=1e-12)
     assert d["reaction_N"] < 1e-8 * 50
     assert len(d["max_tensile_location_mm"]) == 3
     assert d["max_tensile_stress_MPa"] >= d["centre_tensile_stress_MPa"] * 0.999
@@ -172,3 +175,17 @@ def test_a_punch_refusal_is_one_line_even_where_the_tip_warns(capsys, tmp_path, 
     rc, so, err = run(capsys, "fe", "punch", design, *extra, "--steel", "S7_tempered_205C", "--out", tmp_path / "o")
     assert rc == 2 and err.count("\n") == 1 and err.startswith(f"error: {extra[-2]} = "), err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_punch_force_above_its_rating_is_warned_of(capsys, tmp_path):
+    """20,000 kN (newtons typed as kN) printed a von Mises stress of 3.6e5 MPa beside the rating without a word."""
+    design = tmp_path / "tooled.toml"
+    design.write_text(TOOLED)
+    rc, so, err = run(capsys, "fe", "punch", design, "--force", 5000, "--steel", "S7_tempered_205C", "--mesh-size", 1.0,
+                      "--json")
+    assert rc == 0
+    d = json.loads(so)
+    assert err.splitlines() == [f"warning: --force 5000 kN is {5000 / d['allowed_force_kN']:.3g} times the allowed force "
+                                f"({d['allowed_force_kN']:.4g} kN): the tip would yield or buckle (--force is in kN)"]
+    rc, so, err = run(capsys, "fe", "punch", design, "--force", 5, "--steel", "S7_tempered_205C", "--mesh-size", 1.0)
+    assert rc == 0 and "times the allowed force" not in err
