@@ -430,15 +430,20 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
     used = obj_spec == FE_QUANTITY or (isinstance(constraints, list) and any(
         isinstance(c, dict) and c.get("quantity") == FE_QUANTITY for c in constraints))
     fe_set = _fe_settings(fe, used)
-    if fe_set is not None and fe_set["symmetric"]:  # a quarter model of another shape: refused before any solve
-        from tabletcad.fe.diametral import check_symmetric
-
+    first = None
+    if held is not None or (fe_set is not None and fe_set["symmetric"]):
         try:
             first = build({v.name: v.initial if v.initial is not None else 0.5 * (v.lower + v.upper) for v in vs})
-        except DesignError:  # the start is the optimiser's to report
-            first = None
-        if first is not None:  # a family's symmetry does not change with its dimensions
-            check_symmetric(first, fe_set["direction"], "[fe] symmetric")
+        except DesignError as exc:
+            if held is not None and exc.parameter == "target_volume_mm3":  # no design of the start has that volume
+                raise DesignError("[problem] volume_mm3", held[1], f"at the start's dimensions it {exc.allowed}", "mm3") from None
+            # any other failure of the start is the optimiser's to report
+    if first is not None and fe_set is not None and fe_set["symmetric"]:
+        from tabletcad.fe.diametral import check_symmetric
+
+        # a quarter model of another shape: refused before any solve (a family's symmetry does not
+        # change with its dimensions)
+        check_symmetric(first, fe_set["direction"], "[fe] symmetric")
     quantities = dict(QUANTITIES)
     if fe_set is not None:
         from tabletcad.optimise.strength import fe_breaking_force
