@@ -35,7 +35,8 @@ def raise_starts(starts: str, method: str) -> None:
 @click.option("--method", default=None,
               help="Solver: SLSQP, trust-constr, multistart or differential_evolution (default: the file's "
                    "[problem] method, else SLSQP).")
-@click.option("--starts", default=None, help="Number of Sobol starts for multistart (integer).")
+@click.option("--starts", default=None,
+              help="Sobol starts for multistart besides the initial point (integer; 0: the initial point alone).")
 @click.option("--maxiter", default=None, help="Iteration limit (integer).")
 @click.option("--quiet", is_flag=True, help="No progress display.")
 def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: str | None, maxiter: str | None,
