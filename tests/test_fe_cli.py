@@ -52,7 +52,6 @@ def test_diametral_json_and_files(capsys, tmp_path, thin):
     assert d["strip_width_mm"] == pytest.approx(0.8, rel=1e-12)  # D/10
     assert d["centre_tensile_stress_MPa"] == pytest.approx(0.988 * ref, rel=0.03)
     assert abs(d["discretisation_error_relative"]) < 0.03
-    # the same signed estimate, relative to the centre stress (it was its magnitude beside a signed MPa)
     assert d["discretisation_error_relative"] * d["centre_tensile_stress_MPa"] == pytest.approx(
         d["discretisation_error_MPa"], rel=1e-12)
     assert d["reaction_N"] < 1e-8 * 50
@@ -189,3 +188,16 @@ def test_a_punch_force_above_its_rating_is_warned_of(capsys, tmp_path):
                                 f"({d['allowed_force_kN']:.4g} kN): the tip would yield or buckle (--force is in kN)"]
     rc, so, err = run(capsys, "fe", "punch", design, "--force", 5, "--steel", "S7_tempered_205C", "--mesh-size", 1.0)
     assert rc == 0 and "times the allowed force" not in err
+
+
+def test_the_relative_discretisation_error_keeps_the_sign_of_the_estimate():
+    """A negative Richardson estimate (-0.0226 MPa on a concave round) was reported as +0.0091 relative."""
+    import dataclasses
+
+    from tabletcad.families import flat_face_round
+    from tabletcad.fe.diametral import diametral
+
+    r = diametral(flat_face_round(diameter=8.0, thickness=1.0), 50.0, "x", mesh_size=0.8, error_estimate=False)
+    for err in (-0.0226, 0.0085):
+        d = dataclasses.replace(r, discretisation_error_MPa=err).to_dict()
+        assert d["discretisation_error_relative"] == pytest.approx(err / r.centre_tensile_stress_MPa, rel=1e-15)

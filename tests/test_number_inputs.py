@@ -23,6 +23,7 @@ def _design(diameter):
 
 
 @pytest.mark.parametrize("value", [np.int64(10), np.int32(10), np.float64(10.0), np.float32(10.0), np.array(10.0),
+                                   np.longdouble(10),
                                    fractions.Fraction(10), decimal.Decimal("10"), decimal.Decimal("10.000")])
 def test_numeric_types_give_the_tablet_of_the_float(value):
     a = _design(value).build()
@@ -78,3 +79,10 @@ def test_an_outline_as_an_array_or_pairs_is_the_outline_as_lists():
     assert volume(pts) == ref and volume([tuple(p) for p in pts.tolist()]) == ref
     with pytest.raises(DesignError, match=r"^tablet.diameter = \[10.0, 3.0\] is not allowed: must be a number$"):
         _design(np.array([10.0, 3.0])).build()
+
+
+def test_a_design_that_contains_itself_is_refused():
+    data = {"tablet": {"family": "concave_round", "diameter": 10.0, "band": 2.8, "cup_depth": 0.9}}
+    data["tablet"]["again"] = data
+    with pytest.raises(DesignError, match=r"^design = 'dict' is not allowed: must not contain itself$"):
+        Design.from_dict(data)

@@ -206,16 +206,19 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
         ("reference_breaking_force_N", "--reference-force", reference_force),
         ("reference_diameter_mm", "--reference-diameter", reference_diameter),
         ("reference_thickness_mm", "--reference-thickness", reference_thickness)) if v is not None}
-    if any(v is not None for v in (reference_force, reference_diameter, reference_thickness)):
-        # a reference test from the options: the one it lacks is named as its option too
-        given.update({"report.reference_breaking_force_N": "--reference-force",
-                      "report.reference_diameter_mm": "--reference-diameter",
-                      "report.reference_thickness_mm": "--reference-thickness"})
+    options = {"report.reference_breaking_force_N": "--reference-force",
+               "report.reference_diameter_mm": "--reference-diameter",
+               "report.reference_thickness_mm": "--reference-thickness"}
     with option_names(given):  # an option given overrides the design's [report] key: named as given
-        inputs = StrengthInputs.from_table(spec.report, tensile_strength_MPa=tensile_strength,
-                                           reference_breaking_force_N=reference_force,
-                                           reference_diameter_mm=reference_diameter,
-                                           reference_thickness_mm=reference_thickness)
+        try:
+            inputs = StrengthInputs.from_table(spec.report, tensile_strength_MPa=tensile_strength,
+                                               reference_breaking_force_N=reference_force,
+                                               reference_diameter_mm=reference_diameter,
+                                               reference_thickness_mm=reference_thickness)
+        except DesignError as exc:  # the input a reference test from the options lacks: named as its option
+            if exc.value == "missing" and exc.parameter in options and any(o in given for o in options):
+                raise exc.renamed(options[exc.parameter]) from None
+            raise
         pred = (coarse_prediction(tablet, inputs, direction, solid=solid) if coarse
                 else predict_breaking_force(tablet, inputs, direction, solid=solid, mesh_size=mesh_size,
                                             error_estimate=False))

@@ -32,7 +32,6 @@ from typing import Any
 import numpy as np
 
 from tabletcad.errors import DesignError
-from tabletcad.fe.diametral import PLANE_MESH_FACTOR, STRIP_FRACTION, default_averaging_radius, load_axis
 from tabletcad.fe.prediction import STRENGTH_KEYS, StrengthInputs, StrengthPrediction, predict_breaking_force
 
 __all__ = ["COARSE_MESH_FRACTION", "COARSE_STRIP_FRACTION", "breaking_force", "coarse_mesh", "coarse_prediction",
@@ -45,15 +44,15 @@ COARSE_STRIP_FRACTION = 1.0 / 10.0
 
 
 def coarse_mesh(tablet: Any, direction: str = "width") -> dict[str, float]:
-    """The coarse mesh's sizes (mm) for ``tablet``: ``mesh_size``, ``strip_mesh_size``, ``plane_mesh_size``
-    (keyword arguments of :func:`tabletcad.fe.diametral.diametral`)."""
+    """The coarse mesh's sizes (mm) for ``tablet``: ``mesh_size``, ``strip_mesh_size``, ``centre_mesh_size``
+    (keyword arguments of :func:`tabletcad.fe.diametral.diametral`); the loaded plane takes diametral's
+    default, ``PLANE_MESH_FACTOR · R`` where that fits.  ``direction`` is the signature's of
+    :func:`~tabletcad.fe.prediction.predict_breaking_force`'s ``sizes``."""
     lo, hi = (np.asarray(a, float) for a in tablet.bounds())
     ext = hi - lo
     plan = float(min(ext[0], ext[1]))
-    D = float(ext[load_axis(direction, ext)])
-    R = default_averaging_radius(STRIP_FRACTION * D, float(ext[2]))
     return {"mesh_size": plan * COARSE_MESH_FRACTION, "strip_mesh_size": plan * COARSE_STRIP_FRACTION,
-            "plane_mesh_size": PLANE_MESH_FACTOR * R, "centre_mesh_size": plan * COARSE_MESH_FRACTION / 2.0}
+            "centre_mesh_size": plan * COARSE_MESH_FRACTION / 2.0}
 
 
 def breaking_force(tablet: Any, tensile_strength_MPa: float, direction: str = "width", *, coarse: bool = True,
@@ -76,8 +75,8 @@ def coarse_prediction(tablet: Any, inputs: StrengthInputs, direction: str = "wid
     """:func:`tabletcad.fe.prediction.predict_breaking_force` on the coarse mesh (whole tablet, no error
     estimate): what ``tabletcad fe strength --coarse`` prints and the design report shows.  ``solid``:
     the tablet's B-rep when it is not the plain one (scored, embossed)."""
-    return predict_breaking_force(tablet, inputs, direction, solid=solid, **coarse_mesh(tablet, direction),
-                                  error_estimate=False)
+    # the tablet and a reference disc each on its own coarse mesh
+    return predict_breaking_force(tablet, inputs, direction, solid=solid, sizes=coarse_mesh, error_estimate=False)
 
 
 def report_breaking_force(tablet: Any, options: Any, tooling: Any = None) -> dict[str, Any]:

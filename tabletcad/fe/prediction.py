@@ -24,7 +24,7 @@ tensile strength does not depend on the shape (same solid fraction).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
 from tabletcad.errors import DesignError, check_range
 from tabletcad.tolerance import DEFAULT
@@ -68,9 +68,11 @@ class StrengthInputs:
             raise DesignError("[report] tensile_strength_MPa", "missing",
                               "give it, or all of reference_breaking_force_N, reference_diameter_mm, "
                               "reference_thickness_mm")
-        if self.tensile_strength_MPa is not None and given:
-            raise DesignError("[report] reference_breaking_force_N", self.reference_breaking_force_N,
-                              "give either tensile_strength_MPa or the reference test, not both")
+        if self.tensile_strength_MPa is not None and given:  # named by the first reference input given
+            names = ("reference_breaking_force_N", "reference_diameter_mm", "reference_thickness_mm")
+            k, v = next((k, v) for k, v in zip(names, ref) if v is not None)
+            raise DesignError(f"[report] {k}", v, "give either tensile_strength_MPa or the reference test, not both",
+                              STRENGTH_KEYS[k])
         if given == 3 and self.reference_thickness_mm > self.reference_diameter_mm:
             raise DesignError("[report] reference_thickness_mm", self.reference_thickness_mm,
                               f"must be <= reference_diameter_mm ({self.reference_diameter_mm:g} mm)", "mm")
@@ -118,34 +120,47 @@ class StrengthPrediction:
         }
 
 
-def reference_tensile_strength(inputs: StrengthInputs, **fe: Any) -> tuple[float, DiametralResult]:
-    """Tensile strength (MPa) from the reference test, with the FE result of the reference disc."""
+def reference_tensile_strength(inputs: StrengthInputs, sizes: Callable[[Any, str], dict] | None = None,
+                               **fe: Any) -> tuple[float, DiametralResult]:
+    """Tensile strength (MPa) from the reference test, with the FE result of the reference disc;
+    ``sizes(disc, "x")`` gives the disc's own mesh sizes (the coarse mesh's), else ``fe``'s or the default."""
     from tabletcad.families import flat_face_round
 
     D, t = inputs.reference_diameter_mm, inputs.reference_thickness_mm
     ref = flat_face_round(diameter=D, thickness=t)
+    given = {k for k, v in fe.items() if v is not None}  # sizes the caller chose: refusals of them stand
+    if sizes is not None:
+        fe = {**fe, **sizes(ref, "x")}
     try:
         r = diametral(ref, 1.0, "x", **fe)
     except DesignError as exc:  # a size the disc's own dimensions chose: named by the reference thickness
-        if exc.parameter in fe and fe[exc.parameter] is not None:
+        if exc.parameter in given:
             raise
         value = f"{exc.value:.4g}" if isinstance(exc.value, float) else exc.value
         raise DesignError("[report] reference_thickness_mm", t, f"makes a {D:g} x {t:g} mm reference disc that the "
                           f"FE cannot mesh: its {exc.parameter.replace('_', ' ')} {value} {exc.unit} {exc.allowed}",
                           "mm") from None
+    if not r.max_tensile_stress_MPa > 0.0:  # a disc too thin for its mesh finds no tension: no strength from it
+        raise DesignError("[report] reference_thickness_mm", t, f"makes a {D:g} x {t:g} mm reference disc in which "
+                          "the FE mesh finds no tensile stress: give a thicker reference", "mm")
     return inputs.reference_breaking_force_N * r.max_tensile_stress_MPa, r
 
 
 def predict_breaking_force(tablet: Any, inputs: StrengthInputs, direction: str = "width", *, solid: Any = None,
-                           **fe: Any) -> StrengthPrediction:
+                           sizes: Callable[[Any, str], dict] | None = None, **fe: Any) -> StrengthPrediction:
     """Breaking force (N) of ``tablet`` loaded across ``direction``; ``fe`` goes to :func:`diametral`
     (for the tablet and the reference compact), ``solid`` (the tablet's B-rep, e.g. the scored one)
-    to the tablet's alone."""
+    to the tablet's alone; ``sizes(body, direction)`` gives each body its own mesh sizes (the coarse
+    mesh's: a thin reference disc is not meshed at the tablet's sizes)."""
     ref = None
+    if sizes is not None:
+        fe = {**fe, **sizes(tablet, direction)}
     if inputs.tensile_strength_MPa is not None:
         st, basis = inputs.tensile_strength_MPa, "given"
     else:
-        st, ref = reference_tensile_strength(inputs, **fe)
+        base = {k: v for k, v in fe.items() if sizes is None or k not in sizes(tablet, direction)}
+        st, ref = reference_tensile_strength(inputs, sizes, **base) if sizes is not None else \
+            reference_tensile_strength(inputs, **fe)
         basis = (f"FE on a {inputs.reference_diameter_mm:g} x {inputs.reference_thickness_mm:g} mm flat-faced "
                  f"round reference broken at {inputs.reference_breaking_force_N:g} N")
     r = diametral(tablet, 1.0, direction, solid=solid, **fe)

@@ -37,6 +37,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+import numbers
 import re
 import sys
 from dataclasses import dataclass, field, replace
@@ -414,15 +415,22 @@ def _check_size(tablet: Tablet, tol: Tolerances = DEFAULT, *, what: dict | None 
 _CUSTOM_KEYS = {"outline", "segments", "band", "cup_depth", "land", "cup_width", "central_radius", "edge_radius"}
 
 
-def _as_toml(value: Any) -> Any:
+def _as_toml(value: Any, _open: frozenset = frozenset()) -> Any:
     """A copy of a design's data as TOML would give it: numpy arrays as (nested) lists, numpy scalars
     as Python ones and tuples as lists (a Python caller's outline may be an (n, 2) array or pairs)."""
-    if isinstance(value, dict):
-        return {k: _as_toml(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_as_toml(v) for v in value]
+    if isinstance(value, (dict, list, tuple)):
+        if id(value) in _open:  # TOML has no cycles
+            raise DesignError("design", type(value).__name__, "must not contain itself")
+        inner = _open | {id(value)}
+        if isinstance(value, dict):
+            return {k: _as_toml(v, inner) for k, v in value.items()}
+        return [_as_toml(v, inner) for v in value]
     if type(value).__module__ == "numpy" and hasattr(value, "tolist"):  # an array or a numpy scalar
-        return _as_toml(value.tolist())
+        plain = value.tolist()
+        if type(plain).__module__ != "numpy":
+            return _as_toml(plain, _open)
+        # no Python type holds it (np.longdouble): the float it rounds to, else as given
+        return float(plain) if isinstance(plain, numbers.Real) else copy.deepcopy(plain)
     return copy.deepcopy(value)
 
 
