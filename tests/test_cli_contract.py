@@ -527,3 +527,17 @@ def test_a_json_file_may_not_overwrite_a_folders_ownership_record(capsys, tmp_pa
                      "--out", tmp_path / "o", "--json-file", tmp_path / "o" / ".tabletcad-fe.json")
     assert "must not be the record of the files a tabletcad run owns" in assert_refused(rc, err, "--json-file")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_json_file_may_not_overwrite_a_file_a_build_owns(capsys, tmp_path):
+    """report --json-file out/report.json replaced the build's report, and the next build into the folder
+    refused it as edited; any other name in the folder is the user's to take."""
+    out = tmp_path / "o"
+    assert main(["build", str(ROOT / "samples" / "spherical.toml"), "--out", str(out), "--quiet"]) == 0
+    capsys.readouterr()
+    before = (out / "report.json").read_bytes()
+    rc, _, err = run(capsys, "report", ROOT / "samples" / "spherical.toml", "--json-file", out / "report.json")
+    assert "is a file the tabletcad run in" in assert_refused(rc, err, "--json-file")
+    assert (out / "report.json").read_bytes() == before
+    rc, _, err = run(capsys, "report", ROOT / "samples" / "spherical.toml", "--json-file", out / "mine.json")
+    assert rc == 0 and (out / "mine.json").is_file()
