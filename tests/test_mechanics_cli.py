@@ -103,6 +103,19 @@ def test_strength_commands(capsys):
     assert rc == 0 and "W/D" in err and json.loads(out)["warnings"]
     rc, out, err = run(capsys, "strength", "sphere", "--force", 8.6, "--material", "kostrolith", "--radius", 0.7047)
     assert rc == 0 and "MPa" in out
+    # an option replaces the material's value, and the result says where each input came from
+    assert "radius 0.7047 mm from --radius" in out and "E 820 MPa from material kostrolith" in out
+    rc, out, err = run(capsys, "strength", "sphere", "--force", 8.6, "--material", "kostrolith", "--radius", 0.7047,
+                       "--json")
+    d = json.loads(out)
+    from tabletcad.mechanics import strength as st
+    from tabletcad.mechanics.materials import get_material
+
+    m = get_material("kostrolith")
+    assert d["inputs"] == {"E_MPa": m.E, "nu": m.nu, "radius_mm": 0.7047, "s_y_MPa": m.s_y,
+                           "source": {"E": "material kostrolith", "nu": "material kostrolith", "radius": "--radius",
+                                      "s_y": "material kostrolith"}}
+    assert d["tensile_strength_MPa"] == pytest.approx(st.sphere_hertz(8.6, m.E, m.nu, 0.7047, m.s_y), rel=1e-15)
     rc, out, err = run(capsys, "strength", "pitt", "--force", 100, "--diameter", 10)
     assert rc == 2 and "--thickness" in err
 

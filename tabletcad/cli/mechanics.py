@@ -386,6 +386,9 @@ def strength_cmd(method: str, F: float, D, t, W, L, R, material, E, nu, radius, 
         elif method == "podczeck":
             sigma, eq = st.podczeck_convex(F, need("--diameter", D), need("--thickness", t), W, R), "Podczeck 2013"
         else:
+            # each input from its option, else from --material's table row; the result says which
+            source = {k: (o if v is not None else None) for k, o, v in
+                      (("E", "--E", E), ("nu", "--nu", nu), ("radius", "--radius", radius), ("s_y", "--s-y", s_y))}
             if material:
                 from tabletcad.mechanics.materials import get_material
 
@@ -394,10 +397,18 @@ def strength_cmd(method: str, F: float, D, t, W, L, R, material, E, nu, radius, 
                 nu = m.nu if nu is None else nu
                 radius = m.radius if radius is None else radius
                 s_y = m.s_y if s_y is None else s_y
+                source = {k: o or f"material {material}" for k, o in source.items()}
             sigma = st.sphere_hertz(F, need("--E", E), need("--nu", nu), need("--radius", radius), need("--s-y", s_y))
             eq = "2.10-2.11"
-    _finish({"method": method, "equation": eq, "tensile_strength_MPa": sigma, "warnings": msgs}, as_json, json_file,
-            [f"{method} (eq {eq}): tensile strength = {sigma:.4g} MPa"])
+            sphere = {"E_MPa": E, "nu": nu, "radius_mm": radius, "s_y_MPa": s_y, "source": source}
+    result = {"method": method, "equation": eq, "tensile_strength_MPa": sigma, "warnings": msgs}
+    line = f"{method} (eq {eq}): tensile strength = {sigma:.4g} MPa"
+    if method == "sphere":
+        result["inputs"] = sphere
+        src = sphere["source"]
+        line += (f" (E {E:g} MPa from {src['E']}, nu {nu:g} from {src['nu']}, radius {radius:g} mm from "
+                 f"{src['radius']}, s_y {s_y:g} MPa from {src['s_y']})")
+    _finish(result, as_json, json_file, [line])
 
 
 # --------------------------------------------------------------------------- contact
