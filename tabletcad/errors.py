@@ -158,6 +158,8 @@ def _fmt(value: Any) -> str:
     if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**15:
         digits = int(value.bit_length() * math.log10(2))  # str() of a huge int may be refused
         digits += 10**digits <= abs(value)
+        if digits <= 40:  # as given (--nodes 99999999999999999999, not 1e+20)
+            return str(value)
         return f"{value:.6g}" if digits < 300 else f"an integer of {digits} digits"
     text = repr(value) if isinstance(value, str) else str(value)
     text = " ".join(text.split())  # one line, whatever the value holds

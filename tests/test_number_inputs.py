@@ -42,6 +42,9 @@ def test_numeric_types_give_the_tablet_of_the_float(value):
     (float("nan"), "tablet.diameter = nan mm is not allowed: must be a finite number"),
     (decimal.Decimal("Infinity"), "tablet.diameter = Infinity mm is not allowed: must be a finite number"),
     (10**400, "tablet.diameter = an integer of 401 digits is not allowed: must be a finite number"),
+    # an integer shown as given up to 40 digits (it was 1e+20)
+    (99999999999999999999, "tablet.diameter = 99999999999999999999 mm is not allowed: must be within ±1000 mm "
+                           "(size limit, Tolerances.max_length)"),
     (-1, "tablet.diameter = -1 mm is not allowed: must be > 0"),
 ])
 def test_the_unit_follows_only_a_number(value, message):
