@@ -138,9 +138,8 @@ def mesh_cmd(design: Path, nodes: tuple[int, int, int], out_file: Path) -> None:
         which = ", ".join(f"{n} {k}" for k, n in bad.items())
         click.echo(f"warning: {sum(bad.values())} of {mesh.n_cells} cells ({which}) have a zero Jacobian at a corner: "
                    "the cup folds onto its centre line or corners next to the spine, where the solid map of eq 4.12 "
-                   "collapses; their "
-                   "volumes are positive, but a solver that checks corner Jacobians refuses them (tabletcad fe meshes "
-                   "the B-rep with tetrahedra)", err=True)
+                   "collapses; their volumes are positive, but a solver that checks corner Jacobians refuses them "
+                   "(tabletcad fe meshes the B-rep with tetrahedra)", err=True)
     if abs(rel) > tablet.tol.mesh_volume:
         # the error falls as the square of the cell size in u and v (the solid map is linear in w):
         # scale those node spacings to land at half the bound

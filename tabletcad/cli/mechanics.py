@@ -371,6 +371,8 @@ def strength_cmd(method: str, F: float, D, t, W, L, R, material, E, nu, radius, 
     names = {"force": "--force", "diameter": "--diameter", "width": "--diameter", "thickness": "--thickness",
              "band thickness": "--band", "length": "--length", "face radius": "--face-radius", "E": "--E",
              "nu": "--nu", "radius": "--radius", "s_y": "--s-y"}
+    inputs: dict = {}  # the sphere method's inputs and their sources
+    said = ""
     with _collect() as msgs, option_names(names):
         if method == "diametral":
             sigma, eq = st.diametral_flat(F, need("--diameter", D), need("--thickness", t)), "2.4"
@@ -400,15 +402,11 @@ def strength_cmd(method: str, F: float, D, t, W, L, R, material, E, nu, radius, 
                 source = {k: o or f"material {material}" for k, o in source.items()}
             sigma = st.sphere_hertz(F, need("--E", E), need("--nu", nu), need("--radius", radius), need("--s-y", s_y))
             eq = "2.10-2.11"
-            sphere = {"E_MPa": E, "nu": nu, "radius_mm": radius, "s_y_MPa": s_y, "source": source}
-    result = {"method": method, "equation": eq, "tensile_strength_MPa": sigma, "warnings": msgs}
-    line = f"{method} (eq {eq}): tensile strength = {sigma:.4g} MPa"
-    if method == "sphere":
-        result["inputs"] = sphere
-        src = sphere["source"]
-        line += (f" (E {E:g} MPa from {src['E']}, nu {nu:g} from {src['nu']}, radius {radius:g} mm from "
-                 f"{src['radius']}, s_y {s_y:g} MPa from {src['s_y']})")
-    _finish(result, as_json, json_file, [line])
+            inputs = {"inputs": {"E_MPa": E, "nu": nu, "radius_mm": radius, "s_y_MPa": s_y, "source": source}}
+            said = (f" (E {E:g} MPa from {source['E']}, nu {nu:g} from {source['nu']}, radius {radius:g} mm from "
+                    f"{source['radius']}, s_y {s_y:g} MPa from {source['s_y']})")
+    _finish({"method": method, "equation": eq, "tensile_strength_MPa": sigma, "warnings": msgs, **inputs}, as_json,
+            json_file, [f"{method} (eq {eq}): tensile strength = {sigma:.4g} MPa{said}"])
 
 
 # --------------------------------------------------------------------------- contact

@@ -24,14 +24,13 @@ def check_output(option: str, path: Path | None, suffixes: tuple[str, ...] = (".
         raise DesignError(option, str(path), f"must end in {allowed}")
     if path.is_dir():
         raise DesignError(option, str(path), "is a folder; give a file name")
-    from tabletcad.io.outputs import FE_MANIFEST, MANIFEST, OPTIMISE_MANIFEST
+    from tabletcad.io.outputs import FE_MANIFEST, MANIFEST, OPTIMISE_MANIFEST, read_manifest
 
-    if path.name in (MANIFEST, FE_MANIFEST, OPTIMISE_MANIFEST):  # overwritten, the folder's next run refuses its own files
+    records = (MANIFEST, FE_MANIFEST, OPTIMISE_MANIFEST)
+    if path.name in records:  # overwritten, the folder's next run refuses its own files
         raise DesignError(option, str(path), "must not be the record of the files a tabletcad run owns in a folder "
                           "(give another name)")
-    from tabletcad.io.outputs import read_manifest
-
-    for record in (MANIFEST, FE_MANIFEST, OPTIMISE_MANIFEST):  # a file a build, FE or optimise run owns there
+    for record in records:  # a file a build, FE or optimise run owns there
         if path.name in read_manifest(path.parent, record):
             raise DesignError(option, str(path), f"is a file the tabletcad run in {path.parent} owns (its next run "
                               "would refuse it as edited): give another name or folder")

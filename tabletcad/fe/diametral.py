@@ -105,7 +105,8 @@ import numpy as np
 from tabletcad.errors import DesignError, GeometryError, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
 from tabletcad.fe.elasticity import Material, PressureLoad, boundary_facets, principal_stresses, solve_elasticity
-from tabletcad.fe.mesh import MAX_DOFS, CutPlane, Refinement, check_mesh_size, estimated_dofs, mesh_solid
+from tabletcad.fe.mesh import (MAX_DOFS, CutPlane, Refinement, check_mesh_size, estimated_dofs, finest_size,
+                               mesh_solid)
 
 __all__ = ["DIRECTIONS", "DiametralResult", "diametral", "hondros_centre_stress", "line_load_stress",
            "load_axis", "STRIP_FRACTION", "default_averaging_radius", "largest_tensile", "split_plane_points",
@@ -572,14 +573,13 @@ def diametral(
     # near the loaded plane the balls of radius R are resolved as on the optimiser's coarse mesh: a thin
     # disc's R = t/6 under elements of t/2 read its largest tensile stress 9.6 % high (10 x 2 mm); the
     # band within R + h of the plane is kept to half the unknowns that fit (a 25 x 0.1 mm disc's 1.5 R would not)
-    band = box * min(1.0, 2.0 * (R + h) / float(ext[px]))
+    in_band = min(1.0, 2.0 * (R + h) / float(ext[px]))  # the band's share of the tablet
     if plane_mesh_size is None:
-        fits = (3.0 * 8.0 * 1.4 * band / (0.5 * MAX_DOFS)) ** (1.0 / 3.0)  # estimated_dofs(band, fits) = MAX/2
-        hp = min(h, max(PLANE_MESH_FACTOR * R, fits))
+        hp = min(h, max(PLANE_MESH_FACTOR * R, finest_size(box * in_band, 0.5 * MAX_DOFS)))
     else:
         hp = min(h, check_positive("plane_mesh_size", plane_mesh_size, "mm"))
-        if estimated_dofs(band, hp) > MAX_DOFS:
-            check_mesh_size(float(tablet.volume()) * min(1.0, 2.0 * (R + h) / float(ext[px])), hp, "plane_mesh_size")
+        if estimated_dofs(box * in_band, hp) > MAX_DOFS:
+            check_mesh_size(float(tablet.volume()) * in_band, hp, "plane_mesh_size")
     if solid is None:
         from tabletcad.cad.tablet_solid import tablet_solid
 

@@ -100,6 +100,12 @@ def estimated_dofs(volume: float, size: float) -> float:
     return 3.0 * 8.0 * 1.4 * volume / size**3
 
 
+def finest_size(volume: float, dofs: float = MAX_DOFS) -> float:
+    """The element size (mm) at which a solid of ``volume`` mm³ has about ``dofs`` unknowns
+    (the inverse of :func:`estimated_dofs`)."""
+    return (3.0 * 8.0 * 1.4 * volume / dofs) ** (1.0 / 3.0)
+
+
 def check_mesh_size(volume: float, size: float, name: str = "mesh_size") -> float:
     """Refuse (DesignError) a mesh size whose system would not fit in memory; return ``size``."""
     if not (np.isfinite(size) and size > 0):
@@ -109,7 +115,7 @@ def check_mesh_size(volume: float, size: float, name: str = "mesh_size") -> floa
         raise DesignError(name, size, f"must be <= {largest:.3g} mm (10 x the cube root of the solid's volume)", "mm")
     n = estimated_dofs(volume, size)
     if n > MAX_DOFS:
-        smallest = (3.0 * 8.0 * 1.4 * volume / MAX_DOFS) ** (1.0 / 3.0)
+        smallest = finest_size(volume)
         raise DesignError(name, size, f"must be >= {smallest:.3g} mm for this solid "
                           f"(about {n:.3g} unknowns; at most {MAX_DOFS:.3g} fit in memory)", "mm")
     return size

@@ -40,6 +40,8 @@ STRENGTH_KEYS = {
     "reference_diameter_mm": "mm",
     "reference_thickness_mm": "mm",
 }
+#: the reference test's keys, in the order a refusal names the first missing or given one
+REFERENCE_KEYS = ("reference_breaking_force_N", "reference_diameter_mm", "reference_thickness_mm")
 
 
 @dataclass(frozen=True)
@@ -60,17 +62,15 @@ class StrengthInputs:
         ref = [self.reference_breaking_force_N, self.reference_diameter_mm, self.reference_thickness_mm]
         given = sum(v is not None for v in ref)
         if self.tensile_strength_MPa is None and 0 < given < 3:  # name the one the reference test lacks
-            names = ("reference_breaking_force_N", "reference_diameter_mm", "reference_thickness_mm")
-            lacking = next(k for k, v in zip(names, ref) if v is None)
+            lacking = next(k for k, v in zip(REFERENCE_KEYS, ref) if v is None)
             raise DesignError(f"[report] {lacking}", "missing", "the reference test needs "
-                              f"{', '.join(names)} (or give tensile_strength_MPa instead)")
+                              f"{', '.join(REFERENCE_KEYS)} (or give tensile_strength_MPa instead)")
         if self.tensile_strength_MPa is None and given != 3:
             raise DesignError("[report] tensile_strength_MPa", "missing",
                               "give it, or all of reference_breaking_force_N, reference_diameter_mm, "
                               "reference_thickness_mm")
         if self.tensile_strength_MPa is not None and given:  # named by the first reference input given
-            names = ("reference_breaking_force_N", "reference_diameter_mm", "reference_thickness_mm")
-            k, v = next((k, v) for k, v in zip(names, ref) if v is not None)
+            k, v = next((k, v) for k, v in zip(REFERENCE_KEYS, ref) if v is not None)
             raise DesignError(f"[report] {k}", v, "give either tensile_strength_MPa or the reference test, not both",
                               STRENGTH_KEYS[k])
         if given == 3 and self.reference_thickness_mm > self.reference_diameter_mm:
@@ -153,17 +153,13 @@ def predict_breaking_force(tablet: Any, inputs: StrengthInputs, direction: str =
     to the tablet's alone; ``sizes(body, direction)`` gives each body its own mesh sizes (the coarse
     mesh's: a thin reference disc is not meshed at the tablet's sizes)."""
     ref = None
-    if sizes is not None:
-        fe = {**fe, **sizes(tablet, direction)}
     if inputs.tensile_strength_MPa is not None:
         st, basis = inputs.tensile_strength_MPa, "given"
     else:
-        base = {k: v for k, v in fe.items() if sizes is None or k not in sizes(tablet, direction)}
-        st, ref = reference_tensile_strength(inputs, sizes, **base) if sizes is not None else \
-            reference_tensile_strength(inputs, **fe)
+        st, ref = reference_tensile_strength(inputs, sizes, **fe)
         basis = (f"FE on a {inputs.reference_diameter_mm:g} x {inputs.reference_thickness_mm:g} mm flat-faced "
                  f"round reference broken at {inputs.reference_breaking_force_N:g} N")
-    r = diametral(tablet, 1.0, direction, solid=solid, **fe)
+    r = diametral(tablet, 1.0, direction, solid=solid, **{**fe, **(sizes(tablet, direction) if sizes else {})})
     if r.max_tensile_stress_MPa <= 0 or r.centre_tensile_stress_MPa <= 0:
         raise DesignError("direction", direction, "loads this shape without tension at its centre; choose another")
     return StrengthPrediction(
