@@ -73,10 +73,13 @@ def baseline() -> float:
 
 
 def default_sizes(t, refine: float) -> dict[str, float]:
-    """The default mesh sizes of :func:`tabletcad.fe.diametral.diametral` divided by ``refine`` (mm)."""
+    """The default mesh sizes of :func:`tabletcad.fe.diametral.diametral` divided by ``refine`` (mm), but no
+    finer than fits in memory (``fe.mesh.finest_size``: the capsule's would need 2.5e5 unknowns)."""
+    from tabletcad.fe.mesh import finest_size
+
     lo, hi = (np.asarray(a, float) for a in t.bounds())
     ext = hi - lo
-    h = min(ext[2] / 2.0, float(min(ext[0], ext[1])) / 12.0) / refine
+    h = max(min(ext[2] / 2.0, float(min(ext[0], ext[1])) / 12.0) / refine, 1.01 * finest_size(float(t.volume())))
     b = STRIP_FRACTION * float(ext[load_axis("width", ext)])
     return {"mesh_size": h, "strip_mesh_size": min(h, b / 3.0)}
 
