@@ -335,6 +335,35 @@ def test_a_ctrl_c_that_a_library_swallowed_is_still_an_interruption(tmp_path):
     assert os.listdir(tmp_path) == []
 
 
+_LOGGED_AFTER = """
+import logging, os, signal, sys, threading
+import tabletcad.pipeline.build as g
+from tabletcad.cli import main
+
+def build(*a, **k):  # a library whose thread logs an error once the Ctrl-C has stopped the main thread
+    try:
+        os.kill(os.getpid(), signal.SIGINT)
+    finally:
+        t = threading.Thread(target=lambda: logging.getLogger("tornado.application").error("Exception in callback"))
+        t.start()
+        t.join()
+
+g.build_design = build
+sys.argv = ["tabletcad", "build", sys.argv[1], "--out", sys.argv[2]]
+sys.exit(main())
+"""
+
+
+def test_a_librarys_log_after_a_ctrl_c_is_not_printed(tmp_path):
+    """After a Ctrl-C the program's one line is ``interrupted``: a sweep's Dask client, stopped while it
+    waited, had logged a traceback from its event loop's thread first (distributed 2026.8.0)."""
+    p = subprocess.run([sys.executable, "-c", _LOGGED_AFTER, str(ROOT / "samples" / "spherical.toml"),
+                        str(tmp_path / "out")], cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)},
+                       capture_output=True, text=True, timeout=120)
+    assert (p.returncode, p.stderr) == (130, "interrupted\n")
+    assert os.listdir(tmp_path) == []
+
+
 _EXIT_HANDLERS = """
 import atexit, sys
 from tabletcad.cli import main
