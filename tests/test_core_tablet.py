@@ -27,6 +27,28 @@ def _rel(a, b):
     return abs(a - b) / abs(b)
 
 
+@pytest.mark.parametrize("path", ["families/capsule.toml", "families/rounded_triangle.toml", "spherical.toml",
+                                  "ring.toml", "shallow_convex_oval.toml"])
+def test_solid_volume_from_the_properties_samples_is_the_solid_volumes_own(path):
+    """At the default rules, properties() hands its outer faces' samples to solid_volume() (one
+    evaluation of each patch for both); the figure is the one solid_volume() computes alone, and
+    properties() gives a copy each time (a caller's change does not reach the next caller)."""
+    from tabletcad.pipeline.design import Design
+
+    design = Design.from_toml(Path(__file__).resolve().parents[1] / "samples" / path)
+    alone, shared = design.build(), design.build()
+    expected = alone.solid_volume()
+    p = shared.properties()
+    assert shared.solid_volume() == pytest.approx(expected, rel=1e-13)
+    if alone.trim.whole and alone.section is None:  # shared samples: the solid volume is already there
+        assert "_solid_volume" in shared.__dict__
+    p["volume_mm3"] = -1.0
+    p["patches"][0]["volume_mm3"] = -1.0
+    q = shared.properties()
+    assert q["volume_mm3"] == pytest.approx(expected, rel=1e-9) and q["patches"][0]["volume_mm3"] != -1.0
+    assert q == alone.properties()
+
+
 @pytest.mark.parametrize("name", NAMES)
 def test_surface_volume_equals_solid_volume(name, family_tablet):
     t = family_tablet(name)

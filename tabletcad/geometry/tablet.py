@@ -11,6 +11,7 @@ the union of the patch solids.  A :class:`Trim` restricts ``u``, ``v`` and
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field, replace
 from typing import Any, Callable
@@ -340,6 +341,13 @@ class Tablet:
 
     def faces(self) -> list[Face]:
         """The faces bounding the (trimmed) solid, oriented outward (up to the global sign)."""
+        hit = self.__dict__.get("_faces")
+        if hit is None:
+            hit = tuple(self._make_faces())
+            object.__setattr__(self, "_faces", hit)
+        return list(hit)
+
+    def _make_faces(self) -> list[Face]:
         t = self.trim
         out: list[Face] = []
         full_u = t.u == (0.0, 1.0)
@@ -384,12 +392,20 @@ class Tablet:
             tw = 0.5 * (t1 - t0) * wt
         return s, sw, t, tw
 
-    def _face_integrals(self, face: Face, nu=None, nv=None) -> tuple[float, float, float]:
-        """(area, signed volume contribution (1/3)∫X·n dA, plan-area contribution ∫max(n_z,0) dA)."""
+    def _face_integrals(self, face: Face, nu=None, nv=None, solid: list | None = None) -> tuple[float, float, float]:
+        """(area, signed volume contribution (1/3)∫X·n dA, plan-area contribution ∫max(n_z,0) dA).
+
+        With ``solid`` (a list), an outer face ``w = 1`` whose rule is :meth:`solid_volume`'s
+        (the whole solid at the default rules) also appends its patch's triple integral of the
+        solid map's Jacobian, from the same surface samples."""
         s, sw, t, tw = self._rules(face, nu, nv)
         X = face.evaluate_grid(self, s, t)
         Xs = face.evaluate_grid(self, s, t, "s")
         Xt = face.evaluate_grid(self, s, t, "t")
+        if solid is not None and face.kind == "w" and face.value == 1.0 and face.sign > 0:
+            u, uw, v, vw = self._solid_rules(face.patch)
+            if np.array_equal(u, s) and np.array_equal(uw, sw) and np.array_equal(v, t) and np.array_equal(vw, tw):
+                solid.append(self._jacobian_integral(face.patch, u, uw, vw, X, Xs, Xt))
         n = cross(Xs, Xt) * face.sign
         W = np.outer(sw, tw)
         dA = np.linalg.norm(n, axis=-1)
@@ -420,13 +436,20 @@ class Tablet:
         ``volume_mm3``, its term ``(1/3)∫X·n dA`` of the divergence theorem,
         which depends on the origin while the total does not).
         """
+        default = nu is None and nv is None
+        if default and "_properties" in self.__dict__:
+            return copy.deepcopy(self.__dict__["_properties"])
         sgn = None
         per = [dict(surface_area_mm2=0.0, volume_mm3=0.0, other_faces_area_mm2=0.0) for _ in self.patches]
         tot_a = tot_v = 0.0
         rows = []
+        # at the default rules on a whole solid, the outer faces' samples also give solid_volume()
+        solid = [] if default and self.trim.whole and "_solid_volume" not in self.__dict__ else None
         for f in self.faces():
-            a, v, pz = self._face_integrals(f, nu, nv)
+            a, v, pz = self._face_integrals(f, nu, nv, solid)
             rows.append((f, a, v, pz))
+        if solid is not None and len(solid) == len(self.patches):
+            object.__setattr__(self, "_solid_volume", float(abs(sum(solid))))
         vol = sum(r[2] for r in rows)
         sgn = 1.0 if vol >= 0 else -1.0
         for f, a, v, pz in rows:
@@ -437,12 +460,15 @@ class Tablet:
             else:
                 per[f.patch]["other_faces_area_mm2"] += a
             per[f.patch]["volume_mm3"] += sgn * v
-        return dict(
+        out = dict(
             surface_area_mm2=tot_a,
             volume_mm3=tot_v,
             orientation=sgn,
             patches=per,
         )
+        if default:  # a tablet is immutable: computed once, handed out as copies
+            object.__setattr__(self, "_properties", copy.deepcopy(out))
+        return out
 
     def band(self) -> Band | None:
         """The band patch (:class:`Band`), or None when the tablet has none (a sphere, a free form).
@@ -734,7 +760,29 @@ class Tablet:
     def solid_volume(self, nu: int | None = None, nv: int | None = None, nw: int = 3) -> float:
         """Volume (mm³) as the triple integral of the solid map's Jacobian, an
         independent check of :meth:`volume` (exact in ``w``: the Jacobian is
-        quadratic in ``w``)."""
+        quadratic in ``w``).  At the default rules, a whole solid's figure comes from the
+        same surface samples as :meth:`properties` (the two integrals are independent, the
+        surface they integrate is one)."""
+        default = nu is None and nv is None and nw == 3
+        hit = self.__dict__.get("_solid_volume") if default else None
+        if hit is not None:
+            return hit
+        total = 0.0
+        for i, p in enumerate(self.patches):
+            u, uw, v, vw = self._solid_rules(i, nu, nv)
+            X = p.evaluate_grid(u, v)
+            Xu = p.evaluate_grid(u, v, du=1)
+            Xv = p.evaluate_grid(u, v, dv=1)
+            total += self._jacobian_integral(i, u, uw, vw, X, Xu, Xv, nw)
+        total = abs(total)
+        if default:
+            object.__setattr__(self, "_solid_volume", total)
+        return total
+
+    def _solid_rules(self, i: int, nu: int | None = None, nv: int | None = None):
+        """:meth:`solid_volume`'s nodes and weights ``(u, wu, v, wv)`` for patch ``i``: Gauss-Legendre in
+        ``u``, the trapezoidal rule in a whole turn of ``v`` (Gauss-Legendre per smooth piece between an
+        outline's joins, or over a trimmed range)."""
         t = self.trim
         nu = nu or self.tol.quad_u
         if nv is None and self.section is not None:
@@ -744,38 +792,41 @@ class Tablet:
             nv = _REVOLUTION_NV
         nv = nv or self.tol.quad_v
         xu, wu = gauss_legendre(nu)
-        xw, ww = gauss_legendre(nw)
         u = 0.5 * (t.u[1] - t.u[0]) * (xu + 1) + t.u[0]
         uw = 0.5 * (t.u[1] - t.u[0]) * wu
-        w = 0.5 * (t.w[1] - t.w[0]) * (xw + 1) + t.w[0]
-        wwt = 0.5 * (t.w[1] - t.w[0]) * ww
-        if t.full_v:
+        bps = self.patches[i].breakpoints()
+        if t.full_v and bps.size:
+            v, vw = _composite_gauss(bps, nv)
+        elif bps.size:
+            v, vw = _split_gauss(t.v[0], t.v[1], bps, nv)
+        elif t.full_v:
             v = np.arange(nv) * (math.tau / nv) + t.v[0]
             vw = np.full(nv, math.tau / nv)
         else:
             xv, wv = gauss_legendre(nv)
             v = 0.5 * (t.v[1] - t.v[0]) * (xv + 1) + t.v[0]
             vw = 0.5 * (t.v[1] - t.v[0]) * wv
+        return u, uw, v, vw
+
+    def _jacobian_integral(self, i: int, u, uw, vw, X, Xu, Xv, nw: int = 3) -> float:
+        """Patch ``i``'s signed triple integral of the solid map's Jacobian ``X_u · (X_v × (X - A0))``
+        (eq 4.12) over the trimmed ``w`` by ``nw``-point Gauss-Legendre, from the surface and its first
+        partials on the grid ``u × v`` (weights ``uw``, ``vw``)."""
+        t = self.trim
+        p = self.patches[i]
+        xw, ww = gauss_legendre(nw)
+        w = 0.5 * (t.w[1] - t.w[0]) * (xw + 1) + t.w[0]
+        wwt = 0.5 * (t.w[1] - t.w[0]) * ww
+        A = p.spine(u)[:, None, :]
+        Au = p.spine(u, du=1)[:, None, :]
+        D = X - A
+        Du = Xu - Au
+        W = np.outer(uw, vw)
         total = 0.0
-        v_all, vw_all = v, vw
-        for p in self.patches:
-            v, vw = v_all, vw_all
-            bps = p.breakpoints()
-            if t.full_v and bps.size:
-                v, vw = _composite_gauss(bps, nv)
-            elif bps.size:
-                v, vw = _split_gauss(t.v[0], t.v[1], bps, nv)
-            X = p.evaluate_grid(u, v)
-            Xu = p.evaluate_grid(u, v, du=1)
-            Xv = p.evaluate_grid(u, v, dv=1)
-            A = p.spine(u)[:, None, :]
-            Au = p.spine(u, du=1)[:, None, :]
-            D = X - A
-            Du = Xu - Au
-            for wk, wq in zip(w, wwt):
-                J = np.einsum("uvc,uvc->uv", Au + wk * Du, cross(wk * Xv, D))
-                total += wq * float(np.sum(np.outer(uw, vw) * J))
-        return abs(total)
+        for wk, wq in zip(w, wwt):
+            J = np.einsum("uvc,uvc->uv", Au + wk * Du, cross(wk * Xv, D))
+            total += wq * float(np.sum(W * J))
+        return total
 
     # ------------------------------------------------------------------ geometry summaries
     def sample(self, nu: int = 65, nv: int = 128) -> np.ndarray:
@@ -1019,14 +1070,31 @@ class Tablet:
         ext = hi - lo
         return dict(length_mm=float(ext[0]), width_mm=float(ext[1]), height_mm=float(ext[2]))
 
+    def seam_v(self, nv: int = 720) -> np.ndarray:
+        """The seam checks' ``v`` samples (rad, sorted): ``nv`` meridians (4 on a tablet of revolution,
+        whose meridians are all alike) and each side (1e-7 rad) of every join of the patches' outlines
+        (:meth:`PDEPatch.breakpoints`), where a seam's normals turn fastest.  One array for every seam
+        check of a tablet (:meth:`seams`, the families' design report), so its patches evaluate the
+        data curves there once."""
+        key = ("_seam_v", nv)
+        hit = self.__dict__.get("_seam_v")
+        if hit is not None and hit[0] == key:
+            return hit[1]
+        v = np.linspace(0.0, math.tau, 4 if self.revolution is not None else nv, endpoint=False)
+        joins = [p.breakpoints() for p in self.patches]
+        b = np.unique(np.concatenate(joins)) if joins else np.zeros(0)
+        if b.size:
+            v = np.unique(np.concatenate([v, np.mod(b + 1e-7, math.tau), np.mod(b - 1e-7, math.tau)]))
+        v.setflags(write=False)
+        object.__setattr__(self, "_seam_v", (key, v))
+        return v
+
     def seams(self, nv: int = 720) -> list[dict[str, Any]]:
         """For every curve shared by consecutive patches: largest gap (mm) and
-        largest angle (deg) between the two patches' normals (on ``nv`` meridians; 4 for a
-        tablet of revolution, whose meridians are all alike)."""
+        largest angle (deg) between the two patches' normals (on :meth:`seam_v`: ``nv`` meridians,
+        4 on a tablet of revolution, and each side of the outline's joins)."""
         out = []
-        if self.revolution is not None:  # every meridian meets its neighbour patch alike
-            nv = 4
-        v = np.linspace(0.0, math.tau, nv, endpoint=False)
+        v = self.seam_v(nv)
         for i in range(len(self.patches) - 1):
             a, b = self.patches[i], self.patches[i + 1]
             xa, xb = a.evaluate(1.0, v), b.evaluate(0.0, v)

@@ -144,12 +144,7 @@ def family_seams(tablet: Tablet, nv: int = 720) -> list[dict[str, Any]]:
     """
     nom = tablet.nominal
     expected = list(getattr(nom, "expected_sharp", []))
-    if tablet.revolution is not None:  # every meridian meets its neighbour patch alike
-        nv = 4
-    v = np.linspace(0.0, 2 * math.pi, nv, endpoint=False)
-    if isinstance(nom, SweepNominal):
-        b = np.asarray(nom.outline.breaks)[:-1]
-        v = np.unique(np.concatenate([v, np.mod(b + 1e-7, 2 * math.pi), np.mod(b - 1e-7, 2 * math.pi)]))
+    v = tablet.seam_v(nv)  # the geometry report's seams' samples: each side of the outline's joins included
     out = []
     for i in range(len(tablet.patches) - 1):
         pa, pb = tablet.patches[i], tablet.patches[i + 1]
