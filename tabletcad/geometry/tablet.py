@@ -1007,8 +1007,9 @@ class Tablet:
 
     def _bounds_sampled(self) -> tuple[np.ndarray, np.ndarray]:
         u, v = self._grid(97, 256)
-        pts = np.stack([self._outer_grid(p, u, v) for p in self.patches])
-        lo, hi = coordinate_range([pts], 3)
+        # (patches, 3, nu, nv): each coordinate a contiguous block (evaluate_grid's own layout, no transposed copy)
+        pts = np.stack([self._outer_grid(p, u, v, axes=(0, 1, 2)) for p in self.patches])
+        lo, hi = pts.min(axis=(0, 2, 3)), pts.max(axis=(0, 2, 3))
         t = self.trim
         if not t.full_v or t.u != (0.0, 1.0):
             # a cut-away's cut faces run in to the spine A0(u) (eq 4.12), or to w0 of the way out to the
@@ -1026,8 +1027,9 @@ class Tablet:
             lo, hi = np.minimum(lo, inner.min(axis=0)), np.maximum(hi, inner.max(axis=0))
         for axis in range(3):
             for sign, store in ((-1.0, lo), (1.0, hi)):
-                k = int(np.argmax(sign * pts[..., axis]))
-                pi, ui, vi = np.unravel_index(k, pts.shape[:3])
+                c = pts[:, axis]
+                k = int(np.argmax(c) if sign > 0 else np.argmin(c))
+                pi, ui, vi = np.unravel_index(k, c.shape)
                 val = self._polish_extreme(self.patches[pi], axis, sign, u[ui], v[vi], u[1] - u[0], v[1] - v[0])
                 store[axis] = max(store[axis], val) if sign > 0 else min(store[axis], val)
         return lo, hi
@@ -1045,7 +1047,7 @@ class Tablet:
         n = 33
         for round_ in range(2):
             line = np.linspace(t.u[0], t.u[1], 513)
-            g = sign * self._outer(p, line, np.full(line.shape, v0))[:, axis]
+            g = sign * self._outer_grid(p, line, np.array([v0]), axes=(axis,))[0, :, 0]
             i = int(np.argmax(g))
             if g[i] > best or (round_ == 0 and g[i] == best):
                 best, u0 = float(g[i]), float(line[i])
@@ -1057,7 +1059,7 @@ class Tablet:
                 vv = v0 + np.linspace(-b, b, n)
                 if not t.full_v:
                     vv = np.clip(vv, t.v[0], t.v[1])
-                g = sign * self._outer_grid(p, uu, vv)[..., axis]
+                g = sign * self._outer_grid(p, uu, vv, axes=(axis,))[0]
                 i, j = np.unravel_index(int(np.argmax(g)), g.shape)
                 if g[i, j] >= best:
                     best, u0, v0 = float(g[i, j]), float(uu[i]), float(vv[j])
