@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import array_shapes, arrays
 
 from tabletcad.geometry.tables import CARDINAL, SharedTables
-from tabletcad.geometry.vectors import cross
+from tabletcad.geometry.vectors import cross, norm3
 
 
 def test_least_recently_used_goes_first_and_results_are_read_only():
@@ -72,3 +72,11 @@ def test_cross_equals_numpy_cross(a, b, data):
     np.testing.assert_array_equal(cross(a, other * b), np.cross(a, other * b))
     if a.ndim >= 2:  # broadcast along a leading axis
         np.testing.assert_array_equal(cross(a[..., :1, :], other), np.cross(a[..., :1, :], other))
+
+
+@settings(max_examples=80, deadline=None)
+@given(a=arrays(np.float64, array_shapes(min_dims=1, max_dims=3, min_side=1, max_side=5).map(lambda s: s[:-1] + (3,)),
+                elements=st.floats(-1e150, 1e150) | st.floats(-1e-150, 1e-150)))
+def test_norm3_equals_numpy_norm(a):
+    """The core's lengths of 3-vectors are numpy's, to the last bit (the same squares in the same order)."""
+    np.testing.assert_array_equal(norm3(a), np.linalg.norm(a, axis=-1))

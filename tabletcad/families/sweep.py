@@ -50,7 +50,7 @@ from tabletcad.families.profile import Piece, profile_line, distance_to_chain, j
 from tabletcad.geometry.patch import PDEPatch
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT, Tolerances
-from tabletcad.geometry.vectors import cross
+from tabletcad.geometry.vectors import cross, norm3
 from tabletcad.geometry.quadrature import gauss_legendre
 
 __all__ = [
@@ -575,7 +575,7 @@ def sweep_properties(tablet: Tablet, nu: int = 24, nv_per: int = 48) -> dict[str
     for i, p in enumerate(tablet.patches):
         X = p.evaluate_grid(u, v)
         n = cross(p.evaluate_grid(u, v, du=1), p.evaluate_grid(u, v, dv=1))
-        dA = np.linalg.norm(n, axis=-1)
+        dA = norm3(n)
         a = float(np.sum(W * dA))
         area += a
         vol += float(np.sum(W * np.einsum("uvc,uvc->uv", X, n))) / 3.0

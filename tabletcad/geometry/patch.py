@@ -40,7 +40,7 @@ from tabletcad.geometry.tables import CARDINAL, TRIG
 from tabletcad.geometry.curves import fourier_coefficients, modes_needed, sample_v
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
-from tabletcad.geometry.vectors import cross
+from tabletcad.geometry.vectors import cross, norm3
 
 __all__ = ["PDEPatch", "AUTO_A_LADDER"]
 
@@ -485,15 +485,15 @@ class PDEPatch:
         xu = self.evaluate(u, v, du=1)
         xv = self.evaluate(u, v, dv=1)
         n = cross(xu, xv)
-        norm = np.linalg.norm(n, axis=-1)
-        scale = np.max(np.linalg.norm(xu, axis=-1)) + 1e-300
+        norm = norm3(n)
+        scale = np.max(norm3(xu)) + 1e-300
         bad = norm <= 1e-9 * scale * scale
         if np.any(bad):
             ub = u[bad]
             ush = np.where(ub > 0.5, ub - 1e-5, ub + 1e-5)
             nb = cross(self.evaluate(ush, v[bad], du=1), self.evaluate(ush, v[bad], dv=1))
             n[bad] = nb
-            norm[bad] = np.linalg.norm(nb, axis=-1)
+            norm[bad] = norm3(nb)
         return n / np.maximum(norm, 1e-300)[..., None]
 
     # ------------------------------------------------------------------ coefficients (thesis form)
@@ -583,7 +583,8 @@ class PDEPatch:
                 L = L[:, :2]
                 r = r[:2]
             fine += np.einsum("uk,kvc->uvc", L, r)
-        return float(np.max(np.linalg.norm(fine, axis=-1)))
+        x, y, z = fine[..., 0], fine[..., 1], fine[..., 2]
+        return math.sqrt(float(np.max(x * x + y * y + z * z)))  # the largest |fine|: one root, no norm pass
 
     def _check_stray(self) -> None:
         s = self.stray()
@@ -698,7 +699,7 @@ class PDEPatch:
         D = X - self.spine(u)[:, None, :]
         # (a) the radius must not turn negative: the radial vector may not point
         #     against that of the widest curve (the surface would pass through its spine)
-        Dn = np.linalg.norm(D, axis=-1)
+        Dn = norm3(D)
         k = int(np.argmax(Dn.max(axis=1)))
         ref = D[k] / np.maximum(Dn[k], 1e-300)[:, None]
         along = np.einsum("uvc,vc->uv", D, ref)
@@ -707,7 +708,7 @@ class PDEPatch:
         Xu = self.evaluate_grid(u, v, du=1)
         Xv = self.evaluate_grid(u, v, dv=1)
         n = cross(Xu, Xv)
-        nn = np.linalg.norm(n, axis=-1)
+        nn = norm3(n)
         dots = np.einsum("uvc,uvc->uv", n[1:], n[:-1])
         self._refuse_fold_back(dots, nn, u, v)
 

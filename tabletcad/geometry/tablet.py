@@ -26,7 +26,7 @@ from tabletcad.geometry.revolution import profile_extreme
 #: (``X·n``, ``|n|``, the solid map's Jacobian) are the same on every meridian.
 _REVOLUTION_NV = 4
 from tabletcad.tolerance import DEFAULT, Tolerances
-from tabletcad.geometry.vectors import cross
+from tabletcad.geometry.vectors import cross, norm3
 from tabletcad.geometry.quadrature import gauss_legendre
 
 __all__ = ["Band", "Trim", "Tablet", "Face", "solid_map"]
@@ -408,7 +408,7 @@ class Tablet:
                 solid.append(self._jacobian_integral(face.patch, u, uw, vw, X, Xs, Xt))
         n = cross(Xs, Xt) * face.sign
         W = np.outer(sw, tw)
-        dA = np.linalg.norm(n, axis=-1)
+        dA = norm3(n)
         area = float(np.sum(W * dA))
         vol = float(np.sum(W * np.einsum("...c,...c->...", X, n))) / 3.0
         return area, vol, float(np.sum(W * n[..., 2]))
@@ -1106,7 +1106,7 @@ class Tablet:
             else:
                 # skip points where the shared curve has (nearly) zero speed, such as a
                 # corner collapsed to a point: the normals are undefined there
-                speed = np.linalg.norm(a.evaluate(1.0, v, dv=1), axis=-1)
+                speed = norm3(a.evaluate(1.0, v, dv=1))
                 ok = speed > 1e-6 * float(np.max(speed))
                 na, nb = a.normal(1.0, v[ok]), b.normal(0.0, v[ok])
                 cosang = np.clip(np.einsum("ij,ij->i", na, nb), -1.0, 1.0)
