@@ -57,8 +57,8 @@ def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
     for which in ("upper_punch", "lower_punch"):
         body = ts.report[which]["body"]
         assert body["working_length_mm"] == pytest.approx(133.35 - 0.9, abs=1e-6)
-    for text in ("working length (head flat to cup bottom): upper 132.45, lower 132.45", "bore Ø10.00 (the tablet's",
-                 "tips Ø9.96 (the bore less the clearance 0.020 per side)"):
+    for text in ("working length (head flat to cup bottom): upper 132.45, lower 132.45", "bore Ø10.000 (the tablet's",
+                 "tips Ø9.960 (the bore less the clearance 0.020 per side)"):
         assert text in tsvg, text
     dxf = (out / "tooling.dxf").read_text(encoding="utf-8", errors="replace")
     assert "overall 133.35" in dxf and "TC-0001" in dxf

@@ -28,7 +28,8 @@ def test_rating_and_buckling_are_the_closed_forms_for_a_round_tip(frame):
                               allowed_tip_pressure_MPa=300.0, allowed_tip_pressure_source=SRC,
                               punch_youngs_modulus_MPa=210000.0, punch_youngs_modulus_source=SRC))
     r = tip_rating(frame, spec, ReportOptions(compaction_force_kN=15.0))
-    rt = 5.0 - 0.02
+    rt = 5.0 - (0.02 - frame.bore_offset)  # the tip: the die bore (clearing the band's bulge) less the clearance
+    assert 0.002 < frame.bore_offset < 0.003 and r["overloaded"] is False
     assert r["tip_projected_area_mm2"] == pytest.approx(math.pi * rt ** 2, rel=1e-9)
     assert r["rated_force_kN"] == pytest.approx(300.0 * math.pi * rt ** 2 / 1000.0, rel=1e-9)
     assert r["utilisation"] == pytest.approx(15.0 / r["rated_force_kN"], rel=1e-12)
@@ -71,3 +72,23 @@ def test_unsourced_or_bad_limits_are_design_errors(table, parameter):
     with pytest.raises(DesignError) as e:
         parse_tooling(table)
     assert parameter in e.value.parameter
+
+
+def test_a_compaction_force_above_the_rating_is_warned_of_and_drawn(frame):
+    """A force above the tips' rating is an overload: a warning, ``overloaded`` in the report and a line on
+    the drawing (a 1 kN force on a 2 mm tip rated 0.924 kN had passed in silence)."""
+    from tabletcad.tooling.drawing import rating_notes
+
+    spec = parse_tooling(dict(clearance_mm=0.02, allowed_tip_pressure_MPa=300.0, allowed_tip_pressure_source=SRC))
+    rated = 300.0 * math.pi * (5.0 - (0.02 - frame.bore_offset)) ** 2 / 1000.0
+    force = 1.08 * rated
+    with pytest.warns(UserWarning, match=r"exceeds the tips' rated force .* utilisation 1\.08"):
+        r = tip_rating(frame, spec, ReportOptions(compaction_force_kN=force))
+    assert r["overloaded"] is True and r["utilisation"] == pytest.approx(1.08, rel=1e-9)
+    assert any(n.startswith("OVERLOADED: compaction force") for n in rating_notes(r))
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # within the rating: no warning
+        ok = tip_rating(frame, spec, ReportOptions(compaction_force_kN=0.99 * rated))
+    assert ok["overloaded"] is False and not any("OVERLOADED" in n for n in rating_notes(ok))

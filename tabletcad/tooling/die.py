@@ -23,7 +23,7 @@ from tabletcad.cad._occ import cast, explore
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.tooling.booleans import boolean, translated, volume
 from tabletcad.tooling.outline import TabletFrame, offset_wire, plan_face, prism
-from tabletcad.tooling.spec import MIN_BORE_OFFSET_MM, MIN_DIE_WALL_MM, standard_die_size
+from tabletcad.tooling.spec import MIN_DIE_WALL_MM, standard_die_size
 
 __all__ = ["die", "default_die_size", "tapered_prism", "MIN_WALL_MM"]
 
@@ -78,7 +78,7 @@ def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, 
     od0, h0, kind = default_die_size(frame) if outer_diameter is None or height is None else (None, None, "custom")
     od = outer_diameter if outer_diameter is not None else od0
     H = height if height is not None else h0
-    bulge = max(frame.band_bulge, MIN_BORE_OFFSET_MM) if frame.band_bulge > 0 else 0.0
+    bulge = frame.bore_offset
     bore = offset_wire(frame.outline, bulge) if bulge > 0 else frame.outline
     r_bore = _max_radius(bore)
     if od / 2.0 - r_bore < MIN_WALL_MM:

@@ -307,6 +307,9 @@ def rating_notes(r: dict) -> list[str]:
         lead = "pressure-rule rating" if notes else "tip force rating"
         notes.append(f"{lead} {r['rated_force_kN']:.3g} kN = {r['allowed_pressure_MPa']:g} MPa x "
                      f"{r['tip_projected_area_mm2']:.4g} mm2 tip area (allowed pressure: {r['allowed_pressure_source']})")
+        if r.get("overloaded"):
+            notes.append(f"OVERLOADED: compaction force {r['compaction_force_kN']:.4g} kN is {r['utilisation']:.3g} x "
+                         f"the rated {r['rated_force_kN']:.3g} kN")
     return notes
 
 
@@ -341,10 +344,16 @@ def _toleranced(dims: list, ts) -> list:
 
 def _plan_size(fr, inset: float) -> str:
     """The plan size of the outline offset inward by ``inset`` mm: ``Ø`` of a round, else length x width
-    (a convex outline's extents shrink by twice the offset)."""
+    (a convex outline's extents shrink by twice the offset), to the micrometre a bore and its tips are
+    ground to (a thesis tablet's bore, 2.5 µm a side over the outline, read "Ø10.00" at two decimals)."""
     if fr.round_radius is not None:
-        return f"Ø{_fmt(2.0 * (fr.round_radius - inset))}"
-    return f"{_fmt(fr.length - 2.0 * inset)} x {_fmt(fr.width - 2.0 * inset)}"
+        return f"Ø{2.0 * (fr.round_radius - inset):.3f}"
+    return f"{fr.length - 2.0 * inset:.3f} x {fr.width - 2.0 * inset:.3f}"
+
+
+def _bore_growth(fr) -> str:
+    """The bore's growth over the outline in words (empty when there is none)."""
+    return "" if fr.bore_offset < 1e-4 else f" + {fr.bore_offset * 1000:.3g} µm a side for the band's bulge"
 
 
 def _title(ts) -> str:
@@ -578,7 +587,8 @@ def tooling_model(ts) -> Drawing:
                "die": (Dh + 25.0 + gap, -die["bottom_z_mm"])}
     dims: list[Dim] = []
     tol = ts.spec.drawing.tolerance
-    for name, b, edge, sgn in (("upper punch", up, fr.band_z[1], 1.0), ("lower punch", lo, fr.band_z[0], -1.0)):
+    for name, b, edge, sgn in (("upper punch", up, rep["upper_punch"]["tip_edge_z_mm"], 1.0),
+                               ("lower punch", lo, rep["lower_punch"]["tip_edge_z_mm"], -1.0)):
         ox, oy = origins[name]
         z_tip, z_head = oy + edge, oy + b["head_flat_z_mm"]
         z_shoulder = z_tip + sgn * b["tip_length_mm"]
@@ -605,9 +615,10 @@ def tooling_model(ts) -> Drawing:
              f"upper tip {_fmt(up['tip_length_mm'])}, lower tip {_fmt(lo['tip_length_mm'])}",
              f"working length (head flat to cup bottom): upper {_fmt(up['working_length_mm'])}, lower "
              f"{_fmt(lo['working_length_mm'])}",
-             f"die Ø{_fmt(die['outer_diameter_mm'])} x {_fmt(die['height_mm'])}, bore {_plan_size(fr, 0.0)} (the "
-             f"tablet's {die['bore']} outline), taper {die['taper_deg']:g} deg; tips {_plan_size(fr, ts.spec.clearance_mm)} "
-             f"(the bore less the clearance {_fmt(ts.spec.clearance_mm)} per side)",
+             f"die Ø{_fmt(die['outer_diameter_mm'])} x {_fmt(die['height_mm'])}, bore {_plan_size(fr, -fr.bore_offset)} (the "
+             f"tablet's {die['bore']} outline{_bore_growth(fr)}), taper {die['taper_deg']:g} deg; tips "
+             f"{_plan_size(fr, fr.tip_inset(ts.spec.clearance_mm))} (the bore less the clearance "
+             f"{_fmt(ts.spec.clearance_mm)} per side)",
              "standard dimensions: tabletcad/data/tooling_standards.toml (sources per value in report.json)"
              if up["standard"] != "custom" else "user-defined set: every dimension from [tooling.punch]"]
     return Drawing(views, origins, dims, notes, title=f"{_title(ts)} — punches and die",

@@ -182,7 +182,7 @@ def legibility(frame: TabletFrame, e: EmbossSpec, figure: TopoDS_Shape, clearanc
             t_end, t_start = tans[k][1], tans[(k + 1) % len(tans)][0]
             if t_end.Magnitude() > 1e-12 and t_start.Magnitude() > 1e-12 and t_end.Angle(t_start) > math.radians(5.0):
                 sharp += 1
-    tip_edge = offset_wire(frame.outline, -clearance)
+    tip_edge = offset_wire(frame.outline, -frame.tip_inset(clearance))
     dss = BRepExtrema_DistShapeShape(figure, tip_edge)
     land = float(dss.Value()) if dss.IsDone() else None
     width = 2.0 * area / perimeter if perimeter > 0 else 0.0

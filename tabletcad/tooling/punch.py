@@ -39,43 +39,55 @@ class PunchTip:
 
 def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, tip_length: float, *,
               check: bool = True, deflection: float = 0.005, tablet_manifold=None):
-    """The ``"upper"`` or ``"lower"`` punch tip; returns ``(PunchTip, BooleanCheck or None)``."""
-    tip_wire = offset_wire(frame.outline, -clearance)
+    """The ``"upper"`` or ``"lower"`` punch tip; returns ``(PunchTip, BooleanCheck or None)``.
+
+    The tip's edge is where its wall meets the tablet's face: the band's edge when the tablet has a
+    land wider than the tip's inset, else higher up the cup (a tablet without a land: 0.013 mm on a
+    2.5 mm-deep oval cup at 0.025 mm clearance).  ``tip_length`` runs from that edge, so the punch's
+    overall length, measured from its tip edge, is the one its body gives."""
+    inset = frame.tip_inset(clearance)  # the tip follows the die bore, the clearance inside it
+    tip_wire = offset_wire(frame.outline, -inset)
     z_mid = 0.5 * (frame.band_z[0] + frame.band_z[1])
-    if which == "upper":
-        edge = frame.band_z[1]
-        z0, z1 = z_mid, edge + tip_length
-        cup_point = frame.z_max
-        datum = z1
+    up = which == "upper"
+    edge = frame.band_z[1] if up else frame.band_z[0]
+
+    def cut(edge_z: float):
+        z0, z1 = (z_mid, edge_z + tip_length) if up else (edge_z - tip_length, z_mid)
+        body = prism(tip_wire, z0, z1)
+        # the manifold check is on "prism minus tablet": the removed volume is the tablet inside the prism
+        return checked_boolean("cut", body, tablet_shape, what=f"{which} punch tip", deflection=deflection,
+                               check=check, a_manifold=None, sliver=1e-4,
+                               exact=lambda: tip_cell(body, tablet_shape, z_mid, z0, z1, which))
+
+    shape, chk = cut(edge)
+    lo, hi = tight_z_range(shape)
+    tip_edge = lo if up else hi  # the tip's end nearest the tablet: where its wall meets the face
+    if abs(tip_edge - edge) > 1e-6:  # (OCC's optimal box is good to ~1e-7 mm: a land's edge is the band's)
+        shape, chk = cut(tip_edge)
     else:
-        edge = frame.band_z[0]
-        z0, z1 = edge - tip_length, z_mid
-        cup_point = frame.z_min
-        datum = z0
-    body = prism(tip_wire, z0, z1)
-    # the manifold check is on "prism minus tablet": the removed volume is the tablet inside the prism
-    shape, chk = checked_boolean("cut", body, tablet_shape, what=f"{which} punch tip", deflection=deflection,
-                                 check=check, a_manifold=None, sliver=1e-4,
-                                 exact=lambda: tip_cell(body, tablet_shape, z_mid, z0, z1, which))
+        tip_edge = edge
+    cup_point = frame.z_max if up else frame.z_min
+    datum = tip_edge + tip_length if up else tip_edge - tip_length
     vol = volume(shape)
     cup = frame.cup_depth_top if which == "upper" else frame.cup_depth_bottom
-    land = None if frame.land is None or cup < 1e-9 else frame.land - clearance  # a flat tip has no land
-    quad = punch_volume_quadrature(frame, clearance, tip_length, which)
+    land = None if frame.land is None or cup < 1e-9 else frame.land - inset  # a flat tip has no land
+    quad = punch_volume_quadrature(frame, clearance, tip_length + abs(tip_edge - edge), which)
     info = dict(
         tip_outline=frame.outline_kind,
         tip_plan_area_mm2=face_area(plan_face(tip_wire)),
         tip_perimeter_mm=wire_length(tip_wire),
-        tip_diameter_mm=None if frame.round_radius is None else 2.0 * (frame.round_radius - clearance),
+        tip_diameter_mm=None if frame.round_radius is None else 2.0 * (frame.round_radius - inset),
         tip_length_mm=tip_length,
         clearance_mm=clearance,
+        tip_inset_from_outline_mm=inset,
         land_mm=land,
-        tip_edge_z_mm=edge,
+        tip_edge_z_mm=tip_edge,
         cup_depth_mm=frame.cup_depth_top if which == "upper" else frame.cup_depth_bottom,
         working_length_datum=dict(
             datum_plane_z_mm=datum,
             cup_bottom_point_mm=[0.0, 0.0, cup_point],
             datum_to_cup_bottom_mm=abs(datum - cup_point),
-            datum_to_tip_edge_mm=abs(datum - edge),
+            datum_to_tip_edge_mm=abs(datum - tip_edge),
             note="datum = back face of the tip; working length = head flat to cup bottom, i.e. "
                  "(head flat to datum) + datum_to_cup_bottom_mm",
         ),
@@ -84,6 +96,17 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
         volume_rel_diff_vs_quadrature=None if quad is None else (vol - quad) / quad,
     )
     return PunchTip(f"{which}_punch", shape, vol, info), chk
+
+
+def tight_z_range(shape) -> tuple[float, float]:
+    """The lowest and highest z (mm) of ``shape``'s geometry itself (OCC's optimal box: the surfaces'
+    extrema, not their poles or a tolerance-widened box)."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    box = Bnd_Box()
+    BRepBndLib.AddOptimal_s(shape, box, False, False)
+    return box.CornerMin().Z(), box.CornerMax().Z()
 
 
 def _z_range(shape) -> tuple[float, float]:
@@ -171,10 +194,12 @@ def cup_volume_within(frame: TabletFrame, rho: float, which: str = "upper", n: i
 
 
 def punch_volume_quadrature(frame: TabletFrame, clearance: float, tip_length: float, which: str = "upper") -> float | None:
-    """Volume (mm^3) of a plain round punch tip: cylinder of radius ``R - clearance`` and
-    ``tip_length`` minus the cup inside it (:func:`cup_volume_within`); None if not round."""
+    """Volume (mm^3) of a plain round punch tip: cylinder of radius ``R - inset`` (the clearance less
+    the die bore's offset, :meth:`~tabletcad.tooling.outline.TabletFrame.tip_inset`) and ``tip_length``
+    (its length beyond the band's edge plane: the tip's own plus its edge's rise up a cup without a
+    land) minus the cup inside it (:func:`cup_volume_within`); None if not round."""
     if frame.round_radius is None:
         return None
-    rho = frame.round_radius - clearance
+    rho = frame.round_radius - frame.tip_inset(clearance)
     cup = cup_volume_within(frame, rho, which)
     return math.pi * rho * rho * tip_length - cup

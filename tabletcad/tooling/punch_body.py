@@ -102,8 +102,9 @@ def relief_volume(frame: TabletFrame, b: PunchBody, clearance: float, tip_length
     outline times the relieved length."""
     if b.tip_relief_mm <= 0 or tip_length <= b.tip_straight_mm:
         return 0.0
-    a = face_area(plan_face(offset_wire(frame.outline, -clearance)))
-    r = face_area(plan_face(offset_wire(frame.outline, -clearance - b.tip_relief_mm)))
+    inset = frame.tip_inset(clearance)
+    a = face_area(plan_face(offset_wire(frame.outline, -inset)))
+    r = face_area(plan_face(offset_wire(frame.outline, -inset - b.tip_relief_mm)))
     return (a - r) * (tip_length - b.tip_straight_mm)
 
 
@@ -123,16 +124,21 @@ def check_body_fits(frame: TabletFrame, b: PunchBody, tip_radius: float) -> None
                           f"tablets up to {lim:g} mm (tabletcad/data/tooling_standards.toml); this one is {size:.4g} mm")
 
 
-def complete_punch(frame: TabletFrame, tip_shape, which: str, b: PunchBody, clearance: float, tip_length: float):
-    """The complete ``"upper"``/``"lower"`` punch from its tip solid: ``(shape, info)``."""
+def complete_punch(frame: TabletFrame, tip_shape, which: str, b: PunchBody, clearance: float, tip_length: float,
+                   edge: float | None = None):
+    """The complete ``"upper"``/``"lower"`` punch from its tip solid: ``(shape, info)``.  ``edge``: the
+    tip's edge z (mm; :func:`~tabletcad.tooling.punch.punch_tip`'s ``tip_edge_z_mm``, the band's edge by
+    default), from which the tip length and the overall length run."""
     up = which == "upper"
-    edge = frame.band_z[1] if up else frame.band_z[0]
+    if edge is None:
+        edge = frame.band_z[1] if up else frame.band_z[0]
     sign = 1.0 if up else -1.0
     shape = tip_shape
     if b.tip_relief_mm > 0 and tip_length > b.tip_straight_mm:
         a, c = sorted((edge + sign * b.tip_straight_mm, edge + sign * (tip_length + 1.0)))
-        ring = boolean("cut", prism(offset_wire(frame.outline, -clearance + 0.05), a, c),
-                       prism(offset_wire(frame.outline, -clearance - b.tip_relief_mm), a - 1.0, c + 1.0),
+        inset = frame.tip_inset(clearance)
+        ring = boolean("cut", prism(offset_wire(frame.outline, -inset + 0.05), a, c),
+                       prism(offset_wire(frame.outline, -inset - b.tip_relief_mm), a - 1.0, c + 1.0),
                        what=f"{which} tip relief ring")
         shape = boolean("cut", shape, ring, what=f"{which} tip relief")
     lb = b.barrel_length_mm(tip_length)

@@ -50,7 +50,8 @@ def tip_rating(frame: TabletFrame, spec, options: ReportOptions | None = None) -
     force), or None.
     """
     options = ReportOptions() if options is None else options
-    area, _ = section_properties(offset_wire(frame.outline, -spec.clearance_mm))
+    inset = frame.tip_inset(spec.clearance_mm)  # the tips' outline (the die bore less the clearance)
+    area, _ = section_properties(offset_wire(frame.outline, -inset))
     out: dict = dict(tip_projected_area_mm2=area, rule="F = p_allowed x tip projected area")
     p, src = spec.allowed_tip_pressure_MPa, spec.allowed_tip_pressure_source
     if p is None and options.max_punch_pressure_MPa is not None:
@@ -60,12 +61,19 @@ def tip_rating(frame: TabletFrame, spec, options: ReportOptions | None = None) -
     force = options.compaction_force_kN
     out["compaction_force_kN"] = force
     out["utilisation"] = None if force is None or p is None else force / out["rated_force_kN"]
+    out["overloaded"] = None if out["utilisation"] is None else out["utilisation"] > 1.0
+    if out["overloaded"]:
+        import warnings
+
+        warnings.warn(f"the compaction force {force:.4g} kN exceeds the tips' rated force {out['rated_force_kN']:.4g} kN "
+                      f"({p:g} MPa x {area:.4g} mm2 tip area; utilisation {out['utilisation']:.3g}): the tips would be "
+                      "overloaded; lower [report] compaction_force_kN or enlarge the tablet", stacklevel=2)
     if p is None:
         out["note"] = "no allowed pressure given ([tooling] allowed_tip_pressure_MPa with its source): no rating"
     E = spec.punch_youngs_modulus_MPa
     body = spec.body
     relief = 0.0 if body is None else body.tip_relief_mm
-    _, i_min = section_properties(offset_wire(frame.outline, -spec.clearance_mm - relief))
+    _, i_min = section_properties(offset_wire(frame.outline, -inset - relief))
     tips = {}
     for name, L in (("upper", spec.tip_length_mm), ("lower", spec.lower_tip)):
         p_cr = None if E is None else math.pi ** 2 * E * i_min / (EULER_K * L) ** 2 / 1000.0

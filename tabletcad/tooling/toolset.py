@@ -65,7 +65,7 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
     from tabletcad.tooling.die import _max_radius, die_position
     from tabletcad.tooling.punch_body import check_body_fits
 
-    check_body_fits(frame, spec.body, _max_radius(frame.outline) - spec.clearance_mm)
+    check_body_fits(frame, spec.body, _max_radius(frame.outline) - frame.tip_inset(spec.clearance_mm))
     if frame.round_radius is None and not spec.body.key:
         import warnings
 
@@ -120,11 +120,14 @@ def _warn_sharp_edge(frame, clearance: float) -> None:
     (FFBE, FFRE) and a concave face's bevel are the edge's own design: none of them warns."""
     cupped = max(frame.cup_depth_top, frame.cup_depth_bottom) > 1e-9
     edge_designed = frame.info.get("face") == "flat" or bool(frame.info.get("bevel_width_mm"))
-    if cupped and not edge_designed and frame.land is not None and frame.land - clearance <= 1e-9:
+    inset = frame.tip_inset(clearance)  # the clearance less the bore's growth over the outline
+    if cupped and not edge_designed and frame.land is not None and frame.land - inset <= 1e-9:
         import warnings
 
-        warnings.warn(f"the punch tips have no land ({frame.land:.4g} mm tablet land - {clearance:.4g} mm clearance "
-                      f"= {frame.land - clearance:.4g} mm): the cup runs into the tip's wall at a sharp edge, which "
+        what = ("clearance" if frame.bore_offset < 1e-4 else
+                f"tip inset (the {clearance:.4g} mm clearance less the bore's {frame.bore_offset * 1000:.3g} µm growth)")
+        warnings.warn(f"the punch tips have no land ({frame.land:.4g} mm tablet land - {inset:.4g} mm {what} "
+                      f"= {frame.land - inset:.4g} mm): the cup runs into the tip's wall at a sharp edge, which "
                       "chips in service; give the tablet a land wider than the clearance", stacklevel=3)
 
 
@@ -223,7 +226,8 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
 
         for tip, tl in ((upper, spec.tip_length_mm), (lower, spec.lower_tip)):
             which = tip.name.split("_")[0]
-            shape_, info_ = complete_punch(frame, tip.shape, which, spec.body, spec.clearance_mm, tl)
+            shape_, info_ = complete_punch(frame, tip.shape, which, spec.body, spec.clearance_mm, tl,
+                                           edge=tip.info["tip_edge_z_mm"])
             # working length: head flat to the cup's bottom (the tip's datum note), the length a press sets
             info_["working_length_mm"] = abs(info_["head_flat_z_mm"]
                                              - tip.info["working_length_datum"]["cup_bottom_point_mm"][2])
