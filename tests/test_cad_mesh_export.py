@@ -161,3 +161,37 @@ def test_edge_check_agrees_with_trimesh(seed):
         T = np.vstack([T, T[k]])  # repeated
     tm = trimesh.Trimesh(base.vertices, T, process=False)
     assert _edge_check(T) == (tm.is_watertight, tm.is_winding_consistent)
+
+
+@pytest.mark.parametrize("kw, parameter", [
+    (dict(linear_deflection=float("nan")), "linear_deflection"),   # had meshed until the memory ran out
+    (dict(linear_deflection=1e-7), "linear_deflection"),
+    (dict(linear_deflection=float("inf")), "linear_deflection"),  # had written an empty mesh
+    (dict(linear_deflection=0.0), "linear_deflection"),
+    (dict(angular_deflection=float("nan")), "angular_deflection"),  # had given 15x the triangles, silently
+    (dict(angular_deflection=2.0), "angular_deflection"),
+    (dict(linear_deflection=2.0, relative=True), "linear_deflection"),
+])
+def test_a_deflection_out_of_range_is_refused_naming_it(tmp_path, kw, parameter):
+    from tabletcad.cad.mesh import tessellate_solid
+    from tabletcad.errors import DesignError
+
+    solid = build_solid(cylinder(5.0, 3.0).patches)
+    with pytest.raises(DesignError) as err:
+        export(solid, tmp_path / "t.stl", **kw)
+    assert err.value.parameter == parameter and "\n" not in str(err.value)
+    if not kw.get("relative"):
+        with pytest.raises(DesignError):
+            tessellate_solid(solid, **kw)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_export_refuses_an_option_it_does_not_know_and_applies_relative(tmp_path):
+    """A misspelt mesh option had been dropped in silence (the file byte-identical to the default's), and
+    ``relative`` with it."""
+    solid = build_solid(cylinder(5.0, 3.0).patches)
+    with pytest.raises(TypeError, match="linear_deflexion"):
+        export(solid, tmp_path / "a.stl", linear_deflexion=0.1)
+    a = export(solid, tmp_path / "a.stl").read_bytes()
+    b = export(solid, tmp_path / "b.stl", linear_deflection=0.01, relative=True).read_bytes()
+    assert a != b and len(b) > 84

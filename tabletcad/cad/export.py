@@ -127,11 +127,16 @@ def export_step(obj: Any, path: str | os.PathLike[str], *, name: str = "tablet",
 def _mesh_of(obj: Any, mesh: MeshResult | None, **kw: Any) -> MeshResult:
     if mesh is not None:
         return mesh
-    opts = {**MESH_DEFAULTS, **kw}
-    if hasattr(obj, "surfaces") and hasattr(obj, "shape"):  # a TabletSolid: meshed from its faces' data, as the CAD stage does
+    unknown = sorted(set(kw) - {"linear_deflection", "angular_deflection", "relative"})
+    if unknown:  # as Python's own call would: a misspelt option is not dropped in silence
+        raise TypeError(f"export got an unexpected keyword argument {unknown[0]!r} (mesh options: linear_deflection "
+                        "mm, angular_deflection rad, relative)")
+    opts = {**MESH_DEFAULTS, "relative": False, **kw}
+    if hasattr(obj, "surfaces") and hasattr(obj, "shape") and not opts["relative"]:
+        # a TabletSolid: meshed from its faces' data, as the CAD stage does
         m = tessellate_solid(obj, opts["linear_deflection"], opts["angular_deflection"])
     else:
-        m = tessellate(_shape_of(obj), opts["linear_deflection"], opts["angular_deflection"])
+        m = tessellate(_shape_of(obj), opts["linear_deflection"], opts["angular_deflection"], relative=bool(opts["relative"]))
     if not m.ok:
         raise GeometryError(
             f"tessellation is not a closed manifold (manifold3d: {m.manifold_status}, "

@@ -24,7 +24,7 @@ from OCP.TopoDS import TopoDS_Shape
 
 from tabletcad.brep.weld import weld
 from tabletcad.cad._occ import explore
-from tabletcad.errors import GeometryError
+from tabletcad.errors import GeometryError, check_range
 from tabletcad.io.forked import OCC_PARALLEL
 from tabletcad.tolerance import DEFAULT
 
@@ -128,8 +128,7 @@ def triangulate(
     comparable triangle count; both with surface deflection control).  ``face_ids``: also
     return each triangle's face, its index in ``explore(shape, "Face")`` (m,).
     """
-    if linear_deflection <= 0 or angular_deflection <= 0:
-        raise ValueError("linear_deflection and angular_deflection must be > 0")
+    linear_deflection, angular_deflection = check_deflections(linear_deflection, angular_deflection, relative)
     if algo not in MESH_ALGOS:
         raise ValueError(f"algo = {algo!r} is not allowed: must be one of {', '.join(MESH_ALGOS)}")
     BRepTools.Clean_s(shape)  # drop an older triangulation, or BRepMesh would keep it
@@ -192,6 +191,23 @@ def _edge_check(T: np.ndarray) -> tuple[bool, bool]:
     return watertight, bool(np.all(runs == 1))
 
 
+#: the mesh deflections a tessellation takes: linear (mm, or a fraction of each edge when ``relative``)
+#: and angular (rad).  Below 1e-4 mm the triangles of one tablet run into the millions (a NaN had made
+#: OCC mesh until the memory ran out); above 5 mm, or an angle above π/2, a tablet has no shape left.
+LINEAR_DEFLECTION_RANGE = (1e-4, 5.0)
+RELATIVE_DEFLECTION_RANGE = (1e-4, 1.0)
+ANGULAR_DEFLECTION_RANGE = (1e-3, 0.5 * 3.141592653589793)
+
+
+def check_deflections(linear_deflection: float, angular_deflection: float, relative: bool = False) -> tuple[float, float]:
+    """The deflections as floats, or a :class:`~tabletcad.errors.DesignError` naming the one outside its
+    range (:data:`LINEAR_DEFLECTION_RANGE`, :data:`RELATIVE_DEFLECTION_RANGE`, :data:`ANGULAR_DEFLECTION_RANGE`)."""
+    lo, hi = RELATIVE_DEFLECTION_RANGE if relative else LINEAR_DEFLECTION_RANGE
+    lin = check_range("linear_deflection", linear_deflection, lo, hi, "" if relative else "mm")
+    ang = check_range("angular_deflection", angular_deflection, *ANGULAR_DEFLECTION_RANGE, "rad")
+    return lin, ang
+
+
 def tessellate(
     shape: TopoDS_Shape,
     linear_deflection: float = DEFAULT.mesh_deflection,
@@ -218,6 +234,7 @@ def tessellate_solid(solid, linear_deflection: float = DEFAULT.mesh_deflection,
     from tabletcad.brep.grid_mesh import grid_mesh
     from tabletcad.brep.revolved import RevolvedSurfaceData, revolved_mesh
 
+    linear_deflection, angular_deflection = check_deflections(linear_deflection, angular_deflection)
     if solid.surfaces and all(isinstance(sd, RevolvedSurfaceData) for sd in solid.surfaces):
         V, T, _ = revolved_mesh(solid.surfaces, linear_deflection, angular_deflection)
         return mesh_result(V, T, linear_deflection, angular_deflection, check=check)
