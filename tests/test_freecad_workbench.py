@@ -262,9 +262,13 @@ def test_tooling_valid_and_linked(headless, family):
     if family == "thesis.ring":
         import math
 
-        # annular punch inside the ring by the clearance c both ways: pi ((R - c)^2 - (r + c)^2) x 10 mm
-        c = 0.025
-        assert up["volume"] == pytest.approx(math.pi * ((6.0 - c) ** 2 - (3.0 + c) ** 2) * 10.0, rel=1e-3)
+        from tabletcad import families
+
+        # annular punch: the clearance c inside the die bore (the outline grown by the band's bulge b, 3 µm)
+        # and c outside the ring's hole: pi ((R + b - c)^2 - (r + c)^2) x 10 mm (to the cup's volume under it)
+        c, b = 0.025, families.FAMILIES["thesis.ring"].build().plan_overhang()
+        assert 0.002 < b < 0.004
+        assert up["volume"] == pytest.approx(math.pi * ((6.0 + b - c) ** 2 - (3.0 + c) ** 2) * 10.0, rel=2e-4)
 
 
 def _outline_area_perimeter(segs):
@@ -286,8 +290,8 @@ def test_capsule_die_bore_is_the_exact_outline_and_the_tips_its_inward_offset(he
     """The workbench's die bore is the capsule's exact outline (lines and arcs) offset by the band's
     bulge b (at least 1e-6 mm, as ``tabletcad build`` makes it): die volume = pi R^2 H - (A + P b +
     pi b^2) H (Steiner), A and P from the core's outline (the bore had been the outline offset outward
-    by the clearance: a 10 mm design got a 10.10 mm die).  The punch tips are the outline offset
-    inward by the clearance c: plan extents length - 2c by width - 2c."""
+    by the clearance: a 10 mm design got a 10.10 mm die).  The punch tips are the bore offset inward
+    by the clearance c (as build's): plan extents length + 2b - 2c by width + 2b - 2c."""
     from tabletcad import families
     from tabletcad.tooling.spec import MIN_BORE_OFFSET_MM, standard_die_size
 
@@ -295,15 +299,15 @@ def test_capsule_die_bore_is_the_exact_outline_and_the_tips_its_inward_offset(he
     tablet = families.FAMILIES["capsule"].build()
     outline = tablet.nominal.outline
     A, P = _outline_area_perimeter(outline.segs)
-    b = tablet.band().bulge
+    b = tablet.plan_overhang()
     b = max(b, MIN_BORE_OFFSET_MM) if b > 0 else 0.0
     OD, H, _ = standard_die_size(max(outline.extent()))  # the TSM die for its size, as build takes it
     c = 0.025  # the punches' clearance
     expected = math.pi * (OD / 2) ** 2 * H - (A + P * b + math.pi * b * b) * H
     assert step["die"]["volume"] == pytest.approx(expected, rel=1e-9)
-    for k, extent in enumerate(outline.extent()):  # the punch's plan extents are its tip's: the outline's less 2c
+    for k, extent in enumerate(outline.extent()):  # the punch's plan extents are its tip's: the bore's less 2c
         tight = step["upper"]["tight_bbox"]
-        assert tight[3 + k] - tight[k] == pytest.approx(extent - 2 * c, abs=1e-6)
+        assert tight[3 + k] - tight[k] == pytest.approx(extent + 2 * b - 2 * c, abs=1e-6)
 
 
 def test_make_tooling_reads_the_design_files_tooling_table(headless):
@@ -480,6 +484,46 @@ def test_techdraw_page_with_main_dimensions(headless):
 def test_punch_gap_lifts_the_punch(headless):
     (step,) = _steps(headless, "gap")
     assert step["dz"] == pytest.approx(2.0, abs=1e-9) and step["upper"]["valid"]
+
+
+def test_a_nan_or_negative_gap_is_refused_and_a_scripts_tracebacks_stay_whole(headless):
+    """A NaN Gap had placed the punch at NaN (its STEP full of NaN points, a Boolean with it hung FreeCAD)
+    and a negative one pushed it into the tablet, both shown valid; headless, a refused recompute had also
+    left ``sys.tracebacklimit = 0`` behind, cutting the script's own tracebacks to one line."""
+    steps = _steps(headless, "bad_gap")
+    assert [s["value"] for s in steps] == ["nan", "-3.0"]
+    for s in steps:
+        assert "Invalid" in s["state"] and s["placement_finite"], s
+        assert s["tracebacklimit"] is None
+
+
+def test_an_edited_design_file_is_read_again(headless):
+    """The rebuild key held the file's name only: an edited file kept the old solid until the document
+    was reopened."""
+    (s,) = _steps(headless, "design_file_edited")
+    assert s["family"] == "design_file"
+    assert s["after"] == pytest.approx(s["before"] * 1.44, rel=0.05) and s["after"] > s["before"] * 1.3
+    assert s["xlength"] == pytest.approx(12.0, abs=0.02)
+
+
+def test_a_density_quantity_and_a_designs_report_density(headless):
+    """float() of a FreeCAD density Quantity is kg/mm^3: 1.2 g/cm^3 had been stored as 1.2e-6 mg/mm^3 and
+    the weight as 0; a plain design's [report] solid fraction x true density had been dropped for 1.2."""
+    (s,) = _steps(headless, "density_quantity")
+    assert s["density"] == pytest.approx(1.2, rel=1e-12) and s["weight"] == pytest.approx(1.2 * s["volume"], rel=1e-12)
+    design = ROOT / "samples" / "families" / "concave_round.toml"
+    import tomllib
+
+    r = tomllib.loads(design.read_text())["report"]
+    assert s["report_density"] == pytest.approx(r["solid_fraction"] * r["true_density_mg_mm3"], rel=1e-12)
+
+
+def test_tooling_of_a_tablet_without_a_band_is_refused_and_a_domes_overhang_is_cleared(headless):
+    """A sphere has no band (only its equator's seam, which the domes overhang): its die overlapped it by
+    0.0117 mm3; the caplet's top dome overhangs its band by 2 µm, which its die bore had not cleared."""
+    (s,) = _steps(headless, "bandless_tooling")
+    assert all("Invalid" in st for st in s["states"])
+    assert s["caplet_die_valid"] and s["caplet_overlap"] < 1e-9
 
 
 def test_family_switch_rebuilds_dimension_properties(headless):

@@ -5,6 +5,8 @@ Stdlib + FreeCAD + the installed workbench only.
 """
 
 import json
+import math
+import sys
 import os
 import time
 import traceback
@@ -210,6 +212,51 @@ try:
     doc.recompute()
     step("gap", dz=up.Shape.BoundBox.ZMin - z0, upper=shape_info(up))
     up.Gap = 0.0
+    doc.recompute()
+
+    # ---- a NaN or negative Gap is refused (a NaN had placed the punch at NaN, a negative one in the tablet)
+    for bad in (float("nan"), -3.0):
+        up.Gap = bad
+        doc.recompute()
+        step("bad_gap", value=repr(bad), state=list(up.State), zmin=up.Shape.BoundBox.ZMin,
+             placement_finite=all(math.isfinite(x) for x in up.Placement.Base),
+             tracebacklimit=getattr(sys, "tracebacklimit", None))
+    up.Gap = 0.0
+    doc.recompute()
+
+    # ---- a design file edited after the tablet was made: the next recompute reads it again
+    edited = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"tabletcad_fc_edit_{os.getpid()}.toml")
+    with open(edited, "w", encoding="utf-8") as f:
+        f.write('[tablet]\nfamily = "thesis.shallow_convex_round"\ndiameter = 10.0\nthickness = 3.0\nband = 2.0\n'
+                '[trim]\nw = [0.0, 1.0]\n')
+    ed = make_tablet(doc, edited)
+    v_before = float(ed.Volume)
+    with open(edited, "w", encoding="utf-8") as f:
+        f.write('[tablet]\nfamily = "thesis.shallow_convex_round"\ndiameter = 12.0\nthickness = 3.0\nband = 2.0\n'
+                '[trim]\nw = [0.0, 1.0]\n')
+    ed.touch()
+    doc.recompute()
+    step("design_file_edited", family=ed.Family, before=v_before, after=float(ed.Volume),
+         xlength=ed.Shape.BoundBox.XLength)
+    os.remove(edited)
+
+    # ---- density as a FreeCAD Quantity, and a plain design's [report] density
+    q = make_tablet(doc, "concave_round", density=FreeCAD.Units.Quantity("1.2 g/cm^3"))
+    rep = make_tablet(doc, os.path.join(root, "samples", "families", "concave_round.toml"))
+    step("density_quantity", density=float(q.Density), weight=float(q.Weight), volume=float(q.Volume),
+         report_density=float(rep.Density), report_weight=float(rep.Weight))
+
+    # ---- tooling of a tablet without a band is refused (as tabletcad build); the caplet's die clears its domes
+    sph = make_tablet(doc, "thesis.spherical")
+    sph_tools = make_tooling(doc, sph)
+    doc.recompute()
+    cap = make_tablet(doc, "thesis.caplet")
+    cap_die = make_die(doc, cap)
+    doc.recompute()
+    step("bandless_tooling", states=[list(o.State) for o in sph_tools],
+         caplet_die_valid=bool(cap_die.isValid()), caplet_overlap=float(cap.Shape.common(cap_die.Shape).Volume))
+    for o in [*sph_tools, sph, cap_die, cap, q, rep, ed]:  # (the document's later steps recompute it whole)
+        doc.removeObject(o.Name)
     doc.recompute()
 
     # ---- family switch: Dimensions group follows the family

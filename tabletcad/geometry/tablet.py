@@ -481,6 +481,30 @@ class Tablet:
             object.__setattr__(self, "_band", self._find_band())
         return self.__dict__["_band"]
 
+    def plan_overhang(self) -> float:
+        """How far (mm) the tablet's plan reaches beyond its band's edge curve: the band's own bulge, or
+        more where a PDE dome overhangs the band (the thesis caplet's top dome by 2 µm), so that a die
+        bore grown by it clears the whole tablet.  Exact (polished) for a tablet of revolution and for
+        one of scaled copies of one plan ellipse (:attr:`section`: the largest section's reach less the
+        band's, an upper bound of the normal distance between the two similar ellipses); the band's
+        bulge otherwise (a family's cups lie inside its band).  0 without a band.  Cached."""
+        hit = self.__dict__.get("_overhang")
+        if hit is None:
+            b = self.band()
+            hit = 0.0 if b is None else b.bulge
+            if b is not None and self.trim.whole:
+                edge = self.patches[b.patch]
+                if self.revolution is not None:
+                    r_band = float(np.hypot(*edge.evaluate(0.0, 0.0)[:2]))
+                    hit = max(hit, self._largest_radius() - r_band)
+                elif self.section is not None and self._one_plan():
+                    r_band = abs(float(edge.section.profile(np.array([0.0]))[0, 0]))
+                    reach = float(np.max(self.section[0].reach()))
+                    hit = max(hit, (self._radius_range()[1] - r_band) * reach)
+            hit = float(hit) if hit > 1e-12 * max(1.0, float(np.max(np.abs(self.bounds()[1])))) else 0.0
+            object.__setattr__(self, "_overhang", hit)
+        return hit
+
     def _find_band(self) -> Band | None:
         v = np.linspace(0.0, math.tau, 96, endpoint=False)
         gap = self.tol.seam_gap  # the end curves are the design's own: flat and identical to round-off

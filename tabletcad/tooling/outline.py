@@ -347,7 +347,8 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
     land = info.get("land_mm")
     if land is None and tablet.family in NO_LAND:  # the thesis's shapes say so in the catalogue
         land = 0.0
-    bulge = found.bulge if found is not None else 0.0
+    # the die bore clears the whole plan, not only the band: a PDE dome may overhang its band
+    bulge = tablet.plan_overhang() if found is not None else 0.0
     return TabletFrame(tablet, shape, (float(band_z[0]), float(band_z[1])), bulge, float(lo[2]), float(hi[2]), wire, kind,
                        round_radius, None if land is None else float(land), float(hi[0] - lo[0]), float(hi[1] - lo[1]), info,
                        revolved)

@@ -261,8 +261,10 @@ def build_tablet(tablet, tol=None):
         if not r["inner"]:
             if outline:  # the die bore follows the exact outline (lines and arcs), not the fitted rim
                 r["outline"] = outline
-            # how far the band's PDE surface leaves the outline (mm): the bore clears it, as build's does
-            r["band_bulge"] = 0.0 if band is None else float(band.bulge)
+            # how far the tablet's plan leaves the outline (mm): the band's PDE bulge, or a dome's overhang
+            # (the caplet's); the bore clears it, as build's does
+            r["band_bulge"] = float(tablet.plan_overhang())
+            r["band"] = band is not None
     # exact volume of the B-spline solid (FreeCAD's Shape.Volume is OCCT's default integration,
     # measured 8.5e-4 relative off on a free-form stadium tablet)
     props = dict(props, solid_volume_mm3=abs(enclosed_volume([f.surface for f in fits])))
@@ -370,15 +372,18 @@ def _offset_rim_wire(rim, distance):
     return Part.Wire([e.toNurbs().Edges[0] for e in edges])
 
 
-def _rim_face(rims, clearance=0.0):
+def _rim_face(rims, clearance=0.0, hole_clearance=None):
     """The plan face inside the rims (a ring's hole cut out); with ``clearance`` > 0 a punch tip's:
-    the outer rims offset inward and the holes outward by it."""
+    the outer rims offset inward by it and the holes outward by ``hole_clearance`` (``clearance`` when
+    not given)."""
     import Part
 
     outer = [r for r in rims if not r["inner"]]
     inner = [r for r in rims if r["inner"]]
-    if clearance > 0:
-        wires = [_offset_rim_wire(r, -clearance) for r in outer] + [_offset_rim_wire(r, clearance) for r in inner]
+    hole = clearance if hole_clearance is None else hole_clearance
+    if clearance > 0 or hole > 0:
+        wires = ([_offset_rim_wire(r, -clearance) if clearance > 0 else _rim_wire(r) for r in outer]
+                 + [_offset_rim_wire(r, hole) if hole > 0 else _rim_wire(r) for r in inner])
     else:
         wires = [_rim_wire(r) for r in outer + inner]
     if len(wires) == 1:
@@ -408,6 +413,16 @@ def _select(rims, which):
     return [r for r in rims if abs(r["z"] - z) <= 1e-7 * max(1.0, abs(z))], z
 
 
+def _require_band(rims):
+    """DesignError unless the tablet has a band (as ``tabletcad build``: a sphere or a spheroid has only a
+    seam at its equator, which its domes overhang; a die made on it overlapped the tablet)."""
+    from tabletcad.errors import DesignError
+
+    if any(r.get("band") is False for r in rims if not r["inner"]):
+        raise DesignError("Tablet", "no band", "tooling needs a tablet with a band (a cylindrical side wall the die "
+                          "forms); this one has none")
+
+
 def punch_shape(tablet_shape, rims, which="upper", length=10.0, clearance=0.025):
     """Punch tip: prism on the upper (lower) rims offset inward by ``clearance`` (the radial room
     between tip and die bore), ``length`` mm up (down), minus the tablet."""
@@ -421,10 +436,17 @@ def punch_shape(tablet_shape, rims, which="upper", length=10.0, clearance=0.025)
         raise DesignError("punch length", length, "must be > 0", "mm")
     if not 0.0 <= clearance <= MAX_CLEARANCE_MM:
         raise DesignError("punch clearance", clearance, f"must be >= 0 and <= {MAX_CLEARANCE_MM:g}", "mm")
+    _require_band(rims)
     sel, _ = _select(rims, which)
     sign = 1.0 if which == "upper" else -1.0
+    # the tip follows the die bore (the outline grown by the plan's overhang, :func:`die_shape`), the clearance
+    # inside it, as tabletcad build's tips (TabletFrame.tip_inset)
+    from tabletcad.tooling.spec import MIN_BORE_OFFSET_MM
+
+    over = max(float(r.get("band_bulge", 0.0)) for r in sel if not r["inner"]) if any(not r["inner"] for r in sel) else 0.0
+    bore = max(over, MIN_BORE_OFFSET_MM) if over > 0 else 0.0
     try:
-        face = _rim_face(sel, clearance)
+        face = _rim_face(sel, max(clearance - bore, 0.0), clearance)
     except (GeometryError, Part.OCCError) as exc:
         raise DesignError("punch clearance", clearance, f"leaves no punch tip inside the tablet's outline ({exc})",
                           "mm") from None
@@ -454,6 +476,7 @@ def die_shape(rims, height=22.22, outer_diameter=30.16):
 
     if not height > 0:
         raise DesignError("die height", height, "must be > 0", "mm")
+    _require_band(rims)
     outer = [r for r in rims if not r["inner"]]
     if not outer:
         raise GeometryError(

@@ -55,6 +55,8 @@ def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, reco
     if family.endswith(".toml") or os.path.sep in family or Path(family).is_file():
         design = Path(family).resolve()
         plain = objects.design_is_parametric(design)
+        if density is None:  # the design's own [report] solid fraction x true density, as its report weighs it
+            density = objects.design_density(design)
         if plain is not None:
             family, dims, design_name = plain
             params = {**dims, **params}
@@ -77,10 +79,12 @@ def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, reco
             raise ValueError(f"family {family!r} has no parameter {k!r}")
         setattr(obj, objects.prop_name(k), _value(v, "deg" if fam.params[k] == "deg" else "mm"))
     if density is not None:  # mg/mm^3, or a string with units ("1.2 g/cm^3")
-        if isinstance(density, str):
+        if isinstance(density, str) or (hasattr(density, "Unit") and hasattr(density, "Value")):
+            # a string with units or a FreeCAD Quantity (float() of one is its value in kg/mm^3: 1.2 g/cm^3 had
+            # been stored as 1.2e-6 mg/mm^3)
             q = FreeCAD.Units.Quantity(density)
             if q.Unit != FreeCAD.Units.Unit("kg/mm^3"):
-                raise ValueError(f"density {density!r} is not a density")
+                raise ValueError(f"density {density!r} is not a density (give mg/mm^3, or units such as g/cm^3)")
             obj.Density = float(q.Value) * 1e6  # kg/mm^3 -> mg/mm^3
         else:
             obj.Density = float(density)

@@ -76,12 +76,53 @@ def _fail(obj, exc):
             QtCore.QTimer.singleShot(0, _restore_traceback)
         except Exception:
             pass
+    else:  # headless: restored once the recompute is over (a script's own tracebacks had been cut to one line)
+        _RestoreAfterRecompute.arm()
     raise exc.with_traceback(None)
+
+
+class _RestoreAfterRecompute:
+    """A document observer that restores ``sys.tracebacklimit`` when a recompute ends (headless, where no
+    event loop runs a timer), then removes itself."""
+
+    _armed = None
+
+    @classmethod
+    def arm(cls):
+        if cls._armed is None:
+            cls._armed = cls()
+            FreeCAD.addDocumentObserver(cls._armed)
+
+    def slotRecomputedDocument(self, doc):
+        _restore_traceback()
+        type(self)._armed = None
+        try:
+            FreeCAD.removeDocumentObserver(self)
+        except Exception:
+            pass
 
 
 def _restore_traceback():
     if getattr(sys, "tracebacklimit", None) == 0:
         del sys.tracebacklimit
+
+
+#: the largest punch lift off the tablet (mm) of an exploded view
+MAX_GAP_MM = 1000.0
+
+
+def _file_digest(path) -> str | None:
+    """A digest of a design file's bytes (None without one, or when it cannot be read): a tablet from a
+    file is rebuilt when the file changes, not only when another file is named."""
+    if not path:
+        return None
+    import hashlib
+
+    try:
+        with open(os.fspath(path), "rb") as f:
+            return hashlib.sha256(f.read()).hexdigest()
+    except OSError:
+        return None
 
 
 def family_names() -> list[str]:
@@ -345,7 +386,7 @@ class TabletProxy(_Proxy):
         if not (density > 0.0 and density < 1e3):
             raise DesignError("Density", density, "0 < Density < 1000", "mg/mm³")
         s = self.spec(obj)
-        key = repr((s, float(obj.FitTolerance.Value)))
+        key = repr((s, float(obj.FitTolerance.Value), _file_digest(s["design"])))
         if key != getattr(self, "_built", None) or obj.Shape.isNull() or not obj.RimData:
             # rebuild only when the geometry's inputs changed (not for Density, Label, Placement)
             tablet = self.core_tablet(obj)
@@ -434,6 +475,10 @@ class PunchProxy(_Proxy):
         shape = geometry.punch_shape(_local_shape(tab), rims, obj.Which, float(obj.Length.Value),
                                      float(obj.Clearance.Value))
         gap = float(obj.Gap.Value)
+        if not 0.0 <= gap <= MAX_GAP_MM:  # (a NaN gap had placed the punch at NaN; a negative one pushed it into the tablet)
+            from tabletcad.errors import DesignError
+
+            raise DesignError("Gap", gap, f"must be >= 0 and <= {MAX_GAP_MM:g} (the lift off the tablet)", "mm")
         lift = FreeCAD.Placement(
             FreeCAD.Vector(0, 0, gap if obj.Which == "upper" else -gap), FreeCAD.Rotation()
         )
@@ -570,6 +615,21 @@ class ViewProviderTabletcad:
 def attach_view_provider(obj) -> None:
     if FreeCAD.GuiUp and getattr(obj, "ViewObject", None) is not None:
         ViewProviderTabletcad(obj.ViewObject)
+
+
+def design_density(path) -> float | None:
+    """The compact's density (mg/mm³) a design file's ``[report]`` table gives (its solid fraction times
+    its true density), or None when it gives neither or the file cannot be read."""
+    try:
+        import tomllib
+    except ImportError:  # Python < 3.11
+        import tomli as tomllib
+    try:
+        rep = tomllib.loads(open(os.fspath(path), encoding="utf-8").read()).get("report", {})
+        sf, rho = rep.get("solid_fraction"), rep.get("true_density_mg_mm3")
+        return None if sf is None or rho is None else float(sf) * float(rho)
+    except Exception:
+        return None
 
 
 def design_is_parametric(path) -> tuple[str, dict, str] | None:
