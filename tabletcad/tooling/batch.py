@@ -57,18 +57,19 @@ def tooling_batch(family: str, sizes: Iterable[dict], spec: ToolingSpec | dict |
     family = lookup_family(family, parameter="family").name
     sizes = [dict(p) for p in sizes]
 
-    def write(k: int, res: dict) -> None:
-        if out_dir is not None:
-            d = Path(out_dir) / f"{family}_{k:03d}"
-            d.mkdir(parents=True, exist_ok=True)
-            for name, data in res["files"].items():
-                (d / name).write_bytes(data)
-
+    # every size is made before any file is written: a size refused half-way (a tablet too large for its
+    # die) had left the folders of the sizes before it
     results = map_tasks(_tooling_task, sizes, kwargs=dict(family=family, spec=spec, check=check,
                                                           interference_check=interference_check, drawing=drawing,
                                                           files=out_dir is not None),
                         client=client, scheduler=scheduler, workers=None if client or scheduler else workers,
-                        progress=progress, desc=f"tooling {family}", on_result=write)
+                        progress=progress, desc=f"tooling {family}")
+    if out_dir is not None:
+        for k, res in enumerate(results):
+            d = Path(out_dir) / f"{family}_{k:03d}"
+            d.mkdir(parents=True, exist_ok=True)
+            for name, data in res["files"].items():
+                (d / name).write_bytes(data)
     return [r["row"] for r in results]
 
 

@@ -41,6 +41,12 @@ def _max_radius(wire) -> float:
     return r
 
 
+def _up(x: float) -> str:
+    """``x`` (mm) rounded up to the micrometre, as a bound a user can give back (28 mm had been refused
+    as "must be >= 28 mm" for a bound of 28.000002)."""
+    return f"{math.ceil(x * 1000.0 - 1e-9) / 1000.0:g}"
+
+
 def tapered_prism(wire, z0: float, z1: float, taper_deg: float):
     """The plan ``wire`` extruded from ``z0`` to ``z1`` with its walls drafted outward by ``taper_deg``.
 
@@ -81,15 +87,19 @@ def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, 
     bulge = frame.bore_offset
     bore = offset_wire(frame.outline, bulge) if bulge > 0 else frame.outline
     r_bore = _max_radius(bore)
-    if od / 2.0 - r_bore < MIN_WALL_MM:
+    if od / 2.0 - r_bore < MIN_WALL_MM - 1e-9:  # (the sampled bore's round-off is no wall)
         raise DesignError("[tooling] die_outer_diameter_mm", od,
-                          f"must be >= {2 * (r_bore + MIN_WALL_MM):.4g} mm (bore reaches {r_bore:.4g} mm from the axis, "
+                          f"must be >= {_up(2 * (r_bore + MIN_WALL_MM))} mm (bore reaches {r_bore:.6g} mm from the axis, "
                           f"walls need {MIN_WALL_MM} mm)", "mm")
     pen, z_top, z_bot = die_position(frame, H, penetration)
     if z_bot > frame.band_z[0] - 1.0:
+        # H - entry >= band + 1 with the entry min(3, H/4): H >= (band + 1) / 0.75 up to 12 mm, else band + 4
+        # (the bound had been quoted for the given height's entry, and refused in turn when given)
+        need = frame.band + 1.0 + penetration if penetration is not None else (
+            (frame.band + 1.0) / 0.75 if (frame.band + 1.0) / 0.75 <= 12.0 else frame.band + 4.0)
         raise DesignError("[tooling] die_height_mm", H,
-                          f"must be >= {pen + frame.band + 1.0:.4g} mm (upper punch entry {pen:.3g} mm + band "
-                          f"{frame.band:.4g} mm + 1 mm below the tablet)", "mm")
+                          f"must be >= {_up(need)} mm (the upper punch's entry, min(3 mm, a quarter of the height), + "
+                          f"band {frame.band:.4g} mm + 1 mm below the tablet)", "mm")
     blank = translated(BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), od / 2.0, H).Shape(), dz=z_bot)
     z_taper = frame.band_z[1] if taper_deg > 0 else z_top + 1.0
     straight = prism(bore, z_bot - 1.0, min(z_taper, z_top + 1.0))

@@ -608,7 +608,11 @@ def tooling_model(ts) -> Drawing:
     zb, zt = oy + die["bottom_z_mm"], oy + die["top_z_mm"]
     dims.append(Dim((ox - R, zt), (ox + R, zt), 4.0, f"Ø{_fmt(die['outer_diameter_mm'])} ±{_fmt(tol('die_diameter'))}"))
     dims.append(Dim((ox + R, zb), (ox + R, zt), 3.0, f"H {_fmt(die['height_mm'])} ±{_fmt(tol('die_height'))}", vertical=True))
-    notes = [f"{ts.tablet.name}: {up['standard']} {up['type'] or 'user-defined'} tooling, {up['head']} heads",
+    mod = up.get("modified_from_standard") or {}
+    changed = "; ".join(f"{k.replace('_mm', '').replace('_deg', '').replace('_', ' ')} {_fmt(v['given'])} "
+                        f"(standard {_fmt(v['standard'])})" for k, v in mod.items())
+    notes = [f"{ts.tablet.name}: {up['standard']} {up['type'] or 'user-defined'} tooling"
+             f"{', MODIFIED' if mod else ''}, {up['head']} heads" + (f"; modified: {changed}" if mod else ""),
              f"barrel Ø{_fmt(up['barrel_diameter_mm'])}, neck Ø{_fmt(up['neck_diameter_mm'])} x {_fmt(up['neck_length_mm'])}, "
              f"head Ø{_fmt(up['head_diameter_mm'])} (flat Ø{_fmt(up['head_flat_diameter_mm'])})",
              f"tip: straight {_fmt(up['tip_straight_mm'])}, relief {_fmt(up['tip_relief_mm'])} per side; "
@@ -619,7 +623,8 @@ def tooling_model(ts) -> Drawing:
              f"tablet's {die['bore']} outline{_bore_growth(fr)}), taper {die['taper_deg']:g} deg; tips "
              f"{_plan_size(fr, fr.tip_inset(ts.spec.clearance_mm))} (the bore less the clearance "
              f"{_fmt(ts.spec.clearance_mm)} per side)",
-             "standard dimensions: tabletcad/data/tooling_standards.toml (sources per value in report.json)"
+             ("standard dimensions: tabletcad/data/tooling_standards.toml (sources per value in report.json)"
+              + (", but for the modified ones above (from [tooling.punch])" if mod else ""))
              if up["standard"] != "custom" else "user-defined set: every dimension from [tooling.punch]"]
     return Drawing(views, origins, dims, notes, title=f"{_title(ts)} — punches and die",
                    title_block=title_block(ts, "punches and die"))

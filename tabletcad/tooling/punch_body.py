@@ -160,5 +160,6 @@ def complete_punch(frame: TabletFrame, tip_shape, which: str, b: PunchBody, clea
                 key=b.key, head_flat_z_mm=edge + sign * b.overall_length_mm, volume_mm3=volume(shape),
                 body_volume_closed_form_mm3=body_volume(b, lb),
                 relief_volume_mm3=relief_volume(frame, b, clearance, tip_length),
-                sources={k: v for k, v in b.sources.items()})
+                sources={k: v for k, v in b.sources.items()},
+                modified_from_standard={k: dict(v) for k, v in b.modified.items()})
     return shape, info

@@ -78,6 +78,10 @@ __all__ = ["ToolingSpec", "ScoreSpec", "EmbossSpec", "FeRatingSpec", "parse_tool
 
 FONT_DIR = Path("/usr/share/fonts/truetype/dejavu")
 
+#: the narrowest V of a score (deg): a narrower one is a knife edge on the punch's score bar (a 2 deg V
+#: had failed in the mesh check, "NotManifold", rather than as an input)
+MIN_SCORE_ANGLE_DEG = 20.0
+
 #: the largest radial clearance between punch tip and die bore (mm)
 MAX_CLEARANCE_MM = 1.0
 
@@ -363,12 +367,16 @@ def _score(i: int, t: Any) -> ScoreSpec:
     kind = _choice(f"{w} kind", t.get("kind", d.kind), ("bisect", "quadrisect"))
     profile = _choice(f"{w} profile", t.get("profile", d.profile), ("v", "u", "pressure_sensitive"))
     depth = check_positive(f"{w} depth_mm", t.get("depth_mm", d.depth_mm), "mm")
-    angle = check_range(f"{w} angle_deg", t.get("angle_deg", d.angle_deg), 0.0, 180.0, "deg", lo_open=True, hi_open=True)
+    angle = check_range(f"{w} angle_deg", t.get("angle_deg", d.angle_deg), MIN_SCORE_ANGLE_DEG, 180.0, "deg",
+                        hi_open=True)
     width = check_range(f"{w} width_mm", t.get("width_mm", d.width_mm), 0.0, None, "mm")
     if profile == "u" and width <= 0:
         raise DesignError(f"{w} width_mm", width, "must be > 0 for a U profile", "mm")
     if profile == "v" and width > 0 and "angle_deg" not in t:
         angle = math.degrees(2.0 * math.atan(0.5 * width / depth))
+        if angle < MIN_SCORE_ANGLE_DEG:
+            raise DesignError(f"{w} width_mm", width, f"must be >= {2 * depth * math.tan(math.radians(MIN_SCORE_ANGLE_DEG / 2)):.4g}"
+                              f" mm for a V {depth:g} mm deep: its angle {angle:.3g} deg is below {MIN_SCORE_ANGLE_DEG:g} deg", "mm")
     slot = check_positive(f"{w} slot_width_mm", t.get("slot_width_mm", d.slot_width_mm), "mm")
     cut = _bool(f"{w} cut_through", t.get("cut_through", d.cut_through))
     length = t.get("length_mm")

@@ -93,6 +93,9 @@ class PunchBody:
     max_shaped_tablet_mm: float | None = None
     die_outer_diameter_mm: float | None = None
     sources: dict = field(default_factory=dict)
+    #: the standard's dimensions the user changed: ``{key: {"given": x, "standard": y}}`` (such a set is
+    #: the standard's modified, and its drawing and report say so)
+    modified: dict = field(default_factory=dict)
 
     @property
     def head_under_mm(self) -> float:
@@ -165,6 +168,12 @@ def resolve_body(standard: str, kind: str | None, table: Any, tip_length: float,
     relief = _num(w, t, "tip_relief_mm", entry, src, zero_ok=True)
     if Dn >= Db:
         raise DesignError(f"{w} neck_diameter_mm", Dn, f"must be < barrel_diameter_mm {Db:.4g} mm", "mm")
+    if Dn < 0.5 * Db:  # (a 0.5 mm neck on a 19 mm barrel had been built)
+        raise DesignError(f"{w} neck_diameter_mm", Dn, f"must be >= half the barrel diameter, {0.5 * Db:.4g} mm: the "
+                          "neck carries the punch's pull-down and ejection loads", "mm")
+    if Dh <= Db:  # (a 15 mm head on a 19 mm barrel had been built)
+        raise DesignError(f"{w} head_diameter_mm", Dh, f"must be > barrel_diameter_mm {Db:.4g} mm: the head runs on the "
+                          "press's cams and pressure rolls outside the barrel's guide", "mm")
     if Dh <= Dn:
         raise DesignError(f"{w} head_diameter_mm", Dh, f"must be > neck_diameter_mm {Dn:.4g} mm", "mm")
     if Df >= Dh:
@@ -188,10 +197,13 @@ def resolve_body(standard: str, kind: str | None, table: Any, tip_length: float,
            if k in entry}
     for k in ext:
         src[k] = list(entry[k]["source"])
+    modified = {k: {"given": float(t[k]), "standard": float(entry[k]["value"])} for k in t
+                if isinstance(entry.get(k), dict) and "value" in entry[k] and not isinstance(t[k], bool)
+                and float(t[k]) != float(entry[k]["value"])}
     body = PunchBody(standard, kind, head, L, Db, Dh, Df, rim, a_in, a_top, Rd, Dn, Ln, straight, relief, key,
                      kv["key_width_mm"], kv["key_length_mm"], kv["key_height_mm"], kv["key_offset_mm"], key_angle,
                      ext.get("max_round_tablet_mm"), ext.get("max_shaped_tablet_mm"), ext.get("die_outer_diameter_mm"),
-                     src)
+                     src, modified)
     parts = {"neck_length_mm": Ln, "inside_head_angle_deg": body.head_under_mm, "head_rim_mm": rim,
              ("head_top_angle_deg" if head == "angled" else "dome_radius_mm"): body.head_top_mm}
     if Ln + body.head_height_mm >= L:  # no barrel left: name the longest of neck and head's parts

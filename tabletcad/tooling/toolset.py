@@ -84,6 +84,23 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
                           f"closed position (the barrel stays out of the die)", "mm")
 
 
+#: the least steel (mm) a punch tip keeps behind the deepest point of its face (the cup's, or a raised
+#: figure's engraving in it): a 0.9 mm tip on a 0.9 mm cup had been built with nothing behind the cup's centre
+MIN_TIP_BACKING_MM = 1.0
+
+
+def _check_tip_lengths(frame, spec: ToolingSpec) -> None:
+    """Each tip at least as long as its face is deep (the cup, and a raised figure's engraving) plus
+    :data:`MIN_TIP_BACKING_MM`, as a DesignError before any geometry."""
+    for name, tl, face, cup in (("tip_length_mm", spec.tip_length_mm, "top", frame.cup_depth_top),
+                                ("lower_tip_length_mm", spec.lower_tip, "bottom", frame.cup_depth_bottom)):
+        raised = max((e.depth_mm for e in spec.emboss if e.face == face and e.mode == "emboss"), default=0.0)
+        need = cup + raised + MIN_TIP_BACKING_MM
+        if not tl >= need:
+            raise DesignError(f"[tooling] {name}", tl, f"must be >= {need:.4g} mm: the {face} face is {cup + raised:.4g} mm "
+                              f"deep and the tip keeps {MIN_TIP_BACKING_MM:g} mm of steel behind it", "mm")
+
+
 def _warn_crossings(frame, spec: ToolingSpec, emb_checked: list) -> None:
     """One warning for each embossed figure that crosses a score groove on its face: the letters are cut
     in two when the tablet is split, and the narrow land between groove and stroke picks and sticks.
@@ -200,6 +217,7 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     for i, s in enumerate(spec.scores):  # fail on bad input before any Boolean
         check_score(frame, s, i)
     emb_checked = [check_emboss(frame, e, spec.clearance_mm, i) for i, e in enumerate(spec.emboss)]
+    _check_tip_lengths(frame, spec)  # (after the figures' own limits: a figure too tall is named as the figure)
     _warn_crossings(frame, spec, emb_checked)
     _warn_sharp_edge(frame, spec.clearance_mm)
     if spec.body is not None:

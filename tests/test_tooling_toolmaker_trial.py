@@ -1,0 +1,138 @@
+"""Tooling a toolmaker would refuse or misread (session 26's trial): a modified standard punch labelled as
+the standard, tips too short for their cups, V scores too narrow to make, bounds quoted that were refused in
+turn, heads smaller than their barrels, and a batch that stopped half-way with files written.
+
+Each refusal: the one ``error: <parameter> = <value> is not allowed: <range>`` line, exit 2, nothing written.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("OCP")
+
+from tabletcad.cli import main  # noqa: E402
+from tabletcad.errors import DesignError  # noqa: E402
+from tabletcad.tooling.standards import resolve_body  # noqa: E402
+
+pytestmark = pytest.mark.cad
+
+ONE_LINE = re.compile(r"^error: (\S+) = (.+) is not allowed: (.+)$")
+ROUND = ('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 3.0\ncup_depth = 0.9\nland = 0.08\n'
+         '[tooling]\nclearance_mm = 0.02\n')
+#: the sample's punch figures (TSM B's bundled values lack the head flat, rim and neck)
+PUNCH = {"head_diameter_mm": 25.4, "head_top_angle_deg": 10.0, "head_flat_diameter_mm": 12.0, "head_rim_mm": 2.5, "neck_diameter_mm": 12.7, "neck_length_mm": 12.0,
+         "tip_straight_mm": 4.0, "tip_relief_mm": 0.1}
+
+
+def _refused(capsys, tmp_path: Path, design: str) -> tuple[str, str, str]:
+    src = tmp_path / "d.toml"
+    src.write_text(design, encoding="utf-8")
+    assert main(["build", str(src), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    m = ONE_LINE.match(err[0])
+    assert m, err[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.toml"]
+    return m.group(1), m.group(2), m.group(3)
+
+
+@pytest.mark.parametrize("tip, lower, parameter, least", [
+    (0.9, 19.0, "tooling.tip_length_mm", 1.9),        # had built with no steel behind the cup's centre
+    (1e-9, 19.0, "tooling.tip_length_mm", 1.9),       # had failed as "the cut gave 0 solids"
+    (8.0, 1.5, "tooling.lower_tip_length_mm", 1.9),
+])
+def test_a_tip_shorter_than_its_cup_and_the_backing_is_refused(capsys, tmp_path, tip, lower, parameter, least):
+    extra = f"tip_length_mm = {tip!r}\nlower_tip_length_mm = {lower!r}\n"
+    name, _, why = _refused(capsys, tmp_path, ROUND + extra)
+    assert name == parameter and f">= {least:g} mm" in why
+
+
+def test_a_v_score_narrower_than_it_can_be_made_is_refused(capsys, tmp_path):
+    name, _, why = _refused(capsys, tmp_path, ROUND + "[[tooling.score]]\ndepth_mm = 0.3\nangle_deg = 2.0\n")
+    assert name == "tooling.score[0].angle_deg" and ">= 20 and" in why
+    name, _, why = _refused(capsys, tmp_path, ROUND + "[[tooling.score]]\ndepth_mm = 0.3\nwidth_mm = 0.05\n")
+    assert name == "tooling.score[0].width_mm" and "below 20 deg" in why
+
+
+def test_the_least_die_height_quoted_is_accepted(capsys, tmp_path):
+    """The bound had been computed for the given height's punch entry (min(3, H/4)), so each quoted bound
+    was refused in turn (3 -> 4.55 -> 4.938 -> ...)."""
+    name, _, why = _refused(capsys, tmp_path, ROUND + "die_height_mm = 3.0\n")
+    least = float(re.search(r">= ([0-9.]+) mm", why).group(1))
+    assert name == "tooling.die_height_mm" and least == pytest.approx(4.0 / 0.75, abs=1e-3)
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.die import die
+    from tabletcad.tooling.outline import tablet_frame
+
+    frame = tablet_frame(Design.from_toml(_write(tmp_path, ROUND)).build())
+    shape, info = die(frame, 30.16, least)
+    assert info["height_mm"] == least and info["bottom_z_mm"] <= frame.band_z[0] - 1.0 + 1e-12
+    with pytest.raises(DesignError):
+        die(frame, 30.16, least - 0.002)
+
+
+def _write(tmp_path: Path, text: str) -> Path:
+    p = tmp_path / "ok.toml"
+    p.write_text(text, encoding="utf-8")
+    return p
+
+
+def test_the_least_die_diameter_quoted_is_accepted(tmp_path):
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.die import die
+    from tabletcad.tooling.outline import tablet_frame
+
+    frame = tablet_frame(Design.from_toml(_write(tmp_path, ROUND)).build())
+    with pytest.raises(DesignError) as err:
+        die(frame, 11.0, 22.22)
+    least = float(re.search(r">= ([0-9.]+) mm", str(err.value)).group(1))
+    die(frame, least, 22.22)  # the bound, rounded up to the micrometre, is a diameter the die takes
+
+
+@pytest.mark.parametrize("table, parameter", [
+    ({"head_diameter_mm": 15.0}, "head_diameter_mm"),   # a head smaller than the 19 mm barrel had been built
+    ({"neck_diameter_mm": 0.5}, "neck_diameter_mm"),    # a 0.5 mm neck had been built
+])
+def test_a_head_inside_the_barrel_and_a_needle_neck_are_refused(table, parameter):
+    with pytest.raises(DesignError) as err:
+        resolve_body("TSM", "B", {**PUNCH, **table}, 8.0, 19.0)
+    assert err.value.parameter.endswith(parameter)
+
+
+def test_a_modified_standard_punch_says_so():
+    """An overall length or barrel other than TSM B's had been drawn as "TSM B tooling" with the standard's
+    data file as the source of its dimensions."""
+    same = resolve_body("TSM", "B", PUNCH, 8.0, 19.0)
+    assert same.modified == {}
+    body = resolve_body("TSM", "B", {**PUNCH, "overall_length_mm": 120.0, "barrel_diameter_mm": 19.0}, 8.0, 19.0)
+    assert body.modified == {"overall_length_mm": {"given": 120.0, "standard": 133.35}}
+
+
+def test_the_drawing_of_a_modified_standard_punch_says_modified(tmp_path):
+    text = (Path(__file__).resolve().parents[1] / "samples" / "tooling" / "tsm_b_round.toml").read_text()
+    text = re.sub(r"^(\[tooling\.punch\][^\n]*\n)", r"\1overall_length_mm = 120.0\n", text, count=1, flags=re.M)
+    assert "overall_length_mm = 120.0" in text
+    src = tmp_path / "m.toml"
+    src.write_text(text, encoding="utf-8")
+    assert main(["build", str(src), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    import json
+
+    rep = json.loads((tmp_path / "out" / "report.json").read_text())["tooling"]
+    assert rep["upper_punch"]["body"]["modified_from_standard"] == {"overall_length_mm": {"given": 120.0,
+                                                                                          "standard": 133.35}}
+    first = rep["tooling_drawing"]["notes"][0]
+    assert "TSM B tooling, MODIFIED" in first and "overall length 120.00 (standard 133.35)" in first
+
+
+def test_a_batch_refused_at_one_size_writes_nothing(tmp_path):
+    from tabletcad.tooling import tooling_batch
+
+    sizes = [dict(diameter=8.0, thickness=2.4, band=1.6), dict(diameter=40.0, thickness=12.0, band=8.0)]
+    with pytest.raises(DesignError):
+        tooling_batch("thesis.shallow_convex_round", sizes, {"clearance_mm": 0.02}, out_dir=tmp_path / "b",
+                      progress=False, check=False, drawing=False)
+    assert not (tmp_path / "b").exists() or list((tmp_path / "b").iterdir()) == []
