@@ -179,7 +179,6 @@ def _solved(tablet, design, opts, vary: str, target_weight: float | None, target
         option = {"target_volume_mm3": "--target-volume", "target_weight_mg": "--target-weight", "vary": "--solve-for",
                   vary: "--solve-for", "family": "tablet.family", "solid_fraction": "--solid-fraction",
                   "true_density_mg_mm3": "--true-density",
-                  "solid_fraction, true_density_mg_mm3": "--solid-fraction/--true-density",
                   **{k: f"tablet.{k}" for k in given if k != vary}}
         option = {one_token(k): v for k, v in option.items()}.get(exc.parameter)  # (parameters are one token)
         raise exc.renamed(option or one_token(exc.parameter)) from None

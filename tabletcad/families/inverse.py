@@ -456,8 +456,9 @@ def solve_for(
                           "give exactly one of target_volume_mm3 and target_weight_mg")
     mg_per_mm3 = None
     if solid_fraction is not None or true_density_mg_mm3 is not None or target_weight_mg is not None:
-        if solid_fraction is None or true_density_mg_mm3 is None:
-            raise DesignError("solid_fraction, true_density_mg_mm3", "missing", "both are needed for a weight")
+        if solid_fraction is None or true_density_mg_mm3 is None:  # name the one left out
+            missing = "solid_fraction" if solid_fraction is None else "true_density_mg_mm3"
+            raise DesignError(missing, "missing", "a weight needs both solid_fraction and true_density_mg_mm3")
         mg_per_mm3 = check_range("solid_fraction", solid_fraction, 0.0, 1.0, lo_open=True) * \
             check_range("true_density_mg_mm3", true_density_mg_mm3, 0.0, MAX_TRUE_DENSITY_MG_MM3, "mg/mm3", lo_open=True)
     if target_volume_mm3 is not None:

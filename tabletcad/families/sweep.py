@@ -480,8 +480,9 @@ def _plateau_ring(outline, d_end: float, c: np.ndarray):
         if float(np.min(outline.signed_distance(q))) > d_end + 0.1 * lam * d_q:
             return lam, lam * d_q
     raise DesignError("cup_width", round(d_end, 6),
-                      f"must be < {outline.min_convex_radius:.6g} mm (the outline's smallest corner radius: cupped "
-                      f"that far in, {outline.name}'s flat centre is too narrow for its plateau patches)", "mm")
+                      f"must be < {outline.min_convex_radius:.6g} mm, the outline's smallest corner radius (a cup_width "
+                      f"left out is that radius): cupped that far in, {outline.name}'s flat centre is too narrow for "
+                      "its plateau patches; give a cup_width below it", "mm")
 
 
 def _v_samples(outline, nv: int) -> np.ndarray:
