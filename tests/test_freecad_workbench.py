@@ -497,6 +497,12 @@ def test_a_nan_or_negative_gap_is_refused_and_a_scripts_tracebacks_stay_whole(he
         assert s["tracebacklimit"] is None
 
 
+def test_a_nan_fit_tolerance_is_refused_naming_it(headless):
+    """A NaN FitTolerance had reached the core as "tol = nan" (a ValueError and its traceback)."""
+    (s,) = _steps(headless, "bad_fit_tolerance")
+    assert "Invalid" in s["state"] and "FitTolerance = nan" in s["tablet"]["status"], s
+
+
 def test_an_edited_design_file_is_read_again(headless):
     """The rebuild key held the file's name only: an edited file kept the old solid until the document
     was reopened."""

@@ -223,6 +223,12 @@ try:
              tracebacklimit=getattr(sys, "tracebacklimit", None))
     up.Gap = 0.0
     doc.recompute()
+    fit0 = float(t.FitTolerance.Value)
+    t.FitTolerance = float("nan")
+    doc.recompute()
+    step("bad_fit_tolerance", tablet=tablet_info(t), state=list(t.State))
+    t.FitTolerance = fit0
+    doc.recompute()
 
     # ---- a design file edited after the tablet was made: the next recompute reads it again
     edited = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"tabletcad_fc_edit_{os.getpid()}.toml")

@@ -107,6 +107,17 @@ def _restore_traceback():
         del sys.tracebacklimit
 
 
+#: the B-spline fit tolerances (mm) a tablet takes (0: the core's default): below 1e-7 mm the fit runs
+#: into the surfaces' own rounding, above 0.01 mm a face would be visibly off its PDE surface
+MIN_FIT_TOLERANCE_MM, MAX_FIT_TOLERANCE_MM = 1e-7, 0.01
+
+
+def _default_fit() -> float:
+    from tabletcad.tolerance import DEFAULT
+
+    return DEFAULT.fit
+
+
 #: the largest punch lift off the tablet (mm) of an exploded view
 MAX_GAP_MM = 1000.0
 
@@ -385,12 +396,16 @@ class TabletProxy(_Proxy):
         density = float(obj.Density)
         if not (density > 0.0 and density < 1e3):
             raise DesignError("Density", density, "0 < Density < 1000", "mg/mm³")
+        fit = float(obj.FitTolerance.Value)
+        if not (fit == 0.0 or MIN_FIT_TOLERANCE_MM <= fit <= MAX_FIT_TOLERANCE_MM):  # (NaN had reached the core as "tol")
+            raise DesignError("FitTolerance", fit, f"must be 0 (the default, {_default_fit():g} mm) or within "
+                              f"[{MIN_FIT_TOLERANCE_MM:g}, {MAX_FIT_TOLERANCE_MM:g}]", "mm")
         s = self.spec(obj)
-        key = repr((s, float(obj.FitTolerance.Value), _file_digest(s["design"])))
+        key = repr((s, fit, _file_digest(s["design"])))
         if key != getattr(self, "_built", None) or obj.Shape.isNull() or not obj.RimData:
             # rebuild only when the geometry's inputs changed (not for Density, Label, Placement)
             tablet = self.core_tablet(obj)
-            geo = geometry.build_tablet(tablet, tol=float(obj.FitTolerance.Value) or None)
+            geo = geometry.build_tablet(tablet, tol=fit or None)
             pl = obj.Placement
             obj.Shape = geo.solid
             obj.Placement = pl
