@@ -497,6 +497,15 @@ def test_a_nan_or_negative_gap_is_refused_and_a_scripts_tracebacks_stay_whole(he
         assert s["tracebacklimit"] is None
 
 
+def test_a_standard_die_follows_the_tablets_size(headless):
+    """A TSM die made for a 9 mm tablet had stayed 30.16 mm when the tablet grew to 20 mm (refused, its old
+    shape overlapping the tablet by 1732 mm3): it is now the D die for the new size, as build takes it."""
+    (s,) = _steps(headless, "resize_die")
+    assert s["standard"] and s["tablet"]["valid"] and s["die"]["valid"]
+    assert (s["od"], s["height"]) == pytest.approx((38.10, 23.81), abs=1e-9)
+    assert s["overlap"] < 1e-9
+
+
 def test_a_nan_fit_tolerance_is_refused_naming_it(headless):
     """A NaN FitTolerance had reached the core as "tol = nan" (a ValueError and its traceback)."""
     (s,) = _steps(headless, "bad_fit_tolerance")

@@ -171,6 +171,16 @@ try:
         lower=shape_info(low),
         die=shape_info(die),
     )
+    # a size past the B die's 16 mm: the TSM D die follows (the B die had stayed, overlapping the tablet)
+    t.Diameter = 20.0
+    t.CupDepth = 1.5
+    doc.recompute()
+    step("resize_die", tablet=tablet_info(t), die=shape_info(die), standard=bool(die.StandardSize),
+         od=float(die.OuterDiameter.Value), height=float(die.Height.Value),
+         overlap=float(t.Shape.common(die.Shape).Volume))
+    t.Diameter = 9.0
+    t.CupDepth = 0.8
+    doc.recompute()
 
     # ---- invalid values: error state, previous shape kept, tooling untouched
     before = shape_info(t)

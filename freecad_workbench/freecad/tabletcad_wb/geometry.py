@@ -463,6 +463,16 @@ def punch_shape(tablet_shape, rims, which="upper", length=10.0, clearance=0.025)
     return punch
 
 
+def plan_size(shape) -> float:
+    """The tablet's largest plan extent (mm) from its solid's tight box (the surfaces' extrema, as the
+    core's dimensions: the loose box of B-spline poles could cross a TSM die's size limit)."""
+    try:
+        box = shape.optimalBoundingBox(False, False)
+    except Exception:  # (an older FreeCAD without it)
+        box = shape.BoundBox
+    return max(box.XLength, box.YLength)
+
+
 def die_shape(rims, height=22.22, outer_diameter=30.16):
     """Die: cylinder (``outer_diameter``, ``height``, centred on the band) minus the bore, the
     tablet's exact plan outline when it has one, else its outer rim, offset by the band's bulge

@@ -137,6 +137,7 @@ def make_die(doc, tablet, *, height=None, outer_diameter=None, recompute=True):
     if outer_diameter is None and height is None:  # the design file's [tooling] table, as build reads it
         values = design_tooling(tablet)[0]
         height, outer_diameter = values.get("die_height"), values.get("die_outer_diameter")
+    standard = outer_diameter is None and height is None  # the TSM die, followed when the tablet changes
     if outer_diameter is None:  # (an outer diameter given alone keeps the 22.22 mm height, as build does)
         from tabletcad.tooling.spec import standard_die_size
 
@@ -144,7 +145,7 @@ def make_die(doc, tablet, *, height=None, outer_diameter=None, recompute=True):
         outer_diameter, h, _ = standard_die_size(max(dims["length_mm"], dims["width_mm"]))
         height = h if height is None else height
     obj = _new(doc, "Die")
-    objects.DieProxy(obj, tablet)
+    objects.DieProxy(obj, tablet, standard_size=standard)
     for prop, v in (("Height", height), ("OuterDiameter", outer_diameter)):
         if v is not None:
             setattr(obj, prop, _value(v))

@@ -507,13 +507,18 @@ class DieProxy(_Proxy):
 
     Type = "TabletcadDie"
 
-    def __init__(self, obj, tablet=None):
+    def __init__(self, obj, tablet=None, standard_size: bool = False):
         super().__init__(obj)
         self._setup(obj)
         obj.Tablet = tablet
+        obj.StandardSize = bool(standard_size)
 
     def _setup(self, obj):
         self._add(obj, "App::PropertyLink", "Tablet", "Die", "the tablet this die forms")
+        self._add(obj, "App::PropertyBool", "StandardSize", "Die",
+                  "the TSM die for the tablet's size, as tabletcad build takes it (B 30.16 x 22.22 mm up to 16 mm, "
+                  "D 38.10 x 23.81 mm up to 25.4 mm), followed when the tablet changes; false: OuterDiameter and "
+                  "Height as given")
         if "Clearance" in obj.PropertiesList:  # a document of an earlier version: the punches take it now
             self._hand_clearance_to_punches(obj)
             obj.removeProperty("Clearance")
@@ -546,6 +551,12 @@ class DieProxy(_Proxy):
     def build(self, obj):
         tab = _tablet_of(obj)
         rims = geometry.rims_from_json(tab.RimData)
+        if getattr(obj, "StandardSize", False):  # the die follows the tablet's size (a 10 mm die had stayed on 28 mm)
+            from tabletcad.tooling.spec import standard_die_size
+
+            od, height, _ = standard_die_size(geometry.plan_size(tab.Shape))
+            if abs(float(obj.OuterDiameter.Value) - od) > 1e-12 or abs(float(obj.Height.Value) - height) > 1e-12:
+                obj.OuterDiameter, obj.Height = _qty(od, "mm"), _qty(height, "mm")
         shape = geometry.die_shape(rims, float(obj.Height.Value), float(obj.OuterDiameter.Value))
         obj.Shape = shape
         obj.Placement = tab.Placement
