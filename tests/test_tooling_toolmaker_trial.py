@@ -136,3 +136,22 @@ def test_a_batch_refused_at_one_size_writes_nothing(tmp_path):
         tooling_batch("thesis.shallow_convex_round", sizes, {"clearance_mm": 0.02}, out_dir=tmp_path / "b",
                       progress=False, check=False, drawing=False)
     assert not (tmp_path / "b").exists() or list((tmp_path / "b").iterdir()) == []
+
+
+def test_a_raised_figure_counts_in_the_finished_thickness():
+    """A raised figure stands above the cup: the finished tablet's thickness (report and drawing) had stayed
+    the plain tablet's."""
+    from tabletcad.families import FAMILIES
+    from tabletcad.tooling import make_tooling
+    from tabletcad.tooling.drawing import drawing_model
+    from tabletcad.tooling.spec import parse_tooling
+
+    t = FAMILIES["concave_round"].build(diameter=10.0, band=3.0, cup_depth=0.9, land=0.08)
+    spec = parse_tooling({"clearance_mm": 0.02, "emboss": [{"text": "I", "mode": "emboss", "depth_mm": 0.2,
+                                                            "height_mm": 2.0}]})
+    ts = make_tooling(t, spec, check=False, interference_check=False)
+    r = ts.report["tablet"]
+    assert r["thickness_plain_mm"] == pytest.approx(4.8, abs=1e-9)
+    assert 4.8 + 0.15 < r["thickness_mm"] <= 4.8 + 0.2 + 1e-6
+    texts = [d.text for d in drawing_model(ts).dims]
+    assert any(x.startswith(f"T {r['thickness_mm']:.2f}") for x in texts) and not any(x.startswith("T 4.80") for x in texts)

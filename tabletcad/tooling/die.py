@@ -82,6 +82,11 @@ def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, 
         penetration: float | None = None):
     """The die solid at the closed position and its facts (``(shape, info)``)."""
     od0, h0, kind = default_die_size(frame) if outer_diameter is None or height is None else (None, None, "custom")
+    if kind == "custom":  # a size given that is a TSM die's is named as it (30.16 x 22.22 had been "custom")
+        from tabletcad.tooling.spec import TSM_DIES
+
+        kind = next((name for _, d, h, name in TSM_DIES if abs(d - outer_diameter) <= 1e-9 and abs(h - height) <= 1e-9),
+                    "custom")
     od = outer_diameter if outer_diameter is not None else od0
     H = height if height is not None else h0
     bulge = frame.bore_offset

@@ -187,7 +187,10 @@ def drawing_model(ts) -> Drawing:
     fr = ts.frame
     shape = ts.parts["tablet"]
     views = {k: project_view(shape, k) for k in VIEWS}
-    L, W, T = fr.length, fr.width, fr.thickness
+    L, W = fr.length, fr.width
+    # the finished tablet's thickness: raised figures stand above the cups (a 1.5 mm one had been drawn as 4.6)
+    z_lo, z_hi = ts.report["tablet"].get("z_range_mm", (fr.z_min, fr.z_max))
+    T = z_hi - z_lo
     gap = 6.0 + 0.3 * max(L, W)
     origins = {"front": (0.0, 0.0), "plan": (0.0, T / 2 + gap + W / 2), "side": (L / 2 + gap + W / 2, 0.0)}
     # views are centred on the tablet's axis: front/side z runs from z_min to z_max
@@ -208,7 +211,7 @@ def drawing_model(ts) -> Drawing:
     if fr.cup_depth_top > 1e-6:  # a flat face has no cup to dimension
         dims.append(Dim((fx + x1, fy + b1), (fx + x1, fy + fr.z_max), 2.0 + 4.0, f"cup {_fmt(fr.cup_depth_top)}",
                         vertical=True))
-    dims.append(Dim((fx + x0, fy + fr.z_min), (fx + x0, fy + fr.z_max), -3.0, f"T {_fmt(T)}", vertical=True))
+    dims.append(Dim((fx + x0, fy + z_lo), (fx + x0, fy + z_hi), -3.0, f"T {_fmt(T)}", vertical=True))
     notes = [f"{ts.tablet.name} ({ts.tablet.family})", f"overall thickness {_fmt(T)} mm", f"band {_fmt(fr.band)} mm",
              f"cup depth {_fmt(fr.cup_depth_top)} mm (bottom {_fmt(fr.cup_depth_bottom)} mm)"]
     if fr.round_radius is not None:
@@ -365,7 +368,7 @@ def title_block(ts, sheet: str = "tablet") -> list[str]:
     """Title block lines: drawing number, revision, material, date, author and the tolerance note."""
     d = ts.spec.drawing
     number = d.number or "—"
-    rows = [f"drawing no. {number}{'' if sheet == 'tablet' else '-T'}   rev. {d.revision or '—'}   sheet: {sheet}",
+    rows = [f"drawing no. {number}{'' if sheet == 'tablet' or not d.number else '-T'}   rev. {d.revision or '—'}   sheet: {sheet}",
             f"material: {d.material or '—'}", f"date: {d.date or '—'}   author: {d.author or '—'}",
             f"general tolerance ±{_fmt(d.tolerance_mm)} mm" + ("" if d.tolerance_given else
                                                              " (tabletcad default, not a standard's value)")]

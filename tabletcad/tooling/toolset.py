@@ -254,6 +254,12 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     die_shape, die_info = die(frame, spec.die_outer_diameter_mm, die_height(frame, spec), spec.taper_deg)
     t2 = time.perf_counter()
     v1 = volume(solid)  # the finished (scored, embossed) tablet's
+    z_range = (frame.z_min, frame.z_max)
+    if any(e.mode == "emboss" for e in spec.emboss):  # raised figures stand above the cups
+        from tabletcad.tooling.punch import tight_z_range
+
+        lo, hi = tight_z_range(solid)
+        z_range = (min(lo, frame.z_min), max(hi, frame.z_max))
     parts = {"tablet": solid, "upper_punch": upper.shape, "lower_punch": lower.shape, "die": die_shape}
     gap = gap_closed if spec.gap_mm is None else spec.gap_mm
     checks = [c for c in [*score_checks, *emb_checks, chk_u, chk_l] if c is not None]
@@ -264,7 +270,8 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
         tablet=dict(volume_plain_mm3=v0, volume_mm3=v1, weight_plain_mg=None if density is None else v0 * density,
                     weight_mg=None if density is None else v1 * density, band_mm=frame.band, band_z_mm=list(frame.band_z),
                     band_bulge_mm=frame.band_bulge, cup_depth_top_mm=frame.cup_depth_top,
-                    cup_depth_bottom_mm=frame.cup_depth_bottom, thickness_mm=frame.thickness,
+                    cup_depth_bottom_mm=frame.cup_depth_bottom, thickness_mm=z_range[1] - z_range[0],
+                    thickness_plain_mm=frame.thickness, z_range_mm=list(z_range),
                     land_mm=frame.land, outline=frame.outline_kind, length_mm=frame.length, width_mm=frame.width),
         scores=score_info,
         split=split,
