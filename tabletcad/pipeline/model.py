@@ -164,9 +164,9 @@ class TabletModel(_Shaped):
     """A core :class:`~tabletcad.geometry.tablet.Tablet` (``.tablet``) with CAD, export and notebook methods.
 
     The B-rep is fitted on first use (:func:`tabletcad.cad.tablet_solid.tablet_solid`) and kept.
-    ``design``: the :class:`~tabletcad.pipeline.design.Design` it was built from (:func:`load`),
-    whose ``[report]`` options and ``[tooling]`` specification :meth:`report` and :meth:`tooling`
-    use; None for a tablet made in Python (:func:`make`).
+    ``design``: the :class:`~tabletcad.pipeline.design.Design` it was built from (:func:`load`,
+    :func:`make`), whose ``[report]`` options and ``[tooling]`` specification :meth:`report` and
+    :meth:`tooling` use, and which :meth:`replace` changes; None for a model of a bare core tablet.
     """
 
     tablet: Tablet
@@ -175,6 +175,20 @@ class TabletModel(_Shaped):
     @property
     def name(self) -> str:
         return self.tablet.name
+
+    def replace(self, **changes: Any) -> TabletModel:
+        """The same design with ``[tablet]`` values changed (mm, deg), its other tables kept:
+        ``m.replace(length=18.0)``.  The tablet's ``params`` are what it was built with, derived values
+        included (a capsule's cup width), so ``make(family, **params)`` with one of them changed may
+        refuse what this accepts.  Checked as :func:`make` checks, before any geometry."""
+        if self.design is None:
+            raise ValueError(f"{self.name}: a model of a bare core tablet has no design to change; make it with "
+                             "tabletcad.make or tabletcad.load")
+        data = self.design.to_dict()
+        data["tablet"].update(changes)
+        design = Design.from_dict(data, default_name=self.design.name, comment=self.design.comment,
+                                  folder=self.design.folder)
+        return TabletModel(design.build(), design)
 
     @property
     def volume(self) -> float:
