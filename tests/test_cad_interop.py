@@ -64,3 +64,22 @@ def test_missing_cadquery_gives_clear_error(ts, monkeypatch):
     monkeypatch.setitem(sys.modules, "cadquery", None)  # as if cadquery were not installed
     with pytest.raises(ImportError, match="cadquery-ocp"):
         to_cadquery(ts)
+
+
+def test_a_revolved_solids_rim_takes_a_fillet_of_the_closed_form_volume():
+    """The README's advice for fillets: on the exact faces of revolution a 0.5 mm fillet of a 10 x 4 mm flat
+    face round's top rim removes the spandrel r^2 (1 - pi/4) swept at its centroid R - r (10 - 3 pi) /
+    (3 (4 - pi)) (Pappus), and the result is valid."""
+    import math
+
+    import tabletcad
+    from tabletcad.cad.tablet_solid import tablet_solid
+
+    m = tabletcad.make("flat_face_round", diameter=10.0, thickness=4.0)
+    s = to_build123d(tablet_solid(m.tablet, revolved=True).shape)
+    rim = [e for e in s.edges() if e.geom_type.name == "CIRCLE" and e.center().Z > 3.9]
+    assert len(rim) == 1
+    f = s.fillet(0.5, rim)
+    r, R = 0.5, 5.0
+    removed = 2 * math.pi * (R - r * (10 - 3 * math.pi) / (3 * (4 - math.pi))) * r * r * (1 - math.pi / 4)
+    assert f.is_valid and f.volume == pytest.approx(math.pi * R * R * 4.0 - removed, rel=1e-8)
