@@ -82,4 +82,4 @@ def test_a_revolved_solids_rim_takes_a_fillet_of_the_closed_form_volume():
     f = s.fillet(0.5, rim)
     r, R = 0.5, 5.0
     removed = 2 * math.pi * (R - r * (10 - 3 * math.pi) / (3 * (4 - math.pi))) * r * r * (1 - math.pi / 4)
-    assert f.is_valid and f.volume == pytest.approx(math.pi * R * R * 4.0 - removed, rel=1e-8)
+    assert f.is_valid and f.volume == pytest.approx(math.pi * R * R * 4.0 - removed, rel=1e-6)  # (OCC integration)
