@@ -44,7 +44,7 @@ DIMS = dict(diameter=10.0, cup_depth=1.0)  # what a concave round needs besides 
     (dict(family="flat_face_round", vary="band", target_volume_mm3=100.0), "vary"),
     (dict(family="concave_round", vary="band", **DIMS), "target"),
     (dict(family="concave_round", vary="band", target_volume_mm3=1.0, target_weight_mg=1.0, **DIMS), "target"),
-    (dict(family="concave_round", vary="band", target_weight_mg=100.0, solid_fraction=0.9, **DIMS), "solid_fraction"),
+    (dict(family="concave_round", vary="band", target_weight_mg=100.0, solid_fraction=0.9, **DIMS), "true_density_mg_mm3"),
     (dict(family="concave_round", vary="band", target_volume_mm3=-5.0, **DIMS), "target_volume_mm3"),
     (dict(family="concave_round", vary="band", target_volume_mm3=300.0, diameter=10.0), "cup_depth"),  # a default stood in
     (dict(family="no_such", vary="band", target_volume_mm3=5.0), "family"),
