@@ -155,3 +155,10 @@ def test_a_raised_figure_counts_in_the_finished_thickness():
     assert 4.8 + 0.15 < r["thickness_mm"] <= 4.8 + 0.2 + 1e-6
     texts = [d.text for d in drawing_model(ts).dims]
     assert any(x.startswith(f"T {r['thickness_mm']:.2f}") for x in texts) and not any(x.startswith("T 4.80") for x in texts)
+
+
+def test_a_standard_punch_length_is_quoted_whole():
+    """The 133.35 mm TSM punch had been quoted as "133.3 mm" in the refusal of a tip too long for it."""
+    with pytest.raises(DesignError) as err:
+        resolve_body("TSM", "B", PUNCH, 200.0, 19.0)
+    assert "the punch is 133.35 mm long" in str(err.value)

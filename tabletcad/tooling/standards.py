@@ -214,12 +214,12 @@ def resolve_body(standard: str, kind: str | None, table: Any, tip_length: float,
                  else f"must be < {rest:.4g} mm: " if k in ("neck_length_mm", "head_rim_mm") and rest > 0 else "")
         raise DesignError(f"{w} {k}", t.get(k, entry.get(k, {}).get("value")),
                           f"{bound}leaves no barrel: the neck and head ({parts[k]:.4g} mm of it from {k}) take "
-                          f"{Ln + body.head_height_mm:.4g} mm of the {L:.4g} mm punch",
+                          f"{Ln + body.head_height_mm:.4g} mm of the {L:.6g} mm punch",
                           "deg" if k.endswith("_deg") else "mm")
     for name, tl in (("tip_length_mm", tip_length), ("lower_tip_length_mm", lower_tip_length)):
         room = L - Ln - body.head_height_mm
         if tl >= room:
-            raise DesignError(f"[tooling] {name}", tl, f"must be < {room:.4g} mm: the punch is {L:.4g} mm long and "
+            raise DesignError(f"[tooling] {name}", tl, f"must be < {room:.4g} mm: the punch is {L:.6g} mm long and "
                               f"its neck and head take {Ln + body.head_height_mm:.4g} mm", "mm")
         if straight > tl:
             raise DesignError(f"{w} tip_straight_mm", straight, f"must be <= the tip length {tl:.4g} mm", "mm")
