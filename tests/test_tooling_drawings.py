@@ -83,6 +83,7 @@ def test_dxf_dimensions_measure_what_their_texts_say(drawn):
     for name in ("drawing.dxf", "tooling.dxf"):
         doc = ezdxf.readfile(out / name)
         assert doc.header["$INSUNITS"] == 4  # millimetres
+        assert doc.header["$DIMLFAC"] == 1.0  # (ezdxf's default 100 had stayed in the header)
         for d in doc.modelspace().query("DIMENSION"):
             number = float(re.search(r"\d+(?:\.\d+)?", d.dxf.text).group())
             lfac = d.override().get("dimlfac", 1.0)

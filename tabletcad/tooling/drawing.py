@@ -528,6 +528,7 @@ def _write_dxf(dr: Drawing, path: Path) -> None:
     # ezdxf's EZDXF style measures in centimetres of metre drawing units (DIMLFAC 100): here 1 unit is 1 mm,
     # so a reader that recomputes a measurement gets the model's millimetres (a detail's over its scale)
     doc.dimstyles.get("EZDXF").dxf.dimlfac = 1.0
+    doc.header["$DIMLFAC"] = 1.0  # and the drawing's own default, which a dimension added in a CAD program takes
     doc.layers.add("VISIBLE", color=7)
     doc.layers.add("HIDDEN", color=8, linetype="DASHED")
     doc.layers.add("DIMENSIONS", color=1)
