@@ -51,3 +51,15 @@ def test_a_model_with_one_dimension_changed():
     with pytest.raises(DesignError) as err:
         m.replace(length=-1.0)
     assert err.value.parameter == "tablet.length"
+
+
+def test_make_takes_the_report_table_for_a_weight():
+    """``make`` had no way to a weight: ``solid_fraction=`` was refused as a dimension."""
+    from tabletcad import make
+
+    m = make("concave_round", diameter=10.0, band=3.0, cup_depth=1.0,
+             report=dict(solid_fraction=0.85, true_density_mg_mm3=1.5))
+    assert m.report()["design_report"]["weight_mg"] == pytest.approx(m.volume * 0.85 * 1.5, rel=1e-12)
+    with pytest.raises(DesignError) as err:
+        make("concave_round", diameter=10.0, band=3.0, cup_depth=1.0, report=dict(solid_fraction=1.5))
+    assert "solid_fraction" in err.value.parameter
