@@ -501,7 +501,9 @@ class Tablet:
                     r_band = abs(float(edge.section.profile(np.array([0.0]))[0, 0]))
                     reach = float(np.max(self.section[0].reach()))
                     hit = max(hit, (self._radius_range()[1] - r_band) * reach)
-            hit = float(hit) if hit > 1e-12 * max(1.0, float(np.max(np.abs(self.bounds()[1])))) else 0.0
+            if b is not None:  # rounding is no overhang (the scale: the band's own reach, not a costly bounds())
+                reach = float(np.max(np.abs(self.patches[b.patch].evaluate(0.0, np.linspace(0.0, math.tau, 16, endpoint=False)))))
+                hit = float(hit) if hit > 1e-12 * max(1.0, reach) else 0.0
             object.__setattr__(self, "_overhang", hit)
         return hit
 
