@@ -1104,17 +1104,16 @@ class Tablet:
         (:meth:`PDEPatch.breakpoints`), where a seam's normals turn fastest.  One array for every seam
         check of a tablet (:meth:`seams`, the families' design report), so its patches evaluate the
         data curves there once."""
-        key = ("_seam_v", nv)
-        hit = self.__dict__.get("_seam_v")
-        if hit is not None and hit[0] == key:
-            return hit[1]
+        cache = self.__dict__.setdefault("_seam_vs", {})
+        if nv in cache:
+            return cache[nv]
         v = np.linspace(0.0, math.tau, 4 if self.revolution is not None else nv, endpoint=False)
         joins = [p.breakpoints() for p in self.patches]
         b = np.unique(np.concatenate(joins)) if joins else np.zeros(0)
         if b.size:
             v = np.unique(np.concatenate([v, np.mod(b + 1e-7, math.tau), np.mod(b - 1e-7, math.tau)]))
         v.setflags(write=False)
-        object.__setattr__(self, "_seam_v", (key, v))
+        cache[nv] = v
         return v
 
     def seams(self, nv: int = 720) -> list[dict[str, Any]]:

@@ -76,18 +76,18 @@ class TabletFrame:
     @property
     def bore_offset(self) -> float:
         """How far (mm) the die bore stands outside the outline: the band's PDE bulge (at least
-        ``MIN_BORE_OFFSET_MM`` when the band bulges at all), 0 for a band that is a prism."""
-        from tabletcad.tooling.spec import MIN_BORE_OFFSET_MM
+        ``MIN_BORE_OFFSET_MM`` when the band bulges at all), 0 for a band that is a prism
+        (:func:`~tabletcad.tooling.spec.bore_offset`)."""
+        from tabletcad.tooling.spec import bore_offset
 
-        return max(self.band_bulge, MIN_BORE_OFFSET_MM) if self.band_bulge > 0 else 0.0
+        return bore_offset(self.band_bulge)
 
     def tip_inset(self, clearance: float) -> float:
         """How far (mm) the punch tips' walls stand inside the outline for a radial ``clearance`` (mm)
-        between tip and die bore: the clearance less :attr:`bore_offset`, so that the tips follow the
-        bore and the punch-to-die clearance is the one asked for (a thesis tablet's band bulges
-        2.5 µm: tips cut from the outline had left 0.0275 mm where 0.025 was asked); never negative
-        (a clearance below the bore offset leaves the tips on the outline)."""
-        return max(clearance - self.bore_offset, 0.0)
+        between tip and die bore (:func:`~tabletcad.tooling.spec.tip_inset` of :attr:`bore_offset`)."""
+        from tabletcad.tooling.spec import tip_inset
+
+        return tip_inset(clearance, self.bore_offset)
 
     @property
     def cup_depth_top(self) -> float:

@@ -251,7 +251,6 @@ def build_tablet(tablet, tol=None):
         # cut alike where a boundary row stands still over part of its length (tabletcad.brep.slit)
         pieces = chain_face_surfaces([f.surface for f in fits], 1e-7, names)
         faces = [bspline_face(p) for ps in pieces for p in ps]
-    signed = enclosed_volume([f.surface for f in fits])  # the faces' own data: the solid's check below
     solid = solid_from_faces(faces, max(2.0 * tol, 1e-6), tablet.name)
     t2 = time.perf_counter()
     props = tablet.properties()
@@ -270,7 +269,7 @@ def build_tablet(tablet, tol=None):
             r["band"] = band is not None
     # exact volume of the B-spline solid (FreeCAD's Shape.Volume is OCCT's default integration,
     # measured 8.5e-4 relative off on a free-form stadium tablet)
-    props = dict(props, solid_volume_mm3=abs(signed))
+    props = dict(props, solid_volume_mm3=abs(enclosed_volume([f.surface for f in fits])))
     props["plan_area_mm2"] = plan_area(tablet, rims)
     timings = dict(fit=t1 - t0, part=t2 - t1, properties=t3 - t2, total=time.perf_counter() - t0)
     return TabletGeometry(tablet, solid, fits, props, rims, timings)
@@ -444,14 +443,11 @@ def punch_shape(tablet_shape, rims, which="upper", length=10.0, clearance=0.025)
     _require_band(rims)
     sel, _ = _select(rims, which)
     sign = 1.0 if which == "upper" else -1.0
-    # the tip follows the die bore (the outline grown by the plan's overhang, :func:`die_shape`), the clearance
-    # inside it, as tabletcad build's tips (TabletFrame.tip_inset)
-    from tabletcad.tooling.spec import MIN_BORE_OFFSET_MM
+    # the tip follows the die bore (:func:`die_shape`), the clearance inside it, as tabletcad build's tips
+    from tabletcad.tooling.spec import tip_inset
 
-    over = max(float(r.get("band_bulge", 0.0)) for r in sel if not r["inner"]) if any(not r["inner"] for r in sel) else 0.0
-    bore = max(over, MIN_BORE_OFFSET_MM) if over > 0 else 0.0
     try:
-        face = _rim_face(sel, max(clearance - bore, 0.0), clearance)
+        face = _rim_face(sel, tip_inset(clearance, _bore_offset(sel)), clearance)
     except (GeometryError, Part.OCCError) as exc:
         raise DesignError("punch clearance", clearance, f"leaves no punch tip inside the tablet's outline ({exc})",
                           "mm") from None
@@ -466,6 +462,14 @@ def punch_shape(tablet_shape, rims, which="upper", length=10.0, clearance=0.025)
     if not punch.isValid():
         raise GeometryError(f"{which} punch: Boolean result is not valid", punch)
     return punch
+
+
+def _bore_offset(rims) -> float:
+    """The die bore's offset (mm) outside the outer rims: their plan overhang (stored as ``band_bulge``, the
+    key older documents' RimData has) cleared as ``tabletcad build`` clears it (``tooling.spec.bore_offset``)."""
+    from tabletcad.tooling.spec import bore_offset
+
+    return bore_offset(max((float(r.get("band_bulge", 0.0)) for r in rims if not r["inner"]), default=0.0))
 
 
 def plan_size(shape) -> float:
@@ -487,7 +491,7 @@ def die_shape(rims, height=22.22, outer_diameter=30.16):
     import Part
 
     from tabletcad.errors import DesignError, GeometryError
-    from tabletcad.tooling.spec import MIN_BORE_OFFSET_MM, MIN_DIE_WALL_MM
+    from tabletcad.tooling.spec import MIN_DIE_WALL_MM
 
     if not height > 0:
         raise DesignError("die height", height, "must be > 0", "mm")
@@ -499,8 +503,7 @@ def die_shape(rims, height=22.22, outer_diameter=30.16):
         )
     lo = min(outer, key=lambda r: r["z"])
     z_lo, z_hi = lo["z"], max(r["z"] for r in outer)
-    bulge = float(lo.get("band_bulge", 0.0))
-    bulge = max(bulge, MIN_BORE_OFFSET_MM) if bulge > 0 else 0.0  # (a thesis band bulges 2.5 µm)
+    bulge = _bore_offset([lo])  # (a thesis band bulges 2.5 µm)
     if bulge > 0:
         bore_wire = _offset_rim_wire(lo, bulge)
     else:
