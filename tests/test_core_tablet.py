@@ -178,6 +178,32 @@ def test_nominal_deviation_polished_reaches_the_dense_grids_largest(sample):
         assert certify(t).max_deviation_mm == dev
 
 
+def test_a_family_certificate_and_its_report_share_one_nominal_measurement(monkeypatch):
+    """The build's certificate and the geometry report's nominal deviation are one measurement
+    (``Tablet.nominal_peaks``, kept on the nominal with the patches it measured): the report polishes
+    no peak again and states the certificate's figure; a cut-away of the same patches is measured anew."""
+    from tabletcad.geometry.tablet import Tablet
+    from tabletcad.pipeline.design import Design
+    from tabletcad.pipeline.report import geometry_report
+
+    d = Design.from_toml(Path(__file__).resolve().parents[1] / "samples" / "families" / "oval.toml")
+    t = d.build()
+    calls = []
+    peaks = Tablet.deviation_peaks
+    monkeypatch.setattr(Tablet, "deviation_peaks", lambda self, *a, **k: calls.append(a) or peaks(self, *a, **k))
+    rep = geometry_report(t, d.report_options)
+    assert calls == []
+    assert rep["nominal"]["max_deviation_um"] == rep["nominal_max_deviation_um"] == 1e3 * t.nominal.certificate.max_deviation_mm
+    # the certificate's samples: every other u of 129 and 128 v plus each side of the outline's joins
+    u, v, hv = t.nominal_grid()
+    assert t.nominal.certificate.samples == (65, len(v)) and hv == 2 * math.pi / 128
+    joins = np.asarray(t.nominal.outline.breaks)[:-1]
+    assert np.all(np.min(np.abs(v[None, :] - joins[:, None]), axis=1) == 0.0)
+    cut = t.trimmed(v=(0.0, 3.0))
+    dev = cut.nominal_deviation()
+    assert len(calls) == 1 and 0.0 < dev <= t.nominal_deviation() * (1 + 1e-9)
+
+
 def test_spherical_and_flat_round_close_to_formulae(family_tablet):
     """Thesis Tables 4.2(a,b): PDE values are close to, not equal to, the standard formulae."""
     s = family_tablet("spherical").properties()

@@ -208,6 +208,12 @@ class SweepNominal:
         self._dz_top = _graph(self.top, d_far)
         self._dz_bot = _graph(self.bottom[::-1], d_far, reverse=True)
 
+    def v_samples(self, nv: int) -> np.ndarray:
+        """``nv`` equally spaced ``v`` (rad) over a whole turn and each side of every join of the outline
+        (where the offset is only piecewise smooth): the ``v`` samples of a distance to this nominal
+        (:meth:`~tabletcad.geometry.tablet.Tablet.nominal_deviation`, :func:`certify`)."""
+        return _v_samples(self.outline, nv)
+
     @property
     def axisymmetric(self) -> bool:
         """True when the nominal is a solid of revolution about the z axis: its outline is one
@@ -498,30 +504,28 @@ def _axisymmetric_nv(tablet: Tablet, nv: int) -> int:
     return 4 if tablet.revolution is not None and getattr(tablet.nominal, "axisymmetric", False) else nv
 
 
-def certify(tablet: Tablet, nu: int = 33, nv: int = 512) -> Certificate:
+def certify(tablet: Tablet, nu: int = 129, nv: int = 256) -> Certificate:
     """Measure the largest distance from the PDE surface to the exact nominal.
 
-    Every patch is sampled on half as many as ``nu`` equally spaced ``u`` values (ends
-    included) times ``nv / 2`` values of ``v`` plus the outline's joins, and the
-    distance is polished around the largest local maxima of those samples
-    (:meth:`~tabletcad.geometry.tablet.Tablet.deviation_peaks`: each peak resolved
-    32 times finer than ``nu × nv``); a surface and nominal of revolution on ``4 nu - 3``
-    samples of one meridian, every peak polished in ``u``
-    (:meth:`~tabletcad.geometry.tablet.Tablet.meridian_peaks`).  The distance of each point to the nominal is exact
-    (planar distance to the profile's lines and arcs at the point's exact plan
-    offset).  The result is stored on the nominal (``tablet.nominal.certificate``).
+    The distances are :meth:`~tabletcad.geometry.tablet.Tablet.nominal_peaks`' (the geometry
+    report's nominal deviation is the same measurement, computed once): every patch sampled on
+    ``(nu - 1) / 2 + 1`` equally spaced ``u`` values (ends included) times ``nv / 2`` values of
+    ``v`` and each side of the outline's joins, and polished around the largest local maxima of
+    those samples (:meth:`~tabletcad.geometry.tablet.Tablet.deviation_peaks`: each peak resolved
+    32 times finer than ``nu × nv``); a surface and nominal of revolution on ``nu`` samples of one
+    meridian, every peak polished in ``u`` (:meth:`~tabletcad.geometry.tablet.Tablet.meridian_peaks`).
+    The distance of each point to the nominal is exact (planar distance to the profile's lines and
+    arcs at the point's exact plan offset).  The result is stored on the nominal
+    (``tablet.nominal.certificate``).
     """
     nom = tablet.nominal
     if not isinstance(nom, SweepNominal):
         raise DesignError("tablet", tablet.name, "has no swept nominal to certify against")
-    u = np.linspace(0.0, 1.0, nu)
     if _axisymmetric_nv(tablet, nv) == 4:  # of revolution: every meridian gives the same distances
-        # one meridian at 4 nu - 3 points, each peak polished in u (shared with Tablet.nominal_deviation)
-        u, v = np.linspace(0.0, 1.0, 4 * nu - 3), np.zeros(1)
-        per = [float(x) for x in tablet.meridian_peaks(len(u))]
+        u, v = np.linspace(0.0, 1.0, nu), np.zeros(1)
     else:  # a grid half as fine each way, polished around its peaks
-        u, v = u[::2] if nu % 2 else np.linspace(0.0, 1.0, nu // 2 + 1), _v_samples(nom.outline, max(nv // 2, 4))
-        per = [float(x) for x in tablet.deviation_peaks(u, v, math.tau / max(nv // 2, 4))]
+        u, v, _ = tablet.nominal_grid(nu, nv)
+    per = [float(x) for x in tablet.nominal_peaks(nu, nv)]
     cert = Certificate(max(per), tuple(per), tablet.tol.nominal, (len(u), len(v)), max(per) <= tablet.tol.nominal)
     nom.certificate = cert
     nom.patch_ids = tuple(id(p) for p in tablet.patches)

@@ -1147,23 +1147,53 @@ class Tablet:
         return out
 
     def nominal_deviation(self, nu: int = 129, nv: int = 256) -> float | None:
-        """Largest distance (mm) of the surface from the nominal shape, or None.
+        """Largest distance (mm) of the surface from the nominal shape, or None: the largest of
+        :meth:`nominal_peaks`."""
+        per = self.nominal_peaks(nu, nv)
+        return None if per is None else float(np.max(per))
 
-        Every patch is sampled on a grid half as fine as ``nu × nv`` in each direction; the
-        distance is then polished around the largest local maxima of those samples
-        (:meth:`_polish_deviation`), which resolves each peak more finely than the whole
-        ``nu × nv`` grid would, at a quarter of its cost.  A surface of revolution measured
-        against a nominal of revolution (``nominal.axisymmetric``) takes ``nu`` samples of one
-        meridian, polished in ``u`` (:meth:`meridian_peaks`), since every meridian (in its
-        trimmed ``v`` range) gives the same distances.
+    def nominal_grid(self, nu: int = 129, nv: int = 256) -> tuple[np.ndarray, np.ndarray, float]:
+        """The samples ``(u, v, hv)`` of :meth:`nominal_peaks` on a tablet not of revolution: a grid
+        half as fine as ``nu × nv`` in each direction (``(nu - 1) // 2 + 1`` values of ``u`` over the
+        trimmed range, ends included, and ``nv // 2`` of ``v``), ``hv`` the step in ``v``.  Untrimmed in
+        ``v``, a nominal that names its own samples (``nominal.v_samples(n)``: a family's, with each side
+        of its outline's joins, where the surface is only piecewise smooth) gives ``v``."""
+        nu_c, nv_c = max((nu - 1) // 2 + 1, 3), max(nv // 2, 4)
+        u, v = self._grid(nu_c, nv_c)
+        hv = (self.trim.v[1] - self.trim.v[0]) / (nv_c if self.trim.full_v else max(nv_c - 1, 1))
+        sampler = getattr(self.nominal, "v_samples", None)
+        if sampler is not None and self.trim.full_v:
+            v = np.asarray(sampler(nv_c), dtype=float)
+        return u, v, hv
+
+    def nominal_peaks(self, nu: int = 129, nv: int = 256) -> np.ndarray | None:
+        """Largest distance (mm) of each patch from the nominal shape (a copy), or None without one.
+
+        Every patch is sampled on :meth:`nominal_grid`; the distance is then polished around the
+        largest local maxima of those samples (:meth:`deviation_peaks`), which resolves each peak
+        more finely than the whole ``nu × nv`` grid would, at a quarter of its cost.  A surface of
+        revolution measured against a nominal of revolution (``nominal.axisymmetric``) takes ``nu``
+        samples of one meridian, polished in ``u`` (:meth:`meridian_peaks`), since every meridian (in
+        its trimmed ``v`` range) gives the same distances.  Cached on the nominal with the patches it
+        measured, so a family's certificate (:func:`~tabletcad.families.sweep.certify`, the same
+        measurement) and the geometry report share one.
         """
         if self.nominal is None:
             return None
         if self.revolution is not None and getattr(self.nominal, "axisymmetric", False):
-            return float(np.max(self.meridian_peaks(nu)))
-        nu_c, nv_c = max((nu - 1) // 2 + 1, 3), max(nv // 2, 4)
-        u, v = self._grid(nu_c, nv_c)
-        return float(np.max(self.deviation_peaks(u, v, v[1] - v[0])))
+            return self.meridian_peaks(nu)
+        memo = getattr(self.nominal, "__dict__", self.__dict__).setdefault("_tabletcad_nominal_peaks", {})
+        key = (self.trim.u, self.trim.v, nu, nv)
+        hit = memo.get(key)
+        if hit is not None and len(hit[0]) == len(self.patches) and all(a is b for a, b in zip(hit[0], self.patches)):
+            return hit[1].copy()
+        u, v, hv = self.nominal_grid(nu, nv)
+        per = self.deviation_peaks(u, v, hv)
+        per.setflags(write=False)
+        if len(memo) >= 8:
+            memo.pop(next(iter(memo)))
+        memo[key] = (self.patches, per)
+        return per.copy()
 
     def meridian_peaks(self, nu: int = 129) -> np.ndarray:
         """Largest ``|nominal|`` (mm) on each patch of a tablet and nominal of revolution (cached).
