@@ -205,29 +205,42 @@ class PlanOutline:
 
     def _frame(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         s, idx = self._locate(v)
-        O = np.zeros((v.size, 2))
-        T = np.zeros((v.size, 2))
-        k = np.zeros(v.size)
-        for i, seg in enumerate(self.segs):
-            m = idx == i
-            if not np.any(m):
-                continue
-            t = s[m] - self._cum[i]
-            if seg.kind == "line":
-                d = np.subtract(seg.p1, seg.p0) / seg.length
-                O[m] = np.asarray(seg.p0) + t[:, None] * d
-                T[m] = d
-            else:
-                sg = math.copysign(1.0, seg.sweep)
-                th = seg.theta0 + sg * t / seg.radius
-                c, sn = np.cos(th), np.sin(th)
-                O[m, 0] = seg.center[0] + seg.radius * c
-                O[m, 1] = seg.center[1] + seg.radius * sn
-                T[m, 0] = -sg * sn
-                T[m, 1] = sg * c
-                k[m] = sg / seg.radius
+        arc, p0, d, centre, radius, theta0, sg = self._segment_table()
+        # every point by its own segment's formula, gathered from the table (the same arithmetic as
+        # segment by segment, without a Python loop over segments)
+        t = s - self._cum[idx]
+        a = arc[idx]
+        th = theta0[idx] + sg[idx] * t / radius[idx]
+        c, sn = np.cos(th), np.sin(th)
+        r = radius[idx]
+        O = np.where(a[:, None], centre[idx] + np.column_stack([r * c, r * sn]), p0[idx] + t[:, None] * d[idx])
+        T = np.where(a[:, None], np.column_stack([-sg[idx] * sn, sg[idx] * c]), d[idx])
+        k = np.where(a, sg[idx] / r, 0.0)
         N = np.column_stack([-T[:, 1], T[:, 0]])
         return O, T, N, k
+
+    def _segment_table(self) -> tuple[np.ndarray, ...]:
+        """Per segment: whether it is an arc, a line's start and unit direction, an arc's centre,
+        radius, start angle and turning sign (an arc's line entries and a line's arc entries are
+        harmless fillers).  Built once."""
+        hit = self.__dict__.get("_segtab")
+        if hit is None:
+            n = len(self.segs)
+            arc = np.array([q.kind != "line" for q in self.segs])
+            p0, d, centre = np.zeros((n, 2)), np.zeros((n, 2)), np.zeros((n, 2))
+            radius, theta0, sg = np.ones(n), np.zeros(n), np.zeros(n)
+            for i, q in enumerate(self.segs):
+                if q.kind == "line":
+                    p0[i] = q.p0
+                    d[i] = np.subtract(q.p1, q.p0) / q.length
+                else:
+                    centre[i], radius[i], theta0[i] = q.center, q.radius, q.theta0
+                    sg[i] = math.copysign(1.0, q.sweep)
+            hit = (arc, p0, d, centre, radius, theta0, sg)
+            for x in hit:
+                x.setflags(write=False)
+            self.__dict__["_segtab"] = hit
+        return hit
 
     @property
     def speed(self) -> float:

@@ -29,6 +29,7 @@ to compute them, so the basis is chosen for accuracy:
 
 from __future__ import annotations
 
+import math
 from functools import lru_cache
 
 import numpy as np
@@ -45,30 +46,32 @@ _SMALL = 1.0  # λ at or below which the hyperbolic basis is used
 LAMBDA_MAX = 1500.0
 
 
+#: Taylor coefficients of ``g(x) = (x cosh x - sinh x) / x³ = Σ_j 2(j + 1) x^{2j} / (2j + 3)!``, enough
+#: for full precision where ``|x| <= 1`` (the next term is below 4e-19)
+_G_SERIES = tuple(2.0 * (j + 1) / math.factorial(2 * j + 3) for j in range(10))
+
+
 def _sinhc(x: np.ndarray) -> np.ndarray:
-    """sinh(x)/x, accurate near 0."""
+    """sinh(x)/x, accurate near 0 (1 at 0; ``sinh`` is accurate to an ulp relative to itself there)."""
     x = np.asarray(x, dtype=float)
-    out = np.empty_like(x)
-    small = np.abs(x) < 1e-3
-    xs = x[small]
-    out[small] = 1.0 + xs * xs / 6.0 + xs**4 / 120.0
-    xl = x[~small]
-    out[~small] = np.sinh(xl) / xl
+    out = np.ones_like(x)
+    np.divide(np.sinh(x), x, out=out, where=x != 0.0)
     return out
 
 
 def _g(x: np.ndarray) -> np.ndarray:
-    """(x cosh x - sinh x) / x³, accurate near 0 (limit 1/3)."""
+    """(x cosh x - sinh x) / x³, accurate near 0 (limit 1/3): its Taylor series where ``|x| <= 1``
+    (every ``λ u`` of the hyperbolic basis), the closed form beyond."""
     x = np.asarray(x, dtype=float)
-    out = np.empty_like(x)
-    small = np.abs(x) < 0.1
-    xs2 = x[small] ** 2
-    # series: 1/3 + x²/30 + x⁴/840 + x⁶/45360 + x⁸/3991680 + x¹⁰/518918400
-    out[small] = 1 / 3 + xs2 * (
-        1 / 30 + xs2 * (1 / 840 + xs2 * (1 / 45360 + xs2 * (1 / 3991680 + xs2 / 518918400)))
-    )
-    xl = x[~small]
-    out[~small] = (xl * np.cosh(xl) - np.sinh(xl)) / xl**3
+    x2 = x * x
+    out = np.full_like(x, _G_SERIES[-1])
+    for c in _G_SERIES[-2::-1]:  # Horner in x²
+        out *= x2
+        out += c
+    big = np.abs(x) > 1.0
+    if np.any(big):
+        xl = x[big]
+        out[big] = (xl * np.cosh(xl) - np.sinh(xl)) / xl**3
     return out
 
 
@@ -173,9 +176,17 @@ def cardinals(u: np.ndarray, lams, nodes, form: str = "curves", der: int = 0) ->
     for sel, cols in ((lams > _SMALL, _exp_columns), (lams <= _SMALL, _hyp_columns)):
         if np.any(sel):
             b = np.stack(cols(u, lams[sel][:, None], der), axis=-1)  # (k, m, 4)
-            C = np.stack([cardinal_coefficients(float(lam), nodes, form) for lam in lams[sel]])
-            out[sel] = np.matmul(b, C)
+            out[sel] = np.matmul(b, _stacked_coefficients(lams[sel].tobytes(), nodes, form))
     return out
+
+
+@lru_cache(maxsize=512)
+def _stacked_coefficients(lams: bytes, nodes: tuple[float, ...], form: str) -> np.ndarray:
+    """:func:`cardinal_coefficients` of every rate in ``lams`` (a float64 array's bytes), stacked
+    ``(k, 4, 4)`` and read-only: a patch's modes ask for the same rates at every evaluation."""
+    C = np.stack([cardinal_coefficients(float(lam), nodes, form) for lam in np.frombuffer(lams)])
+    C.setflags(write=False)
+    return C
 
 
 def lebesgue_max(lam: float, nodes, form: str = "curves", samples: int = 401) -> float:

@@ -233,7 +233,11 @@ class PDEPatch:
         # the active modes' cosine and sine coefficients side by side, (modes, 4 data, 6): one
         # product with the cardinal functions gives both halves of every mode's u-profile
         act = np.array(self._active, dtype=int)
+        # the active modes' coefficients as rows (cosines over sines) by (4 data · 3): the residuals' series
+        object.__setattr__(self, "_res_rows", np.ascontiguousarray(
+            np.concatenate([self._ac_rows[act - 1], self._bc_rows[act - 1]]) if act.size else np.zeros((0, 12))))
         object.__setattr__(self, "_n_active", act)
+        self._v_memo.clear()  # residuals taken above with every mode's series: from here on, the active ones'
         object.__setattr__(self, "_abT", np.ascontiguousarray(
             np.concatenate([ac[:, act - 1], bc[:, act - 1]], axis=2).transpose(1, 0, 2)))
         # what the cardinal tables in u depend on besides u (patches alike in these share them)
@@ -351,9 +355,14 @@ class PDEPatch:
                 out[k] = out[j] if j < k else c.evaluate(v, dv)
             if dv == 0:
                 out -= self._a0[:, None, :]
-            if N:  # the four truncated series in two products: (m, N) by (N, 4·3)
-                c, s = self._trig_cached(v, N, dv)
+            act = self.__dict__.get("_n_active")
+            if act is None and N:  # (while the patch is set up: every mode) the four truncated series
+                c, s = self._trig_cached(v, N, dv)  # in two products: (m, N) by (N, 4·3)
                 out -= (c @ self._ac_rows + s @ self._bc_rows).reshape(v.size, 4, 3).transpose(1, 0, 2)
+            elif act is not None and act.size:  # the series the surface sums: its active modes, in one
+                # product with the table of cosine over sine rows that evaluate_grid takes at these v
+                T = _trig_shared(v, act, dv, rows=True)  # (2n, m)
+                out -= (T.T @ self._res_rows).reshape(v.size, 4, 3).transpose(1, 0, 2)
             return out
 
         if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
@@ -370,9 +379,10 @@ class PDEPatch:
 
         def make():
             n = np.array(self._active, dtype=int)
-            modes = cardinals(u, self._lams[n], self.u_nodes, self.form, du) if n.size else np.zeros((0, u.size, 4))
-            rem = cardinal(u, self._beta, self.u_nodes, self.form, du) if self._has_remainder else np.zeros((0, 4))
-            return modes, cardinal(u, 0.0, self.u_nodes, self.form, du), rem
+            # the modes', the spine's (λ = 0) and the remainder's (β) in one call
+            lams = np.concatenate([self._lams[n], [0.0], [self._beta] if self._has_remainder else []])
+            L = cardinals(u, lams, self.u_nodes, self.form, du)
+            return L[: n.size], L[n.size], L[n.size + 1] if self._has_remainder else np.zeros((0, 4))
 
         if u.size > 1024:
             return make()
