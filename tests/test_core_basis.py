@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tabletcad.geometry.basis import basis, cardinal, cardinal_coefficients, lebesgue_max
 
@@ -235,3 +237,29 @@ def test_small_lambda_tends_to_cubic_with_order_lambda_squared(lam):
         assert err <= 0.1 * lam**2 + 1e-13
     err = np.max(np.abs(cardinal(U, lam, NODE_SETS[0], "hermite") - _hermite(U)))
     assert err <= 0.1 * lam**2 + 1e-13
+
+
+def _g_exact(x: float) -> float:
+    """(x cosh x - sinh x) / x³ in exact rational arithmetic: its Taylor series Σ 2(j+1) x^{2j} / (2j+3)!
+    to 40 terms (the tail is below 1e-60 for |x| <= 1.5), rounded once."""
+    from fractions import Fraction
+    from math import factorial
+
+    q = Fraction(x) ** 2
+    return float(sum(Fraction(2 * (j + 1), factorial(2 * j + 3)) * q**j for j in range(40)))
+
+
+@given(st.floats(min_value=-1.5, max_value=1.5, allow_nan=False))
+@settings(max_examples=300, deadline=None)
+def test_hyperbolic_basis_g_against_its_exact_series(x):
+    """The hyperbolic basis's ``g(x) = (x cosh x - sinh x)/x³`` (its Taylor series where ``|x| <= 1``,
+    the closed form beyond) is within 2e-15 relative of the exact series (rational arithmetic), and
+    ``sinh(x)/x`` within 2 ulp of ``math.sinh(x)/x`` (1 at 0)."""
+    import math
+
+    from tabletcad.geometry.basis import _g, _sinhc
+
+    got = float(_g(np.array([x]))[0])
+    assert abs(got - _g_exact(x)) <= 2e-15 * _g_exact(x)
+    s = float(_sinhc(np.array([x]))[0])
+    assert s == 1.0 if x == 0.0 else abs(s - math.sinh(x) / x) <= 4.5e-16 * s
