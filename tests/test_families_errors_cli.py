@@ -185,6 +185,29 @@ def test_design_files_of_every_family_build(tmp_path):
         assert t.nominal.certificate.passed
 
 
+@pytest.mark.parametrize("length", [7.5, 9.0, 12.75])
+def test_elongated_strength_below_pitt_heasleys_ratio(length):
+    """Pitt & Heasley's 2/3 of the round value holds from length/width 1.7 (eq 2.9).  A capsule as long as
+    wide is the round tablet of its width (eq 2.7: the same solid's strength); in between no formula is
+    published, so no value but the range from eq 2.9 to eq 2.7 (it had been eq 2.9's, up to a third low)."""
+    from tabletcad.pipeline.designreport import ReportOptions, design_report
+
+    W, band, h, F_N = 7.5, 3.0, 1.0, 100.0
+    T = band + 2 * h
+    round_ = 10 * F_N / (math.pi * W * W * (2.84 * T / W - 0.126 * T / band + 3.15 * band / W + 0.01))  # eq 2.7
+    ts = design_report(F.capsule(length, W, band, h), ReportOptions(breaking_force_N=F_N))["design_report"]["tensile_strength"]
+    if length == W:
+        assert ts["tensile_strength_MPa"] == pytest.approx(round_, rel=1e-12) and "eq 2.7" in ts["formula"]
+        same = design_report(F.concave_round(W, band, h), ReportOptions(breaking_force_N=F_N))["design_report"]
+        assert same["tensile_strength"]["tensile_strength_MPa"] == pytest.approx(ts["tensile_strength_MPa"], rel=1e-12)
+    elif length / W < 1.7:
+        assert ts["tensile_strength_MPa"] is None and ts["within_range"] is False
+        assert ts["tensile_strength_range_MPa"] == pytest.approx([2 / 3 * round_, round_], rel=1e-12)
+        assert ts["range_flags"][0].startswith("length/width = 1.2 < 1.7")
+    else:
+        assert ts["tensile_strength_MPa"] == pytest.approx(2 / 3 * round_, rel=1e-12) and "eq 2.9" in ts["formula"]
+
+
 def test_elongated_strength_uses_pitt_heasley():
     from tabletcad.pipeline.designreport import ReportOptions, design_report
 

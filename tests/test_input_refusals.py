@@ -277,3 +277,39 @@ def test_a_cut_away_s_extents_reach_its_cut_faces():
                           "trim": {"v": [0.0, 1.0]}})
     lo, hi = d.build().bounds()
     assert lo[0] == pytest.approx(0.0, abs=1e-9) and hi[0] == pytest.approx(9.0, abs=1e-6)
+
+
+ROUND = '[tablet]\nfamily = "concave_round"\ndiameter = 12.0\nband = 3.0\ncup_depth = 1.2\n'
+
+
+@pytest.mark.parametrize("report, line", [
+    # taken, and printed as "force = 1e+300 mm must be > 0 and <= 1e+09 N" in the report's strength row
+    ("breaking_force_N = 1e300", "error: report.breaking_force_N = 1e+300 N is not allowed: must be > 0 and <= 1e+09 N"),
+    ("compaction_force_kN = 2e6", "error: report.compaction_force_kN = 2e+06 kN is not allowed: must be > 0 and <= 1e+06 kN"),
+    # built with every file written; only `tabletcad fe strength` refused them
+    ("tensile_strength_MPa = -3", "error: report.tensile_strength_MPa = -3 MPa is not allowed: must be > 0"),
+    ("reference_diameter_mm = -1", "error: report.reference_diameter_mm = -1 mm is not allowed: must be >= 0.001"),
+    ("reference_thickness_mm = 0", "error: report.reference_thickness_mm = 0 mm is not allowed: must be >= 0.001"),
+])
+@pytest.mark.parametrize("command", ["report", "build"])
+def test_report_numbers_out_of_range_refused_by_every_command(tmp_path, capsys, report, line, command):
+    d = tmp_path / "d.toml"
+    d.write_text(ROUND + "[report]\n" + report + "\n", encoding="utf-8")
+    extra = ["--out", str(tmp_path / "out")] if command == "build" else []
+    assert main([command, str(d), *extra]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(line), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.toml"]
+
+
+@pytest.mark.parametrize("fixed, line", [
+    # a fixed value the family refuses at the start: the solver had stopped at once (exit 3, files written)
+    ("band = 3.0\ncup_depth = 0.0", "error: fixed.cup_depth = 0 mm is not allowed: must be > 0 and <= 6 mm "
+     "(a hemisphere over the 12 mm wide cup) (at the start: diameter = 12;"),
+    ("band = 3.0\ncup_depth = 7.0", "error: fixed.cup_depth = 7 mm is not allowed: must be > 0 and <= 6 mm"),
+])
+def test_a_start_the_family_refuses_is_the_files_error(tmp_path, capsys, fixed, line):
+    rc, out, err = _optimise(tmp_path, capsys, CONCAVE.format(
+        sense="min", variables="diameter = { lower = 8.0, upper = 14.0, initial = 12.0 }", fixed=fixed))
+    assert rc == 2 and len(err) == 1 and err[0].startswith(line), err
+    assert out == [] and sorted(p.name for p in tmp_path.iterdir()) == ["problem.toml"]

@@ -430,14 +430,20 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
     used = obj_spec == FE_QUANTITY or (isinstance(constraints, list) and any(
         isinstance(c, dict) and c.get("quantity") == FE_QUANTITY for c in constraints))
     fe_set = _fe_settings(fe, used)
-    first = None
-    if held is not None or (fe_set is not None and fe_set["symmetric"]):
-        try:
-            first = build({v.name: v.initial if v.initial is not None else 0.5 * (v.lower + v.upper) for v in vs})
-        except DesignError as exc:
-            if held is not None and exc.parameter == "target_volume_mm3":  # no design of the start has that volume
-                raise DesignError("[problem] volume_mm3", held[1], f"at the start's dimensions it {exc.allowed}", "mm3") from None
-            # any other failure of the start is the optimiser's to report
+    start = {v.name: v.initial if v.initial is not None else 0.5 * (v.lower + v.upper) for v in vs}
+    try:  # the start must build: a value in the file that the family refuses there is the file's error
+        first = build(start)
+    except DesignError as exc:
+        if held is not None and exc.parameter == "target_volume_mm3":  # no design of the start has that volume
+            raise DesignError("[problem] volume_mm3", held[1], f"at the start's dimensions it {exc.allowed}", "mm3") from None
+        at = ", ".join(f"{k} = {v:g}" for k, v in start.items())
+        if exc.parameter in fixed:
+            raise DesignError(f"[fixed] {exc.parameter}", exc.value, f"{exc.allowed} (at the start: {at}; give "
+                              "variables an initial value at which the design builds)", exc.unit) from None
+        if exc.parameter in start:
+            raise DesignError(f"[variables] {exc.parameter} initial", exc.value, f"{exc.allowed} (the start: {at})",
+                              exc.unit) from None
+        first = None  # any other failure of the start is the optimiser's to report
     if first is not None and fe_set is not None and fe_set["symmetric"]:
         from tabletcad.fe.diametral import check_symmetric
 

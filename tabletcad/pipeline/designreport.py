@@ -31,7 +31,7 @@ from tabletcad.errors import DesignError, check_range
 from tabletcad.families.sweep import SweepNominal, certify, sweep_properties
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.geometry.vectors import cross
-from tabletcad.tolerance import MAX_TRUE_DENSITY_MG_MM3
+from tabletcad.tolerance import DEFAULT, MAX_TRUE_DENSITY_MG_MM3
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -60,6 +60,22 @@ REPORT_KEYS = {
     "reference_thickness_mm": "mm",
     # true: `tabletcad report` and `build` run that prediction on the coarse mesh (tabletcad.fe.objective)
     "fe_breaking_force": "true or false",
+}
+
+
+#: The largest value of each number of ``[report]`` (all must be > 0): a true density in mg/mm³ (not
+#: kg/m³), forces as a breaking test's (:data:`tabletcad.mechanics.strength.MAX_FORCE_N`, 1e9 N; in kN,
+#: 1e6), stresses as the FE prediction's (1e9 MPa); the reference tablet's lengths as a design's.
+_REPORT_LIMITS = {
+    "true_density_mg_mm3": MAX_TRUE_DENSITY_MG_MM3,
+    "breaking_force_N": 1e9,
+    "compaction_force_kN": 1e6,
+    "max_punch_force_kN": 1e6,
+    "max_punch_pressure_MPa": 1e9,
+    "tensile_strength_MPa": 1e9,
+    "reference_breaking_force_N": 1e9,
+    "reference_diameter_mm": None,
+    "reference_thickness_mm": None,
 }
 
 
@@ -101,11 +117,13 @@ class ReportOptions:
     def __post_init__(self) -> None:
         if self.solid_fraction is not None:
             check_range("[report] solid_fraction", self.solid_fraction, 0.0, 1.0, lo_open=True)
-        for k in ("true_density_mg_mm3", "breaking_force_N", "compaction_force_kN", "max_punch_force_kN", "max_punch_pressure_MPa"):
+        for k, hi in _REPORT_LIMITS.items():
             v = getattr(self, k)
             if v is not None:
-                hi = MAX_TRUE_DENSITY_MG_MM3 if k == "true_density_mg_mm3" else None  # (not kg/m³)
-                check_range(f"[report] {k}", v, 0.0, hi, REPORT_KEYS[k], lo_open=True)
+                if REPORT_KEYS[k] == "mm":  # a reference tablet's lengths as a design's (0.001 mm to 1 m)
+                    check_range(f"[report] {k}", v, DEFAULT.min_length, DEFAULT.max_length, "mm")
+                else:
+                    check_range(f"[report] {k}", v, 0.0, hi, REPORT_KEYS[k], lo_open=True)
 
     @classmethod
     def from_table(cls, table: Any) -> "ReportOptions":
@@ -198,6 +216,8 @@ def _strength_module():
 class _LocalStrength:
     """Fallback formulas (thesis eqs 2.4, 2.7-2.9), F in N, lengths in mm, result MPa."""
 
+    ELONGATED_RATIO = 1.7  # length/width from which eqs 2.8, 2.9 hold
+
     @staticmethod
     def diametral_flat(F, D, t):  # eq 2.4
         return 2.0 * F / (math.pi * D * t)
@@ -220,8 +240,10 @@ def tensile_strength(info: dict, thickness: float, F: float) -> dict[str, Any]:
 
     Flat round: eq 2.4 ``2F/(πDt)``; convex round: eq 2.7 (Pitt et al. 1988);
     elongated (capsule, oval, modified capsule): eqs 2.8/2.9 (Pitt & Heasley,
-    2/3 of the round value, ``D`` the width).  Other plans: none.  Range
-    warnings of the formulas are returned in ``range_flags``.
+    2/3 of the round value, ``D`` the width) from length/width 1.7; as long as wide, the
+    round formula; in between no value but ``tensile_strength_range_MPa`` (from the
+    elongated to the round value).  Other plans: none.  Range warnings of the formulas
+    are returned in ``range_flags``.
     """
     st = _strength_module()
     shape = info.get("shape")
@@ -239,6 +261,13 @@ def tensile_strength(info: dict, thickness: float, F: float) -> dict[str, Any]:
                     flags.append("bevel/radius edge: the flat-disc formula is applied with the overall thickness (approximation)")
             else:
                 val, formula = st.pitt_convex(F, D, thickness, band), "eq 2.7: Pitt et al. (1988), convex-faced round"
+        elif info.get("elongated") and Ln is not None and abs(Ln - D) <= 1e-9 * D:  # length = width: a round tablet
+            if flat:
+                val, formula = st.diametral_flat(F, D, thickness), "eq 2.4: 2F/(pi D t) (length = width: a flat-faced round)"
+            else:
+                val, formula = st.pitt_convex(F, D, thickness, band), "eq 2.7: Pitt et al. (1988) (length = width: a convex round)"
+        elif info.get("elongated") and Ln is not None and Ln / D < st.ELONGATED_RATIO:
+            return _between_round_and_elongated(st, F, D, Ln, thickness, band, flat)
         elif info.get("elongated"):
             if flat:
                 val, formula = st.pitt_heasley_elongated_flat(F, D, thickness, length=Ln), "eq 2.8: Pitt & Heasley (2013), flat elongated, 2/3 of eq 2.4"
@@ -254,6 +283,29 @@ def tensile_strength(info: dict, thickness: float, F: float) -> dict[str, Any]:
                 within_range=not any(True for w in rec))
 
 
+def _between_round_and_elongated(st, F: float, D: float, Ln: float, t: float, band, flat: bool) -> dict[str, Any]:
+    """The tensile strength of an elongated tablet shorter than Pitt & Heasley's 2/3 limit (``1 < L/W < 1.7``):
+    no published formula gives it, so no value, but the range it lies in: from the elongated limit
+    (eq 2.8 or 2.9, 2/3 of the round value) up to the round value (eq 2.4 or 2.7) on the width."""
+    with warnings.catch_warnings(record=True) as rec, _no_value(F) as refused:
+        warnings.simplefilter("always")
+        if flat:
+            hi, lo = st.diametral_flat(F, D, t), st.pitt_heasley_elongated_flat(F, D, t)
+            names = "eq 2.8", "eq 2.4"
+        else:
+            hi, lo = st.pitt_convex(F, D, t, band), st.pitt_heasley_elongated_convex(F, D, t, band)
+            names = "eq 2.9", "eq 2.7"
+    if refused:
+        return refused[0]
+    return dict(tensile_strength_MPa=None, formula=None, breaking_force_N=F,
+                tensile_strength_range_MPa=[float(lo), float(hi)],
+                range_flags=[f"length/width = {Ln / D:.3g} < {st.ELONGATED_RATIO}: Pitt & Heasley's 2/3 of the round value "
+                             f"holds from about {st.ELONGATED_RATIO}; the strength lies between {names[0]}'s {lo:.4g} MPa "
+                             f"(elongated) and {names[1]}'s {hi:.4g} MPa (round, on the width)"]
+                + list(dict.fromkeys(str(w.message) for w in rec)),
+                within_range=False)
+
+
 @contextlib.contextmanager
 def _no_value(F: float) -> Iterator[list[dict[str, Any]]]:
     """Turn a formula's refusal of the geometry (eq 2.7 with a band so thin that its denominator is <= 0)
@@ -263,7 +315,8 @@ def _no_value(F: float) -> Iterator[list[dict[str, Any]]]:
         yield out
     except DesignError as exc:
         out.append(dict(tensile_strength_MPa=None, formula=None, breaking_force_N=F,
-                        range_flags=[f"{exc.parameter} = {exc.value:g} mm {exc.allowed}"], within_range=False))
+                        range_flags=[f"{exc.parameter} = {exc.value:g}{' ' + exc.unit if exc.unit else ''} {exc.allowed}"],
+                        within_range=False))
 
 
 def _punch_check(plan_area: float | None, opts: ReportOptions) -> dict[str, Any]:
