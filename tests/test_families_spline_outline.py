@@ -39,3 +39,26 @@ def test_spline_cup_limit_keeps_the_offset_regular(egg):
     # for the ellipse-like outline the radius of curvature is near b^2 / a = 2 mm (spline of 20 points)
     if egg == 0.0:
         assert 1.8 < 1.0 / ol.max_curvature < 2.0
+
+
+@pytest.mark.parametrize("kind", ["spline", "arcs"])
+def test_a_patchs_data_evaluated_together_equal_each_on_its_own(kind):
+    """A swept tablet's four data of a patch are offsets of one outline: evaluated together (one frame,
+    ``evaluate_curves``) they are bit for bit each curve's own ``evaluate``, values and two derivatives,
+    on a spline outline (its own offset rule) and on one of lines and arcs."""
+    from tabletcad.families.shaped import outline_tablet, rounded_triangle
+    from tabletcad.families.sweep import SweepCurve
+    from tabletcad.geometry.curves import evaluate_curves
+
+    t = outline_tablet(SplineOutline(ellipse_points(egg=0.3)), band=2.5, cup_depth=0.6) if kind == "spline" \
+        else rounded_triangle()
+    v = np.random.default_rng(3).uniform(-1.0, 7.5, 301)
+    seen = 0
+    for p in t.patches:
+        if type(p.data[0]) is not SweepCurve:
+            continue
+        for der in (0, 1, 2):
+            together = evaluate_curves(p.data, v, der)
+            assert np.array_equal(together, np.stack([c.evaluate(v, der) for c in p.data]))
+            seen += 1
+    assert seen >= 3 * (len(t.patches) - 2)

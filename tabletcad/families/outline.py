@@ -284,6 +284,21 @@ class PlanOutline:
             return (g * (alpha - beta * k))[:, None] * T
         return ((alpha * k - beta * k * k) * g * g)[:, None] * N
 
+    def offsets(self, v, der: int, alphas: np.ndarray, betas: np.ndarray) -> np.ndarray:
+        """:meth:`offset` for several weights at once, ``(len(alphas), m, 2)`` (mm), from one :meth:`frame`
+        (the same arithmetic as each :meth:`offset`)."""
+        if der not in (0, 1, 2):
+            raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
+        O, T, N, k = self.frame(v)
+        g = self.speed
+        a = np.asarray(alphas, dtype=float).reshape(-1, 1)
+        b = np.asarray(betas, dtype=float).reshape(-1, 1)
+        if der == 0:
+            return a[:, :, None] * O + b[:, :, None] * N
+        if der == 1:
+            return (g * (a - b * k))[:, :, None] * T
+        return ((a * k - b * k * k) * g * g)[:, :, None] * N
+
     def centroid(self) -> np.ndarray:
         """Area centroid (mm), exact for lines and arcs."""
         sx = sy = 0.0
@@ -522,6 +537,9 @@ class SplineOutline(PlanOutline):
 
     def offset(self, v, der: int, alpha: float, beta: float) -> np.ndarray:
         return alpha * self.point(v, der) + beta * self.normal(v, der)
+
+    def offsets(self, v, der: int, alphas: np.ndarray, betas: np.ndarray) -> np.ndarray:
+        return np.stack([self.offset(v, der, float(a), float(b)) for a, b in zip(alphas, betas)])
 
     def centroid(self) -> np.ndarray:
         p, d1 = self._ps, self._sp(self._vs, 1)

@@ -130,6 +130,26 @@ class SweepCurve(Curve):
             raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
         return out
 
+    @classmethod
+    def evaluate_several(cls, curves, v, der: int = 0) -> np.ndarray | None:
+        """Several offsets of one outline in one call (:meth:`~tabletcad.families.outline.PlanOutline.offsets`:
+        one frame, the same arithmetic as each curve's :meth:`evaluate`); None for different outlines."""
+        ol = curves[0].outline
+        if any(c.outline is not ol for c in curves):
+            return None
+        v = np.asarray(v, dtype=float).reshape(-1)
+        if der not in (0, 1, 2):
+            raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
+        out = np.zeros((len(curves), v.size, 3))
+        a = np.array([c.alpha for c in curves])
+        b = np.array([c.beta for c in curves])
+        live = (a != 0.0) | (b != 0.0)  # (a point's offset is its constant alone, as in evaluate)
+        if np.any(live):
+            out[live, :, :2] = ol.offsets(v, der, a[live], b[live])
+        if der == 0:
+            out += np.array([c.const for c in curves], dtype=float)[:, None, :]
+        return out
+
     @property
     def is_point(self) -> bool:
         return self.alpha == 0.0 and self.beta == 0.0

@@ -19,6 +19,7 @@ import math
 import weakref
 from dataclasses import dataclass, field
 from functools import lru_cache
+from collections.abc import Sequence
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -42,6 +43,7 @@ __all__ = [
     "modes_needed",
     "sample_v",
     "nearest_of",
+    "evaluate_curves",
 ]
 
 
@@ -58,6 +60,24 @@ def _vec3(name: str, value) -> np.ndarray:
     return arr
 
 
+def evaluate_curves(curves: Sequence, v: np.ndarray, der: int = 0) -> np.ndarray:
+    """``(len(curves), len(v), 3)``: each curve (or its ``der``-th derivative, mm) at ``v``, a curve given twice
+    evaluated once; curves all of one class that shares work between them (an outline's frame: a swept
+    tablet's data) in one :meth:`Curve.evaluate_several` call."""
+    v = np.asarray(v, dtype=float).reshape(-1)
+    kind = type(curves[0])
+    several = getattr(kind, "evaluate_several", None)
+    if several is not None and all(type(c) is kind for c in curves):
+        hit = several(curves, v, der)
+        if hit is not None:
+            return hit
+    out = np.empty((len(curves), v.size, 3))
+    for k, c in enumerate(curves):
+        j = next(j for j in range(k + 1) if curves[j] is c)
+        out[k] = out[j] if j < k else c.evaluate(v, der)
+    return out
+
+
 @runtime_checkable
 class CurveLike(Protocol):
     def evaluate(self, v: np.ndarray, der: int = 0) -> np.ndarray: ...
@@ -71,6 +91,12 @@ class Curve:
 
     def __call__(self, v) -> np.ndarray:
         return self.evaluate(v)
+
+    @classmethod
+    def evaluate_several(cls, curves: Sequence["Curve"], v: np.ndarray, der: int = 0) -> np.ndarray | None:
+        """Every curve of ``curves`` (all of this class) at ``v``: ``(len(curves), len(v), 3)`` mm, or None
+        when this class has no shared work to save (then each is evaluated on its own: :func:`evaluate_curves`)."""
+        return None
 
     # -- convenience ------------------------------------------------------------------
     def fourier(self, modes: int, samples: int | None = None):

@@ -37,7 +37,7 @@ import numpy as np
 from tabletcad.geometry.basis import cardinal, cardinal_coefficients, cardinals
 from tabletcad.geometry.revolution import Revolution, Section, detect_revolution, detect_section
 from tabletcad.geometry.tables import CARDINAL, TRIG
-from tabletcad.geometry.curves import fourier_coefficients, modes_needed, sample_v
+from tabletcad.geometry.curves import evaluate_curves, fourier_coefficients, modes_needed, sample_v
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
 from tabletcad.geometry.vectors import cross, norm3
@@ -349,10 +349,7 @@ class PDEPatch:
 
         def make() -> np.ndarray:
             N = self.modes
-            out = np.empty((4, v.size, 3))
-            for k, c in enumerate(self.data):  # a datum repeated (a fan's two equal derivatives) is evaluated once
-                j = next(j for j in range(k + 1) if self.data[j] is c)
-                out[k] = out[j] if j < k else c.evaluate(v, dv)
+            out = evaluate_curves(self.data, v, dv)  # (a datum repeated, a fan's two equal derivatives, once)
             if dv == 0:
                 out -= self._a0[:, None, :]
             act = self.__dict__.get("_n_active")
