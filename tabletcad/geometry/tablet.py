@@ -321,11 +321,7 @@ class Tablet:
         j = i - 1 if end == 0 else i + 1
         if not 0 <= j < len(self.patches):
             return False
-        a = self.patches[i]
-        b = self.patches[j]
-        v = self._edge_v()
-        xa = a.evaluate(float(end), v)
-        xb = b.evaluate(float(1 - end), v)
+        xa, xb = self._end_row(i, end), self._end_row(j, 1 - end)
         scale = max(1.0, float(np.max(np.abs(xa))))
         return float(np.max(np.linalg.norm(xa - xb, axis=1))) <= 1e-9 * scale
 
@@ -334,9 +330,18 @@ class Tablet:
         (every meridian of a patch of revolution meets its neighbour and the axis alike)."""
         return np.linspace(0.0, math.tau, 4 if self.revolution is not None else 64, endpoint=False)
 
+    def _end_row(self, i: int, end: int) -> np.ndarray:
+        """Patch ``i``'s boundary curve ``u = end`` at :meth:`_edge_v` (read-only), both ends of a patch
+        from one evaluation and kept: the topology checks ask for each end several times."""
+        rows = self.__dict__.setdefault("_end_rows", {})
+        if i not in rows:
+            X = self.patches[i].evaluate_grid(np.array([0.0, 1.0]), self._edge_v())
+            X.setflags(write=False)
+            rows[i] = X
+        return rows[i][end]
+
     def _end_is_point(self, i: int, end: int) -> bool:
-        v = self._edge_v()
-        x = self.patches[i].evaluate(float(end), v)
+        x = self._end_row(i, end)
         return float(np.max(np.ptp(x, axis=0))) <= 1e-12 * max(1.0, float(np.max(np.abs(x))))
 
     def faces(self) -> list[Face]:
