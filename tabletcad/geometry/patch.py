@@ -485,12 +485,14 @@ class PDEPatch:
         L = self._u_tables(uf, du)[1] if uf.size <= 1024 else cardinal(uf, 0.0, self.u_nodes, self.form, du)
         return (L @ self._a0).reshape(u.shape + (3,))
 
-    def normal(self, u, v, *, eps: float = 1e-7) -> np.ndarray:
+    def normal(self, u, v, *, eps: float = 1e-7, xu: np.ndarray | None = None,
+               xv: np.ndarray | None = None) -> np.ndarray:
         """Unit normal ``X_u × X_v / |X_u × X_v|`` (eq 6.4); at degenerate points
-        (poles) the limit from inside the patch is used."""
+        (poles) the limit from inside the patch is used.  ``xu``, ``xv``: the partials at these
+        points when the caller has them (mm per unit parameter)."""
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
-        xu = self.evaluate(u, v, du=1)
-        xv = self.evaluate(u, v, dv=1)
+        xu = self.evaluate(u, v, du=1) if xu is None else xu
+        xv = self.evaluate(u, v, dv=1) if xv is None else xv
         n = cross(xu, xv)
         norm = norm3(n)
         scale = np.max(norm3(xu)) + 1e-300

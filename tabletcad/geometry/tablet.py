@@ -1121,24 +1121,42 @@ class Tablet:
         cache[nv] = v
         return v
 
+    def seam_rows(self, nv: int = 720) -> tuple[np.ndarray, ...]:
+        """Every patch's boundary curves ``u = 0, 1`` and their partials on :meth:`seam_v`: one
+        ``(3, 2, len(v), 3)`` array per patch (``X``, ``X_u``, ``X_v`` by end), read-only, three
+        evaluations per patch for every seam check of the tablet (:meth:`seams`, the families'
+        design report).  Cached."""
+        cache = self.__dict__.setdefault("_seam_rows", {})
+        if nv not in cache:
+            v, ends = self.seam_v(nv), np.array([0.0, 1.0])
+            rows = []
+            for p in self.patches:
+                R = np.stack([p.evaluate_grid(ends, v), p.evaluate_grid(ends, v, du=1), p.evaluate_grid(ends, v, dv=1)])
+                R.setflags(write=False)
+                rows.append(R)
+            cache[nv] = tuple(rows)
+        return cache[nv]
+
     def seams(self, nv: int = 720) -> list[dict[str, Any]]:
         """For every curve shared by consecutive patches: largest gap (mm) and
         largest angle (deg) between the two patches' normals (on :meth:`seam_v`: ``nv`` meridians,
         4 on a tablet of revolution, and each side of the outline's joins)."""
         out = []
         v = self.seam_v(nv)
+        rows = self.seam_rows(nv)
         for i in range(len(self.patches) - 1):
             a, b = self.patches[i], self.patches[i + 1]
-            xa, xb = a.evaluate(1.0, v), b.evaluate(0.0, v)
+            (xa, xua, xva), (xb, xub, xvb) = rows[i][:, 1], rows[i + 1][:, 0]
             gap = float(np.max(np.linalg.norm(xa - xb, axis=1)))
             if self._end_is_point(i, 1):
                 ang = float("nan")
             else:
                 # skip points where the shared curve has (nearly) zero speed, such as a
                 # corner collapsed to a point: the normals are undefined there
-                speed = norm3(a.evaluate(1.0, v, dv=1))
+                speed = norm3(xva)
                 ok = speed > 1e-6 * float(np.max(speed))
-                na, nb = a.normal(1.0, v[ok]), b.normal(0.0, v[ok])
+                na = a.normal(1.0, v[ok], xu=xua[ok], xv=xva[ok])
+                nb = b.normal(0.0, v[ok], xu=xub[ok], xv=xvb[ok])
                 cosang = np.clip(np.einsum("ij,ij->i", na, nb), -1.0, 1.0)
                 ang = float(np.degrees(np.max(np.arccos(cosang))))
             out.append(

@@ -162,17 +162,16 @@ def family_seams(tablet: Tablet, nv: int = 720) -> list[dict[str, Any]]:
     """
     nom = tablet.nominal
     expected = list(getattr(nom, "expected_sharp", []))
-    v = tablet.seam_v(nv)  # the geometry report's seams' samples: each side of the outline's joins included
+    # the geometry report's seams' samples (each side of the outline's joins included) and rows
+    rows = tablet.seam_rows(nv)
     out = []
     for i in range(len(tablet.patches) - 1):
-        pa, pb = tablet.patches[i], tablet.patches[i + 1]
-        xa, xb = pa.evaluate(1.0, v), pb.evaluate(0.0, v)
+        (xa, xua, xv), (xb, xub, xvb) = rows[i][:, 1], rows[i + 1][:, 0]
         gap = float(np.max(np.linalg.norm(xa - xb, axis=1)))
-        xv = pa.evaluate(1.0, v, dv=1)
         scale = max(1e-300, float(np.max(np.linalg.norm(xv, axis=1))))
         good = np.linalg.norm(xv, axis=1) > 1e-6 * scale
-        na = cross(pa.evaluate(1.0, v, du=1), xv)
-        nb = cross(pb.evaluate(0.0, v, du=1), pb.evaluate(0.0, v, dv=1))
+        na = cross(xua, xv)
+        nb = cross(xub, xvb)
         la, lb = np.linalg.norm(na, axis=1), np.linalg.norm(nb, axis=1)
         good &= (la > 1e-9 * la.max()) & (lb > 1e-9 * lb.max())
         if np.any(good):
