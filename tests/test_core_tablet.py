@@ -194,9 +194,9 @@ def test_a_family_certificate_and_its_report_share_one_nominal_measurement(monke
     rep = geometry_report(t, d.report_options)
     assert calls == []
     assert rep["nominal"]["max_deviation_um"] == rep["nominal_max_deviation_um"] == 1e3 * t.nominal.certificate.max_deviation_mm
-    # the certificate's samples: every other u of 129 and 128 v plus each side of the outline's joins
+    # the certificate's samples: every other u of 65 and 128 v plus each side of the outline's joins
     u, v, hv = t.nominal_grid()
-    assert t.nominal.certificate.samples == (65, len(v)) and hv == 2 * math.pi / 128
+    assert t.nominal.certificate.samples == (33, len(v)) == (len(u), len(v)) and hv == 2 * math.pi / 128
     joins = np.asarray(t.nominal.outline.breaks)[:-1]
     assert np.all(np.min(np.abs(v[None, :] - joins[:, None]), axis=1) == 0.0)
     cut = t.trimmed(v=(0.0, 3.0))

@@ -228,6 +228,9 @@ class SweepNominal:
         self._dz_top = _graph(self.top, d_far)
         self._dz_bot = _graph(self.bottom[::-1], d_far, reverse=True)
 
+    #: ``nu`` of the distance to this nominal (:meth:`~tabletcad.geometry.tablet.Tablet.nominal_nu`)
+    deviation_nu = 65
+
     def v_samples(self, nv: int) -> np.ndarray:
         """``nv`` equally spaced ``v`` (rad) over a whole turn and each side of every join of the outline
         (where the offset is only piecewise smooth): the ``v`` samples of a distance to this nominal
@@ -524,7 +527,7 @@ def _axisymmetric_nv(tablet: Tablet, nv: int) -> int:
     return 4 if tablet.revolution is not None and getattr(tablet.nominal, "axisymmetric", False) else nv
 
 
-def certify(tablet: Tablet, nu: int = 129, nv: int = 256) -> Certificate:
+def certify(tablet: Tablet, nu: int | None = None, nv: int = 256) -> Certificate:
     """Measure the largest distance from the PDE surface to the exact nominal.
 
     The distances are :meth:`~tabletcad.geometry.tablet.Tablet.nominal_peaks`' (the geometry
@@ -532,8 +535,9 @@ def certify(tablet: Tablet, nu: int = 129, nv: int = 256) -> Certificate:
     ``(nu - 1) / 2 + 1`` equally spaced ``u`` values (ends included) times ``nv / 2`` values of
     ``v`` and each side of the outline's joins, and polished around the largest local maxima of
     those samples (:meth:`~tabletcad.geometry.tablet.Tablet.deviation_peaks`: each peak resolved
-    32 times finer than ``nu × nv``); a surface and nominal of revolution on ``nu`` samples of one
-    meridian, every peak polished in ``u`` (:meth:`~tabletcad.geometry.tablet.Tablet.meridian_peaks`).
+    32 times finer than ``nu × nv``; ``nu`` None: :attr:`SweepNominal.deviation_nu`); a surface and
+    nominal of revolution on 129 samples of one meridian (``nu`` when given), every peak polished
+    in ``u`` (:meth:`~tabletcad.geometry.tablet.Tablet.meridian_peaks`).
     The distance of each point to the nominal is exact (planar distance to the profile's lines and
     arcs at the point's exact plan offset).  The result is stored on the nominal
     (``tablet.nominal.certificate``).
@@ -542,7 +546,7 @@ def certify(tablet: Tablet, nu: int = 129, nv: int = 256) -> Certificate:
     if not isinstance(nom, SweepNominal):
         raise DesignError("tablet", tablet.name, "has no swept nominal to certify against")
     if _axisymmetric_nv(tablet, nv) == 4:  # of revolution: every meridian gives the same distances
-        u, v = np.linspace(0.0, 1.0, nu), np.zeros(1)
+        u, v = np.linspace(0.0, 1.0, 129 if nu is None else nu), np.zeros(1)
     else:  # a grid half as fine each way, polished around its peaks
         u, v, _ = tablet.nominal_grid(nu, nv)
     per = [float(x) for x in tablet.nominal_peaks(nu, nv)]
