@@ -11,9 +11,11 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable
 from typing import Any
 
 __all__ = [
+    "run_interruptibly",
     "TabletcadError",
     "DesignError",
     "GeometryError",
@@ -24,6 +26,37 @@ __all__ = [
     "one_token",
     "reraise_interrupt",
 ]
+
+
+def run_interruptibly(fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+    """``fn(*args, **kwargs)`` in a helper thread while the main thread waits on it, so that a Ctrl-C
+    (or SIGTERM) is acted on at once.
+
+    A long call into compiled code that releases the GIL (SuperLU's factorisation of an FE system:
+    minutes on a fine mesh) keeps Python's signal handlers from running until it returns when it
+    runs in the main thread; waiting on a thread instead, the main thread raises the interrupt within
+    0.1 s.  The abandoned call runs on in its (daemon) thread until it ends or the program exits, so
+    it must own everything it touches.  Called from another thread, ``fn`` simply runs there.
+    """
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return fn(*args, **kwargs)
+    out: dict[str, Any] = {}
+
+    def run() -> None:
+        try:
+            out["value"] = fn(*args, **kwargs)
+        except BaseException as exc:  # noqa: BLE001 - handed to the caller's thread
+            out["error"] = exc
+
+    worker = threading.Thread(target=run, name="tabletcad-solve", daemon=True)
+    worker.start()
+    while worker.is_alive():
+        worker.join(0.1)
+    if "error" in out:
+        raise out["error"]
+    return out["value"]
 
 
 def reraise_interrupt(exc: BaseException) -> None:

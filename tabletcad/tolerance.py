@@ -128,3 +128,18 @@ DEFAULT = Tolerances()
 #: the largest true density taken, mg/mm³ (= g/cm³): above every solid's (osmium 22.6); a density in
 #: kg/m³ (lactose 1540) is 1000 times too large and refused (press data, design reports, inverse design)
 MAX_TRUE_DENSITY_MG_MM3 = 25.0
+
+#: The least force (N) an FE load (diametral test, punch) takes: below it the stresses underflow (a
+#: force of 1e-320 N read a centre stress of -0 MPa, and 1e-200 kN on a punch left no stress to divide
+#: the yield stress by).
+#: The analyses are linear, so their figures per newton do not depend on it.
+MIN_FORCE_N = 1e-6
+#: The largest yield stress (MPa) a punch rating takes: no tool steel reaches 4 GPa, and a yield stress
+#: typed in pascals (1.45e9) had rated a punch at 2508 kN.
+MAX_YIELD_MPA = 10000.0
+#: The largest effective-length factor ``K`` of the punch's buckling check (a column fixed at one end and
+#: free at the other has 2; 1e9 had rated a punch at 1e-14 kN).
+MAX_EFFECTIVE_LENGTH_FACTOR = 10.0
+#: The largest tensile strength (MPa) a breaking-force prediction or a design's ``[report]`` takes:
+#: pharmaceutical compacts break at 0.1-10 MPa, and one typed in pascals (2e6) had been taken.
+MAX_TENSILE_STRENGTH_MPA = 1000.0

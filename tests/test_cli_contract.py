@@ -570,3 +570,41 @@ def test_a_json_file_may_not_overwrite_a_file_a_build_owns(capsys, tmp_path):
     assert (out / "report.json").read_bytes() == before
     rc, _, err = run(capsys, "report", ROOT / "samples" / "spherical.toml", "--json-file", out / "mine.json")
     assert rc == 0 and (out / "mine.json").is_file()
+
+
+def test_a_ctrl_c_stops_a_long_compiled_call_at_once():
+    """``errors.run_interruptibly``: a call into compiled code that holds no GIL (SuperLU's factorisation
+    of an FE system ran minutes past a Ctrl-C) runs in a helper thread, so the interrupt is raised while
+    the call is still running.  Here an SVD of a 1600 x 1600 matrix (seconds on one core) and a SIGALRM
+    whose handler raises KeyboardInterrupt 0.05 s in: the interrupt arrives before the SVD ends (called
+    directly, it would only arrive after)."""
+    import threading
+
+    import numpy as np
+
+    from tabletcad.errors import run_interruptibly
+
+    a = np.random.default_rng(0).standard_normal((1600, 1600))
+    done = threading.Event()
+
+    def long_call():
+        np.linalg.svd(a)
+        done.set()
+
+    def on_alarm(signum, frame):
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGALRM, on_alarm)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 0.05)
+        with pytest.raises(KeyboardInterrupt):
+            run_interruptibly(long_call)
+        assert not done.is_set()
+        done.wait(120)  # (the abandoned call runs on in its thread; let it end before the next test)
+        assert done.is_set()
+        assert run_interruptibly(sum, [1, 2, 3]) == 6  # and a value comes back
+        with pytest.raises(ZeroDivisionError):  # as does an error
+            run_interruptibly(lambda: 1 / 0)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, old)

@@ -67,8 +67,12 @@ def test_diametral_json_and_files(capsys, tmp_path, thin):
 @pytest.mark.parametrize(
     "extra, match",
     [
-        (["--force", "0"], "--force = 0 N is not allowed: must be > 0 and <= 1e+09 N"),  # the range 1e12 gets
-        (["--force", "-5"], "--force = -5 N is not allowed: must be > 0"),
+        (["--force", "0"], "--force = 0 N is not allowed: must be >= 1e-06 and <= 1e+09 N"),  # the range 1e12 gets
+        (["--force", "-5"], "--force = -5 N is not allowed: must be >= 1e-06"),
+        # a force so small its stresses underflowed: a centre stress of -0 MPa, shape factor -0
+        (["--force", "1e-320"], "--force = 9.99989e-321 N is not allowed: must be >= 1e-06 and <= 1e+09 N"),
+        # a mesh size whose cube underflowed to 0: a ZeroDivisionError (exit 1) in the unknowns' estimate
+        (["--force", "10", "--mesh-size", "1e-200"], "--mesh-size = 1e-200 mm is not allowed: must be >="),
         (["--force", "10", "--direction", "diagonal"], "--direction = 'diagonal' is not allowed"),
         # the FE functions' keyword arguments are named as the options that set them
         (["--force", "10", "--strip-width", "5"], "error: --strip-width = 5 mm is not allowed"),
@@ -78,7 +82,9 @@ def test_diametral_json_and_files(capsys, tmp_path, thin):
         (["--force", "10", "--strip-width", "0.02"], "error: --strip-width = 0.02 mm is not allowed: meshes its strips "
                                                      "at b/3 = 0.00667 mm, a size that must be >= "),
         (["--force", "10", "--nu", "0.5"], "error: --nu = 0.5 is not allowed"),
-        (["--force", "10", "--E", "-1"], "error: --E = -1 MPa is not allowed: must be > 0"),
+        (["--force", "10", "--E", "-1"], "error: --E = -1 MPa is not allowed: must be >= 0.001"),
+        # E = 1e-300 with a 1e9 N force overflowed the solve (LinAlgError, exit 1)
+        (["--force", "1e9", "--E", "1e-300"], "error: --E = 1e-300 MPa is not allowed: must be >= 0.001 and <= 1e+07 MPa"),
     ],
 )
 def test_diametral_bad_input_one_line_exit_2_nothing_written(capsys, tmp_path, thin, extra, match):
@@ -126,7 +132,14 @@ def test_punch_json_and_files(capsys, tmp_path):
     [
         (["--force", "5"], "--yield-stress = 'missing' is not allowed: give --yield-stress (MPa) or --steel"),
         (["--force", "5", "--steel", "unobtainium"], "--steel = 'unobtainium' is not allowed: must be one of"),
-        (["--force", "0", "--yield-stress", "1000"], "--force = 0 kN is not allowed: must be > 0 and <= 1e+06 kN"),
+        (["--force", "0", "--yield-stress", "1000"], "--force = 0 kN is not allowed: must be >= 1e-09 and <= 1e+06 kN"),
+        # 1e-200 kN left no stress to divide by (ZeroDivisionError, exit 1)
+        (["--force", "1e-200", "--yield-stress", "1000"], "--force = 1e-200 kN is not allowed: must be >= 1e-09"),
+        # a yield stress in pascals had rated the punch at 2508 kN; K = 1e9 at 1e-14 kN
+        (["--force", "12", "--yield-stress", "1.45e9"], "--yield-stress = 1.45e+09 MPa is not allowed: must be > 0 and "
+                                                        "<= 10000 MPa"),
+        (["--force", "12", "--yield-stress", "1000", "--effective-length-factor", "1e9"],
+         "--effective-length-factor = 1e+09 is not allowed: must be > 0 and <= 10"),
         (["--force", "5", "--yield-stress", "1000", "--steel", "S7_tempered_205C"], "not both"),
     ],
 )

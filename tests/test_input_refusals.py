@@ -288,6 +288,8 @@ ROUND = '[tablet]\nfamily = "concave_round"\ndiameter = 12.0\nband = 3.0\ncup_de
     ("compaction_force_kN = 2e6", "error: report.compaction_force_kN = 2e+06 kN is not allowed: must be > 0 and <= 1e+06 kN"),
     # built with every file written; only `tabletcad fe strength` refused them
     ("tensile_strength_MPa = -3", "error: report.tensile_strength_MPa = -3 MPa is not allowed: must be > 0"),
+    # a strength in pascals: the report had printed an FE breaking force of 1.3e8 N
+    ("tensile_strength_MPa = 2e6", "error: report.tensile_strength_MPa = 2e+06 MPa is not allowed: must be > 0 and <= 1000 MPa"),
     ("reference_diameter_mm = -1", "error: report.reference_diameter_mm = -1 mm is not allowed: must be >= 0.001"),
     ("reference_thickness_mm = 0", "error: report.reference_thickness_mm = 0 mm is not allowed: must be >= 0.001"),
 ])

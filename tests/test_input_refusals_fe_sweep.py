@@ -19,8 +19,8 @@ DISC = '[tablet]\nfamily = "flat_face_round"\ndiameter = 10.0\nthickness = 1.0\n
 
 
 @pytest.mark.parametrize("args, line", [
-    (["--force", "1e308"], "error: --force = 1e+308 N is not allowed: must be > 0 and <= 1e+09 N"),
-    (["--force", "100", "--E", "1e308"], "error: --E = 1e+308 MPa is not allowed: must be > 0 and <= 1e+07 MPa"),
+    (["--force", "1e308"], "error: --force = 1e+308 N is not allowed: must be >= 1e-06 and <= 1e+09 N"),
+    (["--force", "100", "--E", "1e308"], "error: --E = 1e+308 MPa is not allowed: must be >= 0.001 and <= 1e+07 MPa"),
     (["--force", "100", "--mesh-size", "1e200"], "error: --mesh-size = 1e+200 mm is not allowed: must be > 0 and <= 10 mm"),
     (["--force", "100", "--strip-width", "1e-300"],
      "error: --strip-width = 1e-300 mm is not allowed: must be >= 0.001 mm (Tolerances.min_length)"),
@@ -43,7 +43,9 @@ def test_fe_diametral_refuses_what_it_cannot_solve(tmp_path, capsys, args, line)
 @pytest.mark.parametrize("args, line", [
     (["--reference-force", "80", "--reference-diameter", "8", "--reference-thickness", "0.0005"],
      "error: --reference-thickness = 0.0005 mm is not allowed: must be >= 0.001 and <= 1000 mm"),
-    (["--tensile-strength", "1e308"], "error: --tensile-strength = 1e+308 MPa is not allowed: must be > 0 and <= 1e+09 MPa"),
+    (["--tensile-strength", "1e308"], "error: --tensile-strength = 1e+308 MPa is not allowed: must be > 0 and <= 1000 MPa"),
+    # a strength in pascals had been taken (an FE breaking force of 1.3e8 N)
+    (["--tensile-strength", "2e6"], "error: --tensile-strength = 2e+06 MPa is not allowed: must be > 0 and <= 1000 MPa"),
 ])
 def test_fe_strength_names_the_reference_options(tmp_path, capsys, args, line):
     d = tmp_path / "disc.toml"

@@ -110,6 +110,8 @@ def test_without_fe_rating_the_drawing_keeps_the_pressure_rule():
     ({"steel": STEEL, "yield_stress_MPa": 1400.0}, "steel"),
     ({"yield_stress_MPa": 1400.0}, "yield_stress_source"),
     ({"yield_stress_MPa": -1.0, "yield_stress_source": "x"}, "yield_stress_MPa"),
+    # a yield stress in pascals (1.45e9) had been taken: the punch rated at 2508 kN
+    ({"yield_stress_MPa": 1.45e9, "yield_stress_source": "x"}, "yield_stress_MPa"),
     ({"steel": STEEL, "punch": "middle"}, "punch"),
     ({"steel": STEEL, "safety_factor": 0.0}, "safety_factor"),
     ({"steel": STEEL, "bogus": 1}, "bogus"),
@@ -118,6 +120,20 @@ def test_bad_fe_rating_is_one_design_error(table, parameter):
     with pytest.raises(DesignError) as e:
         parse_tooling({"fe_rating": table})
     assert parameter in e.value.parameter and "\n" not in str(e.value)
+
+
+def test_a_mesh_size_too_fine_for_the_tip_is_named_by_the_design_key(monkeypatch):
+    """``[tooling.fe_rating] mesh_size_mm`` finer than the tip's memory allows is refused naming that key
+    (it had been named ``--mesh-size``, the command's option).  The tip is a stand-in: the size is
+    checked against its plan area and length before it is meshed."""
+    import tabletcad.fe.punch as P
+
+    tip = dict(tip_plan_area_mm2=78.54, tip_length_mm=19.0)
+    monkeypatch.setattr(P, "tool_set_tip", lambda ts, which: (None, tip))
+    rating = parse_tooling({"fe_rating": {"steel": STEEL, "mesh_size_mm": 0.05}}).fe_rating
+    with pytest.raises(DesignError) as e:
+        P.fe_tip_rating(None, rating)
+    assert str(e.value).startswith("tooling.fe_rating.mesh_size_mm = 0.05 mm is not allowed: must be >= ")
 
 
 def test_fe_rating_spec():

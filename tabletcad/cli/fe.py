@@ -17,6 +17,7 @@ import click
 from tabletcad.cli.options import option_names
 from tabletcad.cli.outputs import out_folder
 from tabletcad.errors import DesignError, check_range
+from tabletcad.tolerance import MAX_EFFECTIVE_LENGTH_FACTOR, MAX_YIELD_MPA, MIN_FORCE_N
 
 __all__ = ["COMMANDS"]
 
@@ -127,7 +128,7 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
     from tabletcad.cli.report import load_family_design
     from tabletcad.fe.diametral import DIRECTIONS
 
-    check_range("--force", force, 0.0, 1e9, "N", lo_open=True)  # the whole range, as diametral states it
+    check_range("--force", force, MIN_FORCE_N, 1e9, "N")  # the whole range, as diametral states it
     if direction not in DIRECTIONS:
         raise DesignError("--direction", direction, "must be one of " + ", ".join(DIRECTIONS))
     _check_json_file(json_file)
@@ -256,9 +257,11 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
     from tabletcad.cli.report import load_family_design
     from tabletcad.errors import check_positive, check_range
 
-    check_range("--force", force, 0.0, 1e6, "kN", lo_open=True)  # the whole range, as punch_stress states it
+    check_range("--force", force, MIN_FORCE_N / 1000.0, 1e6, "kN")  # the whole range, as punch_stress states it
     check_range("--safety-factor", safety_factor, 1.0, 100.0)  # as [tooling.fe_rating] safety_factor
-    check_positive("--effective-length-factor", effective_length_factor)
+    check_range("--effective-length-factor", effective_length_factor, 0.0, MAX_EFFECTIVE_LENGTH_FACTOR, lo_open=True)
+    if yield_stress is not None:
+        check_range("--yield-stress", yield_stress, 0.0, MAX_YIELD_MPA, "MPa", lo_open=True)
     _check_json_file(json_file)
     _check_out(out)
     from tabletcad.fe.punch import tool_steels

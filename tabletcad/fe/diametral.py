@@ -104,6 +104,7 @@ import numpy as np
 
 from tabletcad.errors import DesignError, GeometryError, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
+from tabletcad.tolerance import MIN_FORCE_N
 from tabletcad.fe.elasticity import Material, PressureLoad, boundary_facets, principal_stresses, solve_elasticity
 from tabletcad.fe.mesh import (MAX_DOFS, CutPlane, Refinement, check_mesh_size, estimated_dofs, finest_size,
                                mesh_solid)
@@ -529,7 +530,7 @@ def diametral(
         discretisation error of the centre stress by Richardson extrapolation
         with the nominal order 2 of quadratic elements: ``(σ_h - σ_1.5h)/(1.5² - 1)``.
     """
-    P = check_range("force", force, 0.0, 1e9, "N", lo_open=True)  # (1e308 overflowed the solve)
+    P = check_range("force", force, MIN_FORCE_N, 1e9, "N")  # (1e308 overflowed the solve, 1e-320 gave -0 MPa)
     material = material or Material()
     trim = getattr(tablet, "trim", None)
     if trim is not None and trim.w[0] > 0:

@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from tabletcad.errors import DesignError, GeometryError, check_finite, check_positive, check_range
+from tabletcad.errors import DesignError, GeometryError, check_finite, check_positive, check_range, run_interruptibly
 from tabletcad.fe.mesh import TetMesh
 
 __all__ = ["Material", "PressureLoad", "ElasticSolution", "boundary_facets", "solve_elasticity",
@@ -54,7 +54,7 @@ class Material:
     nu: float = 0.3
 
     def __post_init__(self) -> None:
-        check_range("E", self.E, 0.0, 1e7, "MPa", lo_open=True)  # (diamond: 1.2e6 MPa)
+        check_range("E", self.E, 1e-3, 1e7, "MPa")  # (diamond: 1.2e6 MPa; 1e-300 overflowed the solve)
         nu = check_finite("nu", self.nu)
         if not (-0.9 <= nu <= 0.49):  # nearly incompressible (0.4999) stalled the direct solve for minutes
             raise DesignError("nu", self.nu, "must be >= -0.9 and <= 0.49 (towards 0.5 the quadratic tetrahedra's "
@@ -429,7 +429,8 @@ def solve_elasticity(
         D = _supports(m, basis, np.asarray(support_centre, float), float(support_arm))
     free = np.setdiff1d(np.arange(basis.N), D)
     Kf = K[free][:, free].tocsc()
-    lu = spla.splu(Kf, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
+    # (in a helper thread: SuperLU holds no GIL, and a Ctrl-C must not wait minutes for it)
+    lu = run_interruptibly(spla.splu, Kf, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
     u = np.zeros(basis.N)
     u[free] = lu.solve(f[free])
     reaction = float(np.abs((K @ u - f)[D]).max())

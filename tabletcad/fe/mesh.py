@@ -97,7 +97,7 @@ def estimated_dofs(volume: float, size: float) -> float:
     A mesh of size ``h`` has about ``7 V / h³`` tetrahedra and about ``1.4 V / h³``
     vertices, and ``ElementTetP2`` has about 8 nodes per vertex, three unknowns each.
     """
-    return 3.0 * 8.0 * 1.4 * volume / size**3
+    return 3.0 * 8.0 * 1.4 * volume / size / size / size  # (size**3 underflows to 0 below ~1e-103 mm: inf here)
 
 
 def finest_size(volume: float, dofs: float = MAX_DOFS) -> float:

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 from tabletcad.errors import DesignError, check_range
+from tabletcad.tolerance import MAX_TENSILE_STRENGTH_MPA
 from tabletcad.tolerance import DEFAULT
 from tabletcad.fe.diametral import DiametralResult, diametral
 
@@ -56,8 +57,9 @@ class StrengthInputs:
     def __post_init__(self) -> None:
         for k, unit in STRENGTH_KEYS.items():
             v = getattr(self, k)
-            if v is not None:  # lengths as a design's (Tolerances: 0.001 mm to 1 m), a force or strength <= 1e9
-                lo, hi = (DEFAULT.min_length, DEFAULT.max_length) if unit == "mm" else (0.0, 1e9)
+            if v is not None:  # lengths as a design's (Tolerances: 0.001 mm to 1 m), a force <= 1e9 N, a strength
+                lo, hi = ((DEFAULT.min_length, DEFAULT.max_length) if unit == "mm" else  # <= 1000 MPa
+                          (0.0, MAX_TENSILE_STRENGTH_MPA) if unit == "MPa" else (0.0, 1e9))
                 check_range(f"[report] {k}", v, lo, hi, unit, lo_open=unit != "mm")
         ref = [self.reference_breaking_force_N, self.reference_diameter_mm, self.reference_thickness_mm]
         given = sum(v is not None for v in ref)

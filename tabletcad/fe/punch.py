@@ -40,6 +40,7 @@ import numpy as np
 
 from tabletcad.errors import DesignError, GeometryError, check_positive, check_range
 from tabletcad.fe.elasticity import Material, PressureLoad, _skfem_mesh, boundary_facets, solve_elasticity, von_mises
+from tabletcad.tolerance import MAX_YIELD_MPA, MIN_FORCE_N
 from tabletcad.fe.mesh import Refinement, check_mesh_size, mesh_solid
 
 if sys.version_info >= (3, 11):
@@ -211,10 +212,11 @@ def punch_stress(
     effective_length_factor : float
         ``K`` of the buckling check.
     """
-    F = check_range("--force", force_kN, 0.0, 1e6, "kN", lo_open=True) * 1000.0  # (1e308 overflowed the solve)
+    # (1e308 overflowed the solve; 1e-200 kN left no stress to divide by)
+    F = check_range("--force", force_kN, MIN_FORCE_N / 1000.0, 1e6, "kN") * 1000.0
     S = check_range("--safety-factor", safety_factor, 1.0, 100.0)
     if yield_MPa is not None:
-        check_positive("--yield-stress", yield_MPa, "MPa")
+        check_range("--yield-stress", yield_MPa, 0.0, MAX_YIELD_MPA, "MPa", lo_open=True)
     axis = np.array([0.0, 0.0, 1.0 if which == "upper" else -1.0])
     A_plan = float(tip["tip_plan_area_mm2"])
     width = 2.0 * math.sqrt(A_plan / math.pi)
@@ -293,8 +295,13 @@ def fe_tip_rating(ts: Any, rating: Any, force_kN: float | None = None) -> dict[s
     force = REFERENCE_FORCE_KN if force_kN is None else force_kN
     tips = {}
     for which in rating.punches:
-        res = punch_stress(*tool_set_tip(ts, which), force, which, yield_MPa=y,
-                           safety_factor=rating.safety_factor, E=E, mesh_size=rating.mesh_size_mm)
+        try:
+            res = punch_stress(*tool_set_tip(ts, which), force, which, yield_MPa=y,
+                               safety_factor=rating.safety_factor, E=E, mesh_size=rating.mesh_size_mm)
+        except DesignError as exc:  # named by the design's key, not the command's option
+            if exc.parameter == "--mesh-size":
+                raise exc.renamed("[tooling.fe_rating] mesh_size_mm") from None
+            raise
         tips[which] = {k: v for k, v in res.to_dict().items() if k != "buckling"}
         tips[which]["buckling"] = res.buckling
     allowed = min(t["allowed_force_kN"] for t in tips.values())

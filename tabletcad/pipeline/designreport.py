@@ -31,7 +31,7 @@ from tabletcad.errors import DesignError, check_range
 from tabletcad.families.sweep import SweepNominal, certify, sweep_properties
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.geometry.vectors import cross
-from tabletcad.tolerance import DEFAULT, MAX_TRUE_DENSITY_MG_MM3
+from tabletcad.tolerance import DEFAULT, MAX_TENSILE_STRENGTH_MPA, MAX_TRUE_DENSITY_MG_MM3
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -65,14 +65,15 @@ REPORT_KEYS = {
 
 #: The largest value of each number of ``[report]`` (all must be > 0): a true density in mg/mm³ (not
 #: kg/m³), forces as a breaking test's (:data:`tabletcad.mechanics.strength.MAX_FORCE_N`, 1e9 N; in kN,
-#: 1e6), stresses as the FE prediction's (1e9 MPa); the reference tablet's lengths as a design's.
+#: 1e6), a punch-tip pressure up to 1e9 MPa, a tensile strength as the FE prediction's (1000 MPa: not
+#: pascals); the reference tablet's lengths as a design's.
 _REPORT_LIMITS = {
     "true_density_mg_mm3": MAX_TRUE_DENSITY_MG_MM3,
     "breaking_force_N": 1e9,
     "compaction_force_kN": 1e6,
     "max_punch_force_kN": 1e6,
     "max_punch_pressure_MPa": 1e9,
-    "tensile_strength_MPa": 1e9,
+    "tensile_strength_MPa": MAX_TENSILE_STRENGTH_MPA,
     "reference_breaking_force_N": 1e9,
     "reference_diameter_mm": None,
     "reference_thickness_mm": None,

@@ -71,6 +71,7 @@ from typing import Any
 
 from tabletcad.errors import DesignError, check_finite, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
+from tabletcad.tolerance import MAX_YIELD_MPA
 from tabletcad.tooling.polygon import polygon_problem
 from tabletcad.tooling.standards import PunchBody, resolve_body
 
@@ -202,7 +203,7 @@ def _fe_rating(t: Any) -> FeRatingSpec | None:
         if src is not None:
             raise DesignError(f"{w} yield_stress_source", src, "give it with yield_stress_MPa (a steel has its own)")
     else:
-        y = check_positive(f"{w} yield_stress_MPa", y, "MPa")
+        y = check_range(f"{w} yield_stress_MPa", y, 0.0, MAX_YIELD_MPA, "MPa", lo_open=True)
         if not (isinstance(src, str) and src.strip()):
             raise DesignError(f"{w} yield_stress_source", src if src is not None else "missing",
                               "must name the source of yield_stress_MPa (a non-empty string)")
