@@ -187,6 +187,32 @@ def test_toml_block_parses(text: str) -> None:
     tomllib.loads(text)
 
 
+@pytest.mark.parametrize("text", _ids("toml"))
+def test_toml_block_is_taken_by_its_reader(text: str, tmp_path: Path) -> None:
+    """A design, ``[tooling]`` or sweep block copied from the README is what tabletcad takes (the
+    ``[tooling]`` example once put ``gap_mm`` under ``[tooling.punch]``, which a design refuses)."""
+    data = tomllib.loads(text)
+    readers = 0
+    if "tablet" in data:
+        from tabletcad.pipeline.design import Design
+
+        Design.from_dict(data)
+        readers += 1
+    if "tooling" in data:
+        from tabletcad.tooling.spec import parse_tooling
+
+        parse_tooling(data["tooling"])
+        readers += 1
+    if "sweep" in data:
+        from tabletcad.sweep.spec import load_sweep
+
+        f = tmp_path / "sweep.toml"
+        f.write_text(text, encoding="utf-8")
+        load_sweep(f)
+        readers += 1
+    assert readers, f"a TOML block no reader checks: {text.splitlines()[0]}"
+
+
 def test_every_block_is_checked() -> None:
     """A block in a language the tests above do not read would rot unseen (``text`` marks a
     block that is no command, such as the layout tree)."""
