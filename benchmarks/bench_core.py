@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 import os
+from dataclasses import replace
 import sys
 import time
 from pathlib import Path
@@ -150,7 +151,9 @@ def bench_integrals(names=("thesis.flat_faced_round", "thesis.spherical")):
     for name in names:
         t = FAMILIES[name].build()
         ref = t.properties(nu=4 * t.tol.quad_u, nv=4 * t.tol.quad_v)
-        t_fast, fast = _timeit(lambda: t.properties(), min_time=0.5)
+        # a fresh Tablet of the same patches each time: properties() is kept on the tablet once computed,
+        # and timing the kept copy (0.0000 s, "43,000x dblquad") measured a dictionary look-up
+        t_fast, fast = _timeit(lambda: replace(t).properties(), min_time=0.5)
         sgn = fast["orientation"]
         t0 = time.perf_counter()
         dq_area = dq_vol = 0.0
