@@ -44,8 +44,11 @@ def _optimise(tmp_path, capsys, text: str, *extra: str) -> tuple[int, list[str],
     # band from 0: the solver stopped at 9.1e-12 mm, which no design takes
     ("band = { lower = 0.0, upper = 3.0, initial = 1.0 }", "diameter = 10.0\ncup_depth = 0.9",
      "error: variables.band.lower = 0 mm is not allowed: family 'concave_round' refuses band = 0 (must be > 0)"),
+    # (a band of 0 is refused too: "must be 0 or at least 0.001 mm" had offered it)
     ("band = { lower = 0.0005, upper = 3.0 }", "diameter = 10.0\ncup_depth = 0.9",
-     "error: variables.band.lower = 0.0005 mm is not allowed: must be 0 or at least 0.001 mm"),
+     "error: variables.band.lower = 0.0005 mm is not allowed: must be at least 0.001 mm"),
+    ("land = { lower = 0.0005, upper = 0.2 }", "diameter = 10.0\nband = 2.8\ncup_depth = 0.9",
+     "error: variables.land.lower = 0.0005 mm is not allowed: must be 0 or at least 0.001 mm"),
 ])
 def test_family_problem_refused_before_the_solve(tmp_path, capsys, variables, fixed, line):
     rc, out, err = _optimise(tmp_path, capsys, CONCAVE.format(sense="min", variables=variables, fixed=fixed))

@@ -362,15 +362,17 @@ def _check_lower_lengths(fam_name: str, fam: Any, vs: list, fixed: dict) -> None
     for v in vs:
         if v.unit != "mm" or v.lower >= TOL.min_length:
             continue
-        if v.lower > 0.0:
-            raise DesignError(f"[variables] {v.name} lower", v.lower, f"must be 0 or at least {TOL.min_length:g} mm "
-                              "(Tolerances.min_length, the least length a design takes)", "mm")
         try:
             fam.build(**fixed, **{**start, v.name: 0.0})
+            refused = None
         except DesignError as exc:
-            if exc.parameter == v.name:
-                raise DesignError(f"[variables] {v.name} lower", 0.0, f"family {fam_name!r} refuses {v.name} = 0 "
-                                  f"({exc.allowed}): give a lower bound of at least {TOL.min_length:g} mm", "mm") from None
+            refused = exc if exc.parameter == v.name else None
+        if v.lower > 0.0:  # (a family that refuses 0 for it: "0 or at least" would offer a bound it refuses)
+            raise DesignError(f"[variables] {v.name} lower", v.lower, f"must be {'' if refused else '0 or '}at least "
+                              f"{TOL.min_length:g} mm (Tolerances.min_length, the least length a design takes)", "mm")
+        if refused is not None:
+            raise DesignError(f"[variables] {v.name} lower", 0.0, f"family {fam_name!r} refuses {v.name} = 0 "
+                              f"({refused.allowed}): give a lower bound of at least {TOL.min_length:g} mm", "mm")
 
 
 def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe: Any = None) -> Problem:
