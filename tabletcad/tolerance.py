@@ -128,6 +128,9 @@ DEFAULT = Tolerances()
 #: the largest true density taken, mg/mm³ (= g/cm³): above every solid's (osmium 22.6); a density in
 #: kg/m³ (lactose 1540) is 1000 times too large and refused (press data, design reports, inverse design)
 MAX_TRUE_DENSITY_MG_MM3 = 25.0
+#: the least true density taken, mg/mm³: below every pharmaceutical solid's (waxes, about 0.9); one in
+#: g/mm³ (lactose 0.00154) is 1000 times too small and refused (it had given a weight 1000 times low)
+MIN_TRUE_DENSITY_MG_MM3 = 0.1
 
 #: The least force (N) an FE load (diametral test, punch) takes: below it the stresses underflow (a
 #: force of 1e-320 N read a centre stress of -0 MPa, and 1e-200 kN on a punch left no stress to divide

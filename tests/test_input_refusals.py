@@ -98,7 +98,7 @@ def test_solve_for_needs_every_dimension_of_a_named_family():
     # a constructor passed in keeps its defaults (documented)
     r = solve_for(concave_round, target_volume_mm3=300, vary="band", diameter=10)
     assert r.volume_mm3 == pytest.approx(300, rel=1e-9)
-    with pytest.raises(DesignError, match=r"true_density_mg_mm3 = 1540 mg/mm3 is not allowed: must be > 0 and <= 25"):
+    with pytest.raises(DesignError, match=r"true_density_mg_mm3 = 1540 mg/mm3 is not allowed: must be >= 0.1 and <= 25"):
         solve_for("concave_round", target_weight_mg=300, vary="band", diameter=10, cup_depth=1,
                   solid_fraction=0.8, true_density_mg_mm3=1540)
 
@@ -151,7 +151,9 @@ def test_design_report_gives_no_strength_where_the_formula_has_none(capsys, tmp_
 
 
 @pytest.mark.parametrize("args, line", [
-    (["--true-density", "1540"], "error: --true-density = 1540 mg/mm3 is not allowed: must be > 0 and <= 25 mg/mm3"),
+    (["--true-density", "1540"], "error: --true-density = 1540 mg/mm3 is not allowed: must be >= 0.1 and <= 25 mg/mm3"),
+    # g/mm³ (lactose 0.00154) had been taken: a weight 1000 times low
+    (["--true-density", "0.00154"], "error: --true-density = 0.00154 mg/mm3 is not allowed: must be >= 0.1 and <= 25 mg/mm3"),
     (["--solid-fraction", "1.2"], "error: --solid-fraction = 1.2 is not allowed: must be > 0 and <= 1"),
     (["--breaking-force", "inf"], "error: --breaking-force = inf N is not allowed"),
 ])
@@ -167,7 +169,7 @@ def test_a_density_in_kg_per_m3_in_the_design_file(tmp_path, capsys):
                  '[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1540\n')
     assert main(["report", str(d)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["error: report.true_density_mg_mm3 = 1540 mg/mm3 is not allowed: must be > 0 and <= 25 mg/mm3"]
+    assert err == ["error: report.true_density_mg_mm3 = 1540 mg/mm3 is not allowed: must be >= 0.1 and <= 25 mg/mm3"]
 
 
 def test_heckel_says_why_no_row_is_left(tmp_path, capsys):

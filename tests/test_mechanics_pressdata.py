@@ -124,10 +124,12 @@ def test_bad_files(tmp_path, text, match):
         read_press_data(_write(tmp_path, text), **META)
 
 
-@pytest.mark.parametrize("key,value", [("mass_mg", 0.0), ("true_density", -1.3), ("diameter", 0.0)])
-def test_bad_metadata(tmp_path, key, value):
+@pytest.mark.parametrize("key,value,match", [("mass_mg", 0.0, "must be > 0"), ("true_density", -1.3, "must be >= 0.1"),
+                                             ("true_density", 0.00154, "must be >= 0.1 and <= 25"),  # g/mm³
+                                             ("diameter", 0.0, "must be > 0")])
+def test_bad_metadata(tmp_path, key, value, match):
     p = _write(tmp_path, "force,displacement\n1,-5\n2,-4.9\n3,-4.8\n")
-    with pytest.raises(DesignError, match="must be > 0"):
+    with pytest.raises(DesignError, match=match):
         read_press_data(p, **(META | {key: value}))
 
 

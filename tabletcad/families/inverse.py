@@ -58,7 +58,7 @@ from tabletcad.errors import DesignError, GeometryError, check_finite, check_pos
 from tabletcad.families.sweep import NominalBuilt, SweepNominal, nominal_only, nominal_volume
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT
-from tabletcad.tolerance import MAX_TRUE_DENSITY_MG_MM3
+from tabletcad.tolerance import MAX_TRUE_DENSITY_MG_MM3, MIN_TRUE_DENSITY_MG_MM3
 
 __all__ = ["InverseResult", "Reach", "reachable", "solve_for", "solvable", "VARY"]
 
@@ -460,7 +460,8 @@ def solve_for(
             missing = "solid_fraction" if solid_fraction is None else "true_density_mg_mm3"
             raise DesignError(missing, "missing", "a weight needs both solid_fraction and true_density_mg_mm3")
         mg_per_mm3 = check_range("solid_fraction", solid_fraction, 0.0, 1.0, lo_open=True) * \
-            check_range("true_density_mg_mm3", true_density_mg_mm3, 0.0, MAX_TRUE_DENSITY_MG_MM3, "mg/mm3", lo_open=True)
+            check_range("true_density_mg_mm3", true_density_mg_mm3, MIN_TRUE_DENSITY_MG_MM3, MAX_TRUE_DENSITY_MG_MM3,
+                        "mg/mm3")
     if target_volume_mm3 is not None:
         target = check_positive("target_volume_mm3", target_volume_mm3, "mm3")
     else:

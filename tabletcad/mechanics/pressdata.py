@@ -66,7 +66,7 @@ import tomllib
 from tabletcad.errors import DesignError, check_finite, check_range
 from tabletcad.tolerance import DEFAULT
 from tabletcad.mechanics.units import DIMENSIONS, header_unit, strip_unit, unit_factor
-from tabletcad.tolerance import MAX_TRUE_DENSITY_MG_MM3
+from tabletcad.tolerance import MAX_TRUE_DENSITY_MG_MM3, MIN_TRUE_DENSITY_MG_MM3
 from tabletcad.mechanics.validity import DataWarning, warn
 
 __all__ = [
@@ -192,7 +192,7 @@ class PressMetadata:
     def __post_init__(self) -> None:
         # generous physical limits: a compact of up to 1 kg, any solid's density, a die up to 1 m
         check_range("mass_mg", self.mass_mg, 0.0, 1e6, "mg", lo_open=True)
-        check_range("true_density", self.true_density, 0.0, MAX_TRUE_DENSITY_MG_MM3, "mg/mm³", lo_open=True)
+        check_range("true_density", self.true_density, MIN_TRUE_DENSITY_MG_MM3, MAX_TRUE_DENSITY_MG_MM3, "mg/mm³")
         if self.diameter is None and self.face_area is None:
             raise DesignError("diameter", "missing", "give the die diameter (mm) or the punch face area (mm²)", "mm")
         if self.diameter is not None and self.face_area is not None:

@@ -31,7 +31,7 @@ from tabletcad.errors import DesignError, check_range
 from tabletcad.families.sweep import SweepNominal, certify, sweep_properties
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.geometry.vectors import cross
-from tabletcad.tolerance import DEFAULT, MAX_TENSILE_STRENGTH_MPA, MAX_TRUE_DENSITY_MG_MM3
+from tabletcad.tolerance import DEFAULT, MAX_TENSILE_STRENGTH_MPA, MAX_TRUE_DENSITY_MG_MM3, MIN_TRUE_DENSITY_MG_MM3
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -123,6 +123,8 @@ class ReportOptions:
             if v is not None:
                 if REPORT_KEYS[k] == "mm":  # a reference tablet's lengths as a design's (0.001 mm to 1 m)
                     check_range(f"[report] {k}", v, DEFAULT.min_length, DEFAULT.max_length, "mm")
+                elif k == "true_density_mg_mm3":  # neither kg/m³ nor g/mm³
+                    check_range(f"[report] {k}", v, MIN_TRUE_DENSITY_MG_MM3, hi, REPORT_KEYS[k])
                 else:
                     check_range(f"[report] {k}", v, 0.0, hi, REPORT_KEYS[k], lo_open=True)
 
