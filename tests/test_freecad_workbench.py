@@ -504,6 +504,17 @@ def test_a_nan_or_negative_gap_is_refused_and_a_scripts_tracebacks_stay_whole(he
         assert s["tracebacklimit"] is None
 
 
+def test_a_density_in_the_wrong_unit_is_refused(headless):
+    """A density of 1200 (kg/m³ typed for mg/mm³) had been taken (the object allowed up to 1000, the task
+    panel 30), and 0.0015 (g/mm³) too: both are refused now, with the task panel's own range, and the
+    tablet recomputes again once the density is put back."""
+    bad = _steps(headless, "bad_density")
+    assert [s["value"] for s in bad] == [1200.0, 0.0015]
+    assert all("Invalid" in s["state"] for s in bad), bad
+    (ok,) = _steps(headless, "density_restored")
+    assert "Invalid" not in ok["state"] and ok["weight"] == pytest.approx(ok["volume"] * ok["density"], rel=1e-12)
+
+
 def test_a_standard_die_follows_the_tablets_size(headless):
     """A TSM die made for a 9 mm tablet had stayed 30.16 mm when the tablet grew to 20 mm (refused, its old
     shape overlapping the tablet by 1732 mm3): it is now the D die for the new size, as build takes it."""

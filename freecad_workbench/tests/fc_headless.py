@@ -239,6 +239,15 @@ try:
     step("bad_fit_tolerance", tablet=tablet_info(t), state=list(t.State))
     t.FitTolerance = fit0
     doc.recompute()
+    dens0 = float(t.Density)
+    for bad in (1200.0, 0.0015):  # kg/m³ and g/mm³ where mg/mm³ belong
+        t.Density = bad
+        doc.recompute()
+        step("bad_density", value=bad, state=list(t.State), weight=float(t.Weight))
+    t.Density = dens0
+    doc.recompute()
+    step("density_restored", state=list(t.State), weight=float(t.Weight), volume=float(t.Volume),
+         density=float(t.Density))
 
     # ---- a design file edited after the tablet was made: the next recompute reads it again
     edited = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"tabletcad_fc_edit_{os.getpid()}.toml")

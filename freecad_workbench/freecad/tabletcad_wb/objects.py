@@ -110,6 +110,10 @@ def _restore_traceback():
 #: the B-spline fit tolerances (mm) a tablet takes (0: the core's default): below 1e-7 mm the fit runs
 #: into the surfaces' own rounding, above 0.01 mm a face would be visibly off its PDE surface
 MIN_FIT_TOLERANCE_MM, MAX_FIT_TOLERANCE_MM = 1e-7, 0.01
+#: the apparent density a tablet takes, mg/mm³ (= g/cm³): from a very porous compact's to the largest true
+#: density tabletcad takes (tabletcad.tolerance.MAX_TRUE_DENSITY_MG_MM3: a density in kg/m³ is refused);
+#: the task panel offers the same range (the object had taken up to 1000)
+DENSITY_LIMITS = (0.01, 25.0)
 
 
 def _default_fit() -> float:
@@ -394,8 +398,9 @@ class TabletProxy(_Proxy):
 
         t0 = time.perf_counter()
         density = float(obj.Density)
-        if not (density > 0.0 and density < 1e3):
-            raise DesignError("Density", density, "0 < Density < 1000", "mg/mm³")
+        if not (DENSITY_LIMITS[0] <= density <= DENSITY_LIMITS[1]):  # (also refuses NaN)
+            raise DesignError("Density", density, f"must be >= {DENSITY_LIMITS[0]:g} and <= {DENSITY_LIMITS[1]:g} mg/mm³ "
+                              "(= g/cm³)", "mg/mm³")
         fit = float(obj.FitTolerance.Value)
         if not (fit == 0.0 or MIN_FIT_TOLERANCE_MM <= fit <= MAX_FIT_TOLERANCE_MM):  # (NaN had reached the core as "tol")
             raise DesignError("FitTolerance", fit, f"must be 0 (the default, {_default_fit():g} mm) or within "

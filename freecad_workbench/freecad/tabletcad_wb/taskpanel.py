@@ -20,7 +20,7 @@ current = None  # the panel shown last (scripts and tests drive it)
 
 # spin-box ranges by unit; the core's own checks (DesignError) give the exact allowed range
 LIMITS = {"mm": (0.0, 100.0, 3), "deg": (0.0, 90.0, 2)}
-DENSITY_LIMITS = (0.01, 30.0)  # mg/mm^3 (= g/cm^3)
+DENSITY_LIMITS = objects.DENSITY_LIMITS  # mg/mm^3 (= g/cm^3), as the object checks it
 
 
 class TabletForm:
