@@ -29,6 +29,8 @@ class _Recording(Forked):
 
     def __init__(self, work):
         super().__init__(work)
+        # (a fork the system refused runs its work in this process: the test then names the reason)
+        assert self.pid is not None, f"the system refused the fork: {self.refused!r}"
         _Recording.made.append(self.pid)
 
 

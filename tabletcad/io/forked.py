@@ -81,6 +81,7 @@ class Forked:
 
     def __init__(self, work: Callable[[], Any]) -> None:
         self.pid: int | None = None  #: the child's process id (None when the fork was refused)
+        self.refused: OSError | None = None  #: why the system refused the fork, if it did
         self._pid: int | None = None
         self._r: int | None = None
         self._work: Callable[[], Any] | None = None
@@ -93,7 +94,8 @@ class Forked:
             with warnings.catch_warnings():  # Python >= 3.12 warns about fork() in a process with threads
                 warnings.simplefilter("ignore", DeprecationWarning)
                 pid = os.fork()
-        except OSError:
+        except OSError as exc:
+            self.refused = exc
             signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
             os.close(r)
             os.close(w)
