@@ -35,28 +35,54 @@ def run_interruptibly(fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
     A long call into compiled code that releases the GIL (SuperLU's factorisation of an FE system:
     minutes on a fine mesh) keeps Python's signal handlers from running until it returns when it
     runs in the main thread; waiting on a thread instead, the main thread raises the interrupt within
-    0.1 s.  The abandoned call runs on in its (daemon) thread until it ends or the program exits, so
-    it must own everything it touches.  Called from another thread, ``fn`` simply runs there.
+    0.1 s.  One helper thread (a daemon) serves every call of the process: a new thread per call
+    leaked OpenBLAS's per-thread buffers, about 16 MB a call (200 factorisations: 3.4 GB, and a test
+    worker's fork was refused).  An abandoned call runs on in the helper until it ends (a later call
+    waits for it), so it must own everything it touches.  Called from another thread, ``fn`` simply
+    runs there.
     """
     import threading
 
     if threading.current_thread() is not threading.main_thread():
         return fn(*args, **kwargs)
+    done = threading.Event()
     out: dict[str, Any] = {}
-
-    def run() -> None:
-        try:
-            out["value"] = fn(*args, **kwargs)
-        except BaseException as exc:  # noqa: BLE001 - handed to the caller's thread
-            out["error"] = exc
-
-    worker = threading.Thread(target=run, name="tabletcad-solve", daemon=True)
-    worker.start()
-    while worker.is_alive():
-        worker.join(0.1)
+    _helper_queue().put((fn, args, kwargs, out, done))
+    while not done.wait(0.1):
+        pass
     if "error" in out:
         raise out["error"]
     return out["value"]
+
+
+#: ``(process id, queue)`` of :func:`run_interruptibly`'s helper thread (a forked child makes its own)
+_HELPER: list = [None]
+
+
+def _helper_queue():
+    import os
+    import queue
+    import threading
+
+    hit = _HELPER[0]
+    if hit is not None and hit[0] == os.getpid():
+        return hit[1]
+    jobs: queue.SimpleQueue = queue.SimpleQueue()
+
+    def serve() -> None:
+        while True:
+            fn, args, kwargs, out, done = jobs.get()
+            try:
+                out["value"] = fn(*args, **kwargs)
+            except BaseException as exc:  # noqa: BLE001 - handed to the caller's thread
+                out["error"] = exc
+            finally:
+                del fn, args, kwargs  # (nothing of a finished call kept alive by this frame)
+                done.set()
+
+    threading.Thread(target=serve, name="tabletcad-helper", daemon=True).start()
+    _HELPER[0] = (os.getpid(), jobs)
+    return jobs
 
 
 def reraise_interrupt(exc: BaseException) -> None:
