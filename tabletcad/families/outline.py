@@ -274,15 +274,7 @@ class PlanOutline:
     def offset(self, v, der: int, alpha: float, beta: float) -> np.ndarray:
         """``d^der/dv^der (alpha O + beta N)`` (mm), shape (m, 2): :meth:`point` and
         :meth:`normal` combined from one :meth:`frame` (a swept tablet's boundary data)."""
-        if der not in (0, 1, 2):
-            raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
-        O, T, N, k = self.frame(v)
-        g = self.speed
-        if der == 0:
-            return alpha * O + beta * N
-        if der == 1:
-            return (g * (alpha - beta * k))[:, None] * T
-        return ((alpha * k - beta * k * k) * g * g)[:, None] * N
+        return self.offsets(v, der, np.array([alpha]), np.array([beta]))[0]
 
     def offsets(self, v, der: int, alphas: np.ndarray, betas: np.ndarray) -> np.ndarray:
         """:meth:`offset` for several weights at once, ``(len(alphas), m, 2)`` (mm), from one :meth:`frame`

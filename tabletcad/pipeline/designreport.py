@@ -31,6 +31,7 @@ from tabletcad.errors import DesignError, check_range
 from tabletcad.families.sweep import SweepNominal, certify, sweep_properties
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.geometry.vectors import cross
+from tabletcad.mechanics.strength import MAX_FORCE_N
 from tabletcad.tolerance import DEFAULT, MAX_TENSILE_STRENGTH_MPA, MAX_TRUE_DENSITY_MG_MM3, MIN_TRUE_DENSITY_MG_MM3
 
 if sys.version_info >= (3, 11):
@@ -69,12 +70,12 @@ REPORT_KEYS = {
 #: pascals); the reference tablet's lengths as a design's.
 _REPORT_LIMITS = {
     "true_density_mg_mm3": MAX_TRUE_DENSITY_MG_MM3,
-    "breaking_force_N": 1e9,
+    "breaking_force_N": MAX_FORCE_N,
     "compaction_force_kN": 1e6,
     "max_punch_force_kN": 1e6,
     "max_punch_pressure_MPa": 1e9,
     "tensile_strength_MPa": MAX_TENSILE_STRENGTH_MPA,
-    "reference_breaking_force_N": 1e9,
+    "reference_breaking_force_N": MAX_FORCE_N,
     "reference_diameter_mm": None,
     "reference_thickness_mm": None,
 }
