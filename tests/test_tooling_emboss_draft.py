@@ -61,7 +61,7 @@ def _valid(shape) -> bool:
 def _end_areas(solid, z_lo: float, z_hi: float) -> tuple[float, float]:
     """Areas (mm²) of the solid's planar faces at ``z_lo`` and ``z_hi``."""
     from tabletcad.cad._occ import explore
-    from tabletcad.tooling.emboss import _z_range
+    from tabletcad.tooling.punch import tight_z_range as _z_range
 
     lo = hi = 0.0
     for f in explore(solid, "Face"):
@@ -89,7 +89,8 @@ def test_disc_gives_the_frustum(a):
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
     from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Pnt
 
-    from tabletcad.tooling.emboss import _z_range, figure_prism
+    from tabletcad.tooling.emboss import figure_prism
+    from tabletcad.tooling.punch import tight_z_range as _z_range
     from tabletcad.tooling.outline import plan_face
 
     r, t = 1.5, math.tan(math.radians(a))
@@ -111,7 +112,8 @@ def test_square_with_square_hole_gives_the_pyramid_frusta(a, up):
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
 
     from tabletcad.cad._occ import explore
-    from tabletcad.tooling.emboss import _z_range, figure_prism
+    from tabletcad.tooling.emboss import figure_prism
+    from tabletcad.tooling.punch import tight_z_range as _z_range
     from tabletcad.tooling.outline import plan_face
 
     c, b, t = 1.0, 0.4, math.tan(math.radians(a))
@@ -143,7 +145,8 @@ def test_square_with_square_hole_gives_the_pyramid_frusta(a, up):
 @pytest.mark.parametrize("text", [string.digits, string.ascii_uppercase])
 def test_every_glyph_gives_one_valid_drafted_solid(a, text):
     from tabletcad.cad._occ import explore
-    from tabletcad.tooling.emboss import _z_range, figure_prism, text_faces
+    from tabletcad.tooling.emboss import figure_prism, text_faces
+    from tabletcad.tooling.punch import tight_z_range as _z_range
     from tabletcad.tooling.outline import face_area, wire_length
 
     t = math.tan(math.radians(a))

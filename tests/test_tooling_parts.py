@@ -49,6 +49,32 @@ def test_parts_are_single_valid_solids(thesis):
         check_solid(shape, name)
 
 
+def _whole_optimal_z(shape):
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    box = Bnd_Box()
+    BRepBndLib.AddOptimal_s(shape, box, False, False)
+    return box.CornerMin().Z(), box.CornerMax().Z()
+
+
+def test_tight_z_range_is_occs_optimal_box_of_the_whole_solid(thesis):
+    """The faces' optimal boxes, only where their pole hulls reach past the extremes found so far, give
+    the box OCC computes for the whole solid bit for bit: on the thesis tooling's parts (faces of
+    revolution, a punch's Boolean faces) and on the capsule sample's B-spline solid (36 faces, its
+    cups cut at the outline's joins); a side not asked for is None."""
+    from tabletcad.cad.tablet_solid import tablet_solid
+    from tabletcad.tooling.punch import tight_z_range
+
+    capsule = tablet_solid(load_design(ROOT / "samples" / "families" / "capsule.toml")).shape
+    for name, shape in [*thesis.parts.items(), ("capsule", capsule)]:
+        lo, hi = _whole_optimal_z(shape)
+        assert tight_z_range(shape) == (lo, hi), name
+        assert tight_z_range(shape, high=False) == (lo, None), name
+        assert tight_z_range(shape, low=False) == (None, hi), name
+    assert hi - lo == pytest.approx(3.2 + 2 * 1.3, abs=1e-6)  # the capsule sample's band and two cups
+
+
 def test_closed_position_encloses_exactly_the_tablet(thesis):
     r = thesis.report
     assert r["interference_mm3"] == pytest.approx(0.0, abs=1e-9)

@@ -76,8 +76,11 @@ def tablet_info(t):
     return d
 
 
+_T0 = time.perf_counter()
+
+
 def step(name, **data):
-    result["steps"].append(dict(name=name, **data))
+    result["steps"].append(dict(name=name, at_s=time.perf_counter() - _T0, **data))
 
 
 try:

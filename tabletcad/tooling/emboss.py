@@ -459,15 +459,6 @@ def _loft(sections):
     return solids[0] if len(solids) == 1 and BRepCheck_Analyzer(solids[0]).IsValid() else None
 
 
-def _z_range(shape) -> tuple[float, float]:
-    from OCP.Bnd import Bnd_Box
-    from OCP.BRepBndLib import BRepBndLib
-
-    box = Bnd_Box()
-    BRepBndLib.AddOptimal_s(shape, box, False, False)
-    return box.CornerMin().Z(), box.CornerMax().Z()
-
-
 def apply_emboss(frame: TabletFrame, shape, items, clearance: float, *, check: bool = True,
                  deflection: float = 0.005, a_manifold=None, checked=None) -> tuple[Any, list, list[dict]]:
     """Emboss/deboss every item on ``shape``; returns ``(solid, Boolean checks, per-item info)``.
