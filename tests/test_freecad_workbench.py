@@ -581,6 +581,10 @@ def test_design_files(headless):
     assert t["volume"] == pytest.approx(core, rel=2e-3)  # OCCT default integration, measured 8.5e-4 off
     for part in ("die", "upper"):
         assert ff[part]["valid"] and ff[part]["n_solids"] == 1, (part, ff[part]["status"])
+    # its flat top lies on the rim's plane (z = 3): the tip is its whole 10 mm prism from there (to the
+    # 1e-7 mm that Part's optimal box of the extruded B-spline walls adds)
+    lo, hi = ff["upper"]["tight_bbox"][2], ff["upper"]["tight_bbox"][5]
+    assert (lo, hi) == (pytest.approx(3.0, abs=2e-7), pytest.approx(13.0, abs=2e-7))
 
 
 def test_save_reopen_recompute(headless):
