@@ -15,7 +15,7 @@ pytest.importorskip("ezdxf")
 from tabletcad.cad.solid import check_solid  # noqa: E402
 from tabletcad.cli import main  # noqa: E402
 from tabletcad.pipeline.design import load_design  # noqa: E402
-from tabletcad.errors import DesignError, GeometryError  # noqa: E402
+from tabletcad.errors import DesignError  # noqa: E402
 from tabletcad.families.thesis import shallow_convex_round  # noqa: E402
 from tabletcad.tooling import EmbossSpec, ScoreSpec, ToolingSpec, make_tooling, parse_tooling, tooling_batch  # noqa: E402
 from tabletcad.pipeline.design import Design  # noqa: E402
