@@ -48,6 +48,35 @@ def test_the_design_owns_its_tables_and_is_separate_from_the_tablet():
     assert d.tooling_spec.clearance_mm == 0.02 and d.report_options == ReportOptions()
 
 
+def test_the_tables_are_read_only_and_the_design_hashes_by_them():
+    """A new user changed ``m.design.tablet["diameter"]`` in place: the model's volume stayed at the old
+    tablet and ``m.replace(band=2)`` (the same band) built a 20 mm one; ``hash(design)`` raised."""
+    import pickle
+
+    import tabletcad
+
+    m = tabletcad.make("concave_round", diameter=10.0, band=2.0, cup_depth=1.0,
+                       tooling={"score": [{"depth_mm": 0.3}]})
+    d = m.design
+    for change in (lambda: d.tablet.__setitem__("diameter", 20.0), lambda: d.tablet.update(diameter=20.0),
+                   lambda: d.tablet.pop("band"), lambda: d.tooling["score"].append({}),
+                   lambda: d.tooling["score"][0].__setitem__("depth_mm", 9.0)):
+        with pytest.raises(TypeError, match="read-only"):
+            change()
+    assert d.tablet["diameter"] == 10.0 and m.replace(band=2.0).volume == pytest.approx(m.volume, rel=1e-12)
+    copy = d.to_dict()  # plain, changeable copies
+    copy["tablet"]["diameter"] = 11.0
+    copy["tooling"]["score"].append({"depth_mm": 0.2, "direction_deg": 90.0})
+    assert type(copy["tablet"]) is dict and type(copy["tooling"]["score"]) is list
+    assert Design.from_dict(copy).tablet["diameter"] == 11.0 and d.tablet["diameter"] == 10.0
+    same = Design.from_dict({"tooling": d.to_dict()["tooling"], "tablet": dict(reversed(list(d.tablet.items())))})
+    assert same == d and hash(same) == hash(d) and len({d, same, Design.from_dict(copy)}) == 2
+    back = pickle.loads(pickle.dumps(d))  # (sweeps send designs to their workers)
+    assert back == d and isinstance(back.tablet, dict) and back.build().volume() == pytest.approx(m.volume, rel=1e-15)
+    with pytest.raises(TypeError, match="read-only"):
+        back.tablet["band"] = 1.0
+
+
 def test_an_old_family_name_is_read_as_the_new_one():
     with pytest.warns(FutureWarning):
         d = Design.from_dict({"tablet": {"family": "spherical", "diameter": 5.0}})

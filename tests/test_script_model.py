@@ -299,3 +299,26 @@ def test_exporting_onto_a_folder_names_the_folder(tmp_path):
     assert e.value.parameter == "path" and e.value.value == str(tmp_path / "x.step")
     assert "is a folder" in str(e.value) and "x.step' is not allowed" in str(e.value)
     assert [p.name for p in tmp_path.iterdir()] == ["x.step"] and not any((tmp_path / "x.step").iterdir())
+
+
+def test_export_writes_the_builds_solid_and_refuses_in_one_line(tmp_path):
+    """A new user's trial: ``m.export("x.step")`` wrote B-spline faces (3.9e-9 low on the concave round)
+    where ``tabletcad build`` writes exact faces of revolution (within 1e-13 by OCC's default rule, the
+    rule that reads such faces best: README); a folder that takes no files raised FileNotFoundError naming
+    a temporary file, a file in the way FileExistsError, and a mesh option for STEP a TypeError naming
+    ``export_step``."""
+    from support.readback import ocp_read_steps
+
+    m = tabletcad.load(ROOT / "samples" / "families" / "concave_round.toml")
+    (back,) = ocp_read_steps([m.export(tmp_path / "x.step")])
+    assert back["valid"] and back["n_solids"] == 1
+    assert back["volume_default"] == pytest.approx(m.volume, rel=1e-12)
+    (tmp_path / "file").write_text("")
+    for path, why in ((Path("/proc/x.step"), "cannot be written in /proc"),
+                      (tmp_path / "file" / "x.stl", "a file of that name is in the way")):
+        with pytest.raises(DesignError) as e:
+            m.export(path)
+        assert e.value.parameter == "path" and e.value.value == str(path) and why in str(e.value)
+    with pytest.raises(TypeError, match=r"export got an unexpected keyword argument 'linear_deflection': a \.step"):
+        m.export(tmp_path / "y.step", linear_deflection=0.1)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file", "x.step"]

@@ -252,5 +252,11 @@ def export(obj: Any, path: str | os.PathLike[str], *, name: str | None = None, *
     suffix = Path(path).suffix.lower()
     if suffix not in SUFFIXES:
         raise ValueError(f"file suffix {suffix!r} is not allowed: must be one of {', '.join(sorted(SUFFIXES))}")
+    exact = {".step": ("schema",), ".stp": ("schema",), ".brep": ()}  # the exact formats take no mesh options
+    if suffix in exact and set(kw) - set(exact[suffix]):
+        extra = sorted(set(kw) - set(exact[suffix]))[0]
+        takes = f"takes only {exact[suffix][0]}=" if exact[suffix] else "takes no options"
+        raise TypeError(f"export got an unexpected keyword argument {extra!r}: a {suffix} file (exact B-rep, not a "
+                        f"mesh) {takes}")
     name = name or getattr(obj, "name", None) or "tablet"
     return SUFFIXES[suffix](obj, path, name=str(name), **kw)

@@ -21,15 +21,23 @@ def atomic_path(target: str | os.PathLike[str]) -> Iterator[Path]:
     The temporary file keeps the target's suffix so that writers which choose a
     format by suffix (meshio, OCC exporters) behave the same.  If the body
     raises, the temporary file is removed and ``target`` is left untouched.  A ``target`` that
-    is a folder is a :class:`~tabletcad.errors.DesignError` before anything is written.
+    is a folder, or whose folder cannot be made or take files, is a
+    :class:`~tabletcad.errors.DesignError` naming it, before anything is written.
     """
     target = Path(target)
     if target.is_dir():  # the rename would fail after the work with an error naming the temporary file
         from tabletcad.errors import DesignError
 
         raise DesignError("path", str(target), "is a folder: give the file's name (its suffix chooses the format)")
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=target.suffix, dir=target.parent)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=target.suffix, dir=target.parent)
+    except OSError as exc:  # (a file where a folder is needed, /proc): the target named, not the temporary file
+        from tabletcad.errors import DesignError
+
+        why = "a file of that name is in the way" if isinstance(exc, (FileExistsError, NotADirectoryError)) else \
+            (exc.strerror or type(exc).__name__).lower()
+        raise DesignError("path", str(target), f"cannot be written in {target.parent}: {why}") from None
     os.close(fd)
     tmp_path = Path(tmp)
     try:

@@ -190,6 +190,54 @@ def _curve(spec: Any, where: str, previous: Curve | None) -> Curve:
 _TABLES = ("trim", "reshape", "report", "tooling")
 
 
+class _ReadOnly:
+    """What a design's tables raise on any change: they are its value (a model built from it keeps its
+    tablet, and :meth:`Design.__hash__` reads them)."""
+
+    def _refuse(self, *args: Any, **kw: Any):
+        raise TypeError(f"a design's tables are read-only ({type(self).__name__}): change a copy, "
+                        "design.to_dict(), and make a new design (Design.from_dict, TabletModel.replace)")
+
+    __setitem__ = __delitem__ = __iadd__ = __imul__ = __ior__ = _refuse
+    append = extend = insert = remove = pop = popitem = clear = update = setdefault = sort = reverse = _refuse
+
+
+class TableDict(_ReadOnly, dict):
+    """A read-only ``dict`` (still a ``dict`` to every reader); a copy (``copy.deepcopy``, ``dict(t)``)
+    is a plain, changeable one."""
+
+    def __deepcopy__(self, memo):
+        return {k: copy.deepcopy(v, memo) for k, v in self.items()}
+
+    def __copy__(self):
+        return dict(self)
+
+    def __reduce__(self):  # pickled (sweeps send designs to their workers) as itself, without __setitem__
+        return TableDict, (dict(self),)
+
+
+class TableList(_ReadOnly, list):
+    """A read-only ``list`` (``[[patch]]`` tables, a table's arrays); copies are plain lists."""
+
+    def __deepcopy__(self, memo):
+        return [copy.deepcopy(v, memo) for v in self]
+
+    def __copy__(self):
+        return list(self)
+
+    def __reduce__(self):
+        return TableList, (list(self),)
+
+
+def _read_only(value: Any) -> Any:
+    """``value`` with every dict and list in it read-only (:class:`TableDict`, :class:`TableList`)."""
+    if isinstance(value, dict):
+        return TableDict({k: _read_only(v) for k, v in value.items()})
+    if isinstance(value, list):
+        return TableList(_read_only(v) for v in value)
+    return value
+
+
 @dataclass(frozen=True)
 class Design:
     """A design as data: the tables of a design file, checked, before any geometry is built.
@@ -217,8 +265,10 @@ class Design:
     tooling_spec : ToolingSpec or None
         The ``[tooling]`` table, checked (derived; not an argument), or None without one.
 
-    The tables are the design's own copies; treat them as read-only.  A bad ``[report]`` or
-    ``[tooling]`` value is refused when the design is made, before any geometry.
+    The tables are the design's own read-only copies (a change raises ``TypeError``: change
+    :meth:`to_dict`'s copy and make a new design); designs with equal tables are equal and hash
+    alike.  A bad ``[report]`` or ``[tooling]`` value is refused when the design is made, the
+    ``[tablet]`` dimensions when it builds (:meth:`build`), both before any geometry.
     """
 
     tablet: dict
@@ -233,9 +283,14 @@ class Design:
     tooling_spec: ToolingSpec | None = field(init=False, compare=False, repr=False)
 
     def __post_init__(self) -> None:
+        for table in ("tablet", "patch", *_TABLES):  # the design's own read-only copies
+            object.__setattr__(self, table, _read_only(copy.deepcopy(getattr(self, table))))
         object.__setattr__(self, "report_options", ReportOptions.from_table(self.report))
         object.__setattr__(self, "tooling_spec",
                            None if self.tooling is None else parse_tooling(self.tooling, base=self.folder))
+
+    def __hash__(self) -> int:  # of the tables, as == compares them (key order aside)
+        return hash(json.dumps(self.to_dict(), sort_keys=True, default=repr))
 
     @property
     def name(self) -> str:
