@@ -209,7 +209,23 @@ def is_number(value: Any) -> bool:
         type(value).__name__ != "bool_"
 
 
+class _Missing(str):
+    """The value of a parameter that was not given (:data:`MISSING`): equal to ``"missing"`` for code
+    that compares, shown as ``(not given)`` in a refusal, not as a value the user could have typed."""
+
+    __slots__ = ()
+
+    def __repr__(self) -> str:
+        return "(not given)"
+
+
+#: the :class:`DesignError` value of a parameter that was not given
+MISSING = _Missing("missing")
+
+
 def _fmt(value: Any) -> str:
+    if isinstance(value, _Missing):
+        return "(not given)"
     if isinstance(value, bool):
         return "true" if value else "false"  # as TOML writes them
     if isinstance(value, float):

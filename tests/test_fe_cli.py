@@ -130,7 +130,7 @@ def test_punch_json_and_files(capsys, tmp_path):
 @pytest.mark.parametrize(
     "extra, match",
     [
-        (["--force", "5"], "--yield-stress = 'missing' is not allowed: give --yield-stress (MPa) or --steel"),
+        (["--force", "5"], "--yield-stress = (not given) is not allowed: give --yield-stress (MPa) or --steel"),
         (["--force", "5", "--steel", "unobtainium"], "--steel = 'unobtainium' is not allowed: must be one of"),
         (["--force", "0", "--yield-stress", "1000"], "--force = 0 kN is not allowed: must be >= 1e-09 and <= 1e+06 kN"),
         # 1e-200 kN left no stress to divide by (ZeroDivisionError, exit 1)
@@ -155,7 +155,7 @@ def test_punch_bad_input(capsys, tmp_path, extra, match):
 def test_strength_needs_its_inputs(capsys, thin):
     rc, so, err = run(capsys, "fe", "strength", thin)
     assert rc == 2 and err.count("\n") == 1
-    assert err.startswith("error: report.tensile_strength_MPa = 'missing' is not allowed: give it, or all of"), err
+    assert err.startswith("error: report.tensile_strength_MPa = (not given) is not allowed: give it, or all of"), err
 
 
 def test_diametral_refuses_a_ring_fast(capsys):

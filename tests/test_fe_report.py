@@ -76,7 +76,7 @@ def test_report_and_build_run_the_coarse_fe_strength(capsys, tmp_path):
     ('tensile_strength_MPa = 2.0\nfe_breaking_force = "yes"',
      "error: report.fe_breaking_force = 'yes' is not allowed: must be a TOML boolean (true or false)"),
     ("fe_breaking_force = true",
-     "error: report.tensile_strength_MPa = 'missing' is not allowed: give it, or all of reference_breaking_force_N"),
+     "error: report.tensile_strength_MPa = (not given) is not allowed: give it, or all of reference_breaking_force_N"),
 ])
 def test_bad_fe_report_input_is_one_line_and_writes_nothing(capsys, tmp_path, report, message):
     p = tmp_path / "bad.toml"

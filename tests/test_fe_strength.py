@@ -48,9 +48,9 @@ def test_tensile_strength_scales_the_force_linearly():
         ({"tensile_strength_MPa": -1.0}, "tensile_strength_MPa = -1 MPa is not allowed: must be > 0"),
         # a reference test lacking one input names it (it was "tensile_strength_MPa = 'missing'")
         ({"reference_breaking_force_N": 50.0, "reference_diameter_mm": 10.0},
-         r"^report\.reference_thickness_mm = 'missing' is not allowed: the reference test needs"),
+         r"^report\.reference_thickness_mm = \(not given\) is not allowed: the reference test needs"),
         ({"reference_diameter_mm": 10.0, "reference_thickness_mm": 3.0},
-         r"^report\.reference_breaking_force_N = 'missing'"),
+         r"^report\.reference_breaking_force_N = \(not given\)"),
         ({"tensile_strength_MPa": 2.0, "reference_breaking_force_N": 50.0}, "not both"),
         ({"reference_breaking_force_N": 50.0, "reference_diameter_mm": 5.0, "reference_thickness_mm": 6.0},
          "must be <= reference_diameter_mm"),
@@ -119,6 +119,6 @@ def test_a_reference_disc_too_thin_to_mesh_is_named_by_its_thickness(capsys):
                              "disc that the FE cannot mesh: its mesh size 0.005 mm must be >= ")
     rc = main(["fe", "strength", str(design), "--reference-force", "80", "--reference-diameter", "10"])
     err = capsys.readouterr().err.strip().splitlines()
-    assert rc == 2 and err == ["error: --reference-thickness = 'missing' is not allowed: the reference test needs "
+    assert rc == 2 and err == ["error: --reference-thickness = (not given) is not allowed: the reference test needs "
                                "reference_breaking_force_N, reference_diameter_mm, reference_thickness_mm (or give "
                                "tensile_strength_MPa instead)"]

@@ -40,7 +40,7 @@ def _optimise(tmp_path, capsys, text: str, *extra: str) -> tuple[int, list[str],
     # cup_depth neither varied nor fixed: the constructor's default 1.0 mm stood in for it, and the
     # optimum file (without it) could not be built
     ("diameter = { lower = 6.0, upper = 12.0 }", "band = 2.8",
-     "error: fixed.cup_depth = 'missing' is not allowed: family 'concave_round' needs diameter, band, cup_depth"),
+     "error: fixed.cup_depth = (not given) is not allowed: family 'concave_round' needs diameter, band, cup_depth"),
     # band from 0: the solver stopped at 9.1e-12 mm, which no design takes
     ("band = { lower = 0.0, upper = 3.0, initial = 1.0 }", "diameter = 10.0\ncup_depth = 0.9",
      "error: variables.band.lower = 0 mm is not allowed: family 'concave_round' refuses band = 0 (must be > 0)"),
@@ -94,7 +94,7 @@ def test_solve_for_needs_every_dimension_of_a_named_family():
 
     with pytest.raises(DesignError) as e:
         solve_for("concave_round", target_volume_mm3=300, vary="band", diameter=10)
-    assert str(e.value) == "cup_depth = 'missing' is not allowed: concave_round needs diameter, cup_depth besides band"
+    assert str(e.value) == "cup_depth = (not given) is not allowed: concave_round needs diameter, cup_depth besides band"
     # a constructor passed in keeps its defaults (documented)
     r = solve_for(concave_round, target_volume_mm3=300, vary="band", diameter=10)
     assert r.volume_mm3 == pytest.approx(300, rel=1e-9)
@@ -110,7 +110,7 @@ def test_solve_for_needs_every_dimension_of_a_named_family():
     (["strength", "pitt", "--force", "-100", "--diameter", "10", "--thickness", "4.6", "--band", "1"],
      "error: --force = -100 N is not allowed: must be > 0"),
     (["strength", "pitt", "--force", "100", "--thickness", "4.6", "--band", "1"],
-     "error: --diameter = 'missing' is not allowed: is required for method 'pitt'"),
+     "error: --diameter = (not given) is not allowed: is required for method 'pitt'"),
     (["strength", "elongated-convex", "--force", "100", "--diameter", "0", "--thickness", "4", "--band", "1"],
      "error: --diameter = 0 mm is not allowed: must be >= 0.001 and <= 1000 mm"),
     # an infinite strength was printed with exit 0; a 1e-9 mm tablet only warned (1.6e10 MPa)

@@ -90,14 +90,14 @@ BAD = {
     "empty range": ('[sweep.vary]\n"tablet.cup_depth" = { min = 1.0, max = 0.5, num = 3 }\n', "the range is empty"),
     "num zero": ('[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0, num = 0 }\n', "num = 0 is not allowed"),
     "num negative": ('[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0, num = -2 }\n', "num = -2 is not allowed"),
-    "num missing": ('[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0 }\n', "num = 'missing'"),
+    "num missing": ('[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0 }\n', "num = (not given)"),
     "samples without seed": ('[sweep]\nmethod = "lhs"\nsamples = 10\n[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0 }\n',
-                             "sweep.seed = 'missing'"),
+                             "sweep.seed = (not given)"),
     "samples zero": ('[sweep]\nmethod = "lhs"\nsamples = 0\nseed = 1\n[sweep.vary]\n"tablet.cup_depth" = { min = 0.5, max = 1.0 }\n',
                      "sweep.samples = 0"),
     "unknown method": ('[sweep]\nmethod = "random"\n[sweep.vary]\n"tablet.cup_depth" = [0.8]\n', "sweep.method = 'random'"),
     "unknown output": ('[sweep]\noutputs = ["iges"]\n[sweep.vary]\n"tablet.cup_depth" = [0.8]\n', "sweep.outputs = 'iges'"),
-    "no vary": ("[sweep]\n", "sweep.vary = 'missing'"),
+    "no vary": ("[sweep]\n", "sweep.vary = (not given)"),
 }
 
 

@@ -149,7 +149,7 @@ def _usage_line(exc) -> str:
     """One ``error:`` line for a click usage error not raised by a parameter's type."""
     import click
 
-    from tabletcad.errors import DesignError
+    from tabletcad.errors import MISSING, DesignError
 
     ctx = exc.ctx
     where = ctx.command_path if ctx is not None else "tabletcad"
@@ -160,9 +160,9 @@ def _usage_line(exc) -> str:
                 opts.extend(o for o in getattr(p, "opts", []) if o.startswith("--"))
         return str(DesignError("option", exc.option_name, f"{where} takes " + (", ".join(opts) or "no options")))
     if isinstance(exc, click.MissingParameter):
-        return str(DesignError(_param_name(exc.param), "missing", f"{where} needs it"))
+        return str(DesignError(_param_name(exc.param), MISSING, f"{where} needs it"))
     if isinstance(exc, click.BadOptionUsage):
-        return str(DesignError(exc.option_name, "missing", f"{exc.option_name} needs a value"))
+        return str(DesignError(exc.option_name, MISSING, f"{exc.option_name} needs a value"))
     if isinstance(exc, click.BadParameter):
         return str(DesignError(_param_name(exc.param), "given", " ".join(exc.format_message().split()).rstrip(".")))
     msg = " ".join(exc.format_message().split()).rstrip(".")

@@ -16,7 +16,7 @@ import click
 
 from tabletcad.cli.options import option_names
 from tabletcad.cli.outputs import out_folder
-from tabletcad.errors import DesignError, check_range
+from tabletcad.errors import MISSING, DesignError, check_range
 from tabletcad.tolerance import MAX_EFFECTIVE_LENGTH_FACTOR, MAX_YIELD_MPA, MIN_FORCE_N
 
 __all__ = ["COMMANDS"]
@@ -217,7 +217,7 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
                                                reference_diameter_mm=reference_diameter,
                                                reference_thickness_mm=reference_thickness)
         except DesignError as exc:  # the input a reference test from the options lacks: named as its option
-            if exc.value == "missing" and exc.parameter in options and any(o in given for o in options):
+            if exc.value == MISSING and exc.parameter in options and any(o in given for o in options):
                 raise exc.renamed(options[exc.parameter]) from None
             raise
         pred = (coarse_prediction(tablet, inputs, direction, solid=solid) if coarse
@@ -275,7 +275,7 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
         yield_stress = steels[steel].yield_MPa
         E = steels[steel].E_MPa if E is None else E
     if yield_stress is None:
-        raise DesignError("--yield-stress", "missing", "give --yield-stress (MPa) or --steel " + "|".join(steels)
+        raise DesignError("--yield-stress", MISSING, "give --yield-stress (MPa) or --steel " + "|".join(steels)
                           + ": no rating is invented")
     check_positive("--yield-stress", yield_stress, "MPa")
     E = 206000.0 if E is None else check_positive("--E", E, "MPa")

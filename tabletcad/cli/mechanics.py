@@ -23,7 +23,7 @@ import numpy as np
 from tabletcad.cli.options import option_names
 from tabletcad.cli.outputs import check_output as _check_output
 from tabletcad.cli.outputs import staged as _staged
-from tabletcad.errors import DesignError, check_finite, check_positive, check_range
+from tabletcad.errors import MISSING, DesignError, check_finite, check_positive, check_range
 
 __all__ = ["COMMANDS"]
 
@@ -364,7 +364,7 @@ def strength_cmd(method: str, F: float, D, t, W, L, R, material, E, nu, radius, 
 
     def need(name: str, v):
         if v is None:
-            raise DesignError(name, "missing", f"is required for method {method!r}")
+            raise DesignError(name, MISSING, f"is required for method {method!r}")
         return v
 
     # the formulas name their arguments; here they are options

@@ -20,7 +20,7 @@ from typing import Any
 
 import click
 
-from tabletcad.errors import DesignError, one_token
+from tabletcad.errors import MISSING, DesignError, one_token
 
 __all__ = ["COMMANDS", "load_family_design", "nominal_note"]
 
@@ -306,7 +306,7 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
         except ImportError:
             raise DesignError("--xlsx", str(xlsx_out), "needs openpyxl: pip install 'tabletcad[tables]'") from None
     if solve_for is None and (target_weight is not None or target_volume is not None):
-        raise DesignError("--solve-for", "missing", f"a target needs the dimension to solve for: {', '.join(_SOLVABLE)}")
+        raise DesignError("--solve-for", MISSING, f"a target needs the dimension to solve for: {', '.join(_SOLVABLE)}")
     if solve_for is not None and (target_weight is None) == (target_volume is None):
         raise DesignError("--target-weight/--target-volume", "both" if target_weight is not None else "none",
                           "give exactly one target for --solve-for")

@@ -54,7 +54,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from tabletcad.errors import DesignError, GeometryError, check_finite, check_positive, check_range
+from tabletcad.errors import MISSING, DesignError, GeometryError, check_finite, check_positive, check_range
 from tabletcad.families.sweep import NominalBuilt, SweepNominal, nominal_only, nominal_volume
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT
@@ -313,7 +313,7 @@ def _prepare(family, vary, dims):
         required = lookup(family, parameter="family").required
         missing = [k for k in required if k != vary and k not in dims]
         if missing:
-            raise DesignError(missing[0], "missing", f"{name} needs {', '.join(k for k in required if k != vary)} "
+            raise DesignError(missing[0], MISSING, f"{name} needs {', '.join(k for k in required if k != vary)} "
                               f"besides {vary}")
     params = inspect.signature(func).parameters
     for k, v in dims.items():  # a dimension is a number: "10" is refused here, not as a failed search
@@ -458,7 +458,7 @@ def solve_for(
     if solid_fraction is not None or true_density_mg_mm3 is not None or target_weight_mg is not None:
         if solid_fraction is None or true_density_mg_mm3 is None:  # name the one left out
             missing = "solid_fraction" if solid_fraction is None else "true_density_mg_mm3"
-            raise DesignError(missing, "missing", "a weight needs both solid_fraction and true_density_mg_mm3")
+            raise DesignError(missing, MISSING, "a weight needs both solid_fraction and true_density_mg_mm3")
         mg_per_mm3 = check_range("solid_fraction", solid_fraction, 0.0, 1.0, lo_open=True) * \
             check_range("true_density_mg_mm3", true_density_mg_mm3, MIN_TRUE_DENSITY_MG_MM3, MAX_TRUE_DENSITY_MG_MM3,
                         "mg/mm3")

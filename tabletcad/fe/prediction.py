@@ -26,7 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from tabletcad.errors import DesignError, check_range
+from tabletcad.errors import MISSING, DesignError, check_range
 from tabletcad.tolerance import MAX_TENSILE_STRENGTH_MPA
 from tabletcad.tolerance import DEFAULT
 from tabletcad.fe.diametral import DiametralResult, diametral
@@ -65,10 +65,10 @@ class StrengthInputs:
         given = sum(v is not None for v in ref)
         if self.tensile_strength_MPa is None and 0 < given < 3:  # name the one the reference test lacks
             lacking = next(k for k, v in zip(REFERENCE_KEYS, ref) if v is None)
-            raise DesignError(f"[report] {lacking}", "missing", "the reference test needs "
+            raise DesignError(f"[report] {lacking}", MISSING, "the reference test needs "
                               f"{', '.join(REFERENCE_KEYS)} (or give tensile_strength_MPa instead)")
         if self.tensile_strength_MPa is None and given != 3:
-            raise DesignError("[report] tensile_strength_MPa", "missing",
+            raise DesignError("[report] tensile_strength_MPa", MISSING,
                               "give it, or all of reference_breaking_force_N, reference_diameter_mm, "
                               "reference_thickness_mm")
         if self.tensile_strength_MPa is not None and given:  # named by the first reference input given

@@ -62,7 +62,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.errors import MISSING, DesignError, check_positive, check_range
 from tabletcad.mechanics.compaction import CompactionCurves
 from tabletcad.mechanics.validity import FitQualityWarning, warn
 
@@ -316,7 +316,7 @@ def fit_heckel_arrays(
     P = np.asarray(pressure, dtype=float).ravel()
     if heckel is None:
         if relative_density is None:
-            raise DesignError("relative_density", "missing", "give relative_density or heckel")
+            raise DesignError("relative_density", MISSING, "give relative_density or heckel")
         D = np.asarray(relative_density, dtype=float).ravel()
         with np.errstate(divide="ignore", invalid="ignore"):
             H = np.where(D < 1.0, -np.log1p(-np.minimum(D, 1.0 - 1e-300)), np.nan)

@@ -63,7 +63,7 @@ from typing import Any
 import numpy as np
 import tomllib
 
-from tabletcad.errors import DesignError, check_finite, check_range
+from tabletcad.errors import MISSING, DesignError, check_finite, check_range
 from tabletcad.tolerance import DEFAULT
 from tabletcad.mechanics.units import DIMENSIONS, header_unit, strip_unit, unit_factor
 from tabletcad.tolerance import MAX_TRUE_DENSITY_MG_MM3, MIN_TRUE_DENSITY_MG_MM3
@@ -194,7 +194,7 @@ class PressMetadata:
         check_range("mass_mg", self.mass_mg, 0.0, 1e6, "mg", lo_open=True)
         check_range("true_density", self.true_density, MIN_TRUE_DENSITY_MG_MM3, MAX_TRUE_DENSITY_MG_MM3, "mg/mm³")
         if self.diameter is None and self.face_area is None:
-            raise DesignError("diameter", "missing", "give the die diameter (mm) or the punch face area (mm²)", "mm")
+            raise DesignError("diameter", MISSING, "give the die diameter (mm) or the punch face area (mm²)", "mm")
         if self.diameter is not None and self.face_area is not None:
             raise DesignError("face_area", self.face_area, "give diameter or face_area, not both (the punch face "
                               "area is one quantity)", "mm²")
@@ -444,7 +444,7 @@ def read_columns(path: str | Path, columns: Mapping[str, tuple[str, str]]) -> di
         if isinstance(col, np.ndarray) and not np.all(np.isfinite(col)):
             col = int(np.flatnonzero(~np.isfinite(col))[0])  # a missing value: every row is one tablet
         if not isinstance(col, np.ndarray):
-            raise DesignError(f"{path.name!r} line {line_numbers[col]} {header[j]!r}", by_column[j][col].strip() or "missing",
+            raise DesignError(f"{path.name!r} line {line_numbers[col]} {header[j]!r}", by_column[j][col].strip() or MISSING,
                               "must be a number")
         out[key] = col * factor if exponent is None else col
     out["_lines"] = np.asarray(line_numbers)
@@ -711,7 +711,7 @@ def read_metadata(source: str | Path | Mapping[str, Any], **overrides: Any) -> P
     compliance = _compliance(raw.get("compliance"))
     missing = [k for k in ("mass_mg", "true_density") if k not in raw]
     if missing:
-        raise DesignError(missing[0], "missing", "is required (metadata file or command-line option)")
+        raise DesignError(missing[0], MISSING, "is required (metadata file or command-line option)")
     sign = raw.get("displacement_sign", "auto")
     if isinstance(sign, float) and sign in (1.0, -1.0):
         sign = int(sign)

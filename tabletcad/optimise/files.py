@@ -61,7 +61,7 @@ import sys
 from pathlib import Path
 from typing import Any, Callable
 
-from tabletcad.errors import DesignError, one_token
+from tabletcad.errors import MISSING, DesignError, one_token
 from tabletcad.optimise.problem import METHODS, Constraint, Objective, Problem, Variable
 
 if sys.version_info >= (3, 11):
@@ -268,7 +268,7 @@ def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
     kind = prob.get("kind")
     kinds = (*THESIS_PARAMETERS, "family")
     if kind is None:
-        raise DesignError("[problem] kind", "missing", "must be one of " + ", ".join(kinds))
+        raise DesignError("[problem] kind", MISSING, "must be one of " + ", ".join(kinds))
     choice("[problem] kind", kind, kinds)
     method = choice("[problem] method", prob.get("method", "SLSQP"), METHODS)
     if "sense" in prob:
@@ -306,14 +306,14 @@ def _fe_settings(fe: Any, used: bool) -> dict | None:
     """The checked ``[fe]`` table (None when no FE quantity is used; refused when given unused)."""
     if fe is None:
         if used:
-            raise DesignError("[fe] tensile_strength_MPa", "missing",
+            raise DesignError("[fe] tensile_strength_MPa", MISSING,
                               f"must be given (MPa) when {FE_QUANTITY} is the objective or a constraint")
         return None
     _check_keys("[fe]", fe, _FE_KEYS)
     if not used:
         raise DesignError("[fe]", "given", f"only problems using {FE_QUANTITY} take it")
     if "tensile_strength_MPa" not in fe:
-        raise DesignError("[fe] tensile_strength_MPa", "missing", "must be given (MPa)")
+        raise DesignError("[fe] tensile_strength_MPa", MISSING, "must be given (MPa)")
     return {
         "tensile_strength_MPa": number("[fe] tensile_strength_MPa", fe["tensile_strength_MPa"], "MPa", lo=0.0,
                                        lo_open=True, hi=LIMITS["MPa"]),
@@ -342,7 +342,7 @@ def _held_volume(prob: dict, fam_name: str, fam: Any, variables: dict, fixed: di
         return None
     if "solve_for" not in prob or "volume_mm3" not in prob:
         missing = "solve_for" if "solve_for" not in prob else "volume_mm3"
-        raise DesignError(f"[problem] {missing}", "missing", "solve_for and volume_mm3 go together")
+        raise DesignError(f"[problem] {missing}", MISSING, "solve_for and volume_mm3 go together")
     from tabletcad.families.inverse import VARY
 
     vary = choice("[problem] solve_for", prob["solve_for"], tuple(v for v in VARY if v in fam.params))
@@ -417,7 +417,7 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
     given = set(variables) | set(fixed) | ({held[0]} if held else set())
     missing = [k for k in fam.required if k not in given]
     if missing:  # the family's default would stand in for it, unseen, and the optimum would not build
-        raise DesignError(f"[fixed] {missing[0]}", "missing", f"family {fam_name!r} needs {', '.join(fam.required)}: "
+        raise DesignError(f"[fixed] {missing[0]}", MISSING, f"family {fam_name!r} needs {', '.join(fam.required)}: "
                           "give each as a variable, in [fixed] or as [problem] solve_for")
 
     def build(x):

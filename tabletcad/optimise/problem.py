@@ -31,7 +31,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from tabletcad.errors import DesignError, TabletcadError, check_finite
+from tabletcad.errors import MISSING, DesignError, TabletcadError, check_finite
 
 __all__ = [
     "Variable",
@@ -148,7 +148,7 @@ class Constraint:
             raise DesignError(f"constraint {self.name} uses", self.uses, "must be 'design' or 'x'")
         if self.kind == "eq":
             if self.target is None:
-                raise DesignError(f"constraint {self.name} target", "missing", "an equality constraint needs a target")
+                raise DesignError(f"constraint {self.name} target", MISSING, "an equality constraint needs a target")
             check_finite(f"constraint {self.name} target", self.target, self.unit)
             if self.lower is not None or self.upper is not None:
                 raise DesignError(f"constraint {self.name}", "lower/upper", "an equality constraint takes only a target")

@@ -47,7 +47,7 @@ from typing import Any
 import numpy as np
 
 from tabletcad.geometry.curves import Circle, Curve, Ellipse, PointCurve, RoundedRectangle, Stadium
-from tabletcad.errors import DesignError, check_finite, is_number, one_token
+from tabletcad.errors import MISSING, DesignError, check_finite, is_number, one_token
 from tabletcad.geometry.patch import PDEPatch
 from tabletcad.families import FAMILIES, RENAMED
 from tabletcad.families import family as lookup_family
@@ -156,7 +156,7 @@ def _curve(spec: Any, where: str, previous: Curve | None) -> Curve:
     _check_keys(where, spec, _CURVE_KEYS[kind] | {"type", "z", "center"})
     for k in _CURVE_KEYS[kind]:
         if k not in spec:
-            raise DesignError(f"{where}.{k}", "missing", f"a {kind} curve needs {', '.join(sorted(_CURVE_KEYS[kind]))}")
+            raise DesignError(f"{where}.{k}", MISSING, f"a {kind} curve needs {', '.join(sorted(_CURVE_KEYS[kind]))}")
     if "center" in spec and "z" in spec:
         raise DesignError(f"{where}.z", spec["z"], "give either z or center, not both")
     center = spec.get("center", (0.0, 0.0, spec.get("z", 0.0)))
@@ -316,7 +316,7 @@ class Design:
             raise DesignError("design", type(data).__name__, "must be a TOML table")
         _check_keys("", data, set(TOP_LEVEL_KEYS))
         if "tablet" not in data or not isinstance(data["tablet"], dict):
-            raise DesignError("tablet", "missing" if "tablet" not in data else data["tablet"],
+            raise DesignError("tablet", MISSING if "tablet" not in data else data["tablet"],
                               "a design needs a [tablet] table with a family")
         data = _as_toml(data)
         tab = data["tablet"]
@@ -326,7 +326,7 @@ class Design:
         family = tab.get("family")
         families = ", ".join(FAMILIES) + ", custom_outline or free_form"
         if family is None:
-            raise DesignError("tablet.family", "missing", f"must be one of {families}")
+            raise DesignError("tablet.family", MISSING, f"must be one of {families}")
         if not isinstance(family, str):
             raise DesignError("tablet.family", family, f"must be one of {families}")
         for table in _TABLES:
@@ -399,7 +399,7 @@ class Design:
             missing = [k for k in fam.params if k in fam.required and k not in kw]
             if missing:
                 optional = [k for k in fam.params if k not in fam.required]
-                raise DesignError(f"tablet.{missing[0]}", "missing",
+                raise DesignError(f"tablet.{missing[0]}", MISSING,
                                   f"family {family!r} needs {', '.join(fam.required)}"
                                   + (f" (optional: {', '.join(optional)})" if optional else ""))
             if a is not None:
@@ -500,11 +500,11 @@ def _custom_outline(tab: dict, name: str) -> Tablet:
 
     _check_keys("tablet", tab, _CUSTOM_KEYS)
     if ("outline" in tab) == ("segments" in tab):
-        raise DesignError("tablet.outline", "missing" if "outline" not in tab else "both",
+        raise DesignError("tablet.outline", MISSING if "outline" not in tab else "both",
                           "give either outline (points) or segments (lines and arcs)")
     for k in ("band", "cup_depth"):
         if k not in tab:
-            raise DesignError(f"tablet.{k}", "missing", "a custom_outline design needs outline or segments, band and cup_depth "
+            raise DesignError(f"tablet.{k}", MISSING, "a custom_outline design needs outline or segments, band and cup_depth "
                               "(optional: land, cup_width, central_radius, edge_radius)")
     key = "outline" if "outline" in tab else "segments"
     shape = tab[key]
@@ -528,7 +528,7 @@ def _custom_outline(tab: dict, name: str) -> Tablet:
 
 def _free_form(patches: Any, name: str, a) -> Tablet:
     if not isinstance(patches, list) or not patches:
-        raise DesignError("patch", "missing", "a free_form design needs at least one [[patch]] with 4 curves")
+        raise DesignError("patch", MISSING, "a free_form design needs at least one [[patch]] with 4 curves")
     out = []
     prev: Curve | None = None
     for j, p in enumerate(patches):

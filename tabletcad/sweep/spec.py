@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from tabletcad.errors import DesignError
+from tabletcad.errors import MISSING, DesignError
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -271,7 +271,7 @@ def _axis(key: str, spec: Any, method: str) -> Axis:
             raise DesignError(f"{where} key {k!r}", spec[k], f"a {method} range takes {', '.join(sorted(allowed))}")
     for k in ("min", "max"):
         if k not in spec:
-            raise DesignError(f"{where} {k}", "missing", f"a range needs {', '.join(sorted(allowed))}")
+            raise DesignError(f"{where} {k}", MISSING, f"a range needs {', '.join(sorted(allowed))}")
     lo, hi = _number(f"{where} min", spec["min"]), _number(f"{where} max", spec["max"])
     if hi < lo:
         raise DesignError(f"{where} max", hi, f"the range is empty: max must be >= min = {lo:g}")
@@ -280,7 +280,7 @@ def _axis(key: str, spec: Any, method: str) -> Axis:
     if method == "lhs":
         return Axis(key, (), lo, hi)
     if "num" not in spec:
-        raise DesignError(f"{where} num", "missing", "a grid range needs num (the number of values, >= 1)")
+        raise DesignError(f"{where} num", MISSING, "a grid range needs num (the number of values, >= 1)")
     num = spec["num"]
     if isinstance(num, bool) or not isinstance(num, int) or not 0 < num <= MAX_DESIGNS:
         raise DesignError(f"{where} num", num, f"must be an integer from 1 to {MAX_DESIGNS:,}")
@@ -302,7 +302,7 @@ def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
             raise DesignError(f"top-level key {k!r}", data[k], "a sweep file has a [design] and a [sweep] table")
     design = data.get("design")
     if not isinstance(design, dict) or not isinstance(design.get("tablet"), dict):
-        raise DesignError("[design]", "missing", "a sweep file needs a [design] table with a [design.tablet] table")
+        raise DesignError("[design]", MISSING, "a sweep file needs a [design] table with a [design.tablet] table")
     from tabletcad.pipeline.design import TOP_LEVEL_KEYS
 
     for k in design:
@@ -310,7 +310,7 @@ def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
             raise DesignError(f"[design] key {k!r}", design[k], f"allowed keys are {', '.join(TOP_LEVEL_KEYS)}")
     sw = data.get("sweep")
     if not isinstance(sw, dict):
-        raise DesignError("[sweep]", "missing", "a sweep file needs a [sweep] table with [sweep.vary]")
+        raise DesignError("[sweep]", MISSING, "a sweep file needs a [sweep] table with [sweep.vary]")
     for k in sw:
         if k not in _SWEEP_KEYS:
             raise DesignError(f"[sweep] key {k!r}", sw[k], f"allowed keys are {', '.join(sorted(_SWEEP_KEYS))}")
@@ -320,12 +320,12 @@ def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
     samples = seed = None
     if method == "lhs":
         if "samples" not in sw:
-            raise DesignError("[sweep] samples", "missing", "a Latin hypercube needs samples (an integer >= 1)")
+            raise DesignError("[sweep] samples", MISSING, "a Latin hypercube needs samples (an integer >= 1)")
         samples = sw["samples"]
         if isinstance(samples, bool) or not isinstance(samples, int) or not 0 < samples <= MAX_DESIGNS:
             raise DesignError("[sweep] samples", samples, f"must be an integer from 1 to {MAX_DESIGNS:,}")
         if "seed" not in sw:
-            raise DesignError("[sweep] seed", "missing", "samples need a seed (an integer >= 0) so that the sweep can be repeated")
+            raise DesignError("[sweep] seed", MISSING, "samples need a seed (an integer >= 0) so that the sweep can be repeated")
         seed = sw["seed"]
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
             raise DesignError("[sweep] seed", seed, "must be an integer >= 0")
@@ -346,7 +346,7 @@ def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
         raise DesignError("[sweep] store", store, "must be a folder path or fsspec URL")
     vary = sw.get("vary")
     if not isinstance(vary, dict) or not vary:
-        raise DesignError("[sweep.vary]", "missing" if vary is None else vary, "give at least one dotted design key to vary")
+        raise DesignError("[sweep.vary]", MISSING if vary is None else vary, "give at least one dotted design key to vary")
     _check_family_keys(design)
     _check_fixed_dimensions(design, set(vary))
     known = _known_keys(design)

@@ -69,7 +69,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-from tabletcad.errors import DesignError, check_finite, check_positive, check_range
+from tabletcad.errors import MISSING, DesignError, check_finite, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
 from tabletcad.tolerance import MAX_YIELD_MPA
 from tabletcad.tooling.polygon import polygon_problem
@@ -115,7 +115,7 @@ def standard_die_size(size_mm: float) -> tuple[float, float, str]:
     for lim, od, h, name in TSM_DIES:
         if size_mm <= lim:
             return od, h, name
-    raise DesignError("[tooling] die_outer_diameter_mm", "missing",
+    raise DesignError("[tooling] die_outer_diameter_mm", MISSING,
                       f"give it for a tablet {size_mm:.4g} mm long (larger than a TSM 'D' die takes, 25.4 mm)", "mm")
 
 
@@ -194,7 +194,7 @@ def _fe_rating(t: Any) -> FeRatingSpec | None:
     d = FeRatingSpec()
     steel, y = t.get("steel"), t.get("yield_stress_MPa")
     if (steel is None) == (y is None):
-        raise DesignError(f"{w} steel", steel if steel is not None else "missing",
+        raise DesignError(f"{w} steel", steel if steel is not None else MISSING,
                           "give steel (one of " + ", ".join(steel_names()) + ") or yield_stress_MPa with its "
                           "yield_stress_source: no allowed stress is invented")
     src = t.get("yield_stress_source")
@@ -205,7 +205,7 @@ def _fe_rating(t: Any) -> FeRatingSpec | None:
     else:
         y = check_range(f"{w} yield_stress_MPa", y, 0.0, MAX_YIELD_MPA, "MPa", lo_open=True)
         if not (isinstance(src, str) and src.strip()):
-            raise DesignError(f"{w} yield_stress_source", src if src is not None else "missing",
+            raise DesignError(f"{w} yield_stress_source", src if src is not None else MISSING,
                               "must name the source of yield_stress_MPa (a non-empty string)")
     mesh = t.get("mesh_size_mm")
     return FeRatingSpec(steel, y, src, check_range(f"{w} safety_factor", t.get("safety_factor", d.safety_factor), 1.0, 100.0),
@@ -509,17 +509,17 @@ def parse_tooling(table: Any, base: Path | None = None) -> ToolingSpec:
     lower = None if lower is None else check_range("[tooling] lower_tip_length_mm", lower, 0.0, big, "mm", lo_open=True)
     body = None
     if "standard" in t or "type" in t or "punch" in t:
-        std = _choice("[tooling] standard", t.get("standard", "missing"), ("TSM", "EU", "custom"))
+        std = _choice("[tooling] standard", t.get("standard", MISSING), ("TSM", "EU", "custom"))
         kind = None
         if std != "custom":
-            kind = _choice("[tooling] type", t.get("type", "missing"), ("B", "D"))
+            kind = _choice("[tooling] type", t.get("type", MISSING), ("B", "D"))
         body = resolve_body(std, kind, t.get("punch"), tip, tip if lower is None else lower)
         if "die_height_mm" not in t:
-            raise DesignError("[tooling] die_height_mm", "missing", "required with complete punches: no citable "
+            raise DesignError("[tooling] die_height_mm", MISSING, "required with complete punches: no citable "
                               "public die height is bundled (tabletcad/data/tooling_standards.toml)", "mm")
         if od is None:
             if body.die_outer_diameter_mm is None:
-                raise DesignError("[tooling] die_outer_diameter_mm", "missing", "required with standard = 'custom'", "mm")
+                raise DesignError("[tooling] die_outer_diameter_mm", MISSING, "required with standard = 'custom'", "mm")
             od = body.die_outer_diameter_mm
     sourced = {}
     for key, unit in (("allowed_tip_pressure_MPa", "MPa"), ("punch_youngs_modulus_MPa", "MPa")):
@@ -528,7 +528,7 @@ def parse_tooling(table: Any, base: Path | None = None) -> ToolingSpec:
             sourced[key] = check_positive(f"[tooling] {key}", t[key], unit)
             src = t.get(skey)
             if not (isinstance(src, str) and src.strip()):
-                raise DesignError(f"[tooling] {skey}", src if src is not None else "missing",
+                raise DesignError(f"[tooling] {skey}", src if src is not None else MISSING,
                                   f"must name the source of {key} (a non-empty string)")
             sourced[skey] = src
         elif skey in t:

@@ -26,7 +26,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.errors import MISSING, DesignError, check_positive, check_range
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -129,7 +129,7 @@ def _num(where: str, t: dict, key: str, entry: dict, sources: dict, lo: float | 
         v = entry[key]["value"]
         sources[key] = list(entry[key]["source"])
     else:
-        raise DesignError(f"{where} {key}", "missing", "required: no citable public value is bundled for it "
+        raise DesignError(f"{where} {key}", MISSING, "required: no citable public value is bundled for it "
                           "(tabletcad/data/tooling_standards.toml); give the toolmaker's figure", unit)
     if lo is None and hi is None and not zero_ok:
         return check_positive(f"{where} {key}", v, unit)
@@ -152,7 +152,7 @@ def resolve_body(standard: str, kind: str | None, table: Any, tip_length: float,
     src: dict = {}
     head = t.get("head", entry.get("head"))
     if head not in ("angled", "domed"):
-        raise DesignError(f"{w} head", head if head is not None else "missing",
+        raise DesignError(f"{w} head", head if head is not None else MISSING,
                           "must be 'angled' (TSM) or 'domed' (EU); required with standard = 'custom'")
     L = _num(w, t, "overall_length_mm", entry, src)
     Db = _num(w, t, "barrel_diameter_mm", entry, src)
