@@ -292,6 +292,23 @@ def test_a_plot_column_no_design_had_keeps_the_results_and_says_where(tmp_path, 
     assert sorted(p.name for p in out.iterdir()) == ["plot_volume_mm3.png", "results.csv"]
 
 
+def test_a_plot_column_every_design_leaves_empty_says_so(tmp_path, capsys):
+    """A new user's ``--plot design_report.punch_tip_check.compaction_force_kN``: a column of every report,
+    so accepted before the run, but empty in every row (the sweep's design gives no compaction force).
+    The refusal had said it was no report column, listing it among those that are."""
+    sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
+    out = tmp_path / "sw"
+    col = "design_report.punch_tip_check.compaction_force_kN"
+    rc = main(["sweep", str(sweep), "--out", str(out), "--workers", "1", "--quiet", "--plot", col])
+    err = capsys.readouterr().err.strip().splitlines()
+    n = len(pd.read_csv(out / "results.csv"))
+    assert rc == 2 and err == [f"error: --plot = '{col}' is not allowed: must be a report column with a number in "
+                               f"some design: every one of the {n} designs that built leaves it empty in results.csv "
+                               "(the input it needs is not in the sweep's design); the results are in "
+                               f"{out / 'results.csv'}: plot one with --resume"]
+    assert sorted(p.name for p in out.iterdir()) == ["results.csv"]
+
+
 def test_a_local_cluster_takes_no_fixed_port():
     """With 8787 (Dask's default HTTP port) taken, as by another sweep or a notebook, a local cluster
     starts without a warning, its scheduler's HTTP server on a free port of this machine only."""

@@ -153,6 +153,12 @@ def plot_results(df, keys: Sequence[str], outputs: Sequence[str], out_dir: str |
     numeric = [c for c in df.columns if c not in keys and c not in TAIL_COLUMNS
                and pd.to_numeric(ok[c], errors="coerce").notna().any()]
     for o in outputs:
+        if o in df.columns and o not in keys and o not in TAIL_COLUMNS and o not in numeric:
+            # a column known before the run (the first design's report has the name) but no number in any
+            # design that built (a tip rating without a compaction force): not "not a column"
+            raise DesignError("--plot", o, f"must be a report column with a number in some design: every one of the "
+                              f"{len(ok)} designs that built leaves it empty in results.csv (the input it needs is "
+                              "not in the sweep's design)")
         if o not in numeric:
             raise plot_column_error(o, numeric, keys)
     paths = []

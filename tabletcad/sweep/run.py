@@ -143,10 +143,11 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
         if plot:
             try:
                 plot_results(df, spec.keys, plot, out)
-            except DesignError as exc:  # a column no design's report had: the results stay, and say so
-                raise DesignError(exc.parameter, exc.value, exc.allowed.replace(
-                    "of results.csv:", f"of results.csv (the results are in {out / RESULTS_CSV}: plot one with "
-                    "--resume):", 1)) from None
+            except DesignError as exc:  # a column no design's report had, or none filled: the results stay, and say so
+                where = f"the results are in {out / RESULTS_CSV}: plot one with --resume"
+                allowed = exc.allowed.replace("of results.csv:", f"of results.csv ({where}):", 1) \
+                    if "of results.csv:" in exc.allowed else f"{exc.allowed}; {where}"
+                raise DesignError(exc.parameter, exc.value, allowed) from None
     return df
 
 
