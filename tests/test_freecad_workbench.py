@@ -585,6 +585,10 @@ def test_design_files(headless):
     # 1e-7 mm that Part's optimal box of the extruded B-spline walls adds)
     lo, hi = ff["upper"]["tight_bbox"][2], ff["upper"]["tight_bbox"][5]
     assert (lo, hi) == (pytest.approx(3.0, abs=2e-7), pytest.approx(13.0, abs=2e-7))
+    # and it is made without the tablet's solid (given None, which the cut would have failed on)
+    (prism,) = _steps(headless, "flat_rim_prism")
+    assert prism["made"] and prism["valid"], prism.get("error")
+    assert prism["volume"] == pytest.approx(prism["upper_volume"], rel=1e-12)
 
 
 def test_save_reopen_recompute(headless):

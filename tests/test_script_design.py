@@ -71,6 +71,18 @@ def test_the_tables_are_read_only_and_the_design_hashes_by_them():
     assert Design.from_dict(copy).tablet["diameter"] == 11.0 and d.tablet["diameter"] == 10.0
     same = Design.from_dict({"tooling": d.to_dict()["tooling"], "tablet": dict(reversed(list(d.tablet.items())))})
     assert same == d and hash(same) == hash(d) and len({d, same, Design.from_dict(copy)}) == 2
+    # equal designs hash alike whatever the numbers' types and zeros' signs (a review: 10 against 10.0)
+    ints = Design.from_dict({"tablet": {"family": "concave_round", "diameter": 10, "band": 2, "cup_depth": 1},
+                             "trim": {"v": [-0.0, 3.0]}})
+    floats = Design.from_dict({"tablet": {"family": "concave_round", "diameter": 10.0, "band": 2.0, "cup_depth": 1.0},
+                               "trim": {"v": [0.0, 3.0]}})
+    assert ints == floats and hash(ints) == hash(floats) and len({ints, floats}) == 1
+    import copy as copying
+
+    for dup in (copying.copy(d), copying.deepcopy(d)):  # a copy is the same read-only value
+        assert dup == d
+        with pytest.raises(TypeError, match="read-only"):
+            dup.tablet["diameter"] = 12.0
     back = pickle.loads(pickle.dumps(d))  # (sweeps send designs to their workers)
     assert back == d and isinstance(back.tablet, dict) and back.build().volume() == pytest.approx(m.volume, rel=1e-15)
     with pytest.raises(TypeError, match="read-only"):

@@ -285,7 +285,7 @@ def test_a_plot_column_no_design_had_keeps_the_results_and_says_where(tmp_path, 
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1
     assert err[0].startswith("error: --plot = 'design_report.cup_radii_mm.central' is not allowed: must be a report "
-                             f"column of results.csv (the results are in {out / 'results.csv'}: plot one with --resume): ")
+                             f"column of results.csv (the results are in {out / 'results.csv'}: plot another column with --resume): ")
     assert sorted(p.name for p in out.iterdir()) == ["results.csv"]
     assert main(["sweep", str(sweep), "--out", str(out), "--workers", "1", "--quiet", "--resume", "--plot",
                  "volume_mm3"]) == 0
@@ -305,7 +305,7 @@ def test_a_plot_column_every_design_leaves_empty_says_so(tmp_path, capsys):
     assert rc == 2 and err == [f"error: --plot = '{col}' is not allowed: must be a report column with a number in "
                                f"some design: every one of the {n} designs that built leaves it empty in results.csv "
                                "(the input it needs is not in the sweep's design); the results are in "
-                               f"{out / 'results.csv'}: plot one with --resume"]
+                               f"{out / 'results.csv'}: plot another column with --resume"]
     assert sorted(p.name for p in out.iterdir()) == ["results.csv"]
 
 

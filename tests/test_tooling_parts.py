@@ -58,21 +58,86 @@ def _whole_optimal_z(shape):
     return box.CornerMin().Z(), box.CornerMax().Z()
 
 
+def _bumped_solid_of_revolution(plateau: float | None = None):
+    """A solid of revolution (``BRepPrimAPI_MakeRevol``) whose B-spline profile has a narrow bump, so that
+    its face of revolution peaks between the samples of OCC's quick box, topped by a flat disc at
+    ``plateau`` (mm); returns ``(solid, face of revolution)``."""
+    import numpy as np
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeRevol
+    from OCP.GeomAbs import GeomAbs_SurfaceType
+    from OCP.GeomAPI import GeomAPI_PointsToBSpline
+    from OCP.TColgp import TColgp_Array1OfPnt
+    from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt
+
+    from tabletcad.cad._occ import explore
+
+    r = np.linspace(5.0, 2.0, 41)
+    z = 1.0 + 0.1 * r + 0.6 * np.exp(-(((r - 3.37) / 0.08) ** 2))
+    arr = TColgp_Array1OfPnt(1, r.size)
+    for i, (ri, zi) in enumerate(zip(r, z), start=1):
+        arr.SetValue(i, gp_Pnt(float(ri), 0.0, float(zi)))
+    top = 1.5 if plateau is None else plateau
+
+    def seg(a, b):
+        return BRepBuilderAPI_MakeEdge(gp_Pnt(a[0], 0.0, a[1]), gp_Pnt(b[0], 0.0, b[1])).Edge()
+
+    end = (float(r[-1]), float(z[-1]))
+    wire = BRepBuilderAPI_MakeWire()
+    for e in (seg((0, 0), (5, 0)), seg((5, 0), (5.0, float(z[0]))), BRepBuilderAPI_MakeEdge(GeomAPI_PointsToBSpline(arr).Curve()).Edge(),
+              seg(end, (end[0], top)), seg((end[0], top), (0, top)), seg((0, top), (0, 0))):
+        wire.Add(e)
+    solid = BRepPrimAPI_MakeRevol(BRepBuilderAPI_MakeFace(wire.Wire(), True).Face(),
+                                  gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1))).Shape()
+    (face,) = [f for f in explore(solid, "Face")
+               if BRepAdaptor_Surface(f).GetType() == GeomAbs_SurfaceType.GeomAbs_SurfaceOfRevolution]
+    return solid, face
+
+
 def test_tight_z_range_is_occs_optimal_box_of_the_whole_solid(thesis):
-    """The faces' optimal boxes, only where their pole hulls reach past the extremes found so far, give
-    the box OCC computes for the whole solid bit for bit: on the thesis tooling's parts (faces of
-    revolution, a punch's Boolean faces) and on the capsule sample's B-spline solid (36 faces, its
-    cups cut at the outline's joins); a side not asked for is None."""
+    """Faces' optimal boxes, a B-spline face's only where its pole hull (widened by its edges'
+    tolerance) reaches past the extremes found so far, give the box OCC computes for the whole shape
+    bit for bit: on the thesis tooling's parts (B-spline faces, a punch's Boolean faces), the capsule
+    sample's B-spline solid (36 faces, its cups cut at the outline's joins), the concave round's solid
+    with faces of revolution, a solid of revolution whose bump peaks between the samples of its face's
+    quick box under a plateau between that box and the peak (a review: the quick box of a face of
+    revolution is sampled, not a hull, and the peak was missed), and a compound with a free edge and a
+    free vertex beyond its box; a side not asked for is None."""
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+    from OCP.TopoDS import TopoDS_Compound
+    from OCP.gp import gp_Pnt
+
     from tabletcad.cad.tablet_solid import tablet_solid
     from tabletcad.tooling.punch import tight_z_range
 
     capsule = tablet_solid(load_design(ROOT / "samples" / "families" / "capsule.toml")).shape
-    for name, shape in [*thesis.parts.items(), ("capsule", capsule)]:
+    revolved = tablet_solid(load_design(ROOT / "samples" / "families" / "concave_round.toml")).shape
+    _, face = _bumped_solid_of_revolution()
+    quick, best = Bnd_Box(), Bnd_Box()
+    BRepBndLib.Add_s(face, quick, False)
+    BRepBndLib.AddOptimal_s(face, best, False, False)
+    assert quick.CornerMax().Z() < best.CornerMax().Z() - 1e-3  # the sampled quick box misses the peak
+    bumped, _ = _bumped_solid_of_revolution(0.5 * (quick.CornerMax().Z() + best.CornerMax().Z()))
+    loose = TopoDS_Compound()
+    builder = BRep_Builder()
+    builder.MakeCompound(loose)
+    builder.Add(loose, BRepPrimAPI_MakeBox(1.0, 1.0, 1.0).Shape())
+    builder.Add(loose, BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, 5), gp_Pnt(1, 0, 6)).Edge())
+    builder.Add(loose, BRepBuilderAPI_MakeVertex(gp_Pnt(0, 0, -3)).Vertex())
+    shapes = [*thesis.parts.items(), ("capsule", capsule), ("concave round", revolved), ("bump", bumped),
+              ("loose", loose)]
+    for name, shape in shapes:
         lo, hi = _whole_optimal_z(shape)
         assert tight_z_range(shape) == (lo, hi), name
         assert tight_z_range(shape, high=False) == (lo, None), name
         assert tight_z_range(shape, low=False) == (None, hi), name
-    assert hi - lo == pytest.approx(3.2 + 2 * 1.3, abs=1e-6)  # the capsule sample's band and two cups
+    assert _whole_optimal_z(bumped)[1] == best.CornerMax().Z() and _whole_optimal_z(loose) == (-3.0, 6.0)
+    assert _whole_optimal_z(capsule)[1] - _whole_optimal_z(capsule)[0] == pytest.approx(3.2 + 2 * 1.3, abs=1e-6)
 
 
 def test_closed_position_encloses_exactly_the_tablet(thesis):

@@ -369,6 +369,15 @@ try:
         upper=shape_info(d2up),
     )
 
+    # ---- the free-form stadium's flat top lies on its rim's plane: its tip is the prism alone, made
+    # without touching the tablet's solid (None here: the cut would raise)
+    try:
+        bare = wb_geometry.punch_shape(None, wb_geometry.rims_from_json(d2.RimData), "upper", 10.0, 0.025)
+        prism = dict(made=True, valid=bool(bare.isValid()), volume=float(bare.Volume))
+    except Exception as exc:  # noqa: BLE001 - recorded for the test
+        prism = dict(made=False, error=repr(exc))
+    step("flat_rim_prism", upper_volume=float(d2up.Shape.Volume), **prism)
+
     # ---- a document of an earlier version: its die held the clearance (0.05 mm), its punch none
     d2up.removeProperty("Clearance")
     d2die.addProperty("App::PropertyLength", "Clearance", "Die", "radial clearance (an earlier version's)")

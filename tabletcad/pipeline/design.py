@@ -229,6 +229,19 @@ class TableList(_ReadOnly, list):
         return TableList, (list(self),)
 
 
+def _table_hash(value: Any) -> int:
+    """A hash of a table consistent with ``==`` on it: Python's own for scalars (``hash(10) ==
+    hash(10.0)``, ``hash(0.0) == hash(-0.0)``), order-free for a table's keys, in order for a list."""
+    if isinstance(value, dict):
+        return hash(frozenset((k, _table_hash(v)) for k, v in value.items()))
+    if isinstance(value, (list, tuple)):
+        return hash(tuple(_table_hash(v) for v in value))
+    try:
+        return hash(value)
+    except TypeError:  # (an array given to Design() directly)
+        return hash(repr(value))
+
+
 def _read_only(value: Any) -> Any:
     """``value`` with every dict and list in it read-only (:class:`TableDict`, :class:`TableList`)."""
     if isinstance(value, dict):
@@ -289,8 +302,14 @@ class Design:
         object.__setattr__(self, "tooling_spec",
                            None if self.tooling is None else parse_tooling(self.tooling, base=self.folder))
 
-    def __hash__(self) -> int:  # of the tables, as == compares them (key order aside)
-        return hash(json.dumps(self.to_dict(), sort_keys=True, default=repr))
+    def __hash__(self) -> int:  # of the tables, as == compares them: 10 and 10.0, 0.0 and -0.0 hash alike
+        return hash(tuple(_table_hash(getattr(self, t)) for t in ("tablet", "patch", *_TABLES)))
+
+    def __copy__(self) -> Design:  # a value: its tables are read-only, so a copy is itself
+        return self
+
+    def __deepcopy__(self, memo) -> Design:  # (a deep copy had made the tables plain, changeable dicts)
+        return self
 
     @property
     def name(self) -> str:

@@ -144,7 +144,7 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
             try:
                 plot_results(df, spec.keys, plot, out)
             except DesignError as exc:  # a column no design's report had, or none filled: the results stay, and say so
-                where = f"the results are in {out / RESULTS_CSV}: plot one with --resume"
+                where = f"the results are in {out / RESULTS_CSV}: plot another column with --resume"
                 allowed = exc.allowed.replace("of results.csv:", f"of results.csv ({where}):", 1) \
                     if "of results.csv:" in exc.allowed else f"{exc.allowed}; {where}"
                 raise DesignError(exc.parameter, exc.value, allowed) from None

@@ -103,33 +103,57 @@ def tight_z_range(shape, *, low: bool = True, high: bool = True) -> tuple[float 
     extrema, not their poles or a tolerance-widened box); a side not asked for (``low``/``high``
     false) is None.
 
-    The optimal box of a solid is the union of its faces' (every edge bounds a face): a face's is
-    only computed where its quick box (the hull of its poles, which contains the face) reaches past
-    the extremes found so far, the faces reaching farthest first.  The result is the whole solid's
-    box to the last bit (tests/test_tooling_parts.py); a punch tip needs one side, and most of its
-    faces (0.1-0.5 s of OCC's optimisation each solid) lie within it."""
+    OCC's optimal box of a shape is the union of its faces' (and of any edge or vertex that bounds
+    no face).  Here a B-spline or Bézier face's optimal box is only computed where its quick box (the
+    hull of its poles, which contains the surface), widened by the face's largest edge or vertex
+    tolerance (how far its edges' curves may leave the surface), reaches past the extremes found so
+    far, the faces reaching farthest first; every other face (whose quick box is made from samples
+    of the surface, which can miss a bump) is always computed.  A shape with free edges or vertices
+    takes OCC's box of the whole shape.  The result equals that box (tests/test_tooling_parts.py);
+    a punch tip needs one side, and most of its B-spline faces (0.1-0.5 s of OCC's optimisation
+    each solid) lie within it."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
+    from OCP.GeomAbs import GeomAbs_SurfaceType
+    from OCP.TopAbs import TopAbs_ShapeEnum
+    from OCP.TopExp import TopExp_Explorer
 
     from tabletcad.cad._occ import explore
 
-    faces = []
-    for f in explore(shape, "Face"):
-        quick = Bnd_Box()
-        BRepBndLib.Add_s(f, quick, False)
-        faces.append((quick.CornerMin().Z(), quick.CornerMax().Z(), f))
-    if not faces:  # (edges or vertices alone: the whole shape's box)
+    def free(kind, outside) -> bool:  # a sub-shape of ``kind`` not inside any ``outside``
+        return TopExp_Explorer(shape, kind, outside).More()
+
+    def optimal(s) -> Bnd_Box:
         box = Bnd_Box()
-        BRepBndLib.AddOptimal_s(shape, box, False, False)
+        BRepBndLib.AddOptimal_s(s, box, False, False)
+        return box
+
+    faces = explore(shape, "Face")
+    if not faces or free(TopAbs_ShapeEnum.TopAbs_EDGE, TopAbs_ShapeEnum.TopAbs_FACE) \
+            or free(TopAbs_ShapeEnum.TopAbs_VERTEX, TopAbs_ShapeEnum.TopAbs_EDGE):
+        box = optimal(shape)
         return (box.CornerMin().Z() if low else None), (box.CornerMax().Z() if high else None)
-    q_lo, q_hi = min(f[0] for f in faces), max(f[1] for f in faces)
-    faces.sort(key=lambda f: min(f[0] - q_lo if low else math.inf, q_hi - f[1] if high else math.inf))
+    hull_kinds = (GeomAbs_SurfaceType.GeomAbs_BSplineSurface, GeomAbs_SurfaceType.GeomAbs_BezierSurface)
+    entries = []
+    for f in faces:
+        if BRepAdaptor_Surface(f, False).GetType() in hull_kinds:
+            quick = Bnd_Box()
+            BRepBndLib.Add_s(f, quick, False)
+            tol = max([BRep_Tool.Tolerance_s(e) for e in explore(f, "Edge")]
+                      + [BRep_Tool.Tolerance_s(v) for v in explore(f, "Vertex")] + [0.0])
+            entries.append((quick.CornerMin().Z() - tol, quick.CornerMax().Z() + tol, f))
+        else:
+            entries.append((-math.inf, math.inf, f))
+    q_lo, q_hi = min(e[0] for e in entries), max(e[1] for e in entries)
+    entries.sort(key=lambda e: min(e[0] - q_lo if low else math.inf, q_hi - e[1] if high else math.inf))
     lo, hi = math.inf, -math.inf
-    for f_lo, f_hi, face in faces:
-        if (low and f_lo < lo) or (high and f_hi > hi):
-            box = Bnd_Box()
-            BRepBndLib.AddOptimal_s(face, box, False, False)
-            lo, hi = min(lo, box.CornerMin().Z()), max(hi, box.CornerMax().Z())
+    for f_lo, f_hi, face in entries:
+        if (low and f_lo <= lo) or (high and f_hi >= hi):
+            box = optimal(face)
+            if not box.IsVoid():  # (a face of a triangulation alone: OCC's whole box skips it too)
+                lo, hi = min(lo, box.CornerMin().Z()), max(hi, box.CornerMax().Z())
     return (lo if low else None), (hi if high else None)
 
 
