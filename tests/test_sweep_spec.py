@@ -202,6 +202,13 @@ def test_a_fixed_dimension_no_design_could_take_is_refused_before_the_sweep(tmp_
     _refused_up_front(tmp_path, capsys, f'land = {land!r}\n'.replace("'", '"'), line)
 
 
+@pytest.mark.parametrize("a", [2.0, 0.0, -1.0])
+def test_a_fixed_smoothing_parameter_outside_its_range_is_refused_before_the_sweep(tmp_path, capsys, a):
+    """A new user's fixed ``a = 2``: every design had failed on it (exit 0, "0 ok, 3 failed")."""
+    _refused_up_front(tmp_path, capsys, f"a = {a!r}\n", f"error: design.tablet.a = {a:g} is not allowed: must be > 0 "
+                      "and <= 1")
+
+
 def _refused_up_front(tmp_path, capsys, body: str, line: str) -> None:
     """The sample base with ``body`` added and its cup depth varied: one line starting ``line``, exit 2,
     no output folder."""

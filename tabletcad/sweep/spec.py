@@ -188,12 +188,22 @@ def _check_family_keys(design: dict) -> None:
 def _check_fixed_dimensions(design: dict, varied: set[str]) -> None:
     """Refuse a dimension of ``[design.tablet]`` that the sweep does not vary and that no design could
     take, whatever the varied values: not a number, not finite, beyond the size limit, below the
-    smallest length, or a negative length (every family's lengths are >= 0).  Every row would fail."""
+    smallest length, or a negative length (every family's lengths are >= 0); and a smoothing parameter
+    ``a`` outside (0, 1] (the range of every design).  Every row would fail.  A value that one family
+    refuses by its own rules (a concave round's band of 0) is left to the rows: whether it fails can
+    depend on the varied values."""
     from tabletcad.pipeline.design import _number
 
     fam = _family_of(design)
     if fam is None:
         return
+    a = design["tablet"].get("a")
+    if a is not None and a != "auto" and "tablet.a" not in varied:  # the smoothing parameter: one range for all
+        from tabletcad.errors import check_range
+
+        x = _number("design.tablet.a", a)
+        if not 0.0 < x <= 1.0:
+            check_range("design.tablet.a", x, 0.0, 1.0, lo_open=True)
     for k, v in design["tablet"].items():
         if k in fam.params and f"tablet.{k}" not in varied:
             where = f"design.tablet.{k}"
