@@ -312,6 +312,24 @@ def test_header_roles_and_units(header, role, unit):
     assert unit is None or unit not in strip_unit(header).split()
 
 
+@pytest.mark.parametrize("header, unit", [("Force/kN", "kN"), ("Force [kN] upper", "kN"), ("Force (kN) upper punch", "kN"),
+                                          ("Displacement/µm", "µm"), ("Upper punch kN force", "kN"),
+                                          ("Displacement in mm of the punch", "mm")])
+def test_a_unit_where_the_header_is_not_read_for_one_is_refused(tmp_path, header, unit):
+    """A new user's ``Force/kN`` and ``Force [kN] upper``: no unit was read there, so the forces in kN were taken
+    as N (K 9.632 1/MPa for 0.008557) with only a warning on Py.  Refused now, naming the column and its unit;
+    a name whose words are also unit symbols (``in``, ``m``, ``min``) is not (the cases above)."""
+    assert strip_unit(header)  # (the role is still found from the name)
+    with pytest.raises(DesignError) as e:
+        header_unit(header)
+    assert e.value.parameter == "column" and e.value.value == header
+    assert f"states the unit {unit!r} where tabletcad does not read one" in str(e.value)
+    other = "Displacement (mm)" if unit == "kN" else "Force (N)"
+    p = _write(tmp_path, f"{header};{other}\n" + "\n".join(f"{k},5;{k}" for k in range(1, 4)) + "\n")
+    with pytest.raises(DesignError, match="where tabletcad does not read one"):
+        read_press_data(p, **META)
+
+
 def test_cp1252_micro_sign_comments_and_inch(tmp_path):
     text = "# exported by a press\r\nZeit [s]\tKraft\tForce (lbf)\tGap (\u00b5m)\r\n# note\r\n0\t0\t10\t5000\r\n0,1\t0\t20\t4900\r\n"
     p = tmp_path / "w.tsv"

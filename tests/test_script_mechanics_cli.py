@@ -202,6 +202,11 @@ def test_profiles_read_a_solid_fraction_in_percent_and_a_strength_in_kpa(capsys,
     assert rc == 0, err
     rd = json.loads(out)["ryshkewitch_duckworth"]
     assert rd["sigma0_MPa"] == pytest.approx(SIGMA0, rel=1e-9) and rd["k"] == pytest.approx(K, rel=1e-9)
+    # without the options: the default names (pressure, solid_fraction, tensile_strength) find the headers
+    # whose words are spaced (a new user's "Solid fraction (%)" had been "not one of the header's columns")
+    rc, out2, err = run(capsys, "profiles", data, "--json")
+    assert rc == 0, err
+    assert json.loads(out2)["ryshkewitch_duckworth"] == rd
 
 
 @pytest.mark.parametrize("header, line", [

@@ -408,7 +408,8 @@ def read_columns(path: str | Path, columns: Mapping[str, tuple[str, str]]) -> di
     its header and converted (``Pressure (kPa)``, ``thickness_um``, ``Solid fraction (%)``).
 
     ``columns`` maps a key to ``(header, dimension)``: the header is found case-insensitively, as
-    written or by its name without the unit (``pressure_MPa`` finds ``Pressure (kPa)``); the
+    written or by its name without the unit, spaces, underscores and hyphens alike (``pressure_MPa``
+    finds ``Pressure (kPa)``, ``solid_fraction`` finds ``Solid fraction (%)``); the
     dimension (``"pressure"``, ``"length"``, ``"fraction"``) gives the units a header may state and the
     unit taken when it states none (:data:`TABLE_UNITS`: MPa, mm, a fraction).  Returns the columns in
     MPa, mm or as fractions, and ``_lines`` (each row's line number in the file).
@@ -426,13 +427,16 @@ def read_columns(path: str | Path, columns: Mapping[str, tuple[str, str]]) -> di
     names = [h.lower() for h in header]
     decimal_comma = delim != "," and any("," in c for col in by_column for c in col[:50])
     out: dict[str, np.ndarray] = {}
-    bare = [strip_unit(h).lower() for h in header]
+    def word(text: str) -> str:  # "Solid fraction", "solid_fraction" and "solid-fraction" are one name
+        return re.sub(r"[\s_\-]+", "_", strip_unit(text).strip().lower())
+
+    bare = [word(h) for h in header]
     for key, (name, dimension) in columns.items():
         want = name.strip().lower()
         if want in names:  # the header as written, else the one header of that name in any unit
             j = names.index(want)
-        elif bare.count(strip_unit(name).lower()) == 1:
-            j = bare.index(strip_unit(name).lower())
+        elif bare.count(word(name)) == 1:
+            j = bare.index(word(name))
         else:
             raise DesignError("column", name, f"must be one of the header's columns of {path.name} (or its name "
                               f"without the unit): {', '.join(header)}")

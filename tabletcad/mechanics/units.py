@@ -90,7 +90,30 @@ def header_unit(header: str) -> str | None:
         unit = _normalise(m.group(1))
         return None if unit.lower() in _NO_UNIT else unit
     m = _trailing(header)
-    return None if m is None else _normalise(m.group(2))
+    if m is not None:
+        return _normalise(m.group(2))
+    _refuse_misplaced_unit(header)
+    return None
+
+
+#: a bracket anywhere in a header, and its words (a unit may stand inside a longer name)
+_ANY_BRACKET = re.compile(r"[\(\[]\s*([^\)\]]*?)\s*[\)\]]")
+_WORD = re.compile(r"[A-Za-zµμ%²]+(?:/[A-Za-z²]+)?")
+#: unit symbols that are also words of column names (``position in``, ``max force``): never a unit inside a name
+_ALSO_WORDS = {"in", "inch", "m", "h", "s", "sec", "min"}
+
+
+def _refuse_misplaced_unit(header: str) -> None:
+    """Refuse a header that states a unit where :func:`header_unit` does not read one (``Force/kN``,
+    ``Force [kN] upper``): read as no unit, the column would take the default (N, mm) and a record in
+    kN be read 1000 times too small."""
+    found = [g for g in _ANY_BRACKET.findall(header) if _normalise(g).lower() not in _NO_UNIT]
+    words = [w for part in re.split(r"[/\s_,;:|\-]+", header) for w in _WORD.findall(part)]
+    found += [w for w in words if _normalise(w) in UNITS and _normalise(w) not in _ALSO_WORDS]
+    if found:
+        raise DesignError("column", header, f"states the unit {found[0]!r} where tabletcad does not read one: write "
+                          "it at the end of the header, in brackets ('Force [kN]') or after an underscore ('force_kN'), or give it as "
+                          "an option where the command takes one (--force-unit)")
 
 
 def strip_unit(header: str) -> str:
