@@ -146,3 +146,7 @@ MAX_EFFECTIVE_LENGTH_FACTOR = 10.0
 #: The largest tensile strength (MPa) a breaking-force prediction or a design's ``[report]`` takes:
 #: pharmaceutical compacts break at 0.1-10 MPa, and one typed in pascals (2e6) had been taken.
 MAX_TENSILE_STRENGTH_MPA = 1000.0
+#: The largest machine compliance (mm/N) a press record's correction takes: press frames and punches
+#: deflect about 2e-5 mm/N (the thesis's Appendix B); 1e-3 is a millimetre per kilonewton.  A
+#: calibration typed in kN (0.02 mm/N) had been taken, and 1e300 gave a Heckel slope of -2.6e-303.
+MAX_COMPLIANCE_MM_PER_N = 1e-3

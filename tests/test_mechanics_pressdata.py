@@ -124,9 +124,18 @@ def test_bad_files(tmp_path, text, match):
         read_press_data(_write(tmp_path, text), **META)
 
 
-@pytest.mark.parametrize("key,value,match", [("mass_mg", 0.0, "must be > 0"), ("true_density", -1.3, "must be >= 0.1"),
-                                             ("true_density", 0.00154, "must be >= 0.1 and <= 25"),  # g/mm³
-                                             ("diameter", 0.0, "must be > 0")])
+@pytest.mark.parametrize("key,value,match", [
+    ("mass_mg", 0.0, "must be > 0"), ("true_density", -1.3, "must be >= 0.1"),
+    ("true_density", 0.00154, "must be >= 0.1 and <= 25"),  # g/mm³
+    ("diameter", 0.0, "must be > 0"),
+    # a new user's compliances: 1e300 mm/N had given K = -2.6e-303, an offset of 1e300 mm Py = inf, a
+    # negative slope a thickness of -3.9e300 mm, and a calibration typed in kN K = -0.0024 1/MPa
+    ("compliance", (1e300, 0.0), r"compliance\.slope = 1e\+300 mm/N is not allowed: must be >= 0 and <= 0\.001"),
+    ("compliance", (0.0, 1e300), r"compliance\.offset = 1e\+300 mm is not allowed: must be >= -1000 and <= 1000"),
+    ("compliance", (-2e-5, 0.0), r"compliance\.slope = -2e-05 mm/N is not allowed"),
+    ("compliance", {"force": [0.0, 10.0], "deflection": [0.0267, 0.2267]},
+     r"compliance\.table = '0\.2 mm over 0-10 N' is not allowed: must deflect at most 0\.001 mm/N"),
+])
 def test_bad_metadata(tmp_path, key, value, match):
     p = _write(tmp_path, "force,displacement\n1,-5\n2,-4.9\n3,-4.8\n")
     with pytest.raises(DesignError, match=match):

@@ -66,7 +66,7 @@ import tomllib
 from tabletcad.errors import MISSING, DesignError, check_finite, check_range
 from tabletcad.tolerance import DEFAULT
 from tabletcad.mechanics.units import DIMENSIONS, header_unit, strip_unit, unit_factor
-from tabletcad.tolerance import MAX_TRUE_DENSITY_MG_MM3, MIN_TRUE_DENSITY_MG_MM3
+from tabletcad.tolerance import MAX_COMPLIANCE_MM_PER_N, MAX_TRUE_DENSITY_MG_MM3, MIN_TRUE_DENSITY_MG_MM3
 from tabletcad.mechanics.validity import DataWarning, warn
 
 __all__ = [
@@ -107,8 +107,8 @@ class MachineCompliance:
     table_deflection: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
-        check_finite("compliance slope", self.slope, "mm/N")
-        check_finite("compliance offset", self.offset, "mm")
+        check_range("compliance slope", self.slope, 0.0, MAX_COMPLIANCE_MM_PER_N, "mm/N")
+        check_range("compliance offset", self.offset, -DEFAULT.max_length, DEFAULT.max_length, "mm")
         if len(self.table_force) != len(self.table_deflection):
             raise DesignError(
                 "compliance table", f"{len(self.table_force)} forces, {len(self.table_deflection)} deflections",
@@ -121,6 +121,14 @@ class MachineCompliance:
                 raise DesignError("compliance table", f.size, "needs >= 2 finite (force, deflection) pairs")
             if np.any(np.diff(f) <= 0):
                 raise DesignError("compliance table force", list(f), "must be strictly increasing", "N")
+            for x in d:
+                check_range("compliance table deflection", float(x), -DEFAULT.max_length, DEFAULT.max_length, "mm")
+            steep = np.abs(np.diff(d) / np.diff(f))
+            if np.any(steep > MAX_COMPLIANCE_MM_PER_N):
+                k = int(np.argmax(steep))
+                raise DesignError("compliance table", f"{d[k + 1] - d[k]:.4g} mm over {f[k]:.4g}-{f[k + 1]:.4g} N",
+                                  f"must deflect at most {MAX_COMPLIANCE_MM_PER_N:g} mm/N between its rows (a press "
+                                  "frame's is about 2e-5): forces in N, deflections in mm")
 
     @classmethod
     def from_compensation_line(cls, slope: float, intercept: float) -> MachineCompliance:
