@@ -455,3 +455,15 @@ def test_heckel_with_diameter_beside_a_files_face_area_fits_with_the_diameter(tm
     assert main(["heckel", str(SAMPLE), "--meta", str(meta), "--diameter", "10", "--json"]) == 0
     got = json.loads(capsys.readouterr().out)
     assert got["K_per_MPa"] == want["K_per_MPa"] and got["A"] == want["A"]
+
+
+def test_a_record_no_powder_could_give_is_refused():
+    """A new user's mass in grams (0.3 for 300 mg): a relative density of at most 0.0008, which no powder bed
+    has, and Py = 3.6e5 MPa with a warning, exit 0.  Refused now, naming the relative density and what to check;
+    the same record with its own metadata fits as before (K = 0.008557 1/MPa on the automatic window)."""
+    fit = fit_heckel(compaction_curves(read_press_data(SAMPLE)))
+    assert fit.K_per_MPa == pytest.approx(0.008557, abs=5e-7)
+    with pytest.raises(DesignError) as e:
+        compaction_curves(read_press_data(SAMPLE, mass_mg=0.3))
+    assert e.value.parameter == "relative_density" and e.value.value == "at most 0.000819"
+    assert "check the mass (mg, not g)" in str(e.value)

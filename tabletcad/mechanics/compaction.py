@@ -110,6 +110,23 @@ def split_branches(force, drop: float = 0.02) -> Branches:
     return Branches(loading=(0, peak + 1), unloading=(peak + 1, stop), peak=peak, reloading_from=reload_from)
 
 
+#: The least relative density a press record must reach under load: no powder bed is that loose (it starts
+#: near 0.3).  A mass typed in grams (0.3 for 300 mg) gave 0.0006 and Py = 3.6e5 MPa, exit 0.
+MIN_PEAK_RELATIVE_DENSITY = 0.05
+
+
+def check_peak_relative_density(D) -> None:
+    """Refuse relative densities (under load) whose largest is below :data:`MIN_PEAK_RELATIVE_DENSITY`:
+    a mass in grams, a density or a diameter in the wrong unit, or a displacement in µm read as mm."""
+    D = np.asarray(D, dtype=float)
+    D = D[np.isfinite(D)]
+    if D.size and float(np.max(D)) < MIN_PEAK_RELATIVE_DENSITY:
+        raise DesignError("relative_density", f"at most {float(np.max(D)):.3g}",
+                          f"must reach {MIN_PEAK_RELATIVE_DENSITY:g} under load (a powder bed starts near 0.3, a "
+                          "compact reaches 0.7-1): check the mass (mg, not g), the true density (mg/mm³), the die "
+                          "diameter (mm) and the displacement's unit")
+
+
 def relative_density(thickness, mass_mg: float, true_density: float, area: float) -> np.ndarray:
     """Relative density ``D = m / (ρ_true A h)`` (eq 2.3), dimensionless.
 
@@ -199,6 +216,7 @@ def compaction_curves(
     h = np.asarray(data.thickness, dtype=float)
     D = relative_density(h, meta.mass_mg, meta.true_density, meta.area)
     branches = split_branches(data.force, drop=drop)
+    check_peak_relative_density(D[slice(*branches.loading)])
     over = D >= 1.0
     with np.errstate(divide="ignore", invalid="ignore"):
         H = np.where(over, np.nan, -np.log1p(-np.where(over, 0.0, D)))

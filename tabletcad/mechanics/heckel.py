@@ -63,7 +63,7 @@ from pathlib import Path
 import numpy as np
 
 from tabletcad.errors import MISSING, DesignError, check_positive, check_range
-from tabletcad.mechanics.compaction import CompactionCurves
+from tabletcad.mechanics.compaction import CompactionCurves, check_peak_relative_density
 from tabletcad.mechanics.validity import FitQualityWarning, warn
 
 __all__ = ["PY_PLAUSIBLE_MPA", "HeckelFit", "fit_heckel", "fit_heckel_arrays", "heckel_noise_sd", "plot_heckel"]
@@ -318,6 +318,7 @@ def fit_heckel_arrays(
         if relative_density is None:
             raise DesignError("relative_density", MISSING, "give relative_density or heckel")
         D = np.asarray(relative_density, dtype=float).ravel()
+        check_peak_relative_density(D[np.isfinite(P) & (P > 0)] if D.size == P.size else D)
         with np.errstate(divide="ignore", invalid="ignore"):
             H = np.where(D < 1.0, -np.log1p(-np.minimum(D, 1.0 - 1e-300)), np.nan)
     else:
