@@ -150,3 +150,9 @@ MAX_TENSILE_STRENGTH_MPA = 1000.0
 #: deflect about 2e-5 mm/N (the thesis's Appendix B); 1e-3 is a millimetre per kilonewton.  A
 #: calibration typed in kN (0.02 mm/N) had been taken, and 1e300 gave a Heckel slope of -2.6e-303.
 MAX_COMPLIANCE_MM_PER_N = 1e-3
+#: The largest Young's modulus (MPa) an analysis takes: above every solid's (diamond 1.2e6); E = 1e300
+#: had given shell displacements of 1e-297 mm and a Heckel Py of inf (love).
+MAX_MODULUS_MPA = 1e7
+#: The largest pressure (MPa) a mechanics model takes: a hundred times any tool steel's strength; a platen
+#: pressure of 1e300 had given a shell displacement of -7.5e297 mm, exit 0.
+MAX_PRESSURE_MPA = 1e5

@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from tabletcad.cli import main
@@ -56,6 +57,10 @@ def test_heckel_options_replace_metadata_file(capsys, tmp_path):
         (["--true-density", "0"], "--true-density = 0"),
         (["--diameter", "0"], "diameter"),
         (["--window", "10", "10.5"], "need >= 3"),
+        # a new user's trial: each of these had been exit 0 (K = -2.6e-303; Py = inf; D 0.0008, Py 3.6e5 MPa)
+        (["--compliance", "1e300", "0"], "--compliance = 1e+300 mm/N is not allowed: must be >= 0 and <= 0.001 mm/N"),
+        (["--compliance", "0", "1e300"], "--compliance = 1e+300 mm is not allowed: must be >= -1000 and <= 1000 mm"),
+        (["--mass", "0.3"], "relative_density = 'at most 0.000819' is not allowed: must reach 0.05 under load"),
     ],
 )
 def test_heckel_bad_input_exit_2_and_no_file(capsys, tmp_path, extra, match):
@@ -299,3 +304,32 @@ def test_fuzzed_press_files_keep_the_one_line_contract(capsys, tmp_path, body, w
         assert not plot.exists()
     else:
         assert math.isfinite(json.loads(out)["K_per_MPa"])
+
+
+@pytest.mark.parametrize("cmd, line", [
+    (["shell", "--outer", "5", "--inner", "4", "--E", "1000", "--nu", "0.3", "--p-ext", "1e300"],
+     "error: --p-ext = 1e+300 MPa is not allowed: must be >= -100000 and <= 100000 MPa"),
+    (["shell", "--outer", "5", "--inner", "4", "--E", "1e300", "--nu", "0.3", "--p-ext", "10"],
+     "error: --E = 1e+300 MPa is not allowed: must be > 0 and <= 1e+07 MPa"),
+    (["love", "--E", "1e300"], "error: --E = 1e+300 MPa is not allowed: must be > 0 and <= 1e+07 MPa"),
+    (["love", "--z", "10"], "error: --z = 10 mm is not allowed: must be >= 0 and <= 6 mm"),
+])
+def test_absurd_moduli_pressures_and_heights_are_refused(capsys, cmd, line):
+    """A new user's trial: a platen pressure of 1e300 MPa gave u_r = -7.5e297 mm, E = 1e300 a Heckel Py of
+    inf (printed into the JSON as Infinity), and a height above the 6 mm bed K = -0.015 1/MPa: all exit 0."""
+    rc, out, err = run(capsys, *cmd)
+    assert rc == 2 and err.strip().splitlines() == [line] and out == ""
+
+
+def test_json_is_strict_json_where_a_figure_is_not_finite(capsys):
+    """A Heckel slope of 0 (a constant relative density: eq 5.18 with a huge modulus) has Py = 1/K = inf,
+    which had been written as ``Infinity``; strict JSON has no such value, so it is null now."""
+    from tabletcad.cli.outputs import json_text
+
+    text = json_text({"Py_MPa": float("inf"), "K": np.float64(0.0), "v": np.array([1.0, np.nan]), "n": np.int64(3)})
+    strict = json.loads(text, parse_constant=lambda c: pytest.fail(f"{c} in JSON"))
+    assert strict == {"Py_MPa": None, "K": 0.0, "v": [1.0, None], "n": 3}
+    rc, out, _ = run(capsys, "love", "--E", "1e7", "--json")
+    assert rc == 0
+    json.loads(out, parse_constant=lambda c: pytest.fail(f"{c} in JSON"))
+

@@ -8,14 +8,13 @@ extra (scikit-fem, gmsh) and the ``cad`` extra.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 import click
 
 from tabletcad.cli.options import option_names
-from tabletcad.cli.outputs import out_folder
+from tabletcad.cli.outputs import json_text, out_folder
 from tabletcad.errors import MISSING, DesignError, check_range
 from tabletcad.tolerance import MAX_EFFECTIVE_LENGTH_FACTOR, MAX_YIELD_MPA, MIN_FORCE_N
 
@@ -36,9 +35,9 @@ def _echo(payload: dict[str, Any], as_json: bool, lines: list[str], json_file: P
         from tabletcad.cli.outputs import staged
 
         with staged(json=json_file) as out:
-            out["json"].write_text(json.dumps(payload, indent=2) + "\n", encoding="utf-8")
+            out["json"].write_text(json_text(payload) + "\n", encoding="utf-8")
     if as_json:
-        click.echo(json.dumps(payload, indent=2))
+        click.echo(json_text(payload))
     else:
         for ln in lines + ([f"json -> {json_file}"] if json_file is not None else []):
             click.echo(ln)

@@ -10,7 +10,6 @@ mechanics code are printed as ``warning:`` lines on stderr and, with
 from __future__ import annotations
 
 import contextlib
-import json
 import math
 import warnings
 from collections.abc import Iterator
@@ -22,8 +21,10 @@ import numpy as np
 
 from tabletcad.cli.options import option_names
 from tabletcad.cli.outputs import check_output as _check_output
+from tabletcad.cli.outputs import json_text
 from tabletcad.cli.outputs import staged as _staged
 from tabletcad.errors import MISSING, DesignError, check_finite, check_positive, check_range
+from tabletcad.tolerance import MAX_MODULUS_MPA, MAX_PRESSURE_MPA
 
 __all__ = ["COMMANDS"]
 
@@ -46,18 +47,10 @@ def _collect() -> Iterator[list[str]]:
 
 def _emit(payload: dict[str, Any], as_json: bool, lines: list[str]) -> None:
     if as_json:
-        click.echo(json.dumps(payload, indent=2, default=_jsonable))
+        click.echo(json_text(payload))
     else:
         for ln in lines:
             click.echo(ln)
-
-
-def _jsonable(o: Any) -> Any:
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    if isinstance(o, (np.floating, np.integer)):
-        return o.item()
-    raise TypeError(type(o).__name__)
 
 
 def _check_input(name: str, path: Path | None) -> None:
@@ -193,7 +186,7 @@ def _finish(payload: dict[str, Any], as_json: bool, json_file: Path | None, line
     plot_file, draw = plot
     with _staged(json=json_file, plot=plot_file) as out:
         if json_file is not None:
-            out["json"].write_text(json.dumps(payload, indent=2, default=_jsonable) + "\n", encoding="utf-8")
+            out["json"].write_text(json_text(payload) + "\n", encoding="utf-8")
         if plot_file is not None:
             draw(out["plot"])
     _emit(payload, as_json, lines + ([f"json -> {json_file}"] if json_file and not as_json else [])
@@ -472,13 +465,14 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
         raise DesignError("--plot", str(plot_file), "must differ from --csv")
     _check_json_file(json_file, csv=csv_file, plot=plot_file)
     check_range("--terms", terms, 2, 20000)
-    for name, v in (("--outer", a), ("--inner", b), ("--E", E)):
-        check_positive(name, v, "MPa" if name == "--E" else "mm")
+    for name, v in (("--outer", a), ("--inner", b)):
+        check_positive(name, v, "mm")
+    check_range("--E", E, 0.0, MAX_MODULUS_MPA, "MPa", lo_open=True)
     if b >= a:
         raise DesignError("--inner", b, f"must be < --outer = {a:g} mm (inner radius below outer)", "mm")
     check_range("--nu", nu, -1.0, 0.5, lo_open=True, hi_open=True)
-    check_finite("--p-ext", p_ext, "MPa")
-    check_finite("--p-int", p_int, "MPa")
+    check_range("--p-ext", p_ext, -MAX_PRESSURE_MPA, MAX_PRESSURE_MPA, "MPa")
+    check_range("--p-int", p_int, -MAX_PRESSURE_MPA, MAX_PRESSURE_MPA, "MPa")
     check_range("--psi", psi, 0, 90, "deg")
     with _collect() as msgs:
         sol = solve_shell(a, b, E, nu, p_ext=p_ext, p_int=p_int, psi=math.radians(check_range("--psi", psi, 0, 90, "deg")),
@@ -506,7 +500,7 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
     }
     with _staged(csv=csv_file, plot=plot_file, json=json_file) as out:
         if json_file is not None:
-            out["json"].write_text(json.dumps(payload, indent=2, default=_jsonable) + "\n", encoding="utf-8")
+            out["json"].write_text(json_text(payload) + "\n", encoding="utf-8")
         if csv_file is not None:
             rows = ["theta_deg,u_r_outer_mm,u_r_inner_mm"] + [f"{d:g},{x:.10g},{y:.10g}" for d, x, y in
                                                             zip(np.degrees(th), ua, ub)]
@@ -542,13 +536,14 @@ def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json, json_file) -> None:
 
     _check_json_file(json_file)
     lo, hi = window
-    if not (math.isfinite(hi) and 0 < lo < hi):
-        raise DesignError("--window", window, "must be two increasing positive pressures", "MPa")
+    if not (math.isfinite(hi) and 0 < lo < hi <= MAX_PRESSURE_MPA):
+        raise DesignError("--window", window, f"must be two increasing positive pressures up to {MAX_PRESSURE_MPA:g}",
+                          "MPa")
     # every option is checked here, by its own name, before the model runs
-    check_positive("--E", E, "MPa")
+    check_range("--E", E, 0.0, MAX_MODULUS_MPA, "MPa", lo_open=True)
     check_range("--nu", nu, 0.0, 0.5, hi_open=True)
     check_positive("--h0", h0, "mm")
-    check_range("--z", z, 0.0, None, "mm")
+    check_range("--z", z, 0.0, h0, "mm")  # a height within the bed (above it, eq 5.18 gave K = -0.015 1/MPa)
     if r is not None:
         check_positive("--r", r, "mm")  # (r <= die radius is checked by the model)
     if omega_z0 is not None:
