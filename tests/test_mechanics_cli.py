@@ -75,9 +75,9 @@ def test_heckel_bad_input_exit_2_and_no_file(capsys, tmp_path, extra, match):
 @pytest.mark.parametrize(
     "text,match",
     [
-        ("force,displacement\n1,-5\nabc,-4\n3,-3\n", "must be a number"),
+        ("force_N,displacement_mm\n1,-5\nabc,-4\n3,-3\n", "must be a number"),
         ("force,time\n1,0\n2,1\n3,2\n", "displacement or thickness"),
-        ("force,displacement\n100,-5\n90,-4.9\n80,-4.8\n", "no loading branch"),
+        ("force_N,displacement_mm\n100,-5\n90,-4.9\n80,-4.8\n", "no loading branch"),
     ],
 )
 def test_heckel_bad_data(capsys, tmp_path, text, match):

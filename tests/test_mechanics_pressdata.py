@@ -106,7 +106,7 @@ def test_missing_values_dropped_with_count(tmp_path):
 
 
 def test_tab_separated_thickness_and_time(tmp_path):
-    p = _write(tmp_path, "time (s)\tforce\tthickness (mm)\n0\t1\t5\n0.1\t2\t4.9\n0.2\t3\t4.8\n", "run.tsv")
+    p = _write(tmp_path, "time (s)\tforce (N)\tthickness (mm)\n0\t1\t5\n0.1\t2\t4.9\n0.2\t3\t4.8\n", "run.tsv")
     d = read_press_data(p, **META)
     assert np.allclose(d.thickness, [5, 4.9, 4.8]) and np.allclose(d.time, [0, 0.1, 0.2])
 
@@ -114,7 +114,7 @@ def test_tab_separated_thickness_and_time(tmp_path):
 @pytest.mark.parametrize(
     "text,match",
     [
-        ("force,displacement\n1,-5\nabc,-4\n", "must be a number"),
+        ("force_N,displacement_mm\n1,-5\nabc,-4\n", "must be a number"),
         ("load_cell,time\n1,0\n2,1\n", "displacement or thickness"),
         ("pos,displacement\n1,-5\n", "force column"),
     ],
@@ -137,13 +137,13 @@ def test_bad_files(tmp_path, text, match):
      r"compliance\.table = '0\.2 mm over 0-10 N' is not allowed: must deflect at most 0\.001 mm/N"),
 ])
 def test_bad_metadata(tmp_path, key, value, match):
-    p = _write(tmp_path, "force,displacement\n1,-5\n2,-4.9\n3,-4.8\n")
+    p = _write(tmp_path, "force_N,displacement_mm\n1,-5\n2,-4.9\n3,-4.8\n")
     with pytest.raises(DesignError, match=match):
         read_press_data(p, **(META | {key: value}))
 
 
 def test_missing_diameter(tmp_path):
-    p = _write(tmp_path, "force,displacement\n1,-5\n2,-4.9\n3,-4.8\n")
+    p = _write(tmp_path, "force_N,displacement_mm\n1,-5\n2,-4.9\n3,-4.8\n")
     with pytest.raises(DesignError, match="diameter"):
         read_press_data(p, mass_mg=1.0, true_density=1.0)
 
@@ -154,7 +154,7 @@ def test_no_loading_branch():
 
 
 def test_metadata_beside_file_is_found(tmp_path):
-    p = _write(tmp_path, "force,displacement\n1,-5\n2,-4.9\n3,-4.8\n")
+    p = _write(tmp_path, "force_N,displacement_mm\n1,-5\n2,-4.9\n3,-4.8\n")
     (tmp_path / "run.toml").write_text("mass_mg = 10\ntrue_density = 1.5\nface_area = 20\n")
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -339,6 +339,21 @@ def test_a_unit_where_the_header_is_not_read_for_one_is_refused(tmp_path, header
         read_press_data(p, **META)
 
 
+@pytest.mark.parametrize("header, role, units", [
+    ("force;displacement_mm", "force", {"force": "N"}),
+    ("Force [N];Displacement", "displacement", {"displacement": "mm"}),
+    ("Load;Gap", "force", {"force": "N", "thickness": "mm"}),
+])
+def test_a_force_or_position_column_without_a_unit_is_refused_not_guessed(tmp_path, header, role, units):
+    """A new user's ``force,displacement`` record in kN and µm had been read as N and mm (Py 0.1 MPa, or a
+    relative density of 0.0005), exit 0: a unit is never guessed.  The option gives it instead."""
+    p = _write(tmp_path, f"{header}\n" + "\n".join(f"{k};{6 - 0.1 * k:.1f}" for k in range(1, 4)) + "\n")
+    with pytest.raises(DesignError) as e:
+        read_press_data(p, **META)
+    assert e.value.parameter == "column" and f"states no unit for its {role}" in str(e.value)
+    assert np.allclose(read_press_data(p, units=units, **META).force, [1.0, 2.0, 3.0])
+
+
 def test_cp1252_micro_sign_comments_and_inch(tmp_path):
     text = "# exported by a press\r\nZeit [s]\tKraft\tForce (lbf)\tGap (\u00b5m)\r\n# note\r\n0\t0\t10\t5000\r\n0,1\t0\t20\t4900\r\n"
     p = tmp_path / "w.tsv"
@@ -359,14 +374,14 @@ def test_fast_and_line_by_line_reading_agree(tmp_path):
     assert list(slow.line_numbers[:15]) == list(fast.line_numbers[:15])  # 4 comments, header, 15 rows
     assert np.array_equal(slow.line_numbers[15:], fast.line_numbers[15:] + 2)
     with pytest.raises(DesignError, match=r"line\[4\] = 3 is not allowed: has more cells than the 2 headers"):
-        read_press_data(_write(tmp_path, "force,displacement\n1,-5\n2,-4.9\n3,-4.8,7\n"), **META)
+        read_press_data(_write(tmp_path, "force_N,displacement_mm\n1,-5\n2,-4.9\n3,-4.8,7\n"), **META)
 
 
 def test_utf16_without_bom_and_tensile_forces(tmp_path):
     p = tmp_path / "u16.csv"
-    p.write_bytes("force,displacement\n1,-5\n2,-4.9\n3,-4.8\n".encode("utf-16-le"))
+    p.write_bytes("force_N,displacement_mm\n1,-5\n2,-4.9\n3,-4.8\n".encode("utf-16-le"))
     assert np.allclose(read_press_data(p, **META).force, [1, 2, 3])
-    neg = _write(tmp_path, "force,displacement\n-1,5\n-2,4.5\n-3,4\n", "neg.csv")
+    neg = _write(tmp_path, "force_N,displacement_mm\n-1,5\n-2,4.5\n-3,4\n", "neg.csv")
     with pytest.raises(DesignError, match=r"row\[1\]\.force = -1 N is not allowed: has no loading branch"):
         compaction_curves(read_press_data(neg, **META))
 

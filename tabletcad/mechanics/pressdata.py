@@ -638,6 +638,11 @@ def read_press_data(
             factors[j] = option_units.get(r, option_units.get(unit_role))
             continue
         u = header_unit(header[j])
+        if u is None and r != "time":  # never guessed: a record in kN read as N gave a Py of 0.1 MPa
+            example = {"force": "'Force [kN]', 'force_N'", "displacement": "'Displacement [mm]', 'position_um'",
+                       "thickness": "'Thickness [mm]', 'gap_um'"}[r]
+            raise DesignError("column", header[j], f"states no unit for its {r}: write it in the header "
+                              f"({example}) or give --{unit_role}-unit (tabletcad does not guess one)")
         factors[j] = (1.0, 0) if u is None else unit_factor(
             u, DIMENSIONS[r], f"column {header[j]!r} unit", f"; or give --{unit_role}-unit")
     used = {roles["force"], roles[pos_role]} | ({roles["time"]} if "time" in roles else set())
