@@ -210,11 +210,11 @@ def test_profiles_read_a_solid_fraction_in_percent_and_a_strength_in_kpa(capsys,
 
 
 @pytest.mark.parametrize("header, line", [
-    ("Pressure (mm),thickness_mm", "error: column.\"Pressure\\u0020(mm)\".unit = 'mm' is not allowed: is not a known "
+    ("Pressure (mm),thickness_mm", "error: column = 'Pressure (mm)' is not allowed: states the unit 'mm', which is not a known "
                                    "pressure unit (MPa, N/mm², N/mm2, kPa, Pa, GPa, bar, psi)"),
-    ("Pressure (atm),thickness_mm", "error: column.\"Pressure\\u0020(atm)\".unit = 'atm' is not allowed: is not a known "
+    ("Pressure (atm),thickness_mm", "error: column = 'Pressure (atm)' is not allowed: states the unit 'atm', which is not a known "
                                     "pressure unit"),
-    ("pressure_MPa,Thickness (kN)", "error: column.\"Thickness\\u0020(kN)\".unit = 'kN' is not allowed: is not a known "
+    ("pressure_MPa,Thickness (kN)", "error: column = 'Thickness (kN)' is not allowed: states the unit 'kN', which is not a known "
                                     "length unit (mm, µm, um, cm, m, in, inch)"),
 ])
 def test_a_header_unit_of_another_quantity_is_refused(capsys, tmp_path, header, line):

@@ -449,9 +449,8 @@ def read_columns(path: str | Path, columns: Mapping[str, tuple[str, str]]) -> di
             raise DesignError("column", name, f"must be one of the header's columns of {path.name} (or its name "
                               f"without the unit): {', '.join(header)}")
         unit = header_unit(header[j])
-        factor, exponent = (1.0, 0) if unit is None else unit_factor(
-            unit, dimension, f"column {header[j]!r} unit",
-            f"; or no unit in the header for {TABLE_UNITS[dimension] or 'a fraction'}")
+        factor, exponent = (1.0, 0) if unit is None else _column_unit(
+            header[j], unit, dimension, f"; or no unit in the header for {TABLE_UNITS[dimension] or 'a fraction'}")
         col = _parse_column(by_column[j], exponent, decimal_comma)
         if isinstance(col, np.ndarray) and not np.all(np.isfinite(col)):
             col = int(np.flatnonzero(~np.isfinite(col))[0])  # a missing value: every row is one tablet
@@ -461,6 +460,15 @@ def read_columns(path: str | Path, columns: Mapping[str, tuple[str, str]]) -> di
         out[key] = col * factor if exponent is None else col
     out["_lines"] = np.asarray(line_numbers)
     return out
+
+
+def _column_unit(header: str, unit: str, dimension: str, hint: str) -> tuple[float, int | None]:
+    """:func:`unit_factor` of a header's unit, a refusal naming the column as written (``column = 'Force (Kn)'``,
+    not an escaped token)."""
+    try:
+        return unit_factor(unit, dimension, "column", hint)
+    except DesignError as exc:
+        raise DesignError("column", header, f"states the unit {unit!r}, which {exc.allowed}") from None
 
 
 def _parse_column(cells: Sequence[str], exponent: int | None, decimal_comma: bool) -> np.ndarray | int:
@@ -643,8 +651,7 @@ def read_press_data(
                        "thickness": "'Thickness [mm]', 'gap_um'"}[r]
             raise DesignError("column", header[j], f"states no unit for its {r}: write it in the header "
                               f"({example}) or give --{unit_role}-unit (tabletcad does not guess one)")
-        factors[j] = (1.0, 0) if u is None else unit_factor(
-            u, DIMENSIONS[r], f"column {header[j]!r} unit", f"; or give --{unit_role}-unit")
+        factors[j] = (1.0, 0) if u is None else _column_unit(header[j], u, DIMENSIONS[r], f"; or give --{unit_role}-unit")
     used = {roles["force"], roles[pos_role]} | ({roles["time"]} if "time" in roles else set())
     nrow = len(line_numbers)
     decimal_comma = delim != "," and any("," in c for col in by_column for c in col[:50])
