@@ -353,3 +353,16 @@ def test_a_concave_bevels_report_gives_both_cup_depths(capsys):
     assert _main(["report", str(path)]) == 0
     line = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("cup depth"))
     assert line.endswith(f"(from the band; {tab['cup_depth']:g} mm below the bevel: the design's cup_depth)")
+
+
+def test_a_compaction_force_without_a_limit_is_shown_as_its_tip_pressure(tmp_path, capsys):
+    """A new user's ``compaction_force_kN = 15000`` (newtons typed for kilonewtons) with no limit had printed
+    only "not checked: no limit given": the force is shown as the pressure it puts on the tip's face now,
+    15000 kN over the 10 mm face's 78.54 mm² = 1.91e5 MPa, which no punch steel bears."""
+    p = tmp_path / "d.toml"
+    p.write_text('[tablet]\nfamily = "flat_face_round"\ndiameter = 10.0\nthickness = 4.0\n'
+                 '[report]\ncompaction_force_kN = 15000.0\n')
+    assert main(["report", str(p)]) == 0
+    (line,) = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("punch-tip check")]
+    pressure = 15000.0 * 1000.0 / (math.pi * 25.0)
+    assert f"not checked: 15000 kN is {pressure:.4g} MPa on {math.pi * 25.0:.4g} mm2; no limit given" in line

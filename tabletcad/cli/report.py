@@ -112,7 +112,11 @@ def _table(name: str, sec: dict[str, Any]) -> str:
         rows.append(("tensile strength", "- (" + (ts.get("note") or "; ".join(ts.get("range_flags", []))) + ")"))
     pc = r["punch_tip_check"]
     if pc.get("ok") is None:
-        rows.append(("punch-tip check", f"not checked: {pc['limit_basis']}" if pc.get("allowed_force_kN") is None
+        given = ""  # the force given, as a pressure on the tip (15000 kN typed for 15 kN: 1.9e5 MPa, shown now)
+        if pc.get("compaction_force_kN") is not None and pc.get("compaction_pressure_MPa") is not None:
+            given = (f"{pc['compaction_force_kN']:g} kN is {pc['compaction_pressure_MPa']:.4g} MPa on "
+                     f"{pc['tip_face_area_mm2']:.4g} mm2; ")
+        rows.append(("punch-tip check", f"not checked: {given}{pc['limit_basis']}" if pc.get("allowed_force_kN") is None
                      else f"limit {pc['allowed_force_kN']:.4g} kN ({pc['limit_basis']}); give compaction_force_kN"))
     else:
         on = ("plan area not known" if pc.get("tip_face_area_mm2") is None  # (a shaped cut-away, Tablet.plan_area)
