@@ -482,3 +482,18 @@ def test_a_record_no_powder_could_give_is_refused():
         compaction_curves(read_press_data(SAMPLE, mass_mg=0.3))
     assert e.value.parameter == "relative_density" and e.value.value == "at most 0.000819"
     assert "check the mass (mg, not g)" in str(e.value)
+
+
+def test_a_compliance_table_short_of_the_records_forces_is_warned_of():
+    """A new user's calibration over 0-10 N on a record reaching 5128 N was extrapolated 500-fold in silence
+    (K = -0.0024 1/MPa; such a table in kN is now refused by its slope).  A table over part of the forces
+    warns, naming both ranges; one over all of them does not."""
+    from tabletcad.mechanics.pressdata import read_metadata
+
+    short = read_metadata(SAMPLE_META, compliance={"force": [0.0, 1000.0], "deflection": [-0.0267, -0.0067]})
+    with pytest.warns(DataWarning, match="covers 0-1000 N and the record 3.891-5128 N"):
+        read_press_data(SAMPLE, short)
+    whole = read_metadata(SAMPLE_META, compliance={"force": [0.0, 6000.0], "deflection": [-0.0267, 0.0933]})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DataWarning)
+        read_press_data(SAMPLE, whole)

@@ -314,7 +314,15 @@ def _assemble(F, pos, is_thickness, t, meta, extra, lines, dropped, source) -> P
         if sign == "auto":
             sign = -1 if np.all(disp <= 0.0) else 1
         gap = meta.displacement_zero + sign * disp
-    thickness = gap if meta.compliance is None else gap + meta.compliance.deflection(F)
+    comp = meta.compliance
+    if comp is not None and comp.is_table and np.any(np.isfinite(F)):
+        f_hi, f_lo = float(np.nanmax(F)), float(np.nanmin(F))
+        span = comp.table_force[-1] - comp.table_force[0]
+        if f_hi > comp.table_force[-1] + 0.1 * span or f_lo < comp.table_force[0] - 0.1 * span:
+            warn(DataWarning, f"the compliance table covers {comp.table_force[0]:g}-{comp.table_force[-1]:g} N and "
+                              f"the record {f_lo:.4g}-{f_hi:.4g} N: the deflection beyond it is extrapolated along "
+                              "the table's end segments (calibrate over the record's forces)")
+    thickness = gap if comp is None else gap + comp.deflection(F)
     if np.any(thickness <= 0.0):
         i = int(np.flatnonzero(thickness <= 0.0)[0])
         raise DesignError(
