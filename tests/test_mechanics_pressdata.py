@@ -115,6 +115,8 @@ def test_tab_separated_thickness_and_time(tmp_path):
     "text,match",
     [
         ("force_N,displacement_mm\n1,-5\nabc,-4\n", "must be a number"),
+        # decimal commas in a comma-separated file (a new user's): the refusal says why the cells are too many
+        ("force_N,displacement_mm\n3,891,-6,032\n3,891,-5,992\n", "a decimal comma in a comma-separated file"),
         ("load_cell,time\n1,0\n2,1\n", "displacement or thickness"),
         ("pos,displacement\n1,-5\n", "force column"),
     ],

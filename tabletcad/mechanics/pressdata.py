@@ -407,7 +407,9 @@ def _read_table(text: str, source: str) -> tuple[list[str], list[int], list[Sequ
     for k, cells in enumerate(rows):
         if len(cells) != ncol:
             if len(cells) > ncol and any(c.strip() for c in cells[ncol:]):
-                raise DesignError(f"line {numbered[k][0]}", len(cells), f"has more cells than the {ncol} headers")
+                hint = (" (a number with a decimal comma in a comma-separated file splits in two: separate the "
+                        "columns with ; or tabs)") if delim == "," and "," in numbered[k][1] else ""
+                raise DesignError(f"line {numbered[k][0]}", len(cells), f"has more cells than the {ncol} headers{hint}")
             rows[k] = (cells + [""] * ncol)[:ncol]
     columns = [list(col) for col in zip(*rows)] if rows else [[] for _ in header]
     return header, [i for i, _ in numbered], columns, delim
