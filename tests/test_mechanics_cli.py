@@ -145,7 +145,7 @@ def test_shell_command(capsys, tmp_path):
     d = json.loads(out)
     from tabletcad.mechanics.shell import lame_displacement
 
-    assert d["u_r_outer_mm"]["theta_90"] == pytest.approx(float(lame_displacement(2.5, 2.5, 2.0, 100, 0.3, 3, 1)),
+    assert d["u_r_outer_mm"]["at_90_deg"] == pytest.approx(float(lame_displacement(2.5, 2.5, 2.0, 100, 0.3, 3, 1)),
                                                           rel=1e-10)
     assert len(csv.read_text().splitlines()) == 182
     bad = tmp_path / "bad.csv"
@@ -332,4 +332,22 @@ def test_json_is_strict_json_where_a_figure_is_not_finite(capsys):
     rc, out, _ = run(capsys, "love", "--E", "1e7", "--json")
     assert rc == 0
     json.loads(out, parse_constant=lambda c: pytest.fail(f"{c} in JSON"))
+
+
+def test_json_keys_carry_their_units(capsys):
+    """A new user's trial: heckel's metadata (true_density, diameter, compliance slope/offset), love's
+    assumptions (h0, z, E...) and shell's angles (theta_0) had keys without units."""
+    rc, out, _ = run(capsys, "heckel", SAMPLE, "--json")
+    meta = json.loads(out)["metadata"]
+    assert rc == 0 and set(meta) == {"mass_mg", "true_density_mg_mm3", "diameter_mm", "compliance"}
+    assert meta["true_density_mg_mm3"] == 1.3 and meta["diameter_mm"] == 10.0
+    assert set(meta["compliance"]) == {"slope_mm_per_N", "offset_mm"}
+    rc, out, _ = run(capsys, "love", "--json")
+    assert rc == 0 and set(json.loads(out)["assumptions"]) == {
+        "h0_mm", "z_mm", "r_mm", "c_mm", "E_MPa", "nu", "scale", "reference_pressure_MPa",
+        "model_displacement_at_reference_mm", "experimental_displacement_mm"}
+    rc, out, _ = run(capsys, "shell", "--outer", "5", "--inner", "4", "--E", "1000", "--nu", "0.3", "--p-ext", "10",
+                     "--json")
+    d = json.loads(out)
+    assert rc == 0 and set(d["u_r_outer_mm"]) == {"at_0_deg", "at_45_deg", "at_90_deg", "min", "max"}
 

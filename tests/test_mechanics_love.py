@@ -155,7 +155,7 @@ def test_love_command_default_z_is_the_readme_figure(capsys):
     assert next(p.default for p in love_cmd.params if p.name == "z") == love.THESIS_Z
     assert main(["love", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
-    assert d["assumptions"]["z"] == love.THESIS_Z
+    assert d["assumptions"]["z_mm"] == love.THESIS_Z
     assert d["omega_z0_mm"] == pytest.approx(-1.078, abs=5e-5)
     assert round(d["K_per_MPa"], 5) == 0.01143 and round(d["A"], 4) == 0.8363
     # at the nominal thickness z = 3 mm the same chain gives K 0.01176: z matters at the 3 % level

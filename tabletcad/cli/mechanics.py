@@ -53,6 +53,17 @@ def _emit(payload: dict[str, Any], as_json: bool, lines: list[str]) -> None:
             click.echo(ln)
 
 
+#: the metadata's keys (as a metadata file writes them) with their units, for the JSON documents
+_METADATA_UNITS = {"true_density": "true_density_mg_mm3", "diameter": "diameter_mm", "face_area": "face_area_mm2",
+                   "slope": "slope_mm_per_N", "offset": "offset_mm", "force": "force_N", "deflection": "deflection_mm"}
+
+
+def _metadata_with_units(meta: dict[str, Any]) -> dict[str, Any]:
+    """A record's metadata with its units in its keys (``true_density_mg_mm3``; a JSON document's keys
+    carry them, as the metadata file's need not)."""
+    return {_METADATA_UNITS.get(k, k): (_metadata_with_units(v) if isinstance(v, dict) else v) for k, v in meta.items()}
+
+
 def _check_input(name: str, path: Path | None) -> None:
     if path is not None and not path.is_file():
         raise DesignError(name, str(path), "must be a file: it is a folder" if path.is_dir() else
@@ -144,7 +155,7 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
         "loading_rows": [curves.branches.loading[0] + 1, curves.branches.loading[1]],
         "fitted_rows": [fit.rows[0] + 1, fit.rows[-1] + 1] if fit.rows else [],
         "elastic_recovery": curves.elastic_recovery,
-        "metadata": rec.metadata.to_dict(),
+        "metadata": _metadata_with_units(rec.metadata.to_dict()),
     }
     lo, hi = fit.window_MPa
     how = fit.method if fit.noise_sd is None else f"auto: widest run linear within the noise σ = {fit.noise_sd:.3g}"
@@ -491,9 +502,10 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
     payload = {
         "outer_mm": a, "inner_mm": b, "E_MPa": E, "nu": nu, "p_ext_MPa": p_ext, "p_int_MPa": p_int, "psi_deg": psi,
         "region": region, "terms": terms,
-        "u_r_outer_mm": {"theta_0": float(ua[0]), "theta_45": float(ua[45]), "theta_90": eq,
+        "u_r_outer_mm": {"at_0_deg": float(ua[0]), "at_45_deg": float(ua[45]), "at_90_deg": eq,
                          "min": float(ua.min()), "max": float(ua.max())},
-        "u_r_inner_mm": {"theta_0": float(ub[0]), "theta_90": float(ub[90]), "min": float(ub.min()), "max": float(ub.max())},
+        "u_r_inner_mm": {"at_0_deg": float(ub[0]), "at_90_deg": float(ub[90]), "min": float(ub.min()),
+                         "max": float(ub.max())},
         "thickness_change_at_90deg_mm": eq - float(ub[90]),
         "series_change_at_90deg_mm": eq - float(half),
         "warnings": msgs,

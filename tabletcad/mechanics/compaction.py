@@ -85,7 +85,7 @@ def split_branches(force, drop: float = 0.02) -> Branches:
     check_range("drop", drop, 0.0, 1.0, lo_open=True, hi_open=True)
     n = F.size
     if n < 3:
-        raise DesignError("data", f"{n} rows", "need at least 3 rows with a loading branch")
+        raise DesignError("data", f"{n} row" + ("" if n == 1 else "s"), "need at least 3 rows with a loading branch")
     runmax = np.maximum.accumulate(F)
     fall = np.flatnonzero(F < (1.0 - drop) * runmax)
     end = int(fall[0]) if fall.size else n

@@ -188,7 +188,8 @@ class SimulatedCompression:
     omega_z0 : float
         mm.
     assumptions : dict
-        h0, z, r, c, E, nu, scale, reference pressure and displacement.
+        h0_mm, z_mm, r_mm, c_mm, E_MPa, nu, scale, reference_pressure_MPa and the model's and the
+        experiment's displacements there (mm).
     """
 
     pressure: np.ndarray
@@ -237,9 +238,9 @@ def simulate_compression(
     fit = fit_heckel_arrays(P, D, window=(float(P.min()), float(P.max())))
     return SimulatedCompression(
         pressure=P, omega_z=w, thickness=h, relative_density=D, heckel=fit, omega_z0=float(omega_z0),
-        assumptions={"h0": h0, "z": z, "r": r, "c": c, "E": E, "nu": nu, "scale": scale,
-                     "reference_pressure": reference_pressure, "model_displacement_at_reference": model_ref,
-                     "experimental_displacement": experimental_displacement},
+        assumptions={"h0_mm": h0, "z_mm": z, "r_mm": r, "c_mm": c, "E_MPa": E, "nu": nu, "scale": scale,
+                     "reference_pressure_MPa": reference_pressure, "model_displacement_at_reference_mm": model_ref,
+                     "experimental_displacement_mm": experimental_displacement},
     )
 
 
