@@ -225,8 +225,8 @@ def compaction_curves(
     if n_over:
         warn(
             DataWarning,
-            f"{n_over} loading row(s) have relative density >= 1 (check mass, true density, compliance); "
-            "their Heckel term is undefined",
+            f"{n_over} loading row(s) have relative density >= 1 (check the mass, the true density, the die "
+            "diameter or face area (mm, mm²), the compliance); their Heckel term is undefined",
         )
     ulo, uhi = branches.unloading
     if uhi - ulo < 1:

@@ -328,8 +328,8 @@ def fit_heckel_arrays(
     idx = np.arange(P.size) if rows is None else np.asarray(rows, dtype=int).ravel()
     good = np.isfinite(P) & np.isfinite(H) & (P > 0)
     n_dense = int(np.sum(np.isfinite(P) & (P > 0) & ~np.isfinite(H)))  # relative density >= 1: no Heckel term
-    why = (f" ({n_dense} loaded row(s) have relative density >= 1 and no Heckel term: check mass, true density, "
-           "compliance)") if n_dense else ""
+    why = (f" ({n_dense} loaded row(s) have relative density >= 1 and no Heckel term: check the mass, the true "
+           "density, the die diameter or face area (mm, mm²), the compliance)") if n_dense else ""
     order = np.argsort(P[good], kind="stable")
     Pg, Hg, ig = P[good][order], H[good][order], idx[good][order]
     if window is not None:
