@@ -10,9 +10,24 @@ from __future__ import annotations
 
 
 def dask_setup(worker) -> None:  # noqa: ARG001 - distributed's preload hook
-    """Ignore SIGINT in this worker process (its parent stops it)."""
+    """Ignore SIGINT in this worker process (its parent stops it), and keep the heartbeat's lost-scheduler
+    error out of the terminal: the scheduler lives in the command line's process, which closes it first on
+    a Ctrl-C; a heartbeat in flight then logged 30 lines ("Failed to communicate with scheduler during
+    heartbeat", StreamClosedError) after ``interrupted`` now and then (a fresh clone's full test run)."""
+    import logging
     import signal
     import threading
 
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+    logger = logging.getLogger("distributed.worker")
+    if not any(isinstance(f, _LostScheduler) for f in logger.filters):
+        logger.addFilter(_LostScheduler())
+
+
+class _LostScheduler:
+    """A logging filter dropping the heartbeat's report of a scheduler gone (the local cluster's, which
+    only goes with its sweep)."""
+
+    def filter(self, record) -> bool:
+        return not str(record.msg).startswith("Failed to communicate with scheduler during heartbeat")

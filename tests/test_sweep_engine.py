@@ -389,3 +389,28 @@ def test_a_plot_column_none_in_the_first_design_is_left_to_the_end(tmp_path):
                                        "report": {"breaking_force_N": 100.0}},
                             "sweep": {"vary": {"tablet.band": bands}}}, name="s")
         _check_plot_columns((col,), spec.designs()[0], spec)
+
+
+def test_the_workers_drop_only_the_heartbeats_report_of_a_closed_scheduler(caplog):
+    """A fresh clone's full run caught a Ctrl-C's ``interrupted`` followed by 30 lines: a worker's heartbeat
+    in flight when the command line closed its scheduler ("Failed to communicate with scheduler during
+    heartbeat", StreamClosedError).  The local workers' set-up drops that record, and only that one."""
+    import logging
+    import signal
+
+    from tabletcad.worker_setup import dask_setup
+
+    before = signal.getsignal(signal.SIGINT)
+    logger = logging.getLogger("distributed.worker")
+    kept = list(logger.filters)
+    try:
+        dask_setup(None)
+        dask_setup(None)  # (once per worker: the filter is not added twice)
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN and len(logger.filters) == len(kept) + 1
+        with caplog.at_level(logging.ERROR, logger="distributed.worker"):
+            logger.error("Failed to communicate with scheduler during heartbeat.")
+            logger.error("Unexpected exception during heartbeat. Closing worker.")
+        assert [r.getMessage() for r in caplog.records] == ["Unexpected exception during heartbeat. Closing worker."]
+    finally:
+        signal.signal(signal.SIGINT, before)
+        logger.filters[:] = kept
