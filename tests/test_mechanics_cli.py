@@ -324,7 +324,7 @@ def test_absurd_moduli_pressures_and_heights_are_refused(capsys, cmd, line):
 def test_json_is_strict_json_where_a_figure_is_not_finite(capsys):
     """A Heckel slope of 0 (a constant relative density: eq 5.18 with a huge modulus) has Py = 1/K = inf,
     which had been written as ``Infinity``; strict JSON has no such value, so it is null now."""
-    from tabletcad.cli.outputs import json_text
+    from tabletcad.io.jsontext import json_text
 
     text = json_text({"Py_MPa": float("inf"), "K": np.float64(0.0), "v": np.array([1.0, np.nan]), "n": np.int64(3)})
     strict = json.loads(text, parse_constant=lambda c: pytest.fail(f"{c} in JSON"))

@@ -14,7 +14,8 @@ from typing import Any
 import click
 
 from tabletcad.cli.options import option_names
-from tabletcad.cli.outputs import json_text, out_folder
+from tabletcad.cli.outputs import out_folder
+from tabletcad.io.jsontext import json_text
 from tabletcad.errors import MISSING, DesignError, check_range
 from tabletcad.tolerance import MAX_EFFECTIVE_LENGTH_FACTOR, MAX_YIELD_MPA, MIN_FORCE_N
 

@@ -21,7 +21,7 @@ import numpy as np
 
 from tabletcad.cli.options import option_names
 from tabletcad.cli.outputs import check_output as _check_output
-from tabletcad.cli.outputs import json_text
+from tabletcad.io.jsontext import json_text
 from tabletcad.cli.outputs import staged as _staged
 from tabletcad.errors import MISSING, DesignError, check_finite, check_positive, check_range
 from tabletcad.tolerance import MAX_MODULUS_MPA, MAX_PRESSURE_MPA

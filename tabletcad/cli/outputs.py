@@ -12,7 +12,7 @@ import click
 
 from tabletcad.errors import DesignError
 
-__all__ = ["check_output", "check_out_folder", "json_text", "out_folder", "staged"]
+__all__ = ["check_output", "check_out_folder", "out_folder", "staged"]
 
 
 def check_output(option: str, path: Path | None, suffixes: tuple[str, ...] = (".png", ".svg", ".pdf")) -> None:
@@ -113,31 +113,3 @@ def staged(**targets: Path | None) -> Iterator[dict[str, Path]]:
                 raise DesignError({"json": "--json-file"}.get(k, f"--{k}"), str(targets[k]),
                                   f"cannot be written: {(exc.strerror or str(exc)).lower()}") from None
             raise
-
-
-def _plain(o):
-    """``o`` as JSON can hold it: numpy arrays and scalars as Python values, a non-finite number as None."""
-    import math
-
-    import numpy as np
-
-    if isinstance(o, dict):
-        return {k: _plain(v) for k, v in o.items()}
-    if isinstance(o, (list, tuple, np.ndarray)):
-        return [_plain(v) for v in (o.tolist() if isinstance(o, np.ndarray) else o)]
-    if isinstance(o, (np.bool_, bool)):
-        return bool(o)
-    if isinstance(o, (np.integer, int)):
-        return int(o)
-    if isinstance(o, (np.floating, float)):
-        return float(o) if math.isfinite(o) else None
-    return o
-
-
-def json_text(payload) -> str:
-    """A command's ``--json`` document: valid JSON (RFC 8259), a non-finite number written as null (a Heckel
-    slope of 0 had printed ``"Py_MPa": Infinity``, which strict readers refuse)."""
-    import json
-
-    return json.dumps(_plain(payload), indent=2, allow_nan=False)
-

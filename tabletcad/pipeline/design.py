@@ -296,8 +296,8 @@ class Design:
     tooling_spec: ToolingSpec | None = field(init=False, compare=False, repr=False)
 
     def __post_init__(self) -> None:
-        for table in ("tablet", "patch", *_TABLES):  # the design's own read-only copies
-            object.__setattr__(self, table, _read_only(copy.deepcopy(getattr(self, table))))
+        for table in ("tablet", "patch", *_TABLES):  # the design's own read-only copies (new dicts and lists)
+            object.__setattr__(self, table, _read_only(getattr(self, table)))
         object.__setattr__(self, "report_options", ReportOptions.from_table(self.report))
         object.__setattr__(self, "tooling_spec",
                            None if self.tooling is None else parse_tooling(self.tooling, base=self.folder))

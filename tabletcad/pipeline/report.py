@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import json
 import math
 from typing import Any
 
 import numpy as np
 
+from tabletcad.io.jsontext import json_text
 from tabletcad.pipeline.designreport import ReportOptions, design_report, shape_design_report
 from tabletcad.families.sweep import SweepNominal
 from tabletcad.geometry.tablet import Tablet
@@ -77,24 +77,9 @@ def geometry_report(tablet: Tablet, options: ReportOptions | None = None) -> dic
     return rep
 
 
-def _clean(o: Any) -> Any:
-    if isinstance(o, dict):
-        return {k: _clean(v) for k, v in o.items()}
-    if isinstance(o, (list, tuple)):
-        return [_clean(v) for v in o]
-    if isinstance(o, (np.floating, float)):
-        x = float(o)
-        return x if math.isfinite(x) else None
-    if isinstance(o, np.integer):
-        return int(o)
-    if isinstance(o, np.bool_):
-        return bool(o)
-    return o
-
-
 def to_json(report: dict[str, Any]) -> str:
-    """JSON text (NaN/inf written as null)."""
-    return json.dumps(_clean(report), indent=2, sort_keys=False) + "\n"
+    """JSON text (NaN/inf written as null: :func:`tabletcad.io.jsontext.json_text`)."""
+    return json_text(report) + "\n"
 
 
 def flatten_report(report: dict[str, Any], prefix: str = "") -> dict[str, Any]:
