@@ -154,8 +154,8 @@ def test_solid_is_outward_whichever_way_its_faces_come(turn, monkeypatch):
 
 
 def test_a_solid_that_fails_its_check_names_the_invalid_face(monkeypatch):
-    """Faces are checked once, as part of the solid; when that check fails, each face is
-    checked on its own and the first invalid one is named (spied: OCC makes valid faces of
+    """Faces are checked once, as part of the solid; when that check fails (for the assembled
+    shell, then for the sewn one), each face is checked on its own and the first invalid one is named (spied: OCC makes valid faces of
     every B-spline it accepts)."""
     import tabletcad.cad.solid as solid_module
 
@@ -170,8 +170,8 @@ def test_a_solid_that_fails_its_check_names_the_invalid_face(monkeypatch):
             return not self.face.IsSame(made[1])
 
     made = []
-    real_make_face = solid_module.make_face
-    monkeypatch.setattr(solid_module, "make_face", lambda *a, **k: made.append(real_make_face(*a, **k)) or made[-1])
+    real_face_of = solid_module.face_of
+    monkeypatch.setattr(solid_module, "face_of", lambda *a, **k: made.append(real_face_of(*a, **k)) or made[-1])
     monkeypatch.setattr(solid_module, "_solid_from_faces", fail)
     monkeypatch.setattr(solid_module, "BRepCheck_Analyzer", Analyzer)
     with pytest.raises(GeometryError, match=r"^face of patch 1 is not valid"):

@@ -59,7 +59,7 @@ from tabletcad.brep.surface import BSplineSurfaceData
 from tabletcad.cad._occ import Array1OfInteger, Array1OfPnt, Array1OfReal, Array2OfPnt
 from tabletcad.errors import GeometryError
 
-__all__ = ["knot_boundary_pcurves", "make_face", "make_geom_surface", "make_revolved_face", "surface_data_from_geom"]
+__all__ = ["face_of", "knot_boundary_pcurves", "make_face", "make_geom_surface", "make_revolved_face", "surface_data_from_geom"]
 
 
 def _real_array(values) -> Array1OfReal:
@@ -110,14 +110,20 @@ def make_face(data: BSplineSurfaceData, *, tol_degen: float = 1e-7, name: str = 
     ``tol_degen`` is the length below which a boundary iso-curve becomes a
     degenerated edge (a pole of the patch).
     """
-    surf = make_geom_surface(data)
-    maker = BRepBuilderAPI_MakeFace(surf, float(tol_degen))
-    if not maker.IsDone():
-        raise GeometryError(f"BRepBuilderAPI_MakeFace failed for {name} (error {maker.Error()})", data)
-    face = maker.Face()
-    knot_boundary_pcurves(face)
+    face = face_of(make_geom_surface(data), tol_degen=tol_degen, name=name)
     if check and not BRepCheck_Analyzer(face).IsValid():
         raise GeometryError(f"face of {name} is not valid (BRepCheck_Analyzer)", data)
+    return face
+
+
+def face_of(surf: Geom_BSplineSurface, *, tol_degen: float = 1e-7, name: str = "surface") -> TopoDS_Face:
+    """The face of the natural limits of ``surf`` (unchecked), its iso-``u`` boundary p-curves
+    carrying the surface's C0/C1 ``v`` knots (:func:`knot_boundary_pcurves`)."""
+    maker = BRepBuilderAPI_MakeFace(surf, float(tol_degen))
+    if not maker.IsDone():
+        raise GeometryError(f"BRepBuilderAPI_MakeFace failed for {name} (error {maker.Error()})", surf)
+    face = maker.Face()
+    knot_boundary_pcurves(face)
     return face
 
 

@@ -9,8 +9,10 @@ free edge) that failed.
 2. :func:`tabletcad.cad.faces.make_face` - one periodic B-spline face per patch, or
    the whole chain cut alike into pieces where a boundary row stands still over part
    of its length (:func:`tabletcad.brep.slit.chain_face_surfaces`);
-3. ``BRepBuilderAPI_Sewing`` with tolerance ``max(2 tol, 1e-6)`` mm - no free
-   or multiple edges allowed, exactly one closed shell;
+3. one closed shell: assembled edge by edge from the chain's known topology
+   (:func:`tabletcad.cad.shell.assemble_shell`), or, for a chain it cannot assemble (the
+   capsule's slit) or whose assembled solid fails its check, ``BRepBuilderAPI_Sewing`` with
+   tolerance ``max(2 tol, 1e-6)`` mm - no free or multiple edges allowed;
 4. ``BRepBuilderAPI_MakeSolid`` + ``BRepLib::OrientClosedSolid`` (matter
    inside, positive volume; faces of revolution: reversed if their volume is
    negative) + ``BRepCheck_Analyzer``;
@@ -44,7 +46,8 @@ from tabletcad.brep.revolved import RevolvedSurfaceData
 from tabletcad.brep.fit import PatchFunction, SurfaceFit, chain_breakpoints, fit_patches
 from tabletcad.brep.surface import BSplineSurfaceData, volume_and_area
 from tabletcad.cad._occ import cast, explore, shape_type
-from tabletcad.cad.faces import knot_boundary_pcurves, make_face
+from tabletcad.cad.faces import face_of, knot_boundary_pcurves, make_geom_surface
+from tabletcad.cad.shell import assemble_shell
 from tabletcad.errors import GeometryError
 from tabletcad.brep.slit import chain_face_surfaces
 
@@ -100,7 +103,8 @@ def mass_properties(shape: TopoDS_Shape, eps: float | None = DEFAULT_EPS) -> Mas
 
 @dataclass(frozen=True, eq=False)
 class TabletSolid:
-    """A validated, outward-oriented closed solid and how it was made.
+    """A validated, outward-oriented closed solid and how it was made (``sewn``: its shell by
+    ``BRepBuilderAPI_Sewing``, else assembled edge by edge: :mod:`tabletcad.cad.shell`).
 
     ``volume_fit_bound`` = ``max_fit_deviation * area`` bounds the volume change
     caused by replacing the patches with their B-splines (the surfaces are at
@@ -116,6 +120,7 @@ class TabletSolid:
     sew_tolerance: float
     eps: float | None = DEFAULT_EPS
     timings: dict[str, float] = field(default_factory=dict)
+    sewn: bool = True
 
     @property
     def mass(self) -> MassProperties:
@@ -166,6 +171,7 @@ class TabletSolid:
             "area_mm2": self.area,
             "volume_rel_error_estimate": self.mass.volume_error,
             "sew_tolerance_mm": self.sew_tolerance,
+            "sewn": self.sewn,
             "timings_s": dict(self.timings),
         }
 
@@ -277,13 +283,24 @@ def solid_from_surfaces(
     names = list(names) if names is not None else [f"patch {j}" for j in range(len(surfaces))]
     # one face per surface; the whole chain cut alike where a boundary row stands still over
     # part of its length (the capsule's centre line, collapsed outline corners: tabletcad.brep.slit)
-    faces_l: list = []
+    pieces = chain_face_surfaces(surfaces, tol_degen, names)
     face_names: list[str] = []
-    for pieces, n in zip(chain_face_surfaces(surfaces, tol_degen, names), names):
-        # each face is checked as part of the solid (BRepCheck_Analyzer of the solid checks its
-        # faces); only when that fails are they checked one by one, to name the bad one
-        faces_l.extend(make_face(p, tol_degen=tol_degen, name=n, check=False) for p in pieces)
-        face_names.extend([n] if len(pieces) == 1 else [f"{n} (piece {k + 1})" for k in range(len(pieces))])
+    for ps, n in zip(pieces, names):
+        face_names.extend([n] if len(ps) == 1 else [f"{n} (piece {k + 1})" for k in range(len(ps))])
+    geoms = [[make_geom_surface(p) for p in ps] for ps in pieces]
+    # the chain's topology is known: its shell is assembled edge by edge (tabletcad.cad.shell);
+    # a chain that cannot be (the capsule's slit), or whose assembled solid fails its check, is sewn
+    assembled = assemble_shell(pieces, geoms, tol_degen)
+    if assembled is not None:
+        shell, faces_a = assembled
+        try:
+            return _solid_from_faces(tuple(faces_a), face_names, surfaces, names, fits, sew_tolerance, eps, name, t0,
+                                     shell=shell)
+        except GeometryError:
+            pass
+    # each face is checked as part of the solid (BRepCheck_Analyzer of the solid checks its
+    # faces); only when that fails are they checked one by one, to name the bad one
+    faces_l = [face_of(g, tol_degen=tol_degen, name=n) for gs, n in zip(geoms, names) for g in gs]
     try:
         return _solid_from_faces(tuple(faces_l), face_names, surfaces, names, fits, sew_tolerance, eps, name, t0)
     except GeometryError as exc:
@@ -294,14 +311,18 @@ def solid_from_surfaces(
 
 
 def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequence, names: Sequence[str],
-                      fits: Sequence, sew_tolerance: float, eps: float, name: str, t0: float) -> TabletSolid:
-    """Sew ``faces`` into one closed shell, make the outward solid and check it (its mass
-    properties are integrated when first asked for: :attr:`TabletSolid.mass`)."""
+                      fits: Sequence, sew_tolerance: float, eps: float, name: str, t0: float,
+                      shell=None) -> TabletSolid:
+    """Sew ``faces`` into one closed shell (unless the ``shell`` they make is given), make the
+    outward solid and check it (its mass properties are integrated when first asked for:
+    :attr:`TabletSolid.mass`)."""
     t1 = time.perf_counter()
-    shell = sew_faces(faces, face_names, sew_tolerance)
-    # sewing may rebuild p-curves: make sure the boundary p-curves still carry the C0/C1
-    # v knots that BRepGProp needs to integrate across them (see tabletcad.cad.faces)
-    knot_boundary_pcurves(shell)
+    sewn = shell is None
+    if sewn:
+        shell = sew_faces(faces, face_names, sew_tolerance)
+        # sewing may rebuild p-curves: make sure the boundary p-curves still carry the C0/C1
+        # v knots that BRepGProp needs to integrate across them (see tabletcad.cad.faces)
+        knot_boundary_pcurves(shell)
     va = volume_and_area(surfaces)  # the faces' own volume and area, also the stage's check
     # a face of revolution is OCC's (angle, profile) surface, the data's (profile, angle) one with
     # the parameters swapped: its normal, and the volume its faces enclose, is the data's reversed
@@ -318,7 +339,8 @@ def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequenc
         fits=tuple(fits),
         sew_tolerance=float(sew_tolerance),
         eps=eps,
-        timings={"faces": t1 - t0, "sew_and_check": t2 - t1},
+        timings={"faces": t1 - t0, "sew_and_check" if sewn else "shell_and_check": t2 - t1},
+        sewn=sewn,
     )
     object.__setattr__(out, "_data_volume_area", va)
     return out
