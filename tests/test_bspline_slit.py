@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tabletcad.brep.fit import fit_patches
-from tabletcad.brep.surface import BSplineSurfaceData, enclosed_volume, segment_v
+from tabletcad.brep.surface import BSplineSurfaceData, enclosed_volume, segment_v, segments_v
 from tabletcad.errors import GeometryError
 from tabletcad.brep.slit import chain_face_surfaces, row_pieces
 
@@ -55,9 +55,15 @@ def test_segment_v_is_exact(degree, seed, periodic, c0_first):
             ranges += [(0.0, cuts[0]), (cuts[1], 2.0)]
     else:
         ranges += [(0.0, cuts[0]), (cuts[1], 2.0)]
-    for a, b in ranges:
+    together = segments_v(S, ranges)  # the same pieces, the knot vector set up once
+    for (a, b), same in zip(ranges, together):
         piece = segment_v(S, a, b)
         assert not piece.v_periodic and piece.v_range == (a, b)
+        # made without the constructor's checks: they pass, and the data are read-only
+        checked = BSplineSurfaceData(**{k: getattr(piece, k) for k in BSplineSurfaceData.__dataclass_fields__})
+        for k in ("poles", "v_knots", "v_mults"):
+            assert np.array_equal(getattr(checked, k), getattr(piece, k))
+            assert np.array_equal(getattr(same, k), getattr(piece, k)) and not getattr(piece, k).flags.writeable
         v = np.linspace(a, b, 41)
         U, V = np.meshgrid(u, v)
         np.testing.assert_allclose(piece.evaluate(U, V), S.evaluate(U, V), atol=1e-12)

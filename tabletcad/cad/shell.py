@@ -126,41 +126,43 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
             return pieces[r][k], surfaces[r][k], 0
         return pieces[n_patch - 1][k], surfaces[n_patch - 1][k], -1
 
-    def corner(r: int, k: int, end: int) -> np.ndarray:
-        """The point where row ``r``'s piece ``k`` starts (``end`` 0) or ends (1), mm."""
+    def ends(r: int, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """The points where row ``r``'s piece ``k`` starts and ends, mm: its end poles (clamped
+        in ``v``), or the periodic row's point at the period's start, twice."""
         d, s, i = row_data(r, k)
-        q = s.Value(float(d.u_knots[i]), v_ranges[k][end])
-        return np.array([q.X(), q.Y(), q.Z()])
+        if not periodic:
+            row = d.poles[i]
+            return row[0], row[-1]
+        q = s.Value(float(d.u_knots[i]), v_ranges[k][0])
+        p = np.array([q.X(), q.Y(), q.Z()])
+        return p, p
 
     B = BRep_Builder()
 
-    # ---- vertices: per row, per cut (the start of each piece); equal points share one vertex
+    # ---- vertices: per row, per cut (the start of each piece); equal points share one vertex,
+    # its tolerance the largest distance to the piece ends it stands for
     vertices: list[list[TopoDS_Vertex]] = []
-    vtol: dict[int, float] = {}
     for r in range(n_row):
-        pool: list[tuple[np.ndarray, TopoDS_Vertex]] = []
+        se = [ends(r, k) for k in range(n_piece)]
+        pool: list[list] = []  # [point, vertex, tolerance]
         row_v = []
         for k in range(n_piece):
-            p = corner(r, k, 0)
-            for q, v in pool:
-                dist = float(np.linalg.norm(p - q))
+            p = se[k][0]
+            for item in pool:
+                dist = float(np.linalg.norm(p - item[0]))
                 if dist <= 10.0 * tol_degen:
-                    vtol[id(v)] = max(vtol[id(v)], dist)
+                    item[2] = max(item[2], dist)
                     break
             else:
-                v = TopoDS_Vertex()
-                vtol[id(v)] = 0.0
-                pool.append((p, v))
-            row_v.append(v)
-        vertices.append(row_v)
-        for p, v in pool:  # the rows' ends: the start of the next piece, and the last one's end
-            for k in range(n_piece):
-                end = corner(r, k, 1)
-                nxt = row_v[(k + 1) % n_piece]
-                if nxt is v:
-                    vtol[id(v)] = max(vtol[id(v)], float(np.linalg.norm(end - p)))
-        for p, v in pool:
-            B.MakeVertex(v, gp_Pnt(*p.tolist()), EDGE_TOL + 1.01 * vtol[id(v)])
+                item = [p, TopoDS_Vertex(), 0.0]
+                pool.append(item)
+            row_v.append(item)
+        for k in range(n_piece):  # each piece ends where the next starts
+            item = row_v[(k + 1) % n_piece]
+            item[2] = max(item[2], float(np.linalg.norm(se[k][1] - item[0])))
+        for p, v, tol in pool:
+            B.MakeVertex(v, gp_Pnt(*p.tolist()), EDGE_TOL + 1.01 * tol)
+        vertices.append([item[1] for item in row_v])
 
     # ---- row edges per row and piece: shared by the faces on both sides, or None where the
     # piece's row is one pole (each face gets its own degenerated edge there, as sewing leaves it)
