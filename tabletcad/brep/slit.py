@@ -73,25 +73,56 @@ def _is_c0_knot(data: BSplineSurfaceData, v: float) -> bool:
     return abs(float(knots[i]) - v) <= 1e-12 * max(1.0, abs(v)) and int(data.v_mults[i]) >= data.v_degree
 
 
-def _standing_rows(data: BSplineSurfaceData, tol: float) -> dict[int, list]:
+def _standing_rows(data: BSplineSurfaceData, tol: float, made: dict | None = None) -> dict[int, list]:
     """``{row: pieces}`` for the boundary rows of ``data`` that stand still over part of their
-    length (:func:`row_pieces` gives both ``"point"`` and ``"run"`` pieces)."""
+    length (both ``"point"`` and ``"run"`` pieces, as :func:`row_pieces` gives them).
+
+    A row of a surface clamped in ``u`` is its pole row, and over a piece between C0 knots
+    the row's curve is a convex combination of that piece's poles: it stands within ``tol``
+    of its start wherever they do.  The pieces' poles (:func:`~tabletcad.brep.surface.segments_v`)
+    then say it without evaluating the row; a row not clamped is sampled (:func:`row_pieces`).
+    The pieces go into ``made[id(data)]`` with their cuts, for :func:`_pieces` to take."""
+    if not data.v_periodic or data.u_periodic:
+        return {}
+    knots = np.asarray(data.v_knots, dtype=float)
+    cuts = sorted({float(knots[0]), float(knots[-1]),
+                   *[float(k) for k, m in zip(knots, data.v_mults) if m >= data.v_degree]})
+    if len(cuts) < 3:
+        return {}
+    spans = list(zip(cuts[:-1], cuts[1:]))
+    wrap = not _is_c0_knot(data, float(knots[0]))  # the first and last spans: one piece across the seam
+    pieces = None
     out = {}
     for k in (0, -1):
-        found = row_pieces(data, k, tol)
-        if found is not None and len({kind for _, _, kind in found[0]}) == 2:
-            out[k] = found[0]
+        if data.u_mults[k] != data.u_degree + 1:
+            found = row_pieces(data, k, tol)
+            if found is not None and len({kind for _, _, kind in found[0]}) == 2:
+                out[k] = found[0]
+            continue
+        if pieces is None:
+            period = float(knots[-1] - knots[0])
+            pieces = segments_v(data, [(spans[-1][0], spans[0][1] + period), *spans[1:-1]] if wrap else spans)
+            if made is not None:
+                made[id(data)] = (cuts, pieces)
+        kinds = ["point" if float(np.max(np.linalg.norm(q.poles[k] - q.poles[k][0], axis=-1))) <= tol else "run"
+                 for q in pieces]
+        if wrap:
+            kinds = [kinds[0], *kinds[1:], kinds[0]]
+        if len(set(kinds)) == 2:
+            out[k] = [(a, b, kind) for (a, b), kind in zip(spans, kinds)]
     return out
 
 
-def _pieces(data: BSplineSurfaceData, cuts: list[float], tol: float) -> tuple[BSplineSurfaceData, ...]:
+def _pieces(data: BSplineSurfaceData, cuts: list[float], tol: float,
+            made: dict | None = None) -> tuple[BSplineSurfaceData, ...]:
     period = float(data.v_knots[-1] - data.v_knots[0])
     cuts = sorted({float(data.v_knots[0]), float(data.v_knots[-1]), *cuts})
     spans = list(zip(cuts[:-1], cuts[1:]))
     if not _is_c0_knot(data, float(data.v_knots[0])):
         spans = [(spans[-1][0], spans[0][1] + period), *spans[1:-1]]
+    hit = (made or {}).get(id(data))
     out = []
-    for piece in segments_v(data, spans):
+    for piece in hit[1] if hit is not None and hit[0] == cuts else segments_v(data, spans):
         poles = None
         for k in (0, -1):
             r = piece.poles[k]
@@ -122,8 +153,9 @@ def chain_face_surfaces(surfaces, tol: float = 1e-7, names=None) -> list[tuple[B
     surfaces = list(surfaces)
     names = list(names) if names is not None else [f"surface {j}" for j in range(len(surfaces))]
     cuts: set[float] = set()
+    made: dict = {}  # pieces cut while looking, kept for the cut (when at the same cuts)
     for data, name in zip(surfaces, names):
-        for k, pieces in _standing_rows(data, tol).items():
+        for k, pieces in _standing_rows(data, tol, made).items():
             other = np.asarray(data.poles[-1 if k == 0 else 0])
             if float(np.max(np.linalg.norm(other - other[0], axis=-1))) <= tol:
                 raise GeometryError(f"{name}: a row that stands still in part opposite a pole is not supported", data)
@@ -135,5 +167,5 @@ def chain_face_surfaces(surfaces, tol: float = 1e-7, names=None) -> list[tuple[B
         if not data.v_periodic:
             raise GeometryError(f"{name}: cannot be cut at v = {sorted(cuts)} with its neighbours (not periodic in v)",
                                 data)
-        out.append(_pieces(data, sorted(cuts), tol))
+        out.append(_pieces(data, sorted(cuts), tol, made))
     return out
