@@ -171,8 +171,8 @@ def _deviation(f: SurfaceFunction, data: BSplineSurfaceData, u: np.ndarray, v: n
     vs = np.concatenate([v, [v[0] + math.tau]])
     vc = (vs[:-1, None] + (np.arange(factor) / factor)[None, :] * np.diff(vs)[:, None]).ravel()
     F = _eval_f(f, uc, vc)
-    S = data.evaluate_grid(uc, vc)
-    E = np.linalg.norm(S - F, axis=-1)
+    D = data.evaluate_grid(uc, vc) - F
+    E = np.sqrt(np.einsum("...k,...k->...", D, D))
     # split: points on sample v-lines (pure u-interpolation error) and on sample u-lines
     err_u = float(E[:, ::factor].max())
     err_v = float(E[::factor, :].max())
