@@ -80,7 +80,9 @@ def _standing_rows(data: BSplineSurfaceData, tol: float, made: dict | None = Non
     A row of a surface clamped in ``u`` is its pole row, and over a piece between C0 knots
     the row's curve is a convex combination of that piece's poles: it stands within ``tol``
     of its start wherever they do.  The pieces' poles (:func:`~tabletcad.brep.surface.segments_v`)
-    then say it without evaluating the row; a row not clamped is sampled (:func:`row_pieces`).
+    then say it without evaluating the row, when they are clearly within ``tol`` or beyond
+    ``100 tol``; a row not clamped, a piece across the seam or poles in between are sampled
+    (:func:`row_pieces`), as before.
     The pieces go into ``made[id(data)]`` with their cuts, for :func:`_pieces` to take."""
     if not data.v_periodic or data.u_periodic:
         return {}
@@ -94,22 +96,23 @@ def _standing_rows(data: BSplineSurfaceData, tol: float, made: dict | None = Non
     pieces = None
     out = {}
     for k in (0, -1):
-        if data.u_mults[k] != data.u_degree + 1:
+        kinds = None
+        if data.u_mults[k] == data.u_degree + 1 and not wrap:
+            if pieces is None:
+                pieces = segments_v(data, spans)
+                if made is not None:
+                    made[id(data)] = (cuts, pieces)
+            spread = [float(np.max(np.linalg.norm(q.poles[k] - q.poles[k][0], axis=-1))) for q in pieces]
+            if all(x <= tol or x > 100.0 * tol for x in spread):  # clear either way: the poles say it
+                kinds = ["point" if x <= tol else "run" for x in spread]
+        if kinds is None:  # not clamped, across the seam, or poles just beyond tol: the row's samples
             found = row_pieces(data, k, tol)
-            if found is not None and len({kind for _, _, kind in found[0]}) == 2:
-                out[k] = found[0]
-            continue
-        if pieces is None:
-            period = float(knots[-1] - knots[0])
-            pieces = segments_v(data, [(spans[-1][0], spans[0][1] + period), *spans[1:-1]] if wrap else spans)
-            if made is not None:
-                made[id(data)] = (cuts, pieces)
-        kinds = ["point" if float(np.max(np.linalg.norm(q.poles[k] - q.poles[k][0], axis=-1))) <= tol else "run"
-                 for q in pieces]
-        if wrap:
-            kinds = [kinds[0], *kinds[1:], kinds[0]]
-        if len(set(kinds)) == 2:
-            out[k] = [(a, b, kind) for (a, b), kind in zip(spans, kinds)]
+            kinds = None if found is None else [kind for _, _, kind in found[0]]
+            spans_k = None if found is None else [(a, b) for a, b, _ in found[0]]
+        else:
+            spans_k = spans
+        if kinds is not None and len(set(kinds)) == 2:
+            out[k] = [(a, b, kind) for (a, b), kind in zip(spans_k, kinds)]
     return out
 
 

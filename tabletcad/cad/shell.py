@@ -110,14 +110,18 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
                     or d.u_mults[-1] != d.u_degree + 1:
                 return None
     v_ranges = [(float(d.v_knots[0]), float(d.v_knots[-1])) for d in pieces[0]]
-    for p in pieces[1:]:
-        if [(float(d.v_knots[0]), float(d.v_knots[-1])) for d in p] != v_ranges:
-            return None
+    for p in pieces[1:]:  # every patch's piece k: the same v knots, multiplicities and degree
+        for a, b in zip(pieces[0], p):
+            if a.v_degree != b.v_degree or not (np.array_equal(a.v_knots, b.v_knots)
+                                                and np.array_equal(a.v_mults, b.v_mults)):
+                return None
     for j in range(n_patch - 1):  # neighbours share their rows, piece by piece
         for a, b in zip(pieces[j], pieces[j + 1]):
             if not np.array_equal(a.poles[-1], b.poles[0]):
                 return None
     closed = all(np.array_equal(a.poles[-1], b.poles[0]) for a, b in zip(pieces[-1], pieces[0]))
+    if closed and n_patch == 1:  # one patch closed on itself: its one row would bound it twice
+        return None
     n_row = n_patch if closed else n_patch + 1
 
     def row_data(r: int, k: int) -> tuple[BSplineSurfaceData, Geom_BSplineSurface, int]:
@@ -198,19 +202,30 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
         return e
 
     # ---- column edges: per patch and cut (the start of each piece); a periodic patch's seam
+    # (its curve is piece k's; piece k - 1's side may differ where a collapsed row was snapped to
+    # one pole, by at most its poles' difference: the edge's tolerance covers that)
     col_edges: list[list[TopoDS_Edge]] = []
+    col_tol: list[list[float]] = []
     for j in range(n_patch):
-        out = []
+        out, tols = [], []
         for k in range(n_piece):
             d, s = pieces[j][k], surfaces[j][k]
             if _spread(np.asarray(d.poles)[:, 0]) <= tol_degen:
                 return None
+            tol = EDGE_TOL
+            if not periodic:
+                prev = pieces[j][(k - 1) % n_piece].poles[:, -1]
+                if prev.shape != d.poles[:, 0].shape:
+                    return None
+                tol += 1.01 * float(np.max(np.linalg.norm(prev - d.poles[:, 0], axis=-1)))
             e = TopoDS_Edge()
-            B.MakeEdge(e, s.VIso(v_ranges[k][0]), EDGE_TOL)
+            B.MakeEdge(e, s.VIso(v_ranges[k][0]), tol)
             B.Add(e, vertices[j][k].Oriented(_FORWARD))
             B.Add(e, vertices[(j + 1) % n_row][k].Oriented(_REVERSED))
             out.append(e)
+            tols.append(tol)
         col_edges.append(out)
+        col_tol.append(tols)
 
     # ---- faces: the parameter rectangle, counter-clockwise; p-curves on each face
     shell = TopoDS_Shell()
@@ -226,17 +241,17 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
             breaks = _v_breaks(d)
             low = row_edges[j][k] or degenerated(j, k)
             high = row_edges[(j + 1) % n_row][k] or degenerated((j + 1) % n_row, k)
-            start = col_edges[j][k]
+            start, start_tol = col_edges[j][k], col_tol[j][k]
             for e, u in ((low, u0), (high, u1)):
                 B.UpdateEdge(e, _row_pcurve(u, a, b, breaks), f, EDGE_TOL)
             if periodic:
                 B.UpdateEdge(start, Geom2d_Line(gp_Pnt2d(0.0, a), gp_Dir2d(1.0, 0.0)),
-                             Geom2d_Line(gp_Pnt2d(0.0, b), gp_Dir2d(1.0, 0.0)), f, EDGE_TOL)
+                             Geom2d_Line(gp_Pnt2d(0.0, b), gp_Dir2d(1.0, 0.0)), f, start_tol)
                 end = start
             else:
-                end = col_edges[j][(k + 1) % n_piece]
-                B.UpdateEdge(start, Geom2d_Line(gp_Pnt2d(0.0, a), gp_Dir2d(1.0, 0.0)), f, EDGE_TOL)
-                B.UpdateEdge(end, Geom2d_Line(gp_Pnt2d(0.0, b), gp_Dir2d(1.0, 0.0)), f, EDGE_TOL)
+                end, end_tol = col_edges[j][(k + 1) % n_piece], col_tol[j][(k + 1) % n_piece]
+                B.UpdateEdge(start, Geom2d_Line(gp_Pnt2d(0.0, a), gp_Dir2d(1.0, 0.0)), f, start_tol)
+                B.UpdateEdge(end, Geom2d_Line(gp_Pnt2d(0.0, b), gp_Dir2d(1.0, 0.0)), f, end_tol)
             w = TopoDS_Wire()
             B.MakeWire(w)
             B.Add(w, start.Oriented(_FORWARD))

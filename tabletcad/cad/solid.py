@@ -290,7 +290,10 @@ def solid_from_surfaces(
     geoms = [[make_geom_surface(p) for p in ps] for ps in pieces]
     # the chain's topology is known: its shell is assembled edge by edge (tabletcad.cad.shell);
     # a chain that cannot be (the capsule's slit), or whose assembled solid fails its check, is sewn
-    assembled = assemble_shell(pieces, geoms, tol_degen)
+    try:
+        assembled = assemble_shell(pieces, geoms, tol_degen)
+    except Exception:  # an OCC exception while building it: sewing decides  # noqa: BLE001
+        assembled = None
     if assembled is not None:
         shell, faces_a = assembled
         try:
