@@ -181,7 +181,7 @@ def bench_report(paths=None, repeat=3):
     paths = paths or [root / "samples" / n for n in ("flat_faced_round.toml", "spherical.toml", "caplet.toml")] + [
         root / "samples" / "families" / n for n in ("flat_face_round.toml", "concave_round.toml", "capsule.toml",
                                                      "oval.toml", "rounded_triangle.toml", "almond.toml")]
-    from tabletcad.geometry.tables import CARDINAL, TRIG
+    from tabletcad.geometry.tables import CARDINAL, COLLOCATION, TRIG
 
     print("Load + geometry report per design (best of %d; peak traced heap of one run; 'cold': the first run," % repeat)
     print("with the tables shared between patches and builds (tabletcad.geometry.tables) emptied before it)")
@@ -191,6 +191,7 @@ def bench_report(paths=None, repeat=3):
         best = (math.inf, math.inf)
         TRIG.clear()
         CARDINAL.clear()
+        COLLOCATION.clear()
         cold = None
         for _ in range(repeat):
             t0 = time.perf_counter()

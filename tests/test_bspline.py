@@ -180,3 +180,25 @@ def test_basis_on_whole_columns_is_the_textbook_recursion_bit_for_bit(seed, degr
     np.testing.assert_array_equal(span, _find_span(t, degree, n, x))
     np.testing.assert_array_equal(N, _cox_de_boor_guarded(t, degree, x, span))
     assert np.max(np.abs(N.sum(axis=1) - 1.0)) < 1e-14
+
+
+def test_collocation_is_shared_between_surfaces_with_the_same_knots():
+    """The faces of a chain share their knots: their collocation matrices are one read-only table
+    (:data:`tabletcad.geometry.tables.COLLOCATION`), what each would compute alone, and a surface
+    with other knots or other samples gets its own."""
+    from tabletcad.geometry.tables import COLLOCATION
+
+    fits = fit_patches(cylinder(2.5, 3.0).patches, 1e-4)
+    a, b = fits[0].surface, fits[1].surface
+    assert np.array_equal(a.v_knots, b.v_knots) and np.array_equal(a.v_mults, b.v_mults)
+    v = np.linspace(0.0, math.tau, 41)
+    COLLOCATION.clear()
+    alone = np.array(a.collocation("v", v, 1))
+    shared = b.collocation("v", v, 1)
+    assert shared is a.collocation("v", v, 1) and not shared.flags.writeable
+    np.testing.assert_array_equal(shared, alone)
+    assert a.collocation("v", v + 1e-12, 1) is not shared and a.collocation("v", v, 0) is not shared
+    # and it is the B-splines' derivative: the surface's own v-derivative at the samples
+    u = np.array([0.3])
+    np.testing.assert_allclose(np.einsum("ai,ijk,bj->abk", a.collocation("u", u), a.poles, shared)[0],
+                               a.evaluate(np.full(v.shape, 0.3), v, dv=1), atol=1e-12)

@@ -32,6 +32,7 @@ from tabletcad.brep.knots import basis_derivatives, flat_knots
 from tabletcad.errors import GeometryError
 from tabletcad.geometry.vectors import cross
 from tabletcad.geometry.quadrature import gauss_legendre
+from tabletcad.geometry.tables import COLLOCATION
 
 __all__ = ["BSplineSurfaceData", "enclosed_volume", "volume_and_area", "segment_v", "segments_v"]
 
@@ -165,14 +166,24 @@ class BSplineSurfaceData:
 
     def collocation(self, which: str, x: np.ndarray, order: int = 0) -> np.ndarray:
         """Dense matrix ``B[a, i]`` = value (``order`` 0) or first derivative (``order`` 1) of the
-        B-spline attached to pole ``i`` at ``x[a]``."""
+        B-spline attached to pole ``i`` at ``x[a]``; read-only, shared by every surface with the
+        same knots in that direction (:data:`~tabletcad.geometry.tables.COLLOCATION`)."""
         x = np.asarray(x, dtype=float).ravel()
-        idx, N = self._basis(which, x, order)
         n = self.shape[0] if which == "u" else self.shape[1]
-        B = np.zeros((x.size, n))
-        rows = np.repeat(np.arange(x.size), idx.shape[1])
-        np.add.at(B, (rows, idx.ravel()), N.ravel())
-        return B
+
+        def make() -> np.ndarray:
+            idx, N = self._basis(which, x, order)
+            B = np.zeros((x.size, n))
+            rows = np.repeat(np.arange(x.size), idx.shape[1])
+            np.add.at(B, (rows, idx.ravel()), N.ravel())
+            return B
+
+        if which == "u":
+            knots, mults, deg, per = self.u_knots, self.u_mults, self.u_degree, self.u_periodic
+        else:
+            knots, mults, deg, per = self.v_knots, self.v_mults, self.v_degree, self.v_periodic
+        key = ("collocation", order, n, deg, per, knots.tobytes(), mults.tobytes(), x.tobytes())
+        return COLLOCATION.get(key, make)
 
     def degenerate_rows(self, tol: float = 0.0) -> tuple[bool, bool]:
         """Whether the pole rows at ``u`` min / max collapse to a single point (within ``tol``)."""

@@ -17,7 +17,7 @@ from typing import Callable, Hashable
 
 import numpy as np
 
-__all__ = ["SharedTables", "TRIG", "CARDINAL"]
+__all__ = ["SharedTables", "TRIG", "CARDINAL", "COLLOCATION"]
 
 
 class SharedTables:
@@ -84,3 +84,7 @@ TRIG = SharedTables(32, 8_000_000, 64_000_000)
 #: :mod:`tabletcad.geometry.revolution`): the patches of a family share ``a`` and the nodes, so the
 #: checks' and quadratures' ``u`` lines serve them all.  96 tables, none above 4 MB, 48 MB in all.
 CARDINAL = SharedTables(96, 4_000_000, 48_000_000)
+#: B-spline collocation matrices (:meth:`tabletcad.brep.surface.BSplineSurfaceData.collocation`):
+#: the faces of a chain share their knots, and the fit, its check, the volume and area and the mesh
+#: evaluate them on the same samples.  64 tables, none above 2 MB, 32 MB in all.
+COLLOCATION = SharedTables(64, 2_000_000, 32_000_000)
