@@ -30,7 +30,8 @@ row).  Until it is within the deflection the
 densities grow by half (at most ``max_rounds`` times).
 
 Arrays are components first, ``(3, nu, nv)``: dot and cross products are then sums of
-contiguous planes.  Surfaces with the same knots share their collocation matrices.
+contiguous planes.  Surfaces with the same knots share their collocation matrices
+(:meth:`~tabletcad.brep.surface.BSplineSurfaceData.collocation`).
 """
 
 from __future__ import annotations
@@ -95,18 +96,11 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 class _Collocation:
-    """Value and first-derivative collocation matrices, computed once per knot vector and samples."""
-
-    def __init__(self) -> None:
-        self._store: dict = {}
+    """Value and first-derivative collocation matrices (each computed once per knot vector and
+    samples, and shared between surfaces: :data:`tabletcad.geometry.tables.COLLOCATION`)."""
 
     def __call__(self, s: BSplineSurfaceData, which: str, x: np.ndarray):
-        knots, mults, deg = (s.u_knots, s.u_mults, s.u_degree) if which == "u" else (s.v_knots, s.v_mults, s.v_degree)
-        key = (which, deg, knots.tobytes(), mults.tobytes(), x.tobytes())
-        hit = self._store.get(key)
-        if hit is None:
-            hit = self._store[key] = (s.collocation(which, x), s.collocation(which, x, 1))
-        return hit
+        return s.collocation(which, x), s.collocation(which, x, 1)
 
 
 def _points_normals(s: BSplineSurfaceData, u: np.ndarray, v: np.ndarray, col: _Collocation):

@@ -45,8 +45,8 @@ from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface, Geom_SurfaceOfRevolution
-from OCP.Geom2d import Geom2d_BSplineCurve
-from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt, gp_Pnt2d
+from OCP.Geom2d import Geom2d_BSplineCurve, Geom2d_Line
+from OCP.gp import gp_Ax1, gp_Dir, gp_Dir2d, gp_Pnt, gp_Pnt2d
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 
 try:  # OCP >= 8.0
@@ -59,7 +59,7 @@ from tabletcad.brep.surface import BSplineSurfaceData
 from tabletcad.cad._occ import Array1OfInteger, Array1OfPnt, Array1OfReal, Array2OfPnt
 from tabletcad.errors import GeometryError
 
-__all__ = ["face_of", "knot_boundary_pcurves", "make_face", "make_geom_surface", "make_revolved_face", "surface_data_from_geom"]
+__all__ = ["face_of", "iso_u_pcurve", "knot_boundary_pcurves", "make_face", "v_breaks", "make_geom_surface", "make_revolved_face", "surface_data_from_geom"]
 
 
 def _real_array(values) -> Array1OfReal:
@@ -154,11 +154,28 @@ def make_revolved_face(data: RevolvedSurfaceData, *, tol_degen: float = 1e-7, na
     return face
 
 
+def v_breaks(knots, mults, degree: int) -> list[float]:
+    """Interior ``v`` knots where a surface is at most C1 (multiplicity >= degree - 1)."""
+    return [float(k) for k, m in zip(list(knots)[1:-1], list(mults)[1:-1]) if m >= max(degree - 1, 1)]
+
+
 def _v_breaks(surf: Geom_BSplineSurface) -> list[float]:
-    """Interior ``v`` knots where the surface is at most C1 (multiplicity >= degree - 1)."""
-    deg = surf.VDegree()
     n = surf.NbVKnots()
-    return [surf.VKnot(i) for i in range(1, n + 1) if surf.VMultiplicity(i) >= max(deg - 1, 1)]
+    return v_breaks([surf.VKnot(i) for i in range(1, n + 1)], [surf.VMultiplicity(i) for i in range(1, n + 1)],
+                    surf.VDegree())
+
+
+def iso_u_pcurve(u0: float, a: float, b: float, breaks) -> Geom2d_BSplineCurve | Geom2d_Line:
+    """The p-curve ``t -> (u0, t)`` on ``[a, b]``: a ``Geom2d_Line``, or where ``breaks`` fall
+    inside the range a degree-1 ``Geom2d_BSplineCurve`` with knots there (the same line, which
+    ``BRepGProp`` splits its integration at: see the module docstring)."""
+    ks = [a] + [k for k in breaks if a + 1e-9 < k < b - 1e-9] + [b]
+    if len(ks) == 2:
+        return Geom2d_Line(gp_Pnt2d(u0, 0.0), gp_Dir2d(0.0, 1.0))
+    poles = Array1OfPnt2d(1, len(ks))
+    for i, k in enumerate(ks, start=1):
+        poles.SetValue(i, gp_Pnt2d(u0, k))
+    return Geom2d_BSplineCurve(poles, _real_array(ks), _int_array([2] + [1] * (len(ks) - 2) + [2]), 1)
 
 
 def knot_boundary_pcurves(shape: TopoDS_Shape) -> int:
@@ -203,13 +220,7 @@ def knot_boundary_pcurves(shape: TopoDS_Shape) -> int:
             u0 = pts[0].X()
             if max(max(abs(p.X() - u0), abs(p.Y() - x)) for p, x in zip(pts, ts)) > 1e-9:
                 continue
-            m = len(ks)
-            poles = Array1OfPnt2d(1, m)
-            for i, k in enumerate(ks, start=1):
-                poles.SetValue(i, gp_Pnt2d(u0, k))
-            mults = [2] + [1] * (m - 2) + [2]
-            curve = Geom2d_BSplineCurve(poles, _real_array(ks), _int_array(mults), 1)
-            builder.UpdateEdge(edge, curve, face, BRep_Tool.Tolerance_s(edge))
+            builder.UpdateEdge(edge, iso_u_pcurve(u0, a, b, breaks), face, BRep_Tool.Tolerance_s(edge))
             builder.Range(edge, face, a, b)
             count += 1
     return count

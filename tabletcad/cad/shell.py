@@ -31,49 +31,19 @@ from collections.abc import Sequence
 import numpy as np
 from OCP.BRep import BRep_Builder
 from OCP.Geom import Geom_BSplineSurface
-from OCP.Geom2d import Geom2d_BSplineCurve, Geom2d_Line
+from OCP.Geom2d import Geom2d_Line
 from OCP.gp import gp_Dir2d, gp_Pnt, gp_Pnt2d
 from OCP.TopAbs import TopAbs_Orientation
 from OCP.TopoDS import TopoDS_Edge, TopoDS_Face, TopoDS_Shell, TopoDS_Vertex, TopoDS_Wire
 
-try:  # OCP >= 8.0
-    from OCP.collections import Array1_gp_Pnt2d as Array1OfPnt2d
-except ImportError:  # pragma: no cover - OCP 7.x
-    from OCP.TColgp import TColgp_Array1OfPnt2d as Array1OfPnt2d
-
 from tabletcad.brep.surface import BSplineSurfaceData
-from tabletcad.cad._occ import Array1OfInteger, Array1OfReal
+from tabletcad.cad.faces import iso_u_pcurve, v_breaks
 
 __all__ = ["assemble_shell"]
 
 _FORWARD = TopAbs_Orientation.TopAbs_FORWARD
 _REVERSED = TopAbs_Orientation.TopAbs_REVERSED
 EDGE_TOL = 1e-7  # mm: Precision::Confusion, the tolerance MakeFace gives its edges
-
-
-def _array(values, cls):
-    arr = cls(1, len(values))
-    for i, x in enumerate(values, start=1):
-        arr.SetValue(i, x)
-    return arr
-
-
-def _row_pcurve(u0: float, a: float, b: float, breaks: Sequence[float]):
-    """The p-curve ``t -> (u0, t)`` on ``[a, b]``, with knots at the ``breaks`` inside it."""
-    ks = [a] + [k for k in breaks if a + 1e-9 < k < b - 1e-9] + [b]
-    if len(ks) == 2:
-        return Geom2d_Line(gp_Pnt2d(u0, 0.0), gp_Dir2d(0.0, 1.0))
-    poles = Array1OfPnt2d(1, len(ks))
-    for i, k in enumerate(ks, start=1):
-        poles.SetValue(i, gp_Pnt2d(u0, k))
-    mults = [2] + [1] * (len(ks) - 2) + [2]
-    return Geom2d_BSplineCurve(poles, _array(ks, Array1OfReal), _array(mults, Array1OfInteger), 1)
-
-
-def _v_breaks(data: BSplineSurfaceData) -> list[float]:
-    """Interior ``v`` knots where the surface is at most C1 (multiplicity >= degree - 1)."""
-    deg = data.v_degree
-    return [float(k) for k, m in zip(data.v_knots[1:-1], data.v_mults[1:-1]) if m >= max(deg - 1, 1)]
 
 
 def _spread(points: np.ndarray) -> float:
@@ -238,12 +208,12 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
             a, b = v_ranges[k]
             f = TopoDS_Face()
             B.MakeFace(f, s, EDGE_TOL)
-            breaks = _v_breaks(d)
+            breaks = v_breaks(d.v_knots, d.v_mults, d.v_degree)
             low = row_edges[j][k] or degenerated(j, k)
             high = row_edges[(j + 1) % n_row][k] or degenerated((j + 1) % n_row, k)
             start, start_tol = col_edges[j][k], col_tol[j][k]
             for e, u in ((low, u0), (high, u1)):
-                B.UpdateEdge(e, _row_pcurve(u, a, b, breaks), f, EDGE_TOL)
+                B.UpdateEdge(e, iso_u_pcurve(u, a, b, breaks), f, EDGE_TOL)
             if periodic:
                 B.UpdateEdge(start, Geom2d_Line(gp_Pnt2d(0.0, a), gp_Dir2d(1.0, 0.0)),
                              Geom2d_Line(gp_Pnt2d(0.0, b), gp_Dir2d(1.0, 0.0)), f, start_tol)

@@ -6,7 +6,7 @@ free edge) that failed.
 
 1. :func:`tabletcad.brep.fit.fit_patches` - B-spline fit of every patch within
    ``tol`` (shared boundary rows are bit-identical between neighbours);
-2. :func:`tabletcad.cad.faces.make_face` - one periodic B-spline face per patch, or
+2. :func:`tabletcad.cad.faces.make_geom_surface` - one periodic B-spline surface per patch, or
    the whole chain cut alike into pieces where a boundary row stands still over part
    of its length (:func:`tabletcad.brep.slit.chain_face_surfaces`);
 3. one closed shell: assembled edge by edge from the chain's known topology
@@ -39,6 +39,7 @@ from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepGProp import BRepGProp
 from OCP.BRepLib import BRepLib
 from OCP.GProp import GProp_GProps
+from OCP.Standard import Standard_Failure
 from OCP.TopAbs import TopAbs_Orientation
 from OCP.TopoDS import TopoDS_Shape, TopoDS_Solid
 
@@ -288,24 +289,26 @@ def solid_from_surfaces(
     for ps, n in zip(pieces, names):
         face_names.extend([n] if len(ps) == 1 else [f"{n} (piece {k + 1})" for k in range(len(ps))])
     geoms = [[make_geom_surface(p) for p in ps] for ps in pieces]
+    va = volume_and_area(surfaces)  # the faces' own volume and area (orientation, the stage's check)
     # the chain's topology is known: its shell is assembled edge by edge (tabletcad.cad.shell);
     # a chain that cannot be (the capsule's slit), or whose assembled solid fails its check, is sewn
     try:
         assembled = assemble_shell(pieces, geoms, tol_degen)
-    except Exception:  # an OCC exception while building it: sewing decides  # noqa: BLE001
+    except Standard_Failure:  # an OCC exception while building it: sewing decides
         assembled = None
     if assembled is not None:
         shell, faces_a = assembled
         try:
             return _solid_from_faces(tuple(faces_a), face_names, surfaces, names, fits, sew_tolerance, eps, name, t0,
-                                     shell=shell)
+                                     shell=shell, va=va)
         except GeometryError:
             pass
     # each face is checked as part of the solid (BRepCheck_Analyzer of the solid checks its
     # faces); only when that fails are they checked one by one, to name the bad one
     faces_l = [face_of(g, tol_degen=tol_degen, name=n) for gs, n in zip(geoms, names) for g in gs]
     try:
-        return _solid_from_faces(tuple(faces_l), face_names, surfaces, names, fits, sew_tolerance, eps, name, t0)
+        return _solid_from_faces(tuple(faces_l), face_names, surfaces, names, fits, sew_tolerance, eps, name, t0,
+                                 va=va)
     except GeometryError as exc:
         for face, n in zip(faces_l, face_names):
             if not BRepCheck_Analyzer(face).IsValid():
@@ -315,10 +318,10 @@ def solid_from_surfaces(
 
 def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequence, names: Sequence[str],
                       fits: Sequence, sew_tolerance: float, eps: float, name: str, t0: float,
-                      shell=None) -> TabletSolid:
+                      shell=None, va: tuple[float, float] | None = None) -> TabletSolid:
     """Sew ``faces`` into one closed shell (unless the ``shell`` they make is given), make the
     outward solid and check it (its mass properties are integrated when first asked for:
-    :attr:`TabletSolid.mass`)."""
+    :attr:`TabletSolid.mass`).  ``va``: the surfaces' :func:`volume_and_area`, if known."""
     t1 = time.perf_counter()
     sewn = shell is None
     if sewn:
@@ -326,7 +329,8 @@ def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequenc
         # sewing may rebuild p-curves: make sure the boundary p-curves still carry the C0/C1
         # v knots that BRepGProp needs to integrate across them (see tabletcad.cad.faces)
         knot_boundary_pcurves(shell)
-    va = volume_and_area(surfaces)  # the faces' own volume and area, also the stage's check
+    if va is None:
+        va = volume_and_area(surfaces)  # the faces' own volume and area, also the stage's check
     # a face of revolution is OCC's (angle, profile) surface, the data's (profile, angle) one with
     # the parameters swapped: its normal, and the volume its faces enclose, is the data's reversed
     revolved = [isinstance(sd, RevolvedSurfaceData) for sd in surfaces]
