@@ -53,6 +53,70 @@ def pytest_make_collect_report(collector):
     outcome = yield
     _fail_skip_in_ci(outcome.get_result())
 
+# --------------------------------------------------------------------------- signal handlers
+# A test (or a library it starts: gmsh's initialize sets SIGINT to SIG_DFL and never puts it back, a
+# Jupyter client restores Python's handler) that leaves SIGINT or SIGTERM handled otherwise, or blocked
+# in the main thread, changes what the Ctrl-C tests run after it in the same worker process see, which
+# depends on the files xdist gave that worker: the state is put right and the test that left it fails.
+_HELD_SIGNALS = ("SIGINT", "SIGTERM")
+
+
+def _ctrl_c_as_at_a_terminal() -> None:
+    """Python's own Ctrl-C handler, whoever started pytest: a shell starts a background job (``cmd &``,
+    as the fresh-clone runs are started) with SIGINT ignored, and Python then keeps it ignored, so the
+    Ctrl-C tests passed or failed with the worker that ran them (a Jupyter kernel client, run by an
+    earlier test in the same worker, put Python's handler back)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread() and signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
+_ctrl_c_as_at_a_terminal()
+
+
+#: the handlers and main-thread signal mask this worker process started its tests with, and the last test run
+_SIGNAL_STATE: dict = {}
+
+
+def _signal_state():
+    import signal
+
+    return ({s: signal.getsignal(getattr(signal, s)) for s in _HELD_SIGNALS},
+            frozenset(signal.pthread_sigmask(signal.SIG_BLOCK, [])))
+
+
+def _restore_signal_state(state) -> None:
+    import signal
+
+    handlers, mask = state
+    for s, handler in handlers.items():
+        signal.signal(getattr(signal, s), handler)
+    signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+
+
+@pytest.fixture(autouse=True)
+def _signal_handlers_restored(request):
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    start = _SIGNAL_STATE.setdefault("start", _signal_state())
+    found = _signal_state()
+    if found != start:  # changed outside any test: a module- or session-scoped fixture, a module's import
+        _restore_signal_state(start)
+        raise AssertionError(f"signal handlers or mask changed since the worker's first test, after "
+                             f"{_SIGNAL_STATE.get('last')}: {found} (was {start})")
+    yield
+    _SIGNAL_STATE["last"] = request.node.nodeid
+    left = _signal_state()
+    if left != start:
+        _restore_signal_state(start)
+        raise AssertionError(f"the test left signal handlers or mask changed: {left} (was {start})")
+
+
 # --------------------------------------------------------------------------- core-only run
 # .ci/test runs the suite a second time in .venv-oldest (the oldest numpy/scipy pyproject
 # claims, no CAD, FE or Dask library) with TABLETCAD_CORE_ONLY=1: files whose module-level

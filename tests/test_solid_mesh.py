@@ -304,7 +304,7 @@ def test_degenerate_cells_agree_with_gmsh_quality(tmp_path, family, degenerate):
     ours = degenerate_cells(m)
     assert {k: n for k, n in ours.items() if n} == degenerate
     write_mesh(m, tmp_path / "m.msh")
-    gmsh.initialize(["-noenv"], readConfigFiles=False)
+    gmsh.initialize(["-noenv"], readConfigFiles=False, interruptible=False)  # (gmsh 4.15 never restores its SIGINT handler)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.open(str(tmp_path / "m.msh"))
