@@ -85,6 +85,12 @@ def coordinate_range(arrays, k: int) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
+def _cross_c(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product of vector fields stored coordinates first, ``(3, ...)``: each coordinate one
+    contiguous block (the layout :meth:`PDEPatch.evaluate_grid` gives with ``components``)."""
+    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
 def _composite_gauss(breaks: np.ndarray, n_total: int) -> tuple[np.ndarray, np.ndarray]:
     """Gauss-Legendre nodes and weights over the periodic intervals between ``breaks``.
 
@@ -404,19 +410,36 @@ class Tablet:
         (the whole solid at the default rules) also appends its patch's triple integral of the
         solid map's Jacobian, from the same surface samples."""
         s, sw, t, tw = self._rules(face, nu, nv)
-        X = face.evaluate_grid(self, s, t)
-        Xs = face.evaluate_grid(self, s, t, "s")
-        Xt = face.evaluate_grid(self, s, t, "t")
+        if face.kind == "w":  # the patch's own grids, coordinates first (each one contiguous block)
+            X, Xs, Xt = self._w_face_grids(face, s, t)
+        else:
+            X, Xs, Xt = (np.moveaxis(face.evaluate_grid(self, s, t, der), -1, 0) for der in ("", "s", "t"))
         if solid is not None and face.kind == "w" and face.value == 1.0 and face.sign > 0:
             u, uw, v, vw = self._solid_rules(face.patch)
             if np.array_equal(u, s) and np.array_equal(uw, sw) and np.array_equal(v, t) and np.array_equal(vw, tw):
                 solid.append(self._jacobian_integral(face.patch, u, uw, vw, X, Xs, Xt))
-        n = cross(Xs, Xt) * face.sign
-        W = np.outer(sw, tw)
-        dA = norm3(n)
-        area = float(np.sum(W * dA))
-        vol = float(np.sum(W * np.einsum("...c,...c->...", X, n))) / 3.0
-        return area, vol, float(np.sum(W * n[..., 2]))
+        n = _cross_c(Xs, Xt)
+        if face.sign < 0:
+            n = -n
+        # Σ_ij sw_i tw_j f_ij as two products (no weight grid)
+        area = float(sw @ np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) @ tw)
+        vol = float(sw @ (X[0] * n[0] + X[1] * n[1] + X[2] * n[2]) @ tw) / 3.0
+        return area, vol, float(sw @ n[2] @ tw)
+
+    def _w_face_grids(self, face: Face, s: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """A face ``w = const`` and its ``s`` (``u``) and ``t`` (``v``) partials on the grid ``s × t``,
+        coordinates first: three ``(3, len(s), len(t))`` arrays (mm; mm per unit parameter).  The outer
+        surface ``w = 1`` is the patch itself."""
+        p = self.patches[face.patch]
+        X = p.evaluate_grid(s, t, components=True)
+        Xs = p.evaluate_grid(s, t, du=1, components=True)
+        Xt = p.evaluate_grid(s, t, dv=1, components=True)
+        w = face.value
+        if w == 1.0:
+            return X, Xs, Xt
+        A = p.spine(s).T[:, :, None]
+        As = p.spine(s, du=1).T[:, :, None]
+        return A + w * (X - A), As + w * (Xs - As), w * Xt
 
     @property
     def orientation(self) -> float:
@@ -801,9 +824,9 @@ class Tablet:
         total = 0.0
         for i, p in enumerate(self.patches):
             u, uw, v, vw = self._solid_rules(i, nu, nv)
-            X = p.evaluate_grid(u, v)
-            Xu = p.evaluate_grid(u, v, du=1)
-            Xv = p.evaluate_grid(u, v, dv=1)
+            X = p.evaluate_grid(u, v, components=True)
+            Xu = p.evaluate_grid(u, v, du=1, components=True)
+            Xv = p.evaluate_grid(u, v, dv=1, components=True)
             total += self._jacobian_integral(i, u, uw, vw, X, Xu, Xv, nw)
         total = abs(total)
         if default:
@@ -842,22 +865,23 @@ class Tablet:
     def _jacobian_integral(self, i: int, u, uw, vw, X, Xu, Xv, nw: int = 3) -> float:
         """Patch ``i``'s signed triple integral of the solid map's Jacobian ``X_u · (X_v × (X - A0))``
         (eq 4.12) over the trimmed ``w`` by ``nw``-point Gauss-Legendre, from the surface and its first
-        partials on the grid ``u × v`` (weights ``uw``, ``vw``)."""
+        partials on the grid ``u × v`` (weights ``uw``, ``vw``), coordinates first ``(3, len(u), len(v))``.
+
+        At ``w`` the map's partials are ``A0_u + w (X_u - A0_u)``, ``w X_v`` and ``X - A0``, so the
+        Jacobian is ``w J1 + w² J2`` with ``J1 = A0_u · C``, ``J2 = (X_u - A0_u) · C``,
+        ``C = X_v × (X - A0)``: two surface integrals, weighted by the rule's ``Σ w`` and ``Σ w²``."""
         t = self.trim
         p = self.patches[i]
         xw, ww = gauss_legendre(nw)
         w = 0.5 * (t.w[1] - t.w[0]) * (xw + 1) + t.w[0]
         wwt = 0.5 * (t.w[1] - t.w[0]) * ww
-        A = p.spine(u)[:, None, :]
-        Au = p.spine(u, du=1)[:, None, :]
-        D = X - A
+        A = p.spine(u).T[:, :, None]
+        Au = p.spine(u, du=1).T[:, :, None]
+        C = _cross_c(Xv, X - A)
         Du = Xu - Au
-        W = np.outer(uw, vw)
-        total = 0.0
-        for wk, wq in zip(w, wwt):
-            J = np.einsum("uvc,uvc->uv", Au + wk * Du, cross(wk * Xv, D))
-            total += wq * float(np.sum(W * J))
-        return total
+        J1 = Au[0] * C[0] + Au[1] * C[1] + Au[2] * C[2]
+        J2 = Du[0] * C[0] + Du[1] * C[1] + Du[2] * C[2]
+        return float(np.dot(wwt, w)) * float(uw @ J1 @ vw) + float(np.dot(wwt, w * w)) * float(uw @ J2 @ vw)
 
     # ------------------------------------------------------------------ geometry summaries
     def sample(self, nu: int = 65, nv: int = 128) -> np.ndarray:
