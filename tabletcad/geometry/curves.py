@@ -779,12 +779,14 @@ def _subset_errors(curve: CurveLike, a0, a, b, max_modes: int, m: int) -> np.nda
     step = max(1, m // 256)
     pts = curve.evaluate(sample_v(m)[::step])
     cos, sin = _trig_table(m, max_modes)
-    run = np.empty((pts.shape[0], max_modes + 1, 3))
-    run[:, 0] = a0
-    run[:, 1:] = cos[::step, :, None] * a[None] + sin[::step, :, None] * b[None]
-    np.cumsum(run, axis=1, out=run)  # the partial sums: a0 plus modes 1..N
-    d = pts[:, None, :] - run
-    errs = np.sqrt(np.max(np.einsum("knc,knc->kn", d, d), axis=0))
+    # laid out (N, coordinate, sample): the running sum over the modes adds whole contiguous rows
+    run = np.empty((max_modes + 1, 3, pts.shape[0]))
+    run[0] = np.asarray(a0, dtype=float)[:, None]
+    run[1:] = a[:, :, None] * cos[::step].T[:, None, :] + b[:, :, None] * sin[::step].T[:, None, :]
+    for n in range(1, max_modes + 1):  # the partial sums a0 + modes 1..N, row by row (numpy's cumsum
+        np.add(run[n], run[n - 1], out=run[n])  # along this axis runs element by element: 6x slower)
+    run -= pts.T[None]
+    errs = np.sqrt(np.max(run[:, 0] * run[:, 0] + run[:, 1] * run[:, 1] + run[:, 2] * run[:, 2], axis=1))
     errs.setflags(write=False)
     return errs
 

@@ -578,22 +578,26 @@ class PDEPatch:
         n_design = min(n_design, self.modes)
         u = np.linspace(0.0, 1.0, nu)
         v = sample_v(nv or max(256, 8 * self.modes))
-        fine = np.zeros((u.size, v.size, 3))
-        n = np.array([k for k in self._active if k > n_design], dtype=int)
-        if n.size:
-            A = np.stack([cardinal(u, self._lams[i], self.u_nodes, self.form) @ self._ac[:, i - 1] for i in n])
-            B = np.stack([cardinal(u, self._lams[i], self.u_nodes, self.form) @ self._bc[:, i - 1] for i in n])
-            c, s = _trig(v, n, 0)
-            fine += np.einsum("nuc,vn->uvc", A, c) + np.einsum("nuc,vn->uvc", B, s)
+        # the fine part on the grid, coordinates first (3, nu, nv), in one matrix product as in
+        # evaluate_grid: the fine modes' u-profiles (cosine and sine) by their rows of the v table
+        L, _, Lr = self._u_tables(u, 0)
+        left, right = [], []
+        fine_modes = np.flatnonzero(self._n_active > n_design)
+        if fine_modes.size:
+            AB = np.matmul(L[fine_modes], self._abT[fine_modes])  # (k, nu, 6)
+            left += [AB[:, :, :3].transpose(2, 1, 0), AB[:, :, 3:].transpose(2, 1, 0)]
+            T = _trig_shared(v, self._n_active, 0, rows=True)  # (2 active, nv): cosines over sines
+            right.append(T[np.concatenate([fine_modes, self._n_active.size + fine_modes])])
         if self._has_remainder:
-            L = cardinal(u, self._beta, self.u_nodes, self.form)
-            r = self._residuals(v, 0)
-            if self.form == "hermite":
-                L = L[:, :2]
-                r = r[:2]
-            fine += np.einsum("uk,kvc->uvc", L, r)
-        x, y, z = fine[..., 0], fine[..., 1], fine[..., 2]
-        return math.sqrt(float(np.max(x * x + y * y + z * z)))  # the largest |fine|: one root, no norm pass
+            k = 2 if self.form == "hermite" else 4  # (the Hermite form's derivative data: not counted)
+            r = self._residuals(v, 0)[:k]  # (k, nv, 3)
+            left.append((_EYE3[:, None, None, :] * Lr[None, :, :k, None]).reshape(3, u.size, 3 * k))
+            right.append(r.transpose(0, 2, 1).reshape(3 * k, v.size))
+        if not left:
+            return 0.0
+        U = np.concatenate(left, axis=2)
+        F = (U.reshape(-1, U.shape[2]) @ np.concatenate(right)).reshape(3, u.size, v.size)
+        return math.sqrt(float(np.max(F[0] * F[0] + F[1] * F[1] + F[2] * F[2])))  # the largest |fine|: one root
 
     def _check_stray(self) -> None:
         s = self.stray()
