@@ -82,8 +82,32 @@ def _fold_u(nu: int, n_ends: int) -> np.ndarray:
 
 
 def _trig_rows(v: np.ndarray, n: np.ndarray, dv: int) -> np.ndarray:
-    c, s = _trig(v, n, dv)
-    return np.ascontiguousarray(np.concatenate([c, s], axis=1).T)
+    """``_trig(v, n, dv)`` as rows ``(2 len(n), len(v))``, cosines over sines, taken from the table of every
+    mode up to ``max(n)`` at ``v`` (:func:`_trig_base`): the same products and values, computed once for
+    patches whose active modes differ."""
+    if not n.size:
+        return np.zeros((0, v.size))
+    C, S = _trig_base(v, int(n.max()))
+    c, s = C[n - 1], S[n - 1]
+    k = dv % 4
+    out = np.concatenate({0: (c, s), 1: (-s, c), 2: (-c, -s), 3: (s, -c)}[k])
+    if dv:
+        fac = n.astype(float) ** dv
+        out *= np.concatenate([fac, fac])[:, None]
+    return out
+
+
+def _trig_base(v: np.ndarray, nmax: int) -> tuple[np.ndarray, np.ndarray]:
+    """``cos(n v)`` and ``sin(n v)`` for ``n = 1..nmax``, each ``(nmax, len(v))`` (read-only; shared
+    for grid-sized ``v`` like :func:`_trig_shared`)."""
+
+    def make():
+        nv = np.outer(np.arange(1, nmax + 1), v)
+        return np.cos(nv), np.sin(nv)
+
+    if v.size > _CACHED_V[1]:
+        return make()
+    return TRIG.get(("base", nmax, v.tobytes()), make)
 
 
 def _trig_shared(v: np.ndarray, n: np.ndarray, dv: int, rows: bool = False):

@@ -91,6 +91,13 @@ def _cross_c(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
+def _interp_turn(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:
+    """``np.interp(x, xp, fp, period=2π)`` for angles ``xp`` already sorted in ``[-π, π]`` and ``x`` in
+    ``[-π, π)``: the samples wrapped once at each end, without the sort and reduction ``period`` repeats."""
+    return np.interp(x, np.concatenate([xp[-1:] - math.tau, xp, xp[:1] + math.tau]),
+                     np.concatenate([fp[-1:], fp, fp[:1]]))
+
+
 def _composite_gauss(breaks: np.ndarray, n_total: int) -> tuple[np.ndarray, np.ndarray]:
     """Gauss-Legendre nodes and weights over the periodic intervals between ``breaks``.
 
@@ -742,12 +749,12 @@ class Tablet:
                 continue
             phi = np.arctan2(dd[keep, 1], dd[keep, 0])
             order = np.argsort(phi)
-            env_full = np.maximum(env_full, np.interp(grid, phi[order], rr[keep][order], period=math.tau))
+            env_full = np.maximum(env_full, _interp_turn(grid, phi[order], rr[keep][order]))
             half = keep & (cols % 2 == 0)
             if np.count_nonzero(half) >= 8:
                 phi = np.arctan2(dd[half, 1], dd[half, 0])
                 order = np.argsort(phi)
-                env_half = np.maximum(env_half, np.interp(grid, phi[order], rr[half][order], period=math.tau))
+                env_half = np.maximum(env_half, _interp_turn(grid, phi[order], rr[half][order]))
         hole = 0.0
         if self.trim.w[0] > 0.0:  # hollow solid (ring): subtract the see-through hole
             A = np.stack([p.spine(np.linspace(self.trim.u[0], self.trim.u[1], nu)) for p in self.patches])
@@ -758,7 +765,7 @@ class Tablet:
             di = inner[0, 0, :, :2] - c
             phi = np.arctan2(di[:, 1], di[:, 0])
             order = np.argsort(phi)
-            hole = 0.5 * float(np.sum(np.interp(grid, phi[order], ri[order], period=math.tau) ** 2)) * (math.tau / m)
+            hole = 0.5 * float(np.sum(_interp_turn(grid, phi[order], ri[order]) ** 2)) * (math.tau / m)
         full = 0.5 * float(np.sum(env_full**2)) * (math.tau / m)
         if nv % 2 or not self.trim.full_v or not np.all(env_half > 0.0):
             return full - hole
