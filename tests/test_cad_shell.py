@@ -59,6 +59,9 @@ def test_assembled_shell_is_the_sewn_one(sample, monkeypatch):
     made = tablet_solid(tablet, revolved=False)
     sewn = _sewn(monkeypatch, lambda: tablet_solid(tablet, revolved=False))
     assert not made.sewn and sewn.sewn
+    # the summary names a sewing tolerance only for the solid that was sewn
+    assert made.summary()["sew_tolerance_mm"] is None and made.summary()["sewn"] is False
+    assert sewn.summary()["sew_tolerance_mm"] == sewn.sew_tolerance > 0.0 and sewn.summary()["sewn"] is True
     assert BRepCheck_Analyzer(made.shape).IsValid()
     shells = explore(made.shape, "Shell")
     assert len(shells) == 1 and BRep_Tool.IsClosed_s(shells[0])

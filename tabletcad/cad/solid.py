@@ -171,7 +171,7 @@ class TabletSolid:
             "volume_mm3": self.volume,
             "area_mm2": self.area,
             "volume_rel_error_estimate": self.mass.volume_error,
-            "sew_tolerance_mm": self.sew_tolerance,
+            "sew_tolerance_mm": self.sew_tolerance if self.sewn else None,  # (an assembled shell was not sewn)
             "sewn": self.sewn,
             "timings_s": dict(self.timings),
         }
