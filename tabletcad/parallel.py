@@ -42,6 +42,51 @@ def check_scheduler_address(scheduler: str) -> None:
                           "(or tls://, ws://, wss://), the port from 1 to 65535")
 
 
+def _check_main_guarded() -> None:
+    """Refuse (:class:`RuntimeError`, one message) to start local worker processes from a script's top-level
+    code outside ``if __name__ == "__main__":``.
+
+    The workers are spawned: each imports the script again and, unguarded, would start a cluster of its
+    own; Python's refusal of that then came back as about 490 lines of tracebacks from the workers and
+    their nannies.  Read from the script's own text: the line of the call in its top-level code must lie
+    inside such an ``if`` block.  Interactive sessions, notebooks and ``python -c`` have no script to import.
+    """
+    import ast
+    import sys
+
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    if main is None or not path or not str(path).endswith(".py"):
+        return
+    name = getattr(getattr(main, "__spec__", None), "name", None)
+    if name is not None and (name == "__main__" or name.endswith(".__main__")):  # python -m package: not
+        return  # imported again by the workers (multiprocessing.spawn skips a package's __main__)
+    frame, line = sys._getframe(1), None
+    while frame is not None:
+        if frame.f_globals is main.__dict__ and frame.f_code.co_name == "<module>":
+            line = frame.f_lineno
+            break
+        frame = frame.f_back
+    if line is None:  # called from a function the script calls under its guard (or from another module)
+        return
+    try:
+        tree = ast.parse(open(path, encoding="utf-8").read())
+    except (OSError, SyntaxError, ValueError):
+        return
+
+    def is_guard(node: ast.AST) -> bool:
+        t = getattr(node, "test", None)
+        return (isinstance(node, ast.If) and isinstance(t, ast.Compare) and len(t.ops) == 1
+                and isinstance(t.ops[0], ast.Eq) and {ast.dump(t.left), ast.dump(t.comparators[0])}
+                == {ast.dump(ast.Name("__name__", ast.Load())), ast.dump(ast.Constant("__main__"))})
+
+    if any(is_guard(n) and n.lineno <= line <= (n.end_lineno or n.lineno) for n in tree.body):
+        return
+    raise RuntimeError(f"{path}, line {line}: a sweep or batch on local worker processes must be started under "
+                       "'if __name__ == \"__main__\":' (the workers import the script again), or with workers=0 "
+                       "to run in this process")
+
+
 @contextlib.contextmanager
 def open_client(workers: int | None = None, scheduler: str | None = None,
                 connect_timeout: float = CONNECT_TIMEOUT_S) -> Iterator[Any]:
@@ -67,6 +112,7 @@ def open_client(workers: int | None = None, scheduler: str | None = None,
         return
     import dask
 
+    _check_main_guarded()
     n = workers if workers is not None else (os.cpu_count() or 1)
     # distributed sets MALLOC_TRIM_THRESHOLD_=65536 in every worker it spawns; glibc then maps and
     # unmaps every large NumPy array, which made the report take 1.8x the CPU time of this process

@@ -414,3 +414,31 @@ def test_the_workers_drop_only_the_heartbeats_report_of_a_closed_scheduler(caplo
     finally:
         signal.signal(signal.SIGINT, before)
         logger.filters[:] = kept
+
+
+@pytest.mark.parametrize("guarded", [False, True])
+def test_a_script_starting_local_workers_outside_its_main_guard_gets_one_error(tmp_path, guarded):
+    """Local workers are spawned and import the calling script again: a script that starts a sweep from its
+    top-level code outside ``if __name__ == "__main__":`` is refused before any worker starts, with one
+    message naming the script and line (unguarded it printed about 490 lines of the workers' and nannies'
+    tracebacks), and nothing is written; inside the guard the same call passes the check."""
+    sample = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
+    out = tmp_path / "out"
+    call = f"run_sweep({str(sample)!r}, {str(out)!r}, workers=2, progress=False)"
+    if guarded:  # the check alone (a cluster would take seconds): it must not refuse this script
+        body = ("from tabletcad.parallel import _check_main_guarded\n"
+                "if __name__ == \"__main__\":\n    _check_main_guarded()\n    print('passed')\n")
+    else:
+        body = f"import sys\nfrom tabletcad.sweep import run_sweep\n\n{call}\n"
+    script = tmp_path / "script.py"
+    script.write_text(body, encoding="utf-8")
+    r = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    if guarded:
+        assert r.returncode == 0 and r.stdout.strip() == "passed", r.stderr
+        return
+    last = r.stderr.strip().splitlines()[-1]
+    assert r.returncode == 1 and len(r.stderr.splitlines()) < 30, r.stderr
+    assert last == (f"RuntimeError: {script}, line 4: a sweep or batch on local worker processes must be started "
+                    "under 'if __name__ == \"__main__\":' (the workers import the script again), or with workers=0 "
+                    "to run in this process")
+    assert r.stderr.count("Traceback") == 1 and not out.exists()  # Python's own report of the one error
