@@ -87,6 +87,8 @@ def _trig_rows(v: np.ndarray, n: np.ndarray, dv: int) -> np.ndarray:
     patches whose active modes differ."""
     if not n.size:
         return np.zeros((0, v.size))
+    if int(n.min()) < 1:
+        raise ValueError(f"modes = {n.tolist()} is not allowed: the rows are of modes 1 and up")
     C, S = _trig_base(v, int(n.max()))
     c, s = C[n - 1], S[n - 1]
     k = dv % 4
