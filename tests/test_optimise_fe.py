@@ -31,7 +31,7 @@ def test_problem_file_with_the_fe_objective_is_checked():
     from tabletcad.errors import DesignError
     from tabletcad.optimise.files import problem_from_dict
 
-    base = {"problem": {"kind": "family", "family": "concave_round", "objective": "fe_breaking_force_N"},
+    base = {"problem": {"kind": "family", "family": "concave_round", "sense": "max", "objective": "fe_breaking_force_N"},
             "variables": {"band": {"lower": 2.0, "upper": 3.0}}, "fixed": {"diameter": 10.0, "cup_depth": 0.9}}
     with pytest.raises(DesignError, match=r"fe\.tensile_strength_MPa = \(not given\) is not allowed"):
         problem_from_dict(base)

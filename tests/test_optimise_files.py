@@ -70,6 +70,10 @@ BAD = [
     ("radius_constraints_string", CAPSULE.replace("false", '"false"'), "parameters.radius_constraints"),
     ("displacement_unknown", ROUND + 'displacement = "exact"\n', "parameters.displacement"),
     ("sense_unknown", FAMILY.replace('"min"', '"minimum"'), "problem.sense"),
+    # no default: left out, a minimum-area problem had silently found the largest area (304.5 mm² at 12 mm)
+    ("sense_missing", FAMILY.replace('sense = "min"\n', ""), "problem.sense"),
+    # said so, not "allowed keys are (none)"
+    ("fixed_and_varied", FAMILY + "\n[fixed]\ndiameter = 5.0\n", "fixed.diameter"),
     ("kind_list", SPHERE.replace('"spherical_tablet"', '["spherical_tablet"]'), "problem.kind"),
     ("not_toml", "[problem\nkind = 1\n", "problem.file"),
 ]

@@ -407,10 +407,16 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
         if hi < lo:  # named by the file's key (the Variable would say "variable NAME bounds")
             raise DesignError(f"[variables] {name} upper", hi, f"must be >= lower = {lo:g}", unit)
         vs.append(Variable(name, lo, hi, x0, unit, least=TOL.min_length if unit == "mm" else None))
+    both = [k for k in fixed if k in variables]
+    if both:  # (else: "allowed keys are (none)", as if the family had no such parameter)
+        raise DesignError(f"[fixed] {both[0]}", _shown(fixed[both[0]]), "must not also be in [variables]: "
+                          "a parameter is either varied or fixed")
     _check_keys("[fixed]", fixed, set(fam.params) - set(variables))
     fixed = {k: number(f"[fixed] {k}", v, fam.params[k], lo=0.0, hi=LIMITS.get(fam.params[k], LIMITS[""]))
              for k, v in fixed.items()}
-    sense = prob.get("sense", "max")
+    if "sense" not in prob:  # no default: one left out would silently pick the other extreme
+        raise DesignError("[problem] sense", MISSING, "must be given for a family problem: 'min' or 'max'")
+    sense = prob["sense"]
     name = prob.get("name", f"{fam_name}_optimum")
     held = _held_volume(prob, fam_name, fam, variables, fixed)
     _check_lower_lengths(fam_name, fam, vs, fixed)
