@@ -458,6 +458,31 @@ def test_mesh_reports_its_volume_error_and_warns_with_a_node_count_that_meets_th
     assert len(got.points) == 400
 
 
+def test_ctrl_c_after_an_optimisation_built_its_optimum_is_an_interruption(tmp_path, capsys, monkeypatch):
+    """An optimisation builds its optimum into a folder inside its own staging folder, then publishes the
+    whole.  A Ctrl-C between the two is an interruption (exit 130, nothing written): it had exited 0 with
+    "interrupted after the build was complete: outputs in .out.xxxx/tablet/", a folder then removed."""
+    import tabletcad.io.outputs as outputs
+
+    real_replace = os.replace
+    sent = []
+    out = tmp_path / "out"
+
+    def replace_then_interrupt(src, dst):
+        real_replace(src, dst)
+        if not sent and Path(dst).parent.name == "tablet" and Path(dst).parent.parent != out:
+            sent.append(dst)  # the optimum's build, put in place inside the optimisation's staging folder
+            os.kill(os.getpid(), signal.SIGINT)
+
+    monkeypatch.setattr(outputs.os, "replace", replace_then_interrupt)
+    rc, _, err = run(capsys, "optimise", str(ROOT / "samples" / "optimise" / "cylinder_min_area.toml"), "--out",
+                     str(out), "--quiet")
+    assert sent, "the optimum was never built"
+    assert (rc, err) == (130, "interrupted\n")
+    assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == []
+    assert not outputs._open_staging
+
+
 def test_ctrl_c_while_a_build_publishes_leaves_the_whole_build(tmp_path, capsys, monkeypatch):
     """SIGINT sent while the outputs are being moved into place (after the first file) waits until
     every file and the manifest are there: the folder holds the whole build and the command says

@@ -54,6 +54,9 @@ FE_MANIFEST = ".tabletcad-fe.json"
 #: Ctrl-C that reaches a build after its outputs are in place is too late to undo it, and the
 #: command reports the finished build rather than "interrupted" beside a full folder.
 published: list[Path] = []
+#: Staging folders open in this process (:func:`staging_folder`): a publish into one of them (an optimisation's
+#: build of its optimum, put in place inside the optimisation's staging folder) is not a finished output.
+_open_staging: list[Path] = []
 STAGING_MARKER = ".tabletcad-staging.json"
 #: a staging folder of another host (its process cannot be asked) is stale after this many seconds
 STALE_AFTER_S = 24 * 3600.0
@@ -159,11 +162,13 @@ def staging_folder(out_dir: str | os.PathLike[str]) -> Iterator[Path]:
                            else tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
         except OSError as exc:  # e.g. a folder of a read-only or virtual file system (/proc)
             raise DesignError("--out", str(out_dir), f"cannot be written: {(exc.strerror or str(exc)).lower()}") from None
+        _open_staging.append(staging)
         try:
             marker = dict(pid=os.getpid(), host=socket.gethostname(), started=time.time(), target=out_dir.name)
             (staging / STAGING_MARKER).write_text(json.dumps(marker), encoding="utf-8")
             yield staging
         finally:
+            _open_staging.remove(staging)
             shutil.rmtree(staging, ignore_errors=True)
 
 
@@ -218,8 +223,19 @@ def publish(staging: str | os.PathLike[str], out_dir: str | os.PathLike[str], ma
     check_replaceable(out_dir, [rel.as_posix() for rel in files], earlier, manifest)
     with _signals_deferred():  # Ctrl-C or SIGTERM now would leave half a build in out_dir
         _move_in(staging, out_dir, files, hashes, earlier, manifest)
-        published.append(out_dir)
+        if not _inside_open_staging(out_dir):  # (a Ctrl-C now finds a finished output only if it is the final one)
+            published.append(out_dir)
     return sorted(hashes)
+
+
+def _inside_open_staging(folder: Path) -> bool:
+    """Whether ``folder`` lies in a staging folder this process has open (its outputs are not yet published)."""
+    here = os.path.realpath(folder)
+    for st in _open_staging:
+        root = os.path.realpath(st)
+        if here == root or here.startswith(root + os.sep):
+            return True
+    return False
 
 
 def check_replaceable(out_dir: str | os.PathLike[str], names, earlier: dict[str, str] | None = None,
