@@ -70,8 +70,12 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
 
     # the folder may hold only this command's earlier, unchanged results where it writes: checked before the
     # solve (minutes for an FE problem); a build's files or anyone else's are never replaced
-    check_replaceable(out_dir, ["report.json", "convergence.png", "optimum.toml", "last_point.toml",
-                                "tablet/report.json", "tablet/tablet.png"], manifest=OPTIMISE_MANIFEST)
+    from tabletcad.pipeline.build import cad_available
+
+    # (the optimum's build writes what `tabletcad build` of it would: its CAD files too when it can)
+    built = ["report.json", "tablet.png"] + (["tablet.step", "tablet.stl", "tablet.glb"] if cad_available() else [])
+    check_replaceable(out_dir, ["report.json", "convergence.png", "optimum.toml", "last_point.toml"]
+                      + [f"tablet/{n}" for n in built], manifest=OPTIMISE_MANIFEST)
     method = method or default_method
     if starts is not None and method != "multistart":
         raise_starts(starts, method)
