@@ -57,6 +57,12 @@ BAD = [
     ("maxiter_bool", SPHERE + "\n[solver]\nmaxiter = true\n", "solver.maxiter"),
     ("maxiter_float", SPHERE + "\n[solver]\nmaxiter = 2.5\n", "solver.maxiter"),
     ("solver_unknown", SPHERE + "\n[solver]\ntolerance = 1e-9\n", "solver.tolerance"),
+    # settings the file's method would ignore (--starts with SLSQP was already refused)
+    ("starts_with_slsqp", SPHERE + "\n[solver]\nstarts = 3\n", "solver.starts"),
+    ("popsize_with_slsqp", SPHERE + "\n[solver]\npopsize = 5\n", "solver.popsize"),
+    ("seed_with_slsqp", SPHERE + "\n[solver]\nseed = 5\n", "solver.seed"),
+    ("popsize_with_multistart", SPHERE.replace('kind = "spherical_tablet"', 'kind = "spherical_tablet"\n'
+                                               'method = "multistart"') + "\n[solver]\npopsize = 5\n", "solver.popsize"),
     ("name_escape", FAMILY.replace('sense = "min"', 'sense = "min"\nname = "../../escape"'), "problem.name"),
     ("name_on_thesis_kind", SPHERE.replace('kind = "spherical_tablet"', 'kind = "spherical_tablet"\nname = "x"'),
      "problem.name"),

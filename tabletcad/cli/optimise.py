@@ -54,6 +54,14 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
         choice("--method", method, METHODS)
 
     problem, default_method, opts = load_problem(problem_file)
+    if method is None:  # the file's own method: its [solver] table may not hold settings that method ignores
+        from tabletcad.errors import DesignError
+
+        for key, readers in (("starts", ("multistart",)), ("popsize", ("differential_evolution",)),
+                             ("seed", ("multistart", "differential_evolution"))):
+            if key in opts and default_method not in readers:
+                raise DesignError(f"[solver] {key}", opts[key], f"is read by method {' or '.join(readers)} only "
+                                  f"(this file's method: {default_method})")
     for key, value in (("starts", starts), ("maxiter", maxiter)):
         if value is not None:  # the same limits as the file's [solver] table
             opts[key] = SOLVER_KEYS[key](f"--{key}", int(value) if value.strip().lstrip("+-").isdigit() else value)
