@@ -71,6 +71,9 @@ def test_strongest_concave_round_of_a_given_volume():
     assert res.success, res.message
     # every design of the run has the held volume (PDE tablet against the family's exact nominal volume)
     assert res.design.volume() == pytest.approx(289.1, rel=1e-5)
+    assert prob.description.endswith("; band solved for the family's nominal volume 289.1 mm3 (the PDE surface's "
+                                     "volume is within its certified deviation of it)")
+    print(f"\nthe optimum's PDE volume {res.design.volume():.10g} mm3, {res.design.volume() / 289.1 - 1:+.2e} relative")
 
     def force(cup):
         t = prob.build({"cup_depth": cup})

@@ -507,4 +507,6 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
 
     extras = _fe_recheck(fe_set) if fe_set is not None and fe_set["recheck"] else None
     return Problem(name=name, variables=vs, objective=objective, sense=sense, constraints=cons, build=build,
-                   to_toml=to_toml, description=f"family {fam_name}: {sense} {objective.name}", extras=extras)
+                   to_toml=to_toml, description=f"family {fam_name}: {sense} {objective.name}" + (
+                       "" if held is None else f"; {held[0]} solved for the family's nominal volume {held[1]:g} mm3 "
+                       "(the PDE surface's volume is within its certified deviation of it)"), extras=extras)
