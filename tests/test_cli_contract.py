@@ -60,7 +60,7 @@ FLAT = '[tablet]\nfamily = "thesis.flat_faced_round"\nthickness = 6.0\n'
     [
         (FLAT + "diameter = 1e300\n", "tablet.diameter", "within ±1000 mm"),
         (FLAT + "diameter = " + "9" * 401 + "\n", "tablet.diameter", "an integer of 401 digits"),
-        (FLAT + "diameter = " + "9" * 5000 + "\n", "design_file", "numbers Python can read"),
+        (FLAT + "diameter = " + "9" * 5000 + "\n", "DESIGN", "numbers Python can read"),
         (FLAT + "diameter = true\n", "tablet.diameter", "true and false are not numbers"),
         (FLAT + 'diameter = "10"\n', "tablet.diameter", "must be a number"),
         (FLAT + "diameter = -1e-300\n", "tablet.diameter", "> 0"),
@@ -75,7 +75,7 @@ FLAT = '[tablet]\nfamily = "thesis.flat_faced_round"\nthickness = 6.0\n'
         (FLAT, "tablet.diameter", "needs diameter, thickness"),
         ('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\ncup_depth = 1.0\nband = 1e300\n', "tablet.band", "within ±1000 mm"),
         ('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 3.0\n', "tablet.cup_depth", "optional: land"),
-        ("x = " + "[" * 5000 + "]" * 5000 + "\n", "design_file", "nested"),
+        ("x = " + "[" * 5000 + "]" * 5000 + "\n", "DESIGN", "nested"),
         (FLAT + "diameter = 10.0\n[trim]\nv = [0.0, true]\n", "trim.v", "not numbers"),
         (FLAT + "diameter = 10.0\n[reshape]\nradius = 1e300\n", "reshape.radius", "<= 1000"),
         (FLAT + "diameter = 10.0\n[reshape]\nradius = 500.0\n", "reshape", "it reaches 25"),

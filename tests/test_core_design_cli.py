@@ -222,7 +222,7 @@ def test_toml_files_with_a_byte_order_mark_load_and_binary_ones_are_refused(tmp_
             assert load_problem(bom)[1:] == load_problem(src)[1:]
     junk = tmp_path / "junk.toml"
     junk.write_bytes(b"\x89PNG\r\n\x1a\n\xff\xfe\x00")
-    for args, parameter in ((["report", str(junk)], "design_file"),
+    for args, parameter in ((["report", str(junk)], "DESIGN"),
                             (["optimise", str(junk), "--out", str(tmp_path / "o")], "problem.file")):
         assert main(args) == 2
         err = capsys.readouterr().err

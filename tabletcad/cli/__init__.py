@@ -223,6 +223,8 @@ def _run(argv: list[str] | None) -> int:
         exc.show()
         return exc.exit_code
     except DesignError as exc:
+        if exc.parameter == "design_file":  # the design file a command was given: its usage line's DESIGN
+            exc = exc.renamed("DESIGN")
         _say(f"error: {' '.join(str(exc).split())}")
         return 2
     except TabletcadError as exc:
