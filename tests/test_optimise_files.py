@@ -287,7 +287,9 @@ def test_an_optimisation_folder_and_a_build_folder_keep_each_others_files(tmp_pa
     assert {p.name: p.read_bytes() for p in (tmp_path / "b").iterdir()} == before
 
 
-@pytest.mark.parametrize("name", ["tablet/tablet.step", "tablet/tablet.glb", "convergence.png"])
+@pytest.mark.parametrize("name", [pytest.param("tablet/tablet.step", marks=pytest.mark.cad),  # (CAD files: written
+                                  pytest.param("tablet/tablet.glb", marks=pytest.mark.cad),   # with the cad extra)
+                                  "tablet/tablet.png", "convergence.png"])
 def test_someone_elses_file_where_the_optimum_is_built_is_refused_before_the_solve(tmp_path, capsys, monkeypatch,
                                                                                  name):
     """Every file the optimum's build writes (its CAD files in ``tablet/`` too) is checked before the solve:
