@@ -308,3 +308,25 @@ def test_someone_elses_file_where_the_optimum_is_built_is_refused_before_the_sol
     left = {name} | ({"tablet"} if name.startswith("tablet/") else set())  # nothing but the user's file
     assert {p.relative_to(out).as_posix() for p in out.rglob("*")} == left
     assert (out / name).read_text(encoding="utf-8") == "mine"
+
+
+def test_an_upper_bound_the_family_refuses_is_warned_of():
+    """A cup depth bounded at 8 mm on a 10 mm concave round (the family takes at most half the diameter) was
+    accepted in silence, and the optimum on that limit read "not_converged": the bound is now warned of,
+    naming the family's limit; a bound the family builds is not."""
+    import warnings
+
+    from tabletcad.optimise.files import problem_from_dict
+
+    doc = {"problem": {"kind": "family", "family": "concave_round", "sense": "max", "objective": "volume_mm3"},
+           "variables": {"cup_depth": {"lower": 0.5, "upper": 8.0, "initial": 1.0}},
+           "fixed": {"diameter": 10.0, "band": 2.0}}
+    with pytest.warns(UserWarning) as seen:
+        problem_from_dict(doc)
+    (w,) = [str(x.message) for x in seen]
+    assert w.startswith("[variables] cup_depth upper = 8 mm: family 'concave_round' refuses it at the start's other "
+                        "values (") and "not converged" in w
+    doc["variables"]["cup_depth"]["upper"] = 4.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        problem_from_dict(doc)

@@ -375,6 +375,25 @@ def _check_lower_lengths(fam_name: str, fam: Any, vs: list, fixed: dict) -> None
                               f"({refused.allowed}): give a lower bound of at least {TOL.min_length:g} mm", "mm")
 
 
+def _warn_unbuildable_upper(fam_name: str, vs: list, start: dict, build: Callable[[dict], Any]) -> None:
+    """Warn of an upper bound the family refuses for that variable at the start's other values (a cup deeper
+    than half the diameter): designs past that limit do not build, and an optimum on it is then reported
+    as not converged.  A warning, not a refusal: the limit may move with the other variables."""
+    import warnings
+
+    for v in vs:
+        try:
+            build({**start, v.name: v.upper})
+        except DesignError as exc:
+            if exc.parameter == v.name:
+                unit = f" {v.unit}" if v.unit else ""
+                warnings.warn(f"[variables] {v.name} upper = {v.upper:g}{unit}: family {fam_name!r} refuses it at the "
+                              f"start's other values ({exc.allowed}); designs past that limit do not build, and an "
+                              "optimum on it is reported as not converged", UserWarning, stacklevel=2)
+        except Exception:  # noqa: BLE001 - any other failure there is the optimiser's to meet and report
+            pass
+
+
 def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe: Any = None) -> Problem:
     """A :class:`Problem` over the parameters of a tablet family (:data:`tabletcad.families.FAMILIES`).
 
@@ -452,6 +471,8 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
             raise DesignError(f"[variables] {exc.parameter} initial", exc.value, f"{exc.allowed} (the start: {at})",
                               exc.unit) from None
         first = None  # any other failure of the start is the optimiser's to report
+    if first is not None:
+        _warn_unbuildable_upper(fam_name, vs, start, build)
     if first is not None and fe_set is not None and fe_set["symmetric"]:
         from tabletcad.fe.diametral import check_symmetric
 
