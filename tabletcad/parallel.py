@@ -56,8 +56,8 @@ def _check_main_guarded() -> None:
 
     main = sys.modules.get("__main__")
     path = getattr(main, "__file__", None)
-    if main is None or not path or not str(path).endswith(".py"):
-        return
+    if main is None or not path or not str(path).endswith(".py") or os.path.basename(str(path)) == "__main__.py":
+        return  # (a package's __main__.py is never imported again by the workers)
     name = getattr(getattr(main, "__spec__", None), "name", None)
     if name is not None and (name == "__main__" or name.endswith(".__main__")):  # python -m package: not
         return  # imported again by the workers (multiprocessing.spawn skips a package's __main__)
@@ -74,13 +74,17 @@ def _check_main_guarded() -> None:
     except (OSError, SyntaxError, ValueError):
         return
 
-    def is_guard(node: ast.AST) -> bool:
-        t = getattr(node, "test", None)
-        return (isinstance(node, ast.If) and isinstance(t, ast.Compare) and len(t.ops) == 1
-                and isinstance(t.ops[0], ast.Eq) and {ast.dump(t.left), ast.dump(t.comparators[0])}
-                == {ast.dump(ast.Name("__name__", ast.Load())), ast.dump(ast.Constant("__main__"))})
+    main_test = {ast.dump(ast.Name("__name__", ast.Load())), ast.dump(ast.Constant("__main__"))}
 
-    if any(is_guard(n) and n.lineno <= line <= (n.end_lineno or n.lineno) for n in tree.body):
+    def names_main(t: ast.AST) -> bool:  # `__name__ == "__main__"`, alone or in an `and`
+        if isinstance(t, ast.BoolOp) and isinstance(t.op, ast.And):
+            return any(names_main(x) for x in t.values)
+        return (isinstance(t, ast.Compare) and len(t.ops) == 1 and isinstance(t.ops[0], ast.Eq)
+                and {ast.dump(t.left), ast.dump(t.comparators[0])} == main_test)
+
+    # any such `if` (at the top level, or inside a top-level `with` or `try`) whose body holds the line
+    if any(isinstance(n, ast.If) and names_main(n.test) and n.body
+           and n.body[0].lineno <= line <= (n.body[-1].end_lineno or n.body[-1].lineno) for n in ast.walk(tree)):
         return
     raise RuntimeError(f"{path}, line {line}: a sweep or batch on local worker processes must be started under "
                        "'if __name__ == \"__main__\":' (the workers import the script again), or with workers=0 "

@@ -80,6 +80,7 @@ BAD = [
     ("sense_missing", FAMILY.replace('sense = "min"\n', ""), "problem.sense"),
     # said so, not "allowed keys are (none)"
     ("fixed_and_varied", FAMILY + "\n[fixed]\ndiameter = 5.0\n", "fixed.diameter"),
+    ("fixed_not_a_table", FAMILY.replace("[problem]", "fixed = 5\n\n[problem]"), "fixed"),
     ("kind_list", SPHERE.replace('"spherical_tablet"', '["spherical_tablet"]'), "problem.kind"),
     ("not_toml", "[problem\nkind = 1\n", "problem.file"),
 ]

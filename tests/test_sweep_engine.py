@@ -425,9 +425,13 @@ def test_a_script_starting_local_workers_outside_its_main_guard_gets_one_error(t
     sample = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
     out = tmp_path / "out"
     call = f"run_sweep({str(sample)!r}, {str(out)!r}, workers=2, progress=False)"
-    if guarded:  # the check alone (a cluster would take seconds): it must not refuse this script
-        body = ("from tabletcad.parallel import _check_main_guarded\n"
-                "if __name__ == \"__main__\":\n    _check_main_guarded()\n    print('passed')\n")
+    if guarded:  # the check alone (a cluster would take seconds): it must refuse none of these guards
+        body = ("import contextlib, sys\nfrom tabletcad.parallel import _check_main_guarded\n"
+                "if __name__ == \"__main__\":\n    _check_main_guarded()\n"
+                "if __name__ == \"__main__\" and len(sys.argv) >= 1:\n    _check_main_guarded()\n"
+                "with contextlib.suppress(KeyboardInterrupt):\n    if \"__main__\" == __name__:\n"
+                "        _check_main_guarded()\n"
+                "if __name__ == \"__main__\":\n    print('passed')\n")
     else:
         body = f"import sys\nfrom tabletcad.sweep import run_sweep\n\n{call}\n"
     script = tmp_path / "script.py"

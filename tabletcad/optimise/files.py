@@ -426,7 +426,7 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
         if hi < lo:  # named by the file's key (the Variable would say "variable NAME bounds")
             raise DesignError(f"[variables] {name} upper", hi, f"must be >= lower = {lo:g}", unit)
         vs.append(Variable(name, lo, hi, x0, unit, least=TOL.min_length if unit == "mm" else None))
-    both = [k for k in fixed if k in variables]
+    both = [k for k in fixed if k in variables] if isinstance(fixed, dict) else []
     if both:  # (else: "allowed keys are (none)", as if the family had no such parameter)
         raise DesignError(f"[fixed] {both[0]}", _shown(fixed[both[0]]), "must not also be in [variables]: "
                           "a parameter is either varied or fixed")
