@@ -54,14 +54,6 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
         choice("--method", method, METHODS)
 
     problem, default_method, opts = load_problem(problem_file)
-    if method is None:  # the file's own method: its [solver] table may not hold settings that method ignores
-        from tabletcad.errors import DesignError
-
-        for key, readers in (("starts", ("multistart",)), ("popsize", ("differential_evolution",)),
-                             ("seed", ("multistart", "differential_evolution"))):
-            if key in opts and default_method not in readers:
-                raise DesignError(f"[solver] {key}", opts[key], f"is read by method {' or '.join(readers)} only "
-                                  f"(this file's method: {default_method})")
     for key, value in (("starts", starts), ("maxiter", maxiter)):
         if value is not None:  # the same limits as the file's [solver] table
             opts[key] = SOLVER_KEYS[key](f"--{key}", int(value) if value.strip().lstrip("+-").isdigit() else value)
@@ -78,12 +70,11 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
 
     # the folder may hold only this command's earlier, unchanged results where it writes: checked before the
     # solve (minutes for an FE problem); a build's files or anyone else's are never replaced
-    from tabletcad.pipeline.build import cad_available
+    from tabletcad.pipeline.build import build_outputs, cad_available
 
     # (the optimum's build writes what `tabletcad build` of it would: its CAD files too when it can)
-    built = ["report.json", "tablet.png"] + (["tablet.step", "tablet.stl", "tablet.glb"] if cad_available() else [])
     check_replaceable(out_dir, ["report.json", "convergence.png", "optimum.toml", "last_point.toml"]
-                      + [f"tablet/{n}" for n in built], manifest=OPTIMISE_MANIFEST)
+                      + [f"tablet/{n}" for n in build_outputs(cad_available())], manifest=OPTIMISE_MANIFEST)
     method = method or default_method
     if starts is not None and method != "multistart":
         raise_starts(starts, method)

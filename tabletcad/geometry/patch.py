@@ -40,7 +40,7 @@ from tabletcad.geometry.tables import CARDINAL, TRIG
 from tabletcad.geometry.curves import evaluate_curves, fourier_coefficients, modes_needed, sample_v
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
-from tabletcad.geometry.vectors import cross, norm3
+from tabletcad.geometry.vectors import cross, cross_first, norm3
 
 __all__ = ["PDEPatch", "AUTO_A_LADDER"]
 
@@ -54,18 +54,9 @@ AUTO_A_LADDER = (1.0, 0.5, 0.25, 0.1, 0.05, 0.02, 0.01)
 
 
 def _trig(v: np.ndarray, n: np.ndarray, dv: int) -> tuple[np.ndarray, np.ndarray]:
-    """d^dv/dv^dv of cos(n v) and sin(n v); shapes (len(v), len(n))."""
-    nv = np.outer(v, n)
-    c, s = np.cos(nv), np.sin(nv)
-    k = dv % 4
-    fac = n.astype(float) ** dv
-    if k == 0:
-        return c * fac, s * fac
-    if k == 1:
-        return -s * fac, c * fac
-    if k == 2:
-        return -c * fac, -s * fac
-    return s * fac, -c * fac
+    """d^dv/dv^dv of cos(n v) and sin(n v); shapes (len(v), len(n)): :func:`_trig_rows`, transposed."""
+    rows = _trig_rows(v, n, dv)
+    return rows[: n.size].T, rows[n.size :].T
 
 
 _EYE3 = np.eye(3)
@@ -698,7 +689,7 @@ class PDEPatch:
         Xu = self.evaluate_grid(u, v, du=1, components=True)
         Xv = self.evaluate_grid(u, v, dv=1, components=True)
         D = self.evaluate_grid(u, v, components=True) - self.spine(u).T[:, :, None]
-        m = (Xv[1] * D[2] - Xv[2] * D[1], Xv[2] * D[0] - Xv[0] * D[2], Xv[0] * D[1] - Xv[1] * D[0])  # Xv × D
+        m = cross_first(Xv, D)  # Xv × D
         det = Xu[0] * m[0] + Xu[1] * m[1] + Xu[2] * m[2]
         mag = lambda a: math.sqrt(float(np.max(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])))  # noqa: E731
         scale = mag(Xu) * mag(Xv) * mag(D)

@@ -26,7 +26,7 @@ from tabletcad.geometry.revolution import profile_extreme
 #: (``X·n``, ``|n|``, the solid map's Jacobian) are the same on every meridian.
 _REVOLUTION_NV = 4
 from tabletcad.tolerance import DEFAULT, Tolerances
-from tabletcad.geometry.vectors import cross, norm3
+from tabletcad.geometry.vectors import cross_first, norm3
 from tabletcad.geometry.quadrature import gauss_legendre
 
 __all__ = ["Band", "Trim", "Tablet", "Face", "solid_map"]
@@ -83,12 +83,6 @@ def coordinate_range(arrays, k: int) -> tuple[np.ndarray, np.ndarray]:
     lo = np.array([min(float(a[..., j].min()) for a in arrays) for j in range(k)])
     hi = np.array([max(float(a[..., j].max()) for a in arrays) for j in range(k)])
     return lo, hi
-
-
-def _cross_c(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross product of vector fields stored coordinates first, ``(3, ...)``: each coordinate one
-    contiguous block (the layout :meth:`PDEPatch.evaluate_grid` gives with ``components``)."""
-    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
 def _interp_turn(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:
@@ -425,7 +419,7 @@ class Tablet:
             u, uw, v, vw = self._solid_rules(face.patch)
             if np.array_equal(u, s) and np.array_equal(uw, sw) and np.array_equal(v, t) and np.array_equal(vw, tw):
                 solid.append(self._jacobian_integral(face.patch, u, uw, vw, X, Xs, Xt))
-        n = _cross_c(Xs, Xt)
+        n = cross_first(Xs, Xt)
         if face.sign < 0:
             n = -n
         # Σ_ij sw_i tw_j f_ij as two products (no weight grid)
@@ -898,7 +892,7 @@ class Tablet:
         wwt = 0.5 * (t.w[1] - t.w[0]) * ww
         A = p.spine(u).T[:, :, None]
         Au = p.spine(u, du=1).T[:, :, None]
-        C = _cross_c(Xv, X - A)
+        C = cross_first(Xv, X - A)
         Du = Xu - Au
         J1 = Au[0] * C[0] + Au[1] * C[1] + Au[2] * C[2]
         J2 = Du[0] * C[0] + Du[1] * C[1] + Du[2] * C[2]

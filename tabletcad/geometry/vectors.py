@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["cross", "norm3"]
+__all__ = ["cross", "cross_first", "norm3"]
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -26,6 +26,13 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     np.multiply(a0, b1, out=out[..., 2])
     out[..., 2] -= a1 * b0
     return out
+
+
+def cross_first(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product of vector fields stored coordinates first, ``(3, ...)``: each coordinate one
+    contiguous block (the layout :meth:`~tabletcad.geometry.patch.PDEPatch.evaluate_grid` gives with
+    ``components``), so every product runs over whole blocks."""
+    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
 def norm3(a: np.ndarray) -> np.ndarray:

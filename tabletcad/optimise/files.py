@@ -277,6 +277,11 @@ def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
         plain_name("[problem] name", prob["name"])
     solver_table = _check_keys("[solver]", data.get("solver", {}), set(SOLVER_KEYS))
     solver = {k: SOLVER_KEYS[k](f"[solver] {k}", v) for k, v in solver_table.items()}
+    for key, readers in (("starts", ("multistart",)), ("popsize", ("differential_evolution",)),
+                         ("seed", ("multistart", "differential_evolution"))):
+        if key in solver and method not in readers:  # a setting the file's own method would ignore
+            raise DesignError(f"[solver] {key}", solver[key], f"is read by method {' or '.join(readers)} only "
+                              f"(this file's method: {method})")
     if kind == "family":
         for k in ("parameters",):
             if k in data:

@@ -25,7 +25,7 @@ from tabletcad.pipeline.plot import plot_tablet
 from tabletcad.pipeline.report import geometry_report, to_json
 from tabletcad.tooling.spec import ToolingSpec
 
-__all__ = ["build_design", "build_tablet", "cad_available", "CAD_MODULES"]
+__all__ = ["build_design", "build_outputs", "build_tablet", "cad_available", "CAD_MODULES"]
 
 #: The modules of the ``cad`` extra the CAD stage imports (OpenCascade, the mesh checks).
 CAD_MODULES = ("OCP", "manifold3d", "trimesh")
@@ -42,6 +42,17 @@ def cad_available() -> bool:
     if os.environ.get("TABLETCAD_REQUIRE_CAD"):
         return True
     return all(importlib.util.find_spec(m) is not None for m in CAD_MODULES)
+
+
+def build_outputs(cad: bool, tooling: ToolingSpec | None = None) -> list[str]:
+    """Every file a build may write (relative names): the report and picture, with ``cad`` the CAD files,
+    with ``tooling`` its parts and drawings (checked against the output folder before any geometry)."""
+    names = ["report.json", "tablet.png"] + (["tablet.step", "tablet.stl", "tablet.glb"] if cad else [])
+    if tooling is not None:
+        from tabletcad.tooling.stage import tooling_outputs
+
+        names += tooling_outputs(tooling)
+    return names
 
 
 def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | None = None,
@@ -77,11 +88,7 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
     if not cad:
         tooling = None
     # every file this build may write, refused before the geometry if the folder holds one it may not replace
-    names = ["report.json", "tablet.png"] + (["tablet.step", "tablet.stl", "tablet.glb"] if cad else [])
-    if tooling is not None:
-        from tabletcad.tooling.stage import tooling_outputs
-
-        names += tooling_outputs(tooling)
+    names = build_outputs(cad, tooling)
     check_replaceable(out_dir, names)
     steps = 2 + cad + (tooling is not None)
     with staging_folder(out_dir) as staging:
