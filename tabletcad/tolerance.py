@@ -52,6 +52,12 @@ class Tolerances:
         Largest depth (mm) to which a patch's solid map may fold back on
         itself before the patch is refused (see :meth:`PDEPatch.fold_depth`);
         the thesis's domes fold by ~1 µm at their poles.
+    fold_fraction : float
+        The same as a fraction of the patch's reach (its largest distance from
+        its spine), where that allows more (:meth:`PDEPatch.fold_limit`): the
+        thesis's domes fold in proportion to their size (the sphere and the
+        oblong by 3.3e-4 of their radius, the prolate spheroid by 6.6e-4), so a
+        shape taken at 5 mm is taken at 500 mm.
     fit : float
         Largest deviation (mm) of a B-spline face from its PDE patch (CAD layer).
     nominal : float
@@ -109,6 +115,7 @@ class Tolerances:
     seam_gap: float = 1e-7
     seam_angle_deg: float = 0.01
     fold: float = 5e-3
+    fold_fraction: float = 2e-3
     fit: float = 1e-4
     nominal: float = 1e-3
     max_length: float = 1000.0

@@ -20,7 +20,8 @@ PKG = ROOT / "tabletcad"
 # itself (``tabletcad/__init__.py``) imports nothing: its ``make``, ``load`` and ``show`` are
 # looked up in ``tabletcad.pipeline.model`` on first use, as attributes, never by an import of the package.
 LAYERS: list[tuple[str, ...]] = [
-    ("tabletcad", "tabletcad.errors", "tabletcad.tolerance", "tabletcad.io", "tabletcad.parallel"),  # support
+    ("tabletcad", "tabletcad.errors", "tabletcad.tolerance", "tabletcad.io", "tabletcad.parallel",
+     "tabletcad.readonly"),  # support
     ("tabletcad.geometry", "tabletcad.geometry.basis", "tabletcad.geometry.curves",
      "tabletcad.geometry.nominal"),  # maths: the PDE's cardinal functions, boundary curves, nominal shapes
     ("tabletcad.geometry.patch",),  # PDE patches

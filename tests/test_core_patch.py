@@ -18,6 +18,7 @@ import pytest
 from tabletcad.geometry.curves import Circle, Ellipse, PointCurve, RoundedRectangle, Stadium, Transformed
 from tabletcad.errors import DesignError
 from tabletcad.geometry.patch import AUTO_A_LADDER, PDEPatch
+from tabletcad.tolerance import DEFAULT
 
 TWO_PI = 2 * math.pi
 V = np.linspace(0.0, TWO_PI, 720, endpoint=False) + 0.0037  # not the FFT nodes
@@ -349,6 +350,26 @@ def test_fold_check_refuses_section_turning_inside_out():
     with pytest.raises(DesignError, match="fold") as exc:
         PDEPatch(curves, a=1.0)
     assert "curves" in exc.value.parameter
+
+
+@pytest.mark.parametrize("scale", [1.0, 10.0, 100.0])
+def test_fold_check_is_the_same_at_every_size(scale):
+    """A fold is a length: a shape scaled by k folds k times as deep, and its limit grows with it where
+    ``tol.fold_fraction`` of its reach passes ``tol.fold``.  The thesis's sphere (which folds by 3.3e-4
+    of its radius at the pole) builds at 5, 50 and 500 mm (a trial: refused above 30 mm), while the
+    spine running backwards is refused at every size."""
+    from tabletcad.families.thesis import spherical
+
+    t = spherical(diameter=5.0 * scale)
+    ratio = [p.checked_fold_depth / (2.5 * scale) for p in t.patches]
+    assert ratio == pytest.approx([3.28e-4] * 2, rel=0.01)
+    for p in t.patches:  # (the reach: the PDE sphere's largest radius, 0.22 % above the sphere's)
+        assert p.fold_limit() == pytest.approx(max(DEFAULT.fold, DEFAULT.fold_fraction * 2.5 * scale), rel=3e-3)
+    bad = _coaxial(tuple(scale * r for r in (5.0, 4.0, 3.0, 0.0)), tuple(scale * z for z in (0.0, 2.0, 1.0, 3.0)))
+    depth = PDEPatch(bad, a=1.0, check=False).fold_depth()
+    with pytest.raises(DesignError, match="fold"):
+        PDEPatch(bad, a=1.0)
+    assert depth > 0.01 * 5.0 * scale  # (a fold of a twentieth of the radius and more, at every size)
 
 
 def test_fold_check_accepts_valid_dome_and_band():

@@ -272,3 +272,28 @@ def test_meridian_peaks_of_every_patch_reach_a_dense_meridian(name):
     for p, figure in zip(t.patches, per):
         dense = float(np.max(np.abs(t.nominal(p.evaluate(u, np.zeros(u.size))))))
         assert figure >= dense * (1 - 1e-9)
+
+
+def test_a_tablets_parameters_are_read_only_and_travel_as_they_are():
+    """The tablet is immutable, its ``params`` too (a trial changed ``m.tablet.params["diameter"]`` and the
+    report then gave a diameter of 3 mm beside a width of 10 mm); copies and pickles keep the values."""
+    import copy
+    import dataclasses
+    import json
+    import pickle
+
+    from tabletcad.families import concave_round
+
+    t = concave_round(diameter=10.0, band=2.8, cup_depth=0.9)
+    before = dict(t.params)
+    for change in (lambda p: p.__setitem__("diameter", 3.0), lambda p: p.update(diameter=3.0),
+                   lambda p: p.pop("diameter"), lambda p: p.clear(), lambda p: p.setdefault("x", 1.0)):
+        with pytest.raises(TypeError, match="read-only"):
+            change(t.params)
+    assert dict(t.params) == before and before["diameter"] == 10.0
+    assert pickle.loads(pickle.dumps(t.params)) == before and json.loads(json.dumps(t.params)) == before
+    mine = copy.deepcopy(t.params)
+    mine["diameter"] = 3.0  # a copy is the caller's own
+    assert t.params["diameter"] == 10.0
+    with pytest.raises(TypeError, match="read-only"):
+        dataclasses.replace(t, params={"diameter": 3.0}).params["diameter"] = 4.0

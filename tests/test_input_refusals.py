@@ -254,6 +254,10 @@ def test_extents_and_plan_area_of_a_w_trim_are_the_solid_s():
     ("spine = [1.0, 2.0]", "error: reshape.spine = [1.0, 2.0] is not allowed: need one per patch (3)"),
     ("spine = [1.0, -2.0, 1.0]", "error: reshape.spine[1] = -2 is not allowed"),
     ("radius = 1000.0", "error: reshape = {'radius': 1000.0} is not allowed: must keep the tablet within ±1000 mm"),
+    # a trial: radius 1e-5 mm built a tablet 1e-4 mm across, below the least length a design takes
+    ("radius = 1e-5", "error: reshape = {'radius': 1e-05} is not allowed: must leave the tablet's length, width and "
+                      "height at least 0.001 mm (Tolerances.min_length, the least length a design takes; the smallest "
+                      "is 0.000100051 mm)"),
 ])
 def test_reshape_refusals_name_the_key(tmp_path, capsys, reshape, line):
     """They said ``spine.factors = 2`` and ``reshape = 'factors'``."""
@@ -320,3 +324,32 @@ def test_a_start_the_family_refuses_is_the_files_error(tmp_path, capsys, fixed, 
         sense="min", variables="diameter = { lower = 8.0, upper = 14.0, initial = 12.0 }", fixed=fixed))
     assert rc == 2 and len(err) == 1 and err[0].startswith(line), err
     assert out == [] and sorted(p.name for p in tmp_path.iterdir()) == ["problem.toml"]
+
+
+def test_a_ffbe_is_given_by_its_bevel_width_or_its_bevel_depth(tmp_path, capsys):
+    """``bevel_width`` and ``bevel_depth`` are alternatives (give one): a design, a script, an inverse
+    design and an optimisation take the depth alone (a trial: "tablet.bevel_width = (not given) is not
+    allowed" until a width of 0 was written), and the refusal of neither names both."""
+    import math
+
+    from tabletcad.families.inverse import solve_for
+    from tabletcad.pipeline.design import Design
+
+    base = dict(family="ffbe", diameter=10.0, thickness=3.0, bevel_angle=30.0)
+    by_depth = Design.from_dict({"tablet": {**base, "bevel_depth": 0.3}}).build()
+    by_width = Design.from_dict({"tablet": {**base, "bevel_width": 0.3 / math.tan(math.radians(30.0))}}).build()
+    assert by_depth.volume() == pytest.approx(by_width.volume(), rel=1e-12)
+    assert by_depth.params["bevel_width"] == 0.0 and by_depth.params["bevel_depth"] == 0.3
+    d = tmp_path / "d.toml"
+    d.write_text('[tablet]\nfamily = "ffbe"\ndiameter = 10.0\nthickness = 3.0\nbevel_angle = 30.0\n')
+    assert main(["report", str(d)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["error: tablet.bevel_width = (not given) is not allowed: family 'ffbe' needs diameter, thickness, "
+                   "bevel_angle, bevel_width (or bevel_depth) (optional: bevel_depth)"]
+    solved = solve_for("ffbe", target_volume_mm3=by_depth.volume(), vary="thickness", diameter=10.0, bevel_angle=30.0,
+                       bevel_depth=0.3)
+    assert solved.value == pytest.approx(3.0, rel=1e-9)
+    rc, out, err = _optimise(tmp_path, capsys, '[problem]\nkind = "family"\nfamily = "ffbe"\nsense = "min"\n'
+                             'objective = "surface_area_mm2"\n[variables]\nthickness = { lower = 2.0, upper = 4.0 }\n'
+                             '[fixed]\ndiameter = 10.0\nbevel_angle = 30.0\nbevel_depth = 0.3\n', "--maxiter", "30")
+    assert rc == 0, err

@@ -61,6 +61,34 @@ def test_build123d_boolean(model):
     assert model.volume - cut.volume == pytest.approx(_core_cylinder_cut(1.0), rel=1e-5)
 
 
+def test_moving_what_the_model_hands_out_leaves_the_model_where_it_is(tmp_path):
+    """build123d's and cadquery's ``move`` and OCC's ``Move`` change the shape object they are called on:
+    ``to_build123d``, ``to_cadquery`` and ``to_occ`` hand out new objects on the same topology (a trial:
+    a moved ``to_build123d()`` had moved the model, its STEP and its tooling, whose punches then failed
+    their manifold3d check), so the model, its export and its volume stay where they were."""
+    from OCP.gp import gp_Trsf, gp_Vec
+    from OCP.TopLoc import TopLoc_Location
+
+    from tabletcad.cad.solid import mass_properties
+
+    m = tabletcad.make("capsule", length=14.0, width=6.0, band=2.5, cup_depth=1.0)
+    box0 = bd.Solid(m.to_occ()).bounding_box()
+    moved = m.to_build123d().move(bd.Location((50.0, 0.0, 0.0)))
+    assert moved.bounding_box().min.X == pytest.approx(box0.min.X + 50.0, abs=1e-6)  # the copy did move
+    tr = gp_Trsf()
+    tr.SetTranslation(gp_Vec(0.0, 0.0, 5.0))
+    m.to_occ().Move(TopLoc_Location(tr))
+    cq = pytest.importorskip("cadquery")
+    m.to_cadquery().val().move(cq.Location(cq.Vector(0.0, -30.0, 0.0)))
+    for solid in (m.to_occ(), m.to_build123d().wrapped, m.to_cadquery().val().wrapped):
+        box = bd.Solid(solid).bounding_box()
+        assert (box.min.X, box.min.Y, box.min.Z, box.max.Z) == pytest.approx((box0.min.X, box0.min.Y, box0.min.Z, box0.max.Z), abs=1e-9)
+    m.export(tmp_path / "t.step")
+    back = bd.import_step(str(tmp_path / "t.step")).bounding_box()
+    assert (back.min.X, back.min.Z) == pytest.approx((box0.min.X, box0.min.Z), abs=1e-6)
+    assert mass_properties(m.to_occ()).volume == pytest.approx(m.volume, rel=1e-6)
+
+
 def test_cadquery_hole_on_top_face():
     cq = pytest.importorskip("cadquery")
     m = tabletcad.make("flat_face_round", diameter=8.0, thickness=3.0)
@@ -169,6 +197,9 @@ def test_make_checks_dimensions_as_a_design_file_does(family, dims, parameter):
 def test_tooling_parts_have_the_same_vocabulary(model):
     tools = model.tooling(clearance_mm=0.03)
     assert set(tools.parts) == {"tablet", "upper_punch", "lower_punch", "die"}
+    with pytest.raises(TypeError, match="read-only"):  # a frozen tool set's parts (a trial replaced the die by None)
+        tools.parts["die"] = None
+    assert isinstance(tools.die, tabletcad.pipeline.model.PartModel)
     assert tools.report["keys"]["clearance_mm"] == 0.03
     up = tools.upper_punch
     assert isinstance(up.to_build123d(), bd.Solid)
@@ -254,6 +285,21 @@ def test_tooling_keywords_are_checked_like_the_table(tmp_path):
         m.tooling(clearance_mm=-1)  # refused before any geometry, as in the design file
     with pytest.raises(DesignError, match="standard"):
         m.tooling(standard="XYZ", type="B")
+    # a ToolingSpec changed by keywords, with_ or made in Python is checked as the table is (a trial: the
+    # spec's negative clearance built punches as wide as the bore)
+    spec = m.design.tooling_spec
+    with pytest.raises(DesignError, match=r"clearance_mm = -0.01 mm is not allowed: must be >= 0 and <= 1 mm"):
+        m.tooling(spec, clearance_mm=-0.01)
+    from tabletcad.tooling.spec import ToolingSpec
+
+    for kw, name in ((dict(clearance_mm=1.5), "clearance_mm"), (dict(taper_deg=10.0), "taper_deg"),
+                     (dict(tip_length_mm=0.0), "tip_length_mm"), (dict(gap_mm=math.inf), "gap_mm"),
+                     (dict(allowed_tip_pressure_MPa=-5.0), "allowed_tip_pressure_MPa")):
+        for make_spec in (lambda: spec.with_(**kw), lambda: ToolingSpec(**kw)):
+            with pytest.raises(DesignError) as exc:
+                make_spec()
+            assert exc.value.parameter.endswith(name)
+    assert spec.with_(clearance_mm=0).clearance_mm == 0.0 and spec.with_(taper_deg=9.5).taper_deg == 9.5
 
 
 @pytest.mark.parametrize("design, v", [("cutaway_convex_round", None), ("families/almond", (0.0, 3.0))])

@@ -17,7 +17,7 @@ except ImportError:  # pragma: no cover - OCP 7.x
     from OCP.TColStd import TColStd_Array1OfInteger as Array1OfInteger
     from OCP.TColStd import TColStd_Array1OfReal as Array1OfReal
 
-__all__ = ["Array1OfPnt", "Array1OfReal", "Array1OfInteger", "Array2OfPnt", "cast", "shape_type"]
+__all__ = ["Array1OfPnt", "Array1OfReal", "Array1OfInteger", "Array2OfPnt", "cast", "handle", "shape_type"]
 
 _NAMES = {
     TopAbs_ShapeEnum.TopAbs_VERTEX: "Vertex",
@@ -41,6 +41,21 @@ def cast(shape: TopoDS_Shape, kind: str | None = None):
     kind = kind or shape_type(shape)
     fn = getattr(TopoDS, kind, None) or getattr(TopoDS, kind + "_s")
     return fn(shape)
+
+
+def handle(shape: TopoDS_Shape):
+    """A new ``TopoDS_<type>`` object on the same topology and geometry as ``shape`` (its ``TShape``,
+    location and orientation; nothing is copied).  OCC's in-place edits of a shape object
+    (``Move``, ``Location``, ``Orientation``: build123d's ``Shape.move``, cadquery's ``Shape.move``)
+    change only the object they are called on, so a shape handed out as a new handle cannot move
+    the one it came from."""
+    import OCP.TopoDS as topods
+
+    out = getattr(topods, f"TopoDS_{shape_type(shape)}")()
+    out.TShape(shape.TShape())
+    out.Location(shape.Location())
+    out.Orientation(shape.Orientation())
+    return out
 
 
 def explore(shape: TopoDS_Shape, kind: str) -> list:

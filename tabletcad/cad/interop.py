@@ -9,9 +9,10 @@ Version constraints (the pins in ``pyproject.toml``):
   ``cadquery-ocp==7.9.3.1.1`` of the same OCP (cadquery imports ``OCP.IVtkOCC``,
   which only the VTK wheel ships); both wheels install identical OCP files.
 
-Both libraries wrap the very same ``TopoDS_Shape`` object (no copy, no
-translation); this module only checks that the installed library uses the OCP
-that built the shape.
+Both libraries wrap the solid's own topology and geometry (no copy, no translation) in a
+new shape object (:func:`~tabletcad.cad._occ.handle`): moving or reorienting what they
+return leaves the tablet or part it came from where it was.  This module also checks that
+the installed library uses the OCP that built the shape.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from typing import Any
 
 from OCP.TopoDS import TopoDS_Shape
 
-from tabletcad.cad._occ import cast, explore, shape_type
+from tabletcad.cad._occ import cast, explore, handle, shape_type
 from tabletcad.geometry.tablet import Tablet
 
 __all__ = ["to_build123d", "to_build123d_part", "to_cadquery", "to_cadquery_workplane", "from_any"]
@@ -62,13 +63,14 @@ def from_any(obj: Any) -> TopoDS_Shape:
 
 
 def _solid_of(obj: Any):
+    """The one solid of ``obj`` as a new handle (:func:`~tabletcad.cad._occ.handle`)."""
     shape = from_any(obj)
     if shape_type(shape) == "Solid":
-        return cast(shape, "Solid")
+        return handle(shape)
     solids = explore(shape, "Solid")
     if len(solids) != 1:
         raise TypeError(f"expected exactly one solid, found {len(solids)}")
-    return solids[0]
+    return handle(solids[0])
 
 
 def _import_build123d():
@@ -88,7 +90,7 @@ def _import_cadquery():
 
 
 def to_build123d(obj: Any):
-    """A ``build123d.Solid`` wrapping the solid (same ``TopoDS_Solid``)."""
+    """A ``build123d.Solid`` wrapping the solid (its topology and geometry in a new handle: see the module)."""
     bd = _import_build123d()
     return bd.Solid(_solid_of(obj))
 

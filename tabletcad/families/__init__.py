@@ -78,6 +78,8 @@ __all__ = [
 ]
 
 _UNITS = {"bevel_angle": "deg"}
+#: a required dimension that another may replace: a ffbe's bevel is given by its width or its depth
+_ALTERNATIVES = {"ffbe": {"bevel_width": "bevel_depth"}}
 
 FAMILY_FUNCTIONS = (
     flat_face_round, ffbe, ffre, concave_round, compound_cup, concave_bevel,
@@ -93,7 +95,7 @@ THESIS_FAMILIES: tuple[str, ...] = tuple(f"thesis.{n}" for n in THESIS_SHAPES)
 
 #: Every family by name: the industry families, then the thesis's shapes (static, read-only).
 FAMILIES: Mapping[str, Family] = MappingProxyType({
-    **{f.__name__: Family.of(f, _UNITS) for f in FAMILY_FUNCTIONS},
+    **{f.__name__: Family.of(f, _UNITS, alternatives=_ALTERNATIVES.get(f.__name__)) for f in FAMILY_FUNCTIONS},
     **{f"thesis.{n}": replace(f, name=f"thesis.{n}") for n, f in THESIS_SHAPES.items()},
 })
 

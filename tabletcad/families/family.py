@@ -35,20 +35,36 @@ class Family:
         ``func(**params, a=..., tol=...) -> Tablet``.
     params : mapping
         Parameter name -> unit (``"mm"``, ``"deg"``), in the constructor's order.
+    alternatives : mapping
+        A required parameter -> the optional one that may be given instead (a bevel's width or its
+        depth): with only the alternative given, the required one is 0 (:meth:`left_out`).
     """
 
     name: str
     func: Callable[..., Tablet]
     params: Mapping[str, str]
     doc: str = field(default="", repr=False)
+    alternatives: Mapping[str, str] = field(default_factory=dict, repr=False)
 
     @classmethod
-    def of(cls, func: Callable[..., Tablet], units: Mapping[str, str] | None = None, name: str | None = None) -> Family:
+    def of(cls, func: Callable[..., Tablet], units: Mapping[str, str] | None = None, name: str | None = None,
+           alternatives: Mapping[str, str] | None = None) -> Family:
         """The family of a constructor: its positional-or-keyword parameters, in mm unless ``units`` says."""
         units = units or {}
         sig = inspect.signature(func)
         params = {k: units.get(k, "mm") for k, p in sig.parameters.items() if p.kind is p.POSITIONAL_OR_KEYWORD}
-        return cls(name or func.__name__, func, params, (func.__doc__ or "").strip().splitlines()[0])
+        return cls(name or func.__name__, func, params, (func.__doc__ or "").strip().splitlines()[0],
+                   dict(alternatives or {}))
+
+    def left_out(self, given: Mapping[str, Any]) -> dict[str, float]:
+        """The required parameters not in ``given`` (name -> value, None for a value still to be found)
+        whose alternative is, other than 0, each 0 (``{"bevel_width": 0.0}`` for a ffbe given its
+        ``bevel_depth``): what a design adds before it builds."""
+        return {k: 0.0 for k, alt in self.alternatives.items() if k not in given and alt in given and given[alt] != 0.0}
+
+    def needs(self) -> str:
+        """The required parameters as a design's refusal names them (``bevel_width (or bevel_depth)``)."""
+        return ", ".join(f"{k} (or {self.alternatives[k]})" if k in self.alternatives else k for k in self.required)
 
     @property
     def defaults(self) -> dict[str, Any]:

@@ -310,7 +310,9 @@ def _prepare(family, vary, dims):
     if isinstance(family, str):  # a named family needs what its design file needs (a callable: its defaults)
         from tabletcad.families import family as lookup
 
-        required = lookup(family, parameter="family").required
+        fam = lookup(family, parameter="family")
+        dims = {**fam.left_out({vary: None, **dims}), **dims}  # (a ffbe's bevel_width, given its bevel_depth)
+        required = fam.required
         missing = [k for k in required if k != vary and k not in dims]
         if missing:
             raise DesignError(missing[0], MISSING, f"{name} needs {', '.join(k for k in required if k != vary)} "

@@ -650,15 +650,14 @@ class PDEPatch:
         revolution, or of scaled copies of one plan ellipse (:attr:`section`), whose depth is the
         same on every meridian, is always measured on four.
         """
+        return self._fold_entry(nu, nv)[0]
+
+    def _fold_entry(self, nu: int, nv: int | None) -> tuple[float, float]:
+        """:meth:`_fold_depth_of` on :meth:`fold_depth`'s samples, computed once."""
         v = None
-        if self._revolution is not None:  # every meridian alike (the section's argument, M a rotation)
+        if self._revolution is not None:
             nv = self._check_nv()
         elif self._section is not None:
-            # a surface of revolution, or of one plan ellipse (x, y) = R(u) M e(v), z = Z(u), M = [p q], folds
-            # alike on every meridian: D = X - A0 = (R M e, 0), X_v × D = (0, 0, -R² det M) and the Jacobian
-            # X_u · (X_v × D) = -Z' R² det M, so the speed |Jacobian| / |X_v × D| is |Z'(u)| on every v.  The
-            # four principal meridians also give the largest |X_u|, |X_v| and |D| of any, the scale of the
-            # threshold below which a sign change is round-off
             nv, v = "principal", self._principal_v()
         elif nv is None:
             nv = self._check_nv()
@@ -666,6 +665,13 @@ class PDEPatch:
         if key not in self.__dict__.get("_checks", {}):
             self.__dict__.setdefault("_checks", {})[key] = self._fold_depth_of(nu, nv, v)
         return self._checks[key]
+
+    def fold_limit(self, nu: int = 257, nv: int | None = None) -> float:
+        """The deepest fold (mm) the patch may have: ``tol.fold``, or ``tol.fold_fraction`` of its reach
+        (the largest distance of the surface from its spine, on :meth:`fold_depth`'s samples ``nu, nv``)
+        where that is more.  A fold is a length: the same shape at another size folds in proportion (the
+        thesis's sphere 0.8 µm at 5 mm, 5.1 µm at 31 mm, which a fixed 5 µm refused)."""
+        return max(self.tol.fold, self.tol.fold_fraction * self._fold_entry(nu, nv)[1])
 
     @property
     def checked_fold_depth(self) -> float:
@@ -682,7 +688,9 @@ class PDEPatch:
         V = np.linalg.eigh(pq @ pq.T)[1]  # MᵀM = [p·p p·q; p·q q·q]
         return float(np.arctan2(V[1, 0], V[0, 0])) + 0.5 * math.pi * np.arange(4)
 
-    def _fold_depth_of(self, nu: int, nv: int, v: np.ndarray | None = None) -> float:
+    def _fold_depth_of(self, nu: int, nv: int, v: np.ndarray | None = None) -> tuple[float, float]:
+        """``(fold depth, reach)`` (mm) on ``nu`` rows and ``nv`` (or ``v``) meridians: see :meth:`fold_depth`
+        and :meth:`fold_limit`."""
         u = _fold_u(nu, 48)
         v = sample_v(nv) if v is None else v
         # coordinates as contiguous (nu, nv) blocks (evaluate_grid's components layout)
@@ -692,29 +700,31 @@ class PDEPatch:
         m = cross_first(Xv, D)  # Xv × D
         det = Xu[0] * m[0] + Xu[1] * m[1] + Xu[2] * m[2]
         mag = lambda a: math.sqrt(float(np.max(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])))  # noqa: E731
-        scale = mag(Xu) * mag(Xv) * mag(D)
+        reach = mag(D)
+        scale = mag(Xu) * mag(Xv) * reach
         if scale == 0.0:
-            return 0.0
+            return 0.0, reach
         ref = 1.0 if float(np.sum(det)) >= 0.0 else -1.0
         folded = det * ref < -1e-9 * scale
         if not np.any(folded):
-            return 0.0
+            return 0.0, reach
         speed = np.abs(det) / np.maximum(np.sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]), 1e-300) * folded
         du = np.diff(u)[:, None]
         back = np.sum(0.5 * (speed[1:] + speed[:-1]) * du, axis=0)
-        return float(np.max(back))
+        return float(np.max(back)), reach
 
     def _check_fold(self) -> None:
         """Refuse a patch whose surface folds over itself, passes through its
         spine, or whose solid map folds deeper than ``tol.fold``."""
         depth = self.fold_depth()
+        limit = self.fold_limit()
         object.__setattr__(self, "_fold_depth", depth)
-        if depth > self.tol.fold:
+        if depth > limit:
             raise DesignError(
                 f"patch {self.name or '?'} curves",
                 f"a fold {depth:.3g} mm deep",
-                f"the surface must not cross its spine by more than {self.tol.fold:g} mm "
-                "(a radius would turn negative or the surface self-intersects)",
+                f"the surface must not cross its spine by more than {limit:.3g} mm (Tolerances.fold, or "
+                "fold_fraction of its reach; a radius would turn negative or the surface self-intersects)",
             )
         u = _fold_u(401, 24)
         v = sample_v(self._check_nv())
@@ -782,7 +792,7 @@ class PDEPatch:
 
     def _refuse_negative_radius(self, along: np.ndarray, u: np.ndarray, v: np.ndarray) -> None:
         worst = float(-np.min(along))
-        if worst > self.tol.fold:
+        if worst > self.fold_limit():
             i, j = np.unravel_index(int(np.argmin(along)), along.shape)
             raise DesignError(
                 f"patch {self.name or '?'} curves",

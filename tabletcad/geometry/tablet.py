@@ -25,6 +25,7 @@ from tabletcad.geometry.revolution import profile_extreme
 #: Trapezoidal points in ``v`` for the integrals of a surface of revolution, whose integrands
 #: (``X·n``, ``|n|``, the solid map's Jacobian) are the same on every meridian.
 _REVOLUTION_NV = 4
+from tabletcad.readonly import TableDict
 from tabletcad.tolerance import DEFAULT, Tolerances
 from tabletcad.geometry.vectors import cross_first, norm3
 from tabletcad.geometry.quadrature import gauss_legendre
@@ -296,7 +297,8 @@ class Tablet:
     family : str
         Family the tablet was built from (``"free_form"`` when given patch by patch).
     params : dict
-        The family's parameters (mm), for reports.
+        The family's parameters (mm), for reports; kept read-only (a
+        :class:`~tabletcad.readonly.TableDict`).
     trim : Trim
         Parameter ranges kept (default: everything).
     nominal : callable, optional
@@ -321,6 +323,8 @@ class Tablet:
             if not isinstance(p, PDEPatch):
                 raise DesignError(f"patch {i}", type(p).__name__, "must be a PDEPatch")
         object.__setattr__(self, "patches", patches)
+        if not isinstance(self.params, TableDict):  # read-only, as the tablet is: its reports read them
+            object.__setattr__(self, "params", TableDict(self.params))
 
     # ------------------------------------------------------------------ topology
     def _end_is_shared(self, i: int, end: int) -> bool:

@@ -445,9 +445,10 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
     held = _held_volume(prob, fam_name, fam, variables, fixed)
     _check_lower_lengths(fam_name, fam, vs, fixed)
     given = set(variables) | set(fixed) | ({held[0]} if held else set())
-    missing = [k for k in fam.required if k not in given]
+    fixed.update(fam.left_out({**dict.fromkeys(given), **fixed}))  # (a ffbe's bevel_width, given its bevel_depth)
+    missing = [k for k in fam.required if k not in given and k not in fixed]
     if missing:  # the family's default would stand in for it, unseen, and the optimum would not build
-        raise DesignError(f"[fixed] {missing[0]}", MISSING, f"family {fam_name!r} needs {', '.join(fam.required)}: "
+        raise DesignError(f"[fixed] {missing[0]}", MISSING, f"family {fam_name!r} needs {fam.needs()}: "
                           "give each as a variable, in [fixed] or as [problem] solve_for")
 
     def build(x):

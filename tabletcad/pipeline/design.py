@@ -55,6 +55,7 @@ from tabletcad.pipeline.designreport import ReportOptions
 from tabletcad.tooling.spec import ToolingSpec, parse_tooling
 from tabletcad.geometry.tablet import Tablet, Trim
 from tabletcad.tolerance import DEFAULT, Tolerances
+from tabletcad.readonly import TableDict, TableList
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -188,45 +189,6 @@ def _curve(spec: Any, where: str, previous: Curve | None) -> Curve:
 
 
 _TABLES = ("trim", "reshape", "report", "tooling")
-
-
-class _ReadOnly:
-    """What a design's tables raise on any change: they are its value (a model built from it keeps its
-    tablet, and :meth:`Design.__hash__` reads them)."""
-
-    def _refuse(self, *args: Any, **kw: Any):
-        raise TypeError(f"a design's tables are read-only ({type(self).__name__}): change a copy, "
-                        "design.to_dict(), and make a new design (Design.from_dict, TabletModel.replace)")
-
-    __setitem__ = __delitem__ = __iadd__ = __imul__ = __ior__ = _refuse
-    append = extend = insert = remove = pop = popitem = clear = update = setdefault = sort = reverse = _refuse
-
-
-class TableDict(_ReadOnly, dict):
-    """A read-only ``dict`` (still a ``dict`` to every reader); a copy (``copy.deepcopy``, ``dict(t)``)
-    is a plain, changeable one."""
-
-    def __deepcopy__(self, memo):
-        return {k: copy.deepcopy(v, memo) for k, v in self.items()}
-
-    def __copy__(self):
-        return dict(self)
-
-    def __reduce__(self):  # pickled (sweeps send designs to their workers) as itself, without __setitem__
-        return TableDict, (dict(self),)
-
-
-class TableList(_ReadOnly, list):
-    """A read-only ``list`` (``[[patch]]`` tables, a table's arrays); copies are plain lists."""
-
-    def __deepcopy__(self, memo):
-        return [copy.deepcopy(v, memo) for v in self]
-
-    def __copy__(self):
-        return list(self)
-
-    def __reduce__(self):
-        return TableList, (list(self),)
 
 
 def _table_hash(value: Any) -> int:
@@ -415,11 +377,12 @@ class Design:
                 if k not in fam.params:
                     raise DesignError(one_token(f"tablet.{k}"), v, f"family {family!r} takes {', '.join(fam.params)}")
                 kw[k] = _number(f"tablet.{k}", v, fam.params[k])
+            kw.update(fam.left_out(kw))  # (a ffbe's bevel_width, when its bevel_depth is given)
             missing = [k for k in fam.params if k in fam.required and k not in kw]
             if missing:
                 optional = [k for k in fam.params if k not in fam.required]
                 raise DesignError(f"tablet.{missing[0]}", MISSING,
-                                  f"family {family!r} needs {', '.join(fam.required)}"
+                                  f"family {family!r} needs {fam.needs()}"
                                   + (f" (optional: {', '.join(optional)})" if optional else ""))
             if a is not None:
                 kw["a"] = a
@@ -476,14 +439,19 @@ def design_from_dict(data: dict, default_name: str = "tablet") -> Tablet:
 
 
 def _check_size(tablet: Tablet, tol: Tolerances = DEFAULT, *, what: dict | None = None) -> None:
-    """Refuse a reshaped tablet whose overall size leaves ``±tol.max_length`` (``what``: the
-    ``[reshape]`` table, named in the refusal)."""
+    """Refuse a reshaped tablet whose overall size leaves ``±tol.max_length`` or whose length, width or
+    height is below ``tol.min_length`` (``what``: the ``[reshape]`` table, named in the refusal)."""
     lo, hi = tablet.bounds()
     big = float(max(np.max(np.abs(lo)), np.max(np.abs(hi))))
     if not big <= tol.max_length:
         raise DesignError("reshape", what if what is not None else "factors",
                           f"must keep the tablet within ±{tol.max_length:g} mm "
                           f"(size limit, Tolerances.max_length; it reaches {big:.6g} mm)")
+    small = float(np.min(hi - lo))
+    if not small >= tol.min_length:  # (a radius of 1e-5 mm had made a tablet 1e-4 mm across)
+        raise DesignError("reshape", what if what is not None else "factors",
+                          f"must leave the tablet's length, width and height at least {tol.min_length:g} mm "
+                          f"(Tolerances.min_length, the least length a design takes; the smallest is {small:.6g} mm)")
 
 
 _CUSTOM_KEYS = {"outline", "segments", "band", "cup_depth", "land", "cup_width", "central_radius", "edge_radius"}

@@ -6,7 +6,7 @@
 
     m = tabletcad.make("concave_round", diameter=10, band=2, cup_depth=1)
     m.volume                      # mm³, the core's quadrature
-    part = m.to_build123d()       # build123d.Solid (same TopoDS_Solid as m.to_occ())
+    part = m.to_build123d()       # build123d.Solid on the same topology (moving it leaves m as it is)
     wp = m.to_cadquery()          # cadquery.Workplane holding the solid
     m.export("tablet.step")
     tools = m.tooling(clearance_mm=0.03)
@@ -50,7 +50,8 @@ class _Shaped:
         raise NotImplementedError
 
     def to_build123d(self):
-        """A ``build123d.Solid`` wrapping the very same ``TopoDS_Solid`` (no copy)."""
+        """A ``build123d.Solid`` on the solid's own topology and geometry (no copy), in a new shape object:
+        moving it (``.move``, ``.locate``) leaves this model, its exports and its tooling where they were."""
         from tabletcad.cad.interop import to_build123d
 
         return to_build123d(self.to_occ())
@@ -100,8 +101,11 @@ class PartModel(_Shaped):
     shape: Any  # TopoDS_Shape
 
     def to_occ(self):
-        """The part's ``TopoDS_Shape`` (a solid)."""
-        return self.shape
+        """The part's ``TopoDS_Solid``, a new handle on its topology and geometry
+        (:func:`tabletcad.cad._occ.handle`: moving it leaves the part where it is)."""
+        from tabletcad.cad._occ import handle
+
+        return handle(self.shape)
 
     @property
     def volume(self) -> float:
@@ -124,7 +128,9 @@ class ToolingModel:
     parts: dict[str, PartModel] = field(init=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "parts", {k: PartModel(k, v) for k, v in self.toolset.parts.items()})
+        from tabletcad.readonly import TableDict
+
+        object.__setattr__(self, "parts", TableDict({k: PartModel(k, v) for k, v in self.toolset.parts.items()}))
 
     @property
     def report(self) -> dict[str, Any]:
@@ -209,8 +215,12 @@ class TabletModel(_Shaped):
 
     def to_occ(self):
         """The tablet's ``TopoDS_Solid``; for a cut-away view (``[trim] u`` or ``v``) the cut-away's,
-        made and checked as ``tabletcad build`` makes it (:func:`tabletcad.cad.stage.cutaway_solid`)."""
-        return self.solid.shape if self._whole else self._cutaway[0]
+        made and checked as ``tabletcad build`` makes it (:func:`tabletcad.cad.stage.cutaway_solid`).  A new
+        handle on its topology and geometry each call (:func:`tabletcad.cad._occ.handle`): moving it
+        (``Move``, build123d's ``.move``) leaves the model, its exports and its tooling where they were."""
+        from tabletcad.cad._occ import handle
+
+        return handle(self.solid.shape if self._whole else self._cutaway[0])
 
     @property
     def _whole(self) -> bool:

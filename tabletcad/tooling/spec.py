@@ -331,12 +331,36 @@ class ToolingSpec:
     punch_youngs_modulus_source: str | None = None
     fe_rating: FeRatingSpec | None = None
 
+    def __post_init__(self) -> None:
+        # the [tooling] table's ranges hold however the spec is made: parsed (parse_tooling), built in
+        # Python or changed by with_/replace (a negative clearance given so had built punches as wide as
+        # the bore); numbers are stored as floats
+        big = DEFAULT.max_length
+        checks = {"clearance_mm": dict(lo=0.0, hi=MAX_CLEARANCE_MM), "tip_length_mm": dict(lo=0.0, hi=big, lo_open=True),
+                  "die_outer_diameter_mm": dict(lo=0.0, hi=big, lo_open=True),
+                  "die_height_mm": dict(lo=0.0, hi=big, lo_open=True), "taper_deg": dict(lo=0.0, hi=10.0, hi_open=True),
+                  "gap_mm": dict(lo=0.0, hi=big, lo_open=True), "lower_tip_length_mm": dict(lo=0.0, hi=big, lo_open=True)}
+        for key, rng in checks.items():
+            value = getattr(self, key)
+            if value is not None or key in ("clearance_mm", "tip_length_mm", "taper_deg"):
+                unit = "deg" if key.endswith("_deg") else "mm"
+                object.__setattr__(self, key, check_range(f"[tooling] {key}", value, unit=unit, **rng))
+        for key in ("allowed_tip_pressure_MPa", "punch_youngs_modulus_MPa"):
+            if getattr(self, key) is not None:
+                object.__setattr__(self, key, check_positive(f"[tooling] {key}", getattr(self, key), "MPa"))
+        for key, kind, name in (("scores", ScoreSpec, "[[tooling.score]]"), ("emboss", EmbossSpec, "[[tooling.emboss]]")):
+            items = getattr(self, key)
+            if not isinstance(items, (tuple, list)) or not all(isinstance(x, kind) for x in items):
+                raise DesignError(name, items, f"must be a tuple of {kind.__name__} (parse_tooling makes them from tables)")
+            object.__setattr__(self, key, tuple(items))
+
     @property
     def lower_tip(self) -> float:
         """The lower punch's tip length (mm)."""
         return self.tip_length_mm if self.lower_tip_length_mm is None else self.lower_tip_length_mm
 
     def with_(self, **kw: Any) -> "ToolingSpec":
+        """A copy with fields replaced (``clearance_mm=0.03``), checked as the ``[tooling]`` table is."""
         return replace(self, **kw)
 
 
