@@ -108,8 +108,12 @@ def test_mesh_formats(tmp_path):
 
 def test_unknown_suffix_and_atomicity(tmp_path):
     ts = build_solid(sphere(1.0).patches)
-    with pytest.raises(ValueError, match="suffix"):
+    from tabletcad.errors import DesignError
+
+    with pytest.raises(DesignError, match=r"^path = '.*x\.obj' is not allowed: its file suffix '\.obj' must be one of "
+                                          r"\.3mf, \.brep, \.glb, \.step, \.stl, \.stp$") as exc:
         export(ts, tmp_path / "x.obj")
+    assert exc.value.parameter == "path" and isinstance(exc.value, ValueError)
     export(ts, tmp_path / "x.step")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["x.step"]  # no temporary left behind
 

@@ -173,6 +173,23 @@ def test_make_unknown_family():
         tabletcad.make("no_such_family")
 
 
+def test_make_takes_every_table_of_a_design():
+    """``trim=`` and ``reshape=`` as ``report=`` and ``tooling=`` (a trial: ``make(..., trim=...)`` was
+    refused as an unknown dimension); each the same tablet as the design file's table gives."""
+    from tabletcad.pipeline.design import Design
+
+    dims = dict(diameter=10.0, band=2.8, cup_depth=0.9)
+    whole = tabletcad.make("concave_round", **dims)
+    half = tabletcad.make("concave_round", trim=dict(v=[0.0, math.pi]), **dims)
+    assert half.volume == pytest.approx(0.5 * whole.volume, rel=1e-12)
+    big = tabletcad.make("thesis.flat_faced_round", diameter=10.0, thickness=3.0, reshape=dict(radius=1.5))
+    ref = Design.from_dict({"tablet": dict(family="thesis.flat_faced_round", diameter=10.0, thickness=3.0),
+                            "reshape": dict(radius=1.5)}).build()
+    assert big.volume == ref.volume() and big.design.reshape == {"radius": 1.5}
+    with pytest.raises(DesignError, match="reshape"):
+        tabletcad.make("thesis.flat_faced_round", diameter=10.0, thickness=3.0, reshape=dict(radius=1e-5))
+
+
 def test_make_takes_numpy_scalars():
     import numpy as np
 

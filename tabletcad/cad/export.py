@@ -34,7 +34,7 @@ from OCP.XCAFDoc import XCAFDoc_DocumentTool
 
 from tabletcad.cad._occ import quiet
 from tabletcad.cad.mesh import MeshResult, tessellate, tessellate_solid
-from tabletcad.errors import GeometryError
+from tabletcad.errors import DesignError, GeometryError
 from tabletcad.io import atomic_path
 from tabletcad.tolerance import DEFAULT
 
@@ -251,7 +251,9 @@ def export(obj: Any, path: str | os.PathLike[str], *, name: str | None = None, *
     """
     suffix = Path(path).suffix.lower()
     if suffix not in SUFFIXES:
-        raise ValueError(f"file suffix {suffix!r} is not allowed: must be one of {', '.join(sorted(SUFFIXES))}")
+        # a DesignError (a ValueError) naming the path, as a folder given as the file is named
+        raise DesignError("path", str(path), f"its file suffix {suffix or '(none)'!r} must be one of "
+                          f"{', '.join(sorted(SUFFIXES))}")
     exact = {".step": ("schema",), ".stp": ("schema",), ".brep": ()}  # the exact formats take no mesh options
     if suffix in exact and set(kw) - set(exact[suffix]):
         extra = sorted(set(kw) - set(exact[suffix]))[0]

@@ -312,22 +312,24 @@ class TabletModel(_Shaped):
         return f"TabletModel({self.tablet.name!r}, family={self.tablet.family!r})"
 
 
-def make(family: str, *, report: dict | None = None, tooling: dict | None = None, **dims: Any) -> TabletModel:
+def make(family: str, *, report: dict | None = None, tooling: dict | None = None, trim: dict | None = None,
+         reshape: dict | None = None, **dims: Any) -> TabletModel:
     """A tablet of a named family (``tabletcad shapes`` lists them) with dimensions in mm.
 
     Checked as a design file's ``[tablet]`` table is (:class:`~tabletcad.pipeline.design.Design`):
     every required dimension given, numbers only (no ``"10"``), lengths within ±1000 mm and 0
     or at least ``Tolerances.min_length``; ``a`` (the smoothing parameter) may be given.
-    ``report`` and ``tooling``: the design's ``[report]`` and ``[tooling]`` tables as dicts
-    (``report=dict(solid_fraction=0.85, true_density_mg_mm3=1.5)`` gives :meth:`TabletModel.report`
-    its weight), checked as a design file's are.
+    ``report``, ``tooling``, ``trim`` and ``reshape``: the design's ``[report]``, ``[tooling]``, ``[trim]``
+    and ``[reshape]`` tables as dicts (``report=dict(solid_fraction=0.85, true_density_mg_mm3=1.5)`` gives
+    :meth:`TabletModel.report` its weight, ``trim=dict(v=[0.0, 3.14159])`` a cut-away), checked as a
+    design file's are.
     """
     import numpy as np
 
     # numpy's scalars (np.arange(...)[i], np.float32) are the numbers they hold; arrays are not numbers
     dims = {k: v.item() if isinstance(v, np.generic) else v for k, v in dims.items()}
     data: dict[str, Any] = {"tablet": {"family": family, **dims}}
-    for table, value in (("report", report), ("tooling", tooling)):
+    for table, value in (("report", report), ("tooling", tooling), ("trim", trim), ("reshape", reshape)):
         if value is not None:
             data[table] = value
     design = Design.from_dict(data, default_name=str(family).split(".")[-1])
