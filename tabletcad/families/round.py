@@ -131,9 +131,9 @@ def compound_cup(diameter: float = 10.0, band: float = 2.5, cup_depth: float = 1
 
 def concave_bevel(diameter: float = 10.0, band: float = 2.5, cup_depth: float = 0.8, bevel_angle: float = 30.0,
                   bevel_width: float = 0.6, *, a=DEFAULT_A, tol: Tolerances = DEFAULT) -> Tablet:
-    """Round concave bevel-edge tablet: bevel (deg, mm) from the band, then a spherical cup (mm).
-
-    ``cup_depth`` is measured from the bevel's inner edge.
+    """Round concave bevel-edge tablet: bevel (deg, mm) from the band, then a spherical cup whose
+    ``cup_depth`` (mm) is measured from the bevel's inner edge (the design report's ``cup_depth_mm`` is
+    the whole depth, bevel included, and ``cup_depth_below_bevel_mm`` this one).
     """
     D = check_positive("diameter", diameter, "mm")
     b = check_positive("band", band, "mm")
