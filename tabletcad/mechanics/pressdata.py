@@ -61,7 +61,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import tomllib
 
 from tabletcad.errors import MISSING, DesignError, check_finite, check_range
 from tabletcad.tolerance import DEFAULT
@@ -709,15 +708,9 @@ def metadata_beside(path: str | Path) -> Path | None:
 def read_metadata(source: str | Path | Mapping[str, Any], **overrides: Any) -> PressMetadata:
     """Build :class:`PressMetadata` from a TOML file or mapping plus keyword overrides."""
     if isinstance(source, (str, Path)):
-        p = Path(source)
-        try:
-            raw = tomllib.loads(p.read_text(encoding="utf-8-sig"))
-        except tomllib.TOMLDecodeError as exc:
-            raise DesignError("metadata", p.name, f"is not valid TOML ({exc})") from None
-        except UnicodeDecodeError:
-            raise DesignError("metadata", p.name, "must be a UTF-8 text file (TOML)") from None
-        except IsADirectoryError:
-            raise DesignError("metadata", str(p), "must be a file, not a folder") from None
+        from tabletcad.io.tomlfile import read_toml_file
+
+        raw = read_toml_file(source, "metadata")
     else:
         raw = dict(source)
     if set(raw) == {"press"}:  # allow a [press] table

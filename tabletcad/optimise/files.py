@@ -57,17 +57,12 @@ from __future__ import annotations
 
 import math
 import re
-import sys
 from pathlib import Path
 from typing import Any, Callable
 
 from tabletcad.errors import MISSING, DesignError, one_token
 from tabletcad.optimise.problem import METHODS, Constraint, Objective, Problem, Variable
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
 
 __all__ = ["load_problem", "problem_from_dict", "family_problem", "QUANTITIES", "SOLVER_KEYS"]
 
@@ -239,16 +234,9 @@ SOLVER_KEYS: dict[str, Callable[[str, Any], Any]] = {
 
 def load_problem(path: str | Path) -> tuple[Problem, str, dict]:
     """Read a problem file; return ``(problem, default method, solver options)``."""
-    path = Path(path)
-    if not path.is_file():
-        raise DesignError("problem file", str(path), "must be an existing TOML file")
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
-    except tomllib.TOMLDecodeError as exc:
-        raise DesignError("problem file", path.name, f"must be valid TOML ({exc})") from None
-    except UnicodeDecodeError:
-        raise DesignError("problem file", path.name, "must be UTF-8 text (TOML)") from None
-    return problem_from_dict(data)
+    from tabletcad.io.tomlfile import read_toml_file
+
+    return problem_from_dict(read_toml_file(path, "problem file"))
 
 
 def _check_keys(where: str, table: Any, allowed: set) -> dict:

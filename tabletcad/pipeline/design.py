@@ -39,7 +39,6 @@ import json
 import math
 import numbers
 import re
-import sys
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -56,11 +55,8 @@ from tabletcad.tooling.spec import ToolingSpec, parse_tooling
 from tabletcad.geometry.tablet import Tablet, Trim
 from tabletcad.tolerance import DEFAULT, Tolerances
 from tabletcad.readonly import TableDict, TableList
+from tabletcad.io.tomlfile import read_toml_file
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
 
 __all__ = ["Design", "load_design", "read_design_file", "design_from_dict", "design_to_toml", "toml_text", "TOP_LEVEL_KEYS"]
 
@@ -77,26 +73,8 @@ _CURVE_KEYS = {
 def read_design_file(path: str | Path) -> dict[str, Any]:
     """The parsed TOML of a design file; any problem with the file is a :class:`DesignError`
     naming ``design_file`` (a folder, a missing or unreadable file, invalid or too deeply
-    nested TOML, an integer literal longer than Python converts)."""
-    path = Path(path)
-    if path.is_dir():
-        raise DesignError("design_file", str(path), "must be a TOML file, not a folder")
-    if not path.is_file():
-        raise DesignError("design_file", str(path), "must be an existing TOML file")
-    try:
-        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark, as some editors write it, is not TOML
-    except UnicodeDecodeError:
-        raise DesignError("design_file", str(path), "must be UTF-8 text (TOML)") from None
-    except OSError as exc:
-        raise DesignError("design_file", str(path), f"must be a readable file ({exc.strerror})") from None
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise DesignError("design_file", path.name, f"must be valid TOML ({exc})") from None
-    except RecursionError:
-        raise DesignError("design_file", path.name, "must be valid TOML nested less than a few hundred levels deep") from None
-    except ValueError as exc:  # e.g. an integer of more than 4300 digits
-        raise DesignError("design_file", path.name, f"must be valid TOML with numbers Python can read ({exc})") from None
+    nested TOML, an integer literal longer than Python converts: :func:`tabletcad.io.tomlfile.read_toml_file`)."""
+    return read_toml_file(path, "design_file")
 
 
 def load_design(path: str | Path) -> Tablet:

@@ -35,17 +35,12 @@ import hashlib
 import itertools
 import json
 import math
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from tabletcad.errors import MISSING, DesignError
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
 
 __all__ = ["SweepSpec", "Axis", "OUTPUTS", "load_sweep", "parse_sweep", "design_hash", "set_key"]
 
@@ -141,16 +136,10 @@ def design_hash(design: dict[str, Any]) -> str:
 
 def load_sweep(path: str | Path) -> SweepSpec:
     """Read and check a sweep file (see module docstring)."""
+    from tabletcad.io.tomlfile import read_toml_file
+
     path = Path(path)
-    if not path.is_file():
-        raise DesignError("sweep file", str(path), "must be an existing TOML file")
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
-    except tomllib.TOMLDecodeError as exc:
-        raise DesignError("sweep file", path.name, f"must be valid TOML ({exc})") from None
-    except UnicodeDecodeError:
-        raise DesignError("sweep file", path.name, "must be UTF-8 text (TOML)") from None
-    return parse_sweep(data, name=path.stem)
+    return parse_sweep(read_toml_file(path, "sweep file"), name=path.stem)
 
 
 def _number(where: str, v: Any) -> float:
