@@ -260,3 +260,40 @@ def test_a_table_the_sweep_varies_is_read_by_its_rows_whatever_the_order():
     for order in (["EU", "custom"], ["custom", "EU"]):
         spec = parse_sweep({"design": design, "sweep": {"vary": {"tooling.standard": order}}})
         assert [d["tooling"]["standard"] for d in spec.designs()] == order
+
+
+@pytest.mark.parametrize("tablet, varied, expected", [
+    # a trial: each of these ran, every row an error, and the sweep exited 0
+    ({**BASE["tablet"], "family": "concave_rund"}, "tablet.band",
+     "error: design.tablet.family = 'concave_rund' is not allowed: must be one of flat_face_round, "),
+    ({**BASE["tablet"], "family": 7}, "tablet.band", "error: design.tablet.family = 7 is not allowed: must be one of "),
+    ({k: v for k, v in BASE["tablet"].items() if k != "family"}, "tablet.band",
+     "error: design.tablet.family = (not given) is not allowed: must name the tablet's family"),
+    ({k: v for k, v in BASE["tablet"].items() if k != "cup_depth"}, "tablet.diameter",
+     "error: design.tablet.cup_depth = (not given) is not allowed: family 'concave_round' needs diameter, band, "
+     "cup_depth: give it in [design.tablet] or vary it (every design would be refused)"),
+    (dict(family="ffbe", thickness=3.0, bevel_angle=30.0), "tablet.diameter",
+     "error: design.tablet.bevel_width = (not given) is not allowed: family 'ffbe' needs diameter, thickness, "
+     "bevel_angle, bevel_width (or bevel_depth): "),
+])
+def test_a_family_or_dimension_every_row_lacks_is_refused_before_the_sweep(tmp_path, capsys, tablet, varied, expected):
+    import tomllib
+
+    from tabletcad.pipeline.design import toml_text
+
+    p = tmp_path / "s.toml"
+    p.write_text(toml_text({"design": {"tablet": tablet}, "sweep": {"vary": {varied: [9.0, 10.0]}}}), encoding="utf-8")
+    assert tomllib.loads(p.read_text())["design"]["tablet"] == tablet
+    out = tmp_path / "out"
+    assert main(["sweep", str(p), "--out", str(out), "--workers", "1", "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(expected), err
+    assert not out.exists()
+    # what the rows may take: the family varied, a dimension varied, a ffbe by its bevel depth
+    for ok in ({"design": {"tablet": {**BASE["tablet"], "family": "concave_round"}},
+                "sweep": {"vary": {"tablet.family": ["concave_round", "concave_rund"]}}},
+               {"design": {"tablet": {k: v for k, v in BASE["tablet"].items() if k != "cup_depth"}},
+                "sweep": {"vary": {"tablet.cup_depth": [0.8, 0.9]}}},
+               {"design": {"tablet": dict(family="ffbe", thickness=3.0, bevel_angle=30.0, bevel_depth=0.3)},
+                "sweep": {"vary": {"tablet.diameter": [9.0, 10.0]}}}):
+        assert len(parse_sweep(ok).designs()) == 2

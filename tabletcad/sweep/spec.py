@@ -164,6 +164,32 @@ def _dimension_keys(design: dict) -> set[str]:
     return set() if fam is None else {f"tablet.{k}" for k in fam.params}
 
 
+def _check_family(design: dict, varied: set[str]) -> None:
+    """Refuse, when the sweep does not vary it, a ``[design.tablet]`` family that no design takes (none
+    given, not text, an unknown name) and a required dimension of the family that is neither given
+    nor varied: every row would fail (a trial: such sweeps ran, each row an error, and exited 0)."""
+    import warnings
+
+    from tabletcad.families import family
+
+    tab = design["tablet"]
+    if "tablet.family" in varied:
+        return  # each value of the axis is a family of its own rows
+    if "family" not in tab:
+        raise DesignError("design.tablet.family", MISSING, "must name the tablet's family (tabletcad shapes lists them)")
+    if tab["family"] in ("free_form", "custom_outline"):
+        return
+    with warnings.catch_warnings():  # (an old name: each design warns as it is built)
+        warnings.simplefilter("ignore", FutureWarning)
+        fam = family(tab["family"], parameter="design.tablet.family")
+    given = {**{k: v for k, v in tab.items()}, **{k.split(".", 1)[1]: None for k in varied if k.startswith("tablet.")}}
+    given.update(fam.left_out(given))
+    for k in fam.required:
+        if k not in given:
+            raise DesignError(f"design.tablet.{k}", MISSING, f"family {fam.name!r} needs {fam.needs()}: give it in "
+                              "[design.tablet] or vary it (every design would be refused)")
+
+
 def _check_family_keys(design: dict) -> None:
     """Refuse a key of ``[design.tablet]`` that the named family does not take (every row would fail)."""
     fam = _family_of(design)
@@ -301,7 +327,8 @@ def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
             raise DesignError(f"top-level key {k!r}", data[k], "a sweep file has a [design] and a [sweep] table")
     design = data.get("design")
     if not isinstance(design, dict) or not isinstance(design.get("tablet"), dict):
-        raise DesignError("[design]", MISSING, "a sweep file needs a [design] table with a [design.tablet] table")
+        shown = MISSING if design is None else design  # (a [design] given as "tablet = 3" was "not given")
+        raise DesignError("[design]", shown, "a sweep file needs a [design] table with a [design.tablet] table")
     from tabletcad.pipeline.design import TOP_LEVEL_KEYS
 
     for k in design:
@@ -346,6 +373,7 @@ def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
     vary = sw.get("vary")
     if not isinstance(vary, dict) or not vary:
         raise DesignError("[sweep.vary]", MISSING if vary is None else vary, "give at least one dotted design key to vary")
+    _check_family(design, set(vary))
     _check_family_keys(design)
     _check_fixed_dimensions(design, set(vary))
     known = _known_keys(design)
