@@ -131,6 +131,9 @@ def test_unreachable_scheduler_is_one_line_exit_2_after_the_connect_timeout(tmp_
 @pytest.mark.parametrize("args, expected", [
     (["--workers", "0"], "--workers = 0 is not allowed"),
     (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "give either --workers or --scheduler"),
+    # a trial: 100000 was taken (a typo would have started one worker of ~340 MB per design)
+    (["--workers", "100000"], "error: --workers = 100000 is not allowed: must be at most "
+                              f"{4 * (__import__('os').cpu_count() or 1)} (4 per CPU of this machine"),
 ])
 def test_bad_engine_options(tmp_path, capsys, args, expected):
     p = _write(tmp_path, '[sweep.vary]\n"tablet.cup_depth" = [0.8]\n')

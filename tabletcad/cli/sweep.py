@@ -42,7 +42,7 @@ def sweep_cmd(sweep_file: Path, out_dir: Path, workers, scheduler, resume: bool,
     if workers is not None and scheduler is not None:
         raise DesignError("--workers", workers, "give either --workers or --scheduler, not both")
     if workers is not None and workers < 1:
-        raise DesignError("--workers", workers, "must be an integer >= 1")
+        raise DesignError("--workers", workers, "must be an integer >= 1")  # (and at most 4 per CPU: run_sweep)
     if connect_timeout is not None and not 0 < connect_timeout <= 3600:  # (inf reached Dask as "infs")
         raise DesignError("--connect-timeout", connect_timeout, "must be > 0 and <= 3600", "s")
     df = run_sweep(sweep_file, out_dir, workers=workers, scheduler=scheduler, resume=resume, progress=not quiet,

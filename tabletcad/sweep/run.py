@@ -24,6 +24,11 @@ def _spec(sweep: Any) -> SweepSpec:
     return load_sweep(sweep)
 
 
+def max_local_workers() -> int:
+    """The most worker processes a local cluster may have: 4 per CPU of this machine."""
+    return 4 * (os.cpu_count() or 1)
+
+
 def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | None = None,
               scheduler: str | None = None, client: Any = None, resume: bool = False, progress: bool = True,
               store: str | None = None, plot: tuple[str, ...] = (),
@@ -58,6 +63,9 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
         raise DesignError("--workers", workers, "must be an integer >= 1 (0 runs the designs in this process)")
     if workers is not None and (scheduler is not None or client is not None):
         raise DesignError("--workers", workers, "give either --workers or --scheduler, not both")
+    if workers is not None and workers > max_local_workers():  # (a typo of 100000 would start one per design)
+        raise DesignError("--workers", workers, f"must be at most {max_local_workers()} (4 per CPU of this machine: a "
+                          "local worker is a process of about 340 MB, and more than the CPUs only wait)")
     if store is not None or spec.store is not None:
         _check_store(store if store is not None else spec.store, "--store" if store is not None else "[sweep] store",
                      local=scheduler is None)
