@@ -446,3 +446,28 @@ def test_a_script_starting_local_workers_outside_its_main_guard_gets_one_error(t
                     "under 'if __name__ == \"__main__\":' (the workers import the script again), or with workers=0 "
                     "to run in this process")
     assert r.stderr.count("Traceback") == 1 and not out.exists()  # Python's own report of the one error
+
+
+@pytest.mark.cad
+def test_a_report_only_row_has_the_fe_breaking_force_the_report_command_gives(tmp_path, capsys):
+    """``[report] fe_breaking_force = true``: a report-only sweep's row holds the ``fe_breaking_force``
+    figures of ``tabletcad report`` for the same design (a trial: the columns were missing unless the
+    sweep also wrote files, and a --plot of them was refused)."""
+    pytest.importorskip("skfem")
+    report = dict(solid_fraction=0.85, true_density_mg_mm3=1.5, tensile_strength_MPa=2.0, fe_breaking_force=True)
+    tablet = dict(family="concave_round", diameter=10.0, band=2.8, cup_depth=0.9, land=0.08)
+    df = run_sweep({"design": {"tablet": tablet, "report": report}, "sweep": {"vary": {"tablet.cup_depth": [0.9]}}},
+                   tmp_path / "s", workers=0, progress=False)
+    assert list(df["status"]) == ["ok"]
+    design = tmp_path / "d.toml"
+    from tabletcad.pipeline.design import toml_text
+
+    design.write_text(toml_text({"tablet": tablet, "report": report}), encoding="utf-8")
+    assert main(["report", str(design), "--json-file", str(tmp_path / "r.json")]) == 0
+    capsys.readouterr()
+    fe = json.loads((tmp_path / "r.json").read_text())["fe_breaking_force"]
+    row = df.iloc[0]
+    assert row["fe_breaking_force.breaking_force_N"] == fe["breaking_force_N"] and 100.0 < fe["breaking_force_N"] < 200.0
+    for key, value in fe.items():
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            assert row[f"fe_breaking_force.{key}"] == value, key

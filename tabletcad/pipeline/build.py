@@ -55,6 +55,17 @@ def build_outputs(cad: bool, tooling: ToolingSpec | None = None) -> list[str]:
     return names
 
 
+def fe_breaking_force_section(tablet: Any, options: Any, tooling: Any, cad: bool) -> dict[str, Any]:
+    """The report's ``fe_breaking_force`` (``[report] fe_breaking_force = true``): the coarse-mesh FE
+    prediction (:func:`tabletcad.fe.objective.report_breaking_force`) when the build makes a CAD solid,
+    else a note saying it was not computed.  One function for ``tabletcad build`` and a sweep's rows."""
+    if not cad:
+        return {"breaking_force_N": None, "note": "not computed: this build made no CAD solid"}
+    from tabletcad.fe.objective import report_breaking_force
+
+    return report_breaking_force(tablet, options, tooling)
+
+
 def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | None = None,
                  options: ReportOptions | None = None, cad: bool | None = None, progress: bool = True,
                  parallel: bool = False) -> dict[str, Any]:
@@ -117,13 +128,7 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
                                   fe_rating=fe, parallel=parallel)
                     bar.update()
             if options is not None and options.fe_breaking_force:  # [report] fe_breaking_force = true
-                if cad:
-                    from tabletcad.fe.objective import report_breaking_force
-
-                    report["fe_breaking_force"] = report_breaking_force(tablet, options, tooling)
-                else:
-                    report["fe_breaking_force"] = {"breaking_force_N": None,
-                                                   "note": "not computed: this build made no CAD solid"}
+                report["fe_breaking_force"] = fe_breaking_force_section(tablet, options, tooling, cad)
             if picture is None:
                 plot_tablet(tablet, staging / "tablet.png")
             else:

@@ -89,10 +89,14 @@ def evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",)
                 report = build_tablet(tablet, Path(tmp) / "build", tooling=tooling, options=spec.report_options,
                                       cad=True, progress=False)
                 files.update(_files_of(Path(tmp) / "build", wanted))
-            else:
+            else:  # the report of `tabletcad build`, without its files
+                from tabletcad.pipeline.build import cad_available, fe_breaking_force_section
                 from tabletcad.pipeline.report import geometry_report
 
                 report = geometry_report(tablet, spec.report_options)
+                if spec.report_options is not None and spec.report_options.fe_breaking_force:
+                    report["fe_breaking_force"] = fe_breaking_force_section(tablet, spec.report_options,
+                                                                            spec.tooling_spec, cad_available())
         if store is not None and files:
             _store_files(store, folder, files)
             files = {}
