@@ -457,8 +457,9 @@ def test_a_report_only_row_has_the_fe_breaking_force_the_report_command_gives(tm
     report = dict(solid_fraction=0.85, true_density_mg_mm3=1.5, tensile_strength_MPa=2.0, fe_breaking_force=True)
     tablet = dict(family="concave_round", diameter=10.0, band=2.8, cup_depth=0.9, land=0.08)
     df = run_sweep({"design": {"tablet": tablet, "report": report}, "sweep": {"vary": {"tablet.cup_depth": [0.9]}}},
-                   tmp_path / "s", workers=0, progress=False)
+                   tmp_path / "s", workers=0, progress=False, plot=("fe_breaking_force.breaking_force_N",))
     assert list(df["status"]) == ["ok"]
+    assert [q.name for q in (tmp_path / "s").glob("plot_*.png")] == ["plot_fe_breaking_force.breaking_force_N.png"]
     design = tmp_path / "d.toml"
     from tabletcad.pipeline.design import toml_text
 
@@ -471,3 +472,42 @@ def test_a_report_only_row_has_the_fe_breaking_force_the_report_command_gives(tm
     for key, value in fe.items():
         if isinstance(value, (int, float)) and not isinstance(value, bool):
             assert row[f"fe_breaking_force.{key}"] == value, key
+
+
+@pytest.mark.cad
+def test_a_ctrl_c_during_file_builds_leaves_no_temporary_folder(tmp_path):
+    """The workers make each design's files in a folder of the run's own, which the command line removes
+    however the run ends (a trial: workers ended by a Ctrl-C left their build folders, 250-570 KB each,
+    in /tmp); a run stopped before any design finished leaves no empty --out folder either."""
+    import os
+    import signal
+    import time
+
+    tmp = tmp_path / "tmp"
+    tmp.mkdir()
+    sweep = tmp_path / "s.toml"
+    sweep.write_text('[design.tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 2.8\ncup_depth = 0.9\n'
+                     '[sweep]\noutputs = ["report", "step", "stl", "glb"]\n[sweep.vary]\n'
+                     '"tablet.cup_depth" = { min = 0.6, max = 1.2, num = 40 }\n', encoding="utf-8")
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(tmp)}
+    for out, wait_for_journal in ((tmp_path / "early", False), (tmp_path / "late", True)):
+        p = subprocess.Popen([sys.executable, "-m", "tabletcad", "sweep", str(sweep), "--out", str(out), "--workers", "2",
+                              "--quiet"], cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True, start_new_session=True)
+        t0 = time.monotonic()
+        if wait_for_journal:  # then into the next designs' builds
+            while time.monotonic() - t0 < 120 and not (out / JOURNAL).exists():
+                time.sleep(0.1)
+            time.sleep(0.4)
+        else:
+            while time.monotonic() - t0 < 120 and not list(tmp.glob("tabletcad-sweep-*")):
+                time.sleep(0.05)  # the run's folder exists: the workers start next
+        os.killpg(p.pid, signal.SIGINT)
+        _, err = p.communicate(timeout=120)
+        assert p.returncode == 130 and err.splitlines()[0] == "interrupted", err
+        # (Dask keeps its dask-scratch-space there, for every later cluster)
+        assert [q for q in tmp.iterdir() if q.name != "dask-scratch-space"] == []
+        if wait_for_journal:
+            assert (out / JOURNAL).stat().st_size > 0
+        else:
+            assert not out.exists()

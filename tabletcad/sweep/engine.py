@@ -50,7 +50,7 @@ def _store_files(store: str, sub: str, files: dict[str, bytes]) -> list[str]:
 
 
 def evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",), *, name: str = "sweep",
-                    store: str | None = None, folder: str = "") -> dict[str, Any]:
+                    store: str | None = None, folder: str = "", tmp_root: str | None = None) -> dict[str, Any]:
     """Build one design from its dictionary and return its results as plain data; never raises.
 
     Returns ``dict(values=..., status="ok"|"error", error=..., files=...)``:
@@ -60,7 +60,9 @@ def evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",)
     :func:`tabletcad.pipeline.build.build_tablet` itself (a failed tooling check is then a failed design,
     as in ``tabletcad build``).  ``files`` maps file names to
     bytes (empty when ``store`` is given: the worker then writes them to
-    ``store/folder/`` through fsspec).
+    ``store/folder/`` through fsspec).  ``tmp_root``: the folder the build's files are made in (a local
+    sweep's own, which it removes however it ends: a worker ended by a Ctrl-C cannot), else the
+    system's temporary folder.
     """
     try:
         from tabletcad.pipeline.design import Design
@@ -73,7 +75,9 @@ def evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",)
             check_tooling(tablet, spec.tooling_spec)
         files: dict[str, bytes] = {}
         wanted = [f for o in outputs if o not in ("report", "tooling") for f in OUTPUTS[o]]
-        with tempfile.TemporaryDirectory(prefix="tabletcad-sweep-") as tmp:
+        if tmp_root is not None and not Path(tmp_root).is_dir():  # (a remote worker: its own temporary folder)
+            tmp_root = None
+        with tempfile.TemporaryDirectory(prefix="tabletcad-sweep-", dir=tmp_root) as tmp:
             if wanted or "tooling" in outputs:
                 from tabletcad.pipeline.build import build_tablet
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -132,16 +133,26 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
     kw = dict(outputs=spec.outputs, name=spec.name, store=store)
     common = dict(kwargs=kw, progress=progress, desc=spec.name, failed=lambda r: r["status"] != "ok",
                   on_result=on_result, on_error=failed_design)
-    with contextlib.ExitStack() as stack:
-        if items and client is None and workers != 0:  # connect first: an unreachable scheduler writes nothing
-            n = None if scheduler is not None else min(workers or os.cpu_count() or 1, len(items))
-            client = stack.enter_context(open_client(n, scheduler, connect_timeout))
-        if out is not None:
-            try:
-                out.mkdir(parents=True, exist_ok=True)
-            except OSError as exc:  # (/proc/sweep): named as the option
-                raise DesignError("--out", str(out), f"cannot be written: {(exc.strerror or str(exc)).lower()}") from None
-        map_tasks(sweep_task, items, client=client, workers=0 if client is None else None, **common)
+    created = out is not None and not out.exists()
+    try:
+        with contextlib.ExitStack() as stack:
+            if files_wanted and scheduler is None and client is None:
+                # the builds' temporary folders in one of this run's own, removed below once the workers are
+                # gone however the run ends (a trial: a Ctrl-C left the killed workers' folders in /tmp)
+                kw["tmp_root"] = stack.enter_context(tempfile.TemporaryDirectory(prefix="tabletcad-sweep-"))
+            if items and client is None and workers != 0:  # connect first: an unreachable scheduler writes nothing
+                n = None if scheduler is not None else min(workers or os.cpu_count() or 1, len(items))
+                client = stack.enter_context(open_client(n, scheduler, connect_timeout))
+            if out is not None:
+                try:
+                    out.mkdir(parents=True, exist_ok=True)
+                except OSError as exc:  # (/proc/sweep): named as the option
+                    raise DesignError("--out", str(out), f"cannot be written: {(exc.strerror or str(exc)).lower()}") from None
+            map_tasks(sweep_task, items, client=client, workers=0 if client is None else None, **common)
+    except BaseException:
+        if created and out.is_dir() and not any(out.iterdir()):  # stopped before any design: no empty folder left
+            out.rmdir()
+        raise
 
     rows = [results.get(h) or _restored(done[h], spec.keys, values[h]) for h in hashes]
     df = results_frame(spec.keys, rows)
@@ -190,6 +201,8 @@ def _check_plot_columns(plot: tuple[str, ...], design: dict[str, Any], spec) -> 
         return
     files = any(o != "report" for o in spec.outputs)
     sections = {c.split(".")[0] for c in cols}
+    if d.report_options is not None and d.report_options.fe_breaking_force:  # (added after the geometry report)
+        sections.add("fe_breaking_force")
     numeric = [c for c, v in cols.items() if _plottable(v) or v is None]
     for o in plot:
         unknown = o not in cols and o.split(".")[0] not in sections and not files
