@@ -200,6 +200,13 @@ def test_file_outputs_come_back_as_bytes_or_go_to_a_store(local_client, tmp_path
     df2 = run_sweep(sw, tmp_path / "out2", client=local_client, progress=False, store=f"file://{store}")
     assert (store / h / "tablet.step").is_file() and not (tmp_path / "out2" / "designs").exists()
     assert df2["brep.volume_mm3"][0] == df["brep.volume_mm3"][0]
+    # a first run owns only what it writes, in a store too (a trial: a file there was replaced): refused,
+    # before any design, the file and the folders as they were
+    (store / h / "tablet.step").write_text("mine", encoding="utf-8")
+    with pytest.raises(DesignError, match=rf"^--store = 'file://{store}' is not allowed: must not hold files this "
+                                          rf"sweep writes that no earlier run of it wrote \({h}/tablet.step\)"):
+        run_sweep(sw, tmp_path / "out3", client=local_client, progress=False, store=f"file://{store}")
+    assert (store / h / "tablet.step").read_text() == "mine" and not (tmp_path / "out3").exists()
 
 
 def test_tooling_batch_runs_on_the_cluster(local_client, tmp_path):

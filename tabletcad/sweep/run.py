@@ -70,6 +70,7 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
     if store is not None or spec.store is not None:
         _check_store(store if store is not None else spec.store, "--store" if store is not None else "[sweep] store",
                      local=scheduler is None)
+    store_given = store is not None
     store = store if store is not None else spec.store
     files_wanted = any(o != "report" for o in spec.outputs)
     out = Path(out_dir) if out_dir is not None else None
@@ -109,6 +110,12 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
     for h, d in zip(hashes, designs):
         if h not in done and h not in todo:
             todo[h] = d
+    if store is not None and files_wanted and not resume:  # a first run owns only what it writes, a store too
+        clash = _held_files(store, list(todo), spec.outputs)
+        if clash:
+            raise DesignError("--store" if store_given else "[sweep] store", store,
+                              f"must not hold files this sweep writes that no earlier run of it wrote ({clash}): "
+                              "move them, use another store, or give --resume to continue the run that wrote them")
     items = [(d, h) for h, d in todo.items()]
     values = dict(zip(hashes, spec.points()))
     results: dict[str, dict[str, Any]] = {}
@@ -168,6 +175,23 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
                     if "of results.csv:" in exc.allowed else f"{exc.allowed}; {where}"
                 raise DesignError(exc.parameter, exc.value, allowed) from None
     return df
+
+
+def _held_files(store: str, keys: list[str], outputs) -> str:
+    """The first file of ``outputs`` that ``store`` already holds for one of the designs ``keys``
+    (``store/key/name``), or ``""``."""
+    import fsspec
+
+    from tabletcad.sweep.spec import OUTPUTS
+
+    fs, root = fsspec.core.url_to_fs(store)
+    names = [f for o in outputs for f in OUTPUTS[o]]
+    for key in keys:
+        if fs.exists(f"{root.rstrip('/')}/{key}"):
+            for n in names:
+                if fs.exists(f"{root.rstrip('/')}/{key}/{n}"):
+                    return f"{key}/{n}"
+    return ""
 
 
 def _has_files(out: Path, store: str | None, key: str, outputs) -> bool:
