@@ -135,7 +135,7 @@ def test_rows_equal_a_single_tabletcad_build_exactly(local_results, tmp_path):
     row = df.iloc[2].to_dict()
     compared = 0
     for k, v in row.items():
-        if k in (KEY, "status", "error", "design_hash"):
+        if k in (KEY, "warnings", "status", "error", "design_hash"):  # (the sweep's own columns)
             continue
         assert k in built, k
         if built[k] is None:
@@ -518,3 +518,22 @@ def test_a_ctrl_c_during_file_builds_leaves_no_temporary_folder(tmp_path):
             assert (out / JOURNAL).stat().st_size > 0
         else:
             assert not out.exists()
+
+
+def test_a_designs_warnings_are_its_rows_not_lines_on_the_terminal(tmp_path, capsys):
+    """An old family name warns once per design (FutureWarning): the row's ``warnings`` says it, the
+    terminal does not (a trial: each design printed Python's raw two-line warning, with the file and
+    line, and the results kept none); a design without warnings has an empty cell."""
+    from tabletcad.sweep.results import read_results
+
+    sw = {"design": {"tablet": {"family": "spherical", "diameter": 5.0}},
+          "sweep": {"vary": {"tablet.diameter": [5.0, 6.0]}}}
+    df = run_sweep(sw, tmp_path / "old", workers=0, progress=False)
+    assert list(df["status"]) == ["ok", "ok"]
+    assert list(df["warnings"]) == ["family 'spherical' is now 'thesis.spherical'; the old name is accepted until "
+                                    "tabletcad 0.3"] * 2
+    assert read_results(tmp_path / "old" / "results.csv")["warnings"].tolist() == list(df["warnings"])
+    sw["design"]["tablet"]["family"] = "thesis.spherical"
+    assert run_sweep(sw, tmp_path / "new", workers=0, progress=False)["warnings"].tolist() == ["", ""]
+    cap = capsys.readouterr()
+    assert "Warning" not in cap.err + cap.out and "warning" not in cap.err + cap.out

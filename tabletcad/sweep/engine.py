@@ -15,6 +15,7 @@ worker processes, or on an existing cluster.
 from __future__ import annotations
 
 import tempfile
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -51,9 +52,21 @@ def _store_files(store: str, sub: str, files: dict[str, bytes]) -> list[str]:
 
 def evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",), *, name: str = "sweep",
                     store: str | None = None, folder: str = "", tmp_root: str | None = None) -> dict[str, Any]:
+    """See :func:`_evaluate_design`; the warnings the design gives (a punch tip without a land, an old family
+    name) are its row's ``warnings`` (each once, ``"; "`` between), not lines on the terminal."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        res = _evaluate_design(design, outputs, name=name, store=store, folder=folder, tmp_root=tmp_root)
+    res["warnings"] = "; ".join(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
+    return res
+
+
+def _evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",), *, name: str = "sweep",
+                     store: str | None = None, folder: str = "", tmp_root: str | None = None) -> dict[str, Any]:
     """Build one design from its dictionary and return its results as plain data; never raises.
 
-    Returns ``dict(values=..., status="ok"|"error", error=..., files=...)``:
+    Returns ``dict(values=..., status="ok"|"error", error=..., files=...)`` (and ``warnings``, from
+    :func:`evaluate_design`):
     ``values`` holds every scalar of the report (:func:`flatten_report`) — the
     geometry report of :func:`tabletcad.pipeline.report.geometry_report`, which is the
     ``report.json`` of ``tabletcad build``; with file or tooling outputs the report of
@@ -111,7 +124,7 @@ def evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",)
 
 def failed_design(exc: BaseException) -> dict[str, Any]:
     """The result of a design that failed with ``exc`` (in the worker, or by losing its worker)."""
-    return dict(values={}, status="error", error=error_message(exc), files={})
+    return dict(values={}, status="error", error=error_message(exc), files={}, warnings="")
 
 
 def sweep_task(item: tuple[dict[str, Any], str], **kw: Any) -> dict[str, Any]:

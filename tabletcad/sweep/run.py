@@ -121,8 +121,8 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
     results: dict[str, dict[str, Any]] = {}
 
     def row_of(h: str, res: dict[str, Any]) -> dict[str, Any]:
-        return {**dict(zip(spec.keys, values[h])), **res["values"], "status": res["status"], "error": res["error"],
-                "design_hash": h}
+        return {**dict(zip(spec.keys, values[h])), **res["values"], "warnings": res.get("warnings", ""),
+                "status": res["status"], "error": res["error"], "design_hash": h}
 
     def on_result(i: int, res: dict[str, Any]) -> None:
         h = items[i][1]
