@@ -48,7 +48,7 @@ def sweep_cmd(sweep_file: Path, out_dir: Path, workers, scheduler, resume: bool,
     df = run_sweep(sweep_file, out_dir, workers=workers, scheduler=scheduler, resume=resume, progress=not quiet,
                    store=store, plot=tuple(plots), connect_timeout=connect_timeout or CONNECT_TIMEOUT_S)
     n_err = int((df["status"] != "ok").sum())
-    click.echo(f"{len(df)} designs ({len(df) - n_err} ok, {n_err} failed) -> {out_dir / 'results.csv'}")
+    click.echo(f"{len(df)} design{'' if len(df) == 1 else 's'} ({len(df) - n_err} ok, {n_err} failed) -> {out_dir / 'results.csv'}")
 
 
 COMMANDS = [sweep_cmd]
