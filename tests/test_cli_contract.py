@@ -658,3 +658,39 @@ def test_solves_in_the_helper_thread_leave_no_memory_behind():
     for _ in range(100):
         run_interruptibly(_factor_and_solve, K, b)
     assert rss_mb() - before < 200.0
+
+
+def test_a_ctrl_c_swallowed_by_a_gc_callback_is_delivered_again():
+    """A Ctrl-C raised inside a garbage-collector callback (distributed's ``GCDiagnosis`` while a sweep's
+    cluster started, in a full run) is "Exception ignored" to Python and was lost, the sweep running on:
+    the program's unraisable hook delivers it to the main thread again; other unraisable errors still
+    reach the previous hook."""
+    import gc
+    import time
+    import types
+
+    from tabletcad.cli import _unraisable_interrupt
+
+    seen = []
+    hook = _unraisable_interrupt(seen.append)
+    other = types.SimpleNamespace(exc_value=ValueError("x"))
+    hook(other)
+    assert seen == [other]
+
+    def swallowing_callback(phase, info):
+        if phase == "start":
+            raise KeyboardInterrupt  # what the SIGINT handler raises when the signal arrives here
+
+    previous = sys.unraisablehook
+    sys.unraisablehook = hook
+    gc.callbacks.append(swallowing_callback)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            gc.collect()  # the callback's KeyboardInterrupt is unraisable: the hook re-delivers it
+            t0 = time.monotonic()
+            while time.monotonic() - t0 < 5.0:
+                pass
+    finally:
+        gc.callbacks.remove(swallowing_callback)
+        sys.unraisablehook = previous
+    assert seen == [other]

@@ -275,6 +275,9 @@ def test_a_table_the_sweep_varies_is_read_by_its_rows_whatever_the_order():
     ({k: v for k, v in BASE["tablet"].items() if k != "cup_depth"}, "tablet.diameter",
      "error: design.tablet.cup_depth = (not given) is not allowed: family 'concave_round' needs diameter, band, "
      "cup_depth: give it in [design.tablet] or vary it (every design would be refused)"),
+    # a misspelt key is named first (it is why the dimension is missing)
+    ({**{k: v for k, v in BASE["tablet"].items() if k != "cup_depth"}, "cup_dept": 0.9}, "tablet.band",
+     "error: design.tablet.cup_dept = 0.9 is not allowed: family 'concave_round' takes "),
     (dict(family="ffbe", thickness=3.0, bevel_angle=30.0), "tablet.diameter",
      "error: design.tablet.bevel_width = (not given) is not allowed: family 'ffbe' needs diameter, thickness, "
      "bevel_angle, bevel_width (or bevel_depth): "),

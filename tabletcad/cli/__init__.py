@@ -260,6 +260,7 @@ def main(argv: list[str] | None = None) -> int:
 
         _SIGINT_SEEN[0] = False
         signal.signal(signal.SIGINT, _on_sigint)
+        sys.unraisablehook = _unraisable_interrupt(sys.unraisablehook)
     try:
         try:
             with warnings.catch_warnings():
@@ -324,6 +325,28 @@ def _on_sigint(signum, frame) -> None:
     _SIGINT_SEEN[0] = True
     logging.disable(logging.CRITICAL)
     raise KeyboardInterrupt
+
+
+def _unraisable_interrupt(previous):
+    """``sys.unraisablehook`` for the program: a Ctrl-C's KeyboardInterrupt raised where Python cannot raise
+    it (a garbage-collector callback, ``__del__``: distributed's ``GCDiagnosis`` while a sweep's cluster
+    started) was printed as "Exception ignored in ..." and lost, and the sweep ran on.  It is delivered
+    again to the main thread instead, 50 ms later (:func:`_thread.interrupt_main` from a timer thread:
+    called at once it would raise inside this hook, still in the callback), which raises it in the
+    program's own code; any other unraisable exception goes to ``previous``."""
+
+    def hook(unraisable) -> None:
+        if isinstance(unraisable.exc_value, KeyboardInterrupt):
+            import _thread
+            import threading
+
+            again = threading.Timer(0.05, _thread.interrupt_main)
+            again.daemon = True
+            again.start()
+            return
+        previous(unraisable)
+
+    return hook
 
 
 def _published() -> list:

@@ -15,6 +15,7 @@ worker processes, or on an existing cluster.
 from __future__ import annotations
 
 import tempfile
+import threading
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
@@ -53,12 +54,23 @@ def _store_files(store: str, sub: str, files: dict[str, bytes]) -> list[str]:
 def evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",), *, name: str = "sweep",
                     store: str | None = None, folder: str = "", tmp_root: str | None = None) -> dict[str, Any]:
     """See :func:`_evaluate_design`; the warnings the design gives (a punch tip without a land, an old family
-    name) are its row's ``warnings`` (each once, ``"; "`` between), not lines on the terminal."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    name) are its row's ``warnings`` (each once, ``"; "`` between), not lines on the terminal.
+
+    Python's warning state is one per process, so the designs of one worker process run one at a time
+    (:data:`_WARNINGS_HELD`; a worker of several threads, which the GIL held by OpenCascade and the
+    quadrature leaves little to gain from, would otherwise put one design's warnings in another's row).
+    Only tabletcad's own categories (``UserWarning``, ``FutureWarning``) are shown every time; the
+    filters of other categories stand (a ``-W error`` or the test suite's errors on RuntimeWarning)."""
+    with _WARNINGS_HELD, warnings.catch_warnings(record=True) as caught:
+        for category in (UserWarning, FutureWarning):
+            warnings.filterwarnings("always", category=category)
         res = _evaluate_design(design, outputs, name=name, store=store, folder=folder, tmp_root=tmp_root)
     res["warnings"] = "; ".join(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
     return res
+
+
+#: held while a design's warnings are recorded (see :func:`evaluate_design`)
+_WARNINGS_HELD = threading.Lock()
 
 
 def _evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",), *, name: str = "sweep",

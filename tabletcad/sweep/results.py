@@ -30,7 +30,9 @@ __all__ = ["RESULTS_CSV", "JOURNAL", "TAIL_COLUMNS", "results_frame", "write_res
 
 RESULTS_CSV = "results.csv"
 JOURNAL = "results.partial.jsonl"
-TAIL_COLUMNS = ("status", "error", "design_hash")
+TAIL_COLUMNS = ("warnings", "status", "error", "design_hash")
+#: the tail columns a results.csv must have (one written before rows had ``warnings`` is read with them empty)
+_REQUIRED_TAIL = ("status", "error", "design_hash")
 
 
 def results_frame(keys: Sequence[str], rows: Iterable[dict[str, Any]]):
@@ -57,8 +59,9 @@ def write_results(df, path: str | Path) -> Path:
 def read_results(path: str | Path):
     """Read a ``results.csv`` back, every value exactly as written.
 
-    Cells (except the text columns ``status``, ``error`` and ``design_hash``) are parsed by Python itself (``int``, then ``float`` — exact for
-    ``repr`` output —, ``True``/``False``, else text; an empty cell is None),
+    Cells (except the text columns ``warnings``, ``status``, ``error`` and ``design_hash``, which are text,
+    ``warnings`` and ``error`` ``""`` when empty as a run gives them) are parsed by Python itself (``int``,
+    then ``float`` — exact for ``repr`` output —, ``True``/``False``, else text; an empty cell is None),
     so the columns have ``object`` dtype.
     """
     import pandas as pd
@@ -67,10 +70,18 @@ def read_results(path: str | Path):
         df = pd.read_csv(path, dtype=str, keep_default_na=False)
     except (ValueError, pd.errors.ParserError) as exc:
         raise DesignError("results file", str(path), f"must be a results.csv written by tabletcad sweep ({exc})") from None
-    missing = [c for c in TAIL_COLUMNS if c not in df.columns]
+    missing = [c for c in _REQUIRED_TAIL if c not in df.columns]
     if missing:
         raise DesignError("results file", str(path), f"has no {', '.join(missing)} column; it was not written by tabletcad sweep")
-    cols = {c: pd.Series([(v or None) if c in TAIL_COLUMNS else parse_cell(v) for v in df[c]], dtype=object)
+    if "warnings" not in df.columns:
+        df.insert(len(df.columns) - len(_REQUIRED_TAIL), "warnings", "")
+
+    def cell(c: str, v: str) -> Any:
+        if c in ("warnings", "error"):
+            return v
+        return (v or None) if c in TAIL_COLUMNS else parse_cell(v)
+
+    cols = {c: pd.Series([cell(c, v) for v in df[c]], dtype=object)
             for c in df.columns}  # the text columns stay text (a hash of digits too)
     return pd.DataFrame(cols, columns=df.columns)
 

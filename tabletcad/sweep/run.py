@@ -113,9 +113,11 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
     if store is not None and files_wanted and not resume:  # a first run owns only what it writes, a store too
         clash = _held_files(store, list(todo), spec.outputs)
         if clash:
+            again = ("give --resume with the --out folder of the run that wrote them" if out is not None else
+                     "a run without --out cannot be resumed")
             raise DesignError("--store" if store_given else "[sweep] store", store,
-                              f"must not hold files this sweep writes that no earlier run of it wrote ({clash}): "
-                              "move them, use another store, or give --resume to continue the run that wrote them")
+                              f"must not hold a file this sweep would write ({clash}): move it, use another store, "
+                              f"or {again}")
     items = [(d, h) for h, d in todo.items()]
     values = dict(zip(hashes, spec.points()))
     results: dict[str, dict[str, Any]] = {}
@@ -179,19 +181,20 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
 
 def _held_files(store: str, keys: list[str], outputs) -> str:
     """The first file of ``outputs`` that ``store`` already holds for one of the designs ``keys``
-    (``store/key/name``), or ``""``."""
-    import fsspec
-
+    (``store/key/name``), or ``""``: from one listing of the store.  A store whose fsspec library this
+    machine lacks (a remote cluster's workers may have it) or that cannot be listed here is not looked at."""
     from tabletcad.sweep.spec import OUTPUTS
 
-    fs, root = fsspec.core.url_to_fs(store)
+    try:
+        import fsspec
+
+        fs, root = fsspec.core.url_to_fs(store)
+        root = root.rstrip("/")
+        held = {p.rstrip("/")[len(root) + 1:] for p in fs.find(root)} if fs.exists(root) else set()
+    except (ImportError, OSError, ValueError):
+        return ""
     names = [f for o in outputs for f in OUTPUTS[o]]
-    for key in keys:
-        if fs.exists(f"{root.rstrip('/')}/{key}"):
-            for n in names:
-                if fs.exists(f"{root.rstrip('/')}/{key}/{n}"):
-                    return f"{key}/{n}"
-    return ""
+    return next((f"{key}/{n}" for key in keys for n in names if f"{key}/{n}" in held), "")
 
 
 def _has_files(out: Path, store: str | None, key: str, outputs) -> bool:
@@ -218,9 +221,14 @@ def _check_plot_columns(plot: tuple[str, ...], design: dict[str, Any], spec) -> 
     from tabletcad.pipeline.design import Design
     from tabletcad.pipeline.report import flatten_report, geometry_report
 
+    import warnings
+
     try:
-        d = Design.from_dict(design, default_name=spec.name)
-        cols = flatten_report(geometry_report(d.build(), d.report_options))
+        with warnings.catch_warnings():  # (the design's warnings are its row's, not this check's)
+            warnings.simplefilter("ignore", UserWarning)
+            warnings.simplefilter("ignore", FutureWarning)
+            d = Design.from_dict(design, default_name=spec.name)
+            cols = flatten_report(geometry_report(d.build(), d.report_options))
     except Exception:  # noqa: BLE001 - a design that fails is the sweep's row, not a reason to stop here
         return
     files = any(o != "report" for o in spec.outputs)
@@ -268,5 +276,5 @@ def _check_store(store: str, name: str, local: bool) -> None:
 def _restored(row: dict[str, Any], keys: tuple[str, ...], values: tuple[Any, ...]) -> dict[str, Any]:
     """A row of an earlier run; the varied values are taken from the sweep (identical by the hash)."""
     rest = {k: v for k, v in row.items() if k not in keys and k not in TAIL_COLUMNS}
-    return {**dict(zip(keys, values)), **rest, "status": row.get("status"), "error": row.get("error") or "",
-            "design_hash": row.get("design_hash")}
+    return {**dict(zip(keys, values)), **rest, "warnings": row.get("warnings") or "", "status": row.get("status"),
+            "error": row.get("error") or "", "design_hash": row.get("design_hash")}

@@ -182,7 +182,7 @@ def _check_family(design: dict, varied: set[str]) -> None:
     with warnings.catch_warnings():  # (an old name: each design warns as it is built)
         warnings.simplefilter("ignore", FutureWarning)
         fam = family(tab["family"], parameter="design.tablet.family")
-    given = {**{k: v for k, v in tab.items()}, **{k.split(".", 1)[1]: None for k in varied if k.startswith("tablet.")}}
+    given = {**tab, **{k.split(".", 1)[1]: None for k in varied if isinstance(k, str) and k.startswith("tablet.")}}
     given.update(fam.left_out(given))
     for k in fam.required:
         if k not in given:
@@ -373,8 +373,8 @@ def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
     vary = sw.get("vary")
     if not isinstance(vary, dict) or not vary:
         raise DesignError("[sweep.vary]", MISSING if vary is None else vary, "give at least one dotted design key to vary")
+    _check_family_keys(design)  # (a misspelt key first: it is why a dimension is missing)
     _check_family(design, set(vary))
-    _check_family_keys(design)
     _check_fixed_dimensions(design, set(vary))
     known = _known_keys(design)
     dims = _dimension_keys(design)
