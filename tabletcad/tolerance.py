@@ -49,15 +49,17 @@ class Tolerances:
     seam_angle_deg : float
         Normal angle (deg) below which a seam counts as tangent-continuous (G1).
     fold : float
-        Largest depth (mm) to which a patch's solid map may fold back on
-        itself before the patch is refused (see :meth:`PDEPatch.fold_depth`);
-        the thesis's domes fold by ~1 µm at their poles.
+        Depth (mm) to which a patch's solid map may fold back on itself before
+        the patch is refused (see :meth:`PDEPatch.fold_depth`), or
+        ``fold_fraction`` of its reach where that is more (:meth:`PDEPatch.fold_limit`);
+        the thesis's domes fold by ~1 µm at their poles.  A swept family's patches
+        and the radius check (a surface passing through its spine) use ``fold`` alone.
     fold_fraction : float
-        The same as a fraction of the patch's reach (its largest distance from
-        its spine), where that allows more (:meth:`PDEPatch.fold_limit`): the
-        thesis's domes fold in proportion to their size (the sphere and the
-        oblong by 3.3e-4 of their radius, the prolate spheroid by 6.6e-4), so a
-        shape taken at 5 mm is taken at 500 mm.
+        The fold limit as a fraction of the patch's reach (its largest distance
+        from its spine): the thesis's domes fold in proportion to their size (the
+        sphere, and an oblong whose domes are half its diameter high, by 3.3e-4 of
+        their radius; the prolate spheroid by 6.6e-4), so a shape taken at 5 mm
+        is taken at 500 mm.  To tighten the limit, lower both.
     fit : float
         Largest deviation (mm) of a B-spline face from its PDE patch (CAD layer).
     nominal : float

@@ -246,8 +246,9 @@ def test_trim_validation():
 
 
 def test_report_fold_depth_is_the_figure_each_patch_was_checked_with():
-    """The report's ``fold_depth_mm`` is what the build compared with ``tol.fold``: a thesis patch's
-    own check (the default grid), a swept family's builder's (65 rows of u, 128 meridians)."""
+    """The report's ``fold_depth_mm`` is what the build compared with the patch's limit (``tol.fold``, or
+    ``tol.fold_fraction`` of a thesis patch's reach): a thesis patch's own check (the default grid), a swept
+    family's builder's (65 rows of u, 128 meridians)."""
     from tabletcad.families import FAMILIES
     from tabletcad.pipeline.report import geometry_report
 
@@ -256,7 +257,7 @@ def test_report_fold_depth_is_the_figure_each_patch_was_checked_with():
         rep = geometry_report(t)
         for p, row in zip(t.patches, rep["patches"]):
             assert row["fold_depth_mm"] == p.fold_depth(nu=nu, nv=128 if nu == 65 else None)
-            assert row["fold_depth_mm"] <= t.tol.fold
+            assert row["fold_depth_mm"] <= t.tol.fold and row["fold_depth_mm"] <= p.fold_limit()
 
 
 @pytest.mark.parametrize("name", ["compound_cup", "concave_round", "ffre"])

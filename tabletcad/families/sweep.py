@@ -403,12 +403,13 @@ def build_sweep_tablet(
         patch = PDEPatch(tuple(data), a=a, form="hermite", tol=tol, name=f"{name}[{len(patches)}:{label}]", check=False)
         # the patches are cubic-like in u: a coarser u grid than the core default suffices; a
         # patch of revolution is measured on a few meridians at the default (the report's) u grid
-        nu = 65 if patch.revolution is None else 257
-        depth, limit = patch.fold_depth(nu=nu, nv=128), patch.fold_limit(nu=nu, nv=128)
+        # (tol.fold alone, not a fraction of the patch's size: a family's patches do not fold at all, and
+        # one that does has offsets that are not star-shaped)
+        depth = patch.fold_depth(nu=65 if patch.revolution is None else 257, nv=128)
         object.__setattr__(patch, "_fold_depth", depth)  # the figure checked (the report's)
-        if depth > limit:
+        if depth > tol.fold:
             raise DesignError(f"patch {patch.name} curves", f"a fold {depth:.3g} mm deep",
-                              f"the surface must not cross its spine by more than {limit:.3g} mm "
+                              f"the surface must not cross its spine by more than {tol.fold:g} mm "
                               "(the outline's offsets are not star-shaped about its centroid)")
         return patch
 

@@ -655,9 +655,14 @@ class PDEPatch:
     def _fold_entry(self, nu: int, nv: int | None) -> tuple[float, float]:
         """:meth:`_fold_depth_of` on :meth:`fold_depth`'s samples, computed once."""
         v = None
-        if self._revolution is not None:
+        if self._revolution is not None:  # every meridian alike (the section's argument, M a rotation)
             nv = self._check_nv()
         elif self._section is not None:
+            # a surface of revolution, or of one plan ellipse (x, y) = R(u) M e(v), z = Z(u), M = [p q], folds
+            # alike on every meridian: D = X - A0 = (R M e, 0), X_v × D = (0, 0, -R² det M) and the Jacobian
+            # X_u · (X_v × D) = -Z' R² det M, so the speed |Jacobian| / |X_v × D| is |Z'(u)| on every v.  The
+            # four principal meridians also give the largest |X_u|, |X_v| and |D| of any, the scale of the
+            # threshold below which a sign change is round-off
             nv, v = "principal", self._principal_v()
         elif nv is None:
             nv = self._check_nv()
@@ -792,7 +797,7 @@ class PDEPatch:
 
     def _refuse_negative_radius(self, along: np.ndarray, u: np.ndarray, v: np.ndarray) -> None:
         worst = float(-np.min(along))
-        if worst > self.fold_limit():
+        if worst > self.tol.fold:  # (no shape of the catalogue has one at any size: tol.fold alone)
             i, j = np.unravel_index(int(np.argmin(along)), along.shape)
             raise DesignError(
                 f"patch {self.name or '?'} curves",

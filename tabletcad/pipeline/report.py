@@ -46,7 +46,7 @@ def geometry_report(tablet: Tablet, options: ReportOptions | None = None) -> dic
                 u_nodes=list(p.u_nodes),
                 spine_height_mm=float(s[1, 2] - s[0, 2]),
                 stray_mm=p.stray(),
-                fold_depth_mm=p.checked_fold_depth,  # the figure its check compared with tol.fold
+                fold_depth_mm=p.checked_fold_depth,  # the figure its check compared with its limit (fold_limit)
             )
         )
     v = props["volume_mm3"]
