@@ -317,6 +317,19 @@ def test_tooling_keywords_are_checked_like_the_table(tmp_path):
                 make_spec()
             assert exc.value.parameter.endswith(name)
     assert spec.with_(clearance_mm=0).clearance_mm == 0.0 and spec.with_(taper_deg=9.5).taper_deg == 9.5
+    # the table's rules between keys hold too (a review): a standard punch's body follows its tip, a die
+    # height stays required with complete punches, a tip pressure needs its source
+    tsm = tabletcad.load(ROOT / "samples" / "tooling" / "tsm_b_round.toml").design.tooling_spec
+    assert tsm.body is not None and tsm.with_(tip_length_mm=9.0).with_(tip_length_mm=tsm.tip_length_mm) == tsm
+    with pytest.raises(DesignError, match=r"tip_length_mm = 130 mm is not allowed: must be < 112.9 mm: the punch is "
+                                          r"133.35 mm long"):
+        tsm.with_(tip_length_mm=130.0)  # (replace() had taken it: the body checks the tip against the punch)
+    with pytest.raises(DesignError, match=r"die_height_mm = \(not given\) is not allowed: required with complete punches"):
+        tsm.with_(die_height_mm=None)
+    with pytest.raises(DesignError, match=r"allowed_tip_pressure_source = \(not given\) is not allowed: must name the source"):
+        ToolingSpec(allowed_tip_pressure_MPa=300.0)
+    with pytest.raises(DesignError, match=r"allowed_tip_pressure_source = 'x' is not allowed: give it together with"):
+        tsm.with_(allowed_tip_pressure_source="x")
 
 
 @pytest.mark.parametrize("design, v", [("cutaway_convex_round", None), ("families/almond", (0.0, 3.0))])

@@ -63,6 +63,7 @@
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
@@ -330,6 +331,9 @@ class ToolingSpec:
     punch_youngs_modulus_MPa: float | None = None
     punch_youngs_modulus_source: str | None = None
     fe_rating: FeRatingSpec | None = None
+    #: ``(table, base folder)`` the spec was parsed from (:func:`parse_tooling`), which :meth:`with_` parses
+    #: again with its changes, so that the table's rules between keys hold too
+    source: Any = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         # the [tooling] table's ranges hold however the spec is made: parsed (parse_tooling), built in
@@ -346,8 +350,15 @@ class ToolingSpec:
                 unit = "deg" if key.endswith("_deg") else "mm"
                 object.__setattr__(self, key, check_range(f"[tooling] {key}", value, unit=unit, **rng))
         for key in ("allowed_tip_pressure_MPa", "punch_youngs_modulus_MPa"):
+            skey = key.replace("_MPa", "_source")
+            src = getattr(self, skey)
             if getattr(self, key) is not None:
                 object.__setattr__(self, key, check_positive(f"[tooling] {key}", getattr(self, key), "MPa"))
+                if not (isinstance(src, str) and src.strip()):  # no figure without its source (as in the table)
+                    raise DesignError(f"[tooling] {skey}", src if src is not None else MISSING,
+                                      f"must name the source of {key} (a non-empty string)")
+            elif src is not None:
+                raise DesignError(f"[tooling] {skey}", src, f"give it together with {key}")
         for key, kind, name in (("scores", ScoreSpec, "[[tooling.score]]"), ("emboss", EmbossSpec, "[[tooling.emboss]]")):
             items = getattr(self, key)
             if not isinstance(items, (tuple, list)) or not all(isinstance(x, kind) for x in items):
@@ -360,8 +371,20 @@ class ToolingSpec:
         return self.tip_length_mm if self.lower_tip_length_mm is None else self.lower_tip_length_mm
 
     def with_(self, **kw: Any) -> "ToolingSpec":
-        """A copy with fields replaced (``clearance_mm=0.03``), checked as the ``[tooling]`` table is."""
-        return replace(self, **kw)
+        """A copy with fields replaced (``clearance_mm=0.03``), checked as the ``[tooling]`` table is: a spec
+        parsed from a table (:func:`parse_tooling`) changed only in the table's own keys is that table with
+        them changed, parsed again (a standard punch's tip length is checked against its body; ``None``
+        takes a key's default); any other change is range-checked (:meth:`__post_init__`)."""
+        if self.source is not None and kw and set(kw) <= _TABLE_FIELDS:
+            table, base = self.source
+            return parse_tooling({k: v for k, v in {**table, **kw}.items() if v is not None}, base=base)
+        return replace(self, **kw, source=None)
+
+
+#: the ToolingSpec fields that are keys of the [tooling] table of the same meaning (see ToolingSpec.with_)
+_TABLE_FIELDS = frozenset({"clearance_mm", "tip_length_mm", "die_outer_diameter_mm", "die_height_mm", "taper_deg",
+                           "gap_mm", "lower_tip_length_mm", "allowed_tip_pressure_MPa", "allowed_tip_pressure_source",
+                           "punch_youngs_modulus_MPa", "punch_youngs_modulus_source"})
 
 
 def _keys(where: str, table: Any, allowed: set[str]) -> dict:
@@ -560,4 +583,5 @@ def parse_tooling(table: Any, base: Path | None = None) -> ToolingSpec:
     return ToolingSpec(clearance, tip, od, height, taper, gap,
                        tuple(_score(i, s) for i, s in enumerate(scores)),
                        tuple(_emboss(i, e, base) for i, e in enumerate(emb)), body=body, lower_tip_length_mm=lower,
-                       drawing=_drawing(t.get("drawing", {})), fe_rating=_fe_rating(t.get("fe_rating")), **sourced)
+                       drawing=_drawing(t.get("drawing", {})), fe_rating=_fe_rating(t.get("fe_rating")),
+                       source=(copy.deepcopy(dict(t)), base), **sourced)
