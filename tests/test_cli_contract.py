@@ -236,7 +236,8 @@ def test_shapes_marks_required_and_optional_and_prints_whole_descriptions(capsys
     assert rc == 0
     text = " ".join(out.split())
     for name, fam in FAMILIES.items():
-        assert f"{name} required: " + ", ".join(f"{k} [{fam.params[k]}]" for k in fam.required) in text
+        assert f"{name} required: " + ", ".join(f"{k} [{fam.params[k]}]" + (f" (or {fam.alternatives[k]})" if k in
+                                                fam.alternatives else "") for k in fam.required) in text
         doc = " ".join(fam.func.__doc__.strip().split("\n\n")[0].replace("``", "").split())
         assert fam.description == doc and doc in text and doc[-1] in ".)"
     assert "concave_round required: diameter [mm], band [mm], cup_depth [mm]; optional: land [mm] = 0" in text
@@ -244,6 +245,10 @@ def test_shapes_marks_required_and_optional_and_prints_whole_descriptions(capsys
     d = json.loads(out)
     assert d["concave_round"]["required"] == ["diameter", "band", "cup_depth"] and d["concave_round"]["optional"] == ["land"]
     assert d["thesis.flat_faced_round"]["optional"] == []
+    # a ffbe's bevel by its width or its depth: listed so, and in the JSON
+    assert "ffbe required: diameter [mm], thickness [mm], bevel_angle [deg], bevel_width [mm] (or bevel_depth); " \
+           "optional: bevel_depth [mm] = 0" in text
+    assert d["ffbe"]["alternatives"] == {"bevel_width": "bevel_depth"} and d["concave_round"]["alternatives"] == {}
 
 
 @pytest.mark.parametrize("exc", [ZeroDivisionError("division by zero"), ValueError("a bare ValueError is a bug")])

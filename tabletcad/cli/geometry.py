@@ -31,6 +31,7 @@ def shapes_cmd(as_json: bool, json_file: Path | None) -> None:
         # a required parameter has no default: its constructor's value is only an example
         text = json.dumps({n: dict(params=f.params, required=list(f.required),
                                    optional=[k for k in f.params if k not in f.required],
+                                   alternatives=dict(f.alternatives),  # a required one another may replace
                                    defaults={k: (None if k in f.required else v) for k, v in f.defaults.items()},
                                    description=f.description)
                            for n, f in FAMILIES.items()}, indent=2)
@@ -49,7 +50,8 @@ def shapes_cmd(as_json: bool, json_file: Path | None) -> None:
     for name, fam in FAMILIES.items():
         if name in heads:
             click.echo(("" if name == INDUSTRY_FAMILIES[0] else "\n") + heads[name])
-        req = ", ".join(f"{k} [{fam.params[k]}]" for k in fam.required)
+        req = ", ".join(f"{k} [{fam.params[k]}]" + (f" (or {fam.alternatives[k]})" if k in fam.alternatives else "")
+                        for k in fam.required)
         opt = ", ".join(f"{k} [{u}] = {fam.defaults[k]:g}" for k, u in fam.params.items() if k not in fam.required)
         click.echo(f"{name:{w}s} required: {req}" + (f"; optional: {opt}" if opt else ""))
         click.echo(textwrap.fill(fam.description, width=100, initial_indent=" " * (w + 1), subsequent_indent=" " * (w + 1)))

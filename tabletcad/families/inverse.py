@@ -315,8 +315,9 @@ def _prepare(family, vary, dims):
         required = fam.required
         missing = [k for k in required if k != vary and k not in dims]
         if missing:
-            raise DesignError(missing[0], MISSING, f"{name} needs {', '.join(k for k in required if k != vary)} "
-                              f"besides {vary}")
+            needs = ", ".join(f"{k} (or {fam.alternatives[k]})" if k in fam.alternatives else k
+                              for k in required if k != vary)
+            raise DesignError(missing[0], MISSING, f"{name} needs {needs} besides {vary}")
     params = inspect.signature(func).parameters
     for k, v in dims.items():  # a dimension is a number: "10" is refused here, not as a failed search
         d = params[k].default if k in params else None

@@ -101,7 +101,7 @@ class PartModel(_Shaped):
     shape: Any  # TopoDS_Shape
 
     def to_occ(self):
-        """The part's ``TopoDS_Solid``, a new handle on its topology and geometry
+        """The part's shape (a solid), a new handle on its topology and geometry
         (:func:`tabletcad.cad._occ.handle`: moving it leaves the part where it is)."""
         from tabletcad.cad._occ import handle
 

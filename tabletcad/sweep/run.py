@@ -66,7 +66,7 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
         raise DesignError("--workers", workers, "give either --workers or --scheduler, not both")
     if workers is not None and workers > max_local_workers():  # (a typo of 100000 would start one per design)
         raise DesignError("--workers", workers, f"must be at most {max_local_workers()} (4 per CPU of this machine: a "
-                          "local worker is a process of about 340 MB, and more than the CPUs only wait)")
+                          "local worker is a process of 130-340 MB, and more than the CPUs only wait)")
     if store is not None or spec.store is not None:
         _check_store(store if store is not None else spec.store, "--store" if store is not None else "[sweep] store",
                      local=scheduler is None)
@@ -148,7 +148,8 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
             if files_wanted and scheduler is None and client is None:
                 # the builds' temporary folders in one of this run's own, removed below once the workers are
                 # gone however the run ends (a trial: a Ctrl-C left the killed workers' folders in /tmp)
-                kw["tmp_root"] = stack.enter_context(tempfile.TemporaryDirectory(prefix="tabletcad-sweep-"))
+                kw["tmp_root"] = stack.enter_context(tempfile.TemporaryDirectory(prefix="tabletcad-sweep-",
+                                                                                 ignore_cleanup_errors=True))
             if items and client is None and workers != 0:  # connect first: an unreachable scheduler writes nothing
                 n = None if scheduler is not None else min(workers or os.cpu_count() or 1, len(items))
                 client = stack.enter_context(open_client(n, scheduler, connect_timeout))
