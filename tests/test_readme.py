@@ -201,8 +201,17 @@ def test_toml_block_is_taken_by_its_reader(text: str, tmp_path: Path) -> None:
     if "tooling" in data:
         from tabletcad.tooling.spec import parse_tooling
 
-        parse_tooling(data["tooling"])
+        spec = parse_tooling(data["tooling"])
         readers += 1
+        if "tablet" not in data:  # every check short of the Booleans, on the README's 10 mm concave round (a
+            # trial: the example's lower tip of 8 mm, the default, could never clear the 22.22 mm die)
+            from tabletcad.pipeline.design import Design
+            from tabletcad.tooling.outline import tablet_frame
+            from tabletcad.tooling.toolset import check_on_frame
+
+            tablet = Design.from_dict({"tablet": dict(family="concave_round", diameter=10.0, band=2.8, cup_depth=0.9,
+                                                      land=0.08)}).build()
+            check_on_frame(tablet_frame(tablet), spec)
     if "sweep" in data:
         from tabletcad.sweep.spec import load_sweep
 

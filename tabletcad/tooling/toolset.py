@@ -59,6 +59,34 @@ def die_height(frame, spec: ToolingSpec) -> float:
     return DEFAULT_DIE_HEIGHT_MM if spec.die_outer_diameter_mm is not None else default_die_size(frame)[1]
 
 
+def check_on_frame(frame, spec: ToolingSpec) -> list:
+    """Every check of ``spec`` against the tablet (its :func:`~tabletcad.tooling.outline.tablet_frame`) that
+    needs no tooling geometry: the gap, the scores, the figures, the tips' lengths, a complete punch's body;
+    a :class:`DesignError` before any Boolean.  Returns :func:`~tabletcad.tooling.emboss.check_emboss`'s
+    result for each figure."""
+    from tabletcad.tooling.emboss import check_emboss
+    from tabletcad.tooling.scores import check_score
+
+    narrow = min(frame.length, frame.width)
+    if not frame.tip_inset(spec.clearance_mm) <= 0.25 * narrow:  # (a trial: 1 mm on a 2 mm round failed in OCC's
+        # offset of the outline by -3.54 mm, a figure of its own scaling; 0.7 mm on 1.5 mm built a 0.1 mm tip)
+        raise DesignError("[tooling] clearance_mm", spec.clearance_mm,
+                          f"must leave the punch tips at least half the tablet's {narrow:.4g} mm width: at most "
+                          f"{0.25 * narrow - frame.tip_inset(0.0):.4g} mm", "mm")
+    gap_closed = frame.band
+    if spec.gap_mm is not None and spec.gap_mm < gap_closed - 1e-9:
+        raise DesignError("[tooling] gap_mm", spec.gap_mm, f"must be >= the band {gap_closed:.4g} mm (the closed position)", "mm")
+    for i, s in enumerate(spec.scores):  # fail on bad input before any Boolean
+        check_score(frame, s, i)
+    emb_checked = [check_emboss(frame, e, spec.clearance_mm, i) for i, e in enumerate(spec.emboss)]
+    _check_tip_lengths(frame, spec)  # (after the figures' own limits: a figure too tall is named as the figure)
+    _warn_crossings(frame, spec, emb_checked)
+    _warn_sharp_edge(frame, spec.clearance_mm)
+    if spec.body is not None:
+        _check_complete_punches(frame, spec)
+    return emb_checked
+
+
 def _check_complete_punches(frame, spec: ToolingSpec) -> None:
     """Bad complete-punch input (tablet larger than the barrel or the standard, a tip too short to keep
     the barrel out of the die) as a DesignError, before any tooling geometry is built."""
@@ -201,27 +229,18 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     Boolean or a check fails.
     """
     from tabletcad.tooling.die import die
-    from tabletcad.tooling.emboss import apply_emboss, check_emboss
+    from tabletcad.tooling.emboss import apply_emboss
     from tabletcad.tooling.outline import tablet_frame
     from tabletcad.tooling.punch import punch_tip
-    from tabletcad.tooling.scores import apply_scores, check_score
+    from tabletcad.tooling.scores import apply_scores
 
     spec = spec or ToolingSpec()
     t0 = time.perf_counter()
     b0 = dict(TIMER)
     CACHE.clear()  # meshes and volumes of the previous build's solids are not asked for again
     frame = tablet_frame(tablet, shape)
+    emb_checked = check_on_frame(frame, spec)
     gap_closed = frame.band
-    if spec.gap_mm is not None and spec.gap_mm < gap_closed - 1e-9:
-        raise DesignError("[tooling] gap_mm", spec.gap_mm, f"must be >= the band {gap_closed:.4g} mm (the closed position)", "mm")
-    for i, s in enumerate(spec.scores):  # fail on bad input before any Boolean
-        check_score(frame, s, i)
-    emb_checked = [check_emboss(frame, e, spec.clearance_mm, i) for i, e in enumerate(spec.emboss)]
-    _check_tip_lengths(frame, spec)  # (after the figures' own limits: a figure too tall is named as the figure)
-    _warn_crossings(frame, spec, emb_checked)
-    _warn_sharp_edge(frame, spec.clearance_mm)
-    if spec.body is not None:
-        _check_complete_punches(frame, spec)
     solid = frame.shape
     v0 = volume(solid)
     a_man = to_manifold(solid, deflection) if check and (spec.scores or spec.emboss) else None
