@@ -175,7 +175,8 @@ def test_punch_volume_from_tablet_properties_without_clearance():
     # cup volume from the tablet's own quadrature: (V - pi R^2 band) / 2 for a symmetric tablet whose
     # band is a true cylinder (the family tablets'; the thesis's PDE band bows inward by ~1 µm)
     t = load_design(ROOT / "samples" / "families" / "concave_round.toml")
-    ts = make_tooling(t, ToolingSpec(clearance_mm=0.0, tip_length_mm=5.0), check=False, interference_check=False)
+    with pytest.warns(UserWarning, match=r"^clearance_mm = 0: the punch tips fit the die bore line to line"):
+        ts = make_tooling(t, ToolingSpec(clearance_mm=0.0, tip_length_mm=5.0), check=False, interference_check=False)
     V = t.properties()["volume_mm3"]
     R, band = 5.0, 2.8
     expected = math.pi * R * R * 5.0 - 0.5 * (V - math.pi * R * R * band)

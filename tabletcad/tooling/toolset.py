@@ -82,6 +82,11 @@ def check_on_frame(frame, spec: ToolingSpec) -> list:
     _check_tip_lengths(frame, spec)  # (after the figures' own limits: a figure too tall is named as the figure)
     _warn_crossings(frame, spec, emb_checked)
     _warn_sharp_edge(frame, spec.clearance_mm)
+    if spec.clearance_mm == 0.0:  # allowed (a model of the nominal fit), but no punch runs in its die so
+        import warnings
+
+        warnings.warn("clearance_mm = 0: the punch tips fit the die bore line to line, with no running clearance "
+                      "(presses use about 0.01-0.05 mm a side); the parts model the nominal fit", stacklevel=3)
     if spec.body is not None:
         _check_complete_punches(frame, spec)
     return emb_checked
