@@ -337,3 +337,28 @@ def test_texts_the_sheet_font_cannot_draw_are_escaped_not_boxed():
                  title_block=["material: acier"])
     assert dr.title == "\\u9320\\u526410" and dr.notes == ["\\u9320\\u526410 (concave_round)", "deboss 'Paracétamol'"]
     assert dr.title_block == ["material: acier"]
+
+
+def test_a_tolerance_as_large_as_its_dimension_is_warned_of():
+    """The general ±0.076 mm on a 0.050 mm land draws a negative lower limit (a toolmaker's trial: drawn in
+    silence): one warning naming each such dimension and its key; a tolerance below the size, given or
+    general, draws as before."""
+    import warnings
+    from types import SimpleNamespace
+
+    from tabletcad.tooling.drawing import Dim, _toleranced
+    from tabletcad.tooling.spec import DrawingSpec
+
+    dims = [Dim((0.0, 0.0), (1.0, 0.0), 1.0, "land 0.050"), Dim((0.0, 0.0), (1.0, 0.0), 1.0, "cup 0.900"),
+            Dim((0.0, 0.0), (1.0, 0.0), 1.0, "band 0.070")]
+    general = SimpleNamespace(spec=SimpleNamespace(drawing=DrawingSpec()))
+    with pytest.warns(UserWarning) as caught:
+        texts = [d.text for d in _toleranced(dims, general)]
+    assert texts == ["land 0.050 ±0.076", "cup 0.900 ±0.076", "band 0.070 ±0.076"]
+    assert [str(w.message) for w in caught] == [
+        "the drawing's tolerances reach below zero: land 0.050 ±0.076 ([tooling.drawing] tolerances.land); band 0.070 "
+        "±0.076 ([tooling.drawing] tolerances.band): give each a tolerance smaller than its size"]
+    given = SimpleNamespace(spec=SimpleNamespace(drawing=DrawingSpec(tolerances=(("land", 0.02), ("band", 0.05)))))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert [d.text for d in _toleranced(dims, given)] == ["land 0.050 ±0.020", "cup 0.900 ±0.076", "band 0.070 ±0.050"]

@@ -336,12 +336,21 @@ def _toleranced(dims: list, ts) -> list:
     """``dims`` with ``±tolerance`` appended to each text (the drawing spec's value for its key)."""
     from dataclasses import replace
 
+    import re
+    import warnings
+
     dspec = ts.spec.drawing
-    out = []
+    out, negative = [], []
     for d in dims:
         head = d.text.split()[0]
         key = _DIM_KEYS.get(head, _DIM_KEYS.get(head[:1], None))
         out.append(replace(d, text=f"{d.text} ±{_fmt(dspec.tolerance(key))}") if key else d)
+        size = re.search(r"\d+(?:\.\d+)?", d.text)
+        if key and size and dspec.tolerance(key) >= float(size.group()) > 0.0:
+            negative.append(f"{d.text} ±{_fmt(dspec.tolerance(key))} ([tooling.drawing] tolerances.{key})")
+    if negative:  # (a toolmaker's trial: "land 0.050 ±0.076" was drawn in silence)
+        warnings.warn("the drawing's tolerances reach below zero: " + "; ".join(dict.fromkeys(negative)) +
+                      ": give each a tolerance smaller than its size", stacklevel=3)
     return out
 
 
