@@ -57,9 +57,14 @@ def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
     for which in ("upper_punch", "lower_punch"):
         body = ts.report[which]["body"]
         assert body["working_length_mm"] == pytest.approx(133.35 - 0.9, abs=1e-6)
+    # (in the sheet's notes, whose lines wrap where the sheet's room puts them: every one of them on the
+    # sheet is test_drawing_sheet_keeps_every_text_on_the_sheet's)
+    notes = " ".join(tooling_model(ts).notes)
     for text in ("working length (head flat to cup bottom): upper 132.45, lower 132.45", "bore Ø10.000 (the tablet's",
                  "tips Ø9.960 (the bore less the clearance 0.020 per side)"):
-        assert text in tsvg, text
+        assert text in notes, text
+    flat = " ".join(re.sub(r"<[^>]+>", " ", tsvg).split())  # the sheet's text, wrapped lines joined
+    assert "working length (head flat to cup bottom): upper 132.45," in flat and "tips Ø9.960" in flat
     dxf = (out / "tooling.dxf").read_text(encoding="utf-8", errors="replace")
     assert "overall 133.35" in dxf and "TC-0001" in dxf
     # read back by ezdxf: the cup radius is a radius DIMENSION measuring the sphere's radius
@@ -180,6 +185,9 @@ def test_every_dimension_takes_its_own_tolerance():
     assert abs(land.p2[0] - land.p1[0]) == pytest.approx(10.0 * 0.08, rel=1e-12)
     assert f"cup radius R{(4.92 ** 2 + 0.81) / 1.8:.2f} ±{tols['cup_radius']:.3f} mm" in dr.notes
     assert f"land 0.080 ±{tols['land']:.3f} mm" in dr.notes
+    # the key as the toolmaker makes it (a trial: on no sheet), from the sample's [tooling.punch] key_*
+    assert "key 4.76 wide x 15.00 long x 1.50 proud, 25.00 up the barrel from the tip's back face, at 0 deg to +x" \
+        in tr.notes
 
 
 def test_bevel_and_radii_notes_carry_tolerances():

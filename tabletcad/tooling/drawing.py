@@ -639,5 +639,10 @@ def tooling_model(ts) -> Drawing:
              ("standard dimensions: tabletcad/data/tooling_standards.toml (sources per value in report.json)"
               + (", but for the modified ones above (from [tooling.punch])" if mod else ""))
              if up["standard"] != "custom" else "user-defined set: every dimension from [tooling.punch]"]
+    body = ts.spec.body
+    if body is not None and body.key:  # (a toolmaker's trial: the keyway could not be made from the drawing)
+        notes.append(f"key {_fmt(body.key_width_mm)} wide x {_fmt(body.key_length_mm)} long x {_fmt(body.key_height_mm)} "
+                     f"proud, {_fmt(body.key_offset_mm)} up the barrel from the tip's back face, at "
+                     f"{body.key_angle_deg:g} deg to +x")
     return Drawing(views, origins, dims, notes, title=f"{_title(ts)} — punches and die",
                    title_block=title_block(ts, "punches and die"))
