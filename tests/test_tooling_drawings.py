@@ -166,7 +166,8 @@ def test_every_dimension_takes_its_own_tolerance():
     spec = design.tooling_spec
     # a distinct tolerance per key: 0.001, 0.002, ... (none is the general 0.076)
     tols = {k: round(0.001 * (i + 1), 3) for i, k in enumerate(TOLERANCE_KEYS)}
-    spec = replace(spec, drawing=replace(spec.drawing, tolerances=tuple(tols.items())))
+    spec = replace(spec, drawing=replace(spec.drawing, tolerances=tuple(tols.items())), allowed_tip_pressure_MPa=300.0,
+                   allowed_tip_pressure_source="a test value")
     ts = make_tooling(load_design(SAMPLE), spec, check=False, interference_check=False)
     dr, tr = drawing_model(ts), tooling_model(ts)
     texts = [d.text for d in dr.dims] + [d.text for d in tr.dims]
@@ -188,6 +189,9 @@ def test_every_dimension_takes_its_own_tolerance():
     # the key as the toolmaker makes it (a trial: on no sheet), from the sample's [tooling.punch] key_*
     assert "key 4.76 wide x 15.00 long x 1.50 proud, 25.00 up the barrel from the tip's back face, at 0 deg to +x" \
         in tr.notes
+    # the tip-force rating on the punches' sheet too, where the toolmaker looks (a trial: the tablet's only)
+    rating = [n for n in dr.notes if n.startswith("tip force rating")]
+    assert len(rating) == 1 and rating[0] in tr.notes and "300 MPa x" in rating[0] and "(allowed pressure: a test value)" in rating[0]
 
 
 def test_bevel_and_radii_notes_carry_tolerances():

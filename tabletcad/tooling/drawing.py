@@ -639,6 +639,7 @@ def tooling_model(ts) -> Drawing:
              ("standard dimensions: tabletcad/data/tooling_standards.toml (sources per value in report.json)"
               + (", but for the modified ones above (from [tooling.punch])" if mod else ""))
              if up["standard"] != "custom" else "user-defined set: every dimension from [tooling.punch]"]
+    notes += rating_notes(ts.report.get("tip_rating") or {})  # (a toolmaker's trial: on the tablet's sheet only)
     body = ts.spec.body
     if body is not None and body.key:  # (a toolmaker's trial: the keyway could not be made from the drawing)
         notes.append(f"key {_fmt(body.key_width_mm)} wide x {_fmt(body.key_length_mm)} long x {_fmt(body.key_height_mm)} "
