@@ -64,6 +64,22 @@ def test_samples_cover_tsm_b_eu_d_a_scored_capsule_and_an_embossed_shaped_tablet
     assert any(ts.frame.outline_kind != "circle" and ts.spec.emboss for _, ts in res.values())
 
 
+def test_every_complete_punch_is_tip_minus_relief_plus_body_and_key(built):
+    """The volume of each sample's complete punches: tip - relief + the body's closed form + the key's
+    (a toolmaker's trial: the README's sum was 114.26 mm³, the key, short on the keyed TSM B sample)."""
+    _, res = built
+    keyed = 0
+    for name, (_, ts) in res.items():
+        for which in ("upper_punch", "lower_punch") if ts.spec.body is not None else ():
+            info = ts.report[which]
+            body = info["body"]
+            expected = (info["tip_volume_mm3"] - body["relief_volume_mm3"] + body["body_volume_closed_form_mm3"]
+                        + body["key_volume_mm3"])
+            assert body["volume_mm3"] == pytest.approx(expected, rel=1e-7), (name, which)
+            keyed += body["key_volume_mm3"] > 0.0
+    assert keyed >= 2  # (the TSM B sample's two keyed punches: 114.27 mm³ each, 4.76 x 1.5 proud x 15 long)
+
+
 def test_assembly_names_and_colours_each_part(built):
     _, res = built
     for out, _ in res.values():

@@ -24,7 +24,8 @@ from tabletcad.tooling.booleans import boolean, volume
 from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, prism
 from tabletcad.tooling.standards import PunchBody
 
-__all__ = ["body_profile", "body_solid", "body_volume", "relief_volume", "complete_punch", "check_body_fits"]
+__all__ = ["body_profile", "body_solid", "body_volume", "key_volume", "relief_volume", "complete_punch",
+           "check_body_fits"]
 
 
 def body_profile(b: PunchBody, barrel_length: float) -> list[tuple[float, float]]:
@@ -97,6 +98,17 @@ def body_volume(b: PunchBody, barrel_length: float) -> float:
     return v
 
 
+def key_volume(b: PunchBody) -> float:
+    """Closed-form volume of the key outside the barrel (mm³), 0 without one: its section, the rectangle
+    ``w`` wide reaching ``h`` beyond the barrel's radius ``r`` less the circle's part of it,
+    ``w (r + h) - (w/2) sqrt(r² - w²/4) - r² asin(w / 2r)``, times its length."""
+    if not b.key:
+        return 0.0
+    r, w, h = 0.5 * b.barrel_diameter_mm, b.key_width_mm, b.key_height_mm
+    section = w * (r + h) - 0.5 * w * math.sqrt(r * r - 0.25 * w * w) - r * r * math.asin(0.5 * w / r)
+    return section * b.key_length_mm
+
+
 def relief_volume(frame: TabletFrame, b: PunchBody, clearance: float, tip_length: float) -> float:
     """Volume the tip relief removes (mm³): the plan ring between the tip outline and its relieved
     outline times the relieved length."""
@@ -158,7 +170,7 @@ def complete_punch(frame: TabletFrame, tip_shape, which: str, b: PunchBody, clea
                 head_flat_diameter_mm=b.head_flat_diameter_mm, head_height_mm=b.head_height_mm,
                 tip_length_mm=tip_length, tip_straight_mm=b.tip_straight_mm, tip_relief_mm=b.tip_relief_mm,
                 key=b.key, head_flat_z_mm=edge + sign * b.overall_length_mm, volume_mm3=volume(shape),
-                body_volume_closed_form_mm3=body_volume(b, lb),
+                body_volume_closed_form_mm3=body_volume(b, lb), key_volume_mm3=key_volume(b),
                 relief_volume_mm3=relief_volume(frame, b, clearance, tip_length),
                 sources={k: v for k, v in b.sources.items()},
                 modified_from_standard={k: dict(v) for k, v in b.modified.items()})
