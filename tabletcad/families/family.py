@@ -62,9 +62,10 @@ class Family:
         ``bevel_depth``): what a design adds before it builds."""
         return {k: 0.0 for k, alt in self.alternatives.items() if k not in given and alt in given and given[alt] != 0.0}
 
-    def needs(self) -> str:
-        """The required parameters as a design's refusal names them (``bevel_width (or bevel_depth)``)."""
-        return ", ".join(f"{k} (or {self.alternatives[k]})" if k in self.alternatives else k for k in self.required)
+    def needs(self, besides: str | None = None) -> str:
+        """The required parameters (but ``besides``) as a refusal names them (``bevel_width (or bevel_depth)``)."""
+        return ", ".join(f"{k} (or {self.alternatives[k]})" if k in self.alternatives else k
+                         for k in self.required if k != besides)
 
     @property
     def defaults(self) -> dict[str, Any]:

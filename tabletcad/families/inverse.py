@@ -315,9 +315,7 @@ def _prepare(family, vary, dims):
         required = fam.required
         missing = [k for k in required if k != vary and k not in dims]
         if missing:
-            needs = ", ".join(f"{k} (or {fam.alternatives[k]})" if k in fam.alternatives else k
-                              for k in required if k != vary)
-            raise DesignError(missing[0], MISSING, f"{name} needs {needs} besides {vary}")
+            raise DesignError(missing[0], MISSING, f"{name} needs {fam.needs(besides=vary)} besides {vary}")
     params = inspect.signature(func).parameters
     for k, v in dims.items():  # a dimension is a number: "10" is refused here, not as a failed search
         d = params[k].default if k in params else None

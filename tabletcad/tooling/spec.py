@@ -339,16 +339,10 @@ class ToolingSpec:
         # the [tooling] table's ranges hold however the spec is made: parsed (parse_tooling), built in
         # Python or changed by with_/replace (a negative clearance given so had built punches as wide as
         # the bore); numbers are stored as floats
-        big = DEFAULT.max_length
-        checks = {"clearance_mm": dict(lo=0.0, hi=MAX_CLEARANCE_MM), "tip_length_mm": dict(lo=0.0, hi=big, lo_open=True),
-                  "die_outer_diameter_mm": dict(lo=0.0, hi=big, lo_open=True),
-                  "die_height_mm": dict(lo=0.0, hi=big, lo_open=True), "taper_deg": dict(lo=0.0, hi=10.0, hi_open=True),
-                  "gap_mm": dict(lo=0.0, hi=big, lo_open=True), "lower_tip_length_mm": dict(lo=0.0, hi=big, lo_open=True)}
-        for key, rng in checks.items():
+        for key in _RANGES:
             value = getattr(self, key)
             if value is not None or key in ("clearance_mm", "tip_length_mm", "taper_deg"):
-                unit = "deg" if key.endswith("_deg") else "mm"
-                object.__setattr__(self, key, check_range(f"[tooling] {key}", value, unit=unit, **rng))
+                object.__setattr__(self, key, _in_range(key, value))
         for key in ("allowed_tip_pressure_MPa", "punch_youngs_modulus_MPa"):
             skey = key.replace("_MPa", "_source")
             src = getattr(self, skey)
@@ -379,6 +373,20 @@ class ToolingSpec:
             table, base = self.source
             return parse_tooling({k: v for k, v in {**table, **kw}.items() if v is not None}, base=base)
         return replace(self, **kw, source=None)
+
+
+#: the [tooling] table's numbers and their ranges, for the table (parse_tooling) and every ToolingSpec alike;
+#: steel longer than a metre is no tablet tooling (1e300 reached OCC as a zero vector)
+_RANGES = {"clearance_mm": dict(lo=0.0, hi=MAX_CLEARANCE_MM), "tip_length_mm": dict(lo=0.0, hi=DEFAULT.max_length, lo_open=True),
+           "die_outer_diameter_mm": dict(lo=0.0, hi=DEFAULT.max_length, lo_open=True),
+           "die_height_mm": dict(lo=0.0, hi=DEFAULT.max_length, lo_open=True),
+           "taper_deg": dict(lo=0.0, hi=10.0, hi_open=True), "gap_mm": dict(lo=0.0, hi=DEFAULT.max_length, lo_open=True),
+           "lower_tip_length_mm": dict(lo=0.0, hi=DEFAULT.max_length, lo_open=True)}
+
+
+def _in_range(key: str, value: Any) -> float:
+    """``float(value)`` of the [tooling] number ``key`` within :data:`_RANGES`, else a :class:`DesignError`."""
+    return check_range(f"[tooling] {key}", value, unit="deg" if key.endswith("_deg") else "mm", **_RANGES[key])
 
 
 #: the ToolingSpec fields that are keys of the [tooling] table of the same meaning (see ToolingSpec.with_)
@@ -536,16 +544,15 @@ def parse_tooling(table: Any, base: Path | None = None) -> ToolingSpec:
             "standard", "type", "punch", "lower_tip_length_mm", "drawing", "allowed_tip_pressure_MPa",
             "allowed_tip_pressure_source", "punch_youngs_modulus_MPa", "punch_youngs_modulus_source", "fe_rating"}
     t = _keys("[tooling]", table, keys)
-    clearance = check_range("[tooling] clearance_mm", t.get("clearance_mm", d.clearance_mm), 0.0, MAX_CLEARANCE_MM, "mm")
-    big = DEFAULT.max_length  # steel longer than a metre is no tablet tooling (1e300 reached OCC as a zero vector)
-    tip = check_range("[tooling] tip_length_mm", t.get("tip_length_mm", d.tip_length_mm), 0.0, big, "mm", lo_open=True)
+    clearance = _in_range("clearance_mm", t.get("clearance_mm", d.clearance_mm))
+    tip = _in_range("tip_length_mm", t.get("tip_length_mm", d.tip_length_mm))
     od = t.get("die_outer_diameter_mm")
-    od = None if od is None else check_range("[tooling] die_outer_diameter_mm", od, 0.0, big, "mm", lo_open=True)
+    od = None if od is None else _in_range("die_outer_diameter_mm", od)
     height = t.get("die_height_mm")  # given, it is kept (22.22 given was taken for the default and replaced)
-    height = None if height is None else check_range("[tooling] die_height_mm", height, 0.0, big, "mm", lo_open=True)
-    taper = check_range("[tooling] taper_deg", t.get("taper_deg", d.taper_deg), 0.0, 10.0, "deg", hi_open=True)
+    height = None if height is None else _in_range("die_height_mm", height)
+    taper = _in_range("taper_deg", t.get("taper_deg", d.taper_deg))
     gap = t.get("gap_mm")
-    gap = None if gap is None else check_range("[tooling] gap_mm", gap, 0.0, big, "mm", lo_open=True)
+    gap = None if gap is None else _in_range("gap_mm", gap)
     scores = t.get("score", [])
     emb = t.get("emboss", [])
     if not isinstance(scores, list):
@@ -553,7 +560,7 @@ def parse_tooling(table: Any, base: Path | None = None) -> ToolingSpec:
     if not isinstance(emb, list):
         raise DesignError("[[tooling.emboss]]", emb, "must be an array of tables")
     lower = t.get("lower_tip_length_mm")
-    lower = None if lower is None else check_range("[tooling] lower_tip_length_mm", lower, 0.0, big, "mm", lo_open=True)
+    lower = None if lower is None else _in_range("lower_tip_length_mm", lower)
     body = None
     if "standard" in t or "type" in t or "punch" in t:
         std = _choice("[tooling] standard", t.get("standard", MISSING), ("TSM", "EU", "custom"))
