@@ -162,3 +162,18 @@ def test_a_standard_punch_length_is_quoted_whole():
     with pytest.raises(DesignError) as err:
         resolve_body("TSM", "B", PUNCH, 200.0, 19.0)
     assert "the punch is 133.35 mm long" in str(err.value)
+
+
+@pytest.mark.parametrize("sample, kind", [("capsule", "B"), ("concave_round", "B")])
+def test_an_18_mm_capsule_gets_the_b_die_blank_its_standard_takes(sample, kind):
+    """The tips-only placeholder die of the 18 mm capsule sample is TSM B (shaped tablets up to 19 mm), as
+    the 10 mm round's: the frame's outline kind chooses the standard's round or shaped limit (the capsule had
+    been given a D blank, 38.10 mm, by the round tablets' 16 mm)."""
+    from tabletcad.pipeline.design import load_design
+    from tabletcad.tooling.die import default_die_size
+    from tabletcad.tooling.outline import tablet_frame
+
+    frame = tablet_frame(load_design(Path(__file__).resolve().parents[1] / "samples" / "families" / f"{sample}.toml"),
+                         None)
+    assert max(frame.length, frame.width) == pytest.approx({"capsule": 18.0, "concave_round": 10.0}[sample], abs=1e-6)
+    assert default_die_size(frame) == (30.16, 22.22, kind)

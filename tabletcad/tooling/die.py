@@ -69,7 +69,7 @@ def tapered_prism(wire, z0: float, z1: float, taper_deg: float):
 
 def default_die_size(frame: TabletFrame) -> tuple[float, float, str]:
     """``(outer diameter, height, TSM type)`` for the tablet's largest plan dimension."""
-    return standard_die_size(max(frame.length, frame.width))
+    return standard_die_size(max(frame.length, frame.width), shaped=frame.outline_kind != "circle")
 
 
 def die_position(frame: TabletFrame, height: float, penetration: float | None = None) -> tuple[float, float, float]:
@@ -85,7 +85,7 @@ def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, 
     if kind == "custom":  # a size given that is a TSM die's is named as it (30.16 x 22.22 had been "custom")
         from tabletcad.tooling.spec import TSM_DIES
 
-        kind = next((name for _, d, h, name in TSM_DIES if abs(d - outer_diameter) <= 1e-9 and abs(h - height) <= 1e-9),
+        kind = next((name for d, h, name in TSM_DIES if abs(d - outer_diameter) <= 1e-9 and abs(h - height) <= 1e-9),
                     "custom")
     od = outer_diameter if outer_diameter is not None else od0
     H = height if height is not None else h0

@@ -106,18 +106,31 @@ def tip_inset(clearance_mm: float, bore_offset_mm: float) -> float:
     clearance below the bore's offset leaves the tips on the outline)."""
     return max(clearance_mm - bore_offset_mm, 0.0)
 
-#: TSM die sizes: (largest tablet size, outer diameter, height, type), mm
-TSM_DIES = ((16.0, 30.16, 22.22, "B"), (25.4, 38.10, 23.81, "D"))
+#: TSM die blanks: (outer diameter, height, type), mm; the largest tablet each takes, round and shaped,
+#: is the standard's (``max_round_tablet_mm``, ``max_shaped_tablet_mm`` in tabletcad/data/tooling_standards.toml)
+TSM_DIES = ((30.16, 22.22, "B"), (38.10, 23.81, "D"))
 
 
-def standard_die_size(size_mm: float) -> tuple[float, float, str]:
+def tsm_die_limits(kind: str) -> tuple[float, float]:
+    """``(largest round, largest shaped)`` tablet (mm) a TSM ``kind`` ("B"/"D") die takes, from the standards file."""
+    from tabletcad.tooling.standards import load_standards
+
+    entry = load_standards()["TSM"][kind]
+    return float(entry["max_round_tablet_mm"]["value"]), float(entry["max_shaped_tablet_mm"]["value"])
+
+
+def standard_die_size(size_mm: float, shaped: bool = False) -> tuple[float, float, str]:
     """``(outer diameter, height, TSM type)`` of the die for a tablet whose largest plan dimension is
-    ``size_mm`` (:data:`TSM_DIES`); a :class:`DesignError` for one larger than a 'D' die takes."""
-    for lim, od, h, name in TSM_DIES:
-        if size_mm <= lim:
+    ``size_mm`` (:data:`TSM_DIES`): the smallest type that takes it, round or ``shaped`` (a B die takes
+    round tablets up to 16 mm and shaped ones up to 19 mm); a :class:`DesignError` for one larger than a
+    'D' die takes."""
+    for od, h, name in TSM_DIES:
+        lim = tsm_die_limits(name)[1 if shaped else 0]
+        if size_mm <= lim + 1e-9:
             return od, h, name
     raise DesignError("[tooling] die_outer_diameter_mm", MISSING,
-                      f"give it for a tablet {size_mm:.4g} mm long (larger than a TSM 'D' die takes, 25.4 mm)", "mm")
+                      f"give it for a {'shaped' if shaped else 'round'} tablet {size_mm:.4g} mm long (larger than a "
+                      f"TSM 'D' die takes, {lim:g} mm)", "mm")
 
 
 @dataclass(frozen=True)

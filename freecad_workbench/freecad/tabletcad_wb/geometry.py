@@ -268,6 +268,8 @@ def build_tablet(tablet, tol=None):
             # (the caplet's); the bore clears it, as build's does
             r["band_bulge"] = float(tablet.plan_overhang())
             r["band"] = band is not None
+            # a TSM B die takes round tablets up to 16 mm and shaped ones up to 19 mm (the standard die's size)
+            r["shaped"] = tablet.revolution is None
             # the tablet's lowest and highest z (mm, the core's polished bounds): a face flat at its rim
             # gives the punch its whole prism (punch_shape)
             r["tablet_z"] = [float(lo[2]), float(hi[2])]

@@ -132,7 +132,7 @@ def make_die(doc, tablet, *, height=None, outer_diameter=None, recompute=True):
     """Die linked to ``tablet``: cylinder minus the bore (the tablet's outline); keywords only (the
     clearance that came third is the punches' now: an old positional call is a TypeError).  Without
     ``outer_diameter``, the TSM die for the tablet's size, as ``tabletcad build`` takes it (B,
-    30.16 x 22.22 mm, up to 16 mm; D, 38.10 x 23.81 mm, up to 25.4 mm); neither given, the design
+    30.16 x 22.22 mm, round tablets up to 16 mm and shaped ones up to 19 mm; D, 38.10 x 23.81 mm, up to 25 mm); neither given, the design
     file's ``[tooling]`` table first."""
     if outer_diameter is None and height is None:  # the design file's [tooling] table, as build reads it
         values = design_tooling(tablet)[0]
@@ -141,8 +141,9 @@ def make_die(doc, tablet, *, height=None, outer_diameter=None, recompute=True):
     if outer_diameter is None:  # (an outer diameter given alone keeps the 22.22 mm height, as build does)
         from tabletcad.tooling.spec import standard_die_size
 
-        dims = tablet.Proxy.core_tablet(tablet).dimensions()
-        outer_diameter, h, _ = standard_die_size(max(dims["length_mm"], dims["width_mm"]))
+        core = tablet.Proxy.core_tablet(tablet)
+        dims = core.dimensions()
+        outer_diameter, h, _ = standard_die_size(max(dims["length_mm"], dims["width_mm"]), shaped=core.revolution is None)
         height = h if height is None else height
     obj = _new(doc, "Die")
     objects.DieProxy(obj, tablet, standard_size=standard)

@@ -559,7 +559,8 @@ class DieProxy(_Proxy):
         if getattr(obj, "StandardSize", False):  # the die follows the tablet's size (a 10 mm die had stayed on 28 mm)
             from tabletcad.tooling.spec import standard_die_size
 
-            od, height, _ = standard_die_size(geometry.plan_size(tab.Shape))
+            shaped = any(r.get("shaped", False) for r in rims if not r["inner"])  # (not in a document of before)
+            od, height, _ = standard_die_size(geometry.plan_size(tab.Shape), shaped=shaped)
             if abs(float(obj.OuterDiameter.Value) - od) > 1e-12 or abs(float(obj.Height.Value) - height) > 1e-12:
                 obj.OuterDiameter, obj.Height = _qty(od, "mm"), _qty(height, "mm")
         shape = geometry.die_shape(rims, float(obj.Height.Value), float(obj.OuterDiameter.Value))
