@@ -351,3 +351,19 @@ def test_json_keys_carry_their_units(capsys):
     d = json.loads(out)
     assert rc == 0 and set(d["u_r_outer_mm"]) == {"at_0_deg", "at_45_deg", "at_90_deg", "min", "max"}
 
+
+
+@pytest.mark.parametrize("args, line", [
+    (("contact", "--force", 3.5, "--material", "foo"), "error: --material = 'foo' is not allowed: must be one of "),
+    (("contact", "--force", 3.5, "--radius", -1), "error: --radius = -1 mm is not allowed: must be > 0"),
+    (("strength", "sphere", "--force", 3, "--material", "foo"), "error: --material = 'foo' is not allowed: "),
+    (("strength", "sphere", "--force", 3, "--material", "kostrolith", "--radius", -1),
+     "error: --radius = -1 mm is not allowed: must be > 0"),
+    (("heckel", SAMPLE, "--window", 1000, 2000), "error: --window = '1000-2000' is not allowed: holds 0 loading points"),
+])
+def test_a_refusal_names_the_option_as_typed(capsys, args, line):
+    """A value that reached a library function was named by its keyword there (``material``, ``r_s`` of the
+    sphere's radius, heckel's ``window``) where the user had typed ``--material``, ``--radius``, ``--window``."""
+    rc, out, err = run(capsys, *args)
+    assert rc == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and err.startswith(line), err

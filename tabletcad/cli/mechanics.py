@@ -135,7 +135,7 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
     given = {k: o for k, o, v in (("mass_mg", "--mass", mass), ("true_density", "--true-density", true_density),
                                   ("diameter", "--diameter", diameter), ("face_area", "--face-area", face_area),
                                   ("compliance slope", "--compliance", compliance),
-                                  ("compliance offset", "--compliance", compliance))
+                                  ("compliance offset", "--compliance", compliance), ("window", "--window", window))
              if v is not None}  # an option overrides the metadata file's key: named as given
     with _collect() as msgs, option_names(given):
         comp = MachineCompliance(slope=compliance[0], offset=compliance[1]) if compliance else None
@@ -374,7 +374,7 @@ def strength_cmd(method: str, F: float, D, t, W, L, R, material, E, nu, radius, 
     # the formulas name their arguments; here they are options
     names = {"force": "--force", "diameter": "--diameter", "width": "--diameter", "thickness": "--thickness",
              "band thickness": "--band", "length": "--length", "face radius": "--face-radius", "E": "--E",
-             "nu": "--nu", "radius": "--radius", "s_y": "--s-y"}
+             "nu": "--nu", "radius": "--radius", "r_s": "--radius", "s_y": "--s-y", "material": "--material"}
     inputs: dict = {}  # the sphere method's inputs and their sources
     said = ""
     with _collect() as msgs, option_names(names):
@@ -433,7 +433,7 @@ def contact_cmd(material: str, forces: tuple[float, ...], radius: float | None, 
         check_finite("--force", f, "N")
     if radius is not None:
         check_positive("--radius", radius, "mm")
-    with _collect() as msgs:
+    with _collect() as msgs, option_names({"material": "--material", "radius": "--radius", "force": "--force"}):
         m = get_material(material)
         results = [ct.compress_sphere(f, m, radius) for f in forces]
         r = results[0].radius

@@ -154,6 +154,11 @@ class SweepCurve(Curve):
     def is_point(self) -> bool:
         return self.alpha == 0.0 and self.beta == 0.0
 
+    @property
+    def flat(self) -> bool:
+        """Always: an outline's offset moves in plan only, at the constant's height (its z derivatives are 0)."""
+        return True
+
     def band_limit(self) -> int | None:
         """1 on a circular outline (an offset circle, or a constant), else None."""
         return 1 if getattr(self.outline, "is_circle", False) else None

@@ -98,6 +98,13 @@ class Curve:
         when this class has no shared work to save (then each is evaluated on its own: :func:`evaluate_curves`)."""
         return None
 
+    @property
+    def flat(self) -> bool:
+        """True when the curve's z does not change with ``v`` by construction (a plan curve lifted to a
+        height): a patch whose data are all flat has a z that is its spine's alone,
+        :meth:`~tabletcad.geometry.patch.PDEPatch.level`.  False unless a class knows it."""
+        return False
+
     # -- convenience ------------------------------------------------------------------
     def fourier(self, modes: int, samples: int | None = None):
         """Fourier coefficients ``(a0, a, b)`` up to ``modes``; see :func:`fourier_coefficients`."""
@@ -176,6 +183,10 @@ class Circle(Curve):
     def is_point(self) -> bool:
         return self.radius == 0.0
 
+    @property
+    def flat(self) -> bool:
+        return True
+
     def band_limit(self) -> int:
         return 1
 
@@ -207,6 +218,10 @@ class Ellipse(Curve):
         if der == 2:
             return np.stack([-self.rx * c, -self.ry * s, z], axis=-1)
         raise ValueError(f"der = {der} is not allowed: must be 0, 1 or 2")
+
+    @property
+    def flat(self) -> bool:
+        return True
 
     def band_limit(self) -> int:
         return 1
@@ -585,6 +600,11 @@ class Transformed(Curve):
     def band_limit(self) -> int | None:
         bl = getattr(self.base, "band_limit", None)  # an affine map keeps a trigonometric sum's modes
         return bl() if bl is not None else None
+
+    @property
+    def flat(self) -> bool:
+        """A flat curve stays flat when its new z takes nothing from its x and y (a move, a turn about z, a scale)."""
+        return getattr(self.base, "flat", False) is True and bool(self.matrix[2, 0] == 0.0 and self.matrix[2, 1] == 0.0)
 
     def evaluate(self, v, der: int = 0) -> np.ndarray:
         p = self.base.evaluate(v, der) @ self.matrix.T

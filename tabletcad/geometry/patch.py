@@ -495,6 +495,13 @@ class PDEPatch:
         X = X.reshape(-1, u.size, v.size)
         return X if components else np.ascontiguousarray(X.transpose(1, 2, 0))
 
+    @property
+    def level(self) -> bool:
+        """True when every datum is :attr:`~tabletcad.geometry.curves.Curve.flat` (its z does not change with
+        ``v``): then no mode and no remainder has a z part, and the surface's z at ``(u, v)`` is the spine's
+        at ``u`` (a swept family's patches: each line ``u`` lies in one plane ``z = A0_z(u)``)."""
+        return all(getattr(c, "flat", False) is True for c in self.data)
+
     def spine(self, u, du: int = 0) -> np.ndarray:
         """The spine ``A0(u)`` (eq 3.13, mm), the ``n = 0`` term; shape ``u.shape + (3,)``."""
         u = np.asarray(u, dtype=float)

@@ -1099,7 +1099,11 @@ class Tablet:
                           for p in self.patches for uc in t.u]
             inner = np.concatenate(inner)
             lo, hi = np.minimum(lo, inner.min(axis=0)), np.maximum(hi, inner.max(axis=0))
-        for axis in range(3):
+        level = all(p.level for p in self.patches)
+        if level:  # z is each patch's spine's alone (PDEPatch.level): its extremes from the spines, polished in u
+            zlo, zhi = self._spine_z_range()
+            lo[2], hi[2] = min(lo[2], zlo), max(hi[2], zhi)
+        for axis in range(2 if level else 3):
             for sign, store in ((-1.0, lo), (1.0, hi)):
                 c = pts[:, axis]
                 k = int(np.argmax(c) if sign > 0 else np.argmin(c))
@@ -1107,6 +1111,23 @@ class Tablet:
                 val = self._polish_extreme(self.patches[pi], axis, sign, u[ui], v[vi], u[1] - u[0], v[1] - v[0])
                 store[axis] = max(store[axis], val) if sign > 0 else min(store[axis], val)
         return lo, hi
+
+    def _spine_z_range(self) -> tuple[float, float]:
+        """Lowest and highest z (mm) of the patches' spines over the trimmed ``u`` range: the tablet's z extent
+        when every patch is :attr:`~tabletcad.geometry.patch.PDEPatch.level` (the trim's ``w`` scales the
+        plan only, eq 4.12).  Each spine is sampled (513 points) and polished
+        (:func:`~tabletcad.geometry.revolution.profile_extreme`) where its best sample comes within the
+        samples' largest second difference of the best of all, as :meth:`_profile_maxima`."""
+        lo, hi = self.trim.u
+        u = np.linspace(lo, hi, 513)
+        z = [p.spine(u)[:, 2] for p in self.patches]
+        out = []
+        for sign in (-1.0, 1.0):
+            best = max(float(np.max(sign * x)) for x in z)
+            slack = max(float(np.max(np.abs(np.diff(x, 2)))) for x in z)
+            out.append(sign * max(profile_extreme(lambda uu, p=p: sign * p.spine(uu)[:, 2], lo, hi)[1]
+                                  for p, x in zip(self.patches, z) if float(np.max(sign * x)) >= best - slack))
+        return out[0], out[1]
 
     def _polish_extreme(self, p, axis: int, sign: float, u0: float, v0: float, hu: float, hv: float) -> float:
         """Largest ``sign·X[axis]`` near ``(u0, v0)`` (see :meth:`bounds`).
