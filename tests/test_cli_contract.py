@@ -251,6 +251,20 @@ def test_shapes_marks_required_and_optional_and_prints_whole_descriptions(capsys
     assert d["ffbe"]["alternatives"] == {"bevel_width": "bevel_depth"} and d["concave_round"]["alternatives"] == {}
 
 
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
+@pytest.mark.parametrize("args", [["shapes", "--json"], ["report", str(ROOT / "samples" / "families" / "concave_round.toml")]])
+def test_standard_output_on_a_full_disk_is_the_machines_state_not_a_bug(tmp_path, args):
+    """``> /dev/full`` (every write: no space left on device) had been reported as an internal error with a
+    traceback log, exit 1: it is one line naming the output, exit 2, and no log."""
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], stdout=full, stderr=subprocess.PIPE,
+                              text=True, env=env, timeout=120)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.splitlines() == ["error: output = '(being written)' is not allowed: no space left on device"]
+    assert not (tmp_path / "cache").exists()
+
+
 @pytest.mark.parametrize("exc", [ZeroDivisionError("division by zero"), ValueError("a bare ValueError is a bug")])
 def test_internal_error_exit_1_with_log(capsys, tmp_path, monkeypatch, exc):
     import tabletcad.pipeline.build

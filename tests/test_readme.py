@@ -220,6 +220,11 @@ def test_toml_block_is_taken_by_its_reader(text: str, tmp_path: Path) -> None:
         load_sweep(f)
         readers += 1
     assert readers, f"a TOML block no reader checks: {text.splitlines()[0]}"
+    # a block that names the sample it shows holds that sample's data (the sweep block had an outputs line
+    # the file lacks)
+    named = re.search(r"#\s*(samples/\S+\.toml)", text.splitlines()[0])
+    if named:
+        assert data == tomllib.loads((REPO / named.group(1)).read_text(encoding="utf-8")), named.group(1)
 
 
 def test_every_block_is_checked() -> None:

@@ -233,7 +233,14 @@ def _run(argv: list[str] | None) -> int:
         return 2
     except OSError as exc:
         if exc.filename is None:
-            raise
+            import errno
+
+            # the system refused a write with no file named: standard output on a full disk (``> /dev/full``),
+            # or an open file's handle; the machine's state, not a bug in tabletcad
+            if isinstance(exc, BrokenPipeError) or exc.errno not in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO):
+                raise
+            _say("error: " + str(DesignError("output", "(being written)", exc.strerror.lower())))
+            return 2
         _say("error: " + str(DesignError("path", str(exc.filename), (exc.strerror or type(exc).__name__).lower())))
         return 2
     return 0
