@@ -455,7 +455,12 @@ def test_task_panel_form(headless):
     (st,) = _steps(headless, "form")
     assert [f[:3] for f in st["fields"]] == [[k, k.title().replace("_", ""), u] for k, u in fam.params.items()]
     assert [f[5] for f in st["fields"]] == [fam.defaults[k] for k in fam.params]
-    assert all(f[3] == 0.0 and f[4] == 100.0 for f in st["fields"])  # the core checks the rest
+    assert all(f[3] == 0.0 and f[4] == 1000.0 for f in st["fields"])  # the core's 1000 mm; it checks the rest
+    # what is typed is read with its unit (FreeCAD's parser), a plain number in the field's; text of another
+    # kind is the field's refusal until it is typed again
+    assert st["read"][:4] == [True, pytest.approx(10.16, abs=1e-12), True, 3.0]
+    assert st["read"][4] is False and st["read"][5] == "Diameter = '10 kg' is not allowed: must be a length (mm, cm, in, ...)"
+    assert st["read"][6] is False
     ok, msg, figs = st["bad"]
     assert not ok and "cup_depth" in msg and "hemisphere" in msg and figs == {}
     ok, msg, figs = st["good"]
@@ -515,6 +520,68 @@ def test_a_density_in_the_wrong_unit_is_refused(headless):
     assert all("Invalid" in s["state"] for s in bad), bad
     (ok,) = _steps(headless, "density_restored")
     assert "Invalid" not in ok["state"] and ok["weight"] == pytest.approx(ok["volume"] * ok["density"], rel=1e-12)
+
+
+def test_undo_of_a_family_change_brings_back_the_users_dimensions(headless):
+    """A FreeCAD user's trial: undo of Family concave_round -> capsule had left the round's defaults (10 / 3 /
+    1 mm, 315.2 mm3), not the 12 / 2.5 / 1.5 mm given; redo gives the capsule back."""
+    (s,) = _steps(headless, "trial_fc")
+    v_before, v_capsule = s["undo_volume"]
+    assert s["undone"][:4] == ["concave_round", 12.0, 2.5, 1.5]
+    assert s["undone"][4] == pytest.approx(v_before, rel=1e-12)
+    assert v_before == pytest.approx(_core_volume("concave_round", dict(diameter=12, band=2.5, cup_depth=1.5)), rel=1e-9)
+    assert s["redone"] == ["capsule", pytest.approx(v_capsule, rel=1e-12)]
+
+
+def test_make_tablet_refuses_its_arguments_before_making_an_object(headless):
+    """A misspelt dimension, text that is no quantity and a quantity of another kind are refused naming the
+    argument, and leave no unbuilt "Tablet" behind (each had); '0.4 in' is 10.16 mm."""
+    (s,) = _steps(headless, "trial_fc")
+    assert s["refusals"][0] == "family 'concave_round' has no parameter 'cup_depht'"
+    assert s["refusals"][1].startswith("diameter = 'abc' is not a quantity")
+    assert s["refusals"][2] == "diameter = '10 kg' is not a length"
+    assert "is not a density" in s["refusals"][3]
+    assert s["left_by_refusals"] == 0
+    assert s["inch_diameter"] == pytest.approx(10.16, abs=1e-12)
+
+
+def test_tooling_a_die_cannot_take_is_refused_before_any_part(headless):
+    """A 30 mm round is larger than a TSM D die takes: refused naming the die's OuterDiameter (the punches had
+    been made before the die failed, with the design file's key in the message); an 18 mm capsule's standard
+    die is a B (shaped tablets up to 19 mm)."""
+    (s,) = _steps(headless, "trial_fc")
+    assert s["big_refusal"].startswith("DesignError: OuterDiameter = (not given) is not allowed: give it and the "
+                                       "die's Height (StandardSize false) for a round tablet 30 mm across")
+    assert s["big_left"] == 0
+    assert s["capsule18_die"] == [30.16, 22.22, True, True]
+
+
+def test_tool_values_a_toolmaker_would_not_make_are_refused_naming_the_property(headless):
+    """A 1e-6 mm punch had failed inside a Boolean ("0 solids"), a 1e7 mm one and a 1 mm high die around a
+    3 mm band were built, a NaN outer diameter reached the Boolean: each is one line naming the property."""
+    (s,) = _steps(headless, "bad_tools")
+    (l1, l2, od, h) = s["refused"]
+    assert l1[:2] == ["Length", False] and "punch.Length = 1e-06 mm is not allowed: must be >= " in l1[2]
+    assert "mm of steel behind it" in l1[2]
+    assert l2[:2] == ["Length", False] and "punch.Length = 1e+07 mm is not allowed: must be > 0 and <= 1000" in l2[2]
+    assert od[:2] == ["OuterDiameter", False] and "die.OuterDiameter = nan mm is not allowed" in od[2]
+    assert h[:2] == ["Height", False] and "die.Height = 1 mm is not allowed: must be >= 5 mm: the band is 3 mm high" in h[2]
+    assert s["restored"] == [True, True]
+    # a size the user sets is kept: the standard die became a custom one (the 1 mm height had been set back to
+    # the standard's 22.22 mm at the recompute, without a word)
+    assert s["standard_after"] is False and s["die_size_after"] == [30.16, 22.22]
+
+
+def test_step_export_beside_a_tablet_without_a_band(headless):
+    """A document holding a sphere had failed to export at all, leaving three invalid tools in it: the sphere is
+    exported alone (a warning says why), the round with its tooling, and no invalid object stays."""
+    (s,) = _steps(headless, "export_with_sphere")
+    assert s["written"] == ["all", "concave_round", "concave_round die", "concave_round lower punch",
+                            "concave_round upper punch", "thesis.spherical"]
+    assert len(s["files"]) == 6 and all(f.endswith(".step") for f in s["files"])
+    assert [label for label, _ in s["objects"]] == ["thesis.spherical", "concave_round", "concave_round upper punch",
+                                                   "concave_round lower punch", "concave_round die"]
+    assert all(valid for _, valid in s["objects"])
 
 
 def test_a_standard_die_follows_the_tablets_size(headless):
@@ -746,11 +813,16 @@ def test_gui_smoke_and_screenshot(fc, fc_home, tmp_path):
     from tabletcad import families
 
     assert r["panel_shown"] and r["panel_fields"] == sorted(families.FAMILIES["concave_round"].params)
-    assert r["panel_suffix"] == " mm"
+    assert r["panel_suffix"].endswith(" mm")
     assert r["panel_invalid"][0] is False and "cup_depth" in r["panel_invalid"][1] and "hemisphere" in r["panel_invalid"][1]
+    # a FreeCAD user's trial: units as typed, a mass refused naming the field
+    assert r["panel_kg"][0] is False and "Diameter = '10 kg' is not allowed: must be a length" in r["panel_kg"][1]
+    assert r["panel_inch"] == pytest.approx(10.16, abs=1e-12)
     assert r["panel_valid"][0] is True and "Volume" in r["panel_valid"][2] and "mg" in r["panel_valid"][2]
     assert r["panel_accept"] and r["panel_closed"]
-    assert r["panel_tablet"] == ["concave_round", 1.0, True]
+    assert r["panel_tablet"] == ["concave_round", 1.0, pytest.approx(10.0, abs=1e-12), True]  # typed "1 cm"
+    assert r["panel_edit_accept"] and r["panel_edited"] == [10.0004, 0.08349, pytest.approx(1.1, abs=1e-12), True]
+    assert r["design_file_edit"] == [True, False, "design_file", True]
     # the TechDraw page of the concave round tablet: length, width and height as the core has them
     from tabletcad import families as _families
 

@@ -40,11 +40,17 @@ try:
     result["panel_shown"] = FreeCADGui.Control.activeDialog()
     panel.family.setCurrentIndex(panel.model.families.index("concave_round"))
     result["panel_fields"] = sorted(panel.spins)
-    result["panel_suffix"] = panel.spins["diameter"].suffix()
-    panel.spins["cup_depth"].setValue(10.0)  # deeper than a hemisphere: refused as you type
+    result["panel_suffix"] = panel.spins["diameter"].text()
+    panel.type_text("cup_depth", "10 mm")  # deeper than a hemisphere: refused as you type
     result["panel_invalid"] = [panel.ok, panel.status.text()]
     mark("invalid")
-    panel.spins["cup_depth"].setValue(1.0)
+    panel.type_text("cup_depth", "1")
+    # units as typed (a plain spin box had read '0.4 in' as 0.4 mm), a quantity of another kind refused
+    panel.type_text("diameter", "10 kg")
+    result["panel_kg"] = [panel.ok, panel.status.text()]
+    panel.type_text("diameter", "0.4 in")
+    result["panel_inch"] = panel.model.values["diameter"]
+    panel.type_text("diameter", "1 cm")  # (the drawing's checks below take the family's 10 mm)
     result["panel_valid"] = [panel.ok, panel.status.text(), panel.figures.text()]
     mark("valid")
     mw = FreeCADGui.getMainWindow()
@@ -57,7 +63,35 @@ try:
     mark("accept")
     result["panel_closed"] = FreeCADGui.Control.activeDialog() is False
     tab = doc.Objects[-1]
-    result["panel_tablet"] = [tab.Family, float(tab.CupDepth.Value), bool(tab.isValid())]
+    result["panel_tablet"] = [tab.Family, float(tab.CupDepth.Value), float(tab.Diameter.Value), bool(tab.isValid())]
+    # editing one field keeps the others' exact values (the fields show 2-3 decimals; OK had written every
+    # field back rounded, and capped at 100 mm)
+    before = {k: getattr(tab, k) for k in ("Diameter", "Land", "CupDepth")}
+    tab.Diameter = "10.0004 mm"
+    tab.Land = "0.08349 mm"
+    doc.recompute()
+    from freecad.tabletcad_wb.taskpanel import edit_tablet
+
+    edit = edit_tablet(tab)
+    edit.type_text("cup_depth", "1.1 mm")
+    result["panel_edit_accept"] = bool(edit.accept())
+    result["panel_edited"] = [float(tab.Diameter.Value), float(tab.Land.Value), float(tab.CupDepth.Value),
+                              bool(tab.isValid())]
+    for k, v in before.items():  # (the checks below read the panel's tablet as it was made)
+        setattr(tab, k, v)
+    doc.recompute()
+    # a design file's tablet is not edited in the panel (OK had made it the panel's first family)
+    stadium = os.path.join(os.environ["TABLETCAD_ROOT"], "samples", "free_form_stadium.toml")
+    from freecad.tabletcad_wb.make import make_tablet
+
+    dt = make_tablet(doc, stadium)
+    volume = float(dt.Volume)
+    FreeCADGui.ActiveDocument.setEdit(dt.Name, 0)
+    QtGui.QApplication.processEvents()
+    result["design_file_edit"] = [taskpanel.current is None, FreeCADGui.Control.activeDialog(), dt.Family,
+                                  float(dt.Volume) == volume]
+    doc.removeObject(dt.Name)
+    doc.recompute()
 
     # a refused value: what the Report view shows
     tab.CupDepth = 10.0

@@ -10,6 +10,7 @@ import sys
 import os
 import time
 import traceback
+from pathlib import Path
 
 import FreeCAD
 
@@ -287,6 +288,79 @@ try:
         doc.removeObject(o.Name)
     doc.recompute()
 
+    # ---- a FreeCAD user's trial (session 32): undo of a family change, arguments refused before any object,
+    # tooling a die cannot take refused before any part, a shaped tablet's B die, STEP export beside a sphere
+    doc.UndoMode = 1
+    un = make_tablet(doc, "concave_round", diameter=12, band=2.5, cup_depth=1.5)
+    v_before = float(un.Volume)
+    doc.openTransaction("family")
+    un.Family = "capsule"
+    doc.commitTransaction()
+    doc.recompute()
+    v_capsule = float(un.Volume)
+    doc.undo()
+    doc.recompute()
+    undone = [un.Family, float(un.Diameter.Value), float(un.Band.Value), float(un.CupDepth.Value), float(un.Volume)]
+    doc.redo()
+    doc.recompute()
+    redone = [un.Family, float(un.Volume)]
+    n_objects = len(doc.Objects)
+    refusals = []
+    for kw in (dict(cup_depht=1.0), dict(diameter="abc"), dict(diameter="10 kg"), dict(density="1.2 kg")):
+        try:
+            make_tablet(doc, "concave_round", **kw)
+            refusals.append(None)
+        except ValueError as exc:
+            refusals.append(str(exc))
+    left_by_refusals = len(doc.Objects) - n_objects
+    inch = make_tablet(doc, "concave_round", diameter="0.4 in", band="3", cup_depth=1)
+    big = make_tablet(doc, "concave_round", diameter=30, band=3, cup_depth=1)
+    n_objects = len(doc.Objects)
+    try:
+        make_tooling(doc, big)
+        big_refusal = None
+    except Exception as exc:
+        big_refusal = f"{type(exc).__name__}: {exc}"
+    big_left = len(doc.Objects) - n_objects
+    cap18 = make_tablet(doc, "capsule", length=18, width=8)
+    cap18_die = make_die(doc, cap18)
+    doc.recompute()
+    cap18_die_info = [float(cap18_die.OuterDiameter.Value), float(cap18_die.Height.Value), bool(cap18_die.isValid()),
+                      bool(cap18_die.StandardSize)]
+    # values a toolmaker would not make, each refused naming its property
+    cap18_up = make_upper_punch(doc, cap18)
+    bad_tools = []
+    for o, prop, value in ((cap18_up, "Length", 1e-6), (cap18_up, "Length", 1e7), (cap18_die, "OuterDiameter", float("nan")),
+                           (cap18_die, "Height", 1.0)):
+        good = getattr(o, prop)
+        setattr(o, prop, value)
+        doc.recompute()
+        bad_tools.append([prop, bool(o.isValid()), o.getStatusString()])
+        setattr(o, prop, good)
+        doc.recompute()
+    step("bad_tools", refused=bad_tools, restored=[bool(cap18_up.isValid()), bool(cap18_die.isValid())],
+         standard_after=bool(cap18_die.StandardSize), die_size_after=[float(cap18_die.OuterDiameter.Value),
+                                                                      float(cap18_die.Height.Value)])
+    doc.removeObject(cap18_up.Name)
+    step("trial_fc", undo_volume=[v_before, v_capsule], undone=undone, redone=redone, refusals=refusals,
+         left_by_refusals=left_by_refusals, inch_diameter=float(inch.Diameter.Value), big_refusal=big_refusal,
+         big_left=big_left, capsule18_die=cap18_die_info)
+    for o in [cap18_die, cap18, big, inch, un]:
+        doc.removeObject(o.Name)
+    doc.UndoMode = 0
+    doc.recompute()
+    from freecad.tabletcad_wb import tasks
+
+    exp_doc = FreeCAD.newDocument("export_sphere")
+    make_tablet(exp_doc, "thesis.spherical")
+    make_tablet(exp_doc, "concave_round")
+    exp_dir = Path(os.environ["TABLETCAD_FC_WORK"]) / "step_with_sphere"
+    written = tasks.export_step(exp_doc, str(exp_dir))
+    step("export_with_sphere", written=sorted(written), files=sorted(p.name for p in exp_dir.iterdir()),
+         objects=[(o.Label, bool(o.isValid())) for o in exp_doc.Objects])
+    FreeCAD.closeDocument(exp_doc.Name)
+    FreeCAD.setActiveDocument(doc.Name)  # (TechDraw's commands below work on the active document)
+
     # ---- family switch: Dimensions group follows the family
     sw = make_tablet(doc, "thesis.flat_faced_round")
     label_before = sw.Label
@@ -332,6 +406,9 @@ try:
     fields = form.fields()
     form.values["cup_depth"] = 10.0
     bad = form.validate()
+    read = [form.read("diameter", "0.4 in"), form.values["diameter"], form.read("band", "3"), form.values["band"],
+            form.read("diameter", "10 kg"), form.validate()[1], form.read("diameter", "nan mm")]
+    form.read("diameter", "8 mm")
     form.values.update(cup_depth=1.0, diameter=8.0)
     good = form.validate()
     made = form.create(doc, tooling=True)
@@ -349,6 +426,7 @@ try:
         bad=list(bad),
         good=list(good),
         from_object=same,
+        read=read,
         tablet=tablet_info(made),
         tooling=sorted(o.Label for o in linked),
         tooling_valid=[bool(o.isValid()) for o in linked],

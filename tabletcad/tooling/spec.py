@@ -106,6 +106,10 @@ def tip_inset(clearance_mm: float, bore_offset_mm: float) -> float:
     clearance below the bore's offset leaves the tips on the outline)."""
     return max(clearance_mm - bore_offset_mm, 0.0)
 
+#: the least steel (mm) a punch tip keeps behind the deepest point of its face (the cup's, or a raised
+#: figure's engraving in it): a 0.9 mm tip on a 0.9 mm cup had been built with nothing behind the cup's centre
+MIN_TIP_BACKING_MM = 1.0
+
 #: TSM die blanks: (outer diameter, height, type), mm; the largest tablet each takes, round and shaped,
 #: is the standard's (``max_round_tablet_mm``, ``max_shaped_tablet_mm`` in tabletcad/data/tooling_standards.toml)
 TSM_DIES = ((30.16, 22.22, "B"), (38.10, 23.81, "D"))

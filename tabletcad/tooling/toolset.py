@@ -16,7 +16,7 @@ from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.designreport import ReportOptions
 from tabletcad.tooling.booleans import CACHE, TIMER, to_manifold, volume
 from tabletcad.tolerance import DEFAULT
-from tabletcad.tooling.spec import ToolingSpec
+from tabletcad.tooling.spec import MIN_TIP_BACKING_MM, ToolingSpec
 
 __all__ = ["ToolSet", "make_tooling", "check_closed_position", "finished_solid", "DEFLECTION_MM"]
 
@@ -117,14 +117,11 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
                           f"closed position (the barrel stays out of the die)", "mm")
 
 
-#: the least steel (mm) a punch tip keeps behind the deepest point of its face (the cup's, or a raised
-#: figure's engraving in it): a 0.9 mm tip on a 0.9 mm cup had been built with nothing behind the cup's centre
-MIN_TIP_BACKING_MM = 1.0
 
 
 def _check_tip_lengths(frame, spec: ToolingSpec) -> None:
     """Each tip at least as long as its face is deep (the cup, and a raised figure's engraving) plus
-    :data:`MIN_TIP_BACKING_MM`, as a DesignError before any geometry."""
+    :data:`~tabletcad.tooling.spec.MIN_TIP_BACKING_MM`, as a DesignError before any geometry."""
     for name, tl, face, cup in (("tip_length_mm", spec.tip_length_mm, "top", frame.cup_depth_top),
                                 ("lower_tip_length_mm", spec.lower_tip, "bottom", frame.cup_depth_bottom)):
         raised = max((e.depth_mm for e in spec.emboss if e.face == face and e.mode == "emboss"), default=0.0)

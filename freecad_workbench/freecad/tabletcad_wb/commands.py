@@ -42,6 +42,19 @@ def _fit():
         FreeCADGui.SendMsgToActiveView("ViewFit")
 
 
+def _transaction(doc, name, make):
+    """``make()`` as one undo step named ``name`` (a command that adds objects is undone in one Std_Undo,
+    which had taken back the edit before it); nothing of it is left when it fails."""
+    doc.openTransaction(name)
+    try:
+        out = make()
+    except Exception:
+        doc.abortTransaction()
+        raise
+    doc.commitTransaction()
+    return out
+
+
 class _Command:
     name = ""
     icon = "Tablet"
@@ -83,9 +96,7 @@ class TabletFromDesignCommand(_Command):
         )
         if path:
             doc = _doc()
-            doc.openTransaction("Tablet from design")
-            make_tablet(doc, path)
-            doc.commitTransaction()
+            _transaction(doc, "Tablet from design", lambda: make_tablet(doc, path))
             _fit()
 
 
@@ -99,7 +110,8 @@ class UpperPunchCommand(_ToolCommand):
     tip = "Upper punch of the selected tablet (follows the tablet)"
 
     def Activated(self):
-        make_upper_punch(FreeCAD.ActiveDocument, _selected_tablet())
+        doc = FreeCAD.ActiveDocument
+        _transaction(doc, "Upper punch", lambda: make_upper_punch(doc, _selected_tablet()))
 
 
 class LowerPunchCommand(_ToolCommand):
@@ -107,7 +119,8 @@ class LowerPunchCommand(_ToolCommand):
     tip = "Lower punch of the selected tablet (follows the tablet)"
 
     def Activated(self):
-        make_lower_punch(FreeCAD.ActiveDocument, _selected_tablet())
+        doc = FreeCAD.ActiveDocument
+        _transaction(doc, "Lower punch", lambda: make_lower_punch(doc, _selected_tablet()))
 
 
 class DieCommand(_ToolCommand):
@@ -115,7 +128,8 @@ class DieCommand(_ToolCommand):
     tip = "Die of the selected tablet: the bore is its outline (follows the tablet)"
 
     def Activated(self):
-        make_die(FreeCAD.ActiveDocument, _selected_tablet())
+        doc = FreeCAD.ActiveDocument
+        _transaction(doc, "Die", lambda: make_die(doc, _selected_tablet()))
 
 
 class ToolingCommand(_ToolCommand):
@@ -123,7 +137,8 @@ class ToolingCommand(_ToolCommand):
     tip = "Upper punch, lower punch and die of the selected tablet"
 
     def Activated(self):
-        make_tooling(FreeCAD.ActiveDocument, _selected_tablet())
+        doc = FreeCAD.ActiveDocument
+        _transaction(doc, "Punches and die", lambda: make_tooling(doc, _selected_tablet()))
         _fit()
 
 
@@ -138,7 +153,8 @@ class ExportStepCommand(_ToolCommand):
 
         d = QtGui.QFileDialog.getExistingDirectory(None, "STEP output folder")
         if d:
-            tasks.export_step(FreeCAD.ActiveDocument, d)
+            doc = FreeCAD.ActiveDocument
+            _transaction(doc, "Export STEP", lambda: tasks.export_step(doc, d))
 
 
 class DrawingCommand(_ToolCommand):
@@ -149,9 +165,7 @@ class DrawingCommand(_ToolCommand):
         from .techdraw import make_page
 
         doc = FreeCAD.ActiveDocument
-        doc.openTransaction("Tablet drawing")
-        page, _, _ = make_page(doc, _selected_tablet())
-        doc.commitTransaction()
+        page, _, _ = _transaction(doc, "Tablet drawing", lambda: make_page(doc, _selected_tablet()))
         if hasattr(page, "ViewObject") and page.ViewObject is not None:
             page.ViewObject.show()
 

@@ -441,15 +441,23 @@ def punch_shape(tablet_shape, rims, which="upper", length=10.0, clearance=0.025)
     import Part
 
     from tabletcad.errors import DesignError, GeometryError
-    from tabletcad.tooling.spec import MAX_CLEARANCE_MM
+    from tabletcad.tolerance import DEFAULT
+    from tabletcad.tooling.spec import MAX_CLEARANCE_MM, MIN_TIP_BACKING_MM
 
-    if not length > 0:
-        raise DesignError("punch length", length, "must be > 0", "mm")
+    if not 0.0 < length <= DEFAULT.max_length:
+        raise DesignError("punch Length", length, f"must be > 0 and <= {DEFAULT.max_length:g}", "mm")
     if not 0.0 <= clearance <= MAX_CLEARANCE_MM:
-        raise DesignError("punch clearance", clearance, f"must be >= 0 and <= {MAX_CLEARANCE_MM:g}", "mm")
+        raise DesignError("punch Clearance", clearance, f"must be >= 0 and <= {MAX_CLEARANCE_MM:g}", "mm")
     _require_band(rims)
     sel, _ = _select(rims, which)
     sign = 1.0 if which == "upper" else -1.0
+    z = float(sel[0]["z"])
+    span = sel[0].get("tablet_z")  # (documents saved before it was kept: the cut)
+    rise = None if span is None else (span[1] - z if which == "upper" else z - span[0])
+    if rise is not None and not length >= rise + MIN_TIP_BACKING_MM:  # (a 1e-6 mm tip: "Boolean gave 0 solids")
+        raise DesignError("punch Length", length, f"must be >= {rise + MIN_TIP_BACKING_MM:.4g} mm: the tablet's face rises "
+                          f"{rise:.4g} mm beyond its band edge and the tip keeps {MIN_TIP_BACKING_MM:g} mm of steel "
+                          "behind it (as tabletcad build)", "mm")
     # the tip follows the die bore (:func:`die_shape`), the clearance inside it, as tabletcad build's tips
     from tabletcad.tooling.spec import tip_inset
 
@@ -459,9 +467,6 @@ def punch_shape(tablet_shape, rims, which="upper", length=10.0, clearance=0.025)
         raise DesignError("punch clearance", clearance, f"leaves no punch tip inside the tablet's outline ({exc})",
                           "mm") from None
     prism = face.extrude(FreeCAD.Vector(0, 0, sign * float(length)))
-    z = float(sel[0]["z"])
-    span = sel[0].get("tablet_z")  # (documents saved before it was kept: the cut)
-    rise = None if span is None else (span[1] - z if which == "upper" else z - span[0])
     if rise is not None and rise <= 1e-9 * max(1.0, abs(z)):
         # nothing of the tablet beyond the rim's plane (a flat face at the rim: the free-form stadium's):
         # the prism only touches it, and is the tip.  OCC's cut of a prism lying on a B-spline plane took
@@ -507,10 +512,12 @@ def die_shape(rims, height=22.22, outer_diameter=30.16):
     import Part
 
     from tabletcad.errors import DesignError, GeometryError
+    from tabletcad.tolerance import DEFAULT
     from tabletcad.tooling.spec import MIN_DIE_WALL_MM
 
-    if not height > 0:
-        raise DesignError("die height", height, "must be > 0", "mm")
+    for name, value in (("die Height", height), ("die OuterDiameter", outer_diameter)):
+        if not 0.0 < value <= DEFAULT.max_length:  # (a NaN outer diameter had reached the Boolean)
+            raise DesignError(name, value, f"must be > 0 and <= {DEFAULT.max_length:g}", "mm")
     _require_band(rims)
     outer = [r for r in rims if not r["inner"]]
     if not outer:
@@ -519,6 +526,9 @@ def die_shape(rims, height=22.22, outer_diameter=30.16):
         )
     lo = min(outer, key=lambda r: r["z"])
     z_lo, z_hi = lo["z"], max(r["z"] for r in outer)
+    if not height >= z_hi - z_lo + 2.0:  # centred on the band, 1 mm of it past each band edge at least
+        raise DesignError("die Height", height, f"must be >= {z_hi - z_lo + 2.0:.4g} mm: the band is {z_hi - z_lo:.4g} mm "
+                          "high and the die, centred on it, reaches 1 mm past each of its edges", "mm")
     bulge = _bore_offset([lo])  # (a thesis band bulges 2.5 µm)
     if bulge > 0:
         bore_wire = _offset_rim_wire(lo, bulge)
@@ -527,7 +537,7 @@ def die_shape(rims, height=22.22, outer_diameter=30.16):
     reach = bulge + (lo["radius"] if "radius" in lo else float(np.max(np.hypot(*np.asarray(lo["poles"])[:, :2].T))))
     if outer_diameter / 2.0 - reach < MIN_DIE_WALL_MM:  # tabletcad build's rule
         raise DesignError(
-            "die outer diameter",
+            "die OuterDiameter",
             outer_diameter,
             f"must be >= {2 * (reach + MIN_DIE_WALL_MM):.4g} mm (the tablet reaches {reach:.4g} mm from the axis, "
             f"the die's walls need {MIN_DIE_WALL_MM} mm)",

@@ -23,11 +23,21 @@ from . import objects
 __all__ = ["design_tooling", "make_die", "make_lower_punch", "make_tablet", "make_tooling", "make_upper_punch"]
 
 
-def _value(v, unit="mm"):
-    """Accept numbers (mm / deg), strings with units (``"9 mm"``) or Quantities."""
+def _value(v, unit="mm", name=None):
+    """Accept numbers (mm / deg), strings with units (``"9 mm"``, ``"0.4 in"``) or Quantities; a ValueError
+    naming ``name`` for text that is no quantity or one of another kind (``"10 kg"`` for a length)."""
     if isinstance(v, (int, float)):
         return FreeCAD.Units.Quantity(float(v), FreeCAD.Units.Unit(unit))
-    return FreeCAD.Units.Quantity(v)
+    try:
+        q = FreeCAD.Units.Quantity(v)
+    except Exception as exc:  # FreeCAD's parser: ValueError "syntax error", ArithmeticError ...
+        raise ValueError(f"{name or 'value'} = {v!r} is not a quantity ({exc})") from None
+    if q.Unit == FreeCAD.Units.Unit():  # a plain number in text: the property's unit
+        return FreeCAD.Units.Quantity(float(q.Value), FreeCAD.Units.Unit(unit))
+    if q.Unit != FreeCAD.Units.Unit(unit):
+        kind = "an angle" if unit == "deg" else "a length"
+        raise ValueError(f"{name or 'value'} = {v!r} is not {kind}")
+    return q
 
 
 def _new(doc, name):
@@ -69,29 +79,45 @@ def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, reco
         from tabletcad.families import family as lookup_family
 
         family = lookup_family(family, parameter="family").name
-    obj = _new(doc, "Tablet")
-    objects.TabletProxy(obj, family)
-    if design is not None:
-        obj.DesignFile = str(design)
+    # every argument read before the object is made: a misspelt name or a value of the wrong kind leaves
+    # nothing in the document (an unbuilt "Tablet" had stayed behind each time)
     fam = objects._family(family) if family != objects.DESIGN_FILE else None
+    values = {}
     for k, v in params.items():
         if fam is None or k not in fam.params:
             raise ValueError(f"family {family!r} has no parameter {k!r}")
-        setattr(obj, objects.prop_name(k), _value(v, "deg" if fam.params[k] == "deg" else "mm"))
+        values[objects.prop_name(k)] = _value(v, "deg" if fam.params[k] == "deg" else "mm", k)
     if density is not None:  # mg/mm^3, or a string with units ("1.2 g/cm^3")
         if isinstance(density, str) or (hasattr(density, "Unit") and hasattr(density, "Value")):
             # a string with units or a FreeCAD Quantity (float() of one is its value in kg/mm^3: 1.2 g/cm^3 had
             # been stored as 1.2e-6 mg/mm^3)
-            q = FreeCAD.Units.Quantity(density)
+            try:
+                q = FreeCAD.Units.Quantity(density)
+            except Exception as exc:
+                raise ValueError(f"density = {density!r} is not a quantity ({exc})") from None
             if q.Unit != FreeCAD.Units.Unit("kg/mm^3"):
                 raise ValueError(f"density {density!r} is not a density (give mg/mm^3, or units such as g/cm^3)")
-            obj.Density = float(q.Value) * 1e6  # kg/mm^3 -> mg/mm^3
+            density = float(q.Value) * 1e6  # kg/mm^3 -> mg/mm^3
         else:
-            obj.Density = float(density)
+            density = float(density)
     if fit_tol is not None:
-        obj.FitTolerance = _value(fit_tol)
-    obj.Label = label or family
-    objects.attach_view_provider(obj)
+        fit_tol = _value(fit_tol, "mm", "fit_tolerance")
+    obj = _new(doc, "Tablet")
+    try:
+        objects.TabletProxy(obj, family)
+        if design is not None:
+            obj.DesignFile = str(design)
+        for p, q in values.items():
+            setattr(obj, p, q)
+        if density is not None:
+            obj.Density = density
+        if fit_tol is not None:
+            obj.FitTolerance = fit_tol
+        obj.Label = label or family
+        objects.attach_view_provider(obj)
+    except BaseException:
+        doc.removeObject(obj.Name)
+        raise
     if recompute:
         doc.recompute()
     return obj
@@ -132,24 +158,23 @@ def make_die(doc, tablet, *, height=None, outer_diameter=None, recompute=True):
     """Die linked to ``tablet``: cylinder minus the bore (the tablet's outline); keywords only (the
     clearance that came third is the punches' now: an old positional call is a TypeError).  Without
     ``outer_diameter``, the TSM die for the tablet's size, as ``tabletcad build`` takes it (B,
-    30.16 x 22.22 mm, round tablets up to 16 mm and shaped ones up to 19 mm; D, 38.10 x 23.81 mm, up to 25 mm); neither given, the design
-    file's ``[tooling]`` table first."""
+    30.16 x 22.22 mm, round tablets up to 16 mm and shaped ones up to 19 mm; D, 38.10 x 23.81 mm, up to 25
+    mm); neither given, the design file's ``[tooling]`` table first."""
     if outer_diameter is None and height is None:  # the design file's [tooling] table, as build reads it
         values = design_tooling(tablet)[0]
         height, outer_diameter = values.get("die_height"), values.get("die_outer_diameter")
     standard = outer_diameter is None and height is None  # the TSM die, followed when the tablet changes
     if outer_diameter is None:  # (an outer diameter given alone keeps the 22.22 mm height, as build does)
-        from tabletcad.tooling.spec import standard_die_size
-
         core = tablet.Proxy.core_tablet(tablet)
         dims = core.dimensions()
-        outer_diameter, h, _ = standard_die_size(max(dims["length_mm"], dims["width_mm"]), shaped=core.revolution is None)
+        outer_diameter, h, _ = objects.standard_die(max(dims["length_mm"], dims["width_mm"]), core.revolution is None)
         height = h if height is None else height
     obj = _new(doc, "Die")
-    objects.DieProxy(obj, tablet, standard_size=standard)
+    objects.DieProxy(obj, tablet)
     for prop, v in (("Height", height), ("OuterDiameter", outer_diameter)):
         if v is not None:
             setattr(obj, prop, _value(v))
+    obj.StandardSize = standard  # (after the sizes: a size set while it is true makes the die a custom one)
     obj.Label = f"{tablet.Label} die"
     objects.attach_view_provider(obj)
     if recompute:
@@ -194,10 +219,18 @@ def make_tooling(doc, tablet, recompute=True, **kw):
         FreeCAD.Console.PrintWarning(
             f"tabletcad: {tablet.Label}: the workbench makes plain punch tips and a die; {', '.join(left)} of "
             f"{Path(tablet.DesignFile).name} are built by `tabletcad build` only\n")
-    up = make_upper_punch(doc, tablet, values.get("length"), False, values.get("clearance"))
-    low = make_lower_punch(doc, tablet, values.get("lower_length", values.get("length")), False, values.get("clearance"))
-    die = make_die(doc, tablet, height=values.get("die_height"), outer_diameter=values.get("die_outer_diameter"),
-                   recompute=False)
+    made = []  # nothing of it is left when a part cannot be made (the punches had stayed without their die)
+    try:
+        made.append(make_upper_punch(doc, tablet, values.get("length"), False, values.get("clearance")))
+        made.append(make_lower_punch(doc, tablet, values.get("lower_length", values.get("length")), False,
+                                     values.get("clearance")))
+        made.append(make_die(doc, tablet, height=values.get("die_height"),
+                             outer_diameter=values.get("die_outer_diameter"), recompute=False))
+    except BaseException:
+        for o in made:
+            doc.removeObject(o.Name)
+        raise
+    up, low, die = made
     if recompute:
         doc.recompute()
     return up, low, die

@@ -151,6 +151,21 @@ def prop_name(param: str) -> str:
     return "".join(w[:1].upper() + w[1:] for w in param.split("_"))
 
 
+def standard_die(size: float, shaped: bool) -> tuple[float, float, str]:
+    """``(outer diameter, height, TSM type)`` of the standard die for a tablet ``size`` mm across
+    (:func:`tabletcad.tooling.spec.standard_die_size`); one larger than a D die takes is refused naming the
+    die's ``OuterDiameter`` and ``StandardSize``, the properties that take a die of another size."""
+    from tabletcad.errors import DesignError
+    from tabletcad.tooling.spec import standard_die_size
+
+    try:
+        return standard_die_size(size, shaped=shaped)
+    except DesignError as exc:
+        raise DesignError("OuterDiameter", exc.value, f"give it and the die's Height (StandardSize false) for a "
+                          f"{'shaped' if shaped else 'round'} tablet {size:.4g} mm across: the largest TSM die, D, "
+                          "takes 25 mm") from None
+
+
 def is_tablet(obj) -> bool:
     return getattr(getattr(obj, "Proxy", None), "Type", None) == TabletProxy.Type
 
@@ -358,6 +373,10 @@ class TabletProxy(_Proxy):
         if prop == "Family":
             old = getattr(self, "_family_label", None)
             self._family_label = obj.Family
+            if getattr(obj.Document, "Transacting", False):
+                # undo or redo: the transaction restores the family's own dimension properties and values
+                # (resetting them to the family's defaults had lost the user's)
+                return
             suffix = obj.Label[len(old):] if old and obj.Label.startswith(old) else None
             if suffix is not None and (suffix == "" or suffix.isdigit()):
                 obj.Label = obj.Family  # the label was the family's name (FreeCAD numbers it if taken)
@@ -521,9 +540,9 @@ class DieProxy(_Proxy):
     def _setup(self, obj):
         self._add(obj, "App::PropertyLink", "Tablet", "Die", "the tablet this die forms")
         self._add(obj, "App::PropertyBool", "StandardSize", "Die",
-                  "the TSM die for the tablet's size, as tabletcad build takes it (B 30.16 x 22.22 mm up to 16 mm, "
-                  "D 38.10 x 23.81 mm up to 25.4 mm), followed when the tablet changes; false: OuterDiameter and "
-                  "Height as given")
+                  "the TSM die for the tablet's size, as tabletcad build takes it (B 30.16 x 22.22 mm up to 16 mm "
+                  "round and 19 mm shaped, D 38.10 x 23.81 mm up to 25 mm), followed when the tablet changes; false "
+                  "(also once OuterDiameter or Height is set): OuterDiameter and Height as given")
         if "Clearance" in obj.PropertiesList:  # a document of an earlier version: the punches take it now
             self._hand_clearance_to_punches(obj)
             obj.removeProperty("Clearance")
@@ -539,6 +558,21 @@ class DieProxy(_Proxy):
             _qty(30.16, "mm"),
         )
         self._add(obj, "App::PropertyFloat", "Volume", "Results (mm³)", "volume of the die, mm³", mode=_READONLY)
+
+    def set_size(self, obj, outer_diameter: float, height: float) -> None:
+        """Set the die's size as the standard's (``StandardSize`` stays as it is)."""
+        self._sizing = True
+        try:
+            obj.OuterDiameter, obj.Height = _qty(outer_diameter, "mm"), _qty(height, "mm")
+        finally:
+            self._sizing = False
+
+    def onChanged(self, obj, prop):
+        # a size the user sets is kept: the die stops following the standard (it had been set back to the
+        # standard's at the next recompute, without a word)
+        if (prop in ("Height", "OuterDiameter") and getattr(self, "_ready", False) and not getattr(self, "_sizing", False)
+                and getattr(obj, "StandardSize", False) and not getattr(obj.Document, "Transacting", False)):
+            obj.StandardSize = False
 
     @staticmethod
     def _hand_clearance_to_punches(obj):
@@ -557,12 +591,10 @@ class DieProxy(_Proxy):
         tab = _tablet_of(obj)
         rims = geometry.rims_from_json(tab.RimData)
         if getattr(obj, "StandardSize", False):  # the die follows the tablet's size (a 10 mm die had stayed on 28 mm)
-            from tabletcad.tooling.spec import standard_die_size
-
             shaped = any(r.get("shaped", False) for r in rims if not r["inner"])  # (not in a document of before)
-            od, height, _ = standard_die_size(geometry.plan_size(tab.Shape), shaped=shaped)
+            od, height, _ = standard_die(geometry.plan_size(tab.Shape), shaped)
             if abs(float(obj.OuterDiameter.Value) - od) > 1e-12 or abs(float(obj.Height.Value) - height) > 1e-12:
-                obj.OuterDiameter, obj.Height = _qty(od, "mm"), _qty(height, "mm")
+                self.set_size(obj, od, height)
         shape = geometry.die_shape(rims, float(obj.Height.Value), float(obj.OuterDiameter.Value))
         obj.Shape = shape
         obj.Placement = tab.Placement
@@ -602,8 +634,12 @@ class ViewProviderTabletcad:
             return None
         from .taskpanel import edit_tablet
 
-        edit_tablet(vobj.Object)
-        return True
+        if edit_tablet(vobj.Object) is None:  # a design file's tablet: a message, no panel, edit mode left at once
+            from PySide import QtCore
+            import FreeCADGui
+
+            QtCore.QTimer.singleShot(0, lambda: FreeCADGui.ActiveDocument and FreeCADGui.ActiveDocument.resetEdit())
+        return True  # (False would start FreeCAD's own Transform edit)
 
     def unsetEdit(self, vobj, mode=0):
         if mode != 0 or not is_tablet(vobj.Object):

@@ -18,8 +18,9 @@ __all__ = ["LIMITS", "TabletForm", "TabletTaskPanel", "edit_tablet"]
 
 current = None  # the panel shown last (scripts and tests drive it)
 
-# spin-box ranges by unit; the core's own checks (DesignError) give the exact allowed range
-LIMITS = {"mm": (0.0, 100.0, 3), "deg": (0.0, 90.0, 2)}
+# field ranges by unit, the core's own (Tolerances.max_length: 1000 mm); its checks (DesignError) give the
+# exact allowed range of each dimension
+LIMITS = {"mm": (0.0, 1000.0, 3), "deg": (0.0, 90.0, 2)}
 DENSITY_LIMITS = objects.DENSITY_LIMITS  # mg/mm^3 (= g/cm^3), as the object checks it
 
 
@@ -32,9 +33,30 @@ class TabletForm:
     def __init__(self, family: str = "thesis.flat_faced_round", values: dict | None = None, density: float = 1.2):
         self.families = objects.family_names()
         self.density = float(density)
+        self.errors: dict[str, str] = {}  # a field whose text is no value of its kind: the refusal
         self.set_family(family)
         if values:
             self.values.update({k: float(v) for k, v in values.items() if k in self.values})
+        self._family0, self._values0, self._density0 = self.family, dict(self.values), self.density
+
+    def read(self, key: str, text: str) -> bool:
+        """Take what was typed into the field ``key``: a length or angle with its unit (``0.4 in``, ``1 cm``,
+        ``0.5 rad``, FreeCAD's unit parser), or a plain number in the field's own unit (mm, deg).  Text that
+        is no quantity, or one of another kind (``10 kg``), is kept as the field's refusal (:meth:`validate`)."""
+        unit = self.units[key]
+        want = FreeCAD.Units.Unit("deg" if unit == "deg" else "mm")
+        label = objects.prop_name(key)
+        try:
+            q = FreeCAD.Units.Quantity(str(text).strip())
+        except Exception:
+            q = None
+        if q is None or not (q.Unit == want or q.Unit == FreeCAD.Units.Unit()) or not math.isfinite(float(q.Value)):
+            kind = "an angle (deg, rad)" if unit == "deg" else "a length (mm, cm, in, ...)"
+            self.errors[key] = f"{label} = {str(text).strip()!r} is not allowed: must be {kind}"
+            return False
+        self.errors.pop(key, None)
+        self.values[key] = float(q.Value) if q.Unit == FreeCAD.Units.Unit() else float(q.getValueAs(unit))
+        return True
 
     @classmethod
     def from_object(cls, obj) -> TabletForm:
@@ -48,6 +70,7 @@ class TabletForm:
         self.family = fam.name  # the catalogue's name (an old name of a renamed family becomes the new one)
         self.units = dict(fam.params)
         self.values = {k: float(v) for k, v in fam.defaults.items() if v is not None}
+        self.errors = {}
 
     def fields(self) -> list[tuple[str, str, str, float, float, float]]:
         """``(parameter, label, unit, minimum, maximum, value)`` per dimension."""
@@ -62,6 +85,8 @@ class TabletForm:
         figures: volume (mm³), surface area (mm²), weight (mg), height (mm)."""
         from tabletcad.errors import TabletcadError
 
+        if self.errors:
+            return False, next(iter(self.errors.values())), {}
         if not (DENSITY_LIMITS[0] <= self.density <= DENSITY_LIMITS[1]):
             return False, f"Density = {self.density:g} mg/mm³ is not allowed: {DENSITY_LIMITS[0]} to {DENSITY_LIMITS[1]}", {}
         try:
@@ -81,13 +106,18 @@ class TabletForm:
         return True, "valid", figs
 
     def apply(self, obj) -> None:
-        """Write the form into a Tablet object (family first: it resets the dimensions)."""
+        """Write what the form changed into a Tablet object: its family (which resets the dimensions) and then
+        every dimension, else only the dimensions and density that changed (a field the user did not touch
+        keeps the object's exact value: the fields show 3 decimals)."""
+        new_family = obj.Family != self.family or self.family != self._family0
         if obj.Family != self.family:
             obj.Family = self.family
         for k, unit in self.units.items():
-            q = FreeCAD.Units.Quantity(float(self.values[k]), FreeCAD.Units.Unit("deg" if unit == "deg" else "mm"))
-            setattr(obj, objects.prop_name(k), q)
-        obj.Density = float(self.density)
+            if new_family or self.values[k] != self._values0.get(k):
+                q = FreeCAD.Units.Quantity(float(self.values[k]), FreeCAD.Units.Unit("deg" if unit == "deg" else "mm"))
+                setattr(obj, objects.prop_name(k), q)
+        if new_family or self.density != self._density0:
+            obj.Density = float(self.density)
 
     def create(self, doc, tooling: bool = False):
         """A new Tablet (and its punches and die) from the form; recomputed."""
@@ -158,29 +188,52 @@ class TabletTaskPanel:
     def _build_dimensions(self):
         from PySide import QtGui
 
-        while self.dims.rowCount():
-            self.dims.removeRow(0)
+        import FreeCADGui
+
+        # the old rows are taken out and deleted later, once the new fields exist: a field made at a freed
+        # field's address had been handed the old field's deleted wrapper ("Internal C++ object already
+        # deleted", PySide2 with FreeCAD's QuantitySpinBox)
         self.spins = {}
+        while self.dims.count():
+            item = self.dims.takeAt(self.dims.count() - 1)
+            w = item.widget() if item is not None else None
+            if w is not None:
+                w.hide()
+                w.deleteLater()
+        loader = FreeCADGui.UiLoader()
         for k, label, unit, lo, hi, value in self.model.fields():
-            sb = QtGui.QDoubleSpinBox()
-            _, _, decimals = LIMITS.get(unit, LIMITS["mm"])
-            sb.setDecimals(decimals)
-            sb.setRange(lo, hi)
-            sb.setSingleStep(0.1)
-            sb.setSuffix(" °" if unit == "deg" else f" {unit}")
-            sb.setValue(value)
-            sb.setToolTip(f"{k} ({unit}), {lo:g} to {hi:g}; the tablet is checked as you type")
-            sb.valueChanged.connect(self._changed)
+            # FreeCAD's quantity field: '0.4 in', '1 cm', '0.5 rad' are read with their units (a plain spin box
+            # had taken '0.4 in' as 0.4 mm and capped values at 100 mm, 3 decimals)
+            sb = loader.createWidget("Gui::QuantitySpinBox", self.dims_box)
+            sb.setProperty("unit", "deg" if unit == "deg" else "mm")
+            sb.setProperty("minimum", lo)
+            sb.setProperty("maximum", hi)
+            sb.setProperty("singleStep", 0.1)
+            sb.setProperty("rawValue", value)
+            sb.setToolTip(f"{k} ({unit}, or any {'angle' if unit == 'deg' else 'length'} unit), {lo:g} to {hi:g}; "
+                          "the tablet is checked as you type")
+            sb.textChanged.connect(lambda text, key=k: self._typed(key, text))
             self.dims.addRow(label, sb)
             self.spins[k] = sb
+
+    def type_text(self, key: str, text: str) -> None:
+        """Put ``text`` into the field ``key`` as typing it would (scripts and tests)."""
+        from PySide import QtGui
+
+        self.spins[key].lineEdit().setText(text)
+        QtGui.QApplication.processEvents()
+        self._typed(key, self.spins[key].text())  # (the field may not signal text it does not accept)
 
     def _family_changed(self, index):
         self.model.set_family(self.model.families[int(index)])
         self._build_dimensions()
         self.refresh()
 
+    def _typed(self, key: str, text: str):
+        self.model.read(key, text)  # only the field typed in: the others keep their exact values
+        self.refresh()
+
     def _changed(self, *_):
-        self.model.values = {k: float(sb.value()) for k, sb in self.spins.items()}
         self.model.density = float(self.density.value())
         self.refresh()
 
@@ -228,11 +281,18 @@ class TabletTaskPanel:
             FreeCADGui.Control.closeDialog()
 
 
-def edit_tablet(obj=None, doc=None) -> TabletTaskPanel:
-    """Show the panel (GUI): edit ``obj`` or create a new tablet."""
+def edit_tablet(obj=None, doc=None) -> TabletTaskPanel | None:
+    """Show the panel (GUI): edit ``obj`` or create a new tablet.  A tablet read from a design file is not
+    edited here (None, and a message): its shape is the file's, which the panel's families cannot show (OK had
+    turned it into the panel's first family)."""
     import FreeCADGui
 
     global current
+    if obj is not None and obj.Family == objects.DESIGN_FILE:
+        FreeCAD.Console.PrintWarning(f"tabletcad: {obj.Label} is read from {obj.DesignFile}: edit that file (or "
+                                     "DesignFile), then recompute\n")
+        current = None
+        return None
     panel = TabletTaskPanel(obj, doc)
     FreeCADGui.Control.showDialog(panel)
     current = panel

@@ -80,7 +80,9 @@ def export_step(doc=None, directory=None, with_tooling=True):
     tablets = [o for o in doc.Objects if objects.is_tablet(o)]
     if not tablets:
         raise RuntimeError(f"document {doc.Label} has no tabletcad Tablet")
+    skipped = {}
     if with_tooling:
+        made = {}
         for t in tablets:
             linked = [
                 o
@@ -88,8 +90,21 @@ def export_step(doc=None, directory=None, with_tooling=True):
                 if getattr(getattr(o, "Proxy", None), "Type", "") in ("TabletcadPunch", "TabletcadDie")
             ]
             if not linked:
-                make_tooling(doc, t, recompute=False)
+                try:
+                    made[t.Label] = make_tooling(doc, t, recompute=False)
+                except Exception as exc:  # (a tablet too large for a standard die: refused before any part)
+                    skipped[t.Label] = " ".join(str(exc).split())
         doc.recompute()
+        # a tablet that cannot have tooling (a sphere has no band, a cut-away no whole outline) is exported
+        # alone: the tools made for it, which could not be built, are taken out again
+        for label, parts in made.items():
+            bad = [o for o in parts if not o.isValid() or o.Shape.isNull()]
+            if bad:
+                skipped[label] = " ".join(str(bad[0].getStatusString() or "recompute failed").split())
+                for o in parts:
+                    doc.removeObject(o.Name)
+        if skipped:
+            doc.recompute()
     wanted = [
         o for o in doc.Objects if getattr(getattr(o, "Proxy", None), "Type", "").startswith("Tabletcad")
     ]
@@ -104,6 +119,8 @@ def export_step(doc=None, directory=None, with_tooling=True):
     allp = directory / (_safe(doc.Label) + "_all.step")
     Import.export(wanted, str(allp))
     out["all"] = str(allp)
+    for label, why in skipped.items():
+        FreeCAD.Console.PrintWarning(f"tabletcad: {label} exported without tooling: {why}\n")
     FreeCAD.Console.PrintMessage(f"tabletcad: STEP written to {directory}\n")
     return out
 
