@@ -223,7 +223,7 @@ def test_toml_files_with_a_byte_order_mark_load_and_binary_ones_are_refused(tmp_
     junk = tmp_path / "junk.toml"
     junk.write_bytes(b"\x89PNG\r\n\x1a\n\xff\xfe\x00")
     for args, parameter in ((["report", str(junk)], "DESIGN"),
-                            (["optimise", str(junk), "--out", str(tmp_path / "o")], "problem.file")):
+                            (["optimise", str(junk), "--out", str(tmp_path / "o")], "PROBLEM.toml")):
         assert main(args) == 2
         err = capsys.readouterr().err
         assert err.startswith(f"error: {parameter} = ") and "UTF-8" in err and len(err.splitlines()) == 1

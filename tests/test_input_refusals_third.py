@@ -225,11 +225,11 @@ def test_every_toml_reader_refuses_nesting_too_deep_in_one_line(tmp_path, capsys
         f = tmp_path / "deep.toml"
         f.write_text('[design.tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 2.8\ncup_depth = 0.9\n'
                      f'[sweep]\nmethod = "grid"\n[sweep.vary]\n"tablet.band" = {deep}\n', encoding="utf-8")
-        args, name = ["sweep", f, "--out", tmp_path / "out"], "sweep.file"
+        args, name = ["sweep", f, "--out", tmp_path / "out"], "SWEEP.toml"  # (its usage line's name)
     elif kind == "optimise":
         f = tmp_path / "deep.toml"
         f.write_text(f'[problem]\nkind = "family"\nx = {deep}\n', encoding="utf-8")
-        args, name = ["optimise", f, "--out", tmp_path / "out"], "problem.file"
+        args, name = ["optimise", f, "--out", tmp_path / "out"], "PROBLEM.toml"
     else:
         from pathlib import Path
 
@@ -246,7 +246,7 @@ def test_every_toml_reader_refuses_nesting_too_deep_in_one_line(tmp_path, capsys
 
         with pytest.raises(DesignError) as exc:
             load_sweep(f)
-        rc, err = 2, [f"error: {exc.value}".replace("sweep_file", "sweep.file")]
+        rc, err = 2, [f"error: {exc.value}".replace("sweep.file", "SWEEP.toml")]
     else:
         rc, err = _run(capsys, tmp_path, *args)
     assert rc == 2 and len(err) == 1, err

@@ -82,7 +82,7 @@ BAD = [
     ("fixed_and_varied", FAMILY + "\n[fixed]\ndiameter = 5.0\n", "fixed.diameter"),
     ("fixed_not_a_table", FAMILY.replace("[problem]", "fixed = 5\n\n[problem]"), "fixed"),
     ("kind_list", SPHERE.replace('"spherical_tablet"', '["spherical_tablet"]'), "problem.kind"),
-    ("not_toml", "[problem\nkind = 1\n", "problem.file"),
+    ("not_toml", "[problem\nkind = 1\n", "PROBLEM.toml"),
 ]
 
 
@@ -129,7 +129,7 @@ def test_bad_paths_one_line(tmp_path, capsys, where):
     rc = main(["optimise", str(problem), "--out", str(out), "--quiet"])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1 and ONE_LINE.match(err[0]), err
-    assert err[0].startswith("error: problem.file =" if where == "problem_is_folder" else "error: --out =")
+    assert err[0].startswith("error: PROBLEM.toml =" if where == "problem_is_folder" else "error: --out =")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["blocker", "problem.toml"]
     assert blocker.read_text() == "not a folder"
 

@@ -223,8 +223,10 @@ def _run(argv: list[str] | None) -> int:
         exc.show()
         return exc.exit_code
     except DesignError as exc:
-        if exc.parameter == "design_file":  # the design file a command was given: its usage line's DESIGN
-            exc = exc.renamed("DESIGN")
+        # the file a command was given, named as its usage line names it
+        usage = {"design_file": "DESIGN", "sweep.file": "SWEEP.toml", "problem.file": "PROBLEM.toml"}
+        if exc.parameter in usage:
+            exc = exc.renamed(usage[exc.parameter])
         _say(f"error: {' '.join(str(exc).split())}")
         return 2
     except TabletcadError as exc:
