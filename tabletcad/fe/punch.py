@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from tabletcad.errors import DesignError, GeometryError, check_positive, check_range
+from tabletcad.errors import MISSING, DesignError, GeometryError, check_positive, check_range
 from tabletcad.fe.elasticity import Material, PressureLoad, _skfem_mesh, boundary_facets, solve_elasticity, von_mises
 from tabletcad.tolerance import MAX_YIELD_MPA, MIN_FORCE_N
 from tabletcad.fe.mesh import Refinement, check_mesh_size, mesh_solid
@@ -154,7 +154,8 @@ def punch_tip_solid(tablet: Any, spec: Any, which: str = "upper") -> tuple[Any, 
     if which not in ("upper", "lower"):
         raise DesignError("punch", which, "must be upper or lower")
     if spec is None:
-        raise DesignError("[tooling]", tablet.name, "fe punch needs a design file with a [tooling] table")
+        raise DesignError("[tooling]", MISSING, "a punch tip is made from the design's [tooling] table (clearance, tip "
+                          "length, standard): add one")
     from tabletcad.tooling.stage import check_tooling
     from tabletcad.tooling.toolset import make_tooling
 
