@@ -210,6 +210,26 @@ def test_file_outputs_come_back_as_bytes_or_go_to_a_store(local_client, tmp_path
     assert (store / h / "tablet.step").read_text() == "mine" and not (tmp_path / "out3").exists()
 
 
+def test_a_tooling_output_holds_every_file_its_build_writes(tmp_path):
+    """The "tooling" output of a design with complete punches (the TSM B sample's [tooling]) holds what
+    `tabletcad build` writes of it: the parts, and the tablet's and the punches' drawings in SVG, PDF and
+    DXF (the PDFs and the punches' drawing had been left out of the sweep's folders)."""
+    import tomllib
+
+    from tabletcad.tooling.spec import parse_tooling
+    from tabletcad.tooling.stage import tooling_outputs
+
+    sample = tomllib.loads((ROOT / "samples" / "tooling" / "tsm_b_round.toml").read_text(encoding="utf-8"))
+    sw = {"design": sample, "sweep": {"outputs": ["tooling"], "vary": {"tablet.band": [sample["tablet"]["band"]]}}}
+    df = run_sweep(sw, tmp_path / "out", workers=0, progress=False)
+    assert df["status"].tolist() == ["ok"], df["error"].tolist()
+    folder = tmp_path / "out" / "designs" / df["design_hash"][0]
+    names = sorted(p.name for p in folder.iterdir())
+    assert names == sorted(tooling_outputs(parse_tooling(sample["tooling"])))
+    assert {"drawing.pdf", "tooling.pdf", "tooling.svg", "tooling.dxf"} <= set(names)
+    assert (folder / "drawing.pdf").read_bytes().startswith(b"%PDF") and (folder / "tooling.pdf").read_bytes().startswith(b"%PDF")
+
+
 def test_tooling_batch_runs_on_the_cluster(local_client, tmp_path):
     from tabletcad.tooling import tooling_batch
 

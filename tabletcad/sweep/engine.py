@@ -112,9 +112,10 @@ def _evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",
                 tooling = None
                 if "tooling" in outputs:
                     from tabletcad.tooling.spec import ToolingSpec
+                    from tabletcad.tooling.stage import tooling_outputs
 
                     tooling = spec.tooling_spec or ToolingSpec()
-                    wanted += list(OUTPUTS["tooling"])
+                    wanted += tooling_outputs(tooling)  # (the PDF drawing and complete punches' had been left out)
                 report = build_tablet(tablet, Path(tmp) / "build", tooling=tooling, options=spec.report_options,
                                       cad=True, progress=False)
                 files.update(_files_of(Path(tmp) / "build", wanted))

@@ -51,7 +51,10 @@ OUTPUTS = {
     "stl": ("tablet.stl",),
     "glb": ("tablet.glb",),
     "png": ("tablet.png",),
-    "tooling": ("assembly.step", "upper_punch.step", "lower_punch.step", "die.step", "drawing.svg", "drawing.dxf"),
+    # (every tool set's; complete punches add their drawing, a scored or embossed tablet its plain one:
+    # tabletcad.tooling.stage.tooling_outputs, which a design's build collects)
+    "tooling": ("assembly.step", "upper_punch.step", "lower_punch.step", "die.step", "drawing.svg", "drawing.pdf",
+                "drawing.dxf"),
 }
 _SWEEP_KEYS = {"method", "samples", "seed", "outputs", "vary", "store"}
 
