@@ -80,13 +80,35 @@ def test_moving_what_the_model_hands_out_leaves_the_model_where_it_is(tmp_path):
     m.to_occ().Move(TopLoc_Location(tr))
     cq = pytest.importorskip("cadquery")
     m.to_cadquery().val().move(cq.Location(cq.Vector(0.0, -30.0, 0.0)))
-    for solid in (m.to_occ(), m.to_build123d().wrapped, m.to_cadquery().val().wrapped):
+    # the attributes too (a review: m.solid.shape had been the model's own object)
+    m.solid.shape.Move(TopLoc_Location(tr))
+    m.solid.faces[0].Move(TopLoc_Location(tr))
+    for solid in (m.to_occ(), m.to_build123d().wrapped, m.to_cadquery().val().wrapped, m.solid.shape):
         box = bd.Solid(solid).bounding_box()
         assert (box.min.X, box.min.Y, box.min.Z, box.max.Z) == pytest.approx((box0.min.X, box0.min.Y, box0.min.Z, box0.max.Z), abs=1e-9)
     m.export(tmp_path / "t.step")
     back = bd.import_step(str(tmp_path / "t.step")).bounding_box()
     assert (back.min.X, back.min.Z) == pytest.approx((box0.min.X, box0.min.Z), abs=1e-6)
     assert mass_properties(m.to_occ()).volume == pytest.approx(m.volume, rel=1e-6)
+    f0 = bd.Face(m.solid.faces[0]).bounding_box()
+    assert f0.min.Z == pytest.approx(bd.Face(m._solid.faces[0]).bounding_box().min.Z, abs=1e-12)
+
+
+def test_moving_a_tool_parts_shape_leaves_the_tool_set_where_it_is():
+    """``PartModel.shape`` is a new handle, as ``to_occ()`` is (it had been the tool set's own shape, whose move
+    moved the part in the model's assembly and exports)."""
+    from OCP.gp import gp_Trsf, gp_Vec
+    from OCP.TopLoc import TopLoc_Location
+
+    m = tabletcad.make("flat_face_round", diameter=8.0, thickness=3.0)
+    tools = m.tooling(clearance_mm=0.02, tip_length_mm=6.0)
+    die0 = bd.Solid(tools.die.to_occ()).bounding_box()
+    tr = gp_Trsf()
+    tr.SetTranslation(gp_Vec(100.0, 0.0, 0.0))
+    tools.die.shape.Move(TopLoc_Location(tr))
+    tools.parts["die"].shape.Move(TopLoc_Location(tr))
+    for shape in (tools.die.shape, tools.die.to_occ(), tools.toolset.parts["die"]):
+        assert bd.Solid(shape).bounding_box().min.X == pytest.approx(die0.min.X, abs=1e-9)
 
 
 def test_cadquery_hole_on_top_face():

@@ -98,14 +98,20 @@ class PartModel(_Shaped):
     """One solid of a tool set (``tablet``, ``upper_punch``, ``lower_punch``, ``die``)."""
 
     name: str
-    shape: Any  # TopoDS_Shape
+    _shape: Any = field(repr=False)  # the tool set's TopoDS_Shape, never handed out itself
 
-    def to_occ(self):
-        """The part's shape (a solid), a new handle on its topology and geometry
-        (:func:`tabletcad.cad._occ.handle`: moving it leaves the part where it is)."""
+    @property
+    def shape(self):
+        """The part's shape (a solid), a new handle on its topology and geometry each time
+        (:func:`tabletcad.cad._occ.handle`: moving it leaves the part, the tool set and its exports where
+        they are; the attribute had handed out the tool set's own shape)."""
         from tabletcad.cad._occ import handle
 
-        return handle(self.shape)
+        return handle(self._shape)
+
+    def to_occ(self):
+        """:attr:`shape`."""
+        return self.shape
 
     @property
     def volume(self) -> float:
@@ -202,16 +208,26 @@ class TabletModel(_Shaped):
         return self.tablet.volume()
 
     @cached_property
+    def _solid(self):
+        from tabletcad.cad.tablet_solid import tablet_solid
+
+        return tablet_solid(self.tablet, revolved=False)
+
+    @property
     def solid(self):
-        """The validated :class:`~tabletcad.cad.solid.TabletSolid` (B-spline faces, sewn).
+        """The validated :class:`~tabletcad.cad.solid.TabletSolid` (B-spline faces, sewn), a copy whose
+        ``shape`` is a new handle (moving it leaves the model, its exports and its tooling where they are).
 
         B-spline faces even for a tablet of revolution (whose ``tabletcad build`` STEP has exact
         surfaces of revolution): a surface of revolution has no normal at its pole, where
         cadquery's ``faces(">Z").workplane()`` asks for one (the face's centre projects onto it).
         """
-        from tabletcad.cad.tablet_solid import tablet_solid
+        from dataclasses import replace
 
-        return tablet_solid(self.tablet, revolved=False)
+        from tabletcad.cad._occ import handle
+
+        sol = self._solid
+        return replace(sol, shape=handle(sol.shape), faces=tuple(handle(f) for f in sol.faces))
 
     def to_occ(self):
         """The tablet's ``TopoDS_Solid``; for a cut-away view (``[trim] u`` or ``v``) the cut-away's,
@@ -220,7 +236,7 @@ class TabletModel(_Shaped):
         (``Move``, build123d's ``.move``) leaves the model, its exports and its tooling where they were."""
         from tabletcad.cad._occ import handle
 
-        return handle(self.solid.shape if self._whole else self._cutaway[0])
+        return handle(self._solid.shape if self._whole else self._cutaway[0])
 
     @property
     def _whole(self) -> bool:
@@ -271,7 +287,7 @@ class TabletModel(_Shaped):
         from tabletcad.brep.surfaces import tablet_profiles
         from tabletcad.cad.tablet_solid import tablet_solid
 
-        return tablet_solid(self.tablet) if tablet_profiles(self.tablet) is not None else self.solid
+        return tablet_solid(self.tablet) if tablet_profiles(self.tablet) is not None else self._solid
 
     def report(self) -> dict[str, Any]:
         """The geometry and design report (the content of ``report.json``)."""
