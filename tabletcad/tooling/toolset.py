@@ -23,10 +23,10 @@ __all__ = ["ToolSet", "make_tooling", "check_closed_position", "finished_solid",
 DEFLECTION_MM = DEFAULT.mesh_deflection
 
 
-@dataclass(eq=False)
+@dataclass(frozen=True, eq=False)
 class ToolSet:
-    """Solids at the closed position (``parts``: tablet, upper_punch, lower_punch, die), the
-    upper punch's lift for the chosen gap, and the report section."""
+    """Solids at the closed position (``parts``: tablet, upper_punch, lower_punch, die; read-only, a
+    :class:`~tabletcad.readonly.TableDict`), the upper punch's lift for the chosen gap, and the report section."""
 
     tablet: Tablet
     spec: ToolingSpec
@@ -34,6 +34,11 @@ class ToolSet:
     parts: dict
     lift_mm: float
     report: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        from tabletcad.readonly import TableDict
+
+        object.__setattr__(self, "parts", TableDict(self.parts))  # (a part set to None had been taken)
 
     def placed(self) -> dict:
         """Parts at the press position of ``spec.gap_mm`` (the upper punch lifted by ``lift_mm``)."""
