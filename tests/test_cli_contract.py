@@ -265,6 +265,37 @@ def test_standard_output_on_a_full_disk_is_the_machines_state_not_a_bug(tmp_path
     assert not (tmp_path / "cache").exists()
 
 
+def test_a_full_disk_while_writing_a_file_names_the_file(capsys, tmp_path, monkeypatch):
+    """A write into the temporary file that stands for an output, refused for want of space, carries no file
+    name: the output it stands for is named (a review: "output = '(being written)'" on a full tmpfs), and
+    nothing is left behind."""
+    import errno
+
+    import tabletcad.io.atomic as atomic
+    from tabletcad.io.atomic import atomic_path
+
+    target = tmp_path / "m.vtu"
+    with pytest.raises(OSError) as info:
+        with atomic_path(target) as tmp:
+            tmp.write_bytes(b"x")
+            raise OSError(errno.ENOSPC, "No space left on device")
+    assert info.value.filename == str(target) and info.value.errno == errno.ENOSPC
+    assert sorted(tmp_path.iterdir()) == []
+
+    def full(self, data):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(Path, "write_bytes", full)
+    monkeypatch.setattr(Path, "write_text", lambda self, *a, **k: full(self, b""))
+    import meshio
+
+    monkeypatch.setattr(meshio, "write", lambda path, *a, **k: full(path, b""))
+    out = tmp_path / "m.vtu"
+    rc, _, err = run(capsys, "mesh", ROOT / "samples" / "flat_faced_round.toml", "--nodes", 5, 8, 3, "--out", out)
+    assert rc == 2 and err.splitlines() == [f"error: path = '{out}' is not allowed: no space left on device"], err
+    assert sorted(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("exc", [ZeroDivisionError("division by zero"), ValueError("a bare ValueError is a bug")])
 def test_internal_error_exit_1_with_log(capsys, tmp_path, monkeypatch, exc):
     import tabletcad.pipeline.build

@@ -538,10 +538,15 @@ def test_make_tablet_refuses_its_arguments_before_making_an_object(headless):
     argument, and leave no unbuilt "Tablet" behind (each had); '0.4 in' is 10.16 mm."""
     (s,) = _steps(headless, "trial_fc")
     assert s["refusals"][0] == "family 'concave_round' has no parameter 'cup_depht'"
-    assert s["refusals"][1].startswith("diameter = 'abc' is not a quantity")
-    assert s["refusals"][2] == "diameter = '10 kg' is not a length"
+    assert s["refusals"][1].startswith("diameter = 'abc' is not allowed: must be a length (mm, cm, in, ...)")
+    assert s["refusals"][2] == "diameter = '10 kg' is not allowed: must be a length (mm, cm, in, ...)"
     assert "is not a density" in s["refusals"][3]
     assert s["left_by_refusals"] == 0
+    # the tools' constructors too, each argument named
+    assert [r.split(" = ")[0] for r in s["tool_refusals"]] == ["length", "die_height", "die_outer_diameter",
+                                                               "clearance", "lower_length"], s["tool_refusals"]
+    assert all("is not allowed: must be a length" in r for r in s["tool_refusals"])
+    assert s["tools_left"] == 0
     assert s["inch_diameter"] == pytest.approx(10.16, abs=1e-12)
 
 
@@ -554,6 +559,8 @@ def test_tooling_a_die_cannot_take_is_refused_before_any_part(headless):
                                        "die's Height (StandardSize false) for a round tablet 30 mm across")
     assert s["big_left"] == 0
     assert s["capsule18_die"] == [30.16, 22.22, True, True]
+    # at the standard's limits (19 mm shaped, 16 mm round) the B die, as made and after recomputes
+    assert s["limit_dies"] == {f: [30.16, 30.16, True, True] for f in ("capsule", "oval", "concave_round")}
 
 
 def test_tool_values_a_toolmaker_would_not_make_are_refused_naming_the_property(headless):
@@ -818,6 +825,9 @@ def test_gui_smoke_and_screenshot(fc, fc_home, tmp_path):
     # a FreeCAD user's trial: units as typed, a mass refused naming the field
     assert r["panel_kg"][0] is False and "Diameter = '10 kg' is not allowed: must be a length" in r["panel_kg"][1]
     assert r["panel_inch"] == pytest.approx(10.16, abs=1e-12)
+    assert r["panel_typed"] == {"10.1234": ["10.1234", pytest.approx(10.1234, abs=1e-12)],
+                                "0.41 in": ["0.41 in", pytest.approx(10.414, abs=1e-12)],
+                                "1.2345 cm": ["1.2345 cm", pytest.approx(12.345, abs=1e-12)]}
     assert r["panel_valid"][0] is True and "Volume" in r["panel_valid"][2] and "mg" in r["panel_valid"][2]
     assert r["panel_accept"] and r["panel_closed"]
     assert r["panel_tablet"] == ["concave_round", 1.0, pytest.approx(10.0, abs=1e-12), True]  # typed "1 cm"

@@ -60,13 +60,14 @@ def test_standard_values_agree_with_the_published_inch_figures_and_differences()
     assert (d["TSM"]["B"]["head"], d["EU"]["B"]["head"]) == ("angled", "domed")
 
 
-@pytest.mark.parametrize("size, shaped, kind", [(16.0, False, "B"), (16.01, False, "D"), (16.01, True, "B"),
-                                                 (19.0, True, "B"), (19.01, True, "D"), (25.0, False, "D"),
-                                                 (25.0, True, "D")])
+@pytest.mark.parametrize("size, shaped, kind", [(16.0, False, "B"), (16.005, False, "B"), (16.02, False, "D"),
+                                                 (16.02, True, "B"), (19.0, True, "B"), (19.000001, True, "B"),
+                                                 (19.02, True, "D"), (25.0, False, "D"), (25.0, True, "D")])
 def test_the_placeholder_die_is_the_smallest_tsm_type_the_standard_lets_take_the_tablet(size, shaped, kind):
     """Tips only, no die size given: the TSM B blank for round tablets up to 16 mm and shaped ones up to 19 mm
     (the standards file's ``max_round_tablet_mm``/``max_shaped_tablet_mm``; an 18 mm capsule had been given
-    a D die), D up to 25 mm; larger is refused, naming the die's outer diameter."""
+    a D die), D up to 25 mm; larger is refused, naming the die's outer diameter.  A PDE surface's micrometres
+    beyond the nominal size keep its die (a 19 mm rounded rectangle measured 19.00000088 mm and got a D)."""
     from tabletcad.tooling.spec import standard_die_size
 
     d = load_standards()["TSM"]
@@ -74,7 +75,7 @@ def test_the_placeholder_die_is_the_smallest_tsm_type_the_standard_lets_take_the
     assert name == kind
     assert od == d[kind]["die_outer_diameter_mm"]["value"] and h == {"B": 22.22, "D": 23.81}[kind]
     with pytest.raises(DesignError, match=r"die_outer_diameter_mm = \(not given\).*TSM 'D' die takes, 25 mm"):
-        standard_die_size(25.01, shaped=shaped)
+        standard_die_size(25.02, shaped=shaped)
 
 
 # ----------------------------------------------------------------------------- spec checks (no geometry)

@@ -50,6 +50,11 @@ try:
     result["panel_kg"] = [panel.ok, panel.status.text()]
     panel.type_text("diameter", "0.4 in")
     result["panel_inch"] = panel.model.values["diameter"]
+    typed = {}
+    for text in ("10.1234", "0.41 in", "1.2345 cm"):  # as typed, not rounded to the display's decimals (a review)
+        panel.type_text("diameter", text)
+        typed[text] = [panel.spins["diameter"].text(), panel.model.values["diameter"]]
+    result["panel_typed"] = typed
     panel.type_text("diameter", "1 cm")  # (the drawing's checks below take the family's 10 mm)
     result["panel_valid"] = [panel.ok, panel.status.text(), panel.figures.text()]
     mark("valid")

@@ -342,7 +342,34 @@ try:
          standard_after=bool(cap18_die.StandardSize), die_size_after=[float(cap18_die.OuterDiameter.Value),
                                                                       float(cap18_die.Height.Value)])
     doc.removeObject(cap18_up.Name)
+    # tools refused on their arguments leave nothing either (a review)
+    n_objects = len(doc.Objects)
+    tool_refusals = []
+    for make, kw in ((make_upper_punch, dict(length="abc")), (make_die, dict(height="abc")),
+                     (make_tooling, dict(die_outer_diameter="10 kg")), (make_tooling, dict(clearance="1 kg")),
+                     (make_tooling, dict(lower_length="x"))):
+        try:
+            make(doc, inch, **kw)
+            tool_refusals.append(None)
+        except ValueError as exc:
+            tool_refusals.append(str(exc))
+    tools_left = len(doc.Objects) - n_objects
+    # the standard die at the limits, as made and after a recompute (sized from the core's bounds both times: the
+    # solid's box had turned a 19 mm capsule's B die into a D at the first recompute)
+    limit_dies = {}
+    for fam, kw in (("capsule", dict(length=19, width=8)), ("oval", dict(length=19, width=9)),
+                    ("concave_round", dict(diameter=16, band=3, cup_depth=1))):
+        lt = make_tablet(doc, fam, **kw)
+        ld = make_die(doc, lt, recompute=False)
+        made_od = float(ld.OuterDiameter.Value)
+        doc.recompute()
+        lt.Band = float(lt.Band.Value) + 0.1
+        doc.recompute()
+        limit_dies[fam] = [made_od, float(ld.OuterDiameter.Value), bool(ld.isValid()), bool(ld.StandardSize)]
+        doc.removeObject(ld.Name)
+        doc.removeObject(lt.Name)
     step("trial_fc", undo_volume=[v_before, v_capsule], undone=undone, redone=redone, refusals=refusals,
+         tool_refusals=tool_refusals, tools_left=tools_left, limit_dies=limit_dies,
          left_by_refusals=left_by_refusals, inch_diameter=float(inch.Diameter.Value), big_refusal=big_refusal,
          big_left=big_left, capsule18_die=cap18_die_info)
     for o in [cap18_die, cap18, big, inch, un]:

@@ -41,7 +41,14 @@ def atomic_path(target: str | os.PathLike[str]) -> Iterator[Path]:
     os.close(fd)
     tmp_path = Path(tmp)
     try:
-        yield tmp_path
+        try:
+            yield tmp_path
+        except OSError as exc:
+            if exc.errno is None or exc.filename not in (None, str(tmp_path)):
+                raise
+            # a write into the temporary file refused by the system (no space left on device) names no file:
+            # the target it stands for is named (the command line had said "output")
+            raise OSError(exc.errno, exc.strerror, str(target)) from exc
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp_path, 0o666 & ~umask)  # mkstemp creates 0600; give the file normal permissions

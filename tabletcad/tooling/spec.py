@@ -123,14 +123,20 @@ def tsm_die_limits(kind: str) -> tuple[float, float]:
     return float(entry["max_round_tablet_mm"]["value"]), float(entry["max_shaped_tablet_mm"]["value"])
 
 
+#: how far (mm) a tablet may measure beyond a die type's largest tablet and still be taken as that size: a
+#: PDE surface leaves its nominal outline by micrometres (a 19 mm rounded rectangle measured 19.00000088 mm
+#: and had been given a D die, a 19 mm capsule a B)
+DIE_SIZE_SLACK_MM = 0.01
+
+
 def standard_die_size(size_mm: float, shaped: bool = False) -> tuple[float, float, str]:
     """``(outer diameter, height, TSM type)`` of the die for a tablet whose largest plan dimension is
     ``size_mm`` (:data:`TSM_DIES`): the smallest type that takes it, round or ``shaped`` (a B die takes
-    round tablets up to 16 mm and shaped ones up to 19 mm); a :class:`DesignError` for one larger than a
-    'D' die takes."""
+    round tablets up to 16 mm and shaped ones up to 19 mm; :data:`DIE_SIZE_SLACK_MM` beyond a limit is at
+    it); a :class:`DesignError` for one larger than a 'D' die takes."""
     for od, h, name in TSM_DIES:
         lim = tsm_die_limits(name)[1 if shaped else 0]
-        if size_mm <= lim + 1e-9:
+        if size_mm <= lim + DIE_SIZE_SLACK_MM:
             return od, h, name
     raise DesignError("[tooling] die_outer_diameter_mm", MISSING,
                       f"give it for a {'shaped' if shaped else 'round'} tablet {size_mm:.4g} mm long (larger than a "

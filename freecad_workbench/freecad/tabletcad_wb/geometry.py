@@ -270,6 +270,9 @@ def build_tablet(tablet, tol=None):
             r["band"] = band is not None
             # a TSM B die takes round tablets up to 16 mm and shaped ones up to 19 mm (the standard die's size)
             r["shaped"] = tablet.revolution is None
+            # the core's largest plan extent (its polished bounds, as tabletcad build sizes its die): the
+            # solid's box is looser (0.20 has no tight box: an 18.9 mm capsule's read 19.02 mm, a D die)
+            r["plan_size"] = float(max(hi[0] - lo[0], hi[1] - lo[1]))
             # the tablet's lowest and highest z (mm, the core's polished bounds): a face flat at its rim
             # gives the punch its whole prism (punch_shape)
             r["tablet_z"] = [float(lo[2]), float(hi[2])]
@@ -464,7 +467,7 @@ def punch_shape(tablet_shape, rims, which="upper", length=10.0, clearance=0.025)
     try:
         face = _rim_face(sel, tip_inset(clearance, _bore_offset(sel)), clearance)
     except (GeometryError, Part.OCCError) as exc:
-        raise DesignError("punch clearance", clearance, f"leaves no punch tip inside the tablet's outline ({exc})",
+        raise DesignError("punch Clearance", clearance, f"leaves no punch tip inside the tablet's outline ({exc})",
                           "mm") from None
     prism = face.extrude(FreeCAD.Vector(0, 0, sign * float(length)))
     if rise is not None and rise <= 1e-9 * max(1.0, abs(z)):

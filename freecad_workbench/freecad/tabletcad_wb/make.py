@@ -31,12 +31,13 @@ def _value(v, unit="mm", name=None):
     try:
         q = FreeCAD.Units.Quantity(v)
     except Exception as exc:  # FreeCAD's parser: ValueError "syntax error", ArithmeticError ...
-        raise ValueError(f"{name or 'value'} = {v!r} is not a quantity ({exc})") from None
+        kind = "an angle (deg, rad)" if unit == "deg" else "a length (mm, cm, in, ...)"
+        raise ValueError(f"{name or 'value'} = {v!r} is not allowed: must be {kind} ({exc})") from None
     if q.Unit == FreeCAD.Units.Unit():  # a plain number in text: the property's unit
         return FreeCAD.Units.Quantity(float(q.Value), FreeCAD.Units.Unit(unit))
     if q.Unit != FreeCAD.Units.Unit(unit):
-        kind = "an angle" if unit == "deg" else "a length"
-        raise ValueError(f"{name or 'value'} = {v!r} is not {kind}")
+        kind = "an angle (deg, rad)" if unit == "deg" else "a length (mm, cm, in, ...)"
+        raise ValueError(f"{name or 'value'} = {v!r} is not allowed: must be {kind}")
     return q
 
 
@@ -129,14 +130,21 @@ def _punch(doc, tablet, which, length, clearance, recompute):
         if length is None:
             length = values.get("lower_length", values.get("length")) if which == "lower" else values.get("length")
         clearance = values.get("clearance") if clearance is None else clearance
+    # read before the object is made: a bad one leaves nothing behind
+    length = None if length is None else _value(length, "mm", "length" if which == "upper" else "lower_length")
+    clearance = None if clearance is None else _value(clearance, "mm", "clearance")
     obj = _new(doc, "UpperPunch" if which == "upper" else "LowerPunch")
-    objects.PunchProxy(obj, tablet, which)
-    if length is not None:
-        obj.Length = _value(length)
-    if clearance is not None:
-        obj.Clearance = _value(clearance)
-    obj.Label = f"{tablet.Label} {which} punch"
-    objects.attach_view_provider(obj)
+    try:
+        objects.PunchProxy(obj, tablet, which)
+        if length is not None:
+            obj.Length = length
+        if clearance is not None:
+            obj.Clearance = clearance
+        obj.Label = f"{tablet.Label} {which} punch"
+        objects.attach_view_provider(obj)
+    except BaseException:
+        doc.removeObject(obj.Name)
+        raise
     if recompute:
         doc.recompute()
     return obj
@@ -169,14 +177,20 @@ def make_die(doc, tablet, *, height=None, outer_diameter=None, recompute=True):
         dims = core.dimensions()
         outer_diameter, h, _ = objects.standard_die(max(dims["length_mm"], dims["width_mm"]), core.revolution is None)
         height = h if height is None else height
+    sizes = {prop: _value(v, "mm", name) for prop, name, v in (("Height", "die_height", height),
+                                                                ("OuterDiameter", "die_outer_diameter", outer_diameter))
+             if v is not None}  # read before the object is made: a bad one leaves nothing behind
     obj = _new(doc, "Die")
-    objects.DieProxy(obj, tablet)
-    for prop, v in (("Height", height), ("OuterDiameter", outer_diameter)):
-        if v is not None:
-            setattr(obj, prop, _value(v))
-    obj.StandardSize = standard  # (after the sizes: a size set while it is true makes the die a custom one)
-    obj.Label = f"{tablet.Label} die"
-    objects.attach_view_provider(obj)
+    try:
+        objects.DieProxy(obj, tablet)
+        for prop, q in sizes.items():
+            setattr(obj, prop, q)
+        obj.StandardSize = standard  # (after the sizes: a size set while it is true makes the die a custom one)
+        obj.Label = f"{tablet.Label} die"
+        objects.attach_view_provider(obj)
+    except BaseException:
+        doc.removeObject(obj.Name)
+        raise
     if recompute:
         doc.recompute()
     return obj

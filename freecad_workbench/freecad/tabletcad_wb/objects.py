@@ -151,19 +151,22 @@ def prop_name(param: str) -> str:
     return "".join(w[:1].upper() + w[1:] for w in param.split("_"))
 
 
-def standard_die(size: float, shaped: bool) -> tuple[float, float, str]:
+def standard_die(size: float, shaped: bool, current=None) -> tuple[float, float, str]:
     """``(outer diameter, height, TSM type)`` of the standard die for a tablet ``size`` mm across
     (:func:`tabletcad.tooling.spec.standard_die_size`); one larger than a D die takes is refused naming the
-    die's ``OuterDiameter`` and ``StandardSize``, the properties that take a die of another size."""
-    from tabletcad.errors import DesignError
-    from tabletcad.tooling.spec import standard_die_size
+    die's ``OuterDiameter`` (``current``: its value now, when the die exists) and ``StandardSize``, the
+    properties that take a die of another size."""
+    from tabletcad.errors import MISSING, DesignError
+    from tabletcad.tooling.spec import standard_die_size, tsm_die_limits
 
     try:
         return standard_die_size(size, shaped=shaped)
-    except DesignError as exc:
-        raise DesignError("OuterDiameter", exc.value, f"give it and the die's Height (StandardSize false) for a "
-                          f"{'shaped' if shaped else 'round'} tablet {size:.4g} mm across: the largest TSM die, D, "
-                          "takes 25 mm") from None
+    except DesignError:
+        kind = "shaped" if shaped else "round"
+        raise DesignError("OuterDiameter", MISSING if current is None else current,
+                          f"give it and the die's Height (StandardSize false) for a {kind} tablet {size:.4g} mm across: "
+                          f"the largest TSM die, D, takes {kind} tablets up to {tsm_die_limits('D')[1 if shaped else 0]:g} mm",
+                          "" if current is None else "mm") from None
 
 
 def is_tablet(obj) -> bool:
@@ -591,8 +594,11 @@ class DieProxy(_Proxy):
         tab = _tablet_of(obj)
         rims = geometry.rims_from_json(tab.RimData)
         if getattr(obj, "StandardSize", False):  # the die follows the tablet's size (a 10 mm die had stayed on 28 mm)
-            shaped = any(r.get("shaped", False) for r in rims if not r["inner"])  # (not in a document of before)
-            od, height, _ = standard_die(geometry.plan_size(tab.Shape), shaped)
+            outer = [r for r in rims if not r["inner"]]
+            shaped = any(r.get("shaped", False) for r in outer)  # (not in a document of before)
+            sizes = [r["plan_size"] for r in outer if "plan_size" in r]
+            size = max(sizes) if sizes else geometry.plan_size(tab.Shape)
+            od, height, _ = standard_die(size, shaped, float(obj.OuterDiameter.Value))
             if abs(float(obj.OuterDiameter.Value) - od) > 1e-12 or abs(float(obj.Height.Value) - height) > 1e-12:
                 self.set_size(obj, od, height)
         shape = geometry.die_shape(rims, float(obj.Height.Value), float(obj.OuterDiameter.Value))

@@ -125,7 +125,11 @@ class TabletForm:
 
         obj = make_tablet(doc, self.family, recompute=False, density=self.density, **self.values)
         if tooling:
-            make_tooling(doc, obj, recompute=False)
+            try:
+                make_tooling(doc, obj, recompute=False)
+            except BaseException:  # nothing of the form is left (without undo, a script's document)
+                doc.removeObject(obj.Name)
+                raise
         doc.recompute()
         return obj
 
@@ -188,11 +192,10 @@ class TabletTaskPanel:
     def _build_dimensions(self):
         from PySide import QtGui
 
-        import FreeCADGui
+        from PySide import QtGui
 
-        # the old rows are taken out and deleted later, once the new fields exist: a field made at a freed
-        # field's address had been handed the old field's deleted wrapper ("Internal C++ object already
-        # deleted", PySide2 with FreeCAD's QuantitySpinBox)
+        # the old rows are taken out and deleted later, once the new fields exist (a field made at a freed
+        # field's address can be handed the old field's deleted wrapper in PySide2)
         self.spins = {}
         while self.dims.count():
             item = self.dims.takeAt(self.dims.count() - 1)
@@ -200,29 +203,31 @@ class TabletTaskPanel:
             if w is not None:
                 w.hide()
                 w.deleteLater()
-        loader = FreeCADGui.UiLoader()
         for k, label, unit, lo, hi, value in self.model.fields():
-            # FreeCAD's quantity field: '0.4 in', '1 cm', '0.5 rad' are read with their units (a plain spin box
-            # had taken '0.4 in' as 0.4 mm and capped values at 100 mm, 3 decimals)
-            sb = loader.createWidget("Gui::QuantitySpinBox", self.dims_box)
-            sb.setProperty("unit", "deg" if unit == "deg" else "mm")
-            sb.setProperty("minimum", lo)
-            sb.setProperty("maximum", hi)
-            sb.setProperty("singleStep", 0.1)
-            sb.setProperty("rawValue", value)
-            sb.setToolTip(f"{k} ({unit}, or any {'angle' if unit == 'deg' else 'length'} unit), {lo:g} to {hi:g}; "
-                          "the tablet is checked as you type")
+            # a text field read by FreeCAD's unit parser as typed ('0.4 in', '1.2345 cm', '0.5 rad', a plain
+            # number in mm or degrees): a plain spin box had taken '0.4 in' as 0.4 mm and capped values at
+            # 100 mm, 3 decimals; FreeCAD's QuantitySpinBox signals its text rounded to the display's decimals
+            # and, on 0.20, drops keys it does not accept ('10 kg' became '10 k', read as 10 mm)
+            sb = QtGui.QLineEdit(self.dims_box)
+            sb.setText(f"{value:.12g} {'°' if unit == 'deg' else unit}")
+            sb.setToolTip(f"{k} ({unit}, or any {'angle' if unit == 'deg' else 'length'} unit: 0.4 in, 1 cm, "
+                          f"0.5 rad), {lo:g} to {hi:g}; the tablet is checked as you type")
             sb.textChanged.connect(lambda text, key=k: self._typed(key, text))
             self.dims.addRow(label, sb)
             self.spins[k] = sb
 
     def type_text(self, key: str, text: str) -> None:
-        """Put ``text`` into the field ``key`` as typing it would (scripts and tests)."""
-        from PySide import QtGui
+        """Type ``text`` into the field ``key``, key by key as a user would (scripts and tests)."""
+        from PySide import QtCore, QtGui
 
-        self.spins[key].lineEdit().setText(text)
+        field = self.spins[key]
+        field.setFocus()
+        field.selectAll()
+        QtGui.QApplication.sendEvent(field, QtGui.QKeyEvent(QtCore.QEvent.KeyPress, QtCore.Qt.Key_Delete,
+                                                            QtCore.Qt.NoModifier))
+        for ch in text:
+            QtGui.QApplication.sendEvent(field, QtGui.QKeyEvent(QtCore.QEvent.KeyPress, 0, QtCore.Qt.NoModifier, ch))
         QtGui.QApplication.processEvents()
-        self._typed(key, self.spins[key].text())  # (the field may not signal text it does not accept)
 
     def _family_changed(self, index):
         self.model.set_family(self.model.families[int(index)])
@@ -232,6 +237,7 @@ class TabletTaskPanel:
     def _typed(self, key: str, text: str):
         self.model.read(key, text)  # only the field typed in: the others keep their exact values
         self.refresh()
+        self.spins[key].setStyleSheet("color: #c62828;" if key in self.model.errors else "")
 
     def _changed(self, *_):
         self.model.density = float(self.density.value())
@@ -257,16 +263,26 @@ class TabletTaskPanel:
             FreeCAD.Console.PrintError(f"tabletcad: {self.status.text()[2:]}\n")
             return False
         self.doc.openTransaction("tabletcad tablet")
-        if self.obj is None:
-            self.obj = self.model.create(self.doc, tooling=self.tooling.isChecked())
-        else:
-            self.model.apply(self.obj)
-            if self.tooling.isChecked():
-                from .make import make_tooling
+        try:
+            if self.obj is None:
+                made = self.model.create(self.doc, tooling=self.tooling.isChecked())
+            else:
+                self.model.apply(self.obj)
+                if self.tooling.isChecked():
+                    from .make import make_tooling
 
-                make_tooling(self.doc, self.obj, recompute=False)
-            self.doc.recompute()
+                    make_tooling(self.doc, self.obj, recompute=False)
+                self.doc.recompute()
+        except Exception as exc:  # (tooling a die cannot take: the tablet had stayed, the transaction open)
+            self.doc.abortTransaction()
+            msg = " ".join(str(exc).split())
+            self.status.setText(f"✘ {msg}")
+            self.status.setStyleSheet("color: #c62828;")
+            FreeCAD.Console.PrintError(f"tabletcad: {msg}\n")
+            return False
         self.doc.commitTransaction()
+        if self.obj is None:
+            self.obj = made
         self._close()
         return True
 
