@@ -298,3 +298,19 @@ def test_a_tablets_parameters_are_read_only_and_travel_as_they_are():
     assert t.params["diameter"] == 10.0
     with pytest.raises(TypeError, match="read-only"):
         dataclasses.replace(t, params={"diameter": 3.0}).params["diameter"] = 4.0
+
+
+@pytest.mark.parametrize("lo, hi, ok", [(1.0, 1.001, True), (0.0, 0.001, True), (0.3, 0.301, True), (1.0, 1.0009, False),
+                                        (1.0, 1.0, False)])
+def test_a_trim_exactly_the_least_width_as_typed_is_taken(lo, hi, ok):
+    """``[trim] v = [1.0, 1.001]`` is 0.001 rad wide as typed, just under it in binary: it had been refused
+    ("at least 0.001 rad"); 0.0009 still is.  The same for u and w."""
+    from tabletcad.errors import DesignError
+
+    w = (lo / 10, lo / 10 + (hi - lo))  # the same width within [0, 1]
+    if ok:
+        assert Trim(v=(lo, hi)).v == (lo, hi) and Trim(u=w).u == w and Trim(w=w).w == w
+    else:
+        for kw in (dict(v=(lo, hi)), dict(u=w), dict(w=w)):
+            with pytest.raises(DesignError, match="at least 0.001"):
+                Trim(**kw)

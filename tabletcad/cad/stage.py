@@ -80,7 +80,10 @@ def check_tablet_solid(tablet: Tablet, report: dict[str, Any] | None = None):
             winding_consistent=bool(mesh.winding_consistent),
             genus=mesh.manifold_genus,
             genus_expected=genus_expected,
-            volume_mm3=mesh.manifold_volume,
+            # the written mesh's own volume (divergence theorem on its triangles), and manifold3d's of the same
+            # triangles beside it (float32 vertices; on a folded mesh the two part: a trial)
+            volume_mm3=mesh.volume,
+            manifold3d_volume_mm3=mesh.manifold_volume,
             volume_rel_diff_vs_brep=(mesh.volume - volume) / volume,
             triangles=int(len(mesh.triangles)),
             linear_deflection_mm=MESH_LINEAR_MM,
@@ -181,6 +184,15 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
         shape = chain.shape
         how = ("fitted and sewn as one chain: the outer surface between the cuts and the ruled cut faces "
                f"A0(u) + w (X(u, v) - A0(u)) at v = {v0:.6g} and {v1:.6g}")
+        import warnings
+
+        # a trial: the ruled cut faces of a patch without volume (a flat plateau or land) lie on that patch's
+        # own face, and where a cup's spine runs off-centre they can cross the neighbouring cut face; OCC's
+        # BRepCheck passes the solid, gmsh refuses to mesh it ("overlapping facets")
+        warnings.warn(f"{tablet.name}: the cut-away of a shaped tablet is a view: its ruled cut faces can overlap "
+                      "where a patch has no volume (a flat plateau or land), so a mesher or a Boolean may refuse "
+                      "tablet.step (BRepCheck passes it); cut the whole tablet's STEP in your CAD program for a "
+                      "solid to mesh", UserWarning, stacklevel=2)
     else:
         # angles grow with v (counter-clockwise sections); the kept sector runs from phi0 to phi1
         span = (phi1 - phi0) % (2.0 * np.pi) or 2.0 * np.pi
@@ -223,7 +235,8 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
     sections = dict(
         brep=brep,
         mesh=dict(manifold=mesh.is_manifold, watertight=bool(mesh.watertight), winding_consistent=bool(mesh.winding_consistent),
-                  genus=mesh.manifold_genus, genus_expected=genus_expected, volume_mm3=mesh.manifold_volume,
+                  genus=mesh.manifold_genus, genus_expected=genus_expected, volume_mm3=mesh.volume,
+                  manifold3d_volume_mm3=mesh.manifold_volume,
                   volume_rel_diff_vs_brep=(mesh.volume - mass.volume) / mass.volume, triangles=int(len(mesh.triangles)),
                   linear_deflection_mm=MESH_LINEAR_MM, angular_deflection_rad=MESH_ANGULAR_RAD),
     )

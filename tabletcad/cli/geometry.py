@@ -142,6 +142,10 @@ def mesh_cmd(design: Path, nodes: tuple[int, int, int], out_file: Path) -> None:
                    "the cup folds onto its centre line or corners next to the spine, where the solid map of eq 4.12 "
                    "collapses; their volumes are positive, but a solver that checks corner Jacobians refuses them "
                    "(tabletcad fe meshes the B-rep with tetrahedra)", err=True)
+    if mesh.nonconforming:
+        click.echo(f"warning: the mesh is not conforming across {', '.join(mesh.nonconforming)}: a flat patch has no "
+                   "volume, and the solids on either side of it meet there without sharing their nodes (separate "
+                   "blocks to a solver); tabletcad fe meshes the B-rep with conforming tetrahedra", err=True)
     if abs(rel) > tablet.tol.mesh_volume:
         # the error falls as the square of the cell size in u and v (the solid map is linear in w):
         # scale those node spacings to land at half the bound

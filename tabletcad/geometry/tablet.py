@@ -156,11 +156,13 @@ class Trim:
         for name, (lo, hi), top in (("u", self.u, 1.0), ("w", self.w, 1.0)):
             check_range(f"trim {name}[0]", lo, 0.0, 1.0)
             check_range(f"trim {name}[1]", hi, 0.0, 1.0)
-            if not hi - lo >= TRIM_MIN_WIDTH:  # (w = [0, 1e-12] made a solid 1e-11 mm wide)
+            # (w = [0, 1e-12] made a solid 1e-11 mm wide); a width of exactly the least, as typed, is taken
+            # (1.001 - 1.0 is just under 0.001 in binary: a trial)
+            if not hi - lo >= TRIM_MIN_WIDTH * (1.0 - 1e-9):
                 raise DesignError(f"trim {name}", (lo, hi), f"must be an increasing pair within [0, 1], at least "
                                   f"{TRIM_MIN_WIDTH:g} apart")
         v0, v1 = (float(x) for x in self.v)
-        if not (math.isfinite(v0) and math.isfinite(v1) and TRIM_MIN_WIDTH <= v1 - v0 <= math.tau + 1e-12):
+        if not (math.isfinite(v0) and math.isfinite(v1) and TRIM_MIN_WIDTH * (1.0 - 1e-9) <= v1 - v0 <= math.tau + 1e-12):
             raise DesignError("trim v", self.v, f"must be an increasing pair spanning at most 2π rad and at least "
                               f"{TRIM_MIN_WIDTH:g} rad")
         object.__setattr__(self, "u", tuple(float(x) for x in self.u))

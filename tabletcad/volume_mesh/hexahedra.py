@@ -190,6 +190,11 @@ class SolidMesh:
     dropped : int
         Grid cells not written: flat ones (zero volume) and those collapsing
         to fewer than four nodes.
+    nonconforming : tuple of str
+        Names of the flat patches (a land) between two patches with volume whose end rows differ: the two
+        solids beside them meet across the flat patch's plane without sharing their nodes there (the cup's
+        nodes along its rim's radius, the band's along its own), so the mesh is not conforming across
+        that plane (empty when it is conforming throughout).
     """
 
     points: np.ndarray
@@ -198,6 +203,7 @@ class SolidMesh:
     nodes: tuple = (0, 0, 0)
     u_nodes: tuple = ()
     dropped: int = field(default=0)
+    nonconforming: tuple = ()
 
     @property
     def n_points(self) -> int:
@@ -483,7 +489,29 @@ def hex_mesh(tablet: "Tablet", nodes: tuple[int, int, int] = (11, 21, 5), *, che
     new = np.cumsum(used, dtype=np.int64) - 1
     return SolidMesh(points=raw[used], cells={k: new[c] for k, c in cells.items()},
                      patch_id={k: np.concatenate(pids[k]) for k in cells}, nodes=(sx, sy, sz),
-                     u_nodes=tuple(g.u for g in grids), dropped=dropped)
+                     u_nodes=tuple(g.u for g in grids), dropped=dropped,
+                     nonconforming=_nonconforming(tablet, grids))
+
+
+def _nonconforming(tablet: "Tablet", grids: list["_Grid"]) -> tuple[str, ...]:
+    """Names of the runs of flat patches between two patches with volume whose first and last rows differ
+    (by more than ``tol.seam_gap``): see :attr:`SolidMesh.nonconforming`."""
+    out = []
+    p = 1
+    while p < len(grids) - 1:
+        if not grids[p].flat:
+            p += 1
+            continue
+        q = p
+        while q < len(grids) - 1 and grids[q].flat:
+            q += 1
+        # flat patches p .. q-1, then patch q; patch p-1 before them
+        if q < len(grids) and not grids[q].flat and not grids[p - 1].flat:
+            gap = float(np.max(np.linalg.norm(grids[p].P[0] - grids[q - 1].P[-1], axis=-1)))
+            if gap > tablet.tol.seam_gap:
+                out.extend(tablet.patches[k].name or f"patch {k}" for k in range(p, q))
+        p = q
+    return tuple(out)
 
 
 class _Grid(NamedTuple):
