@@ -91,9 +91,11 @@ def test_mesh_formats(tmp_path):
     obj = root.find(".//m:object", ns)
     assert obj.get("name") == "ring"
     assert len(obj.findall(".//m:triangle", ns)) == len(m.triangles)
-    # GLB: metres
+    # GLB: metres, glTF's +Y up (the tablet's z), outward as the mesh (a rotation keeps the volume's sign)
     glb = trimesh.load(export(ts, tmp_path / "r.glb", mesh=m), force="mesh")
     assert glb.volume == pytest.approx(m.volume * 1e-9, rel=1e-5)
+    lo, hi = np.asarray(m.vertices).min(axis=0) * 1e-3, np.asarray(m.vertices).max(axis=0) * 1e-3
+    np.testing.assert_allclose(glb.bounds, [[lo[0], lo[2], -hi[1]], [hi[0], hi[2], -lo[1]]], rtol=0, atol=1e-9)
     # BREP
     from OCP.BRep import BRep_Builder
     from OCP.BRepTools import BRepTools

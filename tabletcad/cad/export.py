@@ -212,11 +212,14 @@ def _xml_text(text: str) -> str:
 def export_glb(
     obj: Any, path, *, name: str = "tablet", mesh: MeshResult | None = None, glb_scale: float = 1e-3, **mesh_kw: Any
 ) -> Path:
-    """Binary glTF; vertices are multiplied by ``glb_scale`` (default mm -> m, glTF's unit)."""
+    """Binary glTF in glTF's frame: vertices multiplied by ``glb_scale`` (default mm -> m, glTF's unit) and
+    turned so that the tablet's z axis is glTF's up, +Y (``(x, y, z) -> (x, z, -y)``, a rotation: viewers had
+    shown the tablet lying on its side)."""
     import trimesh
 
     m = _mesh_of(obj, mesh, **mesh_kw)
-    tm = trimesh.Trimesh(np.asarray(m.vertices) * float(glb_scale), m.triangles, process=False)
+    v = np.asarray(m.vertices, dtype=float) * float(glb_scale)
+    tm = trimesh.Trimesh(np.column_stack([v[:, 0], v[:, 2], -v[:, 1]]), m.triangles, process=False)
     scene = trimesh.Scene()
     scene.add_geometry(tm, node_name=name, geom_name=name)
     data = trimesh.exchange.gltf.export_glb(scene)
