@@ -366,3 +366,17 @@ def test_a_compaction_force_without_a_limit_is_shown_as_its_tip_pressure(tmp_pat
     (line,) = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("punch-tip check")]
     pressure = 15000.0 * 1000.0 / (math.pi * 25.0)
     assert f"not checked: 15000 kN is {pressure:.4g} MPa on {math.pi * 25.0:.4g} mm2; no limit given" in line
+
+
+def test_a_file_name_that_cannot_be_a_tablet_name_says_where_the_name_came_from(tmp_path, capsys):
+    """A design without [tablet] name takes its file's name; one holding a backslash had been refused as
+    "tablet.name", a key not in the file: the line says the file's name stands for it, and what to do."""
+    src = tmp_path / "O'Brien \\ 50% x.toml"
+    src.write_text((ROOT / "samples" / "families" / "concave_round.toml").read_text(encoding="utf-8"), encoding="utf-8")
+    assert main(["report", str(src)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith('error: tablet.name = "O\'Brien \\\\ 50% x" is not allowed: must be a plain ')
+    assert "the design file's name is the tablet's when its [tablet] table gives none" in err[0]
+    ok = tmp_path / "O'Brien 50% x.toml"  # an apostrophe is taken
+    ok.write_text(src.read_text(encoding="utf-8"), encoding="utf-8")
+    assert main(["report", str(ok)]) == 0

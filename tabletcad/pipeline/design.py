@@ -281,7 +281,11 @@ class Design:
         tab = data["tablet"]
         name = tab.get("name", default_name)  # given empty, it is refused (not replaced by the default)
         if not isinstance(name, str) or not name.strip() or any(ch in name for ch in '/\\"\n') or len(name) > 200:
-            raise DesignError("tablet.name", name, "must be a plain non-empty name (no / \\ or quotes, at most 200 characters)")
+            allowed = 'must be a plain non-empty name (no / \\ " or line break, at most 200 characters)'
+            if "name" not in tab and folder is not None:  # the file's name stands for it (a trial: a key not in the file)
+                raise DesignError("tablet.name", name, f"{allowed}: the design file's name is the tablet's when its "
+                                  "[tablet] table gives none; give name = ... there, or rename the file")
+            raise DesignError("tablet.name", name, allowed)
         family = tab.get("family")
         families = ", ".join(FAMILIES) + ", custom_outline or free_form"
         if family is None:
