@@ -236,15 +236,13 @@ def test_the_cup_radius_is_dimensioned_only_where_the_section_shows_the_cup(scor
 def test_the_longest_title_block_texts_stay_on_the_sheet_and_apart(drawn, sheet):
     """Every title-block text at its longest (``TITLE_MAX_CHARS``) in the widest letter: the sheet's
     texts stay inside the sheet and no two overlap (a 20,000-character name ran off the sheet)."""
-    import copy
     from dataclasses import replace
 
     import matplotlib.pyplot as plt
 
     from tabletcad.tooling.spec import TITLE_MAX_CHARS, DrawingSpec
 
-    ts = copy.copy(drawn[0])
-    ts.spec = replace(ts.spec, drawing=DrawingSpec(**{k: "W" * n for k, n in TITLE_MAX_CHARS.items()}))
+    ts = replace(drawn[0], spec=replace(drawn[0].spec, drawing=DrawingSpec(**{k: "W" * n for k, n in TITLE_MAX_CHARS.items()})))
     dr = drawing_model(ts) if sheet == "tablet" else tooling_model(ts)
     fig = sheet_figure(dr, "A4")
     try:
@@ -286,16 +284,13 @@ def test_title_block_texts_that_do_not_fit_are_refused_when_read(key, value, fra
 def test_a_tablet_name_of_200_characters_is_cut_to_the_room_beside_the_title_block(drawn):
     """Without ``[tooling.drawing] name`` the title is the tablet's name, up to 200 characters: it
     overlapped the title block (and ran off the sheet in a wide letter); now cut with an ellipsis."""
-    import copy
     from dataclasses import replace
 
     import matplotlib.pyplot as plt
 
     from tabletcad.tooling.spec import DrawingSpec
 
-    ts = copy.copy(drawn[0])
-    ts.spec = replace(ts.spec, drawing=DrawingSpec())
-    ts.tablet = replace(ts.tablet, name="W" * 200)
+    ts = replace(drawn[0], spec=replace(drawn[0].spec, drawing=DrawingSpec()), tablet=replace(drawn[0].tablet, name="W" * 200))
     fig = sheet_figure(drawing_model(ts), "A4")
     try:
         fig.canvas.draw()
