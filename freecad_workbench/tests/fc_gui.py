@@ -17,8 +17,11 @@ import FreeCADGui
 result = {"ok": False, "reached": []}
 
 
-def mark(name):  # how far the script got (written at once: a hang shows where)
+def mark(name):  # how far the script got (written at once: a hang shows where), and when
+    import time
+
     result["reached"].append(name)
+    result.setdefault("reached_at", []).append(round(time.perf_counter(), 2))
     with open(os.environ["TABLETCAD_FC_OUTPUT"], "w") as fh:
         json.dump(result, fh)
 

@@ -217,16 +217,13 @@ class TabletTaskPanel:
             self.spins[k] = sb
 
     def type_text(self, key: str, text: str) -> None:
-        """Type ``text`` into the field ``key``, key by key as a user would (scripts and tests)."""
-        from PySide import QtCore, QtGui
+        """Replace the field ``key``'s text with ``text`` as an edit, as typing over it does (``insert`` on the
+        selected text: the same signals, without key events, which a virtual X display answered in seconds)."""
+        from PySide import QtGui
 
         field = self.spins[key]
-        field.setFocus()
         field.selectAll()
-        QtGui.QApplication.sendEvent(field, QtGui.QKeyEvent(QtCore.QEvent.KeyPress, QtCore.Qt.Key_Delete,
-                                                            QtCore.Qt.NoModifier))
-        for ch in text:
-            QtGui.QApplication.sendEvent(field, QtGui.QKeyEvent(QtCore.QEvent.KeyPress, 0, QtCore.Qt.NoModifier, ch))
+        field.insert(text)
         QtGui.QApplication.processEvents()
 
     def _family_changed(self, index):
