@@ -153,16 +153,16 @@ class Trim:
     w: tuple[float, float] = (0.0, 1.0)
 
     def __post_init__(self) -> None:
+        # a width of exactly the least, as typed, is taken (1.001 - 1.0 is just under 0.001 in binary: a trial)
+        least = TRIM_MIN_WIDTH * (1.0 - 1e-9)
         for name, (lo, hi), top in (("u", self.u, 1.0), ("w", self.w, 1.0)):
             check_range(f"trim {name}[0]", lo, 0.0, 1.0)
             check_range(f"trim {name}[1]", hi, 0.0, 1.0)
-            # (w = [0, 1e-12] made a solid 1e-11 mm wide); a width of exactly the least, as typed, is taken
-            # (1.001 - 1.0 is just under 0.001 in binary: a trial)
-            if not hi - lo >= TRIM_MIN_WIDTH * (1.0 - 1e-9):
+            if not hi - lo >= least:  # (w = [0, 1e-12] made a solid 1e-11 mm wide)
                 raise DesignError(f"trim {name}", (lo, hi), f"must be an increasing pair within [0, 1], at least "
                                   f"{TRIM_MIN_WIDTH:g} apart")
         v0, v1 = (float(x) for x in self.v)
-        if not (math.isfinite(v0) and math.isfinite(v1) and TRIM_MIN_WIDTH * (1.0 - 1e-9) <= v1 - v0 <= math.tau + 1e-12):
+        if not (math.isfinite(v0) and math.isfinite(v1) and least <= v1 - v0 <= math.tau + 1e-12):
             raise DesignError("trim v", self.v, f"must be an increasing pair spanning at most 2π rad and at least "
                               f"{TRIM_MIN_WIDTH:g} rad")
         object.__setattr__(self, "u", tuple(float(x) for x in self.u))
@@ -963,14 +963,7 @@ class Tablet:
     def _profile_extents(self) -> tuple[float, float, float]:
         """``(R_max, Z_min, Z_max)`` (mm) of the profiles of a tablet of revolution (or of one plan
         ellipse, :attr:`section`, ``R`` its sections' equal-area radius) over the trimmed ``u``
-        range (cached).
-
-        Every profile is sampled once (513 points); a quantity is then polished
-        (:func:`~tabletcad.geometry.revolution.profile_extreme`) on each profile whose best
-        sample comes within ``max |Δ²g|`` (the samples' largest second difference, a bound on
-        what lies between samples) of the best sample of all, so no profile that could hold
-        the extreme is skipped.
-        """
+        range (cached), sampled and polished as :meth:`_maxima_over` says."""
         hit = self.__dict__.get("_extents")
         if hit is None:
             out = self._profile_maxima((lambda P: np.abs(P[..., 0]), lambda P: -P[..., 1], lambda P: P[..., 1]))
@@ -990,17 +983,25 @@ class Tablet:
 
     def _profile_maxima(self, quantities) -> list[float]:
         """The largest value of each ``g(profile)`` over every profile (:meth:`_profile_extents`)."""
+        return self._maxima_over([r.profile for r in self.revolution or self.section], quantities)
+
+    def _maxima_over(self, curves, quantities) -> list[float]:
+        """The largest value of each ``g(c(u))`` over every curve ``c`` of ``u`` and the trimmed ``u`` range.
+
+        Every curve is sampled once (513 points); a quantity is then polished
+        (:func:`~tabletcad.geometry.revolution.profile_extreme`) on each curve whose best sample comes within
+        ``max |Δ²g|`` (the samples' largest second difference, a bound on what lies between samples) of the
+        best sample of all, so no curve that could hold the extreme is skipped."""
         lo, hi = self.trim.u
         u = np.linspace(lo, hi, 513)
-        profiles = self.revolution or self.section
-        prof = [r.profile(u) for r in profiles]
+        values = [c(u) for c in curves]
         out = []
         for g in quantities:
-            samples = [g(P) for P in prof]
+            samples = [g(P) for P in values]
             best = max(float(x.max()) for x in samples)
             slack = max(float(np.max(np.abs(np.diff(x, 2)))) for x in samples)
-            out.append(max(profile_extreme(lambda uu, r=r, g=g: g(r.profile(uu)), lo, hi)[1]
-                           for r, x in zip(profiles, samples) if float(x.max()) >= best - slack))
+            out.append(max(profile_extreme(lambda uu, c=c, g=g: g(c(uu)), lo, hi)[1]
+                           for c, x in zip(curves, samples) if float(x.max()) >= best - slack))
         return out
 
     def _one_plan(self) -> bool:
@@ -1115,21 +1116,11 @@ class Tablet:
         return lo, hi
 
     def _spine_z_range(self) -> tuple[float, float]:
-        """Lowest and highest z (mm) of the patches' spines over the trimmed ``u`` range: the tablet's z extent
-        when every patch is :attr:`~tabletcad.geometry.patch.PDEPatch.level` (the trim's ``w`` scales the
-        plan only, eq 4.12).  Each spine is sampled (513 points) and polished
-        (:func:`~tabletcad.geometry.revolution.profile_extreme`) where its best sample comes within the
-        samples' largest second difference of the best of all, as :meth:`_profile_maxima`."""
-        lo, hi = self.trim.u
-        u = np.linspace(lo, hi, 513)
-        z = [p.spine(u)[:, 2] for p in self.patches]
-        out = []
-        for sign in (-1.0, 1.0):
-            best = max(float(np.max(sign * x)) for x in z)
-            slack = max(float(np.max(np.abs(np.diff(x, 2)))) for x in z)
-            out.append(sign * max(profile_extreme(lambda uu, p=p: sign * p.spine(uu)[:, 2], lo, hi)[1]
-                                  for p, x in zip(self.patches, z) if float(np.max(sign * x)) >= best - slack))
-        return out[0], out[1]
+        """Lowest and highest z (mm) of the patches' spines over the trimmed ``u`` range (:meth:`_maxima_over`):
+        the tablet's z extent when every patch is :attr:`~tabletcad.geometry.patch.PDEPatch.level` (the trim's
+        ``w`` scales the plan only, eq 4.12)."""
+        low, high = self._maxima_over([p.spine for p in self.patches], (lambda A: -A[..., 2], lambda A: A[..., 2]))
+        return -low, high
 
     def _polish_extreme(self, p, axis: int, sign: float, u0: float, v0: float, hu: float, hv: float) -> float:
         """Largest ``sign·X[axis]`` near ``(u0, v0)`` (see :meth:`bounds`).

@@ -14,6 +14,7 @@ Example (``freecadcmd``)::
 from __future__ import annotations
 
 import os
+from contextlib import contextmanager
 from pathlib import Path
 
 import FreeCAD
@@ -24,25 +25,33 @@ __all__ = ["design_tooling", "make_die", "make_lower_punch", "make_tablet", "mak
 
 
 def _value(v, unit="mm", name=None):
-    """Accept numbers (mm / deg), strings with units (``"9 mm"``, ``"0.4 in"``) or Quantities; a ValueError
-    naming ``name`` for text that is no quantity or one of another kind (``"10 kg"`` for a length)."""
+    """Accept numbers (mm / deg), strings with units (``"9 mm"``, ``"0.4 in"``, FreeCAD's unit parser; a plain
+    number in ``unit``) or Quantities; a ValueError naming ``name`` for text that is no quantity or one of
+    another kind (``"10 kg"`` for a length)."""
     if isinstance(v, (int, float)):
         return FreeCAD.Units.Quantity(float(v), FreeCAD.Units.Unit(unit))
+    kind = "an angle (deg, rad)" if unit == "deg" else "a length (mm, cm, in, ...)"
     try:
         q = FreeCAD.Units.Quantity(v)
     except Exception as exc:  # FreeCAD's parser: ValueError "syntax error", ArithmeticError ...
-        kind = "an angle (deg, rad)" if unit == "deg" else "a length (mm, cm, in, ...)"
         raise ValueError(f"{name or 'value'} = {v!r} is not allowed: must be {kind} ({exc})") from None
     if q.Unit == FreeCAD.Units.Unit():  # a plain number in text: the property's unit
         return FreeCAD.Units.Quantity(float(q.Value), FreeCAD.Units.Unit(unit))
     if q.Unit != FreeCAD.Units.Unit(unit):
-        kind = "an angle (deg, rad)" if unit == "deg" else "a length (mm, cm, in, ...)"
         raise ValueError(f"{name or 'value'} = {v!r} is not allowed: must be {kind}")
     return q
 
 
+@contextmanager
 def _new(doc, name):
-    return doc.addObject("Part::FeaturePython", name)
+    """A new scripted object, taken out of the document again when what is made of it fails (a misspelt
+    argument or a refused value had left an unbuilt object behind)."""
+    obj = doc.addObject("Part::FeaturePython", name)
+    try:
+        yield obj
+    except BaseException:
+        doc.removeObject(obj.Name)
+        raise
 
 
 def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, recompute=True, **params):
@@ -103,8 +112,7 @@ def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, reco
             density = float(density)
     if fit_tol is not None:
         fit_tol = _value(fit_tol, "mm", "fit_tolerance")
-    obj = _new(doc, "Tablet")
-    try:
+    with _new(doc, "Tablet") as obj:
         objects.TabletProxy(obj, family)
         if design is not None:
             obj.DesignFile = str(design)
@@ -116,9 +124,6 @@ def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, reco
             obj.FitTolerance = fit_tol
         obj.Label = label or family
         objects.attach_view_provider(obj)
-    except BaseException:
-        doc.removeObject(obj.Name)
-        raise
     if recompute:
         doc.recompute()
     return obj
@@ -133,8 +138,7 @@ def _punch(doc, tablet, which, length, clearance, recompute):
     # read before the object is made: a bad one leaves nothing behind
     length = None if length is None else _value(length, "mm", "length" if which == "upper" else "lower_length")
     clearance = None if clearance is None else _value(clearance, "mm", "clearance")
-    obj = _new(doc, "UpperPunch" if which == "upper" else "LowerPunch")
-    try:
+    with _new(doc, "UpperPunch" if which == "upper" else "LowerPunch") as obj:
         objects.PunchProxy(obj, tablet, which)
         if length is not None:
             obj.Length = length
@@ -142,9 +146,6 @@ def _punch(doc, tablet, which, length, clearance, recompute):
             obj.Clearance = clearance
         obj.Label = f"{tablet.Label} {which} punch"
         objects.attach_view_provider(obj)
-    except BaseException:
-        doc.removeObject(obj.Name)
-        raise
     if recompute:
         doc.recompute()
     return obj
@@ -180,17 +181,13 @@ def make_die(doc, tablet, *, height=None, outer_diameter=None, recompute=True):
     sizes = {prop: _value(v, "mm", name) for prop, name, v in (("Height", "die_height", height),
                                                                 ("OuterDiameter", "die_outer_diameter", outer_diameter))
              if v is not None}  # read before the object is made: a bad one leaves nothing behind
-    obj = _new(doc, "Die")
-    try:
+    with _new(doc, "Die") as obj:
         objects.DieProxy(obj, tablet)
         for prop, q in sizes.items():
             setattr(obj, prop, q)
         obj.StandardSize = standard  # (after the sizes: a size set while it is true makes the die a custom one)
         obj.Label = f"{tablet.Label} die"
         objects.attach_view_provider(obj)
-    except BaseException:
-        doc.removeObject(obj.Name)
-        raise
     if recompute:
         doc.recompute()
     return obj

@@ -534,11 +534,10 @@ class DieProxy(_Proxy):
 
     Type = "TabletcadDie"
 
-    def __init__(self, obj, tablet=None, standard_size: bool = False):
+    def __init__(self, obj, tablet=None):
         super().__init__(obj)
         self._setup(obj)
-        obj.Tablet = tablet
-        obj.StandardSize = bool(standard_size)
+        obj.Tablet = tablet  # (StandardSize false until the maker has set the sizes: see onChanged)
 
     def _setup(self, obj):
         self._add(obj, "App::PropertyLink", "Tablet", "Die", "the tablet this die forms")

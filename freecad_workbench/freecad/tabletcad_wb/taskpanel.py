@@ -43,19 +43,20 @@ class TabletForm:
         """Take what was typed into the field ``key``: a length or angle with its unit (``0.4 in``, ``1 cm``,
         ``0.5 rad``, FreeCAD's unit parser), or a plain number in the field's own unit (mm, deg).  Text that
         is no quantity, or one of another kind (``10 kg``), is kept as the field's refusal (:meth:`validate`)."""
-        unit = self.units[key]
-        want = FreeCAD.Units.Unit("deg" if unit == "deg" else "mm")
-        label = objects.prop_name(key)
+        from .make import _value
+
+        unit = "deg" if self.units[key] == "deg" else "mm"
+        text = str(text).strip()
         try:
-            q = FreeCAD.Units.Quantity(str(text).strip())
-        except Exception:
-            q = None
-        if q is None or not (q.Unit == want or q.Unit == FreeCAD.Units.Unit()) or not math.isfinite(float(q.Value)):
-            kind = "an angle (deg, rad)" if unit == "deg" else "a length (mm, cm, in, ...)"
-            self.errors[key] = f"{label} = {str(text).strip()!r} is not allowed: must be {kind}"
+            value = float(_value(text, unit, objects.prop_name(key)).getValueAs(unit))
+        except ValueError as exc:
+            self.errors[key] = str(exc)
+            return False
+        if not math.isfinite(value):
+            self.errors[key] = f"{objects.prop_name(key)} = {text!r} is not allowed: must be finite"
             return False
         self.errors.pop(key, None)
-        self.values[key] = float(q.Value) if q.Unit == FreeCAD.Units.Unit() else float(q.getValueAs(unit))
+        self.values[key] = value
         return True
 
     @classmethod
@@ -192,8 +193,6 @@ class TabletTaskPanel:
     def _build_dimensions(self):
         from PySide import QtGui
 
-        from PySide import QtGui
-
         # the old rows are taken out and deleted later, once the new fields exist (a field made at a freed
         # field's address can be handed the old field's deleted wrapper in PySide2)
         self.spins = {}
@@ -259,27 +258,27 @@ class TabletTaskPanel:
         if not self.refresh():
             FreeCAD.Console.PrintError(f"tabletcad: {self.status.text()[2:]}\n")
             return False
-        self.doc.openTransaction("tabletcad tablet")
-        try:
-            if self.obj is None:
-                made = self.model.create(self.doc, tooling=self.tooling.isChecked())
-            else:
-                self.model.apply(self.obj)
-                if self.tooling.isChecked():
-                    from .make import make_tooling
+        from .commands import _transaction
 
-                    make_tooling(self.doc, self.obj, recompute=False)
-                self.doc.recompute()
-        except Exception as exc:  # (tooling a die cannot take: the tablet had stayed, the transaction open)
-            self.doc.abortTransaction()
+        def work():
+            if self.obj is None:
+                return self.model.create(self.doc, tooling=self.tooling.isChecked())
+            self.model.apply(self.obj)
+            if self.tooling.isChecked():
+                from .make import make_tooling
+
+                make_tooling(self.doc, self.obj, recompute=False)
+            self.doc.recompute()
+            return self.obj
+
+        try:  # one undo step, rolled back when it fails (a die a tablet is too large for: the tablet had stayed)
+            self.obj = _transaction(self.doc, "tabletcad tablet", work)
+        except Exception as exc:
             msg = " ".join(str(exc).split())
             self.status.setText(f"✘ {msg}")
             self.status.setStyleSheet("color: #c62828;")
             FreeCAD.Console.PrintError(f"tabletcad: {msg}\n")
             return False
-        self.doc.commitTransaction()
-        if self.obj is None:
-            self.obj = made
         self._close()
         return True
 
