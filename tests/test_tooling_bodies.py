@@ -15,7 +15,7 @@ SAMPLES = ROOT / "samples" / "tooling"
 INCH = 25.4
 
 #: a complete EU B set: every [tooling.punch] key the standards file cannot supply
-EU_B = dict(standard="EU", type="B", die_height_mm=22.0, tip_length_mm=8.0, lower_tip_length_mm=19.0,
+EU_B = dict(standard="EU", type="B", die_height_mm=22.0, tip_length_mm=8.0, lower_tip_length_mm=25.4,
             clearance_mm=0.025,
             punch=dict(head_diameter_mm=25.0, head_flat_diameter_mm=12.0, head_rim_mm=3.0, dome_radius_mm=30.0,
                        neck_diameter_mm=13.0, neck_length_mm=10.0, tip_straight_mm=4.0, tip_relief_mm=0.1))
@@ -83,7 +83,7 @@ def test_standard_fills_barrel_length_angle_and_die_and_records_sources():
     s = parse_tooling(EU_B)
     b = s.body
     assert (b.barrel_diameter_mm, b.overall_length_mm, b.inside_head_angle_deg) == (19.0, 133.60, 30.0)
-    assert s.die_outer_diameter_mm == 30.16 and s.die_height_mm == 22.0 and s.lower_tip == 19.0
+    assert s.die_outer_diameter_mm == 30.16 and s.die_height_mm == 22.0 and s.lower_tip == 25.4
     assert set(b.sources) >= {"barrel_diameter_mm", "overall_length_mm", "inside_head_angle_deg", "die_outer_diameter_mm"}
     assert "head_diameter_mm" not in b.sources  # the user's
     # the overall length is tip + barrel + neck + head exactly
@@ -207,8 +207,11 @@ def test_barrel_smaller_than_the_tablet_and_oversize_tablets_are_design_errors()
                    punch_neck_diameter_mm=7.0, punch_head="domed")
     with pytest.raises(DesignError, match=r"barrel_diameter_mm = 9 mm .* circumscribed diameter 9.955 mm"):
         make_tooling(t, parse_tooling(custom), check=False, interference_check=False)
-    with pytest.raises(DesignError, match=r"lower_tip_length_mm = 12 mm .* must be > 17 mm"):
-        make_tooling(t, parse_tooling(_with(lower_tip_length_mm=12.0)), check=False, interference_check=False)
+    # at ejection the lower tip edge is at the die's top face: the tip must outreach the 22 mm die (20 mm
+    # clears the die's bottom face at the closed position, 17 mm below the tip edge, and is still refused)
+    for short in (12.0, 20.0, 22.0):
+        with pytest.raises(DesignError, match=rf"lower_tip_length_mm = {short:g} mm .* must be > 22 mm, the die's height"):
+            make_tooling(t, parse_tooling(_with(lower_tip_length_mm=short)), check=False, interference_check=False)
 
 
 @pytest.mark.cad

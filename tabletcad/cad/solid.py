@@ -15,7 +15,8 @@ free edge) that failed.
    tolerance ``max(2 tol, 1e-6)`` mm - no free or multiple edges allowed;
 4. ``BRepBuilderAPI_MakeSolid`` + ``BRepLib::OrientClosedSolid`` (matter
    inside, positive volume; faces of revolution: reversed if their volume is
-   negative) + ``BRepCheck_Analyzer``;
+   negative) + ``BRepCheck_Analyzer``; flat B-spline faces become exact planes
+   (:mod:`tabletcad.cad.planes`);
 5. volume/area/centroid by *adaptive* Gauss integration
    (``BRepGProp::VolumeProperties(shape, props, eps)``, ``eps`` = 1e-9): the
    default integration was measured up to ~1e-3 relative off on dense B-spline faces;
@@ -48,6 +49,7 @@ from tabletcad.brep.fit import PatchFunction, SurfaceFit, chain_breakpoints, fit
 from tabletcad.brep.surface import BSplineSurfaceData, volume_and_area
 from tabletcad.cad._occ import cast, explore, shape_type
 from tabletcad.cad.faces import face_of, knot_boundary_pcurves, make_geom_surface
+from tabletcad.cad.planes import flat_faces_as_planes
 from tabletcad.cad.shell import assemble_shell
 from tabletcad.errors import GeometryError
 from tabletcad.brep.slit import chain_face_surfaces
@@ -105,7 +107,8 @@ def mass_properties(shape: TopoDS_Shape, eps: float | None = DEFAULT_EPS) -> Mas
 @dataclass(frozen=True, eq=False)
 class TabletSolid:
     """A validated, outward-oriented closed solid and how it was made (``sewn``: its shell by
-    ``BRepBuilderAPI_Sewing``, else assembled edge by edge: :mod:`tabletcad.cad.shell`).
+    ``BRepBuilderAPI_Sewing``, else assembled edge by edge: :mod:`tabletcad.cad.shell`); ``planes``: how many
+    flat B-spline faces became exact planes (:mod:`tabletcad.cad.planes`).
 
     ``volume_fit_bound`` = ``max_fit_deviation * area`` bounds the volume change
     caused by replacing the patches with their B-splines (the surfaces are at
@@ -122,6 +125,7 @@ class TabletSolid:
     eps: float | None = DEFAULT_EPS
     timings: dict[str, float] = field(default_factory=dict)
     sewn: bool = True
+    planes: int = 0
 
     @property
     def mass(self) -> MassProperties:
@@ -173,6 +177,7 @@ class TabletSolid:
             "volume_rel_error_estimate": self.mass.volume_error,
             "sew_tolerance_mm": self.sew_tolerance if self.sewn else None,  # (an assembled shell was not sewn)
             "sewn": self.sewn,
+            "plane_faces": self.planes,
             "timings_s": dict(self.timings),
         }
 
@@ -336,6 +341,9 @@ def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequenc
     revolved = [isinstance(sd, RevolvedSurfaceData) for sd in surfaces]
     enclosed = -va[0] if all(revolved) else va[0] if not any(revolved) else math.nan
     solid = _make_solid(shell, name, enclosed)
+    # flat B-spline pieces as exact planes: OCCT's face merging, which build123d and CadQuery run after
+    # every Boolean, crashed the process on them (tabletcad.cad.planes)
+    solid, n_planes = flat_faces_as_planes(solid)
     t2 = time.perf_counter()
     out = TabletSolid(
         name=name,
@@ -348,6 +356,7 @@ def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequenc
         eps=eps,
         timings={"faces": t1 - t0, "sew_and_check" if sewn else "shell_and_check": t2 - t1},
         sewn=sewn,
+        planes=n_planes,
     )
     object.__setattr__(out, "_data_volume_area", va)
     return out

@@ -11,7 +11,8 @@
     gap_mm = 2.8                   # distance between the punch tip edges; default: closed (= band)
     standard = "TSM"               # complete punches: "TSM" | "EU" | "custom" (absent: punch tips only)
     type = "B"                     # "B" | "D" (TSM and EU; see tabletcad/data/tooling_standards.toml)
-    lower_tip_length_mm = 19.0     # lower punch tip length (default: tip_length_mm)
+    lower_tip_length_mm = 25.4     # lower punch tip length (default: tip_length_mm); with complete
+                                   # punches longer than the die is high (ejection)
     allowed_tip_pressure_MPa = 300.0          # tip-force rating F = p x tip area; needs its source:
     allowed_tip_pressure_source = "..."       # (no allowed pressure is bundled)
     punch_youngs_modulus_MPa = 210000.0       # tip buckling (Euler); needs its source:

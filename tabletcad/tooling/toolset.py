@@ -115,11 +115,14 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
     if spec.tip_length_mm <= need_up:
         raise DesignError("[tooling] tip_length_mm", spec.tip_length_mm,
                           f"must be > {need_up:.4g} mm, the upper punch's entry into the die (the barrel stays out)", "mm")
-    need_low = frame.band_z[0] - bottom
+    # ejection: the lower tip edge rises to the die's top face to push the tablet out, and the barrel's
+    # shoulder, the tip's length below it, must still be below the die's bottom face (the longer of the lower
+    # tip's two travels: at the closed position the edge is below the top face)
+    need_low = top - bottom
     if spec.lower_tip <= need_low:
         raise DesignError("[tooling] lower_tip_length_mm", spec.lower_tip,
-                          f"must be > {need_low:.4g} mm: from the lower tip edge to the die's bottom face at the "
-                          f"closed position (the barrel stays out of the die)", "mm")
+                          f"must be > {need_low:.4g} mm, the die's height: at ejection the lower tip edge rises to "
+                          f"the die's top face and the barrel must stay below the die", "mm")
 
 
 

@@ -1,0 +1,115 @@
+"""Flat B-spline faces of a solid as exact planes.
+
+A tablet's flat regions (a shaped family's plateau, a flat face cut into pieces where its
+spine collapses: :mod:`tabletcad.brep.slit`) are B-spline faces whose poles lie in one plane,
+so the surface lies in it exactly.  Handed to other tools as B-splines they are a trap:
+``ShapeUpgrade_UnifySameDomain``, which build123d's Booleans and ``clean()`` and
+CadQuery's ``clean=True`` run after every operation, merges coplanar faces, and on
+OCCT 7.9 it crashed the process (a segmentation fault) on such pieces with a pole at a
+collapsed end (the oval, almond, rounded triangle, square and rectangle, modified capsule).
+As ``Geom_Plane`` faces bounded by the same edges they merge cleanly, and a CAD user gets
+the planes they expect.
+
+Only faces bounded by one wire without a seam are replaced (a face of revolution's
+flat disc keeps its seam and its surface); the replaced solid must be valid, else the
+solid is returned unchanged.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from OCP.BRep import BRep_Tool
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
+from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.BRepTools import BRepTools_ReShape, BRepTools_WireExplorer
+from OCP.Geom import Geom_BSplineSurface
+from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt
+from OCP.Standard import Standard_Failure
+from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
+
+from tabletcad.cad._occ import cast, explore
+
+__all__ = ["flat_faces_as_planes", "plane_of"]
+
+#: poles this far from their plane (relative to the face's size) still make a flat face
+FLAT_REL_TOL = 1e-12
+
+
+def plane_of(surf: Geom_BSplineSurface) -> tuple[np.ndarray, np.ndarray] | None:
+    """``(point, unit normal)`` of the plane holding every pole of ``surf`` (the surface's own
+    normal ``S_u × S_v`` sense), or None when the poles are not coplanar to :data:`FLAT_REL_TOL`
+    of their extent.  A B-spline surface (rational or not) is an affine combination of its
+    poles, so coplanar poles make it lie in their plane exactly."""
+    nu, nv = surf.NbUPoles(), surf.NbVPoles()
+    P = np.array([[surf.Pole(i, j).Coord() for j in range(1, nv + 1)] for i in range(1, nu + 1)])
+    pts = P.reshape(-1, 3)
+    c = pts.mean(axis=0)
+    size = float(np.max(np.ptp(pts, axis=0)))
+    if size == 0.0:
+        return None
+    _, s, vt = np.linalg.svd(pts - c, full_matrices=False)
+    n = vt[2]
+    if s[1] <= 1e-9 * size or float(np.max(np.abs((pts - c) @ n))) > FLAT_REL_TOL * max(size, 1.0):
+        return None
+    # the surface's own normal: the polygon's cross products summed over the net (orientation of the face)
+    du, dv = P[1:, :-1] - P[:-1, :-1], P[:-1, 1:] - P[:-1, :-1]
+    sense = float(np.sum(np.cross(du, dv) @ n))
+    if sense == 0.0:
+        return None
+    return c, (n if sense > 0 else -n)
+
+
+def _plane_face(face: TopoDS_Face, point: np.ndarray, normal: np.ndarray) -> TopoDS_Face | None:
+    """``face`` rebuilt on its plane from its own edges (degenerate ones, a pole's, left out), with
+    its orientation; None when it has more than one wire or a seam."""
+    wires = explore(face, "Wire")
+    if len(wires) != 1:
+        return None
+    mw = BRepBuilderAPI_MakeWire()
+    it = BRepTools_WireExplorer(wires[0], face)
+    seen = []
+    while it.More():
+        e = it.Current()
+        if BRep_Tool.IsClosed_s(e, face) or any(e.IsSame(o) for o in seen):
+            return None  # a seam (the edge twice in the wire)
+        seen.append(e)
+        if not BRep_Tool.Degenerated_s(e):
+            mw.Add(e)
+        it.Next()
+    if not mw.IsDone():
+        return None
+    pln = gp_Pln(gp_Ax3(gp_Pnt(*map(float, point)), gp_Dir(*map(float, normal))))
+    mf = BRepBuilderAPI_MakeFace(pln, mw.Wire(), True)
+    if not mf.IsDone():
+        return None
+    new = mf.Face()
+    new.Orientation(face.Orientation())
+    return new
+
+
+def flat_faces_as_planes(solid: TopoDS_Shape) -> tuple[TopoDS_Shape, int]:
+    """``(solid, n)``: ``solid`` with its flat B-spline faces replaced by plane faces (``n`` of them),
+    or ``(solid, 0)`` unchanged when there are none or the result is not a valid solid
+    (``BRepCheck_Analyzer``: a face turned the wrong way fails it).  Each plane face is bounded by the
+    B-spline face's own edges, so the solid encloses the same volume (the CAD stage's cross-check of
+    the solid's volume against the surface data's holds it to that)."""
+    rs = BRepTools_ReShape()
+    n = 0
+    try:
+        for f in explore(solid, "Face"):
+            surf = BRep_Tool.Surface_s(f)
+            if not isinstance(surf, Geom_BSplineSurface):
+                continue
+            plane = plane_of(surf)
+            new = None if plane is None else _plane_face(f, *plane)
+            if new is not None:
+                rs.Replace(f, new)
+                n += 1
+        if not n:
+            return solid, 0
+        out = cast(rs.Apply(solid), "Solid")
+    except (Standard_Failure, ValueError):
+        return solid, 0
+    if out.IsNull() or not BRepCheck_Analyzer(out).IsValid():
+        return solid, 0
+    return out, n

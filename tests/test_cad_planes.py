@@ -1,0 +1,90 @@
+"""Flat B-spline faces become exact planes (tabletcad.cad.planes): build123d's and CadQuery's
+Booleans and clean() run OCCT's face merging, which crashed the process (SIGSEGV) on the
+shaped families' flat pieces.  Each script runs in a subprocess, where a crash is an exit
+status, not a lost test worker."""
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("OCP")
+pytest.importorskip("build123d")
+pytest.importorskip("cadquery")
+
+pytestmark = pytest.mark.cad
+
+ROOT = Path(__file__).resolve().parents[1]
+CRASHED = ("oval", "almond", "rounded_triangle", "rounded_square", "rounded_rectangle", "modified_capsule")
+
+SCRIPT = r"""
+import math, sys
+import build123d as bd, cadquery as cq
+from tabletcad.pipeline.design import Design
+from tabletcad.pipeline.model import TabletModel
+from tabletcad.cad._occ import explore
+from tabletcad.cad.solid import mass_properties
+from OCP.BRep import BRep_Tool
+from OCP.Geom import Geom_Plane
+
+d = Design.from_toml(sys.argv[1])
+m = TabletModel(d.build(), d)
+T = m.report()["height_mm"]
+planes = [f for f in explore(m.to_occ(), "Face") if isinstance(BRep_Tool.Surface_s(f), Geom_Plane)]
+b = m.to_build123d()
+r = 0.2  # a pin through the centre, inside the flat centre of the top and bottom faces
+cut = b - bd.Cylinder(r, 4 * T)
+q = m.to_cadquery().cut(cq.Workplane().cylinder(4 * T, r))  # clean=True: the face merging
+c = m.to_build123d().clean()
+vol = lambda s: mass_properties(s.wrapped).volume  # the adaptive integration (eps 1e-9) for every volume
+print(len(planes), vol(b), T, vol(cut), cut.is_valid, vol(q.val()), q.val().isValid(), vol(c), c.is_valid,
+      len(c.faces()), len(b.faces()))
+"""
+
+
+@pytest.mark.parametrize("family", CRASHED)
+def test_booleans_and_clean_on_flat_centred_families_run_and_are_exact(family, tmp_path):
+    """The pin through the flat centre removes pi r^2 T exactly; clean() merges the flat pieces
+    and keeps the volume.  On the code before tabletcad.cad.planes each ended in SIGSEGV (-11)."""
+    p = subprocess.run([sys.executable, "-c", SCRIPT, str(ROOT / "samples" / "families" / f"{family}.toml")],
+                       capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    assert p.returncode == 0, (p.returncode, p.stderr[-2000:])
+    n, V, T, cut, cut_ok, qv, q_ok, cv, c_ok, c_faces, b_faces = p.stdout.split()[-11:]
+    V, T, cut, qv, cv = map(float, (V, T, cut, qv, cv))
+    assert int(n) >= 2  # the top's and the bottom's flat pieces at least
+    pin = math.pi * 0.2**2 * T
+    assert V - cut == pytest.approx(pin, rel=1e-7) and cut_ok == "True"
+    assert qv == pytest.approx(cut, rel=1e-9) and q_ok == "True"
+    assert cv == pytest.approx(V, rel=1e-9) and c_ok == "True" and int(c_faces) < int(b_faces)
+
+
+def test_plane_of_reads_coplanar_poles_with_the_surface_normal():
+    from OCP.TColgp import TColgp_Array2OfPnt
+    from OCP.Geom import Geom_BSplineSurface
+    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+    from OCP.gp import gp_Pnt
+
+    from tabletcad.cad.planes import plane_of
+
+    rng = np.random.default_rng(3)
+    n = np.array([0.3, -0.4, 0.866]); n /= np.linalg.norm(n)
+    e1 = np.cross(n, [1.0, 0.0, 0.0]); e1 /= np.linalg.norm(e1)
+    e2 = np.cross(n, e1)
+
+    def surface(bump: float):
+        P = TColgp_Array2OfPnt(1, 4, 1, 4)
+        for i in range(4):
+            for j in range(4):
+                x = 5.0 + i * e1 + j * e2 + 0.01 * rng.normal() * (e1 + e2) + (bump if (i, j) == (1, 2) else 0.0) * n
+                P.SetValue(i + 1, j + 1, gp_Pnt(*x))
+        k = TColStd_Array1OfReal(1, 2); k.SetValue(1, 0.0); k.SetValue(2, 1.0)
+        m = TColStd_Array1OfInteger(1, 2); m.SetValue(1, 4); m.SetValue(2, 4)
+        return Geom_BSplineSurface(P, k, k, m, m, 3, 3)
+
+    point, normal = plane_of(surface(0.0))
+    assert np.allclose(normal, np.cross(e1, e2), atol=1e-12)  # S_u x S_v: along i (e1) then j (e2)
+    assert abs((point - 5.0) @ n) < 1e-12
+    assert plane_of(surface(1e-6)) is None  # a micrometre off the plane: not flat
