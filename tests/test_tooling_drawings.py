@@ -48,7 +48,7 @@ def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
     cup_r = (4.92 ** 2 + 0.9 ** 2) / (2 * 0.9)
     for text in (f"R{cup_r:.2f} ±0.076", "land 0.080 ±0.076"):
         assert text in svg, text
-    for text in ("overall 133.35 ±0.076", "Ø19.00 ±0.076", "Ø25.40 ±0.076", "tip 8.00 ±0.076", "tip 19.00 ±0.076",
+    for text in ("overall 133.35 ±0.076", "Ø19.00 ±0.076", "Ø25.40 ±0.076", "tip 8.00 ±0.076", "tip 25.40 ±0.076",
                  "Ø30.16 ±0.076", "H 22.22 ±0.076",
                  "UPPER PUNCH", "LOWER PUNCH", "DIE", "drawing no. TC-0001-T", "TSM B tooling, angled heads"):
         assert text in tsvg, text

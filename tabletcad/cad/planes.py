@@ -33,6 +33,8 @@ __all__ = ["flat_faces_as_planes", "plane_of"]
 
 #: poles this far from their plane (relative to the face's size) still make a flat face
 FLAT_REL_TOL = 1e-12
+#: and each of its edges this far from that plane (mm)
+EDGE_PLANE_TOL_MM = 1e-9
 
 
 def plane_of(surf: Geom_BSplineSurface) -> tuple[np.ndarray, np.ndarray] | None:
@@ -59,6 +61,20 @@ def plane_of(surf: Geom_BSplineSurface) -> tuple[np.ndarray, np.ndarray] | None:
     return c, (n if sense > 0 else -n)
 
 
+def _in_plane(edge, point: np.ndarray, normal: np.ndarray, samples: int = 17) -> bool:
+    """True when the edge's 3D curve lies in the plane to :data:`EDGE_PLANE_TOL_MM` at ``samples`` points
+    (an edge shared with a face whose poles were moved, such as a collapsed corner's snapped row, may not:
+    the plane face bounded by it would then enclose another region than the B-spline face did)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+
+    curve = BRepAdaptor_Curve(edge)
+    for t in np.linspace(curve.FirstParameter(), curve.LastParameter(), samples):
+        x = np.array(curve.Value(float(t)).Coord())
+        if abs(float((x - point) @ normal)) > EDGE_PLANE_TOL_MM:
+            return False
+    return True
+
+
 def _plane_face(face: TopoDS_Face, point: np.ndarray, normal: np.ndarray) -> TopoDS_Face | None:
     """``face`` rebuilt on its plane from its own edges (degenerate ones, a pole's, left out), with
     its orientation; None when it has more than one wire or a seam."""
@@ -74,6 +90,8 @@ def _plane_face(face: TopoDS_Face, point: np.ndarray, normal: np.ndarray) -> Top
             return None  # a seam (the edge twice in the wire)
         seen.append(e)
         if not BRep_Tool.Degenerated_s(e):
+            if not _in_plane(e, point, normal):
+                return None
             mw.Add(e)
         it.Next()
     if not mw.IsDone():

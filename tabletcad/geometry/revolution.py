@@ -47,7 +47,14 @@ __all__ = ["Revolution", "Section", "detect_revolution", "detect_section", "prof
 
 class _Profile:
     """``profile(u, du)``: ``(R(u), Z(u))`` from the fields ``radius``, ``height``, ``lam``,
-    ``u_nodes`` and ``form`` of the dataclasses below."""
+    ``u_nodes`` and ``form`` of the dataclasses below, whose arrays are read-only copies (a tablet is
+    immutable: ``tablet.revolution[0].radius[1] = 99`` had changed its report, not its solid)."""
+
+    def _freeze(self, *names: str) -> None:
+        for name in names:
+            a = np.array(getattr(self, name), dtype=float)
+            a.setflags(write=False)
+            object.__setattr__(self, name, a)
 
     radius: np.ndarray
     height: np.ndarray
@@ -103,6 +110,9 @@ class Revolution(_Profile):
     u_nodes: tuple[float, float, float, float]
     form: str
 
+    def __post_init__(self) -> None:
+        self._freeze("radius", "height")
+
     def section(self) -> "Section":
         """The same profile as a :class:`Section` (``S = I``; ``p = e_φ``, ``q = sense · e_φ+90°``)."""
         c, s = math.cos(self.phase), math.sin(self.phase)
@@ -140,6 +150,9 @@ class Section(_Profile):
     lam: float
     u_nodes: tuple[float, float, float, float]
     form: str
+
+    def __post_init__(self) -> None:
+        self._freeze("plan", "radius", "height")
 
     @property
     def shape(self) -> np.ndarray:

@@ -599,6 +599,10 @@ def parse_tooling(table: Any, base: Path | None = None) -> ToolingSpec:
             if body.die_outer_diameter_mm is None:
                 raise DesignError("[tooling] die_outer_diameter_mm", MISSING, "required with standard = 'custom'", "mm")
             od = body.die_outer_diameter_mm
+        elif body.die_outer_diameter_mm is not None and od != body.die_outer_diameter_mm:
+            # (a 27 mm die had gone out on a sheet saying plain "TSM B tooling")
+            body = replace(body, modified={**body.modified, "die_outer_diameter_mm": {
+                "given": float(od), "standard": float(body.die_outer_diameter_mm)}})
     sourced = {}
     for key, unit in (("allowed_tip_pressure_MPa", "MPa"), ("punch_youngs_modulus_MPa", "MPa")):
         skey = key.replace("_MPa", "_source")

@@ -40,7 +40,8 @@ def tooling_outputs(spec: ToolingSpec) -> list[str]:
 
 
 def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
-    """Refuse a tablet that cannot have tooling (a cut-away or a ring), before any geometry is built.
+    """Refuse a tablet that cannot have tooling (a cut-away or a ring, one too large for its die or for every
+    TSM die when no die is given), before any geometry is built.
 
     ``spec`` is the design's checked ``[tooling]`` table
     (:attr:`tabletcad.pipeline.design.Design.tooling_spec`); raises :class:`DesignError`.
@@ -49,7 +50,12 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
     if t.u != (0.0, 1.0) or not t.full_v or t.w[0] > 0:
         raise DesignError("[tooling]", tablet.name, "tooling needs a whole solid tablet (no [trim], no ring)")
     od = spec.die_outer_diameter_mm
-    if od is not None:  # the die's wall around the tablet's plan (the bore adds at most 1e-6 mm to it)
+    if od is None:  # the TSM die the build will take: one larger than a 'D' takes is refused here, not after the CAD
+        from tabletcad.tooling.spec import standard_die_size
+
+        dims = tablet.dimensions()
+        standard_die_size(max(dims["length_mm"], dims["width_mm"]), shaped=tablet.revolution is None)
+    else:  # the die's wall around the tablet's plan (the bore adds at most 1e-6 mm to it)
         import numpy as np
 
         from tabletcad.tooling.spec import MIN_DIE_WALL_MM

@@ -1,0 +1,97 @@
+"""A punch-and-die maker's trial (session 33): a lower punch whose barrel would hit the die at ejection, a
+die outer diameter other than the standard's sent out as the standard, and a tablet too large for every TSM
+die refused only after the CAD stage (49 s and 3 GB for a 1000 mm round).
+
+Each refusal: the one ``error: <parameter> = <value> is not allowed: <range>`` line, exit 2, nothing written.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from tabletcad.cli import main
+
+ONE_LINE = re.compile(r"^error: (\S+) = (.+) is not allowed: (.+)$")
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLE = (ROOT / "samples" / "tooling" / "tsm_b_round.toml").read_text(encoding="utf-8")
+
+
+def _refused(capsys, tmp_path: Path, design: str) -> tuple[str, str, str]:
+    src = tmp_path / "d.toml"
+    src.write_text(design, encoding="utf-8")
+    assert main(["build", str(src), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    m = ONE_LINE.match(err[0])
+    assert m, err[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.toml"]
+    return m.group(1), m.group(2), m.group(3)
+
+
+@pytest.mark.cad
+@pytest.mark.parametrize("lower", ["19.0", "22.22"])
+def test_a_lower_tip_no_longer_than_the_die_is_refused(capsys, tmp_path, lower):
+    """At ejection the lower tip edge rises to the die's top face: with a 19 mm tip in the 22.22 mm die the
+    barrel's shoulder stood 3.22 mm inside the bore (the sample's own figures until session 33)."""
+    pytest.importorskip("OCP")
+    design = SAMPLE.replace("lower_tip_length_mm = 25.4", f"lower_tip_length_mm = {lower}")
+    assert design != SAMPLE
+    name, value, why = _refused(capsys, tmp_path, design)
+    assert name == "tooling.lower_tip_length_mm" and value == f"{float(lower):g} mm"
+    assert why.startswith("must be > 22.22 mm, the die's height")
+
+
+def test_a_die_other_than_the_standards_is_labelled_modified():
+    from tabletcad.pipeline.design import Design
+
+    spec = Design.from_dict(__import__("tomllib").loads(SAMPLE.replace(
+        "die_height_mm = 22.22", "die_height_mm = 22.22\ndie_outer_diameter_mm = 27.0"))).tooling_spec
+    assert spec.body.modified == {"die_outer_diameter_mm": {"given": 27.0, "standard": 30.16}}
+    same = Design.from_dict(__import__("tomllib").loads(SAMPLE.replace(
+        "die_height_mm = 22.22", "die_height_mm = 22.22\ndie_outer_diameter_mm = 30.16"))).tooling_spec
+    assert same.body.modified == {}
+
+
+@pytest.mark.parametrize("design, shaped", [
+    ('[tablet]\nfamily = "concave_round"\ndiameter = 1000.0\nband = 280\ncup_depth = 90\nland = 0.08\n', "round"),
+    ('[tablet]\nfamily = "capsule"\nlength = 25.5\nwidth = 9.0\nband = 3.0\ncup_depth = 1.0\n', "shaped"),
+])
+def test_a_tablet_larger_than_every_tsm_die_is_refused_before_the_cad(capsys, tmp_path, monkeypatch, design, shaped):
+    """No die outer diameter given: the TSM die is chosen from the tablet's size, and one larger than a 'D'
+    takes (25 mm) is refused from the PDE tablet's extents, not after its solid (49 s for the 1000 mm round)."""
+    pytest.importorskip("OCP")
+    import tabletcad.cad.stage
+
+    def no_cad(**kw):
+        raise AssertionError("the CAD stage ran before the refusal")
+
+    monkeypatch.setattr(tabletcad.cad.stage, "cad_stage", no_cad)
+    name, value, why = _refused(capsys, tmp_path, design + "[tooling]\nclearance_mm = 0.02\ntip_length_mm = 8.0\n")
+    assert name == "tooling.die_outer_diameter_mm" and value == "(not given)"
+    size = "1000" if shaped == "round" else "25.5"
+    assert why == f"give it for a {shaped} tablet {size} mm long (larger than a TSM 'D' die takes, 25 mm)"
+
+
+def test_a_tablets_profile_arrays_are_read_only():
+    """A tablet is immutable: writing into its profile's arrays had changed its report (length 154 mm) and
+    not its solid (a scripting user's trial, session 33)."""
+    import numpy as np
+
+    import tabletcad
+
+    m = tabletcad.make("concave_round", diameter=10, band=2, cup_depth=1)
+    rev = m.tablet.revolution
+    for prof in (rev[0], rev[0].section(), m.tablet.section[0]):
+        for name in ("radius", "height") + (("plan",) if hasattr(prof, "plan") else ()):
+            with pytest.raises(ValueError, match="read-only"):
+                getattr(prof, name)[0] = 99.0
+    assert m.report()["length_mm"] == pytest.approx(10.0, abs=1e-6)
+    radius = np.array([1.0, 2.0, 3.0, 4.0])
+    from tabletcad.geometry.revolution import Revolution
+
+    r = Revolution(0.0, 1, radius, np.zeros(4), 1.0, (0.0, 1 / 3, 2 / 3, 1.0), "curves")
+    radius[0] = 7.0  # the caller's array is not the profile's
+    assert r.radius[0] == 1.0
