@@ -95,3 +95,52 @@ def test_a_tablets_profile_arrays_are_read_only():
     r = Revolution(0.0, 1, radius, np.zeros(4), 1.0, (0.0, 1 / 3, 2 / 3, 1.0), "curves")
     radius[0] = 7.0  # the caller's array is not the profile's
     assert r.radius[0] == 1.0
+
+
+@pytest.mark.cad
+def test_a_batch_owns_its_folder(tmp_path):
+    """A second, smaller batch into the same folder had left the first one's other sizes (stale 10-14 mm
+    folders beside new 7-9 mm ones) and overwritten a file the user had edited."""
+    pytest.importorskip("OCP")
+    import json
+
+    from tabletcad.errors import DesignError
+    from tabletcad.tooling import tooling_batch
+
+    fam = "thesis.shallow_convex_round"
+    kw = dict(progress=False, check=False, drawing=False)
+    out = tmp_path / "b"
+    sizes = [dict(diameter=d, thickness=0.3 * d, band=0.2 * d) for d in (6.0, 7.0, 8.0)]
+    tooling_batch(fam, sizes, {"clearance_mm": 0.02}, out_dir=out, **kw)
+    index = json.loads((out / "batch.json").read_text())
+    assert [r["folder"] for r in index] == [f"{fam}_{k:03d}" for k in range(3)]
+    assert [r["params"] for r in index] == sizes
+    tooling_batch(fam, sizes[:1], {"clearance_mm": 0.02}, out_dir=out, **kw)
+    assert sorted(p.name for p in out.iterdir()) == [".tabletcad-build.json", "batch.json", f"{fam}_000"]
+    step = out / f"{fam}_000" / "assembly.step"
+    step.write_text(step.read_text() + "\n/* edited */\n")
+    with pytest.raises(DesignError, match="edited since"):
+        tooling_batch(fam, sizes[:1], {"clearance_mm": 0.02}, out_dir=out, **kw)
+    assert step.read_text().endswith("/* edited */\n")
+
+
+@pytest.mark.cad
+@pytest.mark.parametrize("clearance, warned", [(0.05, False), (0.1, False), (0.11, True), (1.0, True)])
+def test_a_clearance_wider_than_presses_use_is_warned_of(clearance, warned):
+    """1 mm a side had been built without a word, where 0 is warned of."""
+    pytest.importorskip("OCP")
+    import warnings
+
+    from tabletcad.families.thesis import shallow_convex_round
+    from tabletcad.tooling.outline import tablet_frame
+    from tabletcad.tooling.spec import parse_tooling
+    from tabletcad.tooling.toolset import check_on_frame
+
+    frame = tablet_frame(shallow_convex_round())
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        check_on_frame(frame, parse_tooling({"clearance_mm": clearance}))
+    wide = [w for w in got if "powder flashes into the gap" in str(w.message)]
+    assert len(wide) == int(warned)
+    if warned:
+        assert str(wide[0].message).startswith(f"clearance_mm = {clearance:g}: wider than 0.1 mm a side")

@@ -255,6 +255,14 @@ def test_drawing_states_the_design_numbers(built):
     for text in ("band 2.80", "cup 0.90", "T 4.60", "R13.90", "land 0.080"):  # (the radius: a DIMENSION entity)
         assert text in dxf, text
     assert "10.00" in dxf
+    # the lettering as an engraver needs it (a toolmaker's trial: the note had given only the text and depth);
+    # the sheet's notes wrap at spaces, so its texts are joined with spaces
+    import html
+    import re
+
+    words = " ".join(html.unescape(t) for t in re.findall(r"<text[^>]*>([^<]*)</text>", svg))
+    assert ("deboss '10' 2.50 mm high in DejaVuSans-Bold, 0.12 mm deep (along the face normal) on the bottom face, "
+            "stroke angle 0 deg, centred at (0.000, 0.000) mm, turned 0 deg") in " ".join(words.split())
 
 
 def test_emboss_and_scores_on_both_faces():

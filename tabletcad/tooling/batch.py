@@ -41,7 +41,12 @@ def tooling_batch(family: str, sizes: Iterable[dict], spec: ToolingSpec | dict |
                   drawing: bool = True, workers: int = 0, scheduler: str | None = None, client=None) -> list[dict]:
     """Tooling for every parameter set in ``sizes`` of ``family``; one summary row per size.
 
-    Files go to ``out_dir/<family>_<k>/`` when ``out_dir`` is given.  Rows hold the parameters,
+    Files go to ``out_dir/<family>_<k>/`` when ``out_dir`` is given, with ``batch.json`` naming each
+    folder's parameters and summary row.  The batch owns ``out_dir`` as a build owns its folder
+    (:mod:`tabletcad.io.outputs`): everything is written at once when every size is made, the folders of
+    an earlier, larger batch are removed, and a file it would replace that no batch wrote there, or that
+    was edited since, is refused (:class:`~tabletcad.errors.DesignError`) before any size is made.
+    Rows hold the parameters,
     tablet and punch volumes, the quadrature check, the largest OCC/manifold3d disagreement and
     the seconds spent (total and in OCC Booleans).
 
@@ -56,6 +61,12 @@ def tooling_batch(family: str, sizes: Iterable[dict], spec: ToolingSpec | dict |
         spec = parse_tooling(spec)
     family = lookup_family(family, parameter="family").name
     sizes = [dict(p) for p in sizes]
+    if out_dir is not None:  # a folder's files of someone else's, or edited, refused before any size is made
+        from tabletcad.io.outputs import check_replaceable
+        from tabletcad.tooling.stage import tooling_outputs
+
+        names = tooling_outputs(spec if spec is not None else ToolingSpec()) if drawing else ["assembly.step"]
+        check_replaceable(out_dir, ["batch.json"] + [f"{family}_{k:03d}/{n}" for k in range(len(sizes)) for n in names])
 
     # every size is made before any file is written: a size refused half-way (a tablet too large for its
     # die) had left the folders of the sizes before it
@@ -64,13 +75,22 @@ def tooling_batch(family: str, sizes: Iterable[dict], spec: ToolingSpec | dict |
                                                           files=out_dir is not None),
                         client=client, scheduler=scheduler, workers=None if client or scheduler else workers,
                         progress=progress, desc=f"tooling {family}")
-    if out_dir is not None:
-        for k, res in enumerate(results):
-            d = Path(out_dir) / f"{family}_{k:03d}"
-            d.mkdir(parents=True, exist_ok=True)
-            for name, data in res["files"].items():
-                (d / name).write_bytes(data)
-    return [r["row"] for r in results]
+    rows = [r["row"] for r in results]
+    if out_dir is not None:  # all at once, as a build publishes (an earlier batch's other sizes go)
+        import json
+
+        from tabletcad.io.outputs import publish, staging_folder
+
+        with staging_folder(out_dir) as staging:
+            for k, res in enumerate(results):
+                d = staging / f"{family}_{k:03d}"
+                d.mkdir()
+                for name, data in res["files"].items():
+                    (d / name).write_bytes(data)
+            index = [dict(folder=f"{family}_{k:03d}", family=family, **row) for k, row in enumerate(rows)]
+            (staging / "batch.json").write_text(json.dumps(index, indent=1, default=float) + "\n", encoding="utf-8")
+            publish(staging, out_dir)
+    return rows
 
 
 def _tooling_task(params: dict, *, family: str, spec: ToolingSpec | None, check: bool, interference_check: bool,

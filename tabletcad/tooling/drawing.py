@@ -237,8 +237,12 @@ def drawing_model(ts) -> Drawing:
                                                                "±1 deg (ISO 2768-m, legs up to 10 mm)"))
     for s in ts.report.get("scores", []):
         notes.append(_score_note(s, ts.spec.scores[s["index"]]))
-    for e in ts.report.get("emboss", []):
-        notes.append(f"{e['mode']} '{e['text'] or 'outline'}' {_fmt(e['depth_mm'])} mm on the {e['face']} face")
+    for e in ts.spec.emboss:  # what the engraver needs: the figure, its size, font, draft, place and turn
+        what = (f"'{e.text}' {_fmt(e.height_mm)} mm high in {e.font}" if e.text is not None
+                else "the SVG figure" if e.svg is not None else "the outline")
+        notes.append(f"{e.mode} {what}, {_fmt(e.depth_mm)} mm deep ({'along the face normal' if e.projection == 'normal' else 'axially'}) "
+                     f"on the {e.face} face, stroke angle {e.draft_deg:g} deg, centred at "
+                     f"({_fmt(e.position_mm[0])}, {_fmt(e.position_mm[1])}) mm, turned {e.rotation_deg:g} deg")
     r = ts.report.get("tip_rating") or {}
     notes += rating_notes(r)
     for k, b in ((r.get("buckling") or {}).get("tips") or {}).items():

@@ -52,6 +52,8 @@ class ToolSet:
 
 #: die height (mm) when only the outer diameter is given
 DEFAULT_DIE_HEIGHT_MM = 22.22
+#: a punch-to-die clearance (mm a side) above which a build warns
+WIDE_CLEARANCE_MM = 0.1
 
 
 def die_height(frame, spec: ToolingSpec) -> float:
@@ -92,6 +94,12 @@ def check_on_frame(frame, spec: ToolingSpec) -> list:
 
         warnings.warn("clearance_mm = 0: the punch tips fit the die bore line to line, with no running clearance "
                       "(presses use about 0.01-0.05 mm a side); the parts model the nominal fit", stacklevel=3)
+    elif spec.clearance_mm > WIDE_CLEARANCE_MM:  # (1 mm a side had been built without a word)
+        import warnings
+
+        warnings.warn(f"clearance_mm = {spec.clearance_mm:g}: wider than {WIDE_CLEARANCE_MM:g} mm a side (presses use "
+                      "about 0.01-0.05 mm): powder flashes into the gap and the tablet's band edge gets a burr",
+                      stacklevel=3)
     if spec.body is not None:
         _check_complete_punches(frame, spec)
     return emb_checked
