@@ -1,5 +1,6 @@
 """Drawings a toolmaker can quote from: tolerances, title block, scale, punch and die sheet, no text on geometry."""
 
+import math
 import re
 from pathlib import Path
 
@@ -63,6 +64,12 @@ def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
     for text in ("working length (head flat to cup bottom): upper 132.45, lower 132.45", "bore Ø10.000 (the tablet's",
                  "tips Ø9.960 (the bore less the clearance 0.020 per side)"):
         assert text in notes, text
+    # the head that runs on the press's cams (a toolmaker's trial: only its diameters were on the sheet): the
+    # TSM head's height is its rim, the underside cone over (25.4 - 12.7) / 2 at 37 deg and the top over
+    # (25.4 - 12) / 2 at 10 deg
+    h = 2.5 + 6.35 * math.tan(math.radians(37.0)) + 6.7 * math.tan(math.radians(10.0))
+    assert (f"head Ø25.40 (flat Ø12.00), rim 2.50, inside head angle 37 deg, top angle 10 deg, head height {h:.2f}"
+            in notes)
     flat = " ".join(re.sub(r"<[^>]+>", " ", tsvg).split())  # the sheet's text, wrapped lines joined
     assert "working length (head flat to cup bottom): upper 132.45," in flat and "tips Ø9.960" in flat
     dxf = (out / "tooling.dxf").read_text(encoding="utf-8", errors="replace")

@@ -631,7 +631,10 @@ def tooling_model(ts) -> Drawing:
     notes = [f"{ts.tablet.name}: {up['standard']} {up['type'] or 'user-defined'} tooling"
              f"{', MODIFIED' if mod else ''}, {up['head']} heads" + (f"; modified: {changed}" if mod else ""),
              f"barrel Ø{_fmt(up['barrel_diameter_mm'])}, neck Ø{_fmt(up['neck_diameter_mm'])} x {_fmt(up['neck_length_mm'])}, "
-             f"head Ø{_fmt(up['head_diameter_mm'])} (flat Ø{_fmt(up['head_flat_diameter_mm'])})",
+             f"head Ø{_fmt(up['head_diameter_mm'])} (flat Ø{_fmt(up['head_flat_diameter_mm'])}), rim "
+             f"{_fmt(up['head_rim_mm'])}, inside head angle {up['inside_head_angle_deg']:g} deg, "
+             + (f"top angle {up['head_top_angle_deg']:g} deg" if up["head"] == "angled"
+                else f"dome R{_fmt(up['dome_radius_mm'])}") + f", head height {_fmt(up['head_height_mm'])}",
              f"tip: straight {_fmt(up['tip_straight_mm'])}, relief {_fmt(up['tip_relief_mm'])} per side; "
              f"upper tip {_fmt(up['tip_length_mm'])}, lower tip {_fmt(lo['tip_length_mm'])}",
              f"working length (head flat to cup bottom): upper {_fmt(up['working_length_mm'])}, lower "

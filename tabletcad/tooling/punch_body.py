@@ -168,6 +168,8 @@ def complete_punch(frame: TabletFrame, tip_shape, which: str, b: PunchBody, clea
                 barrel_diameter_mm=b.barrel_diameter_mm, barrel_length_mm=lb, neck_diameter_mm=b.neck_diameter_mm,
                 neck_length_mm=b.neck_length_mm, head_diameter_mm=b.head_diameter_mm,
                 head_flat_diameter_mm=b.head_flat_diameter_mm, head_height_mm=b.head_height_mm,
+                head_rim_mm=b.head_rim_mm, inside_head_angle_deg=b.inside_head_angle_deg,
+                head_top_angle_deg=b.head_top_angle_deg, dome_radius_mm=b.dome_radius_mm,
                 tip_length_mm=tip_length, tip_straight_mm=b.tip_straight_mm, tip_relief_mm=b.tip_relief_mm,
                 key=b.key, head_flat_z_mm=edge + sign * b.overall_length_mm, volume_mm3=volume(shape),
                 body_volume_closed_form_mm3=body_volume(b, lb), key_volume_mm3=key_volume(b),
