@@ -182,6 +182,29 @@ def _fmt(x: float) -> str:
     return f"{x:.2f}" if abs(x) >= 0.1 else f"{x:.3f}"
 
 
+def _outline_notes(ts) -> list[str]:
+    """A shaped tablet's outline radii (its design's ``end_radius``, ``corner_radius``) and, for a cup swept
+    over the outline's offsets, how far in the cup runs and whether a flat plateau finishes the face (a
+    toolmaker's trial: an oval's sheet gave only the cup radius, and its 10 x 2.5 mm plateau went unsaid)."""
+    notes = []
+    params = getattr(ts.tablet, "params", None) or {}
+    general = ts.spec.drawing.tolerance_mm
+    for k in ("end_radius", "corner_radius"):
+        v = params.get(k)
+        if isinstance(v, (int, float)) and v > 0:
+            notes.append(f"outline {k.replace('_', ' ')} R{_fmt(v)} ±{_fmt(general)} mm")
+    info = ts.frame.info
+    cw = info.get("cup_width_mm")
+    outline = getattr(getattr(ts.tablet, "nominal", None), "outline", None)
+    if isinstance(cw, (int, float)) and cw > 0 and info.get("cup_depth_mm", 0.0) > 0 and outline is not None:
+        reach = outline.inscribed_radius()
+        inside = ("a flat plateau inside (the outline offset inwards by it)" if cw < reach - 1e-6
+                  else "closing at the centre")
+        notes.append(f"cup swept over the outline's offsets: it runs {_fmt(cw)} mm in from the outline (land "
+                     f"included), {inside}")
+    return notes
+
+
 def drawing_model(ts) -> Drawing:
     """Views and dimensions of a :class:`~tabletcad.tooling.toolset.ToolSet`'s tablet."""
     fr = ts.frame
@@ -222,6 +245,7 @@ def drawing_model(ts) -> Drawing:
     radii = {k: v for k, v in fr.info.items() if k.endswith("radius_mm") and isinstance(v, (int, float)) and v > 0}
     for k, v in radii.items():
         notes.append(f"{k[:-3].replace('_', ' ')} R{_fmt(v)} ±{_fmt(tol('cup_radius'))} mm")
+    notes += _outline_notes(ts)
     if not radii and fr.round_radius is not None and fr.cup_depth_top > 1e-6 and not fr.info:
         R, d = fr.round_radius, fr.cup_depth_top  # a thesis shape: its PDE cup is not a sphere
         notes.append(f"sphere through the cup's rim and apex R{_fmt((R * R + d * d) / (2 * d))} mm (reference: "

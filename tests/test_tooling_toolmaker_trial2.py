@@ -1,6 +1,8 @@
-"""A punch-and-die maker's trial (session 33): a lower punch whose barrel would hit the die at ejection, a
+"""A punch-and-die maker's second trial (session 33): a lower punch whose barrel would hit the die at ejection, a
 die outer diameter other than the standard's sent out as the standard, and a tablet too large for every TSM
-die refused only after the CAD stage (49 s and 3 GB for a 1000 mm round).
+die refused only after the CAD stage (49 s and 3 GB for a 1000 mm round), a batch that overwrote an edited file
+and left an earlier batch's sizes, a 1 mm clearance unwarned, sheets without the lettering's, the head's and
+a shaped outline's figures; and from a scripting user's trial, a tablet's writable profile arrays.
 
 Each refusal: the one ``error: <parameter> = <value> is not allowed: <range>`` line, exit 2, nothing written.
 """
@@ -144,3 +146,22 @@ def test_a_clearance_wider_than_presses_use_is_warned_of(clearance, warned):
     assert len(wide) == int(warned)
     if warned:
         assert str(wide[0].message).startswith(f"clearance_mm = {clearance:g}: wider than 0.1 mm a side")
+
+
+@pytest.mark.cad
+def test_a_shaped_sheet_gives_the_outline_radius_and_the_plateau():
+    """The oval sample: end radius 3 mm; its cup runs 3 mm in (the smallest convex radius) where the 8 mm
+    width leaves 4, so a flat plateau 2 mm wide finishes the face (its 16 pieces are planes in the solid)."""
+    pytest.importorskip("OCP")
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling import make_tooling
+    from tabletcad.tooling.drawing import drawing_model
+    from tabletcad.tooling.spec import parse_tooling
+
+    t = Design.from_toml(ROOT / "samples" / "families" / "oval.toml").build()
+    assert t.nominal.outline.inscribed_radius() == pytest.approx(4.0, abs=1e-9)
+    ts = make_tooling(t, parse_tooling({"clearance_mm": 0.02}), check=False, interference_check=False)
+    notes = drawing_model(ts).notes
+    assert "outline end radius R3.00 ±0.076 mm" in notes
+    assert ("cup swept over the outline's offsets: it runs 3.00 mm in from the outline (land included), a flat "
+            "plateau inside (the outline offset inwards by it)") in notes
