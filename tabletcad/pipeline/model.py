@@ -179,10 +179,24 @@ class TabletModel(_Shaped):
     ``design``: the :class:`~tabletcad.pipeline.design.Design` it was built from (:func:`load`,
     :func:`make`), whose ``[report]`` options and ``[tooling]`` specification :meth:`report` and
     :meth:`tooling` use, and which :meth:`replace` changes; None for a model of a bare core tablet.
+
+    Models of equal designs (the same tables, read from the same folder) are equal and hash alike: a build
+    is a function of its design (``make("oval", ...) == make("oval", ...)``, ``m == m.replace()``); a model
+    of a bare core tablet is equal only to itself.
     """
 
     tablet: Tablet
     design: Design | None = None
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, TabletModel):
+            return NotImplemented
+        if self.design is None or other.design is None:
+            return self is other
+        return self.design == other.design and self.design.folder == other.design.folder
+
+    def __hash__(self) -> int:
+        return object.__hash__(self) if self.design is None else hash(self.design)
 
     @property
     def name(self) -> str:
