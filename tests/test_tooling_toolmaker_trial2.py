@@ -57,6 +57,7 @@ def test_a_die_other_than_the_standards_is_labelled_modified():
     assert same.body.modified == {}
 
 
+@pytest.mark.cad
 @pytest.mark.parametrize("design, shaped", [
     ('[tablet]\nfamily = "concave_round"\ndiameter = 1000.0\nband = 280\ncup_depth = 90\nland = 0.08\n', "round"),
     ('[tablet]\nfamily = "capsule"\nlength = 25.5\nwidth = 9.0\nband = 3.0\ncup_depth = 1.0\n', "shaped"),
