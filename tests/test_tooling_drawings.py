@@ -61,8 +61,8 @@ def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
     # (in the sheet's notes, whose lines wrap where the sheet's room puts them: every one of them on the
     # sheet is test_drawing_sheet_keeps_every_text_on_the_sheet's)
     notes = " ".join(tooling_model(ts).notes)
-    for text in ("working length (head flat to cup bottom): upper 132.45, lower 132.45", "bore Ø10.000 (the tablet's",
-                 "tips Ø9.960 (the bore less the clearance 0.020 per side)"):
+    for text in ("working length (head flat to cup bottom): upper 132.45, lower 132.45 ±0.076",
+                 "bore Ø10.000 ±0.076 (the tablet's", "tips Ø9.960 ±0.076 (the bore less the clearance 0.020 per side)"):
         assert text in notes, text
     # the head that runs on the press's cams (a toolmaker's trial: only its diameters were on the sheet): the
     # TSM head's height is its rim, the underside cone over (25.4 - 12.7) / 2 at 37 deg and the top over
@@ -181,8 +181,13 @@ def test_every_dimension_takes_its_own_tolerance():
     assert all("±" in t for t in texts) and not any("±0.076" in t for t in texts)
     shown = {t.rsplit("±", 1)[1] for t in texts}
     # every key the tablet and punch sheets dimension (a round: no length or width) appears
-    expected = {k for k in TOLERANCE_KEYS if k not in ("length", "width", "score_depth", "bevel_width", "bevel_angle")}
+    fit = ("working_length", "tip_diameter", "bore_diameter")  # the fit's sizes: in the punch sheet's notes
+    expected = {k for k in TOLERANCE_KEYS if k not in ("length", "width", "score_depth", "bevel_width", "bevel_angle")
+                + fit}
     assert {f"{tols[k]:.3f}" for k in expected} <= shown
+    notes = " ".join(tr.notes)
+    for k, text in zip(fit, ("lower 132.45 ±{:.3f}", "tips Ø9.960 ±{:.3f} (", "bore Ø10.000 ±{:.3f} (")):
+        assert text.format(tols[k]) in notes, k
     radius = [d for d in dr.dims if d.radius]
     assert len(radius) == 1
     (cx, cy), (px, py) = radius[0].p1, radius[0].p2
@@ -376,3 +381,31 @@ def test_a_tolerance_as_large_as_its_dimension_is_warned_of():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert [d.text for d in _toleranced(dims, given)] == ["land 0.050 ±0.020", "cup 0.900 ±0.076", "band 0.070 ±0.050"]
+
+
+def test_fits_take_limit_deviations_and_the_working_length_its_own_tolerance(drawn):
+    """A toolmaker's trial: working length, tip and bore could not be toleranced, and a barrel's fit could
+    not be one-sided ([0.0, -0.013] was refused), so Ø19.00 ±0.076 was drawn for a barrel that must not
+    exceed its guide's 19 mm."""
+    from dataclasses import replace
+
+    from tabletcad.errors import DesignError
+    from tabletcad.tooling.spec import parse_tooling
+
+    ts, _, _ = drawn
+    table = {"clearance_mm": 0.02, "drawing": {"tolerances": {
+        "barrel_diameter": [0.0, -0.013], "working_length": 0.025, "tip_diameter": [-0.005, -0.015],
+        "bore_diameter": [0.012, 0.0], "bevel_angle": [1, -2]}}}
+    dspec = parse_tooling(table).drawing
+    assert dspec.tolerance_text("barrel_diameter") == "+0.000/-0.013" and dspec.tolerance("tip_diameter") == 0.015
+    tm = tooling_model(replace(ts, spec=replace(ts.spec, drawing=dspec)))
+    texts = [d.text for d in tm.dims]
+    assert "Ø19.00 +0.000/-0.013" in texts and "H 22.22 ±0.076" in texts
+    notes = " ".join(tm.notes)
+    for text in ("upper 132.45, lower 132.45 ±0.025", "bore Ø10.000 +0.012/+0.000 (the tablet's",
+                 "tips Ø9.960 -0.005/-0.015 (the bore less"):
+        assert text in notes, text
+    for bad, why in (([0.0, 0.013], "upper > lower"), ([0.01], "two limit deviations"), (["a", 0.0], "two limit"),
+                     ([0.0, -11.0], "-10"), (0.0, "> 0")):
+        with pytest.raises(DesignError, match=why):
+            parse_tooling({"drawing": {"tolerances": {"tip_diameter": bad}}})

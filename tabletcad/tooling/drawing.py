@@ -241,24 +241,25 @@ def drawing_model(ts) -> Drawing:
         notes.insert(1, f"diameter Ø{_fmt(2 * fr.round_radius)} mm")
     else:
         notes.insert(1, f"length {_fmt(L)} mm x width {_fmt(W)} mm")
-    tol = ts.spec.drawing.tolerance
+    tol = ts.spec.drawing.tolerance_text
     radii = {k: v for k, v in fr.info.items() if k.endswith("radius_mm") and isinstance(v, (int, float)) and v > 0}
     for k, v in radii.items():
-        notes.append(f"{k[:-3].replace('_', ' ')} R{_fmt(v)} ±{_fmt(tol('cup_radius'))} mm")
+        notes.append(f"{k[:-3].replace('_', ' ')} R{_fmt(v)} {tol('cup_radius')} mm")
     notes += _outline_notes(ts)
     if not radii and fr.round_radius is not None and fr.cup_depth_top > 1e-6 and not fr.info:
         R, d = fr.round_radius, fr.cup_depth_top  # a thesis shape: its PDE cup is not a sphere
         notes.append(f"sphere through the cup's rim and apex R{_fmt((R * R + d * d) / (2 * d))} mm (reference: "
                      "the cup is the PDE surface of the STEP file)")
     if fr.land:
-        notes.append(f"land {_fmt(fr.land)} ±{_fmt(tol('land'))} mm")
+        notes.append(f"land {_fmt(fr.land)} {tol('land')} mm")
     elif fr.land is not None:
         notes.append("no land")
     if fr.info.get("bevel_width_mm"):
         ang = dict(ts.spec.drawing.tolerances).get("bevel_angle")
-        notes.append(f"bevel {_fmt(fr.info['bevel_width_mm'])} ±{_fmt(tol('bevel_width'))} mm wide at "
-                     f"{fr.info['bevel_angle_deg']:g} deg " + (f"±{ang:g} deg" if ang is not None else
-                                                               "±1 deg (ISO 2768-m, legs up to 10 mm)"))
+        ang_text = (f"{ang[0]:+g}/{ang[1]:+g} deg" if isinstance(ang, tuple) else f"±{ang:g} deg" if ang is not None
+                    else "±1 deg (ISO 2768-m, legs up to 10 mm)")
+        notes.append(f"bevel {_fmt(fr.info['bevel_width_mm'])} {tol('bevel_width')} mm wide at "
+                     f"{fr.info['bevel_angle_deg']:g} deg " + ang_text)
     for s in ts.report.get("scores", []):
         notes.append(_score_note(s, ts.spec.scores[s["index"]]))
     for e in ts.spec.emboss:  # what the engraver needs: the figure, its size, font, draft, place and turn
@@ -372,10 +373,10 @@ def _toleranced(dims: list, ts) -> list:
     for d in dims:
         head = d.text.split()[0]
         key = _DIM_KEYS.get(head, _DIM_KEYS.get(head[:1], None))
-        out.append(replace(d, text=f"{d.text} ±{_fmt(dspec.tolerance(key))}") if key else d)
+        out.append(replace(d, text=f"{d.text} {dspec.tolerance_text(key)}") if key else d)
         size = re.search(r"\d+(?:\.\d+)?", d.text)
         if key and size and dspec.tolerance(key) >= float(size.group()) > 0.0:
-            negative.append(f"{d.text} ±{_fmt(dspec.tolerance(key))} ([tooling.drawing] tolerances.{key})")
+            negative.append(f"{d.text} {dspec.tolerance_text(key)} ([tooling.drawing] tolerances.{key})")
     if negative:  # (a toolmaker's trial: "land 0.050 ±0.076" was drawn in silence)
         warnings.warn("the drawing's tolerances reach below zero: " + "; ".join(dict.fromkeys(negative)) +
                       ": give each a tolerance smaller than its size", stacklevel=3)
@@ -627,7 +628,7 @@ def tooling_model(ts) -> Drawing:
     origins = {"upper punch": (0.0, -fr.band_z[1]), "lower punch": (Dh + 25.0, lo["overall_length_mm"] - fr.band_z[0]),
                "die": (Dh + 25.0 + gap, -die["bottom_z_mm"])}
     dims: list[Dim] = []
-    tol = ts.spec.drawing.tolerance
+    tol = ts.spec.drawing.tolerance_text
     for name, b, edge, sgn in (("upper punch", up, rep["upper_punch"]["tip_edge_z_mm"], 1.0),
                                ("lower punch", lo, rep["lower_punch"]["tip_edge_z_mm"], -1.0)):
         ox, oy = origins[name]
@@ -635,20 +636,20 @@ def tooling_model(ts) -> Drawing:
         z_shoulder = z_tip + sgn * b["tip_length_mm"]
         rb, rh = 0.5 * b["barrel_diameter_mm"], 0.5 * b["head_diameter_mm"]
         dims.append(Dim((ox - rh, min(z_tip, z_head)), (ox - rh, max(z_tip, z_head)), -4.0,
-                        f"overall {_fmt(b['overall_length_mm'])} ±{_fmt(tol('overall_length'))}", vertical=True))
+                        f"overall {_fmt(b['overall_length_mm'])} {tol('overall_length')}", vertical=True))
         dims.append(Dim((ox + rb, min(z_tip, z_shoulder)), (ox + rb, max(z_tip, z_shoulder)), 3.0,
-                        f"tip {_fmt(b['tip_length_mm'])} ±{_fmt(tol('tip_length'))}", vertical=True))
+                        f"tip {_fmt(b['tip_length_mm'])} {tol('tip_length')}", vertical=True))
         zb = z_shoulder + sgn * 0.5 * b["barrel_length_mm"]
         dims.append(Dim((ox - rb, zb), (ox + rb, zb), 0.0,
-                        f"Ø{_fmt(b['barrel_diameter_mm'])} ±{_fmt(tol('barrel_diameter'))}"))
+                        f"Ø{_fmt(b['barrel_diameter_mm'])} {tol('barrel_diameter')}"))
         zh = z_head - sgn * 0.5 * b["head_height_mm"]
         dims.append(Dim((ox - rh, zh), (ox + rh, zh), sgn * (b["head_height_mm"] + 3.0),
-                        f"Ø{_fmt(b['head_diameter_mm'])} ±{_fmt(tol('head_diameter'))}"))
+                        f"Ø{_fmt(b['head_diameter_mm'])} {tol('head_diameter')}"))
     ox, oy = origins["die"]
     R = 0.5 * die["outer_diameter_mm"]
     zb, zt = oy + die["bottom_z_mm"], oy + die["top_z_mm"]
-    dims.append(Dim((ox - R, zt), (ox + R, zt), 4.0, f"Ø{_fmt(die['outer_diameter_mm'])} ±{_fmt(tol('die_diameter'))}"))
-    dims.append(Dim((ox + R, zb), (ox + R, zt), 3.0, f"H {_fmt(die['height_mm'])} ±{_fmt(tol('die_height'))}", vertical=True))
+    dims.append(Dim((ox - R, zt), (ox + R, zt), 4.0, f"Ø{_fmt(die['outer_diameter_mm'])} {tol('die_diameter')}"))
+    dims.append(Dim((ox + R, zb), (ox + R, zt), 3.0, f"H {_fmt(die['height_mm'])} {tol('die_height')}", vertical=True))
     mod = up.get("modified_from_standard") or {}
     changed = "; ".join(f"{k.replace('_mm', '').replace('_deg', '').replace('_', ' ')} {_fmt(v['given'])} "
                         f"(standard {_fmt(v['standard'])})" for k, v in mod.items())
@@ -662,11 +663,11 @@ def tooling_model(ts) -> Drawing:
              f"tip: straight {_fmt(up['tip_straight_mm'])}, relief {_fmt(up['tip_relief_mm'])} per side; "
              f"upper tip {_fmt(up['tip_length_mm'])}, lower tip {_fmt(lo['tip_length_mm'])}",
              f"working length (head flat to cup bottom): upper {_fmt(up['working_length_mm'])}, lower "
-             f"{_fmt(lo['working_length_mm'])}",
-             f"die Ø{_fmt(die['outer_diameter_mm'])} x {_fmt(die['height_mm'])}, bore {_plan_size(fr, -fr.bore_offset)} (the "
-             f"tablet's {die['bore']} outline{_bore_growth(fr)}), taper {die['taper_deg']:g} deg; tips "
-             f"{_plan_size(fr, fr.tip_inset(ts.spec.clearance_mm))} (the bore less the clearance "
-             f"{_fmt(ts.spec.clearance_mm)} per side)",
+             f"{_fmt(lo['working_length_mm'])} {tol('working_length')}",
+             f"die Ø{_fmt(die['outer_diameter_mm'])} x {_fmt(die['height_mm'])}, bore {_plan_size(fr, -fr.bore_offset)} "
+             f"{tol('bore_diameter')} (the tablet's {die['bore']} outline{_bore_growth(fr)}), taper {die['taper_deg']:g} "
+             f"deg; tips {_plan_size(fr, fr.tip_inset(ts.spec.clearance_mm))} {tol('tip_diameter')} (the bore less the "
+             f"clearance {_fmt(ts.spec.clearance_mm)} per side)",
              ("standard dimensions: tabletcad/data/tooling_standards.toml (sources per value in report.json)"
               + (", but for the modified ones above (from [tooling.punch])" if mod else ""))
              if up["standard"] != "custom" else "user-defined set: every dimension from [tooling.punch]"]

@@ -250,7 +250,9 @@ DEFAULT_TOLERANCE_MM = 0.076
 TOLERANCE_KEYS = ("diameter", "length", "width", "band", "cup_depth", "thickness", "land", "score_depth", "cup_radius",
                   "bevel_width", "bevel_angle",  # bevel_angle in degrees, the others mm
                   # the punches and die sheet (complete punches)
-                  "overall_length", "tip_length", "barrel_diameter", "head_diameter", "die_diameter", "die_height")
+                  "overall_length", "tip_length", "barrel_diameter", "head_diameter", "die_diameter", "die_height",
+                  # the fit: working length (head flat to cup bottom), punch tip and die bore sizes
+                  "working_length", "tip_diameter", "bore_diameter")
 TITLE_KEYS = ("name", "number", "revision", "material", "date", "author")
 #: the most characters a title-block text may have: what fits the A4 sheet's title block in its
 #: smallest type (``tabletcad.tooling.drawing.sheet_figure`` shrinks long texts to fit)
@@ -272,8 +274,34 @@ class DrawingSpec:
     tolerances: tuple = ()
 
     def tolerance(self, key: str) -> float:
-        """The +- tolerance (mm) of dimension ``key``."""
-        return dict(self.tolerances).get(key, self.tolerance_mm)
+        """The largest deviation (mm) dimension ``key`` may have: its ``±`` tolerance, or the larger of its
+        limit deviations' sizes."""
+        t = dict(self.tolerances).get(key, self.tolerance_mm)
+        return max(abs(t[0]), abs(t[1])) if isinstance(t, tuple) else t
+
+    def tolerance_text(self, key: str) -> str:
+        """The tolerance of dimension ``key`` as drawn: ``±0.076``, or limit deviations ``+0.000/-0.013``."""
+        t = dict(self.tolerances).get(key, self.tolerance_mm)
+        if isinstance(t, tuple):
+            return f"{t[0]:+.3f}/{t[1]:+.3f}"
+        return f"±{t:.2f}" if t >= 0.1 else f"±{t:.3f}"  # (as the sheets print sizes)
+
+
+def _tolerance(name: str, value: Any, unit: str) -> float | tuple[float, float]:
+    """A tolerance as given: a number > 0 (``±``), or limit deviations ``[upper, lower]`` with upper > lower
+    (``[0.0, -0.013]``: a punch barrel's fit), each finite and at most :data:`MAX_LIMIT_DEVIATION` in size."""
+    if isinstance(value, list):
+        if len(value) != 2 or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in value):
+            raise DesignError(name, value, "must be a number > 0 (±) or two limit deviations [upper, lower]")
+        up, lo = (float(check_range(name, x, -MAX_LIMIT_DEVIATION, MAX_LIMIT_DEVIATION, unit)) for x in value)
+        if not up > lo:
+            raise DesignError(name, value, "must be [upper, lower] limit deviations with upper > lower", unit)
+        return (up, lo)
+    return check_positive(name, value, unit)
+
+
+#: the largest limit deviation (mm, or deg for bevel_angle) a tolerance may give
+MAX_LIMIT_DEVIATION = 10.0
 
 
 def _one_line(text: str) -> bool:
@@ -331,7 +359,7 @@ def _drawing(t: Any) -> DrawingSpec:
         kw["tolerance_mm"] = check_positive(f"{w} tolerance_mm", t["tolerance_mm"], "mm")
         kw["tolerance_given"] = True
     tol = _keys(f"{w} tolerances", t.get("tolerances", {}), set(TOLERANCE_KEYS))
-    kw["tolerances"] = tuple((k, check_positive(f"{w} tolerances.{k}", v, "deg" if k == "bevel_angle" else "mm"))
+    kw["tolerances"] = tuple((k, _tolerance(f"{w} tolerances.{k}", v, "deg" if k == "bevel_angle" else "mm"))
                              for k, v in tol.items())
     return DrawingSpec(**kw)
 
