@@ -123,14 +123,22 @@ def _segments_display(ax, dr):
     return np.concatenate(pts)
 
 
-@pytest.mark.parametrize("which", ["tablet", "tooling", "capsule"])
+@pytest.mark.parametrize("which", ["tablet", "tooling", "capsule", "capsule tips"])
 def test_no_text_leaves_the_sheet_or_lies_on_the_views(drawn, capsule, which):
     import matplotlib.pyplot as plt
+
+    from tabletcad.tooling.drawing import tips_model
 
     ts, _, _ = drawn
     if which == "capsule":
         dr, paper = drawing_model(capsule), "A4"
         assert {"L 14.00 ±0.076", "W 6.00 ±0.076", "score 0.30 ±0.076"} <= {d.text for d in dr.dims}
+    elif which == "capsule tips":  # tips-only tooling's sheet (a toolmaker's trial: it had none)
+        assert capsule.spec.body is None
+        dr, paper = tips_model(capsule), "A4"
+        fit = capsule.frame.tip_inset(capsule.spec.clearance_mm)
+        assert [d.text for d in dr.dims] == ["tip 8.00 ±0.076", "tip 8.00 ±0.076", "Ø30.16 ±0.076", "H 22.22 ±0.076"]
+        assert f"tips {14.0 - 2 * fit:.3f} x {6.0 - 2 * fit:.3f} ±0.076 (" in dr.notes[1]
     elif which == "tablet":
         dr, paper = drawing_model(ts), "A4"
     else:

@@ -606,14 +606,53 @@ def write_drawing(ts, out_dir) -> list[Path]:
                                 title=dr.title, title_block=dr.title_block, scale=dr.scale, paper=dr.paper,
                                 visible_polylines={k: len(v["visible"]) for k, v in dr.views.items()})
     files = [svg, pdf, dxf]
-    if ts.spec.body is not None:
-        tr = tooling_model(ts)
-        files += [out_dir / "tooling.svg", out_dir / "tooling.pdf", out_dir / "tooling.dxf"]
-        _write_matplotlib(tr, files[3], files[4])
-        _write_dxf(tr, files[5])
-        ts.report["tooling_drawing"] = dict(views=list(tr.views), dimension_texts=[d.text for d in tr.dims],
-                                            notes=tr.notes, scale=tr.scale, paper=tr.paper)
+    # complete punches and die, or the tips and die (a toolmaker's trial: tips-only tooling had no sheet)
+    tr = tooling_model(ts) if ts.spec.body is not None else tips_model(ts)
+    files += [out_dir / "tooling.svg", out_dir / "tooling.pdf", out_dir / "tooling.dxf"]
+    _write_matplotlib(tr, files[3], files[4])
+    _write_dxf(tr, files[5])
+    ts.report["tooling_drawing"] = dict(views=list(tr.views), dimension_texts=[d.text for d in tr.dims],
+                                        notes=tr.notes, scale=tr.scale, paper=tr.paper)
     return files
+
+
+def tips_model(ts) -> Drawing:
+    """Front elevations of the upper and lower punch tips and the die (closed position, side by side), for
+    tooling without complete punches: each tip's length, the die's diameter and height dimensioned, and the
+    fit (tips, bore, clearance, taper) and the cups as the tips carry them in the notes."""
+    rep = ts.report
+    up, lo, die = rep["upper_punch"], rep["lower_punch"], rep["die"]
+    fr = ts.frame
+    views = {k.replace("_", " "): project_view(ts.parts[k], "front") for k in ("upper_punch", "lower_punch", "die")}
+    wt = max(fr.length, fr.width)
+    gap = 0.5 * wt + 0.5 * die["outer_diameter_mm"] + 20.0
+    origins = {"upper punch": (0.0, 0.0), "lower punch": (wt + 20.0, 0.0), "die": (wt + 20.0 + gap, 0.0)}
+    tol = ts.spec.drawing.tolerance_text
+    dims: list[Dim] = []
+    for name, tip, sgn in (("upper punch", up, 1.0), ("lower punch", lo, -1.0)):
+        ox, oy = origins[name]
+        z0 = oy + tip["tip_edge_z_mm"]
+        z1 = z0 + sgn * tip["tip_length_mm"]
+        dims.append(Dim((ox + 0.5 * wt, min(z0, z1)), (ox + 0.5 * wt, max(z0, z1)), 3.0,
+                        f"tip {_fmt(tip['tip_length_mm'])} {tol('tip_length')}", vertical=True))
+    ox, oy = origins["die"]
+    R = 0.5 * die["outer_diameter_mm"]
+    zb, zt = oy + die["bottom_z_mm"], oy + die["top_z_mm"]
+    dims.append(Dim((ox - R, zt), (ox + R, zt), 4.0, f"Ø{_fmt(die['outer_diameter_mm'])} {tol('die_diameter')}"))
+    dims.append(Dim((ox + R, zb), (ox + R, zt), 3.0, f"H {_fmt(die['height_mm'])} {tol('die_height')}", vertical=True))
+    notes = [f"{ts.tablet.name}: punch tips and die (no punch bodies: the tips fit the toolmaker's punches)"
+             + (f", die TSM {die['tsm_size']}" if die.get("tsm_size") not in (None, "custom") else ""),
+             f"tips {_plan_size(fr, fr.tip_inset(ts.spec.clearance_mm))} {tol('tip_diameter')} ({up['tip_outline']}; the "
+             f"bore less the clearance {_fmt(ts.spec.clearance_mm)} per side); upper tip {_fmt(up['tip_length_mm'])}, "
+             f"lower tip {_fmt(lo['tip_length_mm'])} from the tip edge",
+             f"cups on the tips: upper {_fmt(up['cup_depth_on_tip_mm'])}, lower {_fmt(lo['cup_depth_on_tip_mm'])} deep "
+             "from the tip edge (the tablet's face, as on the tablet's sheet)",
+             f"die Ø{_fmt(die['outer_diameter_mm'])} x {_fmt(die['height_mm'])}, bore {_plan_size(fr, -fr.bore_offset)} "
+             f"{tol('bore_diameter')} (the tablet's {die['bore']} outline{_bore_growth(fr)}), taper {die['taper_deg']:g} "
+             f"deg, upper punch entry {_fmt(die['punch_entry_mm'])} at the closed position"]
+    notes += rating_notes(rep.get("tip_rating") or {})
+    return Drawing(views, origins, dims, notes, title=f"{_title(ts)} — punch tips and die",
+                   title_block=title_block(ts, "punch tips and die"))
 
 
 def tooling_model(ts) -> Drawing:

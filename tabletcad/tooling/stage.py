@@ -28,12 +28,10 @@ __all__ = ["check_tooling", "tooling_outputs", "tooling_stage", "write_tooling",
 
 def tooling_outputs(spec: ToolingSpec) -> list[str]:
     """The files :func:`tooling_stage` writes for ``spec`` besides ``tablet.*`` (which it may replace):
-    the assembly, the parts, the tablet's drawing, the punch and die drawing of complete tooling
-    (``[tooling.punch]``) and the plain tablet beside a scored or embossed one."""
+    the assembly, the parts, the tablet's drawing, the punch and die drawing (complete punches with
+    ``[tooling.punch]``, else the tips) and the plain tablet beside a scored or embossed one."""
     names = ["assembly.step", "upper_punch.step", "lower_punch.step", "die.step",
-             "drawing.svg", "drawing.pdf", "drawing.dxf"]
-    if spec.body is not None:
-        names += ["tooling.svg", "tooling.pdf", "tooling.dxf"]
+             "drawing.svg", "drawing.pdf", "drawing.dxf", "tooling.svg", "tooling.pdf", "tooling.dxf"]
     if spec.scores or spec.emboss:
         names.append("tablet_plain.step")
     return names
