@@ -92,6 +92,13 @@ def test_a_tablets_profile_arrays_are_read_only():
             with pytest.raises(ValueError, match="read-only"):
                 getattr(prof, name)[0] = 99.0
     assert m.report()["length_mm"] == pytest.approx(10.0, abs=1e-6)
+    import copy
+    import pickle
+
+    for again in (pickle.loads(pickle.dumps(m.tablet)), copy.deepcopy(m.tablet)):  # (came back writeable)
+        for prof in (again.revolution[0], again.section[0]):
+            with pytest.raises(ValueError, match="read-only"):
+                prof.radius[0] = 99.0
     radius = np.array([1.0, 2.0, 3.0, 4.0])
     from tabletcad.geometry.revolution import Revolution
 

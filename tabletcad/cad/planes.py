@@ -22,7 +22,7 @@ from OCP.BRep import BRep_Tool
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepTools import BRepTools_ReShape, BRepTools_WireExplorer
-from OCP.Geom import Geom_BSplineSurface
+from OCP.Geom import Geom_BSplineSurface, Geom_SurfaceOfRevolution
 from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt
 from OCP.Standard import Standard_Failure
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
@@ -61,6 +61,32 @@ def plane_of(surf: Geom_BSplineSurface) -> tuple[np.ndarray, np.ndarray] | None:
     return c, (n if sense > 0 else -n)
 
 
+def _revolved_plane_of(surf) -> tuple[np.ndarray, np.ndarray] | None:
+    """``(point, unit normal)`` of a surface of revolution whose profile's poles lie in one plane normal to its
+    axis (a round flat face: the disc), in the surface's own normal sense; else None."""
+    from OCP.Geom import Geom_BSplineCurve
+    from OCP.gp import gp_Vec
+
+    basis = surf.BasisCurve()
+    if not isinstance(basis, Geom_BSplineCurve):
+        return None
+    ax = surf.Axis()
+    o, d = np.array(ax.Location().Coord()), np.array(ax.Direction().Coord())
+    P = np.array([basis.Pole(i).Coord() for i in range(1, basis.NbPoles() + 1)])
+    h = (P - o) @ d
+    size = float(np.max(np.ptp(P, axis=0)))
+    if size == 0.0 or float(np.ptp(h)) > FLAT_REL_TOL * max(size, 1.0):
+        return None
+    u0, u1, v0, v1 = surf.Bounds()
+    for fv in (0.5, 0.25, 0.75):  # the normal's sense where the profile is off the axis
+        p, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
+        surf.D1(u0 + 0.3 * (u1 - u0), v0 + fv * (v1 - v0), p, du, dv)
+        sense = float(np.array(du.Crossed(dv).Coord()) @ d)
+        if abs(sense) > 1e-12:
+            return o + float(np.mean(h)) * d, (d if sense > 0 else -d)
+    return None
+
+
 def _in_plane(edge, point: np.ndarray, normal: np.ndarray, samples: int = 17) -> bool:
     """True when the edge's 3D curve lies in the plane to :data:`EDGE_PLANE_TOL_MM` at ``samples`` points
     (an edge shared with a face whose poles were moved, such as a collapsed corner's snapped row, may not:
@@ -76,25 +102,28 @@ def _in_plane(edge, point: np.ndarray, normal: np.ndarray, samples: int = 17) ->
 
 
 def _plane_face(face: TopoDS_Face, point: np.ndarray, normal: np.ndarray) -> TopoDS_Face | None:
-    """``face`` rebuilt on its plane from its own edges (degenerate ones, a pole's, left out), with
-    its orientation; None when it has more than one wire or a seam."""
+    """``face`` rebuilt on its plane from its own edges, with its orientation; the edges that bound no
+    region are left out: degenerate ones (a pole's) and a seam (a round flat face's, the edge twice in the
+    wire), so a disc becomes the plane inside its circle.  None when it has more than one wire or what
+    is left is not one closed wire."""
     wires = explore(face, "Wire")
     if len(wires) != 1:
         return None
-    mw = BRepBuilderAPI_MakeWire()
+    edges = []
     it = BRepTools_WireExplorer(wires[0], face)
-    seen = []
     while it.More():
-        e = it.Current()
-        if BRep_Tool.IsClosed_s(e, face) or any(e.IsSame(o) for o in seen):
-            return None  # a seam (the edge twice in the wire)
-        seen.append(e)
-        if not BRep_Tool.Degenerated_s(e):
-            if not _in_plane(e, point, normal):
-                return None
-            mw.Add(e)
+        edges.append(it.Current())
         it.Next()
-    if not mw.IsDone():
+    mw = BRepBuilderAPI_MakeWire()
+    for k, e in enumerate(edges):
+        if BRep_Tool.Degenerated_s(e) or BRep_Tool.IsClosed_s(e, face):
+            continue
+        if any(e.IsSame(o) for o in edges[:k]):
+            return None  # an edge twice that is no seam (a slit): not a plain boundary
+        if not _in_plane(e, point, normal):
+            return None
+        mw.Add(e)
+    if not mw.IsDone() or not BRep_Tool.IsClosed_s(mw.Wire()):
         return None
     pln = gp_Pln(gp_Ax3(gp_Pnt(*map(float, point)), gp_Dir(*map(float, normal))))
     mf = BRepBuilderAPI_MakeFace(pln, mw.Wire(), True)
@@ -105,9 +134,10 @@ def _plane_face(face: TopoDS_Face, point: np.ndarray, normal: np.ndarray) -> Top
     return new
 
 
-def flat_faces_as_planes(solid: TopoDS_Shape) -> tuple[TopoDS_Shape, int]:
-    """``(solid, n)``: ``solid`` with its flat B-spline faces replaced by plane faces (``n`` of them),
-    or ``(solid, 0)`` unchanged when there are none or the result is not a valid solid
+def flat_faces_as_planes(solid: TopoDS_Shape) -> tuple[TopoDS_Shape, int, BRepTools_ReShape | None]:
+    """``(solid, n, reshape)``: ``solid`` with its flat B-spline faces and flat faces of revolution replaced
+    by plane faces (``n`` of them; ``reshape.Value(face)`` is a face's replacement), or ``(solid, 0, None)``
+    unchanged when there are none or the result is not a valid solid
     (``BRepCheck_Analyzer``: a face turned the wrong way fails it).  Each plane face is bounded by the
     B-spline face's own edges, so the solid encloses the same volume (the CAD stage's cross-check of
     the solid's volume against the surface data's holds it to that)."""
@@ -116,18 +146,21 @@ def flat_faces_as_planes(solid: TopoDS_Shape) -> tuple[TopoDS_Shape, int]:
     try:
         for f in explore(solid, "Face"):
             surf = BRep_Tool.Surface_s(f)
-            if not isinstance(surf, Geom_BSplineSurface):
+            if isinstance(surf, Geom_BSplineSurface):
+                plane = plane_of(surf)
+            elif isinstance(surf, Geom_SurfaceOfRevolution):
+                plane = _revolved_plane_of(surf)
+            else:
                 continue
-            plane = plane_of(surf)
             new = None if plane is None else _plane_face(f, *plane)
             if new is not None:
                 rs.Replace(f, new)
                 n += 1
         if not n:
-            return solid, 0
+            return solid, 0, None
         out = cast(rs.Apply(solid), "Solid")
     except (Standard_Failure, ValueError):
-        return solid, 0
+        return solid, 0, None
     if out.IsNull() or not BRepCheck_Analyzer(out).IsValid():
-        return solid, 0
-    return out, n
+        return solid, 0, None
+    return out, n, rs

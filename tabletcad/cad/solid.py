@@ -343,7 +343,9 @@ def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequenc
     solid = _make_solid(shell, name, enclosed)
     # flat B-spline pieces as exact planes: OCCT's face merging, which build123d and CadQuery run after
     # every Boolean, crashed the process on them (tabletcad.cad.planes)
-    solid, n_planes = flat_faces_as_planes(solid)
+    solid, n_planes, reshape = flat_faces_as_planes(solid)
+    if reshape is not None:  # the faces as the solid has them
+        faces = tuple(cast(reshape.Value(f), "Face") for f in faces)
     t2 = time.perf_counter()
     out = TabletSolid(
         name=name,

@@ -50,11 +50,17 @@ class _Profile:
     ``u_nodes`` and ``form`` of the dataclasses below, whose arrays are read-only copies (a tablet is
     immutable: ``tablet.revolution[0].radius[1] = 99`` had changed its report, not its solid)."""
 
+    _arrays: tuple[str, ...] = ("radius", "height")
+
     def _freeze(self, *names: str) -> None:
         for name in names:
             a = np.array(getattr(self, name), dtype=float)
             a.setflags(write=False)
             object.__setattr__(self, name, a)
+
+    def __setstate__(self, state: dict) -> None:  # (unpickled and deep-copied arrays come back writeable)
+        self.__dict__.update(state)
+        self._freeze(*self._arrays)
 
     radius: np.ndarray
     height: np.ndarray
@@ -111,7 +117,7 @@ class Revolution(_Profile):
     form: str
 
     def __post_init__(self) -> None:
-        self._freeze("radius", "height")
+        self._freeze(*self._arrays)
 
     def section(self) -> "Section":
         """The same profile as a :class:`Section` (``S = I``; ``p = e_φ``, ``q = sense · e_φ+90°``)."""
@@ -151,8 +157,10 @@ class Section(_Profile):
     u_nodes: tuple[float, float, float, float]
     form: str
 
+    _arrays = ("plan", "radius", "height")
+
     def __post_init__(self) -> None:
-        self._freeze("plan", "radius", "height")
+        self._freeze(*self._arrays)
 
     @property
     def shape(self) -> np.ndarray:

@@ -130,7 +130,9 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
     if spec.lower_tip <= need_low:
         raise DesignError("[tooling] lower_tip_length_mm", spec.lower_tip,
                           f"must be > {need_low:.4g} mm, the die's height: at ejection the lower tip edge rises to "
-                          f"the die's top face and the barrel must stay below the die", "mm")
+                          f"the die's top face and the barrel must stay below the die"
+                          + ("" if spec.lower_tip_length_mm is not None else
+                             " (not given, it is tip_length_mm: give lower_tip_length_mm)"), "mm")
 
 
 
