@@ -55,5 +55,12 @@ def test_build_from_poles_mults_knots_is_the_same_surface(fc, built):
         np.testing.assert_array_equal(back["v_mults"], surf.v_mults)
         assert back["v_periodic"] and not back["u_periodic"]
     assert all(r["faces_valid"]) and r["n_shells"] == 1 and r["shell_closed"] and r["valid"]
-    # same faces -> same (default-integration) volume in FreeCAD's OCCT and in OCP
-    assert r["volume"] == pytest.approx(mass_properties(ts.shape, eps=None).volume, rel=1e-12)
+    # same faces -> same (default-integration) volume in FreeCAD's OCCT and in OCP (the B-spline faces sewn
+    # here: ts.shape's flat caps are planes, tabletcad.cad.planes)
+    from tabletcad.cad.faces import face_of, make_geom_surface
+    from tabletcad.cad.solid import _make_solid, sew_faces
+
+    names = [f"s{k}" for k in range(len(ts.surfaces))]
+    shell = sew_faces([face_of(make_geom_surface(s)) for s in ts.surfaces], names, ts.sew_tolerance)
+    same = _make_solid(shell, "same faces", float("nan"))
+    assert r["volume"] == pytest.approx(mass_properties(same, eps=None).volume, rel=1e-12)

@@ -269,11 +269,15 @@ def _rational_bspline_solid(shape: TopoDS_Shape) -> TopoDS_Shape:
     from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
     from OCP.BRepCheck import BRepCheck_Analyzer
 
+    from tabletcad.cad.planes import flat_faces_as_planes
+
     solids = explore(BRepBuilderAPI_NurbsConvert(shape, True).Shape(), "Solid")
     if len(solids) != 1 or not BRepCheck_Analyzer(solids[0]).IsValid():
         raise GeometryError(f"the tablet's faces of revolution did not convert to one valid B-spline solid "
                             f"({len(solids)} solids)", shape)
-    return solids[0]
+    # the conversion turns the flat faces' planes into B-splines too: planes again (a punch tip's flat face
+    # as a trimmed B-spline plane had carried a 10 N side load in tabletcad.fe.punch's mesh)
+    return flat_faces_as_planes(solids[0])[0]
 
 
 def _has_faces_of_revolution(shape: TopoDS_Shape) -> bool:
