@@ -17,27 +17,15 @@ pytest.importorskip("OCP")
 from tabletcad.cli import main  # noqa: E402
 from tabletcad.errors import DesignError  # noqa: E402
 from tabletcad.tooling.standards import resolve_body  # noqa: E402
+from support.refusals import build_refused as _refused  # noqa: E402
 
 pytestmark = pytest.mark.cad
 
-ONE_LINE = re.compile(r"^error: (\S+) = (.+) is not allowed: (.+)$")
 ROUND = ('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 3.0\ncup_depth = 0.9\nland = 0.08\n'
          '[tooling]\nclearance_mm = 0.02\n')
 #: the sample's punch figures (TSM B's bundled values lack the head flat, rim and neck)
 PUNCH = {"head_diameter_mm": 25.4, "head_top_angle_deg": 10.0, "head_flat_diameter_mm": 12.0, "head_rim_mm": 2.5, "neck_diameter_mm": 12.7, "neck_length_mm": 12.0,
          "tip_straight_mm": 4.0, "tip_relief_mm": 0.1}
-
-
-def _refused(capsys, tmp_path: Path, design: str) -> tuple[str, str, str]:
-    src = tmp_path / "d.toml"
-    src.write_text(design, encoding="utf-8")
-    assert main(["build", str(src), "--out", str(tmp_path / "out"), "--quiet"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1, err
-    m = ONE_LINE.match(err[0])
-    assert m, err[0]
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.toml"]
-    return m.group(1), m.group(2), m.group(3)
 
 
 @pytest.mark.parametrize("tip, lower, parameter, least", [

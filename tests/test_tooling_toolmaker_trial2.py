@@ -9,28 +9,14 @@ Each refusal: the one ``error: <parameter> = <value> is not allowed: <range>`` l
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import pytest
 
-from tabletcad.cli import main
+from support.refusals import build_refused as _refused
 
-ONE_LINE = re.compile(r"^error: (\S+) = (.+) is not allowed: (.+)$")
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLE = (ROOT / "samples" / "tooling" / "tsm_b_round.toml").read_text(encoding="utf-8")
-
-
-def _refused(capsys, tmp_path: Path, design: str) -> tuple[str, str, str]:
-    src = tmp_path / "d.toml"
-    src.write_text(design, encoding="utf-8")
-    assert main(["build", str(src), "--out", str(tmp_path / "out"), "--quiet"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1, err
-    m = ONE_LINE.match(err[0])
-    assert m, err[0]
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.toml"]
-    return m.group(1), m.group(2), m.group(3)
 
 
 @pytest.mark.cad
