@@ -87,7 +87,7 @@ def _revolved_plane_of(surf) -> tuple[np.ndarray, np.ndarray] | None:
     return None
 
 
-def _in_plane(edge, point: np.ndarray, normal: np.ndarray, samples: int = 17) -> bool:
+def _in_plane(edge, point: np.ndarray, normal: np.ndarray, samples: int = 9) -> bool:
     """True when the edge's 3D curve lies in the plane to :data:`EDGE_PLANE_TOL_MM` at ``samples`` points
     (an edge shared with a face whose poles were moved, such as a collapsed corner's snapped row, may not:
     the plane face bounded by it would then enclose another region than the B-spline face did)."""
@@ -134,11 +134,12 @@ def _plane_face(face: TopoDS_Face, point: np.ndarray, normal: np.ndarray) -> Top
     return new
 
 
-def flat_faces_as_planes(solid: TopoDS_Shape) -> tuple[TopoDS_Shape, int, BRepTools_ReShape | None]:
+def flat_faces_as_planes(solid: TopoDS_Shape, check: bool = True) -> tuple[TopoDS_Shape, int, BRepTools_ReShape | None]:
     """``(solid, n, reshape)``: ``solid`` with its flat B-spline faces and flat faces of revolution replaced
     by plane faces (``n`` of them; ``reshape.Value(face)`` is a face's replacement), or ``(solid, 0, None)``
     unchanged when there are none or the result is not a valid solid
-    (``BRepCheck_Analyzer``: a face turned the wrong way fails it).  Each plane face is bounded by the
+    (``BRepCheck_Analyzer``: a face turned the wrong way fails it; ``check`` false leaves that check to the
+    caller, who checks the solid anyway).  Each plane face is bounded by the
     B-spline face's own edges, so the solid encloses the same volume (the CAD stage's cross-check of
     the solid's volume against the surface data's holds it to that)."""
     rs = BRepTools_ReShape()
@@ -161,6 +162,6 @@ def flat_faces_as_planes(solid: TopoDS_Shape) -> tuple[TopoDS_Shape, int, BRepTo
         out = cast(rs.Apply(solid), "Solid")
     except (Standard_Failure, ValueError):
         return solid, 0, None
-    if out.IsNull() or not BRepCheck_Analyzer(out).IsValid():
+    if out.IsNull() or (check and not BRepCheck_Analyzer(out).IsValid()):
         return solid, 0, None
     return out, n, rs

@@ -250,7 +250,7 @@ def check_solid(solid: TopoDS_Shape, what: str = "solid") -> None:
         raise GeometryError(f"{what} fails BRepCheck_Analyzer", solid)
 
 
-def _make_solid(shell, name: str, data_volume: float) -> TopoDS_Solid:
+def _make_solid(shell, name: str, data_volume: float, check: bool = True) -> TopoDS_Solid:
     """The solid of a sewn closed shell, turned outward.  ``data_volume``: the signed volume the
     faces enclose as made, from their own surface data (:attr:`TabletSolid.data_volume_area`; NaN:
     unknown).  When sewing turned no face, the shell encloses exactly that volume, so its sign says
@@ -267,7 +267,8 @@ def _make_solid(shell, name: str, data_volume: float) -> TopoDS_Solid:
             solid = cast(solid.Reversed(), "Solid")
     elif not BRepLib.OrientClosedSolid_s(solid):
         raise GeometryError(f"{name}: the sewn shell cannot be oriented (open or incoherent)", solid)
-    check_solid(solid, name)
+    if check:
+        check_solid(solid, name)
     return solid
 
 
@@ -340,10 +341,19 @@ def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequenc
     # the parameters swapped: its normal, and the volume its faces enclose, is the data's reversed
     revolved = [isinstance(sd, RevolvedSurfaceData) for sd in surfaces]
     enclosed = -va[0] if all(revolved) else va[0] if not any(revolved) else math.nan
-    solid = _make_solid(shell, name, enclosed)
+    solid = _make_solid(shell, name, enclosed, check=False)
     # flat B-spline pieces as exact planes: OCCT's face merging, which build123d and CadQuery run after
-    # every Boolean, crashed the process on them (tabletcad.cad.planes)
-    solid, n_planes, reshape = flat_faces_as_planes(solid)
+    # every Boolean, crashed the process on them (tabletcad.cad.planes); one check of the solid with them,
+    # and of the solid as made only if that fails
+    planar, n_planes, reshape = flat_faces_as_planes(solid, check=False)
+    try:
+        check_solid(planar, name)
+        solid = planar
+    except GeometryError:
+        if not n_planes:
+            raise
+        check_solid(solid, name)
+        n_planes, reshape = 0, None
     if reshape is not None:  # the faces as the solid has them
         faces = tuple(cast(reshape.Value(f), "Face") for f in faces)
     t2 = time.perf_counter()
