@@ -10,9 +10,10 @@ collapsed end (the oval, almond, rounded triangle, square and rectangle, modifie
 As ``Geom_Plane`` faces bounded by the same edges they merge cleanly, and a CAD user gets
 the planes they expect.
 
-Only faces bounded by one wire without a seam are replaced (a face of revolution's
-flat disc keeps its seam and its surface); the replaced solid must be valid, else the
-solid is returned unchanged.
+Faces of revolution whose profile is flat (a round's disc) are replaced too.  A face is
+replaced only when it has one wire and every edge of it lies in the plane; its pole's
+degenerate edge and its seam bound no region and are left out.  The solid with its planes
+must be valid, else it is returned unchanged.
 """
 
 from __future__ import annotations

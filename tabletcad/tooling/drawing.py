@@ -616,6 +616,21 @@ def write_drawing(ts, out_dir) -> list[Path]:
     return files
 
 
+def _die_dims(die: dict, origin: tuple[float, float], tol) -> list[Dim]:
+    """The die's outer diameter and height dimensions on its front view at ``origin``."""
+    ox, oy = origin
+    R = 0.5 * die["outer_diameter_mm"]
+    zb, zt = oy + die["bottom_z_mm"], oy + die["top_z_mm"]
+    return [Dim((ox - R, zt), (ox + R, zt), 4.0, f"Ø{_fmt(die['outer_diameter_mm'])} {tol('die_diameter')}"),
+            Dim((ox + R, zb), (ox + R, zt), 3.0, f"H {_fmt(die['height_mm'])} {tol('die_height')}", vertical=True)]
+
+
+def _die_note(die: dict, fr, tol) -> str:
+    """The die's note: its size, the toleranced bore (the tablet's outline, grown by a band's bulge), the taper."""
+    return (f"die Ø{_fmt(die['outer_diameter_mm'])} x {_fmt(die['height_mm'])}, bore {_plan_size(fr, -fr.bore_offset)} "
+            f"{tol('bore_diameter')} (the tablet's {die['bore']} outline{_bore_growth(fr)}), taper {die['taper_deg']:g} deg")
+
+
 def tips_model(ts) -> Drawing:
     """Front elevations of the upper and lower punch tips and the die (closed position, side by side), for
     tooling without complete punches: each tip's length, the die's diameter and height dimensioned, and the
@@ -635,11 +650,7 @@ def tips_model(ts) -> Drawing:
         z1 = z0 + sgn * tip["tip_length_mm"]
         dims.append(Dim((ox + 0.5 * wt, min(z0, z1)), (ox + 0.5 * wt, max(z0, z1)), 3.0,
                         f"tip {_fmt(tip['tip_length_mm'])} {tol('tip_length')}", vertical=True))
-    ox, oy = origins["die"]
-    R = 0.5 * die["outer_diameter_mm"]
-    zb, zt = oy + die["bottom_z_mm"], oy + die["top_z_mm"]
-    dims.append(Dim((ox - R, zt), (ox + R, zt), 4.0, f"Ø{_fmt(die['outer_diameter_mm'])} {tol('die_diameter')}"))
-    dims.append(Dim((ox + R, zb), (ox + R, zt), 3.0, f"H {_fmt(die['height_mm'])} {tol('die_height')}", vertical=True))
+    dims += _die_dims(die, origins["die"], tol)
     notes = [f"{ts.tablet.name}: punch tips and die (no punch bodies: the tips fit the toolmaker's punches)"
              + (f", die TSM {die['tsm_size']}" if die.get("tsm_size") not in (None, "custom") else ""),
              f"tips {_plan_size(fr, fr.tip_inset(ts.spec.clearance_mm))} {tol('tip_diameter')} ({up['tip_outline']}; the "
@@ -647,9 +658,7 @@ def tips_model(ts) -> Drawing:
              f"lower tip {_fmt(lo['tip_length_mm'])} from the tip edge",
              f"cups on the tips: upper {_fmt(up['cup_depth_on_tip_mm'])}, lower {_fmt(lo['cup_depth_on_tip_mm'])} deep "
              "from the tip edge (the tablet's face, as on the tablet's sheet)",
-             f"die Ø{_fmt(die['outer_diameter_mm'])} x {_fmt(die['height_mm'])}, bore {_plan_size(fr, -fr.bore_offset)} "
-             f"{tol('bore_diameter')} (the tablet's {die['bore']} outline{_bore_growth(fr)}), taper {die['taper_deg']:g} "
-             f"deg, upper punch entry {_fmt(die['punch_entry_mm'])} at the closed position"]
+             f"{_die_note(die, fr, tol)}, upper punch entry {_fmt(die['punch_entry_mm'])} at the closed position"]
     notes += rating_notes(rep.get("tip_rating") or {})
     return Drawing(views, origins, dims, notes, title=f"{_title(ts)} — punch tips and die",
                    title_block=title_block(ts, "punch tips and die"))
@@ -684,11 +693,7 @@ def tooling_model(ts) -> Drawing:
         zh = z_head - sgn * 0.5 * b["head_height_mm"]
         dims.append(Dim((ox - rh, zh), (ox + rh, zh), sgn * (b["head_height_mm"] + 3.0),
                         f"Ø{_fmt(b['head_diameter_mm'])} {tol('head_diameter')}"))
-    ox, oy = origins["die"]
-    R = 0.5 * die["outer_diameter_mm"]
-    zb, zt = oy + die["bottom_z_mm"], oy + die["top_z_mm"]
-    dims.append(Dim((ox - R, zt), (ox + R, zt), 4.0, f"Ø{_fmt(die['outer_diameter_mm'])} {tol('die_diameter')}"))
-    dims.append(Dim((ox + R, zb), (ox + R, zt), 3.0, f"H {_fmt(die['height_mm'])} {tol('die_height')}", vertical=True))
+    dims += _die_dims(die, origins["die"], tol)
     mod = up.get("modified_from_standard") or {}
     changed = "; ".join(f"{k.replace('_mm', '').replace('_deg', '').replace('_', ' ')} {_fmt(v['given'])} "
                         f"(standard {_fmt(v['standard'])})" for k, v in mod.items())
@@ -703,9 +708,7 @@ def tooling_model(ts) -> Drawing:
              f"upper tip {_fmt(up['tip_length_mm'])}, lower tip {_fmt(lo['tip_length_mm'])}",
              f"working length (head flat to cup bottom): upper {_fmt(up['working_length_mm'])}, lower "
              f"{_fmt(lo['working_length_mm'])} {tol('working_length')}",
-             f"die Ø{_fmt(die['outer_diameter_mm'])} x {_fmt(die['height_mm'])}, bore {_plan_size(fr, -fr.bore_offset)} "
-             f"{tol('bore_diameter')} (the tablet's {die['bore']} outline{_bore_growth(fr)}), taper {die['taper_deg']:g} "
-             f"deg; tips {_plan_size(fr, fr.tip_inset(ts.spec.clearance_mm))} {tol('tip_diameter')} (the bore less the "
+             f"{_die_note(die, fr, tol)}; tips {_plan_size(fr, fr.tip_inset(ts.spec.clearance_mm))} {tol('tip_diameter')} (the bore less the "
              f"clearance {_fmt(ts.spec.clearance_mm)} per side)",
              ("standard dimensions: tabletcad/data/tooling_standards.toml (sources per value in report.json)"
               + (", but for the modified ones above (from [tooling.punch])" if mod else ""))
