@@ -87,10 +87,44 @@ def test_plane_of_reads_coplanar_poles_with_the_surface_normal():
         m = TColStd_Array1OfInteger(1, 2); m.SetValue(1, 4); m.SetValue(2, 4)
         return Geom_BSplineSurface(P, k, k, m, m, 3, 3)
 
-    point, normal = plane_of(surface(0.0))
+    def poles(s):  # read back from OCC, one by one
+        return np.array([[s.Pole(i, j).Coord() for j in range(1, 5)] for i in range(1, 5)])
+
+    flat = surface(0.0)
+    point, normal = plane_of(flat)
     assert np.allclose(normal, np.cross(e1, e2), atol=1e-12)  # S_u x S_v: along i (e1) then j (e2)
     assert abs((point - 5.0) @ n) < 1e-12
     assert plane_of(surface(1e-6)) is None  # a micrometre off the plane: not flat
+    # the caller's numpy poles (the solid's faces are made from them) give the same plane
+    point2, normal2 = plane_of(flat, poles(flat))
+    assert np.array_equal(point2, point) and np.array_equal(normal2, normal)
+    bumped = surface(1e-6)
+    assert plane_of(bumped, poles(bumped)) is None
+
+
+def test_every_flat_face_of_a_shaped_solid_is_judged_on_its_own_numpy_poles(monkeypatch):
+    """The solid builder hands flat_faces_as_planes the poles it made each face from; each face's
+    verdict and plane are those of its poles read back from OCC."""
+    import tabletcad.cad.planes as planes
+    from tabletcad.cad.tablet_solid import tablet_solid
+    from tabletcad.pipeline.design import Design
+
+    seen = []
+    real = planes.plane_of
+
+    def spy(surf, poles=None):
+        got = real(surf, poles)
+        if poles is not None:
+            read = real(surf)
+            assert (got is None) == (read is None)
+            if got is not None:
+                assert np.allclose(got[0], read[0], rtol=0, atol=1e-12) and np.array_equal(got[1], read[1])
+            seen.append(got is not None)
+        return got
+
+    monkeypatch.setattr(planes, "plane_of", spy)
+    solid = tablet_solid(Design.from_toml(ROOT / "samples" / "families" / "rounded_rectangle.toml").build())
+    assert len(seen) == 72 and sum(seen) == solid.planes == 48
 
 
 OFF_CENTRE = r"""

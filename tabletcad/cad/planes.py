@@ -18,6 +18,8 @@ must be valid, else it is returned unchanged.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping
+
 import numpy as np
 from OCP.BRep import BRep_Tool
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
@@ -30,7 +32,7 @@ from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 
 from tabletcad.cad._occ import cast, explore
 
-__all__ = ["flat_faces_as_planes", "plane_of"]
+__all__ = ["flat_faces_as_planes", "made_poles", "plane_of"]
 
 #: poles this far from their plane (relative to the face's size) still make a flat face
 FLAT_REL_TOL = 1e-12
@@ -38,13 +40,18 @@ FLAT_REL_TOL = 1e-12
 EDGE_PLANE_TOL_MM = 1e-9
 
 
-def plane_of(surf: Geom_BSplineSurface) -> tuple[np.ndarray, np.ndarray] | None:
+def plane_of(surf: Geom_BSplineSurface, poles: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray] | None:
     """``(point, unit normal)`` of the plane holding every pole of ``surf`` (the surface's own
     normal ``S_u × S_v`` sense), or None when the poles are not coplanar to :data:`FLAT_REL_TOL`
     of their extent.  A B-spline surface (rational or not) is an affine combination of its
-    poles, so coplanar poles make it lie in their plane exactly."""
-    nu, nv = surf.NbUPoles(), surf.NbVPoles()
-    P = np.array([[surf.Pole(i, j).Coord() for j in range(1, nv + 1)] for i in range(1, nu + 1)])
+    poles, so coplanar poles make it lie in their plane exactly.  ``poles``: the surface's
+    ``(NbUPoles, NbVPoles, 3)`` poles (mm) when the caller made it from them (read from OCC
+    one by one otherwise, 3 µs a pole)."""
+    if poles is not None:
+        P = np.asarray(poles, dtype=float)
+    else:
+        nu, nv = surf.NbUPoles(), surf.NbVPoles()
+        P = np.array([[surf.Pole(i, j).Coord() for j in range(1, nv + 1)] for i in range(1, nu + 1)])
     pts = P.reshape(-1, 3)
     c = pts.mean(axis=0)
     size = float(np.max(np.ptp(pts, axis=0)))
@@ -60,6 +67,12 @@ def plane_of(surf: Geom_BSplineSurface) -> tuple[np.ndarray, np.ndarray] | None:
     if sense == 0.0:
         return None
     return c, (n if sense > 0 else -n)
+
+
+def made_poles(pairs: Iterable[tuple[Geom_BSplineSurface, np.ndarray]]) -> dict[int, tuple[Geom_BSplineSurface, np.ndarray]]:
+    """The ``made`` mapping of :func:`flat_faces_as_planes` for ``(surface, poles)`` pairs; it holds
+    the surfaces, so an ``id`` cannot be reused while it lives."""
+    return {id(g): (g, p) for g, p in pairs}
 
 
 def _revolved_plane_of(surf) -> tuple[np.ndarray, np.ndarray] | None:
@@ -95,11 +108,9 @@ def _in_plane(edge, point: np.ndarray, normal: np.ndarray, samples: int = 9) -> 
     from OCP.BRepAdaptor import BRepAdaptor_Curve
 
     curve = BRepAdaptor_Curve(edge)
-    for t in np.linspace(curve.FirstParameter(), curve.LastParameter(), samples):
-        x = np.array(curve.Value(float(t)).Coord())
-        if abs(float((x - point) @ normal)) > EDGE_PLANE_TOL_MM:
-            return False
-    return True
+    value = curve.Value
+    x = np.array([value(t).Coord() for t in np.linspace(curve.FirstParameter(), curve.LastParameter(), samples).tolist()])
+    return float(np.max(np.abs((x - point) @ normal))) <= EDGE_PLANE_TOL_MM
 
 
 def _plane_face(face: TopoDS_Face, point: np.ndarray, normal: np.ndarray) -> TopoDS_Face | None:
@@ -135,21 +146,28 @@ def _plane_face(face: TopoDS_Face, point: np.ndarray, normal: np.ndarray) -> Top
     return new
 
 
-def flat_faces_as_planes(solid: TopoDS_Shape, check: bool = True) -> tuple[TopoDS_Shape, int, BRepTools_ReShape | None]:
+def flat_faces_as_planes(solid: TopoDS_Shape, check: bool = True,
+                         made: Mapping[int, tuple[Geom_BSplineSurface, np.ndarray]] | None = None,
+                         ) -> tuple[TopoDS_Shape, int, BRepTools_ReShape | None]:
     """``(solid, n, reshape)``: ``solid`` with its flat B-spline faces and flat faces of revolution replaced
     by plane faces (``n`` of them; ``reshape.Value(face)`` is a face's replacement), or ``(solid, 0, None)``
     unchanged when there are none or the result is not a valid solid
     (``BRepCheck_Analyzer``: a face turned the wrong way fails it; ``check`` false leaves that check to the
     caller, who checks the solid anyway).  Each plane face is bounded by the
     B-spline face's own edges, so the solid encloses the same volume (the CAD stage's cross-check of
-    the solid's volume against the surface data's holds it to that)."""
+    the solid's volume against the surface data's holds it to that).
+
+    ``made``: ``id(surface) -> (surface, poles)`` for the B-spline surfaces the caller made from numpy
+    poles (:func:`made_poles`); a face on one of them (the very object) is tested on those poles."""
+    made = made or {}
     rs = BRepTools_ReShape()
     n = 0
     try:
         for f in explore(solid, "Face"):
             surf = BRep_Tool.Surface_s(f)
             if isinstance(surf, Geom_BSplineSurface):
-                plane = plane_of(surf)
+                hit = made.get(id(surf))
+                plane = plane_of(surf, hit[1] if hit is not None and hit[0] is surf else None)
             elif isinstance(surf, Geom_SurfaceOfRevolution):
                 plane = _revolved_plane_of(surf)
             else:

@@ -49,7 +49,7 @@ from tabletcad.brep.fit import PatchFunction, SurfaceFit, chain_breakpoints, fit
 from tabletcad.brep.surface import BSplineSurfaceData, volume_and_area
 from tabletcad.cad._occ import cast, explore, shape_type
 from tabletcad.cad.faces import face_of, knot_boundary_pcurves, make_geom_surface
-from tabletcad.cad.planes import flat_faces_as_planes
+from tabletcad.cad.planes import flat_faces_as_planes, made_poles
 from tabletcad.cad.shell import assemble_shell
 from tabletcad.errors import GeometryError
 from tabletcad.brep.slit import chain_face_surfaces
@@ -295,6 +295,7 @@ def solid_from_surfaces(
     for ps, n in zip(pieces, names):
         face_names.extend([n] if len(ps) == 1 else [f"{n} (piece {k + 1})" for k in range(len(ps))])
     geoms = [[make_geom_surface(p) for p in ps] for ps in pieces]
+    made = made_poles((g, p.poles) for gs, ps in zip(geoms, pieces) for g, p in zip(gs, ps))  # for the planes
     va = volume_and_area(surfaces)  # the faces' own volume and area (orientation, the stage's check)
     # the chain's topology is known: its shell is assembled edge by edge (tabletcad.cad.shell);
     # a chain that cannot be (the capsule's slit), or whose assembled solid fails its check, is sewn
@@ -306,7 +307,7 @@ def solid_from_surfaces(
         shell, faces_a = assembled
         try:
             return _solid_from_faces(tuple(faces_a), face_names, surfaces, names, fits, sew_tolerance, eps, name, t0,
-                                     shell=shell, va=va)
+                                     shell=shell, va=va, made=made)
         except GeometryError:
             pass
     # each face is checked as part of the solid (BRepCheck_Analyzer of the solid checks its
@@ -314,7 +315,7 @@ def solid_from_surfaces(
     faces_l = [face_of(g, tol_degen=tol_degen, name=n) for gs, n in zip(geoms, names) for g in gs]
     try:
         return _solid_from_faces(tuple(faces_l), face_names, surfaces, names, fits, sew_tolerance, eps, name, t0,
-                                 va=va)
+                                 va=va, made=made)
     except GeometryError as exc:
         for face, n in zip(faces_l, face_names):
             if not BRepCheck_Analyzer(face).IsValid():
@@ -324,10 +325,11 @@ def solid_from_surfaces(
 
 def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequence, names: Sequence[str],
                       fits: Sequence, sew_tolerance: float, eps: float, name: str, t0: float,
-                      shell=None, va: tuple[float, float] | None = None) -> TabletSolid:
+                      shell=None, va: tuple[float, float] | None = None, made=None) -> TabletSolid:
     """Sew ``faces`` into one closed shell (unless the ``shell`` they make is given), make the
     outward solid and check it (its mass properties are integrated when first asked for:
-    :attr:`TabletSolid.mass`).  ``va``: the surfaces' :func:`volume_and_area`, if known."""
+    :attr:`TabletSolid.mass`).  ``va``: the surfaces' :func:`volume_and_area`, if known; ``made``: the
+    faces' surfaces and their poles (:func:`~tabletcad.cad.planes.made_poles`), if known."""
     t1 = time.perf_counter()
     sewn = shell is None
     if sewn:
@@ -345,7 +347,7 @@ def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequenc
     # flat B-spline pieces as exact planes: OCCT's face merging, which build123d and CadQuery run after
     # every Boolean, crashed the process on them (tabletcad.cad.planes); one check of the solid with them,
     # and of the solid as made only if that fails
-    planar, n_planes, reshape = flat_faces_as_planes(solid, check=False)
+    planar, n_planes, reshape = flat_faces_as_planes(solid, check=False, made=made)
     try:
         check_solid(planar, name)
         solid = planar
