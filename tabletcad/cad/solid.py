@@ -58,6 +58,7 @@ __all__ = [
     "MassProperties",
     "TabletSolid",
     "mass_properties",
+    "tight_bounds",
     "build_solid",
     "solid_from_surfaces",
     "solid_from_tablet",
@@ -102,6 +103,19 @@ def mass_properties(shape: TopoDS_Shape, eps: float | None = DEFAULT_EPS) -> Mas
         aerr = float(BRepGProp.SurfaceProperties_s(shape, sprops, Eps=float(eps)))
     c = vprops.CentreOfMass()
     return MassProperties(float(vprops.Mass()), float(sprops.Mass()), (c.X(), c.Y(), c.Z()), verr, aerr, eps)
+
+
+def tight_bounds(shape: TopoDS_Shape) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """``(lo, hi)`` (mm): the axis-aligned box of ``shape``'s geometry (``BRepBndLib::AddOptimal`` on its
+    curves and surfaces, neither its triangulation nor its tolerances), as build123d's
+    ``bounding_box(optimal=True)``."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    box = Bnd_Box()
+    BRepBndLib.AddOptimal_s(shape, box, False, False)
+    lo, hi = box.CornerMin(), box.CornerMax()
+    return (lo.X(), lo.Y(), lo.Z()), (hi.X(), hi.Y(), hi.Z())
 
 
 @dataclass(frozen=True, eq=False)

@@ -35,19 +35,75 @@ from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.design import Design
 from tabletcad.tolerance import DEFAULT
 
-__all__ = ["TabletModel", "PartModel", "ToolingModel", "make", "load", "show", "mesh_html", "mesh_png"]
+__all__ = ["BoundingBox", "TabletModel", "PartModel", "ToolingModel", "make", "load", "show", "mesh_html", "mesh_png"]
 
 #: Tessellation used for the notebook view (mm, rad): coarse enough for a small page.
 VIEW_DEFLECTION = (0.02, 0.35)
 
 
+@dataclass(frozen=True)
+class BoundingBox:
+    """An axis-aligned box (mm), named as build123d's ``BoundBox``: ``min`` and ``max`` corners, ``size``,
+    ``diagonal`` and ``center()``."""
+
+    min: tuple[float, float, float]
+    max: tuple[float, float, float]
+
+    @property
+    def size(self) -> tuple[float, float, float]:
+        """Extents along x, y, z (mm)."""
+        return tuple(float(b - a) for a, b in zip(self.min, self.max))
+
+    @property
+    def diagonal(self) -> float:
+        """Length of the box's diagonal (mm)."""
+        return float(np.linalg.norm(self.size))
+
+    def center(self) -> tuple[float, float, float]:
+        """The box's centre (mm)."""
+        return tuple(float(0.5 * (a + b)) for a, b in zip(self.min, self.max))
+
+
 class _Shaped:
-    """The shared build123d/cadquery vocabulary of a tablet and of each tooling part."""
+    """The shared build123d/cadquery vocabulary of a tablet and of each tooling part: ``to_*``, ``volume``,
+    ``area``, ``bounding_box()``, ``export``, ``mesh``, and the Booleans ``-``, ``+`` and ``&`` with another
+    model or any build123d shape (each a ``build123d`` shape: build123d does the Boolean on
+    :meth:`to_build123d`)."""
 
     name: str
 
     def to_occ(self):  # pragma: no cover - overridden
         raise NotImplementedError
+
+    @property
+    def area(self) -> float:
+        """Surface area (mm²) of the B-rep by OpenCascade's adaptive integration."""
+        from tabletcad.cad.solid import mass_properties
+
+        return mass_properties(self.to_occ()).area
+
+    def bounding_box(self) -> BoundingBox:
+        """The solid's axis-aligned box (mm) from its exact geometry (``BRepBndLib::AddOptimal``)."""
+        from tabletcad.cad.solid import tight_bounds
+
+        return BoundingBox(*tight_bounds(self.to_occ()))
+
+    def _boolean(self, other: Any, op: str):
+        other = other.to_build123d() if isinstance(other, _Shaped) else other
+        a = self.to_build123d()
+        return a - other if op == "-" else a + other if op == "+" else a & other
+
+    def __sub__(self, other: Any):
+        """``self.to_build123d() - other`` (a model or a build123d shape): a build123d shape."""
+        return self._boolean(other, "-")
+
+    def __add__(self, other: Any):
+        """``self.to_build123d() + other``: the union, a build123d shape."""
+        return self._boolean(other, "+")
+
+    def __and__(self, other: Any):
+        """``self.to_build123d() & other``: the intersection, a build123d shape."""
+        return self._boolean(other, "&")
 
     def to_build123d(self):
         """A ``build123d.Solid`` on the solid's own topology and geometry (no copy), in a new shape object:
@@ -220,6 +276,18 @@ class TabletModel(_Shaped):
     def volume(self) -> float:
         """Volume (mm³) from the core's Gauss quadrature of the PDE patches."""
         return self.tablet.volume()
+
+    @property
+    def area(self) -> float:
+        """Surface area (mm²): the core's quadrature of the PDE patches for a whole tablet, OpenCascade's of the
+        solid for a cut-away view (whose cut faces the patches do not have)."""
+        return self.tablet.surface_area() if self._whole else super().area
+
+    def bounding_box(self) -> BoundingBox:
+        """The tablet's axis-aligned box (mm) from the core (:meth:`~tabletcad.geometry.tablet.Tablet.bounds`,
+        polished to ~1e-9 mm; a cut-away's with its cut faces), no B-rep needed."""
+        lo, hi = self.tablet.bounds()
+        return BoundingBox(tuple(map(float, lo)), tuple(map(float, hi)))
 
     @cached_property
     def _solid(self):
