@@ -18,7 +18,8 @@ from tabletcad.pipeline.design import Design  # noqa: E402
 
 pytestmark = pytest.mark.cad
 
-SAMPLE = Path(__file__).resolve().parents[1] / "samples" / "tooling" / "tsm_b_round.toml"
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLE = ROOT / "samples" / "tooling" / "tsm_b_round.toml"
 
 
 @pytest.fixture(scope="module")
@@ -417,3 +418,109 @@ def test_fits_take_limit_deviations_and_the_working_length_its_own_tolerance(dra
                      ([0.0, -11.0], "-10"), (0.0, "> 0")):
         with pytest.raises(DesignError, match=why):
             parse_tooling({"drawing": {"tolerances": {"tip_diameter": bad}}})
+
+
+def _entity_points(kind: str, at: dict, n: int = 33) -> np.ndarray:
+    """Points along a DXF entity as written (an ARC counter-clockwise from its start angle to its end angle)."""
+    if kind == "LINE":
+        t = np.linspace(0.0, 1.0, n)[:, None]
+        return np.asarray(at["start"]) * (1 - t) + np.asarray(at["end"]) * t
+    if kind in ("ARC", "CIRCLE"):
+        a0, a1 = (math.radians(at["start_angle"]), math.radians(at["end_angle"])) if kind == "ARC" else (0.0, 2 * math.pi)
+        a1 = a1 + 2 * math.pi if a1 <= a0 else a1
+        a = np.linspace(a0, a1, n)
+        return np.asarray(at["center"]) + at["radius"] * np.column_stack([np.cos(a), np.sin(a)])
+    if kind == "ELLIPSE":
+        c, M, k = np.asarray(at["center"]), np.asarray(at["major_axis"]), at["ratio"]
+        m = k * np.array([-M[1], M[0]])
+        a = np.linspace(0.0, 2 * math.pi, n)[:, None]
+        return c + np.cos(a) * M + np.sin(a) * m
+    return np.asarray(at["points"])
+
+
+def _entity_length(kind: str, at: dict) -> float:
+    if kind == "LINE":
+        return math.dist(at["start"], at["end"])
+    if kind == "CIRCLE":
+        return 2 * math.pi * at["radius"]
+    if kind == "ARC":
+        sweep = (at["end_angle"] - at["start_angle"]) % 360.0
+        return math.radians(sweep) * at["radius"]
+    raise AssertionError(kind)
+
+
+@pytest.mark.parametrize("family", ["capsule", "oval", "almond", "rounded_triangle", "rounded_rectangle",
+                                    "modified_capsule", "custom_outline"])
+def test_the_dxf_outline_entities_are_the_outline_exactly(family):
+    """The DXF's OUTLINE entities (lines, arcs, circles) lie on the tablet's outline, run its whole length
+    once and join end to end: an arc written clockwise would be its complement, off the outline."""
+    from tabletcad.families.sweep import SweepNominal
+    from tabletcad.tooling.drawing import _exact_entities
+    from tabletcad.tooling.outline import segments_wire, wire_length
+
+    t = load_design(ROOT / "samples" / "families" / f"{family}.toml")
+    assert isinstance(t.nominal, SweepNominal)
+    segs = t.nominal.outline.segs
+    wire = segments_wire(segs)
+    origin = (3.0, -7.0)
+    ents = _exact_entities(wire, origin)
+    kinds = sorted(k for k, _ in ents)
+    assert set(kinds) <= {"LINE", "ARC", "CIRCLE"}
+    assert len(ents) == len(segs)
+    assert sum(_entity_length(k, a) for k, a in ents) == pytest.approx(wire_length(wire), rel=1e-12)
+    # every point of every entity lies on the outline (its exact signed distance, moved back by the origin)
+    for k, a in ents:
+        pts = _entity_points(k, a) - np.asarray(origin)
+        assert np.max(np.abs(t.nominal.outline.signed_distance(pts))) < 1e-9, (family, k, a)
+    # end to end: each entity's end is another's start (as drawn, arcs counter-clockwise)
+    ends = [(_entity_points(k, a)[0], _entity_points(k, a)[-1]) for k, a in ents if k != "CIRCLE"]
+    for i, (s, e) in enumerate(ends):
+        assert sum(min(np.linalg.norm(e - s2), np.linalg.norm(e - e2)) < 1e-9
+                   for j, (s2, e2) in enumerate(ends) if j != i) >= 1
+
+
+def test_the_sheets_dxf_carries_the_outline_on_its_own_layer(drawn, capsule, tmp_path):
+    import ezdxf
+
+    from tabletcad.tooling.drawing import _write_dxf
+
+    ts, out, _ = drawn
+    fr = ts.frame
+    msp = ezdxf.readfile(out / "drawing.dxf").modelspace()
+    circles = msp.query('CIRCLE[layer=="OUTLINE"]')
+    assert len(msp.query('*[layer=="OUTLINE"]')) == len(circles) == 1
+    (c,) = circles
+    px, py = drawing_model(ts).origins["plan"]
+    assert c.dxf.radius == pytest.approx(fr.round_radius, rel=1e-14)
+    assert (c.dxf.center.x, c.dxf.center.y) == pytest.approx((px, py), abs=1e-12)
+    # the capsule: two half circles of half its width and two straight sides, its length apart
+    dr = drawing_model(capsule)
+    _write_dxf(dr, tmp_path / "capsule.dxf")
+    msp = ezdxf.readfile(tmp_path / "capsule.dxf").modelspace()
+    arcs, lines = msp.query('ARC[layer=="OUTLINE"]'), msp.query('LINE[layer=="OUTLINE"]')
+    assert len(arcs) == 2 and len(lines) == 2
+    W, L = capsule.tablet.params["width"], capsule.tablet.params["length"]  # (the frame's: the PDE tablet's extents)
+    assert all(a.dxf.radius == pytest.approx(W / 2, rel=1e-12) for a in arcs)
+    assert all((a.dxf.end_angle - a.dxf.start_angle) % 360 == pytest.approx(180.0, abs=1e-9) for a in arcs)
+    assert sorted(math.dist(ln.dxf.start, ln.dxf.end) for ln in lines) == pytest.approx([L - W] * 2, rel=1e-12)
+    assert any("layer OUTLINE" in n for n in dr.notes)
+
+
+def test_an_arc_turning_clockwise_is_written_counter_clockwise_between_the_same_ends():
+    """An outline's concave arcs run clockwise (their circle's axis along -z): the ARC entity, always
+    counter-clockwise, must go from the arc's end to its start, not round the rest of the circle."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
+    from OCP.GC import GC_MakeArcOfCircle
+    from OCP.gp import gp_Pnt
+
+    from tabletcad.tooling.drawing import _exact_entities
+
+    s = math.sqrt(0.5)
+    arc = GC_MakeArcOfCircle(gp_Pnt(0, 2, 0), gp_Pnt(2 * s, 2 * s, 0), gp_Pnt(2, 0, 0)).Value()  # clockwise, r = 2
+    assert arc.BasisCurve().Axis().Direction().Z() < 0
+    wire = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(arc).Edge()).Wire()
+    ((kind, at),) = _exact_entities(wire, (1.0, 1.0))
+    assert kind == "ARC" and at["radius"] == pytest.approx(2.0, rel=1e-15)
+    assert (at["start_angle"], at["end_angle"]) == pytest.approx((0.0, 90.0), abs=1e-12)
+    pts = _entity_points(kind, at)
+    assert pts[16] == pytest.approx((1 + 2 * s, 1 + 2 * s), abs=1e-12)  # through the arc's middle

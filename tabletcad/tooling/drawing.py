@@ -157,6 +157,9 @@ class Drawing:
     title_block: list = field(default_factory=list)
     scale: float | None = None
     paper: str = "A4"
+    #: ``(wire, (x, y))``: plan wires (z = 0, mm) the DXF carries as exact LINE, ARC, CIRCLE and ELLIPSE
+    #: entities on its OUTLINE layer, placed at a view's origin (the tablet's nominal outline in the plan)
+    exact: list = field(default_factory=list)
 
     def __post_init__(self) -> None:
         # a tablet's name or an emboss text in a font of its own may hold characters the sheet's font
@@ -307,7 +310,9 @@ def drawing_model(ts) -> Drawing:
         dims.append(Dim((dx - k * fr.land, dy), (dx, dy), 0.25 * k * half, f"land {_fmt(fr.land)}", scale=k))
     notes.append(f"section A-A through the axis across {th:g} deg{' (the score)' if scores else ''}; "
                  f"detail B: band edge and land, {k:g}:1")
-    return Drawing(views, origins, _toleranced(dims, ts), notes, title=_title(ts), title_block=title_block(ts))
+    notes.append("drawing.dxf: layer OUTLINE holds the nominal outline in the plan as exact lines and arcs")
+    return Drawing(views, origins, _toleranced(dims, ts), notes, title=_title(ts), title_block=title_block(ts),
+                   exact=[(fr.outline, origins["plan"])])
 
 
 def _single_cup_radius(fr, radii: dict) -> float | None:
@@ -559,6 +564,45 @@ def _write_matplotlib(dr: Drawing, svg: Path, pdf: Path) -> None:
             fig.savefig(tmp, format="pdf")
 
 
+def _exact_entities(wire, origin: tuple[float, float]) -> list[tuple[str, dict]]:
+    """``(kind, attributes)`` of DXF entities for the edges of a plan wire moved by ``origin``: a line's
+    LINE, a circle's CIRCLE (whole) or ARC (counter-clockwise from ``start_angle`` to ``end_angle``, degrees),
+    an ellipse's ELLIPSE, anything else (a spline outline) a polyline through points 0.002 mm from it."""
+    from OCP.GeomAbs import GeomAbs_CurveType
+
+    ox, oy = origin
+    out = []
+    for e in explore(wire, "Edge"):
+        c = BRepAdaptor_Curve(e)
+        t0, t1 = c.FirstParameter(), c.LastParameter()
+        kind = c.GetType()
+        a, b = c.Value(t0), c.Value(t1)
+        if kind == GeomAbs_CurveType.GeomAbs_Line:
+            out.append(("LINE", dict(start=(a.X() + ox, a.Y() + oy), end=(b.X() + ox, b.Y() + oy))))
+        elif kind == GeomAbs_CurveType.GeomAbs_Circle:
+            circ = c.Circle()
+            ctr, r = circ.Location(), circ.Radius()
+            centre = (ctr.X() + ox, ctr.Y() + oy)
+            if abs(t1 - t0 - 2.0 * math.pi) < 1e-12:
+                out.append(("CIRCLE", dict(center=centre, radius=r)))
+                continue
+            ang = [math.degrees(math.atan2(p.Y() - ctr.Y(), p.X() - ctr.X())) for p in (a, b)]
+            if circ.Axis().Direction().Z() < 0.0:  # the parameter runs clockwise seen from +z
+                ang.reverse()
+            out.append(("ARC", dict(center=centre, radius=r, start_angle=ang[0], end_angle=ang[1])))
+        elif kind == GeomAbs_CurveType.GeomAbs_Ellipse and abs(t1 - t0 - 2.0 * math.pi) < 1e-12:
+            el = c.Ellipse()
+            ctr, major = el.Location(), el.XAxis().Direction()
+            R = el.MajorRadius()
+            out.append(("ELLIPSE", dict(center=(ctr.X() + ox, ctr.Y() + oy), major_axis=(R * major.X(), R * major.Y()),
+                                        ratio=el.MinorRadius() / R)))
+        else:
+            d = GCPnts_TangentialDeflection(c, 0.05, 0.002)
+            out.append(("POLYLINE", dict(points=[(d.Value(i).X() + ox, d.Value(i).Y() + oy)
+                                                 for i in range(1, d.NbPoints() + 1)])))
+    return out
+
+
 def _write_dxf(dr: Drawing, path: Path) -> None:
     import ezdxf
 
@@ -571,7 +615,21 @@ def _write_dxf(dr: Drawing, path: Path) -> None:
     doc.layers.add("HIDDEN", color=8, linetype="DASHED")
     doc.layers.add("DIMENSIONS", color=1)
     doc.layers.add("NOTES", color=3)
+    doc.layers.add("OUTLINE", color=5)
     msp = doc.modelspace()
+    for wire, origin in dr.exact:
+        for kind, at in _exact_entities(wire, origin):
+            attribs = {"layer": "OUTLINE"}
+            if kind == "LINE":
+                msp.add_line(at["start"], at["end"], dxfattribs=attribs)
+            elif kind == "CIRCLE":
+                msp.add_circle(at["center"], at["radius"], dxfattribs=attribs)
+            elif kind == "ARC":
+                msp.add_arc(at["center"], at["radius"], at["start_angle"], at["end_angle"], dxfattribs=attribs)
+            elif kind == "ELLIPSE":
+                msp.add_ellipse(at["center"], at["major_axis"], at["ratio"], dxfattribs=attribs)
+            else:
+                msp.add_lwpolyline(at["points"], dxfattribs=attribs)
     for kind, p in _sheet_lines(dr):
         msp.add_lwpolyline([tuple(map(float, q)) for q in p], dxfattribs={"layer": kind.upper()})
     for d in dr.dims:
