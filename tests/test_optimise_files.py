@@ -83,6 +83,22 @@ BAD = [
     ("fixed_not_a_table", FAMILY.replace("[problem]", "fixed = 5\n\n[problem]"), "fixed"),
     ("kind_list", SPHERE.replace('"spherical_tablet"', '["spherical_tablet"]'), "problem.kind"),
     ("not_toml", "[problem\nkind = 1\n", "PROBLEM.toml"),
+    # a weight needs the [report] table's solid fraction and true density, and the table needs a weight
+    ("weight_without_report", FAMILY.replace('quantity = "volume_mm3"', 'quantity = "weight_mg"'),
+     "report.solid_fraction"),
+    ("report_without_weight", FAMILY + "\n[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1.5\n", "report"),
+    ("report_key_unknown", FAMILY.replace('quantity = "volume_mm3"', 'quantity = "weight_mg"')
+     + "\n[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1.5\nporosity = 0.1\n", "report.porosity"),
+    ("solid_fraction_above_one", FAMILY.replace('quantity = "volume_mm3"', 'quantity = "weight_mg"')
+     + "\n[report]\nsolid_fraction = 1.5\ntrue_density_mg_mm3 = 1.5\n", "report.solid_fraction"),
+    ("density_missing", FAMILY.replace('quantity = "volume_mm3"', 'quantity = "weight_mg"')
+     + "\n[report]\nsolid_fraction = 0.85\n", "report.true_density_mg_mm3"),
+    ("weight_and_volume_held", FAMILY.replace("thickness = { lower = 1.0, upper = 10.0, initial = 3.0 }\n", "")
+     .replace('objective = "surface_area_mm2"', 'objective = "surface_area_mm2"\nsolve_for = "thickness"\n'
+              "volume_mm3 = 235.0\nweight_mg = 300.0").split("[[constraint]]")[0]
+     + "\n[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1.5\n", "problem.weight_mg"),
+    ("weight_on_thesis_kind", SPHERE.replace('kind = "spherical_tablet"', 'kind = "spherical_tablet"\nweight_mg = 3.0'),
+     "problem.weight_mg"),
 ]
 
 

@@ -28,11 +28,16 @@ A problem over the parameters of any tablet family (``tabletcad shapes``)::
 
     [[constraint]]
     quantity = "volume_mm3"          # volume_mm3 | surface_area_mm2 | plan_area_mm2 |
-    target = 235.0                   #   length_mm | width_mm | height_mm
+    target = 235.0                   #   length_mm | width_mm | height_mm | weight_mg
     relative = true                  # or lower = / upper = ; optional tol, scale
 
+    [report]                         # for weight_mg: weight = volume x solid fraction x true density
+    solid_fraction = 0.85
+    true_density_mg_mm3 = 1.5
+
 Instead of a volume constraint, ``[problem] solve_for = "band"`` (or ``thickness``,
-``cup_depth``) with ``volume_mm3 = 235.0`` builds every point with that parameter
+``cup_depth``) with ``volume_mm3 = 235.0`` (or ``weight_mg = 300.0``, with the ``[report]``
+table) builds every point with that parameter
 solved for the volume (:func:`tabletcad.families.inverse.solve_for`, the family's
 exact nominal volume): the variables then move along the designs of that volume.
 
@@ -85,7 +90,10 @@ QUANTITIES = {
     "width_mm": ("mm", lambda t: t.dimensions()["width_mm"]),
     "height_mm": ("mm", lambda t: t.dimensions()["height_mm"]),
 }
-_TOP = {"problem", "parameters", "solver", "variables", "fixed", "constraint", "fe"}
+_TOP = {"problem", "parameters", "solver", "variables", "fixed", "constraint", "fe", "report"}
+#: The weight (mg): the volume times ``[report]`` solid_fraction and true_density_mg_mm3, as the design report's.
+WEIGHT = "weight_mg"
+_REPORT_KEYS = ("solid_fraction", "true_density_mg_mm3")
 #: The FE quantity (needs the ``[fe]`` table and the ``fe`` extra).
 FE_QUANTITY = "fe_breaking_force_N"
 _FE_KEYS = {"tensile_strength_MPa", "direction", "recheck", "symmetric"}
@@ -252,7 +260,7 @@ def _check_keys(where: str, table: Any, allowed: set) -> dict:
 def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
     _check_keys("top-level", data, _TOP)
     prob = _check_keys("[problem]", data.get("problem", {}), {"kind", "method", "family", "sense", "objective", "name",
-                                                              "solve_for", "volume_mm3"})
+                                                              "solve_for", "volume_mm3", WEIGHT})
     kind = prob.get("kind")
     kinds = (*THESIS_PARAMETERS, "family")
     if kind is None:
@@ -275,11 +283,11 @@ def problem_from_dict(data: dict) -> tuple[Problem, str, dict]:
             if k in data:
                 raise DesignError(f"[{k}]", "given", "family problems take [variables], [fixed] and [[constraint]]")
         return family_problem(prob, data.get("variables"), data.get("fixed", {}), data.get("constraint", []),
-                              data.get("fe")), method, solver
-    for k in ("variables", "fixed", "constraint", "fe"):
+                              data.get("fe"), data.get("report")), method, solver
+    for k in ("variables", "fixed", "constraint", "fe", "report"):
         if k in data:
             raise DesignError(f"[{k}]", "given", f"only family problems take it, not {kind!r}")
-    for k in ("family", "sense", "objective", "name", "solve_for", "volume_mm3"):
+    for k in ("family", "sense", "objective", "name", "solve_for", "volume_mm3", WEIGHT):
         if k in prob:
             raise DesignError(f"[problem] {k}", _shown(prob[k]), f"only family problems take it, not {kind!r}")
     spec = THESIS_PARAMETERS[kind]
@@ -329,18 +337,46 @@ def _fe_recheck(settings: dict) -> Callable[[dict, Any], dict]:
     return extras
 
 
-def _held_volume(prob: dict, fam_name: str, fam: Any, variables: dict, fixed: dict) -> tuple[str, float] | None:
-    """``(parameter, volume mm³)`` when ``[problem] solve_for`` holds the volume by solving one parameter."""
-    if "solve_for" not in prob and "volume_mm3" not in prob:
+def _weight_basis(report: Any, used: bool) -> float | None:
+    """``solid fraction x true density`` (mg/mm³) from the ``[report]`` table, the factor from volume to weight;
+    None when no weight is asked for (a table then given is refused: it would be read by nothing)."""
+    if report is None:
+        if used:
+            raise DesignError("[report] solid_fraction", MISSING, f"must be given with true_density_mg_mm3 when "
+                              f"{WEIGHT} is the objective, a constraint or the held quantity")
         return None
-    if "solve_for" not in prob or "volume_mm3" not in prob:
+    _check_keys("[report]", report, set(_REPORT_KEYS))
+    if not used:
+        raise DesignError("[report]", "given", f"only problems using {WEIGHT} take it")
+    for k in _REPORT_KEYS:
+        if k not in report:
+            raise DesignError(f"[report] {k}", MISSING, f"must be given when {WEIGHT} is used")
+    sf = number("[report] solid_fraction", report["solid_fraction"], "", lo=0.0, lo_open=True, hi=1.0)
+    rho = number("[report] true_density_mg_mm3", report["true_density_mg_mm3"], "mg/mm3", lo=0.0, lo_open=True,
+                 hi=LIMITS["mg/mm3"])
+    return sf * rho
+
+
+def _held_volume(prob: dict, fam_name: str, fam: Any, variables: dict, fixed: dict,
+                 basis: float | None = None) -> tuple[str, float] | None:
+    """``(parameter, volume mm³)`` when ``[problem] solve_for`` holds the volume (or the weight: ``basis`` is
+    solid fraction x true density, mg/mm³) by solving one parameter."""
+    held = [k for k in ("volume_mm3", WEIGHT) if k in prob]
+    if "solve_for" not in prob and not held:
+        return None
+    if len(held) > 1:
+        raise DesignError(f"[problem] {WEIGHT}", prob[WEIGHT], "must not be given with volume_mm3: hold one of them")
+    if "solve_for" not in prob or not held:
         missing = "solve_for" if "solve_for" not in prob else "volume_mm3"
-        raise DesignError(f"[problem] {missing}", MISSING, "solve_for and volume_mm3 go together")
+        raise DesignError(f"[problem] {missing}", MISSING, "solve_for and volume_mm3 (or weight_mg) go together")
     from tabletcad.families.inverse import VARY
 
     vary = choice("[problem] solve_for", prob["solve_for"], tuple(v for v in VARY if v in fam.params))
     if vary in variables or vary in fixed:
         raise DesignError("[problem] solve_for", vary, "must not be a variable or fixed: it is solved for the volume")
+    if held[0] == WEIGHT:
+        weight = number(f"[problem] {WEIGHT}", prob[WEIGHT], "mg", lo=0.0, lo_open=True, hi=LIMITS["mg"])
+        return vary, weight / basis
     return vary, number("[problem] volume_mm3", prob["volume_mm3"], "mm3", lo=0.0, lo_open=True, hi=LIMITS["mm3"])
 
 
@@ -387,10 +423,12 @@ def _warn_unbuildable_upper(fam_name: str, vs: list, start: dict, build: Callabl
             pass
 
 
-def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe: Any = None) -> Problem:
+def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe: Any = None,
+                   report: Any = None) -> Problem:
     """A :class:`Problem` over the parameters of a tablet family (:data:`tabletcad.families.FAMILIES`).
 
-    ``fe`` is the ``[fe]`` table, needed when :data:`FE_QUANTITY` is the objective or a constraint.
+    ``fe`` is the ``[fe]`` table, needed when :data:`FE_QUANTITY` is the objective or a constraint;
+    ``report`` the ``[report]`` table (solid fraction and true density), needed when :data:`WEIGHT` is used.
     """
     from tabletcad.pipeline.design import design_to_toml
     from tabletcad.families import FAMILIES, RENAMED
@@ -430,7 +468,10 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
         raise DesignError("[problem] sense", MISSING, "must be given for a family problem: 'min' or 'max'")
     sense = prob["sense"]
     name = prob.get("name", f"{fam_name}_optimum")
-    held = _held_volume(prob, fam_name, fam, variables, fixed)
+    weighs = prob.get("objective") == WEIGHT or WEIGHT in prob or (isinstance(constraints, list) and any(
+        isinstance(c, dict) and c.get("quantity") == WEIGHT for c in constraints))
+    basis = _weight_basis(report, weighs)
+    held = _held_volume(prob, fam_name, fam, variables, fixed, basis)
     _check_lower_lengths(fam_name, fam, vs, fixed)
     given = set(variables) | set(fixed) | ({held[0]} if held else set())
     fixed.update(fam.left_out({**dict.fromkeys(given), **fixed}))  # (a ffbe's bevel_width, given its bevel_depth)
@@ -456,6 +497,9 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
         first = build(start)
     except DesignError as exc:
         if held is not None and exc.parameter == "target_volume_mm3":  # no design of the start has that volume
+            if WEIGHT in prob:
+                raise DesignError(f"[problem] {WEIGHT}", prob[WEIGHT], f"at the start's dimensions its volume "
+                                  f"{held[1]:g} mm3 {exc.allowed}", "mg") from None
             raise DesignError("[problem] volume_mm3", held[1], f"at the start's dimensions it {exc.allowed}", "mm3") from None
         at = ", ".join(f"{k} = {v:g}" for k, v in start.items())
         if exc.parameter in fixed:
@@ -474,6 +518,8 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
         # change with its dimensions)
         check_symmetric(first, fe_set["direction"], "[fe] symmetric")
     quantities = dict(QUANTITIES)
+    if basis is not None:
+        quantities[WEIGHT] = ("mg", lambda t: _properties(t)["volume_mm3"] * basis)
     if fe_set is not None:
         from tabletcad.optimise.strength import fe_breaking_force
 
@@ -481,7 +527,7 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
                                                           fe_set["symmetric"]))
     if isinstance(obj_spec, str):
         if obj_spec not in quantities:
-            raise DesignError("[problem] objective", obj_spec, "must be one of " + ", ".join([*QUANTITIES, FE_QUANTITY])
+            raise DesignError("[problem] objective", obj_spec, "must be one of " + ", ".join([*QUANTITIES, WEIGHT, FE_QUANTITY])
                               + " or {linear = {...}}")
         unit, f = quantities[obj_spec]
         objective = Objective(f, obj_spec, unit)
@@ -499,8 +545,8 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
     cons = []
     for k, c in enumerate(constraints):
         _check_keys(f"[[constraint]] {k}", c, {"quantity", "target", "lower", "upper", "relative", "tol", "scale", "name"})
-        q = choice(f"[[constraint]] {k} quantity", c.get("quantity"), tuple(quantities) if fe_set else
-                   (*QUANTITIES, FE_QUANTITY))
+        q = choice(f"[[constraint]] {k} quantity", c.get("quantity"), tuple(dict.fromkeys(
+            (*QUANTITIES, WEIGHT, FE_QUANTITY) if not fe_set else (*quantities, WEIGHT))))
         unit, f = quantities[q]
         # every quantity is a size (>= 0): a target must be > 0, bounds >= 0
         kw = {kk: number(f"[[constraint]] {k} {kk}", c[kk], unit, lo=0.0, lo_open=kk == "target", hi=LIMITS[unit])
@@ -523,5 +569,6 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
     extras = _fe_recheck(fe_set) if fe_set is not None and fe_set["recheck"] else None
     return Problem(name=name, variables=vs, objective=objective, sense=sense, constraints=cons, build=build,
                    to_toml=to_toml, description=f"family {fam_name}: {sense} {objective.name}" + (
-                       "" if held is None else f"; {held[0]} solved for the family's nominal volume {held[1]:g} mm3 "
+                       "" if held is None else f"; {held[0]} solved for the family's nominal volume {held[1]:g} mm3"
+                       + (f" ({prob[WEIGHT]:g} mg)" if WEIGHT in prob else "") + " "
                        "(the PDE surface's volume is within its certified deviation of it)"), extras=extras)
