@@ -57,3 +57,40 @@ def test_a_held_weight_solves_the_dimension_for_its_volume():
         t = problem.build({"diameter": d})
         assert t.volume() * SF * RHO == pytest.approx(WEIGHT, rel=1e-6)
     assert "(300 mg)" in problem.description
+
+
+def test_the_optimum_file_carries_the_weight_basis_so_its_build_reports_the_weight(tmp_path):
+    import json
+    import tomllib
+
+    from tabletcad.cli import main
+
+    text = """[problem]
+kind = "family"
+family = "thesis.flat_faced_round"
+sense = "min"
+objective = "weight_mg"
+
+[variables]
+diameter = { lower = 4.0, upper = 14.0, initial = 10.0 }
+thickness = { lower = 1.0, upper = 10.0, initial = 3.0 }
+
+[[constraint]]
+quantity = "surface_area_mm2"
+lower = 150.0
+
+[report]
+solid_fraction = 0.85
+true_density_mg_mm3 = 1.5
+"""
+    f = tmp_path / "weight.toml"
+    f.write_text(text, encoding="utf-8")
+    assert main(["optimise", str(f), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    design = tomllib.loads((tmp_path / "out" / "optimum.toml").read_text(encoding="utf-8"))
+    assert design["report"] == {"solid_fraction": SF, "true_density_mg_mm3": RHO}
+    result = json.loads((tmp_path / "out" / "report.json").read_text(encoding="utf-8"))
+    built = json.loads((tmp_path / "out" / "tablet" / "report.json").read_text(encoding="utf-8"))
+    weight = built["design_report"]["weight_mg"]
+    assert weight == pytest.approx(built["volume_mm3"] * SF * RHO, rel=1e-12)
+    assert result["objective"]["name"] == "weight_mg" and result["objective"]["unit"] == "mg"
+    assert weight == pytest.approx(result["objective"]["value"], rel=1e-9)

@@ -430,7 +430,7 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
     ``fe`` is the ``[fe]`` table, needed when :data:`FE_QUANTITY` is the objective or a constraint;
     ``report`` the ``[report]`` table (solid fraction and true density), needed when :data:`WEIGHT` is used.
     """
-    from tabletcad.pipeline.design import design_to_toml
+    from tabletcad.pipeline.design import design_to_toml, toml_text
     from tabletcad.families import FAMILIES, RENAMED
     from tabletcad.tolerance import DEFAULT as TOL
     from tabletcad.families import family as lookup_family
@@ -564,7 +564,9 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
 
     def to_toml(x, d):
         solved = {} if held is None else {held[0]: float(d.params[held[0]])}
-        return design_to_toml(fam_name, {**fixed, **x, **solved}, name=name)
+        # the weight's basis goes with the optimum, so its build reports the weight it was optimised for
+        extra = "" if report is None else "\n" + toml_text({"report": {k: report[k] for k in _REPORT_KEYS}})
+        return design_to_toml(fam_name, {**fixed, **x, **solved}, name=name, extra=extra)
 
     extras = _fe_recheck(fe_set) if fe_set is not None and fe_set["recheck"] else None
     return Problem(name=name, variables=vs, objective=objective, sense=sense, constraints=cons, build=build,
