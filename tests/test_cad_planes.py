@@ -1,7 +1,8 @@
 """Flat B-spline faces become exact planes (tabletcad.cad.planes): build123d's and CadQuery's
 Booleans and clean() run OCCT's face merging, which crashed the process (SIGSEGV) on the
 shaped families' flat pieces.  Each script runs in a subprocess, where a crash is an exit
-status, not a lost test worker."""
+status, not a lost test worker: the families' checks in a forked child each of one process that
+imported build123d and CadQuery once (the imports took 5 of each family's 5.5 s)."""
 
 import math
 import subprocess
@@ -46,14 +47,63 @@ print(len(planes), vol(b), T, vol(cut), cut.is_valid, vol(q.val()), q.val().isVa
 """
 
 
-@pytest.mark.parametrize("family", CRASHED + FLAT_ROUNDS)
-def test_booleans_and_clean_on_flat_centred_families_run_and_are_exact(family, tmp_path):
+# SCRIPT for each family in a child forked from one process that has imported what SCRIPT imports: each
+# family's run starts from the same freshly imported state, alone in its process (a crash is its own exit
+# status, -11 for SIGSEGV, as for a subprocess of its own), and the imports are paid once, not per family
+FORKED = r"""
+import os, sys, traceback
+import build123d, cadquery, OCP.BRep, OCP.Geom  # noqa: F401
+import tabletcad.pipeline.design, tabletcad.pipeline.model, tabletcad.cad._occ, tabletcad.cad.solid  # noqa: F401
+
+script, out = sys.argv[1], sys.argv[2]
+for family, path in zip(sys.argv[3::2], sys.argv[4::2]):
+    sys.stdout.flush()
+    sys.stderr.flush()
+    pid = os.fork()
+    if pid == 0:
+        code = 1
+        try:
+            sys.argv = ["-c", path]
+            sys.stdout = open(os.path.join(out, family + ".out"), "w")
+            sys.stderr = open(os.path.join(out, family + ".err"), "w")
+            exec(compile(open(script).read(), "<string>", "exec"), {"__name__": "__main__"})
+            code = 0
+        except BaseException:
+            traceback.print_exc()
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os._exit(code)
+    print(family, os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]), flush=True)
+"""
+
+FAMILIES = CRASHED + FLAT_ROUNDS
+
+
+@pytest.fixture(scope="module")
+def forked_runs(tmp_path_factory):
+    """``{family: (exit status, stdout, stderr)}`` of SCRIPT on each family's sample, each in its own forked child."""
+    work = tmp_path_factory.mktemp("planes")
+    (work / "script.py").write_text(SCRIPT)
+    args = [a for f in FAMILIES for a in (f, str(ROOT / "samples" / "families" / f"{f}.toml"))]
+    p = subprocess.run([sys.executable, "-c", FORKED, str(work / "script.py"), str(work), *args],
+                       capture_output=True, text=True, timeout=600, cwd=work)
+    status = dict(line.split() for line in p.stdout.splitlines() if line.split()[:1] and line.split()[0] in FAMILIES)
+    runs = {}
+    for f in FAMILIES:
+        out, err = work / f"{f}.out", work / f"{f}.err"
+        runs[f] = (int(status[f]) if f in status else ("the forking process ended first", p.returncode, p.stderr[-2000:]),
+                   out.read_text() if out.exists() else "", err.read_text() if err.exists() else "")
+    return runs
+
+
+@pytest.mark.parametrize("family", FAMILIES)
+def test_booleans_and_clean_on_flat_centred_families_run_and_are_exact(family, forked_runs):
     """The pin through the flat centre removes pi r^2 T exactly; clean() merges the flat pieces
     and keeps the volume.  On the code before tabletcad.cad.planes each ended in SIGSEGV (-11)."""
-    p = subprocess.run([sys.executable, "-c", SCRIPT, str(ROOT / "samples" / "families" / f"{family}.toml")],
-                       capture_output=True, text=True, timeout=600, cwd=tmp_path)
-    assert p.returncode == 0, (p.returncode, p.stderr[-2000:])
-    n, V, T, cut, cut_ok, qv, q_ok, cv, c_ok, c_faces, b_faces = p.stdout.split()[-11:]
+    returncode, stdout, stderr = forked_runs[family]
+    assert returncode == 0, (returncode, stderr[-2000:])
+    n, V, T, cut, cut_ok, qv, q_ok, cv, c_ok, c_faces, b_faces = stdout.split()[-11:]
     V, T, cut, qv, cv = map(float, (V, T, cut, qv, cv))
     assert int(n) >= 2  # the top's and the bottom's flat pieces at least
     pin = math.pi * 0.2**2 * T

@@ -241,12 +241,17 @@ def test_small_lambda_tends_to_cubic_with_order_lambda_squared(lam):
 
 def _g_exact(x: float) -> float:
     """(x cosh x - sinh x) / x³ in exact rational arithmetic: its Taylor series Σ 2(j+1) x^{2j} / (2j+3)!
-    to 40 terms (the tail is below 1e-60 for |x| <= 1.5), rounded once."""
+    to 40 terms (the tail is below 1e-60 for |x| <= 1.5), rounded once.  The terms over one common
+    denominator, 81! b^39 for x² = a/b, in integers (Fractions reduced every partial sum by a gcd of
+    numbers of up to 80,000 bits: 12 ms a call, now 0.3 ms); int / int is correctly rounded, so the
+    float is the one ``float(Fraction)`` of the same sum gives."""
     from fractions import Fraction
     from math import factorial
 
-    q = Fraction(x) ** 2
-    return float(sum(Fraction(2 * (j + 1), factorial(2 * j + 3)) * q**j for j in range(40)))
+    a, b = Fraction(x).as_integer_ratio()
+    a, b = a * a, b * b
+    top = factorial(2 * 39 + 3)
+    return sum(2 * (j + 1) * (top // factorial(2 * j + 3)) * a**j * b ** (39 - j) for j in range(40)) / (top * b**39)
 
 
 @given(st.floats(min_value=-1.5, max_value=1.5, allow_nan=False))

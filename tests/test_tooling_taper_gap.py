@@ -115,7 +115,8 @@ def test_largest_gap_agrees_with_an_independent_dense_sampling():
     assert 0 < len(candidates) < 5000
     onto = ExactDistance(explore(ts.parts["tablet"], "Shell")[0])
     exact_to = [ExactDistance(s) for s in tools.values()]
-    exact = np.array([min(e(onto.nearest(P[i])[1]) for e in exact_to) for i in candidates])
+    # each candidate moved onto the tablet once (the generator had moved it again for every tool)
+    exact = np.array([min(e(q) for e in exact_to) for q in (onto.nearest(P[i])[1] for i in candidates)])
     sampled = float(exact.max())
     assert res == pytest.approx(0.125 * 0.035 / math.sqrt(3.0))
     assert sampled <= gap + res  # points of the tablet's B-rep, measured exactly
