@@ -524,3 +524,20 @@ def test_an_arc_turning_clockwise_is_written_counter_clockwise_between_the_same_
     assert (at["start_angle"], at["end_angle"]) == pytest.approx((0.0, 90.0), abs=1e-12)
     pts = _entity_points(kind, at)
     assert pts[16] == pytest.approx((1 + 2 * s, 1 + 2 * s), abs=1e-12)  # through the arc's middle
+
+
+@pytest.mark.parametrize("rx, ry", [(5.0, 3.0), (2.5, 4.0)])
+def test_an_elliptic_outline_is_one_ellipse_entity_on_the_outline(rx, ry):
+    """A thesis oval's band is an ellipse (its outline wire a gp_Elips, the major axis along x or y): one
+    ELLIPSE entity whose points all lie on x²/rx² + y²/ry² = 1 about the plan origin, and a circle one CIRCLE."""
+    from tabletcad.tooling.drawing import _exact_entities
+    from tabletcad.tooling.outline import ellipse_wire
+
+    origin = (-2.0, 11.0)
+    ((kind, at),) = _exact_entities(ellipse_wire(rx, ry, (0.5, -0.25)), origin)
+    assert kind == "ELLIPSE"
+    pts = _entity_points(kind, at, 65) - np.asarray(origin) - np.array([0.5, -0.25])
+    assert np.max(np.abs((pts[:, 0] / rx) ** 2 + (pts[:, 1] / ry) ** 2 - 1.0)) < 1e-12
+    assert at["ratio"] == pytest.approx(min(rx, ry) / max(rx, ry), rel=1e-15)
+    ((kind, at),) = _exact_entities(ellipse_wire(3.0, 3.0), (0.0, 0.0))
+    assert kind == "CIRCLE" and at["radius"] == pytest.approx(3.0, rel=1e-15)
