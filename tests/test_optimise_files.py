@@ -97,6 +97,15 @@ BAD = [
      .replace('objective = "surface_area_mm2"', 'objective = "surface_area_mm2"\nsolve_for = "thickness"\n'
               "volume_mm3 = 235.0\nweight_mg = 300.0").split("[[constraint]]")[0]
      + "\n[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1.5\n", "problem.weight_mg"),
+    # the design's own ranges (the optimum's design file carries the table): 30 mg/mm3 had run the whole solve
+    # and then been refused reading the optimum back
+    ("density_a_design_refuses", FAMILY.replace('quantity = "volume_mm3"', 'quantity = "weight_mg"')
+     + "\n[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 30.0\n", "report.true_density_mg_mm3"),
+    # a misspelt quantity is named, not the [report] table that only a weight reads
+    ("weight_misspelt", FAMILY.replace('quantity = "volume_mm3"', 'quantity = "weight"')
+     + "\n[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1.5\n", "constraint[0].quantity"),
+    ("weight_objective_misspelt", FAMILY.replace('objective = "surface_area_mm2"', 'objective = "weight"')
+     + "\n[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1.5\n", "problem.objective"),
     ("weight_on_thesis_kind", SPHERE.replace('kind = "spherical_tablet"', 'kind = "spherical_tablet"\nweight_mg = 3.0'),
      "problem.weight_mg"),
 ]

@@ -338,23 +338,24 @@ def _fe_recheck(settings: dict) -> Callable[[dict, Any], dict]:
 
 
 def _weight_basis(report: Any, used: bool) -> float | None:
-    """``solid fraction x true density`` (mg/mm³) from the ``[report]`` table, the factor from volume to weight;
-    None when no weight is asked for (a table then given is refused: it would be read by nothing)."""
+    """``solid fraction x true density`` (mg/mm³) from the ``[report]`` table, the factor from volume to weight,
+    checked as a design's ``[report]`` table is (the optimum's design file carries it); None when there is no
+    table (refused when a weight is asked for)."""
     if report is None:
         if used:
             raise DesignError("[report] solid_fraction", MISSING, f"must be given with true_density_mg_mm3 when "
                               f"{WEIGHT} is the objective, a constraint or the held quantity")
         return None
+    from tabletcad.pipeline.designreport import ReportOptions
+
     _check_keys("[report]", report, set(_REPORT_KEYS))
-    if not used:
-        raise DesignError("[report]", "given", f"only problems using {WEIGHT} take it")
     for k in _REPORT_KEYS:
         if k not in report:
-            raise DesignError(f"[report] {k}", MISSING, f"must be given when {WEIGHT} is used")
-    sf = number("[report] solid_fraction", report["solid_fraction"], "", lo=0.0, lo_open=True, hi=1.0)
-    rho = number("[report] true_density_mg_mm3", report["true_density_mg_mm3"], "mg/mm3", lo=0.0, lo_open=True,
-                 hi=LIMITS["mg/mm3"])
-    return sf * rho
+            raise DesignError(f"[report] {k}", MISSING, f"must be given with {', '.join(_REPORT_KEYS)}")
+    for k in _REPORT_KEYS:  # TOML numbers, as everywhere in a problem file
+        number(f"[report] {k}", report[k])
+    opts = ReportOptions.from_table(dict(report))  # the design's ranges
+    return opts.solid_fraction * opts.true_density_mg_mm3
 
 
 def _held_volume(prob: dict, fam_name: str, fam: Any, variables: dict, fixed: dict,
@@ -470,8 +471,8 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
     name = prob.get("name", f"{fam_name}_optimum")
     weighs = prob.get("objective") == WEIGHT or WEIGHT in prob or (isinstance(constraints, list) and any(
         isinstance(c, dict) and c.get("quantity") == WEIGHT for c in constraints))
-    basis = _weight_basis(report, weighs)
-    held = _held_volume(prob, fam_name, fam, variables, fixed, basis)
+    basis = _weight_basis(report, weighs)  # (a table without a weight to read it: refused below, once the
+    held = _held_volume(prob, fam_name, fam, variables, fixed, basis)  # quantities' names are known good)
     _check_lower_lengths(fam_name, fam, vs, fixed)
     given = set(variables) | set(fixed) | ({held[0]} if held else set())
     fixed.update(fam.left_out({**dict.fromkeys(given), **fixed}))  # (a ffbe's bevel_width, given its bevel_depth)
@@ -561,6 +562,9 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
             cons.append(Constraint(cname, f, kind="eq" if "target" in c else "ineq", relative=relative, unit=unit, **kw))
         except DesignError as exc:  # "constraint NAME lower": the file's [[constraint]] k
             raise exc.renamed(f"constraint[{k}]" + exc.parameter[len(one_token(f"constraint {cname}")):]) from None
+
+    if report is not None and not weighs:
+        raise DesignError("[report]", "given", f"only problems using {WEIGHT} take it")
 
     def to_toml(x, d):
         solved = {} if held is None else {held[0]: float(d.params[held[0]])}
