@@ -69,3 +69,46 @@ def test_tooling_parts_have_the_same_words():
     z = box.center()[2]
     half = die & bd.Box(od, 2 * od, 4 * box.size[2]).moved(bd.Location((od / 2, 0, z)))  # x >= 0
     assert half.volume == pytest.approx(die.volume / 2, rel=1e-9)  # a round die is symmetric about x = 0
+
+
+def test_a_box_reads_as_build123d_vectors():
+    box = tabletcad.make("flat_face_round", diameter=8, thickness=3).bounding_box()
+    assert box.size.X == pytest.approx(8.0, abs=1e-9) and box.size.Z == pytest.approx(3.0, abs=1e-9)
+    assert box.min.Y == pytest.approx(-4.0, abs=1e-9) and box.center().Z == pytest.approx(1.5, abs=1e-9)
+
+
+def test_operands_that_are_not_shapes_are_a_type_error():
+    m = tabletcad.make("flat_face_round", diameter=8, thickness=3)
+    for other in (5, "pin", m.tooling(clearance_mm=0.03)):
+        with pytest.raises(TypeError, match="unsupported operand"):
+            m - other
+
+
+SHAPED_CUTAWAY = r"""
+import math, sys
+import build123d as bd
+import tabletcad
+cut = tabletcad.make("oval", length=14.0, width=8.0, end_radius=3.0, band=2.0, cup_depth=1.0,
+                     trim={"v": [0.0, math.pi]})
+pin = bd.Cylinder(0.5, 20.0).moved(bd.Location((0.0, 1.5, 0.0)))
+a, b = cut - pin, cut & pin
+whole = cut.to_build123d().volume
+print(a.is_valid, b.is_valid, a.volume, b.volume, whole)
+"""
+
+
+def test_booleans_on_a_shaped_cut_away_run_and_add_up(tmp_path):
+    """A shaped cut-away keeps flat B-spline faces, on which OCC's face merging (build123d runs it after every
+    Boolean) crashed the process: its Booleans skip the merge.  In a subprocess (a crash is an exit status);
+    the cut and the common of the same pin add up to the cut-away."""
+    import subprocess
+    import sys
+
+    p = subprocess.run([sys.executable, "-c", SHAPED_CUTAWAY],
+                       capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    assert p.returncode == 0, (p.returncode, p.stderr[-2000:])
+    a_ok, b_ok, va, vb, whole = p.stdout.split()[-5:]
+    assert a_ok == "True" and b_ok == "True"
+    va, vb, whole = map(float, (va, vb, whole))
+    assert 0.0 < vb < math.pi * 0.25 * 4.0  # the pin's part inside (under r² π x the overall thickness)
+    assert va + vb == pytest.approx(whole, rel=1e-9)

@@ -159,3 +159,22 @@ def test_a_shaped_sheet_gives_the_outline_radius_and_the_plateau():
     assert "outline end radius R3.00 ±0.076 mm" in notes
     assert ("cup swept over the outline's offsets: it runs 3.00 mm in from the outline (land included), a flat "
             "plateau inside (the outline offset inwards by it)") in notes
+
+
+def test_tooling_of_an_outline_through_points_is_refused_naming_the_outline(capsys, tmp_path):
+    """A custom outline given as points is a spline through them, whose band section OpenCascade could not
+    offset for the tips and the bore: an internal IndexError had ended the build (a reviewer's trial), then a
+    bare geometry error; now the one-line refusal names the outline."""
+    design = """[tablet]
+family = "custom_outline"
+outline = [[5.4, 0.0], [5.102834, 0.905867], [4.330127, 1.75], [3.335534, 2.474874], [2.3, 3.031089], [1.22089, 3.38074], [0.0, 3.5], [-1.3673, 3.38074], [-2.7, 3.031089], [-3.735534, 2.474874], [-4.330127, 1.75], [-4.556424, 0.905867], [-4.6, 0.0], [-4.556424, -0.905867], [-4.330127, -1.75], [-3.735534, -2.474874], [-2.7, -3.031089], [-1.3673, -3.38074], [-0.0, -3.5], [1.22089, -3.38074], [2.3, -3.031089], [3.335534, -2.474874], [4.330127, -1.75], [5.102834, -0.905867]]
+band = 2.5
+cup_depth = 0.5
+land = 0.05
+
+[tooling]
+clearance_mm = 0.02
+tip_length_mm = 8.0
+"""
+    param, value, allowed = _refused(capsys, tmp_path, design)
+    assert param == "tablet.outline" and "spline" in value and "lines and arcs" in allowed

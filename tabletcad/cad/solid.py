@@ -107,8 +107,8 @@ def mass_properties(shape: TopoDS_Shape, eps: float | None = DEFAULT_EPS) -> Mas
 
 def tight_bounds(shape: TopoDS_Shape) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
     """``(lo, hi)`` (mm): the axis-aligned box of ``shape``'s geometry (``BRepBndLib::AddOptimal`` on its
-    curves and surfaces, neither its triangulation nor its tolerances), as build123d's
-    ``bounding_box(optimal=True)``."""
+    curves and surfaces, neither its triangulation nor its tolerances; build123d's ``bounding_box(optimal=True)``
+    also counts the tolerances, 1e-7 mm and more on a Boolean's edges)."""
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
 

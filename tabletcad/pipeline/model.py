@@ -26,7 +26,7 @@ import json
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -41,34 +41,50 @@ __all__ = ["BoundingBox", "TabletModel", "PartModel", "ToolingModel", "make", "l
 VIEW_DEFLECTION = (0.02, 0.35)
 
 
+class Vec3(NamedTuple):
+    """A point or extent (mm) that reads as build123d's ``Vector`` does (``.X``, ``.Y``, ``.Z``) and is a tuple."""
+
+    X: float
+    Y: float
+    Z: float
+
+
 @dataclass(frozen=True)
 class BoundingBox:
-    """An axis-aligned box (mm), named as build123d's ``BoundBox``: ``min`` and ``max`` corners, ``size``,
-    ``diagonal`` and ``center()``."""
+    """An axis-aligned box (mm), named as build123d's ``BoundBox``: ``min`` and ``max`` corners, ``size``
+    (each a :class:`Vec3`: ``box.size.X``), ``diagonal`` and ``center()``."""
 
-    min: tuple[float, float, float]
-    max: tuple[float, float, float]
+    min: Vec3
+    max: Vec3
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "min", Vec3(*map(float, self.min)))
+        object.__setattr__(self, "max", Vec3(*map(float, self.max)))
 
     @property
-    def size(self) -> tuple[float, float, float]:
+    def size(self) -> Vec3:
         """Extents along x, y, z (mm)."""
-        return tuple(float(b - a) for a, b in zip(self.min, self.max))
+        return Vec3(*(b - a for a, b in zip(self.min, self.max)))
 
     @property
     def diagonal(self) -> float:
         """Length of the box's diagonal (mm)."""
         return float(np.linalg.norm(self.size))
 
-    def center(self) -> tuple[float, float, float]:
+    def center(self) -> Vec3:
         """The box's centre (mm)."""
-        return tuple(float(0.5 * (a + b)) for a, b in zip(self.min, self.max))
+        return Vec3(*(0.5 * (a + b) for a, b in zip(self.min, self.max)))
 
 
 class _Shaped:
     """The shared build123d/cadquery vocabulary of a tablet and of each tooling part: ``to_*``, ``volume``,
     ``area``, ``bounding_box()``, ``export``, ``mesh``, and the Booleans ``-``, ``+`` and ``&`` with another
-    model or any build123d shape (each a ``build123d`` shape: build123d does the Boolean on
-    :meth:`to_build123d`)."""
+    model or a build123d shape (build123d does the Boolean on :meth:`to_build123d`; its result, which for an
+    empty ``&`` is None as build123d's own; another operand is a TypeError)."""
+
+    #: True where OCC's face merging, which build123d runs after a Boolean, crashed the process on the
+    #: model's faces (a shaped cut-away's flat B-spline faces): its Booleans skip the merge
+    _skip_clean = False
 
     name: str
 
@@ -89,8 +105,17 @@ class _Shaped:
         return BoundingBox(*tight_bounds(self.to_occ()))
 
     def _boolean(self, other: Any, op: str):
-        other = other.to_build123d() if isinstance(other, _Shaped) else other
+        import build123d as bd
+
+        skip = self._skip_clean or getattr(other, "_skip_clean", False)
+        if isinstance(other, _Shaped):
+            other = other.to_build123d()
+        elif not isinstance(other, bd.Shape):
+            return NotImplemented
         a = self.to_build123d()
+        if skip:  # a shaped cut-away: faces kept as they come, not merged (a crash of OCCT 7.9)
+            with bd.SkipClean():
+                return a - other if op == "-" else a + other if op == "+" else a & other
         return a - other if op == "-" else a + other if op == "+" else a & other
 
     def __sub__(self, other: Any):
@@ -280,8 +305,14 @@ class TabletModel(_Shaped):
     @property
     def area(self) -> float:
         """Surface area (mm²): the core's quadrature of the PDE patches for a whole tablet, OpenCascade's of the
-        solid for a cut-away view (whose cut faces the patches do not have)."""
+        solid for a cut-away view (whose cut faces the patches do not have; a cut-away with no solid, as
+        :meth:`to_occ` says, has none)."""
         return self.tablet.surface_area() if self._whole else super().area
+
+    @property
+    def _skip_clean(self) -> bool:
+        """A shaped cut-away (its flat faces stay B-splines, on which OCC's face merging crashed)."""
+        return not self._whole and self.tablet.revolution is None
 
     def bounding_box(self) -> BoundingBox:
         """The tablet's axis-aligned box (mm) from the core (:meth:`~tabletcad.geometry.tablet.Tablet.bounds`,

@@ -310,9 +310,12 @@ def drawing_model(ts) -> Drawing:
         dims.append(Dim((dx - k * fr.land, dy), (dx, dy), 0.25 * k * half, f"land {_fmt(fr.land)}", scale=k))
     notes.append(f"section A-A through the axis across {th:g} deg{' (the score)' if scores else ''}; "
                  f"detail B: band edge and land, {k:g}:1")
-    notes.append("drawing.dxf: layer OUTLINE holds the nominal outline in the plan as exact lines and arcs")
+    exact = fr.outline_kind in ("circle", "ellipse", "lines and arcs")  # (not a section of a free-form band)
+    if exact:
+        notes.append("drawing.dxf: layer OUTLINE holds the nominal outline in the plan as exact "
+                     + {"circle": "a circle", "ellipse": "an ellipse"}.get(fr.outline_kind, "lines and arcs"))
     return Drawing(views, origins, _toleranced(dims, ts), notes, title=_title(ts), title_block=title_block(ts),
-                   exact=[(fr.outline, origins["plan"])])
+                   exact=[(fr.outline, origins["plan"])] if exact else [])
 
 
 def _single_cup_radius(fr, radii: dict) -> float | None:

@@ -321,7 +321,7 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
     lo, hi = tablet.bounds()
     info = dict(getattr(nom, "info", {}) or {})
     round_radius = None
-    if outline_nom is not None and hasattr(outline_nom, "segs"):
+    if outline_nom is not None and getattr(outline_nom, "segs", None):  # (a spline outline has none)
         segs = outline_nom.segs
         if len(segs) == 1 or all(s.kind == "arc" and abs(s.radius - segs[0].radius) < 1e-12 and
                                   np.allclose(s.center, segs[0].center) for s in segs):
@@ -348,6 +348,15 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
                 wire = cast(translated(wire, float(shift[0]), float(shift[1]), 0.0), "Wire")
         else:
             wire, kind = _section_wire(shape, 0.5 * (band_z[0] + band_z[1])), "section of the band"
+            try:  # the tips and the bore are offsets of it: refused here, named, when OCC cannot offset it
+                offset_wire(wire, -0.01)
+            except GeometryError:
+                spline = outline_nom is not None and not getattr(outline_nom, "segs", None)
+                raise DesignError("tablet.outline" if spline else "tablet.family",
+                                  "points (a spline through them)" if spline else tablet.family,
+                                  "tooling needs an outline OpenCascade can offset for the tips and the bore: lines "
+                                  "and arcs (custom_outline segments), a circle or an ellipse; the section of this "
+                                  "tablet's band cannot be offset") from None
     land = info.get("land_mm")
     if land is None and tablet.family in NO_LAND:  # the thesis's shapes say so in the catalogue
         land = 0.0
