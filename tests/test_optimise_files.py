@@ -35,6 +35,15 @@ SPHERE = '[problem]\nkind = "spherical_tablet"\n\n[parameters]\nvariant = "a"\n'
 ROUND = '[problem]\nkind = "flat_faced_round"\n\n[parameters]\nmass_mg = 300.0\n'
 CAPSULE = '[problem]\nkind = "softgel_capsule"\n\n[parameters]\nmodel = "none"\nradius_constraints = false\n'
 
+#: FAMILY with its constraint on the weight
+WEIGHED = FAMILY.replace('quantity = "volume_mm3"', 'quantity = "weight_mg"')
+
+
+def _report(sf: str = "0.85", rho: str = "1.5", extra: str = "") -> str:
+    """A ``[report]`` table of a weight's basis."""
+    return f"\n[report]\nsolid_fraction = {sf}\ntrue_density_mg_mm3 = {rho}\n{extra}"
+
+
 # (name, file text, text that the parameter named in the error line must contain)
 BAD = [
     ("tol_string", FAMILY + 'tol = "loose"\n', "constraint[0].tol"),
@@ -84,28 +93,22 @@ BAD = [
     ("kind_list", SPHERE.replace('"spherical_tablet"', '["spherical_tablet"]'), "problem.kind"),
     ("not_toml", "[problem\nkind = 1\n", "PROBLEM.toml"),
     # a weight needs the [report] table's solid fraction and true density, and the table needs a weight
-    ("weight_without_report", FAMILY.replace('quantity = "volume_mm3"', 'quantity = "weight_mg"'),
-     "report.solid_fraction"),
-    ("report_without_weight", FAMILY + "\n[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1.5\n", "report"),
-    ("report_key_unknown", FAMILY.replace('quantity = "volume_mm3"', 'quantity = "weight_mg"')
-     + "\n[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1.5\nporosity = 0.1\n", "report.porosity"),
-    ("solid_fraction_above_one", FAMILY.replace('quantity = "volume_mm3"', 'quantity = "weight_mg"')
-     + "\n[report]\nsolid_fraction = 1.5\ntrue_density_mg_mm3 = 1.5\n", "report.solid_fraction"),
-    ("density_missing", FAMILY.replace('quantity = "volume_mm3"', 'quantity = "weight_mg"')
-     + "\n[report]\nsolid_fraction = 0.85\n", "report.true_density_mg_mm3"),
+    ("weight_without_report", WEIGHED, "report.solid_fraction"),
+    ("report_without_weight", FAMILY + _report(), "report"),
+    ("report_key_unknown", WEIGHED + _report(extra="porosity = 0.1\n"), "report.porosity"),
+    ("solid_fraction_above_one", WEIGHED + _report(sf="1.5"), "report.solid_fraction"),
+    ("density_missing", WEIGHED + "\n[report]\nsolid_fraction = 0.85\n", "report.true_density_mg_mm3"),
     ("weight_and_volume_held", FAMILY.replace("thickness = { lower = 1.0, upper = 10.0, initial = 3.0 }\n", "")
      .replace('objective = "surface_area_mm2"', 'objective = "surface_area_mm2"\nsolve_for = "thickness"\n'
-              "volume_mm3 = 235.0\nweight_mg = 300.0").split("[[constraint]]")[0]
-     + "\n[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1.5\n", "problem.weight_mg"),
+              "volume_mm3 = 235.0\nweight_mg = 300.0").split("[[constraint]]")[0] + _report(), "problem.weight_mg"),
     # the design's own ranges (the optimum's design file carries the table): 30 mg/mm3 had run the whole solve
     # and then been refused reading the optimum back
-    ("density_a_design_refuses", FAMILY.replace('quantity = "volume_mm3"', 'quantity = "weight_mg"')
-     + "\n[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 30.0\n", "report.true_density_mg_mm3"),
+    ("density_a_design_refuses", WEIGHED + _report(rho="30.0"), "report.true_density_mg_mm3"),
     # a misspelt quantity is named, not the [report] table that only a weight reads
-    ("weight_misspelt", FAMILY.replace('quantity = "volume_mm3"', 'quantity = "weight"')
-     + "\n[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1.5\n", "constraint[0].quantity"),
-    ("weight_objective_misspelt", FAMILY.replace('objective = "surface_area_mm2"', 'objective = "weight"')
-     + "\n[report]\nsolid_fraction = 0.85\ntrue_density_mg_mm3 = 1.5\n", "problem.objective"),
+    ("weight_misspelt", FAMILY.replace('quantity = "volume_mm3"', 'quantity = "weight"') + _report(),
+     "constraint[0].quantity"),
+    ("weight_objective_misspelt", FAMILY.replace('objective = "surface_area_mm2"', 'objective = "weight"') + _report(),
+     "problem.objective"),
     ("weight_on_thesis_kind", SPHERE.replace('kind = "spherical_tablet"', 'kind = "spherical_tablet"\nweight_mg = 3.0'),
      "problem.weight_mg"),
 ]

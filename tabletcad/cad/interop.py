@@ -24,7 +24,7 @@ from OCP.TopoDS import TopoDS_Shape
 from tabletcad.cad._occ import cast, explore, handle, shape_type
 from tabletcad.geometry.tablet import Tablet
 
-__all__ = ["to_build123d", "to_build123d_part", "to_cadquery", "to_cadquery_workplane", "from_any"]
+__all__ = ["to_build123d", "to_build123d_part", "to_cadquery", "to_cadquery_workplane", "from_any", "build123d_boolean"]
 
 _CQ_HINT = (
     "cadquery is not importable with this OCP ({err}); install the 'cadquery' extra "
@@ -111,3 +111,22 @@ def to_cadquery_workplane(obj: Any, plane: str = "XY"):
     """A ``cadquery.Workplane`` on ``plane`` whose stack holds the solid."""
     cq = _import_cadquery()
     return cq.Workplane(plane).add(cq.Solid(_solid_of(obj)))
+
+
+def build123d_boolean(a: Any, b: Any, op: str, *, skip_clean: bool = False):
+    """``a - b``, ``a + b`` or ``a & b`` (``op``) by build123d, ``a`` a solid (:func:`to_build123d`), ``b`` a
+    build123d shape; NotImplemented when ``b`` is none.  ``skip_clean``: without build123d's face merging
+    (``SkipClean``; OCCT 7.9's ``ShapeUpgrade_UnifySameDomain`` crashed on a shaped cut-away's flat B-spline
+    faces)."""
+    bd = _import_build123d()
+    if not isinstance(b, bd.Shape):
+        return NotImplemented
+    a = to_build123d(a)
+
+    def run():
+        return a - b if op == "-" else a + b if op == "+" else a & b
+
+    if skip_clean:
+        with bd.SkipClean():
+            return run()
+    return run()

@@ -105,18 +105,12 @@ class _Shaped:
         return BoundingBox(*tight_bounds(self.to_occ()))
 
     def _boolean(self, other: Any, op: str):
-        import build123d as bd
+        from tabletcad.cad.interop import build123d_boolean
 
-        skip = self._skip_clean or getattr(other, "_skip_clean", False)
+        skip = self._skip_clean or getattr(other, "_skip_clean", False)  # (a shaped cut-away: faces not merged)
         if isinstance(other, _Shaped):
             other = other.to_build123d()
-        elif not isinstance(other, bd.Shape):
-            return NotImplemented
-        a = self.to_build123d()
-        if skip:  # a shaped cut-away: faces kept as they come, not merged (a crash of OCCT 7.9)
-            with bd.SkipClean():
-                return a - other if op == "-" else a + other if op == "+" else a & other
-        return a - other if op == "-" else a + other if op == "+" else a & other
+        return build123d_boolean(self.to_occ(), other, op, skip_clean=skip)
 
     def __sub__(self, other: Any):
         """``self.to_build123d() - other`` (a model or a build123d shape): a build123d shape."""
