@@ -161,6 +161,7 @@ def test_a_shaped_sheet_gives_the_outline_radius_and_the_plateau():
             "plateau inside (the outline offset inwards by it)") in notes
 
 
+@pytest.mark.cad
 def test_tooling_of_an_outline_through_points_is_refused_naming_the_outline(capsys, tmp_path):
     """A custom outline given as points is a spline through them, whose band section OpenCascade could not
     offset for the tips and the bore: an internal IndexError had ended the build (a reviewer's trial), then a
