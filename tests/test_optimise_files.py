@@ -97,6 +97,8 @@ BAD = [
     ("report_without_weight", FAMILY + _report(), "report"),
     ("report_key_unknown", WEIGHED + _report(extra="porosity = 0.1\n"), "report.porosity"),
     ("solid_fraction_above_one", WEIGHED + _report(sf="1.5"), "report.solid_fraction"),
+    ("solid_fraction_string", WEIGHED + _report(sf='"0.85"'), "report.solid_fraction"),
+    ("solid_fraction_nan", WEIGHED + _report(sf="nan"), "report.solid_fraction"),
     ("density_missing", WEIGHED + "\n[report]\nsolid_fraction = 0.85\n", "report.true_density_mg_mm3"),
     ("weight_and_volume_held", FAMILY.replace("thickness = { lower = 1.0, upper = 10.0, initial = 3.0 }\n", "")
      .replace('objective = "surface_area_mm2"', 'objective = "surface_area_mm2"\nsolve_for = "thickness"\n'

@@ -337,6 +337,12 @@ def _fe_recheck(settings: dict) -> Callable[[dict, Any], dict]:
     return extras
 
 
+def _uses(prob: dict, constraints: Any, quantity: str) -> bool:
+    """True when ``quantity`` is the problem's objective or one of its constraints' quantity."""
+    return prob.get("objective") == quantity or (isinstance(constraints, list) and any(
+        isinstance(c, dict) and c.get("quantity") == quantity for c in constraints))
+
+
 def _weight_basis(report: Any, used: bool) -> float | None:
     """``solid fraction x true density`` (mg/mm³) from the ``[report]`` table, the factor from volume to weight,
     checked as a design's ``[report]`` table is (the optimum's design file carries it); None when there is no
@@ -352,9 +358,7 @@ def _weight_basis(report: Any, used: bool) -> float | None:
     for k in _REPORT_KEYS:
         if k not in report:
             raise DesignError(f"[report] {k}", MISSING, f"must be given with {', '.join(_REPORT_KEYS)}")
-    for k in _REPORT_KEYS:  # TOML numbers, as everywhere in a problem file
-        number(f"[report] {k}", report[k])
-    opts = ReportOptions.from_table(dict(report))  # the design's ranges
+    opts = ReportOptions.from_table(dict(report))  # numbers in the design's ranges
     return opts.solid_fraction * opts.true_density_mg_mm3
 
 
@@ -469,8 +473,7 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
         raise DesignError("[problem] sense", MISSING, "must be given for a family problem: 'min' or 'max'")
     sense = prob["sense"]
     name = prob.get("name", f"{fam_name}_optimum")
-    weighs = prob.get("objective") == WEIGHT or WEIGHT in prob or (isinstance(constraints, list) and any(
-        isinstance(c, dict) and c.get("quantity") == WEIGHT for c in constraints))
+    weighs = _uses(prob, constraints, WEIGHT) or WEIGHT in prob
     basis = _weight_basis(report, weighs)  # (a table without a weight to read it: refused below, once the
     held = _held_volume(prob, fam_name, fam, variables, fixed, basis)  # quantities' names are known good)
     _check_lower_lengths(fam_name, fam, vs, fixed)
@@ -490,9 +493,7 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
         return solve_for(fam_name, target_volume_mm3=volume, vary=vary, **fixed, **x).tablet
 
     obj_spec = prob.get("objective")
-    used = obj_spec == FE_QUANTITY or (isinstance(constraints, list) and any(
-        isinstance(c, dict) and c.get("quantity") == FE_QUANTITY for c in constraints))
-    fe_set = _fe_settings(fe, used)
+    fe_set = _fe_settings(fe, _uses(prob, constraints, FE_QUANTITY))
     start = {v.name: v.initial if v.initial is not None else 0.5 * (v.lower + v.upper) for v in vs}
     try:  # the start must build: a value in the file that the family refuses there is the file's error
         first = build(start)
