@@ -229,6 +229,9 @@ class SweepNominal:
         self.certificate: Certificate | None = None
         self.patch_ids: tuple = ()
         self.top_patch_range: tuple[int, int] = (0, 0)
+        #: the plane ``z`` (mm) in which the builder made the lower face's patches as mirror images
+        #: of the upper face's (:meth:`~tabletcad.geometry.tablet.Tablet.mirror`), or None
+        self.mirror_z: float | None = None
         # face heights as functions of d (the faces are graphs over d)
         self._dz_top = _graph(self.top, d_far)
         self._dz_bot = _graph(self.bottom[::-1], d_far, reverse=True)
@@ -398,6 +401,11 @@ def build_sweep_tablet(
     c = outline.centroid()
     patches: list[PDEPatch] = []
     expected: list[bool] = []
+    # the plateau: one fan from the centre to the rim, or - when corners of the rim have
+    # collapsed to points - a fan to an inner curve Q plus a ring from Q to the rim (see _plateau_ring)
+    ring = _plateau_ring(outline, d_end, c) if not closes else None
+    # the lower face's patches and the upper face's are mirror images in z = zm, in reverse order
+    n_total = 2 * (0 if closes else (1 if ring is None else 2)) + len(chain_pieces)
 
     def mk(data, label):
         # The patch's own stray check measures Fourier content the truncated series leaves to
@@ -410,7 +418,11 @@ def build_sweep_tablet(
         # patch of revolution is measured on a few meridians at the default (the report's) u grid
         # (tol.fold alone, not a fraction of the patch's size: a family's patches do not fold at all, and
         # one that does has offsets that are not star-shaped)
-        depth = patch.fold_depth(nu=65 if patch.revolution is None else 257, nv=128)
+        twin = n_total - 1 - len(patches)
+        if twin < len(patches) and patch.mirrors(patches[twin], zm):  # the reflection folds alike
+            depth = patches[twin].checked_fold_depth
+        else:
+            depth = patch.fold_depth(nu=65 if patch.revolution is None else 257, nv=128)
         object.__setattr__(patch, "_fold_depth", depth)  # the figure checked (the report's)
         if depth > tol.fold:
             raise DesignError(f"patch {patch.name} curves", f"a fold {depth:.3g} mm deep",
@@ -419,9 +431,6 @@ def build_sweep_tablet(
         return patch
 
     prev_curve = None
-    # the plateau: one fan from the centre to the rim, or - when corners of the rim have
-    # collapsed to points - a fan to an inner curve Q plus a ring from Q to the rim (see _plateau_ring)
-    ring = _plateau_ring(outline, d_end, c) if not closes else None
     if not closes:
         zb = T - float(top[-1].point(1.0)[1])
         pole = SweepCurve(outline, 0.0, 0.0, (float(c[0]), float(c[1]), zb))
@@ -467,6 +476,7 @@ def build_sweep_tablet(
             expected.append(False)
             patches.append(mk((q, pole, du_in, du_in), "plateau"))
     nom.expected_sharp = expected
+    nom.mirror_z = zm  # the bottom's elements are the top's mirrored in z = zm, and so are their patches
     nom.top_patch_range = (top_start, len(patches))
     tablet = Tablet(tuple(patches), name=name, family=family, params=dict(params), nominal=nom,
                     nominal_name=f"{family} (profile swept along outline offsets)", tol=tol)
@@ -608,17 +618,27 @@ def sweep_properties(tablet: Tablet, nu: int = 24, nv_per: int = 48) -> dict[str
     top_area = plan = cup = 0.0
     z0 = nom.band_z[1]
     t0, t1 = nom.top_patch_range
+    mirror = tablet.mirror()
+    sums: dict[int, tuple[float, float, float, float]] = {}
     for i, p in enumerate(tablet.patches):
-        X = p.evaluate_grid(u, v)
-        n = cross(p.evaluate_grid(u, v, du=1), p.evaluate_grid(u, v, dv=1))
-        dA = norm3(n)
-        a = float(np.sum(W * dA))
+        j = i if mirror is None else mirror[1][i]
+        if j < i:  # patch j reflected in z = zm with u reversed (the rule is symmetric in u): X' = M X + 2 zm e_z,
+            # n' = M n, so the same area, X'·n' = X·n - 2 zm n_z, n'_z = -n_z and X'_z n'_z = X_z n_z - 2 zm n_z
+            a, xn, nz, zn = sums[j]
+            xn, nz, zn = xn - 2.0 * mirror[0] * nz, -nz, zn - 2.0 * mirror[0] * nz
+        else:
+            X = p.evaluate_grid(u, v)
+            n = cross(p.evaluate_grid(u, v, du=1), p.evaluate_grid(u, v, dv=1))
+            a = float(np.sum(W * norm3(n)))
+            xn = float(np.sum(W * np.einsum("uvc,uvc->uv", X, n)))
+            nz, zn = float(np.sum(W * n[..., 2])), float(np.sum(W * X[..., 2] * n[..., 2]))
+            sums[i] = (a, xn, nz, zn)
         area += a
-        vol += float(np.sum(W * np.einsum("uvc,uvc->uv", X, n))) / 3.0
+        vol += xn / 3.0
         if t0 <= i < t1:
             top_area += a
-            plan += float(np.sum(W * n[..., 2]))
-            cup += float(np.sum(W * (X[..., 2] - z0) * n[..., 2]))
+            plan += nz
+            cup += zn - z0 * nz
     sgn = 1.0 if vol >= 0 else -1.0
     # a flat face's cup is 0: its integrand (X_z - z0) vanishes but for rounding, which would
     # show as a negative -3e-15 mm3

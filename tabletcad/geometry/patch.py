@@ -292,6 +292,39 @@ class PDEPatch:
                     "use a smaller a or fewer modes",
                 )
 
+    # ------------------------------------------------------------------ symmetry
+    def mirrors(self, other: "PDEPatch", z0: float) -> bool:
+        """Whether this patch is ``other`` reflected in the plane ``z = z0`` with ``u`` reversed,
+        ``X(u, v) = M X'(1 - u, v) + 2 z0 e_z`` with ``M = diag(1, 1, -1)``, as far as its series
+        shows: both of the Hermite form with the same ``a``, ``β``, modes and remainder, and the
+        Fourier coefficients of its data those of ``(M X'(1) + 2 z0 e_z, M X'(0) + 2 z0 e_z,
+        -M X'_u(1), -M X'_u(0))`` within 1e-12 of their scale (mm).
+
+        The remainder term reads the data curves at any ``v``, which coefficients alone do not
+        fix: a caller relies on this only for data built as reflections of each other (a swept
+        family's lower face, the mirror image of its upper one by construction).
+        """
+        if self.form != "hermite" or other.form != "hermite" or self.modes != other.modes:
+            return False
+        if (self.a, self._beta, self._has_remainder) != (other.a, other._beta, other._has_remainder):
+            return False
+        if not np.array_equal(self._n_active, other._n_active):
+            return False
+        m = np.array([1.0, 1.0, -1.0])
+        shift = np.array([[0.0, 0.0, 2.0 * z0]] * 2 + [[0.0, 0.0, 0.0]] * 2)
+        flip = np.array([1.0, 1.0, -1.0, -1.0])[:, None]
+        order = [1, 0, 3, 2]
+        a0 = flip * (other._a0[order] * m) + shift
+        scale = max(1.0, float(np.max(np.abs(self._a0))), float(np.max(np.abs(self._ac), initial=0.0)),
+                    float(np.max(np.abs(self._bc), initial=0.0)))
+        tol = 1e-12 * scale
+        if float(np.max(np.abs(self._a0 - a0))) > tol:
+            return False
+        for mine, theirs in ((self._ac, other._ac), (self._bc, other._bc)):
+            if mine.size and float(np.max(np.abs(mine - flip[:, :, None] * (theirs[order] * m)))) > tol:
+                return False
+        return True
+
     # ------------------------------------------------------------------ pieces
     def breakpoints(self) -> np.ndarray:
         """Sorted ``v`` in [0, 2π) where the surface is not smooth in ``v``

@@ -357,6 +357,35 @@ class Tablet:
         x = self._end_row(i, end)
         return float(np.max(np.ptp(x, axis=0))) <= 1e-12 * max(1.0, float(np.max(np.abs(x))))
 
+    def mirror(self) -> tuple[float, tuple[int, ...]] | None:
+        """``(z0, twin)`` when the solid is its own mirror image in the plane ``z = z0`` patch by patch,
+        else None.  Patch ``i`` is then patch ``twin[i] = n - 1 - i`` reflected with ``u`` reversed
+        (:meth:`PDEPatch.mirrors`; the middle patch of an odd chain, a band, its own twin).
+
+        Only a whole solid (no trim) whose nominal says its patches were built so
+        (``nominal.mirror_z``: a swept family's lower face is its upper one reflected) and whose
+        patches' series confirm it.  The checks then measure the patches ``i <= twin[i]`` and give
+        each twin its patch's figure, reflected (:meth:`measured`).  Cached.
+        """
+        hit = self.__dict__.get("_mirror", ())
+        if hit != ():
+            return hit
+        z0 = getattr(self.nominal, "mirror_z", None)
+        n = len(self.patches)
+        out = None
+        if z0 is not None and self.trim.whole:
+            twin = tuple(n - 1 - i for i in range(n))
+            if all(self.patches[i].mirrors(self.patches[j], float(z0)) for i, j in enumerate(twin) if j <= i):
+                out = (float(z0), twin)
+        object.__setattr__(self, "_mirror", out)
+        return out
+
+    def measured(self) -> list[int]:
+        """The patches the checks measure: every patch, or of a :meth:`mirror` solid those with
+        ``i <= twin[i]`` (the lower half and the middle patch)."""
+        m = self.mirror()
+        return list(range(len(self.patches))) if m is None else [i for i, j in enumerate(m[1]) if i <= j]
+
     def faces(self) -> list[Face]:
         """The faces bounding the (trimmed) solid, oriented outward (up to the global sign)."""
         hit = self.__dict__.get("_faces")
@@ -480,9 +509,23 @@ class Tablet:
         rows = []
         # at the default rules on a whole solid, the outer faces' samples also give solid_volume()
         solid = [] if default and self.trim.whole and "_solid_volume" not in self.__dict__ else None
+        m = self.mirror()
+        done: dict[int, tuple[float, float, float, float | None]] = {}  # a mirror solid's patches' outer faces
         for f in self.faces():
+            j = None if m is None or f.kind != "w" or f.value != 1.0 or f.sign < 0 else m[1][f.patch]
+            if j is not None and j in done:
+                # reflected with u reversed, X' = M X + 2 z0 e_z and n' = M n: the same area and plan,
+                # X'·n' = X·n - 2 z0 n_z, and the same Jacobian integral of the solid map
+                a, v, pz, jac = done[j]
+                rows.append((f, a, v - 2.0 * m[0] * pz / 3.0, -pz))
+                if solid is not None and jac is not None:
+                    solid.append(jac)
+                continue
+            k = len(solid) if solid is not None else 0
             a, v, pz = self._face_integrals(f, nu, nv, solid)
             rows.append((f, a, v, pz))
+            if j is not None:
+                done[f.patch] = (a, v, pz, solid[k] if solid is not None and len(solid) > k else None)
         if solid is not None and len(solid) == len(self.patches):
             object.__setattr__(self, "_solid_volume", float(abs(sum(solid))))
         vol = sum(r[2] for r in rows)
@@ -723,8 +766,10 @@ class Tablet:
     def _plan_area_sampled(self, nu: int = 33, nv: int = 2048) -> float:
         """:meth:`plan_area` from samples of every patch (any star-shaped plan)."""
         u, v = self._grid(nu, nv)
-        # each (2, nu, nv): x and y as contiguous blocks, no stacked copy
-        pts = [self._outer_grid(p, u, v, axes=(0, 1)) for p in self.patches]
+        # each (2, nu, nv): x and y as contiguous blocks, no stacked copy; a mirror solid's twins
+        # have their patches' plans
+        patches = [self.patches[i] for i in self.measured()]
+        pts = [self._outer_grid(p, u, v, axes=(0, 1)) for p in patches]
         lo, hi = coordinate_range([X.transpose(1, 2, 0) for X in pts], 2)  # views: X[..., j] is the block X[j]
         c = 0.5 * (lo + hi)
         m = 4 * nv
@@ -741,7 +786,7 @@ class Tablet:
             rr = np.sqrt(r2[i, cols])
             r_max = max(r_max, float(rr.max()))
             outer.append((i, rr, np.column_stack([dx[i, cols], dy[i, cols]])))
-        for p, (i, rr, dd) in zip(self.patches, outer):  # each patch's outer curve r_j(φ), then the envelope
+        for p, (i, rr, dd) in zip(patches, outer):  # each patch's outer curve r_j(φ), then the envelope
             inner = (i > 0) & (i < nu - 1)
             if np.any(inner):
                 k = np.flatnonzero(inner)
@@ -760,7 +805,7 @@ class Tablet:
                 env_half = np.maximum(env_half, _interp_turn(grid, phi[order], rr[half][order]))
         hole = 0.0
         if self.trim.w[0] > 0.0:  # hollow solid (a ring): subtract the see-through hole
-            A = np.stack([p.spine(np.linspace(self.trim.u[0], self.trim.u[1], nu)) for p in self.patches])
+            A = np.stack([p.spine(np.linspace(self.trim.u[0], self.trim.u[1], nu)) for p in patches])
             # pts are the outer surface w = w1: the inner one is w0 / w1 of the way from the spine to it
             k = self.trim.w[0] / self.trim.w[1]
             inner = A[:, :, None, :2] + k * (np.stack(pts).transpose(0, 2, 3, 1) - A[:, :, None, :2])
@@ -1084,8 +1129,10 @@ class Tablet:
 
     def _bounds_sampled(self) -> tuple[np.ndarray, np.ndarray]:
         u, v = self._grid(97, 256)
-        # (patches, 3, nu, nv): each coordinate a contiguous block (evaluate_grid's own layout, no transposed copy)
-        pts = np.stack([self._outer_grid(p, u, v, axes=(0, 1, 2)) for p in self.patches])
+        # (patches, 3, nu, nv): each coordinate a contiguous block (evaluate_grid's own layout, no transposed
+        # copy); a mirror solid's twins reach the same x and y, and z reflected (below)
+        patches = [self.patches[i] for i in self.measured()]
+        pts = np.stack([self._outer_grid(p, u, v, axes=(0, 1, 2)) for p in patches])
         lo, hi = pts.min(axis=(0, 2, 3)), pts.max(axis=(0, 2, 3))
         t = self.trim
         if not t.full_v or t.u != (0.0, 1.0):
@@ -1111,8 +1158,11 @@ class Tablet:
                 c = pts[:, axis]
                 k = int(np.argmax(c) if sign > 0 else np.argmin(c))
                 pi, ui, vi = np.unravel_index(k, c.shape)
-                val = self._polish_extreme(self.patches[pi], axis, sign, u[ui], v[vi], u[1] - u[0], v[1] - v[0])
+                val = self._polish_extreme(patches[pi], axis, sign, u[ui], v[vi], u[1] - u[0], v[1] - v[0])
                 store[axis] = max(store[axis], val) if sign > 0 else min(store[axis], val)
+        m = self.mirror()
+        if m is not None:  # the twins' z range: the measured patches' reflected in z = z0
+            lo[2], hi[2] = min(lo[2], 2.0 * m[0] - hi[2]), max(hi[2], 2.0 * m[0] - lo[2])
         return lo, hi
 
     def _spine_z_range(self) -> tuple[float, float]:
@@ -1186,12 +1236,22 @@ class Tablet:
         cache = self.__dict__.setdefault("_seam_rows", {})
         if nv not in cache:
             v, ends = self.seam_v(nv), np.array([0.0, 1.0])
-            rows = []
-            for p in self.patches:
-                R = np.stack([p.evaluate_grid(ends, v), p.evaluate_grid(ends, v, du=1), p.evaluate_grid(ends, v, dv=1)])
+            m = self.mirror()
+            rows: dict[int, np.ndarray] = {}
+            for i in self.measured():
+                p = self.patches[i]
+                rows[i] = np.stack([p.evaluate_grid(ends, v), p.evaluate_grid(ends, v, du=1), p.evaluate_grid(ends, v, dv=1)])
+            if m is not None:  # a twin's ends are its patch's other ends reflected: X' = M X + 2 z0 e_z, X'_u = -M X_u
+                flip = np.array([1.0, 1.0, -1.0])
+                sign = np.array([1.0, -1.0, 1.0])[:, None, None, None]
+                for i, j in enumerate(m[1]):
+                    if i > j:
+                        R = rows[j][:, ::-1] * flip * sign
+                        R[0, ..., 2] += 2.0 * m[0]
+                        rows[i] = R
+            for R in rows.values():
                 R.setflags(write=False)
-                rows.append(R)
-            cache[nv] = tuple(rows)
+            cache[nv] = tuple(rows[i] for i in range(len(self.patches)))
         return cache[nv]
 
     def seams(self, nv: int = 720) -> list[dict[str, Any]]:
@@ -1337,8 +1397,11 @@ class Tablet:
         the ``peaks`` largest local maxima of the samples (of all patches together) and each patch's
         largest sample, each on ``n × n`` grids over one sample step each side (``u``'s step and
         ``hv``), four times finer each round (``rounds`` rounds): a peak is resolved 64 times finer
-        than the grid.  The result is at least each patch's largest sample."""
-        X = np.stack([p.evaluate_grid(u, v) for p in self.patches])
+        than the grid.  The result is at least each patch's largest sample.  A :meth:`mirror` solid's
+        twins lie as far from its nominal (whose faces are mirror images too) as their patches."""
+        measured = self.measured()
+        patches = [self.patches[i] for i in measured]
+        X = np.stack([p.evaluate_grid(u, v) for p in patches])
         D = np.abs(self.nominal(X.reshape(-1, 3))).reshape(X.shape[:3])
         best = D.max(axis=(1, 2))
         t = self.trim
@@ -1365,7 +1428,7 @@ class Tablet:
             pts = np.empty(uu.shape + (3,))
             for p in set(which.tolist()):  # a patch's peaks in one tensor grid; each keeps its diagonal block
                 sel = np.flatnonzero(which == p)
-                G = self.patches[p].evaluate_grid(uu[sel, :, 0].reshape(-1), vv[sel, 0, :].reshape(-1))
+                G = patches[p].evaluate_grid(uu[sel, :, 0].reshape(-1), vv[sel, 0, :].reshape(-1))
                 for k, q in enumerate(sel):
                     pts[q] = G[k * n : (k + 1) * n, k * n : (k + 1) * n]
             g = np.abs(self.nominal(pts.reshape(-1, 3))).reshape(len(which), n * n)
@@ -1374,7 +1437,11 @@ class Tablet:
             rows = np.arange(len(which))
             centre = np.column_stack([uu.reshape(len(which), -1)[rows, top], vv.reshape(len(which), -1)[rows, top]])
             step = step / 4.0
-        return best
+        m = self.mirror()
+        if m is None:
+            return best
+        at = {i: k for k, i in enumerate(measured)}
+        return np.array([best[at[min(i, j)]] for i, j in enumerate(m[1])])
 
     # ------------------------------------------------------------------ variants
     def trimmed(self, u=None, v=None, w=None) -> "Tablet":

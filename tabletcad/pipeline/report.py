@@ -32,7 +32,9 @@ def geometry_report(tablet: Tablet, options: ReportOptions | None = None) -> dic
     seams = tablet.seams()
     dev = tablet.nominal_deviation()
     patches = []
+    mirror = tablet.mirror()  # a mirror solid's twins: their patches' stray (a reflection moves no detail)
     for i, (p, pp) in enumerate(zip(tablet.patches, props["patches"])):
+        stray_of = p if mirror is None else tablet.patches[min(i, mirror[1][i])]
         s = p.spine([0.0, 1.0])
         patches.append(
             dict(
@@ -45,7 +47,7 @@ def geometry_report(tablet: Tablet, options: ReportOptions | None = None) -> dic
                 form=p.form,
                 u_nodes=list(p.u_nodes),
                 spine_height_mm=float(s[1, 2] - s[0, 2]),
-                stray_mm=p.stray(),
+                stray_mm=stray_of.stray(),
                 fold_depth_mm=p.checked_fold_depth,  # the figure its check compared with its limit (fold_limit)
             )
         )
