@@ -378,6 +378,44 @@ class PlanOutline:
                 hi = mid
         return lo
 
+    def support(self, v, center) -> np.ndarray:
+        """Signed distance (mm) from ``center`` to the outline's tangent line at ``v``, positive when
+        ``center`` lies on the inner side: ``h(v) = (O(v) - center) × T(v)``, shape (m,)."""
+        O, T, _, _ = self.frame(v)
+        P = O - np.asarray(center, dtype=float)
+        return P[:, 0] * T[:, 1] - P[:, 1] * T[:, 0]
+
+    def star_limit(self) -> float:
+        """Largest inward offset (mm) up to which every offset is star-shaped about the centroid ``c``
+        (negative when the outline itself is not), to ~1e-12 mm.
+
+        The offset by ``d`` is ``R(v) = O + d N`` with ``R' = |O'| (1 - κ d) T``, so the fan from
+        ``c`` over it (a swept tablet's plateau, its cups' solid map) has the Jacobian
+        ``(R - c) × R' = |O'| (1 - κ d) (h(v) - d)``, ``h`` the :meth:`support` of ``c``.  Within the
+        smallest convex radius ``1 - κ d >= 0``, so the fan does not fold exactly when
+        ``d <= min h``: the distance from ``c`` to the nearest tangent line.  On a convex outline that
+        is no tighter than :meth:`offset_limit` while ``c`` stays inside the offsets (a stadium's:
+        its half width); a concave waist brings the tangent lines at its ends closer to ``c`` than
+        the waist's half width (a peanut cupped to its waist folded its flat centre).  ``h`` is sampled
+        (4096 values of ``v`` and the joins) and its lowest local minima polished by bounded Brent.
+        Cached.
+        """
+        if "_star_limit" not in self.__dict__:
+            from scipy.optimize import minimize_scalar
+
+            c = self.centroid()
+            v = np.unique(np.concatenate([np.linspace(0.0, math.tau, 4096, endpoint=False), self.breaks[:-1]]))
+            h = self.support(v, c)
+            lows = np.flatnonzero((h <= np.roll(h, 1)) & (h <= np.roll(h, -1)))
+            best = float(np.min(h))
+            ext = np.concatenate([[v[-1] - math.tau], v, [v[0] + math.tau]])  # neighbours across 0 = 2π
+            for i in lows[np.argsort(h[lows])[:8]]:
+                r = minimize_scalar(lambda x: float(self.support(np.array([x]), c)[0]),
+                                    bounds=(ext[i], ext[i + 2]), method="bounded", options=dict(xatol=1e-13))
+                best = min(best, float(r.fun))
+            self.__dict__["_star_limit"] = best
+        return self.__dict__["_star_limit"]
+
     def check_offset(self, d: float, parameter: str) -> None:
         """Refuse an inward offset ``d`` (mm) that is not a clean offset of this outline.
 

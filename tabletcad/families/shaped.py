@@ -85,7 +85,9 @@ def outline_tablet(
         Flat land width between band and cup, mm (>= 0, < cup_width).
     cup_width : float
         Inward distance at which the cup becomes horizontal, mm; 0 takes the
-        largest allowed (smallest convex corner radius or inscribed radius).
+        largest allowed (smallest convex corner radius or inscribed radius, and
+        on an outline with a concave waist the centroid's distance to its nearest
+        tangent line, beyond which the flat centre would fold: :func:`_star_limit`).
     central_radius, edge_radius : float
         Both > 0: a compound cup across the cup width (mm); both 0: single radius.
     reach : float, optional
@@ -99,12 +101,17 @@ def outline_tablet(
     limit = min(ol.min_convex_radius, reach)
     if not ol._offset_is_clean(limit):
         limit = ol.offset_limit()
+    star = _star_limit(ol, limit)
     cw = check_range("cup_width", cup_width, 0.0, None, "mm")
     if cw == 0.0:
-        cw = limit
+        cw = min(limit, star)
     if cw > limit * (1 + 1e-9):
         raise DesignError("cup_width", cw, f"must be <= {limit:.6g} mm (the outline's smallest corner radius / inscribed radius: offsets beyond it are not offsets of the outline)", "mm")
-    cw = min(cw, limit)
+    if cw > star * (1 + 1e-9):
+        raise DesignError("cup_width", cw, f"must be <= {star:.6g} mm (the outline's centroid's distance to its "
+                          "nearest tangent line: offsets beyond it are not star-shaped about the centroid, so the "
+                          "flat centre, a fan from the centroid, would fold over itself)", "mm")
+    cw = min(cw, limit, star)
     ol.check_offset(cw, "cup_width")
     L = check_range("land", land, 0.0, cw, "mm", hi_open=True)
     Rc = check_range("central_radius", central_radius, 0.0, None, "mm")
@@ -130,6 +137,17 @@ def outline_tablet(
     p.update(params or {})
     return build_sweep_tablet(ol, face, b, name=name, family=family, params=p,
                               reach=cw if cw >= reach * (1 - 1e-9) else reach, info=full, a=smoothing(a), tol=tol)
+
+
+def _star_limit(ol, limit: float) -> float:
+    """The largest cup width (mm) whose offsets of ``ol`` are all star-shaped about its centroid
+    (:meth:`~tabletcad.families.outline.PlanOutline.star_limit`): a swept face's plateau is a fan
+    from the centroid to the offset at the cup width, and its cups' solid map runs from the
+    centroid too.  ``inf`` when that is no tighter than ``limit`` (the offset limit; rounding
+    aside: a stadium's straight sides are ``limit`` from its centroid), and when the outline itself
+    is not star-shaped (its band's fold check refuses it)."""
+    star = ol.star_limit()
+    return star if 0.0 < star < limit * (1.0 - 1e-9) else math.inf
 
 
 def rounded_triangle(side: float = 10.0, corner_radius: float = 1.5, band: float = 2.5, cup_depth: float = 0.5,

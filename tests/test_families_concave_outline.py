@@ -1,0 +1,125 @@
+"""Outlines with a concave waist (a "peanut": two end arcs joined by two concave side arcs).
+
+A swept face's flat centre is a fan from the outline's centroid to the offset at the cup
+width.  Cupped up to the waist (the offset limit), that offset is not star-shaped about the
+centroid: the fan folded over itself, its area counted twice (0.84 % too much on the peanut
+below, in the quadrature and the B-rep alike, which then disagreed by 2e-6 at the fold's
+kinks).  The cup width now stops at :meth:`PlanOutline.star_limit
+<tabletcad.families.outline.PlanOutline.star_limit>`, the centroid's distance to the nearest
+tangent line; on a peanut of end arcs ``r`` at ``(±e, 0)`` and side arcs ``R`` that is
+``r - e² / (R + r)`` (at the arcs' joins).  A flat-faced peanut is a prism: area
+``2 A + P band``, volume ``A band`` (``A``, ``P`` the outline's exact area and perimeter).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tabletcad.errors import DesignError
+from tabletcad.families import outline_tablet
+from tabletcad.families.outline import outline_from_items, rounded_rectangle_outline, stadium_outline
+
+BAND = 2.5
+
+
+def peanut_segments(e: float, r: float, R: float) -> list:
+    """Segments of a peanut: end arcs of radius ``r`` about ``(±e, 0)``, concave side arcs of radius ``R``
+    about ``(0, ±yc)`` tangent to both (``yc = √((R + r)² - e²)``; the waist is ``2 (yc - R)`` wide)."""
+    yc = math.sqrt((R + r) ** 2 - e * e)
+    phi, side = math.atan2(yc, -e), 2.0 * math.atan(e / yc)
+    return [("arc", (e, 0.0), r, -phi, 2.0 * phi), ("arc", (0.0, yc), R, math.atan2(-yc, e), -side),
+            ("arc", (-e, 0.0), r, math.pi - phi, 2.0 * phi), ("arc", (0.0, -yc), R, phi, -side)]
+
+
+def star_closed_form(e: float, r: float, R: float) -> float:
+    return r - e * e / (R + r)
+
+
+@pytest.mark.parametrize("R", [10.0, 40.0, 200.0])
+def test_star_limit_of_a_peanut_is_the_closed_form(R):
+    ol = outline_from_items(peanut_segments(4.0, 3.0, R))
+    star = ol.star_limit()
+    assert star == pytest.approx(star_closed_form(4.0, 3.0, R), abs=1e-12)
+    assert star < ol.offset_limit()  # tighter than the waist
+
+
+def test_star_limit_of_convex_outlines_is_no_tighter_than_their_offsets():
+    assert stadium_outline(18.0, 8.0).star_limit() == pytest.approx(4.0, abs=1e-12)  # the straight sides
+    assert rounded_rectangle_outline(8.0, 6.0, 1.0).star_limit() == pytest.approx(3.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("R", [10.0, 40.0, 200.0])
+def test_flat_peanut_is_a_prism(R):
+    """The issue's peanut (R = 40) and a deeper and a shallower waist, flat-faced: area and volume
+    against the prism's closed form, the flat centre's area the outline's less the flat face's ring."""
+    segs = peanut_segments(4.0, 3.0, R)
+    ol = outline_from_items(segs)
+    t = outline_tablet(segs, band=BAND, cup_depth=0.0)
+    assert t.nominal.info["cup_width_mm"] == pytest.approx(star_closed_form(4.0, 3.0, R), abs=1e-12)
+    props = t.properties()
+    # the quadrature matches to 3e-10 (the PDE surface lies within 1 µm of the nominal); the folded
+    # fan was 0.8 % (R = 40) to 1.4 % (R = 10) over
+    assert props["surface_area_mm2"] == pytest.approx(2.0 * ol.area + ol.perimeter * BAND, rel=2e-9)
+    assert props["volume_mm3"] == pytest.approx(ol.area * BAND, rel=2e-9)
+    top = [p["surface_area_mm2"] for p in props["patches"][:2]]  # plateau, flat face
+    assert sum(top) == pytest.approx(ol.area, rel=2e-9)
+
+
+def test_cupped_peanut_builds_with_its_cup_stopping_at_the_star_limit():
+    """Cupped to the waist, the cups' solid map folded and the design was refused; the cup now
+    stops where the offsets are still star-shaped about the centroid."""
+    segs = peanut_segments(4.0, 3.0, 10.0)
+    t = outline_tablet(segs, band=BAND, cup_depth=0.3)
+    assert t.nominal.info["cup_width_mm"] == pytest.approx(star_closed_form(4.0, 3.0, 10.0), abs=1e-12)
+    assert t.nominal.certificate.passed
+    assert max(p.checked_fold_depth for p in t.patches) <= t.tol.fold
+
+
+def test_cup_width_beyond_the_star_limit_is_refused():
+    segs = peanut_segments(4.0, 3.0, 40.0)
+    star = star_closed_form(4.0, 3.0, 40.0)
+    outline_tablet(segs, band=BAND, cup_depth=0.0, cup_width=0.999 * star)
+    with pytest.raises(DesignError) as err:
+        outline_tablet(segs, band=BAND, cup_depth=0.0, cup_width=1.01 * star)  # below the waist's 2.8135 mm
+    assert err.value.parameter == "cup_width"
+    assert f"must be <= {star:.6g} mm" in str(err.value) and "fold" in str(err.value)
+
+
+def test_sweep_builder_refuses_a_plateau_rim_beyond_the_star_limit():
+    """The builder itself refuses a flat centre whose fan would fold (any family's face profile)."""
+    from tabletcad.families.profile import profile_line
+    from tabletcad.families.sweep import build_sweep_tablet
+
+    ol = outline_from_items(peanut_segments(4.0, 3.0, 40.0))
+    with pytest.raises(DesignError, match="fold over itself") as err:
+        build_sweep_tablet(ol, [profile_line((0.0, 0.0), (2.7, 0.0), "flat face")], BAND, name="peanut",
+                           family="custom_outline", params={}, reach=3.0)
+    assert err.value.parameter == "cup_width"
+
+
+@pytest.mark.cad
+def test_flat_peanut_builds_through_the_cli_with_the_prism_area(tmp_path, capsys):
+    """The issue's design (``tabletcad build`` said the B-rep and quadrature areas differed by
+    1.97e-6): built, and both areas equal the prism's closed form."""
+    pytest.importorskip("OCP")
+    import json
+
+    from tabletcad.cli import main
+
+    segs = peanut_segments(4.0, 3.0, 40.0)
+    ol = outline_from_items(segs)
+    items = ", ".join(f'["arc", [{c[0]!r}, {c[1]!r}], {rad!r}, {t0!r}, {sw!r}]' for _, c, rad, t0, sw in segs)
+    d = tmp_path / "peanut.toml"
+    d.write_text(f'[tablet]\nfamily = "custom_outline"\nsegments = [{items}]\nband = {BAND}\ncup_depth = 0\n')
+    assert main(["build", str(d), "--out", str(tmp_path / "out"), "--quiet"]) == 0, capsys.readouterr().err
+    rep = json.loads((tmp_path / "out" / "report.json").read_text())
+    area, volume = 2.0 * ol.area + ol.perimeter * BAND, ol.area * BAND
+    assert rep["surface_area_mm2"] == pytest.approx(area, rel=2e-9)
+    # the B-spline faces lie within the fit tolerance of the PDE surface: 4e-8 relative here
+    assert rep["brep"]["surface_area_mm2"] == pytest.approx(area, rel=2e-7)
+    assert abs(rep["brep"]["volume_mm3"]) == pytest.approx(volume, rel=2e-7)
+    assert rep["mesh"]["watertight"] is True and rep["mesh"]["genus"] == 0
+    assert np.isfinite(rep["brep"]["fit_max_deviation_mm"])
