@@ -24,7 +24,7 @@ from tabletcad.errors import GeometryError
 from tabletcad.tooling.booleans import boolean, checked_boolean, split_cells, volume
 from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, prism, wire_length
 
-__all__ = ["PunchTip", "punch_tip", "cup_volume_within", "punch_volume_quadrature"]
+__all__ = ["PunchTip", "punch_tip", "cup_volume_within", "elliptic_tip_quadrature", "punch_volume_quadrature"]
 
 
 @dataclass(eq=False)
@@ -248,9 +248,101 @@ def punch_volume_quadrature(frame: TabletFrame, clearance: float, tip_length: fl
     """Volume (mm^3) of a plain round punch tip: cylinder of radius ``R - inset`` (the clearance less
     the die bore's offset, :meth:`~tabletcad.tooling.outline.TabletFrame.tip_inset`) and ``tip_length``
     (its length beyond the band's edge plane: the tip's own plus its edge's rise up a cup without a
-    land) minus the cup inside it (:func:`cup_volume_within`); None if not round."""
+    land) minus the cup inside it (:func:`cup_volume_within`); for a tablet of elliptic sections on
+    an elliptic outline (the thesis's ovals and caplet) the same with the tip's plan, the ellipse
+    inset, and the cup within it (:func:`elliptic_tip_quadrature`); None for other tablets."""
+    inset = frame.tip_inset(clearance)
     if frame.round_radius is None:
-        return None
-    rho = frame.round_radius - frame.tip_inset(clearance)
+        found = elliptic_tip_quadrature(frame, inset, which)
+        return None if found is None else found[0] * tip_length - found[1]
+    rho = frame.round_radius - inset
     cup = cup_volume_within(frame, rho, which)
     return math.pi * rho * rho * tip_length - cup
+
+
+def _outline_ellipse(frame: TabletFrame):
+    """The frame's outline as a ``gp_Elips`` when it is one ellipse, else None."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.GeomAbs import GeomAbs_CurveType
+
+    from tabletcad.cad._occ import explore
+
+    edges = explore(frame.outline, "Edge")
+    if frame.outline_kind != "ellipse" or len(edges) != 1:
+        return None
+    curve = BRepAdaptor_Curve(edges[0])
+    return curve.Ellipse() if curve.GetType() == GeomAbs_CurveType.GeomAbs_Ellipse else None
+
+
+def _inset_ellipse(ellipse, inset: float, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Points ``P(t)`` (n, 2) of ``ellipse`` (a ``gp_Elips`` in z = 0) moved ``inset`` mm along its inward
+    normal, and ``P × P'`` (n,) at the ellipse's parameters ``t``."""
+    a, b = ellipse.MajorRadius(), ellipse.MinorRadius()
+    c, x, y = ellipse.Location(), ellipse.XAxis().Direction(), ellipse.YAxis().Direction()
+    X, Y = np.array([x.X(), x.Y()]), np.array([y.X(), y.Y()])
+    ct, st = np.cos(t), np.sin(t)
+    w = np.hypot(b * ct, a * st)  # |E'(t)|: the outward normal is (b cos t, a sin t) / w in the (X, Y) frame
+    dw = (a * a - b * b) * st * ct / w
+    ex, ey = a * ct - inset * b * ct / w, b * st - inset * a * st / w
+    dex = -a * st - inset * b * (-st * w - ct * dw) / (w * w)
+    dey = b * ct - inset * a * (ct * w - st * dw) / (w * w)
+    P = np.array([c.X(), c.Y()]) + ex[:, None] * X + ey[:, None] * Y
+    return P, (ex * dey - ey * dex) * float(X[0] * Y[1] - X[1] * Y[0])
+
+
+def _u_at_radius(sec, rho: np.ndarray, rising: bool, steps: int = 60) -> np.ndarray:
+    """The ``u`` where ``|R(u)| = ρ`` on the profile ``sec`` (``|R|`` rising or falling in ``u`` through
+    it), for each ``ρ`` at once, by bisection to ``2^-steps``."""
+    a, b = np.zeros_like(rho), np.ones_like(rho)
+    for _ in range(steps):
+        m = 0.5 * (a + b)
+        inside = (np.abs(sec.profile(m)[:, 0]) < rho) == rising  # the crossing lies above m
+        a, b = np.where(inside, m, a), np.where(inside, b, m)
+    return 0.5 * (a + b)
+
+
+def _section_cup(sections, rho: np.ndarray, z_e: float, n: int = 48) -> np.ndarray:
+    """``∫_0^ρ 2π r |Z - z_e| dr`` (mm^3) for each ``ρ`` over the face profiles ``sections``
+    (:class:`~tabletcad.geometry.revolution.Section`, ``r = |R(u)|`` monotone where it is below ``ρ``): the
+    cup within the section ``xᵀ S⁻¹ x = ρ²`` (area ``π ρ²``, ``det S = 1``).  Each patch's part within
+    ``ρ`` (:func:`_u_at_radius`) by Gauss-Legendre, as :func:`cup_volume_within` for a round tablet."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    total = np.zeros_like(rho)
+    for sec in sections:
+        r0, r1 = np.abs(sec.profile(np.array([0.0, 1.0]))[:, 0])
+        rising = r0 < r1
+        us = np.where(rho >= max(r0, r1), float(rising), _u_at_radius(sec, np.minimum(rho, max(r0, r1)), rising))
+        lo, hi = (np.zeros_like(rho), us) if rising else (us, np.ones_like(rho))
+        u = 0.5 * (hi - lo)[:, None] * (x + 1.0) + lo[:, None]
+        RZ, dRZ = sec.profile(u), sec.profile(u, du=1)
+        f = 2.0 * math.pi * np.abs(RZ[..., 0]) * np.abs(RZ[..., 1] - z_e) * np.abs(dRZ[..., 0])
+        total += 0.5 * (hi - lo) * (f @ w)
+    return total
+
+
+def elliptic_tip_quadrature(frame: TabletFrame, inset: float, which: str = "upper",
+                            m: int = 256) -> tuple[float, float] | None:
+    """Plan area (mm^2) of a punch tip whose outline is the tablet's elliptic outline inset by ``inset`` mm,
+    and the volume (mm^3) of the tablet's cup (above or below the band's edge plane) within it, by
+    quadrature of the face patches' profiles; None unless the outline is one ellipse and every face patch
+    is a :class:`~tabletcad.geometry.revolution.Section` of one shape ``S`` (the thesis's ovals and caplet).
+
+    The face's height above the edge plane depends on the section radius ``ρ = √(xᵀ S⁻¹ x)`` alone, so
+    over the star-shaped tip plan bounded by ``P(t)`` (the ellipse inset along its normal)
+    ``∫∫ h dA = ∫_0^{2π} C(ρ(P)) / (2π ρ(P)²) (P × P') dt``, ``C(ρ)`` the cup within the section
+    :func:`_section_cup`; the plan area is ``∫ (P × P') / 2 dt``.  Both integrands are smooth and
+    periodic: the trapezoid rule on ``m`` points."""
+    ellipse = _outline_ellipse(frame)
+    sections = [p.section for p in _face_patches(frame, which)]
+    if ellipse is None or not sections or any(s is None for s in sections):
+        return None
+    shape = sections[0].shape
+    if any(not np.allclose(s.shape, shape, rtol=0.0, atol=1e-12) for s in sections):
+        return None
+    t = np.linspace(0.0, 2.0 * math.pi, m, endpoint=False)
+    P, cross = _inset_ellipse(ellipse, inset, t)
+    rho = np.sqrt(np.einsum("ij,jk,ik->i", P, np.linalg.inv(shape), P))
+    z_e = frame.band_z[1] if which == "upper" else frame.band_z[0]
+    cup = _section_cup(sections, rho, z_e) / (2.0 * math.pi * rho * rho)
+    h = 2.0 * math.pi / m
+    return abs(0.5 * h * float(np.sum(cross))), abs(h * float(np.sum(cup * cross)))
