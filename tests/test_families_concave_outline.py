@@ -46,6 +46,15 @@ def test_star_limit_of_a_peanut_is_the_closed_form(R):
     assert star < ol.offset_limit()  # tighter than the waist
 
 
+@pytest.mark.parametrize("R", [10.0, 40.0, 200.0])
+def test_star_limit_sampled_and_polished_agrees_with_the_exact_one(R):
+    ol = outline_from_items(peanut_segments(4.0, 3.0, R))
+    assert ol._star_limit_sampled() == pytest.approx(ol._star_limit_of_segments(), abs=1e-11)
+    for other in (stadium_outline(18.0, 8.0), rounded_rectangle_outline(8.0, 6.0, 1.0),
+                  outline_from_items(peanut_segments(2.0, 3.0, 6.0))):
+        assert other._star_limit_sampled() == pytest.approx(other._star_limit_of_segments(), abs=1e-11)
+
+
 def test_star_limit_of_convex_outlines_is_no_tighter_than_their_offsets():
     assert stadium_outline(18.0, 8.0).star_limit() == pytest.approx(4.0, abs=1e-12)  # the straight sides
     assert rounded_rectangle_outline(8.0, 6.0, 1.0).star_limit() == pytest.approx(3.0, abs=1e-12)

@@ -397,24 +397,54 @@ class PlanOutline:
         is no tighter than :meth:`offset_limit` while ``c`` stays inside the offsets (a stadium's:
         its half width); a concave waist brings the tangent lines at its ends closer to ``c`` than
         the waist's half width (a peanut cupped to its waist folded its flat centre).  ``h`` is sampled
-        (4096 values of ``v`` and the joins) and its lowest local minima polished by bounded Brent.
-        Cached.
+        (4096 values of ``v`` and the joins) and its lowest local minima polished by bounded Brent; on
+        lines and arcs it is exact (:meth:`_star_limit_of_segments`).  Cached.
         """
         if "_star_limit" not in self.__dict__:
-            from scipy.optimize import minimize_scalar
-
-            c = self.centroid()
-            v = np.unique(np.concatenate([np.linspace(0.0, math.tau, 4096, endpoint=False), self.breaks[:-1]]))
-            h = self.support(v, c)
-            lows = np.flatnonzero((h <= np.roll(h, 1)) & (h <= np.roll(h, -1)))
-            best = float(np.min(h))
-            ext = np.concatenate([[v[-1] - math.tau], v, [v[0] + math.tau]])  # neighbours across 0 = 2π
-            for i in lows[np.argsort(h[lows])[:8]]:
-                r = minimize_scalar(lambda x: float(self.support(np.array([x]), c)[0]),
-                                    bounds=(ext[i], ext[i + 2]), method="bounded", options=dict(xatol=1e-13))
-                best = min(best, float(r.fun))
-            self.__dict__["_star_limit"] = best
+            exact = bool(getattr(self, "segs", ()))
+            self.__dict__["_star_limit"] = self._star_limit_of_segments() if exact else self._star_limit_sampled()
         return self.__dict__["_star_limit"]
+
+    def _star_limit_sampled(self) -> float:
+        """:meth:`star_limit` from samples of ``h`` polished by bounded Brent (any outline)."""
+        from scipy.optimize import minimize_scalar
+
+        c = self.centroid()
+        v = np.unique(np.concatenate([np.linspace(0.0, math.tau, 4096, endpoint=False), self.breaks[:-1]]))
+        h = self.support(v, c)
+        lows = np.flatnonzero((h <= np.roll(h, 1)) & (h <= np.roll(h, -1)))
+        best = float(np.min(h))
+        ext = np.concatenate([[v[-1] - math.tau], v, [v[0] + math.tau]])  # neighbours across 0 = 2π
+        for i in lows[np.argsort(h[lows])[:8]]:
+            r = minimize_scalar(lambda x: float(self.support(np.array([x]), c)[0]),
+                                bounds=(ext[i], ext[i + 2]), method="bounded", options=dict(xatol=1e-13))
+            best = min(best, float(r.fun))
+        return best
+
+    def _star_limit_of_segments(self) -> float:
+        """:meth:`star_limit` of a chain of lines and arcs, exactly: the least support ``h`` of the
+        centroid ``c`` over each segment.  A line's tangent line is the line itself; on an arc of centre
+        ``C``, radius ``r`` and sweep sign ``s`` (+1 convex), ``T = s e⊥(θ)`` gives
+        ``h(θ) = s (r + (C - c)·e(θ))``, least at an end of the span or where ``e(θ)`` points away from
+        ``C - c`` (convex) or along it (concave), when that direction lies within the span."""
+        c = self.centroid()
+        best = math.inf
+        for sg in self.segs:
+            if sg.kind == "line":
+                (x0, y0), (x1, y1) = sg.p0, sg.p1
+                dx, dy = x1 - x0, y1 - y0
+                best = min(best, ((x0 - c[0]) * dy - (y0 - c[1]) * dx) / math.hypot(dx, dy))
+                continue
+            s = math.copysign(1.0, sg.sweep)
+            ax, ay = sg.center[0] - c[0], sg.center[1] - c[1]
+            thetas = [sg.theta0, sg.theta0 + sg.sweep]
+            rho = math.hypot(ax, ay)
+            if rho > 0.0:
+                ex, ey = -s * ax / rho, -s * ay / rho  # the direction where s (C - c)·e is least
+                if bool(sg.within_sweep(np.array(ex), np.array(ey), np.array(1.0))):
+                    thetas.append(math.atan2(ey, ex))
+            best = min(best, min(s * (sg.radius + ax * math.cos(t) + ay * math.sin(t)) for t in thetas))
+        return best
 
     def check_offset(self, d: float, parameter: str) -> None:
         """Refuse an inward offset ``d`` (mm) that is not a clean offset of this outline.
