@@ -367,3 +367,102 @@ def test_a_refusal_names_the_option_as_typed(capsys, args, line):
     rc, out, err = run(capsys, *args)
     assert rc == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and err.startswith(line), err
+
+
+# ----------------------------------------------------------------------------- a tester's press-data trial (h35c)
+_TOML_HEAD = "mass_mg = 300.0\ntrue_density = 1.3\ndiameter = 10.0\ndisplacement_sign = -1\n[compliance]\n"
+_STEP = "a step must be >= 0 and <= 0.001 mm/N (a press frame shortens under force, about 2e-5 mm/N): forces in N, " \
+        "deflections in mm"
+
+
+def _refused_writing_nothing(capsys, tmp_path, args, line):
+    """``args`` exit 2 with exactly ``line`` on stderr, nothing on stdout, and ``tmp_path`` as it was."""
+    before = sorted(p.name for p in tmp_path.iterdir())
+    rc, out, err = run(capsys, *args, "--json-file", tmp_path / "r.json")
+    assert rc == 2 and out == "" and err.splitlines() == [line], err
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+@pytest.mark.parametrize("table, line", [
+    # an empty table had been taken as no compliance: exit 0, K = 0.00988 instead of 0.008557 1/MPa, no word
+    ("force = []\ndeflection = []\n",
+     "error: compliance.table = 0 is not allowed: needs >= 2 finite (force, deflection) pairs"),
+    # a deflection falling as the force rises had been accepted (K = 0.01103), unlike a negative slope
+    ("force = [0, 5000, 10000]\ndeflection = [0, -0.1, -0.2]\n",
+     "error: compliance.deflection[1] = -0.1 mm is not allowed: its step from 0 mm at 0 N to -0.1 mm at 5000 N is "
+     f"-2e-05 mm/N; {_STEP}"),
+    ("force = [0, 5000, 10000]\ndeflection = [0, 0.1, 0.05]\n",
+     "error: compliance.deflection[2] = 0.05 mm is not allowed: its step from 0.1 mm at 5000 N to 0.05 mm at "
+     f"10000 N is -1e-05 mm/N; {_STEP}"),
+    # the forces had been shown as [np.float64(5000.0), np.float64(0.0), np.float64(10000.0)]
+    ("force = [5000, 0, 10000]\ndeflection = [0.1, 0, 0.2]\n",
+     "error: compliance.force[1] = 0 N is not allowed: must be > compliance.force[0] = 5000 N (the forces strictly "
+     "increasing)"),
+])
+def test_a_compliance_table_no_press_has_is_refused_by_its_entry(capsys, tmp_path, table, line):
+    meta = tmp_path / "m.toml"
+    meta.write_text(_TOML_HEAD + table, encoding="utf-8")
+    _refused_writing_nothing(capsys, tmp_path, ["heckel", SAMPLE, "--meta", meta, "--plot", tmp_path / "h.png"], line)
+
+
+@pytest.mark.parametrize("table", [
+    "force = [0, 6000]\ndeflection = [0.0267, 0.1467]\n",                # the sample's line as a table
+    "force = [0, 3000, 6000]\ndeflection = [0.0267, 0.0867, 0.1467]\n",
+])
+def test_a_valid_compliance_table_gives_the_samples_K(capsys, tmp_path, table):
+    meta = tmp_path / "m.toml"
+    meta.write_text(_TOML_HEAD + table, encoding="utf-8")
+    rc, out, err = run(capsys, "heckel", SAMPLE, "--meta", meta, "--json")
+    assert rc == 0, err
+    got = json.loads(out)
+    assert got["K_per_MPa"] == pytest.approx(0.0085565, abs=5e-7) and got["n_points"] == 13
+    rc, out, _ = run(capsys, "heckel", SAMPLE, "--json")  # its own compensation line
+    assert rc == 0 and got["K_per_MPa"] == pytest.approx(json.loads(out)["K_per_MPa"], rel=1e-9)
+
+
+@pytest.mark.parametrize("cmd", ["kawakita", "walker"])
+@pytest.mark.parametrize("rows, extra, line", [
+    # a pressure had been named "row[1].force = -10 N"
+    ("-10,5\n10,4\n20,3\n", [],
+     'error: "p.csv".line[2].pressure_MPa = -10 MPa is not allowed: must be >= 0 (a compaction pressure)'),
+    # "--window = None" though no --window was given
+    ("0,5\n10,4\n20,3\n", [], "error: data = '2 points with a pressure > 0' is not allowed: need >= 3"),
+    ("0,5\n10,4\n20,3\n", ["--window", "5", "15"],
+     "error: --window = '5-15' is not allowed: holds 1 usable points; need >= 3"),
+    # "peak force at row 3" for a table that has no force column
+    ("10,5\n10,5\n10,5\n", [],
+     "error: data = 'peak pressure at row 3' is not allowed: has no loading branch (pressure must rise over >= 3 rows)"),
+])
+def test_a_compression_table_refusal_names_its_pressures(capsys, tmp_path, cmd, rows, extra, line):
+    data = tmp_path / "p.csv"
+    data.write_text("pressure_MPa,thickness_mm\n" + rows, encoding="utf-8")
+    _refused_writing_nothing(capsys, tmp_path, [cmd, data, *extra], line)
+
+
+def test_walker_warns_of_a_volume_that_does_not_fall(capsys, tmp_path):
+    """A thickness rising with the pressure gave W = -96.94 % per decade, exit 0, without a word.  It is a
+    fit the equation can make (unlike Kawakita's, which has no volume reduction to fit and refuses), so it is
+    warned of, as Heckel's K <= 0 is; a falling thickness gives no warning."""
+    data = tmp_path / "p.csv"
+    data.write_text("pressure_MPa,thickness_mm\n10,5\n20,6\n30,7\n40,8\n", encoding="utf-8")
+    rc, out, err = run(capsys, "walker", data, "--json")
+    warning = ("Walker fit: non-positive coefficient W = -96.94 % per decade: the volume does not fall as the "
+               "pressure rises (check the thickness column and h0)")
+    assert rc == 0 and err.splitlines() == [f"warning: {warning}"]
+    d = json.loads(out)
+    assert d["warnings"] == [warning] and d["W_percent_per_decade"] == pytest.approx(-96.935, abs=1e-3)
+    rc, out, err = run(capsys, "walker", ROOT / "samples" / "press" / "lactose_appendix_b.csv", "--json")
+    assert rc == 0 and err == "" and json.loads(out)["W_percent_per_decade"] > 0
+
+
+@pytest.mark.parametrize("args, line", [
+    (["--r", "100"], "error: --r = 100 mm is not allowed: must be > 0 and <= 5 mm"),  # had been "r = 100 mm"
+    # had been refused as "relative_density = 'at most 2.94e-300'"
+    (["--omega-z0", "1e300"], "error: --omega-z0 = 1e+300 mm is not allowed: must be >= -6 and <= 6 mm"),
+    (["--omega-z0", "-5.9"], "error: --omega-z0 = -5.9 mm is not allowed: the model then compresses the 6 mm bed to "
+                             "zero thickness at 10 MPa (h0 + ω_z must stay > 0)"),  # had been "pressure = 10 MPa"
+    (["--window", "10", "1000"], "error: --window = 232.75 MPa is not allowed: compresses the model bed to zero "
+                                 "thickness (h0 = 6 mm, ω_z0 = -1.078 mm)"),
+])
+def test_love_names_its_options(capsys, tmp_path, args, line):
+    _refused_writing_nothing(capsys, tmp_path, ["love", *args], line)

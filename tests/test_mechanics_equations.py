@@ -68,3 +68,18 @@ def test_profiles_sort_and_convert(tmp_path):
     assert out.stat().st_size > 1000
     with pytest.raises(DesignError):
         tabletability([1, 2], [1, 2, 3])
+
+
+def test_walker_warns_of_a_non_positive_coefficient():
+    """A thickness rising with the pressure is fitted (W = -96.94 % per decade) and warned of, as Heckel's
+    K <= 0 is; a falling one is not."""
+    import warnings
+
+    from tabletcad.mechanics.validity import FitQualityWarning
+
+    with pytest.warns(FitQualityWarning, match=r"^Walker fit: non-positive coefficient W = -96\.94 % per decade"):
+        fit = fit_walker([10, 20, 30, 40], [5, 6, 7, 8])
+    assert fit.W_percent_per_decade == pytest.approx(-96.935, abs=1e-3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FitQualityWarning)
+        assert fit_walker([10, 20, 30, 40], [5, 4.5, 4.2, 4.0]).W_percent_per_decade > 0

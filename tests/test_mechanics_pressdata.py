@@ -88,6 +88,22 @@ def test_compliance_table_matches_line():
     assert np.allclose(table.deflection(F), line.deflection(F))
 
 
+@pytest.mark.parametrize("force, deflection, line", [
+    ((0.0, 5000.0, 10000.0), (0.0, -0.1, -0.2), "compliance.deflection[1] = -0.1 mm is not allowed: its step from 0 mm "
+     "at 0 N to -0.1 mm at 5000 N is -2e-05 mm/N; a step must be >= 0 and <= 0.001 mm/N"),
+    ((5000.0, 0.0, 10000.0), (0.1, 0.0, 0.2), "compliance.force[1] = 0 N is not allowed: must be > compliance.force[0] "
+     "= 5000 N (the forces strictly increasing)"),
+    ((0.0,), (0.0,), "compliance.table = 1 is not allowed: needs >= 2 finite (force, deflection) pairs"),
+])
+def test_a_compliance_table_built_in_python_is_checked_as_a_files(force, deflection, line):
+    """The rule is one function, :func:`check_compliance_table`, for a file's table and the dataclass's."""
+    with pytest.raises(DesignError) as e:
+        MachineCompliance(table_force=force, table_deflection=deflection)
+    assert str(e.value).startswith(line), str(e.value)
+    flat = MachineCompliance(table_force=(0.0, 5000.0), table_deflection=(0.01, 0.01))  # a rigid frame: step 0
+    assert np.allclose(flat.deflection([0.0, 9000.0]), 0.01)
+
+
 def _write(tmp_path: Path, text: str, name="run.csv") -> Path:
     p = tmp_path / name
     p.write_text(text)
@@ -136,7 +152,8 @@ def test_bad_files(tmp_path, text, match):
     ("compliance", (0.0, 1e300), r"compliance\.offset = 1e\+300 mm is not allowed: must be >= -1000 and <= 1000"),
     ("compliance", (-2e-5, 0.0), r"compliance\.slope = -2e-05 mm/N is not allowed"),
     ("compliance", {"force": [0.0, 10.0], "deflection": [0.0267, 0.2267]},
-     r"compliance\.table = '0\.2 mm over 0-10 N' is not allowed: must deflect at most 0\.001 mm/N"),
+     r"compliance\.deflection\[1\] = 0\.2267 mm is not allowed: its step from 0\.0267 mm at 0 N to 0\.2267 mm at "
+     r"10 N is 0\.02 mm/N; a step must be >= 0 and <= 0\.001 mm/N"),
 ])
 def test_bad_metadata(tmp_path, key, value, match):
     p = _write(tmp_path, "force_N,displacement_mm\n1,-5\n2,-4.9\n3,-4.8\n")

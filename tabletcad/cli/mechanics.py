@@ -216,6 +216,10 @@ def _compression_table(data: Path, pressure_column: str, thickness_column: str, 
     if bad.size:  # a thickness is a length: 0 or less is a misread column or a displacement
         raise DesignError(f"{data.name!r} line {int(table['_lines'][bad[0]])} {thickness_column!r}",
                           float(table["h"][bad[0]]), "must be > 0 (the compact's thickness)", "mm")
+    bad = np.flatnonzero(table["P"] < 0.0)
+    if bad.size:  # a compact is pressed, never pulled: a negative pressure is a misread column
+        raise DesignError(f"{data.name!r} line {int(table['_lines'][bad[0]])} {pressure_column!r}",
+                          float(table["P"][bad[0]]), "must be >= 0 (a compaction pressure)", "MPa")
     return table
 
 
@@ -255,7 +259,7 @@ def _compression_command(name: str, fit_name: str, describe, doc: str):
         t = _compression_table(data, pressure_column, thickness_column, h0, window, json_file)
         # the loading branch only (as heckel): a press record goes on past its peak pressure into
         # unloading and reloading rows, whose thickness follows the elastic recovery instead
-        a, b = split_branches(t["P"]).loading
+        a, b = split_branches(t["P"], quantity="pressure", unit="MPa").loading
         lines = [] if (a, b) == (0, len(t["P"])) else [
             f"{data.name}: loading rows {a + 1}-{b} of {len(t['P'])} used (up to the peak pressure; "
             f"the rows after it unload or reload the compact)"]
@@ -544,7 +548,7 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
 @_with_json
 def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json, json_file) -> None:
     """Simulated die compression with the thesis's eq 5.18 and its Heckel fit (thesis defaults)."""
-    from tabletcad.mechanics.love import simulate_compression
+    from tabletcad.mechanics.love import THESIS_DIAMETER, simulate_compression
 
     _check_json_file(json_file)
     lo, hi = window
@@ -556,11 +560,12 @@ def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json, json_file) -> None:
     check_range("--nu", nu, 0.0, 0.5, hi_open=True)
     check_positive("--h0", h0, "mm")
     check_range("--z", z, 0.0, h0, "mm")  # a height within the bed (above it, eq 5.18 gave K = -0.015 1/MPa)
-    if r is not None:
-        check_positive("--r", r, "mm")  # (r <= die radius is checked by the model)
-    if omega_z0 is not None:
-        check_finite("--omega-z0", omega_z0, "mm")
-    with _collect() as msgs:
+    if r is not None:  # a radius within the die (the model's own check named it r)
+        check_range("--r", r, 0.0, THESIS_DIAMETER / 2.0, "mm", lo_open=True)
+    if omega_z0 is not None:  # a shift of the punch face by more than the bed's height: 1e300 mm had been
+        check_range("--omega-z0", omega_z0, -h0, h0, "mm")  # refused as a relative density
+    # the model's refusal of a bed pressed to nothing names its keyword; here the option
+    with _collect() as msgs, option_names({"omega_z0": "--omega-z0", "pressure": "--window"}):
         sim = simulate_compression(np.linspace(lo, hi, 41), E=E, nu=nu, h0=h0, z=z, r=r, omega_z0=omega_z0)
     f = sim.heckel
     payload = {"K_per_MPa": f.K_per_MPa, "A": f.A, "Py_MPa": f.Py_MPa, "r2": f.r2, "window_MPa": list(f.window_MPa),

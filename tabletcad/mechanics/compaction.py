@@ -64,7 +64,7 @@ class Branches:
         return slice(*self.unloading)
 
 
-def split_branches(force, drop: float = 0.02) -> Branches:
+def split_branches(force, drop: float = 0.02, *, quantity: str = "force", unit: str = "N") -> Branches:
     """Split a force series into loading and unloading branches (see module docstring).
 
     Parameters
@@ -74,6 +74,9 @@ def split_branches(force, drop: float = 0.02) -> Branches:
     drop : float
         Fraction of the running peak force that counts as a real fall or rise
         (filters transducer noise); 0 < drop < 1.
+    quantity, unit : str
+        What the series is and its unit, for a refusal's words: ``"pressure"``, ``"MPa"`` when a
+        table of pressures (``tabletcad kawakita``, ``walker``) is split.
 
     Raises
     ------
@@ -90,11 +93,13 @@ def split_branches(force, drop: float = 0.02) -> Branches:
     fall = np.flatnonzero(F < (1.0 - drop) * runmax)
     end = int(fall[0]) if fall.size else n
     if end == 0:  # the first force is already a fall from itself: negative (tensile) forces
-        raise DesignError("row 1 force", float(F[0]), "has no loading branch: compression forces must be > 0", "N")
+        raise DesignError(f"row 1 {quantity}", float(F[0]),
+                          f"has no loading branch: compression {quantity}s must be > 0", unit)
     seg = F[:end]
     peak = int(np.flatnonzero(seg == seg.max())[-1])
     if peak < 2 or F[peak] <= 0.0 or F[peak] <= F[0]:
-        raise DesignError("data", f"peak force at row {peak + 1}", "has no loading branch (force must rise over >= 3 rows)")
+        raise DesignError("data", f"peak {quantity} at row {peak + 1}",
+                          f"has no loading branch ({quantity} must rise over >= 3 rows)")
     reload_from = None
     stop = peak + 1
     if fall.size:

@@ -100,10 +100,12 @@ def _prepare(pressure, thickness, window, h0):
     if window is not None:
         lo, hi = float(window[0]), float(window[1])
         if not lo < hi:
-            raise DesignError("window", (lo, hi), "must be two increasing pressures", "MPa")
+            raise DesignError("window", f"{lo:g}-{hi:g}", "must be two increasing pressures", "MPa")
         sel &= (P >= lo) & (P <= hi)
-    if sel.sum() < 3:
-        raise DesignError("window", window, f"holds {int(sel.sum())} usable points; need >= 3", "MPa")
+    if sel.sum() < 3:  # named as what limited the points: the window given, else the data
+        if window is not None:
+            raise DesignError("window", f"{lo:g}-{hi:g}", f"holds {int(sel.sum())} usable points; need >= 3", "MPa")
+        raise DesignError("data", f"{int(sel.sum())} points with a pressure > 0", "need >= 3")
     return P[sel], h[sel], h0
 
 
@@ -138,12 +140,21 @@ def fit_kawakita(pressure, thickness, *, window: tuple[float, float] | None = No
 
 
 def fit_walker(pressure, thickness, *, window: tuple[float, float] | None = None, h0: float | None = None) -> WalkerFit:
-    """Fit the Walker equation ``100 V/V0 = -W log10 P + c`` (P in MPa, h in mm)."""
+    """Fit the Walker equation ``100 V/V0 = -W log10 P + c`` (P in MPa, h in mm).
+
+    A coefficient ``W <= 0`` (the compact not getting thinner as the pressure rises) is fitted and
+    warned of with a :class:`~tabletcad.mechanics.validity.FitQualityWarning`, as Heckel's ``K <= 0``
+    and Kawakita's non-physical parameters are.
+    """
     P, h, h0 = _prepare(pressure, thickness, window, h0)
     y = 100.0 * h / h0
     x = np.log10(P)
     slope, icpt = np.polyfit(x, y, 1)
-    return WalkerFit(W_percent_per_decade=float(-slope), intercept_percent=float(icpt), r2=_r2(y, slope * x + icpt),
+    W = 0.0 - float(slope)  # (0.0 -: never a "-0")
+    if W <= 0:  # as heckel's K <= 0 and kawakita's non-physical a, b: a fit, warned of
+        warn(FitQualityWarning, f"Walker fit: non-positive coefficient W = {W:.4g} % per decade: the volume "
+                                "does not fall as the pressure rises (check the thickness column and h0)")
+    return WalkerFit(W_percent_per_decade=W, intercept_percent=float(icpt), r2=_r2(y, slope * x + icpt),
                      window_MPa=(float(P.min()), float(P.max())), n_points=int(P.size), h0=h0)
 
 

@@ -58,6 +58,7 @@ from tabletcad.mechanics.compaction import relative_density
 from tabletcad.mechanics.heckel import HeckelFit, fit_heckel_arrays
 
 __all__ = [
+    "THESIS_DIAMETER",
     "THESIS_H0",
     "THESIS_Z",
     "ConfinedCompression",
@@ -73,6 +74,8 @@ __all__ = [
 
 #: Initial powder-bed height inferred from the thesis's numbers, mm.
 THESIS_H0 = 6.0
+#: Die diameter of the thesis's α-lactose case, mm (``simulate_compression``'s default).
+THESIS_DIAMETER = 10.0
 #: Height above the fixed lower punch at which the model displacement is evaluated, mm: where eq 5.18
 #: (r = c, h0 = 6 mm) gives the thesis's -0.2155 mm at 10 MPa (root 2.96347; the nominal thickness 3 mm gives -0.2196).
 THESIS_Z = 2.9635
@@ -206,7 +209,7 @@ def simulate_compression(
     *,
     E: float = 2640.0,
     nu: float = 0.21,
-    diameter: float = 10.0,
+    diameter: float = THESIS_DIAMETER,
     mass_mg: float = 300.0,
     true_density: float = 1.3,
     h0: float = THESIS_H0,
@@ -228,12 +231,13 @@ def simulate_compression(
     c = check_positive("diameter", diameter, "mm") / 2.0
     r = c if r is None else r
     model_ref = float(axial_displacement(reference_pressure, E, nu, c, h0, z, r, scale=scale))
-    if omega_z0 is None:
+    given = omega_z0 is not None
+    if not given:
         omega_z0 = adjustment_omega_z0(experimental_displacement, model_ref)
     w = axial_displacement(P, E, nu, c, h0, z, r, omega_z0=omega_z0, scale=scale)
     h = h0 + w
     if np.any(h <= 0):
-        raise DesignError("pressure", float(P[h <= 0][0]), "compresses the model bed to zero thickness", "MPa")
+        _refuse_collapse(float(P[h <= 0][0]), float(omega_z0), h0, given)
     D = relative_density(h, mass_mg, true_density, math.pi * c * c)
     fit = fit_heckel_arrays(P, D, window=(float(P.min()), float(P.max())))
     return SimulatedCompression(
@@ -242,6 +246,22 @@ def simulate_compression(
                      "reference_pressure_MPa": reference_pressure, "model_displacement_at_reference_mm": model_ref,
                      "experimental_displacement_mm": experimental_displacement},
     )
+
+
+def _refuse_collapse(pressure: float, omega_z0: float, h0: float, given: bool) -> None:
+    """Refuse a simulated bed pressed to zero thickness, naming what the caller chose: ``omega_z0`` when
+    it was given (-5.9 mm in a 6 mm bed had been refused as ``pressure = 10 MPa``), else the pressure.
+
+    Raises
+    ------
+    DesignError
+        Always.
+    """
+    if given:
+        raise DesignError("omega_z0", omega_z0, f"the model then compresses the {h0:.6g} mm bed to zero thickness at "
+                          f"{pressure:.6g} MPa (h0 + ω_z must stay > 0)", "mm")
+    raise DesignError("pressure", pressure, f"compresses the model bed to zero thickness (h0 = {h0:.6g} mm, "
+                      f"ω_z0 = {omega_z0:.4g} mm)", "MPa")
 
 
 @dataclass(frozen=True)

@@ -72,6 +72,7 @@ __all__ = [
     "MachineCompliance",
     "PressData",
     "PressMetadata",
+    "check_compliance_table",
     "metadata_beside",
     "read_metadata",
     "read_press_data",
@@ -108,26 +109,8 @@ class MachineCompliance:
     def __post_init__(self) -> None:
         check_range("compliance slope", self.slope, 0.0, MAX_COMPLIANCE_MM_PER_N, "mm/N")
         check_range("compliance offset", self.offset, -DEFAULT.max_length, DEFAULT.max_length, "mm")
-        if len(self.table_force) != len(self.table_deflection):
-            raise DesignError(
-                "compliance table", f"{len(self.table_force)} forces, {len(self.table_deflection)} deflections",
-                "force and deflection lists must have the same length",
-            )
-        if self.table_force:
-            f = np.asarray(self.table_force, dtype=float)
-            d = np.asarray(self.table_deflection, dtype=float)
-            if f.size < 2 or not np.all(np.isfinite(f)) or not np.all(np.isfinite(d)):
-                raise DesignError("compliance table", f.size, "needs >= 2 finite (force, deflection) pairs")
-            if np.any(np.diff(f) <= 0):
-                raise DesignError("compliance table force", list(f), "must be strictly increasing", "N")
-            for x in d:
-                check_range("compliance table deflection", float(x), -DEFAULT.max_length, DEFAULT.max_length, "mm")
-            steep = np.abs(np.diff(d) / np.diff(f))
-            if np.any(steep > MAX_COMPLIANCE_MM_PER_N):
-                k = int(np.argmax(steep))
-                raise DesignError("compliance table", f"{d[k + 1] - d[k]:.4g} mm over {f[k]:.4g}-{f[k + 1]:.4g} N",
-                                  f"must deflect at most {MAX_COMPLIANCE_MM_PER_N:g} mm/N between its rows (a press "
-                                  "frame's is about 2e-5): forces in N, deflections in mm")
+        if self.table_force or self.table_deflection:
+            check_compliance_table(self.table_force, self.table_deflection)
 
     @classmethod
     def from_compensation_line(cls, slope: float, intercept: float) -> MachineCompliance:
@@ -163,6 +146,53 @@ class MachineCompliance:
         if self.is_table:
             return {"force": list(self.table_force), "deflection": list(self.table_deflection)}
         return {"slope": self.slope, "offset": self.offset}
+
+
+def check_compliance_table(force: Sequence[float], deflection: Sequence[float]) -> None:
+    """Refuse a force-deflection calibration table no press has, naming the entry at fault.
+
+    A table is the ``[compliance]`` keys ``force`` (N) and ``deflection`` (mm) of a metadata file, or
+    :class:`MachineCompliance`'s ``table_force`` and ``table_deflection``.  It needs at least two pairs
+    (an empty one would be no correction at all: the lactose record's K moves by 15 %), forces strictly
+    increasing, deflections within ±1000 mm, and every step between neighbouring rows within
+    0-:data:`~tabletcad.tolerance.MAX_COMPLIANCE_MM_PER_N` mm/N, as the line form's slope: a frame
+    shortens more under more force, by about 2e-5 mm/N (a falling deflection gave K = 0.01103 instead
+    of 0.008557 1/MPa; a table typed in kN is 1000 times too steep).
+
+    Parameters
+    ----------
+    force : sequence of float
+        N, one per row.
+    deflection : sequence of float
+        mm, one per row.
+
+    Raises
+    ------
+    DesignError
+        ``compliance.table`` (lengths or count), or the entry ``compliance.force[i]`` or
+        ``compliance.deflection[i]`` (0-based, as the file's list) at fault.
+    """
+    if len(force) != len(deflection):
+        raise DesignError("compliance table", f"{len(force)} forces, {len(deflection)} deflections",
+                          "force and deflection lists must have the same length")
+    f = np.asarray(force, dtype=float)
+    d = np.asarray(deflection, dtype=float)
+    if f.size < 2 or not np.all(np.isfinite(f)) or not np.all(np.isfinite(d)):
+        raise DesignError("compliance table", f.size, "needs >= 2 finite (force, deflection) pairs")
+    for i in range(1, f.size):
+        if not f[i] > f[i - 1]:
+            raise DesignError(f"compliance force {i}", float(f[i]), f"must be > compliance.force[{i - 1}] = "
+                              f"{f[i - 1]:.6g} N (the forces strictly increasing)", "N")
+    for i, x in enumerate(d):
+        check_range(f"compliance deflection {i}", float(x), -DEFAULT.max_length, DEFAULT.max_length, "mm")
+    step = np.diff(d) / np.diff(f)
+    bad = np.flatnonzero((step < 0.0) | (step > MAX_COMPLIANCE_MM_PER_N))
+    if bad.size:
+        k = int(bad[0])
+        raise DesignError(f"compliance deflection {k + 1}", float(d[k + 1]),
+                          f"its step from {d[k]:.6g} mm at {f[k]:.6g} N to {d[k + 1]:.6g} mm at {f[k + 1]:.6g} N is "
+                          f"{step[k]:.4g} mm/N; a step must be >= 0 and <= {MAX_COMPLIANCE_MM_PER_N:g} mm/N (a press "
+                          "frame shortens under force, about 2e-5 mm/N): forces in N, deflections in mm", "mm")
 
 
 @dataclass(frozen=True)
@@ -787,8 +817,10 @@ def _compliance(comp: Any) -> MachineCompliance | None:
         s, b = _numbers("compliance compensation_line", comp["compensation_line"], "", 2)
         return MachineCompliance.from_compensation_line(s, b)
     if form == ("force", "deflection"):
-        return MachineCompliance(table_force=_numbers("compliance force", comp["force"], "N"),
-                                 table_deflection=_numbers("compliance deflection", comp["deflection"], "mm"))
+        force = _numbers("compliance force", comp["force"], "N")
+        deflection = _numbers("compliance deflection", comp["deflection"], "mm")
+        check_compliance_table(force, deflection)  # here too: an empty table is no table, not the zero line
+        return MachineCompliance(table_force=force, table_deflection=deflection)
     return MachineCompliance(slope=check_finite("compliance slope", comp.get("slope", 0.0), "mm/N"),
                              offset=check_finite("compliance offset", comp.get("offset", 0.0), "mm"))
 
