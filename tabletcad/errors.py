@@ -236,8 +236,10 @@ def _fmt(value: Any) -> str:
         if digits <= 40:  # as given (--nodes 99999999999999999999, not 1e+20)
             return str(value)
         return f"{value:.6g}" if digits < 300 else f"an integer of {digits} digits"
-    text = repr(value) if isinstance(value, str) else str(value)
-    text = " ".join(text.split())  # one line, whatever the value holds
+    if isinstance(value, str):  # as given: its repr is one line (line breaks and control characters escaped)
+        text = repr(value)  # (its spaces kept: text = "   " had been shown as ' ')
+    else:
+        text = " ".join(str(value).split())  # one line, whatever the value holds
     # whole up to 200 characters (a path in a temporary or nested folder), else its start and end
     return text if len(text) <= 200 else f"{text[:150]}...{text[-40:]}"
 

@@ -744,3 +744,47 @@ def test_a_ctrl_c_swallowed_by_a_gc_callback_is_delivered_again():
         gc.callbacks.remove(swallowing_callback)
         sys.unraisablehook = previous
     assert seen == [other]
+
+
+def test_a_name_with_control_characters_is_refused_and_letters_are_kept(capsys, tmp_path):
+    """name = "... \\u0000 x" built (exit 0) with a NUL on stdout and in the picture, and cut the STEP product's
+    name; refused as emboss text is.  é and µ stay accepted."""
+    base = '[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 2.8\ncup_depth = 0.9\n'
+    bad = design(tmp_path, base + 'name = "Parac\\u00e9tamol 500 \\u00b5g \\u0000 x"\n')
+    rc, out, err = run(capsys, "build", bad, "--out", tmp_path / "out")
+    line = assert_refused(rc, err, "tablet.name")
+    assert line == ("error: tablet.name = 'Paracétamol 500 µg \\x00 x' is not allowed: must be a plain non-empty name "
+                    "(no / \\ \" or control character such as a line break or NUL, at most 200 characters)")
+    assert out == "" and sorted(p.name for p in tmp_path.iterdir()) == ["d.toml"]
+    for ch in ("\\t", "\\u001b", "\\u2028", "\\u0085"):
+        rc, _, err = run(capsys, "report", design(tmp_path, base + f'name = "a{ch}b"\n'))
+        assert_refused(rc, err, "tablet.name")
+    rc, out, err = run(capsys, "report", design(tmp_path, base + 'name = "Paracétamol 500 µg x"\n'))
+    assert rc == 0 and "Paracétamol 500 µg x" in out, err
+
+
+def test_an_unknown_subcommand_lists_its_groups_commands(capsys):
+    rc, out, err = run(capsys, "fe", "foo")
+    assert rc == 2 and out == "" and err.splitlines() == [
+        "error: command = 'foo' is not allowed: must be one of diametral, punch, strength (the commands of tabletcad fe)"]
+    rc, _, err = run(capsys, "foo")
+    assert rc == 2 and err.startswith("error: command = 'foo' is not allowed: must be one of build, contact, fe,")
+
+
+def test_text_values_are_shown_as_given(capsys, tmp_path):
+    """Emboss text "   " was shown as ' ' (whitespace collapsed); the repr keeps it."""
+    base = '[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 2.8\ncup_depth = 0.9\n[tooling]\n'
+    rc, out, err = run(capsys, "report", design(tmp_path, base + '[[tooling.emboss]]\ntext = "   "\n'))
+    assert rc == 2 and out == "" and err.splitlines() == [
+        "error: tooling.emboss[0].text = '   ' is not allowed: must be a non-empty string"]
+
+
+def test_a_patch_table_for_an_array_of_tables_is_named(capsys, tmp_path):
+    """[patch] written for [[patch]] was reported as "patch = (not given)"."""
+    rc, out, err = run(capsys, "report", design(tmp_path, '[tablet]\nfamily = "free_form"\n[patch]\ncurves = []\n'))
+    assert rc == 2 and out == "" and err.splitlines() == [
+        "error: patch = {'curves': []} is not allowed: must be an array of tables, [[patch]] (double brackets), one for "
+        "each patch with its 4 curves; [patch] is a single table"]
+    rc, out, err = run(capsys, "report", design(tmp_path, '[tablet]\nfamily = "free_form"\n'))
+    assert err.splitlines() == ["error: patch = (not given) is not allowed: a free_form design needs at least one "
+                                "[[patch]] with 4 curves"]

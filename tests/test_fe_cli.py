@@ -163,7 +163,8 @@ def test_strength_needs_its_inputs(capsys, thin):
 def test_diametral_refuses_a_ring_fast(capsys):
     ring = Path(__file__).resolve().parents[1] / "samples" / "ring.toml"
     rc, so, err = run(capsys, "fe", "diametral", ring, "--force", 10)
-    assert rc == 2 and err.startswith("error: trim.w = [0.5, 1.0] is not allowed: the diametral test needs a solid")
+    assert rc == 2 and err.startswith("error: tablet.inner_diameter = 6 mm is not allowed: a hollow tablet (a ring) is "
+                                      "not supported by the diametral FE test")
 
 
 def test_json_file_writes_what_json_prints(capsys, tmp_path, thin):

@@ -215,3 +215,66 @@ def test_a_store_no_worker_could_write_is_refused(tmp_path, capsys, monkeypatch,
     assert capsys.readouterr().err.strip().splitlines() == [
         f"error: --store = {store!r} is not allowed: " + allowed.format(tmp=tmp_path)]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
+
+
+def test_fe_diametral_names_what_makes_a_tablet_hollow(tmp_path, capsys):
+    """A thesis ring was refused as "trim.w = [0.5, 1.0]", a table its design file does not have."""
+    from pathlib import Path
+
+    ring = Path(__file__).resolve().parents[1] / "samples" / "ring.toml"
+    rc = main(["fe", "diametral", str(ring), "--force", "100", "--out", str(tmp_path / "out")])
+    assert rc == 2 and capsys.readouterr().err.splitlines() == [
+        "error: tablet.inner_diameter = 6 mm is not allowed: a hollow tablet (a ring) is not supported by the diametral "
+        "FE test, which loads solid tablets only"]
+    d = tmp_path / "shell.toml"
+    d.write_text(DISC + "[trim]\nw = [0.5, 1.0]\n")
+    rc = main(["fe", "diametral", str(d), "--force", "100", "--out", str(tmp_path / "out")])
+    assert rc == 2 and capsys.readouterr().err.splitlines() == [
+        "error: trim.w = [0.5, 1.0] is not allowed: a hollow tablet (w from above 0) is not supported by the diametral "
+        "FE test, which loads solid tablets only: remove [trim] w or start it at 0"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["shell.toml"]
+
+
+def test_fe_diametral_says_a_default_mesh_size_is_the_default(tmp_path, capsys):
+    """A 0.001 mm thin disc was refused as "--mesh-size = 0.0005 mm", a value the user never gave."""
+    d = tmp_path / "thin.toml"
+    d.write_text('[tablet]\nfamily = "flat_face_round"\ndiameter = 10.0\nthickness = 0.001\n')
+    rc = main(["fe", "diametral", str(d), "--force", "1", "--out", str(tmp_path / "out")])
+    assert rc == 2 and capsys.readouterr().err.splitlines() == [
+        "error: --mesh-size = (not given) is not allowed: its default for this tablet, min(thickness/2, plan width/12) "
+        "= 0.0005 mm, gives about 2.11e+10 unknowns, more than the 2e+05 that fit in memory: give a mesh size of at "
+        "least 0.0236 mm"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["thin.toml"]
+
+
+@pytest.mark.parametrize("key, value, line", [
+    ("diameter", "-10.0", "error: design.tablet.diameter = -10 mm is not allowed: must be > 0 (a length of "
+                          "concave_round; the sweep does not vary it, so every design would be refused)"),
+    ("land", "-0.1", "error: design.tablet.land = -0.1 mm is not allowed: must be >= 0 (a length of concave_round; the "
+                     "sweep does not vary it, so every design would be refused)"),
+])
+def test_sweep_states_a_fixed_lengths_true_range(tmp_path, capsys, key, value, line):
+    """diameter = -10 was refused as "must be >= 0", but a diameter of 0 is refused too."""
+    text = SWEEP.format(extra="", vary='"tablet.band" = [2.4, 3.0]').replace("[design.tablet]\n",
+                                                                             f"[design.tablet]\n{key} = {value}\n", 1)
+    text = text.replace("diameter = 10.0\n", "") if key == "diameter" else text
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    rc = main(["sweep", str(f), "--out", str(tmp_path / "out"), "--workers", "1"])
+    assert rc == 2 and capsys.readouterr().err.splitlines() == [line]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+def test_sweep_names_the_journal_a_folder_holds(tmp_path, capsys):
+    """A folder holding only a results.partial.jsonl was said to hold results.csv."""
+    from pathlib import Path
+
+    sample = Path(__file__).resolve().parents[1] / "samples" / "sweep" / "concave_round_grid.toml"
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "results.partial.jsonl").write_text('{"x": 1}\n')
+    rc = main(["sweep", str(sample), "--out", str(out), "--workers", "1"])
+    assert rc == 2 and capsys.readouterr().err.splitlines() == [
+        f"error: --out = '{out}' is not allowed: already holds results.partial.jsonl of a sweep; give --resume or "
+        "another folder"]
+    assert sorted(p.name for p in out.iterdir()) == ["results.partial.jsonl"]

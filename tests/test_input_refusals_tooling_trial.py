@@ -211,3 +211,51 @@ def test_a_clearance_that_would_eat_the_tips_is_named(capsys, tmp_path, diameter
     parameter, reason = _refused(capsys, tmp_path, design, "build")
     assert parameter == "tooling.clearance_mm"
     assert reason == f"must leave the punch tips at least half the tablet's {diameter:g} mm width: at most {most} mm"
+
+
+_NO_BAND = '[tablet]\nfamily = "thesis.spherical"\ndiameter = 5\n[tooling]\nclearance_mm = 0.02\n'
+_LAND = '[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 2.8\ncup_depth = 0.9\nland = 0.08\n[tooling]\n'
+
+
+@pytest.mark.parametrize("command", ["report", "build"])
+@pytest.mark.parametrize("design, line", [
+    (_NO_BAND, "error: tooling = 'thesis.spherical' is not allowed: tooling needs a tablet with a band (a cylindrical "
+               "side wall the die forms); this one has none"),
+    (_LAND + '[[tooling.emboss]]\ntext = "10"\nface = "top"\nheight_mm = 2\ndepth_mm = 5\n',
+     "error: tooling.emboss[0].depth_mm = 5 mm is not allowed: must be <= cup depth + band/4 = 1.6 mm"),
+    (_LAND + '[[tooling.score]]\nkind = "bisect"\ndepth_mm = 5\n',
+     "error: tooling.score[0].depth_mm = 5 mm is not allowed: must be < the top cup depth 0.9 mm minus 0.005 mm (a "
+     "standard score runs out on the face; set cut_through = true to cut the band)"),
+])
+def test_tooling_numbers_are_refused_by_report_and_build_before_the_cad(capsys, tmp_path, monkeypatch, command, design,
+                                                                         line):
+    """`report` took these [tooling] tables (exit 0) that `build` refused after 3-5 s of solid building: a sphere
+    has no band, a figure or a score deeper than its face.  Both now refuse them from the PDE tablet's numbers
+    (tabletcad.tooling.spec.check_on_tablet), before any CAD step (which would fail the test here)."""
+    import tabletcad.cad.stage
+
+    def no_cad(**_):
+        raise AssertionError("the CAD stage was reached")
+
+    monkeypatch.setattr(tabletcad.cad.stage, "cad_stage", no_cad)
+    (tmp_path / "d.toml").write_text(design, encoding="utf-8")
+    args = [command, str(tmp_path / "d.toml")] + (["--out", str(tmp_path / "out")] if command == "build" else [])
+    rc = main(args)
+    out, err = capsys.readouterr()
+    assert rc == 2 and err.splitlines() == [line] and out == ""
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.toml"]
+
+
+def test_tooling_numbers_within_their_limits_pass_the_report(capsys, tmp_path):
+    """The limits themselves still pass: a 0.89 mm score on a 0.9 mm cup, a 1.59 mm deboss (cup + band/4 is 1.6)."""
+    d = tmp_path / "d.toml"
+    d.write_text(_LAND + '[[tooling.score]]\ndepth_mm = 0.3\n[[tooling.emboss]]\ntext = "10"\nface = "bottom"\n'
+                 'height_mm = 2\ndepth_mm = 1.59\n', encoding="utf-8")
+    assert main(["report", str(d)]) == 0, capsys.readouterr().err
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.spec import check_on_tablet, parse_tooling
+
+    tablet = Design.from_toml(d).build()
+    check_on_tablet(tablet, parse_tooling({"score": [{"depth_mm": 0.894}], "emboss": [{"text": "1", "depth_mm": 1.59}]}))
+    with pytest.raises(DesignError, match="minus 0.005 mm"):
+        check_on_tablet(tablet, parse_tooling({"score": [{"depth_mm": 0.896}]}))

@@ -166,9 +166,11 @@ def _usage_line(exc) -> str:
     if isinstance(exc, click.BadParameter):
         return str(DesignError(_param_name(exc.param), "given", " ".join(exc.format_message().split()).rstrip(".")))
     msg = " ".join(exc.format_message().split()).rstrip(".")
-    if msg.startswith("No such command"):
-        names = ", ".join(sorted(_group().commands))
-        return str(DesignError("command", msg.split("'")[1] if "'" in msg else msg, f"must be one of {names}"))
+    if msg.startswith("No such command"):  # the commands of the group it was given to (fe: diametral, punch, strength)
+        group = ctx.command if ctx is not None and isinstance(ctx.command, click.Group) else _group()
+        names = ", ".join(sorted(group.commands))
+        return str(DesignError("command", msg.split("'")[1] if "'" in msg else msg, f"must be one of {names}"
+                               + (f" (the commands of {where})" if group is not _group() else "")))
     if "unexpected extra argument" in msg:
         extra = msg[msg.find("(") + 1:msg.rfind(")")] if "(" in msg else msg
         return str(DesignError("argument", extra, f"{where} takes no further arguments (see {where} --help)"))
@@ -227,7 +229,8 @@ def _run(argv: list[str] | None) -> int:
         usage = {"design_file": "DESIGN", "sweep.file": "SWEEP.toml", "problem.file": "PROBLEM.toml"}
         if exc.parameter in usage:
             exc = exc.renamed(usage[exc.parameter])
-        _say(f"error: {' '.join(str(exc).split())}")
+        # one line; its value's repr as given (text = "   " is not ' '), its line breaks joined
+        _say(f"error: {' '.join(str(exc).splitlines())}")
         return 2
     except TabletcadError as exc:
         msg = " ".join(str(exc).split()) or type(exc).__name__

@@ -102,7 +102,7 @@ from typing import Any
 
 import numpy as np
 
-from tabletcad.errors import DesignError, GeometryError, check_positive, check_range
+from tabletcad.errors import MISSING, DesignError, GeometryError, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
 from tabletcad.tolerance import MIN_FORCE_N
 from tabletcad.fe.elasticity import Material, PressureLoad, boundary_facets, principal_stresses, solve_elasticity
@@ -533,8 +533,13 @@ def diametral(
     P = check_range("force", force, MIN_FORCE_N, 1e9, "N")  # (1e308 overflowed the solve, 1e-320 gave -0 MPa)
     material = material or Material()
     trim = getattr(tablet, "trim", None)
-    if trim is not None and trim.w[0] > 0:
-        raise DesignError("[trim] w", list(trim.w), "the diametral test needs a solid tablet (a ring's centre is empty)")
+    if trim is not None and trim.w[0] > 0:  # named as the design makes it hollow: a ring's hole, else its [trim] w
+        inner = (getattr(tablet, "params", None) or {}).get("inner_diameter")
+        if getattr(tablet, "family", None) == "thesis.ring" and inner is not None:
+            raise DesignError("tablet.inner_diameter", inner, "a hollow tablet (a ring) is not supported by the "
+                              "diametral FE test, which loads solid tablets only", "mm")
+        raise DesignError("[trim] w", list(trim.w), "a hollow tablet (w from above 0) is not supported by the diametral "
+                          "FE test, which loads solid tablets only: remove [trim] w or start it at 0")
     if trim is not None and (trim.u != (0.0, 1.0) or not trim.full_v):
         key = "v" if not trim.full_v else "u"
         raise DesignError(f"[trim] {key}", list(getattr(trim, key)), "the diametral test needs the whole tablet, not a "
@@ -563,6 +568,10 @@ def diametral(
     box = float(np.prod(ext))  # the volume is at most the bounding box's: computed only when the box's is too large
     if max(estimated_dofs(box, h), estimated_dofs(box * min(1.0, b / D), hs)) > MAX_DOFS:
         vol = float(tablet.volume())
+        if mesh_size is None and estimated_dofs(vol, h) > MAX_DOFS:  # the default, which the user never set: say so
+            raise DesignError("mesh_size", MISSING, f"its default for this tablet, min(thickness/2, plan width/12) = "
+                              f"{h:.3g} mm, gives about {estimated_dofs(vol, h):.3g} unknowns, more than the "
+                              f"{MAX_DOFS:.3g} that fit in memory: give a mesh size of at least {finest_size(vol):.3g} mm")
         check_mesh_size(vol, h)
         try:
             check_mesh_size(vol * min(1.0, b / D), hs, "strip_mesh_size")

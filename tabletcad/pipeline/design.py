@@ -51,7 +51,7 @@ from tabletcad.geometry.patch import PDEPatch
 from tabletcad.families import FAMILIES, RENAMED
 from tabletcad.families import family as lookup_family
 from tabletcad.pipeline.designreport import ReportOptions
-from tabletcad.tooling.spec import ToolingSpec, parse_tooling
+from tabletcad.tooling.spec import ToolingSpec, parse_tooling, printable_line
 from tabletcad.geometry.tablet import Tablet, Trim
 from tabletcad.tolerance import DEFAULT, Tolerances
 from tabletcad.readonly import TableDict, TableList
@@ -280,8 +280,10 @@ class Design:
         data = _as_toml(data)
         tab = data["tablet"]
         name = tab.get("name", default_name)  # given empty, it is refused (not replaced by the default)
-        if not isinstance(name, str) or not name.strip() or any(ch in name for ch in '/\\"\n') or len(name) > 200:
-            allowed = 'must be a plain non-empty name (no / \\ " or line break, at most 200 characters)'
+        if not isinstance(name, str) or not name.strip() or any(ch in name for ch in '/\\"') or len(name) > 200 or \
+                not printable_line(name):  # (a NUL had reached stdout, the picture's title and the STEP product, cut)
+            allowed = ('must be a plain non-empty name (no / \\ " or control character such as a line break or NUL, at '
+                       'most 200 characters)')
             if "name" not in tab and folder is not None:  # the file's name stands for it (a trial: a key not in the file)
                 raise DesignError("tablet.name", name, f"{allowed}: the design file's name is the tablet's when its "
                                   "[tablet] table gives none; give name = ... there, or rename the file")
@@ -496,8 +498,12 @@ def _custom_outline(tab: dict, name: str) -> Tablet:
 
 
 def _free_form(patches: Any, name: str, a) -> Tablet:
+    if isinstance(patches, dict):  # [patch] written for [[patch]]: a table, not the list of them
+        raise DesignError("patch", patches, "must be an array of tables, [[patch]] (double brackets), one for each patch "
+                          "with its 4 curves; [patch] is a single table")
     if not isinstance(patches, list) or not patches:
-        raise DesignError("patch", MISSING, "a free_form design needs at least one [[patch]] with 4 curves")
+        raise DesignError("patch", MISSING if patches is None else patches,
+                          "a free_form design needs at least one [[patch]] with 4 curves")
     out = []
     prev: Curve | None = None
     for j, p in enumerate(patches):

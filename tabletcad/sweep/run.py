@@ -89,8 +89,9 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
     hashes = [design_hash(d) for d in designs]
     done: dict[str, dict[str, Any]] = {}
     if out is not None and out.is_dir() and ((out / RESULTS_CSV).exists() or (out / JOURNAL).exists()):
-        if not resume:
-            raise DesignError("--out", str(out), f"already holds {RESULTS_CSV} of a sweep; give --resume or another folder")
+        if not resume:  # named as the file it holds (a journal alone, of a stopped run, is no results.csv)
+            held = " and ".join(f for f in (RESULTS_CSV, JOURNAL) if (out / f).exists())
+            raise DesignError("--out", str(out), f"already holds {held} of a sweep; give --resume or another folder")
         done = read_done(out)
         foreign = set(done) - set(hashes)
         if foreign:

@@ -226,9 +226,30 @@ def _check_fixed_dimensions(design: dict, varied: set[str]) -> None:
         if k in fam.params and f"tablet.{k}" not in varied:
             where = f"design.tablet.{k}"
             x = _number(where, v, fam.params[k])
-            if fam.params[k] == "mm" and x < 0.0:
-                raise DesignError(where, v, f"must be >= 0 (a length of {fam.name}; the sweep does not vary it, "
-                                  "so every design would be refused)", "mm")
+            if fam.params[k] == "mm" and x < 0.0:  # no family takes it: named with the family's own range
+                raise DesignError(where, v, f"{_family_range(fam, k, v)} (a length of {fam.name}; the sweep does not "
+                                  "vary it, so every design would be refused)", "mm")
+
+
+def _family_range(fam, key: str, value: float) -> str:
+    """The lower bound ``fam`` sets to a length ``key``, from its own refusal of the negative ``value`` (``must be
+    > 0``: a diameter of 0 is refused too), its constructor called with that value and its defaults (it checks
+    each length before it builds anything; an upper bound, which depends on the other dimensions, is left
+    out); ``must be >= 0`` when the family names another parameter first."""
+    import re
+    import warnings
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            fam.func(**{key: value})
+    except DesignError as exc:
+        bound = re.match(r"must be >=? 0(?![.\d])", exc.allowed) if exc.parameter == key else None
+        if bound:
+            return bound.group(0)
+    except Exception:  # noqa: BLE001 - (a constructor that fails otherwise says nothing of the range)
+        pass
+    return "must be >= 0"
 
 
 def _check_fixed_tables(design: dict, axes) -> None:

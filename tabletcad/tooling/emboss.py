@@ -66,7 +66,7 @@ from tabletcad.errors import DesignError, GeometryError
 from tabletcad.tooling.booleans import checked_boolean, translated
 from tabletcad.tooling.booleans import compound as _compound
 from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, polyline_wire, wire_length
-from tabletcad.tooling.spec import EmbossSpec, font_path
+from tabletcad.tooling.spec import EmbossSpec, check_emboss_depth, font_path
 
 __all__ = ["figure_faces", "figure_prism", "apply_emboss", "check_fit", "check_emboss", "face_heights", "offset_solid"]
 
@@ -239,10 +239,7 @@ def check_emboss(frame: TabletFrame, e: EmbossSpec, clearance: float, i: int = 0
                           f"must be < {math.degrees(math.atan(0.5 * leg['stroke_width_mm'] / e.depth_mm)):.3g} deg: the "
                           f"walls of {leg['stroke_width_mm']:.3g} mm strokes would meet before the depth "
                           f"{e.depth_mm:.3g} mm", "deg")
-    cup = frame.cup_depth_top if e.face == "top" else frame.cup_depth_bottom
-    limit = cup + 0.25 * frame.band
-    if e.depth_mm > limit:  # debossed into the tablet, or raised on it (cut as deep into the punch)
-        raise DesignError(f"[[tooling.emboss]] {i} depth_mm", e.depth_mm, f"must be <= cup depth + band/4 = {limit:.4g} mm", "mm")
+    check_emboss_depth(e, i, frame.cup_depth_top if e.face == "top" else frame.cup_depth_bottom, frame.band)
     return figure, info
 
 

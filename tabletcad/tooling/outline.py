@@ -40,6 +40,7 @@ from tabletcad.errors import DesignError, GeometryError
 from tabletcad.families.thesis import NO_LAND
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tooling.booleans import translated
+from tabletcad.tooling.spec import band_heights
 
 __all__ = ["TabletFrame", "tablet_frame", "offset_wire", "prism", "plan_face", "wire_length", "face_area"]
 
@@ -374,13 +375,8 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
         raise DesignError("[tooling]", tablet.family, "tooling is made for whole tablets: remove [trim] u/v")
     nom = tablet.nominal
     outline_nom = getattr(nom, "outline", None)
-    band_z = getattr(nom, "band_z", None)
+    band_z = band_heights(tablet)  # (a DesignError without a band)
     found = tablet.band()
-    if band_z is None and found is not None:
-        band_z = (found.z0, found.z1)
-    if band_z is None or not band_z[1] - band_z[0] > 1e-6:
-        raise DesignError("[tooling]", tablet.family,
-                          "tooling needs a tablet with a band (a cylindrical side wall the die forms); this one has none")
     if shape is None:
         from tabletcad.cad.tablet_solid import tablet_solid
 

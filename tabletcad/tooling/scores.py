@@ -36,11 +36,10 @@ from OCP.gp import gp_Pnt, gp_Vec
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.tooling.booleans import boolean, checked_boolean
 from tabletcad.tooling.outline import TabletFrame
-from tabletcad.tooling.spec import ScoreSpec
+from tabletcad.tooling.spec import ScoreSpec, check_score_size, groove_width
 
 __all__ = ["groove_profile", "groove_solid", "score_cutter", "apply_scores", "check_score"]
 
-RUN_OUT_MARGIN_MM = 0.005
 ABOVE_MM = 0.5  # the groove's walls continue this far above the face
 
 
@@ -79,13 +78,6 @@ def groove_solid(profile: list[tuple[float, float]], direction_deg: float, lengt
     return BRepPrimAPI_MakePrism(face, gp_Vec(length * d[0], length * d[1], 0.0)).Shape()
 
 
-def groove_width(s: ScoreSpec) -> float:
-    """The groove's width at the face (mm) where it is ``depth_mm`` deep."""
-    t = math.tan(math.radians(0.5 * s.angle_deg))
-    return {"v": 2 * s.depth_mm * t, "u": s.width_mm,
-            "pressure_sensitive": s.slot_width_mm + 2 * (2 * s.depth_mm / 3) * t}[s.profile]
-
-
 def _check_short(frame: TabletFrame, s: ScoreSpec, i: int) -> None:
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
 
@@ -110,38 +102,12 @@ def _check_short(frame: TabletFrame, s: ScoreSpec, i: int) -> None:
 
 
 def check_score(frame: TabletFrame, s: ScoreSpec, i: int = 0) -> None:
-    """Raise :class:`DesignError` if the score is deeper than the cup (and band) allow."""
-    w = f"[[tooling.score]] {i} depth_mm"
-    for face in s.face_list:
-        cup = frame.cup_depth_top if face == "top" else frame.cup_depth_bottom
-        if s.cut_through or s.length_mm is not None:
-            limit = cup + 0.25 * frame.band
-            if s.depth_mm > limit:
-                raise DesignError(w, s.depth_mm, f"must be <= cup depth + band/4 = {limit:.4g} mm on the {face} face "
-                                  "(a cut-through or short score must leave half the band)", "mm")
-        elif s.depth_mm > cup - RUN_OUT_MARGIN_MM:
-            raise DesignError(w, s.depth_mm, f"must be < the {face} cup depth {cup:.4g} mm minus {RUN_OUT_MARGIN_MM} mm "
-                              "(a standard score runs out on the face; set cut_through = true to cut the band)", "mm")
-    room = 0.5 * min(frame.length, frame.width)
-    if groove_width(s) >= room:  # (a depth within its bounds): a V of 179.9 deg was a 687 mm wide "score"
-        _refuse_wide(s, i, room)
+    """Raise :class:`DesignError` if the score is deeper than the cup (and band) allow, wider at the face than half
+    the tablet (:func:`~tabletcad.tooling.spec.check_score_size`) or, a short one, does not end on the face."""
+    check_score_size(s, i, {"top": frame.cup_depth_top, "bottom": frame.cup_depth_bottom}, frame.band,
+                     0.5 * min(frame.length, frame.width))
     if s.length_mm is not None:
         _check_short(frame, s, i)
-
-
-def _refuse_wide(s: ScoreSpec, i: int, room: float) -> None:
-    """DesignError naming what makes the groove at least ``room`` mm wide at the face, with its own limit:
-    a U's width, a V's angle, a pressure-sensitive groove's slot (when it alone is too wide) or angle."""
-    w = f"[[tooling.score]] {i}"
-    flank = {"v": s.depth_mm, "pressure_sensitive": 2.0 * s.depth_mm / 3.0}.get(s.profile)  # a flank's depth
-    if s.profile == "u" or (s.profile == "pressure_sensitive" and s.slot_width_mm >= room):
-        key = "width_mm" if s.profile == "u" else "slot_width_mm"
-        raise DesignError(f"{w} {key}", getattr(s, key), f"must be < {room:.4g} mm, half the tablet's width (the "
-                          "groove's width at the face)", "mm")
-    slot = s.slot_width_mm if s.profile == "pressure_sensitive" else 0.0
-    most = 2.0 * math.degrees(math.atan(0.5 * (room - slot) / flank))
-    raise DesignError(f"{w} angle_deg", s.angle_deg, f"must be < {most:.4g} deg: the groove, {groove_width(s):.4g} mm "
-                      f"wide at the face, must be narrower than half the tablet's width, {room:.4g} mm", "deg")
 
 
 def score_footprints(frame: TabletFrame, s: ScoreSpec) -> list:

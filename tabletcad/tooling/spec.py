@@ -111,6 +111,132 @@ def tip_inset(clearance_mm: float, bore_offset_mm: float) -> float:
 #: figure's engraving in it): a 0.9 mm tip on a 0.9 mm cup had been built with nothing behind the cup's centre
 MIN_TIP_BACKING_MM = 1.0
 
+#: how far (mm) a standard score's groove stays shallower than its cup: it runs out on the face
+RUN_OUT_MARGIN_MM = 0.005
+
+
+def band_heights(tablet: Any) -> tuple[float, float]:
+    """The (bottom, top) heights (mm) of the band of ``tablet`` (a :class:`~tabletcad.geometry.tablet.Tablet`), the
+    cylindrical side wall the die forms: an industry family's nominal ``band_z``, else the band patch the tablet
+    finds (:meth:`~tabletcad.geometry.tablet.Tablet.band`).  A :class:`DesignError` for a tablet with none (a
+    sphere, a spheroid): no pair of punches in a die makes it."""
+    band_z = getattr(tablet.nominal, "band_z", None)
+    if band_z is None:
+        found = tablet.band()
+        band_z = None if found is None else (found.z0, found.z1)
+    if band_z is None or not band_z[1] - band_z[0] > 1e-6:
+        raise DesignError("[tooling]", tablet.family,
+                          "tooling needs a tablet with a band (a cylindrical side wall the die forms); this one has none")
+    return float(band_z[0]), float(band_z[1])
+
+
+def groove_width(s: ScoreSpec) -> float:
+    """The score's groove width at the face (mm) where it is ``depth_mm`` deep."""
+    t = math.tan(math.radians(0.5 * s.angle_deg))
+    return {"v": 2 * s.depth_mm * t, "u": s.width_mm,
+            "pressure_sensitive": s.slot_width_mm + 2 * (2 * s.depth_mm / 3) * t}[s.profile]
+
+
+def check_clearance(spec: ToolingSpec, narrow: float, bore_offset_mm: float) -> None:
+    """The punch tips, inset by the clearance (:func:`tip_inset`), keep at least half the tablet's ``narrow``
+    (mm) plan width; a :class:`DesignError` naming ``clearance_mm`` else."""
+    if not tip_inset(spec.clearance_mm, bore_offset_mm) <= 0.25 * narrow:  # (a trial: 1 mm on a 2 mm round failed in
+        # OCC's offset of the outline by -3.54 mm, a figure of its own scaling; 0.7 mm on 1.5 mm built a 0.1 mm tip)
+        raise DesignError("[tooling] clearance_mm", spec.clearance_mm,
+                          f"must leave the punch tips at least half the tablet's {narrow:.4g} mm width: at most "
+                          f"{0.25 * narrow - tip_inset(0.0, bore_offset_mm):.4g} mm", "mm")
+
+
+def check_gap(spec: ToolingSpec, band: float) -> None:
+    """The punch gap is at least the ``band`` (mm), the closed position; a :class:`DesignError` else."""
+    if spec.gap_mm is not None and spec.gap_mm < band - 1e-9:
+        raise DesignError("[tooling] gap_mm", spec.gap_mm, f"must be >= the band {band:.4g} mm (the closed position)", "mm")
+
+
+def check_score_size(s: ScoreSpec, i: int, cups: dict[str, float], band: float, room: float) -> None:
+    """Score ``i``'s depth against the cup depth of each face it is on (``cups``: face -> mm) and the ``band``,
+    and its width at the face against ``room`` (mm, half the tablet's plan width); a :class:`DesignError` else."""
+    w = f"[[tooling.score]] {i} depth_mm"
+    for face in s.face_list:
+        cup = cups[face]
+        if s.cut_through or s.length_mm is not None:
+            limit = cup + 0.25 * band
+            if s.depth_mm > limit:
+                raise DesignError(w, s.depth_mm, f"must be <= cup depth + band/4 = {limit:.4g} mm on the {face} face "
+                                  "(a cut-through or short score must leave half the band)", "mm")
+        elif s.depth_mm > cup - RUN_OUT_MARGIN_MM:
+            raise DesignError(w, s.depth_mm, f"must be < the {face} cup depth {cup:.4g} mm minus {RUN_OUT_MARGIN_MM} mm "
+                              "(a standard score runs out on the face; set cut_through = true to cut the band)", "mm")
+    if groove_width(s) >= room:  # (a depth within its bounds): a V of 179.9 deg was a 687 mm wide "score"
+        _refuse_wide(s, i, room)
+
+
+def _refuse_wide(s: ScoreSpec, i: int, room: float) -> None:
+    """DesignError naming what makes the groove at least ``room`` mm wide at the face, with its own limit:
+    a U's width, a V's angle, a pressure-sensitive groove's slot (when it alone is too wide) or angle."""
+    w = f"[[tooling.score]] {i}"
+    flank = {"v": s.depth_mm, "pressure_sensitive": 2.0 * s.depth_mm / 3.0}.get(s.profile)  # a flank's depth
+    if s.profile == "u" or (s.profile == "pressure_sensitive" and s.slot_width_mm >= room):
+        key = "width_mm" if s.profile == "u" else "slot_width_mm"
+        raise DesignError(f"{w} {key}", getattr(s, key), f"must be < {room:.4g} mm, half the tablet's width (the "
+                          "groove's width at the face)", "mm")
+    slot = s.slot_width_mm if s.profile == "pressure_sensitive" else 0.0
+    most = 2.0 * math.degrees(math.atan(0.5 * (room - slot) / flank))
+    raise DesignError(f"{w} angle_deg", s.angle_deg, f"must be < {most:.4g} deg: the groove, {groove_width(s):.4g} mm "
+                      f"wide at the face, must be narrower than half the tablet's width, {room:.4g} mm", "deg")
+
+
+def check_emboss_depth(e: EmbossSpec, i: int, cup: float, band: float) -> None:
+    """Figure ``i``, debossed into the tablet or raised on it (cut as deep into the punch), is at most its face's
+    ``cup`` depth + a quarter of the ``band`` (mm) deep; a :class:`DesignError` else."""
+    limit = cup + 0.25 * band
+    if e.depth_mm > limit:
+        raise DesignError(f"[[tooling.emboss]] {i} depth_mm", e.depth_mm, f"must be <= cup depth + band/4 = {limit:.4g} mm",
+                          "mm")
+
+
+def check_tip_lengths(spec: ToolingSpec, cups: dict[str, float]) -> None:
+    """Each tip at least as long as its face is deep (the cup, ``cups``: face -> mm, and a raised figure's
+    engraving) plus :data:`MIN_TIP_BACKING_MM`; a :class:`DesignError` else."""
+    for name, tl, face in (("tip_length_mm", spec.tip_length_mm, "top"), ("lower_tip_length_mm", spec.lower_tip, "bottom")):
+        cup = cups[face]
+        raised = max((e.depth_mm for e in spec.emboss if e.face == face and e.mode == "emboss"), default=0.0)
+        need = cup + raised + MIN_TIP_BACKING_MM
+        if not tl >= need:
+            raise DesignError(f"[tooling] {name}", tl, f"must be >= {need:.4g} mm: the {face} face is {cup + raised:.4g} mm "
+                              f"deep and the tip keeps {MIN_TIP_BACKING_MM:g} mm of steel behind it", "mm")
+
+
+def check_numbers(spec: ToolingSpec, *, band_z: tuple[float, float], z_range: tuple[float, float], length: float,
+                  width: float, bore_offset_mm: float) -> None:
+    """Every check of ``spec`` against the tablet that needs only its numbers (mm: the band's heights ``band_z``,
+    its lowest and highest points ``z_range``, its plan ``length`` and ``width``, the die bore's offset), in the
+    order the tooling meets them: the clearance, the gap, each score's depth and width, each figure's depth, the
+    tips' lengths.  :func:`check_on_tablet` runs it on the PDE tablet before any geometry (``report``,
+    ``build``, a sweep's rows), :func:`tabletcad.tooling.toolset.check_on_frame` on the solid's frame."""
+    band = band_z[1] - band_z[0]
+    cups = {"top": z_range[1] - band_z[1], "bottom": band_z[0] - z_range[0]}
+    check_clearance(spec, min(length, width), bore_offset_mm)
+    check_gap(spec, band)
+    room = 0.5 * min(length, width)
+    for i, s in enumerate(spec.scores):
+        check_score_size(s, i, cups, band, room)
+    for i, e in enumerate(spec.emboss):
+        check_emboss_depth(e, i, cups[e.face], band)
+    check_tip_lengths(spec, cups)
+
+
+def check_on_tablet(tablet: Any, spec: ToolingSpec) -> None:
+    """:func:`check_numbers` on the PDE ``tablet`` (a :class:`~tabletcad.geometry.tablet.Tablet`): its band
+    (:func:`band_heights`: a tablet without one is refused), its extents and plan overhang, which are the
+    tooling frame's (:func:`tabletcad.tooling.outline.tablet_frame`).  No solid is built."""
+    band_z = band_heights(tablet)
+    lo, hi = tablet.bounds()
+    overhang = tablet.plan_overhang() if tablet.band() is not None else 0.0
+    check_numbers(spec, band_z=band_z, z_range=(float(lo[2]), float(hi[2])), length=float(hi[0] - lo[0]),
+                  width=float(hi[1] - lo[1]), bore_offset_mm=bore_offset(overhang))
+
+
 #: TSM die blanks: (outer diameter, height, type), mm; the largest tablet each takes, round and shaped,
 #: is the standard's (``max_round_tablet_mm``, ``max_shaped_tablet_mm`` in tabletcad/data/tooling_standards.toml)
 TSM_DIES = ((30.16, 22.22, "B"), (38.10, 23.81, "D"))
@@ -304,7 +430,7 @@ def _tolerance(name: str, value: Any, unit: str) -> float | tuple[float, float]:
 MAX_LIMIT_DEVIATION = 10.0
 
 
-def _one_line(text: str) -> bool:
+def printable_line(text: str) -> bool:
     """No control, format, private or unassigned character and no line or paragraph separator
     (spaces of every width, such as a no-break space, are text)."""
     import unicodedata
@@ -347,7 +473,7 @@ def _drawing(t: Any) -> DrawingSpec:
             v = t[k]
             if not isinstance(v, (str, int, float)) or isinstance(v, bool) or not str(v).strip():
                 raise DesignError(f"{w} {k}", v, "must be a non-empty string")
-            if not _one_line(str(v)):  # a line break or a NUL would leave its line in the title block
+            if not printable_line(str(v)):  # a line break or a NUL would leave its line in the title block
                 raise DesignError(f"{w} {k}", v, "must be printable text on one line (no control characters)")
             if len(str(v)) > TITLE_MAX_CHARS[k]:
                 raise DesignError(f"{w} {k}", v, f"must be at most {TITLE_MAX_CHARS[k]} characters (the title block's room)")
@@ -544,7 +670,7 @@ def _emboss(i: int, t: Any, base: Path | None = None) -> EmbossSpec:
     stroke = t.get("stroke_angle_deg", t.get("draft_deg", d.draft_deg))
     if text is not None and (not isinstance(text, str) or not text.strip()):
         raise DesignError(f"{w} text", text, "must be a non-empty string")
-    if text is not None and not _one_line(text):  # a NUL or a line break is no glyph
+    if text is not None and not printable_line(text):  # a NUL or a line break is no glyph
         raise DesignError(f"{w} text", text, "must be printable text on one line (no control characters)")
     if text is not None and len(text) > MAX_EMBOSS_CHARS:  # (whether it fits the face is checked on the face)
         raise DesignError(f"{w} text", text, f"must be at most {MAX_EMBOSS_CHARS} characters")

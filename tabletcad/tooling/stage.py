@@ -21,7 +21,7 @@ from typing import Any, Callable
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.designreport import ReportOptions
-from tabletcad.tooling.spec import ToolingSpec
+from tabletcad.tooling.spec import ToolingSpec, band_heights, check_on_tablet
 
 __all__ = ["check_tooling", "tooling_outputs", "tooling_stage", "write_tooling", "write_finished_tablet"]
 
@@ -38,8 +38,11 @@ def tooling_outputs(spec: ToolingSpec) -> list[str]:
 
 
 def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
-    """Refuse a tablet that cannot have tooling (a cut-away or a ring, one too large for its die or for every
-    TSM die when no die is given), before any geometry is built.
+    """Refuse a tablet that cannot have tooling (a cut-away or a ring, one without a band, one too large for its
+    die or for every TSM die when no die is given) and a ``[tooling]`` table its numbers refuse (a score or a
+    figure deeper than its face allows, a groove wider than half the tablet, a clearance, gap or tip length:
+    :func:`~tabletcad.tooling.spec.check_on_tablet`), before any geometry is built: ``report`` and ``build``
+    refuse alike, in a second where the tooling stage had refused after the solid was built.
 
     ``spec`` is the design's checked ``[tooling]`` table
     (:attr:`tabletcad.pipeline.design.Design.tooling_spec`); raises :class:`DesignError`.
@@ -47,6 +50,7 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
     t = tablet.trim
     if t.u != (0.0, 1.0) or not t.full_v or t.w[0] > 0:
         raise DesignError("[tooling]", tablet.name, "tooling needs a whole solid tablet (no [trim], no ring)")
+    band_heights(tablet)  # (a sphere has no band for the die to form)
     od = spec.die_outer_diameter_mm
     if od is None:  # the TSM die the build will take: one larger than a 'D' takes is refused here, not after the CAD
         from tabletcad.tooling.spec import standard_die_size
@@ -65,6 +69,7 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
             raise DesignError("[tooling] die_outer_diameter_mm", od,
                               f"must be >= {2 * (reach + MIN_DIE_WALL_MM):.4g} mm (the tablet reaches {reach:.4g} mm "
                               f"from the axis, the die's walls need {MIN_DIE_WALL_MM} mm)", "mm")
+    check_on_tablet(tablet, spec)
 
 
 def write_tooling(ts, out: Path, *, drawing: bool = True) -> list[Path]:

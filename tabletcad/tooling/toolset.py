@@ -16,7 +16,7 @@ from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.designreport import ReportOptions
 from tabletcad.tooling.booleans import CACHE, TIMER, to_manifold, volume
 from tabletcad.tolerance import DEFAULT
-from tabletcad.tooling.spec import MIN_TIP_BACKING_MM, ToolingSpec
+from tabletcad.tooling.spec import ToolingSpec, check_numbers
 
 __all__ = ["ToolSet", "make_tooling", "check_closed_position", "finished_solid", "DEFLECTION_MM"]
 
@@ -74,19 +74,13 @@ def check_on_frame(frame, spec: ToolingSpec) -> list:
     from tabletcad.tooling.emboss import check_emboss
     from tabletcad.tooling.scores import check_score
 
-    narrow = min(frame.length, frame.width)
-    if not frame.tip_inset(spec.clearance_mm) <= 0.25 * narrow:  # (a trial: 1 mm on a 2 mm round failed in OCC's
-        # offset of the outline by -3.54 mm, a figure of its own scaling; 0.7 mm on 1.5 mm built a 0.1 mm tip)
-        raise DesignError("[tooling] clearance_mm", spec.clearance_mm,
-                          f"must leave the punch tips at least half the tablet's {narrow:.4g} mm width: at most "
-                          f"{0.25 * narrow - frame.tip_inset(0.0):.4g} mm", "mm")
-    gap_closed = frame.band
-    if spec.gap_mm is not None and spec.gap_mm < gap_closed - 1e-9:
-        raise DesignError("[tooling] gap_mm", spec.gap_mm, f"must be >= the band {gap_closed:.4g} mm (the closed position)", "mm")
+    # the checks of numbers alone (clearance, gap, scores' and figures' depths, tips' lengths), as
+    # tabletcad.tooling.stage.check_tooling runs them on the PDE tablet before any geometry
+    check_numbers(spec, band_z=frame.band_z, z_range=(frame.z_min, frame.z_max), length=frame.length,
+                  width=frame.width, bore_offset_mm=frame.bore_offset)
     for i, s in enumerate(spec.scores):  # fail on bad input before any Boolean
         check_score(frame, s, i)
     emb_checked = [check_emboss(frame, e, spec.clearance_mm, i) for i, e in enumerate(spec.emboss)]
-    _check_tip_lengths(frame, spec)  # (after the figures' own limits: a figure too tall is named as the figure)
     _warn_crossings(frame, spec, emb_checked)
     _warn_sharp_edge(frame, spec.clearance_mm)
     if spec.clearance_mm == 0.0:  # allowed (a model of the nominal fit), but no punch runs in its die so
@@ -135,18 +129,6 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
                              " (not given, it is tip_length_mm: give lower_tip_length_mm)"), "mm")
 
 
-
-
-def _check_tip_lengths(frame, spec: ToolingSpec) -> None:
-    """Each tip at least as long as its face is deep (the cup, and a raised figure's engraving) plus
-    :data:`~tabletcad.tooling.spec.MIN_TIP_BACKING_MM`, as a DesignError before any geometry."""
-    for name, tl, face, cup in (("tip_length_mm", spec.tip_length_mm, "top", frame.cup_depth_top),
-                                ("lower_tip_length_mm", spec.lower_tip, "bottom", frame.cup_depth_bottom)):
-        raised = max((e.depth_mm for e in spec.emboss if e.face == face and e.mode == "emboss"), default=0.0)
-        need = cup + raised + MIN_TIP_BACKING_MM
-        if not tl >= need:
-            raise DesignError(f"[tooling] {name}", tl, f"must be >= {need:.4g} mm: the {face} face is {cup + raised:.4g} mm "
-                              f"deep and the tip keeps {MIN_TIP_BACKING_MM:g} mm of steel behind it", "mm")
 
 
 def _warn_crossings(frame, spec: ToolingSpec, emb_checked: list) -> None:
