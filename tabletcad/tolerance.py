@@ -79,8 +79,9 @@ class Tolerances:
         that one command may plan to use; a mesh estimated larger is refused
         before it is allocated.
     mesh_bytes_per_node : int
-        Peak memory (bytes) of a hexahedral mesh per node, for that estimate
-        (measured: ~170 bytes per node from ``tabletcad mesh`` at 2e5-8e5 nodes).
+        Peak memory (bytes) of a mesh per node, for that estimate (measured on 2026-12-06: 151-155
+        bytes per node from ``tabletcad mesh samples/spherical.toml`` with two layers at 1.3e6-2.9e6
+        nodes, 253-281 for hexahedral meshes of 10 and 40 layers at 1.8e6-3.5e6 nodes).
     offset_regularity : float
         Relative margin kept below a smooth (spline) outline's smallest radius of
         curvature by the inward offsets of a cup: at exactly that radius the offset
@@ -123,7 +124,7 @@ class Tolerances:
     max_length: float = 1000.0
     min_length: float = 1e-3
     memory_fraction: float = 0.5
-    mesh_bytes_per_node: int = 200
+    mesh_bytes_per_node: int = 300
     offset_regularity: float = 1e-2
     mesh_deflection: float = 0.005
     mesh_angle: float = 0.2

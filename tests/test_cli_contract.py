@@ -215,8 +215,8 @@ def test_mesh_refused_by_memory_budget_before_allocating(capsys, tmp_path):
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
     line = assert_refused(rc, err, "--nodes")
-    # 2 patches x 2000^3 nodes x 200 bytes = 3.2e12 bytes = 2980 GiB
-    assert "2.98e+03 GiB" in line and "1.6e+10 nodes (2 patches)" in line
+    # 2 patches x 2000^3 nodes x 300 bytes = 4.8e12 bytes = 4470 GiB
+    assert "4.47e+03 GiB" in line and "1.6e+10 nodes (2 patches)" in line
     assert peak < 200 * 2**20  # nothing close to the mesh was allocated
     assert list(tmp_path.iterdir()) == []
 
@@ -225,10 +225,10 @@ def test_memory_budget_scales_with_available_memory(monkeypatch):
     from tabletcad.cli import geometry
 
     monkeypatch.setattr(geometry, "available_memory", lambda: 10_000_000)  # 10 MB
-    geometry._check_mesh_memory((10, 10, 10), 3)  # 3000 nodes x 200 B = 0.6 MB <= 5 MB
+    geometry._check_mesh_memory((10, 10, 10), 3)  # 3000 nodes x 300 B = 0.9 MB <= 5 MB
     with pytest.raises(DesignError) as ei:
-        geometry._check_mesh_memory((30, 30, 30), 3)  # 81000 nodes x 200 B = 16.2 MB > 5 MB
-    assert ei.value.parameter == "--nodes" and "below 8.33e+03" in ei.value.allowed  # 5e6 / (200 * 3)
+        geometry._check_mesh_memory((30, 30, 30), 3)  # 81000 nodes x 300 B = 24.3 MB > 5 MB
+    assert ei.value.parameter == "--nodes" and "below 5.56e+03" in ei.value.allowed  # 5e6 / (300 * 3)
 
 
 def test_shapes_marks_required_and_optional_and_prints_whole_descriptions(capsys):
