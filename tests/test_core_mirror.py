@@ -8,9 +8,12 @@ report's integrals, the builder's fold check) is compared here with the same che
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import glob
+import math
 import os
+import pickle
 
 import numpy as np
 import pytest
@@ -110,3 +113,44 @@ def test_no_mirror_without_the_builders_word_or_on_a_trimmed_solid():
 def test_a_thesis_shape_has_no_mirror_word():
     t = FAMILIES["thesis.flat_faced_round"].build()
     assert t.mirror() is None and t.measured() == list(range(len(t.patches)))
+
+
+class _Bumped:
+    """A datum plus ``eps sin(S v)`` in z: zero at the ``S`` samples a patch's series is taken from."""
+
+    def __init__(self, base, S: int, eps: float) -> None:
+        self.base, self.S, self.eps = base, S, eps
+
+    def evaluate(self, v, der: int = 0):
+        v = np.asarray(v, dtype=float).reshape(-1)
+        out = np.array(self.base.evaluate(v, der), dtype=float)
+        out[:, 2] += self.eps * self.S**der * np.sin(self.S * v + der * math.pi / 2)
+        return out
+
+
+def test_other_patches_with_a_familys_nominal_are_not_vouched_for():
+    # the series of a patch does not show all of its data (the remainder reads the curves anywhere): a top
+    # plateau whose derivative datum gains a ripple vanishing at the series' samples has the same
+    # coefficients as its twin's reflection, and a surface 1.3 µm off (a review's case)
+    t = FAMILIES["oval"].build(length=14.0, width=8.0, end_radius=3.0, band=3.0, cup_depth=0.9)
+    top = t.patches[-1]
+    X0, X1, U0, U1 = top.data
+    S = top.tol.samples
+    bumped = dataclasses.replace(top, data=(X0, X1, _Bumped(U0, S, 0.02), U1))
+    assert bumped.mirrors(t.patches[0], t.mirror()[0])  # what the series shows
+    u, v = np.linspace(0.0, 1.0, 9), np.linspace(0.0, 6.0, 7)
+    assert float(np.max(np.abs(bumped.evaluate_grid(u, v) - top.evaluate_grid(u, v)))) > 1e-3
+    changed = dataclasses.replace(t, patches=t.patches[:-1] + (bumped,))
+    assert changed.mirror() is None
+    full = _unmirrored(changed)
+    assert changed.properties()["surface_area_mm2"] == full.properties()["surface_area_mm2"]
+    assert changed.bounds()[1][2] == full.bounds()[1][2] > t.bounds()[1][2] + 1e-3
+
+
+def test_copies_keep_the_mirror_and_hollow_solids_have_none():
+    t = FAMILIES["capsule"].build()
+    for other in (copy.deepcopy(t), pickle.loads(pickle.dumps(t)), dataclasses.replace(t, name="renamed")):
+        assert other.mirror() == t.mirror()
+        assert other.properties()["volume_mm3"] == pytest.approx(t.properties()["volume_mm3"], rel=1e-15)
+    hollow = t.trimmed(w=(0.5, 1.0))
+    assert hollow.mirror() is None and hollow.measured() == list(range(len(t.patches)))

@@ -17,8 +17,12 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tabletcad.errors import DesignError
+from tabletcad.families.outline import PlanOutline
+from tabletcad.geometry.curves import Seg
 from tabletcad.families import outline_tablet
 from tabletcad.families.outline import outline_from_items, rounded_rectangle_outline, stadium_outline
 
@@ -132,3 +136,43 @@ def test_flat_peanut_builds_through_the_cli_with_the_prism_area(tmp_path, capsys
     assert abs(rep["brep"]["volume_mm3"]) == pytest.approx(volume, rel=2e-7)
     assert rep["mesh"]["watertight"] is True and rep["mesh"]["genus"] == 0
     assert np.isfinite(rep["brep"]["fit_max_deviation_mm"])
+
+
+def _rounded_polygon(corners, r: float, turns: int) -> list:
+    """Lines and fillet arcs of radius ``r`` round the polygon ``corners`` (either way round); each
+    arc's start angle moved by ``turns`` whole turns (spans stored past ±π)."""
+    n, fillets = len(corners), []
+    for i in range(n):
+        A, B, C = (np.array(corners[k % n], dtype=float) for k in (i - 1, i, i + 1))
+        d1, d2 = (B - A) / np.linalg.norm(B - A), (C - B) / np.linalg.norm(C - B)
+        phi = math.atan2(d1[0] * d2[1] - d1[1] * d2[0], float(d1 @ d2))
+        t = r * math.tan(abs(phi) / 2.0)
+        T1, T2 = B - d1 * t, B + d2 * t
+        centre = T1 + r * np.array([-d1[1], d1[0]]) * math.copysign(1.0, phi)
+        theta0 = math.atan2(T1[1] - centre[1], T1[0] - centre[0]) + turns * math.tau
+        fillets.append((T2, Seg.arc(tuple(centre), r, theta0, phi)))
+    segs = []
+    for i in range(n):
+        segs += [fillets[i][1], Seg.line(tuple(fillets[i][0]), tuple(fillets[(i + 1) % n][1].point(0.0)))]
+    return segs
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.tuples(st.floats(0.0, math.tau), st.floats(3.0, 8.0)), min_size=3, max_size=8,
+                unique_by=lambda p: round(p[0], 2)),
+       st.floats(0.3, 2.0), st.integers(-1, 1), st.booleans())
+def test_star_limit_in_closed_form_equals_the_sampled_search_on_random_outlines(polar, r, turns, clockwise):
+    # star-shaped and not (a negative limit), convex and concave fillets, either orientation
+    polar = sorted(polar)
+    corners = [(rho * math.cos(a), rho * math.sin(a)) for a, rho in polar]
+    try:
+        ol = PlanOutline(_rounded_polygon(corners[::-1] if clockwise else corners, r, turns))
+    except (DesignError, ValueError, ZeroDivisionError):  # fillets that overlap, corners too close
+        return
+    assert ol._star_limit_of_segments() == pytest.approx(ol._star_limit_sampled(), abs=1e-9)
+
+
+@pytest.mark.parametrize("theta0, sweep", [(0.0, math.tau), (5.0, math.tau), (-7.0, -math.tau)])
+def test_star_limit_of_a_circle_anywhere_is_its_radius(theta0, sweep):
+    ol = PlanOutline([Seg.arc((1.3, -2.0), 4.0, theta0, sweep)])
+    assert ol._star_limit_of_segments() == pytest.approx(4.0, abs=1e-12) == ol._star_limit_sampled()

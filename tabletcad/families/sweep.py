@@ -232,6 +232,8 @@ class SweepNominal:
         #: the plane ``z`` (mm) in which the builder made the lower face's patches as mirror images
         #: of the upper face's (:meth:`~tabletcad.geometry.tablet.Tablet.mirror`), or None
         self.mirror_z: float | None = None
+        #: the patches that statement is about (held, so that their identity is checked, not their ids)
+        self.mirror_patches: tuple = ()
         # face heights as functions of d (the faces are graphs over d)
         self._dz_top = _graph(self.top, d_far)
         self._dz_bot = _graph(self.bottom[::-1], d_far, reverse=True)
@@ -478,6 +480,7 @@ def build_sweep_tablet(
             patches.append(mk((q, pole, du_in, du_in), "plateau"))
     nom.expected_sharp = expected
     nom.mirror_z = zm  # the bottom's elements are the top's mirrored in z = zm, and so are their patches
+    nom.mirror_patches = tuple(patches)  # (these patches: another tablet with this nominal is not vouched for)
     nom.top_patch_range = (top_start, len(patches))
     tablet = Tablet(tuple(patches), name=name, family=family, params=dict(params), nominal=nom,
                     nominal_name=f"{family} (profile swept along outline offsets)", tol=tol)

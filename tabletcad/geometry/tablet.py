@@ -362,18 +362,21 @@ class Tablet:
         else None.  Patch ``i`` is then patch ``twin[i] = n - 1 - i`` reflected with ``u`` reversed
         (:meth:`PDEPatch.mirrors`; the middle patch of an odd chain, a band, its own twin).
 
-        Only a whole solid (no trim) whose nominal says its patches were built so
-        (``nominal.mirror_z``: a swept family's lower face is its upper one reflected) and whose
-        patches' series confirm it.  The checks then measure the patches ``i <= twin[i]`` and give
+        Only a whole solid (no trim) whose nominal says these very patches were built so
+        (``nominal.mirror_z`` and ``nominal.mirror_patches``: a swept family's lower face is its upper
+        one reflected; a tablet given other patches with that nominal is not vouched for, since a
+        patch's series does not show all of its data curves) and whose patches' series confirm it.  The checks then measure the patches ``i <= twin[i]`` and give
         each twin its patch's figure, reflected (:meth:`measured`).  Cached.
         """
         hit = self.__dict__.get("_mirror", ())
         if hit != ():
             return hit
         z0 = getattr(self.nominal, "mirror_z", None)
+        made = getattr(self.nominal, "mirror_patches", ())
         n = len(self.patches)
         out = None
-        if z0 is not None and self.trim.whole:
+        built = len(made) == n and all(a is b for a, b in zip(made, self.patches))
+        if z0 is not None and built and self.trim.whole:
             twin = tuple(n - 1 - i for i in range(n))
             if all(self.patches[i].mirrors(self.patches[j], float(z0)) for i, j in enumerate(twin) if j <= i):
                 out = (float(z0), twin)
