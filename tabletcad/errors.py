@@ -22,6 +22,7 @@ __all__ = [
     "check_finite",
     "check_positive",
     "check_range",
+    "format_bound",
     "is_number",
     "one_token",
     "reraise_interrupt",
@@ -229,7 +230,7 @@ def _fmt(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"  # as TOML writes them
     if isinstance(value, float):
-        return f"{value:.6g}"
+        return _short(value)
     if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**15:
         digits = int(value.bit_length() * math.log10(2))  # str() of a huge int may be refused
         digits += 10**digits <= abs(value)
@@ -242,6 +243,33 @@ def _fmt(value: Any) -> str:
         text = " ".join(str(value).split())  # one line, whatever the value holds
     # whole up to 200 characters (a path in a temporary or nested folder), else its start and end
     return text if len(text) <= 200 else f"{text[:150]}...{text[-40:]}"
+
+
+def _short(x: float) -> str:
+    """``x`` to 6 significant digits, or as typed when those change it (1000.001, not 1000, refused
+    by a limit of 1000) and it has at most 12 (a computed value keeps 6)."""
+    for n in range(6, 13):
+        text = f"{x:.{n}g}"
+        if float(text) == x:
+            return text
+    return f"{x:.6g}"
+
+
+def format_bound(x: float, upper: bool, digits: int = 6) -> str:
+    """``x`` as the end of an allowed range in a refusal: exactly when at most 12 significant
+    digits give it, else to ``digits`` digits rounded into the range (down for an upper end, up for
+    a lower one), so that every value the stated range holds is accepted (a corner radius
+    ``< 3.17543`` for a limit of 3.1754265 had refused 3.175428)."""
+    text = _short(x)
+    if not math.isfinite(x) or float(text) == x:
+        return text
+    step = 10.0 ** (math.floor(math.log10(abs(x))) - digits + 1)
+    inward = math.floor(x / step) if upper else math.ceil(x / step)
+    y = inward * step
+    text = f"{y:.{digits}g}"
+    if (float(text) > x) if upper else (float(text) < x):  # (the product's rounding)
+        text = f"{(inward - 1 if upper else inward + 1) * step:.{digits}g}"
+    return text
 
 
 def check_finite(name: str, value: float, unit: str = "") -> float:
@@ -291,8 +319,8 @@ def check_range(
     if bad:
         parts = []
         if lo is not None:
-            parts.append(f"{'>' if lo_open else '>='} {lo:g}")
+            parts.append(f"{'>' if lo_open else '>='} {format_bound(lo, upper=False)}")
         if hi is not None:
-            parts.append(f"{'<' if hi_open else '<='} {hi:g}")
+            parts.append(f"{'<' if hi_open else '<='} {format_bound(hi, upper=True)}")
         raise DesignError(name, value, "must be " + " and ".join(parts) + (f" {unit}" if unit else ""), unit)
     return x

@@ -82,7 +82,7 @@ FLAT = '[tablet]\nfamily = "thesis.flat_faced_round"\nthickness = 6.0\n'
         ('[tablet]\nfamily = "custom_outline"\noutline = [[0, 0], [1e300, 0], [0, 5]]\nband = 2.0\ncup_depth = 0.3\n',
          "tablet.outline[1][0]", "within ±1000 mm"),
         ('[tablet]\nfamily = "free_form"\n[[patch]]\ncurves = [{type = "circle", radius = 1.0, z = false}, "previous", '
-         '"previous", "previous"]\n', "patch[0].curves[0].center", "not numbers"),
+         '"previous", "previous"]\n', "patch[0].curves[0].z", "not numbers"),  # the key given (it had said center)
         (FLAT + 'diameter = 10.0\n"bad key" = 1\n', "tablet.bad.key", "takes diameter, thickness"),
         ("[tablet]\nfamily = 3\n", "tablet.family", "must be one of"),
     ],

@@ -20,7 +20,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tabletcad.errors import DesignError
+from tabletcad.errors import DesignError, format_bound
 from tabletcad.families.outline import PlanOutline
 from tabletcad.geometry.curves import Seg
 from tabletcad.families import outline_tablet
@@ -98,7 +98,7 @@ def test_cup_width_beyond_the_star_limit_is_refused():
     with pytest.raises(DesignError) as err:
         outline_tablet(segs, band=BAND, cup_depth=0.0, cup_width=1.01 * star)  # below the waist's 2.8135 mm
     assert err.value.parameter == "cup_width"
-    assert f"must be <= {star:.6g} mm" in str(err.value) and "fold" in str(err.value)
+    assert f"must be <= {format_bound(star, upper=True)} mm" in str(err.value) and "fold" in str(err.value)
 
 
 def test_sweep_builder_refuses_a_plateau_rim_beyond_the_star_limit():

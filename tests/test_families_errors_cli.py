@@ -32,7 +32,9 @@ from tabletcad.families.outline import four_arc_oval, stadium_outline
         # as wide as long: a circle, whose end arcs vanish (it was refused as "outline = 'segment 0 of length 0'")
         (lambda: F.oval(8, 8, 3.0), "width", "must be < length = 8 mm for ends of radius 3 mm"),
         (lambda: F.almond(8, 8, 1.0), "width", "must be < length = 8 mm for ends of radius 1 mm"),
-        (lambda: F.modified_capsule(18, 8, side_radius=5.0), "side_radius", "> length/2"),
+        # the true limit: an end radius of Tolerances.min_length, just above (L² + W²)/(4 W) = 12.125 mm where the
+        # ends vanish (it had said "> length/2 = 9 mm")
+        (lambda: F.modified_capsule(18, 8, side_radius=5.0), "side_radius", "must be >= 12.1258 mm"),
         (lambda: F.outline_tablet([[0, 0], [4, 4], [4, 0], [0, 4]]), "outline", "must not cross itself"),
         (lambda: F.outline_tablet([("line", (0, 0), (4, 0)), ("line", (4, 0), (4, 4)), ("line", (4, 4), (0, 0))]), "outline", "tangent-continuous"),
         (lambda: F.concave_round(-10, 3, 1), "diameter", "> 0"),
@@ -99,15 +101,14 @@ BAD = {
 }
 
 
-def test_cup_width_leaving_too_narrow_a_plateau_names_cup_width():
-    """A wide modified capsule cupped to its corner radius (the default) leaves a flat centre too
-    narrow to split: refused naming cup_width and the corner radius; just below it builds."""
-    with pytest.raises(DesignError) as err:
-        F.modified_capsule(length=15.875, width=11.376, cup_depth=0.476)
-    assert err.value.parameter == "cup_width" and "smallest corner radius" in str(err.value)
-    limit = float(str(err.value).split("must be < ")[1].split(" mm")[0])
-    t = F.modified_capsule(length=15.875, width=11.376, cup_depth=0.476, cup_width=0.99 * limit)
-    assert t.nominal.certificate.passed
+def test_cup_width_at_the_corner_radius_splits_a_narrow_plateau():
+    """A wide modified capsule cupped to its corner radius (the default) leaves a flat centre whose
+    rim's ends have collapsed; the plateau's inner curve shrinks until it fits (it had stopped at
+    λ = 0.1 and refused the default, naming cup_width): the default and the same width given build."""
+    t = F.modified_capsule(length=15.875, width=11.376, cup_depth=0.476)
+    r = t.nominal.outline.min_convex_radius
+    assert t.nominal.info["cup_width_mm"] == pytest.approx(r, rel=1e-12) and t.nominal.certificate.passed
+    assert F.modified_capsule(length=15.875, width=11.376, cup_depth=0.476, cup_width=r).nominal.certificate.passed
 
 
 @pytest.mark.parametrize("case", sorted(BAD))

@@ -31,7 +31,7 @@ SLIVERS = [
     (dict(family="ffbe", diameter=10.0, thickness=2.0001, bevel_angle=45, bevel_width=0.0, bevel_depth=1.0),
      "tablet.bevel_depth = 1 mm is not allowed: leaves a band of 0.0001 mm"),
     (dict(family="ffbe", diameter=10.0, thickness=4.0, bevel_angle=10, bevel_width=4.999999999),
-     "tablet.bevel_width = 5 mm is not allowed: leaves a flat face of 1e-09 mm"),
+     "tablet.bevel_width = 4.999999999 mm is not allowed: leaves a flat face of 1e-09 mm"),  # as given
     (dict(family="ffre", diameter=10.0, thickness=3.000000001, edge_radius=1.5),
      "tablet.edge_radius = 1.5 mm is not allowed: leaves a band of 1e-09 mm"),
     (dict(family="ffre", diameter=3.000000001, thickness=4.0, edge_radius=1.5),

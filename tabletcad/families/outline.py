@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from tabletcad.geometry.curves import Seg, nearest_of, signed_area
-from tabletcad.errors import DesignError, check_finite, check_positive, check_range
+from tabletcad.errors import DesignError, check_finite, check_positive, check_range, format_bound
 from tabletcad.tolerance import DEFAULT
 from tabletcad.geometry.quadrature import gauss_legendre
 
@@ -295,11 +295,12 @@ class PlanOutline:
         """Area centroid (mm), exact for lines and arcs."""
         sx = sy = 0.0
         for s in self.segs:
-            if s.kind == "line":
+            if s.kind == "line":  # the same integrals as the arcs' (the triangle fan's moments are another
+                # split of the total: mixed with the arcs' they had put a rounded triangle's centroid
+                # 0.068 mm off its centre at a corner radius of 3 mm on an 11 mm side)
                 (x0, y0), (x1, y1) = s.p0, s.p1
-                cr = x0 * y1 - x1 * y0
-                sx += (x0 + x1) * cr / 6.0
-                sy += (y0 + y1) * cr / 6.0
+                sx += (y1 - y0) * (x0 * x0 + x0 * x1 + x1 * x1) / 6.0
+                sy -= (x1 - x0) * (y0 * y0 + y0 * y1 + y1 * y1) / 6.0
             else:
                 # ∮ x² dy / 2 and -∮ y² dx / 2 over the arc, by Gauss-Legendre (exact to rounding)
                 xg, wg = gauss_legendre(24)
@@ -832,17 +833,33 @@ def four_arc_oval(length: float, width: float, end_radius: float) -> PlanOutline
 
 def four_arc_oval_from_side_radius(length: float, width: float, side_radius: float) -> PlanOutline:
     """Four-arc oval given its side radius (mm); the end radius follows from tangency:
-    ``r = (R_s W - (L² + W²)/4) / (2 R_s - L)``."""
+    ``r = (R_s W - (L² + W²)/4) / (2 R_s - L)``, and must be at least ``Tolerances.min_length``
+    like any length a design gives, so ``R_s >= ((L² + W²)/4 - m L) / (W - 2 m)``, ``m`` that length
+    (:func:`_side_radius_limit`)."""
     L = check_positive("length", length, "mm")
     W = check_positive("width", width, "mm")
+    if not W < L:  # (a side radius then gives ends of radius W/2 or more: no oval)
+        raise DesignError("width", W, f"must be < length = {L:g} mm for a modified capsule", "mm")
+    if not W > 2.0 * DEFAULT.min_length:  # (ends narrower than W/2 cannot reach the least length)
+        raise DesignError("width", W, f"must be > {2.0 * DEFAULT.min_length:g} mm for a modified capsule (its end "
+                          f"radius, below width/2, must be at least {DEFAULT.min_length:g} mm)", "mm")
     Rs = check_positive("side_radius", side_radius, "mm")
-    if Rs <= L / 2.0:
-        raise DesignError("side_radius", Rs, f"must be > length/2 = {L / 2:g} mm", "mm")
-    r = (Rs * W - (L * L + W * W) / 4.0) / (2.0 * Rs - L)
-    if not 0.0 < r < W / 2.0:
-        lo = (L * L + W * W) / (4.0 * W)
-        raise DesignError("side_radius", Rs, f"must be > {lo:.6g} mm for a {L:g} x {W:g} mm oval (end radius would be <= 0)", "mm")
+    lo = _side_radius_limit(L, W)
+    r = (Rs * W - (L * L + W * W) / 4.0) / (2.0 * Rs - L) if Rs > L / 2.0 else 0.0
+    if not (Rs >= lo and DEFAULT.min_length * (1.0 - 1e-9) <= r < W / 2.0):
+        raise DesignError("side_radius", Rs, f"must be >= {format_bound(lo, upper=False)} mm for a {L:g} x {W:g} mm "
+                          f"oval (its end radius would be below {DEFAULT.min_length:g} mm, Tolerances.min_length)",
+                          "mm")
     return four_arc_oval(L, W, r)
+
+
+def _side_radius_limit(length: float, width: float) -> float:
+    """The least side radius (mm) of a four-arc oval ``length`` × ``width`` (``2 m < width < length``)
+    whose end radius is ``Tolerances.min_length``: the side radius must be > ``(L² + W²)/(4 W)``, where
+    the ends vanish, and a few µm more (it had said "> length/2", refusing 9.51 mm for a 19 × 8.5 mm
+    oval with "> 12.7426 mm")."""
+    m = DEFAULT.min_length
+    return ((length * length + width * width) / 4.0 - m * length) / (width - 2.0 * m)
 
 
 def rounded_polygon(vertices, corner_radius: float, name: str = "polygon") -> PlanOutline:

@@ -4,8 +4,9 @@ The face at inward distance ``d`` from the outline is the outline offset by
 ``d`` (lines to lines, arcs to concentric arcs), raised to the cup profile's
 height ``z(d)``.  The cup runs from the land's inner edge to ``cup_width``
 (default: as far as the outline allows, i.e. its smallest convex corner radius
-or its inscribed radius), where it is horizontal; if the offsets have not
-closed there, a flat plateau finishes the face.  Offsets beyond the smallest
+or its inscribed radius, and at least ``Tolerances.min_length`` short of the
+centroid), where it is horizontal; if the offsets have not closed there, a flat
+plateau finishes the face.  Offsets beyond the smallest
 arc radius or the inscribed radius are refused with a DesignError naming
 ``cup_width``.
 
@@ -20,7 +21,7 @@ import math
 
 import numpy as np
 
-from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.errors import DesignError, check_positive, check_range, format_bound
 from tabletcad.families.cups import CompoundCup, land_line, single_radius_cup
 from tabletcad.families.outline import (
     PlanOutline,
@@ -87,7 +88,9 @@ def outline_tablet(
         Inward distance at which the cup becomes horizontal, mm; 0 takes the
         largest allowed (smallest convex corner radius or inscribed radius, and
         on an outline with a concave waist the centroid's distance to its nearest
-        tangent line, beyond which the flat centre would fold: :func:`_star_limit`).
+        tangent line, beyond which the flat centre would fold: :func:`_star_limit`;
+        a flat centre left is at least ``tol.min_length`` from the centroid to its
+        rim: :func:`_centre_limit`).
     central_radius, edge_radius : float
         Both > 0: a compound cup across the cup width (mm); both 0: single radius.
     reach : float, optional
@@ -102,16 +105,21 @@ def outline_tablet(
     if not ol._offset_is_clean(limit):
         limit = ol.offset_limit()
     star = _star_limit(ol, limit)
+    centre = _centre_limit(ol, limit, reach, tol)
     cw = check_range("cup_width", cup_width, 0.0, None, "mm")
     if cw == 0.0:
-        cw = min(limit, star)
-    if cw > limit * (1 + 1e-9):
-        raise DesignError("cup_width", cw, f"must be <= {limit:.6g} mm (the outline's smallest corner radius / inscribed radius: offsets beyond it are not offsets of the outline)", "mm")
-    if cw > star * (1 + 1e-9):
-        raise DesignError("cup_width", cw, f"must be <= {star:.6g} mm (the outline's centroid's distance to its "
-                          "nearest tangent line: offsets beyond it are not star-shaped about the centroid, so the "
-                          "flat centre, a fan from the centroid, would fold over itself)", "mm")
-    cw = min(cw, limit, star)
+        cw = min(limit, star, centre)
+    bound, why = min((limit, "the outline's smallest corner radius / inscribed radius: offsets beyond it are not "
+                             "offsets of the outline"),
+                     (star, "the outline's centroid's distance to its nearest tangent line: offsets beyond it are "
+                            "not star-shaped about the centroid, so the flat centre, a fan from the centroid, would "
+                            "fold over itself"),
+                     (centre, f"cupped further in, the flat centre would reach less than {tol.min_length:g} mm "
+                              "from the centroid (Tolerances.min_length), too narrow to build"),
+                     key=lambda item: item[0])
+    if cw > bound * (1 + 1e-9):  # the tightest of the three, so that the range stated is the true one
+        raise DesignError("cup_width", cw, f"must be <= {format_bound(bound, upper=True)} mm ({why})", "mm")
+    cw = min(cw, limit, star, centre)
     ol.check_offset(cw, "cup_width")
     L = check_range("land", land, 0.0, cw, "mm", hi_open=True)
     Rc = check_range("central_radius", central_radius, 0.0, None, "mm")
@@ -137,6 +145,22 @@ def outline_tablet(
     p.update(params or {})
     return build_sweep_tablet(ol, face, b, name=name, family=family, params=p,
                               reach=cw if cw >= reach * (1 - 1e-9) else reach, info=full, a=smoothing(a), tol=tol)
+
+
+def _centre_limit(ol, limit: float, reach: float, tol: Tolerances) -> float:
+    """The largest cup width (mm) that leaves a flat centre at least ``tol.min_length`` from the
+    centroid to the plateau's rim (the centroid's distance to the outline less that), or ``inf`` when
+    the cup may reach the centre (``limit`` is the outline's ``reach``: a stadium closes on its centre
+    line) or stops short of it anyway.
+
+    A cup ending nearer the centroid leaves a plateau too narrow to build: at a rounded triangle's
+    largest corner radius it is 1e-5 mm across, and its patches' rows stand still within the B-rep's
+    tolerance (the default cup width had been refused, naming ``cup_width``, from a corner radius of
+    3 mm on an 11 mm triangle)."""
+    if limit >= reach * (1.0 - 1e-9):
+        return math.inf
+    cap = float(ol.signed_distance(ol.centroid()[None])[0]) - tol.min_length
+    return cap if cap < limit else math.inf
 
 
 def _star_limit(ol, limit: float) -> float:

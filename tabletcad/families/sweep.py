@@ -532,6 +532,9 @@ def _plateau_ring(outline, d_end: float, c: np.ndarray):
     ``d_end/2`` (whose corners are still arcs) shrunk towards the centre by ``λ``, and a ruled
     ring joins ``Q`` to the rim: over a corner it is a thin triangle from ``Q``'s small arc to
     the corner point, with positive area.  Both patches are planar, so they lie on the nominal.
+    ``λ`` shrinks from 0.5 by factors of 0.7 until ``Q`` lies inside the rim: a narrow rim (a
+    rounded triangle at nearly its largest corner radius) takes a small one (it had stopped at 0.1,
+    refusing the default cup width from a corner radius of 3 mm on an 11 mm triangle).
     """
     if not _rim_collapses(outline, d_end):
         return None
@@ -539,14 +542,14 @@ def _plateau_ring(outline, d_end: float, c: np.ndarray):
     v = np.linspace(0.0, math.tau, 2048, endpoint=False)
     O = outline.point(v)
     N = outline.normal(v)
-    for lam in (0.5, 0.35, 0.25, 0.15, 0.1):
+    lam = 0.5
+    while lam > 1e-9:  # (the cup widths allowed leave the rim >= Tolerances.min_length from c: lam >~ 1e-6)
         q = c + lam * (O + d_q * N - c)
         if float(np.min(outline.signed_distance(q))) > d_end + 0.1 * lam * d_q:
             return lam, lam * d_q
-    raise DesignError("cup_width", round(d_end, 6),
-                      f"must be < {outline.min_convex_radius:.6g} mm, the outline's smallest corner radius (a cup_width "
-                      f"left out is that radius): cupped that far in, {outline.name}'s flat centre is too narrow for "
-                      "its plateau patches; give a cup_width below it", "mm")
+        lam *= 0.7
+    raise GeometryError(f"{outline.name}: no inner curve of the plateau fits inside its rim at the cup width "
+                        f"{d_end:.6g} mm (the centroid is not inside the rim)", outline)
 
 
 def _v_samples(outline, nv: int) -> np.ndarray:

@@ -25,7 +25,7 @@ from tabletcad.geometry.curves import Circle, Curve, Ellipse
 from tabletcad.errors import DesignError, check_positive, check_range
 from tabletcad.families.family import Family
 from tabletcad.geometry.patch import PDEPatch
-from tabletcad.geometry.tablet import Tablet, Trim
+from tabletcad.geometry.tablet import TRIM_MIN_WIDTH, Tablet, Trim
 from tabletcad.tolerance import DEFAULT, Tolerances
 
 __all__ = [
@@ -214,11 +214,23 @@ def oblong(diameter: float = 5.0, length: float = 15.0, dome: float = 1.0, *, a=
 
 
 # ---------------------------------------------------------------------------- Table 4.5
+def _ring_inner_limit(Do: float, tol: Tolerances = DEFAULT) -> float:
+    """The largest inner diameter (mm) of a ring of outer diameter ``Do``: its ``w`` range
+    ``[inner/outer, 1]`` at least :data:`~tabletcad.geometry.tablet.TRIM_MIN_WIDTH` wide (a trim's
+    least) and its wall at least ``tol.min_length`` thick (a ring 11.999 mm inside 12 had been
+    refused naming ``trim.w``, a table the design did not have)."""
+    hi = min(Do * (1.0 - TRIM_MIN_WIDTH), Do - 2.0 * tol.min_length)
+    if not hi > 0.0:
+        raise DesignError("outer_diameter", Do, f"must be > {2.0 * tol.min_length:g} mm for a ring (a wall of at least "
+                          f"{tol.min_length:g} mm, Tolerances.min_length, around a hole)", "mm")
+    return hi
+
+
 def ring(outer_diameter: float = 12.0, inner_diameter: float = 6.0, thickness: float = 4.5, *, a=1.0, tol=DEFAULT) -> Tablet:
     """Ring tablet: the band of a flat-faced round tablet as a solid with
     ``w ∈ [inner/outer, 1]`` (Table 4.5: 12 × 4.5 mm with a 6 mm hole)."""
     Do = check_positive("outer_diameter", outer_diameter, "mm")
-    Di = check_range("inner_diameter", inner_diameter, 0.0, Do, "mm", lo_open=True, hi_open=True)
+    Di = check_range("inner_diameter", inner_diameter, 0.0, _ring_inner_limit(Do, tol), "mm", lo_open=True)
     T = check_positive("thickness", thickness, "mm")
     R = Do / 2
     t = coaxial_tablet([_band(R, 0.0, T)], a=a, name="ring", family="thesis.ring",

@@ -138,10 +138,13 @@ def _curve(spec: Any, where: str, previous: Curve | None) -> Curve:
             raise DesignError(f"{where}.{k}", MISSING, f"a {kind} curve needs {', '.join(sorted(_CURVE_KEYS[kind]))}")
     if "center" in spec and "z" in spec:
         raise DesignError(f"{where}.z", spec["z"], "give either z or center, not both")
-    center = spec.get("center", (0.0, 0.0, spec.get("z", 0.0)))
-    if not (isinstance(center, (list, tuple)) and len(center) == 3):
-        raise DesignError(f"{where}.center", center, "must be [x, y, z] in mm")
-    center = tuple(_number(f"{where}.center", c, "mm", coordinate=True) for c in center)
+    if "center" in spec:
+        center = spec["center"]
+        if not (isinstance(center, (list, tuple)) and len(center) == 3):
+            raise DesignError(f"{where}.center", center, "must be [x, y, z] in mm")
+        center = tuple(_number(f"{where}.center", c, "mm", coordinate=True) for c in center)
+    else:  # z alone: named as given (z = true had been refused as "center = true")
+        center = (0.0, 0.0, _number(f"{where}.z", spec.get("z", 0.0), "mm", coordinate=True))
     num = {k: _number(f"{where}.{k}", spec[k], "mm") for k in _CURVE_KEYS[kind] if k != "points"}
     try:
         if kind == "circle":
@@ -373,6 +376,9 @@ class Design:
             try:
                 built = fam.build(**kw)
             except DesignError as exc:  # the constructor names its parameter: the design file says tablet.<name>
+                if exc.parameter in fam.params and exc.parameter not in tab:  # its default: said as such
+                    raise DesignError(f"tablet.{exc.parameter}", exc.value, f"{exc.allowed} ({exc.parameter} is not "
+                                      "given: the value it takes by default)", exc.unit) from None
                 if exc.parameter in fam.params or exc.parameter == "a":
                     raise exc.renamed(f"tablet.{exc.parameter}") from None
                 if a is not None and exc.parameter.endswith("smoothing.parameter.a"):  # a patch's: the file's a
@@ -392,6 +398,11 @@ class Design:
 _LEFT_BY = {("ffbe", "band"): ("bevel_depth", "bevel_width"), ("ffbe", "flat face"): ("bevel_width", "bevel_depth"),
             ("ffre", "band"): ("edge_radius",), ("ffre", "flat face"): ("edge_radius",),
             ("concave_bevel", "cup"): ("bevel_width",)}
+#: who leaves a part where the family has no entry in :data:`_LEFT_BY` (a flat-face round 0.001 mm
+#: across leaves a face 0.0005 mm wide: its diameter, not the family, had been named)
+_OUTLINE_DIMS = ("cup_width", "corner_radius", "end_radius", "side_radius")  # a shaped face's default cup width
+_LEFT_BY_PART = {"flat face": ("diameter",) + _OUTLINE_DIMS, "cup": ("land",) + _OUTLINE_DIMS, "land": ("land",),
+                 "band": ("band", "thickness")}
 
 
 def _check_left_lengths(tablet: Tablet, family: str, kw: dict, tol: Tolerances = DEFAULT) -> None:
@@ -409,7 +420,7 @@ def _check_left_lengths(tablet: Tablet, family: str, kw: dict, tol: Tolerances =
     parts = [("band", nom.band_z[1] - nom.band_z[0])] + [(e.label or e.kind, e.length) for e in nom.top]
     for what, length in parts:
         if 0.0 < length < m * (1.0 - 1e-9):  # (3.001 - 2 x 1.5 is 0.000999999999999889: at the least length)
-            names = [k for k in _LEFT_BY.get((family, what), ()) if kw.get(k)]
+            names = [k for k in _LEFT_BY.get((family, what), ()) + _LEFT_BY_PART.get(what, ()) if kw.get(k)]
             left = f"leaves a {what} of {length:.3g} mm: a part the dimensions leave must be at least {m:g} mm " \
                    "(Tolerances.min_length, the least length a design takes) or, where the family allows it, none"
             if names:
@@ -423,14 +434,20 @@ def design_from_dict(data: dict, default_name: str = "tablet") -> Tablet:
 
 
 def _check_size(tablet: Tablet, tol: Tolerances = DEFAULT, *, what: dict | None = None) -> None:
-    """Refuse a reshaped tablet whose overall size leaves ``±tol.max_length`` or whose length, width or
-    height is below ``tol.min_length`` (``what``: the ``[reshape]`` table, named in the refusal)."""
+    """Refuse a reshaped tablet that leaves ``±tol.max_length``, whose length, width or height exceeds
+    ``tol.max_length`` (an overall dimension, as a family's diameter or length: ``Tolerances``) or is
+    below ``tol.min_length`` (``what``: the ``[reshape]`` table, named in the refusal)."""
     lo, hi = tablet.bounds()
     big = float(max(np.max(np.abs(lo)), np.max(np.abs(hi))))
     if not big <= tol.max_length:
         raise DesignError("reshape", what if what is not None else "factors",
                           f"must keep the tablet within ±{tol.max_length:g} mm "
                           f"(size limit, Tolerances.max_length; it reaches {big:.6g} mm)")
+    size = float(np.max(hi - lo))
+    if not size <= tol.max_length:  # an overall dimension, as a diameter (a 10 mm round at radius = 150 was 1501 mm)
+        raise DesignError("reshape", what if what is not None else "factors",
+                          f"must keep the tablet's length, width and height at most {tol.max_length:g} mm "
+                          f"(size limit, Tolerances.max_length, as a diameter or length; the largest is {size:.6g} mm)")
     small = float(np.min(hi - lo))
     if not small >= tol.min_length:  # (a radius of 1e-5 mm had made a tablet 1e-4 mm across)
         raise DesignError("reshape", what if what is not None else "factors",
