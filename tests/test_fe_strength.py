@@ -116,7 +116,8 @@ def test_a_reference_disc_too_thin_to_mesh_is_named_by_its_thickness(capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1
     assert err[0].startswith("error: --reference-thickness = 0.01 mm is not allowed: makes a 10 x 0.01 mm reference "
-                             "disc that the FE cannot mesh: its mesh size 0.005 mm must be >= ")
+                             "disc that the FE cannot mesh: its mesh size's default for this tablet, "
+                             "min(thickness/2, plan width/12) = 0.005 mm, gives about ")
     rc = main(["fe", "strength", str(design), "--reference-force", "80", "--reference-diameter", "10"])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and err == ["error: --reference-thickness = (not given) is not allowed: the reference test needs "

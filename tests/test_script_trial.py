@@ -17,16 +17,16 @@ def test_a_weight_target_names_the_density_figure_left_out(given, missing):
     assert err.value.parameter == missing and "\n" not in str(err.value)
 
 
-def test_a_default_cup_width_too_wide_for_the_plateau_says_it_is_the_default():
-    """rounded_triangle 10 mm, corner 2.7 mm: the cup width left out is the corner radius, whose plateau is too
-    narrow; the error says so and a cup width below it builds."""
+def test_a_default_cup_width_at_a_narrow_plateau_builds():
+    """rounded_triangle 10 mm, corner 2.7 mm: the cup width left out is the corner radius, whose plateau is
+    narrow; it was refused (naming the default), and now builds (its plateau split closer to the centre), as
+    does a cup width below it."""
     from tabletcad import make
 
-    with pytest.raises(DesignError) as err:
-        make("rounded_triangle", side=10.0, corner_radius=2.7, band=3.0, cup_depth=1.0)
-    assert err.value.parameter == "tablet.cup_width" and "a cup_width left out is that radius" in str(err.value)
-    t = make("rounded_triangle", side=10.0, corner_radius=2.7, band=3.0, cup_depth=1.0, cup_width=2.6)
-    assert t.volume > 0
+    t = make("rounded_triangle", side=10.0, corner_radius=2.7, band=3.0, cup_depth=1.0)
+    assert t.tablet.nominal.info["cup_width_mm"] == pytest.approx(2.7, abs=1e-12)
+    narrower = make("rounded_triangle", side=10.0, corner_radius=2.7, band=3.0, cup_depth=1.0, cup_width=2.6)
+    assert narrower.volume > t.volume > 0.0  # the same depth reached sooner: a wider plateau
 
 
 def test_a_model_with_one_dimension_changed():

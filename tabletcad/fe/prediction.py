@@ -138,10 +138,14 @@ def reference_tensile_strength(inputs: StrengthInputs, sizes: Callable[[Any, str
     except DesignError as exc:  # a size the disc's own dimensions chose: named by the reference thickness
         if exc.parameter in given:
             raise
-        value = f"{exc.value:.4g}" if isinstance(exc.value, float) else exc.value
+        what = exc.parameter.replace("_", " ")
+        if exc.value is MISSING:  # a size left to its default: the refusal says which default
+            detail = f"its {what}'s {exc.allowed.removeprefix('its ')}"
+        else:
+            value = f"{exc.value:.4g}" if isinstance(exc.value, float) else exc.value
+            detail = f"its {what} {value} {exc.unit} {exc.allowed}"
         raise DesignError("[report] reference_thickness_mm", t, f"makes a {D:g} x {t:g} mm reference disc that the "
-                          f"FE cannot mesh: its {exc.parameter.replace('_', ' ')} {value} {exc.unit} {exc.allowed}",
-                          "mm") from None
+                          f"FE cannot mesh: {detail}", "mm") from None
     if not r.max_tensile_stress_MPa > 0.0:  # a disc too thin for its mesh finds no tension: no strength from it
         raise DesignError("[report] reference_thickness_mm", t, f"makes a {D:g} x {t:g} mm reference disc in which "
                           "the FE mesh finds no tensile stress: give a thicker reference", "mm")
