@@ -8,6 +8,7 @@ outputs come back to the client as bytes, and ``tooling_batch`` runs on the same
 
 from __future__ import annotations
 
+import csv
 import json
 import math
 import socket
@@ -120,11 +121,12 @@ def test_rows_are_in_sweep_order_and_a_failing_design_is_a_row(local_results):
     assert back.columns.tolist() == cols
     for c in cols:
         for a, b in zip(back[c], df[c]):
-            assert (a == b) or (a is None and (b == "" or b is None or (isinstance(b, float) and math.isnan(b)))), c
+            assert (a is None and (b is pd.NA or b is None or (isinstance(b, float) and math.isnan(b))
+                                   or b == "")) or (b is not pd.NA and a == b), c
 
 
 def test_rows_equal_a_single_tabletcad_build_exactly(local_results, tmp_path):
-    df, _ = local_results
+    df, out = local_results
     design = tmp_path / "sweep.toml"  # the sweep's name is the tablet's name
     lines = ["[tablet]"] + [f"{k} = {v!r}" if not isinstance(v, str) else f'{k} = "{v}"' for k, v in TABLET.items()
                             if k != "cup_depth"]
@@ -144,6 +146,15 @@ def test_rows_equal_a_single_tabletcad_build_exactly(local_results, tmp_path):
             assert v == built[k], k  # exactly: same floats, not approximately
         compared += 1
     assert compared > 50
+    # and as written: a count as the report has it (9, not 9.0: another row failed, leaving its cell empty)
+    with open(out / "results.csv", newline="", encoding="utf-8") as fh:
+        written = list(csv.DictReader(fh))[2]
+    counts = 0
+    for k, v in built.items():
+        if k in written and k not in (KEY, "warnings", "status", "error", "design_hash"):
+            assert written[k] == ("" if v is None else repr(v) if isinstance(v, float) else str(v)), k
+            counts += isinstance(v, int) and not isinstance(v, bool)
+    assert counts >= 1
 
 
 def test_results_do_not_depend_on_the_engine_or_the_number_of_workers(local_results, scheduler_address, tmp_path):

@@ -36,7 +36,11 @@ _REQUIRED_TAIL = ("status", "error", "design_hash")
 
 
 def results_frame(keys: Sequence[str], rows: Iterable[dict[str, Any]]):
-    """A DataFrame of ``rows`` with the columns in the documented order."""
+    """A DataFrame of ``rows`` with the columns in the documented order.
+
+    A column of whole numbers (a count: faces, triangles) that some row leaves empty (a design that
+    failed) is pandas' nullable ``Int64``, so that it is written as the report has it (``9``, not the
+    ``9.0`` a float column with NaN would give)."""
     import pandas as pd
 
     rows = list(rows)
@@ -46,7 +50,13 @@ def results_frame(keys: Sequence[str], rows: Iterable[dict[str, Any]]):
             if k not in cols and k not in TAIL_COLUMNS:
                 cols[k] = None
     cols.update(dict.fromkeys(TAIL_COLUMNS))
-    return pd.DataFrame.from_records(rows, columns=list(cols))
+    df = pd.DataFrame.from_records(rows, columns=list(cols))
+    for c in cols:
+        vals = [r.get(c) for r in rows]
+        given = [v for v in vals if v is not None]
+        if given and len(given) < len(vals) and all(isinstance(v, int) and not isinstance(v, bool) for v in given):
+            df[c] = pd.array(vals, dtype="Int64")
+    return df
 
 
 def write_results(df, path: str | Path) -> Path:
