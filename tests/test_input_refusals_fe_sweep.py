@@ -275,6 +275,6 @@ def test_sweep_names_the_journal_a_folder_holds(tmp_path, capsys):
     (out / "results.partial.jsonl").write_text('{"x": 1}\n')
     rc = main(["sweep", str(sample), "--out", str(out), "--workers", "1"])
     assert rc == 2 and capsys.readouterr().err.splitlines() == [
-        f"error: --out = '{out}' is not allowed: already holds results.partial.jsonl of a sweep; give --resume or "
-        "another folder"]
+        f"error: --out = '{out}' is not allowed: already holds results.partial.jsonl, the name a sweep writes its "
+        "results under; give --resume to go on with that sweep, or another folder"]
     assert sorted(p.name for p in out.iterdir()) == ["results.partial.jsonl"]

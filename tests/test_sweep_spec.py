@@ -150,7 +150,7 @@ def test_an_earlier_results_csv_needs_resume(tmp_path, capsys):
     out.mkdir()
     (out / "results.csv").write_text("tablet.cup_depth,status,error,design_hash\n0.8,ok,,0000000000000000\n")
     assert main(["sweep", str(p), "--out", str(out), "--workers", "1", "--quiet"]) == 2
-    assert "give --resume or another folder" in capsys.readouterr().err
+    assert "give --resume to go on with that sweep, or another folder" in capsys.readouterr().err
     assert main(["sweep", str(p), "--out", str(out), "--workers", "1", "--quiet", "--resume"]) == 2
     assert "1 designs that are not in this sweep file" in capsys.readouterr().err
     assert sorted(q.name for q in out.iterdir()) == ["results.csv"]

@@ -91,7 +91,8 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
     if out is not None and out.is_dir() and ((out / RESULTS_CSV).exists() or (out / JOURNAL).exists()):
         if not resume:  # named as the file it holds (a journal alone, of a stopped run, is no results.csv)
             held = " and ".join(f for f in (RESULTS_CSV, JOURNAL) if (out / f).exists())
-            raise DesignError("--out", str(out), f"already holds {held} of a sweep; give --resume or another folder")
+            raise DesignError("--out", str(out), f"already holds {held}, the name a sweep writes its results under; give --resume to "
+                              "go on with that sweep, or another folder")
         done = read_done(out)
         foreign = set(done) - set(hashes)
         if foreign:
