@@ -150,6 +150,11 @@ def test_a_reshaped_tablet_just_inside_the_size_limit_is_taken():
     assert 999.0 < max(hi - lo) <= 1000.0
     t = Design.from_dict({"tablet": dict(family="concave_round", diameter=1000.0, band=100, cup_depth=50)}).build()
     assert t.params["diameter"] == 1000.0
+    # at the limit itself, whatever the bounds' rounding (a review: 1000.0000000000003 across was refused)
+    for tablet, radius in ((dict(diameter=10.0, thickness=3.0), 100.0), (dict(diameter=1000.0, thickness=3.0), 1.0)):
+        t = Design.from_dict({"tablet": dict(family="flat_face_round", **tablet), "reshape": {"radius": radius}}).build()
+        lo, hi = t.bounds()
+        assert max(hi - lo) == pytest.approx(1000.0, rel=1e-12)
 
 
 @pytest.mark.parametrize("x", [3.1754264805429417, 12.743410214, 2.0 / 3.0, 1e-7 / 3.0, 123456.789, -3.14159265])

@@ -444,7 +444,9 @@ def _check_size(tablet: Tablet, tol: Tolerances = DEFAULT, *, what: dict | None 
                           f"must keep the tablet within ±{tol.max_length:g} mm "
                           f"(size limit, Tolerances.max_length; it reaches {big:.6g} mm)")
     size = float(np.max(hi - lo))
-    if not size <= tol.max_length:  # an overall dimension, as a diameter (a 10 mm round at radius = 150 was 1501 mm)
+    # an overall dimension, as a diameter (a 10 mm round at radius = 150 was 1501 mm); the bounds' rounding
+    # aside (a 1000 mm round measures 1000.0000000000003 across)
+    if not size <= tol.max_length * (1.0 + 1e-9):
         raise DesignError("reshape", what if what is not None else "factors",
                           f"must keep the tablet's length, width and height at most {tol.max_length:g} mm "
                           f"(size limit, Tolerances.max_length, as a diameter or length; the largest is {size:.6g} mm)")
