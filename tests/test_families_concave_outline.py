@@ -176,3 +176,24 @@ def test_star_limit_in_closed_form_equals_the_sampled_search_on_random_outlines(
 def test_star_limit_of_a_circle_anywhere_is_its_radius(theta0, sweep):
     ol = PlanOutline([Seg.arc((1.3, -2.0), 4.0, theta0, sweep)])
     assert ol._star_limit_of_segments() == pytest.approx(4.0, abs=1e-12) == ol._star_limit_sampled()
+
+
+@pytest.mark.parametrize("fraction, folds", [(0.5, False), (0.999, False), (1.05, True), (None, True)])
+def test_a_flat_fan_over_an_offset_past_the_star_limit_is_measured_folding(fraction, folds):
+    # a flat patch's solid map has no volume, so its fold is its own Jacobian's in its plane: the plateau of
+    # the peanut's waist (the offset limit, None) had double-counted 0.99 mm² unseen
+    from tabletcad.families.sweep import SweepCurve
+    from tabletcad.geometry.patch import PDEPatch
+
+    ol = outline_from_items(peanut_segments(4.0, 3.0, 40.0))
+    c = ol.centroid()
+    d = ol.offset_limit() if fraction is None else fraction * ol.star_limit()
+    pole = SweepCurve(ol, 0.0, 0.0, (float(c[0]), float(c[1]), 1.0))
+    rim = SweepCurve(ol, 1.0, d, (0.0, 0.0, 1.0))
+    du = SweepCurve(ol, 1.0, d, (-float(c[0]), -float(c[1]), 0.0))
+    p = PDEPatch((pole, rim, du, du), a=0.01, form="hermite", check=False)
+    depth = p.fold_depth(nu=65, nv=128)
+    assert (depth > 0.1) if folds else depth == 0.0
+    if folds:  # and a patch's own check refuses it (the family builder's stray check is off for its patches)
+        with pytest.raises(DesignError, match="a fold"):
+            p._check_fold()

@@ -62,6 +62,16 @@ def _trig(v: np.ndarray, n: np.ndarray, dv: int) -> tuple[np.ndarray, np.ndarray
 _EYE3 = np.eye(3)
 
 
+def _horizontal(Xu: np.ndarray, Xv: np.ndarray, D: np.ndarray) -> bool:
+    """Whether a patch sampled as ``(3, nu, nv)`` blocks lies in a horizontal plane: no ``z`` in its
+    partials or about its spine, beyond rounding of their sizes (a flat face of a family, a disc)."""
+    def small(a: np.ndarray) -> bool:
+        size = math.sqrt(float(np.max(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])))
+        return float(np.max(np.abs(a[2]))) <= 1e-12 * max(size, 1e-300)
+
+    return small(Xu) and small(Xv) and small(D)
+
+
 @lru_cache(maxsize=8)
 def _fold_u(nu: int, n_ends: int) -> np.ndarray:
     """The fold checks' ``u`` samples: ``nu`` equally spaced and ``n_ends`` geometrically
@@ -749,6 +759,13 @@ class PDEPatch:
         scale = mag(Xu) * mag(Xv) * reach
         if scale == 0.0:
             return 0.0, reach
+        flat = _horizontal(Xu, Xv, D)
+        if flat:  # a flat patch's solid map has no volume (det = 0): it folds where its own Jacobian in its
+            # plane, (X_u × X_v)_z, changes sign (a fan over an outline not star-shaped about its centre counts
+            # the overlap twice), travelling backwards across each v line at |(X_u × X_v)_z| / |X_v|
+            det = Xu[0] * Xv[1] - Xu[1] * Xv[0]
+            m = Xv
+            scale = mag(Xu) * mag(Xv)
         ref = 1.0 if float(np.sum(det)) >= 0.0 else -1.0
         folded = det * ref < -1e-9 * scale
         if not np.any(folded):
