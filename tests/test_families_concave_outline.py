@@ -102,15 +102,16 @@ def test_cup_width_beyond_the_star_limit_is_refused():
 
 
 def test_sweep_builder_refuses_a_plateau_rim_beyond_the_star_limit():
-    """The builder itself refuses a flat centre whose fan would fold (any family's face profile)."""
+    """The builder itself refuses a flat centre whose fan would fold (any family's face profile): its fold
+    check measures a flat patch's own Jacobian in its plane."""
     from tabletcad.families.profile import profile_line
     from tabletcad.families.sweep import build_sweep_tablet
 
     ol = outline_from_items(peanut_segments(4.0, 3.0, 40.0))
-    with pytest.raises(DesignError, match="fold over itself") as err:
+    with pytest.raises(DesignError, match=r"a fold 0\.07\d+ mm deep") as err:
         build_sweep_tablet(ol, [profile_line((0.0, 0.0), (2.7, 0.0), "flat face")], BAND, name="peanut",
                            family="custom_outline", params={}, reach=3.0)
-    assert err.value.parameter == "cup_width"
+    assert err.value.parameter == "patch.peanut[0:plateau].curves"
 
 
 @pytest.mark.cad

@@ -376,7 +376,6 @@ def build_sweep_tablet(
         if abs(float(end_dir[1])) > 1e-9 * float(np.linalg.norm(end_dir)):
             raise DesignError("face profile", f"ends at d = {d_end:.4g} mm with a slope",
                               f"must end horizontally (a flat plateau) or reach the centre (d = {reach:.6g} mm)")
-        _check_plateau_fan(outline, d_end)
     d_far = max(reach, d_end) + 1.0
     nominal_top = list(top)
     nominal_bottom = list(bottom)
@@ -495,20 +494,6 @@ def build_sweep_tablet(
                 f"{family}: PDE surface deviates {cert.max_deviation_mm * 1e3:.3g} µm from the nominal "
                 f"(allowed {tol.nominal * 1e3:.3g} µm)", tablet)
     return tablet
-
-
-def _check_plateau_fan(outline, d_end: float) -> None:
-    """Refuse a plateau rim (the offset of ``outline`` by ``d_end``, mm) that is not star-shaped about
-    the outline's centroid: the plateau is a fan from there, which would fold over itself, and a
-    folded plateau has no volume for the fold checks to see while its area counts twice
-    (:meth:`~tabletcad.families.outline.PlanOutline.star_limit`; a circle's rim always is)."""
-    if getattr(outline, "is_circle", False):
-        return
-    star = outline.star_limit()
-    if 0.0 < star < d_end * (1.0 - 1e-9):
-        raise DesignError("cup_width", round(d_end, 6),
-                          f"must be <= {star:.6g} mm (the outline's centroid's distance to its nearest tangent line): "
-                          "the flat centre, a fan from the centroid, would fold over itself", "mm")
 
 
 def _rim_collapses(outline, d: float) -> bool:
