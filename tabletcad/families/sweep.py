@@ -150,6 +150,21 @@ class SweepCurve(Curve):
             out += np.array([c.const for c in curves], dtype=float)[:, None, :]
         return out
 
+    @classmethod
+    def combination(cls, curves) -> tuple | None:
+        """``(basis, weights, const)`` (:func:`~tabletcad.geometry.curves.combination_of`): each curve is
+        ``alpha O + beta N + const`` of one outline's :class:`OutlineBasis` ``(O, N)``; None for
+        different outlines."""
+        ol = curves[0].outline
+        if any(c.outline is not ol for c in curves):
+            return None
+        basis = ol.__dict__.get("_sweep_basis")
+        if basis is None:
+            basis = OutlineBasis(ol)
+            ol.__dict__["_sweep_basis"] = basis
+        weights = np.array([[c.alpha, c.beta] for c in curves], dtype=float)
+        return basis, weights, np.array([c.const for c in curves], dtype=float)
+
     @property
     def is_point(self) -> bool:
         return self.alpha == 0.0 and self.beta == 0.0
@@ -168,6 +183,24 @@ class SweepCurve(Curve):
         if self.is_point:
             return np.zeros(0)
         return np.asarray(getattr(self.outline, "smooth_breaks", self.outline.breaks[:-1]), dtype=float)
+
+
+@dataclass(frozen=True, eq=False)
+class OutlineBasis:
+    """An outline ``O(v)`` and its unit inward normal ``N(v)`` lifted to ``z = 0``: the two curves every
+    :class:`SweepCurve` on the outline combines (one per outline, :meth:`SweepCurve.combination`)."""
+
+    outline: Any
+
+    def evaluate(self, v, der: int = 0) -> np.ndarray:
+        """``(2, len(v), 3)``: ``d^der O / dv^der`` and ``d^der N / dv^der`` (mm), from one frame."""
+        v = np.asarray(v, dtype=float).reshape(-1)
+        out = np.zeros((2, v.size, 3))
+        out[:, :, :2] = self.outline.offsets(v, der, _UNIT_A, _UNIT_B)
+        return out
+
+
+_UNIT_A, _UNIT_B = np.array([1.0, 0.0]), np.array([0.0, 1.0])
 
 
 @dataclass(frozen=True)

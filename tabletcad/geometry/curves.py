@@ -44,6 +44,7 @@ __all__ = [
     "sample_v",
     "nearest_of",
     "evaluate_curves",
+    "combination_of",
 ]
 
 
@@ -76,6 +77,22 @@ def evaluate_curves(curves: Sequence, v: np.ndarray, der: int = 0) -> np.ndarray
         j = next(j for j in range(k + 1) if curves[j] is c)
         out[k] = out[j] if j < k else c.evaluate(v, der)
     return out
+
+
+def combination_of(curves: Sequence) -> tuple | None:
+    """``(basis, weights, const)`` when every curve is ``weights[j] · basis + const[j]``: a fixed
+    combination of the ``k`` curves of one shared ``basis`` (an object with ``evaluate(v, der)``
+    giving ``(k, len(v), 3)`` mm) and a constant point, as a swept tablet's data are of its
+    outline and its inward normal (:meth:`Curve.combination`); ``weights`` is
+    ``(len(curves), k)``, ``const`` ``(len(curves), 3)`` mm.  None for any other curves.
+
+    A patch whose data are such takes their Fourier coefficients and their residuals above its
+    modes from the basis's, shared by every patch on it (both are linear in the curve)."""
+    kind = type(curves[0])
+    combination = getattr(kind, "combination", None)
+    if combination is None or any(type(c) is not kind for c in curves):
+        return None
+    return combination(curves)
 
 
 @runtime_checkable

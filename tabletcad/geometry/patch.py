@@ -37,7 +37,7 @@ import numpy as np
 from tabletcad.geometry.basis import cardinal, cardinal_coefficients, cardinals
 from tabletcad.geometry.revolution import Revolution, Section, detect_revolution, detect_section
 from tabletcad.geometry.tables import CARDINAL, TRIG
-from tabletcad.geometry.curves import evaluate_curves, fourier_coefficients, modes_needed, sample_v
+from tabletcad.geometry.curves import combination_of, evaluate_curves, fourier_coefficients, modes_needed, sample_v
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
 from tabletcad.geometry.vectors import cross, cross_first, norm3
@@ -125,6 +125,73 @@ def _trig_shared(v: np.ndarray, n: np.ndarray, dv: int, rows: bool = False):
     if v.size > _CACHED_V[1] or 16 * v.size * n.size > TRIG.max_bytes:
         return make(v, n, dv)
     return TRIG.get((rows, dv, n.tobytes(), v.tobytes()), lambda: make(v, n, dv))
+
+
+def _basis_memo(basis) -> dict:
+    """The results kept on a shared curve basis (:func:`~tabletcad.geometry.curves.combination_of`):
+    they live as long as it does (the outline that owns it)."""
+    memo = basis.__dict__.get("_pde_memo")
+    if memo is None:
+        memo = {}
+        basis.__dict__["_pde_memo"] = memo
+    return memo
+
+
+def _basis_fourier(basis, N: int, samples: int) -> tuple[np.ndarray, ...]:
+    """``(a0, a, b, rows)`` of the ``k`` curves of ``basis`` by FFT of ``samples`` samples: ``(k, 3)``,
+    ``(k, N, 3)``, ``(k, N, 3)`` mm and the cosine and sine coefficients as rows ``(N, 3k)`` each,
+    stacked ``(2, N, 3k)`` (read-only; once per basis, modes and samples)."""
+    memo = _basis_memo(basis)
+    key = ("fourier", N, samples)
+    hit = memo.get(key)
+    if hit is None:
+        pts = np.asarray(basis.evaluate(sample_v(samples), 0), dtype=float)  # (k, m, 3)
+        f = np.fft.rfft(pts, axis=1) / samples
+        n = min(N, samples // 2 - 1)
+        k = pts.shape[0]
+        a, b = np.zeros((k, N, 3)), np.zeros((k, N, 3))
+        a[:, :n] = 2.0 * f[:, 1 : n + 1].real
+        b[:, :n] = -2.0 * f[:, 1 : n + 1].imag
+        rows = np.stack([a.transpose(1, 0, 2).reshape(N, 3 * k), b.transpose(1, 0, 2).reshape(N, 3 * k)])
+        hit = (np.ascontiguousarray(f[:, 0].real), a, b, rows)
+        for x in hit:
+            x.setflags(write=False)
+        memo[key] = hit
+    return hit
+
+
+def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: np.ndarray, dv: int) -> np.ndarray:
+    """The ``k`` basis curves less their Fourier series (``active`` modes, or all ``N`` when None), or
+    the ``v``-derivative of that, at ``v``: ``(k, len(v), 3)`` mm, read-only; kept on the basis for
+    grid-sized ``v`` (every patch on it reads the same ``v`` samples in a check)."""
+
+    def make() -> np.ndarray:
+        a0, _, _, rows = _basis_fourier(basis, N, samples)
+        out = np.array(basis.evaluate(v, dv), dtype=float)  # (k, m, 3)
+        k = out.shape[0]
+        if dv == 0:
+            out -= a0[:, None, :]
+        if active is None and N:
+            c, s = _trig_shared(v, np.arange(1, N + 1), dv)  # (m, N) each
+            out -= (c @ rows[0] + s @ rows[1]).reshape(v.size, k, 3).transpose(1, 0, 2)
+        elif active is not None and active.size:
+            T = _trig_shared(v, active, dv, rows=True)  # (2n, m), cosines over sines
+            R = np.concatenate([rows[0][active - 1], rows[1][active - 1]])  # (2n, 3k)
+            out -= (T.T @ R).reshape(v.size, k, 3).transpose(1, 0, 2)
+        out.setflags(write=False)
+        return out
+
+    if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
+        return make()
+    memo = _basis_memo(basis)
+    key = ("res", N, samples, None if active is None else active.tobytes(), dv, v.tobytes())
+    hit = memo.get(key)
+    if hit is None:
+        hit = make()
+        if len(memo) >= 160:
+            memo.pop(next(k for k in memo if k[0] == "res"))
+        memo[key] = hit
+    return hit
 
 
 @dataclass(frozen=True, eq=False)
@@ -232,11 +299,20 @@ class PDEPatch:
         band_limited = all(lim is not None and lim <= N for lim in limits)
         # 8 N + 8 samples give a band-limited curve's coefficients exactly; others get dense ones
         samples = 8 * N + 8 if band_limited else max(self.tol.samples, 8 * N + 8)
-        a0 = np.zeros((4, 3))
-        ac = np.zeros((4, N, 3))
-        bc = np.zeros((4, N, 3))
-        for k, c in enumerate(self.data):
-            a0[k], ac[k], bc[k] = fourier_coefficients(c, N, samples)
+        comb = combination_of(self.data)
+        if comb is not None:  # one basis's coefficients, shared by every patch on it (linear in the curve)
+            basis, W, const = comb
+            a0B, aB, bB = _basis_fourier(basis, N, samples)[:3]
+            a0 = W @ a0B + const
+            ac, bc = np.einsum("jk,knc->jnc", W, aB), np.einsum("jk,knc->jnc", W, bB)
+            comb = (basis, np.asarray(W, dtype=float), samples)
+        else:
+            a0 = np.zeros((4, 3))
+            ac = np.zeros((4, N, 3))
+            bc = np.zeros((4, N, 3))
+            for k, c in enumerate(self.data):
+                a0[k], ac[k], bc[k] = fourier_coefficients(c, N, samples)
+        object.__setattr__(self, "_comb", comb)
         object.__setattr__(self, "_a0", a0)
         object.__setattr__(self, "_ac", ac)
         object.__setattr__(self, "_bc", bc)
@@ -409,6 +485,10 @@ class PDEPatch:
 
         def make() -> np.ndarray:
             N = self.modes
+            comb = self.__dict__.get("_comb")
+            if comb is not None:  # the basis's residuals (shared by the patches on it), combined
+                basis, W, samples = comb
+                return np.einsum("jk,kmc->jmc", W, _basis_residuals(basis, N, samples, self.__dict__.get("_n_active"), v, dv))
             out = evaluate_curves(self.data, v, dv)  # (a datum repeated, a fan's two equal derivatives, once)
             if dv == 0:
                 out -= self._a0[:, None, :]
@@ -476,6 +556,14 @@ class PDEPatch:
                 return self.evaluate_grid(uf[:1], vf, du, dv)[0].reshape(shape + (3,))
             if vf[0] == vf[-1] and np.all(vf == vf[0]):
                 return self.evaluate_grid(uf, vf[:1], du, dv)[:, 0].reshape(shape + (3,))
+            if uf.size >= 64:  # points on a few u lines (samples of a grid's rows): a grid row each
+                rows, which = np.unique(uf, return_inverse=True)
+                if 16 * rows.size <= uf.size:
+                    out = np.empty((uf.size, 3))
+                    for k in range(rows.size):
+                        at = np.flatnonzero(which == k)
+                        out[at] = self.evaluate_grid(rows[k : k + 1], vf[at], du, dv)[0]
+                    return out.reshape(shape + (3,))
         out = np.zeros((uf.size, 3))
         if nmin == 0 and dv == 0:
             out += cardinal(uf, 0.0, self.u_nodes, self.form, du) @ self._a0

@@ -21,14 +21,16 @@ import numpy as np
 from tabletcad.errors import DesignError, check_range
 from tabletcad.geometry.patch import PDEPatch
 from tabletcad.geometry.revolution import profile_extreme
-
-#: Trapezoidal points in ``v`` for the integrals of a surface of revolution, whose integrands
-#: (``X·n``, ``|n|``, the solid map's Jacobian) are the same on every meridian.
-_REVOLUTION_NV = 4
 from tabletcad.readonly import TableDict
 from tabletcad.tolerance import DEFAULT, Tolerances
 from tabletcad.geometry.vectors import cross_first, norm3
 from tabletcad.geometry.quadrature import gauss_legendre
+
+#: Trapezoidal points in ``v`` for the integrals of a surface of revolution, whose integrands
+#: (``X·n``, ``|n|``, the solid map's Jacobian) are the same on every meridian.
+_REVOLUTION_NV = 4
+#: the plan's Newton polish takes a step only when it predicts a gain above this fraction of r² (rounding)
+_POLISH_GAIN = 1e-14
 
 __all__ = ["Band", "Trim", "Tablet", "Face", "solid_map"]
 
@@ -857,6 +859,10 @@ class Tablet:
             g2 = 2.0 * (np.einsum("ij,ij->i", xu, xu) + np.einsum("ij,ij->i", x, xuu))
             with np.errstate(divide="ignore", invalid="ignore"):
                 step = np.where(g2 < 0.0, -g1 / g2, 0.0)
+            # a step whose predicted gain, g1 s / 2 for the Newton step s, is below rounding of r²
+            # is not taken: at a maximum already in the samples (a band symmetric about u = 1/2)
+            # the steps of 1e-16 only moved every point into a scattered evaluation for nothing
+            step = np.where(0.5 * g1 * step > _POLISH_GAIN * best[live], step, 0.0)
             un = np.clip(ub[live] + np.clip(step, -h, h), lo, hi)
             moved = un != ub[live]
             live, un = live[moved], un[moved]
