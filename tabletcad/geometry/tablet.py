@@ -31,6 +31,10 @@ from tabletcad.geometry.quadrature import gauss_legendre
 _REVOLUTION_NV = 4
 #: the plan's Newton polish takes a step only when it predicts a gain above this fraction of r² (rounding)
 _POLISH_GAIN = 1e-14
+#: the extents' zoom stops once its grid spans at most this much each side in ``u`` and ``v``, or ends with
+#: a Newton step (:meth:`Tablet._newton_finish`) once it spans at most ``_NEWTON_FINISH``
+_ZOOM_STOP = 1e-6
+_NEWTON_FINISH = 1e-3
 
 __all__ = ["Band", "Trim", "Tablet", "Face", "solid_map"]
 
@@ -976,9 +980,10 @@ class Tablet:
         Each extreme is taken from a 97 × 256 sample of every patch and then
         polished by zooming: a 33 × 33 grid around the best point, each round eight
         times finer (the next round's grid still spans two of this one's steps each
-        side), until the grid step is below ~6e-8 in ``u`` and ``v`` (the extreme's
-        error falls with the square of the step: on the samples, whole and cut away, the extents
-        equal those of a step ten times smaller to 1.8e-13 mm).
+        side), until the grid step is below ~6e-8 in ``u`` and ``v``, or, once the grid spans
+        1e-3 each side and its best point is a peak inside it, one Newton step from the grid's
+        central differences (:meth:`_newton_finish`): on the samples, whole and cut away, the
+        extents equal those of a zoom carried on to a step of 6e-12 within 1.7e-14 mm.
         A tablet of revolution untrimmed in ``v`` takes its extents from its profile
         (:attr:`revolution`), polished the same way in ``u`` alone; so does a tablet of one
         plan ellipse (:attr:`section`: ``± R_max √S_xx`` in x, ``± R_max √S_yy`` in y) and a
@@ -1201,7 +1206,7 @@ class Tablet:
             elif round_:  # the second line found nothing better: the first zoom's point stands
                 break
             a, b = max(hu, line[1] - line[0]), hv
-            while a > 1e-6 or b > 1e-6:
+            while a > _ZOOM_STOP or b > _ZOOM_STOP:
                 uu = np.clip(u0 + np.linspace(-a, a, n), t.u[0], t.u[1])
                 vv = v0 + np.linspace(-b, b, n)
                 if not t.full_v:
@@ -1210,8 +1215,56 @@ class Tablet:
                 i, j = np.unravel_index(int(np.argmax(g)), g.shape)
                 if g[i, j] >= best:
                     best, u0, v0 = float(g[i, j]), float(uu[i]), float(vv[j])
+                    if a <= _NEWTON_FINISH and b <= _NEWTON_FINISH:
+                        finish = self._newton_finish(p, axis, sign, g, uu, vv, i, j)
+                        if finish is not None:  # the grid's peak is a maximum inside it: one step to its top
+                            best = max(best, finish)
+                            break
                 a, b = a / 8.0, b / 8.0
         return sign * best
+
+    def _newton_finish(self, p, axis: int, sign: float, g: np.ndarray, uu: np.ndarray, vv: np.ndarray,
+                       i: int, j: int) -> float | None:
+        """The value of ``sign·X[axis]`` one Newton step from the grid point ``(uu[i], vv[j])``, its largest
+        sample, with the gradient and Hessian from the grid's central differences; None when the point
+        has no neighbour in ``v`` or the Hessian is not negative definite (then the zoom goes on), but for a
+        grid flat along ``u`` to rounding (a band whose side stands vertical) and a peak on an end of the
+        trimmed ``u`` range (a land's rim), whose step is in ``v`` alone.  The step ends a zoom whose spacing is
+        at most ``_NEWTON_FINISH / 16`` in place of its last two rounds: on the samples, whole and trimmed, the
+        extents equal those of a zoom carried on to a step of 6e-12 within 1.7e-14 mm (the zoom alone, to a
+        step of 6e-8: within 1.8e-13)."""
+        t = self.trim
+        if not 0 < j < g.shape[1] - 1:
+            return None
+        dv = vv[j + 1] - vv[j]
+        if not (dv > 0.0 and abs(vv[j] - vv[j - 1] - dv) <= 1e-9 * dv):  # a grid clipped at an end of the trim
+            return None
+        gv = (g[i, j + 1] - g[i, j - 1]) / (2.0 * dv)
+        hvv = (g[i, j + 1] - 2.0 * g[i, j] + g[i, j - 1]) / (dv * dv)
+        du = uu[min(i + 1, g.shape[0] - 1)] - uu[i]
+        inside = 0 < i < g.shape[0] - 1 and du > 0.0 and abs(uu[i] - uu[i - 1] - du) <= 1e-9 * du
+        noise = 64.0 * np.finfo(float).eps * max(abs(float(g[i, j])), 1.0)  # rounding of the samples (mm)
+        if inside:
+            gu = (g[i + 1, j] - g[i - 1, j]) / (2.0 * du)
+            huu = (g[i + 1, j] - 2.0 * g[i, j] + g[i - 1, j]) / (du * du)
+            huv = (g[i + 1, j + 1] - g[i + 1, j - 1] - g[i - 1, j + 1] + g[i - 1, j - 1]) / (4.0 * du * dv)
+            det = huu * hvv - huv * huv
+            if max(abs(gu) * du, abs(huu) * du * du, abs(huv) * du * dv) <= noise and hvv < 0.0:
+                su, sv = 0.0, -gv / hvv  # flat along u to rounding (a band's side): the top of the parabola in v
+            elif huu < 0.0 and det > 0.0:
+                su = -(hvv * gu - huv * gv) / det
+                sv = -(huu * gv - huv * gu) / det
+            else:
+                return None
+        elif uu[i] in t.u and hvv < 0.0:  # the peak on the trim's end u = u0 or u1 (a land's rim): along it in v
+            su, sv, du = 0.0, -gv / hvv, math.inf
+        else:
+            return None
+        if abs(su) > du or abs(sv) > dv:  # beyond its neighbours: not the quadratic's top
+            return None
+        un = float(np.clip(uu[i] + su, t.u[0], t.u[1]))
+        vn = float(vv[j] + sv) if t.full_v else float(np.clip(vv[j] + sv, t.v[0], t.v[1]))
+        return sign * float(self._outer(p, un, vn)[axis])
 
     def dimensions(self) -> dict[str, float]:
         """``length_mm`` (x extent), ``width_mm`` (y extent), ``height_mm`` (z extent)."""
