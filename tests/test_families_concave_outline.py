@@ -198,3 +198,28 @@ def test_a_flat_fan_over_an_offset_past_the_star_limit_is_measured_folding(fract
     if folds:  # and a patch's own check refuses it (the family builder's stray check is off for its patches)
         with pytest.raises(DesignError, match="a fold"):
             p._check_fold()
+
+
+@pytest.mark.parametrize("fraction", [0.5, 1.05, None])
+@pytest.mark.parametrize("rise", [0.0, 0.8])
+def test_a_level_patch_folds_as_the_general_computation_measures(fraction, rise, monkeypatch):
+    """A patch whose lines ``u`` each lie in a plane (``PDEPatch.level``) takes the fold check's ``x`` and ``y``
+    from its series and ``z`` from its spine: the same depth and reach as the general computation (all three
+    coordinates from the series), flat (``rise`` 0) or cupped, folding or not, to 1e-12 of the reach."""
+    from tabletcad.families.sweep import SweepCurve
+    from tabletcad.geometry.patch import PDEPatch
+
+    ol = outline_from_items(peanut_segments(4.0, 3.0, 40.0))
+    c = ol.centroid()
+    d = ol.offset_limit() if fraction is None else fraction * ol.star_limit()
+    pole = SweepCurve(ol, 0.0, 0.0, (float(c[0]), float(c[1]), 1.0 + rise))
+    rim = SweepCurve(ol, 1.0, d, (0.0, 0.0, 1.0))
+    du = SweepCurve(ol, 1.0, d, (-float(c[0]), -float(c[1]), -rise))
+    p = PDEPatch((pole, rim, du, du), a=0.01, form="hermite", check=False)
+    assert p.level
+    depth, reach = p._fold_depth_of(65, 128)
+    monkeypatch.setattr(PDEPatch, "level", property(lambda self: False))
+    depth_all, reach_all = p._fold_depth_of(65, 128)
+    assert reach == pytest.approx(reach_all, rel=1e-12)
+    assert abs(depth - depth_all) <= 1e-12 * reach
+    assert (depth > 0.05) == (fraction != 0.5)

@@ -837,9 +837,16 @@ class PDEPatch:
         u = _fold_u(nu, 48)
         v = sample_v(nv) if v is None else v
         # coordinates as contiguous (nu, nv) blocks (evaluate_grid's components layout)
-        Xu = self.evaluate_grid(u, v, du=1, components=True)
-        Xv = self.evaluate_grid(u, v, dv=1, components=True)
-        D = self.evaluate_grid(u, v, components=True) - self.spine(u).T[:, :, None]
+        if self.level:  # each line u lies in z = A0_z(u) (PDEPatch.level): x and y from the series, z known
+            Xu, Xv, D = (np.zeros((3, u.size, v.size)) for _ in range(3))
+            Xu[:2] = self.evaluate_grid(u, v, du=1, components=True, axes=(0, 1))
+            Xu[2] = self.spine(u, du=1)[:, 2:]
+            Xv[:2] = self.evaluate_grid(u, v, dv=1, components=True, axes=(0, 1))
+            D[:2] = self.evaluate_grid(u, v, components=True, axes=(0, 1)) - self.spine(u)[:, :2].T[:, :, None]
+        else:
+            Xu = self.evaluate_grid(u, v, du=1, components=True)
+            Xv = self.evaluate_grid(u, v, dv=1, components=True)
+            D = self.evaluate_grid(u, v, components=True) - self.spine(u).T[:, :, None]
         m = cross_first(Xv, D)  # Xv × D
         det = Xu[0] * m[0] + Xu[1] * m[1] + Xu[2] * m[2]
         mag = lambda a: math.sqrt(float(np.max(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])))  # noqa: E731
