@@ -626,6 +626,24 @@ class PDEPatch:
         X = X.reshape(-1, u.size, v.size)
         return X if components else np.ascontiguousarray(X.transpose(1, 2, 0))
 
+    def jet_grid(self, u, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``X``, ``X_u`` and ``X_v`` on the grid ``u × v``, each ``(3, len(u), len(v))`` (coordinates
+        first, as :meth:`evaluate_grid` with ``components``; mm and mm per unit parameter).  A
+        :attr:`level` patch takes ``x`` and ``y`` from its series and ``z`` from its spine (``A0_z(u)``,
+        its derivative, and 0 along ``v``): two thirds of the products, the same values."""
+        u = np.asarray(u, dtype=float).reshape(-1)
+        v = np.asarray(v, dtype=float).reshape(-1)
+        if not self.level:
+            return (self.evaluate_grid(u, v, components=True), self.evaluate_grid(u, v, du=1, components=True),
+                    self.evaluate_grid(u, v, dv=1, components=True))
+        out = []
+        for du, dv in ((0, 0), (1, 0), (0, 1)):
+            G = np.empty((3, u.size, v.size))
+            G[:2] = self.evaluate_grid(u, v, du, dv, components=True, axes=(0, 1))
+            G[2] = self.spine(u, du)[:, 2:] if dv == 0 else 0.0
+            out.append(G)
+        return out[0], out[1], out[2]
+
     @property
     def level(self) -> bool:
         """True when every datum is :attr:`~tabletcad.geometry.curves.Curve.flat` (its z does not change with
@@ -837,16 +855,8 @@ class PDEPatch:
         u = _fold_u(nu, 48)
         v = sample_v(nv) if v is None else v
         # coordinates as contiguous (nu, nv) blocks (evaluate_grid's components layout)
-        if self.level:  # each line u lies in z = A0_z(u) (PDEPatch.level): x and y from the series, z known
-            Xu, Xv, D = (np.zeros((3, u.size, v.size)) for _ in range(3))
-            Xu[:2] = self.evaluate_grid(u, v, du=1, components=True, axes=(0, 1))
-            Xu[2] = self.spine(u, du=1)[:, 2:]
-            Xv[:2] = self.evaluate_grid(u, v, dv=1, components=True, axes=(0, 1))
-            D[:2] = self.evaluate_grid(u, v, components=True, axes=(0, 1)) - self.spine(u)[:, :2].T[:, :, None]
-        else:
-            Xu = self.evaluate_grid(u, v, du=1, components=True)
-            Xv = self.evaluate_grid(u, v, dv=1, components=True)
-            D = self.evaluate_grid(u, v, components=True) - self.spine(u).T[:, :, None]
+        X, Xu, Xv = self.jet_grid(u, v)
+        D = X - self.spine(u).T[:, :, None]  # (a level patch's z: its spine's less itself, 0)
         m = cross_first(Xv, D)  # Xv × D
         det = Xu[0] * m[0] + Xu[1] * m[1] + Xu[2] * m[2]
         mag = lambda a: math.sqrt(float(np.max(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])))  # noqa: E731

@@ -476,9 +476,7 @@ class Tablet:
         coordinates first: three ``(3, len(s), len(t))`` arrays (mm; mm per unit parameter).  The outer
         surface ``w = 1`` is the patch itself."""
         p = self.patches[face.patch]
-        X = p.evaluate_grid(s, t, components=True)
-        Xs = p.evaluate_grid(s, t, du=1, components=True)
-        Xt = p.evaluate_grid(s, t, dv=1, components=True)
+        X, Xs, Xt = p.jet_grid(s, t)
         w = face.value
         if w == 1.0:
             return X, Xs, Xt
@@ -1146,8 +1144,12 @@ class Tablet:
         # (patches, 3, nu, nv): each coordinate a contiguous block (evaluate_grid's own layout, no transposed
         # copy); a mirror solid's twins reach the same x and y, and z reflected (below)
         patches = [self.patches[i] for i in self.measured()]
-        pts = np.stack([self._outer_grid(p, u, v, axes=(0, 1, 2)) for p in patches])
+        level = all(p.level for p in self.patches)  # then z is each patch's spine's (below): x and y alone
+        pts = np.stack([self._outer_grid(p, u, v, axes=(0, 1) if level else (0, 1, 2)) for p in patches])
         lo, hi = pts.min(axis=(0, 2, 3)), pts.max(axis=(0, 2, 3))
+        if level:  # the samples' z: their lines' spine heights
+            z = np.concatenate([p.spine(u)[:, 2] for p in patches])
+            lo, hi = np.append(lo, z.min()), np.append(hi, z.max())
         t = self.trim
         if not t.full_v or t.u != (0.0, 1.0):
             # a cut-away's cut faces run in to the spine A0(u) (eq 4.12), or to w0 of the way out to the
@@ -1163,7 +1165,6 @@ class Tablet:
                           for p in self.patches for uc in t.u]
             inner = np.concatenate(inner)
             lo, hi = np.minimum(lo, inner.min(axis=0)), np.maximum(hi, inner.max(axis=0))
-        level = all(p.level for p in self.patches)
         if level:  # z is each patch's spine's alone (PDEPatch.level): its extremes from the spines, polished in u
             zlo, zhi = self._spine_z_range()
             lo[2], hi[2] = min(lo[2], zlo), max(hi[2], zhi)
