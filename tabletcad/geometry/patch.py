@@ -188,7 +188,7 @@ def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: 
     hit = memo.get(key)
     if hit is None:
         hit = make()
-        if len(memo) >= 160:
+        if len(memo) >= 64:
             memo.pop(next(k for k in memo if k[0] == "res"))
         memo[key] = hit
     return hit
