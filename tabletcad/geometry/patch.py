@@ -188,8 +188,9 @@ def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: 
     hit = memo.get(key)
     if hit is None:
         hit = make()
-        if len(memo) >= 64:
-            memo.pop(next(k for k in memo if k[0] == "res"))
+        old = next((k for k in memo if k[0] == "res"), None) if len(memo) >= 64 else None
+        if old is not None:
+            memo.pop(old, None)
         memo[key] = hit
     return hit
 
