@@ -23,7 +23,7 @@ from tabletcad.cli.options import option_names
 from tabletcad.cli.outputs import check_output as _check_output
 from tabletcad.io.jsontext import json_text
 from tabletcad.cli.outputs import staged as _staged
-from tabletcad.errors import MISSING, DesignError, check_finite, check_positive, check_range
+from tabletcad.errors import MISSING, DesignError, check_finite, check_positive, check_range, format_bound
 from tabletcad.tolerance import MAX_MODULUS_MPA, MAX_PRESSURE_MPA
 
 __all__ = ["COMMANDS"]
@@ -484,7 +484,7 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
         check_positive(name, v, "mm")
     check_range("--E", E, 0.0, MAX_MODULUS_MPA, "MPa", lo_open=True)
     if b >= a:
-        raise DesignError("--inner", b, f"must be < --outer = {a:g} mm (inner radius below outer)", "mm")
+        raise DesignError("--inner", b, f"must be < --outer = {format_bound(a, upper=True)} mm (inner radius below outer)", "mm")
     check_range("--nu", nu, -1.0, 0.5, lo_open=True, hi_open=True)
     check_range("--p-ext", p_ext, -MAX_PRESSURE_MPA, MAX_PRESSURE_MPA, "MPa")
     check_range("--p-int", p_int, -MAX_PRESSURE_MPA, MAX_PRESSURE_MPA, "MPa")

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from tabletcad.errors import DesignError, check_finite, check_range
+from tabletcad.errors import DesignError, check_finite, check_range, format_bound
 from tabletcad.geometry.curves import Seg
 from tabletcad.families.profile import profile_arc, profile_line
 
@@ -60,7 +60,7 @@ def single_radius_cup(d0: float, d1: float, depth: float, z0: float = 0.0, *, de
     w = d1 - d0
     h = check_finite(depth_name, depth, "mm")
     if not 0.0 < h <= w * (1 + 1e-12):
-        raise DesignError(depth_name, h, f"must be > 0 and <= {w:.6g} mm (a hemisphere over the {2 * w:.6g} mm wide cup)", "mm")
+        raise DesignError(depth_name, h, f"must be > 0 and <= {format_bound(w, upper=True)} mm (a hemisphere over the {2 * w:.6g} mm wide cup)", "mm")
     h = min(h, w)
     rho = cup_radius(w, h)
     c = (d1, z0 + h - rho)
@@ -93,7 +93,7 @@ class CompoundCup:
         Rc = check_range("central_radius", central_radius, 0.0, None, "mm", lo_open=True)
         Re = check_range("edge_radius", edge_radius, 0.0, None, "mm", lo_open=True)
         if Re >= Rc:
-            raise DesignError("edge_radius", Re, f"must be < central_radius = {Rc:g} mm (the radii must be internally tangent)", "mm")
+            raise DesignError("edge_radius", Re, f"must be < central_radius = {format_bound(Rc, upper=True)} mm (the radii must be internally tangent)", "mm")
         if Rc < w:
             # a central radius smaller than the half width cannot reach the edge as the upper arc
             pass
@@ -105,7 +105,7 @@ class CompoundCup:
             B = np.array([rb, -Rc + math.sqrt(Rc * Rc - rb * rb)])
             Ce = C1 + (Rc - Re) / Rc * (B - C1)
             if abs(w - Ce[0]) > Re:
-                raise DesignError("edge_radius", Re, f"must be >= {abs(w - Ce[0]):.6g} mm to reach the cup edge from a {2 * rb:g} mm blend diameter", "mm")
+                raise DesignError("edge_radius", Re, f"must be >= {format_bound(abs(w - Ce[0]), upper=False)} mm to reach the cup edge from a {2 * rb:g} mm blend diameter", "mm")
             zE = Ce[1] + math.sqrt(Re * Re - (w - Ce[0]) ** 2)
             h = -zE
             shift = np.array([0.0, h])
@@ -118,7 +118,7 @@ class CompoundCup:
                 lo, hi = _depth_range(w, Rc, Re)
                 if lo != lo:
                     raise DesignError("edge_radius", Re, f"cannot be tangent to central_radius = {Rc:g} mm inside a {2 * w:g} mm cup for any depth", "mm")
-                raise DesignError("cup_depth", h, f"must be between {lo:.6g} and {hi:.6g} mm for a {2 * w:g} mm cup with radii {Rc:g} and {Re:g} mm (otherwise the radii cannot be tangent inside the cup)", "mm")
+                raise DesignError("cup_depth", h, f"must be between {format_bound(lo, upper=False)} and {format_bound(hi, upper=True)} mm for a {2 * w:g} mm cup with radii {Rc:g} and {Re:g} mm (otherwise the radii cannot be tangent inside the cup)", "mm")
             C1 = np.array([0.0, h - Rc])
             E = np.array([w, 0.0])
             Ce = _circle_intersection(C1, Rc - Re, E, Re, prefer_upper=True)
@@ -135,7 +135,7 @@ class CompoundCup:
         if not (0.0 < B[0] < w):
             lo, hi = _depth_range(w, Rc, Re)
             raise DesignError("cup_depth" if not blend_diameter else "blend_diameter", depth or blend_diameter,
-                              f"gives a blend at r = {B[0]:.4g} mm outside the cup (0, {w:g}) mm; cup_depth must be between {lo:.6g} and {hi:.6g} mm", "mm")
+                              f"gives a blend at r = {B[0]:.4g} mm outside the cup (0, {w:g}) mm; cup_depth must be between {format_bound(lo, upper=False)} and {format_bound(hi, upper=True)} mm", "mm")
         if Ce[1] > 1e-12 * w:
             raise DesignError("edge_radius", Re, "makes the cup wall overhang at the edge (edge-radius centre above the cup edge): use a larger edge radius or a shallower cup", "mm")
         if B[1] < 0.0 or B[1] > h:

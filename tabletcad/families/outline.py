@@ -458,10 +458,10 @@ class PlanOutline:
         rmin = self.min_convex_radius
         tol = 1e-9 * max(1.0, self.perimeter)
         if d > rmin + tol:
-            raise DesignError(parameter, d, f"must be <= {rmin:.6g} mm, the smallest corner (arc) radius of the outline", "mm")
+            raise DesignError(parameter, d, f"must be <= {format_bound(rmin, upper=True)} mm, the smallest corner (arc) radius of the outline", "mm")
         if not self._offset_is_clean(d):
             lim = self.offset_limit()
-            raise DesignError(parameter, d, f"must be <= {lim:.6g} mm (the outline's inscribed radius where it is narrowest: the offset would cross itself)", "mm")
+            raise DesignError(parameter, d, f"must be <= {format_bound(lim, upper=True)} mm (the outline's inscribed radius where it is narrowest: the offset would cross itself)", "mm")
 
     # ------------------------------------------------------------------ checks
     def _check_simple(self) -> None:
@@ -782,7 +782,7 @@ def stadium_outline(length: float, width: float, parameter: str = "width") -> Pl
     L = check_positive("length", length, "mm")
     W = check_positive("width", width, "mm")
     if W > L:
-        raise DesignError(parameter, W, f"must be <= length = {L:g} mm", "mm")
+        raise DesignError(parameter, W, f"must be <= length = {format_bound(L, upper=True)} mm", "mm")
     r = W / 2.0
     h = L / 2.0 - r
     if h <= 1e-12 * L:
@@ -808,12 +808,12 @@ def four_arc_oval(length: float, width: float, end_radius: float) -> PlanOutline
     L = check_positive("length", length, "mm")
     W = check_positive("width", width, "mm")
     if W > L:
-        raise DesignError("width", W, f"must be <= length = {L:g} mm", "mm")
+        raise DesignError("width", W, f"must be <= length = {format_bound(L, upper=True)} mm", "mm")
     r = check_range("end_radius", end_radius, 0.0, W / 2.0, "mm", lo_open=True)
     if abs(r - W / 2.0) <= 1e-12 * W:
         return stadium_outline(L, W)
     if not W < L * (1.0 - 1e-12):  # the side arcs are then the circle of diameter W: no end arcs are left
-        raise DesignError("width", W, f"must be < length = {L:g} mm for ends of radius {r:g} mm (an oval as wide as it "
+        raise DesignError("width", W, f"must be < length = {format_bound(L, upper=True)} mm for ends of radius {r:g} mm (an oval as wide as it "
                           "is long is a circle, with no end arcs; or give end_radius = width/2)", "mm")
     hx = L / 2.0 - r
     Rs = (hx * hx + W * W / 4.0 - r * r) / (W - 2.0 * r)
@@ -839,7 +839,7 @@ def four_arc_oval_from_side_radius(length: float, width: float, side_radius: flo
     L = check_positive("length", length, "mm")
     W = check_positive("width", width, "mm")
     if not W < L:  # (a side radius then gives ends of radius W/2 or more: no oval)
-        raise DesignError("width", W, f"must be < length = {L:g} mm for a modified capsule", "mm")
+        raise DesignError("width", W, f"must be < length = {format_bound(L, upper=True)} mm for a modified capsule", "mm")
     if not W > 2.0 * DEFAULT.min_length:  # (ends narrower than W/2 cannot reach the least length)
         raise DesignError("width", W, f"must be > {2.0 * DEFAULT.min_length:g} mm for a modified capsule (its end "
                           f"radius, below width/2, must be at least {DEFAULT.min_length:g} mm)", "mm")
@@ -876,7 +876,7 @@ def rounded_polygon(vertices, corner_radius: float, name: str = "polygon") -> Pl
         half = 0.5 * math.acos(float(np.clip(u1 @ u2, -1, 1)))
         t = rc / math.tan(half)
         if t > 0.5 * min(np.linalg.norm(a - b), np.linalg.norm(c - b)) + 1e-12:
-            raise DesignError("corner_radius", rc, f"must be <= {0.5 * min(np.linalg.norm(a - b), np.linalg.norm(c - b)) * math.tan(half):.6g} mm (the rounded corners would overlap)", "mm")
+            raise DesignError("corner_radius", rc, f"must be <= {format_bound(0.5 * min(np.linalg.norm(a - b), np.linalg.norm(c - b)) * math.tan(half), upper=True)} mm (the rounded corners would overlap)", "mm")
         bis = (u1 + u2) / np.linalg.norm(u1 + u2)
         centre = b + bis * rc / math.sin(half)
         p_in = b + u1 * t

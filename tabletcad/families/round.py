@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.errors import DesignError, check_positive, check_range, format_bound
 from tabletcad.families.cups import CompoundCup, bevel_line, land_line, single_radius_cup
 from tabletcad.families.outline import circle_outline
 from tabletcad.families.profile import profile_arc, profile_line
@@ -57,10 +57,10 @@ def _bevel_dims(R: float, T: float, angle: float, width: float, depth: float) ->
         w = dep / t
     dep = w * t
     if not w < R:
-        raise DesignError("bevel_width", w, f"must be < radius = {R:g} mm", "mm")
+        raise DesignError("bevel_width", w, f"must be < radius = {format_bound(R, upper=True)} mm", "mm")
     if not 2 * dep < T:
         raise DesignError("bevel_depth" if depth else "bevel_width", depth or width,
-                          f"must leave a band: bevel depth {dep:.4g} mm must be < thickness/2 = {T / 2:g} mm", "mm")
+                          f"must leave a band: bevel depth {dep:.4g} mm must be < thickness/2 = {format_bound(T / 2, upper=True)} mm", "mm")
     return w, dep
 
 

@@ -22,7 +22,7 @@ import numpy as np
 
 from tabletcad.geometry import nominal as nom
 from tabletcad.geometry.curves import Circle, Curve, Ellipse
-from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.errors import DesignError, check_positive, check_range, format_bound
 from tabletcad.families.family import Family
 from tabletcad.geometry.patch import PDEPatch
 from tabletcad.geometry.tablet import TRIM_MIN_WIDTH, Tablet, Trim
@@ -167,10 +167,10 @@ def spherical(diameter: float = 5.0, *, a: float | str = 1.0, tol=DEFAULT) -> Ta
 def _convex(name, D, T, band, aspect=1.0, a=1.0, tol=DEFAULT, params=None):
     R = D / 2
     if not 0 < band <= T:
-        raise DesignError("band", band, f"must be > 0 and <= thickness = {T:g} mm", "mm")
+        raise DesignError("band", band, f"must be > 0 and <= thickness = {format_bound(T, upper=True)} mm", "mm")
     d = (T - band) / 2
     if d > R and aspect == 1.0:
-        raise DesignError("band", band, f"must be >= thickness - diameter = {T - D:g} mm (cup deeper than a hemisphere)", "mm")
+        raise DesignError("band", band, f"must be >= thickness - diameter = {format_bound(T - D, upper=False)} mm (cup deeper than a hemisphere)", "mm")
     secs = [_cap(R, d, d, up=False), _band(R, d, d + band), _cap(R, d + band, d, up=True)]
     nominal = nom.convex_round(R, d, d + band, d) if aspect == 1.0 else None
     return coaxial_tablet(secs, aspect, a=a, name=name, family=f"thesis.{name}", params=params, nominal=nominal, tol=tol)

@@ -102,7 +102,7 @@ from typing import Any
 
 import numpy as np
 
-from tabletcad.errors import MISSING, DesignError, GeometryError, check_positive, check_range
+from tabletcad.errors import MISSING, DesignError, GeometryError, check_positive, check_range, format_bound
 from tabletcad.tolerance import DEFAULT
 from tabletcad.tolerance import MIN_FORCE_N
 from tabletcad.fe.elasticity import Material, PressureLoad, boundary_facets, principal_stresses, solve_elasticity
@@ -150,7 +150,7 @@ def hondros_centre_stress(P: float, D: float, t: float, b: float) -> float:
     t = check_positive("thickness", t, "mm")
     b = check_positive("strip_width", b, "mm")
     if b >= D:
-        raise DesignError("strip_width", b, f"must be < the diameter {D:g} mm", "mm")
+        raise DesignError("strip_width", b, f"must be < the diameter {format_bound(D, upper=True)} mm", "mm")
     a = math.asin(b / D)
     return line_load_stress(P, D, t) * (math.sin(2.0 * a) - a) / math.sin(a)
 

@@ -26,7 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from tabletcad.errors import MISSING, DesignError, check_range
+from tabletcad.errors import MISSING, DesignError, check_range, format_bound
 from tabletcad.tolerance import MAX_TENSILE_STRENGTH_MPA
 from tabletcad.tolerance import DEFAULT
 from tabletcad.fe.diametral import DiametralResult, diametral
@@ -77,7 +77,7 @@ class StrengthInputs:
                               STRENGTH_KEYS[k])
         if given == 3 and self.reference_thickness_mm > self.reference_diameter_mm:
             raise DesignError("[report] reference_thickness_mm", self.reference_thickness_mm,
-                              f"must be <= reference_diameter_mm ({self.reference_diameter_mm:g} mm)", "mm")
+                              f"must be <= reference_diameter_mm ({format_bound(self.reference_diameter_mm, upper=True)} mm)", "mm")
 
     @classmethod
     def from_table(cls, table: dict[str, Any] | None, **override: float | None) -> "StrengthInputs":

@@ -24,7 +24,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from tabletcad.errors import DesignError, check_finite, check_positive, check_range
+from tabletcad.errors import DesignError, check_finite, check_positive, check_range, format_bound
 from tabletcad.tolerance import DEFAULT
 
 __all__ = [
@@ -505,7 +505,7 @@ def Stadium(length: float, width: float, z: float = 0.0) -> Outline:
     L = check_positive("length", length, "mm")
     W = check_positive("width", width, "mm")
     if W > L:
-        raise DesignError("width", W, f"must be <= length = {L:g} mm", "mm")
+        raise DesignError("width", W, f"must be <= length = {format_bound(L, upper=True)} mm", "mm")
     r = W / 2.0
     h = L / 2.0 - r  # half straight length
     if h == 0.0:

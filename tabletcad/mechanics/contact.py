@@ -37,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.errors import DesignError, check_positive, check_range, format_bound
 from tabletcad.mechanics.materials import Material, get_material
 
 __all__ = [
@@ -114,7 +114,7 @@ def elastic_plastic_force(omega, r_s: float, s_y: float, omega_y: float) -> np.n
     omega_y = check_positive("omega_y", omega_y, "mm")
     w = np.asarray(omega, dtype=float)
     if np.any(w < omega_y * (1 - 1e-12)):
-        raise DesignError("omega", float(np.min(w)), f"must be >= the yield displacement {omega_y:.6g} mm", "mm")
+        raise DesignError("omega", float(np.min(w)), f"must be >= the yield displacement {format_bound(omega_y, upper=False)} mm", "mm")
     return math.pi * s_y * r_s * w / 2.0 * (1.0 - np.cbrt(omega_y / w) / 3.0)
 
 
@@ -127,7 +127,7 @@ def _check_force_above_yield(F, r_s, s_y, omega_y) -> np.ndarray:
     F = np.asarray(F, dtype=float)
     Fy = yield_force(r_s, s_y, omega_y)
     if np.any(F < Fy * (1 - 1e-12)):
-        raise DesignError("force", float(np.min(F)), f"must be >= the yield force {Fy:.6g} N for eq 2.1", "N")
+        raise DesignError("force", float(np.min(F)), f"must be >= the yield force {format_bound(Fy, upper=False)} N for eq 2.1", "N")
     return F
 
 

@@ -50,7 +50,7 @@ from pathlib import Path
 import numpy as np
 from scipy.special import eval_legendre
 
-from tabletcad.errors import DesignError, check_positive, check_range
+from tabletcad.errors import DesignError, check_positive, check_range, format_bound
 
 __all__ = [
     "ShellSolution",
@@ -271,7 +271,7 @@ def solve_shell(
     a = check_positive("a", a, "mm")
     b = check_positive("b", b, "mm")
     if not b < a:
-        raise DesignError("b", b, f"must be < a = {a:g} (inner radius below outer)", "mm")
+        raise DesignError("b", b, f"must be < a = {format_bound(a, upper=True)} (inner radius below outer)", "mm")
     E = check_positive("E", E, "MPa")
     nu = check_range("nu", nu, -1.0, 0.5, lo_open=True, hi_open=True)
     p_ext = float(p_ext)

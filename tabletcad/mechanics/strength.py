@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 
-from tabletcad.errors import DesignError, check_range
+from tabletcad.errors import DesignError, check_range, format_bound
 from tabletcad.mechanics.contact import contact_radius_at_yield
 from tabletcad.mechanics.validity import ValidityWarning, warn
 from tabletcad.tolerance import DEFAULT
@@ -113,7 +113,7 @@ def _pitt_denominator(D: float, t: float, W: float) -> float:
 
 def _check_convex(name: str, D: float, t: float, W: float, wd: tuple[float, float]) -> None:
     if W > t * (1 + 1e-12):  # the band is part of the tablet's thickness: no such tablet
-        raise DesignError("band thickness", W, f"must be <= the total thickness t = {t:g} mm ({name})", "mm")
+        raise DesignError("band thickness", W, f"must be <= the total thickness t = {format_bound(t, upper=True)} mm ({name})", "mm")
     r = W / D
     if not wd[0] <= r <= wd[1]:
         warn(ValidityWarning, f"{name}: W/D = {r:.3g} is outside {wd[0]:g}-{wd[1]:g}")

@@ -65,7 +65,7 @@ import re
 from pathlib import Path
 from typing import Any, Callable
 
-from tabletcad.errors import MISSING, DesignError, one_token
+from tabletcad.errors import MISSING, DesignError, format_bound, one_token
 from tabletcad.optimise.problem import METHODS, Constraint, Objective, Problem, Variable
 
 
@@ -460,7 +460,7 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
         hi = number(f"[variables] {name} upper", spec["upper"], unit, lo=0.0, hi=lim)
         x0 = None if "initial" not in spec else number(f"[variables] {name} initial", spec["initial"], unit, lo=0.0, hi=lim)
         if hi < lo:  # named by the file's key (the Variable would say "variable NAME bounds")
-            raise DesignError(f"[variables] {name} upper", hi, f"must be >= lower = {lo:g}", unit)
+            raise DesignError(f"[variables] {name} upper", hi, f"must be >= lower = {format_bound(lo, upper=False)}", unit)
         vs.append(Variable(name, lo, hi, x0, unit, least=TOL.min_length if unit == "mm" else None))
     both = [k for k in fixed if k in variables] if isinstance(fixed, dict) else []
     if both:  # (else: "allowed keys are (none)", as if the family had no such parameter)

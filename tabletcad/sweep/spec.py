@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from tabletcad.errors import MISSING, DesignError
+from tabletcad.errors import MISSING, DesignError, format_bound
 
 
 __all__ = ["SweepSpec", "Axis", "OUTPUTS", "load_sweep", "parse_sweep", "design_hash", "set_key"]
@@ -323,7 +323,7 @@ def _axis(key: str, spec: Any, method: str) -> Axis:
             raise DesignError(f"{where} {k}", MISSING, f"a range needs {', '.join(sorted(allowed))}")
     lo, hi = _number(f"{where} min", spec["min"]), _number(f"{where} max", spec["max"])
     if hi < lo:
-        raise DesignError(f"{where} max", hi, f"the range is empty: max must be >= min = {lo:g}")
+        raise DesignError(f"{where} max", hi, f"the range is empty: max must be >= min = {format_bound(lo, upper=False)}")
     if not math.isfinite(hi - lo):  # (-1.7e308 to 1.7e308 gave inf and nan values)
         raise DesignError(f"{where} max", hi, f"the range's width from min = {lo:g} must be a finite number")
     if method == "lhs":
