@@ -202,3 +202,25 @@ def test_collocation_is_shared_between_surfaces_with_the_same_knots():
     u = np.array([0.3])
     np.testing.assert_allclose(np.einsum("ai,ijk,bj->abk", a.collocation("u", u), a.poles, shared)[0],
                                a.evaluate(np.full(v.shape, 0.3), v, dv=1), atol=1e-12)
+
+
+@pytest.mark.parametrize("nu, nv", [(5, 300), (200, 7), (40, 40), (1, 90)])
+def test_grid_products_in_either_order_agree_and_the_cheaper_one_is_taken(nu, nv):
+    """``evaluate_grid`` and ``grid_components`` contract the direction with more samples than poles
+    last (fewer multiply-adds: ``_v_first``); both orders sum the same terms, so they agree to
+    rounding, and with the point-by-point evaluation."""
+    from tabletcad.brep.surface import _v_first
+
+    S = fit_surface(sphere(2.5).patches[0], tol=TOL).surface
+    pu, pv = S.shape
+    u, v = np.linspace(0, 1, nu), np.linspace(0, 2 * np.pi, nv)
+    Bu, Bu1, Bv, Bv1 = S.collocation("u", u), S.collocation("u", u, 1), S.collocation("v", v), S.collocation("v", v, 1)
+    P = np.ascontiguousarray(S.poles.transpose(2, 0, 1))
+    for (a, b), got in zip(((Bu, Bv), (Bu1, Bv), (Bu, Bv1)), S.grid_components(u, v)):
+        for X in ((a @ P) @ b.T, a @ (P @ b.T)):
+            np.testing.assert_allclose(got, X, rtol=0, atol=1e-13)
+    U, V = np.meshgrid(u, v, indexing="ij")
+    np.testing.assert_allclose(S.evaluate_grid(u, v), S.evaluate(U, V), atol=1e-13)
+    cost = {True: 2 * pu * pv * nv + 3 * nu * pu * nv, False: 2 * nu * pu * pv + 3 * nu * pv * nv}
+    assert cost[_v_first(nu, nv, pu, pv, 2, 3)] == min(cost.values())
+    assert _v_first(nu, nv, pu, pv) == (pu * pv * nv + nu * pu * nv < nu * pu * pv + nu * pv * nv)

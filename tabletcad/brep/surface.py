@@ -143,8 +143,10 @@ class BSplineSurfaceData:
         returns ``(len(u), len(v), 3)``."""
         Bu = self.collocation("u", u, du)
         Bv = self.collocation("v", v, dv)
-        # two matrix products per coordinate, (B_u P_c) B_v^T (an einsum searching its path took as long)
-        X = (Bu @ np.ascontiguousarray(self.poles.transpose(2, 0, 1))) @ Bv.T  # (3, len(u), len(v))
+        # two matrix products per coordinate, (B_u P_c) B_v^T or B_u (P_c B_v^T), whichever costs less
+        # (:func:`_v_first`; an einsum searching its path took as long)
+        P = np.ascontiguousarray(self.poles.transpose(2, 0, 1))
+        X = Bu @ (P @ Bv.T) if _v_first(len(Bu), len(Bv), *self.shape) else (Bu @ P) @ Bv.T  # (3, len(u), len(v))
         return np.ascontiguousarray(X.transpose(1, 2, 0))
 
     def grid_components(self, u: np.ndarray, v: np.ndarray, collocation=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -152,15 +154,25 @@ class BSplineSurfaceData:
         ``(3, len(u), len(v))``, C-contiguous.  One collocation matrix per direction and order,
         and two matrix products per component (``B_u P_c B_v^T``).  ``collocation(which, x)``,
         if given, supplies ``(values, first derivatives)`` matrices (e.g. shared by surfaces
-        with the same knots)."""
+        with the same knots).
+
+        The products run in the cheaper order (:func:`_v_first`): the direction with more
+        samples than poles is contracted last, so the large sample grid is made by one product
+        and not two (the volume's Gauss grid of a 17 x 64 pole patch, 108 x 288 points: 6.6
+        instead of 19 million multiply-adds, 0.4 instead of 1.3 ms).  The sums are the same
+        terms in another order: equal to rounding."""
         u, v = np.asarray(u, dtype=float).ravel(), np.asarray(v, dtype=float).ravel()
         if collocation is None:
             def collocation(which, x):
                 return self.collocation(which, x), self.collocation(which, x, 1)
         Bu, Bu1 = collocation("u", u)
         Bv, Bv1 = collocation("v", v)
-        BvT, Bv1T = Bv.T, Bv1.T
+        nu, nv = self.shape
         P = np.ascontiguousarray(self.poles.transpose(2, 0, 1))  # (3, u poles, v poles)
+        if _v_first(len(u), len(v), nu, nv, 2, 3):
+            C, C1 = P @ Bv.T, P @ Bv1.T  # (3, u poles, len(v))
+            return Bu @ C, Bu1 @ C, Bu @ C1
+        BvT, Bv1T = Bv.T, Bv1.T
         A, A1 = Bu @ P, Bu1 @ P  # (3, len(u), v poles)
         return A @ BvT, A1 @ BvT, A @ Bv1T
 
@@ -210,6 +222,17 @@ class BSplineSurfaceData:
     @classmethod
     def from_dict(cls, d: dict) -> "BSplineSurfaceData":
         return cls(**{k: d[k] for k in cls.__dataclass_fields__})
+
+
+def _v_first(n_u: int, n_v: int, poles_u: int, poles_v: int, first: int = 1, second: int = 1) -> bool:
+    """Whether a tensor grid of ``n_u x n_v`` samples of a ``poles_u x poles_v`` net costs fewer
+    multiply-adds contracting ``v`` first (``P B_v^T``, ``poles_u poles_v n_v`` each, then ``B_u``
+    times that, ``n_u poles_u n_v`` each) than ``u`` first, with ``first`` products of the first
+    kind and ``second`` of the second (:meth:`BSplineSurfaceData.grid_components`: 2 and 3, the
+    values and the derivatives; :meth:`~BSplineSurfaceData.evaluate_grid`: 1 and 1)."""
+    v_first = first * poles_u * poles_v * n_v + second * n_u * poles_u * n_v
+    u_first = first * n_u * poles_u * poles_v + second * n_u * poles_v * n_v
+    return v_first < u_first
 
 
 def segment_v(data: BSplineSurfaceData, a: float, b: float) -> BSplineSurfaceData:
