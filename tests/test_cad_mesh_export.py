@@ -201,3 +201,18 @@ def test_export_refuses_an_option_it_does_not_know_and_applies_relative(tmp_path
     a = export(solid, tmp_path / "a.stl").read_bytes()
     b = export(solid, tmp_path / "b.stl", linear_deflection=0.01, relative=True).read_bytes()
     assert a != b and len(b) > 84
+
+
+def test_edge_check_of_a_closed_mesh_with_a_degenerate_triangle_is_trimesh_s():
+    """A closed mesh takes the short way (each directed edge once, its reverse once); one with a
+    triangle that repeats a vertex does not, and gets trimesh's figures."""
+    from tabletcad.cad.mesh import _edge_check
+
+    base = trimesh.creation.icosphere(2)
+    T = np.array(base.faces)
+    assert _edge_check(T) == (True, True)
+    a, b = T[0, 0], T[0, 1]
+    for bad in ([a, a, b], [a, b, a]):
+        T2 = np.vstack([T, [bad]])
+        tm = trimesh.Trimesh(base.vertices, T2, process=False)
+        assert _edge_check(T2) == (tm.is_watertight, tm.is_winding_consistent)

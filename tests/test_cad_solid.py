@@ -176,3 +176,22 @@ def test_a_solid_that_fails_its_check_names_the_invalid_face(monkeypatch):
     monkeypatch.setattr(solid_module, "BRepCheck_Analyzer", Analyzer)
     with pytest.raises(GeometryError, match=r"^face of patch 1 is not valid"):
         build_solid(cylinder(2.0, 3.0).patches, 1e-4, names=["patch 0", "patch 1", "patch 2"])
+
+
+def test_explore_gives_each_sub_shape_once_as_the_explorer_first_meets_it():
+    """``explore`` (``TopExp::MapShapes``) lists what a walk with ``TopExp_Explorer`` keeping the first of
+    each ``IsSame`` group lists: the same shapes, in the same order, with the same orientations."""
+    from OCP.TopExp import TopExp_Explorer
+
+    from tabletcad.cad._occ import _KINDS, cast, explore
+
+    shape = build_solid(ring(1.5, 3.0, 2.0).patches, TOL).shape
+    for kind in ("Vertex", "Edge", "Wire", "Face", "Shell", "Solid"):
+        walk, it = [], TopExp_Explorer(shape, _KINDS[kind])
+        while it.More():
+            if not any(it.Current().IsSame(o) for o in walk):
+                walk.append(it.Current())
+            it.Next()
+        got = explore(shape, kind)
+        assert len(got) == len(walk) > 0
+        assert all(a.IsEqual(b) and type(a) is type(cast(b, kind)) for a, b in zip(got, walk))

@@ -188,3 +188,46 @@ def test_a_deflection_not_reached_leaves_the_mesh_to_the_caller(monkeypatch):
 
     monkeypatch.setattr(gm, "_cell_deviation", lambda *a, **k: np.full(a[5].shape, 1.0))  # never within 0.005
     assert gm.grid_mesh(chain("oval"), 0.005, 0.2, max_rounds=1) is None
+
+
+@pytest.mark.parametrize("name", ["oval", "rounded_triangle"])
+def test_the_measured_deviation_is_the_largest_on_every_cell_s_own_lattice(name):
+    """The measurement takes each lattice point shared by neighbouring cells once (16 points a cell):
+    its largest value is the largest over every cell's own 5 x 5 lattice with the surface evaluated
+    point by point (the triangles agree along a cell's sides), to rounding."""
+    import tabletcad.brep.grid_mesh as gm
+
+    surfaces = chain(name)
+    col = gm._Collocation()
+    nodes = gm._Nodes(surfaces, 0.005, 0.2, col)
+    us, v = nodes.place(1.0)
+    V, row_ids, m = gm._assemble(surfaces, us, v, gm._is_chain(surfaces), col)
+    n = gm._LATTICE
+    for j in (0, len(surfaces) // 2):
+        s, u = surfaces[j], us[j]
+        corners, diag = gm._cells(V, row_ids[j], m)
+        got = float(gm._cell_deviation(s, u, v, V, corners, diag, nodes.curvature[j], col).max())
+        a, b = (x.ravel() / n for x in np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij"))
+        worst = 0.0
+        for i in range(diag.shape[0]):
+            uu = u[i] + a * (u[i + 1] - u[i])
+            vv = v[:-1, None] + b[None, :] * np.diff(v)[:, None]  # (m, 25)
+            UU = np.broadcast_to(uu, vv.shape)
+            S, Su, Sv = (s.evaluate(UU, vv, du, dv) for du, dv in ((0, 0), (1, 0), (0, 1)))
+            N = np.cross(Su, Sv)
+            size = np.linalg.norm(N, axis=-1)
+            ok = size > 1e-9 * np.maximum((Su * Su).sum(-1), (Sv * Sv).sum(-1))
+            N = N / np.where(ok, size, 1.0)[..., None]
+            lo, up = a >= b, a + b <= 1
+            lower = np.where(lo, [1 - a, a - b, 0 * a, b], [1 - b, 0 * a, b - a, a]).T  # (25, 4)
+            upper = np.where(up, [1 - a - b, a, b, 0 * a], [0 * a, 1 - b, 1 - a, a + b - 1]).T
+            w = np.where(diag[i][:, None, None], lower[None], upper[None])  # (m, 25, 4)
+            M = sum(w[..., c, None] * V.T[corners[c][i]][:, None, :] for c in range(4))
+            D = M - S
+            h = (D * N).sum(-1)
+            dd = (D * D).sum(-1)
+            tang = np.maximum(dd - h * h, 0.0)
+            k = nodes.curvature[j]
+            near = ok & (k * k * tang <= 0.25)
+            worst = max(worst, float(np.max(np.where(near, np.abs(h) + 0.5 * k * tang, np.sqrt(dd)))))
+        assert got == pytest.approx(gm._LATTICE_ALLOWANCE * worst, rel=1e-9)

@@ -18,7 +18,8 @@ the nodes that keep these within half the deflection and the turn within the
 angular deflection.
 
 The deflection is then *measured* on 25 parameter points of every cell (a 5 × 5
-lattice: the corners, edge midpoints and 9 interior points of both triangles; the largest
+lattice: the corners, edge midpoints and 9 interior points of both triangles, a point on a
+side shared with the neighbouring cell measured once; the largest
 value raised by 1/15, what a triangle can hide between lattice points): with
 ``Δ`` from the surface point to the triangle point of the same parameters, ``n`` the
 surface normal there and ``κ`` the surface's largest principal curvature, the distance
@@ -274,39 +275,55 @@ def _cells(V: np.ndarray, ids: np.ndarray, m: int):
     return (i00, i10, i01, i11), _dot(d1, d1) <= _dot(d2, d2)
 
 
-def _lattice_weights(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Lattice steps ``a, b`` (``(n + 1)²`` each) and the weights ``(L, 4)`` of the corners
-    ``P00, P10, P01, P11`` of the triangle holding each lattice point, for a cell cut along
-    ``P00-P11`` and along ``P10-P01``."""
-    a, b = (x.ravel() for x in np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij"))
-    s_, t = a / n, b / n
-    z = np.zeros_like(s_)
-    lower = np.where(s_ >= t, [1 - s_, s_ - t, z, t], [1 - t, z, t - s_, s_])
-    upper = np.where(s_ + t <= 1, [1 - s_ - t, s_, t, z], [z, 1 - t, 1 - s_, s_ + t - 1])
-    return a, b, lower.T, upper.T
+def _lattice_weights(s_: np.ndarray, t: np.ndarray, diag: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Weights of the corners ``P00, P10, P01, P11`` of a cell at its local parameters ``(s_, t)``
+    (in [0, 1]) on the triangle holding that point, for a cell cut along ``P00-P11`` (``diag``) or
+    along ``P10-P01``; arrays broadcast together."""
+    z = np.zeros(np.broadcast_shapes(s_.shape, t.shape, diag.shape))
+    lo = s_ >= t
+    up = s_ + t <= 1
+    w00 = np.where(diag, np.where(lo, 1 - s_, 1 - t), np.where(up, 1 - s_ - t, z))
+    w10 = np.where(diag, np.where(lo, s_ - t, z), np.where(up, s_, 1 - t))
+    w01 = np.where(diag, np.where(lo, z, t - s_), np.where(up, t, 1 - s_))
+    w11 = np.where(diag, np.where(lo, t, s_), np.where(up, z, s_ + t - 1))
+    return w00, w10, w01, w11
+
+
+def _lattice_cells(n_cells: int, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """For each of the ``n n_cells + 1`` lattice lines across ``n_cells`` cells (``n`` steps a cell),
+    its cell and its step in that cell (``0..n``; a line between two cells goes to the later one,
+    the last line to the last cell)."""
+    k = np.arange(n * n_cells + 1)
+    cell = np.minimum(k // n, n_cells - 1)
+    return cell, k - n * cell
 
 
 def _cell_deviation(s: BSplineSurfaceData, u: np.ndarray, v: np.ndarray, V: np.ndarray, corners, diag,
                     curvature: float, col: _Collocation) -> np.ndarray:
-    """Largest distance (mm) per cell from the triangles to the surface, estimated on the cell's
-    ``(_LATTICE + 1)²`` lattice points (module docstring; ``curvature`` the surface's largest)."""
+    """Distance (mm) from the triangles to the surface, estimated at every point of the lattice of
+    ``_LATTICE`` steps per cell edge over the whole surface (module docstring; ``curvature`` the
+    surface's largest): ``(n nu1 + 1, n m + 1)``, the caller takes the largest.  A lattice point on
+    a cell's side is measured once, in one of the cells it bounds: both triangulations agree there
+    (along a side the triangles are linear between its two vertices).  This is the per-cell
+    ``(_LATTICE + 1)²`` lattice with its shared points taken once, 16 points a cell instead of 25, and
+    the surface's points and normals on it used in place (no gathered copies)."""
     n = _LATTICE
     S, Nrm, ok = _points_normals(s, _subdivide(u, n), _subdivide(v, n), col)
     nu1, m = diag.shape
-    a, b, lower, upper = _lattice_weights(n)
-    W = np.where(diag[None, None], lower[:, :, None, None], upper[:, :, None, None])  # (L, 4, nu1, m)
-    M = sum(W[:, c] * V[:, idx][:, None] for c, idx in enumerate(corners))  # (3, L, nu1, m)
-    rows = (n * np.arange(nu1))[None, :, None] + a[:, None, None]
-    cols = (n * np.arange(m))[None, None, :] + b[:, None, None]
-    D = M - S[:, rows, cols]
-    h = _dot(D, Nrm[:, rows, cols])
+    ci, a = _lattice_cells(nu1, n)
+    cj, b = _lattice_cells(m, n)
+    cell = (ci[:, None], cj[None, :])
+    weights = _lattice_weights((a / n)[:, None], (b / n)[None, :], diag[cell])
+    M = sum(w * V[:, idx[cell]] for w, idx in zip(weights, corners))  # (3, n nu1 + 1, n m + 1)
+    D = M - S
+    h = _dot(D, Nrm)
     dd = _dot(D, D)
     tang = np.maximum(dd - h * h, 0.0)
     # the tangent-plane estimate holds while the step along the surface is small against its radius
     # of curvature; beyond that (very coarse deflections on a distorted parametrisation) |Δ| itself
-    near = ok[rows, cols] & (curvature * curvature * tang <= 0.25)
+    near = ok & (curvature * curvature * tang <= 0.25)
     est = np.where(near, np.abs(h) + 0.5 * curvature * tang, np.sqrt(dd))
-    return _LATTICE_ALLOWANCE * est.max(axis=0)
+    return _LATTICE_ALLOWANCE * est
 
 
 def grid_mesh(surfaces: Sequence[BSplineSurfaceData], deflection: float, angle: float, *,

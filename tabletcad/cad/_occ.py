@@ -31,6 +31,9 @@ _NAMES = {
 }
 
 
+_KINDS = {v: k for k, v in _NAMES.items()}
+
+
 def shape_type(shape: TopoDS_Shape) -> str:
     """``"Solid"``, ``"Shell"``, ``"Face"``... of a shape."""
     return _NAMES[shape.ShapeType()]
@@ -59,18 +62,17 @@ def handle(shape: TopoDS_Shape):
 
 
 def explore(shape: TopoDS_Shape, kind: str) -> list:
-    """Distinct sub-shapes of ``kind`` (``"Face"``, ``"Edge"``, ``"Solid"``...), downcast."""
-    from OCP.TopExp import TopExp_Explorer
+    """Distinct sub-shapes of ``kind`` (``"Face"``, ``"Edge"``, ``"Solid"``...), downcast, in the order
+    ``TopExp_Explorer`` first meets them, each with the orientation it has there.  ``TopExp::MapShapes``
+    keeps them distinct (``IsSame``: the same ``TShape`` and location) in a hashed map: a comparison
+    with every one found before took 1.5 ms of the rounded square's solid (3,300 ``IsSame`` calls)."""
+    from OCP.TopExp import TopExp
+    from OCP.TopTools import TopTools_IndexedMapOfShape
 
-    enum = {v: k for k, v in _NAMES.items()}[kind]
-    out: list = []
-    exp = TopExp_Explorer(shape, enum)
-    while exp.More():
-        cur = exp.Current()
-        if not any(cur.IsSame(o) for o in out):
-            out.append(cur)
-        exp.Next()
-    return [cast(o, kind) for o in out]
+    enum = _KINDS[kind]
+    found = TopTools_IndexedMapOfShape()
+    TopExp.MapShapes_s(shape, enum, found)
+    return [cast(found.FindKey(i), kind) for i in range(1, found.Extent() + 1)]
 
 
 class quiet:
