@@ -113,3 +113,16 @@ def test_shared_rows_put_into_the_first_fit_give_the_refit_poles_and_a_bound_on_
         measured = _deviation(f, q.surface, q.u_samples, q.v_samples, 4)[0]
         assert measured <= q.max_deviation <= q.tol
         assert q.max_deviation - measured <= 1e-8  # the bound is tight: the rows moved by ~1e-9
+
+
+def test_periodic_knots_are_kept_read_only_for_the_same_arguments():
+    """A chain's fit asks for the same knots again and again: the first answer is kept (read-only),
+    the one the computation gives, and other arguments get their own."""
+    from tabletcad.brep.knots import _periodic_knots
+
+    first = periodic_knots(24, 5, [0.0, 1.0, 4.0], 4)
+    again = periodic_knots(24, 5, np.array([4.0, 1.0, 0.0]), 4)  # the same breakpoints, normalised alike
+    assert all(a is b and not a.flags.writeable for a, b in zip(first, again))
+    for a, b in zip(first, _periodic_knots(24, 5, [0.0, 1.0, 4.0], 4)):
+        np.testing.assert_array_equal(a, b)
+    assert periodic_knots(24, 5, [0.0, 1.0, 4.0], 3)[1] is not first[1]

@@ -90,17 +90,14 @@ def _solve_poles(
     if u_periodic:
         raise NotImplementedError("periodic u is not supported")
     u_knots, u_mults = clamped_interp_knots(u, u_degree)
-    proto = BSplineSurfaceData(
-        poles=np.zeros((nu, nv, 3)),
-        u_knots=u_knots,
-        u_mults=u_mults,
-        v_knots=v_knots,
-        v_mults=v_mults,
-        u_degree=u_degree,
-        v_degree=v_degree,
-        u_periodic=False,
-        v_periodic=True,
-    )
+    # only the knots of the surface to be are asked for (its collocation matrices): set, not validated (the
+    # poles come out of these knots, and the surface made of them is validated)
+    proto = object.__new__(BSplineSurfaceData)
+    for name, value in (("poles", np.broadcast_to(0.0, (nu, nv, 3))), ("u_knots", np.asarray(u_knots, dtype=float)),
+                        ("u_mults", np.asarray(u_mults, dtype=int)), ("v_knots", np.asarray(v_knots, dtype=float)),
+                        ("v_mults", np.asarray(v_mults, dtype=int)), ("u_degree", int(u_degree)),
+                        ("v_degree", int(v_degree)), ("u_periodic", False), ("v_periodic", True)):
+        object.__setattr__(proto, name, value)
     Bu = proto.collocation("u", u)
     Bv = proto.collocation("v", v)
     # along u: the end rows of a clamped interpolant equal the data exactly, so

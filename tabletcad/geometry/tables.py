@@ -86,5 +86,6 @@ TRIG = SharedTables(32, 8_000_000, 64_000_000)
 CARDINAL = SharedTables(96, 4_000_000, 48_000_000)
 #: B-spline collocation matrices (:meth:`tabletcad.brep.surface.BSplineSurfaceData.collocation`):
 #: the faces of a chain share their knots, and the fit, its check, the volume and area and the mesh
-#: evaluate them on the same samples.  64 tables, none above 2 MB, 32 MB in all.
+#: evaluate them on the same samples; and the chain's periodic knots (:func:`tabletcad.brep.knots.periodic_knots`).
+#: 64 tables, none above 2 MB, 32 MB in all.
 COLLOCATION = SharedTables(64, 2_000_000, 32_000_000)
