@@ -261,3 +261,34 @@ def test_plane_faces_store_their_edges_projections_and_enclose_the_same_volume(f
     v_planes, v_made = (mass_properties(s, solid.eps).volume for s in (solid.shape, before[0]))
     assert v_planes == pytest.approx(v_made, rel=1e-12)
     assert v_planes == pytest.approx(abs(solid.data_volume_area[0]), rel=1e-10)  # (the sewn capsule: 5e-12)
+
+
+def test_flat_faces_whose_edges_do_not_chain_are_made_as_before():
+    """Edges left that do not chain vertex to vertex go to MakeWire and MakeFace, as before: a concave
+    round's flat land (two circles once its seam is left out) stays a face of revolution, and the almond
+    cut-away, where a degenerated edge joins two vertices at one point (MakeWire bridges the gap with new
+    edges, and the solid with them fails its check), keeps its B-spline faces; its STEP reads back with
+    its volume (tests/test_build_outputs_cad.py)."""
+    from dataclasses import replace
+
+    import tabletcad.cad.planes as planes
+    from OCP.BRep import BRep_Tool
+    from OCP.Geom import Geom_Plane, Geom_SurfaceOfRevolution
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.cad.stage import cutaway_solid
+    from tabletcad.cad.tablet_solid import tablet_solid
+    from tabletcad.geometry.tablet import Trim
+    from tabletcad.pipeline.design import Design, load_design
+
+    solid = tablet_solid(Design.from_toml(ROOT / "samples" / "families" / "concave_round.toml").build())
+    rings = [f for f in explore(solid.shape, "Face") if isinstance(BRep_Tool.Surface_s(f), Geom_SurfaceOfRevolution)
+             and planes._revolved_plane_of(BRep_Tool.Surface_s(f)) is not None]
+    assert solid.planes == 0 and len(rings) == 2  # the top and bottom lands
+    for f in rings:
+        edges, loop = planes._boundary(f)
+        assert len(edges) == 2 and not loop
+        assert planes._plane_face(f, *planes._revolved_plane_of(BRep_Tool.Surface_s(f))) is None
+    t = replace(load_design(ROOT / "samples" / "families" / "almond.toml"), trim=Trim(v=(0.0, 3.0)))
+    shape = cutaway_solid(t, {"volume_mm3": t.volume(), "surface_area_mm2": t.surface_area()})[0]
+    assert not any(isinstance(BRep_Tool.Surface_s(f), Geom_Plane) for f in explore(shape, "Face"))

@@ -18,15 +18,15 @@ must be valid, else it is returned unchanged.
 Each plane face is built with ``BRep_Builder`` from the B-spline face's own edges, in their own
 order and orientation (the plane's normal is the surface's ``S_u × S_v`` sense, so the loop that
 bounded the B-spline face bounds the same region of the plane; a plane turned the other way
-fails ``BRepCheck_Analyzer``, and the solid is then kept as made), and each edge gets its p-curve
+fails ``BRepCheck_Analyzer``, and the solid is then kept as made; edges that do not chain vertex
+to vertex go to ``BRepBuilderAPI_MakeWire`` and ``MakeFace`` as before), and each edge gets its p-curve
 on the plane stored (``BRepLib::BuildPCurveForEdgeOnPlane``, the exact projection of its 3D
 curve).  OCC computes a plane's p-curves on the fly when none is stored, every time a check,
 an exporter or a mesher asks: ``BRepCheck_Analyzer`` of the rounded square's solid took
 17 ms with them computed so, 13.5 ms with them stored.  ``BRepBuilderAPI_MakeFace(plane, wire,
 Inside=True)``, which classified the wire's inside once more, had taken 6.8 of the 21 ms the
-planes took (2026-12-06).  The STEP files read back (OCC's reader, FreeCAD's) with the same
-faces, validity and volume to 2e-15; where the solid's faces are reversed a plane's loop is
-now written the other way round with its ``FACE_BOUND`` flag ``.F.``, the same bound.
+planes took (2026-12-06).  The faces are held as ``MakeFace`` held them (:func:`_plane_face`):
+the STEP files are the same but for the last digits of the planes' origins.
 """
 
 from __future__ import annotations
@@ -35,11 +35,12 @@ from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
 from OCP.BRep import BRep_Builder, BRep_Tool
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepLib import BRepLib
 from OCP.BRepTools import BRepTools_ReShape, BRepTools_WireExplorer
 from OCP.Geom import Geom_BSplineSurface, Geom_Plane, Geom_SurfaceOfRevolution
-from OCP.gp import gp_Ax3, gp_Dir, gp_Pnt
+from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt
 from OCP.Standard import Standard_Failure
 from OCP.TopAbs import TopAbs_Orientation
 from OCP.TopExp import TopExp
@@ -189,12 +190,12 @@ def _edges_in_plane(edges: Sequence[TopoDS_Edge], point: np.ndarray, normal: np.
     return float(np.max(np.abs((np.concatenate(x) - point) @ normal))) <= EDGE_PLANE_TOL_MM
 
 
-def _boundary(face: TopoDS_Face) -> list[TopoDS_Edge] | None:
-    """The edges of ``face`` (taken ``FORWARD``) that bound a region, in their wire's order and
-    orientation: its one wire's edges but degenerated ones (a pole's) and a seam (a round flat
-    face's, the edge twice in the wire).  None when it has another number of wires, an edge twice
-    that is no seam (a slit), or what is left is not one closed loop, each edge starting where
-    the one before ends."""
+def _boundary(face: TopoDS_Face) -> tuple[list[TopoDS_Edge], bool] | None:
+    """The edges of ``face`` that bound a region, in their wire's order and with their orientation in
+    the face (``BRepTools_WireExplorer``): its one wire's edges but degenerated ones (a pole's) and a seam
+    (a round flat face's, the edge twice in the wire); and whether they make one loop, each edge
+    starting at the vertex where the one before ends.  None when the face has another number of
+    wires, an edge twice that is no seam (a slit), or no edge left."""
     wires = []
     it = TopoDS_Iterator(face)
     while it.More():
@@ -214,10 +215,9 @@ def _boundary(face: TopoDS_Face) -> list[TopoDS_Edge] | None:
         edges.append(e)
     if not edges:
         return None
-    for e, nxt in zip(edges, edges[1:] + edges[:1]):
-        if not TopExp.LastVertex_s(e, True).IsSame(TopExp.FirstVertex_s(nxt, True)):
-            return None
-    return edges
+    loop = all(TopExp.LastVertex_s(e, True).IsSame(TopExp.FirstVertex_s(nxt, True))
+               for e, nxt in zip(edges, edges[1:] + edges[:1]))
+    return edges, loop
 
 
 def _plane_face(face: TopoDS_Face, point: np.ndarray, normal: np.ndarray,
@@ -226,12 +226,20 @@ def _plane_face(face: TopoDS_Face, point: np.ndarray, normal: np.ndarray,
     region are left out (:func:`_boundary`), so a disc becomes the plane inside its circle.  ``normal``
     must be the face's surface normal sense (:func:`plane_of`): the loop then runs round the region
     on the plane as on the surface.  Each edge gets its p-curve on the plane stored.  None when the
-    face has more than one wire, what is left is not one closed loop, or an edge is off the plane
-    (``cache``: the edges' samples, :func:`_edge_samples`)."""
-    forward = cast(face.Oriented(TopAbs_Orientation.TopAbs_FORWARD), "Face")
-    edges = _boundary(forward)
-    if edges is None or not _edges_in_plane(edges, point, normal, cache=cache):
+    face has more than one wire, an edge is off the plane, or (:func:`_made_face`) what is left is
+    not one closed wire (``cache``: the edges' samples, :func:`_edge_samples`).
+
+    The wire holds the edges as the face (in the solid) runs them, and a reversed face holds it
+    reversed: the structure ``BRepBuilderAPI_MakeFace(plane, wire, Inside=True)`` made (it reversed
+    the wire of a reversed face to bound the finite region).  The same bound held the other way
+    round (the wire of the face taken forward) is as valid, but OCC's STEP reader turned the almond
+    cut-away's solid inside out when one of its planes was written so."""
+    found = _boundary(face)
+    if found is None or not _edges_in_plane(found[0], point, normal, cache=cache):
         return None
+    edges, loop = found
+    if not loop:
+        return _made_face(edges, point, normal, face)
     B = BRep_Builder()
     wire = TopoDS_Wire()
     B.MakeWire(wire)
@@ -239,10 +247,36 @@ def _plane_face(face: TopoDS_Face, point: np.ndarray, normal: np.ndarray,
         B.Add(wire, e)
     wire.Closed(True)
     new = TopoDS_Face()
-    B.MakeFace(new, Geom_Plane(gp_Ax3(gp_Pnt(*map(float, point)), gp_Dir(*map(float, normal)))), 1e-7)
-    B.Add(new, wire)
+    B.MakeFace(new, Geom_Plane(_axes(point, normal)), 1e-7)
+    B.Add(new, wire if face.Orientation() == TopAbs_Orientation.TopAbs_FORWARD else wire.Reversed())
     for e in edges:  # stored, not recomputed by every reader of the face
         BRepLib.BuildPCurveForEdgeOnPlane_s(e, new)
+    new.Orientation(face.Orientation())
+    return new
+
+
+def _axes(point: np.ndarray, normal: np.ndarray) -> gp_Ax3:
+    """The plane's axes: origin ``point`` (mm), main direction ``normal``, OCC's x direction for it."""
+    return gp_Ax3(gp_Pnt(*map(float, point)), gp_Dir(*map(float, normal)))
+
+
+def _made_face(edges: Sequence[TopoDS_Edge], point: np.ndarray, normal: np.ndarray,
+               face: TopoDS_Face) -> TopoDS_Face | None:
+    """The plane face ``BRepBuilderAPI_MakeWire`` and ``BRepBuilderAPI_MakeFace(plane, wire, Inside=True)``
+    make of ``edges`` (which do not chain vertex to vertex), with the orientation of ``face``, or None
+    when they make no closed wire: edges in two loops (a flat ring's two circles) fail, and
+    MakeWire joins a gap between distinct vertices at one point (a degenerated edge between two,
+    left out: the almond's and the rounded square's cut-aways) with new edges, whose solid then fails
+    its check and keeps its B-spline faces, as it did before the faces were built here."""
+    mw = BRepBuilderAPI_MakeWire()
+    for e in edges:
+        mw.Add(e)
+    if not mw.IsDone() or not BRep_Tool.IsClosed_s(mw.Wire()):
+        return None
+    mf = BRepBuilderAPI_MakeFace(gp_Pln(_axes(point, normal)), mw.Wire(), True)
+    if not mf.IsDone():
+        return None
+    new = mf.Face()
     new.Orientation(face.Orientation())
     return new
 
