@@ -165,6 +165,27 @@ def test_every_glyph_gives_one_valid_drafted_solid(a, text):
             assert abs(V - linear) <= 0.15 * P * h * h * t / 2.0, (ch, V, linear)
 
 
+def test_floor_cut_down_to_the_prism_box_cuts_the_same():
+    """The letter floor (the tablet offset inwards) cut down to the box around the drafted prism
+    (``_around``) takes the same part of the prism away: one solid, valid, the same volume to
+    1e-9 (OCC's section curves on a face ending near the walls)."""
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.booleans import raw_boolean
+    from tabletcad.tooling.emboss import _around, _offset_base, figure_prism, offset_solid, text_faces
+    from tabletcad.tooling.outline import tablet_frame
+
+    frame = tablet_frame(load_design(ROOT / "samples" / "families" / "concave_round.toml"))
+    floor = offset_solid(_offset_base(frame), -0.12)
+    prism = figure_prism(text_faces("A", 2.5, font_path("DejaVuSans-Bold")), frame.z_max + 0.05, 3.8, 15.0,
+                         z_nominal=4.3)
+    part = _around(floor, prism)
+    assert len(explore(part, "Face")) < len(explore(floor, "Face")) + 5 and _valid(part)
+    assert _volume(part) < 0.5 * _volume(floor)
+    whole, near = (explore(raw_boolean("cut", prism, f), "Solid") for f in (floor, part))
+    assert len(whole) == len(near) == 1 and _valid(near[0])
+    assert _volume(near[0]) == pytest.approx(_volume(whole[0]), rel=1e-9)
+
+
 @pytest.mark.parametrize("family", ["concave_round", "capsule"])
 def test_debossed_digits_with_stroke_angle_build_checked(family):
     """'A8 69' debossed at 15° (LocOpe_DPrism crashed on 8, 6, 9): valid single-solid tablet, every

@@ -141,6 +141,50 @@ def test_tight_z_range_is_occs_optimal_box_of_the_whole_solid(thesis):
     assert whole["capsule"][1] - whole["capsule"][0] == pytest.approx(3.2 + 2 * 1.3, abs=1e-6)
 
 
+def test_volumes_are_occs_and_shared_faces_are_integrated_once(thesis):
+    """:func:`volume_centroid` sums OCC's own face integrals: each part's volume is
+    ``BRepGProp.VolumeProperties``'s to the last bit; a reversed solid's is its negative from the
+    same (cached) integrals; a punch tip integrated about the tablet's point (near its own) integrates
+    only the faces it does not share with the tablet, and agrees with OCC's about its own point to
+    1e-10; a point far from its own is not taken."""
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.booleans import CACHE, reference_point, volume, volume_centroid
+
+    def occ(shape):
+        p = GProp_GProps()
+        BRepGProp.VolumeProperties_s(shape, p, 1e-9)
+        c = p.CentreOfMass()
+        return p.Mass(), (c.X(), c.Y(), c.Z())
+
+    CACHE.clear()
+    for name, shape in thesis.parts.items():
+        v, c = volume_centroid(shape)
+        v_occ, c_occ = occ(shape)
+        assert v == v_occ, name
+        assert c == pytest.approx(c_occ, abs=1e-12), name
+    tablet = thesis.parts["tablet"]
+    misses = CACHE.faces.misses
+    assert volume(tablet.Reversed()) == -volume(tablet)  # from the same integrals:
+    assert CACHE.faces.misses == misses
+    # a debossed "8": the upper tip's face is the tablet's, letters and all
+    e = EmbossSpec(text="8", mode="deboss", height_mm=2.0, depth_mm=0.1)
+    ts = make_tooling(thesis.tablet, ToolingSpec(clearance_mm=CLEARANCE, emboss=(e,)), check=False,
+                      interference_check=False)
+    tablet, punch = ts.parts["tablet"], ts.parts["upper_punch"]
+    CACHE.clear()
+    assert volume(tablet) == occ(tablet)[0]
+    misses = CACHE.faces.misses
+    v = volume(punch, about=reference_point(tablet))
+    shared = [f for f in explore(punch, "Face") if any(f.IsSame(g) for g in explore(tablet, "Face"))]
+    assert len(shared) > 10 and CACHE.faces.misses - misses == len(explore(punch, "Face")) - len(shared)
+    assert v == pytest.approx(occ(punch)[0], rel=1e-10)  # (8.6e-12: the integration's error elsewhere)
+    assert ts.report["upper_punch"]["volume_mm3"] == v
+    assert volume(punch, about=(0.0, 0.0, 100.0)) == occ(punch)[0]  # a point far from its own: not taken
+
+
 def test_closed_position_encloses_exactly_the_tablet(thesis):
     r = thesis.report
     assert r["interference_mm3"] == pytest.approx(0.0, abs=1e-9)

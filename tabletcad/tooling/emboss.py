@@ -490,12 +490,12 @@ def apply_emboss(frame: TabletFrame, shape, items, clearance: float, *, check: b
             # narrower towards the letter bottom, wider out of the tablet
             prism = figure_prism(figure, outer, inner, e.draft_deg, z_nominal=z_face)
             floor = offsets.get(-e.depth_mm) if normal else translated(shape, dz=-sg * e.depth_mm)
-            tool = _cut_each(prism, floor, i)
+            tool = _cut_each(prism, _around(floor, prism), i)
             op = "cut"
         else:
             prism = figure_prism(figure, inner, outer, e.draft_deg, z_nominal=z_face)
             roof = offsets.get(e.depth_mm) if normal else translated(shape, dz=sg * e.depth_mm)
-            tool = _common_each(prism, roof, i)
+            tool = _common_each(prism, _around(roof, prism), i)
             op = "fuse"
         shape, chk = checked_boolean(op, shape, tool, what=f"{e.mode} {i} ({e.text or e.svg or 'outline'}, {e.face})",
                                      deflection=deflection, check=check, a_manifold=a_manifold)
@@ -589,6 +589,32 @@ def offset_solid(shape, d: float):
     if len(solids) != 1 or not BRepCheck_Analyzer(solids[0]).IsValid():
         raise GeometryError(f"normal offset of the tablet by {d:g} mm failed ({len(solids)} solids)", shape)
     return solids[0]
+
+
+def _around(solid: TopoDS_Shape, prism: TopoDS_Shape, margin: float = 0.1) -> TopoDS_Shape:
+    """The part of ``solid`` inside the box of ``prism`` widened by ``margin`` mm, or ``solid`` where
+    that is not one solid.
+
+    The prism lies inside the box, so ``prism - solid`` and ``prism & solid`` are the same with the
+    part: the figure's walls meet the same surface, on a face that ends near them (OCC's Boolean
+    of "A8 69" drafted 15 deg with the floor of a 10 mm concave round: 7.2-8.0 s of one core instead
+    of 9.6-11.0 s; the capsule's the same, 3.8-4.2 s; the box's own Boolean 0.05-0.3 s)."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+
+    from tabletcad.tooling.booleans import raw_boolean
+
+    box = Bnd_Box()
+    BRepBndLib.Add_s(prism, box)  # (contains the prism: its geometry's box, widened by tolerances)
+    lo, hi = box.CornerMin(), box.CornerMax()
+    block = BRepPrimAPI_MakeBox(gp_Pnt(lo.X() - margin, lo.Y() - margin, lo.Z() - margin),
+                                gp_Pnt(hi.X() + margin, hi.Y() + margin, hi.Z() + margin)).Shape()
+    try:
+        part = explore(raw_boolean("common", solid, block), "Solid")
+    except GeometryError:
+        return solid
+    return part[0] if len(part) == 1 else solid
 
 
 def _cut_each(prism, shifted, i):

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tabletcad.errors import GeometryError
-from tabletcad.tooling.booleans import boolean, checked_boolean, split_cells, volume
+from tabletcad.tooling.booleans import boolean, checked_boolean, reference_point, split_cells, volume
 from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, prism, wire_length
 
 __all__ = ["PunchTip", "punch_tip", "cup_volume_within", "elliptic_tip_quadrature", "punch_volume_quadrature"]
@@ -50,13 +50,16 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
     z_mid = 0.5 * (frame.band_z[0] + frame.band_z[1])
     up = which == "upper"
     edge = frame.band_z[1] if up else frame.band_z[0]
+    # the tip's face is the tablet's: its volume is integrated about the tablet's point where that is
+    # near its own (the letters on this face), so that the faces they share are integrated once
+    about = reference_point(tablet_shape)
 
     def cut(edge_z: float):
         z0, z1 = (z_mid, edge_z + tip_length) if up else (edge_z - tip_length, z_mid)
         body = prism(tip_wire, z0, z1)
         # the manifold check is on "prism minus tablet": the removed volume is the tablet inside the prism
         return checked_boolean("cut", body, tablet_shape, what=f"{which} punch tip", deflection=deflection,
-                               check=check, a_manifold=None, sliver=1e-4,
+                               check=check, a_manifold=None, sliver=1e-4, about=about,
                                exact=lambda: tip_cell(body, tablet_shape, z_mid, z0, z1, which))
 
     shape, chk = cut(edge)
@@ -68,7 +71,7 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
         tip_edge = edge
     cup_point = frame.z_max if up else frame.z_min
     datum = tip_edge + tip_length if up else tip_edge - tip_length
-    vol = volume(shape)
+    vol = volume(shape, about=about)
     cup = frame.cup_depth_top if which == "upper" else frame.cup_depth_bottom
     land = None if frame.land is None or cup < 1e-9 else frame.land - inset  # a flat tip has no land
     quad = punch_volume_quadrature(frame, clearance, tip_length + abs(tip_edge - edge), which)

@@ -21,13 +21,17 @@ __all__ = ["ShapeCache", "frozen"]
 
 
 class ShapeCache:
-    """The ``size`` most recently used results ``compute()`` of ``(shape, key)``."""
+    """The ``size`` most recently used results ``compute()`` of ``(shape, key)``.
 
-    def __init__(self, size: int = 48) -> None:
+    ``faces`` > 0: :attr:`faces` is a second cache of that size for results per face (the faces a
+    build's solids share: a punch tip's face is the tablet's), cleared with this one."""
+
+    def __init__(self, size: int = 48, faces: int = 0) -> None:
         self.size = int(size)
         self._entries: OrderedDict = OrderedDict()
         self.hits = 0
         self.misses = 0
+        self.faces: ShapeCache | None = ShapeCache(faces) if faces > 0 else None
 
     def get(self, shape, key: Any, compute: Callable[[], Any]) -> Any:
         slot = (hash(shape), key)
@@ -46,6 +50,8 @@ class ShapeCache:
 
     def clear(self) -> None:
         self._entries.clear()
+        if self.faces is not None:
+            self.faces.clear()
 
 
 def frozen(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
