@@ -552,6 +552,8 @@ class PDEPatch:
         u, v = np.broadcast_arrays(u, v)
         shape = u.shape
         uf, vf = u.reshape(-1), v.reshape(-1)
+        if nmin == 0 and remainder and uf.size == 1:  # one point: a grid of one (one table in u for all terms)
+            return self.evaluate_grid(uf, vf, du, dv).reshape(shape + (3,))
         if nmin == 0 and remainder and uf.size > 1:  # points along one u or one v line: a grid of one row
             if uf[0] == uf[-1] and np.all(uf == uf[0]):
                 return self.evaluate_grid(uf[:1], vf, du, dv)[0].reshape(shape + (3,))
@@ -602,28 +604,28 @@ class PDEPatch:
         u = np.asarray(u, dtype=float).reshape(-1)
         v = np.asarray(v, dtype=float).reshape(-1)
         L, L0, Lr = self._u_tables(u, du)  # (n, nu, 4), (nu, 4), (nu, 4)
-        # X[c, i, j] = Σ_k U[c, i, k] V[k, j]: the modes (cos and sin rows of V, their u-profiles
-        # in U), the spine (a row of ones) and the remainder (rows r_k,c'(v), with U = L_β δ_cc')
-        # in one matrix product of (3 nu, K) by (K, nv), the shape BLAS runs fastest
-        left, right = [], []
+        # X[c, i, j] = Σ_k U[c, i, k] V[k, j]: the modes (cos and sin rows of V, their u-profiles in U)
+        # in one matrix product of (len(axes) nu, 2n) by (2n, nv), the shape BLAS runs fastest; the
+        # remainder (rows r_k,c'(v), with U = L_β δ_cc') added by a product with its 4 rows per
+        # coordinate, and the spine (constant in v) added to each row: no stacked copy of either side
+        ax = list(axes) if components else [0, 1, 2]
+        X = None
         if self._active:
+            n = L.shape[0]
             AB = np.matmul(L, self._abT)  # (n, nu, 6): each mode's cosine and sine profiles
-            left.append(AB[:, :, :3].transpose(2, 1, 0))  # (3, nu, n)
-            left.append(AB[:, :, 3:].transpose(2, 1, 0))
-            right.append(_trig_shared(v, self._n_active, dv, rows=True))  # (2n, nv)
-        if dv == 0:
-            left.append((L0 @ self._a0).T[:, :, None])
-            right.append(np.ones((1, v.size)))
+            # (3, nu, 2n): coordinate c's cosine profiles, then its sine profiles
+            U = AB.reshape(n, u.size, 2, 3).transpose(3, 1, 2, 0)[ax].reshape(len(ax) * u.size, 2 * n)
+            X = U @ _trig_shared(v, self._n_active, dv, rows=True)  # (len(ax) nu, nv)
         if self._has_remainder:
             r = self._residuals(v, dv)  # (4, nv, 3)
-            left.append((_EYE3[:, None, None, :] * Lr[None, :, :, None]).reshape(3, u.size, 12))
-            right.append(r.transpose(0, 2, 1).reshape(12, v.size))
-        if not left:
+            R = np.stack([Lr @ r[:, :, c] for c in ax])  # (len(ax), nu, nv)
+            R = R.reshape(len(ax) * u.size, v.size)
+            X = R if X is None else X.__iadd__(R)
+        if dv == 0:
+            A = (L0 @ self._a0)[:, ax].T.reshape(-1, 1)  # (len(ax) nu, 1): the spine
+            X = np.broadcast_to(A, (A.shape[0], v.size)).copy() if X is None else X.__iadd__(A)
+        if X is None:
             return np.zeros((len(axes), u.size, v.size) if components else (u.size, v.size, 3))
-        U = np.concatenate(left, axis=2)  # (3, nu, K)
-        if components and tuple(axes) != (0, 1, 2):
-            U = U[list(axes)]
-        X = (U.reshape(-1, U.shape[2]) @ (right[0] if len(right) == 1 else np.concatenate(right)))
         X = X.reshape(-1, u.size, v.size)
         return X if components else np.ascontiguousarray(X.transpose(1, 2, 0))
 

@@ -1173,7 +1173,8 @@ class Tablet:
                 c = pts[:, axis]
                 k = int(np.argmax(c) if sign > 0 else np.argmin(c))
                 pi, ui, vi = np.unravel_index(k, c.shape)
-                val = self._polish_extreme(patches[pi], axis, sign, u[ui], v[vi], u[1] - u[0], v[1] - v[0])
+                val = self._polish_extreme(patches[pi], axis, sign, u[ui], v[vi], u[1] - u[0], v[1] - v[0],
+                                           start=float(c[pi, ui, vi]))
                 store[axis] = max(store[axis], val) if sign > 0 else min(store[axis], val)
         m = self.mirror()
         if m is not None:  # the twins' z range: the measured patches' reflected in z = z0
@@ -1187,8 +1188,10 @@ class Tablet:
         low, high = self._maxima_over([p.spine for p in self.patches], (lambda A: -A[..., 2], lambda A: A[..., 2]))
         return -low, high
 
-    def _polish_extreme(self, p, axis: int, sign: float, u0: float, v0: float, hu: float, hv: float) -> float:
-        """Largest ``sign·X[axis]`` near ``(u0, v0)`` (see :meth:`bounds`).
+    def _polish_extreme(self, p, axis: int, sign: float, u0: float, v0: float, hu: float, hv: float,
+                        start: float | None = None) -> float:
+        """Largest ``sign·X[axis]`` near ``(u0, v0)`` (see :meth:`bounds`); ``start``: ``X[axis]`` there, when the
+        caller has it (its sample), else evaluated.
 
         Two passes of: a dense line over the whole ``u`` range at ``v0`` (the
         extreme of a band is nearly flat along ``u``, so its best ``u`` may lie
@@ -1196,7 +1199,7 @@ class Tablet:
         second pass only when its line beats the first zoom's point.
         """
         t = self.trim
-        best = sign * float(self._outer(p, u0, v0)[axis])
+        best = sign * (float(self._outer(p, u0, v0)[axis]) if start is None else start)
         n = 33
         for round_ in range(2):
             line = np.linspace(t.u[0], t.u[1], 513)
