@@ -120,7 +120,7 @@ def compound_cup(diameter: float = 10.0, band: float = 2.5, cup_depth: float = 1
     b = check_positive("band", band, "mm")
     R = D / 2.0
     L = check_range("land", land, 0.0, R, "mm", hi_open=True)
-    cc = CompoundCup(R - L, central_radius, edge_radius, cup_depth, blend_diameter)
+    cc = CompoundCup(R - L, central_radius, edge_radius, cup_depth, blend_diameter, min_length=tol.min_length)
     face = land_line(L) + cc.elements(L)
     return _round("compound_cup", D, face, b,
                   dict(diameter=D, band=b, cup_depth=float(cup_depth), central_radius=float(central_radius),

@@ -130,7 +130,7 @@ def outline_tablet(
     elif Rc > 0 or Re > 0:
         if not (Rc > 0 and Re > 0):
             raise DesignError("edge_radius" if Rc > 0 else "central_radius", Re if Rc > 0 else Rc, "must be > 0 for a compound cup (give both radii, or neither)", "mm")
-        cc = CompoundCup(cw - L, Rc, Re, h)
+        cc = CompoundCup(cw - L, Rc, Re, h, min_length=tol.min_length)
         face = land_line(L) + cc.elements(L)
         extra = dict(central_radius_mm=Rc, edge_radius_mm=Re, blend_offset_mm=cw - cc.blend_radius)
     else:
