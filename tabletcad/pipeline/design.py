@@ -82,10 +82,13 @@ def load_design(path: str | Path) -> Tablet:
     return Design.from_toml(path).build()
 
 
-def _number(where: str, value: Any, unit: str = "", *, tol: Tolerances = DEFAULT, coordinate: bool = False) -> float:
+def _number(where: str, value: Any, unit: str = "", *, tol: Tolerances = DEFAULT, coordinate: bool = False,
+            least: bool = True) -> float:
     """A number read from a design: an int or float (never a boolean or a string), finite,
     and for lengths and coordinates (``unit == "mm"``) within ``±tol.max_length``; a length
-    (not a ``coordinate``) is 0 or at least ``tol.min_length``."""
+    (not a ``coordinate``) is 0 or at least ``tol.min_length`` (not checked here with ``least``
+    False: a family's constructor refuses it, knowing whether 0 builds,
+    :func:`tabletcad.families.family.lengths_checked`)."""
     if isinstance(value, bool):
         raise DesignError(where, value, "must be a number (true and false are not numbers)", unit)
     if not is_number(value):  # an int, float, numpy scalar, Fraction or Decimal
@@ -94,7 +97,7 @@ def _number(where: str, value: Any, unit: str = "", *, tol: Tolerances = DEFAULT
     x = check_finite(where, value, unit)
     if unit == "mm" and abs(x) > tol.max_length:
         raise DesignError(where, value, f"must be within ±{tol.max_length:g} mm (size limit, Tolerances.max_length)", unit)
-    if unit == "mm" and not coordinate and 0.0 < x < tol.min_length:
+    if unit == "mm" and not coordinate and least and 0.0 < x < tol.min_length:
         raise DesignError(where, value, f"must be 0 or at least {tol.min_length:g} mm (Tolerances.min_length: a "
                           "smaller feature is below the tolerance the surface is certified to)", unit)
     return x
@@ -363,7 +366,7 @@ class Design:
             for k, v in tab.items():
                 if k not in fam.params:
                     raise DesignError(one_token(f"tablet.{k}"), v, f"family {family!r} takes {', '.join(fam.params)}")
-                kw[k] = _number(f"tablet.{k}", v, fam.params[k])
+                kw[k] = _number(f"tablet.{k}", v, fam.params[k], least=False)  # (the family's: 0 or not)
             kw.update(fam.left_out(kw))  # (a ffbe's bevel_width, when its bevel_depth is given)
             missing = [k for k in fam.params if k in fam.required and k not in kw]
             if missing:
@@ -505,7 +508,7 @@ def _custom_outline(tab: dict, name: str) -> Tablet:
     _lengths(f"tablet.{key}", shape, kinds=key == "segments")
     if key == "segments":
         shape = [tuple(item) for item in shape]
-    kw = {k: _number(f"tablet.{k}", v, "mm") for k, v in tab.items() if k not in ("outline", "segments")}
+    kw = {k: _number(f"tablet.{k}", v, "mm", least=False) for k, v in tab.items() if k not in ("outline", "segments")}
     try:
         return outline_tablet(shape, name=name, **kw)
     except DesignError as exc:  # the constructor names "outline[...]", "cup_depth": the design's keys are tablet.<key>
