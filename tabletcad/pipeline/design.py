@@ -355,8 +355,10 @@ class Design:
                 raise DesignError(f"tablet.{k}", tab[k], "allowed keys of tablet for free_form are a, family, name "
                                   "(the shape is in the [[patch]] tables)")
             tablet = _free_form(self.patch, name, 1.0 if a is None else a)
+            _check_plan(tablet, "patch")
         elif family == "custom_outline":
             tablet = _custom_outline(tab, name)
+            _check_plan(tablet, "tablet.outline" if "outline" in tab else "tablet.segments")
         else:
             fam = lookup_family(family)  # a Design made directly may hold an old or unknown name
             family = fam.name
@@ -458,6 +460,23 @@ def _check_size(tablet: Tablet, tol: Tolerances = DEFAULT, *, what: dict | None 
         raise DesignError("reshape", what if what is not None else "factors",
                           f"must leave the tablet's length, width and height at least {tol.min_length:g} mm "
                           f"(Tolerances.min_length, the least length a design takes; the smallest is {small:.6g} mm)")
+
+
+def _check_plan(tablet: Tablet, where: str, tol: Tolerances = DEFAULT) -> None:
+    """Refuse a free-form or custom-outline tablet whose plan leaves ``±tol.max_length`` or is longer or wider
+    than ``tol.max_length`` along x or y, the size limit a family's diameter or length keeps (``where``: the
+    design's patches or outline).  Its numbers each lie within the limit, but not what they make: a circle
+    of radius 1000 mm had built a tablet 2000 mm across (2001 mm for a free form, whose surface bulges past
+    its curves), and an arc of radius 400 mm about (900, 0) reached x = 1300 mm."""
+    lo, hi = tablet.bounds()
+    reach = float(max(abs(lo[0]), abs(lo[1]), abs(hi[0]), abs(hi[1])))
+    length, width = float(hi[0] - lo[0]), float(hi[1] - lo[1])
+    limit = tol.max_length * (1.0 + 1e-9)  # (the bounds' rounding aside, as _check_size)
+    if not (reach <= limit and length <= limit and width <= limit):
+        raise DesignError(where, f"a plan {length:.9g} x {width:.9g} mm reaching {reach:.9g} mm",
+                          f"must keep the tablet's plan within ±{tol.max_length:g} mm and its length and width "
+                          f"(along x and y) at most {tol.max_length:g} mm (size limit, Tolerances.max_length, "
+                          "as a family's diameter or length)")
 
 
 _CUSTOM_KEYS = {"outline", "segments", "band", "cup_depth", "land", "cup_width", "central_radius", "edge_radius"}
