@@ -479,3 +479,18 @@ def test_a_cut_aways_area_is_the_area_of_its_solid():
     assert m.area == pytest.approx(mass_properties(m.to_occ()).area, rel=1e-8)
     # a flat-faced cylinder of radius 5 and height 6 cut to three quarters: closed form
     assert m.area == pytest.approx(0.75 * (2 * math.pi * 25 + 2 * math.pi * 5 * 6) + 2 * 5 * 6, rel=1e-6)
+
+
+def test_sum_of_models_is_what_sum_of_build123d_shapes_is(model):
+    """``sum([m, m])`` starts from ``0``: build123d's shapes define no ``0 + shape`` (no ``__radd__``), so
+    it is a TypeError there and here alike; build123d's ``sum(shapes, Part())`` takes the models'
+    ``to_build123d()``, and fuses as ``m + other`` does."""
+    box = bd.Box(1.0, 1.0, 1.0)
+    with pytest.raises(TypeError, match=r"unsupported operand type\(s\) for \+: 'int' and 'Box'"):
+        sum([box, box])
+    with pytest.raises(TypeError, match=r"unsupported operand type\(s\) for \+: 'int' and 'TabletModel'"):
+        sum([model, model])
+    shifted = model.to_build123d().moved(bd.Location((3.0, 0.0, 0.0)))
+    fused = sum([model.to_build123d(), shifted], bd.Part())
+    assert fused.volume == pytest.approx((model + shifted).volume, rel=1e-9)
+    assert model.volume < fused.volume < 2 * model.volume  # (overlapping copies: less than both)
