@@ -455,14 +455,68 @@ def test_walker_warns_of_a_volume_that_does_not_fall(capsys, tmp_path):
     assert rc == 0 and err == "" and json.loads(out)["W_percent_per_decade"] > 0
 
 
+OMEGA_WHY = ("(so that the bed stays thicker than 0, at least 3 of the 41 "
+             "simulated points keep a relative density below 1 for the Hec"
+             "kel fit and the densest reaches 0.05; and within ±6 mm, a sh"
+             "ift of the punch face by at most the bed's height)")
+
+
 @pytest.mark.parametrize("args, line", [
     (["--r", "100"], "error: --r = 100 mm is not allowed: must be > 0 and <= 5 mm"),  # had been "r = 100 mm"
     # had been refused as "relative_density = 'at most 2.94e-300'"
-    (["--omega-z0", "1e300"], "error: --omega-z0 = 1e+300 mm is not allowed: must be >= -6 and <= 6 mm"),
-    (["--omega-z0", "-5.9"], "error: --omega-z0 = -5.9 mm is not allowed: the model then compresses the 6 mm bed to "
-                             "zero thickness at 10 MPa (h0 + ω_z must stay > 0)"),  # had been "pressure = 10 MPa"
+    (["--omega-z0", "1e300"], "error: --omega-z0 = 1e+300 mm is not allowed: must be > -2.80315 and <= 6 mm " + OMEGA_WHY),
+    # had been "pressure = 10 MPa", then "the model then compresses the 6 mm bed to zero thickness at 10 MPa"
+    # although "must be >= -6 and <= 6 mm" had offered it
+    (["--omega-z0", "-5.9"], "error: --omega-z0 = -5.9 mm is not allowed: must be > -2.80315 and <= 6 mm " + OMEGA_WHY),
     (["--window", "10", "1000"], "error: --window = 232.75 MPa is not allowed: compresses the model bed to zero "
                                  "thickness (h0 = 6 mm, ω_z0 = -1.078 mm)"),
 ])
 def test_love_names_its_options(capsys, tmp_path, args, line):
     _refused_writing_nothing(capsys, tmp_path, ["love", *args], line)
+
+
+@pytest.mark.parametrize("options", [[], ["--h0", "10", "--z", "5"], ["--h0", "60"], ["--window", "10", "500"],
+                                     ["--E", "900", "--nu", "0.4"]])
+def test_loves_omega_z0_range_is_what_it_computes(capsys, tmp_path, options):
+    """The stated ``--omega-z0`` range had been ``[-h0, h0]``; in a 6 mm bed -5.9 mm was refused as a bed
+    pressed to nothing and -3 to -4.5 mm as the Heckel fit's window (every point denser than the solid).
+    Now it is where the model runs: its printed ends compute (exit 0, a fit over the window), and a value
+    just outside either end is refused with the same range."""
+    import re
+
+    rc, out, err = run(capsys, "love", *options, "--omega-z0", "-1e6")
+    m = re.fullmatch(r"error: --omega-z0 = -1e\+06 mm is not allowed: must be (>=?) (\S+) and <= (\S+) mm(.*)\n", err)
+    assert rc == 2 and out == "" and m, err
+    lo, hi = float(m.group(2)), float(m.group(3))
+    assert lo < hi
+    for end in (lo, hi):
+        rc, out, err = run(capsys, "love", *options, "--omega-z0", repr(end), "--json")
+        assert rc == 0, err
+        d = json.loads(out)
+        assert d["omega_z0_mm"] == end and d["n_points"] >= 3 and math.isfinite(d["K_per_MPa"])
+    h0 = float(options[options.index("--h0") + 1]) if "--h0" in options else 6.0
+    for out_of in (lo - 2e-5 * max(abs(lo), 1.0), hi + 2e-5 * max(abs(hi), 1.0)):
+        rc, _, err = run(capsys, "love", *options, "--omega-z0", repr(out_of))
+        assert rc == 2 and err.endswith(f"must be {m.group(1)} {m.group(2)} and <= {m.group(3)} mm{m.group(4)}\n"), err
+    assert -h0 <= lo and hi <= h0
+
+
+def test_simulate_compressions_omega_z0_range_from_python():
+    """The model's own rules as bounds on omega_z0, checked against the thickness and density they give."""
+    from tabletcad.errors import DesignError
+    from tabletcad.mechanics.love import omega_z0_range, simulate_compression
+
+    P = np.linspace(10.0, 50.0, 41)
+    lo, hi = omega_z0_range(P)
+    h_dense = 300.0 / (1.3 * math.pi * 25.0)  # thickness at relative density 1 (mm)
+    for w0 in (lo + 1e-9, hi):
+        sim = simulate_compression(P, omega_z0=w0)
+        assert np.all(sim.thickness > 0) and np.sum(sim.thickness > h_dense) >= 3
+        assert sim.relative_density.max() >= 0.05
+    # just below lo the third thickest point is as dense as the solid (or the bed is gone)
+    sim = simulate_compression(P, omega_z0=lo + 1e-6)
+    assert np.sort(sim.thickness)[::-1][2] == pytest.approx(h_dense, abs=2e-6)
+    with pytest.raises(DesignError, match=r"^omega_z0 = -5.9 mm is not allowed: must be > -2.80315 and <= "):
+        simulate_compression(P, omega_z0=-5.9)
+    with pytest.raises(DesignError, match=r"^omega_z0 = "):
+        simulate_compression(P, omega_z0=hi + 1e-6)

@@ -563,7 +563,18 @@ def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json, json_file) -> None:
     if r is not None:  # a radius within the die (the model's own check named it r)
         check_range("--r", r, 0.0, THESIS_DIAMETER / 2.0, "mm", lo_open=True)
     if omega_z0 is not None:  # a shift of the punch face by more than the bed's height: 1e300 mm had been
-        check_range("--omega-z0", omega_z0, -h0, h0, "mm")  # refused as a relative density
+        # refused as a relative density; within it, where the model runs (-5.9 mm in a 6 mm bed had been
+        # offered by "must be >= -6 and <= 6 mm", then refused as a bed pressed to nothing)
+        from tabletcad.mechanics.love import omega_z0_allowed, omega_z0_range
+
+        w_lo, w_hi = omega_z0_range(np.linspace(lo, hi, 41), E=E, nu=nu, h0=h0, z=z, r=r)
+        if not math.isnan(w_lo):
+            w_lo, w_hi = max(w_lo, -h0), min(w_hi, h0)  # (a closed end at -h0, else open: the bed's collapse)
+            if not w_lo < w_hi:
+                w_lo = w_hi = math.nan
+        w0 = check_finite("--omega-z0", omega_z0, "mm")
+        if not (w_lo < w0 or w0 == w_lo == -h0) or not w0 <= w_hi:  # (nan: nothing works)
+            raise DesignError("--omega-z0", omega_z0, omega_z0_allowed(w_lo, w_hi, 41, cap=h0), "mm")
     # the model's refusal of a bed pressed to nothing names its keyword; here the option
     with _collect() as msgs, option_names({"omega_z0": "--omega-z0", "pressure": "--window"}):
         sim = simulate_compression(np.linspace(lo, hi, 41), E=E, nu=nu, h0=h0, z=z, r=r, omega_z0=omega_z0)

@@ -23,6 +23,7 @@ import numpy as np
 from tabletcad.errors import DesignError, check_finite, check_range, format_bound
 from tabletcad.geometry.curves import Seg
 from tabletcad.families.profile import profile_arc, profile_line
+from tabletcad.tolerance import DEFAULT
 
 __all__ = [
     "single_radius_cup",
@@ -88,8 +89,9 @@ class CompoundCup:
     """
 
     def __init__(self, half_width: float, central_radius: float, edge_radius: float,
-                 depth: float = 0.0, blend_diameter: float = 0.0) -> None:
+                 depth: float = 0.0, blend_diameter: float = 0.0, *, min_length: float = DEFAULT.min_length) -> None:
         w = half_width
+        m = min_length
         Rc = check_range("central_radius", central_radius, 0.0, None, "mm", lo_open=True)
         Re = check_range("edge_radius", edge_radius, 0.0, None, "mm", lo_open=True)
         if Re >= Rc:
@@ -100,25 +102,25 @@ class CompoundCup:
         if blend_diameter and depth:
             raise DesignError("blend_diameter", blend_diameter, "give cup_depth or blend_diameter, not both (set one to 0)", "mm")
         if blend_diameter:
-            rb = check_range("blend_diameter", blend_diameter, 0.0, 2 * min(w, Rc), "mm", lo_open=True, hi_open=True) / 2.0
-            C1 = np.array([0.0, -Rc])
-            B = np.array([rb, -Rc + math.sqrt(Rc * Rc - rb * rb)])
-            Ce = C1 + (Rc - Re) / Rc * (B - C1)
-            if abs(w - Ce[0]) > Re:
-                raise DesignError("edge_radius", Re, f"must be >= {format_bound(abs(w - Ce[0]), upper=False)} mm to reach the cup edge from a {2 * rb:g} mm blend diameter", "mm")
-            zE = Ce[1] + math.sqrt(Re * Re - (w - Ce[0]) ** 2)
-            h = -zE
-            shift = np.array([0.0, h])
-            C1, Ce, B = C1 + shift, Ce + shift, B + shift
+            bd = check_finite("blend_diameter", blend_diameter, "mm")
+            g = _blend_geometry(w, Rc, Re, bd / 2.0) if bd > 0.0 else None
+            if g is None or min(_arc_lengths(w, *g[:3], Rc, Re)) < m:
+                lo, hi = _blend_range(w, Rc, Re, m)
+                if lo != lo:
+                    raise DesignError("edge_radius", Re, f"leaves no blend diameter at which it reaches the edge of a {2 * w:g} mm cup from central_radius = {Rc:g} mm with both arcs at least {m:g} mm long (Tolerances.min_length)", "mm")
+                raise DesignError("blend_diameter", bd, f"must be between {format_bound(2 * lo, upper=False)} and {format_bound(2 * hi, upper=True)} mm for a {2 * w:g} mm cup with radii {Rc:g} and {Re:g} mm (otherwise the edge radius cannot reach the cup edge from the blend, or the cup's edge or central arc is shorter than {m:g} mm, Tolerances.min_length)", "mm")
+            C1, Ce, B, h = g
         else:
             h = check_finite("cup_depth", depth, "mm")
             if not 0.0 < h:
                 raise DesignError("cup_depth", h, "must be > 0", "mm")
-            if not _feasible(w, Rc, Re, h):
-                lo, hi = _depth_range(w, Rc, Re)
+            if not _buildable(w, Rc, Re, h, m):
+                lo, hi = _depth_range(w, Rc, Re, m)
                 if lo != lo:
+                    if not math.isnan(_depth_range(w, Rc, Re, 0.0)[0]):
+                        raise DesignError("edge_radius", Re, f"leaves no depth at which both arcs of a {2 * w:g} mm cup with central_radius = {Rc:g} mm are at least {m:g} mm long (Tolerances.min_length)", "mm")
                     raise DesignError("edge_radius", Re, f"cannot be tangent to central_radius = {Rc:g} mm inside a {2 * w:g} mm cup for any depth", "mm")
-                raise DesignError("cup_depth", h, f"must be between {format_bound(lo, upper=False)} and {format_bound(hi, upper=True)} mm for a {2 * w:g} mm cup with radii {Rc:g} and {Re:g} mm (otherwise the radii cannot be tangent inside the cup)", "mm")
+                raise DesignError("cup_depth", h, f"must be between {format_bound(lo, upper=False)} and {format_bound(hi, upper=True)} mm for a {2 * w:g} mm cup with radii {Rc:g} and {Re:g} mm (otherwise the radii cannot be tangent inside the cup, or the cup's edge or central arc is shorter than {m:g} mm, Tolerances.min_length)", "mm")
             C1 = np.array([0.0, h - Rc])
             E = np.array([w, 0.0])
             Ce = _circle_intersection(C1, Rc - Re, E, Re, prefer_upper=True)
@@ -131,15 +133,8 @@ class CompoundCup:
         self.edge_center = (float(Ce[0]), float(Ce[1]))
         self.blend_radius = float(B[0])
         self._B = B
-        # validity: blend inside the cup, edge arc rising from the edge (no undercut)
-        if not (0.0 < B[0] < w):
-            lo, hi = _depth_range(w, Rc, Re)
-            raise DesignError("cup_depth" if not blend_diameter else "blend_diameter", depth or blend_diameter,
-                              f"gives a blend at r = {B[0]:.4g} mm outside the cup (0, {w:g}) mm; cup_depth must be between {format_bound(lo, upper=False)} and {format_bound(hi, upper=True)} mm", "mm")
-        if Ce[1] > 1e-12 * w:
-            raise DesignError("edge_radius", Re, "makes the cup wall overhang at the edge (edge-radius centre above the cup edge): use a larger edge radius or a shallower cup", "mm")
-        if B[1] < 0.0 or B[1] > h:
-            raise DesignError("cup_depth", h, "puts the blend outside the cup's height", "mm")
+        # (both ways in, the cup was checked whole: radii tangent inside it, blend inside the cup and
+        # below its top, edge arc rising from the edge with no undercut, both arcs long enough)
 
     def elements(self, d0: float, z0: float = 0.0) -> list:
         """Edge arc then central arc in the ``(d, z)`` plane, the cup edge at ``(d0, z0)``
@@ -152,6 +147,10 @@ class CompoundCup:
         phi_e0 = math.atan2(z0 - Ce[1], d0 - Ce[0])
         phi_b = math.atan2(B[1] - Ce[1], B[0] - Ce[0])
         phi_c0 = math.atan2(B[1] - C1[1], B[0] - C1[0])
+        # the edge arc turns by less than a half turn: its centre may stand up to 1e-12 w above the cup
+        # edge (an overhang that small is taken), where atan2 puts the edge at -pi, not pi, and the arc
+        # had gone the long way round (a 282 degree arc at the deepest cup the radii allow)
+        phi_b = phi_e0 + _wrap(phi_b - phi_e0)
         return [
             profile_arc(Ce, self.edge_radius, phi_e0, phi_b, "cup edge radius"),
             profile_arc(C1, self.central_radius, phi_c0, math.pi / 2, "cup central radius"),
@@ -175,21 +174,96 @@ def _circle_intersection(c1, r1, c2, r2, prefer_upper: bool):
     return max(cands, key=lambda s: s[1]) if prefer_upper else min(cands, key=lambda s: s[1])
 
 
-def _feasible(w: float, Rc: float, Re: float, h: float) -> bool:
+def _wrap(angle: float) -> float:
+    """``angle`` (rad) taken into ``(-pi, pi]``."""
+    return angle - 2.0 * math.pi * math.ceil((angle - math.pi) / (2.0 * math.pi))
+
+
+def _geometry(w: float, Rc: float, Re: float, h: float):
+    """``(C1, Ce, B)``, the central and edge arcs' centres and the blend point in ``(r, z)``, of a cup of
+    depth ``h`` whose radii are tangent inside it, else None."""
     C1 = np.array([0.0, h - Rc])
     E = np.array([w, 0.0])
     Ce = _circle_intersection(C1, Rc - Re, E, Re, prefer_upper=True)
     if Ce is None:
-        return False
+        return None
     B = C1 + Rc * (Ce - C1) / (Rc - Re)
-    return bool(0.0 < B[0] < w and Ce[1] <= 1e-12 * w and 0.0 <= B[1] <= h)
+    if not (0.0 < B[0] < w and Ce[1] <= 1e-12 * w and 0.0 <= B[1] <= h):
+        return None
+    return C1, Ce, B
 
 
-def _depth_range(w: float, Rc: float, Re: float) -> tuple[float, float]:
-    """Depths (mm) for which a compound cup of half-width ``w`` with radii ``Rc > Re`` exists
-    (scanned on a fine grid, then bisected at both ends)."""
+def _arc_lengths(w: float, C1, Ce, B, Rc: float, Re: float) -> tuple[float, float]:
+    """Lengths (mm) of the edge arc, from the cup edge ``(w, 0)`` to the blend ``B``, and of the
+    central arc, from ``B`` to the centre line (as :meth:`CompoundCup.elements` draws them)."""
+    edge = Re * abs(_wrap(math.atan2(B[1] - Ce[1], B[0] - Ce[0]) - math.atan2(-Ce[1], w - Ce[0])))
+    central = Rc * math.atan2(B[0], B[1] - C1[1])
+    return edge, central
+
+
+def _blend_geometry(w: float, Rc: float, Re: float, rb: float):
+    """``(C1, Ce, B, h)`` of the cup whose radii meet at the blend radius ``rb`` (the cup edge at
+    ``(w, 0)``), else None: the edge radius cannot reach the cup edge, or the blend lies outside the cup."""
+    if not 0.0 < rb < min(w, Rc):
+        return None
+    C1 = np.array([0.0, -Rc])
+    B = np.array([rb, -Rc + math.sqrt(Rc * Rc - rb * rb)])
+    Ce = C1 + (Rc - Re) / Rc * (B - C1)
+    if abs(w - Ce[0]) > Re:
+        return None
+    h = -(Ce[1] + math.sqrt(Re * Re - (w - Ce[0]) ** 2))
+    shift = np.array([0.0, h])
+    C1, Ce, B = C1 + shift, Ce + shift, B + shift
+    if not (0.0 < B[0] < w and Ce[1] <= 1e-12 * w and 0.0 <= B[1] <= h):
+        return None
+    return C1, Ce, B, float(h)
+
+
+def _blend_range(w: float, Rc: float, Re: float, min_length: float = DEFAULT.min_length) -> tuple[float, float]:
+    """Blend radii (mm) at which a compound cup of half-width ``w`` with radii ``Rc > Re`` exists and
+    leaves both arcs at least ``min_length`` long: its edge arc shrinks as the blend moves out, its
+    central arc grows, so they are one interval (scanned, then bisected at both ends)."""
+    def ok(rb: float) -> bool:
+        g = _blend_geometry(w, Rc, Re, rb)
+        return g is not None and min(_arc_lengths(w, *g[:3], Rc, Re)) >= min_length
+
+    top = min(w, Rc)
+    rs = np.linspace(0.0, top, 2002)[1:-1]
+    good = np.array([ok(float(r)) for r in rs])
+    if not good.any():
+        return (math.nan, math.nan)
+    i0, i1 = int(np.argmax(good)), len(good) - 1 - int(np.argmax(good[::-1]))
+
+    def bisect(g, b):
+        for _ in range(60):
+            mid = 0.5 * (g + b)
+            if ok(mid):
+                g = mid
+            else:
+                b = mid
+        return g
+
+    lo = bisect(rs[i0], rs[i0 - 1] if i0 > 0 else 0.0)
+    hi = bisect(rs[i1], rs[i1 + 1] if i1 < len(rs) - 1 else top)
+    return (float(lo), float(hi))
+
+
+def _buildable(w: float, Rc: float, Re: float, h: float, min_length: float) -> bool:
+    """Whether the radii are tangent inside a cup of depth ``h`` and leave both arcs at least
+    ``min_length`` long (or, as :func:`_check_left_lengths` takes them, within 1e-9 of it)."""
+    g = _geometry(w, Rc, Re, h)
+    if g is None:
+        return False
+    return min(_arc_lengths(w, *g, Rc, Re)) >= min_length
+
+
+def _depth_range(w: float, Rc: float, Re: float, min_length: float = DEFAULT.min_length) -> tuple[float, float]:
+    """Depths (mm) for which a compound cup of half-width ``w`` with radii ``Rc > Re`` exists and
+    leaves its edge and central arcs at least ``min_length`` long (0: the radii's tangency alone).
+    Scanned on a fine grid, then bisected at both ends: the edge arc grows with the depth and the
+    central arc shrinks, so the depths are one interval."""
     hs = np.linspace(1e-6 * w, 2 * w, 2001)
-    ok = np.array([_feasible(w, Rc, Re, float(h)) for h in hs])
+    ok = np.array([_buildable(w, Rc, Re, float(h), min_length) for h in hs])
     if not ok.any():
         return (math.nan, math.nan)
     i0, i1 = int(np.argmax(ok)), len(ok) - 1 - int(np.argmax(ok[::-1]))
@@ -197,7 +271,7 @@ def _depth_range(w: float, Rc: float, Re: float) -> tuple[float, float]:
     def bisect(good, bad):
         for _ in range(60):
             mid = 0.5 * (good + bad)
-            if _feasible(w, Rc, Re, mid):
+            if _buildable(w, Rc, Re, mid, min_length):
                 good = mid
             else:
                 bad = mid
@@ -209,7 +283,8 @@ def _depth_range(w: float, Rc: float, Re: float) -> tuple[float, float]:
 
 
 def compound_cup_profile(d0: float, half_width: float, central_radius: float, edge_radius: float,
-                         depth: float = 0.0, blend_diameter: float = 0.0) -> tuple[list, CompoundCup]:
+                         depth: float = 0.0, blend_diameter: float = 0.0, *,
+                         min_length: float = DEFAULT.min_length) -> tuple[list, CompoundCup]:
     """Elements of a compound cup whose edge is at ``d0`` (and the :class:`CompoundCup`)."""
-    cc = CompoundCup(half_width, central_radius, edge_radius, depth, blend_diameter)
+    cc = CompoundCup(half_width, central_radius, edge_radius, depth, blend_diameter, min_length=min_length)
     return cc.elements(d0), cc

@@ -17,6 +17,7 @@ from __future__ import annotations
 from tabletcad.errors import check_positive
 from tabletcad.families.outline import four_arc_oval, four_arc_oval_from_side_radius, stadium_outline
 from tabletcad.families.shaped import outline_tablet
+from tabletcad.families.family import lengths_checked
 from tabletcad.families.sweep import DEFAULT_A
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT, Tolerances
@@ -24,6 +25,7 @@ from tabletcad.tolerance import DEFAULT, Tolerances
 __all__ = ["capsule", "modified_capsule", "oval"]
 
 
+@lengths_checked()
 def capsule(length: float = 18.0, width: float = 8.0, band: float = 3.0, cup_depth: float = 1.2, land: float = 0.0,
             central_radius: float = 0.0, edge_radius: float = 0.0, *, a=DEFAULT_A, tol: Tolerances = DEFAULT) -> Tablet:
     """Capsule: stadium plan ``length`` × ``width``, cup across the width, optional land (mm).
@@ -38,6 +40,7 @@ def capsule(length: float = 18.0, width: float = 8.0, band: float = 3.0, cup_dep
                           info=dict(shape="capsule", elongated=True), a=a, tol=tol)
 
 
+@lengths_checked()
 def modified_capsule(length: float = 18.0, width: float = 8.0, side_radius: float = 40.0, band: float = 3.0,
                      cup_depth: float = 0.6, land: float = 0.0, cup_width: float = 0.0, *, a=DEFAULT_A,
                      tol: Tolerances = DEFAULT) -> Tablet:
@@ -51,6 +54,7 @@ def modified_capsule(length: float = 18.0, width: float = 8.0, side_radius: floa
                           info=dict(elongated=True), a=a, tol=tol)
 
 
+@lengths_checked()
 def oval(length: float = 12.0, width: float = 7.0, end_radius: float = 2.5, band: float = 3.0, cup_depth: float = 0.8,
          land: float = 0.0, cup_width: float = 0.0, *, a=DEFAULT_A, tol: Tolerances = DEFAULT) -> Tablet:
     """Oval: four-arc plan ``length`` × ``width`` with ends of ``end_radius`` (mm)."""

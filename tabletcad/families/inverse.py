@@ -55,6 +55,7 @@ from typing import Any, Callable
 import numpy as np
 
 from tabletcad.errors import MISSING, DesignError, GeometryError, check_finite, check_positive, check_range
+from tabletcad.families.family import lengths_unchecked
 from tabletcad.families.sweep import NominalBuilt, SweepNominal, nominal_only, nominal_volume
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT
@@ -194,7 +195,7 @@ class _Probe:
         if x not in self._cache:
             self.builds += 1
             try:
-                with nominal_only():
+                with nominal_only(), lengths_unchecked():  # (a lower end approached is put on min_length below)
                     t = self.func(**self.dims, **{self.vary: x})
             except NominalBuilt as ready:
                 self._cache[x] = (True, ready.nominal)

@@ -14,6 +14,7 @@ from tabletcad.errors import DesignError, check_positive, check_range, format_bo
 from tabletcad.families.cups import CompoundCup, bevel_line, land_line, single_radius_cup
 from tabletcad.families.outline import circle_outline
 from tabletcad.families.profile import profile_arc, profile_line
+from tabletcad.families.family import lengths_checked
 from tabletcad.families.sweep import DEFAULT_A, build_sweep_tablet
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT, Tolerances
@@ -35,6 +36,7 @@ def _round(name: str, D: float, face: list, band: float, params: dict, info: dic
                               reach=R, info=info, a=smoothing(a), tol=tol)
 
 
+@lengths_checked()
 def flat_face_round(diameter: float = 10.0, thickness: float = 4.0, *, a=DEFAULT_A, tol: Tolerances = DEFAULT) -> Tablet:
     """Round flat-face plain tablet (sharp edges): a cylinder ``diameter`` × ``thickness`` (mm)."""
     D = check_positive("diameter", diameter, "mm")
@@ -64,6 +66,7 @@ def _bevel_dims(R: float, T: float, angle: float, width: float, depth: float) ->
     return w, dep
 
 
+@lengths_checked(skip=("bevel_angle",))
 def ffbe(diameter: float = 10.0, thickness: float = 4.0, bevel_angle: float = 30.0, bevel_width: float = 0.5,
          bevel_depth: float = 0.0, *, a=DEFAULT_A, tol: Tolerances = DEFAULT) -> Tablet:
     """Round flat-face bevel-edge tablet (bevel angle in deg from the face, bevel width or depth in mm).
@@ -80,6 +83,7 @@ def ffbe(diameter: float = 10.0, thickness: float = 4.0, bevel_angle: float = 30
                   dict(face="flat", cup_depth_mm=dep, bevel_width_mm=w, bevel_depth_mm=dep, bevel_angle_deg=float(bevel_angle), land_mm=0.0), a, tol)
 
 
+@lengths_checked()
 def ffre(diameter: float = 10.0, thickness: float = 4.0, edge_radius: float = 1.0, *, a=DEFAULT_A,
          tol: Tolerances = DEFAULT) -> Tablet:
     """Round flat-face radius-edge tablet: toroidal edge of ``edge_radius`` (mm), all seams G1."""
@@ -94,6 +98,7 @@ def ffre(diameter: float = 10.0, thickness: float = 4.0, edge_radius: float = 1.
                   dict(face="flat", cup_depth_mm=re, edge_radius_mm=re, land_mm=0.0), a, tol)
 
 
+@lengths_checked()
 def concave_round(diameter: float = 10.0, band: float = 3.0, cup_depth: float = 1.0, land: float = 0.0, *,
                   a=DEFAULT_A, tol: Tolerances = DEFAULT) -> Tablet:
     """Round standard-concave tablet: spherical cups of ``cup_depth`` on a band, optional ``land`` (mm).
@@ -109,6 +114,7 @@ def concave_round(diameter: float = 10.0, band: float = 3.0, cup_depth: float = 
                   dict(face="convex", cup_depth_mm=float(cup_depth), land_mm=L, cup_radius_mm=cup.radius), a, tol)
 
 
+@lengths_checked()
 def compound_cup(diameter: float = 10.0, band: float = 2.5, cup_depth: float = 1.2, central_radius: float = 15.0,
                  edge_radius: float = 3.0, land: float = 0.0, blend_diameter: float = 0.0, *, a=DEFAULT_A,
                  tol: Tolerances = DEFAULT) -> Tablet:
@@ -120,7 +126,7 @@ def compound_cup(diameter: float = 10.0, band: float = 2.5, cup_depth: float = 1
     b = check_positive("band", band, "mm")
     R = D / 2.0
     L = check_range("land", land, 0.0, R, "mm", hi_open=True)
-    cc = CompoundCup(R - L, central_radius, edge_radius, cup_depth, blend_diameter)
+    cc = CompoundCup(R - L, central_radius, edge_radius, cup_depth, blend_diameter, min_length=tol.min_length)
     face = land_line(L) + cc.elements(L)
     return _round("compound_cup", D, face, b,
                   dict(diameter=D, band=b, cup_depth=float(cup_depth), central_radius=float(central_radius),
@@ -129,6 +135,7 @@ def compound_cup(diameter: float = 10.0, band: float = 2.5, cup_depth: float = 1
                        edge_radius_mm=cc.edge_radius, blend_diameter_mm=2 * cc.blend_radius), a, tol)
 
 
+@lengths_checked(skip=("bevel_angle",))
 def concave_bevel(diameter: float = 10.0, band: float = 2.5, cup_depth: float = 0.8, bevel_angle: float = 30.0,
                   bevel_width: float = 0.6, *, a=DEFAULT_A, tol: Tolerances = DEFAULT) -> Tablet:
     """Round concave bevel-edge tablet: bevel (deg, mm) from the band, then a spherical cup whose

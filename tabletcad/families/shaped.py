@@ -34,6 +34,7 @@ from tabletcad.families.outline import (
 )
 from tabletcad.families.profile import profile_line
 from tabletcad.families.round import smoothing
+from tabletcad.families.family import lengths_checked
 from tabletcad.families.sweep import DEFAULT_A, build_sweep_tablet
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT, Tolerances
@@ -55,6 +56,7 @@ def as_outline(outline) -> PlanOutline:
     return SplineOutline(pts)
 
 
+@lengths_checked(skip=("outline",))
 def outline_tablet(
     outline,
     band: float = 3.0,
@@ -130,7 +132,7 @@ def outline_tablet(
     elif Rc > 0 or Re > 0:
         if not (Rc > 0 and Re > 0):
             raise DesignError("edge_radius" if Rc > 0 else "central_radius", Re if Rc > 0 else Rc, "must be > 0 for a compound cup (give both radii, or neither)", "mm")
-        cc = CompoundCup(cw - L, Rc, Re, h)
+        cc = CompoundCup(cw - L, Rc, Re, h, min_length=tol.min_length)
         face = land_line(L) + cc.elements(L)
         extra = dict(central_radius_mm=Rc, edge_radius_mm=Re, blend_offset_mm=cw - cc.blend_radius)
     else:
@@ -174,6 +176,7 @@ def _star_limit(ol, limit: float) -> float:
     return star if 0.0 < star < limit * (1.0 - 1e-9) else math.inf
 
 
+@lengths_checked()
 def rounded_triangle(side: float = 10.0, corner_radius: float = 1.5, band: float = 2.5, cup_depth: float = 0.5,
                      land: float = 0.0, cup_width: float = 0.0, *, a=DEFAULT_A, tol: Tolerances = DEFAULT) -> Tablet:
     """Rounded equilateral triangle (``side`` of the sharp triangle, ``corner_radius``, mm), swept cup.
@@ -190,6 +193,7 @@ def rounded_triangle(side: float = 10.0, corner_radius: float = 1.5, band: float
                           params=dict(side=s, corner_radius=rc), reach=r_in, a=a, tol=tol)
 
 
+@lengths_checked()
 def rounded_square(side: float = 9.0, corner_radius: float = 1.5, band: float = 2.5, cup_depth: float = 0.5,
                    land: float = 0.0, cup_width: float = 0.0, *, a=DEFAULT_A, tol: Tolerances = DEFAULT) -> Tablet:
     """Rounded square of ``side`` with ``corner_radius`` (mm), cup swept over the outline."""
@@ -201,6 +205,7 @@ def rounded_square(side: float = 9.0, corner_radius: float = 1.5, band: float = 
                           params=dict(side=s, corner_radius=rc), reach=s / 2.0, a=a, tol=tol)
 
 
+@lengths_checked()
 def rounded_rectangle(length: float = 14.0, width: float = 8.0, corner_radius: float = 2.0, band: float = 3.0,
                       cup_depth: float = 0.6, land: float = 0.0, cup_width: float = 0.0, *, a=DEFAULT_A,
                       tol: Tolerances = DEFAULT) -> Tablet:
@@ -214,6 +219,7 @@ def rounded_rectangle(length: float = 14.0, width: float = 8.0, corner_radius: f
                           params=dict(length=Ln, width=W, corner_radius=float(corner_radius)), reach=W / 2.0, a=a, tol=tol)
 
 
+@lengths_checked()
 def almond(length: float = 14.0, width: float = 7.0, end_radius: float = 1.2, band: float = 3.0,
            cup_depth: float = 0.5, land: float = 0.0, cup_width: float = 0.0, *, a=DEFAULT_A,
            tol: Tolerances = DEFAULT) -> Tablet:

@@ -23,7 +23,7 @@ import numpy as np
 from tabletcad.geometry import nominal as nom
 from tabletcad.geometry.curves import Circle, Curve, Ellipse
 from tabletcad.errors import DesignError, check_positive, check_range, format_bound
-from tabletcad.families.family import Family
+from tabletcad.families.family import Family, lengths_checked
 from tabletcad.geometry.patch import PDEPatch
 from tabletcad.geometry.tablet import TRIM_MIN_WIDTH, Tablet, Trim
 from tabletcad.tolerance import DEFAULT, Tolerances
@@ -140,6 +140,7 @@ def _cap(r: float, z_rim: float, depth: float, up: bool) -> list[tuple[float, fl
 
 
 # ---------------------------------------------------------------------------- Table 4.1
+@lengths_checked()
 def flat_faced_round(diameter: float = 10.0, thickness: float = 6.0, *, a: float | str = 1.0, tol=DEFAULT) -> Tablet:
     """Flat-faced round tablet, 3 patches, 10 curves (Table 4.1: 10 × 6 mm)."""
     D = check_positive("diameter", diameter, "mm")
@@ -152,6 +153,7 @@ def flat_faced_round(diameter: float = 10.0, thickness: float = 6.0, *, a: float
     )
 
 
+@lengths_checked()
 def spherical(diameter: float = 5.0, *, a: float | str = 1.0, tol=DEFAULT) -> Tablet:
     """Spherical tablet, 2 patches, 7 curves at 30° steps (eqs 4.1-4.3; Table 4.1: 5 mm)."""
     D = check_positive("diameter", diameter, "mm")
@@ -176,6 +178,7 @@ def _convex(name, D, T, band, aspect=1.0, a=1.0, tol=DEFAULT, params=None):
     return coaxial_tablet(secs, aspect, a=a, name=name, family=f"thesis.{name}", params=params, nominal=nominal, tol=tol)
 
 
+@lengths_checked()
 def shallow_convex_round(diameter: float = 10.0, thickness: float = 3.0, band: float = 2.0, *, a=1.0, tol=DEFAULT) -> Tablet:
     """Shallow convex round tablet: spherical caps on a cylindrical band (Table 4.1: 10 × 3 mm)."""
     D = check_positive("diameter", diameter, "mm")
@@ -184,6 +187,7 @@ def shallow_convex_round(diameter: float = 10.0, thickness: float = 3.0, band: f
     return _convex("shallow_convex_round", D, T, b, a=a, tol=tol, params=dict(diameter=D, thickness=T, band=b))
 
 
+@lengths_checked()
 def shallow_convex_oval(width: float = 6.0, length: float = 12.0, thickness: float = 3.0, band: float = 2.0, *, a=1.0, tol=DEFAULT) -> Tablet:
     """Shallow convex oval: elliptical plan ``length`` (x) × ``width`` (y), caps scaled
     from the round cap profile (Table 4.1: 6 × 12 × 3 mm)."""
@@ -197,6 +201,7 @@ def shallow_convex_oval(width: float = 6.0, length: float = 12.0, thickness: flo
                    params=dict(width=W, length=L, thickness=T, band=b))
 
 
+@lengths_checked()
 def oblong(diameter: float = 5.0, length: float = 15.0, dome: float = 1.0, *, a=1.0, tol=DEFAULT) -> Tablet:
     """Oblong tablet standing on its axis: round section ``diameter``, overall
     ``length`` along z, spherical domes of height ``dome`` (Table 4.1: 5 × 15 mm)."""
@@ -226,6 +231,7 @@ def _ring_inner_limit(Do: float, tol: Tolerances = DEFAULT) -> float:
     return hi
 
 
+@lengths_checked()
 def ring(outer_diameter: float = 12.0, inner_diameter: float = 6.0, thickness: float = 4.5, *, a=1.0, tol=DEFAULT) -> Tablet:
     """Ring tablet: the band of a flat-faced round tablet as a solid with
     ``w ∈ [inner/outer, 1]`` (Table 4.5: 12 × 4.5 mm with a 6 mm hole)."""
@@ -242,6 +248,7 @@ def ring(outer_diameter: float = 12.0, inner_diameter: float = 6.0, thickness: f
     return replace(t, trim=Trim(w=(Di / Do, 1.0)), nominal=lambda p: np.maximum(f_out(p), ri - np.hypot(p[:, 0], p[:, 1])))
 
 
+@lengths_checked()
 def deep_convex_round(diameter: float = 10.0, thickness: float = 4.0, band: float = 1.0, *, a=1.0, tol=DEFAULT) -> Tablet:
     """Deep convex round (Table 4.5: 10 × 4 mm)."""
     D = check_positive("diameter", diameter, "mm")
@@ -259,6 +266,7 @@ def _spheroid(name: str, diameter: float, height: float, a, tol) -> Tablet:
                           params=dict(diameter=diameter, height=height), nominal=nom.spheroid(rx, c, (0, 0, c)), tol=tol)
 
 
+@lengths_checked()
 def oblate_spheroid(diameter: float = 10.0, height: float = 2.5, *, a=1.0, tol=DEFAULT) -> Tablet:
     """Oblate spheroid (Table 4.5: 10 × 2.5 mm)."""
     D = check_positive("diameter", diameter, "mm")
@@ -268,6 +276,7 @@ def oblate_spheroid(diameter: float = 10.0, height: float = 2.5, *, a=1.0, tol=D
     return _spheroid("oblate_spheroid", D, H, a, tol)
 
 
+@lengths_checked()
 def prolate_spheroid(diameter: float = 5.0, height: float = 10.0, *, a=1.0, tol=DEFAULT) -> Tablet:
     """Prolate spheroid (Table 4.5: 5 × 10 mm)."""
     D = check_positive("diameter", diameter, "mm")
@@ -277,6 +286,7 @@ def prolate_spheroid(diameter: float = 5.0, height: float = 10.0, *, a=1.0, tol=
     return _spheroid("prolate_spheroid", D, H, a, tol)
 
 
+@lengths_checked()
 def rod(diameter: float = 3.0, length: float = 7.5, dome: float = 0.2, *, a=1.0, tol=DEFAULT) -> Tablet:
     """Rod: a short oblong (Table 4.5: 3 × 7.5 mm)."""
     t = oblong(diameter, length, dome, a=a, tol=tol)
@@ -285,6 +295,7 @@ def rod(diameter: float = 3.0, length: float = 7.5, dome: float = 0.2, *, a=1.0,
     return replace(t, name="rod", family="thesis.rod")
 
 
+@lengths_checked()
 def caplet(width: float = 3.5, length: float = 7.0, height: float = 15.0, band: float = 10.0, *, a=1.0, tol=DEFAULT) -> Tablet:
     """Caplet: an oval tablet stretched along its axis (Table 4.5: 3.5 × 7 × 15 mm)."""
     try:
@@ -298,6 +309,7 @@ def caplet(width: float = 3.5, length: float = 7.0, height: float = 15.0, band: 
     return replace(t, name="caplet", family="thesis.caplet")
 
 
+@lengths_checked()
 def deep_convex_oval(width: float = 6.0, length: float = 12.0, thickness: float = 3.1, band: float = 1.1, *, a=1.0, tol=DEFAULT) -> Tablet:
     """Deep convex oval (Table 4.5: 6 × 12 × 3.1 mm)."""
     t = shallow_convex_oval(width, length, thickness, band, a=a, tol=tol)

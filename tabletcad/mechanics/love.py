@@ -53,8 +53,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tabletcad.errors import DesignError, check_positive, check_range
-from tabletcad.mechanics.compaction import relative_density
+from tabletcad.errors import DesignError, check_positive, check_range, format_bound
+from tabletcad.mechanics.compaction import MIN_PEAK_RELATIVE_DENSITY, relative_density
 from tabletcad.mechanics.heckel import HeckelFit, fit_heckel_arrays
 
 __all__ = [
@@ -68,6 +68,8 @@ __all__ = [
     "axial_displacement",
     "confined_compression",
     "love_fields",
+    "omega_z0_allowed",
+    "omega_z0_range",
     "simulate_compression",
     "thesis_constants",
 ]
@@ -234,6 +236,12 @@ def simulate_compression(
     given = omega_z0 is not None
     if not given:
         omega_z0 = adjustment_omega_z0(experimental_displacement, model_ref)
+    else:  # (-5.9 mm in a 6 mm bed had been refused as a bed pressed to nothing, -4 mm as the fit's window)
+        lo, hi = omega_z0_range(P, E=E, nu=nu, diameter=diameter, mass_mg=mass_mg, true_density=true_density,
+                                h0=h0, z=z, r=r, scale=scale)
+        w0 = check_range("omega_z0", omega_z0, None, None, "mm")
+        if not lo < w0 <= hi:
+            raise DesignError("omega_z0", omega_z0, omega_z0_allowed(lo, hi, P.size), "mm")
     w = axial_displacement(P, E, nu, c, h0, z, r, omega_z0=omega_z0, scale=scale)
     h = h0 + w
     if np.any(h <= 0):
@@ -246,6 +254,45 @@ def simulate_compression(
                      "reference_pressure_MPa": reference_pressure, "model_displacement_at_reference_mm": model_ref,
                      "experimental_displacement_mm": experimental_displacement},
     )
+
+
+#: Fewest simulated points with a Heckel term (relative density < 1) that the fit takes (its window's rule).
+_MIN_FIT_POINTS = 3
+
+
+def omega_z0_range(pressures, *, E: float = 2640.0, nu: float = 0.21, diameter: float = THESIS_DIAMETER,
+                   mass_mg: float = 300.0, true_density: float = 1.3, h0: float = THESIS_H0, z: float = THESIS_Z,
+                   r: float | None = None, scale: str = "thesis") -> tuple[float, float]:
+    """The adjustments ``omega_z0`` (mm) with which :func:`simulate_compression` runs: ``lo < omega_z0 <= hi``,
+    or ``(nan, nan)`` when none does.
+
+    The thickness is ``h(P) = h0 + omega_z0 + w(P)``, ``w`` the model displacement without adjustment, and
+    the relative density ``D = h_D / h`` with ``h_D = m / (rho A)``, so each rule is a bound on ``omega_z0``:
+    the bed stays thicker than 0 at every pressure (``> -h0 - min w``), at least 3 points keep ``D < 1``
+    for the Heckel fit (``> h_D - h0 - w_3``, ``w_3`` the third largest), and the densest point reaches
+    ``MIN_PEAK_RELATIVE_DENSITY`` (``<= h_D / 0.05 - h0 - min w``)."""
+    P = np.asarray(pressures, dtype=float).ravel()
+    c = check_positive("diameter", diameter, "mm") / 2.0
+    r = c if r is None else r
+    w = np.sort(axial_displacement(P, E, nu, c, h0, z, r, scale=scale))[::-1]  # largest (thickest) first
+    if w.size < _MIN_FIT_POINTS:
+        return (math.nan, math.nan)
+    h_dense = float(relative_density(1.0, mass_mg, true_density, math.pi * c * c))  # h at D = 1
+    lo = max(-h0 - float(w[-1]), h_dense - h0 - float(w[_MIN_FIT_POINTS - 1]))
+    hi = h_dense / MIN_PEAK_RELATIVE_DENSITY - h0 - float(w[-1])
+    return (lo, hi) if lo < hi else (math.nan, math.nan)
+
+
+def omega_z0_allowed(lo: float, hi: float, n: int, cap: float | None = None) -> str:
+    """The refusal's range of ``omega_z0`` for :func:`omega_z0_range`'s ``(lo, hi)`` over ``n`` pressures
+    (``cap``: a caller's own limit ``|omega_z0| <= cap``, already applied to ``lo`` and ``hi``)."""
+    why = (f"so that the bed stays thicker than 0, at least {_MIN_FIT_POINTS} of the {n} simulated points keep a "
+           f"relative density below 1 for the Heckel fit and the densest reaches {MIN_PEAK_RELATIVE_DENSITY:g}"
+           + (f"; and within ±{cap:g} mm, a shift of the punch face by at most the bed's height" if cap else ""))
+    if math.isnan(lo):
+        return f"no value works with these options ({why})"
+    low = ">=" if cap is not None and lo == -cap else ">"
+    return f"must be {low} {format_bound(lo, upper=False)} and <= {format_bound(hi, upper=True)} mm ({why})"
 
 
 def _refuse_collapse(pressure: float, omega_z0: float, h0: float, given: bool) -> None:

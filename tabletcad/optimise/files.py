@@ -485,12 +485,17 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
                           "give each as a variable, in [fixed] or as [problem] solve_for")
 
     def build(x):
-        if held is None:
-            return fam.build(**fixed, **x)
-        from tabletcad.families.inverse import solve_for
+        from tabletcad.families.family import lengths_unchecked
 
-        vary, volume = held
-        return solve_for(fam_name, target_volume_mm3=volume, vary=vary, **fixed, **x).tablet
+        # a solver passes through lengths below Tolerances.min_length on its way to 0 (a land) and puts
+        # its optimum on 0 or the least length itself (solvers.py): the constructors build them here
+        with lengths_unchecked():
+            if held is None:
+                return fam.build(**fixed, **x)
+            from tabletcad.families.inverse import solve_for
+
+            vary, volume = held
+            return solve_for(fam_name, target_volume_mm3=volume, vary=vary, **fixed, **x).tablet
 
     obj_spec = prob.get("objective")
     fe_set = _fe_settings(fe, _uses(prob, constraints, FE_QUANTITY))

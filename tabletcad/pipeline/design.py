@@ -82,10 +82,13 @@ def load_design(path: str | Path) -> Tablet:
     return Design.from_toml(path).build()
 
 
-def _number(where: str, value: Any, unit: str = "", *, tol: Tolerances = DEFAULT, coordinate: bool = False) -> float:
+def _number(where: str, value: Any, unit: str = "", *, tol: Tolerances = DEFAULT, coordinate: bool = False,
+            least: bool = True) -> float:
     """A number read from a design: an int or float (never a boolean or a string), finite,
     and for lengths and coordinates (``unit == "mm"``) within ``±tol.max_length``; a length
-    (not a ``coordinate``) is 0 or at least ``tol.min_length``."""
+    (not a ``coordinate``) is 0 or at least ``tol.min_length`` (not checked here with ``least``
+    False: a family's constructor refuses it, knowing whether 0 builds,
+    :func:`tabletcad.families.family.lengths_checked`)."""
     if isinstance(value, bool):
         raise DesignError(where, value, "must be a number (true and false are not numbers)", unit)
     if not is_number(value):  # an int, float, numpy scalar, Fraction or Decimal
@@ -94,7 +97,7 @@ def _number(where: str, value: Any, unit: str = "", *, tol: Tolerances = DEFAULT
     x = check_finite(where, value, unit)
     if unit == "mm" and abs(x) > tol.max_length:
         raise DesignError(where, value, f"must be within ±{tol.max_length:g} mm (size limit, Tolerances.max_length)", unit)
-    if unit == "mm" and not coordinate and 0.0 < x < tol.min_length:
+    if unit == "mm" and not coordinate and least and 0.0 < x < tol.min_length:
         raise DesignError(where, value, f"must be 0 or at least {tol.min_length:g} mm (Tolerances.min_length: a "
                           "smaller feature is below the tolerance the surface is certified to)", unit)
     return x
@@ -352,8 +355,10 @@ class Design:
                 raise DesignError(f"tablet.{k}", tab[k], "allowed keys of tablet for free_form are a, family, name "
                                   "(the shape is in the [[patch]] tables)")
             tablet = _free_form(self.patch, name, 1.0 if a is None else a)
+            _check_plan(tablet, "patch")
         elif family == "custom_outline":
             tablet = _custom_outline(tab, name)
+            _check_plan(tablet, "tablet.outline" if "outline" in tab else "tablet.segments")
         else:
             fam = lookup_family(family)  # a Design made directly may hold an old or unknown name
             family = fam.name
@@ -363,7 +368,7 @@ class Design:
             for k, v in tab.items():
                 if k not in fam.params:
                     raise DesignError(one_token(f"tablet.{k}"), v, f"family {family!r} takes {', '.join(fam.params)}")
-                kw[k] = _number(f"tablet.{k}", v, fam.params[k])
+                kw[k] = _number(f"tablet.{k}", v, fam.params[k], least=False)  # (the family's: 0 or not)
             kw.update(fam.left_out(kw))  # (a ffbe's bevel_width, when its bevel_depth is given)
             missing = [k for k in fam.params if k in fam.required and k not in kw]
             if missing:
@@ -457,6 +462,23 @@ def _check_size(tablet: Tablet, tol: Tolerances = DEFAULT, *, what: dict | None 
                           f"(Tolerances.min_length, the least length a design takes; the smallest is {small:.6g} mm)")
 
 
+def _check_plan(tablet: Tablet, where: str, tol: Tolerances = DEFAULT) -> None:
+    """Refuse a free-form or custom-outline tablet whose plan leaves ``±tol.max_length`` or is longer or wider
+    than ``tol.max_length`` along x or y, the size limit a family's diameter or length keeps (``where``: the
+    design's patches or outline).  Its numbers each lie within the limit, but not what they make: a circle
+    of radius 1000 mm had built a tablet 2000 mm across (2001 mm for a free form, whose surface bulges past
+    its curves), and an arc of radius 400 mm about (900, 0) reached x = 1300 mm."""
+    lo, hi = tablet.bounds()
+    reach = float(max(abs(lo[0]), abs(lo[1]), abs(hi[0]), abs(hi[1])))
+    length, width = float(hi[0] - lo[0]), float(hi[1] - lo[1])
+    limit = tol.max_length * (1.0 + 1e-9)  # (the bounds' rounding aside, as _check_size)
+    if not (reach <= limit and length <= limit and width <= limit):
+        raise DesignError(where, f"a plan {length:.9g} x {width:.9g} mm reaching {reach:.9g} mm",
+                          f"must keep the tablet's plan within ±{tol.max_length:g} mm and its length and width "
+                          f"(along x and y) at most {tol.max_length:g} mm (size limit, Tolerances.max_length, "
+                          "as a family's diameter or length)")
+
+
 _CUSTOM_KEYS = {"outline", "segments", "band", "cup_depth", "land", "cup_width", "central_radius", "edge_radius"}
 
 
@@ -505,7 +527,7 @@ def _custom_outline(tab: dict, name: str) -> Tablet:
     _lengths(f"tablet.{key}", shape, kinds=key == "segments")
     if key == "segments":
         shape = [tuple(item) for item in shape]
-    kw = {k: _number(f"tablet.{k}", v, "mm") for k, v in tab.items() if k not in ("outline", "segments")}
+    kw = {k: _number(f"tablet.{k}", v, "mm", least=False) for k, v in tab.items() if k not in ("outline", "segments")}
     try:
         return outline_tablet(shape, name=name, **kw)
     except DesignError as exc:  # the constructor names "outline[...]", "cup_depth": the design's keys are tablet.<key>
