@@ -61,6 +61,9 @@ def _trig(v: np.ndarray, n: np.ndarray, dv: int) -> tuple[np.ndarray, np.ndarray
 
 _EYE3 = np.eye(3)
 
+#: Modes per block of :func:`_trig_base` (the first block's cosines and sines are computed directly).
+_TRIG_BLOCK = 8
+
 
 def _horizontal(Xu: np.ndarray, Xv: np.ndarray, D: np.ndarray) -> bool:
     """Whether a patch sampled as ``(3, nu, nv)`` blocks lies in a horizontal plane: no ``z`` in its
@@ -105,8 +108,26 @@ def _trig_base(v: np.ndarray, nmax: int) -> tuple[np.ndarray, np.ndarray]:
     for grid-sized ``v`` like :func:`_trig_shared`)."""
 
     def make():
-        nv = np.outer(np.arange(1, nmax + 1), v)
-        return np.cos(nv), np.sin(nv)
+        if nmax <= 2 * _TRIG_BLOCK:
+            nv = np.outer(np.arange(1, nmax + 1), v)
+            return np.cos(nv), np.sin(nv)
+        # modes 1..B directly, and each later block n = B k + j from cos and sin of B k v by the
+        # addition formulas: B + nmax / B cosines and sines a sample instead of nmax (each value within
+        # a few ulp of the direct one; the direct one's argument n v is itself rounded, to n v eps)
+        B = _TRIG_BLOCK
+        k = -(-nmax // B)  # blocks
+        jv = np.outer(np.arange(1, B + 1), v)
+        cj, sj = np.cos(jv), np.sin(jv)  # (B, m)
+        kv = np.outer(np.arange(1, k) * B, v)
+        ck, sk = np.cos(kv)[:, None, :], np.sin(kv)[:, None, :]  # (k - 1, 1, m)
+        C = np.empty((k, B, v.size))
+        S = np.empty((k, B, v.size))
+        C[0], S[0] = cj, sj
+        np.multiply(ck, cj, out=C[1:])
+        C[1:] -= sk * sj
+        np.multiply(sk, cj, out=S[1:])
+        S[1:] += ck * sj
+        return C.reshape(k * B, v.size)[:nmax], S.reshape(k * B, v.size)[:nmax]
 
     if v.size > _CACHED_V[1]:
         return make()
