@@ -95,3 +95,22 @@ def test_a_design_file_states_the_range_its_family_takes(tmp_path, capsys, famil
     except DesignError:
         built = False
     assert built == zero
+
+
+@pytest.mark.parametrize("name, k", LENGTHS, ids=[f"{n}-{k}" for n, k in LENGTHS])
+def test_every_length_beyond_the_size_limit_is_refused_as_a_design_file_refuses_it(name, k):
+    """The other end: a length beyond ``±Tolerances.max_length`` (1000 mm), the size limit a design file
+    keeps, is refused by the constructor with the design file's words (``concave_round(diameter=5000)``
+    had built a tablet 5 m across)."""
+    fam = FAMILIES[name]
+    for v in (1000.001, -5000.0, 1e300):
+        with pytest.raises(DesignError) as e:
+            fam.func(**{**fam.defaults, k: v})
+        assert str(e.value) == f"{k} = {v:g} mm is not allowed: must be within ±1000 mm (size limit, Tolerances.max_length)" \
+            or str(e.value).startswith(f"{k} = {v!r} mm is not allowed: must be within ±1000 mm"), str(e.value)
+
+
+def test_a_round_of_the_size_limit_builds_from_python_as_from_a_design_file():
+    t = FAMILIES["flat_face_round"].func(diameter=1000.0, thickness=3.0)
+    lo, hi = t.bounds()
+    assert hi[0] - lo[0] == pytest.approx(1000.0, rel=1e-12)

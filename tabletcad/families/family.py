@@ -38,8 +38,8 @@ def lengths_unchecked() -> Iterator[None]:
 
 
 def lengths_checked(*, skip: tuple[str, ...] = ()) -> Callable:
-    """Make a family's constructor refuse a length between 0 and ``tol.min_length`` (1e-3 mm) as a
-    design file does, naming it: each positional-or-keyword parameter but ``skip`` (an angle, the
+    """Make a family's constructor refuse a length between 0 and ``tol.min_length`` (1e-3 mm), or beyond
+    ``±tol.max_length`` (1000 mm, the size limit), as a design file does, naming it: each positional-or-keyword parameter but ``skip`` (an angle, the
     outline's points) is a length.  Below that length the constructors had built nonsense or failed
     late (a 1e-300 mm cup depth made a tablet of volume NaN, 5e-324 mm ran for minutes, a 1e-9 mm band
     built and then failed in the CAD stage with "sewn shell has 2 faces", a 1e-300 mm wide caplet
@@ -68,6 +68,11 @@ def lengths_checked(*, skip: tuple[str, ...] = ()) -> Callable:
             if tol is None:
                 tol = sig.parameters["tol"].default if "tol" in sig.parameters else None
             least = float(getattr(tol, "min_length", 1e-3))
+            most = float(getattr(tol, "max_length", 1000.0))
+            for k in names:  # the size limit a design file keeps (a larger length builds a tablet beyond it)
+                x = bound.arguments.get(k)
+                if is_number(x) and abs(float(x)) > most:
+                    raise DesignError(k, x, f"must be within ±{most:g} mm (size limit, Tolerances.max_length)", "mm")
             bad = short(bound, least)
             if bad:
                 k, value = bad[0], bound.arguments[bad[0]]
