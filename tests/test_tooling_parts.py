@@ -247,6 +247,33 @@ def test_a_build_reuses_the_previous_builds_results_only_where_they_are_its_own(
     assert cell(0.03, solid=plain.parts["tablet"]) is not a  # the unscored face: another cell
 
 
+def test_a_long_tip_trimmed_is_the_tip_cut_to_its_length(thesis):
+    """A tip whose edge rises up the cup is cut long and trimmed by the plane of its prism's end
+    (``tip_trimmed``): the same faces, edges and vertices and the same volume as the prism of its length
+    split by the tablet's face, upper and lower (the thesis round has no land wider than the inset)."""
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.booleans import reference_point, volume
+    from tabletcad.tooling.outline import offset_wire, prism
+    from tabletcad.tooling.punch import _edge_may_rise, tip_cell, tip_trimmed
+
+    frame, tablet = thesis.frame, thesis.parts["tablet"]
+    inset = frame.tip_inset(CLEARANCE)
+    wire, z_mid, about = offset_wire(frame.outline, -inset), 0.5 * sum(frame.band_z), reference_point(tablet)
+    for which, up in (("upper", True), ("lower", False)):
+        assert _edge_may_rise(frame, inset, up)
+        p = thesis.report[f"{which}_punch"]
+        end = p["working_length_datum"]["datum_plane_z_mm"]
+        assert abs(p["tip_edge_z_mm"] - frame.band_z[1 if up else 0]) > 1e-4  # (its edge rose)
+        z0, z1 = (z_mid, end) if up else (end, z_mid)
+        direct = tip_cell(prism(wire, z0, z1), tablet, z_mid, z0, z1, which)
+        z0, z1 = (z_mid, end + 3.0) if up else (end - 3.0, z_mid)
+        trimmed = tip_trimmed(tip_cell(prism(wire, z0, z1), tablet, z_mid, z0, z1, which), wire, end, up)
+        for kind in ("Face", "Edge", "Vertex"):
+            assert len(explore(trimmed, kind)) == len(explore(direct, kind)), (which, kind)
+        assert volume(trimmed, about=about) == pytest.approx(volume(direct, about=about), rel=1e-11), which
+        assert volume(thesis.parts[f"{which}_punch"], about=about) == pytest.approx(volume(direct, about=about), rel=1e-11)
+
+
 def test_closed_position_encloses_exactly_the_tablet(thesis):
     r = thesis.report
     assert r["interference_mm3"] == pytest.approx(0.0, abs=1e-9)

@@ -59,24 +59,51 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
         return checked_boolean("cut", body, tablet_shape, what=f"{which} punch tip", deflection=deflection,
                                check=checking, a_manifold=None, sliver=1e-4, about=about, exact=exact)
 
-    def cut(edge_z: float, checking: bool):
-        z0, z1 = (z_mid, edge_z + tip_length) if up else (edge_z - tip_length, z_mid)
-        body = prism(tip_wire, z0, z1)
-        return (body, *checked(body, lambda: tip_cell(body, tablet_shape, z_mid, z0, z1, which, memo=(frame, inset)),
-                               checking))
+    def tip_prism(edge_z: float, length: float):
+        z0, z1 = (z_mid, edge_z + length) if up else (edge_z - length, z_mid)
+        return z0, z1, prism(tip_wire, z0, z1)
 
-    # first the tip from the band's edge, unchecked: where its wall meets the face is its edge, from
-    # which it is cut again when that is higher up the cup (no land); only the tip kept is checked (the
-    # first one's check, its volume, mesh and manifold3d cut, had been thrown away with it)
-    body, shape, _ = cut(edge, False)
-    lo, hi = tight_z_range(shape, low=up, high=not up)
-    tip_edge = lo if up else hi  # the tip's end nearest the tablet: where its wall meets the face
-    if abs(tip_edge - edge) > 1e-6:  # (OCC's optimal box is good to ~1e-7 mm: a land's edge is the band's)
-        body, shape, chk = cut(tip_edge, check)
+    def cut(edge_z: float, length: float):
+        z0, z1, body = tip_prism(edge_z, length)
+        return body, tip_cell(body, tablet_shape, z_mid, z0, z1, which, memo=(frame, inset))
+
+    def measured_edge(tip) -> float:  # the tip's end nearest the tablet: where its wall meets the face
+        lo, hi = tight_z_range(tip, low=up, high=not up)
+        return lo if up else hi
+
+    # The tip's edge is measured on a tip cut from the band's edge.  Where it may lie higher up the cup (no
+    # land wider than the inset), that tip is cut longer than its length plus the tablet's thickness and,
+    # its edge measured, trimmed to its length by the plane of the prism's end (tip_trimmed): OCC had
+    # split the prism by the tablet's face twice, the second time only to end it higher.  Elsewhere, or
+    # when the trim fails, the tip from the band's edge is kept when its edge is the band's and else cut
+    # again from its edge.  Only the tip kept is checked (the first one's check had been thrown away).
+    body = shape = None
+    if _edge_may_rise(frame, inset, up):
+        reach = frame.z_max - frame.z_min + 1.0  # farther than any edge of the tip can rise
+        _, long_tip = cut(edge, tip_length + reach)
+        tip_edge = measured_edge(long_tip)
+        if abs(tip_edge - edge) <= 1e-6:  # (OCC's optimal box is good to ~1e-7 mm: a land's edge is the band's)
+            tip_edge = edge
+        if abs(tip_edge - edge) < reach - 0.5:
+            try:
+                end = tip_edge + tip_length if up else tip_edge - tip_length
+                # (a long tip reused from an earlier build, tip_cell's memo, has its trimmed tip too)
+                shape = CACHE.get(long_tip, ("tip end", float(end), up), lambda: tip_trimmed(long_tip, tip_wire, end, up))
+            except GeometryError:
+                shape = None
+        if shape is None:
+            body, shape = cut(tip_edge, tip_length)
     else:
-        tip_edge = edge
-        found = shape
-        shape, chk = checked(body, lambda: found, check)  # (the tip found: its check alone)
+        body, shape = cut(edge, tip_length)
+        tip_edge = measured_edge(shape)
+        if abs(tip_edge - edge) > 1e-6:  # (OCC's optimal box is good to ~1e-7 mm: a land's edge is the band's)
+            body, shape = cut(tip_edge, tip_length)
+        else:
+            tip_edge = edge
+    if body is None:
+        body = tip_prism(tip_edge, tip_length)[2]  # the prism the tip is cut from, for its check
+    found = shape
+    shape, chk = checked(body, lambda: found, check)
     cup_point = frame.z_max if up else frame.z_min
     datum = tip_edge + tip_length if up else tip_edge - tip_length
     vol = volume(shape, about=about)
@@ -110,6 +137,29 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
         volume_rel_diff_vs_quadrature=None if quad is None else (vol - quad) / quad,
     )
     return PunchTip(f"{which}_punch", shape, vol, info), chk
+
+
+def _edge_may_rise(frame: TabletFrame, inset: float, up: bool) -> bool:
+    """Whether a tip's edge may stand above the band's edge, up the face: a cupped face without a land wider
+    than the tip's inset (a flat face's tip ends at the band's edge; a radius or bevel edge rises too)."""
+    cup = frame.cup_depth_top if up else frame.cup_depth_bottom
+    return cup > 1e-9 and (frame.land is None or frame.land - inset <= 1e-9)
+
+
+def tip_trimmed(tip, wire, z: float, up: bool):
+    """The punch ``tip`` (a cell of the prism of the plan ``wire``, longer than wanted) ending at height ``z``
+    (mm): split by the plan face of ``wire`` at ``z`` (the end face a prism of ``wire`` ending there has, so
+    the trimmed tip's walls, faces and volume are the shorter prism's cell's: on the family samples the
+    same face, edge and vertex counts and volumes within 2e-12 relative), the part towards the tablet kept."""
+    from tabletcad.tooling.booleans import translated
+
+    end = translated(plan_face(wire), dz=z)
+
+    def keep(cell) -> bool:
+        lo, hi = _z_range(cell)
+        return lo < z - 1e-3 if up else hi > z + 1e-3
+
+    return split_cells(tip, [end], keep, what="punch tip end")
 
 
 def tight_z_range(shape, *, low: bool = True, high: bool = True) -> tuple[float | None, float | None]:
