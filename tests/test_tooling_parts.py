@@ -185,6 +185,95 @@ def test_volumes_are_occs_and_shared_faces_are_integrated_once(thesis):
     assert volume(punch, about=(0.0, 0.0, 100.0)) == occ(punch)[0]  # a point far from its own: not taken
 
 
+def _assert_tip_checks_are_of_the_tips(report, band_z):
+    """Each punch tip's manifold3d check is of the tip the build keeps: OCC's removed volume is that tip's
+    prism (plan area times its length, from the band's middle to the tip's far end, measured from its
+    edge) less the tip (a tip cut again from its edge higher up a cup without land had been checked
+    on its first cut, and one without a check would have no entry)."""
+    z_mid = 0.5 * (band_z[0] + band_z[1])
+    for which in ("upper", "lower"):
+        p = report[f"{which}_punch"]
+        (c,) = [c for c in report["booleans"] if c["what"] == f"{which} punch tip"]
+        edge, length = p["tip_edge_z_mm"], p["tip_length_mm"]
+        height = edge + length - z_mid if which == "upper" else z_mid - (edge - length)
+        assert c["occ_change_mm3"] == pytest.approx(p["tip_plan_area_mm2"] * height - p["volume_mm3"], rel=1e-7), which
+        assert c["ok"], which
+
+
+def test_tip_checks_are_of_the_tips_kept(thesis):
+    _assert_tip_checks_are_of_the_tips(thesis.report, thesis.frame.band_z)
+
+
+def test_a_build_reuses_the_previous_builds_results_only_where_they_are_its_own(thesis):
+    """The shape cache is kept from one build to the next: a scored build after a plain one of the same
+    tablet reuses the lower tip cut from the same faces (the same solid) and the plain tablet's volume, and
+    reports what a build from a cleared cache reports; a tip cell is reused only for the same faces and
+    inset."""
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.booleans import CACHE, volume
+    from tabletcad.tooling.punch import tip_cell
+    from tabletcad.tooling.outline import prism, offset_wire
+
+    def plain_report(r):
+        return {k: v for k, v in r.items() if k != "seconds"}
+
+    shape = thesis.frame.shape
+    plain = make_tooling(thesis.tablet, ToolingSpec(clearance_mm=CLEARANCE), shape=shape, check=False,
+                         interference_check=False)
+    spec = ToolingSpec(clearance_mm=CLEARANCE, scores=(ScoreSpec(kind="bisect", depth_mm=0.2),))
+    scored = make_tooling(thesis.tablet, spec, shape=shape, interference_check=False)
+    assert scored.parts["lower_punch"] is plain.parts["lower_punch"]  # the bottom face is not scored
+    assert scored.parts["upper_punch"] is not plain.parts["upper_punch"]
+    CACHE.clear()
+    fresh = make_tooling(thesis.tablet, spec, shape=shape, interference_check=False)
+    assert fresh.parts["lower_punch"] is not plain.parts["lower_punch"]
+    assert plain_report(fresh.report) == plain_report(scored.report)
+    for name, part in fresh.parts.items():
+        assert len(explore(part, "Face")) == len(explore(scored.parts[name], "Face")), name
+        assert volume(part) == volume(scored.parts[name]), name
+    # the memo of tip cells directly: the same faces and numbers give the same cell, others their own
+    frame, tablet = fresh.frame, fresh.parts["tablet"]
+    z_mid, z1 = 0.5 * sum(frame.band_z), frame.band_z[1] + 8.0
+
+    def cell(inset, solid=tablet, memo=True):
+        body = prism(offset_wire(frame.outline, -inset), z_mid, z1)
+        return tip_cell(body, solid, z_mid, z_mid, z1, "upper", memo=(frame, inset) if memo else None)
+
+    a = cell(0.03)
+    assert cell(0.03) is a
+    assert volume(cell(0.03, memo=False)) == volume(a)
+    other = cell(0.05)
+    assert other is not a and volume(other) < volume(a)  # (a narrower prism's cell is smaller)
+    assert cell(0.03, solid=plain.parts["tablet"]) is not a  # the unscored face: another cell
+
+
+def test_a_long_tip_trimmed_is_the_tip_cut_to_its_length(thesis):
+    """A tip whose edge rises up the cup is cut long and trimmed by the plane of its prism's end
+    (``tip_trimmed``): the same faces, edges and vertices and the same volume as the prism of its length
+    split by the tablet's face, upper and lower (the thesis round has no land wider than the inset)."""
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.booleans import reference_point, volume
+    from tabletcad.tooling.outline import offset_wire, prism
+    from tabletcad.tooling.punch import _edge_may_rise, tip_cell, tip_trimmed
+
+    frame, tablet = thesis.frame, thesis.parts["tablet"]
+    inset = frame.tip_inset(CLEARANCE)
+    wire, z_mid, about = offset_wire(frame.outline, -inset), 0.5 * sum(frame.band_z), reference_point(tablet)
+    for which, up in (("upper", True), ("lower", False)):
+        assert _edge_may_rise(frame, inset, up)
+        p = thesis.report[f"{which}_punch"]
+        end = p["working_length_datum"]["datum_plane_z_mm"]
+        assert abs(p["tip_edge_z_mm"] - frame.band_z[1 if up else 0]) > 1e-4  # (its edge rose)
+        z0, z1 = (z_mid, end) if up else (end, z_mid)
+        direct = tip_cell(prism(wire, z0, z1), tablet, z_mid, z0, z1, which)
+        z0, z1 = (z_mid, end + 3.0) if up else (end - 3.0, z_mid)
+        trimmed = tip_trimmed(tip_cell(prism(wire, z0, z1), tablet, z_mid, z0, z1, which), wire, end, up)
+        for kind in ("Face", "Edge", "Vertex"):
+            assert len(explore(trimmed, kind)) == len(explore(direct, kind)), (which, kind)
+        assert volume(trimmed, about=about) == pytest.approx(volume(direct, about=about), rel=1e-11), which
+        assert volume(thesis.parts[f"{which}_punch"], about=about) == pytest.approx(volume(direct, about=about), rel=1e-11)
+
+
 def test_closed_position_encloses_exactly_the_tablet(thesis):
     r = thesis.report
     assert r["interference_mm3"] == pytest.approx(0.0, abs=1e-9)
@@ -480,3 +569,4 @@ def test_every_family_sample_gets_valid_tooling(path):
         check_solid(ts2.parts["tablet"], "scored tablet")
         (groove,) = [c for c in ts2.report["booleans"] if c["what"].startswith("score")]
         assert groove["ok"] and groove["abs_diff_mm3"] <= groove["bound_mm3"]
+        _assert_tip_checks_are_of_the_tips(ts2.report, ts2.frame.band_z)  # (no land: each tip cut twice)

@@ -47,7 +47,9 @@ _ALGOS = {"cut": BRepAlgoAPI_Cut, "fuse": BRepAlgoAPI_Fuse, "common": BRepAlgoAP
 TIMER = {"occ_boolean_s": 0.0, "manifold_s": 0.0, "occ_booleans": 0, "manifold_booleans": 0}
 
 #: meshes, manifolds, volumes and areas of the shapes a build asks about more than once; the faces'
-#: volume integrals in ``CACHE.faces`` (:func:`volume_centroid`)
+#: volume integrals in ``CACHE.faces`` (:func:`volume_centroid`).  Kept from one build to the next (the
+#: newest entries: a second build of the same tablet asks again about its plain solid and the faces it
+#: shares); each entry holds its shape, so a shape that matches one is that shape
 CACHE = ShapeCache(faces=20_000)
 
 #: a point (mm)

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tabletcad.errors import GeometryError
-from tabletcad.tooling.booleans import boolean, checked_boolean, reference_point, split_cells, volume
+from tabletcad.tooling.booleans import CACHE, boolean, checked_boolean, reference_point, split_cells, volume
 from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, prism, wire_length
 
 __all__ = ["PunchTip", "punch_tip", "cup_volume_within", "elliptic_tip_quadrature", "punch_volume_quadrature"]
@@ -54,21 +54,56 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
     # near its own (the letters on this face), so that the faces they share are integrated once
     about = reference_point(tablet_shape)
 
-    def cut(edge_z: float):
-        z0, z1 = (z_mid, edge_z + tip_length) if up else (edge_z - tip_length, z_mid)
-        body = prism(tip_wire, z0, z1)
+    def checked(body, exact, checking: bool):
         # the manifold check is on "prism minus tablet": the removed volume is the tablet inside the prism
         return checked_boolean("cut", body, tablet_shape, what=f"{which} punch tip", deflection=deflection,
-                               check=check, a_manifold=None, sliver=1e-4, about=about,
-                               exact=lambda: tip_cell(body, tablet_shape, z_mid, z0, z1, which))
+                               check=checking, a_manifold=None, sliver=1e-4, about=about, exact=exact)
 
-    shape, chk = cut(edge)
-    lo, hi = tight_z_range(shape, low=up, high=not up)
-    tip_edge = lo if up else hi  # the tip's end nearest the tablet: where its wall meets the face
-    if abs(tip_edge - edge) > 1e-6:  # (OCC's optimal box is good to ~1e-7 mm: a land's edge is the band's)
-        shape, chk = cut(tip_edge)
+    def tip_prism(edge_z: float, length: float):
+        z0, z1 = (z_mid, edge_z + length) if up else (edge_z - length, z_mid)
+        return z0, z1, prism(tip_wire, z0, z1)
+
+    def cut(edge_z: float, length: float):
+        z0, z1, body = tip_prism(edge_z, length)
+        return body, tip_cell(body, tablet_shape, z_mid, z0, z1, which, memo=(frame, inset))
+
+    def measured_edge(tip) -> float:  # the tip's end nearest the tablet: where its wall meets the face
+        lo, hi = tight_z_range(tip, low=up, high=not up)
+        return lo if up else hi
+
+    # The tip's edge is measured on a tip cut from the band's edge.  Where it may lie higher up the cup (no
+    # land wider than the inset), that tip is cut longer than its length plus the tablet's thickness and,
+    # its edge measured, trimmed to its length by the plane of the prism's end (tip_trimmed): OCC had
+    # split the prism by the tablet's face twice, the second time only to end it higher.  Elsewhere, or
+    # when the trim fails, the tip from the band's edge is kept when its edge is the band's and else cut
+    # again from its edge.  Only the tip kept is checked (the first one's check had been thrown away).
+    body = shape = None
+    if _edge_may_rise(frame, inset, up):
+        reach = frame.z_max - frame.z_min + 1.0  # farther than any edge of the tip can rise
+        _, long_tip = cut(edge, tip_length + reach)
+        tip_edge = measured_edge(long_tip)
+        if abs(tip_edge - edge) <= 1e-6:  # (OCC's optimal box is good to ~1e-7 mm: a land's edge is the band's)
+            tip_edge = edge
+        if abs(tip_edge - edge) < reach - 0.5:
+            try:
+                end = tip_edge + tip_length if up else tip_edge - tip_length
+                # (a long tip reused from an earlier build, tip_cell's memo, has its trimmed tip too)
+                shape = CACHE.get(long_tip, ("tip end", float(end), up), lambda: tip_trimmed(long_tip, tip_wire, end, up))
+            except GeometryError:
+                shape = None
+        if shape is None:
+            body, shape = cut(tip_edge, tip_length)
     else:
-        tip_edge = edge
+        body, shape = cut(edge, tip_length)
+        tip_edge = measured_edge(shape)
+        if abs(tip_edge - edge) > 1e-6:  # (OCC's optimal box is good to ~1e-7 mm: a land's edge is the band's)
+            body, shape = cut(tip_edge, tip_length)
+        else:
+            tip_edge = edge
+    if body is None:
+        body = tip_prism(tip_edge, tip_length)[2]  # the prism the tip is cut from, for its check
+    found = shape
+    shape, chk = checked(body, lambda: found, check)
     cup_point = frame.z_max if up else frame.z_min
     datum = tip_edge + tip_length if up else tip_edge - tip_length
     vol = volume(shape, about=about)
@@ -104,6 +139,29 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
     return PunchTip(f"{which}_punch", shape, vol, info), chk
 
 
+def _edge_may_rise(frame: TabletFrame, inset: float, up: bool) -> bool:
+    """Whether a tip's edge may stand above the band's edge, up the face: a cupped face without a land wider
+    than the tip's inset (a flat face's tip ends at the band's edge; a radius or bevel edge rises too)."""
+    cup = frame.cup_depth_top if up else frame.cup_depth_bottom
+    return cup > 1e-9 and (frame.land is None or frame.land - inset <= 1e-9)
+
+
+def tip_trimmed(tip, wire, z: float, up: bool):
+    """The punch ``tip`` (a cell of the prism of the plan ``wire``, longer than wanted) ending at height ``z``
+    (mm): split by the plan face of ``wire`` at ``z`` (the end face a prism of ``wire`` ending there has, so
+    the trimmed tip's walls, faces and volume are the shorter prism's cell's: on the family samples the
+    same face, edge and vertex counts and volumes within 2e-12 relative), the part towards the tablet kept."""
+    from tabletcad.tooling.booleans import translated
+
+    end = translated(plan_face(wire), dz=z)
+
+    def keep(cell) -> bool:
+        lo, hi = _z_range(cell)
+        return lo < z - 1e-3 if up else hi > z + 1e-3
+
+    return split_cells(tip, [end], keep, what="punch tip end")
+
+
 def tight_z_range(shape, *, low: bool = True, high: bool = True) -> tuple[float | None, float | None]:
     """The lowest and highest z (mm) of ``shape``'s geometry itself (OCC's optimal box: the surfaces'
     extrema, not their poles or a tolerance-widened box); a side not asked for (``low``/``high``
@@ -117,7 +175,11 @@ def tight_z_range(shape, *, low: bool = True, high: bool = True) -> tuple[float 
     of the surface, which can miss a bump) is always computed.  A shape with free edges or vertices
     takes OCC's box of the whole shape.  The result equals that box (tests/test_tooling_parts.py);
     a punch tip needs one side, and most of its B-spline faces (0.1-0.5 s of OCC's optimisation
-    each solid) lie within it."""
+    each solid) lie within it.  Computed once per shape and sides (:data:`~tabletcad.tooling.booleans.CACHE`)."""
+    return CACHE.get(shape, ("tight z range", bool(low), bool(high)), lambda: _tight_z_range(shape, low, high))
+
+
+def _tight_z_range(shape, low: bool, high: bool) -> tuple[float | None, float | None]:
     from OCP.BRep import BRep_Tool
     from OCP.BRepAdaptor import BRepAdaptor_Surface
     from OCP.Bnd import Bnd_Box
@@ -172,7 +234,7 @@ def _z_range(shape) -> tuple[float, float]:
     return box.CornerMin().Z(), box.CornerMax().Z()
 
 
-def tip_cell(body, tablet_shape, z_mid: float, z0: float, z1: float, which: str):
+def tip_cell(body, tablet_shape, z_mid: float, z0: float, z1: float, which: str, *, memo=None):
     """``body - tablet_shape`` for the tip prism ``body`` (``z0`` to ``z1``, its inner end ``z_mid`` inside the
     tablet): the prism split by the tablet's faces beyond the band's middle only, the cell at the tip's far
     end kept (:func:`~tabletcad.tooling.booleans.split_cells`).
@@ -182,7 +244,14 @@ def tip_cell(body, tablet_shape, z_mid: float, z0: float, z1: float, which: str)
     intersects the band with the prism's wall running parallel to it (the full Boolean took 0.5-2 s, the
     split ~0.1 s, with the same volume to 1e-12).  A cell that reaches the prism's inner end would have
     leaked into the tablet past a missing face: it is refused and the full Boolean is done instead, as
-    when the split does not give one such cell."""
+    when the split does not give one such cell.
+
+    ``memo``: ``(frame, inset)`` when ``body`` is the prism of ``frame``'s outline inset by ``inset`` (mm)
+    from ``z0`` to ``z1``: a split of the same faces (``IsEqual``, in the same order) by the prism of the
+    same frame's outline (its tablet the same object, its plain solid the same shape, so the same
+    outline: :func:`~tabletcad.tooling.outline.tablet_frame` is a function of them) is the cell found
+    before, kept in :data:`~tabletcad.tooling.booleans.CACHE` (the plain and the scored tooling of one
+    tablet cut the same lower tip from the same faces; 0.1-0.6 s a split)."""
     from tabletcad.cad._occ import explore
 
     up = which == "upper"
@@ -196,10 +265,29 @@ def tip_cell(body, tablet_shape, z_mid: float, z0: float, z1: float, which: str)
         reaches_near = lo < near + tol if up else hi > near - tol
         return reaches_far and not reaches_near
 
-    try:
+    def split():
         return split_cells(body, faces, keep, what=f"{which} punch tip")
+
+    try:
+        if memo is None:
+            return split()
+        frame, inset = memo
+        return _memo_cell(frame, (which, float(inset), float(z_mid), float(z0), float(z1)), faces, split)
     except GeometryError:
         return boolean("cut", body, tablet_shape, what=f"{which} punch tip", sliver=1e-4)
+
+
+def _memo_cell(frame: TabletFrame, numbers: tuple, faces: list, compute):
+    """``compute()`` (a tip's cell split from ``faces``), or the cell an earlier call found for the same
+    frame (tablet object and plain solid), ``numbers`` and faces (see :func:`tip_cell`); an error is not kept."""
+    found = CACHE.get(frame.shape, ("tip cells", numbers), lambda: [])  # [(tablet, faces, cell)]
+    for tablet, kept, cell in found:
+        if tablet is frame.tablet and len(kept) == len(faces) and all(a.IsEqual(b) for a, b in zip(kept, faces)):
+            return cell
+    cell = compute()
+    found.append((frame.tablet, list(faces), cell))
+    del found[:-4]  # (the last few finished tablets' faces)
+    return cell
 
 
 # ----------------------------------------------------------------------------- quadrature

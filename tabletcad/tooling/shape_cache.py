@@ -1,4 +1,4 @@
-"""Results computed from an OCC shape, kept while the shape lives in the build (meshes, volumes, areas).
+"""Results computed from an OCC shape, kept while the cache holds the shape (meshes, volumes, areas).
 
 A tooling build asks for the same facts of the same solid many times: the finished tablet is
 meshed for every Boolean's manifold3d check, for the overlap check, for the gap check and for its

@@ -14,7 +14,7 @@ from typing import Any
 from tabletcad.errors import DesignError
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.designreport import ReportOptions
-from tabletcad.tooling.booleans import CACHE, TIMER, to_manifold, volume
+from tabletcad.tooling.booleans import TIMER, to_manifold, volume
 from tabletcad.tolerance import DEFAULT
 from tabletcad.tooling.spec import ToolingSpec, check_numbers
 
@@ -210,7 +210,6 @@ def finished_solid(tablet: Tablet, spec: ToolingSpec, *, shape=None, deflection:
     from tabletcad.tooling.outline import tablet_frame
     from tabletcad.tooling.scores import apply_scores
 
-    CACHE.clear()  # as make_tooling: the previous build's meshes and volumes are not asked for again
     frame = tablet_frame(tablet, shape)
     checked = [check_emboss(frame, e, spec.clearance_mm, i) for i, e in enumerate(spec.emboss)]
     solid, _, _ = apply_scores(frame, frame.shape, spec.scores, check=False, deflection=deflection)  # (checks each)
@@ -239,7 +238,9 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     spec = spec or ToolingSpec()
     t0 = time.perf_counter()
     b0 = dict(TIMER)
-    CACHE.clear()  # meshes and volumes of the previous build's solids are not asked for again
+    # (CACHE is kept from the previous build: a build of the same tablet, e.g. the plain and the scored
+    # tooling of one design, asks again for the plain tablet's mesh and volume, its faces' integrals
+    # and a tip cut from the same faces; its entries hold their shapes, so a match is that shape)
     frame = tablet_frame(tablet, shape)
     emb_checked = check_on_frame(frame, spec)
     gap_closed = frame.band
