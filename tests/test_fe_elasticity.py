@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import subprocess
 import sys
@@ -89,6 +90,57 @@ def test_uniaxial_compression_is_exact_and_independent_of_E(box_mesh, E):
     assert s == pytest.approx(expect, abs=1e-8)
     assert von_mises(s) == pytest.approx(3.0, rel=1e-8)
     assert principal_stresses(s) == pytest.approx([-3.0, 0.0, 0.0], abs=1e-8)
+
+
+# CHOLMOD (scikit-sparse, the fe extra) is the solver; the test set-up installs it, so in CI (or with
+# TABLETCAD_REQUIRE_CAD=1) a missing scikit-sparse is a failure, not a skip.
+_HAVE_CHOLMOD = importlib.util.find_spec("sksparse") is not None
+
+
+@pytest.mark.skipif(not _HAVE_CHOLMOD and not (os.environ.get("CI") or os.environ.get("TABLETCAD_REQUIRE_CAD")),
+                    reason="scikit-sparse (CHOLMOD) is not installed: the solve falls back to SuperLU")
+def test_cholmod_solve_is_used_and_agrees_with_superlu(box_mesh, monkeypatch):
+    """A non-uniform field (opposite pressures on half of the top and bottom faces): the displacement and
+    the stresses of the CHOLMOD solve (which must be the one used) match SuperLU's LU to 1e-9, and a
+    matrix that is not positive definite falls back to SuperLU."""
+    import sksparse.cholmod
+
+    import tabletcad.fe.elasticity as el
+
+    calls = []
+    real = sksparse.cholmod.cholesky
+
+    def spy(K, *a, **kw):
+        calls.append(K.shape)
+        return real(K, *a, **kw)
+
+    def halves(bf):
+        return [PressureLoad(np.flatnonzero((s * bf.normals[:, 2] > 0.999) & (bf.centroids[:, 0] < 0)), 2.0)
+                for s in (-1.0, 1.0)]
+
+    monkeypatch.setattr(sksparse.cholmod, "cholesky", spy)
+    _, chol = _solve(box_mesh, halves)
+    assert len(calls) == 1 and calls[0][0] == chol.dofs - 6
+    monkeypatch.setattr(el, "_factor_and_solve", el._superlu_solve)
+    _, lu = _solve(box_mesh, halves)
+    assert len(calls) == 1
+    u, s = np.abs(lu.displacement).max(), np.abs(lu.vertex_stress).max()
+    assert s > 1.0 and np.ptp(lu.vertex_stress[:, :, 2, 2]) > 1.0  # not a uniform field
+    assert np.abs(chol.displacement - lu.displacement).max() < 1e-9 * u
+    assert np.abs(chol.vertex_stress - lu.vertex_stress).max() < 1e-9 * s
+    assert chol.work == pytest.approx(lu.work, rel=1e-9)
+    # -K is not positive definite: CHOLMOD refuses it and SuperLU solves it
+    import scipy.sparse as sp
+
+    monkeypatch.undo()
+    monkeypatch.setattr(sksparse.cholmod, "cholesky", spy)
+    A = sp.random(60, 60, density=0.1, random_state=1)
+    K = (A @ A.T + 60 * sp.eye(60)).tocsc()
+    b = np.arange(60.0)
+    x = el._superlu_solve(K, b)
+    assert np.abs(el._factor_and_solve(K, b) - x).max() < 1e-12 * np.abs(x).max()
+    assert np.abs(el._factor_and_solve(-K, b) + x).max() < 1e-12 * np.abs(x).max()
+    assert len(calls) == 3
 
 
 def test_von_mises_and_principal_closed_forms():

@@ -368,9 +368,32 @@ def _symmetry_dofs(basis: Any, planes: Sequence[tuple[int, float]], centre: np.n
 
 
 def _factor_and_solve(K: Any, b: np.ndarray) -> np.ndarray:
-    """``K⁻¹ b`` by SuperLU (``K`` sparse symmetric, CSC).  The factors live and die in the calling
-    thread: scipy's SuperLU frees its memory only in the thread that made it (factors freed by
-    another thread leaked about 16 MB a solve)."""
+    """``K⁻¹ b`` for the symmetric positive definite ``K`` (sparse, CSC).
+
+    By CHOLMOD's supernodal Cholesky factorisation (scikit-sparse, the ``fe`` extra; fill-reducing
+    ordering AMD or METIS, CHOLMOD's default choice), else, when scikit-sparse is not installed or
+    CHOLMOD finds ``K`` not positive definite, by SuperLU's LU (scipy).  Both are direct solves of the
+    same system, agreeing to round-off (relative 1e-12, tested); CHOLMOD is 3-8x faster on the FE
+    tests' systems of 14,000-36,000 unknowns (half the work of an LU, in blocks through BLAS).
+
+    The factors live and die in the calling thread: scipy's SuperLU frees its memory only in the
+    thread that made it (factors freed by another thread leaked about 16 MB a solve).  (CHOLMOD, unlike
+    SuperLU, keeps the GIL while it factorises, so a Ctrl-C waits for the factorisation to end.)
+    """
+    try:
+        from sksparse.cholmod import CholmodNotPositiveDefiniteError, cholesky
+    except ImportError:
+        pass
+    else:
+        try:
+            return cholesky(K)(b)
+        except CholmodNotPositiveDefiniteError:
+            pass
+    return _superlu_solve(K, b)
+
+
+def _superlu_solve(K: Any, b: np.ndarray) -> np.ndarray:
+    """``K⁻¹ b`` by SuperLU (``K`` sparse symmetric, CSC), in the calling thread."""
     import scipy.sparse.linalg as spla
 
     lu = spla.splu(K, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
@@ -438,7 +461,8 @@ def solve_elasticity(
         D = _supports(m, basis, np.asarray(support_centre, float), float(support_arm))
     free = np.setdiff1d(np.arange(basis.N), D)
     Kf = K[free][:, free].tocsc()
-    # (in a helper thread: SuperLU holds no GIL, and a Ctrl-C must not wait minutes for it)
+    # (in a helper thread: SuperLU holds no GIL, and a Ctrl-C must not wait minutes for it; CHOLMOD
+    # keeps the GIL, but factorises the same system several times faster)
     u = np.zeros(basis.N)
     u[free] = run_interruptibly(_factor_and_solve, Kf, f[free])
     reaction = float(np.abs((K @ u - f)[D]).max())
