@@ -92,6 +92,29 @@ def test_uniaxial_compression_is_exact_and_independent_of_E(box_mesh, E):
     assert principal_stresses(s) == pytest.approx([-3.0, 0.0, 0.0], abs=1e-8)
 
 
+@pytest.mark.parametrize("chunk", [7, 8192])
+def test_stiffness_is_scikit_fems_linear_elasticity(box_mesh, chunk):
+    """The vectorised stiffness equals scikit-fem's ``asm(linear_elasticity)`` to round-off, on the box's
+    mesh with its vertices moved off the axes (general element shapes), for two materials, whether the
+    elements are taken all at once or a few at a time."""
+    import skfem
+    from skfem.models.elasticity import linear_elasticity
+
+    from tabletcad.fe.elasticity import stiffness
+
+    m = _skfem_mesh(box_mesh)
+    rng = np.random.default_rng(3)
+    m = skfem.MeshTet(m.p + 0.05 * rng.standard_normal(m.p.shape), m.t)
+    basis = skfem.Basis(m, skfem.ElementVector(skfem.ElementTetP2()), intorder=2)
+    for mat in (Material(), Material(E=210000.0, nu=-0.5)):
+        lam, mu = mat.lame
+        ref = skfem.asm(linear_elasticity(lam, mu), basis)
+        K = stiffness(basis, lam, mu, chunk=chunk)
+        assert K.shape == ref.shape and abs(ref).max() > 0
+        assert abs(K - ref).max() < 1e-13 * abs(ref).max()
+        assert abs(K - K.T).max() < 1e-13 * abs(ref).max()
+
+
 # CHOLMOD (scikit-sparse, the fe extra) is the solver; the test set-up installs it, so in CI (or with
 # TABLETCAD_REQUIRE_CAD=1) a missing scikit-sparse is a failure, not a skip.
 _HAVE_CHOLMOD = importlib.util.find_spec("sksparse") is not None
