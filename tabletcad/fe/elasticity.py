@@ -249,24 +249,38 @@ class ElasticSolution:
         wr = (np.abs(np.linalg.det(J.transpose(2, 0, 1)))[None, :] * W[:, None]).ravel()
         lam = np.vstack([1.0 - xi.sum(axis=0), xi])  # (4, nq): vertex k of the reference is t[k]
         v = xv[el]  # (e, 4, 3)
-        gx = np.einsum("kq,ekd->eqd", lam, v).reshape(-1, 3)
+        gx = np.einsum("kq,ekd->deq", lam, v)  # (3, e, nq): the points, coordinate by coordinate
         jac = np.abs(np.linalg.det(v[:, 1:] - v[:, :1]))  # 6 x volume
-        gw = (jac[:, None] * wr[None, :]).ravel()
-        gs = np.einsum("kq,ekij->eqij", lam, self.vertex_stress[el]).reshape(-1, 9)
-        tree = cKDTree(gx)
+        gw = jac[:, None] * wr[None, :]  # (e, nq)
+        ce, de = cen[el], diam[el]
+        vs = self.vertex_stress[el].reshape(len(el), 4, 9)
+        # per ball, the elements whose bounding sphere meets it; the weighted sum of the (linear) stress
+        # over their points is Σ_e Σ_k (Σ_q w λ_k) σ_ek, so only the four vertex weights are summed per point
+        cand = cKDTree(ce).query_ball_point(q, R + float(de.max()))
         out = np.zeros((len(q), 9))
         frac = np.zeros(len(q))
-        full = 8.0 * np.pi * R**3 / 105.0  # ∫ (1 - r²/R²)² dV over the whole ball
-        for i, idx in enumerate(tree.query_ball_point(q, R)):
-            if not idx:
+        full = 32.0 * np.pi * R**3 / 105.0  # ∫ (1 - r²/R²)² dV over the whole ball: 4πR³ (1/3 - 2/5 + 1/7)
+        for i, c in enumerate(cand):
+            if not c:
                 continue
-            idx = np.asarray(idx)
-            r2 = ((gx[idx] - q[i]) ** 2).sum(axis=1) / (R * R)
-            w = gw[idx] * (1.0 - r2) ** 2
+            c = np.asarray(c)
+            c = c[np.linalg.norm(ce[c] - q[i], axis=1) <= R + de[c]]
+            d = gx[0, c] - q[i, 0]
+            r2 = d * d
+            d = gx[1, c] - q[i, 1]
+            r2 += d * d
+            d = gx[2, c] - q[i, 2]
+            r2 += d * d
+            r2 /= R * R
+            outside = r2 >= 1.0
+            w = np.subtract(1.0, r2, out=r2)
+            w *= w
+            w *= gw[c]
+            w[outside] = 0.0
             s = w.sum()
             frac[i] = s / full
             if s > 0:
-                out[i] = w @ gs[idx] / s
+                out[i] = np.einsum("ck,ckj->j", w @ lam.T, vs[c]) / s
         out = out.reshape(-1, 3, 3)
         return 0.5 * (out + out.transpose(0, 2, 1)), frac
 
