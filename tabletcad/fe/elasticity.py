@@ -435,7 +435,8 @@ def _factor_and_solve(K: Any, b: np.ndarray) -> np.ndarray:
 
     The factors live and die in the calling thread: scipy's SuperLU frees its memory only in the
     thread that made it (factors freed by another thread leaked about 16 MB a solve).  (CHOLMOD, unlike
-    SuperLU, keeps the GIL while it factorises, so a Ctrl-C waits for the factorisation to end.)
+    SuperLU, keeps the GIL while it factorises, so a Ctrl-C waits for the factorisation to end: 3.4 s at
+    69,000 unknowns and 11 s at 135,000, the 10 x 3 mm disc at 0.45 and 0.345 mm, one thread.)
     """
     try:
         from sksparse.cholmod import CholmodNotPositiveDefiniteError, cholesky
