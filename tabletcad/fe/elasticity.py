@@ -430,7 +430,7 @@ def _factor_and_solve(K: Any, b: np.ndarray) -> np.ndarray:
     By CHOLMOD's supernodal Cholesky factorisation (scikit-sparse, the ``fe`` extra; fill-reducing
     ordering AMD or METIS, CHOLMOD's default choice), else, when scikit-sparse is not installed or
     CHOLMOD finds ``K`` not positive definite, by SuperLU's LU (scipy).  Both are direct solves of the
-    same system, agreeing to round-off (relative 1e-12, tested); CHOLMOD is 3-8x faster on the FE
+    same system, agreeing to round-off (relative 1e-12, tested); CHOLMOD was 2.8-7.6x faster on the FE
     tests' systems of 14,000-36,000 unknowns (half the work of an LU, in blocks through BLAS).
 
     The factors live and die in the calling thread: scipy's SuperLU frees its memory only in the
