@@ -165,7 +165,7 @@ def test_averaged_stress_is_the_composite_rule_over_every_element(box_mesh):
     assert frac[0] == pytest.approx(1.0, rel=0.01) and 0.49 < frac[3] < 0.51 and 0.24 < frac[2] < 0.26 and frac[4] == 0.0
 
 
-# CHOLMOD (scikit-sparse, the fe extra) is the solver; the test set-up installs it, so in CI (or with
+# CHOLMOD (scikit-sparse, the cholmod extra) is the solver; the test set-up installs it, so in CI (or with
 # TABLETCAD_REQUIRE_CAD=1) a missing scikit-sparse is a failure, not a skip.
 _HAVE_CHOLMOD = importlib.util.find_spec("sksparse") is not None
 

@@ -427,7 +427,7 @@ def _symmetry_dofs(basis: Any, planes: Sequence[tuple[int, float]], centre: np.n
 def _factor_and_solve(K: Any, b: np.ndarray) -> np.ndarray:
     """``K⁻¹ b`` for the symmetric positive definite ``K`` (sparse, CSC).
 
-    By CHOLMOD's supernodal Cholesky factorisation (scikit-sparse, the ``fe`` extra; fill-reducing
+    By CHOLMOD's supernodal Cholesky factorisation (scikit-sparse, the ``cholmod`` extra; fill-reducing
     ordering AMD or METIS, CHOLMOD's default choice), else, when scikit-sparse is not installed or
     CHOLMOD finds ``K`` not positive definite, by SuperLU's LU (scipy).  Both are direct solves of the
     same system, agreeing to round-off (relative 1e-12, tested); CHOLMOD was 2.8-7.6x faster on the FE
