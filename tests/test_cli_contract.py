@@ -686,28 +686,31 @@ def test_a_ctrl_c_stops_a_long_compiled_call_at_once():
 
 
 def test_solves_in_the_helper_thread_leave_no_memory_behind():
-    """The FE solve runs in ``run_interruptibly``'s helper thread with its SuperLU factors made and freed
-    there: factors made in one thread and freed in another leaked about 16 MB a solve (a whole test
-    run's FE solves then left a worker too big to fork).  100 solves of a 2000-unknown system: the
-    resident memory grows by far less than the 1.5 GB they had leaked."""
+    """The FE solve runs in ``run_interruptibly``'s helper thread with its factors made and freed there:
+    SuperLU's factors made in one thread and freed in another leaked about 16 MB a solve (a whole test
+    run's FE solves then left a worker too big to fork).  100 solves of a 2000-unknown symmetric positive
+    definite system by each solver (CHOLMOD, the one used, and SuperLU, its fallback): the resident memory
+    grows by far less than the 1.5 GB they had leaked."""
     import numpy as np
     import scipy.sparse as sp
 
     from tabletcad.errors import run_interruptibly
-    from tabletcad.fe.elasticity import _factor_and_solve
+    from tabletcad.fe.elasticity import _factor_and_solve, _superlu_solve
 
     def rss_mb() -> float:
         with open("/proc/self/status", encoding="ascii") as f:
             return next(int(line.split()[1]) for line in f if line.startswith("VmRSS")) / 1024.0
 
-    K = (sp.random(2000, 2000, density=0.002, random_state=0) + 10.0 * sp.eye(2000)).tocsc()
+    R = sp.random(2000, 2000, density=0.002, random_state=0)
+    K = (R + R.T + 10.0 * sp.eye(2000)).tocsc()  # symmetric, diagonally dominant: positive definite
     b = np.ones(2000)
-    x = run_interruptibly(_factor_and_solve, K, b)
-    assert np.allclose(K @ x, b, atol=1e-10)
-    before = rss_mb()
-    for _ in range(100):
-        run_interruptibly(_factor_and_solve, K, b)
-    assert rss_mb() - before < 200.0
+    for solve in (_factor_and_solve, _superlu_solve):
+        x = run_interruptibly(solve, K, b)
+        assert np.allclose(K @ x, b, atol=1e-10)
+        before = rss_mb()
+        for _ in range(100):
+            run_interruptibly(solve, K, b)
+        assert rss_mb() - before < 200.0
 
 
 def test_a_ctrl_c_swallowed_by_a_gc_callback_is_delivered_again():

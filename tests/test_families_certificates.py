@@ -156,6 +156,7 @@ def round_designs(draw):
     band = draw(st.floats(0.5, 5.0))
     if fam == "concave_round":
         land = draw(st.floats(0.0, 0.3)) * R
+        land = land if land >= 1e-3 else 0.0  # (below Tolerances.min_length a land is refused: 0 is that design)
         return fam, dict(diameter=D, band=band, cup_depth=draw(st.floats(0.02, 1.0)) * (R - land), land=land)
     if fam == "concave_bevel":
         w = draw(st.floats(0.02, 0.3)) * R
@@ -187,6 +188,7 @@ def shaped_designs(draw):
         W = draw(st.floats(4.0, 10.0))
         L = W * draw(st.floats(1.2, 2.6))
         land = draw(st.floats(0.0, 0.1)) * W
+        land = land if land >= 1e-3 else 0.0  # (below Tolerances.min_length a land is refused: 0 is that design)
         return fam, dict(length=L, width=W, band=band, land=land, cup_depth=draw(st.floats(0.05, 0.9)) * (W / 2 - land))
     if fam == "oval":
         W = draw(st.floats(5.0, 10.0))

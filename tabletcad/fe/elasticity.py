@@ -425,7 +425,8 @@ def _symmetry_dofs(basis: Any, planes: Sequence[tuple[int, float]], centre: np.n
 
 
 def _factor_and_solve(K: Any, b: np.ndarray) -> np.ndarray:
-    """``K⁻¹ b`` for the symmetric positive definite ``K`` (sparse, CSC).
+    """``K⁻¹ b`` for the symmetric positive definite ``K`` (sparse, CSC; CHOLMOD reads one triangle of it, so
+    ``K`` must be symmetric, as every stiffness matrix here is by construction).
 
     By CHOLMOD's supernodal Cholesky factorisation (scikit-sparse, the ``cholmod`` extra; fill-reducing
     ordering AMD or METIS, CHOLMOD's default choice), else, when scikit-sparse is not installed or
