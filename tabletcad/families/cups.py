@@ -228,13 +228,19 @@ def _blend_range(w: float, Rc: float, Re: float, min_length: float = DEFAULT.min
         return g is not None and min(_arc_lengths(w, *g[:3], Rc, Re)) >= min_length
 
     top = min(w, Rc)
-    rs = np.linspace(0.0, top, 2002)[1:-1]
-    good = np.array([ok(float(r)) for r in rs])
+    return _interval(ok, np.linspace(0.0, top, 2002)[1:-1], 0.0, top)
+
+
+def _interval(ok, xs: np.ndarray, first: float, last: float) -> tuple[float, float]:
+    """The ends of the one interval where ``ok`` holds, scanned on ``xs`` (increasing, within ``first``
+    and ``last``, the ends used when the interval reaches past the scan) and bisected at both ends to
+    rounding (60 halvings); NaNs when no sample holds."""
+    good = np.array([ok(float(x)) for x in xs])
     if not good.any():
         return (math.nan, math.nan)
     i0, i1 = int(np.argmax(good)), len(good) - 1 - int(np.argmax(good[::-1]))
 
-    def bisect(g, b):
+    def bisect(g: float, b: float) -> float:
         for _ in range(60):
             mid = 0.5 * (g + b)
             if ok(mid):
@@ -243,8 +249,8 @@ def _blend_range(w: float, Rc: float, Re: float, min_length: float = DEFAULT.min
                 b = mid
         return g
 
-    lo = bisect(rs[i0], rs[i0 - 1] if i0 > 0 else 0.0)
-    hi = bisect(rs[i1], rs[i1 + 1] if i1 < len(rs) - 1 else top)
+    lo = bisect(xs[i0], xs[i0 - 1] if i0 > 0 else first)
+    hi = bisect(xs[i1], xs[i1 + 1] if i1 < len(xs) - 1 else last)
     return (float(lo), float(hi))
 
 
@@ -263,23 +269,7 @@ def _depth_range(w: float, Rc: float, Re: float, min_length: float = DEFAULT.min
     Scanned on a fine grid, then bisected at both ends: the edge arc grows with the depth and the
     central arc shrinks, so the depths are one interval."""
     hs = np.linspace(1e-6 * w, 2 * w, 2001)
-    ok = np.array([_buildable(w, Rc, Re, float(h), min_length) for h in hs])
-    if not ok.any():
-        return (math.nan, math.nan)
-    i0, i1 = int(np.argmax(ok)), len(ok) - 1 - int(np.argmax(ok[::-1]))
-
-    def bisect(good, bad):
-        for _ in range(60):
-            mid = 0.5 * (good + bad)
-            if _buildable(w, Rc, Re, mid, min_length):
-                good = mid
-            else:
-                bad = mid
-        return good
-
-    lo = bisect(hs[i0], hs[i0 - 1]) if i0 > 0 else hs[0]
-    hi = bisect(hs[i1], hs[i1 + 1]) if i1 < len(hs) - 1 else hs[-1]
-    return (float(lo), float(hi))
+    return _interval(lambda h: _buildable(w, Rc, Re, h, min_length), hs, hs[0], hs[-1])
 
 
 def compound_cup_profile(d0: float, half_width: float, central_radius: float, edge_radius: float,
