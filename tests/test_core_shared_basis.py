@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tabletcad.geometry.curves import combination_of, evaluate_curves, fourier_coefficients
+from tabletcad.geometry.curves import Curve, basis_spectrum, combination_of, evaluate_curves, fourier_coefficients, fourier_tail, modes_needed
 from tabletcad.pipeline.design import Design
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -50,6 +50,36 @@ def test_coefficients_from_the_basis_equal_each_curves_own_fft(swept, name):
             assert np.max(np.abs(a0 - p._a0[k])) <= tol, (p.name, k)
             assert np.max(np.abs(a - p._ac[k])) <= tol, (p.name, k)
             assert np.max(np.abs(b - p._bc[k])) <= tol, (p.name, k)
+
+
+class _Plain(Curve):
+    """The same curve without its basis: :func:`modes_needed` measures it from its own samples and FFT."""
+
+    def __init__(self, curve) -> None:
+        self.curve = curve
+
+    def evaluate(self, v, der: int = 0):
+        return self.curve.evaluate(v, der)
+
+    def band_limit(self):
+        return self.curve.band_limit()
+
+
+@settings(max_examples=25, deadline=None)
+@given(name=st.sampled_from(SWEPT), log_tol=st.floats(-8.0, -1.0), max_modes=st.sampled_from([4, 16, 48, 100]),
+       which=st.integers(0, 1000))
+def test_modes_needed_from_the_basis_equals_each_curves_own(swept, name, log_tol, max_modes, which):
+    """The fewest modes of a swept datum (and the root-mean-square tail that screens it), taken from its
+    outline basis's spectrum and partial sums, are the curve's own: its samples, its FFT, its residuals."""
+    t = swept[name]
+    curves = [c for p in t.patches for c in p.data]  # the points among them too (0 modes)
+    c = curves[which % len(curves)]
+    basis, W, _ = combination_of([c])
+    tol = 10.0**log_tol
+    assert modes_needed(c, tol, max_modes) == modes_needed(_Plain(c), tol, max_modes)
+    gram = basis_spectrum(basis, max_modes, 1024)[3]
+    want = fourier_tail(_Plain(c), max_modes, 1024)
+    assert math.sqrt(max(float(W[0] @ gram @ W[0]), 0.0)) == pytest.approx(want, rel=1e-9, abs=1e-15)
 
 
 def _residual_by_hand(p, v: np.ndarray, dv: int) -> np.ndarray:

@@ -757,6 +757,62 @@ def _truncation_errors(pts, approx, a, b, cos, sin, k0: int, k1: int) -> np.ndar
     return np.max(np.linalg.norm(pts[:, None, :] - run, axis=2), axis=0)
 
 
+def basis_memo(basis) -> dict:
+    """The results kept on a shared curve basis (:func:`combination_of`): they live as long as it
+    does (the outline that owns it)."""
+    memo = basis.__dict__.get("_pde_memo")
+    if memo is None:
+        memo = {}
+        basis.__dict__["_pde_memo"] = memo
+    return memo
+
+
+def basis_spectrum(basis, modes: int, m: int) -> tuple[np.ndarray, ...]:
+    """``(a0, a, b, gram)`` of the ``k`` curves of ``basis`` from ``m`` samples: the coefficients of
+    :func:`fourier_coefficients` ``(k, 3)``, ``(k, modes, 3)``, ``(k, modes, 3)`` mm, and the ``(k, k)``
+    matrix whose form ``w·gram·w`` is the square of :func:`fourier_tail` of the combination
+    ``w · basis + const`` (discrete Parseval: the tail's coefficients are linear in the curve, the
+    constant moves ``a0`` alone).  Read-only, once per basis, modes and samples."""
+    memo = basis_memo(basis)
+    key = ("spectrum", modes, m)
+    hit = memo.get(key)
+    if hit is None:
+        pts = np.asarray(basis.evaluate(sample_v(m), 0), dtype=float)  # (k, m, 3)
+        f = np.fft.rfft(pts, axis=1) / m
+        n = min(modes, m // 2 - 1)
+        k = pts.shape[0]
+        a, b = np.zeros((k, modes, 3)), np.zeros((k, modes, 3))
+        a[:, :n] = 2.0 * f[:, 1 : n + 1].real
+        b[:, :n] = -2.0 * f[:, 1 : n + 1].imag
+        top = m // 2 if m % 2 == 0 else m // 2 + 1  # as in _fourier_and_tail: the Nyquist term counts once
+        t = f[:, n + 1 : top].reshape(k, -1)
+        gram = 2.0 * (t.conj() @ t.T).real
+        if m % 2 == 0 and n < m // 2:
+            ny = f[:, m // 2].real  # (the Nyquist term of real samples is real)
+            gram += ny @ ny.T
+        hit = (np.ascontiguousarray(f[:, 0].real), a, b, gram)
+        for x in hit:
+            x.setflags(write=False)
+        memo[key] = hit
+    return hit
+
+
+def _basis_subset_residuals(basis, max_modes: int, m: int, n_fft: int) -> np.ndarray:
+    """``(k, max_modes + 1, 3, s)``: each curve of ``basis`` less its Fourier series (``n_fft``
+    samples' coefficients) truncated after ``N = 0 .. max_modes`` modes, at :func:`_subset_errors`'s
+    ``s`` samples, mm (read-only, once per basis): a combination's are the same combination of these."""
+    memo = basis_memo(basis)
+    key = ("subset_residuals", max_modes, m, n_fft)
+    hit = memo.get(key)
+    if hit is None:
+        a0, a, b, _ = basis_spectrum(basis, max_modes, n_fft)
+        pts = np.asarray(basis.evaluate(sample_v(m)[:: max(1, m // 256)], 0), dtype=float)  # (k, s, 3)
+        hit = np.stack([_partial_sums(p, c0, ca, cb, max_modes, m) for p, c0, ca, cb in zip(pts, a0, a, b)])
+        hit.setflags(write=False)
+        memo[key] = hit
+    return hit
+
+
 def _modes_needed(curve: CurveLike, tol: float, max_modes: int, m: int) -> int:
     limit = curve.band_limit() if isinstance(curve, Curve) else None
     if limit is not None and limit <= 1 and limit <= max_modes:
@@ -769,20 +825,36 @@ def _modes_needed(curve: CurveLike, tol: float, max_modes: int, m: int) -> int:
         amplitude = math.sqrt(max(0.5 * (aa + bb) + math.hypot(0.5 * (aa - bb), ab), 0.0))
         return 0 if amplitude <= tol else limit
     n_fft = max(4 * max_modes + 8, 1024)
-    if m % n_fft == 0 and fourier_tail(curve, max_modes, n_fft) > tol * (1.0 + 1e-6) + 1e-15:
+    comb = combination_of([curve]) if isinstance(curve, Curve) else None
+    if comb is not None:  # w · basis + const: the basis's spectrum and residuals, shared by its curves
+        basis, W, const = comb
+        w = W[0]
+        if not np.any(w):  # the constant point: its series is itself (the samples' errors are all 0)
+            return 0
+        a0B, aB, bB, gram = basis_spectrum(basis, max_modes, n_fft)
+        tail = math.sqrt(max(float(w @ gram @ w), 0.0))
+    else:
+        tail = fourier_tail(curve, max_modes, n_fft) if m % n_fft == 0 else 0.0
+    if m % n_fft == 0 and tail > tol * (1.0 + 1e-6) + 1e-15:
         # even max_modes leaves a root-mean-square error above tol at the FFT's samples, which are
         # among the m checked below: every N <= max_modes would fail there (the answer below, sooner)
         return max_modes + 1
-    a0, a, b = fourier_coefficients(curve, max_modes, samples=n_fft)
     # The error at a subset of the samples is a lower bound of the error at all of them:
     # every N failing on the subset fails, so the full scan starts at the subset's first pass.
     memo = _memo(curve)
     key = ("subset_errors", int(max_modes), m)
     errs = memo.get(key) if memo is not None else None
-    if errs is None:
-        errs = _subset_errors(curve, a0, a, b, max_modes, m)
-        if memo is not None:
-            memo[key] = errs
+    if comb is not None:
+        a0 = w @ a0B + const[0]
+        a, b = np.tensordot(w, aB, axes=1), np.tensordot(w, bB, axes=1)
+        if errs is None:
+            errs = _errors_of(np.tensordot(w, _basis_subset_residuals(basis, max_modes, m, n_fft), axes=1))
+    else:
+        a0, a, b = fourier_coefficients(curve, max_modes, samples=n_fft)
+        if errs is None:
+            errs = _subset_errors(curve, a0, a, b, max_modes, m)
+    if memo is not None:
+        memo[key] = errs
     passing = np.flatnonzero(errs <= tol)
     if not passing.size:
         return max_modes + 1
@@ -813,8 +885,14 @@ def _subset_errors(curve: CurveLike, a0, a, b, max_modes: int, m: int) -> np.nda
     """Largest distance (mm), over every ``(m // 256)``-th of ``m`` equally spaced samples, of the
     curve from its Fourier series truncated after ``N`` modes, for ``N = 0 .. max_modes``
     (one array, read-only: :func:`modes_needed` asks it once per curve for every tolerance)."""
+    pts = curve.evaluate(sample_v(m)[:: max(1, m // 256)])
+    return _errors_of(_partial_sums(pts, a0, a, b, max_modes, m))
+
+
+def _partial_sums(pts: np.ndarray, a0, a, b, max_modes: int, m: int) -> np.ndarray:
+    """``(max_modes + 1, 3, s)``: the Fourier series ``a0, a, b`` truncated after ``N = 0 .. max_modes``
+    modes less the curve's points ``pts`` (s, 3), at every ``(m // 256)``-th of ``m`` samples (mm)."""
     step = max(1, m // 256)
-    pts = curve.evaluate(sample_v(m)[::step])
     cos, sin = _trig_table(m, max_modes)
     # laid out (N, coordinate, sample): the running sum over the modes adds whole contiguous rows
     run = np.empty((max_modes + 1, 3, pts.shape[0]))
@@ -823,6 +901,11 @@ def _subset_errors(curve: CurveLike, a0, a, b, max_modes: int, m: int) -> np.nda
     for n in range(1, max_modes + 1):  # the partial sums a0 + modes 1..N, row by row (numpy's cumsum
         np.add(run[n], run[n - 1], out=run[n])  # along this axis runs element by element: 6x slower)
     run -= pts.T[None]
+    return run
+
+
+def _errors_of(run: np.ndarray) -> np.ndarray:
+    """Largest length over the samples of each ``N``'s residuals ``run`` (N, 3, s): (N,) mm, read-only."""
     errs = np.sqrt(np.max(run[:, 0] * run[:, 0] + run[:, 1] * run[:, 1] + run[:, 2] * run[:, 2], axis=1))
     errs.setflags(write=False)
     return errs

@@ -37,7 +37,8 @@ import numpy as np
 from tabletcad.geometry.basis import cardinal, cardinal_coefficients, cardinals
 from tabletcad.geometry.revolution import Revolution, Section, detect_revolution, detect_section
 from tabletcad.geometry.tables import CARDINAL, TRIG
-from tabletcad.geometry.curves import combination_of, evaluate_curves, fourier_coefficients, modes_needed, sample_v
+from tabletcad.geometry.curves import (basis_memo, basis_spectrum, combination_of, evaluate_curves, fourier_coefficients,
+                                      modes_needed, sample_v)
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
 from tabletcad.geometry.vectors import cross, cross_first, norm3
@@ -148,35 +149,19 @@ def _trig_shared(v: np.ndarray, n: np.ndarray, dv: int, rows: bool = False):
     return TRIG.get((rows, dv, n.tobytes(), v.tobytes()), lambda: make(v, n, dv))
 
 
-def _basis_memo(basis) -> dict:
-    """The results kept on a shared curve basis (:func:`~tabletcad.geometry.curves.combination_of`):
-    they live as long as it does (the outline that owns it)."""
-    memo = basis.__dict__.get("_pde_memo")
-    if memo is None:
-        memo = {}
-        basis.__dict__["_pde_memo"] = memo
-    return memo
-
-
 def _basis_fourier(basis, N: int, samples: int) -> tuple[np.ndarray, ...]:
     """``(a0, a, b, rows)`` of the ``k`` curves of ``basis`` by FFT of ``samples`` samples: ``(k, 3)``,
     ``(k, N, 3)``, ``(k, N, 3)`` mm and the cosine and sine coefficients as rows ``(N, 3k)`` each,
     stacked ``(2, N, 3k)`` (read-only; once per basis, modes and samples)."""
-    memo = _basis_memo(basis)
+    memo = basis_memo(basis)
     key = ("fourier", N, samples)
     hit = memo.get(key)
     if hit is None:
-        pts = np.asarray(basis.evaluate(sample_v(samples), 0), dtype=float)  # (k, m, 3)
-        f = np.fft.rfft(pts, axis=1) / samples
-        n = min(N, samples // 2 - 1)
-        k = pts.shape[0]
-        a, b = np.zeros((k, N, 3)), np.zeros((k, N, 3))
-        a[:, :n] = 2.0 * f[:, 1 : n + 1].real
-        b[:, :n] = -2.0 * f[:, 1 : n + 1].imag
+        a0, a, b, _ = basis_spectrum(basis, N, samples)
+        k = a.shape[0]
         rows = np.stack([a.transpose(1, 0, 2).reshape(N, 3 * k), b.transpose(1, 0, 2).reshape(N, 3 * k)])
-        hit = (np.ascontiguousarray(f[:, 0].real), a, b, rows)
-        for x in hit:
-            x.setflags(write=False)
+        rows.setflags(write=False)
+        hit = (a0, a, b, rows)
         memo[key] = hit
     return hit
 
@@ -204,7 +189,7 @@ def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: 
 
     if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
         return make()
-    memo = _basis_memo(basis)
+    memo = basis_memo(basis)
     key = ("res", N, samples, None if active is None else active.tobytes(), dv, v.tobytes())
     hit = memo.get(key)
     if hit is None:
