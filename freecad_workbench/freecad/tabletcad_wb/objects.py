@@ -530,9 +530,9 @@ class PunchProxy(_Proxy):
         """The punch tip's shape (:func:`geometry.punch_shape`), cut again only when what it is made of
         changed: the tablet's solid and rims, ``Which``, ``Length`` or ``Clearance``.
 
-        A recompute of the punch for anything else (its ``Gap``, the tablet's ``Density``, ``Label`` or
-        ``Placement``, each of which recomputes the linked tools) had cut the tip from the tablet again:
-        a capsule's two tips, 0.3-0.6 s each.  ``cuts`` counts the cuts made (this session).
+        A recompute of the punch for anything else (its ``Gap``; the tablet's ``Density``, whose recompute
+        recomputes the linked tools) had cut the tip from the tablet again.  ``cuts`` counts the cuts made
+        (this session; tests/test_freecad_workbench.py checks both cases).
 
         Parameters
         ----------
