@@ -138,7 +138,41 @@ def open_client(workers: int | None = None, scheduler: str | None = None,
         if inherited is not None:
             os.environ["MALLOC_TRIM_THRESHOLD_"] = inherited
     with cluster, Client(cluster, set_as_default=False) as client:
-        yield client
+        try:
+            yield client
+        except BaseException:  # a Ctrl-C, or an error: the workers' tasks are not waited for
+            _stop_workers(cluster)
+            raise
+
+
+WORKER_STOP_GRACE_S = 0.5
+"""Seconds a local worker is given to stop when its run ends by an exception (a Ctrl-C) before it is terminated."""
+
+
+def _stop_workers(cluster: Any, grace: float = WORKER_STOP_GRACE_S) -> None:
+    """Stop the worker processes of a local ``cluster`` within about ``grace`` seconds each, their running
+    tasks abandoned.
+
+    Dask's own closing of the cluster gives each worker 4 s to finish the task it is running before
+    terminating it: a Ctrl-C during a sweep's file builds (or its first task's imports of OpenCascade)
+    waited 2-4 s for results nobody would read.  Closed here, the cluster's closing then finds them
+    gone; whatever fails here is left to it.
+
+    Parameters
+    ----------
+    cluster : distributed.LocalCluster
+        The cluster :func:`open_client` started.
+    grace : float
+        Seconds each worker has to stop by itself before its nanny terminates it.
+    """
+    import asyncio
+
+    async def stop() -> None:
+        await asyncio.gather(*(w.close(timeout=grace, reason="tabletcad-run-ended")
+                               for w in list(cluster.workers.values())), return_exceptions=True)
+
+    with contextlib.suppress(Exception):
+        cluster.sync(stop)
 
 
 def map_tasks(func: Callable[..., Any], items: Sequence[Any], *, kwargs: dict[str, Any] | None = None,

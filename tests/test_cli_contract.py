@@ -688,9 +688,10 @@ def test_a_ctrl_c_stops_a_long_compiled_call_at_once():
 def test_solves_in_the_helper_thread_leave_no_memory_behind():
     """The FE solve runs in ``run_interruptibly``'s helper thread with its factors made and freed there:
     SuperLU's factors made in one thread and freed in another leaked about 16 MB a solve (a whole test
-    run's FE solves then left a worker too big to fork).  100 solves of a 2000-unknown symmetric positive
+    run's FE solves then left a worker too big to fork).  25 solves of a 2000-unknown symmetric positive
     definite system by each solver (CHOLMOD, the one used, and SuperLU, its fallback): the resident memory
-    grows by far less than the 1.5 GB they had leaked."""
+    grows by less than 200 MB, where a leak of 16 MB a solve grows it by 400 MB (any leak of 8 MB a solve or
+    more fails; 100 solves a solver took four times as long and fail on no leak of that size more)."""
     import numpy as np
     import scipy.sparse as sp
 
@@ -708,7 +709,7 @@ def test_solves_in_the_helper_thread_leave_no_memory_behind():
         x = run_interruptibly(solve, K, b)
         assert np.allclose(K @ x, b, atol=1e-10)
         before = rss_mb()
-        for _ in range(100):
+        for _ in range(25):
             run_interruptibly(solve, K, b)
         assert rss_mb() - before < 200.0
 

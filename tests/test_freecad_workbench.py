@@ -443,6 +443,8 @@ def test_density_change_rescales_weight_without_rebuilding(headless):
     assert t["weight_mg"] == pytest.approx(st["w0"] / 2, rel=1e-12)
     assert t["weight_mg"] == pytest.approx(t["core_volume"] * 0.6, rel=1e-12)
     assert st["builds"] == [1, 1]  # the capsule's solid was built once, on creation
+    # and its punches' tips were not cut again (each recompute of the tablet recomputes its tools)
+    assert st["tips"] == 2 and st["cuts"][1] == st["cuts"][0] and min(st["cuts"][0]) >= 1, st["cuts"]
 
 
 def test_task_panel_form(headless):
@@ -496,8 +498,10 @@ def test_techdraw_page_with_main_dimensions(headless):
 
 
 def test_punch_gap_lifts_the_punch(headless):
+    """The Gap moves the tip without cutting it from the tablet again."""
     (step,) = _steps(headless, "gap")
     assert step["dz"] == pytest.approx(2.0, abs=1e-9) and step["upper"]["valid"]
+    assert step["cuts"][1] == step["cuts"][0] >= 1, step["cuts"]
 
 
 def test_a_nan_or_negative_gap_is_refused_and_a_scripts_tracebacks_stay_whole(headless):
@@ -765,6 +769,13 @@ def _start_xvfb():
     return proc, f":{display}"
 
 
+@pytest.fixture(scope="module")
+def assembly_step(tmp_path_factory) -> Path:
+    """The tooling assembly STEP of a shallow convex round tablet (tabletcad's own writer), made once for both
+    FreeCADs' GUI tests (which only read it)."""
+    return _assembly_step(tmp_path_factory.mktemp("assembly"))
+
+
 def _assembly_step(tmp_path: Path) -> Path:
     """The tooling assembly STEP of a shallow convex round tablet (tabletcad's own writer)."""
     pytest.importorskip("OCP")
@@ -777,7 +788,7 @@ def _assembly_step(tmp_path: Path) -> Path:
     return write_assembly(ts.parts, tmp_path / "assembly.step", name="tooling")
 
 
-def test_gui_smoke_and_screenshot(fc, fc_home, tmp_path):
+def test_gui_smoke_and_screenshot(fc, fc_home, assembly_step, tmp_path):
     if fc.gui is None:
         pytest.skip(f"FreeCAD {fc.version} GUI not installed")
     ARTIFACTS.mkdir(exist_ok=True)
@@ -792,7 +803,7 @@ def test_gui_smoke_and_screenshot(fc, fc_home, tmp_path):
         "TABLETCAD_FC_SHOT": str(shot),
         "TABLETCAD_FC_WINDOW": str(window),
         "TABLETCAD_FC_PANEL": str(panel),
-        "TABLETCAD_FC_ASSEMBLY": str(_assembly_step(tmp_path)),
+        "TABLETCAD_FC_ASSEMBLY": str(assembly_step),
     }
     if display:
         extra.update(DISPLAY=display, TABLETCAD_FC_SAVEIMAGE="1")

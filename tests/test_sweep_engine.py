@@ -73,9 +73,10 @@ def scheduler_address(tmp_path_factory):
             c.wait_for_workers(1, timeout=120)
         yield addr
     finally:
+        # the worker first, then its scheduler: a worker stopped with its scheduler gone waits for it until
+        # its nanny kills it (8 s: "Worker process still alive after 8.0 seconds, killing")
         for p in reversed(procs):
             p.terminate()
-        for p in reversed(procs):
             try:
                 p.wait(timeout=30)
             except subprocess.TimeoutExpired:

@@ -20,7 +20,9 @@ root = os.environ["TABLETCAD_ROOT"]
 result = {"ok": False, "steps": []}
 
 
-def shape_info(o):
+def shape_info(o, tight=False):
+    """The shape's checks; ``tight``: its box from the geometry too (``optimalBoundingBox``, exact and
+    slow on B-splines: a quarter of this script's time when taken for every shape)."""
     s = o.Shape
     return {
         "valid_obj": bool(o.isValid()),
@@ -41,7 +43,7 @@ def shape_info(o):
         else None,
         # from the geometry, not the poles (BoundBox holds a trimmed B-spline's whole control net)
         "tight_bbox": (lambda b: [b.XMin, b.YMin, b.ZMin, b.XMax, b.YMax, b.ZMax])(s.optimalBoundingBox(False))
-        if not s.isNull()
+        if tight and not s.isNull()
         else None,
     }
 
@@ -53,8 +55,8 @@ def _prop_value(o, p):
     return v if isinstance(v, (int, float, str)) else str(v)
 
 
-def tablet_info(t):
-    d = shape_info(t)
+def tablet_info(t, tight=False):
+    d = shape_info(t, tight)
     d.update(
         family=t.Family,
         core_volume=float(t.Volume),
@@ -117,7 +119,7 @@ try:
     for fam, params in families.items():
         t0 = time.perf_counter()
         tabs[fam] = make_tablet(doc, fam, **params)
-        step("create", family=fam, wall_s=time.perf_counter() - t0, tablet=tablet_info(tabs[fam]))
+        step("create", family=fam, wall_s=time.perf_counter() - t0, tablet=tablet_info(tabs[fam], tight=True))
 
     # ---- tooling of three tablets (round with cups, the hollow ring, a capsule)
     tooling = {}
@@ -132,7 +134,7 @@ try:
             "tooling",
             family=fam,
             wall_s=time.perf_counter() - t0,
-            upper=shape_info(up),
+            upper=shape_info(up, tight=True),
             lower=shape_info(low),
             die=shape_info(die),
             links=[o.Tablet.Name for o in (up, low, die)],
@@ -221,10 +223,10 @@ try:
     doc.recompute()
 
     # ---- exploded view: Gap lifts the punch off the tablet
-    z0 = up.Shape.BoundBox.ZMin
+    z0, cuts0 = up.Shape.BoundBox.ZMin, up.Proxy.cuts
     up.Gap = 2.0
     doc.recompute()
-    step("gap", dz=up.Shape.BoundBox.ZMin - z0, upper=shape_info(up))
+    step("gap", dz=up.Shape.BoundBox.ZMin - z0, upper=shape_info(up), cuts=[cuts0, up.Proxy.cuts])
     up.Gap = 0.0
     doc.recompute()
 
@@ -408,10 +410,13 @@ try:
     # ---- unchanged geometry is not rebuilt: Density only rescales the weight
     c = tabs["capsule"]
     w0, n0 = float(c.Weight), c.Proxy.builds
+    ctips = [o for o in c.InList if getattr(getattr(o, "Proxy", None), "Type", "") == "TabletcadPunch"]
+    cuts0 = [o.Proxy.cuts for o in ctips]
     c.Density = 0.6
     t0 = time.perf_counter()
     doc.recompute()
-    step("density", wall_s=time.perf_counter() - t0, w0=w0, builds=[n0, c.Proxy.builds], tablet=tablet_info(c))
+    step("density", wall_s=time.perf_counter() - t0, w0=w0, builds=[n0, c.Proxy.builds], tablet=tablet_info(c),
+         tips=len(ctips), cuts=[cuts0, [o.Proxy.cuts for o in ctips]])
 
     # ---- TechDraw page: views and the main dimensions
     from freecad.tabletcad_wb.techdraw import make_page
@@ -471,7 +476,7 @@ try:
         label=d2.Label,
         design_file=d2.DesignFile,
         die=shape_info(d2die),
-        upper=shape_info(d2up),
+        upper=shape_info(d2up, tight=True),
     )
 
     # ---- the free-form stadium's flat top lies on its rim's plane: its tip is the prism alone, made
@@ -520,7 +525,7 @@ try:
         old_document=dict(
             punch_clearance=old_clearance,
             die_properties=list(doc.getObject(old_names[1]).PropertiesList),
-            upper=shape_info(doc.getObject(old_names[0])),
+            upper=shape_info(doc.getObject(old_names[0]), tight=True),
         ),
     )
     doc.save()

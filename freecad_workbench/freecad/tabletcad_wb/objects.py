@@ -513,9 +513,7 @@ class PunchProxy(_Proxy):
 
     def build(self, obj):
         tab = _tablet_of(obj)
-        rims = geometry.rims_from_json(tab.RimData)
-        shape = geometry.punch_shape(_local_shape(tab), rims, obj.Which, float(obj.Length.Value),
-                                     float(obj.Clearance.Value))
+        shape = self._tip(obj, tab)
         gap = float(obj.Gap.Value)
         if not 0.0 <= gap <= MAX_GAP_MM:  # (a NaN gap had placed the punch at NaN; a negative one pushed it into the tablet)
             from tabletcad.errors import DesignError
@@ -527,6 +525,36 @@ class PunchProxy(_Proxy):
         obj.Shape = shape
         obj.Placement = tab.Placement.multiply(lift)  # the shape's own placement is the object's
         obj.Volume = float(shape.Volume)
+
+    def _tip(self, obj, tab):
+        """The punch tip's shape (:func:`geometry.punch_shape`), cut again only when what it is made of
+        changed: the tablet's solid and rims, ``Which``, ``Length`` or ``Clearance``.
+
+        A recompute of the punch for anything else (its ``Gap``; the tablet's ``Density``, whose recompute
+        recomputes the linked tools) had cut the tip from the tablet again.  ``cuts`` counts the cuts made
+        (this session; tests/test_freecad_workbench.py checks both cases).
+
+        Parameters
+        ----------
+        obj : App.FeaturePython
+            The punch.
+        tab : App.FeaturePython
+            Its tablet (:func:`_tablet_of`).
+
+        Returns
+        -------
+        Part.Shape
+            The tip, in the tablet's own frame.
+        """
+        key = (tab.RimData, obj.Which, float(obj.Length.Value), float(obj.Clearance.Value))
+        made = getattr(self, "_made", None)
+        if made is not None and made[0] == key and made[1].isPartner(tab.Shape):  # (same solid, wherever placed)
+            return made[2]
+        shape = geometry.punch_shape(_local_shape(tab), geometry.rims_from_json(tab.RimData), obj.Which,
+                                     float(obj.Length.Value), float(obj.Clearance.Value))
+        self._made = (key, tab.Shape, shape)
+        self.cuts = getattr(self, "cuts", 0) + 1
+        return shape
 
 
 class DieProxy(_Proxy):
