@@ -822,7 +822,9 @@ def inside_bore(tablet, die, bore) -> bool:
     block, (z0, z1) = _block(tablet, BLOCK_MARGIN_MM)
     column = prism(bore, z0 - 1.0, z1 + 1.0)
     outside = raw_boolean("cut", block, column)
-    return volume(raw_boolean("common", tablet, outside)) == 0.0 and volume(raw_boolean("common", die, column)) == 0.0
+    if volume(raw_boolean("common", tablet, outside)) != 0.0:
+        return False
+    return volume(raw_boolean("common", die, column)) == 0.0
 
 
 def _block(shape, margin: float):
