@@ -183,3 +183,24 @@ def test_the_bore_proof_holds_only_where_the_tablet_stays_in_the_bore():
         (plain,) = _overlaps(tablet, {"die": die}, 0.005)  # without the bore: the Common with the die alone
         assert pair["occ_method"] != BORE_PROOF
         assert pair["occ_mm3"] == plain["occ_mm3"] > least  # the crescent, the ring or the bump in the die wall
+
+
+def test_a_failing_column_boolean_proves_nothing(monkeypatch):
+    """A Boolean of :func:`~tabletcad.tooling.interference.inside_bore` that fails (``GeometryError``)
+    is no proof and no error: the overlap check falls back on the tablet's Common with the die."""
+    import tabletcad.tooling.interference as I
+    from tabletcad.errors import GeometryError
+    from tabletcad.tooling.outline import circle_wire
+
+    die, tablet = _round_die(5.0, 1.0), _round_tablet(5.0)
+    plain = I.raw_boolean
+
+    def failing_cut(op, a, b, **kw):
+        if op == "cut":
+            raise GeometryError("a test's failing Boolean", (a, b))
+        return plain(op, a, b, **kw)
+
+    monkeypatch.setattr(I, "raw_boolean", failing_cut)
+    assert not I.inside_bore(tablet, die, circle_wire(5.0))
+    (pair,) = I._overlaps(tablet, {"die": die}, 0.005, circle_wire(5.0))
+    assert pair["occ_method"] != I.BORE_PROOF and pair["occ_mm3"] == 0.0

@@ -814,17 +814,20 @@ def inside_bore(tablet, die, bore) -> bool:
     Returns
     -------
     bool
-        True when both Commons have volume 0 mm^3 (then the overlap is 0); False otherwise, and then
-        nothing is proved: the tablet's Common with the die itself decides.
+        True when both Commons have volume 0 mm^3 (then the overlap is 0); False otherwise (a Boolean
+        that fails included), and then nothing is proved: the tablet's Common with the die itself decides.
     """
     from tabletcad.tooling.outline import prism
 
     block, (z0, z1) = _block(tablet, BLOCK_MARGIN_MM)
-    column = prism(bore, z0 - 1.0, z1 + 1.0)
-    outside = raw_boolean("cut", block, column)
-    if volume(raw_boolean("common", tablet, outside)) != 0.0:
+    try:
+        column = prism(bore, z0 - 1.0, z1 + 1.0)
+        outside = raw_boolean("cut", block, column)
+        if volume(raw_boolean("common", tablet, outside)) != 0.0:
+            return False
+        return volume(raw_boolean("common", die, column)) == 0.0
+    except GeometryError:  # a Boolean that fails proves nothing
         return False
-    return volume(raw_boolean("common", die, column)) == 0.0
 
 
 def _block(shape, margin: float):
