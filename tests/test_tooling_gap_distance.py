@@ -16,6 +16,19 @@ from tabletcad.tooling.interference import mesh_distance  # noqa: E402
 pytestmark = pytest.mark.cad
 
 
+@pytest.fixture(scope="module")
+def bisect_tablet():
+    """The finished tablet (scored, debossed) of ``samples/tooling/concave_round_bisect.toml``, built once
+    for the tests that read its faces (read-only)."""
+    from pathlib import Path
+
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.toolset import make_tooling
+
+    d = Design.from_toml(Path(__file__).resolve().parents[1] / "samples" / "tooling" / "concave_round_bisect.toml")
+    return make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False).parts["tablet"]
+
+
 def _brute_force(P: np.ndarray, V: np.ndarray, T: np.ndarray) -> np.ndarray:
     tri = V[T]  # (m, 3, 3)
     out = np.empty(len(P))
@@ -252,19 +265,14 @@ def test_faces_that_fill_their_box_keep_the_same_samples_unclassified(monkeypatc
     assert np.all(np.hypot(P[:, 0] - 2.0, P[:, 1] - 2.0) >= 0.5 - 1e-9)  # no sample inside the hole
 
 
-def test_trimmed_faces_classified_by_their_polygons_keep_the_classifier_samples(monkeypatch):
+def test_trimmed_faces_classified_by_their_polygons_keep_the_classifier_samples(monkeypatch, bisect_tablet):
     """``face_samples`` of trimmed faces decides points away from the wires by the even-odd rule on
     the wires' (u, v) polygons and asks ``BRepTopAdaptor_FClass2d`` only near them: on a debossed,
     scored tablet (letter floors and walls, a cup with holes, a periodic cup cut by a score) the
     samples are the classifier's to the last bit; a polygon with its parity flipped fails it."""
-    from pathlib import Path
-
     import tabletcad.tooling.interference as I
-    from tabletcad.pipeline.design import Design
-    from tabletcad.tooling.toolset import make_tooling
 
-    d = Design.from_toml(Path(__file__).resolve().parents[1] / "samples" / "tooling" / "concave_round_bisect.toml")
-    shape = make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False).parts["tablet"]
+    shape = bisect_tablet
     fast = I.face_samples(shape, spacing=0.02)
     polygons = I._polygon_classes
     asked = []
@@ -285,13 +293,11 @@ def test_trimmed_faces_classified_by_their_polygons_keep_the_classifier_samples(
     assert not np.array_equal(I.face_samples(shape, spacing=0.02), slow)
 
 
-def test_grid_points_on_straight_boundary_sides_are_the_classifiers_on_points():
+def test_grid_points_on_straight_boundary_sides_are_the_classifiers_on_points(bisect_tablet):
     """``_on_straight_sides`` marks grid points that lie on an edge running along a side of the face's
     (u, v) box (the lettered cup's rim and seam, B-spline p-curves after the Boolean): every one is
     ON (or IN) by ``BRepTopAdaptor_FClass2d``, there are over a thousand of them on the sample, and a
     point one step inside the box is never marked."""
-    from pathlib import Path
-
     from OCP.BRepTools import BRepTools
     from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
     from OCP.gp import gp_Pnt2d
@@ -299,13 +305,9 @@ def test_grid_points_on_straight_boundary_sides_are_the_classifiers_on_points():
 
     import tabletcad.tooling.interference as I
     from tabletcad.cad._occ import explore
-    from tabletcad.pipeline.design import Design
-    from tabletcad.tooling.toolset import make_tooling
 
-    d = Design.from_toml(Path(__file__).resolve().parents[1] / "samples" / "tooling" / "concave_round_bisect.toml")
-    shape = make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False).parts["tablet"]
     marked = 0
-    for face in explore(shape, "Face"):
+    for face in explore(bisect_tablet, "Face"):
         u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
         us, vs = np.linspace(u0, u1, 61), np.linspace(v0, v1, 41)
         on = I._on_straight_sides(face, us, vs)

@@ -122,3 +122,85 @@ def test_largest_gap_agrees_with_an_independent_dense_sampling():
     assert sampled <= gap + res  # points of the tablet's B-rep, measured exactly
     assert gap <= 0.0175 + 1e-9  # a real distance of a surface point: not above the land's peak
     assert sampled == pytest.approx(0.0175, abs=1e-4)  # the land's peak, clearance / 2, found by the sampling
+
+
+def _round_die(bore_radius: float, taper_deg: float):
+    """A die on the z axis with a round bore of ``bore_radius`` (mm) from z = -5 to 3 and tapered by
+    ``taper_deg`` above, to its top at z = 6 (as :func:`tabletcad.tooling.die.die` builds one)."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+
+    from tabletcad.tooling.booleans import boolean
+    from tabletcad.tooling.die import tapered_prism
+    from tabletcad.tooling.outline import circle_wire, prism
+
+    blank = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, -5), gp_Dir(0, 0, 1)), 12.0, 11.0).Shape()
+    bore = circle_wire(bore_radius)
+    shape = boolean("cut", blank, prism(bore, -6.0, 3.0))
+    return boolean("cut", shape, tapered_prism(bore, 3.0, 7.0, taper_deg))
+
+
+def _round_tablet(radius: float, dx: float = 0.0):
+    """A flat round "tablet" of ``radius`` (mm), z from 0 to 3 (its top edge where the taper starts), moved by ``dx``."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+
+    return BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(dx, 0, 0), gp_Dir(0, 0, 1)), radius, 3.0).Shape()
+
+
+def _bumped_tablet():
+    """The round tablet of radius 5 mm with a 0.4 x 0.4 x 1 mm bump standing 0.1 mm out of its band at
+    ``x = 5``: its overlap with the die lies at the tablet's extreme, at the edge of its bounding box."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.gp import gp_Pnt
+
+    from tabletcad.tooling.booleans import boolean
+
+    bump = BRepPrimAPI_MakeBox(gp_Pnt(4.9, -0.2, 1.0), gp_Pnt(5.1, 0.2, 2.0)).Shape()
+    return boolean("fuse", _round_tablet(5.0), bump)
+
+
+def test_the_bore_proof_holds_only_where_the_tablet_stays_in_the_bore():
+    """:func:`~tabletcad.tooling.interference.inside_bore` proves a zero overlap only when both of its
+    Commons are empty: a tablet touching the bore wall up to the taper passes; moved 0.05 mm into the
+    wall it fails; and a bore wire wider than the die's real bore (so that the tablet's Common with the
+    column's outside is empty though the tablet cuts 0.05 mm into the die) fails on the die's Common
+    with the column; a bump standing 0.1 mm out of the band fails.  Where it fails, the overlap check
+    falls back on the tablet's Common with the die and reports the overlap."""
+    from tabletcad.tooling.interference import BORE_PROOF, _overlaps, inside_bore
+    from tabletcad.tooling.outline import circle_wire
+
+    die = _round_die(5.0, 1.0)
+    assert inside_bore(_round_tablet(5.0), die, circle_wire(5.0))
+    assert not inside_bore(_round_tablet(5.0, dx=0.05), die, circle_wire(5.0))
+    assert not inside_bore(_round_tablet(5.05), die, circle_wire(5.1))
+    assert not inside_bore(_bumped_tablet(), die, circle_wire(5.0))
+    (touching,) = _overlaps(_round_tablet(5.0), {"die": die}, 0.005, circle_wire(5.0))
+    assert touching["occ_mm3"] == 0.0 and touching["occ_method"] == BORE_PROOF
+    for tablet, bore, least in ((_round_tablet(5.0, dx=0.05), circle_wire(5.0), 0.1),
+                                (_round_tablet(5.05), circle_wire(5.1), 0.1), (_bumped_tablet(), circle_wire(5.0), 0.01)):
+        (pair,) = _overlaps(tablet, {"die": die}, 0.005, bore)
+        (plain,) = _overlaps(tablet, {"die": die}, 0.005)  # without the bore: the Common with the die alone
+        assert pair["occ_method"] != BORE_PROOF
+        assert pair["occ_mm3"] == plain["occ_mm3"] > least  # the crescent, the ring or the bump in the die wall
+
+
+def test_a_failing_column_boolean_proves_nothing(monkeypatch):
+    """A Boolean of :func:`~tabletcad.tooling.interference.inside_bore` that fails (``GeometryError``)
+    is no proof and no error: the overlap check falls back on the tablet's Common with the die."""
+    import tabletcad.tooling.interference as I
+    from tabletcad.errors import GeometryError
+    from tabletcad.tooling.outline import circle_wire
+
+    die, tablet = _round_die(5.0, 1.0), _round_tablet(5.0)
+    plain = I.raw_boolean
+
+    def failing_cut(op, a, b, **kw):
+        if op == "cut":
+            raise GeometryError("a test's failing Boolean", (a, b))
+        return plain(op, a, b, **kw)
+
+    monkeypatch.setattr(I, "raw_boolean", failing_cut)
+    assert not I.inside_bore(tablet, die, circle_wire(5.0))
+    (pair,) = I._overlaps(tablet, {"die": die}, 0.005, circle_wire(5.0))
+    assert pair["occ_method"] != I.BORE_PROOF and pair["occ_mm3"] == 0.0

@@ -25,7 +25,7 @@ from tabletcad.tooling.booleans import boolean, translated, volume
 from tabletcad.tooling.outline import TabletFrame, offset_wire, plan_face, prism
 from tabletcad.tooling.spec import MIN_DIE_WALL_MM, standard_die_size
 
-__all__ = ["die", "default_die_size", "tapered_prism", "MIN_WALL_MM"]
+__all__ = ["die", "default_die_size", "tapered_prism", "bore_wire", "MIN_WALL_MM"]
 
 MIN_WALL_MM = MIN_DIE_WALL_MM  # the die's thinnest wall around the bore (mm)
 
@@ -67,6 +67,24 @@ def tapered_prism(wire, z0: float, z1: float, taper_deg: float):
     return shape
 
 
+def bore_wire(frame: TabletFrame):
+    """The die bore's plan wire at ``z = 0``: its narrowest section, which the taper only widens.
+
+    Parameters
+    ----------
+    frame : TabletFrame
+        The tablet's frame (:func:`~tabletcad.tooling.outline.tablet_frame`).
+
+    Returns
+    -------
+    TopoDS_Wire
+        The tablet's outline, offset outward by :attr:`~tabletcad.tooling.outline.TabletFrame.bore_offset`
+        (mm) where the band bulges; the outline itself where the band is a prism.
+    """
+    bulge = frame.bore_offset
+    return offset_wire(frame.outline, bulge) if bulge > 0 else frame.outline
+
+
 def default_die_size(frame: TabletFrame) -> tuple[float, float, str]:
     """``(outer diameter, height, TSM type)`` for the tablet's largest plan dimension."""
     return standard_die_size(max(frame.length, frame.width), shaped=frame.outline_kind != "circle")
@@ -90,7 +108,7 @@ def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, 
     od = outer_diameter if outer_diameter is not None else od0
     H = height if height is not None else h0
     bulge = frame.bore_offset
-    bore = offset_wire(frame.outline, bulge) if bulge > 0 else frame.outline
+    bore = bore_wire(frame)
     r_bore = _max_radius(bore)
     if od / 2.0 - r_bore < MIN_WALL_MM - 1e-9:  # (the sampled bore's round-off is no wall)
         raise DesignError("[tooling] die_outer_diameter_mm", od,

@@ -327,13 +327,14 @@ def check_closed_position(ts: ToolSet, *, deflection: float = DEFLECTION_MM, for
     by a forked process beside the overlaps (the command line's build, see
     :func:`tabletcad.tooling.interference.interference`).
     """
+    from tabletcad.tooling.die import bore_wire
     from tabletcad.tooling.interference import interference
 
     t0 = time.perf_counter()
     b0 = dict(TIMER)
     parts = ts.parts
     res = interference(parts["tablet"], {k: v for k, v in parts.items() if k != "tablet"}, ts.spec.clearance_mm,
-                       deflection=deflection, tablet_model=ts.tablet, forked=forked)
+                       deflection=deflection, tablet_model=ts.tablet, forked=forked, bore=bore_wire(ts.frame))
     report = ts.report
     seconds = report.pop("seconds")  # kept last, as the sum of the steps
     report.update(interference_mm3=res["interference_mm3"], max_gap_mm=res["max_gap_mm"], interference=res)
