@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import array_shapes, arrays
 
 from tabletcad.geometry.tables import CARDINAL, SharedTables
-from tabletcad.geometry.vectors import cross, norm3
+from tabletcad.geometry.vectors import cross, length2, norm3
 
 
 def test_least_recently_used_goes_first_and_results_are_read_only():
@@ -80,3 +80,13 @@ def test_cross_equals_numpy_cross(a, b, data):
 def test_norm3_equals_numpy_norm(a):
     """The core's lengths of 3-vectors are numpy's, to the last bit (the same squares in the same order)."""
     np.testing.assert_array_equal(norm3(a), np.linalg.norm(a, axis=-1))
+
+
+@settings(max_examples=80, deadline=None)
+@given(xy=arrays(np.float64, st.tuples(st.integers(1, 50), st.just(2)),
+                 elements=st.just(0.0) | st.floats(1e-9, 1e4) | st.floats(-1e4, -1e-9)))
+def test_length2_is_hypot_within_two_ulp(xy):
+    """Plan distances (mm; coordinates 0 or from 1 pm to 10 m, far from under- and overflow) by
+    ``sqrt(x² + y²)``: within two ulp of ``np.hypot``."""
+    got, want = length2(xy[:, 0], xy[:, 1]), np.hypot(xy[:, 0], xy[:, 1])
+    assert np.all(np.abs(got - want) <= 2.0 * np.spacing(want))

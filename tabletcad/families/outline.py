@@ -30,6 +30,7 @@ from tabletcad.geometry.curves import Seg, nearest_of, signed_area
 from tabletcad.errors import DesignError, check_finite, check_positive, check_range, format_bound
 from tabletcad.tolerance import DEFAULT
 from tabletcad.geometry.quadrature import gauss_legendre
+from tabletcad.geometry.vectors import length2
 
 __all__ = [
     "Seg",
@@ -673,19 +674,19 @@ def _signed_to_segment(s, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         dx, dy = bx - ax, by - ay
         t = np.clip(((px - ax) * dx + (py - ay) * dy) / (dx * dx + dy * dy), 0.0, 1.0)
         qx, qy = px - (ax + t * dx), py - (ay + t * dy)
-        return np.hypot(qx, qy), np.where(qx * -dy + qy * dx >= 0.0, 1.0, -1.0)
+        return length2(qx, qy), np.where(qx * -dy + qy * dx >= 0.0, 1.0, -1.0)
 
     def side(x0: float, y0: float, t) -> np.ndarray:  # +1 left of the direction t through (x0, y0)
         return np.where((px - x0) * -t[1] + (py - y0) * t[0] >= 0.0, 1.0, -1.0)
 
     rx, ry = px - s.center[0], py - s.center[1]
-    rho = np.hypot(rx, ry)
+    rho = length2(rx, ry)
     inside_arc = s.within_sweep(rx, ry, rho)
     d_arc = np.abs(rho - s.radius)
     # inward normal of a convex (ccw) arc points to the centre
     sg_arc = np.where((s.radius - rho) * math.copysign(1.0, s.sweep) >= 0.0, 1.0, -1.0)
-    e0 = np.hypot(px - s.p0[0], py - s.p0[1])
-    e1 = np.hypot(px - s.p1[0], py - s.p1[1])
+    e0 = length2(px - s.p0[0], py - s.p0[1])
+    e1 = length2(px - s.p1[0], py - s.p1[1])
     dist = np.where(inside_arc, d_arc, np.minimum(e0, e1))
     sg = np.where(inside_arc, sg_arc, np.where(e0 <= e1, side(*s.p0, s.tangent(0)), side(*s.p1, s.tangent(1))))
     return dist, sg

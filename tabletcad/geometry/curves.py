@@ -26,6 +26,7 @@ import numpy as np
 
 from tabletcad.errors import DesignError, check_finite, check_positive, check_range, format_bound
 from tabletcad.tolerance import DEFAULT
+from tabletcad.geometry.vectors import length2
 
 __all__ = [
     "Seg",
@@ -314,12 +315,12 @@ class Seg:
             d = np.subtract(self.p1, self.p0)
             t = np.clip(((q - a) @ d) / float(d @ d), 0.0, 1.0)
             r = q - (a + t[:, None] * d)
-            return np.hypot(r[:, 0], r[:, 1])
+            return length2(r[:, 0], r[:, 1])
         rx, ry = q[:, 0] - self.center[0], q[:, 1] - self.center[1]
-        rho = np.hypot(rx, ry)
+        rho = length2(rx, ry)
         on = self.within_sweep(rx, ry, rho)
         (x0, y0), (x1, y1) = self.point(0.0), self.point(1.0)
-        ends = np.minimum(np.hypot(q[:, 0] - x0, q[:, 1] - y0), np.hypot(q[:, 0] - x1, q[:, 1] - y1))
+        ends = np.minimum(length2(q[:, 0] - x0, q[:, 1] - y0), length2(q[:, 0] - x1, q[:, 1] - y1))
         return np.where(on, np.abs(rho - self.radius), ends)
 
     def bounding_circle(self) -> tuple[float, float, float]:

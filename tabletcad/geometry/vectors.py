@@ -45,3 +45,9 @@ def norm3(a: np.ndarray) -> np.ndarray:
     a = np.asarray(a, dtype=float)
     x, y, z = a[..., 0], a[..., 1], a[..., 2]
     return np.sqrt(x * x + y * y + z * z)
+
+
+def length2(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``sqrt(x² + y²)`` elementwise (mm): ``np.hypot`` without its care for over- and underflow (a tablet's
+    lengths in mm are far from both), several times cheaper, within two ulp of it (tested)."""
+    return np.sqrt(x * x + y * y)
