@@ -23,7 +23,8 @@ from typing import Any
 import numpy as np
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
 from OCP.BRepBuilderAPI import BRepBuilderAPI_Transform
-from OCP.gp import gp_Trsf, gp_Vec
+from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+from OCP.gp import gp_Pnt, gp_Trsf, gp_Vec
 from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
 from OCP.TopoDS import TopoDS_Shape
 
@@ -453,3 +454,11 @@ def checked_boolean(
             f"{what}: OCC and manifold3d disagree on the {op}: {occ_change:.6g} vs {mesh_change:.6g} mm^3 "
             f"(allowed {bound:.3g} mm^3 at {deflection} mm deflection)", (a, b))
     return result, chk
+
+
+def box_solid(lo, hi, margin: float = 0.0) -> TopoDS_Shape:
+    """The box solid from corner ``lo`` to corner ``hi`` (3 numbers each, mm), grown by ``margin`` (mm) on
+    every side: a block holding a part whose bounding box is ``lo``-``hi`` (emboss's floor cut, the
+    tablet-die proof of :func:`~tabletcad.tooling.interference.inside_bore`)."""
+    return BRepPrimAPI_MakeBox(gp_Pnt(*(float(x) - margin for x in lo)),
+                               gp_Pnt(*(float(x) + margin for x in hi))).Shape()

@@ -601,15 +601,12 @@ def _around(solid: TopoDS_Shape, prism: TopoDS_Shape, margin: float = 0.1) -> To
     of 9.6-11.0 s; the capsule's the same, 3.8-4.2 s; the box's own Boolean 0.05-0.3 s)."""
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
-    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
 
-    from tabletcad.tooling.booleans import raw_boolean
+    from tabletcad.tooling.booleans import box_solid, raw_boolean
 
     box = Bnd_Box()
     BRepBndLib.Add_s(prism, box)  # (contains the prism: its geometry's box, widened by tolerances)
-    lo, hi = box.CornerMin(), box.CornerMax()
-    block = BRepPrimAPI_MakeBox(gp_Pnt(lo.X() - margin, lo.Y() - margin, lo.Z() - margin),
-                                gp_Pnt(hi.X() + margin, hi.Y() + margin, hi.Z() + margin)).Shape()
+    block = box_solid(box.CornerMin().Coord(), box.CornerMax().Coord(), margin)
     try:
         part = explore(raw_boolean("common", solid, block), "Solid")
     except GeometryError:

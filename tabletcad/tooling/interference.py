@@ -31,8 +31,9 @@ from tabletcad.cad._occ import explore
 from tabletcad.errors import GeometryError
 from tabletcad.geometry.tablet import coordinate_range
 from tabletcad.io.forked import OCC_PARALLEL
-from tabletcad.tooling.booleans import (bound_area, mesh_arrays, mesh_face_ids, manifold_op, manifold_volume, raw_boolean, to_manifold,
-                                        volume)
+from tabletcad.tooling.booleans import (bound_area, box_solid, mesh_arrays, mesh_face_ids, manifold_op, manifold_volume,
+                                        raw_boolean, to_manifold, volume)
+from tabletcad.tooling.outline import prism
 from tabletcad.tooling.spec import MIN_BORE_OFFSET_MM
 
 __all__ = ["interference", "inside_bore", "MeshDistance", "mesh_distance", "largest_inside", "ExactDistance"]
@@ -819,8 +820,6 @@ def inside_bore(tablet, die, bore) -> bool:
         True when both Commons have volume 0 mm^3 (then the overlap is 0); False otherwise (a Boolean
         that fails included), and then nothing is proved: the tablet's Common with the die itself decides.
     """
-    from tabletcad.tooling.outline import prism
-
     block, (z0, z1) = _block(tablet, BLOCK_MARGIN_MM)
     try:
         column = prism(bore, z0 - 1.0, z1 + 1.0)
@@ -834,12 +833,9 @@ def inside_bore(tablet, die, bore) -> bool:
 
 def _block(shape, margin: float) -> tuple[object, tuple[float, float]]:
     """A box solid holding ``shape`` with ``margin`` (mm) to spare, and its z range ``(z0, z1)`` (mm)."""
-    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
-    from OCP.gp import gp_Pnt
-
     box = _box(shape)
-    lo, hi = np.array(box.CornerMin().Coord()) - margin, np.array(box.CornerMax().Coord()) + margin
-    return BRepPrimAPI_MakeBox(gp_Pnt(*lo), gp_Pnt(*hi)).Shape(), (float(lo[2]), float(hi[2]))
+    lo, hi = box.CornerMin().Coord(), box.CornerMax().Coord()
+    return box_solid(lo, hi, margin), (lo[2] - margin, hi[2] + margin)
 
 
 def _occ_overlap(a: str, b: str, shapes: dict, entry: dict) -> tuple[float, str]:
