@@ -76,10 +76,13 @@ def _nbytes(result) -> int:
     return result.nbytes if isinstance(result, np.ndarray) else sum(a.nbytes for a in result)
 
 
-#: Trigonometric rows in ``v`` (:func:`tabletcad.geometry.patch._trig_shared`): 32 tables, none
+#: Trigonometric rows in ``v`` (:func:`tabletcad.geometry.patch._trig_shared`): 256 tables, none
 #: above 8 MB (8192 samples of 48 modes are 6.3 MB; 512 modes on 2048 samples, 16.8 MB, are not
-#: kept), 64 MB in all.
-TRIG = SharedTables(32, 8_000_000, 64_000_000)
+#: kept), 64 MB in all.  One shaped family tablet's load and report reads about a hundred (the
+#: rounded triangle 115, 11.8 MB; the capsule 98, 10.0 MB), each design of a family the same: with
+#: 32 kept, the least recently used went before its next read and every one was made again on
+#: every build (~150 a build).
+TRIG = SharedTables(256, 8_000_000, 64_000_000)
 #: Cardinal functions in ``u`` (:meth:`tabletcad.geometry.patch.PDEPatch._u_tables`, the profiles of
 #: :mod:`tabletcad.geometry.revolution`): the patches of a family share ``a`` and the nodes, so the
 #: checks' and quadratures' ``u`` lines serve them all.  96 tables, none above 4 MB, 48 MB in all.
