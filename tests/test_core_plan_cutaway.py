@@ -9,8 +9,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from tabletcad.geometry.tablet import solid_map
+from tabletcad.geometry.tablet import _cover, solid_map
 from tabletcad.pipeline.design import Design
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -174,3 +176,24 @@ def test_a_ring_keeps_its_see_through_hole():
     ring, thicker, solid = t.plan_area(), t.trimmed(w=(0.5 * w0, 1.0)).plan_area(), t.trimmed(w=(0.0, 1.0)).plan_area()
     assert ring < thicker < solid
     assert solid - ring > 0.1 * solid
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(2, 200), st.integers(1, 40), st.integers(0, 2**32 - 1), st.floats(0.0, 1.5))
+def test_the_envelope_passes_over_only_blocks_it_already_reaches(n, block, seed, level):
+    """:func:`_cover` by blocks of chords, each passed over where the envelope already reaches its farthest
+    point, raises the envelope exactly as the whole piece at every angle does (one block, the envelope at 0):
+    random monotone pieces, envelopes partly above them (``level`` times a radius of 1 mm)."""
+    rng = np.random.default_rng(seed)
+    q = np.sort(rng.uniform(-0.3, 2.5, n))
+    q[1:] += np.cumsum(rng.random(n - 1) < 0.1) * 1e-9  # (strictly increasing)
+    r = rng.uniform(0.5, 1.5, n)
+    px, py = r * np.cos(q), r * np.sin(q)
+    grid = np.sort(rng.uniform(-0.5, 3.0, 400))
+    cs = (np.cos(grid), np.sin(grid))
+    env = level * rng.uniform(0.8, 1.2, grid.size)
+    whole = np.zeros(grid.size)
+    _cover(whole, grid, cs, q, px, py, block=10**9)
+    blocks = env.copy()
+    _cover(blocks, grid, cs, q, px, py, block=block)
+    np.testing.assert_array_equal(blocks, np.maximum(env, whole))
