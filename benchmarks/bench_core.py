@@ -178,9 +178,9 @@ def bench_report(paths=None, repeat=3):
     from tabletcad.pipeline.report import geometry_report
 
     root = Path(__file__).resolve().parents[1]
-    paths = paths or [root / "samples" / n for n in ("flat_faced_round.toml", "spherical.toml", "caplet.toml")] + [
-        root / "samples" / "families" / n for n in ("flat_face_round.toml", "concave_round.toml", "capsule.toml",
-                                                     "oval.toml", "rounded_triangle.toml", "almond.toml")]
+    # the thesis's three samples and every family sample (samples/families)
+    paths = paths or [root / "samples" / n for n in ("flat_faced_round.toml", "spherical.toml", "caplet.toml")] + sorted(
+        (root / "samples" / "families").glob("*.toml"))
     from tabletcad.geometry.tables import CARDINAL, COLLOCATION, TRIG
 
     print("Load + geometry report per design (best of %d; peak traced heap of one run; 'cold': the first run," % repeat)
