@@ -214,9 +214,9 @@ def test_an_off_centre_hole_through_a_solid_of_revolution_with_flat_discs(forked
     """The FFRE sample's solid of revolution (its flat discs faces of revolution) took OCC 15 s and 5 GB to
     cut with an off-centre pin (a review of session 33); with the discs as planes it is a plain cut.  The
     pin (radius 0.3 W at 0.5 L/2 from the axis) lies in the flat disc top and bottom, so it removes
-    pi r^2 T.  (In its forked child, whose address space starts at 1.5 GiB with CadQuery imported too, where
-    build123d's alone is 1.2 GiB: the cut peaks about 0.2 GiB above either, far below the 3 GiB limit, and the
-    5 GB cut would still exceed it.)"""
+    pi r^2 T.  (Its forked child's address space starts at 1.5 GiB, CadQuery imported too, where build123d's
+    alone was 1.2 GiB in a subprocess of its own; the cut adds at most 0.2 GiB, so the 3 GiB limit leaves it
+    room and the 5 GB cut would still exceed it: the job fails under a 1.3 GiB limit, passes under 1.5 GiB.)"""
     returncode, stdout, stderr = forked_runs[OFF_CENTRE_JOB]
     assert returncode == 0, (returncode, stderr[-2000:])
     planes, ok, V, cut = stdout.split()[-4:]
@@ -285,7 +285,7 @@ def test_flat_faces_whose_edges_do_not_chain_are_made_as_before():
     from OCP.Geom import Geom_Plane, Geom_SurfaceOfRevolution
 
     from tabletcad.cad._occ import explore
-    from tabletcad.cad.stage import cutaway_solid
+    from tabletcad.cad.stage import cutaway_shape
     from tabletcad.cad.tablet_solid import tablet_solid
     from tabletcad.geometry.tablet import Trim
     from tabletcad.pipeline.design import Design, load_design
@@ -299,5 +299,5 @@ def test_flat_faces_whose_edges_do_not_chain_are_made_as_before():
         assert len(edges) == 2 and not loop
         assert planes._plane_face(f, *planes._revolved_plane_of(BRep_Tool.Surface_s(f))) is None
     t = replace(load_design(ROOT / "samples" / "families" / "almond.toml"), trim=Trim(v=(0.0, 3.0)))
-    shape = cutaway_solid(t, {"volume_mm3": t.volume(), "surface_area_mm2": t.surface_area()})[0]
+    shape = cutaway_shape(t, {"volume_mm3": t.volume(), "surface_area_mm2": t.surface_area()}).shape  # (no mesh)
     assert not any(isinstance(BRep_Tool.Surface_s(f), Geom_Plane) for f in explore(shape, "Face"))
