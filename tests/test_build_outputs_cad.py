@@ -63,8 +63,9 @@ def test_tooling_build_then_cutaway_then_plain_rebuild(tmp_path, tmp_path_factor
     spec = Design.from_toml(ROOT / "samples" / "tooling" / "concave_round_bisect.toml").tooling_spec
     assert set(rep["outputs"]) == {"report.json", "tablet.png", "tablet.step", "tablet.stl", "tablet.glb",
                                    *tooling_outputs(spec)}
-    # the two STEP files are read back after the cut-away's build, with its tablet.step, in one fresh process (one
-    # OCP import): copies outside tmp_path, where the next build replaces tablet.step and removes tablet_plain.step
+    # the two STEP files are read back after the cut-away's build, with its tablet.step, in one fresh
+    # process (one OCP import): copies outside tmp_path, where the next build replaces tablet.step and
+    # removes tablet_plain.step
     first = tmp_path_factory.mktemp("first_build")
     for name in ("tablet.step", "tablet_plain.step"):
         shutil.copy2(out / name, first / name)
@@ -159,7 +160,7 @@ def test_cutaway_with_curved_cut_faces_is_a_solid(tmp_path, capsys, design, trim
     assert rep["mesh"]["volume_mm3"] == pytest.approx(float(stl.volume), rel=1e-7)
     assert rep["mesh"]["volume_mm3"] == pytest.approx(brep["volume_mm3"] * (1 + rep["mesh"]["volume_rel_diff_vs_brep"]),
                                                       rel=1e-12)
-    (cut,) = ocp_read_steps([tmp_path / "out" / "tablet.step"], measure=())  # (no area or bounding box: unread)
+    (cut,) = ocp_read_steps([tmp_path / "out" / "tablet.step"], measure=())  # (area, box unread)
     assert cut["valid"] and cut["n_solids"] == 1
     assert cut["volume"] == pytest.approx(rep["volume_mm3"], rel=1e-6)
 

@@ -96,7 +96,8 @@ def forked_runs(tmp_path_factory):
     names = [j[0] for j in jobs]
     p = subprocess.run([sys.executable, "-c", FORKED, str(work), *(str(a) for j in jobs for a in j)],
                        capture_output=True, text=True, timeout=600, cwd=work)
-    status = dict(line.split() for line in p.stdout.splitlines() if line.split()[:1] and line.split()[0] in names)
+    status = dict(line.split() for line in p.stdout.splitlines()
+                  if line.split()[:1] and line.split()[0] in names)
     runs = {}
     for f in names:
         out, err = work / f"{f}.out", work / f"{f}.err"

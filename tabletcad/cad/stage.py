@@ -140,7 +140,8 @@ def _wedge(phi0: float, phi1: float, radius: float, z0: float, z1: float):
 
 
 class CutawayShape(NamedTuple):
-    """The checked solid of a cut-away view (:func:`cutaway_shape`), before its mesh (:func:`cutaway_mesh`)."""
+    """The checked solid of a cut-away view (:func:`cutaway_shape`), before its mesh
+    (:func:`cutaway_mesh`)."""
 
     name: str  #: the tablet's name
     shape: Any  #: the ``TopoDS_Solid``
@@ -172,8 +173,8 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
 
 def cutaway_shape(tablet: Tablet, report: dict[str, Any], *, _stacklevel: int = 2) -> CutawayShape | str:
     """The solid of :func:`cutaway_solid`, made and checked (BRepCheck, its volume against the quadrature
-    ``report["volume_mm3"]``), without its mesh: a :class:`CutawayShape`, or a string saying why it is not
-    built (what :meth:`tabletcad.pipeline.model.TabletModel.to_occ` needs; the mesh follows when asked for)."""
+    ``report["volume_mm3"]``), without its mesh: a :class:`CutawayShape`, or a string saying why it is
+    not built (what :meth:`tabletcad.pipeline.model.TabletModel.to_occ` needs; the mesh when asked for)."""
     from dataclasses import replace
 
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
@@ -252,8 +253,9 @@ def cutaway_mesh(made: CutawayShape):
             else tessellate(shape, MESH_LINEAR_MM, MESH_ANGULAR_RAD))
     genus_expected = 0
     brep = dict(valid=True, volume_mm3=made.volume_mm3, surface_area_mm2=made.surface_area_mm2,
-                faces=len(explore(shape, "Face")), volume_rel_diff_vs_quadrature=made.volume_rel_diff_vs_quadrature,
-                cutaway=made.how, seconds=made.seconds)
+                faces=len(explore(shape, "Face")),
+                volume_rel_diff_vs_quadrature=made.volume_rel_diff_vs_quadrature, cutaway=made.how,
+                seconds=made.seconds)
     if not mesh.ok or mesh.manifold_genus != genus_expected:
         failed = (f"manifold3d {mesh.manifold_status}, genus {mesh.manifold_genus}, watertight {mesh.watertight}, "
                   f"winding {mesh.winding_consistent}")

@@ -370,8 +370,9 @@ class TabletModel(_Shaped):
 
     @cached_property
     def _cutaway_mesh(self):
-        """The cut-away's mesh as ``tabletcad build`` makes and checks it (its faces' own grids; OCC's mesher
-        leaves the folded cut faces of a shaped cut-away open), or None where that tessellation does not close."""
+        """The cut-away's mesh as ``tabletcad build`` makes and checks it (its faces' own grids; OCC's
+        mesher leaves the folded cut faces of a shaped cut-away open), or None where that tessellation
+        does not close."""
         from tabletcad.cad.stage import cutaway_mesh
 
         made = self._cutaway_shape  # (a wedge-cut cut-away's mesh is made with its solid)

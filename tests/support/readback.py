@@ -208,8 +208,8 @@ def ocp_read_steps(
         raise ValueError(f"unknown measures {sorted(unknown)}: choose from {MEASURES}")
     paths = [str(Path(p).resolve()) for p in paths]
     proc = subprocess.run(
-        [python or sys.executable, "-c", _OCP_READER, ",".join(measure), *paths], capture_output=True, text=True,
-        timeout=timeout,
+        [python or sys.executable, "-c", _OCP_READER, ",".join(measure), *paths],
+        capture_output=True, text=True, timeout=timeout,
     )
     results = [
         json.loads(line[len("TABLETCAD_JSON:"):])
