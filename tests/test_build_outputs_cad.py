@@ -45,7 +45,9 @@ def _listed(line: str) -> list[str]:
 
 @pytest.mark.cad
 @pytest.mark.slow
-def test_tooling_build_then_cutaway_then_plain_rebuild(tmp_path, capsys):
+def test_tooling_build_then_cutaway_then_plain_rebuild(tmp_path, tmp_path_factory, capsys):
+    import shutil
+
     from support.readback import ocp_read_steps
 
     out = tmp_path / "out"
@@ -61,8 +63,19 @@ def test_tooling_build_then_cutaway_then_plain_rebuild(tmp_path, capsys):
     spec = Design.from_toml(ROOT / "samples" / "tooling" / "concave_round_bisect.toml").tooling_spec
     assert set(rep["outputs"]) == {"report.json", "tablet.png", "tablet.step", "tablet.stl", "tablet.glb",
                                    *tooling_outputs(spec)}
+    # the two STEP files are read back after the cut-away's build, with its tablet.step, in one fresh
+    # process (one OCP import): copies outside tmp_path, where the next build replaces tablet.step and
+    # removes tablet_plain.step
+    first = tmp_path_factory.mktemp("first_build")
+    for name in ("tablet.step", "tablet_plain.step"):
+        shutil.copy2(out / name, first / name)
+
+    (out / "notes.txt").write_text("mine")
+    (out / "drawing.svg").write_text((out / "drawing.svg").read_text() + "<!-- edited -->")
+    rep2, line2 = _build(ROOT / "samples" / "cutaway_convex_round.toml", out, capsys)
+    fin, plain, cut = ocp_read_steps([first / "tablet.step", first / "tablet_plain.step", out / "tablet.step"],
+                                     measure=("volume_default",))
     # tablet.step is the finished (scored, debossed) tablet, tablet_plain.step the PDE tablet
-    fin, plain = ocp_read_steps([out / "tablet.step", out / "tablet_plain.step"])
     assert fin["valid"] and plain["valid"] and fin["n_solids"] == plain["n_solids"] == 1
     assert fin["volume"] == pytest.approx(rep["tooling"]["tablet"]["volume_mm3"], rel=1e-6)
     assert plain["volume"] == pytest.approx(rep["volume_mm3"], rel=1e-6)
@@ -80,16 +93,12 @@ def test_tooling_build_then_cutaway_then_plain_rebuild(tmp_path, capsys):
     assert sum(p["mass_mg"] for p in rep["tooling"]["split"]["parts"]) == pytest.approx(tab["weight_mg"], rel=1e-6)
     assert f"finished (scored/embossed) tablet: volume {fin['volume']:.4g} mm3, weight {fin['volume'] * rho:.4g} mg" in line
 
-    (out / "notes.txt").write_text("mine")
-    (out / "drawing.svg").write_text((out / "drawing.svg").read_text() + "<!-- edited -->")
-    rep2, line2 = _build(ROOT / "samples" / "cutaway_convex_round.toml", out, capsys)
     expected = set(rep2["outputs"]) | {MANIFEST, "notes.txt", "drawing.svg"}
     assert {p.name for p in out.iterdir()} == expected
     assert _listed(line2) == rep2["outputs"] and "drawing.svg" not in rep2["outputs"]
     assert "assembly.step" not in expected and "upper_punch.step" not in expected
     # the cut-away is a solid: its STEP holds the trimmed volume of the report
     assert {"tablet.step", "tablet.stl", "tablet.glb"} <= set(rep2["outputs"]) and "tablet_plain.step" not in expected
-    (cut,) = ocp_read_steps([out / "tablet.step"])
     assert cut["valid"] and cut["n_solids"] == 1
     assert cut["volume"] == pytest.approx(rep2["volume_mm3"], rel=1e-6)
     assert rep2["volume_mm3"] == pytest.approx(0.75 * rep3_full_volume(), rel=1e-9)  # 3/4 of the round
@@ -151,7 +160,7 @@ def test_cutaway_with_curved_cut_faces_is_a_solid(tmp_path, capsys, design, trim
     assert rep["mesh"]["volume_mm3"] == pytest.approx(float(stl.volume), rel=1e-7)
     assert rep["mesh"]["volume_mm3"] == pytest.approx(brep["volume_mm3"] * (1 + rep["mesh"]["volume_rel_diff_vs_brep"]),
                                                       rel=1e-12)
-    (cut,) = ocp_read_steps([tmp_path / "out" / "tablet.step"])
+    (cut,) = ocp_read_steps([tmp_path / "out" / "tablet.step"], measure=())  # (area, box unread)
     assert cut["valid"] and cut["n_solids"] == 1
     assert cut["volume"] == pytest.approx(rep["volume_mm3"], rel=1e-6)
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -139,9 +139,23 @@ def _wedge(phi0: float, phi1: float, radius: float, z0: float, z1: float):
     return BRepPrimAPI_MakePrism(face, gp_Vec(0.0, 0.0, z1 - z0)).Shape()
 
 
+class CutawayShape(NamedTuple):
+    """The checked solid of a cut-away view (:func:`cutaway_shape`), before its mesh
+    (:func:`cutaway_mesh`)."""
+
+    name: str  #: the tablet's name
+    shape: Any  #: the ``TopoDS_Solid``
+    chain: Any  #: the fitted and sewn chain (a ``TabletSolid``) of a cut-away with ruled cut faces, else None
+    volume_mm3: float  #: OCC's volume of the solid
+    surface_area_mm2: float  #: OCC's area of the solid
+    volume_rel_diff_vs_quadrature: float
+    how: str  #: how the solid was made (``brep.cutaway``)
+    seconds: float
+
+
 def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
     """The solid of a tablet trimmed in ``v`` (a cut-away view): ``(solid shape, mesh, sections)``,
-    or a string saying why it is not built.
+    or a string saying why it is not built: :func:`cutaway_shape`, then :func:`cutaway_mesh`.
 
     When every patch's ``v = v0`` and ``v = v1`` faces of the solid map are half-planes
     through the z axis (tablets of revolution: circles about the spine), the cut-away is the
@@ -153,11 +167,18 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
     with the core's quadrature over the trimmed domain within ``AGREEMENT_REL`` and its mesh
     must pass the checks.
     """
+    made = cutaway_shape(tablet, report, _stacklevel=3)
+    return made if isinstance(made, str) else cutaway_mesh(made)
+
+
+def cutaway_shape(tablet: Tablet, report: dict[str, Any], *, _stacklevel: int = 2) -> CutawayShape | str:
+    """The solid of :func:`cutaway_solid`, made and checked (BRepCheck, its volume against the quadrature
+    ``report["volume_mm3"]``), without its mesh: a :class:`CutawayShape`, or a string saying why it is
+    not built (what :meth:`tabletcad.pipeline.model.TabletModel.to_occ` needs; the mesh when asked for)."""
     from dataclasses import replace
 
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
 
-    from tabletcad.cad.mesh import tessellate, tessellate_solid
     from tabletcad.cad.solid import check_solid, mass_properties
     from tabletcad.cad.tablet_solid import tablet_solid
     from tabletcad.geometry.tablet import Trim
@@ -192,7 +213,7 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
         warnings.warn(f"{tablet.name}: the cut-away of a shaped tablet is a view: its ruled cut faces can overlap "
                       "where a patch has no volume (a flat plateau or land), so a mesher or a Boolean may refuse "
                       "tablet.step (BRepCheck passes it); cut the whole tablet's STEP in your CAD program for a "
-                      "solid to mesh", UserWarning, stacklevel=2)
+                      "solid to mesh", UserWarning, stacklevel=_stacklevel)
     else:
         # angles grow with v (counter-clockwise sections); the kept sector runs from phi0 to phi1
         span = (phi1 - phi0) % (2.0 * np.pi) or 2.0 * np.pi
@@ -215,29 +236,43 @@ def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
     if abs(dv) > AGREEMENT_REL:
         raise GeometryError(f"{tablet.name}: cut-away B-rep volume differs from the quadrature by {dv:.2e} relative "
                             f"(allowed {AGREEMENT_REL:g})", shape)
+    return CutawayShape(tablet.name, shape, chain, mass.volume, mass.area, dv, how, t1 - t0)
+
+
+def cutaway_mesh(made: CutawayShape):
+    """The rest of :func:`cutaway_solid` for the solid ``made`` by :func:`cutaway_shape`: its mesh, checked,
+    and the report's sections: ``(solid shape, mesh, sections)``.  A wedge-cut solid whose mesh fails a
+    check is an error; a directly sewn one's (ruled cut faces) gets no mesh (None) and says why."""
+    from tabletcad.cad._occ import explore
+    from tabletcad.cad.mesh import tessellate, tessellate_solid
+
+    shape, chain = made.shape, made.chain
     # the sewn chain is meshed on its faces' parameter grids (BRepMesh left cracks in the almond's
     # ruled cut faces), the wedge-cut solid by BRepMesh
     mesh = (tessellate_solid(chain, MESH_LINEAR_MM, MESH_ANGULAR_RAD) if chain is not None
             else tessellate(shape, MESH_LINEAR_MM, MESH_ANGULAR_RAD))
     genus_expected = 0
-    brep = dict(valid=True, volume_mm3=mass.volume, surface_area_mm2=mass.area, faces=len(explore(shape, "Face")),
-                volume_rel_diff_vs_quadrature=dv, cutaway=how, seconds=t1 - t0)
+    brep = dict(valid=True, volume_mm3=made.volume_mm3, surface_area_mm2=made.surface_area_mm2,
+                faces=len(explore(shape, "Face")),
+                volume_rel_diff_vs_quadrature=made.volume_rel_diff_vs_quadrature, cutaway=made.how,
+                seconds=made.seconds)
     if not mesh.ok or mesh.manifold_genus != genus_expected:
         failed = (f"manifold3d {mesh.manifold_status}, genus {mesh.manifold_genus}, watertight {mesh.watertight}, "
                   f"winding {mesh.winding_consistent}")
-        if phi0 is None or phi1 is None:
+        if chain is not None:
             # the directly sewn cut-away is a valid B-rep of the right volume, but where its grid does not
             # close, OCC's tessellation of its ruled cut faces can leave cracks (it did on the almond):
             # the STEP is written, no STL/GLB
             return shape, None, dict(brep=brep, mesh=dict(skipped=f"the tessellation is not a closed mesh ({failed}): "
                                                                  "tablet.step only, no tablet.stl/.glb"))
-        raise GeometryError(f"{tablet.name}: cut-away mesh check failed ({failed})", mesh)
+        raise GeometryError(f"{made.name}: cut-away mesh check failed ({failed})", mesh)
     sections = dict(
         brep=brep,
         mesh=dict(manifold=mesh.is_manifold, watertight=bool(mesh.watertight), winding_consistent=bool(mesh.winding_consistent),
                   genus=mesh.manifold_genus, genus_expected=genus_expected, volume_mm3=mesh.volume,
                   manifold3d_volume_mm3=mesh.manifold_volume,
-                  volume_rel_diff_vs_brep=(mesh.volume - mass.volume) / mass.volume, triangles=int(len(mesh.triangles)),
+                  volume_rel_diff_vs_brep=(mesh.volume - made.volume_mm3) / made.volume_mm3,
+                  triangles=int(len(mesh.triangles)),
                   linear_deflection_mm=MESH_LINEAR_MM, angular_deflection_rad=MESH_ANGULAR_RAD),
     )
     return shape, mesh, sections

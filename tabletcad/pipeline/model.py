@@ -345,7 +345,7 @@ class TabletModel(_Shaped):
         (``Move``, build123d's ``.move``) leaves the model, its exports and its tooling where they were."""
         from tabletcad.cad._occ import handle
 
-        return handle(self._solid.shape if self._whole else self._cutaway[0])
+        return handle(self._solid.shape if self._whole else self._cutaway_shape.shape)
 
     @property
     def _whole(self) -> bool:
@@ -353,24 +353,38 @@ class TabletModel(_Shaped):
         return t.u == (0.0, 1.0) and t.full_v
 
     @cached_property
-    def _cutaway(self):
-        """``(shape, mesh)`` of the cut-away as ``tabletcad build`` makes and checks them (the mesh:
-        its faces' own grids; OCC's mesher leaves the folded cut faces of a shaped cut-away open)."""
-        from tabletcad.cad.stage import cutaway_solid
+    def _cutaway_shape(self):
+        """The cut-away's solid as ``tabletcad build`` makes and checks it
+        (:func:`tabletcad.cad.stage.cutaway_shape`).  A wedge-cut one's mesh is made and checked with it, as
+        the build's is (a failed check refuses the cut-away); a shaped one's (ruled cut faces), which
+        never refuses it, when first asked for (:attr:`_cutaway_mesh`): a Boolean of the solid needs none."""
+        from tabletcad.cad.stage import cutaway_mesh, cutaway_shape
         from tabletcad.errors import GeometryError
 
-        cut = cutaway_solid(self.tablet, {"volume_mm3": self.tablet.volume()})
-        if isinstance(cut, str):
-            raise GeometryError(f"{self.name}: no solid for this cut-away view: {cut}", self.tablet)
-        return cut[0], cut[1]
+        made = cutaway_shape(self.tablet, {"volume_mm3": self.tablet.volume()})
+        if isinstance(made, str):
+            raise GeometryError(f"{self.name}: no solid for this cut-away view: {made}", self.tablet)
+        if made.chain is None:
+            self.__dict__["_cutaway_mesh"] = cutaway_mesh(made)[1]
+        return made
+
+    @cached_property
+    def _cutaway_mesh(self):
+        """The cut-away's mesh as ``tabletcad build`` makes and checks it (its faces' own grids; OCC's
+        mesher leaves the folded cut faces of a shaped cut-away open), or None where that tessellation
+        does not close."""
+        from tabletcad.cad.stage import cutaway_mesh
+
+        made = self._cutaway_shape  # (a wedge-cut cut-away's mesh is made with its solid)
+        return self.__dict__["_cutaway_mesh"] if "_cutaway_mesh" in self.__dict__ else cutaway_mesh(made)[1]
 
     def mesh(self, linear_deflection: float = DEFAULT.mesh_deflection, angular_deflection: float = DEFAULT.mesh_angle,
              check: bool = False):
         """:class:`tabletcad.cad.mesh.MeshResult` of the solid (mm, rad); a cut-away's at the default
         deflections is the one ``tabletcad build`` writes (checked)."""
         if not self._whole and (linear_deflection, angular_deflection) == (DEFAULT.mesh_deflection, DEFAULT.mesh_angle) \
-                and self._cutaway[1] is not None:
-            return self._cutaway[1]
+                and self._cutaway_mesh is not None:
+            return self._cutaway_mesh
         return super().mesh(linear_deflection, angular_deflection, check=check)
 
     def export(self, path: str | Path, **kw: Any) -> Path:
@@ -382,8 +396,8 @@ class TabletModel(_Shaped):
 
         mesh_kw = {"linear_deflection", "angular_deflection", "relative", "mesh"}
         if not self._whole and Path(path).suffix.lower() in (".stl", ".3mf", ".glb") and not mesh_kw & set(kw) \
-                and self._cutaway[1] is not None:
-            kw["mesh"] = self._cutaway[1]
+                and self._cutaway_mesh is not None:
+            kw["mesh"] = self._cutaway_mesh
         if self._whole:  # the solid tabletcad build writes (exact faces of revolution where it has them)
             return export(self._export_solid, path, name=kw.pop("name", self.name), **kw)
         return super().export(path, **kw)

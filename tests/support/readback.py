@@ -149,9 +149,16 @@ def read(path):
         else:
             BRepGProp.VolumeProperties_s(shape, p, Eps=eps)
         return p.Mass()
-    sp = GProp_GProps(); BRepGProp.SurfaceProperties_s(shape, sp, Eps=1e-9)
-    box = Bnd_Box(); BRepBndLib.AddOptimal_s(shape, box, False, False)
-    pmin, pmax = box.CornerMin(), box.CornerMax()
+    out = {}
+    if "area" in MEASURE:
+        sp = GProp_GProps(); BRepGProp.SurfaceProperties_s(shape, sp, Eps=1e-9)
+        out["area"] = sp.Mass()
+    if "bbox" in MEASURE:
+        box = Bnd_Box(); BRepBndLib.AddOptimal_s(shape, box, False, False)
+        pmin, pmax = box.CornerMin(), box.CornerMax()
+        out["bbox"] = [pmin.X(), pmin.Y(), pmin.Z(), pmax.X(), pmax.Y(), pmax.Z()]
+    if "volume_default" in MEASURE:
+        out["volume_default"] = props(None)
     names = []
     try:
         model = reader.WS().Model()
@@ -169,13 +176,12 @@ def read(path):
         "n_faces": count(TopAbs_FACE),
         "valid": bool(BRepCheck_Analyzer(shape).IsValid()),
         "volume": props(1e-9),
-        "volume_default": props(None),
-        "area": sp.Mass(),
-        "bbox": [pmin.X(), pmin.Y(), pmin.Z(), pmax.X(), pmax.Y(), pmax.Z()],
+        **out,
         "products": names,
     }
 
-for path in sys.argv[1:]:
+MEASURE = set(sys.argv[1].split(",")) - {""}
+for path in sys.argv[2:]:
     try:
         result = read(path)
     except Exception as exc:
@@ -184,13 +190,26 @@ for path in sys.argv[1:]:
 """
 
 
+#: what the reader measures beyond the solids, faces, validity, adaptive volume and product names
+MEASURES = ("volume_default", "area", "bbox")
+
+
 def ocp_read_steps(
-    paths: Sequence[str | os.PathLike[str]], timeout: float = 300.0, python: str | None = None
+    paths: Sequence[str | os.PathLike[str]], timeout: float = 300.0, python: str | None = None,
+    measure: Sequence[str] = MEASURES,
 ) -> list[dict[str, Any]]:
-    """:func:`ocp_read_step` for several files in *one* fresh process (one OCP import)."""
+    """:func:`ocp_read_step` for several files in *one* fresh process (one OCP import).
+
+    ``measure``: which of :data:`MEASURES` to compute (all by default); a caller that reads none of
+    them passes ``()`` (the optimal bounding box and the area took up to 1.3 s a cut-away's file), and
+    a key not measured is absent from the result (reading it is a KeyError, not a silent pass)."""
+    unknown = set(measure) - set(MEASURES)
+    if unknown:
+        raise ValueError(f"unknown measures {sorted(unknown)}: choose from {MEASURES}")
     paths = [str(Path(p).resolve()) for p in paths]
     proc = subprocess.run(
-        [python or sys.executable, "-c", _OCP_READER, *paths], capture_output=True, text=True, timeout=timeout
+        [python or sys.executable, "-c", _OCP_READER, ",".join(measure), *paths],
+        capture_output=True, text=True, timeout=timeout,
     )
     results = [
         json.loads(line[len("TABLETCAD_JSON:"):])
@@ -208,9 +227,11 @@ def ocp_read_steps(
     return results
 
 
-def ocp_read_step(path: str | os.PathLike[str], timeout: float = 300.0, python: str | None = None) -> dict[str, Any]:
+def ocp_read_step(path: str | os.PathLike[str], timeout: float = 300.0, python: str | None = None,
+                  measure: Sequence[str] = MEASURES) -> dict[str, Any]:
     """Read STEP with OCP's ``STEPControl_Reader`` in a fresh process (``python`` defaults to this interpreter).
 
-    Returns ``{n_solids, n_faces, valid, volume (adaptive, eps 1e-9), volume_default, area, bbox, products}``.
+    Returns ``{n_solids, n_faces, valid, volume (adaptive, eps 1e-9), volume_default, area, bbox, products}``
+    (of the last three those ``measure`` names: all by default).
     """
-    return ocp_read_steps([path], timeout=timeout, python=python)[0]
+    return ocp_read_steps([path], timeout=timeout, python=python, measure=measure)[0]
