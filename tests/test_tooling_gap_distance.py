@@ -234,6 +234,46 @@ def test_anchored_bound_refines_fewer_points_along_a_ridge():
     assert len(anch) < 0.7 * len(plain)
 
 
+@pytest.mark.parametrize("collide", [False, True])
+def test_branch_and_bound_measures_each_point_once(monkeypatch, collide):
+    """``largest_inside`` asks ``f`` once per distinct point (two triangles that share their longest edge
+    both split it: the ridge's triangles in pairs), and returns every midpoint with ``f``'s own value and
+    nearest point; with every point hashed alike (``collide``) the memo may not merge different points:
+    the same points and values, each bit for bit."""
+    from scipy.spatial import cKDTree
+
+    from tabletcad.tooling import interference
+    from tabletcad.tooling.interference import largest_inside
+
+    xs = np.linspace(-2.0, 2.0, 4001)
+    S = np.concatenate([np.column_stack([xs, np.full_like(xs, -0.1), np.zeros_like(xs)]),
+                        np.column_stack([xs, np.full_like(xs, 0.1), np.zeros_like(xs)])])
+    tree = cKDTree(S)
+    g = np.linspace(-1.0, 1.0, 11)
+    corners = np.array([[[a, -0.1, 0.0], [b, -0.1, 0.0], [a, 0.1, 0.0]] for a, b in zip(g[:-1], g[1:])]
+                       + [[[b, 0.1, 0.0], [a, 0.1, 0.0], [b, -0.1, 0.0]] for a, b in zip(g[:-1], g[1:])])
+    d0, i0 = tree.query(corners.reshape(-1, 3))
+    asked = []
+
+    def f(P):
+        asked.append(np.array(P))
+        d, i = tree.query(P)
+        return d, S[i]
+
+    if collide:
+        monkeypatch.setattr(interference._Memo, "_hash", staticmethod(lambda bits: np.zeros(len(bits), dtype=np.uint64)))
+    Vs, ds = largest_inside(corners, d0.reshape(-1, 3), f, 0.004, float(d0.max()), anchors=S[i0].reshape(-1, 3, 3))
+    asked = np.concatenate(asked)
+    assert np.array_equal(ds, tree.query(Vs)[0])  # every value f's own, to the bit
+    distinct = np.unique(Vs, axis=0)
+    assert len(distinct) < 0.9 * len(Vs)  # the shared edges' midpoints come twice (371 of 450)...
+    if not collide:
+        assert len(asked) == len(distinct)  # ... and are measured once
+        assert len(np.unique(asked, axis=0)) == len(asked)
+    else:
+        assert len(asked) == len(Vs)  # every call's points collide: each measured, none merged wrongly
+
+
 def test_faces_that_fill_their_box_keep_the_same_samples_unclassified(monkeypatch):
     """``face_samples`` keeps the whole grid of a face that is its entire (u, v) box without
     classifying each point: on a tablet's B-spline faces the points are the classified ones to

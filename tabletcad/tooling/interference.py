@@ -158,9 +158,15 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
     the two, ``min_c max_k |v_k - q_c|`` being second order where the triangle runs along the set
     (along a land's ridge: ``sqrt(f² + h²)``) where the first is ``f + h``; the guarantee is the same.
 
+    ``f`` must be a function of each point alone (its value at a point does not depend on the other
+    points asked with it): a midpoint met again (two triangles that share their longest edge split it
+    both, in the same round or later) is measured once (:class:`_Memo`; 42 % of the midpoints on the
+    rounded rectangle's land).
+
     Returns the measured points (m, 3) and their values (m,).
     """
     slack = spacing / math.sqrt(3.0)
+    f = _Memo(f, anchors is not None)
     pts, vals = [], []
     for _ in range(200):
         if not len(tris):
@@ -196,6 +202,73 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
     if not pts:
         return np.zeros((0, 3)), np.zeros(0)
     return np.concatenate(pts), np.concatenate(vals)
+
+
+class _Memo:
+    """``f`` of points (n, 3), each point measured once: a point met again (the same three float64
+    bit patterns) takes the value (and, ``paired``, the nearest point) that ``f`` gave it before,
+    so every answer is ``f``'s own.
+
+    Points are found by a 64-bit hash of their bits (a sorted array searched with ``searchsorted``)
+    and every match is checked bit for bit: a hash shared by two different points costs a second
+    measurement, never a wrong value (in a call where it happens, every point of it is measured)."""
+
+    def __init__(self, f, paired: bool) -> None:
+        self.f, self.paired = f, paired
+        self.hashes = np.zeros(0, dtype=np.uint64)  # sorted
+        self.rows = np.zeros(0, dtype=np.int64)  # the stored row of each hash
+        self.size = 0  # rows stored in the buffers below (grown by doubling)
+        self.bits = np.zeros((0, 3), dtype=np.uint64)
+        self.values = np.zeros(0)
+        self.nearest = np.zeros((0, 3))
+
+    @staticmethod
+    def _hash(bits: np.ndarray) -> np.ndarray:
+        h = bits[:, 0] * np.uint64(0x9E3779B97F4A7C15)
+        h ^= (h >> np.uint64(29)) ^ (bits[:, 1] * np.uint64(0xBF58476D1CE4E5B9))
+        h ^= (h >> np.uint64(31)) ^ (bits[:, 2] * np.uint64(0x94D049BB133111EB))
+        return h ^ (h >> np.uint64(32))
+
+    def _measure(self, P: np.ndarray):
+        out = self.f(P)
+        if self.paired:
+            return np.asarray(out[0], dtype=float).reshape(-1), np.asarray(out[1], dtype=float).reshape(-1, 3)
+        return np.asarray(out, dtype=float).reshape(-1), None
+
+    def __call__(self, P: np.ndarray):
+        P = np.ascontiguousarray(P, dtype=float).reshape(-1, 3)
+        bits = P.view(np.uint64)
+        hashes, first, inverse = np.unique(self._hash(bits), return_index=True, return_inverse=True)
+        inverse = inverse.reshape(-1)
+        if not np.array_equal(bits[first][inverse], bits):  # two points of this call share a hash
+            v, q = self._measure(P)
+            return (v, q) if self.paired else v
+        n = len(self.hashes)
+        pos = np.searchsorted(self.hashes, hashes)
+        row = np.full(len(hashes), -1, dtype=np.int64)
+        hit = np.flatnonzero(pos < n)
+        hit = hit[self.hashes[pos[hit]] == hashes[hit]]
+        same = np.all(self.bits[self.rows[pos[hit]]] == bits[first[hit]], axis=1)  # bit for bit
+        row[hit[same]] = self.rows[pos[hit[same]]]
+        new = np.flatnonzero(row < 0)
+        if len(new):
+            v, q = self._measure(P[first[new]])
+            a, b = self.size, self.size + len(new)
+            if b > len(self.values):
+                cap = max(b, 2 * len(self.values))
+                self.values = np.concatenate([self.values[:a], np.zeros(cap - a)])
+                self.nearest = np.concatenate([self.nearest[:a], np.zeros((cap - a, 3))])
+                self.bits = np.concatenate([self.bits[:a], np.zeros((cap - a, 3), dtype=np.uint64)])
+            row[new] = np.arange(a, b)
+            self.values[a:b] = v
+            if self.paired:
+                self.nearest[a:b] = q
+            self.bits[a:b] = bits[first[new]]
+            self.size = b
+            self.hashes = np.insert(self.hashes, pos[new], hashes[new])  # still sorted
+            self.rows = np.insert(self.rows, pos[new], row[new])
+        rows = row[inverse]
+        return (self.values[rows], self.nearest[rows]) if self.paired else self.values[rows]
 
 
 def _anchored_bound(tris: np.ndarray, anchors: np.ndarray) -> np.ndarray:
