@@ -74,6 +74,41 @@ def test_mesh_distance_with_a_reach_and_per_point_bounds(seed, reach, spread):
     assert np.all(fin[need])
 
 
+@pytest.mark.parametrize("near", [True, False])
+def test_mesh_distance_probe_skips_the_screen_with_the_same_answers(monkeypatch, near):
+    """With 6,000 points in the box the centres' screen is probed first: points within 0.05 of the
+    sphere (all within reach) skip it, points all over the box (half of them too far) run it; either way
+    every finite distance is the brute-force minimum, every point that could beat its bound is measured,
+    and the nearer-than-bound answers (what the gap's nearest tool takes) are those of the screen run on
+    every point."""
+    from tabletcad.tooling.interference import MeshDistance
+
+    rng = np.random.default_rng(7)
+    mesh = trimesh.creation.icosphere(subdivisions=3)
+    V, T = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    if near:
+        P = rng.normal(size=(6000, 3))
+        P = P / np.linalg.norm(P, axis=1)[:, None] * (1.0 + 0.05 * rng.uniform(-1, 1, (len(P), 1)))
+    else:
+        P = rng.uniform(-1.2, 1.2, size=(6000, 3))
+    below = rng.uniform(0.0, 0.3, size=len(P))
+    md = MeshDistance(V, T, reach=0.2)
+    calls = []
+    screen = md._screen
+    monkeypatch.setattr(md, "_screen", lambda *a: calls.append(len(a[1])) or screen(*a))
+    d, q = md(P, below=below, closest=True)
+    assert len(calls) == (1 if near else 2) and calls[0] < len(P) / 10  # the probe, then the screen on all
+    k = np.arange(0, len(P), 20)  # the brute force on 300 of them
+    exact, dk = _brute_force(P[k], V, T), d[k]
+    fin = np.isfinite(dk)
+    assert np.allclose(dk[fin], exact[fin], rtol=0, atol=1e-12)
+    assert np.all(fin[(exact < below[k]) & (exact <= 0.2 * (1 - 1e-9))])
+    monkeypatch.setattr(MeshDistance, "PROBE_MIN", 10**9)  # the screen on every point
+    ds, qs = MeshDistance(V, T, reach=0.2)(P, below=below, closest=True)
+    take, takes = d < below, ds < below
+    assert np.array_equal(take, takes) and np.array_equal(d[take], ds[take]) and np.array_equal(q[take], qs[take])
+
+
 def test_mesh_distance_of_points_on_the_mesh_and_of_nothing():
     mesh = trimesh.creation.box(extents=(2.0, 3.0, 4.0))
     V, T = np.asarray(mesh.vertices), np.asarray(mesh.faces)
