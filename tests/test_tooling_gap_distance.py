@@ -74,6 +74,41 @@ def test_mesh_distance_with_a_reach_and_per_point_bounds(seed, reach, spread):
     assert np.all(fin[need])
 
 
+@pytest.mark.parametrize("near", [True, False])
+def test_mesh_distance_probe_skips_the_screen_with_the_same_answers(monkeypatch, near):
+    """With 6,000 points in the box the centres' screen is probed first: points within 0.05 of the
+    sphere (all within reach) skip it, points all over the box (half of them too far) run it; either way
+    every finite distance is the brute-force minimum, every point that could beat its bound is measured,
+    and the nearer-than-bound answers (what the gap's nearest tool takes) are those of the screen run on
+    every point."""
+    from tabletcad.tooling.interference import MeshDistance
+
+    rng = np.random.default_rng(7)
+    mesh = trimesh.creation.icosphere(subdivisions=3)
+    V, T = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    if near:
+        P = rng.normal(size=(6000, 3))
+        P = P / np.linalg.norm(P, axis=1)[:, None] * (1.0 + 0.05 * rng.uniform(-1, 1, (len(P), 1)))
+    else:
+        P = rng.uniform(-1.2, 1.2, size=(6000, 3))
+    below = rng.uniform(0.0, 0.3, size=len(P))
+    md = MeshDistance(V, T, reach=0.2)
+    calls = []
+    screen = md._screen
+    monkeypatch.setattr(md, "_screen", lambda *a: calls.append(len(a[1])) or screen(*a))
+    d, q = md(P, below=below, closest=True)
+    assert len(calls) == (1 if near else 2) and calls[0] < len(P) / 10  # the probe, then the screen on all
+    k = np.arange(0, len(P), 20)  # the brute force on 300 of them
+    exact, dk = _brute_force(P[k], V, T), d[k]
+    fin = np.isfinite(dk)
+    assert np.allclose(dk[fin], exact[fin], rtol=0, atol=1e-12)
+    assert np.all(fin[(exact < below[k]) & (exact <= 0.2 * (1 - 1e-9))])
+    monkeypatch.setattr(MeshDistance, "PROBE_MIN", 10**9)  # the screen on every point
+    ds, qs = MeshDistance(V, T, reach=0.2)(P, below=below, closest=True)
+    take, takes = d < below, ds < below
+    assert np.array_equal(take, takes) and np.array_equal(d[take], ds[take]) and np.array_equal(q[take], qs[take])
+
+
 def test_mesh_distance_of_points_on_the_mesh_and_of_nothing():
     mesh = trimesh.creation.box(extents=(2.0, 3.0, 4.0))
     V, T = np.asarray(mesh.vertices), np.asarray(mesh.faces)
@@ -232,6 +267,46 @@ def test_anchored_bound_refines_fewer_points_along_a_ridge():
                               anchors=S[i0].reshape(-1, 3, 3))
     assert dp.max() == pytest.approx(0.1, abs=0.004 / np.sqrt(3)) and da.max() == pytest.approx(0.1, abs=0.004 / np.sqrt(3))
     assert len(anch) < 0.7 * len(plain)
+
+
+@pytest.mark.parametrize("collide", [False, True])
+def test_branch_and_bound_measures_each_point_once(monkeypatch, collide):
+    """``largest_inside`` asks ``f`` once per distinct point (two triangles that share their longest edge
+    both split it: the ridge's triangles in pairs), and returns every midpoint with ``f``'s own value and
+    nearest point; with every point hashed alike (``collide``) the memo may not merge different points:
+    the same points and values, each bit for bit."""
+    from scipy.spatial import cKDTree
+
+    from tabletcad.tooling import interference
+    from tabletcad.tooling.interference import largest_inside
+
+    xs = np.linspace(-2.0, 2.0, 4001)
+    S = np.concatenate([np.column_stack([xs, np.full_like(xs, -0.1), np.zeros_like(xs)]),
+                        np.column_stack([xs, np.full_like(xs, 0.1), np.zeros_like(xs)])])
+    tree = cKDTree(S)
+    g = np.linspace(-1.0, 1.0, 11)
+    corners = np.array([[[a, -0.1, 0.0], [b, -0.1, 0.0], [a, 0.1, 0.0]] for a, b in zip(g[:-1], g[1:])]
+                       + [[[b, 0.1, 0.0], [a, 0.1, 0.0], [b, -0.1, 0.0]] for a, b in zip(g[:-1], g[1:])])
+    d0, i0 = tree.query(corners.reshape(-1, 3))
+    asked = []
+
+    def f(P):
+        asked.append(np.array(P))
+        d, i = tree.query(P)
+        return d, S[i]
+
+    if collide:
+        monkeypatch.setattr(interference._Memo, "_hash", staticmethod(lambda bits: np.zeros(len(bits), dtype=np.uint64)))
+    Vs, ds = largest_inside(corners, d0.reshape(-1, 3), f, 0.004, float(d0.max()), anchors=S[i0].reshape(-1, 3, 3))
+    asked = np.concatenate(asked)
+    assert np.array_equal(ds, tree.query(Vs)[0])  # every value f's own, to the bit
+    distinct = np.unique(Vs, axis=0)
+    assert len(distinct) < 0.9 * len(Vs)  # the shared edges' midpoints come twice (371 of 450)...
+    if not collide:
+        assert len(asked) == len(distinct)  # ... and are measured once
+        assert len(np.unique(asked, axis=0)) == len(asked)
+    else:
+        assert len(asked) == len(Vs)  # every call's points collide: each measured, none merged wrongly
 
 
 def test_faces_that_fill_their_box_keep_the_same_samples_unclassified(monkeypatch):
