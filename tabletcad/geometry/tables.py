@@ -76,17 +76,20 @@ def _nbytes(result) -> int:
     return result.nbytes if isinstance(result, np.ndarray) else sum(a.nbytes for a in result)
 
 
-#: Trigonometric rows in ``v`` (:func:`tabletcad.geometry.patch._trig_shared`): 256 tables, none
-#: above 8 MB (8192 samples of 48 modes are 6.3 MB; 512 modes on 2048 samples, 16.8 MB, are not
-#: kept), 64 MB in all.  One shaped family tablet's load and report reads about a hundred (the
-#: rounded triangle 115, 11.8 MB; the capsule 98, 10.0 MB), each design of a family the same: with
-#: 32 kept, the least recently used went before its next read and every one was made again on
-#: every build (~150 a build).
-TRIG = SharedTables(256, 8_000_000, 64_000_000)
+#: Trigonometric rows in ``v`` (:func:`tabletcad.geometry.patch._trig_shared`): none above 8 MB (8192
+#: samples of 48 modes are 6.3 MB; 512 modes on 2048 samples, 16.8 MB, are not kept), 64 MB in all, and
+#: up to 1024 tables, so that the bytes bound them: one shaped family tablet's load and report reads
+#: about a hundred (the rounded triangle 115, 11.8 MB; the capsule 98, 10.0 MB), each design of a family
+#: the same ones.  With 32 kept the least recently used went before its next read and ~150 were made
+#: again on every build; with 256, when four families are built in turn (a sweep or a workbench document
+#: of several), 363 a round (``tests/test_core_tables.py``).
+TRIG = SharedTables(1024, 8_000_000, 64_000_000)
 #: Cardinal functions in ``u`` (:meth:`tabletcad.geometry.patch.PDEPatch._u_tables`, the profiles of
 #: :mod:`tabletcad.geometry.revolution`): the patches of a family share ``a`` and the nodes, so the
-#: checks' and quadratures' ``u`` lines serve them all.  96 tables, none above 4 MB, 48 MB in all.
-CARDINAL = SharedTables(96, 4_000_000, 48_000_000)
+#: checks' and quadratures' ``u`` lines serve them all.  None above 4 MB, 48 MB in all, up to 512 tables:
+#: a shaped tablet reads 50-80 (the rounded triangle 71, 4.2 MB); 96 kept had held one family's, and four
+#: families built in turn made 163 again a round.
+CARDINAL = SharedTables(512, 4_000_000, 48_000_000)
 #: B-spline collocation matrices (:meth:`tabletcad.brep.surface.BSplineSurfaceData.collocation`):
 #: the faces of a chain share their knots, and the fit, its check, the volume and area and the mesh
 #: evaluate them on the same samples; and the chain's periodic knots (:func:`tabletcad.brep.knots.periodic_knots`).
