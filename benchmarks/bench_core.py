@@ -179,8 +179,8 @@ def bench_report(paths=None, repeat=3):
 
     root = Path(__file__).resolve().parents[1]
     # the thesis's three samples and every family sample (samples/families)
-    paths = paths or [root / "samples" / n for n in ("flat_faced_round.toml", "spherical.toml", "caplet.toml")] + sorted(
-        (root / "samples" / "families").glob("*.toml"))
+    thesis = [root / "samples" / n for n in ("flat_faced_round.toml", "spherical.toml", "caplet.toml")]
+    paths = paths or thesis + sorted((root / "samples" / "families").glob("*.toml"))
     from tabletcad.geometry.tables import CARDINAL, COLLOCATION, TRIG
 
     print("Load + geometry report per design (best of %d; peak traced heap of one run; 'cold': the first run," % repeat)

@@ -239,7 +239,8 @@ def test_a_level_patch_folds_as_the_general_computation_measures(fraction, rise,
 
 @settings(max_examples=25, deadline=None)
 @given(RANDOM_OUTLINES, st.integers(0, 2**32 - 1))
-def test_one_point_s_signed_distance_is_the_outline_s_and_no_point_is_deeper_than_its_inscribed_radius(ol, seed):
+def test_one_point_s_signed_distance_is_the_outline_s_and_no_point_is_deeper_than_its_inscribed_radius(
+        ol, seed):
     """The plain-float distance of one point that the inscribed radius's search reads equals
     :meth:`PlanOutline.signed_distance` exactly (inside, outside, at the joins and the arcs' centres, convex
     and concave fillets, either orientation); no point of a dense grid lies deeper inside than the
@@ -248,19 +249,21 @@ def test_one_point_s_signed_distance_is_the_outline_s_and_no_point_is_deeper_tha
         return
     rng = np.random.default_rng(seed)
     special = np.array([p for s in ol.segs for p in (s.p0, s.p1) + ((s.center,) if s.kind == "arc" else ())])
-    q = np.vstack([rng.uniform(-10.0, 10.0, (300, 2)), special, special + rng.normal(0.0, 1e-3, special.shape)])
+    near = special + rng.normal(0.0, 1e-3, special.shape)
+    q = np.vstack([rng.uniform(-10.0, 10.0, (300, 2)), special, near])
     one = ol._point_signed_distance()
     np.testing.assert_array_equal([one(float(x), float(y)) for x, y in q], ol.signed_distance(q))
     g = np.stack(np.meshgrid(np.linspace(-9.0, 9.0, 301), np.linspace(-9.0, 9.0, 301)), -1).reshape(-1, 2)
     radius = ol.inscribed_radius()
     assert float(np.max(ol.signed_distance(g))) <= radius + 1e-12
-    # the same search on the vectorised distance (as it ran before the one-point distance) ends on the same value
+    # the same search on the vectorised distance (as it ran before the one-point distance) ends on the
+    # same value
     from scipy.optimize import minimize
 
     c0 = ol.frame(np.linspace(0, math.tau, 512, endpoint=False))[0]
     lo, hi = c0.min(axis=0), c0.max(axis=0)
     g = np.stack(np.meshgrid(np.linspace(lo[0], hi[0], 81), np.linspace(lo[1], hi[1], 81)), -1).reshape(-1, 2)
     sd = ol.signed_distance(g)
-    found = minimize(lambda x: -float(ol.signed_distance(x[None])[0]), g[int(np.argmax(sd))], method="Nelder-Mead",
-                     options=dict(xatol=1e-11, fatol=1e-13, maxiter=4000))
+    found = minimize(lambda x: -float(ol.signed_distance(x[None])[0]), g[int(np.argmax(sd))],
+                     method="Nelder-Mead", options=dict(xatol=1e-11, fatol=1e-13, maxiter=4000))
     assert radius == max(-found.fun, float(sd.max()))

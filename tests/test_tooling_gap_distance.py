@@ -246,17 +246,23 @@ def test_branch_and_bound_misses_no_peak_by_more_than_its_resolution(seed, ancho
     assert float(tree.query(inside)[0].max()) <= found + spacing / np.sqrt(3.0) + 1e-12
 
 
-def test_anchored_bound_refines_fewer_points_along_a_ridge():
-    """Along a straight ridge the anchored bound is second order (``sqrt(f² + h²)``), the Lipschitz
-    one first order (``f + h``): the same guarantee with fewer refined points."""
+def _ridge():
+    """Two parallel lines of points 0.2 mm apart along x (a land's ridge between two tools) and their
+    k-d tree."""
     from scipy.spatial import cKDTree
-
-    from tabletcad.tooling.interference import largest_inside
 
     xs = np.linspace(-2.0, 2.0, 4001)
     S = np.concatenate([np.column_stack([xs, np.full_like(xs, -0.1), np.zeros_like(xs)]),
                         np.column_stack([xs, np.full_like(xs, 0.1), np.zeros_like(xs)])])
-    tree = cKDTree(S)
+    return S, cKDTree(S)
+
+
+def test_anchored_bound_refines_fewer_points_along_a_ridge():
+    """Along a straight ridge the anchored bound is second order (``sqrt(f² + h²)``), the Lipschitz
+    one first order (``f + h``): the same guarantee with fewer refined points."""
+    from tabletcad.tooling.interference import largest_inside
+
+    S, tree = _ridge()
     g = np.linspace(-1.0, 1.0, 41)
     corners = np.array([[[a, -0.1, 0.0], [b, -0.1, 0.0], [a, 0.1, 0.0]] for a, b in zip(g[:-1], g[1:])]
                        + [[[b, -0.1, 0.0], [b, 0.1, 0.0], [a, 0.1, 0.0]] for a, b in zip(g[:-1], g[1:])])
@@ -275,15 +281,10 @@ def test_branch_and_bound_measures_each_point_once(monkeypatch, collide):
     both split it: the ridge's triangles in pairs), and returns every midpoint with ``f``'s own value and
     nearest point; with every point hashed alike (``collide``) the memo may not merge different points:
     the same points and values, each bit for bit."""
-    from scipy.spatial import cKDTree
-
     from tabletcad.tooling import interference
     from tabletcad.tooling.interference import largest_inside
 
-    xs = np.linspace(-2.0, 2.0, 4001)
-    S = np.concatenate([np.column_stack([xs, np.full_like(xs, -0.1), np.zeros_like(xs)]),
-                        np.column_stack([xs, np.full_like(xs, 0.1), np.zeros_like(xs)])])
-    tree = cKDTree(S)
+    S, tree = _ridge()
     g = np.linspace(-1.0, 1.0, 11)
     corners = np.array([[[a, -0.1, 0.0], [b, -0.1, 0.0], [a, 0.1, 0.0]] for a, b in zip(g[:-1], g[1:])]
                        + [[[b, 0.1, 0.0], [a, 0.1, 0.0], [b, -0.1, 0.0]] for a, b in zip(g[:-1], g[1:])])

@@ -362,7 +362,8 @@ class PlanOutline:
         one = self._point_signed_distance() if self.segs and not self.is_circle else None
         objective = ((lambda x: -one(float(x[0]), float(x[1]))) if one is not None
                      else (lambda x: -float(self.signed_distance(x[None])[0])))
-        r = minimize(objective, x0, method="Nelder-Mead", options=dict(xatol=1e-11, fatol=1e-13, maxiter=4000))
+        r = minimize(objective, x0, method="Nelder-Mead",
+                     options=dict(xatol=1e-11, fatol=1e-13, maxiter=4000))
         found = float(self.signed_distance(r.x[None])[0]) if one is not None else float(-r.fun)
         return max(found, float(sd.max()))
 

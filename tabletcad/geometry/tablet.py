@@ -91,7 +91,8 @@ def _cover(env: np.ndarray, grid: np.ndarray, cs: tuple[np.ndarray, np.ndarray],
     g = grid[gi]
     k = np.clip(np.searchsorted(q, g, "right") - 1, 0, n - 2)
     x0, y0, ex, ey = px[k], py[k], px[k + 1] - px[k], py[k + 1] - py[k]
-    den = ex * cs[1][gi] - ey * cs[0][gi]  # the ray at angle g meets the chord where r (cos g, sin g) = P_k + s E
+    # the ray at angle g meets the chord where r (cos g, sin g) = P_k + s E
+    den = ex * cs[1][gi] - ey * cs[0][gi]
     with np.errstate(divide="ignore", invalid="ignore"):
         r = np.where(np.abs(den) > 0.0, (x0 * ey - y0 * ex) / -den, np.hypot(x0, y0))
     # (a ray almost along a chord: a chord's points are never farther than its ends)
