@@ -441,6 +441,52 @@ def test_evaluate_grid_vectorised_and_scalar_agree(du, dv, which, kit):
     np.testing.assert_allclose(loop, G, atol=1e-12 * scale)
 
 
+@pytest.mark.parametrize("which", ["spine", "trig", "stadium"])
+def test_evaluate_grid_writes_each_term_into_one_array(which, kit):
+    """The grid's product (modes, then each coordinate's remainder and spine added in place) gives the
+    scattered-point path's values for every layout: a patch with no mode and no remainder (coaxial
+    points: the spine alone), modes alone, modes and remainder; every derivative, subsets of the axes
+    in any order, a row or column of one, an empty side."""
+    if which == "spine":
+        p = PDEPatch(tuple(Circle(0.0, (0.1 * k, -0.2 * k, z)) for k, z in enumerate((0.0, 1.0, 2.2, 3.0))), a=1.0)
+        assert not p._active and not p._has_remainder
+    elif which == "trig":
+        p = PDEPatch(_trig_stack(kit, np.random.default_rng(11)), a=1.0)
+        assert p._active and not p._has_remainder
+    else:
+        p = PDEPatch(STADIUM_STACK, a=0.1)
+        assert p._active and p._has_remainder
+    u, v = np.array([0.0, 0.21, 0.5, 0.77, 1.0]), np.array([0.0, 0.4, 1.3, 2.9, 4.4, 5.5, 6.2])
+    for du, dv in ((0, 0), (1, 0), (0, 1), (2, 0), (1, 2)):
+        ref = p.evaluate(u[:, None], v[None, :], du=du, dv=dv)  # 35 points: the scattered path, no grid
+        scale = max(1.0, float(np.max(np.abs(ref))))
+        np.testing.assert_allclose(p.evaluate_grid(u, v, du, dv), ref, rtol=0, atol=1e-12 * scale)
+        for axes in ((2,), (1, 0), (0, 2), (2, 1, 0)):
+            G = p.evaluate_grid(u, v, du, dv, components=True, axes=axes)
+            assert G.shape == (len(axes), u.size, v.size) and G.flags.c_contiguous
+            np.testing.assert_allclose(G, ref[..., list(axes)].transpose(2, 0, 1), rtol=0, atol=1e-12 * scale)
+        np.testing.assert_allclose(p.evaluate_grid(u[2:3], v, du, dv)[0], ref[2], rtol=0, atol=1e-12 * scale)
+        np.testing.assert_allclose(p.evaluate_grid(u, v[3:4], du, dv)[:, 0], ref[:, 3], rtol=0, atol=1e-12 * scale)
+        assert p.evaluate_grid(u[:0], v, du, dv).shape == (0, v.size, 3)
+        assert p.evaluate_grid(u, v[:0], du, dv, components=True, axes=(0, 2)).shape == (2, u.size, 0)
+
+
+def test_gemm_into_a_block_that_is_not_fortran_contiguous():
+    """``_gemm`` writes ``a @ b`` (or adds it) into its output even where BLAS had to take a copy."""
+    from tabletcad.geometry.patch import _gemm
+
+    rng = np.random.default_rng(2)
+    a, b = rng.random((6, 4)), rng.random((4, 5))
+    c = np.zeros((6, 5))  # C-ordered: dgemm works on a Fortran copy
+    assert _gemm(a, b, c) is c
+    np.testing.assert_allclose(c, a @ b, rtol=1e-15)
+    _gemm(a, b, c, fresh=False)
+    np.testing.assert_allclose(c, 2.0 * (a @ b), rtol=1e-15)
+    f = np.empty((6, 5), order="F")
+    _gemm(a.T.copy().T, b, f)  # a Fortran block: written in place
+    np.testing.assert_allclose(f, a @ b, rtol=1e-15)
+
+
 def test_evaluate_broadcasting_shapes():
     p = PDEPatch(_coaxial((0, 2, 3, 3.2), (0, 1, 2, 3)), a=1.0)
     assert p.evaluate(0.5, 0.1).shape == (3,)

@@ -33,6 +33,7 @@ from functools import lru_cache
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.linalg.blas import dgemm as _dgemm
 
 from tabletcad.geometry.basis import cardinal, cardinal_coefficients, cardinals
 from tabletcad.geometry.revolution import Revolution, Section, detect_revolution, detect_section
@@ -147,6 +148,15 @@ def _trig_shared(v: np.ndarray, n: np.ndarray, dv: int, rows: bool = False):
     if v.size > _CACHED_V[1] or 16 * v.size * n.size > TRIG.max_bytes:
         return make(v, n, dv)
     return TRIG.get((rows, dv, n.tobytes(), v.tobytes()), lambda: make(v, n, dv))
+
+
+def _gemm(a: np.ndarray, b: np.ndarray, c: np.ndarray, fresh: bool = True) -> np.ndarray:
+    """``a @ b`` by BLAS ``dgemm`` written into ``c``, a Fortran-contiguous array or block, in place
+    (``c = a @ b`` when ``fresh``, else ``c += a @ b``); transposes of C-ordered arrays pass with no copy."""
+    out = _dgemm(1.0, a, b, beta=0.0 if fresh else 1.0, c=c, overwrite_c=1)
+    if out is not c and not np.shares_memory(out, c):  # (a copy: c was not Fortran-contiguous)
+        c[...] = out
+    return c
 
 
 def _basis_fourier(basis, N: int, samples: int) -> tuple[np.ndarray, ...]:
@@ -610,29 +620,41 @@ class PDEPatch:
         u = np.asarray(u, dtype=float).reshape(-1)
         v = np.asarray(v, dtype=float).reshape(-1)
         L, L0, Lr = self._u_tables(u, du)  # (n, nu, 4), (nu, 4), (nu, 4)
-        # X[c, i, j] = Σ_k U[c, i, k] V[k, j]: the modes (cos and sin rows of V, their u-profiles in U)
-        # in one matrix product of (len(axes) nu, 2n) by (2n, nv), the shape BLAS runs fastest; the
-        # remainder (rows r_k,c'(v), with U = L_β δ_cc') added by a product with its 4 rows per
-        # coordinate, and the spine (constant in v) added to each row: no stacked copy of either side
+        # X[c, i, j] = Σ_k U[c, i, k] V[k, j], built as its transpose Y = X^T (nv, len(axes) nu) in Fortran
+        # order (so Y.T is X, C-ordered, with no copy) by BLAS products that write into Y: the modes (cos and
+        # sin rows of V, their u-profiles in U) in one product of (nv, 2n) by (2n, len(axes) nu); then, per
+        # coordinate, its remainder rows r_k,c(v) and the spine (a row of ones by A0_c(u), when dv = 0) in one
+        # product of (nv, 5) by (5, nu) added in place (beta = 1): no temporary the size of the grid
         ax = list(axes) if components else [0, 1, 2]
-        X = None
+        m, nu, nv = len(ax), u.size, v.size
+        rem, spine = self._has_remainder, dv == 0
+        if not (self._active or rem or spine) or not (nu and nv):
+            return np.zeros((len(axes), nu, nv) if components else (nu, nv, 3))
+        Y = np.empty((nv, m * nu), order="F")
+        fresh = True
         if self._active:
             n = L.shape[0]
             AB = np.matmul(L, self._abT)  # (n, nu, 6): each mode's cosine and sine profiles
             # (3, nu, 2n): coordinate c's cosine profiles, then its sine profiles
-            U = AB.reshape(n, u.size, 2, 3).transpose(3, 1, 2, 0)[ax].reshape(len(ax) * u.size, 2 * n)
-            X = U @ _trig_shared(v, self._n_active, dv, rows=True)  # (len(ax) nu, nv)
-        if self._has_remainder:
-            r = self._residuals(v, dv)  # (4, nv, 3)
-            R = np.stack([Lr @ r[:, :, c] for c in ax])  # (len(ax), nu, nv)
-            R = R.reshape(len(ax) * u.size, v.size)
-            X = R if X is None else X.__iadd__(R)
-        if dv == 0:
-            A = (L0 @ self._a0)[:, ax].T.reshape(-1, 1)  # (len(ax) nu, 1): the spine
-            X = np.broadcast_to(A, (A.shape[0], v.size)).copy() if X is None else X.__iadd__(A)
-        if X is None:
-            return np.zeros((len(axes), u.size, v.size) if components else (u.size, v.size, 3))
-        X = X.reshape(-1, u.size, v.size)
+            U = AB.reshape(n, nu, 2, 3).transpose(3, 1, 2, 0)[ax].reshape(m * nu, 2 * n)
+            _gemm(_trig_shared(v, self._n_active, dv, rows=True).T, U.T, Y)
+            fresh = False
+        if rem or spine:
+            k = 4 * rem + spine
+            r = self._residuals(v, dv) if rem else None  # (4, nv, 3)
+            A = L0 @ self._a0 if spine else None  # (nu, 3)
+            rows, prof = np.empty((k, nv)), np.empty((nu, k))
+            if spine:
+                rows[k - 1] = 1.0
+            if rem:
+                prof[:, :4] = Lr
+            for i, c in enumerate(ax):
+                if rem:
+                    rows[:4] = r[:, :, c]
+                if spine:
+                    prof[:, k - 1] = A[:, c]
+                _gemm(rows.T, prof.T, Y[:, i * nu : (i + 1) * nu], fresh)
+        X = Y.T.reshape(m, nu, nv)
         return X if components else np.ascontiguousarray(X.transpose(1, 2, 0))
 
     def jet_grid(self, u, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
