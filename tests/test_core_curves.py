@@ -322,7 +322,9 @@ def test_outline_signed_distance_against_a_dense_polygon(L, W_frac, seed):
         poly = ol.frame(np.linspace(0.0, TWO_PI, 200_000, endpoint=False))[0]
         q = rng.uniform(-0.8 * L, 0.8 * L, size=(300, 2))
         sd = ol.signed_distance(q)
-        tree = __import__("scipy.spatial", fromlist=["cKDTree"]).cKDTree(poly)
+        # (unbalanced, not compacted: the same nearest points, the tree built 3 times faster)
+        tree = __import__("scipy.spatial", fromlist=["cKDTree"]).cKDTree(poly, balanced_tree=False,
+                                                                          compact_nodes=False)
         near = tree.query(q)[0]
         h = ol.perimeter / 200_000
         assert np.all(near >= np.abs(sd) - 1e-12) and np.all(near <= np.abs(sd) + h)
