@@ -4,6 +4,7 @@ triangles, not polar fans)."""
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 
@@ -12,46 +13,71 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tabletcad.geometry.tablet import _cover, solid_map
+from tabletcad.geometry.tablet import Tablet, _cover, solid_map
 from tabletcad.pipeline.design import Design
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _family(name: str):
+@functools.lru_cache(maxsize=None)
+def _family(name: str) -> Tablet:
+    """The family sample ``name``'s tablet, built once for the module (tablets are immutable; the tests
+    take cut-aways of it, which are new tablets)."""
     return Design.from_toml(ROOT / "samples" / "families" / f"{name}.toml").build()
 
 
-def _union_area(tris: np.ndarray, ny: int) -> float:
+def _line_intervals(tris: np.ndarray, k0: np.ndarray, k1: np.ndarray, lo: float,
+                    dy: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(k, x0, x1)``: the interval ``[x0, x1]`` that line ``k`` (at ``y = lo + (k + 1/2) dy``) cuts
+    from each triangle of ``tris`` (n, 3, 2) it crosses, lines ``k0`` to ``k1`` of each triangle.
+
+    A line between a triangle's lowest and highest corner crosses the edge joining them and, below the
+    middle corner, the edge from the lowest to it, else the edge from it to the highest: the crossings of
+    the three edges without testing each edge for each line."""
+    n = np.maximum(k1 - k0 + 1, 0)
+    t = np.repeat(np.arange(len(tris)), n)
+    k = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n - k0, n)
+    yl = lo + (k + 0.5) * dy
+    order = np.argsort(tris[..., 1], axis=1, kind="stable")
+    p = np.take_along_axis(tris, order[..., None], axis=1)
+    (xa, ya), (xb, yb), (xc, yc) = p[:, 0].T, p[:, 1].T, p[:, 2].T
+    with np.errstate(divide="ignore", invalid="ignore"):  # (a level edge: no slope, never used)
+        slopes = [(x1 - x0) / (y1 - y0)
+                  for x0, y0, x1, y1 in ((xa, ya, xc, yc), (xa, ya, xb, yb), (xb, yb, xc, yc))]
+    ac, ab, bc = (np.where(np.isfinite(m), m, 0.0) for m in slopes)
+    xa, ya, yb = xa[t], ya[t], yb[t]
+    up = yl - ya
+    long = xa + up * ac[t]
+    short = np.where(yl < yb, xa + up * ab[t], xb[t] + (yl - yb) * bc[t])
+    return k, np.minimum(long, short), np.maximum(long, short)
+
+
+def _union_area(tris: np.ndarray, ny: int, block: int = 250) -> float:
     """Area (mm²) of the union of the plan triangles ``tris`` (n, 3, 2): on each of ``ny`` horizontal
-    lines (midpoints) the union of the triangles' exact intervals, summed."""
+    lines (midpoints) the union of the triangles' exact intervals, summed.
+
+    The lines are taken ``block`` at a time (the same sums: each line's union is its own; the arrays of
+    all lines at once, 8 million intervals for the finest reference, took 2.5 times as long)."""
     y = tris[..., 1]
     lo, hi = float(y.min()), float(y.max())
     dy = (hi - lo) / ny
     k0 = np.ceil((y.min(axis=1) - lo) / dy - 0.5).astype(int)
     k1 = np.floor((y.max(axis=1) - lo) / dy - 0.5).astype(int)
-    n = np.maximum(k1 - k0 + 1, 0)
-    t = np.repeat(np.arange(len(tris)), n)
-    k = k0[t] + np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
-    yl = lo + (k + 0.5) * dy
-    X, Y = tris[..., 0], tris[..., 1]
-    x0 = x1 = None
-    for e in range(3):  # where the line meets each edge of its triangle (nan where it misses the edge)
-        ax, ay, bx, by = X[:, e][t], Y[:, e][t], X[:, (e + 1) % 3][t], Y[:, (e + 1) % 3][t]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            s = (yl - ay) / (by - ay)
-            x = np.where((s >= 0.0) & (s <= 1.0), ax + s * (bx - ax), np.nan)
-        # the least and the largest of the edges' crossings, nans ignored (np.nanmin/nanmax of the three,
-        # without the (pairs, 3) array: the same values, 3.5 times faster)
-        x0, x1 = (x, x) if x0 is None else (np.fmin(x0, x), np.fmax(x1, x))
-    # one sort of all intervals, each line's shifted apart from the others'; the running largest end
     big = 4.0 * (float(np.abs(tris[..., 0]).max()) + 1.0)
-    x0, x1 = x0 + k * big, x1 + k * big
-    order = np.argsort(x0, kind="stable")
-    x0, x1 = x0[order], x1[order]
-    reach = np.maximum.accumulate(x1)
-    before = np.r_[-np.inf, reach[:-1]]
-    return float(np.sum(np.maximum(x1 - np.maximum(x0, before), 0.0))) * dy
+    total = 0.0
+    for first in range(0, ny, block):
+        last = first + block - 1
+        sel = (k1 >= first) & (k0 <= last)
+        k, x0, x1 = _line_intervals(tris[sel], np.maximum(k0[sel], first), np.minimum(k1[sel], last), lo, dy)
+        # one sort of the block's intervals, each line's shifted apart from the others'; the running
+        # largest end
+        x0, x1 = x0 + k * big, x1 + k * big
+        order = np.argsort(x0, kind="stable")
+        x0, x1 = x0[order], x1[order]
+        reach = np.maximum.accumulate(x1)
+        before = np.r_[-np.inf, reach[:-1]]
+        total += float(np.sum(np.maximum(x1 - np.maximum(x0, before), 0.0)))
+    return total * dy
 
 
 def _boundary_triangles(t, nu: int, nv: int) -> np.ndarray:

@@ -16,6 +16,7 @@ allowed range.  Conventions (as drawn on TSM / EU-ISO 18084 tooling drawings):
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -222,7 +223,14 @@ def _blend_geometry(w: float, Rc: float, Re: float, rb: float):
 def _blend_range(w: float, Rc: float, Re: float, min_length: float = DEFAULT.min_length) -> tuple[float, float]:
     """Blend radii (mm) at which a compound cup of half-width ``w`` with radii ``Rc > Re`` exists and
     leaves both arcs at least ``min_length`` long: its edge arc shrinks as the blend moves out, its
-    central arc grows, so they are one interval (scanned, then bisected at both ends)."""
+    central arc grows, so they are one interval (scanned, then bisected at both ends).  Remembered for
+    the 256 latest radii, as :func:`_depth_range` is."""
+    return _blend_range_of(float(w), float(Rc), float(Re), float(min_length))
+
+
+@functools.lru_cache(maxsize=256)
+def _blend_range_of(w: float, Rc: float, Re: float, min_length: float) -> tuple[float, float]:
+    """:func:`_blend_range` of Python floats (its memo)."""
     def ok(rb: float) -> bool:
         g = _blend_geometry(w, Rc, Re, rb)
         return g is not None and min(_arc_lengths(w, *g[:3], Rc, Re)) >= min_length
@@ -267,7 +275,17 @@ def _depth_range(w: float, Rc: float, Re: float, min_length: float = DEFAULT.min
     """Depths (mm) for which a compound cup of half-width ``w`` with radii ``Rc > Re`` exists and
     leaves its edge and central arcs at least ``min_length`` long (0: the radii's tangency alone).
     Scanned on a fine grid, then bisected at both ends: the edge arc grows with the depth and the
-    central arc shrinks, so the depths are one interval."""
+    central arc shrinks, so the depths are one interval.
+
+    Remembered for the 256 latest radii (a pure function of its numbers, ~2,100 constructions of
+    the profile; a search of one family's dimension, such as ``tabletcad report --solve-for``, asks
+    for it again at every depth or band it finds out of range)."""
+    return _depth_range_of(float(w), float(Rc), float(Re), float(min_length))
+
+
+@functools.lru_cache(maxsize=256)
+def _depth_range_of(w: float, Rc: float, Re: float, min_length: float) -> tuple[float, float]:
+    """:func:`_depth_range` of Python floats (its memo)."""
     hs = np.linspace(1e-6 * w, 2 * w, 2001)
     return _interval(lambda h: _buildable(w, Rc, Re, h, min_length), hs, hs[0], hs[-1])
 
