@@ -124,3 +124,16 @@ def test_a_child_that_dies_is_an_error_and_cancel_stops_a_running_one():
         pass  # leaving the block without a result cancels it
     assert time.perf_counter() - t0 < 10.0
     assert gone(sleeper.pid)
+
+
+def test_the_child_freezes_the_heap_it_inherits_and_the_parents_is_left_alone():
+    """The child's collector walks only the objects the child makes (``gc.freeze`` after the fork): the
+    parent's objects are in the child's permanent generation, none of them in the parent's."""
+    import gc
+
+    frozen_before = gc.get_freeze_count()
+    tracked = len(gc.get_objects())  # the parent's objects the collector walks (the permanent one's excepted)
+    in_child = Forked(lambda: (gc.get_freeze_count(), len(gc.get_objects()))).result()
+    assert in_child[0] >= frozen_before + tracked // 2 and in_child[1] < tracked // 2
+    assert gc.get_freeze_count() == frozen_before
+
