@@ -137,3 +137,19 @@ def test_the_child_freezes_the_heap_it_inherits_and_the_parents_is_left_alone():
     assert in_child[0] >= frozen_before + tracked // 2 and in_child[1] < tracked // 2
     assert gc.get_freeze_count() == frozen_before
 
+
+def test_import_shared_imports_what_both_drawing_children_draw_with():
+    """Run in a fresh interpreter: the modules are not there before, are after (and the picture's and the
+    drawings' modules import them from there)."""
+    import subprocess
+    import sys
+
+    code = ("import sys\n"
+            "from tabletcad.pipeline.build import SHARED_IMPORTS, import_shared\n"
+            "assert SHARED_IMPORTS and not any(m in sys.modules for m in SHARED_IMPORTS), SHARED_IMPORTS\n"
+            "import_shared()\n"
+            "assert all(m in sys.modules for m in SHARED_IMPORTS)\n"
+            "print('ok')\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                         env={**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"})
+    assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
