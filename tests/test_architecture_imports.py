@@ -21,7 +21,7 @@ PKG = ROOT / "tabletcad"
 # looked up in ``tabletcad.pipeline.model`` on first use, as attributes, never by an import of the package.
 LAYERS: list[tuple[str, ...]] = [
     ("tabletcad", "tabletcad.errors", "tabletcad.tolerance", "tabletcad.io", "tabletcad.parallel",
-     "tabletcad.readonly"),  # support
+     "tabletcad.readonly", "tabletcad.collector"),  # support
     ("tabletcad.geometry", "tabletcad.geometry.basis", "tabletcad.geometry.curves",
      "tabletcad.geometry.nominal"),  # maths: the PDE's cardinal functions, boundary curves, nominal shapes
     ("tabletcad.geometry.patch",),  # PDE patches

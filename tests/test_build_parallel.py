@@ -124,3 +124,71 @@ def test_a_child_that_dies_is_an_error_and_cancel_stops_a_running_one():
         pass  # leaving the block without a result cancels it
     assert time.perf_counter() - t0 < 10.0
     assert gone(sleeper.pid)
+
+
+def test_the_child_freezes_the_heap_it_inherits_and_the_parents_is_left_alone():
+    """The child's collector walks only the objects the child makes (``gc.freeze`` after the fork): the
+    parent's objects are in the child's permanent generation, none of them in the parent's."""
+    import gc
+
+    frozen_before = gc.get_freeze_count()
+    tracked = len(gc.get_objects())  # the parent's objects the collector walks (the permanent one's excepted)
+    in_child = Forked(lambda: (gc.get_freeze_count(), len(gc.get_objects()))).result()
+    assert in_child[0] >= frozen_before + tracked // 2 and in_child[1] < tracked // 2
+    assert gc.get_freeze_count() == frozen_before
+
+
+def test_fewer_full_collections_within_the_block_and_the_thresholds_restored_after():
+    import gc
+
+    from tabletcad.collector import FULL_FACTOR, fewer_full_collections
+
+    old = gc.get_threshold()
+    with fewer_full_collections() as inside:
+        assert inside == gc.get_threshold() == (old[0], old[1], old[2] * FULL_FACTOR) and FULL_FACTOR > 1
+    assert gc.get_threshold() == old
+    with pytest.raises(KeyError):
+        with fewer_full_collections(3):
+            assert gc.get_threshold()[2] == 3 * old[2]
+            raise KeyError("a failing build")
+    assert gc.get_threshold() == old
+    with pytest.raises(ValueError, match="factor = 0 must be >= 1"):
+        with fewer_full_collections(0):
+            pass
+
+
+def test_the_build_command_builds_with_fewer_full_collections(monkeypatch, tmp_path):
+    import gc
+
+    import tabletcad.pipeline.build as build
+    from tabletcad.cli import main
+    from tabletcad.collector import FULL_FACTOR
+
+    seen = []
+
+    def fake(*a, **k):
+        seen.append(gc.get_threshold())
+        raise DesignError("test", "build", "stops here on purpose")
+
+    monkeypatch.setattr(build, "build_design", fake)
+    old = gc.get_threshold()
+    assert main(["build", str(ROOT / "samples" / "tooling" / "concave_round_bisect.toml"), "--out",
+                 str(tmp_path / "out")]) == 2
+    assert seen == [(old[0], old[1], old[2] * FULL_FACTOR)] and gc.get_threshold() == old
+
+
+def test_import_shared_imports_what_both_drawing_children_draw_with():
+    """Run in a fresh interpreter: the modules are not there before, are after (and the picture's and the
+    drawings' modules import them from there)."""
+    import subprocess
+    import sys
+
+    code = ("import sys\n"
+            "from tabletcad.pipeline.build import SHARED_IMPORTS, import_shared\n"
+            "assert SHARED_IMPORTS and not any(m in sys.modules for m in SHARED_IMPORTS), SHARED_IMPORTS\n"
+            "import_shared()\n"
+            "assert all(m in sys.modules for m in SHARED_IMPORTS)\n"
+            "print('ok')\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                         env={**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"})
+    assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr

@@ -59,14 +59,18 @@ def _without_seconds(report: dict) -> dict:
 
 
 @pytest.mark.cad
-def test_a_parallel_tooling_build_writes_what_the_sequential_one_writes(tmp_path, recorded):
+def test_a_parallel_tooling_build_writes_what_the_sequential_one_writes(tmp_path, recorded, monkeypatch):
+    import tabletcad.pipeline.build as build
     from tabletcad.pipeline.build import build_design
 
+    shared = []  # the forks made when the two drawing children's modules were imported: none yet
+    monkeypatch.setattr(build, "import_shared", lambda: shared.append(len(recorded)))
     seq = build_design(SAMPLE, tmp_path / "seq", progress=False, parallel=False)
-    assert recorded == []
+    assert recorded == [] and shared == []
     par = build_design(SAMPLE, tmp_path / "par", progress=False, parallel=True)
     # the picture, the tooling's writers and the closed-position check's gap
     assert len(recorded) == 3 and all(gone(p) for p in recorded)
+    assert shared == [0]
     assert sorted(os.listdir(tmp_path / "par")) == sorted(os.listdir(tmp_path / "seq"))
     assert _without_seconds(par) == _without_seconds(seq)
     assert par["tooling"]["drawing"]["dimension_texts"] and par["tooling"]["files"] == seq["tooling"]["files"]

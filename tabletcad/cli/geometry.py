@@ -70,11 +70,13 @@ def shapes_cmd(as_json: bool, json_file: Path | None) -> None:
 @click.option("--quiet", is_flag=True, help="No progress display.")
 def build_cmd(design: Path, out_dir: Path, quiet: bool) -> None:
     """Build DESIGN.toml: report.json, tablet.png and CAD files in OUT."""
-    from tabletcad.pipeline.build import build_design
-
     from tabletcad.cli.report import nominal_note
+    from tabletcad.collector import fewer_full_collections
 
-    rep = build_design(design, out_dir, progress=not quiet, parallel=True)
+    with fewer_full_collections():  # the build's imports and its work (see tabletcad.collector)
+        from tabletcad.pipeline.build import build_design
+
+        rep = build_design(design, out_dir, progress=not quiet, parallel=True)
     written = rep["outputs"]  # this build's files only (the folder may hold files tabletcad did not write)
     d = rep["design"]
     size = f"{rep['length_mm']:.4g} x {rep['width_mm']:.4g} x {rep['height_mm']:.4g} mm"

@@ -6,11 +6,16 @@ writers, ezdxf), so threads would take turns; a forked child starts with the par
 value (or its exception) through a pipe and leaves with ``os._exit``, so none of the parent's
 clean-up runs twice.  It must not use OCC's thread pool, whose threads live only in the parent:
 :data:`OCC_PARALLEL` is switched off in the child (:func:`tabletcad.cad.mesh.triangulate` and the
-tooling's Booleans and distances read it).
+tooling's Booleans and distances read it).  The child freezes the heap it inherits (``gc.freeze``): its
+garbage collector then walks only the objects the child makes, not the parent's hundreds of thousands,
+whose pages a walk would also copy (it writes to each object's header).  The drawings' child of the
+tooling sample had spent 0.32 s of CPU in two full collections of 330,000 objects that freed 10,000 of
+its own.
 """
 
 from __future__ import annotations
 
+import gc
 import os
 import pickle
 import signal
@@ -103,6 +108,7 @@ class Forked:
             return
         if pid == 0:  # the child
             try:
+                gc.freeze()  # the parent's objects: kept, never walked by this child's collector (see above)
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
                 signal.signal(signal.SIGTERM, signal.SIG_DFL)
                 _die_with_parent(parent)
