@@ -13,6 +13,7 @@ import traceback
 from pathlib import Path
 
 import FreeCAD
+import Part  # noqa: E402 - (FreeCAD first)
 
 out_path = os.environ["TABLETCAD_FC_OUTPUT"]
 work = os.environ["TABLETCAD_FC_WORK"]
@@ -487,6 +488,26 @@ try:
     except Exception as exc:  # noqa: BLE001 - recorded for the test
         prism = dict(made=False, error=repr(exc))
     step("flat_rim_prism", upper_volume=float(d2up.Shape.Volume), **prism)
+
+    # ---- its rim offset edge by edge (what a punch tip falls back to where Part's 2-D offset of the whole
+    # rim fails, as OCC 7.6's did after a last-bit change of the fit), beside Part's own offset and a square's
+    rim_wire = wb_geometry._rim_wire(wb_geometry._select(wb_geometry.rims_from_json(d2.RimData), "upper")[0][0])
+    offsets = []
+    for dist in (-0.025, 0.05):
+        face = Part.Face(wb_geometry.offset_edges_wire(rim_wire, dist))
+        try:
+            whole = float(Part.Face(rim_wire.makeOffset2D(dist, 0, False, False, False)).Area)
+        except Exception:  # noqa: BLE001 - OCC 7.6 may refuse it (the fallback's reason)
+            whole = None
+        offsets.append(dict(distance=dist, area=float(face.Area), valid=bool(face.isValid()), whole_area=whole))
+    square = Part.makePolygon([FreeCAD.Vector(x, y, 0) for x, y in ((0, 0), (4, 0), (4, 4), (0, 4), (0, 0))])
+    try:
+        wb_geometry.offset_edges_wire(square, -0.1)
+        corner = "made"
+    except Exception as exc:  # noqa: BLE001 - recorded for the test
+        corner = type(exc).__name__
+    step("rim_offset_edges", rim_area=float(Part.Face(rim_wire).Area), rim_length=float(rim_wire.Length),
+         offsets=offsets, square=corner)
 
     # ---- a document of an earlier version: its die held the clearance (0.05 mm), its punch none
     d2up.removeProperty("Clearance")

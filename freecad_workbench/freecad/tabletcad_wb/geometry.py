@@ -375,12 +375,65 @@ def _offset_rim_wire(rim, distance):
         return offset_outline_wire(rim["outline"], float(distance), rim["z"])
     if "radius" in rim:
         return _rim_wire(dict(rim, radius=rim["radius"] + float(distance)))
-    wire = _rim_wire(rim).makeOffset2D(float(distance), 0, False, False, False)
+    rim_wire = _rim_wire(rim)
+    try:
+        wire = rim_wire.makeOffset2D(float(distance), 0, False, False, False)
+        failed = wire.isNull()
+    except Exception:  # noqa: BLE001 - Part.OCCError, or FreeCAD's CADKernelError ("result of offsetting is null")
+        failed = True
+    if failed:
+        # OCC 7.6 (FreeCAD 0.20) refused every 2-D offset of a free-form stadium's rim after a last-bit
+        # change of its fit (BLAS on one thread): each smooth edge offset on its own instead
+        return offset_edges_wire(rim_wire, float(distance))
     # offset curves as B-splines: FreeCAD 1.0's STEP writer drops extrusions of offset
     # curves (a die came back as an open shell of 3 of its 5 faces); an inward offset leaves
     # zero-length edges at the rim's C0 joins, which no face takes (Geom_TrimmedCurve::U1 == U2)
     edges = [e for e in wire.OrderedEdges if e.Length > 1e-9 * max(1.0, wire.Length)]
     return Part.Wire([e.toNurbs().Edges[0] for e in edges])
+
+
+#: how far apart (mm) the ends of two consecutive offset edges may lie for :func:`offset_edges_wire`
+#: to join them: the rim's edges meet tangentially (a free-form stadium's: 7e-9 mm)
+OFFSET_JOIN_MM = 1e-6
+
+
+def offset_edges_wire(wire, distance: float):
+    """The closed plan ``wire`` offset outward (away from the area it encloses) by ``distance`` mm, edge by
+    edge: each edge's exact offset curve (``Part.OffsetCurve``, as a B-spline within 1e-9 mm).  For a rim whose edges meet
+    tangentially (a fit's C0 knots at an outline's G1 joins: the offsets of two edges then start and end at
+    the same point); :class:`~tabletcad.errors.GeometryError` where two of them end more than
+    :data:`OFFSET_JOIN_MM` apart (a corner, which needs a join)."""
+    import FreeCAD
+    import Part
+
+    from tabletcad.errors import GeometryError
+
+    pts = wire.discretize(512)
+    twice_area = sum(a.x * b.y - b.x * a.y for a, b in zip(pts, pts[1:] + pts[:1]))
+    # Geom_OffsetCurve moves a point along T x Z: to the right of travel, outward on a counter-clockwise curve
+    side = 1.0 if twice_area > 0.0 else -1.0
+    edges, ends = [], []
+    for e in wire.OrderedEdges:
+        if e.Length <= 1e-9 * max(1.0, wire.Length):
+            continue
+        back = e.Orientation == "Reversed"  # travelled against its curve: the curve's right is the wire's left
+        curve = Part.OffsetCurve(e.Curve, (-side if back else side) * float(distance), FreeCAD.Vector(0, 0, 1))
+        a, b = e.FirstParameter, e.LastParameter
+        # as a B-spline to 1e-9 mm where the edge is its whole curve (a rim's edges are: _rim_wire), since
+        # toNurbs' own approximation lost 2e-7 of the area (the parallel curve's Steiner area A + P d + π d²
+        # and Part's offset of the whole rim agree to 1e-12); else toNurbs
+        whole = max(abs(a - curve.FirstParameter), abs(b - curve.LastParameter)) <= 1e-12 * max(1.0, abs(b - a))
+        edges.append(curve.approximateBSpline(1e-9, 200, 9, "C2").toShape() if whole
+                     else curve.toShape(a, b).toNurbs().Edges[0])
+        ends.append((curve.value(b), curve.value(a)) if back else (curve.value(a), curve.value(b)))
+    gaps = [(p[1] - q[0]).Length for p, q in zip(ends, ends[1:] + ends[:1])]
+    if not edges or max(gaps) > OFFSET_JOIN_MM:
+        raise GeometryError(f"the rim's offset by {distance:g} mm: its edges' offsets end {max(gaps, default=0):.3g} mm "
+                            "apart (a corner)", wire)
+    out = Part.Wire(edges)
+    if not out.isClosed():
+        raise GeometryError(f"the rim's offset by {distance:g} mm is not closed", wire)
+    return out
 
 
 def _rim_face(rims, clearance=0.0, hole_clearance=None):
