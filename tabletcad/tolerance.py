@@ -39,7 +39,8 @@ class Tolerances:
         Upper bound on the number of Fourier modes ``N`` carried analytically;
         content above it goes into the remainder term.
     samples : int
-        Default number of samples per curve used for FFTs and checks.
+        Least number of samples per curve for the FFT of a curve that is not band-limited
+        (rounded up to a multiple of 240: :func:`~tabletcad.geometry.curves.fourier_samples`).
     quad_u : int
         Gauss-Legendre points in ``u`` per patch for area/volume quadrature.
     quad_v : int

@@ -23,6 +23,7 @@ from hypothesis import strategies as st
 from tabletcad.errors import DesignError
 from tabletcad.families import FAMILIES
 from tabletcad.families.sweep import sweep_properties
+from tabletcad.geometry.curves import fourier_samples
 from tabletcad.pipeline.design import Design
 
 SAMPLES = sorted(glob.glob(os.path.join(os.path.dirname(__file__), "..", "samples", "families", "*.toml")))
@@ -135,7 +136,7 @@ def test_other_patches_with_a_familys_nominal_are_not_vouched_for():
     t = FAMILIES["oval"].build(length=14.0, width=8.0, end_radius=3.0, band=3.0, cup_depth=0.9)
     top = t.patches[-1]
     X0, X1, U0, U1 = top.data
-    S = top.tol.samples
+    S = fourier_samples(top.modes, top.tol.samples)  # the samples its series is taken from
     bumped = dataclasses.replace(top, data=(X0, X1, _Bumped(U0, S, 0.02), U1))
     assert bumped.mirrors(t.patches[0], t.mirror()[0])  # what the series shows
     u, v = np.linspace(0.0, 1.0, 9), np.linspace(0.0, 6.0, 7)

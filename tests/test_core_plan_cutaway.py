@@ -98,7 +98,8 @@ def _boundary_triangles(t, nu: int, nv: int) -> np.ndarray:
     return np.concatenate(tris)
 
 
-CASES = [("capsule", (0.0, math.pi)), ("capsule", (math.pi / 2, 2 * math.pi)), ("almond", (1.0, 4.0))]
+CASES = [("capsule", (0.0, math.pi)), ("capsule", (math.pi / 2, 2 * math.pi)), ("almond", (1.0, 4.0)),
+         ("rounded_triangle", (0.3, 2.0))]
 
 
 @pytest.mark.parametrize("name, v", CASES)

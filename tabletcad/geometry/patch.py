@@ -39,7 +39,7 @@ from tabletcad.geometry.basis import cardinal, cardinal_coefficients, cardinals
 from tabletcad.geometry.revolution import Revolution, Section, detect_revolution, detect_section
 from tabletcad.geometry.tables import CARDINAL, TRIG
 from tabletcad.geometry.curves import (basis_memo, basis_spectrum, combination_of, evaluate_curves, fourier_coefficients,
-                                      modes_needed, sample_v)
+                                      fourier_samples, modes_needed, sample_v)
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
 from tabletcad.geometry.vectors import cross, cross_first, norm3
@@ -314,8 +314,9 @@ class PDEPatch:
         # Fourier coefficients of every datum: a0 (4,3), a (4,N,3), b (4,N,3)
         limits = [getattr(c, "band_limit", lambda: None)() for c in self.data]
         band_limited = all(lim is not None and lim <= N for lim in limits)
-        # 8 N + 8 samples give a band-limited curve's coefficients exactly; others get dense ones
-        samples = 8 * N + 8 if band_limited else max(self.tol.samples, 8 * N + 8)
+        # 8 N + 8 samples give a band-limited curve's coefficients exactly; others get dense ones, a
+        # multiple of 240 (a symmetric outline's absent modes stay zero: fourier_samples)
+        samples = 8 * N + 8 if band_limited else fourier_samples(N, self.tol.samples)
         comb = combination_of(self.data)
         if comb is not None:  # one basis's coefficients, shared by every patch on it (linear in the curve)
             basis, W, const = comb
