@@ -50,7 +50,7 @@ from tabletcad.families.profile import Piece, profile_line, distance_to_chain, j
 from tabletcad.geometry.patch import PDEPatch
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tolerance import DEFAULT, Tolerances
-from tabletcad.geometry.vectors import cross, norm3
+from tabletcad.geometry.vectors import cross_first
 from tabletcad.geometry.quadrature import gauss_legendre
 
 __all__ = [
@@ -652,7 +652,6 @@ def sweep_properties(tablet: Tablet, nu: int = 24, nv_per: int = 48) -> dict[str
         v, wv = np.arange(4) * (math.tau / 4), np.full(4, math.tau / 4)
     else:
         v, wv = _rule_v(nom.outline, nv_per)
-    W = np.outer(wu, wv)
     area = vol = 0.0
     top_area = plan = cup = 0.0
     z0 = nom.band_z[1]
@@ -665,12 +664,12 @@ def sweep_properties(tablet: Tablet, nu: int = 24, nv_per: int = 48) -> dict[str
             # n' = M n, so the same area, X'·n' = X·n - 2 zm n_z, n'_z = -n_z and X'_z n'_z = X_z n_z - 2 zm n_z
             a, xn, nz, zn = sums[j]
             xn, nz, zn = xn - 2.0 * mirror[0] * nz, -nz, zn - 2.0 * mirror[0] * nz
-        else:
-            X = p.evaluate_grid(u, v)
-            n = cross(p.evaluate_grid(u, v, du=1), p.evaluate_grid(u, v, dv=1))
-            a = float(np.sum(W * norm3(n)))
-            xn = float(np.sum(W * np.einsum("uvc,uvc->uv", X, n)))
-            nz, zn = float(np.sum(W * n[..., 2])), float(np.sum(W * X[..., 2] * n[..., 2]))
+        else:  # coordinates first (a level patch's z from its spine: PDEPatch.jet_grid); Σ_ij wu_i wv_j f_ij
+            X, Xu, Xv = p.jet_grid(u, v)  # as two products, no weight grid
+            n = cross_first(Xu, Xv)
+            a = float(wu @ np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) @ wv)
+            xn = float(wu @ (X[0] * n[0] + X[1] * n[1] + X[2] * n[2]) @ wv)
+            nz, zn = float(wu @ n[2] @ wv), float(wu @ (X[2] * n[2]) @ wv)
             sums[i] = (a, xn, nz, zn)
         area += a
         vol += xn / 3.0
