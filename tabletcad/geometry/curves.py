@@ -62,7 +62,7 @@ SYMMETRY_SAMPLES = 240
 def fourier_samples(modes: int, least: int | None = None) -> int:
     """Samples per turn for the ``modes`` Fourier coefficients of a curve that is not band-limited:
     the least multiple of :data:`SYMMETRY_SAMPLES` (240) that is at least ``least`` (default
-    ``DEFAULT.samples``: 720) and ``8 modes + 8``.
+    ``DEFAULT.samples``, 512) and ``8 modes + 8``: 720 for up to 89 modes at the default.
 
     Sampled ``m`` times, mode ``n`` takes on the aliased content of modes ``n ± j m``.  A curve with
     ``k``-fold symmetry about the z axis, parametrised alike (``C(v + 2π/k)`` is ``C(v)`` turned by
