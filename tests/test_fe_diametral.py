@@ -241,23 +241,34 @@ def _averaged_line_pair_field(D, t, b, R, centres):
     X, Y = np.meshgrid(gx, gy, indexing="ij")
     inside = X**2 + Y**2 < 0.25 * D * D
     P = np.stack([X[inside], Y[inside]], axis=1)
+    A = np.array([a for a, _ in loads])  # (n, 2) load points
+    nrm = np.array([v for _, v in loads])  # (n, 2) their directions
     S = np.zeros((len(P), 2, 2))
-    for A, nrm in loads:
-        r = P - A
-        rho = np.linalg.norm(r, axis=1)
-        e = r / rho[:, None]
-        cos = e @ nrm
-        S -= (2.0 * f / math.pi) * (cos / rho)[:, None, None] * np.einsum("ki,kj->kij", e, e)
-        S += (f / (math.pi * D)) * np.eye(2)
+    block = 25  # loads at a time: the same superposition as one load after another, in whole arrays
+    for k in range(0, len(loads), block):
+        rx = P[None, :, 0] - A[k:k + block, 0, None]  # (block, points)
+        ry = P[None, :, 1] - A[k:k + block, 1, None]
+        rho = np.sqrt(rx * rx + ry * ry)
+        ex, ey = rx / rho, ry / rho
+        c = (2.0 * f / math.pi) * ((ex * nrm[k:k + block, 0, None] + ey * nrm[k:k + block, 1, None]) / rho)
+        S[:, 0, 0] -= (c * ex * ex).sum(axis=0)
+        S[:, 0, 1] -= (c * ex * ey).sum(axis=0)
+        S[:, 1, 1] -= (c * ey * ey).sum(axis=0)
+    S[:, 1, 0] = S[:, 0, 1]
+    S += len(loads) * (f / (math.pi * D)) * np.eye(2)  # Michell's uniform tension of every load element
     zq = np.linspace(-0.5 * t, 0.5 * t, 41)
     out = []
+    plan = {}  # the grid points in each plan position's ball, found once for the centres above one another
     for c in centres:
-        d2 = ((P - c[:2]) ** 2).sum(axis=1)
-        near = d2 < R * R  # the grid points in the ball's plan: every other point's weight is 0 (r² >= d² >= R²)
-        r2 = d2[near][:, None] + (zq[None, :] - c[2]) ** 2
+        if (c[0], c[1]) not in plan:
+            d2 = ((P - c[:2]) ** 2).sum(axis=1)
+            near = d2 < R * R  # the grid points in the ball's plan: every other point's weight is 0 (r² >= d² >= R²)
+            plan[c[0], c[1]] = d2[near], S[near]
+        d2, S_near = plan[c[0], c[1]]
+        r2 = d2[:, None] + (zq[None, :] - c[2]) ** 2
         w = np.where(r2 < R * R, (1 - r2 / (R * R)) ** 2, 0.0)
         w = getattr(np, "trapezoid", None)(w, zq, axis=1) if hasattr(np, "trapezoid") else np.trapz(w, zq, axis=1)
-        s = np.einsum("k,kij->ij", w, S[near]) / w.sum()
+        s = np.einsum("k,kij->ij", w, S_near) / w.sum()
         out.append(np.linalg.eigvalsh(s)[-1])
     return np.array(out)
 
