@@ -137,19 +137,20 @@ NAME = "Paracétamol 500 µg – 錠剤 O'Brien\\x 😀"
 
 @pytest.fixture(scope="module")
 def named_step(tmp_path_factory):
-    """A box written by tabletcad's STEP writer under a product name outside ASCII (once: both FreeCADs read it)."""
+    """A box written by tabletcad's STEP writer under a product name outside ASCII (once: both FreeCADs
+    read it)."""
     from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
 
     from tabletcad.cad.export import export_step
 
-    return export_step(BRepPrimAPI_MakeBox(1.0, 2.0, 3.0).Shape(), tmp_path_factory.mktemp("named") / "named.step",
-                       name=NAME)
+    path = tmp_path_factory.mktemp("named") / "named.step"
+    return export_step(BRepPrimAPI_MakeBox(1.0, 2.0, 3.0).Shape(), path, name=NAME)
 
 
 @pytest.fixture(scope="module")
 def ocp_products(files, named_step):
-    """The STEP product names of the assembly and of the named box as OCP's STEP reader sees them, read once in
-    one fresh process (OCP's import took 1.4 CPU-s a process; the tests read the names only)."""
+    """The STEP product names of the assembly and of the named box as OCP's STEP reader sees them, read
+    once in one fresh process (OCP's import took 1.4 CPU-s a process; the tests read the names only)."""
     from support.readback import ocp_read_steps
 
     out, _ = files
