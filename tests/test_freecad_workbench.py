@@ -25,6 +25,7 @@ warning says so.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -185,13 +186,27 @@ def _run(exe: tuple[str, ...], script: Path, home: Path, work: Path, timeout: fl
 
 
 def _core_volume(family: str | None, params: dict | None = None, design: Path | None = None) -> float:
-    """tabletcad's own report value (volume_mm3) in this (venv) Python."""
-    from tabletcad import families
+    """tabletcad's own report value (volume_mm3) in this (venv) Python (each asked once: both FreeCADs'
+    tests ask for the same ones)."""
+    return _core_volume_of(family, tuple(sorted((params or {}).items())), design)
+
+
+@functools.lru_cache(maxsize=None)
+def _core_volume_of(family: str | None, params: tuple, design: Path | None) -> float:
     from tabletcad.pipeline.design import load_design
     from tabletcad.pipeline.report import geometry_report
 
-    tablet = load_design(design) if design else families.FAMILIES[family].build(**(params or {}))
+    tablet = load_design(design) if design else _core_tablet(family, params)
     return geometry_report(tablet)["volume_mm3"]
+
+
+@functools.lru_cache(maxsize=None)
+def _core_tablet(family: str, params: tuple = ()):
+    """The core's tablet of ``family`` (``params``: sorted ``(name, value)`` pairs), built once for the module
+    (the tests only read it)."""
+    from tabletcad import families
+
+    return families.FAMILIES[family].build(**dict(params))
 
 
 # ------------------------------------------------------------------------------------------- headless
@@ -252,11 +267,10 @@ def test_tooling_valid_and_linked(headless, family):
     assert up["bbox"][2] <= tab["bbox"][5] + 1e-6 and low["bbox"][5] >= tab["bbox"][2] - 1e-6
     assert up["bbox"][5] == pytest.approx(step["rim_z"][0] + 10.0, abs=1e-6)  # 10 mm tips from the band edges
     assert low["bbox"][2] == pytest.approx(step["rim_z"][1] - 10.0, abs=1e-6)
-    from tabletcad import families
     from tabletcad.tooling.spec import standard_die_size
 
     box = tab["tight_bbox"]
-    shaped = families.FAMILIES[family].build().revolution is None
+    shaped = _core_tablet(family).revolution is None
     od, height, _ = standard_die_size(max(box[3] - box[0], box[4] - box[1]), shaped=shaped)
     # the TSM die for its size, as build takes it: the 18 mm capsule's is a B (shaped tablets up to 19 mm)
     assert (od, shaped) == ((30.16, True) if family == "capsule" else (od, False))
@@ -268,7 +282,7 @@ def test_tooling_valid_and_linked(headless, family):
 
         # annular punch: the clearance c inside the die bore (the outline grown by the band's bulge b, 3 µm)
         # and c outside the ring's hole: pi ((R + b - c)^2 - (r + c)^2) x 10 mm (to the cup's volume under it)
-        c, b = 0.025, families.FAMILIES["thesis.ring"].build().plan_overhang()
+        c, b = 0.025, _core_tablet("thesis.ring").plan_overhang()
         assert 0.002 < b < 0.004
         assert up["volume"] == pytest.approx(math.pi * ((6.0 + b - c) ** 2 - (3.0 + c) ** 2) * 10.0, rel=2e-4)
 
@@ -294,11 +308,10 @@ def test_capsule_die_bore_is_the_exact_outline_and_the_tips_its_inward_offset(he
     pi b^2) H (Steiner), A and P from the core's outline (the bore had been the outline offset outward
     by the clearance: a 10 mm design got a 10.10 mm die).  The punch tips are the bore offset inward
     by the clearance c (as build's): plan extents length + 2b - 2c by width + 2b - 2c."""
-    from tabletcad import families
     from tabletcad.tooling.spec import MIN_BORE_OFFSET_MM, standard_die_size
 
     (step,) = [s for s in _steps(headless, "tooling") if s["family"] == "capsule"]
-    tablet = families.FAMILIES["capsule"].build()
+    tablet = _core_tablet("capsule")
     outline = tablet.nominal.outline
     A, P = _outline_area_perimeter(outline.segs)
     b = tablet.plan_overhang()
@@ -407,7 +420,7 @@ def test_properties_finite_in_user_units_and_internal_data_hidden(headless):
         assert t["props"]["Density"] == pytest.approx(1.2) and t["weight_mg"] > 0
         assert sorted(t["rimdata_mode"]) == ["Hidden", "ReadOnly"]
         fam, params = step["family"], FAMILIES[step["family"]]
-        core = families.FAMILIES[fam].build(**params)
+        core = _core_tablet(fam, tuple(sorted(params.items())))
         assert t["plan_area"] == pytest.approx(core.plan_area(), rel=1e-12), fam
         rel = 1e-6 + 4.0 * core.plan_overhang() / max(core.dimensions()["width_mm"], 1e-9)  # the bulge's share
         d = params.get("diameter", families.FAMILIES[fam].defaults.get("diameter"))
@@ -418,7 +431,7 @@ def test_properties_finite_in_user_units_and_internal_data_hidden(headless):
             b = core.plan_overhang()
             assert t["plan_area"] == pytest.approx(math.pi * ((d / 2) ** 2 - r * r), rel=2 * math.pi * (d / 2 + r) * b / 84.8 + 1e-4)
         elif fam == "capsule":
-            A, _ = _outline_area_perimeter(families.FAMILIES["capsule"].build().nominal.outline.segs)
+            A, _ = _outline_area_perimeter(_core_tablet("capsule").nominal.outline.segs)
             assert t["plan_area"] == pytest.approx(A, rel=rel)
         elif d is not None:  # within the silhouette's growth over the design diameter (a sphere's 5.5 µm)
             grown = abs(core.dimensions()["width_mm"] - d) / d
@@ -481,10 +494,8 @@ def test_task_panel_form(headless):
 def test_techdraw_page_with_main_dimensions(headless):
     """A TechDraw page of the capsule: top and side views on FreeCAD's A4 template and extent
     dimensions equal to the core's length, width and height."""
-    from tabletcad import families
-
     (st,) = _steps(headless, "drawing")
-    dims = families.FAMILIES["capsule"].build().dimensions()
+    dims = _core_tablet("capsule").dimensions()
     assert st["page"] == "TechDraw::DrawPage" and st["template"].startswith("A4_Landscape")
     assert [v[1] for v in st["views"]] == [[0.0, 0.0, 1.0], [0.0, -1.0, 0.0]] and all(v[2] for v in st["views"])
     for key in ("length", "width", "height"):
@@ -763,8 +774,10 @@ def _png_stats(path: Path):
     import numpy as np
 
     img = mpimg.imread(str(path))[..., :3]
-    flat = img.reshape(-1, 3)
-    return float(img.std()), len(np.unique((flat * 255).astype(np.uint8), axis=0))
+    rgb = (img.reshape(-1, 3) * 255).astype(np.uint8).astype(np.uint32)
+    # distinct colours: each pixel's three bytes packed into one integer (np.unique over rows, axis=0, took
+    # 0.6-0.9 s a screenshot for the same count)
+    return float(img.std()), len(np.unique((rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]))
 
 
 def _start_xvfb():
@@ -863,9 +876,7 @@ def test_gui_smoke_and_screenshot(fc, fc_home, assembly_step, tmp_path):
     assert r["panel_edit_accept"] and r["panel_edited"] == [10.0004, 0.08349, pytest.approx(1.1, abs=1e-12), True]
     assert r["design_file_edit"] == [True, False, "design_file", True]
     # the TechDraw page of the concave round tablet: length, width and height as the core has them
-    from tabletcad import families as _families
-
-    core_dims = _families.FAMILIES["concave_round"].build(cup_depth=1.0).dimensions()
+    core_dims = _core_tablet("concave_round", (("cup_depth", 1.0),)).dimensions()
     assert sorted(r["drawing"]) == ["concave_round height", "concave_round length", "concave_round width"]
     for key, value in r["drawing"].items():
         # TechDraw's extent of the projected edges: 1.0 measured 3.1e-6 mm off on the diameter

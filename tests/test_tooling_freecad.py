@@ -80,7 +80,7 @@ def _freecad_part_read(fc, path, tmp_path, mode="read"):
     return (json.loads(out.read_text()) if out.exists() else None), proc
 
 
-def test_freecad_reads_the_assembly_as_valid_solids_with_named_parts(fc, files, tmp_path):
+def test_freecad_reads_the_assembly_as_valid_solids_with_named_parts(fc, files, ocp_products, tmp_path):
     """Part.read gives the four valid solids; Import.insert the four named parts - with
     FreeCAD's default import settings on 1.0, and without link groups on 0.20 (whose
     default crashes on any multi-part STEP, see the next test)."""
@@ -95,9 +95,7 @@ def test_freecad_reads_the_assembly_as_valid_solids_with_named_parts(fc, files, 
     # names as FreeCAD's own importer sees them: four valid, named solids
     assert r["named_solids"] == {"tablet": True, "upper_punch": True, "lower_punch": True, "die": True}
     # and the XCAF product names as OCP's STEP reader sees them in a fresh process
-    from support.readback import ocp_read_step
-
-    products = ocp_read_step(out / "assembly.step")["products"]
+    products = ocp_products["assembly"]
     assert {"tablet", "upper_punch", "lower_punch", "die"} <= set(products)
 
 
@@ -137,25 +135,43 @@ open(os.environ["TABLETCAD_FC_OUTPUT"], "w", encoding="utf-8").write(
 NAME = "Paracétamol 500 µg – 錠剤 O'Brien\\x 😀"
 
 
-def test_a_unicode_name_is_written_in_part21_directives_and_read_back(fc, tmp_path):
+@pytest.fixture(scope="module")
+def named_step(tmp_path_factory):
+    """A box written by tabletcad's STEP writer under a product name outside ASCII (once: both FreeCADs
+    read it)."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+
+    from tabletcad.cad.export import export_step
+
+    path = tmp_path_factory.mktemp("named") / "named.step"
+    return export_step(BRepPrimAPI_MakeBox(1.0, 2.0, 3.0).Shape(), path, name=NAME)
+
+
+@pytest.fixture(scope="module")
+def ocp_products(files, named_step):
+    """The STEP product names of the assembly and of the named box as OCP's STEP reader sees them, read
+    once in one fresh process (OCP's import took 1.4 CPU-s a process; the tests read the names only)."""
+    from support.readback import ocp_read_steps
+
+    out, _ = files
+    assembly, named = ocp_read_steps([out / "assembly.step", named_step], measure=())
+    return {"assembly": assembly["products"], "named": named["products"]}
+
+
+def test_a_unicode_name_is_written_in_part21_directives_and_read_back(fc, named_step, ocp_products, tmp_path):
     """OCC writes a product name outside ASCII as raw UTF-8 bytes under a header of Part 21's second
     edition (basic alphabet only); tabletcad writes ``\\X2\\...\\X0\\`` (``\\X4\\`` beyond U+FFFF), and
     OCC's reader and FreeCAD's importer give the name back."""
     import json
     import subprocess
 
-    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
-
-    from support.readback import ocp_read_step
-    from tabletcad.cad.export import export_step
-
-    path = export_step(BRepPrimAPI_MakeBox(1.0, 2.0, 3.0).Shape(), tmp_path / "named.step", name=NAME)
+    path = named_step
     raw = path.read_bytes()
     assert max(raw) < 0x80  # the whole file is ASCII
     text = raw.decode("ascii")
     assert "'Parac\\X2\\00E9\\X0\\tamol 500 \\X2\\00B5\\X0\\g \\X2\\2013\\X0\\ \\X2\\93205264\\X0\\ O''Brien\\\\x " \
            "\\X4\\0001F600\\X0\\'" in text
-    assert NAME in ocp_read_step(path)["products"]
+    assert NAME in ocp_products["named"]
     script = tmp_path / "fc_name.py"
     script.write_text(_NAME_READ)
     out = tmp_path / "names.json"
