@@ -216,12 +216,18 @@ def _tight_z_range(shape, low: bool, high: bool) -> tuple[float | None, float | 
             entries.append((-math.inf, math.inf, f))
     q_lo, q_hi = min(e[0] for e in entries), max(e[1] for e in entries)
     entries.sort(key=lambda e: min(e[0] - q_lo if low else math.inf, q_hi - e[1] if high else math.inf))
+    def face_z(face) -> tuple[float, float] | None:  # a face's optimal z range, None for a void box
+        box = optimal(face)
+        return None if box.IsVoid() else (box.CornerMin().Z(), box.CornerMax().Z())
+
     lo, hi = math.inf, -math.inf
     for f_lo, f_hi, face in entries:
         if (low and f_lo <= lo) or (high and f_hi >= hi):
-            box = optimal(face)
-            if not box.IsVoid():  # (a face of a triangulation alone: OCC's whole box skips it too)
-                lo, hi = min(lo, box.CornerMin().Z()), max(hi, box.CornerMax().Z())
+            # once per face (CACHE.faces): a shape asked for one side and then the other, or a face
+            # another shape shares, is not optimised again (the same OCC computation of the same face)
+            z = CACHE.faces.get(face, ("optimal z range",), lambda f=face: face_z(f))
+            if z is not None:  # (a face of a triangulation alone: OCC's whole box skips it too)
+                lo, hi = min(lo, z[0]), max(hi, z[1])
     return (lo if low else None), (hi if high else None)
 
 
