@@ -315,31 +315,35 @@ def test_a_plot_of_no_column_is_refused_before_any_design_is_built(tmp_path, cap
         assert "design.name" not in allowed and "status" not in allowed and "tablet.band" not in allowed
 
 
-def test_a_plot_column_no_design_had_keeps_the_results_and_says_where(tmp_path, capsys):
+def test_a_plot_column_no_design_had_keeps_the_results_and_says_where(tmp_path, capsys, local_client):
     """A column left to the end (its section exists) that no design's report has: the sweep's results
-    stay, the one line says where they are, and ``--resume`` plots another column without rebuilding."""
+    stay, the one line says where they are, and ``--resume`` plots another column without rebuilding.
+    (On the module's cluster: a local one of its own cost a cluster start-up a command; the plot
+    checks do not depend on the engine.)"""
     sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
     out = tmp_path / "sw"
-    rc = main(["sweep", str(sweep), "--out", str(out), "--workers", "1", "--quiet", "--plot",
+    engine = ["--scheduler", local_client.scheduler.address]
+    rc = main(["sweep", str(sweep), "--out", str(out), *engine, "--quiet", "--plot",
                "design_report.cup_radii_mm.central"])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1
     assert err[0].startswith("error: --plot = 'design_report.cup_radii_mm.central' is not allowed: must be a report "
                              f"column of results.csv (the results are in {out / 'results.csv'}: plot another column with --resume): ")
     assert sorted(p.name for p in out.iterdir()) == ["results.csv"]
-    assert main(["sweep", str(sweep), "--out", str(out), "--workers", "1", "--quiet", "--resume", "--plot",
+    assert main(["sweep", str(sweep), "--out", str(out), *engine, "--quiet", "--resume", "--plot",
                  "volume_mm3"]) == 0
     assert sorted(p.name for p in out.iterdir()) == ["plot_volume_mm3.png", "results.csv"]
 
 
-def test_a_plot_column_every_design_leaves_empty_says_so(tmp_path, capsys):
+def test_a_plot_column_every_design_leaves_empty_says_so(tmp_path, capsys, local_client):
     """A new user's ``--plot design_report.punch_tip_check.compaction_force_kN``: a column of every report,
     so accepted before the run, but empty in every row (the sweep's design gives no compaction force).
     The refusal had said it was no report column, listing it among those that are."""
     sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
     out = tmp_path / "sw"
     col = "design_report.punch_tip_check.compaction_force_kN"
-    rc = main(["sweep", str(sweep), "--out", str(out), "--workers", "1", "--quiet", "--plot", col])
+    rc = main(["sweep", str(sweep), "--out", str(out), "--scheduler", local_client.scheduler.address, "--quiet",
+               "--plot", col])  # (on the module's cluster, as above)
     err = capsys.readouterr().err.strip().splitlines()
     n = len(pd.read_csv(out / "results.csv"))
     assert rc == 2 and err == [f"error: --plot = '{col}' is not allowed: must be a report column with a number in "
