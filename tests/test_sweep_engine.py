@@ -41,10 +41,17 @@ KEY = "tablet.cup_depth"
 
 @pytest.fixture(scope="module")
 def local_client():
+    import dask
     from distributed import Client, LocalCluster
 
-    with LocalCluster(n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None) as cluster, \
-            Client(cluster, set_as_default=False) as client:
+    # the workers without the statistical profiler, as tabletcad's own local clusters (open_client): a thread
+    # sampling each worker's stack every 10 ms (idle, the two workers took 1.75 CPU-s in 30 s with it, 1.08
+    # without); and the event loops' latency tick (a measurement only) every second, not every 20 ms (idle,
+    # this process 1.02 -> 0.55 and the two workers 0.97 -> 0.45 CPU-s in 30 s). Set for the start only: this
+    # process's own settings stay (the open_client tests read them)
+    with dask.config.set({"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "1s"}):
+        cluster = LocalCluster(n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None)
+    with cluster, Client(cluster, set_as_default=False) as client:
         client.wait_for_workers(2, timeout=120)
         yield client
 
@@ -55,9 +62,10 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def scheduler_address(tmp_path_factory):
-    """``dask scheduler`` and one ``dask worker`` started as separate processes; stopped at the end."""
+    """``dask scheduler`` and one ``dask worker`` started as separate processes; stopped after the test
+    (the one that uses them: kept to the module's end, they polled idle through every later test)."""
     from distributed import Client
 
     port = _free_port()
@@ -315,31 +323,35 @@ def test_a_plot_of_no_column_is_refused_before_any_design_is_built(tmp_path, cap
         assert "design.name" not in allowed and "status" not in allowed and "tablet.band" not in allowed
 
 
-def test_a_plot_column_no_design_had_keeps_the_results_and_says_where(tmp_path, capsys):
+def test_a_plot_column_no_design_had_keeps_the_results_and_says_where(tmp_path, capsys, local_client):
     """A column left to the end (its section exists) that no design's report has: the sweep's results
-    stay, the one line says where they are, and ``--resume`` plots another column without rebuilding."""
+    stay, the one line says where they are, and ``--resume`` plots another column without rebuilding.
+    (On the module's cluster: a local one of its own cost a cluster start-up a command; the plot
+    checks do not depend on the engine.)"""
     sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
     out = tmp_path / "sw"
-    rc = main(["sweep", str(sweep), "--out", str(out), "--workers", "1", "--quiet", "--plot",
+    engine = ["--scheduler", local_client.scheduler.address]
+    rc = main(["sweep", str(sweep), "--out", str(out), *engine, "--quiet", "--plot",
                "design_report.cup_radii_mm.central"])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1
     assert err[0].startswith("error: --plot = 'design_report.cup_radii_mm.central' is not allowed: must be a report "
                              f"column of results.csv (the results are in {out / 'results.csv'}: plot another column with --resume): ")
     assert sorted(p.name for p in out.iterdir()) == ["results.csv"]
-    assert main(["sweep", str(sweep), "--out", str(out), "--workers", "1", "--quiet", "--resume", "--plot",
+    assert main(["sweep", str(sweep), "--out", str(out), *engine, "--quiet", "--resume", "--plot",
                  "volume_mm3"]) == 0
     assert sorted(p.name for p in out.iterdir()) == ["plot_volume_mm3.png", "results.csv"]
 
 
-def test_a_plot_column_every_design_leaves_empty_says_so(tmp_path, capsys):
+def test_a_plot_column_every_design_leaves_empty_says_so(tmp_path, capsys, local_client):
     """A new user's ``--plot design_report.punch_tip_check.compaction_force_kN``: a column of every report,
     so accepted before the run, but empty in every row (the sweep's design gives no compaction force).
     The refusal had said it was no report column, listing it among those that are."""
     sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
     out = tmp_path / "sw"
     col = "design_report.punch_tip_check.compaction_force_kN"
-    rc = main(["sweep", str(sweep), "--out", str(out), "--workers", "1", "--quiet", "--plot", col])
+    rc = main(["sweep", str(sweep), "--out", str(out), "--scheduler", local_client.scheduler.address, "--quiet",
+               "--plot", col])  # (on the module's cluster, as above)
     err = capsys.readouterr().err.strip().splitlines()
     n = len(pd.read_csv(out / "results.csv"))
     assert rc == 2 and err == [f"error: --plot = '{col}' is not allowed: must be a report column with a number in "

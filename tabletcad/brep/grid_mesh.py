@@ -314,7 +314,15 @@ def _cell_deviation(s: BSplineSurfaceData, u: np.ndarray, v: np.ndarray, V: np.n
     cj, b = _lattice_cells(m, n)
     cell = (ci[:, None], cj[None, :])
     weights = _lattice_weights((a / n)[:, None], (b / n)[None, :], diag[cell])
-    M = sum(w * V[:, idx[cell]] for w, idx in zip(weights, corners))  # (3, n nu1 + 1, n m + 1)
+    M = None  # (3, n nu1 + 1, n m + 1): the weighted corners, summed in place (the same sums, fewer arrays)
+    for w, idx in zip(weights, corners):
+        term = V[:, idx[cell]]
+        term *= w
+        if M is None:
+            M = term
+            M += 0.0  # (as sum() did, from 0: 0 + x, a -0.0 made +0.0)
+        else:
+            M += term
     D = M - S
     h = _dot(D, Nrm)
     dd = _dot(D, D)

@@ -34,11 +34,18 @@ def weld(V: np.ndarray, T: np.ndarray, tol: float, tri_labels: np.ndarray | None
     first = np.full(labels.max() + 1, n, dtype=np.int64)
     np.minimum.at(first, labels, np.arange(n))
     roots = first[labels]
-    uniq, inverse = np.unique(roots, return_inverse=True)
+    # np.unique(roots, return_inverse=True) and np.unique(T) as masks over the node numbers: the same
+    # sorted numbers and indices in O(n) (numpy 2's hashing unique took 0.3 s of a 500,000-triangle weld)
+    is_root = np.zeros(n, dtype=bool)
+    is_root[roots] = True
+    uniq = np.flatnonzero(is_root)
+    inverse = (np.cumsum(is_root, dtype=np.int64) - 1)[roots]
     T = inverse[T]
     keep = (T[:, 0] != T[:, 1]) & (T[:, 1] != T[:, 2]) & (T[:, 0] != T[:, 2])
     T = T[keep]
-    used = np.unique(T)
+    is_used = np.zeros(len(uniq), dtype=bool)
+    is_used[T] = True
+    used = np.flatnonzero(is_used)
     remap = -np.ones(len(uniq), dtype=np.int64)
     remap[used] = np.arange(used.size)
     out = np.ascontiguousarray(V[uniq[used]]), np.ascontiguousarray(remap[T])
