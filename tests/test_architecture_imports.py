@@ -6,6 +6,7 @@ solids; the family catalogue is one static mapping; nothing registers itself at 
 from __future__ import annotations
 
 import ast
+import functools
 import subprocess
 import sys
 from pathlib import Path
@@ -66,12 +67,19 @@ def _resolve(name: str) -> str | None:
     return name or None
 
 
-def _imports(module: str) -> list[tuple[str, int]]:
-    """Every import of ``module`` anywhere in its file (functions included): (imported name, line)."""
+@functools.lru_cache(maxsize=None)
+def _source(path: Path) -> str:
+    return path.read_text(encoding="utf-8")
+
+
+@functools.lru_cache(maxsize=None)
+def _imports(module: str) -> tuple[tuple[str, int], ...]:
+    """Every import of ``module`` anywhere in its file (functions included): (imported name, line).
+    Each file is parsed once per test session (the files do not change while the tests run)."""
     path = MODULES[module]
     package = module if path.name == "__init__.py" else module.rpartition(".")[0]
     out = []
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+    for node in ast.walk(ast.parse(_source(path))):
         if isinstance(node, ast.Import):
             out += [(a.name, node.lineno) for a in node.names]
         elif isinstance(node, ast.ImportFrom):
@@ -82,11 +90,11 @@ def _imports(module: str) -> list[tuple[str, int]]:
                 mod = node.module or ""
             out.append((mod, node.lineno))
             out += [(f"{mod}.{a.name}", node.lineno) for a in node.names]
-    return out
+    return tuple(out)
 
 
 def _graph() -> dict[str, dict[str, int]]:
-    """Module -> {imported tabletcad module: line}."""
+    """Module -> {imported tabletcad module: line} (a fresh dict each call, from the cached parses)."""
     graph: dict[str, dict[str, int]] = {m: {} for m in MODULES}
     for m in MODULES:
         for name, line in _imports(m):
@@ -180,7 +188,7 @@ def test_nothing_registers_itself_at_import_time():
     """No in-tree code adds to a registry when imported: the catalogue, the report and the build's
     steps are written out where they are used."""
     for name in ("register_stage", "register_family", "register_report_section", "_load_plugins"):
-        hits = [str(p.relative_to(ROOT)) for p in PKG.rglob("*.py") if name in p.read_text(encoding="utf-8")]
+        hits = [str(p.relative_to(ROOT)) for p in PKG.rglob("*.py") if name in _source(p)]
         assert hits == [], name
 
 

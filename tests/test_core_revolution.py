@@ -6,6 +6,7 @@ Numpy and scipy only (runs in the core-only pass too).
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -156,7 +157,9 @@ class _Section:
 
     def evaluate(self, v, der=0):
         v = np.asarray(v, float).reshape(-1)
-        c, s = [(np.cos(v), np.sin(v)), (-np.sin(v), np.cos(v)), (-np.cos(v), -np.sin(v)), (np.sin(v), -np.cos(v))][der % 4]
+        # d/dv of (cos, sin), der times: only the pair asked for (the same values as building all four)
+        cv, sv = np.cos(v), np.sin(v)
+        c, s = [(cv, sv), (-sv, cv), (-cv, -sv), (sv, -cv)][der % 4]
         out = np.zeros((v.size, 3))
         out[:, :2] = self.rho * (np.outer(c, self.p) + np.outer(s, self.q))
         if der == 0:
@@ -293,6 +296,13 @@ def test_fold_checks_of_a_section_decide_as_the_sampled_ones(rho, z, angle, aspe
     assert patch.fold_depth() == pytest.approx(patch._fold_depth_of(257, 64)[0], abs=1e-9 * max(1.0, max(map(abs, rho))))
 
 
+@functools.lru_cache(maxsize=None)
+def _caplet_and_round():
+    """The two whole tablets the trim test cuts (each example trims them afresh; built once)."""
+    return (FAMILIES["thesis.caplet"].build(),
+            FAMILIES["concave_round"].build(diameter=10.0, band=3.0, cup_depth=1.0, land=0.08))
+
+
 @settings(max_examples=8, deadline=None)
 @given(v0=st.floats(-3.0, 3.0), dv=st.floats(0.2, 6.2), u0=st.sampled_from([0.0, 0.1]), w=st.sampled_from([(0.0, 1.0), (0.0, 0.7), (0.4, 1.0)]))
 def test_trimmed_section_bounds_equal_the_sampled_ones_and_a_cut_away_plan_is_a_sector(v0, dv, u0, w):
@@ -303,9 +313,8 @@ def test_trimmed_section_bounds_equal_the_sampled_ones_and_a_cut_away_plan_is_a_
     of its widest section: ``(v1 - v0) / 2π`` of the whole plan, ``½ (D/2)² (v1 - v0)`` for the round
     (with or without a shell: both reach the axis).
     The solid map's volume (and the round's area and volume) on four points in v equal 256."""
-    caplet = FAMILIES["thesis.caplet"].build()
     d = 10.0
-    rnd = FAMILIES["concave_round"].build(diameter=d, band=3.0, cup_depth=1.0, land=0.08)
+    caplet, rnd = _caplet_and_round()
     for t in (caplet, rnd):
         cut = t.trimmed(u=(u0, 1.0 - u0), v=(v0, v0 + dv), w=w)
         assert cut.section is not None
