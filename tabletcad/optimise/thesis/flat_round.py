@@ -41,19 +41,20 @@ class RoundDesign:
 
 
 @functools.lru_cache(maxsize=32)
-def _round_geometry(key: bytes, check: bool, fast: bool) -> tuple[Tablet, float, float]:
-    """The tablet of the radii and heights packed in ``key`` (8 float64), its volume and largest radius.
+def _round_geometry(key: bytes, n: int, check: bool, fast: bool) -> tuple[Tablet, float, float]:
+    """The tablet of the ``n`` radii and ``n`` heights packed in ``key`` (float64), its volume (mm³) and
+    largest radius (mm).
     A solver's finite differences in ``P`` and ``A`` (and its line searches) ask for the same shape
     again: it is built once (the same floats give the same tablet, bit for bit)."""
     rz = np.frombuffer(key, dtype=float)
-    t = round_tablet(tuple(float(r) for r in rz[:4]), tuple(float(z) for z in rz[4:]), check=check, fast=fast)
+    t = round_tablet(tuple(float(r) for r in rz[:n]), tuple(float(z) for z in rz[n:]), check=check, fast=fast)
     return t, t.volume(), _profile_max_radius(t.patches[1])
 
 
 def _round_eval(radii, heights, P, A, *, mass_mg, true_density, E, nu, displacement, omega_z0, density="volume",
                 check=False, fast=True) -> RoundDesign:
     key = np.asarray([*radii, *heights], dtype=float).tobytes()
-    t, vol, c = _round_geometry(key, bool(check), bool(fast))
+    t, vol, c = _round_geometry(key, len(radii), bool(check), bool(fast))
     h0 = float(heights[3] - heights[0])
     # the cylinder of eqs 5.18 and 6.1: the one with the tablet's volume and height ("volume"), whose
     # π c² t is the loaded volume (V/h0) t, or the one of the largest radius (eq 6.2 as printed, "cylinder")
