@@ -1,5 +1,6 @@
 """Tessellation checks, exporters and STEP read-back with OCP in a fresh process."""
 
+import functools
 import re
 import struct
 import xml.etree.ElementTree as ET
@@ -16,7 +17,7 @@ trimesh = pytest.importorskip("trimesh")
 
 from tabletcad.cad.export import export  # noqa: E402
 from tabletcad.cad.mesh import tessellate  # noqa: E402
-from support.readback import ocp_read_step  # noqa: E402
+from support.readback import ocp_read_steps  # noqa: E402
 from tabletcad.cad.solid import build_solid  # noqa: E402
 from support.standins import cylinder, ring, sphere  # noqa: E402
 
@@ -24,10 +25,32 @@ pytestmark = pytest.mark.cad
 STANDINS = [sphere(2.5), cylinder(2.5, 3.0), ring(1.5, 3.0, 2.0)]
 
 
-@pytest.fixture(scope="module", params=STANDINS, ids=lambda s: s.name)
-def built(request):
-    s = request.param
+UNICODE_NAME = "Tablette Ø10 – «test» 日本"
+
+
+@functools.cache
+def _built(i: int):
+    s = STANDINS[i]
     return s, build_solid(s.patches, 1e-4, name=s.name.replace(" ", "_"))
+
+
+@pytest.fixture(scope="module", params=range(len(STANDINS)), ids=[s.name for s in STANDINS])
+def built(request):
+    return _built(request.param)
+
+
+@pytest.fixture(scope="module")
+def read_back(tmp_path_factory):
+    """The STEP files the read-back tests check, read by OCP in *one* fresh process (one OCP import, not
+    one per file): each stand-in as ``part.step`` (by its index), and the stand-in sphere under a name
+    beyond ASCII as ``u.step`` (key ``"unicode"``).  ``{key: (path, result)}``."""
+    paths = {}
+    for i in range(len(STANDINS)):
+        _, ts = _built(i)
+        paths[i] = export(ts, tmp_path_factory.mktemp(f"standin{i}") / "part.step")
+    ts = build_solid(STANDINS[0].patches, 1e-4, name="standin")
+    paths["unicode"] = export(ts, tmp_path_factory.mktemp("unicode") / "u.step", name=UNICODE_NAME)
+    return {k: (p, r) for (k, p), r in zip(paths.items(), ocp_read_steps(list(paths.values())))}
 
 
 @pytest.mark.parametrize("deflection", [0.01, 0.002])
@@ -47,14 +70,13 @@ def test_finer_mesh_is_closer(built):
     assert abs(fine.volume - ts.volume) < abs(coarse.volume - ts.volume)
 
 
-def test_step_text_and_fresh_process_readback(built, tmp_path):
+def test_step_text_and_fresh_process_readback(built, read_back):
     s, ts = built
-    path = export(ts, tmp_path / "part.step")
+    path, r = read_back[next(i for i in range(len(STANDINS)) if STANDINS[i] is s)]
     text = path.read_text()
     assert "SI_UNIT(.MILLI.,.METRE.)" in text.replace(" ", "")
     assert re.search(r"PRODUCT\s*\(\s*'%s'" % re.escape(ts.name), text)
     assert "AP242" in text
-    r = ocp_read_step(path)
     assert r["n_solids"] == 1 and r["valid"]
     assert r["n_faces"] == len(s.patches)
     assert r["products"] == [ts.name]
@@ -120,7 +142,7 @@ def test_unknown_suffix_and_atomicity(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["x.step"]  # no temporary left behind
 
 
-def test_a_name_beyond_ascii_reads_back_as_written(tmp_path):
+def test_a_name_beyond_ascii_reads_back_as_written(read_back):
     """A design name in any script (design files allow it) is the STEP PRODUCT's name, read back the
     same by STEPControl (fresh process) and by STEPCAFControl's document; it came back double-encoded
     ('Ã\\x98' for 'Ø') when the name was handed to OCC as bytes of Latin-1."""
@@ -131,10 +153,9 @@ def test_a_name_beyond_ascii_reads_back_as_written(tmp_path):
     from OCP.TDocStd import TDocStd_Document
     from OCP.XCAFDoc import XCAFDoc_DocumentTool
 
-    name = "Tablette Ø10 – «test» 日本"
-    ts = build_solid(STANDINS[0].patches, 1e-4, name="standin")
-    path = export(ts, tmp_path / "u.step", name=name)
-    assert ocp_read_step(path)["products"] == [name]
+    name = UNICODE_NAME
+    path, r = read_back["unicode"]  # build_solid(STANDINS[0].patches, 1e-4, name="standin"), exported as `name`
+    assert r["products"] == [name]
     doc = TDocStd_Document(TCollection_ExtendedString("XmlOcaf"))
     reader = STEPCAFControl_Reader()
     reader.SetNameMode(True)

@@ -72,14 +72,25 @@ def test_every_family_has_a_sample():
 
 
 @pytest.mark.parametrize("path", SAMPLES, ids=[p.stem for p in SAMPLES])
-def test_family_sample_builds_an_exact_solid(path, tmp_path):
+def test_family_sample_builds_an_exact_solid(path, tmp_path, monkeypatch):
+    import tabletcad.cad.tablet_solid as tablet_solid_module
+
     t, design = _design(path)
     cert = t.nominal.certificate
     assert cert is not None and cert.passed and cert.max_deviation_mm <= t.tol.nominal <= 1e-3
 
-    # the whole build: report, picture, STEP, STL, GLB
+    # the whole build: report, picture, STEP, STL, GLB; the solid it fits (``tablet_solid(t)``, the same
+    # call as below had made a second time) is kept for the checks of the solid itself
+    real, made = tablet_solid_module.tablet_solid, []
+
+    def keeping(*args, **kwargs):
+        made.append(real(*args, **kwargs))
+        return made[-1]
+
+    monkeypatch.setattr(tablet_solid_module, "tablet_solid", keeping)
     out = tmp_path / path.stem
     rep = build_tablet(t, out, tooling=design.tooling_spec, options=design.report_options, progress=False)
+    monkeypatch.undo()
     for name in ("tablet.step", "tablet.stl", "tablet.glb", "tablet.png", "report.json"):
         assert (out / name).is_file() and (out / name).stat().st_size > 0, name
     assert json.loads((out / "report.json").read_text())["brep"]["valid"] is True
@@ -88,8 +99,9 @@ def test_family_sample_builds_an_exact_solid(path, tmp_path):
     assert abs(b["area_rel_diff_vs_quadrature"]) <= AGREE
     assert m["manifold"] is True and m["watertight"] is True and m["winding_consistent"] is True and m["genus"] == 0
 
-    # the solid itself
-    s = tablet_solid(t)
+    # the solid itself: the one the build fitted and wrote (tablet_solid(t), once)
+    assert len(made) == 1
+    s = made[0]
     assert len(explore(s.shape, "Solid")) == 1 and len(explore(s.shape, "Shell")) == 1
     check_solid(s.shape, t.name)
     # one face per patch; four pieces for a patch whose boundary row is a slit (capsule)

@@ -35,6 +35,7 @@ from OCP.HLRBRep import HLRBRep_Algo, HLRBRep_HLRToShape
 
 from tabletcad.cad._occ import explore
 from tabletcad.io import atomic_path
+from tabletcad.tooling.shape_cache import ShapeCache, frozen
 from tabletcad.tolerance import DEFAULT as DEFAULT_TOLERANCES
 
 __all__ = ["project_view", "drawing_model", "write_drawing", "Drawing", "Dim"]
@@ -63,8 +64,24 @@ def _polylines(compound, deflection: float = 0.002) -> list[np.ndarray]:
     return out
 
 
+#: the projections and sections of the shapes drawn last (a sheet drawn again - another title block or
+#: paper, the same parts - does not run the hidden-line removal again); entries hold their shapes
+VIEW_CACHE = ShapeCache(size=24)
+
+
+def _cached_view(shape, key, compute) -> dict:
+    """``compute()``'s view of ``shape``, once per (shape, ``key``) while :data:`VIEW_CACHE` holds it: new
+    lists of the same read-only polylines each time (a caller may add to a list, not change a polyline)."""
+    view = VIEW_CACHE.get(shape, key, lambda: {k: frozen(*v) for k, v in compute().items()})
+    return {k: list(v) for k, v in view.items()}
+
+
 def project_view(shape, view: str) -> dict:
     """``{"visible": [polylines], "hidden": [polylines]}`` (2-D, mm) of ``shape`` seen in ``view``."""
+    return _cached_view(shape, ("view", view), lambda: _project_view(shape, view))
+
+
+def _project_view(shape, view: str) -> dict:
     d, x = VIEWS[view]
     # tangent (G1) edges - between the patches of a smooth cup, at the outline's line/arc
     # junctions where a chain is cut (tabletcad.brep.slit) - are not drawn, as on a toolmaker's
@@ -84,6 +101,10 @@ def project_view(shape, view: str) -> dict:
 def section_view(shape, direction_deg: float) -> dict:
     """The tablet cut by the plane through its axis across ``direction_deg`` (a score's direction):
     ``{"visible": [polylines (across, z)], "hidden": []}``, seen from the side the score runs to."""
+    return _cached_view(shape, ("section", float(direction_deg)), lambda: _section_view(shape, direction_deg))
+
+
+def _section_view(shape, direction_deg: float) -> dict:
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
 
     from tabletcad.tooling.booleans import raw_boolean

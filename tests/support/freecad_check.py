@@ -3,15 +3,16 @@
 Inputs come from environment variables (freecadcmd treats extra arguments as
 documents to open):
 
-``TABLETCAD_FC_MODE``   ``read_step`` or ``bspline``
-``TABLETCAD_FC_INPUT``  the STEP file, or a JSON file ``{"surfaces": [BSplineSurfaceData.as_dict()...],
-                        "u": [...], "v": [...]}``
+``TABLETCAD_FC_MODE``   ``read_step``, ``read_steps`` or ``bspline``
+``TABLETCAD_FC_INPUT``  the STEP file, a JSON file of a list of STEP files (``read_steps``), or a JSON file
+                        ``{"surfaces": [BSplineSurfaceData.as_dict()...], "u": [...], "v": [...]}``
 ``TABLETCAD_FC_OUTPUT`` where the JSON result is written (also printed after ``TABLETCAD_JSON:``)
 
 ``read_step``: reads the file with ``Part.read`` (FreeCAD's OCCT STEP reader) and
 with ``Import.insert`` (document objects, product names); reports the number of
 solids, ``isValid()``, ``Volume`` and ``Area``.  Note ``Shape.Volume`` uses OCCT's
-default (non-adaptive) integration.
+default (non-adaptive) integration.  ``read_steps``: the same for each file of the list, in one FreeCAD
+process: ``{"results": [{"ok": ..., <read_step's result or "error">}, ...]}`` in the list's order.
 
 ``bspline``: rebuilds every surface with
 ``Part.BSplineSurface().buildFromPolesMultsKnots(...)`` from the kernel-neutral
@@ -51,6 +52,18 @@ def _read_step(path):
     except Exception as exc:  # Import module is optional for the check
         result["labels_error"] = repr(exc)
     return result
+
+
+def _read_steps(path):
+    with open(path) as fh:
+        paths = json.load(fh)
+    results = []
+    for p in paths:
+        try:
+            results.append({"ok": True, "path": p, **_read_step(p)})
+        except Exception as exc:
+            results.append({"ok": False, "path": p, "error": repr(exc), "traceback": traceback.format_exc()})
+    return {"results": results}
 
 
 def _bspline(path):
@@ -113,7 +126,7 @@ def main():
     inp = os.environ["TABLETCAD_FC_INPUT"]
     out_path = os.environ.get("TABLETCAD_FC_OUTPUT")
     try:
-        result = {"ok": True, **(_read_step(inp) if mode == "read_step" else _bspline(inp))}
+        result = {"ok": True, **{"read_step": _read_step, "read_steps": _read_steps}.get(mode, _bspline)(inp)}
     except Exception as exc:
         result = {"ok": False, "error": repr(exc), "traceback": traceback.format_exc()}
     text = json.dumps(result)

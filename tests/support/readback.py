@@ -32,6 +32,7 @@ from tabletcad.errors import TabletcadError
 __all__ = [
     "find_freecadcmd",
     "freecad_read_step",
+    "freecad_read_steps",
     "freecad_build_bspline",
     "ocp_read_step",
     "ocp_read_steps",
@@ -101,6 +102,23 @@ def freecad_read_step(
 
     ``freecadcmd``: the command that runs FreeCAD's ``freecadcmd`` (default: the one on PATH)."""
     return _run_freecad("read_step", Path(path).resolve(), timeout, freecadcmd)
+
+
+def freecad_read_steps(
+    paths: Sequence[str | os.PathLike[str]], timeout: float = 300.0, freecadcmd: Sequence[str] | None = None
+) -> list[dict[str, Any]]:
+    """:func:`freecad_read_step` for several files in *one* ``freecadcmd`` process, in their order."""
+    paths = [str(Path(p).resolve()) for p in paths]
+    with tempfile.TemporaryDirectory(prefix="tabletcad-fcin-") as d:
+        p = Path(d) / "paths.json"
+        p.write_text(json.dumps(paths))
+        results = _run_freecad("read_steps", p, timeout, freecadcmd)["results"]
+    if [r.get("path") for r in results] != paths:
+        raise ReadbackError(f"FreeCAD read {len(results)} results for {len(paths)} files")
+    for r in results:
+        if not r.get("ok"):
+            raise ReadbackError(f"FreeCAD check failed on {r.get('path')}: {r.get('error')}\n{r.get('traceback', '')}")
+    return results
 
 
 def freecad_build_bspline(
