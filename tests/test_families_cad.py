@@ -71,6 +71,20 @@ def test_every_family_has_a_sample():
     assert "custom_outline" in stems
 
 
+def _recorded(monkeypatch, module, name: str) -> list:
+    """Every call of ``module.name`` for the rest of the test (or until ``monkeypatch.undo()``):
+    ``(keyword arguments, result)`` appended as each returns."""
+    real, log = getattr(module, name), []
+
+    def wrapper(*args, **kwargs):
+        result = real(*args, **kwargs)
+        log.append((kwargs, result))
+        return result
+
+    monkeypatch.setattr(module, name, wrapper)
+    return log
+
+
 @pytest.mark.parametrize("path", SAMPLES, ids=[p.stem for p in SAMPLES])
 def test_family_sample_builds_an_exact_solid(path, tmp_path, monkeypatch):
     import tabletcad.cad.tablet_solid as tablet_solid_module
@@ -81,13 +95,7 @@ def test_family_sample_builds_an_exact_solid(path, tmp_path, monkeypatch):
 
     # the whole build: report, picture, STEP, STL, GLB; the solid it fits (``tablet_solid(t)``, the same
     # call as below had made a second time) is kept for the checks of the solid itself
-    real, made = tablet_solid_module.tablet_solid, []
-
-    def keeping(*args, **kwargs):
-        made.append(real(*args, **kwargs))
-        return made[-1]
-
-    monkeypatch.setattr(tablet_solid_module, "tablet_solid", keeping)
+    made = _recorded(monkeypatch, tablet_solid_module, "tablet_solid")
     out = tmp_path / path.stem
     rep = build_tablet(t, out, tooling=design.tooling_spec, options=design.report_options, progress=False)
     monkeypatch.undo()
@@ -101,7 +109,7 @@ def test_family_sample_builds_an_exact_solid(path, tmp_path, monkeypatch):
 
     # the solid itself: the one the build fitted and wrote (tablet_solid(t), once)
     assert len(made) == 1
-    s = made[0]
+    s = made[0][1]
     assert len(explore(s.shape, "Solid")) == 1 and len(explore(s.shape, "Shell")) == 1
     check_solid(s.shape, t.name)
     # one face per patch; four pieces for a patch whose boundary row is a slit (capsule)
@@ -222,18 +230,10 @@ def test_the_build_fits_the_solid_once_for_its_cad_and_tooling_steps(tmp_path, m
     import tabletcad.cad.solid as solid_module
     from tabletcad.pipeline.build import build_design
 
-    calls = []
-
-    def counting(real):
-        def wrapper(*args, **kwargs):
-            calls.append(kwargs.get("name"))
-            return real(*args, **kwargs)
-        return wrapper
-
     # B-spline faces, or faces of revolution for this tablet of revolution: one fit either way
-    for fn in ("build_solid", "revolved_solid"):
-        monkeypatch.setattr(solid_module, fn, counting(getattr(solid_module, fn)))
+    fits = [_recorded(monkeypatch, solid_module, fn) for fn in ("build_solid", "revolved_solid")]
     rep = build_design(ROOT / "samples" / "tooling" / "shallow_convex_round.toml", tmp_path / "out", progress=False)
+    calls = [kwargs.get("name") for log in fits for kwargs, _ in log]
     assert len(calls) == 1, calls
     assert {"tablet.step", "upper_punch.step", "die.step"} <= set(rep["outputs"])
     assert rep["tooling"]["interference_mm3"] == pytest.approx(0.0, abs=1e-6)
