@@ -384,11 +384,18 @@ def block_stiffness(basis: Any, lam: float, mu: float, chunk: int = 8192) -> Blo
 
     sb = skfem.CellBasis(basis.mesh, basis.elem.elem, quadrature=(basis.X, basis.W))
     nb, dim = sb.Nbfun, basis.elem.dim
-    sd = sb.element_dofs  # (nb, nel)
-    expect = (dim * sd[:, None, :] + np.arange(dim)[None, :, None]).reshape(nb * dim, -1)
+    expect = (dim * sb.element_dofs[:, None, :] + np.arange(dim)[None, :, None]).reshape(nb * dim, -1)
     if basis.Nbfun != nb * dim or basis.N != dim * sb.N or not np.array_equal(basis.element_dofs, expect):
         raise ValueError(f"stiffness: {basis.Nbfun} local functions not numbered as {nb} scalar ones x "
                          f"{dim} components")
+    return _scalar_block_stiffness(sb, dim, lam, mu, chunk)
+
+
+def _scalar_block_stiffness(sb: Any, dim: int, lam: float, mu: float, chunk: int = 8192) -> BlockStiffness:
+    """:func:`block_stiffness` from the scalar basis ``sb`` (scikit-fem ``CellBasis``, its quadrature the
+    stiffness's) of the ``dim`` components."""
+    nb = sb.Nbfun
+    sd = sb.element_dofs  # (nb, nel)
     inverse, indptr, indices = _scalar_pairs(sd, sb.N)
     g = np.stack([sb.basis[a][0].grad for a in range(nb)])  # (nb, dim, nel, nq)
     nel = g.shape[2]
@@ -422,7 +429,13 @@ def stiffness(basis: Any, lam: float, mu: float, chunk: int = 8192) -> Any:
     return block_stiffness(basis, lam, mu, chunk).tocsr()
 
 
-def _supports(m: Any, basis: Any, centre: np.ndarray, arm: float) -> np.ndarray:
+def _vector_nodal_dofs(sb: Any, dim: int) -> np.ndarray:
+    """Vector unknowns (dim, vertices) at the mesh vertices: ``dim s + i`` is component ``i`` of the scalar
+    basis ``sb``'s unknown ``s`` (scikit-fem's numbering of ``ElementVector``)."""
+    return dim * sb.nodal_dofs[0][None, :] + np.arange(dim)[:, None]
+
+
+def _supports(m: Any, sb: Any, centre: np.ndarray, arm: float) -> np.ndarray:
     """The six unknowns of a 3-2-1 support at the vertices nearest ``centre``, ``centre + arm·x``, ``+ arm·y``."""
     def near(q: np.ndarray) -> int:
         return int(np.argmin(((m.p.T - q) ** 2).sum(axis=1)))
@@ -433,7 +446,7 @@ def _supports(m: Any, basis: Any, centre: np.ndarray, arm: float) -> np.ndarray:
     pa, pb, pc = m.p[:, a], m.p[:, b], m.p[:, c]
     if np.linalg.norm(np.cross(pb - pa, pc - pa)) < 1e-6 * arm**2:
         raise GeometryError("supports: the three support vertices are collinear", m)
-    nd = basis.nodal_dofs
+    nd = _vector_nodal_dofs(sb, 3)
     return np.array([nd[0, a], nd[1, a], nd[2, a], nd[1, b], nd[2, b], nd[2, c]])
 
 
@@ -479,22 +492,21 @@ def unfold(points: np.ndarray, tets: np.ndarray, displacement: np.ndarray, verte
     return p, t, u, s
 
 
-def _symmetry_dofs(basis: Any, planes: Sequence[tuple[int, float]], centre: np.ndarray, tol: float) -> np.ndarray:
+def _symmetry_dofs(sb: Any, planes: Sequence[tuple[int, float]], centre: np.ndarray, tol: float) -> np.ndarray:
     """Unknowns fixed on mirror planes: the normal displacement of every node on each plane, and the
-    translation along the one axis two planes leave free (at the vertex nearest ``centre``)."""
+    translation along the one axis two planes leave free (at the vertex nearest ``centre``).  ``sb`` is the
+    scalar basis of the three components (see :func:`_vector_nodal_dofs`)."""
     axes = sorted({int(a) for a, _ in planes})
     if len(axes) != len(planes) or len(axes) < 2:
         raise ValueError(f"symmetry: need two or three mirror planes normal to different axes, got {list(planes)}")
-    comp = np.zeros(basis.N, dtype=np.int64)
-    for k, idx in enumerate(basis.split_indices()):
-        comp[idx] = k
-    x = basis.doflocs
+    comp = np.arange(3 * sb.N) % 3
+    x = np.repeat(sb.doflocs, 3, axis=1)
     fixed = [np.flatnonzero((comp == a) & (np.abs(x[a] - c) <= tol)) for a, c in planes]
     if len(axes) == 2:
         free_axis = ({0, 1, 2} - set(axes)).pop()
-        m = basis.mesh
+        m = sb.mesh
         v = int(np.argmin(((m.p.T - centre) ** 2).sum(axis=1)))
-        fixed.append(np.array([basis.nodal_dofs[free_axis, v]]))
+        fixed.append(np.array([_vector_nodal_dofs(sb, 3)[free_axis, v]]))
     return np.unique(np.concatenate(fixed))
 
 
@@ -572,6 +584,25 @@ def _superlu_solve(K: Any, b: np.ndarray, ordering: str = "default") -> np.ndarr
     return lu.solve(b)
 
 
+def _vertex_strain(m: Any, scalar: Any, u: np.ndarray) -> np.ndarray:
+    """Strain (dim, dim, elements, 4) at the four vertices of every element of the displacement ``u``
+    (scalar unknowns, dim), mm, of the scalar element ``scalar`` in every component.
+
+    The displacement gradient is summed over the element's scalar functions in their order, as
+    scikit-fem's ``interpolate`` of the ``ElementVector`` sums it (its other components' terms are zeros),
+    and symmetrised as ``skfem.helpers.sym_grad``: the same numbers, from a basis of 10 scalar functions
+    instead of 30 vector ones.
+    """
+    import skfem
+
+    ref = np.array([[0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])  # quadrature "points"
+    vb = skfem.CellBasis(m, scalar, quadrature=(ref, np.full(4, 1.0 / 24.0)))
+    G = np.zeros((u.shape[1],) + vb.basis[0][0].grad.shape)  # (i, k, elements, 4): ∂ₖuᵢ
+    for a in range(vb.Nbfun):
+        G += u[vb.element_dofs[a]].T[:, None, :, None] * vb.basis[a][0].grad[None]
+    return 0.5 * (G + np.einsum("ij...->ji...", G))
+
+
 def solve_elasticity(
     mesh: TetMesh,
     material: Material,
@@ -606,22 +637,24 @@ def solve_elasticity(
         of the fixed translation.
     """
     import skfem
-    from skfem.helpers import dot, sym_grad
+    from skfem.helpers import dot
     from skfem.models.elasticity import linear_stress
 
     m = skmesh if skmesh is not None else _skfem_mesh(mesh)
     bf = facets if facets is not None else boundary_facets(m)
     elem = skfem.ElementVector(skfem.ElementTetP2())
-    basis = skfem.Basis(m, elem, intorder=2)
+    # the scalar P2 basis of the three components (no vector basis: its 30 functions were evaluated for nothing)
+    sb = skfem.CellBasis(m, elem.elem, intorder=2)
+    N = elem.dim * sb.N
     lam, mu = material.lame
-    KB = block_stiffness(basis, lam, mu)
+    KB = _scalar_block_stiffness(sb, elem.dim, lam, mu)
     K = KB.tocsr()
 
     @skfem.LinearForm
     def pressure(v: Any, w: Any) -> Any:
         return -dot(w.n, v)
 
-    f = np.zeros(basis.N)
+    f = np.zeros(N)
     scale = 0.0
     for ld in loads:
         fb = skfem.FacetBasis(m, elem, facets=bf.ids[ld.facets], intorder=2)
@@ -629,27 +662,24 @@ def solve_elasticity(
         scale = max(scale, float(np.abs(bf.resultant(ld)).max()))
     tol = 1e-9 * float(np.ptp(m.p, axis=1).max())
     if symmetry:
-        D = _symmetry_dofs(basis, symmetry, np.asarray(support_centre, float), tol)
+        D = _symmetry_dofs(sb, symmetry, np.asarray(support_centre, float), tol)
     else:
-        D = _supports(m, basis, np.asarray(support_centre, float), float(support_arm))
+        D = _supports(m, sb, np.asarray(support_centre, float), float(support_arm))
     free = _fill_reducing_order(KB.pattern(), elem.dim, D)
     Kf = K[free][:, free].tocsc()
     # (in a helper thread: SuperLU holds no GIL, and a Ctrl-C must not wait minutes for it; CHOLMOD
     # keeps the GIL, but factorises the same system several times faster)
-    u = np.zeros(basis.N)
+    u = np.zeros(N)
     u[free] = run_interruptibly(_factor_and_solve, Kf, f[free], "natural")
     reaction = float(np.abs((K @ u - f)[D]).max())
-    # stresses at the element vertices: quadrature "points" at the reference vertices
-    ref = np.array([[0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
-    vb = skfem.Basis(m, elem, quadrature=(ref, np.full(4, 1.0 / 24.0)))
-    sig = linear_stress(lam, mu)(sym_grad(vb.interpolate(u)))  # (3, 3, m, 4)
+    sig = linear_stress(lam, mu)(_vertex_strain(m, elem.elem, u.reshape(-1, elem.dim)))  # (3, 3, m, 4)
     vertex_stress = np.ascontiguousarray(np.transpose(sig, (2, 3, 0, 1)))
     # vertex displacements (P2 nodal dofs at the vertices)
-    disp = u[basis.nodal_dofs].T
+    disp = u[_vector_nodal_dofs(sb, elem.dim)].T
     work = float(f @ u)
     if symmetry:
         p, t, disp, vertex_stress = unfold(m.p.T, m.t.T, disp, vertex_stress, symmetry, tol)
         m = skfem.MeshTet(np.ascontiguousarray(p.T), np.ascontiguousarray(t.T))
         work *= 2 ** len(symmetry)
-    return ElasticSolution(mesh=m, displacement=disp, vertex_stress=vertex_stress, dofs=int(basis.N),
+    return ElasticSolution(mesh=m, displacement=disp, vertex_stress=vertex_stress, dofs=int(N),
                            reaction=reaction, load_scale=scale, work=work)
