@@ -114,7 +114,7 @@ def test_tight_z_range_is_occs_optimal_box_of_the_whole_solid(thesis):
     from OCP.gp import gp_Pnt
 
     from tabletcad.cad.tablet_solid import tablet_solid
-    from tabletcad.tooling.punch import tight_z_range
+    from tabletcad.tooling.punch import tight_edge, tight_z_range
 
     capsule = tablet_solid(load_design(ROOT / "samples" / "families" / "capsule.toml")).shape
     revolved = tablet_solid(load_design(ROOT / "samples" / "families" / "concave_round.toml")).shape
@@ -138,6 +138,11 @@ def test_tight_z_range_is_occs_optimal_box_of_the_whole_solid(thesis):
         assert tight_z_range(shape) == (lo, hi), name
         assert tight_z_range(shape, high=False) == (lo, None), name
         assert tight_z_range(shape, low=False) == (None, hi), name
+        # the edge a punch tip measures: the given z within the window, else the extreme bit for bit
+        for z, want_lo, want_hi in ((lo + 5e-7, lo + 5e-7, hi), (hi - 5e-7, lo, hi - 5e-7), (lo - 2e-6, lo, hi),
+                                    (hi + 2e-6, lo, hi)):
+            assert tight_edge(shape, z, 1e-6, low=True) == want_lo, name
+            assert tight_edge(shape, z, 1e-6, low=False) == want_hi, name
     assert whole["bump"][1] == best.CornerMax().Z() and whole["loose"] == (-3.0, 6.0)
     assert whole["capsule"][1] - whole["capsule"][0] == pytest.approx(3.2 + 2 * 1.3, abs=1e-6)
 

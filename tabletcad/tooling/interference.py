@@ -94,7 +94,7 @@ class MeshDistance:
                 centres = tri.mean(axis=1)
                 self.radius = float(np.max(np.linalg.norm(tri - centres[:, None, :], axis=2)))
                 self.centres = cKDTree(centres)
-                lo, hi = coordinate_range([self.V[np.unique(self.T)]], 3)
+                lo, hi = coordinate_range([self.V[_used(self.T, len(self.V))]], 3)
                 self.box = (lo - self.reach, hi + self.reach)
 
     #: the centres' screen is probed on every PROBE_STEP-th of PROBE_MIN or more points in the box, and
@@ -147,6 +147,13 @@ class MeshDistance:
             Q[far] = np.nan
             return out, Q
         return out
+
+
+def _used(T: np.ndarray, n: int) -> np.ndarray:
+    """Mask (n,) of the vertices that triangles ``T`` use (``np.unique(T)`` as a mask: no sort)."""
+    used = np.zeros(n, dtype=bool)
+    used[T] = True
+    return used
 
 
 def mesh_distance(points: np.ndarray, V: np.ndarray, T: np.ndarray, reach: float = np.inf) -> np.ndarray:
@@ -986,8 +993,8 @@ def _largest_gap(tablet, parts: dict, clearance: float, deflection: float, refin
     V, T = mesh_arrays(tablet, deflection, 0.2)
     if contact and free:
         T = T[~np.isin(mesh_face_ids(tablet, deflection, 0.2), sorted(contact))]
-        used = np.unique(T)
-        V, T = V[used], np.searchsorted(used, T)
+        used = _used(T, len(V))
+        V, T = V[used], (np.cumsum(used) - 1)[T]  # (the vertices kept, renumbered in their order)
     if tablet_model is not None:
         S = _surface_samples(tablet_model)
         keep = mesh_distance(S, V, T, reach=2.0 * deflection) <= 2.0 * deflection  # farther: inf, dropped as before
