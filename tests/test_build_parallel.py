@@ -90,6 +90,31 @@ def test_an_interrupted_wait_leaves_no_child_and_no_descriptor():
     assert gone(child.pid) and len(os.listdir("/proc/self/fd")) == before
 
 
+def test_a_ctrl_c_held_during_the_fork_leaves_no_child_writing(monkeypatch, tmp_path):
+    """A Ctrl-C that comes while the fork holds signals is raised when they are let through, inside
+    the constructor: the child it had started is stopped there (the caller never gets the object to
+    cancel, and the child ignores Ctrl-C), so it cannot write into a staging folder being removed."""
+    import signal
+
+    real_fork, pids = os.fork, []
+
+    def fork_then_ctrl_c():
+        pid = real_fork()
+        if pid:  # the parent: a Ctrl-C now waits until the constructor lets signals through
+            pids.append(pid)
+            os.kill(os.getpid(), signal.SIGINT)
+        return pid
+
+    late = tmp_path / "late.png"
+    monkeypatch.setattr(os, "fork", fork_then_ctrl_c)
+    with pytest.raises(KeyboardInterrupt):
+        Forked(lambda: (time.sleep(0.5), late.write_text("written after the interrupt")))
+    monkeypatch.undo()
+    assert pids and gone(pids[0])
+    time.sleep(1.0)
+    assert not late.exists()
+
+
 def test_the_child_dies_with_its_parent(tmp_path):
     """A parent killed outright (SIGKILL) takes its helper with it: no writer goes on alone."""
     import subprocess

@@ -124,10 +124,17 @@ class Forked:
                 _flush()
             finally:
                 os._exit(0)
-        signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
         os.close(w)
         self.pid = self._pid = pid
         self._r = r
+        try:
+            # a Ctrl-C or SIGTERM held since the fork is raised here: the caller never gets this object
+            # to cancel, and the child ignores Ctrl-C, so it is stopped here (else it goes on writing, into
+            # a staging folder its parent is removing)
+            signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
+        except BaseException:
+            self.cancel()
+            raise
 
     def result(self) -> Any:
         """The child's return value (waits for it); its exception is raised here, with the child's
