@@ -24,6 +24,8 @@ import traceback
 import warnings
 from typing import Any, Callable
 
+from tabletcad.io.signals import signals_deferred
+
 __all__ = ["OCC_PARALLEL", "Forked", "can_fork"]
 
 #: Whether OCC algorithms may use OCC's thread pool (``[True]``; ``[False]`` in a forked child).
@@ -91,6 +93,19 @@ class Forked:
         self._r: int | None = None
         self._work: Callable[[], Any] | None = None
         _flush()
+        try:
+            # a Ctrl-C or SIGTERM during the fork and set-up waits until the child is recorded: the system
+            # may deliver it to any thread (OCC's pool, a test runner's), and Python would raise it in this
+            # one at once, before the unmask below, with the child unrecorded and ignoring Ctrl-C, writing
+            # on into a staging folder its parent is removing
+            with signals_deferred():
+                self._start(work)
+        except BaseException:  # raised as the held signal is let through: the caller never gets this object
+            self.cancel()
+            raise
+
+    def _start(self, work: Callable[[], Any]) -> None:
+        """Fork the child that runs ``work`` (or keep ``work`` for :meth:`result` if the system refuses)."""
         parent = os.getpid()
         r, w = os.pipe()
         held = {signal.SIGINT, signal.SIGTERM}
@@ -127,14 +142,7 @@ class Forked:
         os.close(w)
         self.pid = self._pid = pid
         self._r = r
-        try:
-            # a Ctrl-C or SIGTERM held since the fork is raised here: the caller never gets this object
-            # to cancel, and the child ignores Ctrl-C, so it is stopped here (else it goes on writing, into
-            # a staging folder its parent is removing)
-            signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
-        except BaseException:
-            self.cancel()
-            raise
+        signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
 
     def result(self) -> Any:
         """The child's return value (waits for it); its exception is raised here, with the child's

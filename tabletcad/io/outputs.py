@@ -39,6 +39,7 @@ from pathlib import Path
 
 from tabletcad.errors import DesignError
 from tabletcad.io.atomic import atomic_write_text
+from tabletcad.io.signals import signals_deferred
 
 __all__ = ["MANIFEST", "OPTIMISE_MANIFEST", "STAGING_MARKER", "STALE_AFTER_S", "staging_folder", "publish", "read_manifest",
            "clean_stale_staging", "file_sha256", "check_replaceable"]
@@ -172,37 +173,6 @@ def staging_folder(out_dir: str | os.PathLike[str]) -> Iterator[Path]:
             shutil.rmtree(staging, ignore_errors=True)
 
 
-@contextlib.contextmanager
-def _signals_deferred() -> Iterator[None]:
-    """While inside (main thread), SIGINT and SIGTERM wait: publishing is all or nothing.
-
-    Python runs signal handlers in the main thread whichever thread the system
-    delivers to, so holding handlers are installed for the block (a signal mask
-    would hold back only the main thread's deliveries); a signal that came
-    meanwhile goes to the previous handler when the block ends.
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    caught: list[int] = []
-
-    def hold(signum, frame):  # noqa: ARG001
-        caught.append(signum)
-
-    old = {s: signal.signal(s, hold) for s in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for s, handler in old.items():
-            signal.signal(s, handler if handler is not None else signal.SIG_DFL)
-        for s in dict.fromkeys(caught):
-            handler = old[s]
-            if callable(handler):
-                handler(s, None)  # Python's default_int_handler raises KeyboardInterrupt
-            elif handler == signal.SIG_DFL or handler is None:
-                os.kill(os.getpid(), s)
-
-
 def publish(staging: str | os.PathLike[str], out_dir: str | os.PathLike[str], manifest: str = MANIFEST) -> list[str]:
     """Move the files of ``staging`` into ``out_dir`` and record them in its manifest.
 
@@ -221,7 +191,7 @@ def publish(staging: str | os.PathLike[str], out_dir: str | os.PathLike[str], ma
     hashes = {p.as_posix(): file_sha256(staging / p) for p in files}
     earlier = read_manifest(out_dir, manifest)
     check_replaceable(out_dir, [rel.as_posix() for rel in files], earlier, manifest)
-    with _signals_deferred():  # Ctrl-C or SIGTERM now would leave half a build in out_dir
+    with signals_deferred():  # Ctrl-C or SIGTERM now would leave half a build in out_dir
         _move_in(staging, out_dir, files, hashes, earlier, manifest)
         if not _inside_open_staging(out_dir):  # (a Ctrl-C now finds a finished output only if it is the final one)
             published.append(out_dir)
