@@ -181,10 +181,12 @@ def bench_report(paths=None, repeat=15):
     # the thesis's three samples and every family sample (samples/families)
     thesis = [root / "samples" / n for n in ("flat_faced_round.toml", "spherical.toml", "caplet.toml")]
     paths = paths or thesis + sorted((root / "samples" / "families").glob("*.toml"))
+    from tabletcad.families.outline import _SHAPE_MEMO
     from tabletcad.geometry.tables import CARDINAL, COLLOCATION, TRIG
 
     print("Load + geometry report per design (best of %d; peak traced heap of one run; 'cold': the first run," % repeat)
-    print("with the tables shared between patches and builds (tabletcad.geometry.tables) emptied before it)")
+    print("with the tables shared between patches and builds (tabletcad.geometry.tables) emptied before it;")
+    print("the outline checks remembered by an outline's exact segments emptied before every run)")
     print(f"  {'design':22s} {'load':>8s} {'report':>8s} {'total':>8s} {'goal':>6s} {'x goal':>7s} {'cold':>7s}"
           f" {'peak MiB':>9s}")
     for path in paths:
@@ -194,6 +196,7 @@ def bench_report(paths=None, repeat=15):
         COLLOCATION.clear()
         cold = None
         for _ in range(repeat):
+            _SHAPE_MEMO.clear()  # an outline's checks remembered by its exact segments: each run is a new design's
             t0 = time.perf_counter()
             d = Design.from_toml(path)
             t = d.build()
