@@ -126,6 +126,32 @@ def test_a_ctrl_c_during_the_fork_leaves_no_child_writing(monkeypatch, tmp_path,
     assert not late.exists()
 
 
+def test_a_ctrl_c_as_the_build_takes_its_picture_child_stops_the_child(monkeypatch, tmp_path):
+    """A Ctrl-C just after the picture's child is made, before the build has it in hand: raised once it
+    is, so the build's clean-up stops the child and removes the staging folder."""
+    import signal
+
+    import tabletcad.pipeline.build as build
+
+    pids = []
+
+    class _CtrlCAfter(Forked):
+        def __init__(self, work):
+            super().__init__(work)
+            pids.append(self.pid)
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.05)  # (Python runs the handler here)
+
+    monkeypatch.setattr(build, "Forked", _CtrlCAfter)
+    monkeypatch.setattr(build, "can_fork", lambda: True)
+    with pytest.raises(KeyboardInterrupt):
+        build.build_design(ROOT / "samples" / "families" / "concave_round.toml", tmp_path / "out", cad=False,
+                           progress=False, parallel=True)
+    assert pids and pids[0] is not None and gone(pids[0])
+    time.sleep(1.0)
+    assert os.listdir(tmp_path) == []
+
+
 def test_the_child_dies_with_its_parent(tmp_path):
     """A parent killed outright (SIGKILL) takes its helper with it: no writer goes on alone."""
     import subprocess

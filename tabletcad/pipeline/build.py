@@ -19,6 +19,7 @@ from typing import Any
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.io.forked import Forked, can_fork
 from tabletcad.io.outputs import STAGING_MARKER, check_replaceable, publish, staging_folder
+from tabletcad.io.signals import signals_deferred
 from tabletcad.pipeline.design import Design
 from tabletcad.pipeline.designreport import ReportOptions
 from tabletcad.pipeline.plot import plot_tablet
@@ -133,9 +134,12 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
             forks = parallel and can_fork()
             if forks and cad and tooling is not None:  # two children will draw: their modules imported once
                 import_shared()
-            # the picture needs only the tablet: drawn by a forked process beside the CAD stage
-            picture = (helpers.enter_context(Forked(lambda: plot_tablet(tablet, staging / "tablet.png")))
-                       if forks else None)
+            # the picture needs only the tablet: drawn by a forked process beside the CAD stage (a Ctrl-C
+            # waits until the child is in ``helpers``, whose exit then stops it)
+            picture = None
+            if forks:
+                with signals_deferred():
+                    picture = helpers.enter_context(Forked(lambda: plot_tablet(tablet, staging / "tablet.png")))
             if cad:
                 from tabletcad.cad.stage import cad_stage
 
