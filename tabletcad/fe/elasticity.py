@@ -536,7 +536,7 @@ def _factor_and_solve(K: Any, b: np.ndarray, ordering: str = "default") -> np.nd
             return cholesky(K, ordering_method=ordering)(b)
         except CholmodNotPositiveDefiniteError:
             pass
-    return _superlu_solve(K, b, ordering)
+    return _superlu_solve(K, b)
 
 
 def _fill_reducing_order(pattern: Any, dim: int, fixed: np.ndarray) -> np.ndarray:
@@ -575,9 +575,8 @@ def _fill_reducing_order(pattern: Any, dim: int, fixed: np.ndarray) -> np.ndarra
     return q[keep[q]]
 
 
-def _superlu_solve(K: Any, b: np.ndarray, ordering: str = "default") -> np.ndarray:
-    """``K⁻¹ b`` by SuperLU (``K`` sparse symmetric, CSC), in the calling thread; ``ordering`` (CHOLMOD's, see
-    :func:`_factor_and_solve`, whose stand-in this is) is not used: SuperLU orders ``K`` itself."""
+def _superlu_solve(K: Any, b: np.ndarray) -> np.ndarray:
+    """``K⁻¹ b`` by SuperLU (``K`` sparse symmetric, CSC), in the calling thread (SuperLU orders ``K`` itself)."""
     import scipy.sparse.linalg as spla
 
     lu = spla.splu(K, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
