@@ -36,7 +36,7 @@ from OCP.GProp import GProp_GProps
 
 d = Design.from_toml(sys.argv[1])
 m = TabletModel(d.build(), d)
-T = m.report()["height_mm"]
+T = m.tablet.dimensions()["height_mm"]  # the report's height_mm, without the rest of the report
 planes = [f for f in explore(m.to_occ(), "Face") if isinstance(BRep_Tool.Surface_s(f), Geom_Plane)]
 b = m.to_build123d()
 r = 0.2  # a pin through the centre, inside the flat centre of the top and bottom faces
