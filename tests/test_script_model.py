@@ -72,9 +72,15 @@ def test_moving_what_the_model_hands_out_leaves_the_model_where_it_is(tmp_path):
     from tabletcad.cad.solid import mass_properties
 
     m = tabletcad.make("capsule", length=14.0, width=6.0, band=2.5, cup_depth=1.0)
-    box0 = bd.Solid(m.to_occ()).bounding_box()
+    # where a handle lies: its box from the faces' poles (optimal=False; 0.3 ms, the optimal box 0.36 s of the
+    # capsule's B-spline faces), which any move of the handle moves with it; the optimal box (box0) for the
+    # STEP read back, a shape of its own
+    def where(solid):
+        return bd.Solid(solid).bounding_box(optimal=False)
+
+    box0, poles0 = bd.Solid(m.to_occ()).bounding_box(), where(m.to_occ())
     moved = m.to_build123d().move(bd.Location((50.0, 0.0, 0.0)))
-    assert moved.bounding_box().min.X == pytest.approx(box0.min.X + 50.0, abs=1e-6)  # the copy did move
+    assert where(moved.wrapped).min.X == pytest.approx(poles0.min.X + 50.0, abs=1e-6)  # the copy did move
     tr = gp_Trsf()
     tr.SetTranslation(gp_Vec(0.0, 0.0, 5.0))
     m.to_occ().Move(TopLoc_Location(tr))
@@ -84,8 +90,9 @@ def test_moving_what_the_model_hands_out_leaves_the_model_where_it_is(tmp_path):
     m.solid.shape.Move(TopLoc_Location(tr))
     m.solid.faces[0].Move(TopLoc_Location(tr))
     for solid in (m.to_occ(), m.to_build123d().wrapped, m.to_cadquery().val().wrapped, m.solid.shape):
-        box = bd.Solid(solid).bounding_box()
-        assert (box.min.X, box.min.Y, box.min.Z, box.max.Z) == pytest.approx((box0.min.X, box0.min.Y, box0.min.Z, box0.max.Z), abs=1e-9)
+        box = where(solid)
+        assert (box.min.X, box.min.Y, box.min.Z, box.max.Z) == pytest.approx((poles0.min.X, poles0.min.Y, poles0.min.Z,
+                                                                             poles0.max.Z), abs=1e-9)
     m.export(tmp_path / "t.step")
     back = bd.import_step(str(tmp_path / "t.step")).bounding_box()
     assert (back.min.X, back.min.Z) == pytest.approx((box0.min.X, box0.min.Z), abs=1e-6)
