@@ -352,8 +352,8 @@ def _ruled_draft(wire, narrow: float, wide: float, t: float, grow: float):
     ``z = -wide`` by ``+grow*wide*t`` (nominal at 0), axial beyond where an offset ceases to exist.
     Where the two ends have different numbers of edges (OCC's offsets split Bézier edges
     differently at the two ends) or OCC cannot loft them as they are they are replaced by polygons through paired points
-    (:func:`_paired`, 0.08 mm apart); where that fails too the drafted part is
-    shortened (to 1/2, 1/4, 0 at one end or both) until it lofts."""
+    (:func:`_paired`, 0.08 mm apart, held in order where a feature vanishes); where that fails too the
+    drafted part is shortened (to 1/2, 1/4, 0 at one end or both) until it lofts."""
     d_hi, d_lo = -grow * narrow * t, grow * wide * t
     w_hi, f_hi = _section_to(wire, d_hi)
     w_lo, f_lo = _section_to(wire, d_lo)
@@ -405,33 +405,101 @@ def _wire_points(wire, spacing: float):
 
 
 def _paired(wa, wb, spacing: float = 0.08):
-    """Two closed polygons (None where either wire holds fewer than three points): through ``wa``'s points (``spacing`` apart) and through the nearest points
-    of ``wb`` to them, vertex for vertex, so that a ruled loft between them joins
-    each point of one offset to its counterpart along the normal on the other (OCC's offsets of one
-    outline split its edges differently, and pairing by arc length drifts where a feature vanishes).
-    The positions along ``wb`` are kept in order (a step back becomes a step of 1e-3 spacing)."""
-    import numpy as np
+    """Two closed polygons (None where either wire holds fewer than three points) through the paired
+    points of :func:`_paired_points`, vertex for vertex."""
+    pts = _paired_points(wa, wb, spacing)
+    return None if pts is None else (polyline_wire(pts[0]), polyline_wire(pts[1]))
 
+
+def _paired_points(wa, wb, spacing: float = 0.08):
+    """Paired plan points ``(pa, pb)``, arrays (n, 2) in mm, or None where either wire holds fewer
+    than three points: ``wa``'s points (``spacing`` apart) and the nearest points of ``wb`` to them,
+    so that a ruled loft between polygons through them joins each point of one offset to its
+    counterpart along the normal on the other (OCC's offsets of one outline split its edges
+    differently, and pairing by arc length drifts where a feature vanishes).
+
+    The positions along ``wb`` are kept in order once round it: held where they step back
+    (:func:`_held_in_order`: over a stroke's end that ``wb`` has lost, whose points on ``wa`` then
+    fan into where it vanished), or, where that finds no such order, every step back made a step of
+    1e-3 ``spacing`` and all steps scaled to go once round (:func:`_rescaled_in_order`, which twists
+    the walls where many points step back)."""
     pa, pb = _wire_points(wa, spacing), _wire_points(wb, 0.25 * spacing)
     if len(pa) < 3 or len(pb) < 3:  # a wire shorter than a few spacings (a vanishing stroke's offset)
         return None
+    sig, near, per = _nearest_positions(pa, pb)
+    eps = 1e-3 * spacing  # distinct vertices
+    held = _held_in_order(sig, near, per, eps)
+    return pa, _points_at(pb, held if held is not None else _rescaled_in_order(sig, per, eps))
+
+
+def _nearest_positions(pa, pb):
+    """``(sig, near, per)``: the arc-length positions (mm, from ``pb[0]``) along the closed polygon
+    ``pb`` (m, 2) of its nearest points to the points ``pa`` (n, 2), their distances (mm) and the
+    polygon's perimeter (mm)."""
+    import numpy as np
+
     seg = np.roll(pb, -1, axis=0) - pb
     slen = np.linalg.norm(seg, axis=1)
     cum = np.concatenate([[0.0], np.cumsum(slen)])
-    per = cum[-1]
     rel = pa[:, None, :] - pb[None, :, :]
     u = np.clip(np.einsum("ijk,jk->ij", rel, seg) / np.maximum(slen * slen, 1e-30), 0.0, 1.0)
     dist = np.linalg.norm(rel - u[..., None] * seg[None], axis=2)
     j = np.argmin(dist, axis=1)
-    sig = cum[j] + u[np.arange(len(pa)), j] * slen[j]  # arc-length position on wb of each point of wa
-    steps = np.mod(np.diff(np.concatenate([sig, sig[:1]])) + 0.5 * per, per) - 0.5 * per
-    steps = np.maximum(steps, 1e-3 * spacing)  # distinct vertices
-    steps *= per / steps.sum()  # once round wb
-    sig = np.mod(sig[0] + np.concatenate([[0.0], np.cumsum(steps[:-1])]), per)
-    k = np.searchsorted(cum, sig, side="right") - 1
-    k = np.clip(k, 0, len(pb) - 1)
-    pbq = pb[k] + ((sig - cum[k]) / np.maximum(slen[k], 1e-30))[:, None] * seg[k]
-    return polyline_wire(pa), polyline_wire(pbq)
+    rows = np.arange(len(pa))
+    return cum[j] + u[rows, j] * slen[j], dist[rows, j], cum[-1]
+
+
+def _round_steps(sig, per: float):
+    """The steps (mm) from each position ``sig`` along a closed wire of perimeter ``per`` to the next
+    (the last back to the first), each taken the short way round: in [-per/2, per/2)."""
+    import numpy as np
+
+    return np.mod(np.diff(np.concatenate([sig, sig[:1]])) + 0.5 * per, per) - 0.5 * per
+
+
+def _held_in_order(sig, near, per: float, eps: float, tries: int = 16):
+    """The positions ``sig`` (mm along a closed wire of perimeter ``per``, the nearest points to
+    consecutive points of another wire, at distances ``near`` mm) made to go once round in order:
+    kept where they advance, held (``eps`` mm further on per point) where they step back, counted
+    from a point at the typical distance (the median of ``near``: the offsets' distance apart, on
+    the normal).  ``None`` where the positions do not go once round or none of the ``tries`` points
+    nearest the typical distance starts an order that closes (the last at most ``per - eps``)."""
+    import numpy as np
+
+    steps = _round_steps(sig, per)
+    if abs(steps.sum() - per) > 1e-9 * per:  # not once round (none, or twice)
+        return None
+    k = eps * np.arange(len(sig))
+    for start in np.argsort(np.abs(near - np.median(near)), kind="stable")[:tries]:
+        ahead = np.roll(steps, -int(start))
+        pos = np.concatenate([[0.0], np.cumsum(ahead[:-1])])  # from sig[start], unwrapped
+        held = np.maximum.accumulate(pos - k) + k
+        if held[-1] <= per - eps:
+            return np.mod(sig[start] + np.roll(held, int(start)), per)
+    return None
+
+
+def _rescaled_in_order(sig, per: float, eps: float):
+    """The positions ``sig`` (mm along a closed wire of perimeter ``per``) made to go once round in
+    order by making every step back (or shorter than ``eps`` mm) a step of ``eps`` and scaling all
+    steps to sum to ``per``, from ``sig[0]``."""
+    import numpy as np
+
+    steps = np.maximum(_round_steps(sig, per), eps)
+    steps *= per / steps.sum()
+    return np.mod(sig[0] + np.concatenate([[0.0], np.cumsum(steps[:-1])]), per)
+
+
+def _points_at(pb, sig):
+    """The points (n, 2) at the arc-length positions ``sig`` (mm, from ``pb[0]``) along the closed
+    polygon ``pb`` (m, 2)."""
+    import numpy as np
+
+    seg = np.roll(pb, -1, axis=0) - pb
+    slen = np.linalg.norm(seg, axis=1)
+    cum = np.concatenate([[0.0], np.cumsum(slen)])
+    k = np.clip(np.searchsorted(cum, sig, side="right") - 1, 0, len(pb) - 1)
+    return pb[k] + ((sig - cum[k]) / np.maximum(slen[k], 1e-30))[:, None] * seg[k]
 
 
 def _loft(sections):
