@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from tabletcad.errors import DesignError, format_bound
@@ -237,8 +237,15 @@ def test_a_level_patch_folds_as_the_general_computation_measures(fraction, rise,
     assert (depth > 0.05) == (fraction != 0.5)
 
 
+# two lobes 1.6 mm apart, 2.9926 and 2.9874 mm deep: a search polished only from the grid's best point (in
+# the shallower lobe) found 2.9874 where the 301 × 301 grid below reads 2.9887 (hypothesis met it in a full run)
+_TWO_LOBES = ([(0.0, 4.0), (1.0, 3.0), (1.75, 4.0), (1.5625, 3.0), (2.375, 8.0), (3.5, 4.5), (3.625, 4.0625),
+               (5.1875, 4.75)], 0.5, 0, False)
+
+
 @settings(max_examples=25, deadline=None)
 @given(RANDOM_OUTLINES, st.integers(0, 2**32 - 1))
+@example(_outline_of(*_TWO_LOBES), 0)
 def test_one_point_s_signed_distance_is_the_outline_s_and_no_point_is_deeper_than_its_inscribed_radius(
         ol, seed):
     """The plain-float distance of one point that the inscribed radius's search reads equals
@@ -256,14 +263,12 @@ def test_one_point_s_signed_distance_is_the_outline_s_and_no_point_is_deeper_tha
     g = np.stack(np.meshgrid(np.linspace(-9.0, 9.0, 301), np.linspace(-9.0, 9.0, 301)), -1).reshape(-1, 2)
     radius = ol.inscribed_radius()
     assert float(np.max(ol.signed_distance(g))) <= radius + 1e-12
-    # the same search on the vectorised distance (as it ran before the one-point distance) ends on the
-    # same value
+    # an independent search on the vectorised distance, polished from the finer grid's best point, finds no
+    # point deeper than the inscribed radius (to its stated 1e-9 mm); on two lobes the finer grid's best can
+    # lie in the other lobe from the coarse grid's
     from scipy.optimize import minimize
 
-    c0 = ol.frame(np.linspace(0, math.tau, 512, endpoint=False))[0]
-    lo, hi = c0.min(axis=0), c0.max(axis=0)
-    g = np.stack(np.meshgrid(np.linspace(lo[0], hi[0], 81), np.linspace(lo[1], hi[1], 81)), -1).reshape(-1, 2)
     sd = ol.signed_distance(g)
     found = minimize(lambda x: -float(ol.signed_distance(x[None])[0]), g[int(np.argmax(sd))],
                      method="Nelder-Mead", options=dict(xatol=1e-11, fatol=1e-13, maxiter=4000))
-    assert radius == max(-found.fun, float(sd.max()))
+    assert -found.fun <= radius + 1e-9

@@ -375,25 +375,39 @@ class PlanOutline:
         """Largest inward distance reached inside the outline (mm), to ~1e-9 mm.
 
         The best of an 81 × 81 grid over the outline's box, polished by Nelder–Mead on the signed
-        distance of one point.  On a chain of lines and arcs the search reads
+        distance of one point from every peak of the grid that could lead to the largest: the signed
+        distance changes by at most the distance moved, so the deepest point lies within half a cell's
+        diagonal ``δ`` of a grid point reading at least the grid's best less ``δ``.  The grid's local
+        maxima (no neighbour higher) above that level are the starts, adjacent ones (a ridge of equal
+        depth, as along a capsule's sides) as one, from its best; two lobes of an outline, with their
+        own deepest points, are two starts.  On a chain of lines and arcs the search reads
         :meth:`_point_signed_distance` (plain floats, the arithmetic of :meth:`signed_distance` without
-        numpy's cost per call on one point: ~200 calls) and returns :meth:`signed_distance` at the
-        point it found.
+        numpy's cost per call on one point: ~200 calls a start) and returns :meth:`signed_distance` at
+        the point it found.
         """
+        from scipy.ndimage import label, maximum_filter
         from scipy.optimize import minimize
 
+        n = 81
         c0 = self.frame(np.linspace(0, math.tau, 512, endpoint=False))[0]
         lo, hi = c0.min(axis=0), c0.max(axis=0)
-        g = np.stack(np.meshgrid(np.linspace(lo[0], hi[0], 81), np.linspace(lo[1], hi[1], 81)), -1).reshape(-1, 2)
+        g = np.stack(np.meshgrid(np.linspace(lo[0], hi[0], n), np.linspace(lo[1], hi[1], n)), -1).reshape(-1, 2)
         sd = self.signed_distance(g)
-        x0 = g[int(np.argmax(sd))]
+        delta = 0.5 * math.hypot(*((hi - lo) / (n - 1)))  # half a cell's diagonal (mm)
+        grid = sd.reshape(n, n)
+        peaks = (grid >= maximum_filter(grid, size=3, mode="constant", cval=-np.inf)) & (grid >= grid.max() - delta)
+        regions, count = label(peaks, structure=np.ones((3, 3), bool))
+        regions = regions.reshape(-1)
         one = self._point_signed_distance() if self.segs and not self.is_circle else None
         objective = ((lambda x: -one(float(x[0]), float(x[1]))) if one is not None
                      else (lambda x: -float(self.signed_distance(x[None])[0])))
-        r = minimize(objective, x0, method="Nelder-Mead",
-                     options=dict(xatol=1e-11, fatol=1e-13, maxiter=4000))
-        found = float(self.signed_distance(r.x[None])[0]) if one is not None else float(-r.fun)
-        return max(found, float(sd.max()))
+        best = float(sd.max())
+        for k in range(1, count + 1):
+            inside = np.flatnonzero(regions == k)
+            x0 = g[inside[int(np.argmax(sd[inside]))]]
+            r = minimize(objective, x0, method="Nelder-Mead", options=dict(xatol=1e-11, fatol=1e-13, maxiter=4000))
+            best = max(best, float(self.signed_distance(r.x[None])[0]) if one is not None else float(-r.fun))
+        return best
 
     def _point_signed_distance(self):
         """``f(x, y)``: :meth:`signed_distance` of one point (mm, > 0 inside) in plain floats, for a chain of

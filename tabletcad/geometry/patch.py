@@ -848,9 +848,10 @@ class PDEPatch:
         elif self._section is not None:
             # a surface of revolution, or of one plan ellipse (x, y) = R(u) M e(v), z = Z(u), M = [p q], folds
             # alike on every meridian: D = X - A0 = (R M e, 0), X_v × D = (0, 0, -R² det M) and the Jacobian
-            # X_u · (X_v × D) = -Z' R² det M, so the speed |Jacobian| / |X_v × D| is |Z'(u)| on every v.  The
-            # four principal meridians also give the largest |X_u|, |X_v| and |D| of any, the scale of the
-            # threshold below which a sign change is round-off
+            # X_u · (X_v × D) = -Z' R² det M, so the speed |Jacobian| / |X_v × D| is |Z'(u)| on every v.  A level
+            # patch (Z constant) folds in its plane, at the speed |R'| |det M| / |M e'(v)|, deepest where |M e'(v)|
+            # is least: on a principal meridian.  The four principal meridians also give the largest |X_u|, |X_v|
+            # and |D| of any, the scale of the threshold below which a sign change is round-off
             nv, v = "principal", self._principal_v()
         elif nv is None:
             nv = self._check_nv()
