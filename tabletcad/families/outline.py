@@ -234,14 +234,18 @@ class PlanOutline:
         arc, p0, d, centre, radius, theta0, sg = self._segment_table()
         # every point by its own segment's formula, gathered from the table (the same arithmetic as
         # segment by segment, without a Python loop over segments)
+        # (rows of the (segments, 2) tables by take: fancy indexing steps an iterator per row)
         t = s - self._cum[idx]
         a = arc[idx]
-        th = theta0[idx] + sg[idx] * t / radius[idx]
+        g = sg[idx]
+        th = theta0[idx] + g * t / radius[idx]
         c, sn = np.cos(th), np.sin(th)
         r = radius[idx]
-        O = np.where(a[:, None], centre[idx] + np.column_stack([r * c, r * sn]), p0[idx] + t[:, None] * d[idx])
-        T = np.where(a[:, None], np.column_stack([-sg[idx] * sn, sg[idx] * c]), d[idx])
-        k = np.where(a, sg[idx] / r, 0.0)
+        dk = np.take(d, idx, axis=0)
+        O = np.where(a[:, None], np.take(centre, idx, axis=0) + np.column_stack([r * c, r * sn]),
+                     np.take(p0, idx, axis=0) + t[:, None] * dk)
+        T = np.where(a[:, None], np.column_stack([-g * sn, g * c]), dk)
+        k = np.where(a, g / r, 0.0)
         N = np.column_stack([-T[:, 1], T[:, 0]])
         return O, T, N, k
 
