@@ -563,3 +563,30 @@ def test_grid_components_layout_holds_the_same_values(family):
                                        rtol=0, atol=tol)
     with pytest.raises(ValueError):
         t.patches[0].evaluate_grid(u, v, axes=(0, 1))
+
+
+@pytest.mark.parametrize("family", ["capsule", "rounded_triangle"])
+def test_grid_written_into_out_is_the_same_grid(family):
+    """``evaluate_grid(..., components=True, out=block)`` writes the grid into the block it is given (a
+    slice of a larger array, as jet_grid's, bounds' and deviation_peaks' are) and returns it: bit for bit
+    the values of the call without ``out``; an ``out`` of another shape, or without ``components``, is refused."""
+    from tabletcad.families import FAMILIES
+
+    t = FAMILIES[family].build()
+    u, v = np.linspace(0.0, 1.0, 17), np.linspace(0.0, 6.0, 45)
+    for p in t.patches[:3]:
+        for du, dv in ((0, 0), (1, 0), (0, 1), (2, 0)):
+            for axes in ((0, 1, 2), (0, 1), (2,)):
+                big = np.full((len(axes) + 1, u.size, v.size), np.nan)
+                got = p.evaluate_grid(u, v, du, dv, components=True, axes=axes, out=big[1:])
+                assert np.shares_memory(got, big)
+                np.testing.assert_array_equal(big[1:], p.evaluate_grid(u, v, du, dv, components=True, axes=axes))
+                assert np.all(np.isnan(big[0]))  # nothing written outside the block
+        X, Xu, Xv = p.jet_grid(u, v)
+        for G, (du, dv) in zip((X, Xu, Xv), ((0, 0), (1, 0), (0, 1))):
+            np.testing.assert_array_equal(G[:2], p.evaluate_grid(u, v, du, dv, components=True, axes=(0, 1)))
+    p = t.patches[0]
+    with pytest.raises(ValueError):
+        p.evaluate_grid(u, v, components=True, out=np.empty((3, v.size, u.size)))
+    with pytest.raises(ValueError):
+        p.evaluate_grid(u, v, out=np.empty((3, u.size, v.size)))

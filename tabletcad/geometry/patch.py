@@ -606,7 +606,7 @@ class PDEPatch:
         return out.reshape(shape + (3,))
 
     def evaluate_grid(self, u, v, du: int = 0, dv: int = 0, *, components: bool = False,
-                      axes: tuple[int, ...] = (0, 1, 2)) -> np.ndarray:
+                      axes: tuple[int, ...] = (0, 1, 2), out: np.ndarray | None = None) -> np.ndarray:
         """Tensor-grid evaluation: ``X[i, j] = ∂X(u[i], v[j])``, shape (len(u), len(v), 3).
 
         Uses matrix products (cost ~ (nu + nv)·N + nu·nv·N), the fast path
@@ -614,10 +614,14 @@ class PDEPatch:
         come as ``(len(axes), len(u), len(v))`` (``X[c, i, j]`` for the coordinates ``axes``),
         the layout the product makes: no transposed copy, each coordinate one contiguous
         block (for reductions over the grid, such as extents and the plan's silhouette), and
-        only the coordinates asked for are computed.
+        only the coordinates asked for are computed.  ``out`` (with ``components``): a C-contiguous
+        float array ``(len(axes), len(u), len(v))`` (mm) the products write into and that is returned,
+        such as a block of a larger array (no copy of the grid into it).
         """
         if tuple(axes) != (0, 1, 2) and not components:
             raise ValueError(f"axes = {axes} is not allowed: only with components=True")
+        if out is not None and not components:
+            raise ValueError("out is only allowed with components=True")
         u = np.asarray(u, dtype=float).reshape(-1)
         v = np.asarray(v, dtype=float).reshape(-1)
         L, L0, Lr = self._u_tables(u, du)  # (n, nu, 4), (nu, 4), (nu, 4)
@@ -629,9 +633,16 @@ class PDEPatch:
         ax = list(axes) if components else [0, 1, 2]
         m, nu, nv = len(ax), u.size, v.size
         rem, spine = self._has_remainder, dv == 0
+        if out is not None:
+            if out.shape != (m, nu, nv) or out.dtype != np.float64 or not out.flags.c_contiguous:
+                raise ValueError(f"out must be a C-contiguous float array of shape {(m, nu, nv)}")
         if not (self._active or rem or spine) or not (nu and nv):
+            if out is not None:
+                out[...] = 0.0
+                return out
             return np.zeros((len(axes), nu, nv) if components else (nu, nv, 3))
-        Y = np.empty((nv, m * nu), order="F")
+        # (X as (m, nu, nv) in C order is Y in Fortran order: ``out``'s memory, when given, is Y's)
+        Y = np.empty((nv, m * nu), order="F") if out is None else out.reshape(m * nu, nv).T
         fresh = True
         if self._active:
             n = L.shape[0]
@@ -655,6 +666,8 @@ class PDEPatch:
                 if spine:
                     prof[:, k - 1] = A[:, c]
                 _gemm(rows.T, prof.T, Y[:, i * nu : (i + 1) * nu], fresh)
+        if out is not None:
+            return out
         X = Y.T.reshape(m, nu, nv)
         return X if components else np.ascontiguousarray(X.transpose(1, 2, 0))
 
@@ -671,7 +684,7 @@ class PDEPatch:
         out = []
         for du, dv in ((0, 0), (1, 0), (0, 1)):
             G = np.empty((3, u.size, v.size))
-            G[:2] = self.evaluate_grid(u, v, du, dv, components=True, axes=(0, 1))
+            self.evaluate_grid(u, v, du, dv, components=True, axes=(0, 1), out=G[:2])  # x, y in place
             G[2] = self.spine(u, du)[:, 2:] if dv == 0 else 0.0
             out.append(G)
         return out[0], out[1], out[2]

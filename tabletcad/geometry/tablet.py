@@ -1141,9 +1141,11 @@ class Tablet:
         A = p.spine(np.asarray(u, float), du=du)
         return A + w1 * (X - A)
 
-    def _outer_grid(self, p: PDEPatch, u, v, axes: tuple[int, ...] | None = None) -> np.ndarray:
+    def _outer_grid(self, p: PDEPatch, u, v, axes: tuple[int, ...] | None = None,
+                    out: np.ndarray | None = None) -> np.ndarray:
         """:meth:`_outer` on the grid ``u × v``: (len(u), len(v), 3), or with ``axes`` the coordinates
-        ``axes`` as contiguous blocks ``(len(axes), len(u), len(v))`` (``evaluate_grid``'s layout)."""
+        ``axes`` as contiguous blocks ``(len(axes), len(u), len(v))`` (``evaluate_grid``'s layout), written
+        into ``out`` (mm; C-contiguous, that shape) when given."""
         w1 = self.trim.w[1]
         if axes is None:
             X = p.evaluate_grid(u, v)
@@ -1151,11 +1153,11 @@ class Tablet:
                 return X
             A = p.spine(np.asarray(u, float))[:, None, :]
             return A + w1 * (X - A)
-        X = p.evaluate_grid(u, v, components=True, axes=axes)
+        X = p.evaluate_grid(u, v, components=True, axes=axes, out=out)
         if w1 == 1.0:
             return X
         A = p.spine(np.asarray(u, float))[:, list(axes)].T[:, :, None]
-        return A + w1 * (X - A)
+        return A + w1 * (X - A) if out is None else np.add(A, w1 * (X - A), out=out)
 
     def _bounds(self) -> tuple[np.ndarray, np.ndarray]:
         t = self.trim
@@ -1173,7 +1175,10 @@ class Tablet:
         # copy); a mirror solid's twins reach the same x and y, and z reflected (below)
         patches = [self.patches[i] for i in self.measured()]
         level = all(p.level for p in self.patches)  # then z is each patch's spine's (below): x and y alone
-        pts = np.stack([self._outer_grid(p, u, v, axes=(0, 1) if level else (0, 1, 2)) for p in patches])
+        axes = (0, 1) if level else (0, 1, 2)
+        pts = np.empty((len(patches), len(axes), u.size, v.size))
+        for k, p in enumerate(patches):  # each patch's grid written in its block (no stacked copy)
+            self._outer_grid(p, u, v, axes=axes, out=pts[k])
         lo, hi = pts.min(axis=(0, 2, 3)), pts.max(axis=(0, 2, 3))
         if level:  # the samples' z: their lines' spine heights
             z = np.concatenate([p.spine(u)[:, 2] for p in patches])
@@ -1495,7 +1500,10 @@ class Tablet:
         twins lie as far from its nominal (whose faces are mirror images too) as their patches."""
         measured = self.measured()
         patches = [self.patches[i] for i in measured]
-        X = np.stack([p.evaluate_grid(u, v) for p in patches])
+        G = np.empty((len(patches), 3, len(u), len(v)))  # each patch's grid written in its block, coordinates
+        for k, p in enumerate(patches):  # first; then the points (x, y, z) in one transposed copy
+            p.evaluate_grid(u, v, components=True, out=G[k])
+        X = G.transpose(0, 2, 3, 1)
         D = np.abs(self.nominal(X.reshape(-1, 3))).reshape(X.shape[:3])
         best = D.max(axis=(1, 2))
         t = self.trim
