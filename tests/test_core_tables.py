@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import array_shapes, arrays
 
 from tabletcad.geometry.tables import CARDINAL, SharedTables
-from tabletcad.geometry.vectors import cross, length2, norm3
+from tabletcad.geometry.vectors import cross, length2, norm3, points_last
 
 
 def test_least_recently_used_goes_first_and_results_are_read_only():
@@ -162,3 +162,17 @@ def test_length2_is_hypot_within_two_ulp(xy):
     ``sqrt(x² + y²)``: within two ulp of ``np.hypot``."""
     got, want = length2(xy[:, 0], xy[:, 1]), np.hypot(xy[:, 0], xy[:, 1])
     assert np.all(np.abs(got - want) <= 2.0 * np.spacing(want))
+
+
+@settings(max_examples=60, deadline=None)
+@given(a=arrays(np.float64, array_shapes(min_dims=2, max_dims=4, min_side=1, max_side=12),
+                elements=st.floats(allow_nan=True, allow_infinity=True)))
+def test_points_last_is_the_transposed_copy(a):
+    """Coordinates-first grids as points: the values of numpy's copy of the transposed view, bit for bit
+    (NaN payloads and signed zeros included), C-contiguous, above and below 64 points."""
+    for x in (a, a.transpose(0, *range(a.ndim - 1, 0, -1))):  # a C-ordered block and a strided view
+        got, want = points_last(x), np.ascontiguousarray(np.moveaxis(x, 0, -1))
+        assert got.shape == want.shape and got.flags.c_contiguous
+        assert got.tobytes() == want.tobytes()
+    big = np.arange(3 * 9 * 11, dtype=float).reshape(3, 9, 11)
+    assert points_last(big).tobytes() == np.ascontiguousarray(big.transpose(1, 2, 0)).tobytes()

@@ -42,7 +42,7 @@ from tabletcad.geometry.curves import (basis_memo, basis_spectrum, combination_o
                                       fourier_samples, modes_needed, sample_v)
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
-from tabletcad.geometry.vectors import cross, cross_first, norm3
+from tabletcad.geometry.vectors import cross, cross_first, norm3, points_last
 
 __all__ = ["PDEPatch", "AUTO_A_LADDER"]
 
@@ -669,7 +669,7 @@ class PDEPatch:
         if out is not None:
             return out
         X = Y.T.reshape(m, nu, nv)
-        return X if components else np.ascontiguousarray(X.transpose(1, 2, 0))
+        return X if components else points_last(X)
 
     def jet_grid(self, u, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``X``, ``X_u`` and ``X_v`` on the grid ``u × v``, each ``(3, len(u), len(v))`` (coordinates

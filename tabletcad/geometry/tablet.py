@@ -23,7 +23,7 @@ from tabletcad.geometry.patch import PDEPatch
 from tabletcad.geometry.revolution import profile_extreme
 from tabletcad.readonly import TableDict
 from tabletcad.tolerance import DEFAULT, Tolerances
-from tabletcad.geometry.vectors import cross_first, norm3
+from tabletcad.geometry.vectors import cross_first, norm3, points_last
 from tabletcad.geometry.quadrature import gauss_legendre
 
 #: Trapezoidal points in ``v`` for the integrals of a surface of revolution, whose integrands
@@ -1503,7 +1503,7 @@ class Tablet:
         G = np.empty((len(patches), 3, len(u), len(v)))  # each patch's grid written in its block, coordinates
         for k, p in enumerate(patches):  # first; then the points (x, y, z) in one transposed copy
             p.evaluate_grid(u, v, components=True, out=G[k])
-        X = G.transpose(0, 2, 3, 1)
+        X = points_last(G.transpose(1, 0, 2, 3))  # (patches, nu, nv, 3)
         D = np.abs(self.nominal(X.reshape(-1, 3))).reshape(X.shape[:3])
         best = D.max(axis=(1, 2))
         t = self.trim
