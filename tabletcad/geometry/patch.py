@@ -648,7 +648,9 @@ class PDEPatch:
             n = L.shape[0]
             AB = np.matmul(L, self._abT)  # (n, nu, 6): each mode's cosine and sine profiles
             # (3, nu, 2n): coordinate c's cosine profiles, then its sine profiles
-            U = AB.reshape(n, nu, 2, 3).transpose(3, 1, 2, 0)[ax].reshape(m * nu, 2 * n)
+            # (the coordinates a run from the first: a slice, one copy in the reshape; else gathered)
+            P = AB.reshape(n, nu, 2, 3).transpose(3, 1, 2, 0)
+            U = (P[: ax[-1] + 1] if ax == list(range(ax[-1] + 1)) else P[ax]).reshape(m * nu, 2 * n)
             _gemm(_trig_shared(v, self._n_active, dv, rows=True).T, U.T, Y)
             fresh = False
         if rem or spine:
