@@ -251,7 +251,7 @@ def test_one_point_s_signed_distance_is_the_outline_s_and_no_point_is_deeper_tha
     """The plain-float distance of one point that the inscribed radius's search reads equals
     :meth:`PlanOutline.signed_distance` exactly (inside, outside, at the joins and the arcs' centres, convex
     and concave fillets, either orientation); no point of a dense grid lies deeper inside than the
-    inscribed radius, and the search on the vectorised distance finds the same radius."""
+    inscribed radius, nor does an independent search on the vectorised distance find a deeper one."""
     if ol is None:
         return
     rng = np.random.default_rng(seed)

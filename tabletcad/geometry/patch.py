@@ -851,7 +851,8 @@ class PDEPatch:
         runs backwards for ``u`` below ~0.015 (0.8 µm for the 5 mm sphere).
         ``nv`` defaults to the fold checks' sampling in ``v`` (``_check_nv``); a surface of
         revolution, or of scaled copies of one plan ellipse (:attr:`section`), whose depth is the
-        same on every meridian, is always measured on four.
+        same on every meridian (a level one's deepest on a principal meridian), is always measured
+        on four.
         """
         return self._fold_entry(nu, nv)[0]
 
