@@ -385,7 +385,7 @@ class PlanOutline:
         maxima (no neighbour higher) above that level are the starts, adjacent ones as one, from its
         best (a ridge of equal depth along the grid's rows or columns, as a capsule's sides: one start;
         across them, as a turned capsule's, a staircase of starts a cell or two apart, each polished:
-        3.3 ms a call unturned, up to ~50 ms turned); two lobes of an outline, with their own deepest
+        3.3 ms a call unturned, tens of ms turned); two lobes of an outline, with their own deepest
         points, are two starts.  On a chain of lines and arcs the search reads
         :meth:`_point_signed_distance` (plain floats, the arithmetic of :meth:`signed_distance` without
         numpy's cost per call on one point: ~200 calls a start) and returns :meth:`signed_distance` at
