@@ -613,6 +613,8 @@ def test_a_standard_die_follows_the_tablets_size(headless):
     assert s["standard"] and s["tablet"]["valid"] and s["die"]["valid"]
     assert (s["od"], s["height"]) == pytest.approx((38.10, 23.81), abs=1e-9)
     assert s["overlap"] < 1e-9
+    # and a die made before that recompute is the D die too (not the B die of the 9 mm tablet last built)
+    assert s["early_size"] == pytest.approx([38.10, 23.81], abs=1e-9)
 
 
 def test_a_nan_fit_tolerance_is_refused_naming_it(headless):

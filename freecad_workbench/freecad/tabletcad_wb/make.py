@@ -174,7 +174,7 @@ def make_die(doc, tablet, *, height=None, outer_diameter=None, recompute=True):
         height, outer_diameter = values.get("die_height"), values.get("die_outer_diameter")
     standard = outer_diameter is None and height is None  # the TSM die, followed when the tablet changes
     if outer_diameter is None:  # (an outer diameter given alone keeps the 22.22 mm height, as build does)
-        core = tablet.Proxy.core_tablet(tablet)
+        core = tablet.Proxy.current_core_tablet(tablet)  # (the one its recompute built, when current)
         dims = core.dimensions()
         outer_diameter, h, _ = objects.standard_die(max(dims["length_mm"], dims["width_mm"]), core.revolution is None)
         height = h if height is None else height

@@ -415,6 +415,42 @@ class TabletProxy(_Proxy):
             )
         return geometry.tablet_from_spec(s["family"], s["params"], s["design"])
 
+    def _geometry_key(self, obj, fit: float) -> str:
+        """What the solid is made of: the spec, the fit tolerance ``fit`` (mm) and the design file's digest.
+
+        Parameters
+        ----------
+        obj : App.FeaturePython
+            The tablet.
+        fit : float
+            Its ``FitTolerance`` (mm; 0: the core's default).
+
+        Returns
+        -------
+        str
+            A key equal for equal inputs (the solid is rebuilt only when it changes)."""
+        s = self.spec(obj)
+        return repr((s, fit, _file_digest(s["design"])))
+
+    def current_core_tablet(self, obj):
+        """The core tablet of the object's inputs as they are now: the one its last recompute built when they
+        have not changed since (``make_die`` sizes its standard die from it: it had built the same tablet again,
+        0.4 s for a free-form design), else :meth:`core_tablet`.
+
+        Parameters
+        ----------
+        obj : App.FeaturePython
+            The tablet.
+
+        Returns
+        -------
+        tabletcad.geometry.tablet.Tablet
+            The core's tablet (dimensions in mm)."""
+        built = getattr(self, "_core", None)
+        if built is not None and built[0] == self._geometry_key(obj, float(obj.FitTolerance.Value)):
+            return built[1]
+        return self.core_tablet(obj)
+
     def build(self, obj):
         from tabletcad.errors import DesignError
 
@@ -427,8 +463,7 @@ class TabletProxy(_Proxy):
         if not (fit == 0.0 or MIN_FIT_TOLERANCE_MM <= fit <= MAX_FIT_TOLERANCE_MM):  # (NaN had reached the core as "tol")
             raise DesignError("FitTolerance", fit, f"must be 0 (the default, {_default_fit():g} mm) or within "
                               f"[{MIN_FIT_TOLERANCE_MM:g}, {MAX_FIT_TOLERANCE_MM:g}]", "mm")
-        s = self.spec(obj)
-        key = repr((s, fit, _file_digest(s["design"])))
+        key = self._geometry_key(obj, fit)
         if key != getattr(self, "_built", None) or obj.Shape.isNull() or not obj.RimData:
             # rebuild only when the geometry's inputs changed (not for Density, Label, Placement)
             tablet = self.core_tablet(obj)
@@ -445,6 +480,7 @@ class TabletProxy(_Proxy):
             if rims != obj.RimData:
                 obj.RimData = rims
             self._built = key
+            self._core = (key, tablet)  # (not saved with the document: rebuilt on its first recompute)
             self.builds = getattr(self, "builds", 0) + 1  # solids built by this proxy (this session)
         obj.Weight = float(obj.Volume) * density
         obj.RecomputeTime = time.perf_counter() - t0
@@ -628,10 +664,41 @@ class DieProxy(_Proxy):
             od, height, _ = standard_die(size, shaped, float(obj.OuterDiameter.Value))
             if abs(float(obj.OuterDiameter.Value) - od) > 1e-12 or abs(float(obj.Height.Value) - height) > 1e-12:
                 self.set_size(obj, od, height)
-        shape = geometry.die_shape(rims, float(obj.Height.Value), float(obj.OuterDiameter.Value))
+        shape = self._body(tab, rims, float(obj.Height.Value), float(obj.OuterDiameter.Value))
         obj.Shape = shape
         obj.Placement = tab.Placement
         obj.Volume = float(shape.Volume)
+
+    def _body(self, tab, rims: list, height: float, outer_diameter: float):
+        """The die's shape (:func:`geometry.die_shape`), cut again only when what it is made of changed: the
+        tablet's rims, ``height`` and ``outer_diameter`` (mm).
+
+        A recompute of the die for anything else (the tablet's ``Density`` or ``Label``, whose recompute
+        recomputes the linked tools) had cut the bore again, as the punches' tips had been (``cuts`` counts
+        the cuts made, this session).
+
+        Parameters
+        ----------
+        tab : App.FeaturePython
+            The die's tablet (:func:`_tablet_of`).
+        rims : list of dict
+            Its rims (:func:`geometry.rims_from_json` of ``tab.RimData``).
+        height, outer_diameter : float
+            The die's size (mm).
+
+        Returns
+        -------
+        Part.Shape
+            The die, in the tablet's own frame.
+        """
+        key = (tab.RimData, height, outer_diameter)
+        made = getattr(self, "_made", None)
+        if made is not None and made[0] == key:
+            return made[1]
+        shape = geometry.die_shape(rims, height, outer_diameter)
+        self._made = (key, shape)
+        self.cuts = getattr(self, "cuts", 0) + 1
+        return shape
 
 
 # ============================================================================ view providers (GUI only)
