@@ -796,20 +796,27 @@ def _signed_to_segment(s, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         qx, qy = px - (ax + t * dx), py - (ay + t * dy)
         return length2(qx, qy), np.where(qx * -dy + qy * dx >= 0.0, 1.0, -1.0)
 
+    rx, ry = px - s.center[0], py - s.center[1]
+    rho = length2(rx, ry)
+    dist = np.abs(rho - s.radius)
+    # inward normal of a convex (ccw) arc points to the centre
+    sg = np.where((s.radius - rho) * math.copysign(1.0, s.sweep) >= 0.0, 1.0, -1.0)
+    off = np.flatnonzero(~s.within_sweep(rx, ry, rho))  # beyond the arc's span: its nearer end decides
+    if off.size:  # (measured there alone: the same values, elementwise)
+        dist[off], sg[off] = _arc_ends(s, px[off], py[off])
+    return dist, sg
+
+
+def _arc_ends(s, px: np.ndarray, py: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distance (mm) from plan points ``(px, py)`` to the nearer end of the arc ``s`` and the side (+1
+    inward, -1 outward) of that end's tangent they lie on (the start's where the two are equally far)."""
+
     def side(x0: float, y0: float, t) -> np.ndarray:  # +1 left of the direction t through (x0, y0)
         return np.where((px - x0) * -t[1] + (py - y0) * t[0] >= 0.0, 1.0, -1.0)
 
-    rx, ry = px - s.center[0], py - s.center[1]
-    rho = length2(rx, ry)
-    inside_arc = s.within_sweep(rx, ry, rho)
-    d_arc = np.abs(rho - s.radius)
-    # inward normal of a convex (ccw) arc points to the centre
-    sg_arc = np.where((s.radius - rho) * math.copysign(1.0, s.sweep) >= 0.0, 1.0, -1.0)
     e0 = length2(px - s.p0[0], py - s.p0[1])
     e1 = length2(px - s.p1[0], py - s.p1[1])
-    dist = np.where(inside_arc, d_arc, np.minimum(e0, e1))
-    sg = np.where(inside_arc, sg_arc, np.where(e0 <= e1, side(*s.p0, s.tangent(0)), side(*s.p1, s.tangent(1))))
-    return dist, sg
+    return np.minimum(e0, e1), np.where(e0 <= e1, side(*s.p0, s.tangent(0)), side(*s.p1, s.tangent(1)))
 
 
 def _check_polyline_simple(p: np.ndarray, parameter: str) -> None:

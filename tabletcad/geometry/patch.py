@@ -67,14 +67,61 @@ _EYE3 = np.eye(3)
 _TRIG_BLOCK = 8
 
 
-def _horizontal(Xu: np.ndarray, Xv: np.ndarray, D: np.ndarray) -> bool:
-    """Whether a patch sampled as ``(3, nu, nv)`` blocks lies in a horizontal plane: no ``z`` in its
-    partials or about its spine, beyond rounding of their sizes (a flat face of a family, a disc)."""
-    def small(a: np.ndarray) -> bool:
-        size = math.sqrt(float(np.max(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])))
-        return float(np.max(np.abs(a[2]))) <= 1e-12 * max(size, 1e-300)
+def _largest_length(a: np.ndarray) -> float:
+    """Largest length (mm, or mm per unit parameter) of the vectors of a field stored coordinates
+    first ``(3, ...)``: ``sqrt(max(x² + y² + z²))``, one root."""
+    return math.sqrt(float(np.max(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])))
 
-    return small(Xu) and small(Xv) and small(D)
+
+def _horizontal(Xu: np.ndarray, Xv: np.ndarray, D: np.ndarray,
+                sizes: tuple[float, float, float] | None = None) -> bool:
+    """Whether a patch sampled as ``(3, nu, nv)`` blocks lies in a horizontal plane: no ``z`` in its
+    partials or about its spine, beyond rounding of their sizes (a flat face of a family, a disc).
+    ``sizes``: the fields' :func:`_largest_length` (mm per unit parameter, mm), when the caller has them."""
+    sizes = sizes or (_largest_length(Xu), _largest_length(Xv), _largest_length(D))
+    return all(float(np.max(np.abs(a[2]))) <= 1e-12 * max(size, 1e-300) for a, size in zip((Xu, Xv, D), sizes))
+
+
+def _fold_back(u: np.ndarray, det: np.ndarray, length: np.ndarray, scale: float) -> float:
+    """:meth:`PDEPatch.fold_depth` from the solid map's Jacobian ``det`` on the grid ``u × v`` ``(nu, nv)``
+    and the length of the vector ``det`` is taken along (``|X_v × D|``; mm): the largest, over ``v``,
+    distance travelled backwards (mm) where ``det`` has the sign its sum has not, beyond rounding of
+    ``scale`` (the product of the fields' sizes); 0 when it nowhere has."""
+    ref = 1.0 if float(np.sum(det)) >= 0.0 else -1.0
+    folded = det * ref < -1e-9 * scale
+    if not np.any(folded):
+        return 0.0
+    speed = np.abs(det) / np.maximum(length, 1e-300) * folded
+    du = np.diff(u)[:, None]
+    back = np.sum(0.5 * (speed[1:] + speed[:-1]) * du, axis=0)
+    return float(np.max(back))
+
+
+def _fold_level(u: np.ndarray, X: np.ndarray, Xu: np.ndarray, Xv: np.ndarray,
+                A: np.ndarray) -> tuple[float, float] | None:
+    """``(fold depth, reach)`` (mm) of a :attr:`PDEPatch.level` patch from its :meth:`PDEPatch.jet_grid` and
+    spine ``A`` ``(3, nu, 1)``, the figures of the general rule with the ``z`` parts it has not; None where
+    some sample is not finite (the general rule's, whose zero products would then be NaN).
+
+    ``X_z`` is the spine's own ``z`` and ``X_v`` has no ``z``, so ``D = X - A`` has none either (exactly 0):
+    ``X_v × D = (0, 0, m)`` with ``m = X_v,x D_y - X_v,y D_x``, the Jacobian is ``X_u,z m`` and every length
+    and test reads the two plan coordinates (each term left out is a signed zero: the sums, the signs
+    taken and the lengths are those of the whole vectors, bit for bit).
+    """
+    D0, D1 = X[0] - A[0], X[1] - A[1]
+    plan = lambda a, b: math.sqrt(float(np.max(a * a + b * b)))  # noqa: E731
+    reach = plan(D0, D1)
+    size_u, size_v = _largest_length(Xu), plan(Xv[0], Xv[1])
+    if not (math.isfinite(reach) and math.isfinite(size_u) and math.isfinite(size_v) and np.all(np.isfinite(A))):
+        return None
+    scale = size_u * size_v * reach
+    if scale == 0.0:
+        return 0.0, reach
+    if float(np.max(np.abs(Xu[2]))) <= 1e-12 * max(size_u, 1e-300):  # horizontal: the fold in its plane
+        det = Xu[0] * Xv[1] - Xu[1] * Xv[0]
+        return _fold_back(u, det, np.sqrt(Xv[0] * Xv[0] + Xv[1] * Xv[1]), size_u * size_v), reach
+    m = Xv[0] * D1 - Xv[1] * D0
+    return _fold_back(u, Xu[2] * m, np.sqrt(m * m), scale), reach
 
 
 @lru_cache(maxsize=8)
@@ -905,29 +952,26 @@ class PDEPatch:
         v = sample_v(nv) if v is None else v
         # coordinates as contiguous (nu, nv) blocks (evaluate_grid's components layout)
         X, Xu, Xv = self.jet_grid(u, v)
-        D = X - self.spine(u).T[:, :, None]  # (a level patch's z: its spine's less itself, 0)
+        A = self.spine(u).T[:, :, None]
+        hit = _fold_level(u, X, Xu, Xv, A) if self.level else None
+        if hit is not None:
+            return hit
+        D = X - A
         m = cross_first(Xv, D)  # Xv × D
         det = Xu[0] * m[0] + Xu[1] * m[1] + Xu[2] * m[2]
-        mag = lambda a: math.sqrt(float(np.max(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])))  # noqa: E731
-        reach = mag(D)
-        scale = mag(Xu) * mag(Xv) * reach
+        reach = _largest_length(D)
+        size_u, size_v = _largest_length(Xu), _largest_length(Xv)
+        scale = size_u * size_v * reach
         if scale == 0.0:
             return 0.0, reach
-        flat = _horizontal(Xu, Xv, D)
-        if flat:  # a flat patch's solid map has no volume (det = 0): it folds where its own Jacobian in its
+        if _horizontal(Xu, Xv, D, (size_u, size_v, reach)):
+            # a flat patch's solid map has no volume (det = 0): it folds where its own Jacobian in its
             # plane, (X_u × X_v)_z, changes sign (a fan over an outline not star-shaped about its centre counts
             # the overlap twice), travelling backwards across each v line at |(X_u × X_v)_z| / |X_v|
             det = Xu[0] * Xv[1] - Xu[1] * Xv[0]
             m = Xv
-            scale = mag(Xu) * mag(Xv)
-        ref = 1.0 if float(np.sum(det)) >= 0.0 else -1.0
-        folded = det * ref < -1e-9 * scale
-        if not np.any(folded):
-            return 0.0, reach
-        speed = np.abs(det) / np.maximum(np.sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]), 1e-300) * folded
-        du = np.diff(u)[:, None]
-        back = np.sum(0.5 * (speed[1:] + speed[:-1]) * du, axis=0)
-        return float(np.max(back)), reach
+            scale = size_u * size_v
+        return _fold_back(u, det, np.sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]), scale), reach
 
     def _check_fold(self) -> None:
         """Refuse a patch whose surface folds over itself, passes through its
