@@ -201,7 +201,9 @@ class PlanOutline:
 
     def _locate(self, v: np.ndarray):
         s = np.mod(v, math.tau) * (self.perimeter / math.tau)
-        idx = np.clip(np.searchsorted(self._cum, s, side="right") - 1, 0, len(self.segs) - 1)
+        idx = np.searchsorted(self._cum, s, side="right") - 1  # (clipped to the segments: np.clip's cost per call)
+        np.maximum(idx, 0, out=idx)
+        np.minimum(idx, len(self.segs) - 1, out=idx)
         return s, idx
 
     def frame(self, v) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -235,18 +237,26 @@ class PlanOutline:
         # every point by its own segment's formula, gathered from the table (the same arithmetic as
         # segment by segment, without a Python loop over segments)
         # (rows of the (segments, 2) tables by take: fancy indexing steps an iterator per row)
+        # (pairs of columns written into (m, 2) arrays: column_stack's cost per call, the same values)
         t = s - self._cum[idx]
         a = arc[idx]
         g = sg[idx]
-        th = theta0[idx] + g * t / radius[idx]
-        c, sn = np.cos(th), np.sin(th)
         r = radius[idx]
+        th = theta0[idx] + g * t / r
+        c, sn = np.cos(th), np.sin(th)
         dk = np.take(d, idx, axis=0)
-        O = np.where(a[:, None], np.take(centre, idx, axis=0) + np.column_stack([r * c, r * sn]),
-                     np.take(p0, idx, axis=0) + t[:, None] * dk)
-        T = np.where(a[:, None], np.column_stack([-g * sn, g * c]), dk)
+        rim = np.empty((v.size, 2))
+        np.multiply(r, c, out=rim[:, 0])
+        np.multiply(r, sn, out=rim[:, 1])
+        O = np.where(a[:, None], np.take(centre, idx, axis=0) + rim, np.take(p0, idx, axis=0) + t[:, None] * dk)
+        turn = np.empty((v.size, 2))
+        np.multiply(-g, sn, out=turn[:, 0])
+        np.multiply(g, c, out=turn[:, 1])
+        T = np.where(a[:, None], turn, dk)
         k = np.where(a, g / r, 0.0)
-        N = np.column_stack([-T[:, 1], T[:, 0]])
+        N = np.empty((v.size, 2))
+        np.negative(T[:, 1], out=N[:, 0])
+        N[:, 1] = T[:, 0]
         return O, T, N, k
 
     def _segment_table(self) -> tuple[np.ndarray, ...]:

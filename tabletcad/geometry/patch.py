@@ -183,18 +183,19 @@ def _trig_base(v: np.ndarray, nmax: int) -> tuple[np.ndarray, np.ndarray]:
     return TRIG.get(("base", nmax, v.tobytes()), make)
 
 
-def _trig_shared(v: np.ndarray, n: np.ndarray, dv: int, rows: bool = False):
+def _trig_shared(v: np.ndarray, n: np.ndarray, dv: int, rows: bool = False, vbytes: bytes | None = None):
     """:func:`_trig` (read-only), remembered across patches for grid-sized ``v``; with
     ``rows`` the table ``(2 len(n), len(v))`` of the cosines' rows over the sines' rows.
 
     The patches of one tablet are evaluated on the same ``v`` samples with the same modes
     (a swept tablet's nine patches, the checks' grids), so one table serves them all.  Keyed
     on the bytes of ``v`` and ``n``: equal samples hit, nothing is shared between different ones.
+    ``vbytes``: ``v.tobytes()`` when the caller has it (one copy and one hash of the samples a call).
     """
     make = _trig_rows if rows else _trig
     if v.size > _CACHED_V[1] or 16 * v.size * n.size > TRIG.max_bytes:
         return make(v, n, dv)
-    return TRIG.get((rows, dv, n.tobytes(), v.tobytes()), lambda: make(v, n, dv))
+    return TRIG.get((rows, dv, n.tobytes(), v.tobytes() if vbytes is None else vbytes), lambda: make(v, n, dv))
 
 
 def _gemm(a: np.ndarray, b: np.ndarray, c: np.ndarray, fresh: bool = True) -> np.ndarray:
@@ -223,10 +224,12 @@ def _basis_fourier(basis, N: int, samples: int) -> tuple[np.ndarray, ...]:
     return hit
 
 
-def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: np.ndarray, dv: int) -> np.ndarray:
+def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: np.ndarray, dv: int,
+                     vbytes: bytes | None = None) -> np.ndarray:
     """The ``k`` basis curves less their Fourier series (``active`` modes, or all ``N`` when None), or
     the ``v``-derivative of that, at ``v``: ``(k, len(v), 3)`` mm, read-only; kept on the basis for
-    grid-sized ``v`` (every patch on it reads the same ``v`` samples in a check)."""
+    grid-sized ``v`` (every patch on it reads the same ``v`` samples in a check).  ``vbytes``:
+    ``v.tobytes()`` when the caller has it."""
 
     def make() -> np.ndarray:
         a0, _, _, rows = _basis_fourier(basis, N, samples)
@@ -238,7 +241,7 @@ def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: 
             c, s = _trig_shared(v, np.arange(1, N + 1), dv)  # (m, N) each
             out -= (c @ rows[0] + s @ rows[1]).reshape(v.size, k, 3).transpose(1, 0, 2)
         elif active is not None and active.size:
-            T = _trig_shared(v, active, dv, rows=True)  # (2n, m), cosines over sines
+            T = _trig_shared(v, active, dv, rows=True, vbytes=vbytes)  # (2n, m), cosines over sines
             R = np.concatenate([rows[0][active - 1], rows[1][active - 1]])  # (2n, 3k)
             out -= (T.T @ R).reshape(v.size, k, 3).transpose(1, 0, 2)
         out.setflags(write=False)
@@ -247,7 +250,7 @@ def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: 
     if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
         return make()
     memo = basis_memo(basis)
-    key = ("res", N, samples, None if active is None else active.tobytes(), dv, v.tobytes())
+    key = ("res", N, samples, None if active is None else active.tobytes(), dv, v.tobytes() if vbytes is None else vbytes)
     hit = memo.get(key)
     if hit is None:
         hit = make()
@@ -545,15 +548,17 @@ class PDEPatch:
         """``_trig(v, 1..N, dv)`` (read-only), cached for repeated ``v``."""
         return _trig_shared(v, np.arange(1, N + 1), dv)
 
-    def _residuals(self, v: np.ndarray, dv: int) -> np.ndarray:
-        """Every datum's part above mode ``N`` (or its v-derivative) at ``v``: (4, len(v), 3) mm, read-only."""
+    def _residuals(self, v: np.ndarray, dv: int, vbytes: bytes | None = None) -> np.ndarray:
+        """Every datum's part above mode ``N`` (or its v-derivative) at ``v``: (4, len(v), 3) mm, read-only.
+        ``vbytes``: ``v.tobytes()`` when the caller has it (the memos' keys)."""
 
         def make() -> np.ndarray:
             N = self.modes
             comb = self.__dict__.get("_comb")
             if comb is not None:  # the basis's residuals (shared by the patches on it), combined
                 basis, W, samples = comb
-                return np.einsum("jk,kmc->jmc", W, _basis_residuals(basis, N, samples, self.__dict__.get("_n_active"), v, dv))
+                return np.einsum("jk,kmc->jmc", W, _basis_residuals(basis, N, samples, self.__dict__.get("_n_active"), v, dv,
+                                                                    vbytes))
             out = evaluate_curves(self.data, v, dv)  # (a datum repeated, a fan's two equal derivatives, once)
             if dv == 0:
                 out -= self._a0[:, None, :]
@@ -563,13 +568,13 @@ class PDEPatch:
                 out -= (c @ self._ac_rows + s @ self._bc_rows).reshape(v.size, 4, 3).transpose(1, 0, 2)
             elif act is not None and act.size:  # the series the surface sums: its active modes, in one
                 # product with the table of cosine over sine rows that evaluate_grid takes at these v
-                T = _trig_shared(v, act, dv, rows=True)  # (2n, m)
+                T = _trig_shared(v, act, dv, rows=True, vbytes=vbytes)  # (2n, m)
                 out -= (T.T @ self._res_rows).reshape(v.size, 4, 3).transpose(1, 0, 2)
             return out
 
         if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
             return make()
-        return self._memo(("res", dv, v.tobytes()), make)
+        return self._memo(("res", dv, v.tobytes() if vbytes is None else vbytes), make)
 
     def _u_tables(self, u: np.ndarray, du: int) -> tuple[np.ndarray | None, np.ndarray, np.ndarray | None]:
         """The cardinal functions at ``u`` (or their ``u``-derivative) of every active mode
@@ -679,6 +684,7 @@ class PDEPatch:
         # product of (nv, 5) by (5, nu) added in place (beta = 1): no temporary the size of the grid
         ax = list(axes) if components else [0, 1, 2]
         m, nu, nv = len(ax), u.size, v.size
+        vb = v.tobytes() if nv <= _CACHED_V[1] else None  # (the tables' and memos' key: one copy, one hash)
         rem, spine = self._has_remainder, dv == 0
         if out is not None:
             if out.shape != (m, nu, nv) or out.dtype != np.float64 or not out.flags.c_contiguous:
@@ -698,11 +704,11 @@ class PDEPatch:
             # (the coordinates a run from the first: a slice, one copy in the reshape; else gathered)
             P = AB.reshape(n, nu, 2, 3).transpose(3, 1, 2, 0)
             U = (P[: ax[-1] + 1] if ax == list(range(ax[-1] + 1)) else P[ax]).reshape(m * nu, 2 * n)
-            _gemm(_trig_shared(v, self._n_active, dv, rows=True).T, U.T, Y)
+            _gemm(_trig_shared(v, self._n_active, dv, rows=True, vbytes=vb).T, U.T, Y)
             fresh = False
         if rem or spine:
             k = 4 * rem + spine
-            r = self._residuals(v, dv) if rem else None  # (4, nv, 3)
+            r = self._residuals(v, dv, vb) if rem else None  # (4, nv, 3)
             A = L0 @ self._a0 if spine else None  # (nu, 3)
             rows, prof = np.empty((k, nv)), np.empty((nu, k))
             if spine:
