@@ -201,7 +201,8 @@ class PlanOutline:
 
     def _locate(self, v: np.ndarray):
         s = np.mod(v, math.tau) * (self.perimeter / math.tau)
-        idx = np.searchsorted(self._cum, s, side="right") - 1  # (clipped to the segments: np.clip's cost per call)
+        # clipped to the segments in place (np.clip's cost per call)
+        idx = np.searchsorted(self._cum, s, side="right") - 1
         np.maximum(idx, 0, out=idx)
         np.minimum(idx, len(self.segs) - 1, out=idx)
         return s, idx
@@ -248,7 +249,8 @@ class PlanOutline:
         rim = np.empty((v.size, 2))
         np.multiply(r, c, out=rim[:, 0])
         np.multiply(r, sn, out=rim[:, 1])
-        O = np.where(a[:, None], np.take(centre, idx, axis=0) + rim, np.take(p0, idx, axis=0) + t[:, None] * dk)
+        O = np.where(a[:, None], np.take(centre, idx, axis=0) + rim,
+                     np.take(p0, idx, axis=0) + t[:, None] * dk)
         turn = np.empty((v.size, 2))
         np.multiply(-g, sn, out=turn[:, 0])
         np.multiply(g, c, out=turn[:, 1])

@@ -79,7 +79,8 @@ def _horizontal(Xu: np.ndarray, Xv: np.ndarray, D: np.ndarray,
     partials or about its spine, beyond rounding of their sizes (a flat face of a family, a disc).
     ``sizes``: the fields' :func:`_largest_length` (mm per unit parameter, mm), when the caller has them."""
     sizes = sizes or (_largest_length(Xu), _largest_length(Xv), _largest_length(D))
-    return all(float(np.max(np.abs(a[2]))) <= 1e-12 * max(size, 1e-300) for a, size in zip((Xu, Xv, D), sizes))
+    return all(float(np.max(np.abs(a[2]))) <= 1e-12 * max(size, 1e-300)
+               for a, size in zip((Xu, Xv, D), sizes))
 
 
 def _fold_back(u: np.ndarray, det: np.ndarray, length: np.ndarray, scale: float) -> float:
@@ -112,7 +113,8 @@ def _fold_level(u: np.ndarray, X: np.ndarray, Xu: np.ndarray, Xv: np.ndarray,
     plan = lambda a, b: math.sqrt(float(np.max(a * a + b * b)))  # noqa: E731
     reach = plan(D0, D1)
     size_u, size_v = _largest_length(Xu), plan(Xv[0], Xv[1])
-    if not (math.isfinite(reach) and math.isfinite(size_u) and math.isfinite(size_v) and np.all(np.isfinite(A))):
+    if not (math.isfinite(reach) and math.isfinite(size_u) and math.isfinite(size_v)
+            and np.all(np.isfinite(A))):
         return None
     scale = size_u * size_v * reach
     if scale == 0.0:
@@ -195,7 +197,8 @@ def _trig_shared(v: np.ndarray, n: np.ndarray, dv: int, rows: bool = False, vbyt
     make = _trig_rows if rows else _trig
     if v.size > _CACHED_V[1] or 16 * v.size * n.size > TRIG.max_bytes:
         return make(v, n, dv)
-    return TRIG.get((rows, dv, n.tobytes(), v.tobytes() if vbytes is None else vbytes), lambda: make(v, n, dv))
+    vb = v.tobytes() if vbytes is None else vbytes
+    return TRIG.get((rows, dv, n.tobytes(), vb), lambda: make(v, n, dv))
 
 
 def _gemm(a: np.ndarray, b: np.ndarray, c: np.ndarray, fresh: bool = True) -> np.ndarray:
@@ -250,7 +253,8 @@ def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: 
     if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
         return make()
     memo = basis_memo(basis)
-    key = ("res", N, samples, None if active is None else active.tobytes(), dv, v.tobytes() if vbytes is None else vbytes)
+    vb = v.tobytes() if vbytes is None else vbytes
+    key = ("res", N, samples, None if active is None else active.tobytes(), dv, vb)
     hit = memo.get(key)
     if hit is None:
         hit = make()
@@ -557,8 +561,8 @@ class PDEPatch:
             comb = self.__dict__.get("_comb")
             if comb is not None:  # the basis's residuals (shared by the patches on it), combined
                 basis, W, samples = comb
-                return np.einsum("jk,kmc->jmc", W, _basis_residuals(basis, N, samples, self.__dict__.get("_n_active"), v, dv,
-                                                                    vbytes))
+                act = self.__dict__.get("_n_active")
+                return np.einsum("jk,kmc->jmc", W, _basis_residuals(basis, N, samples, act, v, dv, vbytes))
             out = evaluate_curves(self.data, v, dv)  # (a datum repeated, a fan's two equal derivatives, once)
             if dv == 0:
                 out -= self._a0[:, None, :]

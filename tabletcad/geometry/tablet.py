@@ -1482,7 +1482,8 @@ class Tablet:
         u = np.linspace(lo, hi, nu)
         v0 = self.trim.v[0]
         n = len(self.patches)
-        D = self._nominal_distance(np.concatenate([p.evaluate(u, np.full(nu, v0)) for p in self.patches])).reshape(n, nu)
+        pts = np.concatenate([p.evaluate(u, np.full(nu, v0)) for p in self.patches])
+        D = self._nominal_distance(pts).reshape(n, nu)
         per = D.max(axis=1)
         slack = float(np.max(np.abs(np.diff(D, 2, axis=1)))) if nu > 2 else math.inf
         E = np.pad(D, ((0, 0), (1, 1)), mode="edge")
@@ -1506,9 +1507,9 @@ class Tablet:
         return per.copy()
 
     def _nominal_distance(self, points: np.ndarray) -> np.ndarray:
-        """``|nominal(points)|`` (mm) at 3-D points ``(m, 3)``: by the nominal's own unsigned ``distance`` when
-        it has one (a family's :class:`~tabletcad.families.sweep.SweepNominal`, whose signed value is that
-        distance with a side: the same numbers without telling inside from outside)."""
+        """``|nominal(points)|`` (mm) at 3-D points ``(m, 3)``: by the nominal's own unsigned
+        ``distance`` when it has one (a family's :class:`~tabletcad.families.sweep.SweepNominal`, whose
+        signed value is that distance with a side: the same numbers without the inside test)."""
         unsigned = getattr(self.nominal, "distance", None)
         return np.abs(unsigned(points) if unsigned is not None else self.nominal(points))
 
