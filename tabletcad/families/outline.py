@@ -201,7 +201,10 @@ class PlanOutline:
 
     def _locate(self, v: np.ndarray):
         s = np.mod(v, math.tau) * (self.perimeter / math.tau)
-        idx = np.clip(np.searchsorted(self._cum, s, side="right") - 1, 0, len(self.segs) - 1)
+        # clipped to the segments in place (np.clip's cost per call)
+        idx = np.searchsorted(self._cum, s, side="right") - 1
+        np.maximum(idx, 0, out=idx)
+        np.minimum(idx, len(self.segs) - 1, out=idx)
         return s, idx
 
     def frame(self, v) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -235,18 +238,27 @@ class PlanOutline:
         # every point by its own segment's formula, gathered from the table (the same arithmetic as
         # segment by segment, without a Python loop over segments)
         # (rows of the (segments, 2) tables by take: fancy indexing steps an iterator per row)
+        # (pairs of columns written into (m, 2) arrays: column_stack's cost per call, the same values)
         t = s - self._cum[idx]
         a = arc[idx]
         g = sg[idx]
-        th = theta0[idx] + g * t / radius[idx]
-        c, sn = np.cos(th), np.sin(th)
         r = radius[idx]
+        th = theta0[idx] + g * t / r
+        c, sn = np.cos(th), np.sin(th)
         dk = np.take(d, idx, axis=0)
-        O = np.where(a[:, None], np.take(centre, idx, axis=0) + np.column_stack([r * c, r * sn]),
+        rim = np.empty((v.size, 2))
+        np.multiply(r, c, out=rim[:, 0])
+        np.multiply(r, sn, out=rim[:, 1])
+        O = np.where(a[:, None], np.take(centre, idx, axis=0) + rim,
                      np.take(p0, idx, axis=0) + t[:, None] * dk)
-        T = np.where(a[:, None], np.column_stack([-g * sn, g * c]), dk)
+        turn = np.empty((v.size, 2))
+        np.multiply(-g, sn, out=turn[:, 0])
+        np.multiply(g, c, out=turn[:, 1])
+        T = np.where(a[:, None], turn, dk)
         k = np.where(a, g / r, 0.0)
-        N = np.column_stack([-T[:, 1], T[:, 0]])
+        N = np.empty((v.size, 2))
+        np.negative(T[:, 1], out=N[:, 0])
+        N[:, 1] = T[:, 0]
         return O, T, N, k
 
     def _segment_table(self) -> tuple[np.ndarray, ...]:
@@ -796,20 +808,27 @@ def _signed_to_segment(s, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         qx, qy = px - (ax + t * dx), py - (ay + t * dy)
         return length2(qx, qy), np.where(qx * -dy + qy * dx >= 0.0, 1.0, -1.0)
 
+    rx, ry = px - s.center[0], py - s.center[1]
+    rho = length2(rx, ry)
+    dist = np.abs(rho - s.radius)
+    # inward normal of a convex (ccw) arc points to the centre
+    sg = np.where((s.radius - rho) * math.copysign(1.0, s.sweep) >= 0.0, 1.0, -1.0)
+    off = np.flatnonzero(~s.within_sweep(rx, ry, rho))  # beyond the arc's span: its nearer end decides
+    if off.size:  # (measured there alone: the same values, elementwise)
+        dist[off], sg[off] = _arc_ends(s, px[off], py[off])
+    return dist, sg
+
+
+def _arc_ends(s, px: np.ndarray, py: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distance (mm) from plan points ``(px, py)`` to the nearer end of the arc ``s`` and the side (+1
+    inward, -1 outward) of that end's tangent they lie on (the start's where the two are equally far)."""
+
     def side(x0: float, y0: float, t) -> np.ndarray:  # +1 left of the direction t through (x0, y0)
         return np.where((px - x0) * -t[1] + (py - y0) * t[0] >= 0.0, 1.0, -1.0)
 
-    rx, ry = px - s.center[0], py - s.center[1]
-    rho = length2(rx, ry)
-    inside_arc = s.within_sweep(rx, ry, rho)
-    d_arc = np.abs(rho - s.radius)
-    # inward normal of a convex (ccw) arc points to the centre
-    sg_arc = np.where((s.radius - rho) * math.copysign(1.0, s.sweep) >= 0.0, 1.0, -1.0)
     e0 = length2(px - s.p0[0], py - s.p0[1])
     e1 = length2(px - s.p1[0], py - s.p1[1])
-    dist = np.where(inside_arc, d_arc, np.minimum(e0, e1))
-    sg = np.where(inside_arc, sg_arc, np.where(e0 <= e1, side(*s.p0, s.tangent(0)), side(*s.p1, s.tangent(1))))
-    return dist, sg
+    return np.minimum(e0, e1), np.where(e0 <= e1, side(*s.p0, s.tangent(0)), side(*s.p1, s.tangent(1)))
 
 
 def _check_polyline_simple(p: np.ndarray, parameter: str) -> None:

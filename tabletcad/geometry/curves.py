@@ -343,10 +343,13 @@ class Seg:
             return length2(r[:, 0], r[:, 1])
         rx, ry = q[:, 0] - self.center[0], q[:, 1] - self.center[1]
         rho = length2(rx, ry)
-        on = self.within_sweep(rx, ry, rho)
-        (x0, y0), (x1, y1) = self.point(0.0), self.point(1.0)
-        ends = np.minimum(length2(q[:, 0] - x0, q[:, 1] - y0), length2(q[:, 0] - x1, q[:, 1] - y1))
-        return np.where(on, np.abs(rho - self.radius), ends)
+        out = np.abs(rho - self.radius)
+        off = np.flatnonzero(~self.within_sweep(rx, ry, rho))  # beyond the span: the nearer end's distance
+        if off.size:  # (measured there alone: the same values, elementwise)
+            (x0, y0), (x1, y1) = self.point(0.0), self.point(1.0)
+            qx, qy = q[off, 0], q[off, 1]
+            out[off] = np.minimum(length2(qx - x0, qy - y0), length2(qx - x1, qy - y1))
+        return out
 
     def bounding_circle(self) -> tuple[float, float, float]:
         """``(x, y, r)``: a circle holding the whole segment (mm), about its middle point.

@@ -67,14 +67,63 @@ _EYE3 = np.eye(3)
 _TRIG_BLOCK = 8
 
 
-def _horizontal(Xu: np.ndarray, Xv: np.ndarray, D: np.ndarray) -> bool:
-    """Whether a patch sampled as ``(3, nu, nv)`` blocks lies in a horizontal plane: no ``z`` in its
-    partials or about its spine, beyond rounding of their sizes (a flat face of a family, a disc)."""
-    def small(a: np.ndarray) -> bool:
-        size = math.sqrt(float(np.max(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])))
-        return float(np.max(np.abs(a[2]))) <= 1e-12 * max(size, 1e-300)
+def _largest_length(a: np.ndarray) -> float:
+    """Largest length (mm, or mm per unit parameter) of the vectors of a field stored coordinates
+    first ``(3, ...)``: ``sqrt(max(x² + y² + z²))``, one root."""
+    return math.sqrt(float(np.max(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])))
 
-    return small(Xu) and small(Xv) and small(D)
+
+def _horizontal(Xu: np.ndarray, Xv: np.ndarray, D: np.ndarray,
+                sizes: tuple[float, float, float] | None = None) -> bool:
+    """Whether a patch sampled as ``(3, nu, nv)`` blocks lies in a horizontal plane: no ``z`` in its
+    partials or about its spine, beyond rounding of their sizes (a flat face of a family, a disc).
+    ``sizes``: the fields' :func:`_largest_length` (mm per unit parameter, mm), when the caller has them."""
+    sizes = sizes or (_largest_length(Xu), _largest_length(Xv), _largest_length(D))
+    return all(float(np.max(np.abs(a[2]))) <= 1e-12 * max(size, 1e-300)
+               for a, size in zip((Xu, Xv, D), sizes))
+
+
+def _fold_back(u: np.ndarray, det: np.ndarray, length: np.ndarray, scale: float) -> float:
+    """:meth:`PDEPatch.fold_depth` from the solid map's Jacobian ``det`` on the grid ``u × v`` ``(nu, nv)``
+    and the length of the vector ``det`` is taken along (``|X_v × D|``; mm): the largest, over ``v``,
+    distance travelled backwards (mm) where ``det`` has the sign its sum has not, beyond rounding of
+    ``scale`` (the product of the fields' sizes); 0 when it nowhere has."""
+    ref = 1.0 if float(np.sum(det)) >= 0.0 else -1.0
+    folded = det * ref < -1e-9 * scale
+    if not np.any(folded):
+        return 0.0
+    speed = np.abs(det) / np.maximum(length, 1e-300) * folded
+    du = np.diff(u)[:, None]
+    back = np.sum(0.5 * (speed[1:] + speed[:-1]) * du, axis=0)
+    return float(np.max(back))
+
+
+def _fold_level(u: np.ndarray, X: np.ndarray, Xu: np.ndarray, Xv: np.ndarray,
+                A: np.ndarray) -> tuple[float, float] | None:
+    """``(fold depth, reach)`` (mm) of a :attr:`PDEPatch.level` patch from its :meth:`PDEPatch.jet_grid` and
+    spine ``A`` ``(3, nu, 1)``, the figures of the general rule with the ``z`` parts it has not; None where
+    some sample is not finite (the general rule's, whose zero products would then be NaN).
+
+    ``X_z`` is the spine's own ``z`` and ``X_v`` has no ``z``, so ``D = X - A`` has none either (exactly 0):
+    ``X_v × D = (0, 0, m)`` with ``m = X_v,x D_y - X_v,y D_x``, the Jacobian is ``X_u,z m`` and every length
+    and test reads the two plan coordinates (each term left out is a signed zero: the sums, the signs
+    taken and the lengths are those of the whole vectors, bit for bit).
+    """
+    D0, D1 = X[0] - A[0], X[1] - A[1]
+    plan = lambda a, b: math.sqrt(float(np.max(a * a + b * b)))  # noqa: E731
+    reach = plan(D0, D1)
+    size_u, size_v = _largest_length(Xu), plan(Xv[0], Xv[1])
+    if not (math.isfinite(reach) and math.isfinite(size_u) and math.isfinite(size_v)
+            and np.all(np.isfinite(A))):
+        return None
+    scale = size_u * size_v * reach
+    if scale == 0.0:
+        return 0.0, reach
+    if float(np.max(np.abs(Xu[2]))) <= 1e-12 * max(size_u, 1e-300):  # horizontal: the fold in its plane
+        det = Xu[0] * Xv[1] - Xu[1] * Xv[0]
+        return _fold_back(u, det, np.sqrt(Xv[0] * Xv[0] + Xv[1] * Xv[1]), size_u * size_v), reach
+    m = Xv[0] * D1 - Xv[1] * D0
+    return _fold_back(u, Xu[2] * m, np.sqrt(m * m), scale), reach
 
 
 @lru_cache(maxsize=8)
@@ -136,18 +185,20 @@ def _trig_base(v: np.ndarray, nmax: int) -> tuple[np.ndarray, np.ndarray]:
     return TRIG.get(("base", nmax, v.tobytes()), make)
 
 
-def _trig_shared(v: np.ndarray, n: np.ndarray, dv: int, rows: bool = False):
+def _trig_shared(v: np.ndarray, n: np.ndarray, dv: int, rows: bool = False, vbytes: bytes | None = None):
     """:func:`_trig` (read-only), remembered across patches for grid-sized ``v``; with
     ``rows`` the table ``(2 len(n), len(v))`` of the cosines' rows over the sines' rows.
 
     The patches of one tablet are evaluated on the same ``v`` samples with the same modes
     (a swept tablet's nine patches, the checks' grids), so one table serves them all.  Keyed
     on the bytes of ``v`` and ``n``: equal samples hit, nothing is shared between different ones.
+    ``vbytes``: ``v.tobytes()`` when the caller has it (one copy and one hash of the samples a call).
     """
     make = _trig_rows if rows else _trig
     if v.size > _CACHED_V[1] or 16 * v.size * n.size > TRIG.max_bytes:
         return make(v, n, dv)
-    return TRIG.get((rows, dv, n.tobytes(), v.tobytes()), lambda: make(v, n, dv))
+    vb = v.tobytes() if vbytes is None else vbytes
+    return TRIG.get((rows, dv, n.tobytes(), vb), lambda: make(v, n, dv))
 
 
 def _gemm(a: np.ndarray, b: np.ndarray, c: np.ndarray, fresh: bool = True) -> np.ndarray:
@@ -176,10 +227,12 @@ def _basis_fourier(basis, N: int, samples: int) -> tuple[np.ndarray, ...]:
     return hit
 
 
-def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: np.ndarray, dv: int) -> np.ndarray:
+def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: np.ndarray, dv: int,
+                     vbytes: bytes | None = None) -> np.ndarray:
     """The ``k`` basis curves less their Fourier series (``active`` modes, or all ``N`` when None), or
     the ``v``-derivative of that, at ``v``: ``(k, len(v), 3)`` mm, read-only; kept on the basis for
-    grid-sized ``v`` (every patch on it reads the same ``v`` samples in a check)."""
+    grid-sized ``v`` (every patch on it reads the same ``v`` samples in a check).  ``vbytes``:
+    ``v.tobytes()`` when the caller has it."""
 
     def make() -> np.ndarray:
         a0, _, _, rows = _basis_fourier(basis, N, samples)
@@ -191,7 +244,7 @@ def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: 
             c, s = _trig_shared(v, np.arange(1, N + 1), dv)  # (m, N) each
             out -= (c @ rows[0] + s @ rows[1]).reshape(v.size, k, 3).transpose(1, 0, 2)
         elif active is not None and active.size:
-            T = _trig_shared(v, active, dv, rows=True)  # (2n, m), cosines over sines
+            T = _trig_shared(v, active, dv, rows=True, vbytes=vbytes)  # (2n, m), cosines over sines
             R = np.concatenate([rows[0][active - 1], rows[1][active - 1]])  # (2n, 3k)
             out -= (T.T @ R).reshape(v.size, k, 3).transpose(1, 0, 2)
         out.setflags(write=False)
@@ -200,7 +253,8 @@ def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: 
     if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
         return make()
     memo = basis_memo(basis)
-    key = ("res", N, samples, None if active is None else active.tobytes(), dv, v.tobytes())
+    vb = v.tobytes() if vbytes is None else vbytes
+    key = ("res", N, samples, None if active is None else active.tobytes(), dv, vb)
     hit = memo.get(key)
     if hit is None:
         hit = make()
@@ -498,15 +552,17 @@ class PDEPatch:
         """``_trig(v, 1..N, dv)`` (read-only), cached for repeated ``v``."""
         return _trig_shared(v, np.arange(1, N + 1), dv)
 
-    def _residuals(self, v: np.ndarray, dv: int) -> np.ndarray:
-        """Every datum's part above mode ``N`` (or its v-derivative) at ``v``: (4, len(v), 3) mm, read-only."""
+    def _residuals(self, v: np.ndarray, dv: int, vbytes: bytes | None = None) -> np.ndarray:
+        """Every datum's part above mode ``N`` (or its v-derivative) at ``v``: (4, len(v), 3) mm, read-only.
+        ``vbytes``: ``v.tobytes()`` when the caller has it (the memos' keys)."""
 
         def make() -> np.ndarray:
             N = self.modes
             comb = self.__dict__.get("_comb")
             if comb is not None:  # the basis's residuals (shared by the patches on it), combined
                 basis, W, samples = comb
-                return np.einsum("jk,kmc->jmc", W, _basis_residuals(basis, N, samples, self.__dict__.get("_n_active"), v, dv))
+                act = self.__dict__.get("_n_active")
+                return np.einsum("jk,kmc->jmc", W, _basis_residuals(basis, N, samples, act, v, dv, vbytes))
             out = evaluate_curves(self.data, v, dv)  # (a datum repeated, a fan's two equal derivatives, once)
             if dv == 0:
                 out -= self._a0[:, None, :]
@@ -516,13 +572,13 @@ class PDEPatch:
                 out -= (c @ self._ac_rows + s @ self._bc_rows).reshape(v.size, 4, 3).transpose(1, 0, 2)
             elif act is not None and act.size:  # the series the surface sums: its active modes, in one
                 # product with the table of cosine over sine rows that evaluate_grid takes at these v
-                T = _trig_shared(v, act, dv, rows=True)  # (2n, m)
+                T = _trig_shared(v, act, dv, rows=True, vbytes=vbytes)  # (2n, m)
                 out -= (T.T @ self._res_rows).reshape(v.size, 4, 3).transpose(1, 0, 2)
             return out
 
         if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
             return make()
-        return self._memo(("res", dv, v.tobytes()), make)
+        return self._memo(("res", dv, v.tobytes() if vbytes is None else vbytes), make)
 
     def _u_tables(self, u: np.ndarray, du: int) -> tuple[np.ndarray | None, np.ndarray, np.ndarray | None]:
         """The cardinal functions at ``u`` (or their ``u``-derivative) of every active mode
@@ -632,6 +688,7 @@ class PDEPatch:
         # product of (nv, 5) by (5, nu) added in place (beta = 1): no temporary the size of the grid
         ax = list(axes) if components else [0, 1, 2]
         m, nu, nv = len(ax), u.size, v.size
+        vb = v.tobytes() if nv <= _CACHED_V[1] else None  # (the tables' and memos' key: one copy, one hash)
         rem, spine = self._has_remainder, dv == 0
         if out is not None:
             if out.shape != (m, nu, nv) or out.dtype != np.float64 or not out.flags.c_contiguous:
@@ -651,11 +708,11 @@ class PDEPatch:
             # (the coordinates a run from the first: a slice, one copy in the reshape; else gathered)
             P = AB.reshape(n, nu, 2, 3).transpose(3, 1, 2, 0)
             U = (P[: ax[-1] + 1] if ax == list(range(ax[-1] + 1)) else P[ax]).reshape(m * nu, 2 * n)
-            _gemm(_trig_shared(v, self._n_active, dv, rows=True).T, U.T, Y)
+            _gemm(_trig_shared(v, self._n_active, dv, rows=True, vbytes=vb).T, U.T, Y)
             fresh = False
         if rem or spine:
             k = 4 * rem + spine
-            r = self._residuals(v, dv) if rem else None  # (4, nv, 3)
+            r = self._residuals(v, dv, vb) if rem else None  # (4, nv, 3)
             A = L0 @ self._a0 if spine else None  # (nu, 3)
             rows, prof = np.empty((k, nv)), np.empty((nu, k))
             if spine:
@@ -905,29 +962,26 @@ class PDEPatch:
         v = sample_v(nv) if v is None else v
         # coordinates as contiguous (nu, nv) blocks (evaluate_grid's components layout)
         X, Xu, Xv = self.jet_grid(u, v)
-        D = X - self.spine(u).T[:, :, None]  # (a level patch's z: its spine's less itself, 0)
+        A = self.spine(u).T[:, :, None]
+        hit = _fold_level(u, X, Xu, Xv, A) if self.level else None
+        if hit is not None:
+            return hit
+        D = X - A
         m = cross_first(Xv, D)  # Xv × D
         det = Xu[0] * m[0] + Xu[1] * m[1] + Xu[2] * m[2]
-        mag = lambda a: math.sqrt(float(np.max(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])))  # noqa: E731
-        reach = mag(D)
-        scale = mag(Xu) * mag(Xv) * reach
+        reach = _largest_length(D)
+        size_u, size_v = _largest_length(Xu), _largest_length(Xv)
+        scale = size_u * size_v * reach
         if scale == 0.0:
             return 0.0, reach
-        flat = _horizontal(Xu, Xv, D)
-        if flat:  # a flat patch's solid map has no volume (det = 0): it folds where its own Jacobian in its
+        if _horizontal(Xu, Xv, D, (size_u, size_v, reach)):
+            # a flat patch's solid map has no volume (det = 0): it folds where its own Jacobian in its
             # plane, (X_u × X_v)_z, changes sign (a fan over an outline not star-shaped about its centre counts
             # the overlap twice), travelling backwards across each v line at |(X_u × X_v)_z| / |X_v|
             det = Xu[0] * Xv[1] - Xu[1] * Xv[0]
             m = Xv
-            scale = mag(Xu) * mag(Xv)
-        ref = 1.0 if float(np.sum(det)) >= 0.0 else -1.0
-        folded = det * ref < -1e-9 * scale
-        if not np.any(folded):
-            return 0.0, reach
-        speed = np.abs(det) / np.maximum(np.sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]), 1e-300) * folded
-        du = np.diff(u)[:, None]
-        back = np.sum(0.5 * (speed[1:] + speed[:-1]) * du, axis=0)
-        return float(np.max(back)), reach
+            scale = size_u * size_v
+        return _fold_back(u, det, np.sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]), scale), reach
 
     def _check_fold(self) -> None:
         """Refuse a patch whose surface folds over itself, passes through its

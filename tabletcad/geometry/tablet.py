@@ -488,7 +488,9 @@ class Tablet:
         if solid is not None and face.kind == "w" and face.value == 1.0 and face.sign > 0:
             u, uw, v, vw = self._solid_rules(face.patch)
             if np.array_equal(u, s) and np.array_equal(uw, sw) and np.array_equal(v, t) and np.array_equal(vw, tw):
-                solid.append(self._jacobian_integral(face.patch, u, uw, vw, X, Xs, Xt))
+                # (a level patch's grids are jet_grid's: z from its spine, no z along v)
+                level = self.patches[face.patch].level
+                solid.append(self._jacobian_integral(face.patch, u, uw, vw, X, Xs, Xt, level=level))
         n = cross_first(Xs, Xt)
         if face.sign < 0:
             n = -n
@@ -967,14 +969,21 @@ class Tablet:
             vw = 0.5 * (t.v[1] - t.v[0]) * wv
         return u, uw, v, vw
 
-    def _jacobian_integral(self, i: int, u, uw, vw, X, Xu, Xv, nw: int = 3) -> float:
+    def _jacobian_integral(self, i: int, u, uw, vw, X, Xu, Xv, nw: int = 3, level: bool = False) -> float:
         """Patch ``i``'s signed triple integral of the solid map's Jacobian ``X_u · (X_v × (X - A0))``
         (eq 4.12) over the trimmed ``w`` by ``nw``-point Gauss-Legendre, from the surface and its first
         partials on the grid ``u × v`` (weights ``uw``, ``vw``), coordinates first ``(3, len(u), len(v))``.
 
         At ``w`` the map's partials are ``A0_u + w (X_u - A0_u)``, ``w X_v`` and ``X - A0``, so the
         Jacobian is ``w J1 + w² J2`` with ``J1 = A0_u · C``, ``J2 = (X_u - A0_u) · C``,
-        ``C = X_v × (X - A0)``: two surface integrals, weighted by the rule's ``Σ w`` and ``Σ w²``."""
+        ``C = X_v × (X - A0)``: two surface integrals, weighted by the rule's ``Σ w`` and ``Σ w²``.
+
+        ``level``: the grids are a :attr:`~tabletcad.geometry.patch.PDEPatch.level` patch's from its
+        ``jet_grid`` (``X_z`` and ``X_u,z`` its spine's, ``X_v,z = 0``): then ``X - A0`` and ``X_u - A0_u``
+        have no ``z``, ``C`` is ``(0, 0, C_z)``, ``J1 = A0_u,z C_z`` and ``J2 = 0``, and only ``C_z`` is
+        formed (the terms left out are signed zeros: a non-zero integral is the same number, bit for bit,
+        and a zero one at most of the other sign, which the solid's ``abs`` of the patches' sum removes;
+        a sample that is not finite is left to the whole sum, whose zero terms it makes NaN)."""
         t = self.trim
         p = self.patches[i]
         xw, ww = gauss_legendre(nw)
@@ -982,6 +991,12 @@ class Tablet:
         wwt = 0.5 * (t.w[1] - t.w[0]) * ww
         A = p.spine(u).T[:, :, None]
         Au = p.spine(u, du=1).T[:, :, None]
+        if level:
+            Cz = Xv[0] * (X[1] - A[1]) - Xv[1] * (X[0] - A[0])
+            out = float(np.dot(wwt, w)) * float(uw @ (Au[2] * Cz) @ vw) + float(np.dot(wwt, w * w)) * 0.0
+            # (a non-finite sample makes the zero terms NaN: then the whole sum below, as it would)
+            if math.isfinite(out) and math.isfinite(float(np.sum(Xu[0])) + float(np.sum(Xu[1]))):
+                return out
         C = cross_first(Xv, X - A)
         Du = Xu - Au
         J1 = Au[0] * C[0] + Au[1] * C[1] + Au[2] * C[2]
@@ -1363,7 +1378,7 @@ class Tablet:
         for i in range(len(self.patches) - 1):
             a, b = self.patches[i], self.patches[i + 1]
             (xa, xua, xva), (xb, xub, xvb) = rows[i][:, 1], rows[i + 1][:, 0]
-            gap = float(np.max(np.linalg.norm(xa - xb, axis=1)))
+            gap = float(np.max(norm3(xa - xb)))  # (numpy.linalg.norm's values along the last axis)
             if self._end_is_point(i, 1):
                 ang = float("nan")
             else:
@@ -1467,7 +1482,8 @@ class Tablet:
         u = np.linspace(lo, hi, nu)
         v0 = self.trim.v[0]
         n = len(self.patches)
-        D = np.abs(self.nominal(np.concatenate([p.evaluate(u, np.full(nu, v0)) for p in self.patches]))).reshape(n, nu)
+        pts = np.concatenate([p.evaluate(u, np.full(nu, v0)) for p in self.patches])
+        D = self._nominal_distance(pts).reshape(n, nu)
         per = D.max(axis=1)
         slack = float(np.max(np.abs(np.diff(D, 2, axis=1)))) if nu > 2 else math.inf
         E = np.pad(D, ((0, 0), (1, 1)), mode="edge")
@@ -1481,7 +1497,7 @@ class Tablet:
             for j in np.unique(js):
                 k = js == j
                 pts[k] = self.patches[j].evaluate(grid[k].ravel(), np.full(m * int(k.sum()), v0)).reshape(-1, m, 3)
-            vals = np.abs(self.nominal(pts.reshape(-1, 3))).reshape(len(js), m)
+            vals = self._nominal_distance(pts.reshape(-1, 3)).reshape(len(js), m)
             best = np.argmax(vals, axis=1)
             cu = grid[np.arange(len(js)), best]
             np.maximum.at(per, js, vals[np.arange(len(js)), best])
@@ -1489,6 +1505,13 @@ class Tablet:
         per.setflags(write=False)
         memo[key] = (self.patches, per)
         return per.copy()
+
+    def _nominal_distance(self, points: np.ndarray) -> np.ndarray:
+        """``|nominal(points)|`` (mm) at 3-D points ``(m, 3)``: by the nominal's own unsigned
+        ``distance`` when it has one (a family's :class:`~tabletcad.families.sweep.SweepNominal`, whose
+        signed value is that distance with a side: the same numbers without the inside test)."""
+        unsigned = getattr(self.nominal, "distance", None)
+        return np.abs(unsigned(points) if unsigned is not None else self.nominal(points))
 
     def deviation_peaks(self, u: np.ndarray, v: np.ndarray, hv: float, peaks: int = 8, rounds: int = 3,
                         n: int = 9) -> np.ndarray:
@@ -1504,7 +1527,7 @@ class Tablet:
         for k, p in enumerate(patches):  # first; then the points (x, y, z) in one transposed copy
             p.evaluate_grid(u, v, components=True, out=G[k])
         X = points_last(G.transpose(1, 0, 2, 3))  # (patches, nu, nv, 3)
-        D = np.abs(self.nominal(X.reshape(-1, 3))).reshape(X.shape[:3])
+        D = self._nominal_distance(X.reshape(-1, 3)).reshape(X.shape[:3])
         best = D.max(axis=(1, 2))
         t = self.trim
         E = np.pad(D, ((0, 0), (1, 1), (0, 0)), mode="edge")
@@ -1533,7 +1556,7 @@ class Tablet:
                 G = patches[p].evaluate_grid(uu[sel, :, 0].reshape(-1), vv[sel, 0, :].reshape(-1))
                 for k, q in enumerate(sel):
                     pts[q] = G[k * n : (k + 1) * n, k * n : (k + 1) * n]
-            g = np.abs(self.nominal(pts.reshape(-1, 3))).reshape(len(which), n * n)
+            g = self._nominal_distance(pts.reshape(-1, 3)).reshape(len(which), n * n)
             np.maximum.at(best, which, g.max(axis=1))
             top = np.argmax(g, axis=1)
             rows = np.arange(len(which))
