@@ -343,10 +343,12 @@ class Seg:
             return length2(r[:, 0], r[:, 1])
         rx, ry = q[:, 0] - self.center[0], q[:, 1] - self.center[1]
         rho = length2(rx, ry)
-        out = np.abs(rho - self.radius)
+        (x0, y0), (x1, y1) = self.point(0.0), self.point(1.0)
+        # (the type the ends' distances take, as where() had mixed them in: float32 points give float64 on
+        # numpy >= 2 and float32 on 1.24)
+        out = np.abs(rho - self.radius).astype(np.result_type(rho, q[:0, 0] - x0), copy=False)
         off = np.flatnonzero(~self.within_sweep(rx, ry, rho))  # beyond the span: the nearer end's distance
         if off.size:  # (measured there alone: the same values, elementwise)
-            (x0, y0), (x1, y1) = self.point(0.0), self.point(1.0)
             qx, qy = q[off, 0], q[off, 1]
             out[off] = np.minimum(length2(qx - x0, qy - y0), length2(qx - x1, qy - y1))
         return out

@@ -29,6 +29,7 @@ curves is refused with :class:`~tabletcad.errors.DesignError`; pass a smaller
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from functools import lru_cache
 from dataclasses import dataclass, field
 
@@ -83,16 +84,17 @@ def _horizontal(Xu: np.ndarray, Xv: np.ndarray, D: np.ndarray,
                for a, size in zip((Xu, Xv, D), sizes))
 
 
-def _fold_back(u: np.ndarray, det: np.ndarray, length: np.ndarray, scale: float) -> float:
+def _fold_back(u: np.ndarray, det: np.ndarray, length: Callable[[], np.ndarray], scale: float) -> float:
     """:meth:`PDEPatch.fold_depth` from the solid map's Jacobian ``det`` on the grid ``u × v`` ``(nu, nv)``
-    and the length of the vector ``det`` is taken along (``|X_v × D|``; mm): the largest, over ``v``,
-    distance travelled backwards (mm) where ``det`` has the sign its sum has not, beyond rounding of
-    ``scale`` (the product of the fields' sizes); 0 when it nowhere has."""
+    and ``length``, which gives the length of the vector ``det`` is taken along (``|X_v × D|``; mm; called
+    only where something folds): the largest, over ``v``, distance travelled backwards (mm) where ``det``
+    has the sign its sum has not, beyond rounding of ``scale`` (the product of the fields' sizes); 0 when
+    it nowhere has."""
     ref = 1.0 if float(np.sum(det)) >= 0.0 else -1.0
     folded = det * ref < -1e-9 * scale
     if not np.any(folded):
         return 0.0
-    speed = np.abs(det) / np.maximum(length, 1e-300) * folded
+    speed = np.abs(det) / np.maximum(length(), 1e-300) * folded
     du = np.diff(u)[:, None]
     back = np.sum(0.5 * (speed[1:] + speed[:-1]) * du, axis=0)
     return float(np.max(back))
@@ -121,9 +123,9 @@ def _fold_level(u: np.ndarray, X: np.ndarray, Xu: np.ndarray, Xv: np.ndarray,
         return 0.0, reach
     if float(np.max(np.abs(Xu[2]))) <= 1e-12 * max(size_u, 1e-300):  # horizontal: the fold in its plane
         det = Xu[0] * Xv[1] - Xu[1] * Xv[0]
-        return _fold_back(u, det, np.sqrt(Xv[0] * Xv[0] + Xv[1] * Xv[1]), size_u * size_v), reach
+        return _fold_back(u, det, lambda: np.sqrt(Xv[0] * Xv[0] + Xv[1] * Xv[1]), size_u * size_v), reach
     m = Xv[0] * D1 - Xv[1] * D0
-    return _fold_back(u, Xu[2] * m, np.sqrt(m * m), scale), reach
+    return _fold_back(u, Xu[2] * m, lambda: np.sqrt(m * m), scale), reach
 
 
 @lru_cache(maxsize=8)
@@ -981,7 +983,7 @@ class PDEPatch:
             det = Xu[0] * Xv[1] - Xu[1] * Xv[0]
             m = Xv
             scale = size_u * size_v
-        return _fold_back(u, det, np.sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]), scale), reach
+        return _fold_back(u, det, lambda: np.sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]), scale), reach
 
     def _check_fold(self) -> None:
         """Refuse a patch whose surface folds over itself, passes through its
