@@ -222,7 +222,8 @@ def test_branch_and_bound_shortcuts_give_the_direct_formulas_bit_for_bit(seed, s
     m = 0.5 * (a + b)
     halves = _halves(a, b, c, m)
     assert np.array_equal(halves, np.concatenate([np.stack([a, m, c], axis=1), np.stack([m, b, c], axis=1)]))
-    assert np.array_equal(_half_edges(e.reshape(-1)[i1], e.reshape(-1)[i2], a, b, c, m), _edge_lengths(halves))
+    edges = _half_edges(e.reshape(-1)[i1], e.reshape(-1)[i2], a, b, c, m)
+    assert np.array_equal(edges, _edge_lengths(halves))
     u, v = tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]
     assert np.array_equal(_cross(u, v), np.cross(u, v))
     assert np.array_equal(np.stack(_sorted3(*e.T), axis=1), np.sort(e, axis=1))

@@ -204,7 +204,7 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
         split = np.flatnonzero(live)
         if not len(split):
             break
-        i0, i1, i2 = _longest_edge_corners(e, split)  # (no copy of the live triangles: their corners are read)
+        i0, i1, i2 = _longest_edge_corners(e, split)  # (the live rows are not copied: their corners are read)
         a, b, c = (tris.reshape(-1, 3)[i] for i in (i0, i1, i2))
         m = 0.5 * (a + b)
         if anchors is None:
@@ -228,7 +228,8 @@ def _lipschitz_live(tris: np.ndarray, values: np.ndarray, e: np.ndarray, thresho
 
     The radius lies between half the longest edge ``L`` and ``L / √3`` (the same floats as in
     :func:`covering_radius`; float sums are monotonic), which decide alone for all but 8 % of the
-    branch and bound's triangles (the capsule, rounded rectangle and almond): the radius is computed for those."""
+    branch and bound's triangles (the capsule, rounded rectangle and almond): the radius is computed
+    for those."""
     vmax = np.maximum(np.maximum(values[:, 0], values[:, 1]), values[:, 2])
     longest = np.maximum(np.maximum(e[:, 0], e[:, 1]), e[:, 2])
     live = vmax + 0.5 * longest > threshold
@@ -238,8 +239,10 @@ def _lipschitz_live(tris: np.ndarray, values: np.ndarray, e: np.ndarray, thresho
 
 
 def _edge_lengths(tris: np.ndarray) -> np.ndarray:
-    """``|t1 - t0|, |t2 - t1|, |t0 - t2|`` (mm) of triangles ``tris`` (n, 3, 3): edge ``k`` joins corners ``k`` and ``k + 1``."""
-    return np.stack([np.linalg.norm(tris[:, 1] - tris[:, 0], axis=1), np.linalg.norm(tris[:, 2] - tris[:, 1], axis=1),
+    """``|t1 - t0|, |t2 - t1|, |t0 - t2|`` (mm) of triangles ``tris`` (n, 3, 3): edge ``k`` joins corners
+    ``k`` and ``k + 1``."""
+    return np.stack([np.linalg.norm(tris[:, 1] - tris[:, 0], axis=1),
+                     np.linalg.norm(tris[:, 2] - tris[:, 1], axis=1),
                      np.linalg.norm(tris[:, 0] - tris[:, 2], axis=1)], axis=1)
 
 
@@ -371,8 +374,7 @@ def covering_radius(tris: np.ndarray, e: np.ndarray | None = None) -> np.ndarray
     has ``L / 2``.
     """
     if e is None:
-        e = np.stack([np.linalg.norm(tris[:, 1] - tris[:, 0], axis=1), np.linalg.norm(tris[:, 2] - tris[:, 1], axis=1),
-                      np.linalg.norm(tris[:, 0] - tris[:, 2], axis=1)], axis=1)
+        e = _edge_lengths(tris)
     a, b, c = _sorted3(e[:, 0], e[:, 1], e[:, 2])
     half = 0.5 * c
     acute = a * a + b * b > c * c
@@ -384,14 +386,14 @@ def covering_radius(tris: np.ndarray, e: np.ndarray | None = None) -> np.ndarray
 
 
 def _sorted3(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Elementwise smallest, middle and largest of three arrays (``np.sort`` of their columns, without NaN)."""
+    """Elementwise smallest, middle and largest of three arrays (``np.sort`` of their columns; no NaN)."""
     lo, hi = np.minimum(x, y), np.maximum(x, y)
     return np.minimum(lo, z), np.maximum(lo, np.minimum(hi, z)), np.maximum(hi, z)
 
 
 def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Cross products (n, 3) of rows ``u`` and ``v`` (n, 3): ``np.cross``'s products and differences, without its
-    axis handling."""
+    """Cross products (n, 3) of rows ``u`` and ``v`` (n, 3): ``np.cross``'s products and differences,
+    without its axis handling."""
     out = np.empty((len(u), 3))
     out[:, 0] = u[:, 1] * v[:, 2] - u[:, 2] * v[:, 1]
     out[:, 1] = u[:, 2] * v[:, 0] - u[:, 0] * v[:, 2]
