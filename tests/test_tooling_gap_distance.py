@@ -195,6 +195,40 @@ def test_covering_radius_is_the_largest_distance_to_the_nearest_corner(seed, fla
     assert covering_radius(np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float))[0] == pytest.approx(np.sqrt(2) / 2, rel=1e-12)
 
 
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), scale=st.floats(1e-3, 10.0))
+def test_branch_and_bound_shortcuts_give_the_direct_formulas_bit_for_bit(seed, scale):
+    """The branch and bound's shortcuts are the direct formulas to the last bit: the halves' edge lengths
+    from their parents' (:func:`_half_edges`) against :func:`_edge_lengths` of the halves, the live test
+    decided by the covering radius's bounds (:func:`_lipschitz_live`) against ``max + covering_radius``
+    on every triangle, and ``covering_radius``'s own sort and cross product against ``np.sort``/``np.cross``
+    (on random, nearly flat and degenerate triangles, thresholds among their bounds)."""
+    from tabletcad.tooling.interference import (_cross, _edge_lengths, _half_edges, _halves, _lipschitz_live,
+                                                _longest_edge_corners, _sorted3, covering_radius)
+
+    rng = np.random.default_rng(seed)
+    tris = rng.normal(size=(3000, 3, 3)) * scale
+    tris[:300, 2] = tris[:300, 0] + rng.uniform(0, 1, (300, 1)) * (tris[:300, 1] - tris[:300, 0])  # flat
+    tris[300:400, 1] = tris[300:400, 0]  # a zero edge
+    values = rng.uniform(0, scale, (3000, 3))
+    e = _edge_lengths(tris)
+    for threshold in np.quantile(values.max(axis=1) + covering_radius(tris, e), [0.1, 0.5, 0.9]):
+        direct = values.max(axis=1) + covering_radius(tris, e) > threshold
+        assert np.array_equal(_lipschitz_live(tris, values, e, threshold), direct)
+    rows = np.flatnonzero(rng.random(3000) < 0.7)
+    i0, i1, i2 = _longest_edge_corners(e, rows)
+    assert np.array_equal(i0 - 3 * rows, np.argmax(e[rows], axis=1))
+    a, b, c = (tris.reshape(-1, 3)[i] for i in (i0, i1, i2))
+    m = 0.5 * (a + b)
+    halves = _halves(a, b, c, m)
+    assert np.array_equal(halves, np.concatenate([np.stack([a, m, c], axis=1), np.stack([m, b, c], axis=1)]))
+    edges = _half_edges(e.reshape(-1)[i1], e.reshape(-1)[i2], a, b, c, m)
+    assert np.array_equal(edges, _edge_lengths(halves))
+    u, v = tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]
+    assert np.array_equal(_cross(u, v), np.cross(u, v))
+    assert np.array_equal(np.stack(_sorted3(*e.T), axis=1), np.sort(e, axis=1))
+
+
 def test_mesh_distance_closest_points_lie_on_the_mesh_at_the_distance():
     """With ``closest``, each finite distance comes with a point of the mesh that far away (the
     branch and bound's anchors); NaN where the distance is ``inf``."""

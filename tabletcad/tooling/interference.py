@@ -193,40 +193,91 @@ def largest_inside(tris: np.ndarray, values: np.ndarray, f, spacing: float, best
     slack = spacing / math.sqrt(3.0)
     f = _Memo(f, anchors is not None)
     pts, vals = [], []
+    e = _edge_lengths(tris)  # then each round's children's from their parents' (half of them are those)
     for _ in range(200):
         if not len(tris):
             break
-        e = np.stack([np.linalg.norm(tris[:, 1] - tris[:, 0], axis=1), np.linalg.norm(tris[:, 2] - tris[:, 1], axis=1),
-                      np.linalg.norm(tris[:, 0] - tris[:, 2], axis=1)], axis=1)
-        live = values.max(axis=1) + covering_radius(tris, e) > best + slack
+        live = _lipschitz_live(tris, values, e, best + slack)
         if anchors is not None and np.any(live):  # the anchored bound, where the first did not prune
             k = np.flatnonzero(live)
             live[k] = _anchored_bound(tris[k], anchors[k]) > best + slack
-        tris, values, e = tris[live], values[live], e[live]
-        if anchors is not None:
-            anchors = anchors[live]
-        if not len(tris):
+        split = np.flatnonzero(live)
+        if not len(split):
             break
-        k = np.argmax(e, axis=1)  # edge k joins corner k and k + 1
-        r = np.arange(len(tris))
-        i0, i1, i2 = k, (k + 1) % 3, (k + 2) % 3
-        a, b, c = tris[r, i0], tris[r, i1], tris[r, i2]
-        fa, fb, fc = values[r, i0], values[r, i1], values[r, i2]
+        i0, i1, i2 = _longest_edge_corners(e, split)  # (the live rows are not copied: their corners are read)
+        a, b, c = (tris.reshape(-1, 3)[i] for i in (i0, i1, i2))
         m = 0.5 * (a + b)
         if anchors is None:
             fm = f(m)
         else:
             fm, qm = f(m)
-            qa, qb, qc = anchors[r, i0], anchors[r, i1], anchors[r, i2]
-            anchors = np.concatenate([np.stack([qa, qm, qc], axis=1), np.stack([qm, qb, qc], axis=1)])
+            anchors = _halves(*(anchors.reshape(-1, 3)[i] for i in (i0, i1, i2)), qm)
         pts.append(m)
         vals.append(fm)
         best = max(best, float(np.max(fm)))
-        tris = np.concatenate([np.stack([a, m, c], axis=1), np.stack([m, b, c], axis=1)])
-        values = np.concatenate([np.stack([fa, fm, fc], axis=1), np.stack([fm, fb, fc], axis=1)])
+        e = _half_edges(e.reshape(-1)[i1], e.reshape(-1)[i2], a, b, c, m)
+        tris = _halves(a, b, c, m)
+        values = _halves(*(values.reshape(-1)[i] for i in (i0, i1, i2)), fm)
     if not pts:
         return np.zeros((0, 3)), np.zeros(0)
     return np.concatenate(pts), np.concatenate(vals)
+
+
+def _lipschitz_live(tris: np.ndarray, values: np.ndarray, e: np.ndarray, threshold: float) -> np.ndarray:
+    """Whether ``max(values) + covering_radius(tris, e) > threshold`` (mm) for each triangle.
+
+    The radius lies between half the longest edge ``L`` and ``L / √3`` (the same floats as in
+    :func:`covering_radius`; float sums are monotonic), which decide alone for all but 8 % of the
+    branch and bound's triangles (the capsule, rounded rectangle and almond): the radius is computed
+    for those."""
+    vmax = np.maximum(np.maximum(values[:, 0], values[:, 1]), values[:, 2])
+    longest = np.maximum(np.maximum(e[:, 0], e[:, 1]), e[:, 2])
+    live = vmax + 0.5 * longest > threshold
+    k = np.flatnonzero(~live & (vmax + longest / math.sqrt(3.0) > threshold))
+    live[k] = vmax[k] + covering_radius(tris[k], e[k]) > threshold
+    return live
+
+
+def _edge_lengths(tris: np.ndarray) -> np.ndarray:
+    """``|t1 - t0|, |t2 - t1|, |t0 - t2|`` (mm) of triangles ``tris`` (n, 3, 3): edge ``k`` joins corners
+    ``k`` and ``k + 1``."""
+    return np.stack([np.linalg.norm(tris[:, 1] - tris[:, 0], axis=1),
+                     np.linalg.norm(tris[:, 2] - tris[:, 1], axis=1),
+                     np.linalg.norm(tris[:, 0] - tris[:, 2], axis=1)], axis=1)
+
+
+def _longest_edge_corners(e: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Flat indices (``3 row + corner``) of the corners ``k``, ``k + 1`` and ``k + 2`` of triangles ``rows``,
+    ``k`` the longest edge in their lengths ``e[rows]`` (``e`` (n, 3); the first of equal ones)."""
+    k = np.argmax(e[rows], axis=1)
+    base = 3 * rows
+    k1 = k + 1
+    k1[k1 == 3] = 0
+    k2 = k1 + 1
+    k2[k2 == 3] = 0
+    return base + k, base + k1, base + k2
+
+
+def _halves(a: np.ndarray, b: np.ndarray, c: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """The two halves ``(a, m, c)`` then ``(m, b, c)`` of triangles split at ``m`` on their edge ``ab``: an
+    array (2 n, 3, ...) of whatever is given per corner (points, values, nearest points)."""
+    n = len(a)
+    out = np.empty((2 * n, 3) + a.shape[1:], dtype=np.result_type(a, m))
+    out[:n, 0], out[:n, 1], out[:n, 2] = a, m, c
+    out[n:, 0], out[n:, 1], out[n:, 2] = m, b, c
+    return out
+
+
+def _half_edges(ebc: np.ndarray, eca: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray,
+                m: np.ndarray) -> np.ndarray:
+    """:func:`_edge_lengths` (mm) of :func:`_halves` ``(a, b, c, m)``, given the parents' edges ``|c - b|``
+    and ``|a - c|`` (n,): the same numbers (each the norm of the same difference, or of its negation)."""
+    n = len(a)
+    emc = np.linalg.norm(c - m, axis=1)
+    out = np.empty((2 * n, 3))
+    out[:n, 0], out[:n, 1], out[:n, 2] = np.linalg.norm(m - a, axis=1), emc, eca
+    out[n:, 0], out[n:, 1], out[n:, 2] = np.linalg.norm(b - m, axis=1), ebc, emc
+    return out
 
 
 class _Memo:
@@ -323,17 +374,31 @@ def covering_radius(tris: np.ndarray, e: np.ndarray | None = None) -> np.ndarray
     has ``L / 2``.
     """
     if e is None:
-        e = np.stack([np.linalg.norm(tris[:, 1] - tris[:, 0], axis=1), np.linalg.norm(tris[:, 2] - tris[:, 1], axis=1),
-                      np.linalg.norm(tris[:, 0] - tris[:, 2], axis=1)], axis=1)
-    es = np.sort(e, axis=1)
-    a, b, c = es[:, 0], es[:, 1], es[:, 2]
+        e = _edge_lengths(tris)
+    a, b, c = _sorted3(e[:, 0], e[:, 1], e[:, 2])
     half = 0.5 * c
     acute = a * a + b * b > c * c
-    area2 = np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1)  # twice the area
+    area2 = np.linalg.norm(_cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1)  # twice the area
     with np.errstate(divide="ignore", invalid="ignore"):
         R = a * b * c / (2.0 * area2)
     # rounding: never below half the longest edge (any triangle's bound) nor above L / √3
     return np.where(acute & np.isfinite(R), np.clip(R, half, c / math.sqrt(3.0)), half)
+
+
+def _sorted3(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Elementwise smallest, middle and largest of three arrays (``np.sort`` of their columns; no NaN)."""
+    lo, hi = np.minimum(x, y), np.maximum(x, y)
+    return np.minimum(lo, z), np.maximum(lo, np.minimum(hi, z)), np.maximum(hi, z)
+
+
+def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Cross products (n, 3) of rows ``u`` and ``v`` (n, 3): ``np.cross``'s products and differences,
+    without its axis handling."""
+    out = np.empty((len(u), 3))
+    out[:, 0] = u[:, 1] * v[:, 2] - u[:, 2] * v[:, 1]
+    out[:, 1] = u[:, 2] * v[:, 0] - u[:, 0] * v[:, 2]
+    out[:, 2] = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+    return out
 
 
 class ExactDistance:
@@ -531,7 +596,7 @@ def _mesh_near(shape, boxes: list, margin: float, deflection: float) -> tuple[np
     from tabletcad.cad.mesh import triangulate
 
     faces = explore(shape, "Face")
-    near = [f for f in faces if min(_box(f).Distance(b) for b in boxes) <= margin]
+    near = [f for f, box in zip(faces, map(_box, faces)) if min(box.Distance(b) for b in boxes) <= margin]
     if len(near) == len(faces):
         return mesh_arrays(shape, deflection, 0.2)
     if not near:
