@@ -993,7 +993,7 @@ class Tablet:
         Au = p.spine(u, du=1).T[:, :, None]
         if level:
             Cz = Xv[0] * (X[1] - A[1]) - Xv[1] * (X[0] - A[0])
-            out = float(np.dot(wwt, w)) * float(uw @ (Au[2] * Cz) @ vw) + float(np.dot(wwt, w * w)) * 0.0
+            out = float(np.dot(wwt, w)) * float(uw @ (Au[2] * Cz) @ vw)  # (J2's integral is zero)
             # (a non-finite sample makes the zero terms NaN: then the whole sum below, as it would)
             if math.isfinite(out) and math.isfinite(float(np.sum(Xu[0])) + float(np.sum(Xu[1]))):
                 return out
