@@ -147,6 +147,47 @@ def test_tight_z_range_is_occs_optimal_box_of_the_whole_solid(thesis):
     assert whole["capsule"][1] - whole["capsule"][0] == pytest.approx(3.2 + 2 * 1.3, abs=1e-6)
 
 
+def test_a_land_tips_section_face_is_bounded_by_its_poles_and_edges_not_optimised(monkeypatch):
+    """A punch tip over a land (the concave round's): its B-spline faces' optimal z ranges (OCC's) lie within
+    the bound of their poles (widened by 2e-7 mm) and their edges' optimal boxes, and none is optimised to
+    measure the tip's edge (the land's piece, whose section edge with the tip's wall has a tolerance wider
+    than the edge's window, has its bound in the window); the edge is the band's, as OCC's box of the whole
+    tip puts it."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
+    from OCP.BRepBndLib import BRepBndLib
+    from OCP.GeomAbs import GeomAbs_SurfaceType
+    from support.family_tablets import family_tablet
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.outline import tablet_frame
+    from tabletcad.tooling.punch import EDGE_SNAP_MM, _hull_z_bound, punch_tip
+
+    hulls = (GeomAbs_SurfaceType.GeomAbs_BSplineSurface, GeomAbs_SurfaceType.GeomAbs_BezierSurface)
+    optimised = []
+    add_optimal = BRepBndLib.AddOptimal_s
+
+    def recorded(shape, box, triangulation, tolerance):
+        optimised.append(BRepAdaptor_Surface(shape, False).GetType())
+        add_optimal(shape, box, triangulation, tolerance)
+
+    t, shape = family_tablet(ROOT / "samples" / "families" / "concave_round.toml")
+    frame = tablet_frame(t, shape)
+    monkeypatch.setattr(BRepBndLib, "AddOptimal_s", recorded)
+    tip, _ = punch_tip(frame, shape, "upper", 0.0171, 8.0, check=False)  # (a clearance no other test cuts)
+    monkeypatch.undo()
+    assert optimised and not any(kind in hulls for kind in optimised)
+    edge = frame.band_z[1]
+    assert tip.info["tip_edge_z_mm"] == edge and abs(_whole_optimal_z(tip.shape)[0] - edge) <= EDGE_SNAP_MM
+    faces = [f for f in explore(tip.shape, "Face") if BRepAdaptor_Surface(f, False).GetType() in hulls]
+    assert faces
+    for face in faces:
+        box = Bnd_Box()
+        BRepBndLib.AddOptimal_s(face, box, False, False)
+        lo, hi = _hull_z_bound(face)
+        assert lo <= box.CornerMin().Z() and box.CornerMax().Z() <= hi
+
+
 def test_volumes_are_occs_and_shared_faces_are_integrated_once(thesis):
     """:func:`volume_centroid` sums OCC's own face integrals: each part's volume is
     ``BRepGProp.VolumeProperties``'s to the last bit; a reversed solid's is its negative from the

@@ -174,7 +174,10 @@ def tight_z_range(shape, *, low: bool = True, high: bool = True) -> tuple[float 
     tolerance (how far its edges' curves may leave the surface), reaches past the extremes found so
     far, the faces reaching farthest first; every other face (whose quick box is made from samples
     of the surface, which can miss a bump) is always computed.  A shape with free edges or vertices
-    takes OCC's box of the whole shape.  The result equals that box (tests/test_tooling_parts.py);
+    takes OCC's box of the whole shape.  Before a B-spline or Bézier face is optimised, a tighter bound
+    is tried (:func:`_hull_z_bound`: its poles' z range and its edges' optimal boxes, where its quick
+    box is widened by a Boolean's section edges' tolerance).  The result equals OCC's box of the whole
+    shape (tests/test_tooling_parts.py);
     a punch tip needs one side, and most of its B-spline faces (0.1-0.5 s of OCC's optimisation
     each solid) lie within it.  Computed once per shape and sides (:data:`~tabletcad.tooling.booleans.CACHE`)."""
     return CACHE.get(shape, ("tight z range", bool(low), bool(high)), lambda: _tight_z_range(shape, low, high))
@@ -188,7 +191,9 @@ def tight_edge(shape, z: float, tol: float, *, low: bool = True) -> float:
     quick box lies beyond the extreme found so far, those whose quick box (widened by their tolerance)
     lies within ``tol`` of ``z`` once the extreme found so far does (the extreme can then only move within
     that window: the answer is ``z`` whatever their optimal boxes).  A punch tip over a land (its edge the
-    band's) skips its cup's B-spline faces, 0.03-0.28 s of OCC's optimisation a tip.  Computed once per
+    band's) skips its cup's B-spline faces, 0.03-0.28 s of OCC's optimisation a tip, and, by their poles'
+    and edges' bound, the land's pieces cut at the tip's wall (0.03 s a tip of the concave round, whose
+    section edges' tolerance widens their quick box out of the window).  Computed once per
     shape, ``z``, ``tol`` and side (:data:`~tabletcad.tooling.booleans.CACHE`)."""
     return CACHE.get(shape, ("tight edge", float(z), float(tol), bool(low)),
                      lambda: _tight_z_range(shape, low, not low, window=(float(z), float(tol))))
@@ -242,11 +247,20 @@ def _tight_z_range(shape, low: bool, high: bool, window: tuple[float, float] | N
     def near(x: float) -> bool:  # within the window (a float interval: x - z is monotone in x)
         return window is not None and abs(x - window[0]) <= window[1]
 
+    def needed(f_lo: float, f_hi: float) -> bool:  # whether a face within (f_lo, f_hi) may move the answer
+        if not ((low and f_lo <= lo) or (high and f_hi >= hi)):
+            return False
+        # (in the window: the extreme stays in it, between the face's bound and the extreme so far)
+        return not ((near(lo) and near(f_lo)) if low else (near(hi) and near(f_hi)))
+
     lo, hi = math.inf, -math.inf
     for f_lo, f_hi, face in entries:
-        if (low and f_lo <= lo) or (high and f_hi >= hi):
-            if (near(lo) and near(f_lo)) if low else (near(hi) and near(f_hi)):
-                continue  # the extreme stays in the window, between the face's bound and the extreme so far
+        if needed(f_lo, f_hi):
+            # a B-spline or Bézier face (the others' entries are unbounded) whose poles and edges' optimal
+            # boxes bound it tighter (its quick box is widened by its edges' tolerance) cannot move the answer
+            if math.isfinite(f_lo) and not needed(*CACHE.faces.get(face, ("z bound",),
+                                                                   lambda f=face: _hull_z_bound(f))):
+                continue
             # once per face (CACHE.faces): a shape asked for one side and then the other, or a face
             # another shape shares, is not optimised again (the same OCC computation of the same face)
             z = CACHE.faces.get(face, ("optimal z range",), lambda f=face: face_z(f))
@@ -255,6 +269,52 @@ def _tight_z_range(shape, low: bool, high: bool, window: tuple[float, float] | N
     if window is not None:
         return _snapped(lo if low else hi, window)
     return (lo if low else None), (hi if high else None)
+
+
+#: how far (mm) OCC's optimal box of a B-spline or Bézier surface may reach beyond its poles' z range: the
+#: box of its points is widened by ``Precision::Confusion`` (1e-7 mm); the other 1e-7 mm is margin for the
+#: round-off of the points (its samples step a rounding past the parameter range's end)
+HULL_WIDENING_MM = 2e-7
+
+
+def _hull_z_bound(face) -> tuple[float, float]:
+    """Bounds ``(lo, hi)`` (mm) of OCC's optimal z range of the B-spline or Bézier ``face``
+    (``BRepBndLib::AddOptimal`` without triangulation or tolerance), tighter than its quick box where
+    its edges' tolerance is large (a Boolean's section edges: 1e-5 mm and more).
+
+    OCC's box of such a face (``BRepBndLib.cxx``, OCCT 7.9) is, on each side, either the box of its
+    surface over the pcurves' parameter rectangle, clipped to the surface's bounds (a sampled and
+    optimised one: surface points, widened by 1e-7 mm), or the union of its edges' optimal boxes
+    (``BndLib_Add3dCurve::AddOptimal``: what the edges' curves reach, not their tolerance), which replaces
+    the surface's side where the surface's extreme lies outside the face, and is the whole box of a
+    B-spline of degree 1 along one direction.  The surface lies in its poles' hull (a B-spline's, rational
+    too, is a convex combination of its poles), so the first lies within the poles' z range widened by
+    :data:`HULL_WIDENING_MM`; the second is computed here as OCC computes it (the same calls on the same
+    edges, ~0.1 ms a face against 15-40 ms for the face).  The bound is the wider of the two on each
+    side (tests/test_tooling_parts.py checks it on a land's tip)."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
+    from OCP.Bnd import Bnd_Box
+    from OCP.BndLib import BndLib_Add3dCurve
+    from OCP.GeomAbs import GeomAbs_SurfaceType
+
+    from tabletcad.cad._occ import explore
+
+    adaptor = BRepAdaptor_Surface(face, False)
+    bspline = adaptor.GetType() == GeomAbs_SurfaceType.GeomAbs_BSplineSurface
+    surface = adaptor.BSpline() if bspline else adaptor.Bezier()  # (located: in the face's place)
+    nu, nv = surface.NbUPoles(), surface.NbVPoles()
+    zs = [surface.Pole(i, j).Z() for i in range(1, nu + 1) for j in range(1, nv + 1)]
+    lo, hi = min(zs) - HULL_WIDENING_MM, max(zs) + HULL_WIDENING_MM
+    edges = Bnd_Box()
+    for e in explore(face, "Edge"):
+        if not BRep_Tool.Degenerated_s(e) and BRep_Tool.IsGeometric_s(e):  # (the edges OCC adds)
+            box = Bnd_Box()
+            BndLib_Add3dCurve.AddOptimal_s(BRepAdaptor_Curve(e), 0.0, box)
+            edges.Add(box)
+    if edges.IsVoid():
+        return lo, hi
+    return min(lo, edges.CornerMin().Z()), max(hi, edges.CornerMax().Z())
 
 
 def _snapped(x: float, window: tuple[float, float]) -> float:
