@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import array_shapes, arrays
 
 from tabletcad.geometry.tables import CARDINAL, SharedTables
-from tabletcad.geometry.vectors import cross, length2, norm3, points_last
+from tabletcad.geometry.vectors import clip, cross, length2, linspace, norm3, points_last
 
 
 def test_least_recently_used_goes_first_and_results_are_read_only():
@@ -176,3 +176,27 @@ def test_points_last_is_the_transposed_copy(a):
         assert got.tobytes() == want.tobytes()
     big = np.arange(3 * 9 * 11, dtype=float).reshape(3, 9, 11)
     assert points_last(big).tobytes() == np.ascontiguousarray(big.transpose(1, 2, 0)).tobytes()
+
+
+ends = st.floats(-1e6, 1e6) | st.floats(-1e-9, 1e-9) | st.sampled_from([0.0, -0.0, 1.0, 2.0 * np.pi, 5e-324])
+
+
+@settings(max_examples=150, deadline=None)
+@given(a=ends, b=ends, num=st.integers(0, 2100), endpoint=st.booleans(), near=st.booleans())
+def test_linspace_is_numpys(a, b, num, endpoint, near):
+    """The core's samples are ``numpy.linspace``'s, bit for bit (signed zeros included): any two ends, an
+    empty step (equal ends, or a difference that underflows), with and without the end point."""
+    if near:  # ends a few ulp apart: a step that is zero, subnormal or rounded
+        b = float(np.nextafter(np.nextafter(a, np.inf), np.inf))
+    got, want = linspace(a, b, num, endpoint=endpoint), np.linspace(a, b, num, endpoint=endpoint)
+    assert got.dtype == want.dtype and got.shape == want.shape
+    assert got.tobytes() == want.tobytes()
+
+
+@settings(max_examples=80, deadline=None)
+@given(x=arrays(np.float64, st.integers(1, 40), elements=st.floats(allow_nan=True, allow_infinity=True)),
+       lo=st.floats(-10, 10), width=st.floats(0, 10))
+def test_clip_is_numpys(x, lo, width):
+    """The polishes' clip is ``numpy.clip``'s ufunc: the same values (NaN and signed zeros included)."""
+    for bounds in ((lo, lo + width), (0.0, 1.0), (-0.0, 0.0)):
+        assert clip(x, *bounds).tobytes() == np.clip(x, *bounds).tobytes()

@@ -31,7 +31,7 @@ from tabletcad.geometry.curves import Seg, nearest_of, signed_area
 from tabletcad.errors import DesignError, check_finite, check_positive, check_range, format_bound
 from tabletcad.tolerance import DEFAULT
 from tabletcad.geometry.quadrature import gauss_legendre
-from tabletcad.geometry.vectors import length2
+from tabletcad.geometry.vectors import clip, length2, linspace
 
 __all__ = [
     "Seg",
@@ -362,7 +362,7 @@ class PlanOutline:
         return self._remembered(("extent",), self._extent)
 
     def _extent(self) -> tuple[float, float]:
-        p = self.frame(np.linspace(0, math.tau, 4096, endpoint=False))[0]
+        p = self.frame(linspace(0, math.tau, 4096, endpoint=False))[0]
         for s in self.segs:
             if s.kind == "arc":
                 for ang in (0.0, math.pi / 2, math.pi, 1.5 * math.pi):
@@ -407,9 +407,9 @@ class PlanOutline:
         from scipy.optimize import minimize
 
         n = 81
-        c0 = self.frame(np.linspace(0, math.tau, 512, endpoint=False))[0]
+        c0 = self.frame(linspace(0, math.tau, 512, endpoint=False))[0]
         lo, hi = c0.min(axis=0), c0.max(axis=0)
-        g = np.stack(np.meshgrid(np.linspace(lo[0], hi[0], n), np.linspace(lo[1], hi[1], n)), -1).reshape(-1, 2)
+        g = np.stack(np.meshgrid(linspace(lo[0], hi[0], n), linspace(lo[1], hi[1], n)), -1).reshape(-1, 2)
         sd = self.signed_distance(g)
         delta = 0.5 * math.hypot(*((hi - lo) / (n - 1)))  # half a cell's diagonal (mm)
         grid = sd.reshape(n, n)
@@ -490,7 +490,7 @@ class PlanOutline:
         d = float(d)
 
         def clean() -> bool:
-            v = np.linspace(0.0, math.tau, 2048, endpoint=False)
+            v = linspace(0.0, math.tau, 2048, endpoint=False)
             v = np.concatenate([v, self.breaks[:-1]])
             O, T, N, k = self.frame(v)
             dist = self.signed_distance(O + d * N)
@@ -544,7 +544,7 @@ class PlanOutline:
         from scipy.optimize import minimize_scalar
 
         c = self.centroid()
-        v = np.unique(np.concatenate([np.linspace(0.0, math.tau, 4096, endpoint=False), self.breaks[:-1]]))
+        v = np.unique(np.concatenate([linspace(0.0, math.tau, 4096, endpoint=False), self.breaks[:-1]]))
         h = self.support(v, c)
         lows = np.flatnonzero((h <= np.roll(h, 1)) & (h <= np.roll(h, -1)))
         best = float(np.min(h))
@@ -598,7 +598,7 @@ class PlanOutline:
 
     # ------------------------------------------------------------------ checks
     def _check_simple(self) -> None:
-        v = np.linspace(0.0, math.tau, 1537, endpoint=False)
+        v = linspace(0.0, math.tau, 1537, endpoint=False)
         v = np.unique(np.concatenate([v, self.breaks[:-1]]))
         _check_polyline_simple(self.frame(v)[0], self.parameter)
 
@@ -632,7 +632,7 @@ class SplineOutline(PlanOutline):
         self.name = name
         self.parameter = parameter
         self.segs = ()
-        vs = np.linspace(0.0, math.tau, 8192, endpoint=False)
+        vs = linspace(0.0, math.tau, 8192, endpoint=False)
         self._vs = vs
         self._ps = self._sp(vs)
         sp1 = self._sp(vs, 1)
@@ -744,7 +744,7 @@ class SplineOutline(PlanOutline):
         return np.array([sx / a, sy / a])
 
     def extent(self) -> tuple[float, float]:
-        ext = np.ptp(self._sp(np.linspace(0, math.tau, 20000, endpoint=False)), axis=0)
+        ext = np.ptp(self._sp(linspace(0, math.tau, 20000, endpoint=False)), axis=0)
         return float(ext[0]), float(ext[1])
 
     def signed_distance(self, xy) -> np.ndarray:
@@ -759,7 +759,7 @@ class SplineOutline(PlanOutline):
             f = np.einsum("ij,ij->i", q, c1)
             fp = np.einsum("ij,ij->i", c1, c1) + np.einsum("ij,ij->i", q, c2)
             step = np.divide(f, fp, out=np.zeros_like(f), where=np.abs(fp) > 1e-300)
-            t = t - np.clip(step, -0.01, 0.01)
+            t = t - clip(step, -0.01, 0.01)
         O, T, N, k = self.frame(t)
         q = p - O
         return np.einsum("ij,ij->i", q, N)  # q is along N at the foot point
@@ -804,7 +804,7 @@ def _signed_to_segment(s, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if s.kind == "line":
         (ax, ay), (bx, by) = s.p0, s.p1
         dx, dy = bx - ax, by - ay
-        t = np.clip(((px - ax) * dx + (py - ay) * dy) / (dx * dx + dy * dy), 0.0, 1.0)
+        t = clip(((px - ax) * dx + (py - ay) * dy) / (dx * dx + dy * dy), 0.0, 1.0)
         qx, qy = px - (ax + t * dx), py - (ay + t * dy)
         return length2(qx, qy), np.where(qx * -dy + qy * dx >= 0.0, 1.0, -1.0)
 
@@ -828,7 +828,8 @@ def _arc_ends(s, px: np.ndarray, py: np.ndarray) -> tuple[np.ndarray, np.ndarray
 
     e0 = length2(px - s.p0[0], py - s.p0[1])
     e1 = length2(px - s.p1[0], py - s.p1[1])
-    return np.minimum(e0, e1), np.where(e0 <= e1, side(*s.p0, s.tangent(0)), side(*s.p1, s.tangent(1)))
+    t0, t1 = s.end_tangents
+    return np.minimum(e0, e1), np.where(e0 <= e1, side(*s.p0, t0), side(*s.p1, t1))
 
 
 def _check_polyline_simple(p: np.ndarray, parameter: str) -> None:

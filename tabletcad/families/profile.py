@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tabletcad.geometry.curves import Seg, nearest_of
+from tabletcad.geometry.vectors import linspace
 
 __all__ = ["profile_line", "profile_arc", "Piece", "hermite_points", "pieces_for", "distance_to_chain",
            "joint_is_smooth"]
@@ -78,7 +79,7 @@ def pieces_for(element: Seg, target: float, max_angle: float = math.radians(45.0
         return [Piece(element, 0.0, 1.0)]
     sweep = abs(element.sweep)
     n = max(1, math.ceil(sweep / max_angle - 1e-12))
-    u = np.linspace(0.0, 1.0, 257)
+    u = linspace(0.0, 1.0, 257)
     while True:
         ps = [Piece(element, i / n, (i + 1) / n) for i in range(n)]
         err = max(float(np.max(element.distance(hermite_points(p, u)))) for p in ps)

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 import weakref
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from collections.abc import Sequence
 from typing import Protocol, runtime_checkable
 
@@ -26,7 +26,7 @@ import numpy as np
 
 from tabletcad.errors import DesignError, check_finite, check_positive, check_range, format_bound
 from tabletcad.tolerance import DEFAULT
-from tabletcad.geometry.vectors import length2
+from tabletcad.geometry.vectors import clip, length2
 
 __all__ = [
     "Seg",
@@ -338,12 +338,12 @@ class Seg:
         if self.kind == "line":
             a = np.asarray(self.p0)
             d = np.subtract(self.p1, self.p0)
-            t = np.clip(((q - a) @ d) / float(d @ d), 0.0, 1.0)
+            t = clip(((q - a) @ d) / float(d @ d), 0.0, 1.0)
             r = q - (a + t[:, None] * d)
             return length2(r[:, 0], r[:, 1])
         rx, ry = q[:, 0] - self.center[0], q[:, 1] - self.center[1]
         rho = length2(rx, ry)
-        (x0, y0), (x1, y1) = self.point(0.0), self.point(1.0)
+        (x0, y0), (x1, y1) = self.ends
         # (the type the ends' distances take, as where() had mixed them in: float32 points give float64 on
         # numpy >= 2 and float32 on 1.24)
         out = np.abs(rho - self.radius).astype(np.result_type(rho, q[:0, 0] - x0), copy=False)
@@ -393,6 +393,24 @@ class Seg:
         if self.kind == "line":
             return float(math.hypot(self.p1[0] - self.p0[0], self.p1[1] - self.p0[1]))
         return abs(self.radius * self.sweep)
+
+    @cached_property
+    def ends(self) -> tuple[np.ndarray, np.ndarray]:
+        """``point(0.0)`` and ``point(1.0)`` (mm; read-only), computed once: a distance to an arc measures
+        points beyond its span from its ends at every call."""
+        out = (self.point(0.0), self.point(1.0))
+        for a in out:
+            a.setflags(write=False)
+        return out
+
+    @cached_property
+    def end_tangents(self) -> tuple[np.ndarray, np.ndarray]:
+        """``tangent(0)`` and ``tangent(1)`` (read-only), computed once (the side an arc's end puts a
+        point on)."""
+        out = (self.tangent(0), self.tangent(1))
+        for a in out:
+            a.setflags(write=False)
+        return out
 
     def tangent(self, end: int) -> np.ndarray:
         """Unit tangent at the start (0) or end (1)."""
@@ -861,7 +879,7 @@ def _modes_needed(curve: CurveLike, tol: float, max_modes: int, m: int) -> int:
     if comb is not None:  # w · basis + const: the basis's spectrum and residuals, shared by its curves
         basis, W, const = comb
         w = W[0]
-        if not np.any(w):  # the constant point: its series is itself (the samples' errors are all 0)
+        if not w.any():  # the constant point: its series is itself (the samples' errors are all 0)
             return 0
         a0B, aB, bB, gram = basis_spectrum(basis, max_modes, n_fft)
         tail = math.sqrt(max(float(w @ gram @ w), 0.0))
@@ -921,15 +939,27 @@ def _subset_errors(curve: CurveLike, a0, a, b, max_modes: int, m: int) -> np.nda
     return _errors_of(_partial_sums(pts, a0, a, b, max_modes, m))
 
 
+@lru_cache(maxsize=8)
+def _trig_subset(m: int, modes: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_trig_table`'s rows at every ``(m // 256)``-th sample, transposed and contiguous: ``(modes, s)``
+    each, read-only (:func:`_partial_sums` multiplies along the samples; the table's strided columns had
+    cost it half its time)."""
+    step = max(1, m // 256)
+    cos, sin = _trig_table(m, modes)
+    c, s = np.ascontiguousarray(cos[::step].T), np.ascontiguousarray(sin[::step].T)
+    c.setflags(write=False)
+    s.setflags(write=False)
+    return c, s
+
+
 def _partial_sums(pts: np.ndarray, a0, a, b, max_modes: int, m: int) -> np.ndarray:
     """``(max_modes + 1, 3, s)``: the Fourier series ``a0, a, b`` truncated after ``N = 0 .. max_modes``
     modes less the curve's points ``pts`` (s, 3), at every ``(m // 256)``-th of ``m`` samples (mm)."""
-    step = max(1, m // 256)
-    cos, sin = _trig_table(m, max_modes)
+    cos, sin = _trig_subset(m, max_modes)
     # laid out (N, coordinate, sample): the running sum over the modes adds whole contiguous rows
     run = np.empty((max_modes + 1, 3, pts.shape[0]))
     run[0] = np.asarray(a0, dtype=float)[:, None]
-    run[1:] = a[:, :, None] * cos[::step].T[:, None, :] + b[:, :, None] * sin[::step].T[:, None, :]
+    run[1:] = a[:, :, None] * cos[:, None, :] + b[:, :, None] * sin[:, None, :]
     for n in range(1, max_modes + 1):  # the partial sums a0 + modes 1..N, row by row (numpy's cumsum
         np.add(run[n], run[n - 1], out=run[n])  # along this axis runs element by element: 6x slower)
     run -= pts.T[None]
@@ -938,7 +968,7 @@ def _partial_sums(pts: np.ndarray, a0, a, b, max_modes: int, m: int) -> np.ndarr
 
 def _errors_of(run: np.ndarray) -> np.ndarray:
     """Largest length over the samples of each ``N``'s residuals ``run`` (N, 3, s): (N,) mm, read-only."""
-    errs = np.sqrt(np.max(run[:, 0] * run[:, 0] + run[:, 1] * run[:, 1] + run[:, 2] * run[:, 2], axis=1))
+    errs = np.sqrt((run[:, 0] * run[:, 0] + run[:, 1] * run[:, 1] + run[:, 2] * run[:, 2]).max(axis=1))
     errs.setflags(write=False)
     return errs
 

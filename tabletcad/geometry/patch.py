@@ -43,7 +43,7 @@ from tabletcad.geometry.curves import (basis_memo, basis_spectrum, combination_o
                                       fourier_samples, modes_needed, sample_v)
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
-from tabletcad.geometry.vectors import cross, cross_first, norm3, points_last
+from tabletcad.geometry.vectors import cross, cross_first, linspace, norm3, points_last
 
 __all__ = ["PDEPatch", "AUTO_A_LADDER"]
 
@@ -71,7 +71,7 @@ _TRIG_BLOCK = 8
 def _largest_length(a: np.ndarray) -> float:
     """Largest length (mm, or mm per unit parameter) of the vectors of a field stored coordinates
     first ``(3, ...)``: ``sqrt(max(x² + y² + z²))``, one root."""
-    return math.sqrt(float(np.max(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])))
+    return math.sqrt(float((a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).max()))
 
 
 def _horizontal(Xu: np.ndarray, Xv: np.ndarray, D: np.ndarray,
@@ -80,7 +80,7 @@ def _horizontal(Xu: np.ndarray, Xv: np.ndarray, D: np.ndarray,
     partials or about its spine, beyond rounding of their sizes (a flat face of a family, a disc).
     ``sizes``: the fields' :func:`_largest_length` (mm per unit parameter, mm), when the caller has them."""
     sizes = sizes or (_largest_length(Xu), _largest_length(Xv), _largest_length(D))
-    return all(float(np.max(np.abs(a[2]))) <= 1e-12 * max(size, 1e-300)
+    return all(float(np.abs(a[2]).max()) <= 1e-12 * max(size, 1e-300)
                for a, size in zip((Xu, Xv, D), sizes))
 
 
@@ -92,12 +92,12 @@ def _fold_back(u: np.ndarray, det: np.ndarray, length: Callable[[], np.ndarray],
     it nowhere has."""
     ref = 1.0 if float(np.sum(det)) >= 0.0 else -1.0
     folded = det * ref < -1e-9 * scale
-    if not np.any(folded):
+    if not folded.any():
         return 0.0
     speed = np.abs(det) / np.maximum(length(), 1e-300) * folded
     du = np.diff(u)[:, None]
     back = np.sum(0.5 * (speed[1:] + speed[:-1]) * du, axis=0)
-    return float(np.max(back))
+    return float(back.max())
 
 
 def _fold_level(u: np.ndarray, X: np.ndarray, Xu: np.ndarray, Xv: np.ndarray,
@@ -112,16 +112,16 @@ def _fold_level(u: np.ndarray, X: np.ndarray, Xu: np.ndarray, Xv: np.ndarray,
     taken and the lengths are those of the whole vectors, bit for bit).
     """
     D0, D1 = X[0] - A[0], X[1] - A[1]
-    plan = lambda a, b: math.sqrt(float(np.max(a * a + b * b)))  # noqa: E731
+    plan = lambda a, b: math.sqrt(float((a * a + b * b).max()))  # noqa: E731
     reach = plan(D0, D1)
     size_u, size_v = _largest_length(Xu), plan(Xv[0], Xv[1])
     if not (math.isfinite(reach) and math.isfinite(size_u) and math.isfinite(size_v)
-            and np.all(np.isfinite(A))):
+            and np.isfinite(A).all()):
         return None
     scale = size_u * size_v * reach
     if scale == 0.0:
         return 0.0, reach
-    if float(np.max(np.abs(Xu[2]))) <= 1e-12 * max(size_u, 1e-300):  # horizontal: the fold in its plane
+    if float(np.abs(Xu[2]).max()) <= 1e-12 * max(size_u, 1e-300):  # horizontal: the fold in its plane
         det = Xu[0] * Xv[1] - Xu[1] * Xv[0]
         return _fold_back(u, det, lambda: np.sqrt(Xv[0] * Xv[0] + Xv[1] * Xv[1]), size_u * size_v), reach
     m = Xv[0] * D1 - Xv[1] * D0
@@ -133,7 +133,7 @@ def _fold_u(nu: int, n_ends: int) -> np.ndarray:
     """The fold checks' ``u`` samples: ``nu`` equally spaced and ``n_ends`` geometrically
     closer to each end (from 1e-6 to 0.05), where a dome's spine may run backwards (read-only)."""
     ends = np.geomspace(1e-6, 0.05, n_ends)
-    u = np.unique(np.concatenate([ends, np.linspace(0.0, 1.0, nu)[1:-1], 1.0 - ends]))
+    u = np.unique(np.concatenate([ends, linspace(0.0, 1.0, nu)[1:-1], 1.0 - ends]))
     u.setflags(write=False)
     return u
 
@@ -359,7 +359,10 @@ class PDEPatch:
 
     def _setup(self) -> None:
         object.__setattr__(self, "_v_memo", {})
+        object.__setattr__(self, "_v_memo_short", {})
+        object.__setattr__(self, "_u_memo", {})
         object.__setattr__(self, "_checks", {})
+        self.__dict__.pop("_breakpoints", None)  # (they depend on the remainder found below)
         N = self.modes
         beta = self.beta
         if beta is None:
@@ -394,17 +397,17 @@ class PDEPatch:
         object.__setattr__(self, "_bc_rows", np.ascontiguousarray(bc.transpose(1, 0, 2).reshape(N, 12)))
         # is there anything above mode N?  Not for curves band-limited to N modes (circles,
         # ellipses: the FFT of 8 N + 8 samples is exact); else the residual at dense samples
-        scale = max(1.0, float(np.max(np.abs(a0))), float(np.max(np.abs(ac))) if N else 0.0)
+        scale = max(1.0, float(np.abs(a0).max()), float(np.abs(ac).max()) if N else 0.0)
         if band_limited:
             object.__setattr__(self, "_has_remainder", False)
         else:
-            res = float(np.max(np.abs(self._residuals(sample_v(4 * samples), 0))))
+            res = float(np.abs(self._residuals(sample_v(4 * samples), 0)).max())
             object.__setattr__(self, "_has_remainder", res > 1e-14 * scale)
         object.__setattr__(self, "_lams", self.a * np.arange(N + 1))
         # modes with any non-zero coefficient; the others are skipped in every sum
         amp = np.zeros(N + 1)
         if N:
-            amp[1:] = np.maximum(np.max(np.abs(ac), axis=(0, 2)), np.max(np.abs(bc), axis=(0, 2)))
+            amp[1:] = np.maximum(np.abs(ac).max(axis=(0, 2)), np.abs(bc).max(axis=(0, 2)))
         zero = 1e-15 * scale
         object.__setattr__(self, "_active", [n for n in range(1, N + 1) if amp[n] > zero])
         # the active modes' cosine and sine coefficients side by side, (modes, 4 data, 6): one
@@ -415,6 +418,7 @@ class PDEPatch:
             np.concatenate([self._ac_rows[act - 1], self._bc_rows[act - 1]]) if act.size else np.zeros((0, 12))))
         object.__setattr__(self, "_n_active", act)
         self._v_memo.clear()  # residuals taken above with every mode's series: from here on, the active ones'
+        self._v_memo_short.clear()
         object.__setattr__(self, "_abT", np.ascontiguousarray(
             np.concatenate([ac[:, act - 1], bc[:, act - 1]], axis=2).transpose(1, 0, 2)))
         # what the cardinal tables in u depend on besides u (patches alike in these share them)
@@ -463,7 +467,25 @@ class PDEPatch:
         The remainder term reads the data curves at any ``v``, which coefficients alone do not
         fix: a caller relies on this only for data built as reflections of each other (a swept
         family's lower face, the mirror image of its upper one by construction).
+
+        Remembered per pair (patches are immutable): a swept family's builder asks it of each new patch
+        and its twin, and the tablet (:meth:`~tabletcad.geometry.tablet.Tablet.mirror`) of the same pairs.
         """
+        memo = self.__dict__.get("_mirrors_of")
+        if memo is None:
+            memo = {}
+            object.__setattr__(self, "_mirrors_of", memo)
+        # (the middle patch of a chain is its own twin: no reference to itself, no cycle to collect)
+        key = (None if other is self else id(other), float(z0))
+        hit = memo.get(key)
+        if hit is not None and (hit[0] is other or key[0] is None):
+            return hit[1]
+        out = self._mirrors(other, z0)
+        memo[key] = (None if other is self else other, out)
+        return out
+
+    def _mirrors(self, other: "PDEPatch", z0: float) -> bool:
+        """:meth:`mirrors`, computed."""
         if self.form != "hermite" or other.form != "hermite" or self.modes != other.modes:
             return False
         if (self.a, self._beta, self._has_remainder) != (other.a, other._beta, other._has_remainder):
@@ -475,20 +497,30 @@ class PDEPatch:
         flip = np.array([1.0, 1.0, -1.0, -1.0])[:, None]
         order = [1, 0, 3, 2]
         a0 = flip * (other._a0[order] * m) + shift
-        scale = max(1.0, float(np.max(np.abs(self._a0))), float(np.max(np.abs(self._ac), initial=0.0)),
-                    float(np.max(np.abs(self._bc), initial=0.0)))
+        scale = max(1.0, float(np.abs(self._a0).max()), float(np.abs(self._ac).max(initial=0.0)),
+                    float(np.abs(self._bc).max(initial=0.0)))
         tol = 1e-12 * scale
-        if float(np.max(np.abs(self._a0 - a0))) > tol:
+        if float(np.abs(self._a0 - a0).max()) > tol:
             return False
         for mine, theirs in ((self._ac, other._ac), (self._bc, other._bc)):
-            if mine.size and float(np.max(np.abs(mine - flip[:, :, None] * (theirs[order] * m)))) > tol:
+            if mine.size and float(np.abs(mine - flip[:, :, None] * (theirs[order] * m)).max()) > tol:
                 return False
         return True
 
     # ------------------------------------------------------------------ pieces
     def breakpoints(self) -> np.ndarray:
         """Sorted ``v`` in [0, 2π) where the surface is not smooth in ``v``
-        (junctions of its curves' segments; empty when ``R = 0``)."""
+        (junctions of its curves' segments; empty when ``R = 0``); read-only, computed once (each
+        face's quadrature rule and the seams' samples ask for it)."""
+        hit = self.__dict__.get("_breakpoints")
+        if hit is None:
+            hit = self._find_breakpoints()
+            hit.setflags(write=False)
+            object.__setattr__(self, "_breakpoints", hit)
+        return hit
+
+    def _find_breakpoints(self) -> np.ndarray:
+        """:meth:`breakpoints`, computed."""
         if not self._has_remainder:
             return np.zeros(0)
         pts = []
@@ -526,17 +558,20 @@ class PDEPatch:
         """True when some datum has content above mode ``N`` (so ``R != 0``)."""
         return self._has_remainder
 
-    def _memo(self, key: tuple, make):
+    def _memo(self, key: tuple, make, short: bool = False):
         """Small per-patch cache of arrays that depend only on ``v`` (the data's residuals).
 
         The same ``v`` samples are evaluated many times (the surface and its
         derivatives, every datum's residual); keys hold the samples' bytes, so
-        equal samples hit and no result is shared between different ones.
+        equal samples hit and no result is shared between different ones.  ``short``: the
+        few samples of a polish (a point's value and its ``u`` partials), kept apart (the latest
+        eight) so that they never push out a grid's.
         """
-        memo = self.__dict__.get("_v_memo")
+        name = "_v_memo_short" if short else "_v_memo"
+        memo = self.__dict__.get(name)
         if memo is None:
             memo = {}
-            object.__setattr__(self, "_v_memo", memo)
+            object.__setattr__(self, name, memo)
         hit = memo.get(key)
         if hit is None:
             hit = make()
@@ -545,7 +580,7 @@ class PDEPatch:
             else:
                 for a in hit:
                     a.setflags(write=False)
-            if len(memo) >= 48:
+            if len(memo) >= (8 if short else 48):
                 memo.pop(next(iter(memo)))
             memo[key] = hit
         return hit
@@ -578,9 +613,9 @@ class PDEPatch:
                 out -= (T.T @ self._res_rows).reshape(v.size, 4, 3).transpose(1, 0, 2)
             return out
 
-        if not _CACHED_V[0] <= v.size <= _CACHED_V[1]:
+        if v.size > _CACHED_V[1]:
             return make()
-        return self._memo(("res", dv, v.tobytes() if vbytes is None else vbytes), make)
+        return self._memo(("res", dv, v.tobytes() if vbytes is None else vbytes), make, v.size < _CACHED_V[0])
 
     def _u_tables(self, u: np.ndarray, du: int) -> tuple[np.ndarray | None, np.ndarray, np.ndarray | None]:
         """The cardinal functions at ``u`` (or their ``u``-derivative) of every active mode
@@ -630,9 +665,9 @@ class PDEPatch:
         if nmin == 0 and remainder and uf.size == 1:  # one point: a grid of one (one table in u for all terms)
             return self.evaluate_grid(uf, vf, du, dv).reshape(shape + (3,))
         if nmin == 0 and remainder and uf.size > 1:  # points along one u or one v line: a grid of one row
-            if uf[0] == uf[-1] and np.all(uf == uf[0]):
+            if uf[0] == uf[-1] and (uf == uf[0]).all():
                 return self.evaluate_grid(uf[:1], vf, du, dv)[0].reshape(shape + (3,))
-            if vf[0] == vf[-1] and np.all(vf == vf[0]):
+            if vf[0] == vf[-1] and (vf == vf[0]).all():
                 return self.evaluate_grid(uf, vf[:1], du, dv)[:, 0].reshape(shape + (3,))
             if uf.size >= 64:  # points on a few u lines (samples of a grid's rows): a grid row each
                 rows, which = np.unique(uf, return_inverse=True)
@@ -704,13 +739,8 @@ class PDEPatch:
         Y = np.empty((nv, m * nu), order="F") if out is None else out.reshape(m * nu, nv).T
         fresh = True
         if self._active:
-            n = L.shape[0]
-            AB = np.matmul(L, self._abT)  # (n, nu, 6): each mode's cosine and sine profiles
-            # (3, nu, 2n): coordinate c's cosine profiles, then its sine profiles
-            # (the coordinates a run from the first: a slice, one copy in the reshape; else gathered)
-            P = AB.reshape(n, nu, 2, 3).transpose(3, 1, 2, 0)
-            U = (P[: ax[-1] + 1] if ax == list(range(ax[-1] + 1)) else P[ax]).reshape(m * nu, 2 * n)
-            _gemm(_trig_shared(v, self._n_active, dv, rows=True, vbytes=vb).T, U.T, Y)
+            T = _trig_shared(v, self._n_active, dv, rows=True, vbytes=vb)  # (2n, nv): cosines over sines
+            _gemm(T.T, self._mode_profiles(u, du, L, ax).T, Y)
             fresh = False
         if rem or spine:
             k = 4 * rem + spine
@@ -731,6 +761,33 @@ class PDEPatch:
             return out
         X = Y.T.reshape(m, nu, nv)
         return X if components else points_last(X)
+
+    def _mode_profiles(self, u: np.ndarray, du: int, L: np.ndarray, ax: list[int]) -> np.ndarray:
+        """:meth:`evaluate_grid`'s left factor: the active modes' cosine and sine profiles in ``u`` of the
+        coordinates ``ax``, ``(len(ax) len(u), 2 n)`` mm (coordinate c's cosine profiles, then its sine
+        ones), from the cardinal table ``L`` of ``u`` (``du``).  The latest four of ``u`` up to 1024 values
+        are kept (read-only): the surface and its ``v`` partial on one grid (:meth:`jet_grid`, the seams'
+        rows) share one."""
+        key = (du, tuple(ax), u.tobytes()) if u.size <= 1024 else None
+        memo = self.__dict__.get("_u_memo")
+        if memo is None:
+            memo = {}
+            object.__setattr__(self, "_u_memo", memo)
+        hit = memo.get(key) if key is not None else None
+        if hit is not None:
+            return hit
+        n, nu = L.shape[0], u.size
+        AB = np.matmul(L, self._abT)  # (n, nu, 6): each mode's cosine and sine profiles
+        # (3, nu, 2n): coordinate c's cosine profiles, then its sine profiles
+        # (the coordinates a run from the first: a slice, one copy in the reshape; else gathered)
+        P = AB.reshape(n, nu, 2, 3).transpose(3, 1, 2, 0)
+        U = (P[: ax[-1] + 1] if ax == list(range(ax[-1] + 1)) else P[ax]).reshape(len(ax) * nu, 2 * n)
+        if key is not None:
+            U.setflags(write=False)
+            if len(memo) >= 4:
+                memo.pop(next(iter(memo)))
+            memo[key] = U
+        return U
 
     def jet_grid(self, u, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``X``, ``X_u`` and ``X_v`` on the grid ``u × v``, each ``(3, len(u), len(v))`` (coordinates
@@ -774,9 +831,9 @@ class PDEPatch:
         xv = self.evaluate(u, v, dv=1) if xv is None else xv
         n = cross(xu, xv)
         norm = norm3(n)
-        scale = np.max(norm3(xu)) + 1e-300
+        scale = norm3(xu).max() + 1e-300
         bad = norm <= 1e-9 * scale * scale
-        if np.any(bad):
+        if bad.any():
             ub = u[bad]
             ush = np.where(ub > 0.5, ub - 1e-5, ub + 1e-5)
             nb = cross(self.evaluate(ush, v[bad], du=1), self.evaluate(ush, v[bad], dv=1))
@@ -849,13 +906,13 @@ class PDEPatch:
         # every datum's design content counts (in the Hermite form the derivative
         # curves X_u(0), X_u(1) carry design modes of their own)
         if self._revolution is not None:  # one mode: a datum needs it unless it is a point within tol
-            n_design = int(float(np.max(np.abs(self._revolution.radius))) > self.tol.stray / 4)
+            n_design = int(float(np.abs(self._revolution.radius).max()) > self.tol.stray / 4)
         else:
             n_design = max(modes_needed(self.data[k], self.tol.stray / 4, self.modes) for k in range(4))
         if n_design >= self.modes and not self._has_remainder:
             return 0.0
         n_design = min(n_design, self.modes)
-        u = np.linspace(0.0, 1.0, nu)
+        u = linspace(0.0, 1.0, nu)
         v = sample_v(nv or max(256, 8 * self.modes))
         # the fine part on the grid, coordinates first (3, nu, nv), in one matrix product as in
         # evaluate_grid: the fine modes' u-profiles (cosine and sine) by their rows of the v table
@@ -876,7 +933,7 @@ class PDEPatch:
             return 0.0
         U = np.concatenate(left, axis=2)
         F = (U.reshape(-1, U.shape[2]) @ np.concatenate(right)).reshape(3, u.size, v.size)
-        return math.sqrt(float(np.max(F[0] * F[0] + F[1] * F[1] + F[2] * F[2])))  # the largest |fine|: one root
+        return math.sqrt(float((F[0] * F[0] + F[1] * F[1] + F[2] * F[2]).max()))  # the largest |fine|
 
     def _check_stray(self) -> None:
         s = self.stray()
@@ -1063,7 +1120,7 @@ class PDEPatch:
                 np.repeat((R * R1 * det)[:, None], v.size, axis=1))
 
     def _refuse_negative_radius(self, along: np.ndarray, u: np.ndarray, v: np.ndarray) -> None:
-        worst = float(-np.min(along))
+        worst = float(-along.min())
         if worst > self.tol.fold:  # (no shape of the catalogue has one at any size: tol.fold alone)
             i, j = np.unravel_index(int(np.argmin(along)), along.shape)
             raise DesignError(
@@ -1075,9 +1132,9 @@ class PDEPatch:
     def _refuse_fold_back(self, dots: np.ndarray, nn: np.ndarray, u: np.ndarray, v: np.ndarray) -> None:
         """Refuse normals (lengths ``nn`` on the grid ``u × v``) turning by more than 120° between
         neighbouring ``u`` rows (``dots``: their dot products)."""
-        big = nn > 1e-6 * float(np.max(nn))
+        big = nn > 1e-6 * float(nn.max())
         rev = (dots < -0.5 * nn[1:] * nn[:-1]) & big[1:] & big[:-1]
-        if np.any(rev):
+        if rev.any():
             i, j = np.argwhere(rev)[0]
             raise DesignError(
                 f"patch {self.name or '?'} curves",

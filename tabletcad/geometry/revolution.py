@@ -41,6 +41,7 @@ import numpy as np
 
 from tabletcad.geometry.basis import cardinal
 from tabletcad.geometry.tables import CARDINAL
+from tabletcad.geometry.vectors import clip, linspace
 
 __all__ = ["Revolution", "Section", "detect_revolution", "detect_section", "profile_extreme"]
 
@@ -288,13 +289,13 @@ def profile_extreme(f, lo: float, hi: float, samples: int = 513, step: float = 1
     side), the bracket shrinking sixteenfold per round until it is below ``step``.  Never worse than the best sample; an interior
     maximum converges quadratically in the bracket (error ~ bracket² · f'').
     """
-    u = np.linspace(lo, hi, samples)
+    u = linspace(lo, hi, samples)
     g = f(u)
     i = int(np.argmax(g))
     best_u, best = float(u[i]), float(g[i])
     h = (hi - lo) / (samples - 1)
     while h > step:
-        uu = np.clip(best_u + np.linspace(-h, h, 33), lo, hi)
+        uu = clip(best_u + linspace(-h, h, 33), lo, hi)
         g = f(uu)
         i = int(np.argmax(g))
         if g[i] >= best:

@@ -23,7 +23,7 @@ from tabletcad.geometry.patch import PDEPatch
 from tabletcad.geometry.revolution import profile_extreme
 from tabletcad.readonly import TableDict
 from tabletcad.tolerance import DEFAULT, Tolerances
-from tabletcad.geometry.vectors import cross_first, norm3, points_last
+from tabletcad.geometry.vectors import clip, cross_first, linspace, norm3, points_last
 from tabletcad.geometry.quadrature import gauss_legendre
 
 #: Trapezoidal points in ``v`` for the integrals of a surface of revolution, whose integrands
@@ -47,7 +47,7 @@ def _monotone_pieces(psi: np.ndarray, x: np.ndarray, y: np.ndarray):
     if psi.size < 2:
         return []
     d = np.sign(np.diff(psi))
-    if np.any(d == 0.0):  # carry the last direction over pauses, so that a turn through one is seen
+    if (d == 0.0).any():  # carry the last direction over pauses, so that a turn through one is seen
         nz = np.flatnonzero(d)
         if not nz.size:
             return []
@@ -90,7 +90,7 @@ def _cover(env: np.ndarray, grid: np.ndarray, cs: tuple[np.ndarray, np.ndarray],
     G = np.concatenate(([s0], np.searchsorted(grid, q[first[1:]], "left"), [s1]))
     lo = np.minimum.reduceat(env, np.minimum(G[:-1], env.size - 1))
     live = (G[1:] > G[:-1]) & ~(lo * lo >= reach2)
-    if not np.any(live):
+    if not live.any():
         return
     a, b = G[:-1][live], G[1:][live]
     m = b - a
@@ -103,7 +103,7 @@ def _cover(env: np.ndarray, grid: np.ndarray, cs: tuple[np.ndarray, np.ndarray],
     with np.errstate(divide="ignore", invalid="ignore"):
         r = np.where(np.abs(den) > 0.0, (x0 * ey - y0 * ex) / -den, np.hypot(x0, y0))
     # (a ray almost along a chord: a chord's points are never farther than its ends)
-    r = np.clip(r, 0.0, np.maximum(np.hypot(x0, y0), np.hypot(x0 + ex, y0 + ey)))
+    r = clip(r, 0.0, np.maximum(np.hypot(x0, y0), np.hypot(x0 + ex, y0 + ey)))
     env[gi] = np.maximum(env[gi], r)
 
 
@@ -367,13 +367,13 @@ class Tablet:
         if not 0 <= j < len(self.patches):
             return False
         xa, xb = self._end_row(i, end), self._end_row(j, 1 - end)
-        scale = max(1.0, float(np.max(np.abs(xa))))
-        return float(np.max(np.linalg.norm(xa - xb, axis=1))) <= 1e-9 * scale
+        scale = max(1.0, float(np.abs(xa).max()))
+        return float(norm3(xa - xb).max()) <= 1e-9 * scale  # (numpy.linalg.norm's values along the last axis)
 
     def _edge_v(self) -> np.ndarray:
         """``v`` samples of the topology checks: 64 around, or 4 meridians on a tablet of revolution
         (every meridian of a patch of revolution meets its neighbour and the axis alike)."""
-        return np.linspace(0.0, math.tau, 4 if self.revolution is not None else 64, endpoint=False)
+        return linspace(0.0, math.tau, 4 if self.revolution is not None else 64, endpoint=False)
 
     def _end_row(self, i: int, end: int) -> np.ndarray:
         """Patch ``i``'s boundary curve ``u = end`` at :meth:`_edge_v` (read-only), both ends of a patch
@@ -386,8 +386,15 @@ class Tablet:
         return rows[i][end]
 
     def _end_is_point(self, i: int, end: int) -> bool:
-        x = self._end_row(i, end)
-        return float(np.max(np.ptp(x, axis=0))) <= 1e-12 * max(1.0, float(np.max(np.abs(x))))
+        """Whether patch ``i``'s boundary curve ``u = end`` is one point (to 1e-12 of its size); kept (the
+        faces and the seams ask for each end)."""
+        points = self.__dict__.setdefault("_end_points", {})
+        hit = points.get((i, end))
+        if hit is None:
+            x = self._end_row(i, end)  # (its extent by coordinate: numpy.ptp's max - min)
+            hit = float((x.max(axis=0) - x.min(axis=0)).max()) <= 1e-12 * max(1.0, float(np.abs(x).max()))
+            points[(i, end)] = hit
+        return hit
 
     def mirror(self) -> tuple[float, tuple[int, ...]] | None:
         """``(z0, twin)`` when the solid is its own mirror image in the plane ``z = z0`` patch by patch,
@@ -612,36 +619,37 @@ class Tablet:
                     hit = max(hit, self._largest_radius() - r_band)
                 elif self.section is not None and self._one_plan():
                     r_band = abs(float(edge.section.profile(np.array([0.0]))[0, 0]))
-                    reach = float(np.max(self.section[0].reach()))
+                    reach = float(self.section[0].reach().max())
                     hit = max(hit, (self._radius_range()[1] - r_band) * reach)
             if b is not None:  # rounding is no overhang (the scale: the band's own reach, not a costly bounds())
-                reach = float(np.max(np.abs(self.patches[b.patch].evaluate(0.0, np.linspace(0.0, math.tau, 16, endpoint=False)))))
+                meridians = linspace(0.0, math.tau, 16, endpoint=False)
+                reach = float(np.abs(self.patches[b.patch].evaluate(0.0, meridians)).max())
                 hit = float(hit) if hit > 1e-12 * max(1.0, reach) else 0.0
             object.__setattr__(self, "_overhang", hit)
         return hit
 
     def _find_band(self) -> Band | None:
-        v = np.linspace(0.0, math.tau, 96, endpoint=False)
+        v = linspace(0.0, math.tau, 96, endpoint=False)
         gap = self.tol.seam_gap  # the end curves are the design's own: flat and identical to round-off
         for i, p in enumerate(self.patches):
             x0, x1 = p.evaluate(0.0, v), p.evaluate(1.0, v)
             if float(np.ptp(x0[:, 2])) > gap or float(np.ptp(x1[:, 2])) > gap:
                 continue
-            if float(np.max(np.abs(x1[:, :2] - x0[:, :2]))) > gap:
+            if float(np.abs(x1[:, :2] - x0[:, :2]).max()) > gap:
                 continue
             z0, z1 = float(x0[0, 2]), float(x1[0, 2])
             if abs(z1 - z0) <= gap:
                 continue
-            X = p.evaluate_grid(np.linspace(0.0, 1.0, 65), v)
+            X = p.evaluate_grid(linspace(0.0, 1.0, 65), v)
             dev = X[..., :2] - x0[None, :, :2]
-            if float(np.max(np.linalg.norm(dev, axis=-1))) > 0.01 * abs(z1 - z0):
+            if float(np.linalg.norm(dev, axis=-1).max()) > 0.01 * abs(z1 - z0):
                 continue
             out = x0[:, :2] - x0[:, :2].mean(axis=0)  # outward (star-shaped outlines about their centroid)
             out /= np.maximum(np.linalg.norm(out, axis=1, keepdims=True), 1e-300)
-            bulge = float(np.max(np.einsum("uvc,vc->uv", dev, out)))
+            bulge = float(np.einsum("uvc,vc->uv", dev, out).max())
             # rounding is no bulge: a straight band's 1e-16 mm on one machine's BLAS had the die bore
             # offset by MIN_BORE_OFFSET_MM there and not on another
-            bulge = bulge if bulge > 1e-12 * max(1.0, float(np.max(np.abs(x0)))) else 0.0
+            bulge = bulge if bulge > 1e-12 * max(1.0, float(np.abs(x0).max())) else 0.0
             return Band(i, min(z0, z1), max(z0, z1), bulge)
         return None
 
@@ -717,14 +725,14 @@ class Tablet:
         triangles) converges to it at second order (``tests/test_core_plan_cutaway.py``).
         """
         t = self.trim
-        ue = np.linspace(t.u[0], t.u[1], 1025)
+        ue = linspace(t.u[0], t.u[1], 1025)
         spine = np.concatenate([p.spine(ue)[:, :2] for p in self.patches])
         c = 0.5 * (spine.min(axis=0) + spine.max(axis=0))
         nv += nv % 2  # nv intervals: every other line keeps both ends (the Richardson step)
-        u, v = np.linspace(t.u[0], t.u[1], nu), np.linspace(t.v[0], t.v[1], nv + 1)
+        u, v = linspace(t.u[0], t.u[1], nu), linspace(t.v[0], t.v[1], nv + 1)
         pts = [self._outer_grid(p, u, v, axes=(0, 1)) for p in self.patches]
-        size = max(float(np.max(np.hypot(X[0] - c[0], X[1] - c[1]))) for X in pts)
-        if np.max(np.abs(spine - c)) > 1e-9 * max(size, 1.0):
+        size = max(float(np.hypot(X[0] - c[0], X[1] - c[1]).max()) for X in pts)
+        if np.abs(spine - c).max() > 1e-9 * max(size, 1.0):
             return None
         tiny = 1e-9 * max(size, 1.0)
         lines = []  # (x, y relative to c, index along v or None) of every polyline whose fan is in the plan
@@ -737,7 +745,7 @@ class Tablet:
             best = r2[i, cols]
             d = np.column_stack([dx[i, cols], dy[i, cols]])
             inner = (i > 0) & (i < nu - 1)
-            if np.any(inner):
+            if inner.any():
                 k = np.flatnonzero(inner)
                 _, best[k], d[k] = self._farthest_along_u(p, c, u[i[k]], v[k], best[k], u[1] - u[0])
             lines.append((d[:, 0], d[:, 1], cols))
@@ -794,7 +802,7 @@ class Tablet:
             env = np.zeros(grid.size)
             # the farthest pieces first (the band's lines): most of the rest then lie inside the envelope
             # and are passed over (the largest of the radii, in any order, is the same number)
-            for piece in sorted(sets[half], key=lambda p: -float(np.max(p[1] * p[1] + p[2] * p[2]))):
+            for piece in sorted(sets[half], key=lambda p: -float((p[1] * p[1] + p[2] * p[2]).max())):
                 _cover(env, grid, cs, *piece)
             return 0.5 * float(np.sum(env * env * step))
 
@@ -825,7 +833,7 @@ class Tablet:
             outer.append((i, rr, np.column_stack([dx[i, cols], dy[i, cols]])))
         for p, (i, rr, dd) in zip(patches, outer):  # each patch's outer curve r_j(φ), then the envelope
             inner = (i > 0) & (i < nu - 1)
-            if np.any(inner):
+            if inner.any():
                 k = np.flatnonzero(inner)
                 _, r2, dk = self._farthest_along_u(p, c, u[i[k]], v[k], rr[k] ** 2, u[1] - u[0])
                 rr[k], dd[k] = np.sqrt(r2), dk
@@ -842,7 +850,7 @@ class Tablet:
                 env_half = np.maximum(env_half, _interp_turn(grid, phi[order], rr[half][order]))
         hole = 0.0
         if self.trim.w[0] > 0.0:  # hollow solid (a ring): subtract the see-through hole
-            A = np.stack([p.spine(np.linspace(self.trim.u[0], self.trim.u[1], nu)) for p in patches])
+            A = np.stack([p.spine(linspace(self.trim.u[0], self.trim.u[1], nu)) for p in patches])
             # pts are the outer surface w = w1: the inner one is w0 / w1 of the way from the spine to it
             k = self.trim.w[0] / self.trim.w[1]
             inner = A[:, :, None, :2] + k * (np.stack(pts).transpose(0, 2, 3, 1) - A[:, :, None, :2])
@@ -852,7 +860,7 @@ class Tablet:
             # noise in the angles of its centre segment's points)
             x, y = inner[..., 0], inner[..., 1]
             enclosed = 0.5 * np.abs(np.sum(x * np.roll(y, -1, axis=2) - np.roll(x, -1, axis=2) * y, axis=2))
-            scale = max(1.0, float(np.max(np.abs(inner))))
+            scale = max(1.0, float(np.abs(inner).max()))
             if float(enclosed.min()) > 1e-9 * scale * scale:
                 # a ring's hole, star-shaped about c: each v line's nearest inner point, at its own angle
                 rad = np.hypot(x - c[0], y - c[1]).reshape(-1, inner.shape[2])
@@ -863,7 +871,7 @@ class Tablet:
                 order = np.argsort(phi)
                 hole = 0.5 * float(np.sum(_interp_turn(grid, phi[order], rad[j, cols][order]) ** 2)) * (math.tau / m)
         full = 0.5 * float(np.sum(env_full**2)) * (math.tau / m)
-        if nv % 2 or not self.trim.full_v or not np.all(env_half > 0.0):
+        if nv % 2 or not self.trim.full_v or not (env_half > 0.0).all():
             return full - hole
         # the envelope interpolates r(φ) linearly between the v lines' points: an error of order
         # (2π / nv)², which the same envelope from every other line has four times over
@@ -895,7 +903,7 @@ class Tablet:
             # is not taken: at a maximum already in the samples (a band symmetric about u = 1/2)
             # the steps of 1e-16 only moved every point into a scattered evaluation for nothing
             step = np.where(0.5 * g1 * step > _POLISH_GAIN * best[live], step, 0.0)
-            un = np.clip(ub[live] + np.clip(step, -h, h), lo, hi)
+            un = clip(ub[live] + clip(step, -h, h), lo, hi)
             moved = un != ub[live]
             live, un = live[moved], un[moved]
             if not live.size:
@@ -1012,7 +1020,7 @@ class Tablet:
     def _grid(self, nu: int, nv: int) -> tuple[np.ndarray, np.ndarray]:
         """``nu`` equally spaced ``u`` and ``nv`` ``v`` over the trimmed ranges (``v`` periodic when untrimmed)."""
         t = self.trim
-        return np.linspace(t.u[0], t.u[1], nu), np.linspace(t.v[0], t.v[1], nv, endpoint=not t.full_v)
+        return linspace(t.u[0], t.u[1], nu), linspace(t.v[0], t.v[1], nv, endpoint=not t.full_v)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Axis-aligned bounding box (mm) of the surface (the outer one, ``w = w1``, when ``[trim] w``
@@ -1055,7 +1063,7 @@ class Tablet:
             hit = None if any(x is None for x in secs) else secs
             if hit is not None:
                 S = hit[0].shape
-                if any(np.max(np.abs(x.shape - S)) > 1e-12 * max(1.0, float(np.max(np.abs(S)))) for x in hit[1:]):
+                if any(np.abs(x.shape - S).max() > 1e-12 * max(1.0, float(np.abs(S).max())) for x in hit[1:]):
                     hit = None
             object.__setattr__(self, "_sections", hit)
         return hit
@@ -1093,13 +1101,13 @@ class Tablet:
         ``max |Δ²g|`` (the samples' largest second difference, a bound on what lies between samples) of the
         best sample of all, so no curve that could hold the extreme is skipped."""
         lo, hi = self.trim.u
-        u = np.linspace(lo, hi, 513)
+        u = linspace(lo, hi, 513)
         values = [c(u) for c in curves]
         out = []
         for g in quantities:
             samples = [g(P) for P in values]
             best = max(float(x.max()) for x in samples)
-            slack = max(float(np.max(np.abs(np.diff(x, 2)))) for x in samples)
+            slack = max(float(np.abs(np.diff(x, 2)).max()) for x in samples)
             out.append(max(profile_extreme(lambda uu, c=c, g=g: g(c(uu)), lo, hi)[1]
                            for c, x in zip(curves, samples) if float(x.max()) >= best - slack))
         return out
@@ -1107,7 +1115,7 @@ class Tablet:
     def _one_plan(self) -> bool:
         """Whether every patch of a :attr:`section` tablet has the same plan vectors ``p, q`` (to 1e-12)."""
         plan = self.section[0].plan
-        return all(np.max(np.abs(x.plan - plan)) <= 1e-12 for x in self.section)
+        return all(np.abs(x.plan - plan).max() <= 1e-12 for x in self.section)
 
     def _section_radii(self) -> list[tuple[float, float]]:
         """``(R_min, R_max)`` (mm, signed) of each patch's :attr:`section` profile over the trimmed ``u``
@@ -1202,10 +1210,10 @@ class Tablet:
         if not t.full_v or t.u != (0.0, 1.0):
             # a cut-away's cut faces run in to the spine A0(u) (eq 4.12), or to w0 of the way out to the
             # surface: their inner edges, on the cut lines v = v0, v1 and u = u0, u1
-            line = np.linspace(t.u[0], t.u[1], 1025)
+            line = linspace(t.u[0], t.u[1], 1025)
             inner = [p.spine(line) for p in self.patches]
             if t.w[0] > 0.0:
-                ring = np.linspace(t.v[0], t.v[1], 1025)
+                ring = linspace(t.v[0], t.v[1], 1025)
                 inner = [A + t.w[0] * (p.evaluate(line, np.full(line.shape, vc)) - A)
                          for p, A in zip(self.patches, inner) for vc in t.v]
                 inner += [p.spine(np.full(ring.shape, uc)) + t.w[0] * (p.evaluate(np.full(ring.shape, uc), ring)
@@ -1250,7 +1258,7 @@ class Tablet:
         best = sign * (float(self._outer(p, u0, v0)[axis]) if start is None else start)
         n = 33
         for round_ in range(2):
-            line = np.linspace(t.u[0], t.u[1], 513)
+            line = linspace(t.u[0], t.u[1], 513)
             g = sign * self._outer_grid(p, line, np.array([v0]), axes=(axis,))[0, :, 0]
             i = int(np.argmax(g))
             if g[i] > best or (round_ == 0 and g[i] == best):
@@ -1259,10 +1267,10 @@ class Tablet:
                 break
             a, b = max(hu, line[1] - line[0]), hv
             while a > _ZOOM_STOP or b > _ZOOM_STOP:
-                uu = np.clip(u0 + np.linspace(-a, a, n), t.u[0], t.u[1])
-                vv = v0 + np.linspace(-b, b, n)
+                uu = clip(u0 + linspace(-a, a, n), t.u[0], t.u[1])
+                vv = v0 + linspace(-b, b, n)
                 if not t.full_v:
-                    vv = np.clip(vv, t.v[0], t.v[1])
+                    vv = clip(vv, t.v[0], t.v[1])
                 g = sign * self._outer_grid(p, uu, vv, axes=(axis,))[0]
                 i, j = np.unravel_index(int(np.argmax(g)), g.shape)
                 if g[i, j] >= best:
@@ -1314,8 +1322,8 @@ class Tablet:
             return None
         if abs(su) > du or abs(sv) > dv:  # beyond its neighbours: not the quadratic's top
             return None
-        un = float(np.clip(uu[i] + su, t.u[0], t.u[1]))
-        vn = float(vv[j] + sv) if t.full_v else float(np.clip(vv[j] + sv, t.v[0], t.v[1]))
+        un = float(clip(uu[i] + su, t.u[0], t.u[1]))
+        vn = float(vv[j] + sv) if t.full_v else float(clip(vv[j] + sv, t.v[0], t.v[1]))
         return sign * float(self._outer(p, un, vn)[axis])
 
     def dimensions(self) -> dict[str, float]:
@@ -1333,7 +1341,7 @@ class Tablet:
         cache = self.__dict__.setdefault("_seam_vs", {})
         if nv in cache:
             return cache[nv]
-        v = np.linspace(0.0, math.tau, 4 if self.revolution is not None else nv, endpoint=False)
+        v = linspace(0.0, math.tau, 4 if self.revolution is not None else nv, endpoint=False)
         joins = [p.breakpoints() for p in self.patches]
         b = np.unique(np.concatenate(joins)) if joins else np.zeros(0)
         if b.size:
@@ -1378,18 +1386,18 @@ class Tablet:
         for i in range(len(self.patches) - 1):
             a, b = self.patches[i], self.patches[i + 1]
             (xa, xua, xva), (xb, xub, xvb) = rows[i][:, 1], rows[i + 1][:, 0]
-            gap = float(np.max(norm3(xa - xb)))  # (numpy.linalg.norm's values along the last axis)
+            gap = float(norm3(xa - xb).max())  # (numpy.linalg.norm's values along the last axis)
             if self._end_is_point(i, 1):
                 ang = float("nan")
             else:
                 # skip points where the shared curve has (nearly) zero speed, such as a
                 # corner collapsed to a point: the normals are undefined there
                 speed = norm3(xva)
-                ok = speed > 1e-6 * float(np.max(speed))
+                ok = speed > 1e-6 * float(speed.max())
                 na = a.normal(1.0, v[ok], xu=xua[ok], xv=xva[ok])
                 nb = b.normal(0.0, v[ok], xu=xub[ok], xv=xvb[ok])
-                cosang = np.clip(np.einsum("ij,ij->i", na, nb), -1.0, 1.0)
-                ang = float(np.degrees(np.max(np.arccos(cosang))))
+                cosang = clip(np.einsum("ij,ij->i", na, nb), -1.0, 1.0)
+                ang = float(np.degrees(np.arccos(cosang).max()))
             out.append(
                 dict(
                     patches=[i, i + 1],
@@ -1404,7 +1412,7 @@ class Tablet:
         """Largest distance (mm) of the surface from the nominal shape, or None: the largest of
         :meth:`nominal_peaks`."""
         per = self.nominal_peaks(nu, nv)
-        return None if per is None else float(np.max(per))
+        return None if per is None else float(per.max())
 
     def nominal_nu(self) -> int:
         """The default ``nu`` of :meth:`nominal_peaks`: the nominal's own ``deviation_nu`` (a family's
@@ -1479,20 +1487,20 @@ class Tablet:
         if hit is not None and len(hit[0]) == len(self.patches) and all(a is b for a, b in zip(hit[0], self.patches)):
             return hit[1].copy()
         lo, hi = self.trim.u
-        u = np.linspace(lo, hi, nu)
+        u = linspace(lo, hi, nu)
         v0 = self.trim.v[0]
         n = len(self.patches)
         pts = np.concatenate([p.evaluate(u, np.full(nu, v0)) for p in self.patches])
         D = self._nominal_distance(pts).reshape(n, nu)
         per = D.max(axis=1)
-        slack = float(np.max(np.abs(np.diff(D, 2, axis=1)))) if nu > 2 else math.inf
+        slack = float(np.abs(np.diff(D, 2, axis=1)).max()) if nu > 2 else math.inf
         E = np.pad(D, ((0, 0), (1, 1)), mode="edge")
         cand = (D >= E[:, :-2]) & (D >= E[:, 2:]) & (D >= float(per.max()) - slack)
         cand[np.arange(n), np.argmax(D, axis=1)] = True  # and each patch's best: its own figure polished
         js, cs = np.nonzero(cand)
         cu, h, m = u[cs], u[1] - u[0], 65
         for _ in range(2):
-            grid = np.clip(cu[:, None] + np.linspace(-h, h, m), lo, hi)  # (candidates, m)
+            grid = clip(cu[:, None] + linspace(-h, h, m), lo, hi)  # (candidates, m)
             pts = np.empty((len(js), m, 3))
             for j in np.unique(js):
                 k = js == j
@@ -1545,10 +1553,10 @@ class Tablet:
         centre = np.column_stack([u[i], v[j]]).astype(float)
         step = np.array([(u[-1] - u[0]) / max(len(u) - 1, 1), float(hv)])
         for _ in range(rounds):  # every peak's grid as scattered points, one evaluation per patch and round
-            uu = np.clip(centre[:, :1, None] + np.linspace(-step[0], step[0], n)[None, :, None], t.u[0], t.u[1])
-            vv = centre[:, 1:, None] + np.linspace(-step[1], step[1], n)[None, None, :]
+            uu = clip(centre[:, :1, None] + linspace(-step[0], step[0], n)[None, :, None], t.u[0], t.u[1])
+            vv = centre[:, 1:, None] + linspace(-step[1], step[1], n)[None, None, :]
             if not t.full_v:
-                vv = np.clip(vv, t.v[0], t.v[1])
+                vv = clip(vv, t.v[0], t.v[1])
             uu, vv = np.broadcast_arrays(uu, vv)  # (peaks, n, n)
             pts = np.empty(uu.shape + (3,))
             for p in set(which.tolist()):  # a patch's peaks in one tensor grid; each keeps its diagonal block

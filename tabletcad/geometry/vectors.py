@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["cross", "cross_first", "norm3", "points_last"]
+__all__ = ["clip", "cross", "cross_first", "linspace", "norm3", "points_last"]
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -69,3 +69,31 @@ def points_last(a: np.ndarray) -> np.ndarray:
     for c in range(a.shape[0]):
         out[..., c] = a[c]
     return out
+
+
+#: :func:`numpy.clip`'s ufunc itself (the same values): ``numpy.clip`` reaches it through a Python wrapper
+#: that costs several times the ufunc on the short arrays of the polishes (numpy >= 2: ``numpy._core``).
+clip = (np._core if hasattr(np, "_core") else np.core).umath.clip
+
+
+def linspace(start: float, stop: float, num: int, endpoint: bool = True) -> np.ndarray:
+    """``numpy.linspace(start, stop, num, endpoint=endpoint)`` of two scalars, by its own arithmetic
+    (``arange(num) * step + start``, ``step = (stop - start) / div``, the last value ``stop`` with the
+    end point; with a step that underflows to 0, ``arange(num) / div * (stop - start) + start``): the same
+    values, without the general function's cost per call (some 8x on the polishes' 33 samples)."""
+    div = num - 1 if endpoint else num
+    if div <= 0:
+        return np.linspace(start, stop, num, endpoint=endpoint)
+    start, stop = float(start), float(stop)
+    delta = stop - start
+    step = delta / div
+    y = np.arange(num, dtype=float)
+    if step == 0:
+        y /= div
+        y *= delta
+    else:
+        y *= step
+    y += start
+    if endpoint:
+        y[-1] = stop
+    return y

@@ -30,7 +30,7 @@ import numpy as np
 from tabletcad.errors import DesignError, check_range
 from tabletcad.families.sweep import SweepNominal, certify, sweep_properties
 from tabletcad.geometry.tablet import Tablet
-from tabletcad.geometry.vectors import cross, norm3
+from tabletcad.geometry.vectors import clip, cross, norm3
 from tabletcad.mechanics.strength import MAX_FORCE_N
 from tabletcad.tolerance import DEFAULT, MAX_TENSILE_STRENGTH_MPA, MAX_TRUE_DENSITY_MG_MM3, MIN_TRUE_DENSITY_MG_MM3
 
@@ -173,17 +173,17 @@ def family_seams(tablet: Tablet, nv: int = 720) -> list[dict[str, Any]]:
         (xa, xua, xv), (xb, xub, xvb) = rows[i][:, 1], rows[i + 1][:, 0]
         # lengths by norm3: numpy.linalg.norm's values along the last axis (the same squares, summed in
         # the same order) without its general reduction's cost; |X_v| once for the scale and the test
-        gap = float(np.max(norm3(xa - xb)))
+        gap = float(norm3(xa - xb).max())
         speed = norm3(xv)
-        scale = max(1e-300, float(np.max(speed)))
+        scale = max(1e-300, float(speed.max()))
         good = speed > 1e-6 * scale
         na = cross(xua, xv)
         nb = cross(xub, xvb)
         la, lb = norm3(na), norm3(nb)
         good &= (la > 1e-9 * la.max()) & (lb > 1e-9 * lb.max())
-        if np.any(good):
+        if good.any():
             c = np.einsum("ij,ij->i", na[good], nb[good]) / (la[good] * lb[good])
-            ang = float(np.degrees(np.max(np.arccos(np.clip(c, -1.0, 1.0)))))
+            ang = float(np.degrees(np.arccos(clip(c, -1.0, 1.0)).max()))
         else:
             ang = float("nan")
         g1 = bool(ang == ang and ang <= tablet.tol.seam_angle_deg)
