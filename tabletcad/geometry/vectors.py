@@ -73,7 +73,8 @@ def points_last(a: np.ndarray) -> np.ndarray:
 
 #: :func:`numpy.clip`'s ufunc itself (the same values): ``numpy.clip`` reaches it through a Python wrapper
 #: that costs several times the ufunc on the short arrays of the polishes (numpy >= 2: ``numpy._core``).
-clip = (np._core if hasattr(np, "_core") else np.core).umath.clip
+#: A private name: a numpy without it gets ``numpy.clip`` itself.
+clip = getattr(getattr(getattr(np, "_core", None) or getattr(np, "core", None), "umath", None), "clip", None) or np.clip
 
 
 def linspace(start: float, stop: float, num: int, endpoint: bool = True) -> np.ndarray:
