@@ -305,3 +305,28 @@ def test_held_in_order_holds_the_steps_back_and_goes_once_round():
     held = _held_in_order(sig, near, 10.0, 1e-3)
     assert held == pytest.approx([0.0, 2.0, 4.0, 6.0, 6.001, 6.002, 7.0, 9.0], abs=1e-12)
     assert _held_in_order(np.full(8, 3.0), near, 10.0, 1e-3) is None
+
+
+def test_tool_check_catches_a_wrong_prism_cut():
+    """The deboss cutter (drafted prism of "8" - letter floor) is cross-checked with manifold3d
+    (:func:`tool_check`): the right cutter passes with the meshes' difference well inside the bound,
+    a wrong one (the floor cut 0.05 mm lower: valid, 0.1-0.2 mm^3 off, as the merged walls of an
+    earlier attempt came out) raises."""
+    from tabletcad.errors import GeometryError
+    from tabletcad.tooling.booleans import raw_boolean, translated
+    from tabletcad.tooling.emboss import (_around, _offset_base, figure_prism, offset_solid, text_faces,
+                                          tool_check)
+    from tabletcad.tooling.outline import tablet_frame
+
+    frame = tablet_frame(load_design(ROOT / "samples" / "families" / "concave_round.toml"))
+    floor = offset_solid(_offset_base(frame), -0.12)
+    prism = figure_prism(text_faces("8", 2.5, font_path("DejaVuSans-Bold")), frame.z_max + 0.05, 3.8, 15.0,
+                         z_nominal=4.3)
+    part = _around(floor, prism)
+    tool = raw_boolean("cut", prism, part)
+    ok = tool_check("cut", prism, part, tool, "8")
+    assert ok["abs_diff_mm3"] < 0.25 * ok["bound_mm3"]
+    wrong = raw_boolean("cut", prism, translated(part, dz=-0.05))
+    assert abs(_volume(wrong) - _volume(tool)) > ok["bound_mm3"]
+    with pytest.raises(GeometryError, match="disagree on the prism cut"):
+        tool_check("cut", prism, part, wrong, "8")
