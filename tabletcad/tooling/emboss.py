@@ -616,7 +616,7 @@ def _paired_points(wa, wb, spacing: float = 0.08):
     pa, pb = _wire_points(wa, spacing), _wire_points(wb, 0.25 * spacing)
     if len(pa) < 3 or len(pb) < 3:  # a wire shorter than a few spacings (a vanishing stroke's offset)
         return None
-    sig, near, per = _nearest_positions(pa, pb)
+    sig, near, per = _nearest_positions(pa, pb) if spacing >= 0.08 else _nearest_positions_near(pa, pb)
     eps = 1e-3 * spacing  # distinct vertices
     held = _held_in_order(sig, near, per, eps)
     return pa, _points_at(pb, held if held is not None else _rescaled_in_order(sig, per, eps))
@@ -637,6 +637,30 @@ def _nearest_positions(pa, pb):
     j = np.argmin(dist, axis=1)
     rows = np.arange(len(pa))
     return cum[j] + u[rows, j] * slen[j], dist[rows, j], cum[-1]
+
+
+def _nearest_positions_near(pa, pb):
+    """:func:`_nearest_positions` looking only at the segments of ``pb`` that can hold the nearest
+    point (a vertex within the nearest vertex's distance plus the longest segment; a k-d tree), for
+    dense polygons: the same minimum, found among fewer segments."""
+    import numpy as np
+    from scipy.spatial import cKDTree
+
+    seg = np.roll(pb, -1, axis=0) - pb
+    slen = np.linalg.norm(seg, axis=1)
+    cum = np.concatenate([[0.0], np.cumsum(slen)])
+    tree = cKDTree(pb)
+    dv, _ = tree.query(pa)
+    sig, near = np.empty(len(pa)), np.empty(len(pa))
+    m = len(pb)
+    for i, verts in enumerate(tree.query_ball_point(pa, dv + slen.max() + 1e-12)):
+        j = np.unique(np.concatenate([np.asarray(verts, dtype=int), (np.asarray(verts, dtype=int) - 1) % m]))
+        rel = pa[i] - pb[j]
+        u = np.clip(np.einsum("jk,jk->j", rel, seg[j]) / np.maximum(slen[j] * slen[j], 1e-30), 0.0, 1.0)
+        dist = np.linalg.norm(rel - u[:, None] * seg[j], axis=1)
+        k = int(np.argmin(dist))
+        sig[i], near[i] = cum[j[k]] + u[k] * slen[j[k]], dist[k]
+    return sig, near, cum[-1]
 
 
 def _round_steps(sig, per: float):
