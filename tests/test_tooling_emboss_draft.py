@@ -330,3 +330,24 @@ def test_tool_check_catches_a_wrong_prism_cut():
     assert abs(_volume(wrong) - _volume(tool)) > ok["bound_mm3"]
     with pytest.raises(GeometryError, match="disagree on the prism cut"):
         tool_check("cut", prism, part, wrong, "8")
+
+
+def test_an_svg_circle_of_one_arc_and_a_sliver_drafts(tmp_path):
+    """An SVG ring drawn as one arc closed by a 0.01-unit line (a common way to write a circle): OCC's
+    inward offset of such a wire can come out open, which :func:`_offset_section` takes for "no offset"
+    (before: ``plan_face`` raised "outline wire is not a planar closed wire" out of the drafted prism)."""
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.emboss import check_emboss, figure_prism
+    from tabletcad.tooling.outline import tablet_frame
+
+    svg = tmp_path / "ring.svg"
+    svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="100" height="60" viewBox="0 0 100 60">'
+                   '<path fill="black" fill-rule="evenodd" d="M30 5 A25 25 0 1 0 30.01 5 Z '
+                   'M30 18 A12 12 0 1 1 29.99 18 Z"/>'
+                   '<path fill="black" d="M70 15 L77 22 L95 22 L81 33 L86 52 L70 41 L60 52 Z"/></svg>')
+    frame = tablet_frame(load_design(ROOT / "samples" / "families" / "concave_round.toml"))
+    spec = EmbossSpec(svg=str(svg), height_mm=2.5, depth_mm=0.1, draft_deg=25.0)
+    figure, _ = check_emboss(frame, spec, 0.02)
+    prism = figure_prism(figure, 4.5, 3.7, 25.0, z_nominal=4.0)
+    solids = explore(prism, "Solid")
+    assert len(solids) == 2 and all(_valid(s) for s in solids)

@@ -329,7 +329,11 @@ def _offset_section(wire, d: float):
                 wires = explore(mk.Shape(), "Wire") if mk.IsDone() else []
             except Exception:  # OCC raises StdFail_NotDone & co. where the offset breaks up
                 wires = []
-            if len(wires) == 1 and (face_area(plan_face(wires[0])) - a0) * d > 0.0:
+            try:
+                grown = len(wires) == 1 and (face_area(plan_face(wires[0])) - a0) * d > 0.0
+            except GeometryError:  # an offset that is not one closed planar wire (OCC's offset of an SVG
+                grown = False      # circle drawn as one arc and a closing sliver of a line: an open wire)
+            if grown:
                 return wires[0]
     return None
 
