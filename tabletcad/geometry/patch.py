@@ -52,6 +52,10 @@ __all__ = ["PDEPatch", "AUTO_A_LADDER"]
 #: longer ones (scattered points, not grid lines) would hold megabytes each.
 _CACHED_V = (64, 8192)
 
+#: ``u`` lines of this many values or more (to 1024) keep their modes' profile table apart
+#: (:meth:`PDEPatch._profile_table`): a polish's dense line, read again between its short zoom grids.
+_LONG_U = 257
+
 #: Smoothing parameters tried, in order, when ``a="auto"``.
 AUTO_A_LADDER = (1.0, 0.5, 0.25, 0.1, 0.05, 0.02, 0.01)
 
@@ -361,6 +365,7 @@ class PDEPatch:
         object.__setattr__(self, "_v_memo", {})
         object.__setattr__(self, "_v_memo_short", {})
         object.__setattr__(self, "_u_memo", {})
+        self.__dict__.pop("_u_long", None)
         object.__setattr__(self, "_checks", {})
         self.__dict__.pop("_breakpoints", None)  # (they depend on the remainder found below)
         N = self.modes
@@ -777,7 +782,7 @@ class PDEPatch:
         if hit is not None:
             return hit
         n, nu = L.shape[0], u.size
-        AB = np.matmul(L, self._abT)  # (n, nu, 6): each mode's cosine and sine profiles
+        AB = self._profile_table(u, du, L)  # (n, nu, 6): each mode's cosine and sine profiles
         # (3, nu, 2n): coordinate c's cosine profiles, then its sine profiles
         # (the coordinates a run from the first: a slice, one copy in the reshape; else gathered)
         P = AB.reshape(n, nu, 2, 3).transpose(3, 1, 2, 0)
@@ -788,6 +793,23 @@ class PDEPatch:
                 memo.pop(next(iter(memo)))
             memo[key] = U
         return U
+
+    def _profile_table(self, u: np.ndarray, du: int, L: np.ndarray) -> np.ndarray:
+        """Every active mode's cosine and sine profiles in ``u`` of the three coordinates, ``L @ abT``:
+        ``(n, len(u), 6)`` mm, from the cardinal table ``L`` of ``u`` (``du``).  The latest one of a long
+        line (:data:`_LONG_U` to 1024 values) is kept apart from :meth:`_mode_profiles`' memo, whose
+        entries the short grids of a polish push out: the bounds' polishes read one line of 513 ``u``
+        at their extremes' ``v`` in ``x`` and in ``y`` on the same patch, twice each (the same table)."""
+        if not _LONG_U <= u.size <= 1024:
+            return np.matmul(L, self._abT)
+        key = (du, u.tobytes())
+        hit = self.__dict__.get("_u_long")
+        if hit is not None and hit[0] == key:
+            return hit[1]
+        AB = np.matmul(L, self._abT)
+        AB.setflags(write=False)
+        object.__setattr__(self, "_u_long", (key, AB))
+        return AB
 
     def jet_grid(self, u, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``X``, ``X_u`` and ``X_v`` on the grid ``u × v``, each ``(3, len(u), len(v))`` (coordinates

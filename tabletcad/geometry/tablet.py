@@ -824,9 +824,12 @@ class Tablet:
         cols = np.arange(nv)
         r_max = 0.0
         outer = []
+        dx, dy, r2, sq = (np.empty(pts[0].shape[1:]) for _ in range(4))  # (every patch's: no temporaries)
         for X in pts:  # the farthest point along each v line of each patch
-            dx, dy = X[0] - c[0], X[1] - c[1]
-            r2 = dx * dx + dy * dy
+            np.subtract(X[0], c[0], out=dx)
+            np.subtract(X[1], c[1], out=dy)
+            np.multiply(dx, dx, out=r2)  # dx² + dy², as written out
+            r2 += np.multiply(dy, dy, out=sq)
             i = np.argmax(r2, axis=0)
             rr = np.sqrt(r2[i, cols])
             r_max = max(r_max, float(rr.max()))
