@@ -390,21 +390,27 @@ class PlanOutline:
     def inscribed_radius(self) -> float:
         """Largest inward distance reached inside the outline (mm), to ~1e-9 mm.
 
-        The best of an 81 × 81 grid over the outline's box, polished by Nelder–Mead on the signed
-        distance of one point from every peak of the grid that could lead to the largest: the signed
-        distance changes by at most the distance moved, so the deepest point lies within half a cell's
-        diagonal ``δ`` of a grid point reading at least the grid's best less ``δ``.  The grid's local
-        maxima (no neighbour higher) above that level are the starts, adjacent ones as one, from its
-        best (a ridge of equal depth along the grid's rows or columns, as a capsule's sides: one start;
-        across them, as a turned capsule's, a staircase of starts a cell or two apart, each polished:
-        3.3 ms a call unturned, tens of ms turned); two lobes of an outline, with their own deepest
-        points, are two starts.  On a chain of lines and arcs the search reads
-        :meth:`_point_signed_distance` (plain floats, the arithmetic of :meth:`signed_distance` without
-        numpy's cost per call on one point: ~200 calls a start) and returns :meth:`signed_distance` at
-        the point it found.
+        The best of an 81 × 81 grid over the outline's box, polished from every peak of the grid that
+        could lead to the largest: the signed distance changes by at most the distance moved, so the
+        deepest point lies within half a cell's diagonal ``δ`` of a grid point reading at least the grid's
+        best less ``δ``.  The grid's local maxima (no neighbour higher) above that level are the starts,
+        adjacent ones as one, from its best (a ridge of equal depth along the grid's rows or columns, as a
+        capsule's sides: one start; across them, as a turned capsule's, a staircase of starts a cell or two
+        apart, each polished); two lobes of an outline, with their own deepest points, are two starts.  On
+        a chain of lines and arcs each start is polished by the steps of
+        :func:`~tabletcad.families.deepest.deepest_near` (linear programmes in the distances to the
+        segments near it, within a box of ``2 δ`` that shrinks as they converge: on lines the first step
+        lands on the deepest point) reading :meth:`_point_signed_distance` (plain floats, the arithmetic
+        of :meth:`signed_distance` without numpy's cost per call on one point), by Nelder–Mead where those
+        steps do not settle and on a circle; the result is :meth:`signed_distance` at the point found.
+        (Nelder–Mead alone, ~200 calls a start, had taken 3.6 ms on the custom_outline sample, the steps
+        1.7; on 514 random filleted polygons, convex and concave, 9.1 against 3.7 ms, the steps' radius
+        as deep as Nelder–Mead's or deeper, by at most 3.2e-12 mm, 1.3e-12 relative.)
         """
         from scipy.ndimage import label, maximum_filter
         from scipy.optimize import minimize
+
+        from tabletcad.families.deepest import deepest_near, distance_jets
 
         n = 81
         c0 = self.frame(linspace(0, math.tau, 512, endpoint=False))[0]
@@ -417,12 +423,19 @@ class PlanOutline:
         regions, count = label(peaks, structure=np.ones((3, 3), bool))
         regions = regions.reshape(-1)
         one = self._point_signed_distance() if self.segs and not self.is_circle else None
+        jets = distance_jets(self.segs) if one is not None else None
         objective = ((lambda x: -one(float(x[0]), float(x[1]))) if one is not None
                      else (lambda x: -float(self.signed_distance(x[None])[0])))
+        scale = float(max(hi - lo))
         best = float(sd.max())
         for k in range(1, count + 1):
             inside = np.flatnonzero(regions == k)
             x0 = g[inside[int(np.argmax(sd[inside]))]]
+            found = (None if jets is None
+                     else deepest_near(jets, one, float(x0[0]), float(x0[1]), 2.0 * delta, scale))
+            if found is not None:
+                best = max(best, float(self.signed_distance(np.array([found]))[0]))
+                continue
             r = minimize(objective, x0, method="Nelder-Mead", options=dict(xatol=1e-11, fatol=1e-13, maxiter=4000))
             best = max(best, float(self.signed_distance(r.x[None])[0]) if one is not None else float(-r.fun))
         return best
