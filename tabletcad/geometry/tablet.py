@@ -54,7 +54,7 @@ def _monotone_pieces(psi: np.ndarray, x: np.ndarray, y: np.ndarray):
         d = d[nz][np.clip(np.searchsorted(nz, np.arange(d.size), "right") - 1, 0, None)]
     turns = np.flatnonzero(d[1:] != d[:-1]) + 1
     out = []
-    for a, b in zip(np.r_[0, turns], np.r_[turns, d.size]):
+    for a, b in zip([0, *turns.tolist()], [*turns.tolist(), d.size]):
         q, px, py = psi[a:b + 1], x[a:b + 1], y[a:b + 1]
         if q[-1] < q[0]:
             q, px, py = q[::-1], px[::-1], py[::-1]
@@ -62,8 +62,20 @@ def _monotone_pieces(psi: np.ndarray, x: np.ndarray, y: np.ndarray):
     return out
 
 
+def _unwrap(p: np.ndarray, steps: np.ndarray) -> np.ndarray:
+    """``numpy.unwrap(p)`` of angles ``p`` (rad) whose steps' sizes ``|diff(p)|`` are ``steps``: when no step
+    reaches π (a run of a fan's angles nearly always) its corrections are all zero and it returns
+    ``p[1:] + 0.0`` after ``p[0]``, which this does without its dozen passes over the run (the same numbers)."""
+    if float(steps.max()) >= math.pi:
+        return np.unwrap(p)
+    up = p + 0.0
+    up[0] = p[0]
+    return up
+
+
 def _cover(env: np.ndarray, grid: np.ndarray, cs: tuple[np.ndarray, np.ndarray], q: np.ndarray, px: np.ndarray,
-           py: np.ndarray, block: int = 16) -> None:
+           py: np.ndarray, block: int = 16, *, span: tuple[int, int] | None = None,
+           r2: np.ndarray | None = None) -> None:
     """Raise ``env`` (radii at the increasing angles ``grid``, whose cosines and sines are ``cs``) to the
     fan of one monotone piece of a polyline (:func:`_monotone_pieces`): the triangles from the centre
     over its chords, nothing outside the angles it spans (in place).
@@ -75,11 +87,19 @@ def _cover(env: np.ndarray, grid: np.ndarray, cs: tuple[np.ndarray, np.ndarray],
     piece whose farthest point ``env`` reaches at every angle it spans is passed over whole before the
     blocks are formed (then no block is live: the same result; with the pieces outside the grid, 35,000 of
     the 42,000 calls of ``tests/test_core_plan_cutaway.py``'s convergence cases end there).
+
+    ``span``, the indices ``(s0, s1)`` of the angles the piece spans (``grid[s0:s1]``, the ``searchsorted``
+    of ``q[0]`` on the left and ``q[-1]`` on the right), and ``r2``, the squared radii ``px² + py²`` (mm²),
+    may be given when the caller has them (computed for many pieces at once, or once for copies shifted by
+    2π): they are what this function would compute.
     """
-    s0, s1 = int(np.searchsorted(grid, q[0], "left")), int(np.searchsorted(grid, q[-1], "right"))
+    if span is None:
+        span = (int(np.searchsorted(grid, q[0], "left")), int(np.searchsorted(grid, q[-1], "right")))
+    s0, s1 = span
     if s1 <= s0:
         return
-    r2 = px * px + py * py
+    if r2 is None:
+        r2 = px * px + py * py
     low = float(env[s0:s1].min())
     if low * low >= float(r2.max()):  # the envelope already reaches every point at every angle: no block is live
         return
@@ -92,18 +112,32 @@ def _cover(env: np.ndarray, grid: np.ndarray, cs: tuple[np.ndarray, np.ndarray],
     live = (G[1:] > G[:-1]) & ~(lo * lo >= reach2)
     if not live.any():
         return
-    a, b = G[:-1][live], G[1:][live]
-    m = b - a
-    gi = np.repeat(a - np.cumsum(m) + m, m) + np.arange(int(m.sum()))
-    g = grid[gi]
-    k = np.clip(np.searchsorted(q, g, "right") - 1, 0, n - 2)
-    x0, y0, ex, ey = px[k], py[k], px[k + 1] - px[k], py[k + 1] - py[k]
+    # the live blocks' chords, each with the run of angles that falls on it: angle index i falls on chord k
+    # when q[k] <= grid[i] < q[k + 1], i.e. S[k] <= i < S[k + 1] with S[k] = #(grid < q[k]); a block's first
+    # S is its G, its last chord's run ends at the block's end (the piece's last chord keeps its end)
+    j = np.flatnonzero(live)
+    nk = np.minimum(first[j] + block, n - 1) - first[j]
+    ck = np.repeat(first[j] - np.cumsum(nk) + nk, nk) + np.arange(int(nk.sum()))
+    S = np.searchsorted(grid, q[ck], "left")
+    last = np.cumsum(nk) - 1
+    S_next = np.empty_like(S)
+    S_next[:-1] = S[1:]
+    S_next[last] = G[j + 1]
+    cnt = S_next - S
+    gi = np.repeat(S - np.cumsum(cnt) + cnt, cnt) + np.arange(int(cnt.sum()))
+    # each chord's terms once (elementwise: the same numbers as on its angles' copies), then repeated
+    x0, y0 = px[ck], py[ck]
+    ex, ey = px[ck + 1] - x0, py[ck + 1] - y0
+    num = x0 * ey - y0 * ex
+    h0 = np.hypot(x0, y0)
+    ends = np.maximum(h0, np.hypot(x0 + ex, y0 + ey))
+    ex, ey, num, ends, h0 = (np.repeat(a, cnt) for a in (ex, ey, num, ends, h0))
     # the ray at angle g meets the chord where r (cos g, sin g) = P_k + s E
     den = ex * cs[1][gi] - ey * cs[0][gi]
     with np.errstate(divide="ignore", invalid="ignore"):
-        r = np.where(np.abs(den) > 0.0, (x0 * ey - y0 * ex) / -den, np.hypot(x0, y0))
+        r = np.where(np.abs(den) > 0.0, num / -den, h0)
     # (a ray almost along a chord: a chord's points are never farther than its ends)
-    r = clip(r, 0.0, np.maximum(np.hypot(x0, y0), np.hypot(x0 + ex, y0 + ey)))
+    r = clip(r, 0.0, ends)
     env[gi] = np.maximum(env[gi], r)
 
 
@@ -770,25 +804,31 @@ class Tablet:
             x, y = cr * x + sr * y, cr * y - sr * x  # in the frame of the angles psi
             # a line through (or at round-off from) the centre turns by about π there: its fan is the
             # two sides' fans; one across the gap's direction wraps by 2π and is unwrapped
-            cuts = np.flatnonzero(np.abs(np.abs(np.diff(psi)) - math.pi) < 0.5 * math.pi) + 1
-            for s, e in zip(np.r_[0, cuts], np.r_[cuts, psi.size]):
+            steps = np.abs(np.diff(psi))
+            cuts = (np.flatnonzero(np.abs(steps - math.pi) < 0.5 * math.pi) + 1).tolist()
+            for s, e in zip([0, *cuts], [*cuts, psi.size]):
                 if e - s >= 2:
-                    q = np.unwrap(psi[s:e])
+                    q = _unwrap(psi[s:e], steps[s:e - 1])
                     runs.append((q, x[s:e], y[s:e], None if idx is None else idx[s:e]))
                     lo, hi = min(lo, float(q.min())), max(hi, float(q.max()))
         if covered:
             lo, hi = 0.0, math.tau
         shifts = (0.0, -math.tau, math.tau) if covered else (0.0,)
-        sets = []  # the monotone pieces of every fan, from all the lines v and from every other one
+        # the monotone pieces of every fan, from all the lines v and from every other one, each as
+        # (farthest r², angles, x, y, r²): a piece's r² computed once for its copies shifted by 2π
+        sets: list[list[tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray]]] = []
         for half in (False, True):
             pieces = []
             for q, x, y, idx in runs:
                 k = slice(None) if not half or idx is None else idx % 2 == 0
-                pieces += [(qq + sh, xx, yy) for qq, xx, yy in _monotone_pieces(q[k], x[k], y[k]) for sh in shifts]
+                for qq, xx, yy in _monotone_pieces(q[k], x[k], y[k]):
+                    r2 = xx * xx + yy * yy
+                    top = float(r2.max())
+                    pieces += [(top, qq + sh, xx, yy, r2) for sh in shifts]
             sets.append(pieces)
         # midpoints of 8 nv steps across the range, each piece's ends among the steps' ends: the
         # envelope is continuous within each step (a fan ends at its ends), so the rule is of second order
-        ends = np.unique(np.clip([qq[e] for pieces in sets for qq, _, _ in pieces for e in (0, -1)], lo, hi))
+        ends = np.unique(np.clip([p[1][e] for pieces in sets for p in pieces for e in (0, -1)], lo, hi))
         ends = np.unique(np.r_[lo, ends, hi])
         widths = np.diff(ends)
         n = np.maximum(np.ceil(widths * (8 * nv) / (hi - lo)).astype(int), 1)
@@ -800,10 +840,17 @@ class Tablet:
 
         def area(half: bool) -> float:
             env = np.zeros(grid.size)
+            pieces = sets[half]
+            # the angles each piece spans, all at once; the pieces outside the grid (copies shifted by 2π,
+            # most of them) raise nothing and are left out
+            s0 = np.searchsorted(grid, [p[1][0] for p in pieces], "left")
+            s1 = np.searchsorted(grid, [p[1][-1] for p in pieces], "right")
+            inside = np.flatnonzero(s1 > s0)
             # the farthest pieces first (the band's lines): most of the rest then lie inside the envelope
             # and are passed over (the largest of the radii, in any order, is the same number)
-            for piece in sorted(sets[half], key=lambda p: -float((p[1] * p[1] + p[2] * p[2]).max())):
-                _cover(env, grid, cs, *piece)
+            for i in sorted(inside.tolist(), key=lambda i: -pieces[i][0]):
+                _, q, x, y, r2 = pieces[i]
+                _cover(env, grid, cs, q, x, y, span=(int(s0[i]), int(s1[i])), r2=r2)
             return 0.5 * float(np.sum(env * env * step))
 
         return (4.0 * area(False) - area(True)) / 3.0
