@@ -36,6 +36,11 @@ _POLISH_GAIN = 1e-14
 _ZOOM_STOP = 1e-6
 _NEWTON_FINISH = 1e-3
 
+#: the sort of a cut-away's fan angles (runs of increasing or decreasing angles, one per line): numpy 2's
+#: vectorised quicksort took 0.4 times the time of its timsort ("stable"), numpy 1.24's quicksort twice
+#: the time (the same sorted values either way)
+_ANGLE_SORT = "quicksort" if np.lib.NumpyVersion(np.__version__) >= "2.0.0" else "stable"
+
 __all__ = ["Band", "Trim", "Tablet", "Face", "solid_map"]
 
 
@@ -791,7 +796,7 @@ class Tablet:
             keep = np.hypot(x, y) > tiny  # (the poles: no direction)
             polar.append((np.arctan2(y[keep], x[keep]), x[keep], y[keep], None if idx is None else idx[keep]))
         # angles from the middle of the widest direction no point has (the cut's gap), if any
-        phi = np.sort(np.concatenate([a for a, *_ in polar]))
+        phi = np.sort(np.concatenate([a for a, *_ in polar]), kind=_ANGLE_SORT)
         gaps = np.diff(np.r_[phi, phi[0] + math.tau])
         j = int(np.argmax(gaps))
         g0 = float(phi[j] + 0.5 * gaps[j])
