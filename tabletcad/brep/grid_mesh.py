@@ -108,7 +108,9 @@ def _points_normals(s: BSplineSurfaceData, u: np.ndarray, v: np.ndarray, col: _C
     """Points and unit normals ``S_u × S_v`` on the grid ``u × v``, each ``(3, len(u), len(v))``,
     and where the normal is defined (not on a collapsed row, where the cross product vanishes)."""
     S, Su, Sv = s.grid_components(u, v, lambda which, x: col(s, which, x))
-    N = np.stack([Su[1] * Sv[2] - Su[2] * Sv[1], Su[2] * Sv[0] - Su[0] * Sv[2], Su[0] * Sv[1] - Su[1] * Sv[0]])
+    N = np.empty_like(Su)  # the cross product written in place (no stacked copy)
+    for c, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))):
+        np.subtract(Su[i] * Sv[j], Su[j] * Sv[i], out=N[c])
     size = np.sqrt(_dot(N, N))
     ok = size > 1e-9 * np.maximum(_dot(Su, Su), _dot(Sv, Sv))
     N /= np.where(ok, size, 1.0)
@@ -312,18 +314,27 @@ def _cell_deviation(s: BSplineSurfaceData, u: np.ndarray, v: np.ndarray, V: np.n
     nu1, m = diag.shape
     ci, a = _lattice_cells(nu1, n)
     cj, b = _lattice_cells(m, n)
-    cell = (ci[:, None], cj[None, :])
-    weights = _lattice_weights((a / n)[:, None], (b / n)[None, :], diag[cell])
+
+    def spread(x: np.ndarray) -> np.ndarray:
+        """Per-cell values ``(..., nu1, m)`` at every lattice point of their cells: one take along each
+        axis (a two-dimensional index over the whole lattice took three times as long)."""
+        return x.take(cj, axis=-1).take(ci, axis=-2)
+
+    # the weights depend only on a point's steps (a, b) in its cell and the cell's diagonal: a table of
+    # the 2 (n + 1)² values (_lattice_weights' own arithmetic on the same numbers), taken at each point
+    steps = np.arange(n + 1) / n
+    table = _lattice_weights(steps[None, :, None], steps[None, None, :], np.array([False, True])[:, None, None])
+    code = spread(diag.astype(np.intp)) * (n + 1) ** 2 + (a[:, None] * (n + 1) + b[None, :])
     M = None  # (3, n nu1 + 1, n m + 1): the weighted corners, summed in place (the same sums, fewer arrays)
-    for w, idx in zip(weights, corners):
-        term = V[:, idx[cell]]
-        term *= w
+    for w, idx in zip(table, corners):
+        term = spread(V[:, idx])
+        term *= w.ravel().take(code)
         if M is None:
             M = term
             M += 0.0  # (as sum() did, from 0: 0 + x, a -0.0 made +0.0)
         else:
             M += term
-    D = M - S
+    D = np.subtract(M, S, out=M)  # (M is this function's own array)
     h = _dot(D, Nrm)
     dd = _dot(D, D)
     tang = np.maximum(dd - h * h, 0.0)
