@@ -91,7 +91,8 @@ def _cover(env: np.ndarray, grid: np.ndarray, cs: tuple[np.ndarray, np.ndarray],
     ends) and those angles are passed over — on a cut-away's cup lines, inside the band's, nearly all.  A
     piece whose farthest point ``env`` reaches at every angle it spans is passed over whole before the
     blocks are formed (then no block is live: the same result; with the pieces outside the grid, 35,000 of
-    the 42,000 calls of ``tests/test_core_plan_cutaway.py``'s convergence cases end there).
+    the 42,000 calls of ``tests/test_core_plan_cutaway.py``'s convergence cases had ended there; the plan
+    area now leaves the pieces outside the grid out before it calls this).
 
     ``span``, the indices ``(s0, s1)`` of the angles the piece spans (``grid[s0:s1]``, the ``searchsorted``
     of ``q[0]`` on the left and ``q[-1]`` on the right), and ``r2``, the squared radii ``px² + py²`` (mm²),
