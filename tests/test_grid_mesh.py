@@ -235,3 +235,54 @@ def test_the_measured_deviation_is_the_largest_on_every_cell_s_own_lattice(name)
             near = ok & (k * k * tang <= 0.25)
             worst = max(worst, float(np.max(np.where(near, np.abs(h) + 0.5 * k * tang, np.sqrt(dd)))))
         assert got == pytest.approx(gm._LATTICE_ALLOWANCE * worst, rel=1e-9)
+
+
+def _triangle_points(P00, P10, P01, P11, s_, t, diag):
+    """The points at a cell's local parameters ``(s_, t)`` on the triangles the mesh makes of it, by the
+    affine map of each triangle: cut along ``P00-P11`` (``diag``) into ``(P00, P10, P11)`` (``s_ >= t``) and
+    ``(P00, P11, P01)``, else into ``(P00, P10, P01)`` (``s_ + t <= 1``) and ``(P10, P11, P01)``."""
+    on_diag = np.where(s_ >= t, P00 + s_ * (P10 - P00) + t * (P11 - P10), P00 + t * (P01 - P00) + s_ * (P11 - P01))
+    across = np.where(s_ + t <= 1.0, P00 + s_ * (P10 - P00) + t * (P01 - P00),
+                      P11 + (1.0 - s_) * (P01 - P11) + (1.0 - t) * (P10 - P11))
+    return np.where(diag, on_diag, across)
+
+
+def test_the_deviation_is_measured_on_the_triangles_the_mesh_makes(monkeypatch):
+    """Every lattice point's deviation is the surface's distance estimate from the point at the same local
+    parameters on the triangle the mesh actually makes of its cell (the diagonal ``grid_mesh`` chooses),
+    recomputed here by each triangle's affine map: a measurement on the other diagonal's triangles (its
+    weights swapped) differs on the rounded triangle's cells and fails."""
+    import tabletcad.brep.grid_mesh as gm
+
+    calls = []
+    measure = gm._cell_deviation
+
+    def recorded(s, u, v, V, corners, diag, curvature, col):
+        dev = measure(s, u, v, V, corners, diag, curvature, col)
+        calls.append((s, u, v, V, corners, diag, curvature, col, dev))
+        return dev
+
+    monkeypatch.setattr(gm, "_cell_deviation", recorded)
+    assert grid_mesh(chain("rounded_triangle"), 0.02, 0.5) is not None
+    n = gm._LATTICE
+    swapped_off = 0.0
+    for s, u, v, V, (i00, i10, i01, i11), diag, curvature, col, dev in calls:
+        S, N, ok = gm._points_normals(s, gm._subdivide(u, n), gm._subdivide(v, n), col)
+        nu1, m = diag.shape
+        ku, kv = np.arange(n * nu1 + 1), np.arange(n * m + 1)
+        ci, cj = np.minimum(ku // n, nu1 - 1)[:, None], np.minimum(kv // n, m - 1)[None, :]
+        s_, t = ((ku - n * ci[:, 0]) / n)[:, None], ((kv - n * cj[0]) / n)[None, :]
+        P = [V[:, idx[ci, cj]] for idx in (i00, i10, i01, i11)]
+
+        def estimate(cut):
+            D = _triangle_points(*P, s_, t, cut) - S
+            h, dd = np.einsum("i...,i...->...", D, N), np.einsum("i...,i...->...", D, D)
+            tang = np.maximum(dd - h * h, 0.0)
+            near = ok & (curvature * curvature * tang <= 0.25)
+            return gm._LATTICE_ALLOWANCE * np.where(near, np.abs(h) + 0.5 * curvature * tang, np.sqrt(dd))
+
+        cut = diag[ci, cj]
+        # (the affine maps round differently from the weights: ~1e-15 mm on coordinates of a few mm)
+        np.testing.assert_allclose(dev, estimate(cut), rtol=1e-9, atol=1e-12)
+        swapped_off = max(swapped_off, float(np.abs(estimate(~cut) - dev).max()))
+    assert len(calls) >= 9 and swapped_off > 1e-6, swapped_off
