@@ -18,17 +18,19 @@ from __future__ import annotations
 import math
 from typing import Callable, Sequence
 
-__all__ = ["distance_jets", "deepest_near"]
+__all__ = ["distance_jets", "deepest_near", "plain_segments"]
 
 #: A function of a plan point ``(x, y)`` (mm) giving, for every segment, its distance (mm) and that
 #: distance's gradient ``(d, g_x, g_y)`` (a unit vector, or 0 on the segment).
 Jets = Callable[[float, float], list]
 
 
-def distance_jets(segs: Sequence) -> Jets:
-    """The distances of a plan point to each of ``segs`` (lines and arcs) with their gradients, in plain
-    floats: :data:`Jets`.  A line's nearest point is its projection clipped to its ends; an arc's is the
-    radial one within its span, else its nearer end."""
+def plain_segments(segs: Sequence) -> list[tuple]:
+    """``segs`` (lines and arcs) as tuples of plain floats for the one-point loops here and in
+    :meth:`~tabletcad.families.outline.PlanOutline._point_signed_distance`: a line
+    ``(True, ax, ay, dx, dy, dx² + dy²)`` (its start and its run, mm); an arc
+    ``(False, cx, cy, r, cos m, sin m, cos(|sweep|/2), sign of sweep, x0, y0, u0, w0, x1, y1, u1, w1)``
+    (centre and radius, mm; ``m`` its middle angle; its ends and their unit tangents)."""
     items = []
     for sg in segs:
         (ax, ay), (bx, by) = sg.p0, sg.p1
@@ -37,8 +39,18 @@ def distance_jets(segs: Sequence) -> Jets:
             items.append((True, ax, ay, dx, dy, dx * dx + dy * dy))
         else:
             mid = sg.theta0 + 0.5 * sg.sweep
+            t0, t1 = sg.tangent(0), sg.tangent(1)
             items.append((False, sg.center[0], sg.center[1], sg.radius, math.cos(mid), math.sin(mid),
-                          math.cos(0.5 * abs(sg.sweep)), ax, ay, bx, by))
+                          math.cos(0.5 * abs(sg.sweep)), math.copysign(1.0, sg.sweep),
+                          ax, ay, float(t0[0]), float(t0[1]), bx, by, float(t1[0]), float(t1[1])))
+    return items
+
+
+def distance_jets(segs: Sequence) -> Jets:
+    """The distances of a plan point to each of ``segs`` (lines and arcs) with their gradients, in plain
+    floats: :data:`Jets`.  A line's nearest point is its projection clipped to its ends; an arc's is the
+    radial one within its span, else its nearer end."""
+    items = plain_segments(segs)
 
     def unit(qx: float, qy: float) -> tuple[float, float, float]:
         d = math.hypot(qx, qy)
@@ -52,7 +64,7 @@ def distance_jets(segs: Sequence) -> Jets:
                 t = min(max(((x - ax) * dx + (y - ay) * dy) / dd, 0.0), 1.0)
                 out.append(unit(x - (ax + t * dx), y - (ay + t * dy)))
                 continue
-            _, cx, cy, rad, cm, sm, ch, x0, y0, x1, y1 = it
+            _, cx, cy, rad, cm, sm, ch, _, x0, y0, _, _, x1, y1, _, _ = it
             rx, ry = x - cx, y - cy
             rho = math.hypot(rx, ry)
             if rho > 0.0 and rx * cm + ry * sm >= rho * ch:  # within the arc's span: radially

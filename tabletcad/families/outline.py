@@ -444,18 +444,9 @@ class PlanOutline:
         """``f(x, y)``: :meth:`signed_distance` of one point (mm, > 0 inside) in plain floats, for a chain of
         lines and arcs: the nearest segment (the first of equals in the chain's order) and the side it puts
         the point on, by the arithmetic of :func:`_signed_to_segment` term for term."""
-        items = []
-        for sg in self.segs:
-            (ax, ay), (bx, by) = sg.p0, sg.p1
-            if sg.kind == "line":
-                dx, dy = bx - ax, by - ay
-                items.append((True, ax, ay, dx, dy, dx * dx + dy * dy))
-            else:
-                mid = sg.theta0 + 0.5 * sg.sweep
-                t0, t1 = sg.tangent(0), sg.tangent(1)
-                items.append((False, sg.center[0], sg.center[1], sg.radius, math.cos(mid), math.sin(mid),
-                              math.cos(0.5 * abs(sg.sweep)), math.copysign(1.0, sg.sweep),
-                              ax, ay, float(t0[0]), float(t0[1]), bx, by, float(t1[0]), float(t1[1])))
+        from tabletcad.families.deepest import plain_segments
+
+        items = plain_segments(self.segs)
         sqrt = math.sqrt
 
         def f(x: float, y: float) -> float:
