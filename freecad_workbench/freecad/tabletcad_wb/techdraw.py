@@ -63,5 +63,25 @@ def make_page(doc, tablet, scale: float | None = None):
         (dim,) = [o for o in doc.Objects if o.Name not in before and o.TypeId == "TechDraw::DrawViewDimExtent"]
         dim.Label = f"{tablet.Label} {key}"
         dims[key] = dim
+    _keep_projections(top, side)
     doc.recompute()
     return page, [top, side], dims
+
+
+def _keep_projections(*views) -> None:
+    """Spare the views a second projection after their extent dimensions were added.
+
+    ``makeExtentDim`` adds its two end points to the view as cosmetic vertices, both to the
+    ``CosmeticVertexes`` property and to the geometry just projected; the property's change marks the
+    view for recompute, and FreeCAD 0.20 projected each view again for the same edges (the capsule's
+    two views 1.0 s more, doubling the page's time; views, cosmetic vertices and dimensions measured
+    bit-identical without it).  FreeCAD 1.0 projects in a worker thread and had not re-projected.
+
+    Parameters
+    ----------
+    *views : TechDraw.DrawViewPart
+        The page's views, projected and given their dimensions (a view whose source, direction or
+        scale changed later is recomputed as usual).
+    """
+    for view in views:
+        view.purgeTouched()
