@@ -146,3 +146,29 @@ def test_the_plan_polish_finds_a_widest_line_between_the_samples(sample, nu):
     t = _tablet(name, folder)
     exact = t.plan_area()  # a tablet of revolution: pi R_max^2, R_max polished along its profile
     assert t._plan_area_sampled(nu, 256) == pytest.approx(exact, rel=1e-13)
+
+
+@pytest.mark.parametrize("name", SWEPT)
+def test_a_remainder_evident_from_the_basis_is_the_dense_tests(swept, name):
+    """A patch has a remainder term when its data less every mode's series exceed ``1e-14`` of its scale
+    at ``4 samples`` dense samples; on a shared basis the answer is first read from the basis's residuals
+    at every 45th of those samples, less their rounding
+    (:func:`~tabletcad.geometry.patch._basis_evidently_above`).
+    It gives the dense test's answer on every patch of the swept samples (their outlines of lines and arcs
+    leave content above any mode count), and it never reports a limit exceeded that the dense maximum does
+    not exceed (at the maximum itself, or just below the largest of its own samples' combined residuals)."""
+    from tabletcad.geometry.curves import sample_v
+    from tabletcad.geometry.patch import _basis_evidently_above, _basis_residuals
+    from tabletcad.geometry.vectors import einsum
+
+    for p in swept[name].patches:
+        basis, W, samples = p._comb
+        dense = float(np.abs(einsum("jk,kmc->jmc", W, _basis_residuals(basis, p.modes, samples, None,
+                                                                        sample_v(4 * samples), 0))).max())
+        limit = 1e-14 * _scale(p)
+        assert p._has_remainder == (dense > limit), p.name
+        assert _basis_evidently_above(p._comb, p.modes, limit) == p._has_remainder, p.name
+        assert not _basis_evidently_above(p._comb, p.modes, dense), p.name
+        few = _basis_residuals(basis, p.modes, samples, None, sample_v(4 * samples)[::45], 0)
+        own = float(np.abs(einsum("jk,kmc->jmc", W, few)).max())
+        assert not _basis_evidently_above(p._comb, p.modes, own * (1.0 - 1e-15)), p.name

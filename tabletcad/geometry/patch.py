@@ -43,7 +43,7 @@ from tabletcad.geometry.curves import (basis_memo, basis_spectrum, combination_o
                                       fourier_samples, modes_needed, sample_v)
 from tabletcad.errors import DesignError, check_positive
 from tabletcad.tolerance import DEFAULT, Tolerances
-from tabletcad.geometry.vectors import cross, cross_first, linspace, norm3, points_last
+from tabletcad.geometry.vectors import cross, cross_first, einsum, linspace, norm3, points_last
 
 __all__ = ["PDEPatch", "AUTO_A_LADDER"]
 
@@ -233,6 +233,47 @@ def _basis_fourier(basis, N: int, samples: int) -> tuple[np.ndarray, ...]:
     return hit
 
 
+def _basis_evidently_above(comb: tuple, N: int, limit: float) -> bool:
+    """True when the largest residual of a patch's data ``W · basis + const`` above its ``N`` modes at
+    the ``4 samples`` dense samples (``comb = (basis, W, samples)``; the figure :meth:`PDEPatch._above_modes`
+    compares with ``limit``, mm) is surely above ``limit``, from the basis's residuals at every 45th of
+    those samples (kept on the basis: one small evaluation for all its patches); False when that does not
+    settle it.
+
+    Each sample's combined residual is bounded below by its value here less the rounding of both
+    evaluations: the series and the data at a sample are the same sums whatever the array they sit in, up
+    to rounding, taken as 1e-12 of the sum of the sizes of their terms (far more than ``N`` terms' worth),
+    and the combination's own as 8 ulp of its terms.  The dense maximum is at least any of its samples',
+    so a lower bound above ``limit`` gives the dense test's answer."""
+    basis, W, samples = comb
+    v = sample_v(4 * samples)[::45]
+    B = _basis_residuals(basis, N, samples, None, v, 0)  # (k, m, 3)
+    a0, a, b, _ = _basis_fourier(basis, N, samples)
+    k = B.shape[0]
+    terms = (np.abs(B).reshape(k, -1).max(axis=1) + np.abs(a0).sum(axis=1)
+             + np.abs(a).sum(axis=(1, 2)) + np.abs(b).sum(axis=(1, 2)))  # (k,) a bound of each curve's terms
+    flat = B.reshape(k, -1)
+    aw = np.abs(W)
+    lower = (np.abs(W @ flat) - 8.0 * np.finfo(float).eps * (aw @ np.abs(flat))
+             - (aw @ (2e-12 * terms))[:, None])
+    return bool((lower > limit).any())
+
+
+def _basis_active_rows(basis, N: int, samples: int, active: np.ndarray) -> np.ndarray:
+    """The cosine rows over the sine rows of the basis curves' coefficients of the modes ``active``,
+    ``(2 len(active), 3k)`` mm (read-only; once per basis, modes, samples and active set: every residual
+    of a patch on the basis at new ``v`` reads them)."""
+    memo = basis_memo(basis)
+    key = ("active rows", N, samples, active.tobytes())
+    hit = memo.get(key)
+    if hit is None:
+        rows = _basis_fourier(basis, N, samples)[3]
+        hit = np.concatenate([rows[0][active - 1], rows[1][active - 1]])
+        hit.setflags(write=False)
+        memo[key] = hit
+    return hit
+
+
 def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: np.ndarray, dv: int,
                      vbytes: bytes | None = None) -> np.ndarray:
     """The ``k`` basis curves less their Fourier series (``active`` modes, or all ``N`` when None), or
@@ -251,7 +292,7 @@ def _basis_residuals(basis, N: int, samples: int, active: np.ndarray | None, v: 
             out -= (c @ rows[0] + s @ rows[1]).reshape(v.size, k, 3).transpose(1, 0, 2)
         elif active is not None and active.size:
             T = _trig_shared(v, active, dv, rows=True, vbytes=vbytes)  # (2n, m), cosines over sines
-            R = np.concatenate([rows[0][active - 1], rows[1][active - 1]])  # (2n, 3k)
+            R = _basis_active_rows(basis, N, samples, active)  # (2n, 3k)
             out -= (T.T @ R).reshape(v.size, k, 3).transpose(1, 0, 2)
         out.setflags(write=False)
         return out
@@ -386,7 +427,7 @@ class PDEPatch:
             basis, W, const = comb
             a0B, aB, bB = _basis_fourier(basis, N, samples)[:3]
             a0 = W @ a0B + const
-            ac, bc = np.einsum("jk,knc->jnc", W, aB), np.einsum("jk,knc->jnc", W, bB)
+            ac, bc = einsum("jk,knc->jnc", W, aB), einsum("jk,knc->jnc", W, bB)
             comb = (basis, np.asarray(W, dtype=float), samples)
         else:
             a0 = np.zeros((4, 3))
@@ -403,11 +444,8 @@ class PDEPatch:
         # is there anything above mode N?  Not for curves band-limited to N modes (circles,
         # ellipses: the FFT of 8 N + 8 samples is exact); else the residual at dense samples
         scale = max(1.0, float(np.abs(a0).max()), float(np.abs(ac).max()) if N else 0.0)
-        if band_limited:
-            object.__setattr__(self, "_has_remainder", False)
-        else:
-            res = float(np.abs(self._residuals(sample_v(4 * samples), 0)).max())
-            object.__setattr__(self, "_has_remainder", res > 1e-14 * scale)
+        above = False if band_limited else self._above_modes(samples, scale)
+        object.__setattr__(self, "_has_remainder", above)
         object.__setattr__(self, "_lams", self.a * np.arange(N + 1))
         # modes with any non-zero coefficient; the others are skipped in every sum
         amp = np.zeros(N + 1)
@@ -436,6 +474,19 @@ class PDEPatch:
         object.__setattr__(self, "_section", detect_section(*coeffs) if rev is None else rev.section())
         if self.check:
             self._check_amplification(amp, zero)
+
+    def _above_modes(self, samples: int, scale: float) -> bool:
+        """Whether some datum has content above mode ``N``: its residual (every mode's series taken
+        off) at ``4 samples`` dense samples beyond ``1e-14 scale`` (mm) somewhere.  A patch on a shared
+        basis first asks :func:`_basis_evidently_above` (the same answer where it answers: a residual
+        that the basis's at every 45th of those samples already shows, which a swept family's outline
+        of lines and arcs always does), and the dense residual only where it does not."""
+        limit = 1e-14 * scale
+        comb = self.__dict__.get("_comb")
+        fresh = "_n_active" not in self.__dict__  # (set up before: its active modes' series, as below)
+        if comb is not None and fresh and _basis_evidently_above(comb, self.modes, limit):
+            return True
+        return float(np.abs(self._residuals(sample_v(4 * samples), 0)).max()) > limit
 
     def _check_amplification(self, amp: np.ndarray, zero: float) -> None:
         """Refuse modes (and the remainder) amplified more than ``tol.max_amplification`` between the curves.
@@ -604,7 +655,7 @@ class PDEPatch:
             if comb is not None:  # the basis's residuals (shared by the patches on it), combined
                 basis, W, samples = comb
                 act = self.__dict__.get("_n_active")
-                return np.einsum("jk,kmc->jmc", W, _basis_residuals(basis, N, samples, act, v, dv, vbytes))
+                return einsum("jk,kmc->jmc", W, _basis_residuals(basis, N, samples, act, v, dv, vbytes))
             out = evaluate_curves(self.data, v, dv)  # (a datum repeated, a fan's two equal derivatives, once)
             if dv == 0:
                 out -= self._a0[:, None, :]
@@ -622,13 +673,14 @@ class PDEPatch:
             return make()
         return self._memo(("res", dv, v.tobytes() if vbytes is None else vbytes), make, v.size < _CACHED_V[0])
 
-    def _u_tables(self, u: np.ndarray, du: int) -> tuple[np.ndarray | None, np.ndarray, np.ndarray | None]:
+    def _u_tables(self, u: np.ndarray, du: int,
+                  ubytes: bytes | None = None) -> tuple[np.ndarray | None, np.ndarray, np.ndarray | None]:
         """The cardinal functions at ``u`` (or their ``u``-derivative) of every active mode
         ``(modes, len(u), 4)``, of the spine ``(len(u), 4)`` and of the remainder term, read-only;
         cached for short ``u`` arrays, which the checks evaluate again and again (seams at
         ``u = 0, 1``, the same lines for a point and its derivatives), and shared with every
         patch alike in ``λ`` of its active modes, remainder rate, nodes and form
-        (:data:`~tabletcad.geometry.tables.CARDINAL`)."""
+        (:data:`~tabletcad.geometry.tables.CARDINAL`).  ``ubytes``: ``u.tobytes()`` when the caller has it."""
 
         def make():
             n = np.array(self._active, dtype=int)
@@ -639,7 +691,7 @@ class PDEPatch:
 
         if u.size > 1024:
             return make()
-        return CARDINAL.get((du, u.tobytes()) + self._u_key, make)
+        return CARDINAL.get((du, u.tobytes() if ubytes is None else ubytes) + self._u_key, make)
 
     # ------------------------------------------------------------------ evaluation
     def evaluate(self, u, v, du: int = 0, dv: int = 0, *, nmin: int = 0, remainder: bool = True) -> np.ndarray:
@@ -722,7 +774,8 @@ class PDEPatch:
             raise ValueError("out is only allowed with components=True")
         u = np.asarray(u, dtype=float).reshape(-1)
         v = np.asarray(v, dtype=float).reshape(-1)
-        L, L0, Lr = self._u_tables(u, du)  # (n, nu, 4), (nu, 4), (nu, 4)
+        ub = u.tobytes() if u.size <= 1024 else None  # (the u tables' and profiles' key: one copy, one hash)
+        L, L0, Lr = self._u_tables(u, du, ub)  # (n, nu, 4), (nu, 4), (nu, 4)
         # X[c, i, j] = Σ_k U[c, i, k] V[k, j], built as its transpose Y = X^T (nv, len(axes) nu) in Fortran
         # order (so Y.T is X, C-ordered, with no copy) by BLAS products that write into Y: the modes (cos and
         # sin rows of V, their u-profiles in U) in one product of (nv, 2n) by (2n, len(axes) nu); then, per
@@ -745,7 +798,7 @@ class PDEPatch:
         fresh = True
         if self._active:
             T = _trig_shared(v, self._n_active, dv, rows=True, vbytes=vb)  # (2n, nv): cosines over sines
-            _gemm(T.T, self._mode_profiles(u, du, L, ax).T, Y)
+            _gemm(T.T, self._mode_profiles(u, du, L, ax, ub).T, Y)
             fresh = False
         if rem or spine:
             k = 4 * rem + spine
@@ -767,13 +820,14 @@ class PDEPatch:
         X = Y.T.reshape(m, nu, nv)
         return X if components else points_last(X)
 
-    def _mode_profiles(self, u: np.ndarray, du: int, L: np.ndarray, ax: list[int]) -> np.ndarray:
+    def _mode_profiles(self, u: np.ndarray, du: int, L: np.ndarray, ax: list[int],
+                       ubytes: bytes | None = None) -> np.ndarray:
         """:meth:`evaluate_grid`'s left factor: the active modes' cosine and sine profiles in ``u`` of the
         coordinates ``ax``, ``(len(ax) len(u), 2 n)`` mm (coordinate c's cosine profiles, then its sine
         ones), from the cardinal table ``L`` of ``u`` (``du``).  The latest four of ``u`` up to 1024 values
         are kept (read-only): the surface and its ``v`` partial on one grid (:meth:`jet_grid`, the seams'
-        rows) share one."""
-        key = (du, tuple(ax), u.tobytes()) if u.size <= 1024 else None
+        rows) share one.  ``ubytes``: ``u.tobytes()`` when the caller has it."""
+        key = (du, tuple(ax), u.tobytes() if ubytes is None else ubytes) if u.size <= 1024 else None
         memo = self.__dict__.get("_u_memo")
         if memo is None:
             memo = {}

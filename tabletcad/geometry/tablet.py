@@ -23,7 +23,7 @@ from tabletcad.geometry.patch import PDEPatch
 from tabletcad.geometry.revolution import profile_extreme
 from tabletcad.readonly import TableDict
 from tabletcad.tolerance import DEFAULT, Tolerances
-from tabletcad.geometry.vectors import clip, cross_first, linspace, norm3, points_last
+from tabletcad.geometry.vectors import clip, cross_first, einsum, linspace, norm3, points_last
 from tabletcad.geometry.quadrature import gauss_legendre
 
 #: Trapezoidal points in ``v`` for the integrals of a surface of revolution, whose integrands
@@ -884,9 +884,13 @@ class Tablet:
             np.multiply(dx, dx, out=r2)  # dx² + dy², as written out
             r2 += np.multiply(dy, dy, out=sq)
             i = np.argmax(r2, axis=0)
-            rr = np.sqrt(r2[i, cols])
+            at = i * r2.shape[1] + cols  # each line's farthest sample in the flat blocks (a take)
+            rr = np.sqrt(r2.take(at))
             r_max = max(r_max, float(rr.max()))
-            outer.append((i, rr, np.column_stack([dx[i, cols], dy[i, cols]])))
+            d = np.empty((cols.size, 2))
+            dx.take(at, out=d[:, 0])
+            dy.take(at, out=d[:, 1])
+            outer.append((i, rr, d))
         for p, (i, rr, dd) in zip(patches, outer):  # each patch's outer curve r_j(φ), then the envelope
             inner = (i > 0) & (i < nu - 1)
             if inner.any():
@@ -951,8 +955,8 @@ class Tablet:
         live = np.arange(ub.size)  # points whose last step gained (one that did not would only repeat it)
         for _ in range(6):
             x, xu, xuu = X[live], Xu[live], Xuu[live]
-            g1 = 2.0 * np.einsum("ij,ij->i", x, xu)
-            g2 = 2.0 * (np.einsum("ij,ij->i", xu, xu) + np.einsum("ij,ij->i", x, xuu))
+            g1 = 2.0 * einsum("ij,ij->i", x, xu)
+            g2 = 2.0 * (einsum("ij,ij->i", xu, xu) + einsum("ij,ij->i", x, xuu))
             with np.errstate(divide="ignore", invalid="ignore"):
                 step = np.where(g2 < 0.0, -g1 / g2, 0.0)
             # a step whose predicted gain, g1 s / 2 for the Newton step s, is below rounding of r²
@@ -965,7 +969,7 @@ class Tablet:
             if not live.size:
                 break
             xn, xun, xuun = jet(un, v[live])
-            r2 = np.einsum("ij,ij->i", xn, xn)
+            r2 = einsum("ij,ij->i", xn, xn)
             better = r2 > best[live]
             live = live[better]
             if not live.size:
@@ -1452,7 +1456,7 @@ class Tablet:
                 ok = speed > 1e-6 * float(speed.max())
                 na = a.normal(1.0, v[ok], xu=xua[ok], xv=xva[ok])
                 nb = b.normal(0.0, v[ok], xu=xub[ok], xv=xvb[ok])
-                cosang = clip(np.einsum("ij,ij->i", na, nb), -1.0, 1.0)
+                cosang = clip(einsum("ij,ij->i", na, nb), -1.0, 1.0)
                 ang = float(np.degrees(np.arccos(cosang).max()))
             out.append(
                 dict(

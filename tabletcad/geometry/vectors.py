@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["clip", "cross", "cross_first", "linspace", "norm3", "points_last"]
+__all__ = ["clip", "cross", "cross_first", "einsum", "linspace", "norm3", "points_last"]
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -75,6 +75,13 @@ def points_last(a: np.ndarray) -> np.ndarray:
 #: that costs several times the ufunc on the short arrays of the polishes (numpy >= 2: ``numpy._core``).
 #: A private name: a numpy without it gets ``numpy.clip`` itself.
 clip = getattr(getattr(getattr(np, "_core", None) or getattr(np, "core", None), "umath", None), "clip", None) or np.clip
+
+#: :func:`numpy.einsum` without its Python wrapper: with ``optimize`` False (its default) the wrapper only
+#: passes the operands on to this C function, so the values are the same; the wrapper and its dispatcher
+#: cost more than the sum itself on a patch's small residual combinations (numpy >= 2: ``numpy._core``).
+#: A private name: a numpy without it gets ``numpy.einsum`` itself.
+einsum = getattr(getattr(getattr(np, "_core", None) or getattr(np, "core", None), "multiarray", None),
+                 "c_einsum", None) or np.einsum
 
 
 def linspace(start: float, stop: float, num: int, endpoint: bool = True) -> np.ndarray:
