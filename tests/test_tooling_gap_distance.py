@@ -447,6 +447,31 @@ def test_bound_area_is_at_least_the_exact_area_and_close_to_it(radius, height):
     assert bound_area(box, 0.005) == pytest.approx(2 * (radius * height + 2 * radius + 2 * height) / np.cos(0.2), rel=1e-12)
 
 
+def test_lift_allowance_bounds_the_overlap_change_of_a_moved_mesh_and_is_reached():
+    """``lift_allowance`` (what moving a punch's mesh along z for manifold3d's Common can change): two unit
+    cubes stacked 1 mm apart (a vertical line meets them twice) sunk by ``d`` into two slabs they rest on
+    gain exactly ``2 d`` of overlap, the allowance: half the triangles' projected area, 4 mm², times ``d``
+    (the plan area alone, 1 mm², would allow half of it)."""
+    import manifold3d
+
+    from tabletcad.tooling.booleans import manifold_volume
+    from tabletcad.tooling.interference import lift_allowance
+
+    cube = manifold3d.Manifold.cube((1.0, 1.0, 1.0))
+    moved = cube + cube.translate((0.0, 0.0, 2.0))  # z in [0, 1] and [2, 3]
+    rests = manifold3d.Manifold.cube((3.0, 3.0, 1.0)).translate((-1.0, -1.0, -1.0)) \
+        + manifold3d.Manifold.cube((3.0, 3.0, 0.5)).translate((-1.0, -1.0, 1.5))  # touching both from below
+    mesh = moved.to_mesh()
+    V, T = np.asarray(mesh.vert_properties, dtype=float)[:, :3], np.asarray(mesh.tri_verts, dtype=np.int64)
+    for d in (1e-3, 0.25):
+        before = manifold_volume(rests ^ moved)
+        after = manifold_volume(rests ^ moved.translate((0.0, 0.0, -d)))
+        allowance = lift_allowance(V, T, d)
+        assert allowance == pytest.approx(2.0 * d, rel=1e-12)
+        assert abs(after - before) <= allowance * (1 + 1e-9)
+        assert abs(after - before) == pytest.approx(allowance, rel=1e-6)
+
+
 def _classifier_spy(monkeypatch):
     """Count ``BRepClass3d_SolidClassifier.Perform`` calls (the classifier ``ExactDistance`` falls back on)."""
     import OCP.BRepClass3d as C

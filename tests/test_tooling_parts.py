@@ -327,6 +327,9 @@ def test_closed_position_encloses_exactly_the_tablet(thesis):
     for p in r["interference"]["pairs"]:
         assert p["occ_mm3"] == pytest.approx(0.0, abs=1e-9)
         assert p["manifold3d_mm3"] <= p["manifold3d_bound_mm3"]
+    # the punches' meshes moved off the tablet's (coincident cups) for manifold3d, away from it
+    lifts = {tuple(p["parts"]): p.get("manifold3d_lift_mm") for p in r["interference"]["pairs"]}
+    assert lifts[("tablet", "upper_punch")] > 0.0 > lifts[("tablet", "lower_punch")]
     assert 0.0 < r["max_gap_mm"] <= CLEARANCE
     bulge = r["die"]["bore_enlarged_by_band_bulge_mm"]  # the die clears the PDE band's bulge
     assert 0.0 < bulge < 0.005
