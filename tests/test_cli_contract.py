@@ -650,39 +650,52 @@ def test_a_json_file_may_not_overwrite_a_file_a_build_owns(capsys, tmp_path):
 def test_a_ctrl_c_stops_a_long_compiled_call_at_once():
     """``errors.run_interruptibly``: a call into compiled code that holds no GIL (SuperLU's factorisation
     of an FE system ran minutes past a Ctrl-C) runs in a helper thread, so the interrupt is raised while
-    the call is still running.  Here an SVD of a 1600 x 1600 matrix (seconds on one core) and a SIGALRM
-    whose handler raises KeyboardInterrupt 0.05 s in: the interrupt arrives before the SVD ends (called
-    directly, it would only arrive after)."""
+    the call is still running.  Here the C library's ``system()`` (``os.system``: the GIL released, and
+    a signal neither ends its wait for the command nor runs Python's handlers before it returns) running
+    ``head`` on a pipe, which ends only when the test writes to the pipe, and a SIGALRM whose handler
+    raises KeyboardInterrupt 0.05 s in: the interrupt arrives while the call still waits (called
+    directly, it would only arrive after).  (An SVD of a 1600 x 1600 matrix had been the long call: 2-3 s
+    of CPU a run, and its lead over the alarm shrank with the machine's load.)"""
     import threading
-
-    import numpy as np
 
     from tabletcad.errors import run_interruptibly
 
-    a = np.random.default_rng(0).standard_normal((1600, 1600))
+    r, w = os.pipe()
+    os.set_inheritable(r, True)  # (the command reads it as /dev/fd/r)
     done = threading.Event()
 
     def long_call():
-        np.linalg.svd(a)
+        os.system(f"head -c 1 /dev/fd/{r} > /dev/null")
         done.set()
 
     def on_alarm(signum, frame):
         raise KeyboardInterrupt
 
+    # (run_interruptibly broken, the call in this thread: another thread writes to the pipe after 20 s, the
+    # call ends, the interrupt is raised in it and done is never set, which fails the test below)
+    fallback = threading.Timer(20.0, os.write, (w, b"x"))
     old = signal.signal(signal.SIGALRM, on_alarm)
     try:
+        fallback.start()
         signal.setitimer(signal.ITIMER_REAL, 0.05)
         with pytest.raises(KeyboardInterrupt):
             run_interruptibly(long_call)
         assert not done.is_set()
-        done.wait(120)  # (the abandoned call runs on in its thread; let it end before the next test)
-        assert done.is_set()
-        assert run_interruptibly(sum, [1, 2, 3]) == 6  # and a value comes back
-        with pytest.raises(ZeroDivisionError):  # as does an error
-            run_interruptibly(lambda: 1 / 0)
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0.0)
         signal.signal(signal.SIGALRM, old)
+        fallback.cancel()
+        os.write(w, b"x")  # the call may end now (a byte the fallback wrote too stays unread)
+    try:
+        done.wait(120)  # (the abandoned call runs on in its thread; let it end before the next test)
+        assert done.is_set()
+    finally:
+        fallback.join()
+        os.close(r)
+        os.close(w)
+    assert run_interruptibly(sum, [1, 2, 3]) == 6  # and a value comes back
+    with pytest.raises(ZeroDivisionError):  # as does an error
+        run_interruptibly(lambda: 1 / 0)
 
 
 def test_solves_in_the_helper_thread_leave_no_memory_behind():
