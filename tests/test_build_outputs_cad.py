@@ -220,6 +220,22 @@ def test_killed_build_leaves_no_staging_folder_after_the_next_build(tmp_path, ca
     assert {p.name for p in out.iterdir()} == set(rep["outputs"]) | {MANIFEST}
 
 
+#: libraries a plain ``tabletcad build`` does not need: build123d and cadquery (2.3 s of CPU to import: they
+#: pull scikit-learn, pandas and scipy.stats); only embossed tooling (fonts) and the interop functions use them
+NOT_FOR_A_BUILD = ("build123d", "cadquery", "sklearn", "pandas")
+
+
+def test_a_build_writes_its_cad_files_without_build123d_or_cadquery(tmp_path, capsys, monkeypatch):
+    """Every file of a plain build, STEP, STL and GLB included, with :data:`NOT_FOR_A_BUILD` unimportable
+    (``None`` in ``sys.modules``: an import of one of them, at any depth, raises ImportError)."""
+    for name in NOT_FOR_A_BUILD:
+        monkeypatch.setitem(sys.modules, name, None)
+    out = tmp_path / "out"
+    rep, _ = _build(ROOT / "samples" / "flat_faced_round.toml", out, capsys)
+    assert set(rep["outputs"]) == {"report.json", "tablet.png", "tablet.step", "tablet.stl", "tablet.glb"}
+    assert (out / "tablet.glb").read_bytes()[:4] == b"glTF"
+
+
 @pytest.mark.parametrize("extra", ["[tooling]\nbogus = 1\n", "[tooling]\n[[tooling.score]]\nprofile = \"w\"\n",
                                    "[trim]\nv = [0.0, 3.0]\n[tooling]\nclearance_mm = 0.02\n"])
 def test_bad_tooling_table_is_refused_before_any_geometry(tmp_path, capsys, monkeypatch, extra):

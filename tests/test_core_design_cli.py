@@ -118,6 +118,41 @@ def test_cli_bad_design_exits_2_without_traceback_or_files(tmp_path):
     assert r.returncode == 2 and not (tmp_path / "m.vtu").exists()
 
 
+#: what the commands below must not import: the CAD libraries, trimesh, matplotlib, and scipy's larger parts;
+#: a refusal and a help text need no scipy at all
+_LIGHT = '''
+import sys
+from tabletcad.cli import main
+
+HEAVY = ("OCP", "build123d", "cadquery", "trimesh", "matplotlib", "sklearn", "pandas", "scipy.special",
+         "scipy.optimize", "scipy.spatial", "scipy.stats", "scipy.interpolate")
+def loaded(names):
+    return sorted(m for m in sys.modules if any(m == n or m.startswith(n + ".") for n in names))
+
+bad, out, sample = sys.argv[1:4]
+assert main(["build", bad, "--out", out]) == 2
+assert main(["mesh", bad, "--nodes", "5", "9", "3", "--out", out + ".vtu"]) == 2
+for args in (["sweep", "--help"], ["fe", "diametral", "--help"], ["optimise", "--help"]):
+    assert main(args) == 0
+assert not loaded(HEAVY + ("scipy",)), loaded(HEAVY + ("scipy",))
+assert main(["report", sample]) == 0
+assert not loaded(HEAVY), loaded(HEAVY)
+print("light")
+'''
+
+
+def test_refusals_help_and_report_keep_their_imports_light(tmp_path):
+    """A refused design and the help texts load no scipy, no CAD library and no matplotlib; the
+    report adds scipy.linalg only (the patches' products), not scipy.special (the shell model's
+    Legendre polynomials) nor trimesh or build123d; measured in a fresh process."""
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[tablet]\nfamily = "thesis.flat_faced_round"\ndiameter = -10.0\nthickness = 6.0\n')
+    r = subprocess.run([sys.executable, "-c", _LIGHT, str(bad), str(tmp_path / "out"),
+                        str(ROOT / "samples" / "families" / "concave_round.toml")],
+                       env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and r.stdout.splitlines()[-1] == "light", r.stderr
+
+
 def test_cli_mesh_and_shapes(tmp_path):
     out = tmp_path / "sphere.vtu"
     assert main(["mesh", str(ROOT / "samples" / "spherical.toml"), "--nodes", "11", "21", "5", "--out", str(out)]) == 0

@@ -34,7 +34,6 @@ from functools import lru_cache
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg.blas import dgemm as _dgemm
 
 from tabletcad.geometry.basis import cardinal, cardinal_coefficients, cardinals
 from tabletcad.geometry.revolution import Revolution, Section, detect_revolution, detect_section
@@ -207,10 +206,24 @@ def _trig_shared(v: np.ndarray, n: np.ndarray, dv: int, rows: bool = False, vbyt
     return TRIG.get((rows, dv, n.tobytes(), vb), lambda: make(v, n, dv))
 
 
+#: scipy's BLAS ``dgemm``, looked up on the first product (:func:`_dgemm`): importing scipy.linalg takes
+#: 0.05-0.17 s of CPU, which a command that refuses its design before any surface is evaluated need not pay
+_DGEMM: list = []
+
+
+def _dgemm():
+    """scipy's BLAS ``dgemm`` (:func:`scipy.linalg.blas.dgemm`), imported on the first call."""
+    if not _DGEMM:
+        from scipy.linalg.blas import dgemm
+
+        _DGEMM.append(dgemm)
+    return _DGEMM[0]
+
+
 def _gemm(a: np.ndarray, b: np.ndarray, c: np.ndarray, fresh: bool = True) -> np.ndarray:
     """``a @ b`` by BLAS ``dgemm`` written into ``c``, a Fortran-contiguous array or block, in place
     (``c = a @ b`` when ``fresh``, else ``c += a @ b``); transposes of C-ordered arrays pass with no copy."""
-    out = _dgemm(1.0, a, b, beta=0.0 if fresh else 1.0, c=c, overwrite_c=1)
+    out = (_DGEMM[0] if _DGEMM else _dgemm())(1.0, a, b, beta=0.0 if fresh else 1.0, c=c, overwrite_c=1)
     if out is not c and not np.shares_memory(out, c):  # (a copy: c was not Fortran-contiguous)
         c[...] = out
     return c

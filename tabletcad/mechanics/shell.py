@@ -48,7 +48,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.special import eval_legendre
 
 from tabletcad.errors import DesignError, check_positive, check_range, format_bound
 
@@ -60,6 +59,15 @@ __all__ = [
     "plot_shell",
     "solve_shell",
 ]
+
+
+def _legendre(n: int | np.ndarray, x: float | np.ndarray) -> float | np.ndarray:
+    """Legendre polynomial ``P_n(x)`` (dimensionless) by :func:`scipy.special.eval_legendre`, scipy.special
+    imported on first use: the design report reads the strength formulas, which import this package, and
+    scipy.special took 0.03-0.06 s of CPU of every report or refusal that never solves a shell."""
+    from scipy.special import eval_legendre
+
+    return eval_legendre(n, x)
 
 
 def band_coefficients(psi: float, n_max: int, region: str = "equator") -> np.ndarray:
@@ -82,7 +90,7 @@ def band_coefficients(psi: float, n_max: int, region: str = "equator") -> np.nda
         f = np.zeros(n.size)
         f[0] = s
         even = n[(n >= 2) & (n % 2 == 0)]
-        f[even] = eval_legendre(even + 1, s) - eval_legendre(even - 1, s)
+        f[even] = _legendre(even + 1, s) - _legendre(even - 1, s)
         return f
     # caps: indicator = 1 - band with sin(band half-angle) = cos(psi)
     f = -band_coefficients(math.pi / 2 - psi, n_max, "equator")
@@ -107,11 +115,11 @@ def _modes(n: int, nu: float) -> list[tuple[int, float, float]]:
 
 def _dP(n: int, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """P_n(cos θ), dP_n/dθ and d²P_n/dθ² at x = cos θ."""
-    P = eval_legendre(n, x)
+    P = _legendre(n, x)
     if n == 0:
         z = np.zeros_like(x)
         return P, z, z
-    Pm = eval_legendre(n - 1, x)
+    Pm = _legendre(n - 1, x)
     s = np.sqrt(np.clip(1.0 - x * x, 0.0, None))
     pole = s < 1e-12
     safe = np.where(pole, 1.0, s)
@@ -216,7 +224,7 @@ class ShellSolution:
         for n in range(self.n_terms):
             if np.any(self.coeffs[n]):
                 U = self._radial_parts(n, np.array([self.a]))[0][0]
-                out[n] = abs(U * eval_legendre(n, math.cos(theta)))
+                out[n] = abs(U * _legendre(n, math.cos(theta)))
         return out
 
     def max_abs_coefficient(self) -> np.ndarray:
