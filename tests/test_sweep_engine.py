@@ -591,3 +591,27 @@ def test_a_designs_warnings_are_its_rows_not_lines_on_the_terminal(tmp_path):
     sw["design"]["tablet"]["family"] = "thesis.spherical"
     assert run_sweep(sw, tmp_path / "new", workers=0, progress=False)["warnings"].tolist() == ["", ""]
     assert read_results(tmp_path / "new" / "results.csv")["warnings"].tolist() == ["", ""]
+
+
+@pytest.mark.cad
+def test_a_designs_picture_is_drawn_only_for_the_png_output(tmp_path, monkeypatch):
+    """``tablet.png`` is the picture ``tabletcad build`` draws, and a design whose outputs leave it out
+    does not draw it (it was 0.08 of a report-and-STL design's 0.1 CPU-s, and its worker's only
+    reason to import Matplotlib)."""
+    import tabletcad.pipeline.build as build
+    from tabletcad.pipeline.plot import plot_tablet
+    from tabletcad.sweep.engine import evaluate_design
+
+    design = {"tablet": {"family": "flat_face_round", "diameter": 8.0, "thickness": 3.0}}
+    res = evaluate_design(design, ("png",), name="p")
+    assert res["status"] == "ok" and sorted(res["files"]) == ["tablet.png"], res["error"]
+    plot_tablet(design_from_dict(design, default_name="p"), tmp_path / "own.png")
+    assert res["files"]["tablet.png"] == (tmp_path / "own.png").read_bytes()
+
+    def no_picture(*args, **kw):
+        raise AssertionError("the picture was drawn")
+
+    monkeypatch.setattr(build, "plot_tablet", no_picture)
+    res = evaluate_design(design, ("report", "stl"), name="p")
+    assert res["status"] == "ok" and sorted(res["files"]) == ["tablet.stl"], res["error"]
+    assert res["values"]["volume_mm3"] == pytest.approx(math.pi * 16.0 * 3.0, rel=1e-6)

@@ -87,7 +87,7 @@ def fe_breaking_force_section(tablet: Any, options: Any, tooling: Any, cad: bool
 
 def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | None = None,
                  options: ReportOptions | None = None, cad: bool | None = None, progress: bool = True,
-                 parallel: bool = False) -> dict[str, Any]:
+                 parallel: bool = False, picture: bool = True) -> dict[str, Any]:
     """Write ``report.json``, ``tablet.png``, the CAD files and the tooling of ``tablet`` into ``out_dir``.
 
     The steps, in order: the geometry report (:func:`~tabletcad.pipeline.report.geometry_report`,
@@ -104,7 +104,9 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
     ``build``; for a process of its own, not a Dask worker or FreeCAD: see
     :func:`~tabletcad.tooling.stage.tooling_stage`); the files are the same.  Matplotlib, which the
     picture's child and the drawings' child both draw with, is imported before the first fork
-    (:func:`import_shared`), once for both.
+    (:func:`import_shared`), once for both.  ``picture=False`` leaves ``tablet.png`` out (a sweep that
+    keeps only other files: the picture, 0.08 CPU-s, was most of a report-and-CAD-files design's
+    0.1 CPU-s and the only reason its worker imported Matplotlib); nothing else changes.
 
     Returns the report; ``report["outputs"]`` names the files this build wrote.
     Nothing in ``out_dir`` changes if any step fails.  The folder is owned by
@@ -131,15 +133,15 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
                 contextlib.ExitStack() as helpers:
             report = geometry_report(tablet, options)
             bar.update()
-            forks = parallel and can_fork()
+            forks = parallel and can_fork() and picture
             if forks and cad and tooling is not None:  # two children will draw: their modules imported once
                 import_shared()
             # the picture needs only the tablet: drawn by a forked process beside the CAD stage (a Ctrl-C
             # waits until the child is in ``helpers``, whose exit then stops it)
-            picture = None
+            drawn = None
             if forks:
                 with signals_deferred():
-                    picture = helpers.enter_context(Forked(lambda: plot_tablet(tablet, staging / "tablet.png")))
+                    drawn = helpers.enter_context(Forked(lambda: plot_tablet(tablet, staging / "tablet.png")))
             if cad:
                 from tabletcad.cad.stage import cad_stage
 
@@ -156,10 +158,10 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
                     bar.update()
             if options is not None and options.fe_breaking_force:  # [report] fe_breaking_force = true
                 report["fe_breaking_force"] = fe_breaking_force_section(tablet, options, tooling, cad)
-            if picture is None:
+            if drawn is not None:
+                drawn.result()
+            elif picture:
                 plot_tablet(tablet, staging / "tablet.png")
-            else:
-                picture.result()
             bar.update()
         names = sorted(p.name for p in staging.iterdir() if p.name != STAGING_MARKER) + ["report.json"]
         report["outputs"] = sorted(names)

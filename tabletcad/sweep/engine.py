@@ -116,8 +116,9 @@ def _evaluate_design(design: dict[str, Any], outputs: Sequence[str] = ("report",
 
                     tooling = spec.tooling_spec or ToolingSpec()
                     wanted += tooling_outputs(tooling)  # (the PDF drawing and complete punches' had been left out)
+                # (the picture only when the png output asks for it: most of such a build's CPU time)
                 report = build_tablet(tablet, Path(tmp) / "build", tooling=tooling, options=spec.report_options,
-                                      cad=True, progress=False)
+                                      cad=True, progress=False, picture="tablet.png" in wanted)
                 files.update(_files_of(Path(tmp) / "build", wanted))
             else:  # the report of `tabletcad build`, without its files
                 from tabletcad.pipeline.build import cad_available, fe_breaking_force_section
