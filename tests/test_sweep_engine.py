@@ -268,7 +268,8 @@ def test_tooling_batch_runs_on_the_cluster(local_client, tmp_path):
 
 
 def test_local_workers_keep_the_adaptive_malloc_trim_and_no_profiler():
-    """distributed's MALLOC_TRIM_THRESHOLD_=65536 made the report cost 1.8x the CPU (bench_sweep.py)."""
+    """distributed's MALLOC_TRIM_THRESHOLD_=65536 made the report cost 1.8x the CPU (bench_sweep.py); the
+    event loops' latency tick (a measurement) runs every second, not every 20 ms."""
     import os
 
     import dask
@@ -276,9 +277,11 @@ def test_local_workers_keep_the_adaptive_malloc_trim_and_no_profiler():
     from tabletcad.sweep.engine import open_client
 
     with open_client(1) as client:
-        env = client.run(lambda: (os.environ.get("MALLOC_TRIM_THRESHOLD_"),
-                                  dask.config.get("distributed.worker.profile.enabled")))
-    assert list(env.values()) == [(None, False)]
+        env = client.run(lambda dask_worker: (os.environ.get("MALLOC_TRIM_THRESHOLD_"),
+                                              dask.config.get("distributed.worker.profile.enabled"),
+                                              dask_worker._tick_interval))  # (the latency tick, seconds)
+        tick = client.run_on_scheduler(lambda dask_scheduler: dask_scheduler._tick_interval)
+    assert list(env.values()) == [(None, False, 1.0)] and tick == 1.0
     assert dask.config.get("distributed.nanny.pre-spawn-environ")["MALLOC_TRIM_THRESHOLD_"] == 65536  # restored
 
 
