@@ -74,8 +74,9 @@ def scheduler_address(tmp_path_factory):
     procs = [subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", str(port),
                                "--no-dashboard"], cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
     try:
+        # (no nanny process beside the worker: it imported distributed a second time, 0.5 CPU-s)
         procs.append(subprocess.Popen([sys.executable, "-m", "dask", "worker", addr, "--nworkers", "1", "--nthreads", "1",
-                                       "--no-dashboard", "--host", "127.0.0.1"],
+                                       "--no-dashboard", "--no-nanny", "--host", "127.0.0.1"],
                                       cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
         with Client(addr, timeout="60s", set_as_default=False) as c:
             c.wait_for_workers(1, timeout=120)
@@ -90,282 +91,6 @@ def scheduler_address(tmp_path_factory):
             except subprocess.TimeoutExpired:
                 p.kill()
                 p.wait(timeout=30)
-
-
-@pytest.fixture(scope="module")
-def local_results(local_client, tmp_path_factory):
-    out = tmp_path_factory.mktemp("local") / "out"
-    df = run_sweep(SWEEP, out, client=local_client, progress=False)
-    return df, out
-
-
-def test_rows_are_in_sweep_order_and_a_failing_design_is_a_row(local_results):
-    df, out = local_results
-    assert isinstance(df, pd.DataFrame)
-    assert df[KEY].tolist() == [0.7, 9.0, 1.0]
-    assert df["status"].tolist() == ["ok", "error", "ok"]
-    with pytest.raises(DesignError) as exc:
-        design_from_dict({"tablet": {**TABLET, "cup_depth": 9.0}})
-    assert df["error"].tolist() == ["", str(exc.value), ""]
-    assert df["design_hash"].tolist() == [design_hash(d) for d in parse_sweep(SWEEP).designs()]
-    cols = df.columns.tolist()
-    assert cols[0] == KEY and cols[-4:] == ["warnings", "status", "error", "design_hash"]
-    for c in ("volume_mm3", "surface_area_mm2", "design_report.weight_mg",
-              "design_report.tensile_strength.tensile_strength_MPa"):
-        assert c in cols
-    assert math.isnan(df.loc[1, "volume_mm3"])
-    # each cup is a spherical cap of depth h over the land's inner circle (radius a): pi h (3 a^2 + h^2) / 6
-    # (the report's quadrature agrees to 2.4e-6 relative), and two cups are all that changes the volume
-    for i, h in ((0, 0.7), (2, 1.0)):
-        a = 4.0 - 0.08
-        cap = math.pi * h * (3 * a * a + h * h) / 6.0
-        assert df.loc[i, "design_report.cup_volume_mm3"] == pytest.approx(cap, rel=1e-5)
-    assert df.loc[2, "volume_mm3"] - df.loc[0, "volume_mm3"] == pytest.approx(
-        2 * (df.loc[2, "design_report.cup_volume_mm3"] - df.loc[0, "design_report.cup_volume_mm3"]), rel=1e-9)
-    # weight = volume x solid fraction x true density
-    assert df["design_report.weight_mg"][[0, 2]].tolist() == pytest.approx((df["volume_mm3"][[0, 2]] * 0.85 * 1.5).tolist(),
-                                                                            rel=1e-9)
-    assert not (out / JOURNAL).exists()
-    back = read_results(out / "results.csv")
-    assert back.columns.tolist() == cols
-    for c in cols:
-        for a, b in zip(back[c], df[c]):
-            assert (a is None and (b is pd.NA or b is None or (isinstance(b, float) and math.isnan(b))
-                                   or b == "")) or (b is not pd.NA and a == b), c
-
-
-def test_rows_equal_a_single_tabletcad_build_exactly(local_results, tmp_path):
-    df, out = local_results
-    design = tmp_path / "sweep.toml"  # the sweep's name is the tablet's name
-    lines = ["[tablet]"] + [f"{k} = {v!r}" if not isinstance(v, str) else f'{k} = "{v}"' for k, v in TABLET.items()
-                            if k != "cup_depth"]
-    lines += ["cup_depth = 1.0", "[report]"] + [f"{k} = {v!r}" for k, v in REPORT.items()]
-    design.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    assert main(["build", str(design), "--out", str(tmp_path / "b"), "--quiet"]) == 0
-    built = flatten_report(json.loads((tmp_path / "b" / "report.json").read_text()))
-    row = df.iloc[2].to_dict()
-    compared = 0
-    for k, v in row.items():
-        if k in (KEY, "warnings", "status", "error", "design_hash"):  # (the sweep's own columns)
-            continue
-        assert k in built, k
-        if built[k] is None:
-            assert v is None or (isinstance(v, float) and math.isnan(v)), k
-        else:
-            assert v == built[k], k  # exactly: same floats, not approximately
-        compared += 1
-    assert compared > 50
-    # and as written: a count as the report has it (9, not 9.0: another row failed, leaving its cell empty)
-    with open(out / "results.csv", newline="", encoding="utf-8") as fh:
-        written = list(csv.DictReader(fh))[2]
-    counts = 0
-    for k, v in built.items():
-        if k in written and k not in (KEY, "warnings", "status", "error", "design_hash"):
-            assert written[k] == ("" if v is None else repr(v) if isinstance(v, float) else str(v)), k
-            counts += isinstance(v, int) and not isinstance(v, bool)
-    assert counts >= 1
-
-
-def test_results_do_not_depend_on_the_engine_or_the_number_of_workers(local_results, scheduler_address, tmp_path):
-    _, out = local_results
-    text = (out / "results.csv").read_text()
-    assert main(["sweep", str(_sweep_file(tmp_path)), "--out", str(tmp_path / "remote"), "--scheduler", scheduler_address,
-                 "--quiet"]) == 0
-    assert (tmp_path / "remote" / "results.csv").read_text() == text
-    run_sweep(SWEEP, tmp_path / "serial", workers=0, progress=False)
-    assert (tmp_path / "serial" / "results.csv").read_text() == text
-
-
-def _sweep_file(tmp_path):
-    p = tmp_path / "sweep.toml"
-    p.write_text("[design.tablet]\n" + "\n".join(
-        f"{k} = {v!r}" if not isinstance(v, str) else f'{k} = "{v}"' for k, v in TABLET.items())
-        + "\n[design.report]\n" + "\n".join(f"{k} = {v!r}" for k, v in REPORT.items())
-        + '\n[sweep.vary]\n"tablet.cup_depth" = [0.7, 9.0, 1.0]\n', encoding="utf-8")
-    return p
-
-
-def test_resume_skips_finished_designs(local_results, local_client, tmp_path):
-    df, out = local_results
-    lines = (out / "results.csv").read_text().splitlines()
-    # an interrupted run: the journal holds the first design (marked so that a recomputation would show)
-    target = tmp_path / "out"
-    target.mkdir()
-    first = {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in df.iloc[0].to_dict().items()}
-    first["volume_mm3"] = -1.0
-    (target / JOURNAL).write_text(json.dumps(first) + "\n" + '{"design_hash": "cut sho', encoding="utf-8")
-    with pytest.raises(DesignError, match="give --resume"):
-        run_sweep(SWEEP, target, client=local_client, progress=False)
-    res = run_sweep(SWEEP, target, client=local_client, progress=False, resume=True)
-    assert res["volume_mm3"].tolist()[0] == -1.0  # not recomputed
-    assert res["status"].tolist() == ["ok", "error", "ok"]
-    new = (target / "results.csv").read_text().splitlines()
-    assert new[0] == lines[0] and new[2:] == lines[2:]
-    assert not (target / JOURNAL).exists()
-    # a finished sweep resumed again computes nothing and rewrites the same file
-    again = run_sweep(SWEEP, target, workers=0, progress=False, resume=True)
-    assert (target / "results.csv").read_text().splitlines() == new
-    assert again["volume_mm3"].tolist()[0] == -1.0
-
-
-def test_file_outputs_come_back_as_bytes_or_go_to_a_store(local_client, tmp_path):
-    sw = {"design": {"tablet": TABLET}, "sweep": {"outputs": ["step"], "vary": {"tablet.band": [2.6]}}}
-    df = run_sweep(sw, tmp_path / "out", client=local_client, progress=False)
-    assert df["status"].tolist() == ["ok"]
-    h = df["design_hash"][0]
-    step = (tmp_path / "out" / "designs" / h / "tablet.step").read_bytes()
-    assert step.startswith(b"ISO-10303-21;")
-    assert abs(df["brep.volume_mm3"][0] - df["volume_mm3"][0]) <= 1e-6 * df["volume_mm3"][0]
-    store = tmp_path / "store"
-    df2 = run_sweep(sw, tmp_path / "out2", client=local_client, progress=False, store=f"file://{store}")
-    assert (store / h / "tablet.step").is_file() and not (tmp_path / "out2" / "designs").exists()
-    assert df2["brep.volume_mm3"][0] == df["brep.volume_mm3"][0]
-    # a first run owns only what it writes, in a store too (a trial: a file there was replaced): refused,
-    # before any design, the file and the folders as they were
-    (store / h / "tablet.step").write_text("mine", encoding="utf-8")
-    with pytest.raises(DesignError, match=rf"^--store = 'file://{store}' is not allowed: must not hold a file this "
-                                          rf"sweep would write \({h}/tablet.step\): move it, use another store, or "
-                                          rf"give --resume with the --out folder of the run that wrote them$"):
-        run_sweep(sw, tmp_path / "out3", client=local_client, progress=False, store=f"file://{store}")
-    assert (store / h / "tablet.step").read_text() == "mine" and not (tmp_path / "out3").exists()
-
-
-def test_a_tooling_output_holds_every_file_its_build_writes(tmp_path):
-    """The "tooling" output of a design with complete punches (the TSM B sample's [tooling], here on a
-    flat-faced round of the sample's diameter) holds what `tabletcad build` writes of it: the parts, and
-    the tablet's and the punches' drawings in SVG, PDF and DXF (the PDFs and the punches' drawing had been
-    left out of the sweep's folders)."""
-    import tomllib
-
-    from tabletcad.tooling.spec import parse_tooling
-    from tabletcad.tooling.stage import tooling_outputs
-
-    sample = tomllib.loads((ROOT / "samples" / "tooling" / "tsm_b_round.toml").read_text(encoding="utf-8"))
-    # the files are the [tooling] table's, whatever the faces: flat ones build in 2.8 CPU-s, the sample's
-    # concave cups in 5.5 (their closed-position check and drawings)
-    sample["tablet"] = {"family": "flat_face_round", "diameter": sample["tablet"]["diameter"], "thickness": 3.0}
-    sw = {"design": sample, "sweep": {"outputs": ["tooling"], "vary": {"tablet.thickness": [3.0]}}}
-    df = run_sweep(sw, tmp_path / "out", workers=0, progress=False)
-    assert df["status"].tolist() == ["ok"], df["error"].tolist()
-    folder = tmp_path / "out" / "designs" / df["design_hash"][0]
-    names = sorted(p.name for p in folder.iterdir())
-    assert names == sorted(tooling_outputs(parse_tooling(sample["tooling"])))
-    assert {"drawing.pdf", "tooling.pdf", "tooling.svg", "tooling.dxf"} <= set(names)
-    assert (folder / "drawing.pdf").read_bytes().startswith(b"%PDF") and (folder / "tooling.pdf").read_bytes().startswith(b"%PDF")
-
-
-def test_tooling_batch_runs_on_the_cluster(local_client, tmp_path):
-    from tabletcad.tooling import tooling_batch
-
-    sizes = [dict(diameter=d, thickness=0.3 * d, band=0.2 * d) for d in (6.0, 8.0)]
-    rows = tooling_batch("thesis.shallow_convex_round", sizes, {"clearance_mm": 0.02}, out_dir=tmp_path, progress=False,
-                         check=False, drawing=False, client=local_client)
-    assert [r["params"] for r in rows] == sizes
-    for k, r in enumerate(rows):
-        assert r["upper_punch_rel_diff_vs_quadrature"] == pytest.approx(0.0, abs=1e-8)
-        assert (tmp_path / f"thesis.shallow_convex_round_{k:03d}" / "assembly.step").read_bytes().startswith(b"ISO-10303-21;")
-    assert rows[1]["tablet_volume_mm3"] > rows[0]["tablet_volume_mm3"]
-
-
-def test_local_workers_keep_the_adaptive_malloc_trim_and_no_profiler():
-    """distributed's MALLOC_TRIM_THRESHOLD_=65536 made the report cost 1.8x the CPU (bench_sweep.py); the
-    event loops' latency tick (a measurement) runs every second, not every 20 ms."""
-    import os
-
-    import dask
-
-    from tabletcad.sweep.engine import open_client
-
-    with open_client(1) as client:
-        env = client.run(lambda dask_worker: (os.environ.get("MALLOC_TRIM_THRESHOLD_"),
-                                              dask.config.get("distributed.worker.profile.enabled"),
-                                              dask_worker._tick_interval))  # (the latency tick, seconds)
-        tick = client.run_on_scheduler(lambda dask_scheduler: dask_scheduler._tick_interval)
-    assert list(env.values()) == [(None, False, 1.0)] and tick == 1.0
-    assert dask.config.get("distributed.nanny.pre-spawn-environ")["MALLOC_TRIM_THRESHOLD_"] == 65536  # restored
-
-
-def test_a_lost_worker_is_a_failed_row_not_the_end():
-    """A task that kills its worker process (as a crash in a native library would) becomes an error result."""
-    import os
-
-    import dask
-    from distributed import KilledWorker
-
-    from tabletcad.sweep.engine import failed_design, map_tasks, open_client
-
-    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), open_client(1) as client:
-        res = map_tasks(os._exit, [3], client=client, progress=False, on_error=failed_design)
-        assert res[0]["status"] == "error" and res[0]["error"].startswith("KilledWorker")
-        client.wait_for_workers(1, timeout=120)  # the nanny restarts the worker
-        with pytest.raises(KilledWorker):
-            map_tasks(os._exit, [3], client=client, progress=False)
-        assert map_tasks(abs, [-2, 5], client=client, progress=False) == [2, 5]
-
-
-def test_a_plot_of_no_column_is_refused_before_any_design_is_built(tmp_path, capsys):
-    """``--plot`` of a column the reports do not have: one line, exit 2, no folder, no cluster
-    started (it used to run the whole sweep, then stop and leave results.csv, which a corrected
-    rerun then refused); a right column of the report is accepted."""
-    from tabletcad.sweep.run import _check_plot_columns
-
-    sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
-    rc = main(["sweep", str(sweep), "--out", str(tmp_path / "sw"), "--workers", "1", "--plot", "nonexistent_col"])
-    err = capsys.readouterr().err
-    assert rc == 2 and err.startswith("error: --plot = 'nonexistent_col' is not allowed: must be a report column")
-    assert len(err.splitlines()) == 1 and "volume_mm3" in err
-    assert list(tmp_path.iterdir()) == []
-    spec = parse_sweep(__import__("tomllib").loads(sweep.read_text()), name="g")
-    design = spec.designs()[0]
-    _check_plot_columns(("volume_mm3", "design_report.weight_mg"), design, spec)  # columns of the report
-    # a column of a section that another design may have (a flat face has no cup radius): left to the end
-    _check_plot_columns(("design_report.cup_radii_mm.central",), design, spec)
-    # a varied key, the status, no column, a table of columns, text (the same type in every row)
-    for bad in ("tablet.band", "status", "nonexistent_col", "design_report.fda_size", "design.name",
-                "design_report.tensile_strength.formula"):
-        with pytest.raises(DesignError) as e:
-            _check_plot_columns((bad,), design, spec)
-        allowed = e.value.allowed.split(": ", 1)[1].split(", ")
-        assert "volume_mm3" in allowed and "design_report.fda_size.ok" in allowed  # numbers and booleans
-        assert "design.name" not in allowed and "status" not in allowed and "tablet.band" not in allowed
-
-
-def test_a_plot_column_no_design_had_keeps_the_results_and_says_where(tmp_path, capsys, local_client):
-    """A column left to the end (its section exists) that no design's report has: the sweep's results
-    stay, the one line says where they are, and ``--resume`` plots another column without rebuilding.
-    (On the module's cluster: a local one of its own cost a cluster start-up a command; the plot
-    checks do not depend on the engine.)"""
-    sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
-    out = tmp_path / "sw"
-    engine = ["--scheduler", local_client.scheduler.address]
-    rc = main(["sweep", str(sweep), "--out", str(out), *engine, "--quiet", "--plot",
-               "design_report.cup_radii_mm.central"])
-    err = capsys.readouterr().err.strip().splitlines()
-    assert rc == 2 and len(err) == 1
-    assert err[0].startswith("error: --plot = 'design_report.cup_radii_mm.central' is not allowed: must be a report "
-                             f"column of results.csv (the results are in {out / 'results.csv'}: plot another column with --resume): ")
-    assert sorted(p.name for p in out.iterdir()) == ["results.csv"]
-    assert main(["sweep", str(sweep), "--out", str(out), *engine, "--quiet", "--resume", "--plot",
-                 "volume_mm3"]) == 0
-    assert sorted(p.name for p in out.iterdir()) == ["plot_volume_mm3.png", "results.csv"]
-
-
-def test_a_plot_column_every_design_leaves_empty_says_so(tmp_path, capsys, local_client):
-    """A new user's ``--plot design_report.punch_tip_check.compaction_force_kN``: a column of every report,
-    so accepted before the run, but empty in every row (the sweep's design gives no compaction force).
-    The refusal had said it was no report column, listing it among those that are."""
-    sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
-    out = tmp_path / "sw"
-    col = "design_report.punch_tip_check.compaction_force_kN"
-    rc = main(["sweep", str(sweep), "--out", str(out), "--scheduler", local_client.scheduler.address, "--quiet",
-               "--plot", col])  # (on the module's cluster, as above)
-    err = capsys.readouterr().err.strip().splitlines()
-    n = len(pd.read_csv(out / "results.csv"))
-    assert rc == 2 and err == [f"error: --plot = '{col}' is not allowed: must be a report column with a number in "
-                               f"some design: every one of the {n} designs that built leaves it empty in results.csv "
-                               "(the input it needs is not in the sweep's design); the results are in "
-                               f"{out / 'results.csv'}: plot another column with --resume"]
-    assert sorted(p.name for p in out.iterdir()) == ["results.csv"]
 
 
 def test_a_local_cluster_takes_no_fixed_port():
@@ -618,3 +343,281 @@ def test_a_designs_picture_is_drawn_only_for_the_png_output(tmp_path, monkeypatc
     res = evaluate_design(design, ("report", "stl"), name="p")
     assert res["status"] == "ok" and sorted(res["files"]) == ["tablet.stl"], res["error"]
     assert res["values"]["volume_mm3"] == pytest.approx(math.pi * 16.0 * 3.0, rel=1e-6)
+
+
+def test_a_tooling_output_holds_every_file_its_build_writes(tmp_path):
+    """The "tooling" output of a design with complete punches (the TSM B sample's [tooling], here on a
+    flat-faced round of the sample's diameter) holds what `tabletcad build` writes of it: the parts, and
+    the tablet's and the punches' drawings in SVG, PDF and DXF (the PDFs and the punches' drawing had been
+    left out of the sweep's folders)."""
+    import tomllib
+
+    from tabletcad.tooling.spec import parse_tooling
+    from tabletcad.tooling.stage import tooling_outputs
+
+    sample = tomllib.loads((ROOT / "samples" / "tooling" / "tsm_b_round.toml").read_text(encoding="utf-8"))
+    # the files are the [tooling] table's, whatever the faces: flat ones build in 2.8 CPU-s, the sample's
+    # concave cups in 5.5 (their closed-position check and drawings)
+    sample["tablet"] = {"family": "flat_face_round", "diameter": sample["tablet"]["diameter"], "thickness": 3.0}
+    sw = {"design": sample, "sweep": {"outputs": ["tooling"], "vary": {"tablet.thickness": [3.0]}}}
+    df = run_sweep(sw, tmp_path / "out", workers=0, progress=False)
+    assert df["status"].tolist() == ["ok"], df["error"].tolist()
+    folder = tmp_path / "out" / "designs" / df["design_hash"][0]
+    names = sorted(p.name for p in folder.iterdir())
+    assert names == sorted(tooling_outputs(parse_tooling(sample["tooling"])))
+    assert {"drawing.pdf", "tooling.pdf", "tooling.svg", "tooling.dxf"} <= set(names)
+    assert (folder / "drawing.pdf").read_bytes().startswith(b"%PDF") and (folder / "tooling.pdf").read_bytes().startswith(b"%PDF")
+
+
+def test_local_workers_keep_the_adaptive_malloc_trim_and_no_profiler():
+    """distributed's MALLOC_TRIM_THRESHOLD_=65536 made the report cost 1.8x the CPU (bench_sweep.py); the
+    event loops' latency tick (a measurement) runs every second, not every 20 ms."""
+    import os
+
+    import dask
+
+    from tabletcad.sweep.engine import open_client
+
+    with open_client(1) as client:
+        env = client.run(lambda dask_worker: (os.environ.get("MALLOC_TRIM_THRESHOLD_"),
+                                              dask.config.get("distributed.worker.profile.enabled"),
+                                              dask_worker._tick_interval))  # (the latency tick, seconds)
+        tick = client.run_on_scheduler(lambda dask_scheduler: dask_scheduler._tick_interval)
+    assert list(env.values()) == [(None, False, 1.0)] and tick == 1.0
+    assert dask.config.get("distributed.nanny.pre-spawn-environ")["MALLOC_TRIM_THRESHOLD_"] == 65536  # restored
+
+
+def test_a_lost_worker_is_a_failed_row_not_the_end():
+    """A task that kills its worker process (as a crash in a native library would) becomes an error result."""
+    import os
+
+    import dask
+    from distributed import KilledWorker
+
+    from tabletcad.sweep.engine import failed_design, map_tasks, open_client
+
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), open_client(1) as client:
+        res = map_tasks(os._exit, [3], client=client, progress=False, on_error=failed_design)
+        assert res[0]["status"] == "error" and res[0]["error"].startswith("KilledWorker")
+        client.wait_for_workers(1, timeout=120)  # the nanny restarts the worker
+        with pytest.raises(KilledWorker):
+            map_tasks(os._exit, [3], client=client, progress=False)
+        assert map_tasks(abs, [-2, 5], client=client, progress=False) == [2, 5]
+
+
+def test_a_plot_of_no_column_is_refused_before_any_design_is_built(tmp_path, capsys):
+    """``--plot`` of a column the reports do not have: one line, exit 2, no folder, no cluster
+    started (it used to run the whole sweep, then stop and leave results.csv, which a corrected
+    rerun then refused); a right column of the report is accepted."""
+    from tabletcad.sweep.run import _check_plot_columns
+
+    sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
+    rc = main(["sweep", str(sweep), "--out", str(tmp_path / "sw"), "--workers", "1", "--plot", "nonexistent_col"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.startswith("error: --plot = 'nonexistent_col' is not allowed: must be a report column")
+    assert len(err.splitlines()) == 1 and "volume_mm3" in err
+    assert list(tmp_path.iterdir()) == []
+    spec = parse_sweep(__import__("tomllib").loads(sweep.read_text()), name="g")
+    design = spec.designs()[0]
+    _check_plot_columns(("volume_mm3", "design_report.weight_mg"), design, spec)  # columns of the report
+    # a column of a section that another design may have (a flat face has no cup radius): left to the end
+    _check_plot_columns(("design_report.cup_radii_mm.central",), design, spec)
+    # a varied key, the status, no column, a table of columns, text (the same type in every row)
+    for bad in ("tablet.band", "status", "nonexistent_col", "design_report.fda_size", "design.name",
+                "design_report.tensile_strength.formula"):
+        with pytest.raises(DesignError) as e:
+            _check_plot_columns((bad,), design, spec)
+        allowed = e.value.allowed.split(": ", 1)[1].split(", ")
+        assert "volume_mm3" in allowed and "design_report.fda_size.ok" in allowed  # numbers and booleans
+        assert "design.name" not in allowed and "status" not in allowed and "tablet.band" not in allowed
+
+
+# The tests below use the module's local cluster (local_client), which lives until the module ends:
+# the tests above, which do not, run before it starts (it had idled through them, ~40 s, 1 CPU-s)
+@pytest.fixture(scope="module")
+def local_results(local_client, tmp_path_factory):
+    out = tmp_path_factory.mktemp("local") / "out"
+    df = run_sweep(SWEEP, out, client=local_client, progress=False)
+    return df, out
+
+
+def test_rows_are_in_sweep_order_and_a_failing_design_is_a_row(local_results):
+    df, out = local_results
+    assert isinstance(df, pd.DataFrame)
+    assert df[KEY].tolist() == [0.7, 9.0, 1.0]
+    assert df["status"].tolist() == ["ok", "error", "ok"]
+    with pytest.raises(DesignError) as exc:
+        design_from_dict({"tablet": {**TABLET, "cup_depth": 9.0}})
+    assert df["error"].tolist() == ["", str(exc.value), ""]
+    assert df["design_hash"].tolist() == [design_hash(d) for d in parse_sweep(SWEEP).designs()]
+    cols = df.columns.tolist()
+    assert cols[0] == KEY and cols[-4:] == ["warnings", "status", "error", "design_hash"]
+    for c in ("volume_mm3", "surface_area_mm2", "design_report.weight_mg",
+              "design_report.tensile_strength.tensile_strength_MPa"):
+        assert c in cols
+    assert math.isnan(df.loc[1, "volume_mm3"])
+    # each cup is a spherical cap of depth h over the land's inner circle (radius a): pi h (3 a^2 + h^2) / 6
+    # (the report's quadrature agrees to 2.4e-6 relative), and two cups are all that changes the volume
+    for i, h in ((0, 0.7), (2, 1.0)):
+        a = 4.0 - 0.08
+        cap = math.pi * h * (3 * a * a + h * h) / 6.0
+        assert df.loc[i, "design_report.cup_volume_mm3"] == pytest.approx(cap, rel=1e-5)
+    assert df.loc[2, "volume_mm3"] - df.loc[0, "volume_mm3"] == pytest.approx(
+        2 * (df.loc[2, "design_report.cup_volume_mm3"] - df.loc[0, "design_report.cup_volume_mm3"]), rel=1e-9)
+    # weight = volume x solid fraction x true density
+    assert df["design_report.weight_mg"][[0, 2]].tolist() == pytest.approx((df["volume_mm3"][[0, 2]] * 0.85 * 1.5).tolist(),
+                                                                            rel=1e-9)
+    assert not (out / JOURNAL).exists()
+    back = read_results(out / "results.csv")
+    assert back.columns.tolist() == cols
+    for c in cols:
+        for a, b in zip(back[c], df[c]):
+            assert (a is None and (b is pd.NA or b is None or (isinstance(b, float) and math.isnan(b))
+                                   or b == "")) or (b is not pd.NA and a == b), c
+
+
+def test_rows_equal_a_single_tabletcad_build_exactly(local_results, tmp_path):
+    df, out = local_results
+    design = tmp_path / "sweep.toml"  # the sweep's name is the tablet's name
+    lines = ["[tablet]"] + [f"{k} = {v!r}" if not isinstance(v, str) else f'{k} = "{v}"' for k, v in TABLET.items()
+                            if k != "cup_depth"]
+    lines += ["cup_depth = 1.0", "[report]"] + [f"{k} = {v!r}" for k, v in REPORT.items()]
+    design.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    assert main(["build", str(design), "--out", str(tmp_path / "b"), "--quiet"]) == 0
+    built = flatten_report(json.loads((tmp_path / "b" / "report.json").read_text()))
+    row = df.iloc[2].to_dict()
+    compared = 0
+    for k, v in row.items():
+        if k in (KEY, "warnings", "status", "error", "design_hash"):  # (the sweep's own columns)
+            continue
+        assert k in built, k
+        if built[k] is None:
+            assert v is None or (isinstance(v, float) and math.isnan(v)), k
+        else:
+            assert v == built[k], k  # exactly: same floats, not approximately
+        compared += 1
+    assert compared > 50
+    # and as written: a count as the report has it (9, not 9.0: another row failed, leaving its cell empty)
+    with open(out / "results.csv", newline="", encoding="utf-8") as fh:
+        written = list(csv.DictReader(fh))[2]
+    counts = 0
+    for k, v in built.items():
+        if k in written and k not in (KEY, "warnings", "status", "error", "design_hash"):
+            assert written[k] == ("" if v is None else repr(v) if isinstance(v, float) else str(v)), k
+            counts += isinstance(v, int) and not isinstance(v, bool)
+    assert counts >= 1
+
+
+def test_results_do_not_depend_on_the_engine_or_the_number_of_workers(local_results, scheduler_address, tmp_path):
+    _, out = local_results
+    text = (out / "results.csv").read_text()
+    assert main(["sweep", str(_sweep_file(tmp_path)), "--out", str(tmp_path / "remote"), "--scheduler", scheduler_address,
+                 "--quiet"]) == 0
+    assert (tmp_path / "remote" / "results.csv").read_text() == text
+    run_sweep(SWEEP, tmp_path / "serial", workers=0, progress=False)
+    assert (tmp_path / "serial" / "results.csv").read_text() == text
+
+
+def _sweep_file(tmp_path):
+    p = tmp_path / "sweep.toml"
+    p.write_text("[design.tablet]\n" + "\n".join(
+        f"{k} = {v!r}" if not isinstance(v, str) else f'{k} = "{v}"' for k, v in TABLET.items())
+        + "\n[design.report]\n" + "\n".join(f"{k} = {v!r}" for k, v in REPORT.items())
+        + '\n[sweep.vary]\n"tablet.cup_depth" = [0.7, 9.0, 1.0]\n', encoding="utf-8")
+    return p
+
+
+def test_resume_skips_finished_designs(local_results, local_client, tmp_path):
+    df, out = local_results
+    lines = (out / "results.csv").read_text().splitlines()
+    # an interrupted run: the journal holds the first design (marked so that a recomputation would show)
+    target = tmp_path / "out"
+    target.mkdir()
+    first = {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in df.iloc[0].to_dict().items()}
+    first["volume_mm3"] = -1.0
+    (target / JOURNAL).write_text(json.dumps(first) + "\n" + '{"design_hash": "cut sho', encoding="utf-8")
+    with pytest.raises(DesignError, match="give --resume"):
+        run_sweep(SWEEP, target, client=local_client, progress=False)
+    res = run_sweep(SWEEP, target, client=local_client, progress=False, resume=True)
+    assert res["volume_mm3"].tolist()[0] == -1.0  # not recomputed
+    assert res["status"].tolist() == ["ok", "error", "ok"]
+    new = (target / "results.csv").read_text().splitlines()
+    assert new[0] == lines[0] and new[2:] == lines[2:]
+    assert not (target / JOURNAL).exists()
+    # a finished sweep resumed again computes nothing and rewrites the same file
+    again = run_sweep(SWEEP, target, workers=0, progress=False, resume=True)
+    assert (target / "results.csv").read_text().splitlines() == new
+    assert again["volume_mm3"].tolist()[0] == -1.0
+
+
+def test_file_outputs_come_back_as_bytes_or_go_to_a_store(local_client, tmp_path):
+    sw = {"design": {"tablet": TABLET}, "sweep": {"outputs": ["step"], "vary": {"tablet.band": [2.6]}}}
+    df = run_sweep(sw, tmp_path / "out", client=local_client, progress=False)
+    assert df["status"].tolist() == ["ok"]
+    h = df["design_hash"][0]
+    step = (tmp_path / "out" / "designs" / h / "tablet.step").read_bytes()
+    assert step.startswith(b"ISO-10303-21;")
+    assert abs(df["brep.volume_mm3"][0] - df["volume_mm3"][0]) <= 1e-6 * df["volume_mm3"][0]
+    store = tmp_path / "store"
+    df2 = run_sweep(sw, tmp_path / "out2", client=local_client, progress=False, store=f"file://{store}")
+    assert (store / h / "tablet.step").is_file() and not (tmp_path / "out2" / "designs").exists()
+    assert df2["brep.volume_mm3"][0] == df["brep.volume_mm3"][0]
+    # a first run owns only what it writes, in a store too (a trial: a file there was replaced): refused,
+    # before any design, the file and the folders as they were
+    (store / h / "tablet.step").write_text("mine", encoding="utf-8")
+    with pytest.raises(DesignError, match=rf"^--store = 'file://{store}' is not allowed: must not hold a file this "
+                                          rf"sweep would write \({h}/tablet.step\): move it, use another store, or "
+                                          rf"give --resume with the --out folder of the run that wrote them$"):
+        run_sweep(sw, tmp_path / "out3", client=local_client, progress=False, store=f"file://{store}")
+    assert (store / h / "tablet.step").read_text() == "mine" and not (tmp_path / "out3").exists()
+
+
+def test_tooling_batch_runs_on_the_cluster(local_client, tmp_path):
+    from tabletcad.tooling import tooling_batch
+
+    sizes = [dict(diameter=d, thickness=0.3 * d, band=0.2 * d) for d in (6.0, 8.0)]
+    rows = tooling_batch("thesis.shallow_convex_round", sizes, {"clearance_mm": 0.02}, out_dir=tmp_path, progress=False,
+                         check=False, drawing=False, client=local_client)
+    assert [r["params"] for r in rows] == sizes
+    for k, r in enumerate(rows):
+        assert r["upper_punch_rel_diff_vs_quadrature"] == pytest.approx(0.0, abs=1e-8)
+        assert (tmp_path / f"thesis.shallow_convex_round_{k:03d}" / "assembly.step").read_bytes().startswith(b"ISO-10303-21;")
+    assert rows[1]["tablet_volume_mm3"] > rows[0]["tablet_volume_mm3"]
+
+
+def test_a_plot_column_no_design_had_keeps_the_results_and_says_where(tmp_path, capsys, local_client):
+    """A column left to the end (its section exists) that no design's report has: the sweep's results
+    stay, the one line says where they are, and ``--resume`` plots another column without rebuilding.
+    (On the module's cluster: a local one of its own cost a cluster start-up a command; the plot
+    checks do not depend on the engine.)"""
+    sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
+    out = tmp_path / "sw"
+    engine = ["--scheduler", local_client.scheduler.address]
+    rc = main(["sweep", str(sweep), "--out", str(out), *engine, "--quiet", "--plot",
+               "design_report.cup_radii_mm.central"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1
+    assert err[0].startswith("error: --plot = 'design_report.cup_radii_mm.central' is not allowed: must be a report "
+                             f"column of results.csv (the results are in {out / 'results.csv'}: plot another column with --resume): ")
+    assert sorted(p.name for p in out.iterdir()) == ["results.csv"]
+    assert main(["sweep", str(sweep), "--out", str(out), *engine, "--quiet", "--resume", "--plot",
+                 "volume_mm3"]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["plot_volume_mm3.png", "results.csv"]
+
+
+def test_a_plot_column_every_design_leaves_empty_says_so(tmp_path, capsys, local_client):
+    """A new user's ``--plot design_report.punch_tip_check.compaction_force_kN``: a column of every report,
+    so accepted before the run, but empty in every row (the sweep's design gives no compaction force).
+    The refusal had said it was no report column, listing it among those that are."""
+    sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
+    out = tmp_path / "sw"
+    col = "design_report.punch_tip_check.compaction_force_kN"
+    rc = main(["sweep", str(sweep), "--out", str(out), "--scheduler", local_client.scheduler.address, "--quiet",
+               "--plot", col])  # (on the module's cluster, as above)
+    err = capsys.readouterr().err.strip().splitlines()
+    n = len(pd.read_csv(out / "results.csv"))
+    assert rc == 2 and err == [f"error: --plot = '{col}' is not allowed: must be a report column with a number in "
+                               f"some design: every one of the {n} designs that built leaves it empty in results.csv "
+                               "(the input it needs is not in the sweep's design); the results are in "
+                               f"{out / 'results.csv'}: plot another column with --resume"]
+    assert sorted(p.name for p in out.iterdir()) == ["results.csv"]
