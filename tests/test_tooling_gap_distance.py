@@ -77,13 +77,13 @@ def test_mesh_distance_with_a_reach_and_per_point_bounds(seed, reach, spread):
 
 
 @pytest.mark.parametrize("near", [True, False])
-def test_mesh_distance_probe_skips_the_screen_with_the_same_answers(monkeypatch, near):
-    """With 6,000 points in the box the centres' screen is probed first: points within 0.05 of the
-    sphere (all within reach) skip it, points all over the box (half of them too far) run it; either way
-    every finite distance is the brute-force minimum, every point that could beat its bound is measured,
-    and the nearer-than-bound answers (what the gap's nearest tool takes) are those of the screen run on
-    every point."""
-    from tabletcad.tooling.interference import MeshDistance
+def test_mesh_distance_reach_cells_drop_only_points_beyond_reach(monkeypatch, near):
+    """6,000 points within 0.05 of the sphere (all within reach) or all over its box (half of them too
+    far): every finite distance is the brute-force minimum, every point within reach is measured, the
+    answers (distances and nearest points) are those of the same mesh measured without a reach, bit for
+    bit, and the reach cells drop most of the points more than 2.5 times the reach away before the tree
+    is asked; with the grid capped at 64 cells (larger cubes) the same answers."""
+    from tabletcad.tooling.interference import MeshDistance, _ReachCells
 
     rng = np.random.default_rng(7)
     mesh = trimesh.creation.icosphere(subdivisions=3)
@@ -95,20 +95,46 @@ def test_mesh_distance_probe_skips_the_screen_with_the_same_answers(monkeypatch,
         P = rng.uniform(-1.2, 1.2, size=(6000, 3))
     below = rng.uniform(0.0, 0.3, size=len(P))
     md = MeshDistance(V, T, reach=0.2)
-    calls = []
-    screen = md._screen
-    monkeypatch.setattr(md, "_screen", lambda *a: calls.append(len(a[1])) or screen(*a))
     d, q = md(P, below=below, closest=True)
-    assert len(calls) == (1 if near else 2) and calls[0] < len(P) / 10  # the probe, then the screen on all
     k = np.arange(0, len(P), 20)  # the brute force on 300 of them
     exact, dk = _brute_force(P[k], V, T), d[k]
     fin = np.isfinite(dk)
     assert np.allclose(dk[fin], exact[fin], rtol=0, atol=1e-12)
-    assert np.all(fin[(exact < below[k]) & (exact <= 0.2 * (1 - 1e-9))])
-    monkeypatch.setattr(MeshDistance, "PROBE_MIN", 10**9)  # the screen on every point
-    ds, qs = MeshDistance(V, T, reach=0.2)(P, below=below, closest=True)
-    take, takes = d < below, ds < below
-    assert np.array_equal(take, takes) and np.array_equal(d[take], ds[take]) and np.array_equal(q[take], qs[take])
+    assert np.all(fin[exact <= 0.2 * (1 - 1e-9)])
+    d0, q0 = MeshDistance(V, T)(P, closest=True)  # no reach: every point asked of the tree
+    within = d0 <= 0.2
+    assert np.array_equal(d[within], d0[within]) and np.array_equal(q[within], q0[within])
+    assert np.all(np.isinf(d[~within])) and np.all(np.isnan(q[~within]))
+    far = d0 > 0.5
+    assert near or (np.count_nonzero(far) > 1000 and np.count_nonzero(md.cells(P)[far]) < 0.5 * np.count_nonzero(far))
+    monkeypatch.setattr(_ReachCells, "MAX_CELLS", 64)
+    coarse = MeshDistance(V, T, reach=0.2)
+    assert np.prod(coarse.cells.shape) <= 64
+    dc, qc = coarse(P, below=below, closest=True)
+    assert np.array_equal(dc, d) and np.array_equal(qc, q, equal_nan=True)
+
+
+@pytest.mark.parametrize("reach", [1e-3, 0.01, 0.2, 1.5])
+def test_reach_cells_keep_points_at_the_reach(reach):
+    """Points just inside the reach of a box's faces, edges and corners (``reach (1 - 1e-12)`` along the
+    outward normal, the edge's bisector and the corner's diagonal) all lie in marked cells; points three times the
+    reach out do not when the cubes are small beside the reach (``reach / 4``: a grown box's last cell
+    stands out of it by less than that)."""
+    from tabletcad.tooling.interference import _ReachCells
+
+    centre, half = np.array([10.0, -3.0, 1.25]), np.array([10.0, 15.0, 2.5]) * reach  # (a grid of ~3e5 cubes)
+    mesh = trimesh.creation.box(extents=2.0 * half)
+    V, T = np.asarray(mesh.vertices) + centre, np.asarray(mesh.faces)
+    dirs = np.array([s for s in np.ndindex(3, 3, 3) if s != (1, 1, 1)], dtype=float) - 1.0  # 26 directions
+    unit = dirs / np.linalg.norm(dirs, axis=1)[:, None]
+    foot = centre + dirs * half  # the face centre, edge midpoint or corner each direction points out of
+    cells = _ReachCells(V, T, reach)
+    assert np.all(cells(foot + unit * reach * (1.0 - 1e-12)))
+    assert np.all(cells(foot))
+    fine = _ReachCells.__new__(_ReachCells)
+    fine.CELLS_PER_REACH, fine.MAX_CELLS = 4.0, 10**9
+    fine.__init__(V, T, reach)
+    assert not np.any(fine(foot + unit * 3.0 * reach))
 
 
 def test_mesh_distance_of_points_on_the_mesh_and_of_nothing():

@@ -27,7 +27,6 @@ import time
 
 import numpy as np
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
-from scipy.spatial import cKDTree
 
 from tabletcad.cad._occ import explore
 from tabletcad.errors import GeometryError
@@ -72,9 +71,9 @@ class MeshDistance:
     """Exact distance (mm) from points to one triangle mesh ``(V, T)``; ``inf`` beyond ``reach``.
 
     libigl's AABB tree of the triangles (built once; exact point-to-triangle distances
-    in C++), asked only for the points within ``reach``: a point whose nearest triangle
-    centre is farther than ``reach`` plus the largest centre-to-corner radius is farther
-    than ``reach`` from every triangle (an AABB search far from the mesh is slow).
+    in C++), asked only for the points within ``reach``: a point outside every cell of
+    :class:`_ReachCells` (a grid of cubes marking each triangle's box grown by ``reach``)
+    is farther than ``reach`` from every triangle (an AABB search far from the mesh is slow).
     Agrees with a brute-force minimum over all triangles to rounding
     (``tests/test_tooling_gap_distance.py``).
     """
@@ -86,58 +85,27 @@ class MeshDistance:
         self.T = np.ascontiguousarray(T, dtype=np.int64).reshape(-1, 3)
         self.reach = float(reach)
         self.tree = None
-        self.centres = None
-        self.radius = 0.0
+        self.cells = None
         if len(self.T):
             self.tree = igl.AABB()
             self.tree.init(self.V, self.T)
             if math.isfinite(self.reach):
-                tri = self.V[self.T]
-                centres = tri.mean(axis=1)
-                self.radius = float(np.max(np.linalg.norm(tri - centres[:, None, :], axis=2)))
-                self.centres = cKDTree(centres)
-                lo, hi = coordinate_range([self.V[_used(self.T, len(self.V))]], 3)
-                self.box = (lo - self.reach, hi + self.reach)
-
-    #: the centres' screen is probed on every PROBE_STEP-th of PROBE_MIN or more points in the box, and
-    #: skipped when at least PROBE_PASS of the probe would pass it
-    PROBE_MIN, PROBE_STEP, PROBE_PASS = 4096, 16, 0.9
-
-    def _screen(self, P: np.ndarray, idx: np.ndarray, below: np.ndarray | None) -> np.ndarray:
-        """Whether each point ``P[idx]`` may lie within ``reach`` (and below its bound): its nearest triangle
-        centre no farther than that plus the largest centre-to-corner radius."""
-        d, _ = self.centres.query(P[idx], k=1, distance_upper_bound=self.reach + self.radius, workers=-1)
-        ok = np.isfinite(d)
-        if below is not None:
-            ok &= d - self.radius * (1.0 + 1e-9) < below[idx]  # (slack for rounding)
-        return ok
+                self.cells = _ReachCells(self.V, self.T, self.reach)
 
     def __call__(self, points: np.ndarray, below: np.ndarray | None = None, closest: bool = False):
-        """Distances (mm) of ``points`` (``inf`` beyond ``reach``).  With ``below`` (one bound per
-        point), a point whose distance cannot be below its bound (its nearest triangle centre is
-        farther than the bound plus the centre-to-corner radius) may be left at ``inf`` (when the
-        screen runs, see :data:`PROBE_PASS`; else its exact distance, no nearer than the bound): every
-        finite value returned is exact.  With ``closest``, also the mesh's point nearest to each point
-        (NaN where the distance is ``inf``)."""
+        """Distances (mm) of ``points`` (``inf`` beyond ``reach``).  ``below`` (one bound per point, mm)
+        is accepted for callers that take only distances below it: a point whose distance cannot be
+        below its bound may be left at ``inf`` (this screen leaves none: the screen it replaced, by the
+        nearest triangle centre, dropped no point within ``reach`` of the gap's tools); every finite
+        value returned is exact.  With ``closest``, also the mesh's point nearest to each point (NaN
+        where the distance is ``inf``)."""
         P = np.ascontiguousarray(points, dtype=float).reshape(-1, 3)
         out = np.full(len(P), np.inf)
         Q = np.full((len(P), 3), np.nan) if closest else None
         if not len(P) or self.tree is None:
             return (out, Q) if closest else out
-        near = np.arange(len(P))
-        if self.centres is not None:
-            lo, hi = self.box  # farther than reach from the triangles' box: farther from every triangle
-            near = np.flatnonzero((P[:, 0] >= lo[0]) & (P[:, 0] <= hi[0]) & (P[:, 1] >= lo[1]) & (P[:, 1] <= hi[1])
-                                  & (P[:, 2] >= lo[2]) & (P[:, 2] <= hi[2]))
-            # the centres' screen where it drops points: a probe of every 16th point decides (points
-            # between two tools, the gap's branch and bound, all pass the die's screen, which then cost a
-            # third of its time); the answers are the same either way (a point the screen drops is farther
-            # than reach, or than its bound: its exact distance is inf, or is no nearer than the bound)
-            probe = near[::self.PROBE_STEP] if len(near) >= self.PROBE_MIN else near
-            ok = self._screen(P, probe, below)
-            if len(probe) < len(near):
-                ok = self._screen(P, near, below) if np.mean(ok) < self.PROBE_PASS else np.ones(len(near), dtype=bool)
-            near = near[ok]
+        # a point outside the cells is farther than reach: its answer is inf whether measured or not
+        near = np.arange(len(P)) if self.cells is None else np.flatnonzero(self.cells(P))
         if len(near):
             d2, _, C = self.tree.squared_distance(self.V, self.T, np.ascontiguousarray(P[near]))
             out[near] = np.sqrt(np.maximum(d2, 0.0))
@@ -149,6 +117,73 @@ class MeshDistance:
             Q[far] = np.nan
             return out, Q
         return out
+
+
+class _ReachCells:
+    """Which points may lie within ``reach`` (mm) of a triangle of ``(V, T)``: the cells of a regular grid of
+    cubes that meet some triangle's bounding box grown by ``reach``.
+
+    A point within ``reach`` of a triangle lies in that triangle's grown box, so in a marked cell; a point in
+    no marked cell (or outside the grid) is farther than ``reach`` from every triangle.  The boxes are grown
+    by ``reach (1 + 1e-9)``: far more than the rounding of the box corners and of the cell indices, which are
+    monotonic in the coordinates (each a correctly rounded difference and quotient, then ``floor``), so a
+    point within ``reach (1 + 1e-9)`` is never dropped.  The cubes' side is ``reach / CELLS_PER_REACH`` but
+    the grid keeps at most :data:`MAX_CELLS` cells (larger cubes then).  The marks are counted by a
+    difference array: ``+-1`` at each box's eight corner cells, then running sums along the three axes.
+
+    Replaces a k-d tree of the triangles' centres (the nearest centre farther than ``reach`` plus the
+    largest centre-to-corner radius): on the gap's tools that screen cost 0.77 us a point and passed
+    points up to 0.74 mm away (1 mm triangles), this one about 0.03 us.
+    """
+
+    #: cubes of ``reach / CELLS_PER_REACH`` (mm); at most MAX_CELLS of them
+    CELLS_PER_REACH, MAX_CELLS = 1.0, 250_000
+
+    def __init__(self, V: np.ndarray, T: np.ndarray, reach: float) -> None:
+        grow = reach * (1.0 + 1e-9)
+        a, b, c = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
+        tmin = np.minimum(np.minimum(a, b), c) - grow
+        tmax = np.maximum(np.maximum(a, b), c) + grow
+        self.origin = coordinate_range([tmin], 3)[0]
+        extent = coordinate_range([tmax], 3)[1] - self.origin
+        side = reach / self.CELLS_PER_REACH
+        while np.prod(np.floor(extent / side) + 1.0) > self.MAX_CELLS:
+            side *= 1.25
+        self.side = side
+        self.shape = tuple(int(n) for n in np.floor(extent / side) + 1.0)
+        i0, i1 = self._index(tmin), self._index(tmax) + 1  # each box's cells: [i0, i1) along each axis
+        np.clip(i0, 0, self.shape, out=i0)
+        np.clip(i1, 0, self.shape, out=i1)
+        self.marked = _boxes_union(i0, i1, self.shape)
+
+    def _index(self, P: np.ndarray) -> np.ndarray:
+        """The cell index (n, 3) of each point ``P`` (n, 3) (mm), not clipped to the grid."""
+        return np.floor((P - self.origin) / self.side).astype(np.int64)
+
+    def __call__(self, P: np.ndarray) -> np.ndarray:
+        """Mask (n,) of the points ``P`` (n, 3) (mm) that may lie within ``reach`` of a triangle."""
+        k = self._index(P)
+        nx, ny, nz = self.shape
+        ok = (k[:, 0] >= 0) & (k[:, 0] < nx) & (k[:, 1] >= 0) & (k[:, 1] < ny) & (k[:, 2] >= 0) & (k[:, 2] < nz)
+        i = np.flatnonzero(ok)
+        ok[i] = self.marked[(k[i, 0] * ny + k[i, 1]) * nz + k[i, 2]]
+        return ok
+
+
+def _boxes_union(i0: np.ndarray, i1: np.ndarray, shape: tuple[int, int, int]) -> np.ndarray:
+    """Flat mask (``prod(shape)``,) of the cells of a grid ``shape`` in at least one box of cells
+    ``[i0, i1)`` (rows of (n, 3) integer corner indices, already clipped to the grid): ``+1`` at the
+    corners with an even count of upper indices, ``-1`` at the others, summed along each axis."""
+    nx, ny, nz = shape
+    size = (nx + 1) * (ny + 1) * (nz + 1)
+    plus, minus = [], []
+    for corner in itertools.product((0, 1), repeat=3):
+        x, y, z = ((i1 if up else i0)[:, j] for j, up in enumerate(corner))
+        (minus if sum(corner) % 2 else plus).append((x * (ny + 1) + y) * (nz + 1) + z)
+    diff = (np.bincount(np.concatenate(plus), minlength=size)
+            - np.bincount(np.concatenate(minus), minlength=size)).reshape(nx + 1, ny + 1, nz + 1)
+    count = np.cumsum(np.cumsum(np.cumsum(diff, axis=0), axis=1), axis=2)
+    return (count[:nx, :ny, :nz] > 0).reshape(-1)
 
 
 def _used(T: np.ndarray, n: int) -> np.ndarray:
