@@ -68,11 +68,17 @@ def _cloud(V: np.ndarray, T: np.ndarray, per_mm2: float, rng: np.random.Generato
     a, b, c = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
     ab, ac = b - a, c - a
     n = np.ceil(0.5 * np.linalg.norm(np.cross(ab, ac), axis=1) * per_mm2).astype(np.intp)
-    which = np.repeat(np.arange(len(T)), n)
-    u, v = rng.random((2, len(which)))
+    u, v = rng.random((2, int(n.sum())))
     folded = u + v > 1.0  # the parallelogram's far half folded back onto the triangle
     u[folded], v[folded] = 1.0 - u[folded], 1.0 - v[folded]
-    return a[which] + u[:, None] * ab[which] + v[:, None] * ac[which]
+    # a + u ab + v ac, summed in that order, in place on the repeated corners (millions of points)
+    out = np.repeat(ab, n, axis=0)
+    out *= u[:, None]
+    out += np.repeat(a, n, axis=0)
+    step = np.repeat(ac, n, axis=0)
+    step *= v[:, None]
+    out += step
+    return out
 
 
 def _near_triangles(V: np.ndarray, T: np.ndarray, points: np.ndarray,
@@ -92,6 +98,21 @@ def _near_triangles(V: np.ndarray, T: np.ndarray, points: np.ndarray,
     r = np.linalg.norm(tri - c[:, None, :], axis=2).max(axis=1)
     near = cKDTree(points).query(c, distance_upper_bound=reach + r.max())[0] <= reach + r
     return V, T[near]
+
+
+def _largest_least_distance(points, measures) -> float:
+    """``max`` over ``points`` of ``min`` over ``measures`` (exact distance functions, mm) of the point's
+    distance: a point's remaining measures are skipped once one of them is no more than the largest
+    found so far (its least distance cannot raise the maximum), so the result is the full double loop's."""
+    largest = -math.inf
+    for q in points:
+        least = math.inf
+        for measure in measures:
+            least = min(least, measure(q))
+            if least <= largest:
+                break
+        largest = max(largest, least)
+    return float(largest)
 
 
 @pytest.mark.slow
@@ -138,10 +159,10 @@ def test_largest_gap_agrees_with_an_independent_dense_sampling():
     candidates = np.flatnonzero(is_open)
     assert 0 < len(candidates) < 5000
     onto = ExactDistance(explore(ts.parts["tablet"], "Shell")[0])
-    exact_to = [ExactDistance(s) for s in tools.values()]
+    # the die first: its measure is the cheapest (0.1 ms against the punches' 0.5 ms) and often the least
+    exact_to = [ExactDistance(tools[k]) for k in sorted(tools, key=lambda k: k != "die")]
     # each candidate moved onto the tablet once (the generator had moved it again for every tool)
-    exact = np.array([min(e(q) for e in exact_to) for q in (onto.nearest(P[i])[1] for i in candidates)])
-    sampled = float(exact.max())
+    sampled = _largest_least_distance((onto.nearest(P[i])[1] for i in candidates), exact_to)
     assert res == pytest.approx(0.125 * 0.035 / math.sqrt(3.0))
     assert sampled <= gap + res  # points of the tablet's B-rep, measured exactly
     assert gap <= 0.0175 + 1e-9  # a real distance of a surface point: not above the land's peak
