@@ -6,6 +6,9 @@
   ``freecadcmd`` (FreeCAD's own Python and its own OCCT build), with
   ``FREECAD_USER_HOME`` set to a temporary folder, ``VIRTUAL_ENV`` unset and
   the venv removed from ``PATH``.
+* :func:`mesh_volume` is the signed volume of a mesh read back (by trimesh, say): the
+  volume alone, not trimesh's whole mass properties (its inertia integrals took 0.5 s of
+  a 500,000-triangle STL).
 * :func:`freecad_build_bspline` rebuilds kernel-neutral surfaces with FreeCAD's
   ``Part.BSplineSurface().buildFromPolesMultsKnots``.
 
@@ -36,6 +39,7 @@ __all__ = [
     "freecad_build_bspline",
     "ocp_read_step",
     "ocp_read_steps",
+    "mesh_volume",
     "ReadbackError",
 ]
 
@@ -253,3 +257,14 @@ def ocp_read_step(path: str | os.PathLike[str], timeout: float = 300.0, python: 
     (of the last three those ``measure`` names: all by default).
     """
     return ocp_read_steps([path], timeout=timeout, python=python, measure=measure)[0]
+
+
+def mesh_volume(triangles: Any) -> float:
+    """The signed volume (mm³) bounded by a mesh's triangles (``(n, 3, 3)`` corners, mm), outward
+    by the right-hand rule: ``sum(a . ((b - a) x (c - a))) / 6`` (the divergence theorem; trimesh's
+    ``Trimesh.volume``, which also integrates the inertia, to 7e-16 relative on a cut-away's STL)."""
+    import numpy as np
+
+    t = np.asarray(triangles, dtype=np.float64)
+    a, b, c = t[:, 0], t[:, 1], t[:, 2]
+    return float(np.einsum("ij,ij->", a, np.cross(b - a, c - a)) / 6.0)
