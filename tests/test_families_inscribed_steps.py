@@ -49,9 +49,33 @@ def test_the_centre_of_a_circle_of_arcs_is_found():
     assert ol._point_signed_distance()(x, y) == pytest.approx(2.0, abs=1e-12)
 
 
+def _nelder_mead_restarted(ol, x0) -> float:
+    """The depth (mm) Nelder-Mead reaches from ``x0`` on ``ol.signed_distance``, restarted from its own result
+    until a restart gains nothing (at most 6 runs): one run can stall on the ridge where two segments' distances
+    meet (a fresh clone's run found an outline, pinned below by @example, where one run stopped 1.1e-4 mm
+    short of the deepest point and a restart reached it to 1e-13)."""
+    def objective(x):
+        return -float(ol.signed_distance(x[None])[0])
+
+    best = minimize(objective, x0, method="Nelder-Mead", options=dict(xatol=1e-11, fatol=1e-13, maxiter=4000))
+    for _ in range(5):
+        again = minimize(objective, best.x, method="Nelder-Mead", options=dict(xatol=1e-11, fatol=1e-13, maxiter=4000))
+        if not again.fun < best.fun:
+            break
+        best = again
+    return -float(best.fun)
+
+
+#: an outline on which one Nelder-Mead run stalls 1.1e-4 mm short (found by hypothesis in a fresh clone)
+_STALLS = ([(1.34375, 6.375), (2.907142973626543, 6.578125), (2.9682795090471408, 5.62890625), (3.97265625, 4.75),
+            (4.1875, 4.4375), (4.75390625, 6.3125), (6.158307446697017, 5.14453125), (0.0, 4.837890625)],
+           0.4458145369208247, 0, True)
+
+
 @settings(max_examples=40, deadline=None)
 @given(RANDOM_OUTLINES)
 @example(_outline_of(*_TWO_LOBES))
+@example(_outline_of(*_STALLS))
 def test_the_steps_find_the_depth_an_independent_search_finds(ol):
     """Nelder-Mead on the vectorised signed distance, from the four best local peaks of a 161 x 161 grid,
     finds no point deeper than the inscribed radius (to its 1e-9 mm) and the radius is no deeper than a
@@ -70,9 +94,7 @@ def test_the_steps_find_the_depth_an_independent_search_finds(ol):
     peaks = np.flatnonzero(grid >= maximum_filter(grid, size=3, mode="constant", cval=-np.inf))
     found = -math.inf
     for k in peaks[np.argsort(sd[peaks])[::-1][:4]]:
-        r = minimize(lambda x: -float(ol.signed_distance(x[None])[0]), g[k], method="Nelder-Mead",
-                     options=dict(xatol=1e-11, fatol=1e-13, maxiter=4000))
-        found = max(found, -float(r.fun))
+        found = max(found, _nelder_mead_restarted(ol, g[k]))
     assert found - 1e-9 <= radius <= found + 1e-9
     assert radius >= float(sd.max())
 
