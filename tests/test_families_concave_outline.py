@@ -272,3 +272,22 @@ def test_one_point_s_signed_distance_is_the_outline_s_and_no_point_is_deeper_tha
     found = minimize(lambda x: -float(ol.signed_distance(x[None])[0]), g[int(np.argmax(sd))],
                      method="Nelder-Mead", options=dict(xatol=1e-11, fatol=1e-13, maxiter=4000))
     assert -found.fun <= radius + 1e-9
+
+
+@pytest.mark.parametrize("polar, r, turns, clockwise", [_TWO_LOBES, ([(0.0, 5.0), (2.0, 3.5), (4.0, 6.0)], 1.0, 1, True)])
+def test_the_segment_columns_give_the_distances_of_the_segment_by_segment_scan(polar, r, turns, clockwise):
+    """Up to 1,024 points :meth:`PlanOutline.signed_distance` measures every segment at once (its segment
+    columns); beyond, :func:`~tabletcad.geometry.curves.nearest_of` measures segment by segment: the same
+    numbers exactly (at the joins and the arcs' centres, where segments tie, inside, outside, far away)."""
+    from tabletcad.families.outline import _signed_to_segment
+    from tabletcad.geometry.curves import nearest_of
+
+    ol = _outline_of(polar, r, turns, clockwise)
+    rng = np.random.default_rng(7)
+    special = np.array([p for s in ol.segs for p in (s.p0, s.p1) + ((s.center,) if s.kind == "arc" else ())])
+    q = np.vstack([rng.uniform(-10.0, 10.0, (1100, 2)), special, special + rng.normal(0.0, 1e-3, special.shape),
+                   [[1e6, -1e6], [0.0, 0.0]]])
+    best, _, sign = nearest_of(ol.segs, q, _signed_to_segment)  # (over 1,024 points: segment by segment)
+    assert len(q) > 1024
+    for part in (slice(0, 1024), slice(0, 1), slice(1000, None)):
+        np.testing.assert_array_equal(ol.signed_distance(q[part]), (sign * best)[part])
