@@ -483,11 +483,22 @@ def _note_layout(notes: list[str], width_pt: float, height_pt: float, em: float 
 PAPER = {"A4": (11.69, 8.27), "A3": (16.54, 11.69), "A2": (23.39, 16.54)}
 
 
+#: the title block's height, a fraction of the sheet's
+_BLOCK = 0.2
+
+
 def sheet_figure(dr: Drawing, paper: str = "A4"):
     """The landscape matplotlib figure of ``dr`` on ``paper``: the views above a title block that
     holds the notes (in two columns when long), both placed in sheet coordinates so that nothing
     runs past the sheet's edge whatever the tablet's size."""
-    import matplotlib.patches
+    fig = _views_figure(dr, paper)
+    _add_title_block(fig, dr, paper)
+    return fig
+
+
+def _views_figure(dr: Drawing, paper: str):
+    """The figure of ``dr``'s views and dimensions on ``paper`` (no title block yet); sets ``dr.paper``
+    and ``dr.scale`` (paper mm per model mm, the views' limits fixed as a draw fixes them)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.collections import LineCollection
     from matplotlib.figure import Figure
@@ -496,8 +507,7 @@ def sheet_figure(dr: Drawing, paper: str = "A4"):
     fig = Figure(figsize=(w_in, h_in))
     FigureCanvasAgg(fig)  # its own canvas: the global backend is left alone
     dr.paper = paper
-    block = 0.2  # title block height, fraction of the sheet
-    ax = fig.add_axes((0.04, block + 0.04, 0.92, 0.92 - block - 0.04))
+    ax = fig.add_axes((0.04, _BLOCK + 0.04, 0.92, 0.92 - _BLOCK - 0.04))
     # one collection per line style (a Line2D per edge cost 1-2 s to add and draw on a lettered tablet)
     lines = {"visible": [], "hidden": []}
     for kind, p in _sheet_lines(dr):
@@ -533,11 +543,21 @@ def sheet_figure(dr: Drawing, paper: str = "A4"):
     ax.set_aspect("equal", adjustable="datalim")
     ax.margins(0.06)
     ax.axis("off")
-    fig.canvas.draw()  # fix the limits: the scale is paper mm per model mm
+    # fix the limits as drawing would (equal aspect: the data limits grow to the axes' shape), without
+    # rendering the views: the scale is paper mm per model mm
+    ax.apply_aspect()
     x0, x1 = ax.get_xlim()
-    scale = ax.get_window_extent().width / fig.dpi * 25.4 / (x1 - x0)
-    dr.scale = scale
-    # title block: frame, title, notes
+    dr.scale = ax.get_window_extent().width / fig.dpi * 25.4 / (x1 - x0)
+    return fig
+
+
+def _add_title_block(fig, dr: Drawing, paper: str) -> None:
+    """The title block under the views of ``fig`` (from :func:`_views_figure`): frame, title, the title
+    block's lines with the scale and paper, the notes in as many columns as they need."""
+    import matplotlib.patches
+
+    w_in, h_in = PAPER[paper]
+    block, scale = _BLOCK, dr.scale
     fig.add_artist(matplotlib.patches.Rectangle((0.04, 0.03), 0.92, block - 0.01, transform=fig.transFigure,
                                                 fill=False, lw=0.6, ec="0.2"))
     title = fig.text(0.05, 0.03 + block - 0.025, dr.title, fontsize=10, ha="left", va="top", weight="bold")
@@ -565,7 +585,6 @@ def sheet_figure(dr: Drawing, paper: str = "A4"):
             break
         for t in cols:  # a column ran into the next: again, wrapped for wider letters
             t.remove()
-    return fig
 
 
 def _scale_text(scale: float) -> str:
@@ -579,9 +598,10 @@ def _write_matplotlib(dr: Drawing, svg: Path, pdf: Path) -> None:
     # PDF/A and print workflows accept it (Type 3 fonts are glyph drawings)
     with matplotlib.rc_context({"svg.fonttype": "none", "pdf.fonttype": 42}):
         for paper in PAPER:  # the smallest sheet that shows the views at 1:1 or larger (else the largest)
-            fig = sheet_figure(dr, paper)
+            fig = _views_figure(dr, paper)
             if dr.scale >= 1.0 or paper == "A2":
                 break
+        _add_title_block(fig, dr, paper)  # (on the sheet kept only)
         with atomic_path(svg) as tmp:
             fig.savefig(tmp, format="svg")
         with atomic_path(pdf) as tmp:
