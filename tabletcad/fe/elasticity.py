@@ -426,6 +426,44 @@ def block_stiffness(basis: Any, lam: float, mu: float, chunk: int = 8192) -> Blo
     return _scalar_block_stiffness(sb, dim, lam, mu, chunk)
 
 
+def _gradient_products(g: np.ndarray, dx: np.ndarray) -> np.ndarray:
+    """The integrals ``∫ ∂ₖφₐ ∂ₗφ_b`` (mm) of every element, shape (e, nb, dim, nb, dim) in the order (e, a, k, b, l).
+
+    Parameters
+    ----------
+    g : ndarray, shape (nb, dim, e, nq)
+        The basis functions' gradients at the quadrature points, 1/mm.
+    dx : ndarray, shape (e, nq)
+        The quadrature weights times the Jacobians, mm³.
+
+    One batched matrix product per element, ``(∂ₖφₐ dx)`` (rows a k) by ``∂ₗφ_b`` (columns b l) over the
+    quadrature points: the product numpy's ``einsum("akeq,bleq->kleab", g dx, g, optimize=True)`` forms.
+    """
+    nb, dim, ne, nq = g.shape
+    a = np.ascontiguousarray((g * dx).transpose(2, 0, 1, 3)).reshape(ne, nb * dim, nq)
+    b = np.ascontiguousarray(g.transpose(2, 3, 0, 1)).reshape(ne, nq, nb * dim)
+    return np.matmul(a, b).reshape(ne, nb, dim, nb, dim)
+
+
+def _sum_by_pair(inverse: np.ndarray, G: np.ndarray, pairs: int) -> np.ndarray:
+    """Sums of the element integrals ``G`` (e, nb, dim, nb, dim) by pair of scalar unknowns, shape (pairs dim, dim).
+
+    Row ``dim p + k``, column ``l`` is the sum of ``G[e, a, k, b, l]`` over the local pairs ``(e, a, b)``
+    with ``inverse[(e, a, b)] == p`` (flattened in that order), added in that order: a sparse
+    incidence matrix (one 1 per column) times the rows of ``G`` taken ``dim`` at a time, so ``G``
+    is read in place, not transposed per component first (the same sums as ``np.bincount`` of each
+    component over ``inverse``).
+    """
+    import scipy.sparse as sp
+
+    ne, nb, dim = G.shape[:3]
+    n = ne * nb * dim * nb
+    idx = np.int32 if max(pairs * dim, n) < 2**31 - 1 else np.int64
+    rows = (inverse.reshape(ne, nb, 1, nb).astype(idx) * dim + np.arange(dim, dtype=idx)[:, None]).ravel()
+    P = sp.csc_matrix((np.ones(n), rows, np.arange(n + 1, dtype=idx)), shape=(pairs * dim, n))
+    return P @ G.reshape(n, dim)
+
+
 def _scalar_block_stiffness(sb: Any, dim: int, lam: float, mu: float, chunk: int = 8192) -> BlockStiffness:
     """:func:`block_stiffness` from the scalar basis ``sb`` (scikit-fem ``CellBasis``, its quadrature the
     stiffness's) of the ``dim`` components."""
@@ -434,16 +472,12 @@ def _scalar_block_stiffness(sb: Any, dim: int, lam: float, mu: float, chunk: int
     inverse, indptr, indices = _scalar_pairs(sd, sb.N)
     g = np.stack([sb.basis[a][0].grad for a in range(nb)])  # (nb, dim, nel, nq)
     nel = g.shape[2]
-    S = np.zeros((dim * dim, len(indices)))  # Σ_e ∫ ∂ₖφₐ ∂ₗφ_b, component k dim + l, per pair
+    S = np.zeros((len(indices) * dim, dim))  # Σ_e ∫ ∂ₖφₐ ∂ₗφ_b: row (pair, k), column l
     for e0 in range(0, nel, chunk):
         e1 = min(e0 + chunk, nel)
-        ge = g[:, :, e0:e1]
-        G = np.einsum("akeq,bleq->kleab", ge * sb.dx[e0:e1], ge, optimize=True)
-        G = G.reshape(dim * dim, -1)  # (k l, (e, a, b))
-        inv = inverse[e0 * nb * nb:e1 * nb * nb]
-        for c in range(dim * dim):
-            S[c] += np.bincount(inv, weights=G[c], minlength=len(indices))
-    S = S.T.reshape(-1, dim, dim)  # (pairs, k, l)
+        G = _gradient_products(g[:, :, e0:e1], sb.dx[e0:e1])
+        S += _sum_by_pair(inverse[e0 * nb * nb:e1 * nb * nb], G, len(indices))
+    S = S.reshape(-1, dim, dim)  # (pairs, k, l)
     blocks = lam * S + mu * S.transpose(0, 2, 1)
     tr = mu * np.trace(S, axis1=1, axis2=2)
     for i in range(dim):
