@@ -212,7 +212,9 @@ class ElasticSolution:
         ``8^k`` sub-tetrahedra (scikit-fem's uniform refinement of the reference element, with
         ``k`` ≤ 2 chosen so that the sub-elements are about ``R`` across or less) carrying scikit-fem's
         degree-2 rule; the P2 stress is linear in each element, so it is evaluated exactly at
-        those points from the element's vertex values.
+        those points from the element's vertex values.  The points' squared distances from a
+        centre are evaluated as a quadratic form in their barycentric coordinates
+        (:class:`_BumpRule`).
 
         Returns
         -------
@@ -249,9 +251,8 @@ class ElasticSolution:
         wr = (np.abs(np.linalg.det(J.transpose(2, 0, 1)))[None, :] * W[:, None]).ravel()
         lam = np.vstack([1.0 - xi.sum(axis=0), xi])  # (4, nq): vertex k of the reference is t[k]
         v = xv[el]  # (e, 4, 3)
-        gx = np.einsum("kq,ekd->deq", lam, v)  # (3, e, nq): the points, coordinate by coordinate
         jac = np.abs(np.linalg.det(v[:, 1:] - v[:, :1]))  # 6 x volume
-        gw = jac[:, None] * wr[None, :]  # (e, nq)
+        rule = _BumpRule(v, lam, jac[:, None] * wr[None, :], R)
         ce, de = cen[el], diam[el]
         vs = self.vertex_stress[el].reshape(len(el), 4, 9)
         # per ball, the elements whose bounding sphere meets it; the weighted sum of the (linear) stress
@@ -265,18 +266,7 @@ class ElasticSolution:
                 continue
             c = np.asarray(c)
             c = c[np.linalg.norm(ce[c] - q[i], axis=1) <= R + de[c]]
-            d = gx[0, c] - q[i, 0]
-            r2 = d * d
-            d = gx[1, c] - q[i, 1]
-            r2 += d * d
-            d = gx[2, c] - q[i, 2]
-            r2 += d * d
-            r2 /= R * R
-            outside = r2 >= 1.0
-            w = np.subtract(1.0, r2, out=r2)
-            w *= w
-            w *= gw[c]
-            w[outside] = 0.0
+            w = rule.weights(c, q[i])
             s = w.sum()
             frac[i] = s / full
             if s > 0:
@@ -295,6 +285,51 @@ class ElasticSolution:
         A = np.vstack([v, np.ones(4)])
         lam = np.linalg.solve(A, np.append(q.ravel(), 1.0))
         return np.einsum("k,kij->ij", lam, self.vertex_stress[e])
+
+
+class _BumpRule:
+    """The weights ``w (1 - r²/R²)²`` (zero for ``r ≥ R``) of a composite quadrature rule's points about a centre.
+
+    The squared distance of a point ``x = Σⱼ λⱼ vⱼ`` (barycentric coordinates λ in an element with
+    vertices ``vⱼ``) from a centre ``x₀`` is the quadratic form ``r² = Σⱼ Σₖ λⱼ λₖ (vⱼ - x₀)·(vₖ - x₀)``
+    (``Σ λⱼ = 1``): per element and centre only the ten products of the vertices' offsets are formed,
+    and the rule's points are weighed by one matrix product with the ten products of their
+    coordinates, instead of gathering and differencing every point's coordinates (the same squared
+    distances to rounding, about 1e-16 of ``(R + element size)²``).
+
+    Parameters
+    ----------
+    vertices : ndarray, shape (e, 4, 3)
+        The elements' vertices, mm.
+    lam : ndarray, shape (4, nq)
+        Barycentric coordinates of the rule's points (the same in every element).
+    point_weights : ndarray, shape (e, nq)
+        The rule's weights in every element, mm³.
+    radius : float
+        ``R``, mm.
+    """
+
+    _PAIRS = np.triu_indices(4)
+
+    def __init__(self, vertices: np.ndarray, lam: np.ndarray, point_weights: np.ndarray, radius: float) -> None:
+        j, k = self._PAIRS
+        self.vertices = vertices
+        self.point_weights = point_weights
+        self.radius = radius
+        # λⱼ λₖ over the pairs j ≤ k, the off-diagonal ones twice: (10, nq)
+        self.products = lam[j] * lam[k] * np.where(j == k, 1.0, 2.0)[:, None]
+
+    def weights(self, elements: np.ndarray, centre: np.ndarray) -> np.ndarray:
+        """The weights (len(elements), nq), mm³, of the points of ``elements`` about ``centre`` (3,), mm."""
+        j, k = self._PAIRS
+        off = self.vertices[elements] - centre  # (c, 4, 3)
+        gram = np.einsum("cjd,ckd->cjk", off, off)[:, j, k] / (self.radius * self.radius)  # (c, 10)
+        r2 = gram @ self.products
+        np.minimum(r2, 1.0, out=r2)
+        w = np.subtract(1.0, r2, out=r2)
+        w *= w
+        w *= self.point_weights[elements]
+        return w
 
 
 def principal_stresses(s: np.ndarray) -> np.ndarray:
@@ -391,6 +426,44 @@ def block_stiffness(basis: Any, lam: float, mu: float, chunk: int = 8192) -> Blo
     return _scalar_block_stiffness(sb, dim, lam, mu, chunk)
 
 
+def _gradient_products(g: np.ndarray, dx: np.ndarray) -> np.ndarray:
+    """The integrals ``∫ ∂ₖφₐ ∂ₗφ_b`` (mm) of every element, shape (e, nb, dim, nb, dim) in the order (e, a, k, b, l).
+
+    Parameters
+    ----------
+    g : ndarray, shape (nb, dim, e, nq)
+        The basis functions' gradients at the quadrature points, 1/mm.
+    dx : ndarray, shape (e, nq)
+        The quadrature weights times the Jacobians, mm³.
+
+    One batched matrix product per element, ``(∂ₖφₐ dx)`` (rows a k) by ``∂ₗφ_b`` (columns b l) over the
+    quadrature points: the product numpy's ``einsum("akeq,bleq->kleab", g dx, g, optimize=True)`` forms.
+    """
+    nb, dim, ne, nq = g.shape
+    a = np.ascontiguousarray((g * dx).transpose(2, 0, 1, 3)).reshape(ne, nb * dim, nq)
+    b = np.ascontiguousarray(g.transpose(2, 3, 0, 1)).reshape(ne, nq, nb * dim)
+    return np.matmul(a, b).reshape(ne, nb, dim, nb, dim)
+
+
+def _sum_by_pair(inverse: np.ndarray, G: np.ndarray, pairs: int) -> np.ndarray:
+    """Sums of the element integrals ``G`` (e, nb, dim, nb, dim) by pair of scalar unknowns, shape (pairs dim, dim).
+
+    Row ``dim p + k``, column ``l`` is the sum of ``G[e, a, k, b, l]`` over the local pairs ``(e, a, b)``
+    with ``inverse[(e, a, b)] == p`` (flattened in that order), added in that order: a sparse
+    incidence matrix (one 1 per column) times the rows of ``G`` taken ``dim`` at a time, so ``G``
+    is read in place, not transposed per component first (the same sums as ``np.bincount`` of each
+    component over ``inverse``).
+    """
+    import scipy.sparse as sp
+
+    ne, nb, dim = G.shape[:3]
+    n = ne * nb * dim * nb
+    idx = np.int32 if max(pairs * dim, n) < 2**31 - 1 else np.int64
+    rows = (inverse.reshape(ne, nb, 1, nb).astype(idx) * dim + np.arange(dim, dtype=idx)[:, None]).ravel()
+    P = sp.csc_matrix((np.ones(n), rows, np.arange(n + 1, dtype=idx)), shape=(pairs * dim, n))
+    return P @ G.reshape(n, dim)
+
+
 def _scalar_block_stiffness(sb: Any, dim: int, lam: float, mu: float, chunk: int = 8192) -> BlockStiffness:
     """:func:`block_stiffness` from the scalar basis ``sb`` (scikit-fem ``CellBasis``, its quadrature the
     stiffness's) of the ``dim`` components."""
@@ -399,16 +472,12 @@ def _scalar_block_stiffness(sb: Any, dim: int, lam: float, mu: float, chunk: int
     inverse, indptr, indices = _scalar_pairs(sd, sb.N)
     g = np.stack([sb.basis[a][0].grad for a in range(nb)])  # (nb, dim, nel, nq)
     nel = g.shape[2]
-    S = np.zeros((dim * dim, len(indices)))  # Σ_e ∫ ∂ₖφₐ ∂ₗφ_b, component k dim + l, per pair
+    S = np.zeros((len(indices) * dim, dim))  # Σ_e ∫ ∂ₖφₐ ∂ₗφ_b: row (pair, k), column l
     for e0 in range(0, nel, chunk):
         e1 = min(e0 + chunk, nel)
-        ge = g[:, :, e0:e1]
-        G = np.einsum("akeq,bleq->kleab", ge * sb.dx[e0:e1], ge, optimize=True)
-        G = G.reshape(dim * dim, -1)  # (k l, (e, a, b))
-        inv = inverse[e0 * nb * nb:e1 * nb * nb]
-        for c in range(dim * dim):
-            S[c] += np.bincount(inv, weights=G[c], minlength=len(indices))
-    S = S.T.reshape(-1, dim, dim)  # (pairs, k, l)
+        G = _gradient_products(g[:, :, e0:e1], sb.dx[e0:e1])
+        S += _sum_by_pair(inverse[e0 * nb * nb:e1 * nb * nb], G, len(indices))
+    S = S.reshape(-1, dim, dim)  # (pairs, k, l)
     blocks = lam * S + mu * S.transpose(0, 2, 1)
     tr = mu * np.trace(S, axis1=1, axis2=2)
     for i in range(dim):
