@@ -53,10 +53,9 @@ def test_mesh_distance_is_the_exact_minimum_over_all_triangles(seed, noise, spre
 
 @settings(max_examples=30, deadline=None)
 @given(seed=st.integers(0, 2**31 - 1), reach=st.floats(0.05, 2.0), spread=st.floats(0.2, 3.0))
-def test_mesh_distance_with_a_reach_and_per_point_bounds(seed, reach, spread):
-    """Beyond ``reach`` a point is ``inf`` (its box and its nearest triangle centre rule it out
-    without the tree), within it the brute-force minimum; with ``below`` a point is measured
-    where its distance could be below its bound, and every finite value is still exact."""
+def test_mesh_distance_with_a_reach(seed, reach, spread):
+    """Beyond ``reach`` a point is ``inf`` (the reach cells rule it out without the tree), within it
+    the brute-force minimum."""
     from tabletcad.tooling.interference import MeshDistance
 
     rng = np.random.default_rng(seed)
@@ -68,12 +67,6 @@ def test_mesh_distance_with_a_reach_and_per_point_bounds(seed, reach, spread):
     d = md(P)
     assert np.allclose(d[exact <= reach * (1 - 1e-9)], exact[exact <= reach * (1 - 1e-9)], rtol=0, atol=1e-12)
     assert np.all(np.isinf(d[exact > reach * (1 + 1e-9)]))
-    below = rng.uniform(0.0, 1.5, size=len(P))
-    db = md(P, below=below)
-    fin = np.isfinite(db)
-    assert np.allclose(db[fin], exact[fin], rtol=0, atol=1e-12)
-    need = (exact < below) & (exact <= reach * (1 - 1e-9))  # could beat its bound: must be measured
-    assert np.all(fin[need])
 
 
 @pytest.mark.parametrize("near", [True, False])
@@ -93,9 +86,8 @@ def test_mesh_distance_reach_cells_drop_only_points_beyond_reach(monkeypatch, ne
         P = P / np.linalg.norm(P, axis=1)[:, None] * (1.0 + 0.05 * rng.uniform(-1, 1, (len(P), 1)))
     else:
         P = rng.uniform(-1.2, 1.2, size=(6000, 3))
-    below = rng.uniform(0.0, 0.3, size=len(P))
     md = MeshDistance(V, T, reach=0.2)
-    d, q = md(P, below=below, closest=True)
+    d, q = md(P, closest=True)
     k = np.arange(0, len(P), 20)  # the brute force on 300 of them
     exact, dk = _brute_force(P[k], V, T), d[k]
     fin = np.isfinite(dk)
@@ -110,7 +102,7 @@ def test_mesh_distance_reach_cells_drop_only_points_beyond_reach(monkeypatch, ne
     monkeypatch.setattr(_ReachCells, "MAX_CELLS", 64)
     coarse = MeshDistance(V, T, reach=0.2)
     assert np.prod(coarse.cells.shape) <= 64
-    dc, qc = coarse(P, below=below, closest=True)
+    dc, qc = coarse(P, closest=True)
     assert np.array_equal(dc, d) and np.array_equal(qc, q, equal_nan=True)
 
 

@@ -92,13 +92,9 @@ class MeshDistance:
             if math.isfinite(self.reach):
                 self.cells = _ReachCells(self.V, self.T, self.reach)
 
-    def __call__(self, points: np.ndarray, below: np.ndarray | None = None, closest: bool = False):
-        """Distances (mm) of ``points`` (``inf`` beyond ``reach``).  ``below`` (one bound per point, mm)
-        is accepted for callers that take only distances below it: a point whose distance cannot be
-        below its bound may be left at ``inf`` (this screen leaves none: the screen it replaced, by the
-        nearest triangle centre, dropped no point within ``reach`` of the gap's tools); every finite
-        value returned is exact.  With ``closest``, also the mesh's point nearest to each point (NaN
-        where the distance is ``inf``)."""
+    def __call__(self, points: np.ndarray, closest: bool = False):
+        """Distances (mm) of ``points``: exact within ``reach``, ``inf`` beyond it.  With ``closest``,
+        also the mesh's point nearest to each point (NaN where the distance is ``inf``)."""
         P = np.ascontiguousarray(points, dtype=float).reshape(-1, 3)
         out = np.full(len(P), np.inf)
         Q = np.full((len(P), 3), np.nan) if closest else None
