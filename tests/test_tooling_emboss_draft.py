@@ -65,6 +65,8 @@ def _end_areas(solid, z_lo: float, z_hi: float) -> tuple[float, float]:
 
     lo = hi = 0.0
     for f in explore(solid, "Face"):
+        if _vertex_z_span(f) > 1e-6:  # a wall: its z range is wider still (skips its optimal box)
+            continue
         a, b = _z_range(f)
         if b - a < 1e-6:  # the boxes are 1e-7 mm wider than the shapes
             if abs(a - z_lo) < 1e-6:
@@ -72,6 +74,21 @@ def _end_areas(solid, z_lo: float, z_hi: float) -> tuple[float, float]:
             elif abs(a - z_hi) < 1e-6:
                 hi += _area(f)
     return lo, hi
+
+
+def _vertex_z_span(face) -> float:
+    """A lower bound (mm) of the z extent of ``face``: its vertices' z range, each vertex moved
+    towards the others by its tolerance (the face passes within that of its vertices)."""
+    from OCP.BRep import BRep_Tool
+
+    from tabletcad.cad._occ import explore
+
+    lows, highs = [], []
+    for v in explore(face, "Vertex"):
+        z, tol = BRep_Tool.Pnt_s(v).Z(), BRep_Tool.Tolerance_s(v)
+        lows.append(z + tol)
+        highs.append(z - tol)
+    return max(highs) - min(lows) if lows else 0.0
 
 
 def _polygon(points):

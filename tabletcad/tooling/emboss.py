@@ -321,8 +321,11 @@ def _offset_section(wire, d: float):
         return wire
     face = plan_face(wire)
     a0 = face_area(face)
-    for join in (GeomAbs_JoinType.GeomAbs_Intersection, GeomAbs_JoinType.GeomAbs_Arc):
-        for s in (1.0, -1.0):  # OCC's sign depends on the wire's orientation: keep the one that grows by d
+    # OCC's sign depends on the face's orientation, the same for both joins: keep the one that grows by
+    # d, trying the sign that grows a plan face first (it always did: the other sign's Intersection
+    # offset, tried before the Arc one, cost a failed offset where OCC cannot intersect the edges)
+    for s in (1.0, -1.0):
+        for join in (GeomAbs_JoinType.GeomAbs_Intersection, GeomAbs_JoinType.GeomAbs_Arc):
             try:
                 mk = BRepOffsetAPI_MakeOffset(face, join)
                 mk.Perform(s * d)
@@ -411,7 +414,9 @@ def _wire_points(wire, spacing: float):
         us = [ua.Parameter(i) for i in range(1, ua.NbPoints() + 1)] if ua.IsDone() else list(np.linspace(u0, u1, n + 1))
         if edge.Orientation() == TopAbs_REVERSED:
             us = us[::-1]
-        pts += [(curve.Value(u).X(), curve.Value(u).Y()) for u in us[:-1]]
+        for u in us[:-1]:
+            p = curve.Value(u)
+            pts.append((p.X(), p.Y()))
         ex.Next()
     pts = np.array(pts)
     keep = np.linalg.norm(pts - np.roll(pts, 1, axis=0), axis=1) > 0.1 * spacing  # OCC's offsets have 0-length edges
