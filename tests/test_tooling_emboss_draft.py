@@ -65,6 +65,8 @@ def _end_areas(solid, z_lo: float, z_hi: float) -> tuple[float, float]:
 
     lo = hi = 0.0
     for f in explore(solid, "Face"):
+        if _vertex_z_span(f) > 1e-6:  # a wall: its z range is wider still (skips its optimal box)
+            continue
         a, b = _z_range(f)
         if b - a < 1e-6:  # the boxes are 1e-7 mm wider than the shapes
             if abs(a - z_lo) < 1e-6:
@@ -72,6 +74,21 @@ def _end_areas(solid, z_lo: float, z_hi: float) -> tuple[float, float]:
             elif abs(a - z_hi) < 1e-6:
                 hi += _area(f)
     return lo, hi
+
+
+def _vertex_z_span(face) -> float:
+    """A lower bound (mm) of the z extent of ``face``: its vertices' z range, each vertex moved
+    towards the others by its tolerance (the face passes within that of its vertices)."""
+    from OCP.BRep import BRep_Tool
+
+    from tabletcad.cad._occ import explore
+
+    lows, highs = [], []
+    for v in explore(face, "Vertex"):
+        z, tol = BRep_Tool.Pnt_s(v).Z(), BRep_Tool.Tolerance_s(v)
+        lows.append(z + tol)
+        highs.append(z - tol)
+    return max(highs) - min(lows) if lows else 0.0
 
 
 def _polygon(points):
@@ -351,3 +368,24 @@ def test_an_svg_circle_of_one_arc_and_a_sliver_drafts(tmp_path):
     prism = figure_prism(figure, 4.5, 3.7, 25.0, z_nominal=4.0)
     solids = explore(prism, "Solid")
     assert len(solids) == 2 and all(_valid(s) for s in solids)
+
+
+def test_nearest_positions_near_are_the_brute_force_ones():
+    """The k-d tree's candidate segments (:func:`_nearest_positions_near`, all points at once) give
+    the brute force's positions and distances bit for bit, on the offsets of "6" where a stroke end
+    vanishes (points whose nearest segment is far along the wire) and on points with exact ties."""
+    import numpy as np
+    from OCP.BRepTools import BRepTools
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.emboss import (_nearest_positions, _nearest_positions_near, _offset_section,
+                                          _wire_points, text_faces)
+
+    t = math.tan(math.radians(15.0))
+    outline = BRepTools.OuterWire_s(explore(text_faces("6", 2.5, font_path("DejaVuSans-Bold")), "Face")[0])
+    wa, wb = _offset_section(outline, 0.2377 * t), _offset_section(outline, -0.6040 * t)
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    ties = np.array([[0.5, 0.5], [0.5, 0.0], [1.0, 1.0], [2.0, 0.5]])  # centre and a vertex: equidistant segments
+    for pa, pb in ((_wire_points(wa, 0.04), _wire_points(wb, 0.01)), (ties, square)):
+        near, brute = _nearest_positions_near(pa, pb), _nearest_positions(pa, pb)
+        assert all(np.array_equal(x, y) for x, y in zip(near[:2], brute[:2])) and near[2] == brute[2]

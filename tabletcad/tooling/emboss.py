@@ -321,8 +321,11 @@ def _offset_section(wire, d: float):
         return wire
     face = plan_face(wire)
     a0 = face_area(face)
-    for join in (GeomAbs_JoinType.GeomAbs_Intersection, GeomAbs_JoinType.GeomAbs_Arc):
-        for s in (1.0, -1.0):  # OCC's sign depends on the wire's orientation: keep the one that grows by d
+    # OCC's sign depends on the face's orientation, the same for both joins: keep the one that grows by
+    # d, trying the sign that grows a plan face first (it always did: the other sign's Intersection
+    # offset, tried before the Arc one, cost a failed offset where OCC cannot intersect the edges)
+    for s in (1.0, -1.0):
+        for join in (GeomAbs_JoinType.GeomAbs_Intersection, GeomAbs_JoinType.GeomAbs_Arc):
             try:
                 mk = BRepOffsetAPI_MakeOffset(face, join)
                 mk.Perform(s * d)
@@ -411,7 +414,9 @@ def _wire_points(wire, spacing: float):
         us = [ua.Parameter(i) for i in range(1, ua.NbPoints() + 1)] if ua.IsDone() else list(np.linspace(u0, u1, n + 1))
         if edge.Orientation() == TopAbs_REVERSED:
             us = us[::-1]
-        pts += [(curve.Value(u).X(), curve.Value(u).Y()) for u in us[:-1]]
+        for u in us[:-1]:
+            p = curve.Value(u)
+            pts.append((p.X(), p.Y()))
         ex.Next()
     pts = np.array(pts)
     keep = np.linalg.norm(pts - np.roll(pts, 1, axis=0), axis=1) > 0.1 * spacing  # OCC's offsets have 0-length edges
@@ -646,7 +651,8 @@ def _nearest_positions(pa, pb):
 def _nearest_positions_near(pa, pb):
     """:func:`_nearest_positions` looking only at the segments of ``pb`` that can hold the nearest
     point (a vertex within the nearest vertex's distance plus the longest segment; a k-d tree), for
-    dense polygons: the same minimum, found among fewer segments."""
+    dense polygons: the same minimum, found among fewer segments (all points' candidates at once,
+    each point's in ascending order: the first of equal distances wins, as in a loop over them)."""
     import numpy as np
     from scipy.spatial import cKDTree
 
@@ -655,16 +661,45 @@ def _nearest_positions_near(pa, pb):
     cum = np.concatenate([[0.0], np.cumsum(slen)])
     tree = cKDTree(pb)
     dv, _ = tree.query(pa)
-    sig, near = np.empty(len(pa)), np.empty(len(pa))
-    m = len(pb)
-    for i, verts in enumerate(tree.query_ball_point(pa, dv + slen.max() + 1e-12)):
-        j = np.unique(np.concatenate([np.asarray(verts, dtype=int), (np.asarray(verts, dtype=int) - 1) % m]))
-        rel = pa[i] - pb[j]
-        u = np.clip(np.einsum("jk,jk->j", rel, seg[j]) / np.maximum(slen[j] * slen[j], 1e-30), 0.0, 1.0)
-        dist = np.linalg.norm(rel - u[:, None] * seg[j], axis=1)
-        k = int(np.argmin(dist))
-        sig[i], near[i] = cum[j[k]] + u[k] * slen[j[k]], dist[k]
-    return sig, near, cum[-1]
+    i, j = _candidate_segments(tree.query_ball_point(pa, dv + slen.max() + 1e-12), len(pb))
+    rel = pa[i] - pb[j]
+    u = np.clip(np.einsum("jk,jk->j", rel, seg[j]) / np.maximum(slen[j] * slen[j], 1e-30), 0.0, 1.0)
+    dist = np.linalg.norm(rel - u[:, None] * seg[j], axis=1)
+    best = _first_minima(i, dist, len(pa))
+    return cum[j[best]] + u[best] * slen[j[best]], dist[best], cum[-1]
+
+
+def _candidate_segments(verts, m: int):
+    """``(i, j)``, int arrays: for each point ``i`` (in order) the segments ``j`` (ascending, each
+    once) that start or end at one of its vertices ``verts[i]`` (indices into a closed polygon of
+    ``m`` vertices; segment ``j`` runs from vertex ``j`` to ``j + 1``)."""
+    import numpy as np
+
+    counts = np.fromiter((len(v) for v in verts), dtype=np.intp, count=len(verts))
+    flat = np.fromiter((k for v in verts for k in v), dtype=np.intp, count=int(counts.sum()))
+    owner = np.repeat(np.arange(len(verts)), counts)
+    i = np.concatenate([owner, owner])
+    j = np.concatenate([flat, (flat - 1) % m])
+    order = np.lexsort((j, i))
+    i, j = i[order], j[order]
+    keep = np.ones(len(i), dtype=bool)
+    keep[1:] = (i[1:] != i[:-1]) | (j[1:] != j[:-1])
+    return i[keep], j[keep]
+
+
+def _first_minima(group, values, n: int):
+    """Index (into ``values``) of the first smallest value of each of the ``n`` groups; ``group``:
+    each value's group, ascending, every group present."""
+    import numpy as np
+
+    starts = np.flatnonzero(np.r_[True, group[1:] != group[:-1]])
+    low = np.minimum.reduceat(values, starts)
+    at = np.flatnonzero(values == low[group])
+    first = np.r_[True, group[at][1:] != group[at][:-1]]
+    out = at[first]
+    if len(out) != n:  # a group without a candidate or a NaN distance: no minimum to take
+        raise GeometryError("nearest positions: a point without a finite nearest segment", None)
+    return out
 
 
 def _round_steps(sig, per: float):
