@@ -1159,12 +1159,11 @@ def _largest_gap(tablet, parts: dict, clearance: float, deflection: float, refin
                           reach=reach) for s in parts.values()]
 
     def measure(P):
-        # the nearest tool, its distance and its point nearest to P; a tool is asked only where it
-        # could beat the best so far
+        # the nearest tool, its distance and its point nearest to P
         best, which = np.full(len(P), np.inf), np.zeros(len(P), dtype=np.int64)
         q = np.full((len(P), 3), np.nan)
         for j, tool in enumerate(tools):
-            d, c = tool(P, below=best, closest=True)
+            d, c = tool(P, closest=True)
             nearer = d < best
             best[nearer], which[nearer], q[nearer] = d[nearer], j, c[nearer]
         return best, which, q
