@@ -195,3 +195,28 @@ def test_explore_gives_each_sub_shape_once_as_the_explorer_first_meets_it():
         got = explore(shape, kind)
         assert len(got) == len(walk) > 0
         assert all(a.IsEqual(b) and type(a) is type(cast(b, kind)) for a, b in zip(got, walk))
+
+
+def test_mass_properties_are_integrated_once_per_shape_content():
+    """:func:`mass_properties` is memoised by shape content: a box made again (a new ``TShape``) is
+    not integrated again and gives the same result; a moved, a reversed or a 1-ulp taller box is
+    another content, integrated on its own (its centroid moved, its volume negated or larger)."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.gp import gp_Trsf, gp_Vec
+    from OCP.TopLoc import TopLoc_Location
+
+    from tabletcad.cad.solid import MASS_MEMO
+
+    MASS_MEMO.clear()
+    first = mass_properties(BRepPrimAPI_MakeBox(1.0, 2.0, 3.0).Shape())
+    hits, misses = MASS_MEMO.hits, MASS_MEMO.misses
+    again = mass_properties(BRepPrimAPI_MakeBox(1.0, 2.0, 3.0).Shape())
+    assert again is first and (MASS_MEMO.hits, MASS_MEMO.misses) == (hits + 1, misses)
+    box = BRepPrimAPI_MakeBox(1.0, 2.0, 3.0).Shape()
+    shift = gp_Trsf()
+    shift.SetTranslation(gp_Vec(10.0, 0.0, 0.0))
+    moved = mass_properties(box.Moved(TopLoc_Location(shift)))
+    assert moved.centroid == pytest.approx((10.5, 1.0, 1.5), abs=1e-12) and moved.volume == pytest.approx(6.0)
+    assert mass_properties(box.Reversed()).volume == pytest.approx(-6.0)
+    taller = mass_properties(BRepPrimAPI_MakeBox(1.0, 2.0, math.nextafter(3.0, 4.0)).Shape())
+    assert MASS_MEMO.misses == misses + 3 and taller is not first and taller.volume == pytest.approx(6.0)

@@ -232,6 +232,34 @@ def test_volumes_are_occs_and_shared_faces_are_integrated_once(thesis):
     assert volume(punch, about=(0.0, 0.0, 100.0)) == occ(punch)[0]  # a point far from its own: not taken
 
 
+def test_a_face_made_again_is_integrated_once():
+    """A solid made again (new ``TShape`` objects, the same content) takes its faces' integrals from
+    ``CACHE.content``: no face integrated again, the volume OCC's to the last bit; the same solid
+    moved (new geometry) integrates each of its faces, to the same volume within 1e-12."""
+    from OCP.BRepGProp import BRepGProp
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
+    from OCP.GProp import GProp_GProps
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.booleans import CACHE, translated, volume
+
+    def occ(shape):
+        p = GProp_GProps()
+        BRepGProp.VolumeProperties_s(shape, p, 1e-9)
+        return p.Mass()
+
+    CACHE.clear()
+    first = volume(BRepPrimAPI_MakeCylinder(2.0, 3.0).Shape())
+    misses, faces = CACHE.faces.misses, CACHE.content.misses
+    again = BRepPrimAPI_MakeCylinder(2.0, 3.0).Shape()
+    n = len(explore(again, "Face"))
+    assert volume(again) == first == occ(again)
+    assert CACHE.faces.misses == misses + n and CACHE.content.misses == faces  # new faces, known contents
+    moved = translated(again, dz=1.0)
+    assert volume(moved) == pytest.approx(first, rel=1e-12) and volume(moved) == occ(moved)
+    assert CACHE.content.misses == faces + n
+
+
 def _assert_tip_checks_are_of_the_tips(report, band_z):
     """Each punch tip's manifold3d check is of the tip the build keeps: OCC's removed volume is that tip's
     prism (plan area times its length, from the band's middle to the tip's far end, measured from its

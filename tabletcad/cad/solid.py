@@ -48,6 +48,7 @@ from tabletcad.brep.revolved import RevolvedSurfaceData
 from tabletcad.brep.fit import PatchFunction, SurfaceFit, chain_breakpoints, fit_patches
 from tabletcad.brep.surface import BSplineSurfaceData, volume_and_area
 from tabletcad.cad._occ import cast, explore, shape_type
+from tabletcad.cad.content import ContentMemo, content_key, has_all_surfaces
 from tabletcad.cad.faces import face_of, knot_boundary_pcurves, make_geom_surface
 from tabletcad.cad.planes import flat_faces_as_planes, made_poles
 from tabletcad.cad.shell import assemble_shell
@@ -84,21 +85,35 @@ class MassProperties:
     eps: float | None
 
 
+#: :func:`mass_properties` of the newest shapes by content (:mod:`tabletcad.cad.content`): a solid built
+#: again (the same family sample in another stage or test) is not integrated again
+MASS_MEMO = ContentMemo(256)
+
+
 def mass_properties(shape: TopoDS_Shape, eps: float | None = DEFAULT_EPS) -> MassProperties:
     """Volume, area and centroid of ``shape``.
 
     ``eps`` (relative, per face) selects OCCT's adaptive Gauss integration;
     ``eps=None`` uses OCCT's default (non-adaptive) integration, which is what
-    FreeCAD's ``Shape.Volume`` does - only for comparisons.
+    FreeCAD's ``Shape.Volume`` does - only for comparisons.  Integrated once per shape content
+    (:data:`MASS_MEMO`; the same result to the last bit, OCC reads nothing else), except for shapes
+    with faces without a surface.
     """
+    if eps is not None and not 0 < eps <= 1e-3:
+        raise ValueError(f"eps = {eps} is not allowed: must be > 0 and <= 1e-3 (adaptive integration)")
+    if not has_all_surfaces(shape):
+        return _mass_properties(shape, eps)
+    return MASS_MEMO.get((content_key(shape), eps), lambda: _mass_properties(shape, eps))
+
+
+def _mass_properties(shape: TopoDS_Shape, eps: float | None) -> MassProperties:
+    """:func:`mass_properties` integrated by OCC (``eps`` checked by the caller)."""
     vprops, sprops = GProp_GProps(), GProp_GProps()
     if eps is None:
         BRepGProp.VolumeProperties_s(shape, vprops)
         BRepGProp.SurfaceProperties_s(shape, sprops)
         verr = aerr = float("nan")
     else:
-        if not 0 < eps <= 1e-3:
-            raise ValueError(f"eps = {eps} is not allowed: must be > 0 and <= 1e-3 (adaptive integration)")
         verr = float(BRepGProp.VolumeProperties_s(shape, vprops, Eps=float(eps)))
         aerr = float(BRepGProp.SurfaceProperties_s(shape, sprops, Eps=float(eps)))
     c = vprops.CentreOfMass()

@@ -220,7 +220,8 @@ def volume_centroid(shape: TopoDS_Shape, eps: float = 1e-9,
     point, the mean of the shape's vertices (:func:`reference_point`; ``BRepGProp_Vinert``, each
     face integrated adaptively to ``eps`` of its own integral); here the same sums, each face's
     integral kept (``CACHE.faces``, by face and point) for the next solid that has the face
-    (reversed: negated), and the volume is ``VolumeProperties``'s to the last bit.
+    (reversed: negated), and by the face's content (``CACHE.content``) for a face made again, and the
+    volume is ``VolumeProperties``'s to the last bit.
 
     ``about``: a point (mm) to integrate about instead, where it lies within :data:`NEAR_MM` of the
     shape's own, e.g. a punch tip about the finished tablet's point when the tablet's detail (its
@@ -278,12 +279,20 @@ def _volume_about(shape: TopoDS_Shape, eps: float, point: Point | None) -> tuple
             continue
         forward = cast(f.Oriented(fwd), "Face")
         key = ("volume", eps, point)
-        m, s = CACHE.faces.get(forward, key, lambda g=forward: _face_volume(g, eps, point))
+        m, s = CACHE.faces.get(forward, key, lambda g=forward: _face_volume_once(g, eps, point))
         sign = 1.0 if f.Orientation() == fwd else -1.0
         mass += sign * m
         moments += sign * s
     centre = moments / mass if mass != 0.0 else np.zeros(3)
     return mass, (float(centre[0]), float(centre[1]), float(centre[2]))
+
+
+def _face_volume_once(face, eps: float, point: Point) -> tuple[float, np.ndarray]:
+    """:func:`_face_volume`, once per face content (``CACHE.content``: the same face made again by
+    another build of the same tablet gives the same integral to the last bit)."""
+    from tabletcad.cad.content import content_key
+
+    return CACHE.content.get((content_key(face), "volume", eps, point), lambda: _face_volume(face, eps, point))
 
 
 def _face_volume(face, eps: float, point: Point) -> tuple[float, np.ndarray]:

@@ -17,6 +17,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from tabletcad.cad.content import ContentMemo
+
 __all__ = ["ShapeCache", "frozen"]
 
 
@@ -24,7 +26,9 @@ class ShapeCache:
     """The ``size`` most recently used results ``compute()`` of ``(shape, key)``.
 
     ``faces`` > 0: :attr:`faces` is a second cache of that size for results per face (the faces a
-    build's solids share: a punch tip's face is the tablet's), cleared with this one."""
+    build's solids share: a punch tip's face is the tablet's), and :attr:`content` one for results by
+    shape content (:func:`~tabletcad.cad.content.content_key`: a face of a build made again), both
+    cleared with this one."""
 
     def __init__(self, size: int = 48, faces: int = 0) -> None:
         self.size = int(size)
@@ -32,6 +36,7 @@ class ShapeCache:
         self.hits = 0
         self.misses = 0
         self.faces: ShapeCache | None = ShapeCache(faces) if faces > 0 else None
+        self.content: ContentMemo | None = ContentMemo(faces) if faces > 0 else None
 
     def get(self, shape, key: Any, compute: Callable[[], Any]) -> Any:
         slot = (hash(shape), key)
@@ -52,6 +57,8 @@ class ShapeCache:
         self._entries.clear()
         if self.faces is not None:
             self.faces.clear()
+        if self.content is not None:
+            self.content.clear()
 
 
 def frozen(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
