@@ -3,10 +3,12 @@
 Two builds of the same tablet make new shapes (new ``TShape`` objects) with the same geometry to the
 last bit; OCC's adaptive integrals of them are then the same to the last bit too (they read nothing
 else).  :func:`content_key` names a shape by its exact content: its binary BRep (``BinTools``, doubles
-as stored, without triangulations), hashed.  :class:`ContentMemo` keeps the newest results by such keys.
+as stored, and the shapes' status flags), hashed.  :class:`ContentMemo` keeps the newest results by such
+keys.  The flags make a shape meshed or checked since it was last keyed a new key: a miss, never a
+wrong hit.
 
-Only results computed from the geometry alone may be keyed so: an integral over a face without a
-surface (a mesh-only face) reads its triangulation, which the key leaves out
+Only results computed from the exact geometry are keyed so: an integral over a face without a surface
+(a mesh-only face) reads its triangulation instead, and shapes with such a face are not memoised
 (:func:`has_all_surfaces`).
 """
 
@@ -30,8 +32,9 @@ __all__ = ["content_key", "has_all_surfaces", "ContentMemo"]
 
 def content_key(shape: TopoDS_Shape) -> bytes:
     """A 20-byte digest of ``shape``'s binary BRep: its topology, orientations, locations, tolerances and
-    geometry (curves, p-curves, surfaces, parameter ranges) as exact doubles, not its triangulations.
-    Equal keys: the same shape content (BLAKE2b, a collision is not a practical concern)."""
+    geometry (curves, p-curves, surfaces, parameter ranges) as exact doubles, and the status flags of its
+    shapes (meshing a face clears its "checked" flag: a new key); triangulations only of faces without a
+    surface.  Equal keys: the same shape content (BLAKE2b, a collision is not a practical concern)."""
     buf = io.BytesIO()
     BinTools.Write_s(shape, buf, False, False, BinTools_FormatVersion.BinTools_FormatVersion_CURRENT)
     return hashlib.blake2b(buf.getvalue(), digest_size=20).digest()
@@ -39,7 +42,7 @@ def content_key(shape: TopoDS_Shape) -> bytes:
 
 def has_all_surfaces(shape: TopoDS_Shape) -> bool:
     """Whether every face of ``shape`` has a surface (OCC integrates a face without one on its
-    triangulation, which :func:`content_key` does not cover)."""
+    triangulation: such shapes are not memoised)."""
     exp = TopExp_Explorer(shape, TopAbs_FACE)
     while exp.More():
         if BRep_Tool.Surface_s(cast(exp.Current(), "Face")) is None:

@@ -86,7 +86,8 @@ class MassProperties:
 
 
 #: :func:`mass_properties` of the newest shapes by content (:mod:`tabletcad.cad.content`): a solid built
-#: again (the same family sample in another stage or test) is not integrated again
+#: again (the same family sample in another stage or test) is not integrated again, when both copies
+#: carry the same status flags (meshing a shape gives it a new key)
 MASS_MEMO = ContentMemo(256)
 
 

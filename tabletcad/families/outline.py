@@ -377,8 +377,10 @@ class PlanOutline:
         """Exact distance (mm) from plan points ``xy`` (m, 2) to the outline, > 0 inside.
 
         The distance and side of the nearest segment (the first of equals in the chain's
-        order), each segment measured only where its bounding circle allows it to be the
-        nearest (:func:`~tabletcad.geometry.curves.nearest_of`); a circle's is ``R - |xy - c|``.
+        order): for up to 1,024 points every segment measured at every point at once
+        (:class:`_SegmentColumns`), for more each segment only where its bounding circle allows
+        it to be the nearest (:func:`~tabletcad.geometry.curves.nearest_of`); a circle's is
+        ``R - |xy - c|``.
         """
         if self.is_circle:
             s = self.segs[0]
