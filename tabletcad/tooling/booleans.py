@@ -29,6 +29,7 @@ from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
 from OCP.TopoDS import TopoDS_Shape
 
 from tabletcad.cad._occ import cast, explore
+from tabletcad.cad.content import content_key
 from tabletcad.cad.solid import check_solid, mass_properties
 from tabletcad.errors import GeometryError
 from tabletcad.io.forked import OCC_PARALLEL
@@ -290,8 +291,6 @@ def _volume_about(shape: TopoDS_Shape, eps: float, point: Point | None) -> tuple
 def _face_volume_once(face, eps: float, point: Point) -> tuple[float, np.ndarray]:
     """:func:`_face_volume`, once per face content (``CACHE.content``: the same face made again by
     another build of the same tablet gives the same integral to the last bit)."""
-    from tabletcad.cad.content import content_key
-
     return CACHE.content.get((content_key(face), "volume", eps, point), lambda: _face_volume(face, eps, point))
 
 
