@@ -249,3 +249,31 @@ def test_a_failing_column_boolean_proves_nothing(monkeypatch):
     assert not I.inside_bore(tablet, die, circle_wire(5.0))
     (pair,) = I._overlaps(tablet, {"die": die}, 0.005, circle_wire(5.0))
     assert pair["occ_method"] != I.BORE_PROOF and pair["occ_mm3"] == 0.0
+
+
+def test_the_distance_skips_only_a_test_that_cannot_find_an_overlap():
+    """:func:`~tabletcad.tooling.interference._distance_shapes` loads the first solid as its shell when a
+    vertex of the second lies outside its box (that one is then not inside it): the same float as the
+    distance of the two solids, apart or overlapping; and a second solid inside the first, or a first one
+    inside the second, is still found (distance 0)."""
+    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
+    from OCP.gp import gp_Pnt
+
+    from tabletcad.tooling.interference import _distance_shapes
+
+    def box(lo, hi):
+        return BRepPrimAPI_MakeBox(gp_Pnt(*lo), gp_Pnt(*hi)).Shape()
+
+    def solids_distance(a, b):
+        return BRepExtrema_DistShapeShape(a, b).Value()
+
+    big, small = box((0, 0, 0), (10, 10, 10)), box((4, 4, 4), (6, 6, 6))
+    rod = BRepPrimAPI_MakeCylinder(1.0, 20.0).Shape()  # through the big box's corner
+    cases = [(big, box((10.5, 1, 1), (12, 3, 3))), (big, rod), (rod, big),
+             (small, box((6.25, 4, 4), (7, 6, 7.5))), (rod, small)]
+    for a, b in cases:  # apart or meeting: the solids' distance to the last bit
+        assert _distance_shapes(a, b).Value() == solids_distance(a, b)
+    assert _distance_shapes(big, box((10.5, 1, 1), (12, 3, 3))).Value() == pytest.approx(0.5)
+    assert _distance_shapes(big, small).Value() == 0.0  # the second inside the first: no vertex out of its box
+    assert _distance_shapes(small, big).Value() == 0.0  # the first inside the second: its vertices are inside
