@@ -12,6 +12,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import struct
 from pathlib import Path
@@ -145,9 +146,16 @@ def test_plan_outline_has_the_plan_area_and_no_spike(name):
         assert max(d_out, d_in) < min(0.01, 0.005 * size), (d_out, d_in)
 
 
-def _ellipse_distance(x: np.ndarray, z: np.ndarray, a: float, c: float) -> np.ndarray:
+@functools.lru_cache(maxsize=None)
+def _ellipse_tree(a: float, c: float) -> cKDTree:
+    """A k-d tree of 200,001 points of the ellipse of semi-axes ``a`` and ``c`` (mm), built once for the
+    module (each spheroid's is asked for by both methods, each twice)."""
     th = np.linspace(0.0, math.tau, 200001)
-    return cKDTree(np.c_[a * np.cos(th), c * np.sin(th)]).query(np.c_[x, z])[0]
+    return cKDTree(np.c_[a * np.cos(th), c * np.sin(th)])
+
+
+def _ellipse_distance(x: np.ndarray, z: np.ndarray, a: float, c: float) -> np.ndarray:
+    return _ellipse_tree(a, c).query(np.c_[x, z])[0]
 
 
 @pytest.mark.parametrize("general", [False, True], ids=["meridian", "crossings"])
