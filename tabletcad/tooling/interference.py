@@ -940,9 +940,15 @@ def _one_shell(shape):
     return shells[0] if len(shells) == 1 else None
 
 
+#: how far (mm) a vertex of one solid must lie outside the other's box (:func:`_box`) to prove it is not
+#: inside it: such boxes hold B-spline and analytic faces whole but sample other surfaces (an extruded
+#: outline), which may fall short by a sliver (see :func:`_mesh_near`); a die's corners lie centimetres out
+NOT_INSIDE_MARGIN_MM = 1.0
+
+
 def _not_inside(b, a) -> bool:
-    """Whether a vertex of the one solid ``b`` lies outside the bounding box of ``a`` (:func:`_box`, which
-    holds ``a``): then ``b`` is not inside ``a``.
+    """Whether a vertex of the one solid ``b`` lies more than :data:`NOT_INSIDE_MARGIN_MM` outside the
+    bounding box of ``a`` (:func:`_box`): then ``b`` is not inside ``a``.
 
     With ``b`` not inside ``a``, the distance of ``a``'s boundary to the solid ``b`` still proves them
     apart: ``BRepExtrema_DistShapeShape`` classifies the vertices of the first shape in the second when
@@ -955,6 +961,7 @@ def _not_inside(b, a) -> bool:
     if len(explore(b, "Solid")) != 1:
         return False
     box = _box(a)
+    box.Enlarge(NOT_INSIDE_MARGIN_MM)
     return any(box.IsOut(BRep_Tool.Pnt_s(v)) for v in explore(b, "Vertex"))
 
 
