@@ -53,3 +53,20 @@ def test_a_familys_peer_is_its_own_profile_revolved(name):
         d = p["cup_depth"]
         stand_in = bench._band_tablet(p["diameter"] / 2, d, d + p["band"], d, d)
         assert abs(stand_in.volume / tablet.volume() - 1.0) > 5e-3
+
+
+def test_the_issues_peer_is_the_10_mm_standard_concave_round():
+    """The peer issue #12 names (a 10 mm tablet, band 3 mm, spherical cups 1 mm deep): a band cylinder and
+    two caps of a 13 mm sphere ((5² + 1²) / 2), whose volume pi h² (3 R - h) / 3 and area 2 pi R h are
+    closed forms; the bench's ``issue`` column divides by its time."""
+    import math
+
+    peer = _bench_cad().issue_peer()
+    assert peer.is_valid
+    band, cap_r, h = 3.0, 13.0, 1.0
+    volume = math.pi * 25.0 * band + 2.0 * math.pi * h * h * (3.0 * cap_r - h) / 3.0
+    area = 2.0 * math.pi * 5.0 * band + 2.0 * (2.0 * math.pi * cap_r * h)
+    assert peer.volume == pytest.approx(volume, rel=1e-9)
+    assert peer.area == pytest.approx(area, rel=1e-9)
+    bb = peer.bounding_box()
+    assert (bb.size.X, bb.size.Z) == (pytest.approx(10.0, abs=1e-6), pytest.approx(5.0, abs=1e-6))
