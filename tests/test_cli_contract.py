@@ -249,6 +249,13 @@ def test_shapes_marks_required_and_optional_and_prints_whole_descriptions(capsys
     assert "ffbe required: diameter [mm], thickness [mm], bevel_angle [deg], bevel_width [mm] (or bevel_depth); " \
            "optional: bevel_depth [mm] = 0" in text
     assert d["ffbe"]["alternatives"] == {"bevel_width": "bevel_depth"} and d["concave_round"]["alternatives"] == {}
+    # the designs of any shape too, as the listing has them (the JSON had left them out: 25 of the 27)
+    assert list(d) == [*FAMILIES, "custom_outline", "free_form"] and all(f"{n} " in text for n in d)
+    assert d["custom_outline"]["required"] == ["outline", "band", "cup_depth"]
+    assert d["custom_outline"]["alternatives"] == {"outline": "segments"} and d["free_form"]["required"] == ["patch"]
+    for entry in d.values():
+        assert set(entry) == {"params", "required", "optional", "alternatives", "defaults", "description"}
+        assert sorted(entry["required"] + entry["optional"]) == sorted(entry["params"]) == sorted(entry["defaults"])
 
 
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")

@@ -415,3 +415,39 @@ def test_a_file_name_that_cannot_be_a_tablet_name_says_where_the_name_came_from(
     ok = tmp_path / "O'Brien 50% x.toml"  # an apostrophe is taken
     ok.write_text(src.read_text(encoding="utf-8"), encoding="utf-8")
     assert main(["report", str(ok)]) == 0
+
+
+@pytest.mark.parametrize("family, params, measured, note", [
+    # a rod's and an oblong's length run along their axis: the nominal reads length x width x thickness as the
+    # measure does (it had printed "nominal 7.5 x 3 mm" beside "3.002 x 3.002 x 7.5 mm")
+    ("thesis.rod", {"diameter": 3.0, "length": 7.5, "dome": 1.0}, (3.002, 3.002, 7.5), " (PDE surface; nominal 3 x 3 x 7.5 mm)"),
+    ("thesis.oblong", {"diameter": 5.0, "length": 15.0, "dome": 2.0}, (5.003, 5.003, 15.0),
+     " (PDE surface; nominal 5 x 5 x 15 mm)"),
+    # a spheroid's height and a sphere's diameter are their thickness (they had been left out)
+    ("thesis.prolate_spheroid", {"diameter": 5.0, "height": 10.0}, (5.005, 5.005, 10.0),
+     " (PDE surface; nominal 5 x 5 x 10 mm)"),
+    ("thesis.spherical", {"diameter": 5.0}, (5.005, 5.005, 5.002), " (PDE surface; nominal 5 x 5 x 5 mm)"),
+    ("thesis.ring", {"outer_diameter": 12.0, "inner_diameter": 6.0, "thickness": 4.5}, (12.01, 12.01, 4.5),
+     " (PDE surface; nominal 12 x 12 x 4.5 mm)"),
+    ("thesis.shallow_convex_oval", {"length": 12.0, "width": 6.0, "thickness": 3.1, "band": 1.5}, (12.0, 6.0, 3.1), ""),
+    ("concave_round", {"diameter": 10.0, "band": 3.0, "cup_depth": 1.0}, (10.0001, 10.0001, 5.0), ""),
+])
+def test_the_nominal_note_reads_as_the_measure(family, params, measured, note):
+    from tabletcad.cli.report import nominal_note
+
+    assert nominal_note(family, params, *measured) == note
+
+
+@pytest.mark.skipif(not Path("/dev/null").exists(), reason="needs /dev/null")
+@pytest.mark.parametrize("command, line", [
+    (["report", "/dev/null"], "error: DESIGN = '/dev/null' is not allowed: is a pipe or device, not a file (save the "
+                              "design to a .toml file)"),
+    (["build", "/dev/null", "--out", "OUT"], "error: DESIGN = '/dev/null' is not allowed: must be a TOML file, not a pipe "
+                                             "or device"),
+])
+def test_a_design_given_as_a_device_is_not_said_to_be_missing(tmp_path, capsys, command, line):
+    """``tabletcad report <(cat design.toml)`` (a pipe) and /dev/null exist: they had been refused as "does not exist"."""
+    args = [str(tmp_path / "out") if a == "OUT" else a for a in command]
+    assert main(args) == 2
+    assert capsys.readouterr().err.splitlines() == [line]
+    assert list(tmp_path.iterdir()) == []

@@ -112,11 +112,17 @@ def test_a_tip_is_checked_against_the_barrel_less_the_clearance():
 
     b = SimpleNamespace(barrel_diameter_mm=19.0, max_round_tablet_mm=16.0, max_shaped_tablet_mm=19.0, standard="TSM",
                         kind="B")
-    frame = SimpleNamespace(length=19.0, width=8.0, outline_kind="capsule")
+    frame = SimpleNamespace(length=19.0, width=8.0, plan_diameter=19.0, outline_kind="capsule")
     check_body_fits(frame, b, 9.5 - 0.02)
     with pytest.raises(DesignError) as e:
         check_body_fits(frame, b, 9.5)
     assert e.value.parameter == "tooling.punch.barrel_diameter_mm"
+    # the standard's largest tablet is its largest extent in plan: a square 14 mm on the axes is 19.4 mm across
+    # its corners, over B's 19 mm (it had been read as 14 mm), though its tips fit the barrel
+    square = SimpleNamespace(length=14.0, width=14.0, plan_diameter=19.4, outline_kind="lines and arcs")
+    with pytest.raises(DesignError) as e:
+        check_body_fits(square, b, 9.0)
+    assert e.value.parameter == "tooling.type" and e.value.allowed.endswith("this one is 19.4 mm across")
 
 
 def test_make_tooling_passes_the_tip_radius_and_warns_of_a_keyless_shaped_tip(monkeypatch):
@@ -226,6 +232,23 @@ _LAND = '[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 2.8\ncup_de
     (_LAND + '[[tooling.score]]\nkind = "bisect"\ndepth_mm = 5\n',
      "error: tooling.score[0].depth_mm = 5 mm is not allowed: must be < the top cup depth 0.9 mm minus 0.005 mm (a "
      "standard score runs out on the face; set cut_through = true to cut the band)"),
+    # a flat face has no cup for a standard score to run out in (its cup depth, 8.9e-16 mm, had been quoted as the
+    # bound: "< the top cup depth 8.882e-16 mm minus 0.005 mm")
+    ('[tablet]\nfamily = "flat_face_round"\ndiameter = 10.0\nthickness = 3.5\n[tooling]\n[[tooling.score]]\n'
+     'depth_mm = 0.3\n',
+     "error: tooling.score[0].depth_mm = 0.3 mm is not allowed: a standard score runs out in a cup and the top face is "
+     "flat; set cut_through = true to cut it across the face, at most band/4 = 0.875 mm deep"),
+    # complete punches: a lower tip no longer than the die (report had passed it; build refused it after the solid)
+    (ROUND.replace("[tooling]\nclearance_mm = 0.02\n", "") + TSM_B + "head_top_angle_deg = 10.0\n",
+     "error: tooling.lower_tip_length_mm = 8 mm is not allowed: must be > 22.22 mm, the die's height: at ejection the "
+     "lower tip edge rises to the die's top face and the barrel must stay below the die (not given, it is "
+     "tip_length_mm: give lower_tip_length_mm)"),
+    # a rounded square 24 mm on the axes is 33.1 mm across its corners: larger than a D die takes (it had been
+    # read as 24 mm, and an 18 mm one, 24.6 mm across, given a B die, which takes shaped tablets up to 19 mm)
+    ('[tablet]\nfamily = "rounded_square"\nside = 24.0\ncorner_radius = 1.0\nband = 3.0\ncup_depth = 0.5\n'
+     '[tooling]\nclearance_mm = 0.03\n',
+     "error: tooling.die_outer_diameter_mm = (not given) is not allowed: give it for a shaped tablet 33.11 mm across "
+     "(larger than a TSM 'D' die takes, 25 mm)"),
 ])
 def test_tooling_numbers_are_refused_by_report_and_build_before_the_cad(capsys, tmp_path, monkeypatch, command, design,
                                                                          line):

@@ -168,3 +168,24 @@ def test_a_point_outline_s_diameter_is_cheap():
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
     assert d == pytest.approx(12.0, rel=1e-3) and peak < 50e6
+
+
+@pytest.mark.parametrize("tablet, across", [
+    ({"family": "rounded_square", "side": 18.0, "corner_radius": 1.0, "band": 3.0, "cup_depth": 0.5},
+     18.0 * math.sqrt(2.0) - 2.0 * (math.sqrt(2.0) - 1.0)),  # corner centres 8 mm from the axes, + their radius
+    ({"family": "capsule", "length": 19.0, "width": 8.0, "band": 3.0, "cup_depth": 1.0}, 19.0),
+    ({"family": "concave_round", "diameter": 10.0, "band": 3.0, "cup_depth": 1.0}, 10.0),
+])
+def test_the_plan_diameter_a_die_is_chosen_by_is_the_largest_extent_in_any_direction(tablet, across):
+    """:func:`plan_diameter` (what the TSM die and the punch standard's largest tablet are read from): the
+    rounded square's diagonal in closed form (the extents along the axes, 18 mm, had chosen a B die for a
+    24.6 mm-across square), a capsule's length, a round's diameter; never below the PDE tablet's extents,
+    which stand micrometres outside the nominal outline."""
+    from tabletcad.pipeline.designreport import plan_diameter
+
+    t = Design.from_dict({"tablet": tablet}).build()
+    d = plan_diameter(t)
+    lo, hi = t.bounds()
+    assert d >= max(hi[0] - lo[0], hi[1] - lo[1]) and d == pytest.approx(across, rel=1e-12, abs=1e-5)
+    if tablet["family"] == "rounded_square":
+        assert d == pytest.approx(across, rel=1e-12) and d > 1.3 * (hi[0] - lo[0])

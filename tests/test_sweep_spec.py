@@ -212,6 +212,21 @@ def test_a_fixed_smoothing_parameter_outside_its_range_is_refused_before_the_swe
                       "and <= 1")
 
 
+def test_a_thesis_shapes_fixed_smoothing_parameter_is_read_as_its_patches_read_it():
+    """The (0, 1] range is the industry families' (tabletcad.families.round.smoothing); a thesis shape's patches
+    take any a > 0 (``build`` makes the sphere at a = 1.5, 5.015 mm across), so its sweep is not refused up front
+    (it had been: "every row would fail"), and a = 0 still is."""
+    from tabletcad.errors import DesignError
+
+    def sweep(a):
+        return parse_sweep({"design": {"tablet": {"family": "thesis.spherical", "diameter": 5.0, "a": a}},
+                            "sweep": {"vary": {"tablet.diameter": [5.0, 6.0]}}})
+
+    assert len(sweep(1.5).points()) == 2
+    with pytest.raises(DesignError, match=r"^design.tablet.a = 0 is not allowed: must be > 0$"):
+        sweep(0.0)
+
+
 def _refused_up_front(tmp_path, capsys, body: str, line: str) -> None:
     """The sample base with ``body`` added and its cup depth varied: one line starting ``line``, exit 2,
     no output folder."""

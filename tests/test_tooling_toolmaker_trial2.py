@@ -61,7 +61,26 @@ def test_a_tablet_larger_than_every_tsm_die_is_refused_before_the_cad(capsys, tm
     name, value, why = _refused(capsys, tmp_path, design + "[tooling]\nclearance_mm = 0.02\ntip_length_mm = 8.0\n")
     assert name == "tooling.die_outer_diameter_mm" and value == "(not given)"
     size = "1000" if shaped == "round" else "25.5"
-    assert why == f"give it for a {shaped} tablet {size} mm long (larger than a TSM 'D' die takes, 25 mm)"
+    assert why == f"give it for a {shaped} tablet {size} mm across (larger than a TSM 'D' die takes, 25 mm)"
+
+
+@pytest.mark.cad
+@pytest.mark.parametrize("side, kind", [(13.0, "B"), (15.0, "D")])
+def test_a_shaped_tablets_die_is_chosen_by_its_extent_across_its_corners(side, kind):
+    """A rounded square 15 mm on the axes is 20.4 mm across its corners: a TSM D die (a B takes shaped tablets
+    up to 19 mm; it had been given a B, its size read along the axes), and 13 mm (17.6 mm across) keeps its B."""
+    pytest.importorskip("OCP")
+    import math
+
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.die import default_die_size
+    from tabletcad.tooling.outline import tablet_frame
+
+    t = Design.from_dict({"tablet": {"family": "rounded_square", "side": side, "corner_radius": 1.0, "band": 3.0,
+                                     "cup_depth": 0.5}}).build()
+    frame = tablet_frame(t)
+    assert frame.plan_diameter == pytest.approx(side * math.sqrt(2.0) - 2.0 * (math.sqrt(2.0) - 1.0), rel=1e-12)
+    assert default_die_size(frame)[2] == kind
 
 
 def test_a_tablets_profile_arrays_are_read_only():

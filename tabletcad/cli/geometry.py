@@ -16,6 +16,27 @@ from tabletcad.tolerance import DEFAULT, Tolerances
 __all__ = ["COMMANDS"]
 
 
+#: the designs of any shape, in ``shapes --json`` as the families are (their keys: tabletcad.pipeline.design)
+_ANY_SHAPE = {
+    "custom_outline": dict(
+        params={"outline": "points", "segments": "lines and arcs", "band": "mm", "cup_depth": "mm", "land": "mm",
+                "cup_width": "mm", "central_radius": "mm", "edge_radius": "mm"},
+        required=["outline", "band", "cup_depth"], optional=["segments", "land", "cup_width", "central_radius",
+                                                            "edge_radius"],
+        alternatives={"outline": "segments"},
+        defaults={"outline": None, "segments": None, "band": None, "cup_depth": None, "land": 0.0, "cup_width": 0.0,
+                  "central_radius": 0.0, "edge_radius": 0.0},
+        description="Any closed plan outline, given as [x, y] points (a spline through them) or as segments "
+                    "([\"line\", [x0, y0], [x1, y1]] or [\"arc\", [cx, cy], r, theta0, sweep], angles in rad), with "
+                    "a cup swept over it (see README: design files)."),
+    "free_form": dict(
+        params={"patch": "[[patch]] tables of 4 curves each"}, required=["patch"], optional=[], alternatives={},
+        defaults={"patch": None},
+        description="PDE patches through boundary curves of your own, one [[patch]] table of 4 curves each "
+                    "(see README: design files)."),
+}
+
+
 @click.command("shapes")
 @click.option("--json", "as_json", is_flag=True, help="Print the families as JSON on stdout.")
 @click.option("--json-file", type=click.Path(path_type=Path), help="Write the families as JSON to this file.")
@@ -34,7 +55,7 @@ def shapes_cmd(as_json: bool, json_file: Path | None) -> None:
                                    alternatives=dict(f.alternatives),  # a required one another may replace
                                    defaults={k: (None if k in f.required else v) for k, v in f.defaults.items()},
                                    description=f.description)
-                           for n, f in FAMILIES.items()}, indent=2)
+                           for n, f in FAMILIES.items()} | _ANY_SHAPE, indent=2)
         with staged(json=json_file) as out:
             if json_file is not None:
                 out["json"].write_text(text + "\n", encoding="utf-8")

@@ -52,13 +52,23 @@ def _fmt(v: Any, unit: str = "", digits: int = 4) -> str:
     return str(v) + (f" {unit}" if unit else "")
 
 
+#: the thesis's shapes whose ``length`` runs along the tablet's axis (its thickness), not in plan
+_AXIAL_LENGTH = ("thesis.oblong", "thesis.rod")
+
+
 def nominal_note(family: str, params: dict[str, Any], length: float, width: float, thickness: float) -> str:
     """`` (PDE surface; nominal 10 x 10 x 3 mm)`` when one of the thesis's shapes measures other than
     its design's own dimensions at the printed precision (its PDE surface bulges between the
-    thesis's boundary curves), else ``""``."""
-    L = params.get("length", params.get("diameter"))
-    W = params.get("width", params.get("diameter"))
-    T = params.get("thickness")
+    thesis's boundary curves), else ``""``.  The nominal reads as the measure does, length x width x
+    thickness: a rod's or an oblong's ``length`` is its thickness (along its axis), a spheroid's
+    ``height`` and a sphere's ``diameter`` are too, a ring's plan is its ``outer_diameter``."""
+    D = params.get("diameter", params.get("outer_diameter"))
+    if family in _AXIAL_LENGTH:
+        L = W = D
+        T = params.get("length")
+    else:
+        L, W = params.get("length", D), params.get("width", D)
+        T = params.get("thickness", params.get("height", D if family == "thesis.spherical" else None))
     if L is None or W is None or not family.startswith("thesis."):
         return ""
     nominal = (f"{L:.4g}", f"{W:.4g}") + ((f"{T:.4g}",) if T is not None else ())
@@ -299,7 +309,9 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
         if d.suffix.lower() == ".json":
             raise DesignError("DESIGN", str(d), "is a design .toml; write JSON with --json-file (--json prints to stdout)")
         if not d.is_file():
-            raise DesignError("DESIGN", str(d), "is a folder, not a file" if d.is_dir() else "does not exist")
+            raise DesignError("DESIGN", str(d), "is a folder, not a file" if d.is_dir() else
+                              "is a pipe or device, not a file (save the design to a .toml file)" if d.exists() else
+                              "does not exist")
     check_output("--json-file", json_file, (".json",))
     check_output("--csv", csv_out, (".csv",))
     check_output("--xlsx", xlsx_out, (".xlsx",))

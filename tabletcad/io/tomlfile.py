@@ -36,8 +36,9 @@ def read_toml_file(path: str | Path, parameter: str) -> dict[str, Any]:
     path = Path(path)
     if path.is_dir():
         raise DesignError(parameter, str(path), "must be a TOML file, not a folder")
-    if not path.is_file():
-        raise DesignError(parameter, str(path), "must be an existing TOML file")
+    if not path.is_file():  # (a pipe, such as bash's <(...), or a device exists but is not a file)
+        raise DesignError(parameter, str(path), "must be a TOML file, not a pipe or device" if path.exists()
+                          else "must be an existing TOML file")
     try:
         text = path.read_text(encoding="utf-8-sig")  # a byte-order mark, as some editors write it, is not TOML
     except UnicodeDecodeError:

@@ -40,7 +40,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 __all__ = ["ReportOptions", "design_report", "shape_report", "shape_design_report", "family_seams",
-           "punch_rating_table", "tensile_strength", "FDA_MAX_DIMENSION_MM", "REPORT_KEYS"]
+           "punch_rating_table", "tensile_strength", "plan_diameter", "FDA_MAX_DIMENSION_MM", "REPORT_KEYS"]
 
 #: FDA guidance "Size, Shape, and Other Physical Attributes of Generic Tablets and Capsules"
 #: (2015): the largest dimension of a generic tablet should not exceed 22 mm.
@@ -525,6 +525,20 @@ def shape_design_report(tablet: Tablet, opts: ReportOptions | None = None) -> di
     _add_figures(rep, dict(shape=shape, face=face, band_mm=band, cup_depth_mm=cup or 0.0, width_mm=W, length_mm=Ln,
                            elongated=shape == "oval", plan_diameter_mm=_sampled_plan_diameter(tablet)), T, opts)
     return rep
+
+
+def plan_diameter(tablet: Tablet) -> float:
+    """The tablet's largest extent in plan, in any direction (mm): a round tablet's diameter, a capsule's
+    length, a rounded square's diagonal: the size a die is chosen by (a TSM B die takes shaped tablets up to
+    19 mm across) and the FDA's size guidance reads.  The family outline's closed form
+    (:attr:`~tabletcad.families.outline.Outline.diameter`) where the tablet has one, else
+    :func:`_sampled_plan_diameter`; never less than the tablet's extents along x and y (a PDE band may stand
+    micrometres outside its outline)."""
+    lo, hi = tablet.bounds()
+    extent = max(float(hi[0] - lo[0]), float(hi[1] - lo[1]))
+    outline = getattr(tablet.nominal, "outline", None)
+    across = float(outline.diameter) if hasattr(outline, "diameter") else _sampled_plan_diameter(tablet)
+    return max(extent, across or 0.0)
 
 
 def _sampled_plan_diameter(tablet: Tablet) -> float | None:

@@ -207,7 +207,8 @@ def _check_fixed_dimensions(design: dict, varied: set[str]) -> None:
     """Refuse a dimension of ``[design.tablet]`` that the sweep does not vary and that no design could
     take, whatever the varied values: not a number, not finite, beyond the size limit, below the
     smallest length, or a negative length (every family's lengths are >= 0); and a smoothing parameter
-    ``a`` outside (0, 1] (the range of every design).  Every row would fail.  A value that one family
+    ``a`` its family refuses: outside (0, 1] for an industry family, not > 0 for a thesis shape.  Every row
+    would fail.  A value that one family
     refuses by its own rules (a concave round's band of 0) is left to the rows: whether it fails can
     depend on the varied values."""
     from tabletcad.pipeline.design import _number
@@ -216,12 +217,15 @@ def _check_fixed_dimensions(design: dict, varied: set[str]) -> None:
     if fam is None:
         return
     a = design["tablet"].get("a")
-    if a is not None and a != "auto" and "tablet.a" not in varied:  # the smoothing parameter: one range for all
-        from tabletcad.errors import check_range
+    if a is not None and a != "auto" and "tablet.a" not in varied:  # the smoothing parameter, as the family reads it
+        from tabletcad.errors import check_positive, check_range
+        from tabletcad.families import INDUSTRY_FAMILIES
 
         x = _number("design.tablet.a", a)
-        if not 0.0 < x <= 1.0:
+        if fam.name in INDUSTRY_FAMILIES:  # (0, 1] (tabletcad.families.round.smoothing)
             check_range("design.tablet.a", x, 0.0, 1.0, lo_open=True)
+        else:  # a thesis shape's patches take any a > 0 (a = 1.5 builds a sphere 5.015 mm across)
+            check_positive("design.tablet.a", x)
     for k, v in design["tablet"].items():
         if k in fam.params and f"tablet.{k}" not in varied:
             where = f"design.tablet.{k}"

@@ -23,7 +23,7 @@ from tabletcad.cad._occ import cast, explore
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.tooling.booleans import boolean, translated, volume
 from tabletcad.tooling.outline import TabletFrame, offset_wire, plan_face, prism
-from tabletcad.tooling.spec import MIN_DIE_WALL_MM, standard_die_size
+from tabletcad.tooling.spec import MIN_DIE_WALL_MM, die_faces_z, standard_die_size
 
 __all__ = ["die", "default_die_size", "tapered_prism", "bore_wire", "MIN_WALL_MM"]
 
@@ -86,14 +86,16 @@ def bore_wire(frame: TabletFrame):
 
 
 def default_die_size(frame: TabletFrame) -> tuple[float, float, str]:
-    """``(outer diameter, height, TSM type)`` for the tablet's largest plan dimension."""
-    return standard_die_size(max(frame.length, frame.width), shaped=frame.outline_kind != "circle")
+    """``(outer diameter, height, TSM type)`` for the tablet's largest plan dimension, its extent in any
+    direction (:attr:`~tabletcad.tooling.outline.TabletFrame.plan_diameter`: a 24.6 mm-across square of 18 mm
+    sides had been given a B die, which takes shaped tablets up to 19 mm)."""
+    return standard_die_size(frame.plan_diameter, shaped=frame.outline_kind != "circle")
 
 
 def die_position(frame: TabletFrame, height: float, penetration: float | None = None) -> tuple[float, float, float]:
-    """``(upper punch entry, top z, bottom z)`` of a die ``height`` mm high at the closed position (mm)."""
-    pen = min(3.0, 0.25 * height) if penetration is None else penetration
-    return pen, frame.band_z[1] + pen, frame.band_z[1] + pen - height
+    """``(upper punch entry, top z, bottom z)`` of a die ``height`` mm high at the closed position (mm;
+    :func:`~tabletcad.tooling.spec.die_faces_z` of the frame's band)."""
+    return die_faces_z(frame.band_z, height, penetration)
 
 
 def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, taper_deg: float = 0.0,

@@ -112,6 +112,15 @@ class TabletFrame:
         return self.z_max - self.z_min
 
     @property
+    def plan_diameter(self) -> float:
+        """The tablet's largest extent in plan, in any direction (mm; a rounded square's diagonal): the size
+        the standards' die types and punch bodies are rated by
+        (:func:`~tabletcad.pipeline.designreport.plan_diameter`)."""
+        from tabletcad.pipeline.designreport import plan_diameter
+
+        return max(self.length, self.width, plan_diameter(self.tablet))
+
+    @property
     def plan_area(self) -> float:
         return face_area(plan_face(self.outline))
 

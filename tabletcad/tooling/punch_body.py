@@ -128,12 +128,13 @@ def check_body_fits(frame: TabletFrame, b: PunchBody, tip_radius: float) -> None
         raise DesignError("[tooling.punch] barrel_diameter_mm", b.barrel_diameter_mm,
                           f"must be > the punch tip's circumscribed diameter {2 * tip_radius:.4g} mm (the tablet's "
                           "less twice the clearance)", "mm")
-    size = max(frame.length, frame.width)
+    size = frame.plan_diameter  # (its extent in any direction: a rounded square's diagonal)
     round_ = frame.outline_kind == "circle"
     lim = b.max_round_tablet_mm if round_ else b.max_shaped_tablet_mm
     if lim is not None and size > lim + 1e-9:
         raise DesignError("[tooling] type", b.kind, f"{b.standard} {b.kind} tooling takes {'round' if round_ else 'shaped'} "
-                          f"tablets up to {lim:g} mm (tabletcad/data/tooling_standards.toml); this one is {size:.4g} mm")
+                          f"tablets up to {lim:g} mm (tabletcad/data/tooling_standards.toml); this one is {size:.4g} mm "
+                          "across")
 
 
 def complete_punch(frame: TabletFrame, tip_shape, which: str, b: PunchBody, clearance: float, tip_length: float,

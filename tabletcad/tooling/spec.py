@@ -111,6 +111,9 @@ def tip_inset(clearance_mm: float, bore_offset_mm: float) -> float:
 #: figure's engraving in it): a 0.9 mm tip on a 0.9 mm cup had been built with nothing behind the cup's centre
 MIN_TIP_BACKING_MM = 1.0
 
+#: a cup shallower than this (mm) is a flat face (a flat face's cup depth is the round-off of its heights)
+FLAT_FACE_MM = 1e-9
+
 #: how far (mm) a standard score's groove stays shallower than its cup: it runs out on the face
 RUN_OUT_MARGIN_MM = 0.005
 
@@ -165,6 +168,10 @@ def check_score_size(s: ScoreSpec, i: int, cups: dict[str, float], band: float, 
                 raise DesignError(w, s.depth_mm, f"must be <= cup depth + band/4 = {limit:.4g} mm on the {face} face "
                                   "(a cut-through or short score must leave half the band)", "mm")
         elif s.depth_mm > cup - RUN_OUT_MARGIN_MM:
+            if cup < FLAT_FACE_MM:  # (a flat face's cup is its round-off, 8.9e-16 mm had been quoted as the bound)
+                raise DesignError(w, s.depth_mm, f"a standard score runs out in a cup and the {face} face is flat; set "
+                                  f"cut_through = true to cut it across the face, at most band/4 = {0.25 * band:.4g} mm "
+                                  "deep", "mm")
             raise DesignError(w, s.depth_mm, f"must be < the {face} cup depth {cup:.4g} mm minus {RUN_OUT_MARGIN_MM} mm "
                               "(a standard score runs out on the face; set cut_through = true to cut the band)", "mm")
     if groove_width(s) >= room:  # (a depth within its bounds): a V of 179.9 deg was a 687 mm wide "score"
@@ -237,6 +244,47 @@ def check_on_tablet(tablet: Any, spec: ToolingSpec) -> None:
                   width=float(hi[1] - lo[1]), bore_offset_mm=bore_offset(overhang))
 
 
+#: the die height (mm) beside a given outer diameter when no height is given (a TSM B die's)
+DEFAULT_DIE_HEIGHT_MM = 22.22
+
+
+def die_height_for(spec: ToolingSpec, size_mm: float, shaped: bool) -> float:
+    """The die height (mm) a build uses: the given one, else :data:`DEFAULT_DIE_HEIGHT_MM` beside a given outer
+    diameter, else the TSM die's (:func:`standard_die_size`) for a tablet ``size_mm`` across (its plan's
+    largest extent), round or ``shaped``."""
+    if spec.die_height_mm is not None:
+        return spec.die_height_mm
+    if spec.die_outer_diameter_mm is not None:
+        return DEFAULT_DIE_HEIGHT_MM
+    return standard_die_size(size_mm, shaped)[1]
+
+
+def die_faces_z(band_z: tuple[float, float], height: float, penetration: float | None = None) -> tuple[float, float, float]:
+    """``(upper punch entry, top z, bottom z)`` (mm) of a die ``height`` mm high at the closed position, the
+    tablet's band at ``band_z``: the upper punch enters ``min(3 mm, height / 4)`` unless ``penetration`` is given."""
+    pen = min(3.0, 0.25 * height) if penetration is None else penetration
+    return pen, band_z[1] + pen, band_z[1] + pen - height
+
+
+def check_punch_lengths(spec: ToolingSpec, band_z: tuple[float, float], height: float) -> None:
+    """Complete punches' tips against a die ``height`` mm high (the tablet's band at ``band_z``, mm): the upper
+    tip longer than its entry into the die, the lower one longer than the die (at ejection its edge rises to
+    the die's top face and the barrel's shoulder must stay below the die); a :class:`DesignError` else.  Run on
+    the PDE tablet before any geometry (``report`` and ``build`` alike) and on the tooling frame."""
+    _, top, bottom = die_faces_z(band_z, height)
+    need_up = top - band_z[1]
+    if spec.tip_length_mm <= need_up:
+        raise DesignError("[tooling] tip_length_mm", spec.tip_length_mm,
+                          f"must be > {need_up:.4g} mm, the upper punch's entry into the die (the barrel stays out)", "mm")
+    need_low = top - bottom
+    if spec.lower_tip <= need_low:
+        raise DesignError("[tooling] lower_tip_length_mm", spec.lower_tip,
+                          f"must be > {need_low:.4g} mm, the die's height: at ejection the lower tip edge rises to "
+                          f"the die's top face and the barrel must stay below the die"
+                          + ("" if spec.lower_tip_length_mm is not None else
+                             " (not given, it is tip_length_mm: give lower_tip_length_mm)"), "mm")
+
+
 #: TSM die blanks: (outer diameter, height, type), mm; the largest tablet each takes, round and shaped,
 #: is the standard's (``max_round_tablet_mm``, ``max_shaped_tablet_mm`` in tabletcad/data/tooling_standards.toml)
 TSM_DIES = ((30.16, 22.22, "B"), (38.10, 23.81, "D"))
@@ -257,8 +305,8 @@ DIE_SIZE_SLACK_MM = 0.01
 
 
 def standard_die_size(size_mm: float, shaped: bool = False) -> tuple[float, float, str]:
-    """``(outer diameter, height, TSM type)`` of the die for a tablet whose largest plan dimension is
-    ``size_mm`` (:data:`TSM_DIES`): the smallest type that takes it, round or ``shaped`` (a B die takes
+    """``(outer diameter, height, TSM type)`` of the die for a tablet whose largest plan dimension (its extent
+    in any direction) is ``size_mm`` (:data:`TSM_DIES`): the smallest type that takes it, round or ``shaped`` (a B die takes
     round tablets up to 16 mm and shaped ones up to 19 mm; :data:`DIE_SIZE_SLACK_MM` beyond a limit is at
     it); a :class:`DesignError` for one larger than a 'D' die takes."""
     for od, h, name in TSM_DIES:
@@ -266,7 +314,7 @@ def standard_die_size(size_mm: float, shaped: bool = False) -> tuple[float, floa
         if size_mm <= lim + DIE_SIZE_SLACK_MM:
             return od, h, name
     raise DesignError("[tooling] die_outer_diameter_mm", MISSING,
-                      f"give it for a {'shaped' if shaped else 'round'} tablet {size_mm:.4g} mm long (larger than a "
+                      f"give it for a {'shaped' if shaped else 'round'} tablet {size_mm:.4g} mm across (larger than a "
                       f"TSM 'D' die takes, {lim:g} mm)", "mm")
 
 

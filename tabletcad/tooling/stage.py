@@ -41,7 +41,8 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
     """Refuse a tablet that cannot have tooling (a cut-away or a ring, one without a band, one too large for its
     die or for every TSM die when no die is given) and a ``[tooling]`` table its numbers refuse (a score or a
     figure deeper than its face allows, a groove wider than half the tablet, a clearance, gap or tip length:
-    :func:`~tabletcad.tooling.spec.check_on_tablet`), before any geometry is built: ``report`` and ``build``
+    :func:`~tabletcad.tooling.spec.check_on_tablet`; complete punches' tips too short for the die they run in:
+    :func:`~tabletcad.tooling.spec.check_punch_lengths`), before any geometry is built: ``report`` and ``build``
     refuse alike, in a second where the tooling stage had refused after the solid was built.
 
     ``spec`` is the design's checked ``[tooling]`` table
@@ -50,13 +51,14 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
     t = tablet.trim
     if t.u != (0.0, 1.0) or not t.full_v or t.w[0] > 0:
         raise DesignError("[tooling]", tablet.name, "tooling needs a whole solid tablet (no [trim], no ring)")
+    from tabletcad.pipeline.designreport import plan_diameter
+    from tabletcad.tooling.spec import check_punch_lengths, die_height_for, standard_die_size
+
     band_heights(tablet)  # (a sphere has no band for the die to form)
     od = spec.die_outer_diameter_mm
+    size, shaped = plan_diameter(tablet), tablet.revolution is None  # (its largest extent in plan: a square's diagonal)
     if od is None:  # the TSM die the build will take: one larger than a 'D' takes is refused here, not after the CAD
-        from tabletcad.tooling.spec import standard_die_size
-
-        dims = tablet.dimensions()
-        standard_die_size(max(dims["length_mm"], dims["width_mm"]), shaped=tablet.revolution is None)
+        standard_die_size(size, shaped=shaped)
     else:  # the die's wall around the tablet's plan (the bore adds at most 1e-6 mm to it)
         import numpy as np
 
@@ -70,6 +72,8 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
                               f"must be >= {2 * (reach + MIN_DIE_WALL_MM):.4g} mm (the tablet reaches {reach:.4g} mm "
                               f"from the axis, the die's walls need {MIN_DIE_WALL_MM} mm)", "mm")
     check_on_tablet(tablet, spec)
+    if spec.body is not None:  # complete punches: their tips against the die (the build checks them on its frame too)
+        check_punch_lengths(spec, band_heights(tablet), die_height_for(spec, size, shaped))
 
 
 def write_tooling(ts, out: Path, *, drawing: bool = True) -> list[Path]:

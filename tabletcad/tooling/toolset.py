@@ -16,7 +16,7 @@ from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.designreport import ReportOptions
 from tabletcad.tooling.booleans import TIMER, to_manifold, volume
 from tabletcad.tolerance import DEFAULT
-from tabletcad.tooling.spec import ToolingSpec, check_numbers
+from tabletcad.tooling.spec import ToolingSpec, check_numbers, check_punch_lengths, die_height_for
 
 __all__ = ["ToolSet", "make_tooling", "check_closed_position", "finished_solid", "DEFLECTION_MM"]
 
@@ -50,20 +50,14 @@ class ToolSet:
         return out
 
 
-#: die height (mm) when only the outer diameter is given
-DEFAULT_DIE_HEIGHT_MM = 22.22
 #: a punch-to-die clearance (mm a side) above which a build warns
 WIDE_CLEARANCE_MM = 0.1
 
 
 def die_height(frame, spec: ToolingSpec) -> float:
-    """The die height (mm) a build uses: the given one, else 22.22 mm beside a given outer diameter, else the
-    TSM die table's for the tablet's size (:func:`tabletcad.tooling.die.default_die_size`)."""
-    from tabletcad.tooling.die import default_die_size
-
-    if spec.die_height_mm is not None:
-        return spec.die_height_mm
-    return DEFAULT_DIE_HEIGHT_MM if spec.die_outer_diameter_mm is not None else default_die_size(frame)[1]
+    """The die height (mm) a build uses (:func:`~tabletcad.tooling.spec.die_height_for` of the tablet's plan
+    diameter): the given one, else 22.22 mm beside a given outer diameter, else the TSM die table's."""
+    return die_height_for(spec, frame.plan_diameter, frame.outline_kind != "circle")
 
 
 def check_on_frame(frame, spec: ToolingSpec) -> list:
@@ -102,7 +96,7 @@ def check_on_frame(frame, spec: ToolingSpec) -> list:
 def _check_complete_punches(frame, spec: ToolingSpec) -> None:
     """Bad complete-punch input (tablet larger than the barrel or the standard, a tip too short to keep
     the barrel out of the die) as a DesignError, before any tooling geometry is built."""
-    from tabletcad.tooling.die import _max_radius, die_position
+    from tabletcad.tooling.die import _max_radius
     from tabletcad.tooling.punch_body import check_body_fits
 
     check_body_fits(frame, spec.body, _max_radius(frame.outline) - frame.tip_inset(spec.clearance_mm))
@@ -112,23 +106,7 @@ def _check_complete_punches(frame, spec: ToolingSpec) -> None:
         warnings.warn("the shaped punch tips have no key: a shaped tip turns in its die bore unless a "
                       "key in the barrel holds it; set key = true with key_* in [tooling.punch]", stacklevel=3)
     _check_relief(frame, spec)
-    _, top, bottom = die_position(frame, die_height(frame, spec))
-    need_up = top - frame.band_z[1]
-    if spec.tip_length_mm <= need_up:
-        raise DesignError("[tooling] tip_length_mm", spec.tip_length_mm,
-                          f"must be > {need_up:.4g} mm, the upper punch's entry into the die (the barrel stays out)", "mm")
-    # ejection: the lower tip edge rises to the die's top face to push the tablet out, and the barrel's
-    # shoulder, the tip's length below it, must still be below the die's bottom face (the longer of the lower
-    # tip's two travels: at the closed position the edge is below the top face)
-    need_low = top - bottom
-    if spec.lower_tip <= need_low:
-        raise DesignError("[tooling] lower_tip_length_mm", spec.lower_tip,
-                          f"must be > {need_low:.4g} mm, the die's height: at ejection the lower tip edge rises to "
-                          f"the die's top face and the barrel must stay below the die"
-                          + ("" if spec.lower_tip_length_mm is not None else
-                             " (not given, it is tip_length_mm: give lower_tip_length_mm)"), "mm")
-
-
+    check_punch_lengths(spec, frame.band_z, die_height(frame, spec))
 
 
 def _warn_crossings(frame, spec: ToolingSpec, emb_checked: list) -> None:
