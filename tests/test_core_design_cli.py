@@ -90,6 +90,9 @@ def test_free_form_design_with_previous_and_trim():
              "patch": [{"curves": [{"type": "circle", "radius": r, "z": z} for r, z in ((5, 0), (0.1, 1), (0.1, 2), (5, 3))]}]},
             "radius",
         ),
+        # each end of a [trim] range named by its place (it had been "trim.w = 'pi'" for w = [0, "pi"])
+        ({"tablet": {"family": "concave_round", "diameter": 10.0, "band": 3.0, "cup_depth": 1.0},
+          "trim": {"w": [0.0, "pi"]}}, "trim.w[1] = 'pi' is not allowed: must be a number"),
     ],
 )
 def test_bad_designs_name_the_parameter(data, fragment):

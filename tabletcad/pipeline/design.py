@@ -609,7 +609,7 @@ def _check_closed(tablet: Tablet) -> Tablet:
 def _pair(where: str, val: Any) -> tuple[float, float]:
     if not (isinstance(val, list) and len(val) == 2):
         raise DesignError(where, val, "must be a pair [lo, hi]")
-    return (_number(where, val[0]), _number(where, val[1]))
+    return (_number(f"{where}[0]", val[0]), _number(f"{where}[1]", val[1]))  # (each named by its place)
 
 
 def _trim(tablet: Tablet, t: dict) -> Tablet:
