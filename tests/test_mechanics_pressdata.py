@@ -172,6 +172,30 @@ def test_no_loading_branch():
         split_branches([100.0, 90.0, 80.0, 70.0])
 
 
+def test_a_baseline_before_the_punches_meet_the_powder_is_not_the_end_of_loading(tmp_path):
+    """A press export starts with the load cell's noise before the punches meet the powder: 0.5 N then 0.3 N ahead
+    of the thesis's 4.8 kN record had ended the loading branch at row 1 ("has no loading branch"), its fall
+    measured against the running peak (0.5 N) rather than the record's.  The branches are the record's own,
+    two rows later, and the Heckel fit over 10-50 MPa is the record's to the last bit."""
+    from tabletcad.mechanics.heckel import fit_heckel
+
+    lines = [ln for ln in SAMPLE.read_text(encoding="utf-8").splitlines() if not ln.startswith("#")]
+    rows = [ln.split(",")[:2] for ln in lines[1:]]
+    plain = _write(tmp_path, "force_N,displacement_mm\n" + "".join(f"{f},{x}\n" for f, x in rows), "plain.csv")
+    first_x = float(rows[0][1])
+    noisy = _write(tmp_path, "force_N,displacement_mm\n" + f"0.5,{first_x - 0.04}\n0.3,{first_x - 0.02}\n"
+                   + "".join(f"{f},{x}\n" for f, x in rows), "noisy.csv")
+    meta = dict(mass_mg=300.0, true_density=1.3, diameter=10.0)  # (the sample's)
+    b0 = split_branches(read_press_data(plain, **meta).force)
+    b1 = split_branches(read_press_data(noisy, **meta).force)
+    assert b1.loading == (0, b0.loading[1] + 2) and b1.peak == b0.peak + 2
+    assert b1.reloading_from == b0.reloading_from + 2
+    k0, k1 = (fit_heckel(compaction_curves(read_press_data(p, **meta)), window=(10.0, 50.0)) for p in (plain, noisy))
+    assert (k1.K_per_MPa, k1.A, k1.n_points) == (k0.K_per_MPa, k0.A, k0.n_points) and k0.n_points > 20
+    # a dip of more than 2 % of the record's largest force still ends the loading branch (a pre-compression)
+    assert split_branches([10.0, 500.0, 1000.0, 900.0, 2000.0, 4800.0]).loading == (0, 3)
+
+
 def test_metadata_beside_file_is_found(tmp_path):
     p = _write(tmp_path, "force_N,displacement_mm\n1,-5\n2,-4.9\n3,-4.8\n")
     (tmp_path / "run.toml").write_text("mass_mg = 10\ntrue_density = 1.5\nface_area = 20\n")

@@ -11,8 +11,10 @@ Loading and unloading branches
 ------------------------------
 The loading branch runs from the first row to the row of maximum compression,
 found as follows: scan the rows in order; the loading branch ends at the last
-row carrying the running force maximum before the force first falls by more
-than ``drop`` (default 2 %) of that maximum.  If the force never falls that
+row carrying the running force maximum before the force first falls below it by
+more than ``drop`` (default 2 %) of the record's largest force (a load cell's
+noise is a fraction of its range: a baseline's 0.5 N then 0.3 N before the
+punches meet the powder is not the end of loading).  If the force never falls that
 far, the branch ends at the last row of the global force maximum.  The
 unloading branch follows it as long as the force keeps falling; if the force
 rises again by more than ``drop`` of the peak above its running minimum the
@@ -72,8 +74,9 @@ def split_branches(force, drop: float = 0.02, *, quantity: str = "force", unit: 
     force : array_like
         Force per row, N, in recording order.
     drop : float
-        Fraction of the running peak force that counts as a real fall or rise
-        (filters transducer noise); 0 < drop < 1.
+        Fraction of the record's peak force that counts as a real fall or rise
+        (filters transducer noise, which is a fraction of the load cell's range, not of the force
+        reached so far); 0 < drop < 1.
     quantity, unit : str
         What the series is and its unit, for a refusal's words: ``"pressure"``, ``"MPa"`` when a
         table of pressures (``tabletcad kawakita``, ``walker``) is split.
@@ -89,12 +92,15 @@ def split_branches(force, drop: float = 0.02, *, quantity: str = "force", unit: 
     n = F.size
     if n < 3:
         raise DesignError("data", f"{n} row" + ("" if n == 1 else "s"), "need at least 3 rows with a loading branch")
-    runmax = np.maximum.accumulate(F)
-    fall = np.flatnonzero(F < (1.0 - drop) * runmax)
-    end = int(fall[0]) if fall.size else n
-    if end == 0:  # the first force is already a fall from itself: negative (tensile) forces
+    # noise is measured against the record's largest force, not the running one: a press export's rows before the
+    # punches meet the powder (0.5 N then 0.3 N ahead of a 4.8 kN record) had ended the loading branch at row 1
+    scale = float(np.max(F))
+    if F[0] < 0.0 and (scale <= 0.0 or -F[0] > drop * scale):  # a tensile force, not a baseline's noise
         raise DesignError(f"row 1 {quantity}", float(F[0]),
                           f"has no loading branch: compression {quantity}s must be > 0", unit)
+    runmax = np.maximum.accumulate(F)
+    fall = np.flatnonzero(runmax - F > drop * scale)
+    end = int(fall[0]) if fall.size else n
     seg = F[:end]
     peak = int(np.flatnonzero(seg == seg.max())[-1])
     if peak < 2 or F[peak] <= 0.0 or F[peak] <= F[0]:
