@@ -45,7 +45,14 @@ def _report(sf: str = "0.85", rho: str = "1.5", extra: str = "") -> str:
 
 
 # (name, file text, text that the parameter named in the error line must contain)
+FE_PROBLEM = (Path(__file__).resolve().parents[1] / "samples" / "optimise" / "strongest_concave_round_fe.toml").read_text(
+    encoding="utf-8")
+
 BAD = [
+    # the FE's own range (<= 1000 MPa): 5000 MPa had passed the file's check and failed the run after its first
+    # build (exit 3, files left), named report.tensile_strength_MPa
+    ("fe_tensile_strength_beyond_the_fe_range", FE_PROBLEM.replace("tensile_strength_MPa = 2.0", "tensile_strength_MPa = 5000.0"),
+     "fe.tensile_strength_MPa"),
     ("tol_string", FAMILY + 'tol = "loose"\n', "constraint[0].tol"),
     ("P_bounds_one", ROUND + "P_bounds = [50.0]\n", "parameters.P_bounds"),
     ("P_bounds_reversed", ROUND + "P_bounds = [60.0, 20.0]\n", "parameters.P_bounds"),

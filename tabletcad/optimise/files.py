@@ -66,6 +66,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from tabletcad.errors import MISSING, DesignError, format_bound, one_token
+from tabletcad.tolerance import MAX_TENSILE_STRENGTH_MPA
 from tabletcad.optimise.problem import METHODS, Constraint, Objective, Problem, Variable
 
 
@@ -316,8 +317,9 @@ def _fe_settings(fe: Any, used: bool) -> dict | None:
     if "tensile_strength_MPa" not in fe:
         raise DesignError("[fe] tensile_strength_MPa", MISSING, "must be given (MPa)")
     return {
+        # (the FE's own range: 5000 MPa had passed here and failed the run after its first build, exit 3)
         "tensile_strength_MPa": number("[fe] tensile_strength_MPa", fe["tensile_strength_MPa"], "MPa", lo=0.0,
-                                       lo_open=True, hi=LIMITS["MPa"]),
+                                       lo_open=True, hi=MAX_TENSILE_STRENGTH_MPA),
         "direction": choice("[fe] direction", fe.get("direction", "width"), ("width", "length", "x", "y")),
         "recheck": boolean("[fe] recheck", fe.get("recheck", True)),
         "symmetric": boolean("[fe] symmetric", fe.get("symmetric", False)),
