@@ -76,7 +76,7 @@ FLAT = '[tablet]\nfamily = "thesis.flat_faced_round"\nthickness = 6.0\n'
         ('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\ncup_depth = 1.0\nband = 1e300\n', "tablet.band", "within ±1000 mm"),
         ('[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 3.0\n', "tablet.cup_depth", "optional: land"),
         ("x = " + "[" * 5000 + "]" * 5000 + "\n", "DESIGN", "nested"),
-        (FLAT + "diameter = 10.0\n[trim]\nv = [0.0, true]\n", "trim.v", "not numbers"),
+        (FLAT + "diameter = 10.0\n[trim]\nv = [0.0, true]\n", "trim.v[1]", "not numbers"),
         (FLAT + "diameter = 10.0\n[reshape]\nradius = 1e300\n", "reshape.radius", "<= 1000"),
         (FLAT + "diameter = 10.0\n[reshape]\nradius = 500.0\n", "reshape", "it reaches 25"),
         ('[tablet]\nfamily = "custom_outline"\noutline = [[0, 0], [1e300, 0], [0, 5]]\nband = 2.0\ncup_depth = 0.3\n',

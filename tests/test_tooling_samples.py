@@ -114,3 +114,30 @@ def test_freecad_reads_every_sample_part_as_one_valid_solid(built, tmp_path):
                 assert r["volume"] == pytest.approx(v, rel=1e-6), (out.name, f)
         named = got[str(out / "assembly.step")]["named"]
         assert named == {"tablet": True, "upper_punch": True, "lower_punch": True, "die": True}, out.name
+
+
+def test_a_lettered_part_read_back_meshes_for_stl_glb_and_notebooks(built, tmp_path):
+    """OCCT's Delabella leaves the faces of letters cut into a face untriangulated: the EU D oval's lettered tablet
+    and upper punch, read back from their STEP files, had failed export to STL/GLB/3MF and a notebook's picture
+    ("a face has no triangulation after meshing"); :func:`tessellate` meshes them by Watson then, as the tooling's
+    own checks do.  The closed mesh's volume is the solid's within the deflection times the area."""
+    import trimesh
+    from OCP.GProp import GProp_GProps
+    from OCP.BRepGProp import BRepGProp
+    from OCP.STEPControl import STEPControl_Reader
+
+    from tabletcad.cad.export import export
+
+    _, ts = built[1]["eu_d_oval"]
+    assert ts.spec.emboss
+    for name in ("tablet", "upper_punch"):
+        step = export(ts.parts[name], tmp_path / f"{name}.step")  # (a fresh shape: no triangulation on it)
+        reader = STEPControl_Reader()
+        assert reader.ReadFile(str(step)) == 1 and reader.TransferRoots() == 1
+        shape = reader.OneShape()
+        props, area = GProp_GProps(), GProp_GProps()
+        BRepGProp.VolumeProperties_s(shape, props)
+        BRepGProp.SurfaceProperties_s(shape, area)
+        mesh = trimesh.load(export(shape, tmp_path / f"{name}.stl"))
+        assert mesh.is_watertight
+        assert abs(mesh.volume - props.Mass()) <= 0.005 * area.Mass(), name  # (0.005 mm: export's deflection)

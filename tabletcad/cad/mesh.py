@@ -31,7 +31,7 @@ from tabletcad.errors import GeometryError, check_range
 from tabletcad.io.forked import OCC_PARALLEL
 from tabletcad.tolerance import DEFAULT
 
-__all__ = ["MeshResult", "mesh_result", "tessellate", "tessellate_solid", "triangulate", "MESH_ALGOS"]
+__all__ = ["MeshResult", "mesh_result", "tessellate", "tessellate_solid", "triangulate", "MESH_ALGOS", "FaceNotMeshed"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -72,6 +72,11 @@ class MeshResult:
 MESH_ALGOS = ("delabella", "watson")
 
 
+class FaceNotMeshed(GeometryError):
+    """A face the mesher left without triangles (OCCT's Delabella on some Boolean-trimmed faces: the floors and
+    walls of letters cut into a tablet or a punch's face)."""
+
+
 def _mesh_parameters(linear_deflection: float, angular_deflection: float, relative: bool, algo: str):
     from OCP.IMeshTools import IMeshTools_MeshAlgoType, IMeshTools_Parameters
 
@@ -101,7 +106,7 @@ def _face_arrays(face) -> tuple[np.ndarray, np.ndarray]:
     loc = TopLoc_Location()
     tri = BRep_Tool.Triangulation_s(face, loc)
     if tri is None:
-        raise GeometryError("a face has no triangulation after meshing", face)
+        raise FaceNotMeshed("a face has no triangulation after meshing", face)
     nn, nt = tri.NbNodes(), tri.NbTriangles()
     nodes = np.fromiter(chain.from_iterable(map(gp_Pnt.Coord, map(tri.Node, range(1, nn + 1)))), dtype=float,
                         count=3 * nn).reshape(nn, 3)
@@ -225,8 +230,16 @@ def tessellate(
     check: bool = True,
     algo: str = "delabella",
 ) -> MeshResult:
-    """Triangulate ``shape`` (deflections in mm and rad) and run the manifold3d and edge checks."""
-    V, T = triangulate(shape, linear_deflection, angular_deflection, relative=relative, weld_tol=weld_tol, algo=algo)
+    """Triangulate ``shape`` (deflections in mm and rad) and run the manifold3d and edge checks.  Where Delabella
+    leaves a face without triangles (:class:`FaceNotMeshed`: a lettered tablet or punch face), the shape is
+    meshed again by Watson, as the tooling's own meshes are (:func:`tabletcad.tooling.booleans.mesh_arrays`)."""
+    try:
+        V, T = triangulate(shape, linear_deflection, angular_deflection, relative=relative, weld_tol=weld_tol, algo=algo)
+    except FaceNotMeshed:
+        if algo != "delabella":
+            raise
+        V, T = triangulate(shape, linear_deflection, angular_deflection, relative=relative, weld_tol=weld_tol,
+                           algo="watson")
     return mesh_result(V, T, linear_deflection, angular_deflection, check=check)
 
 
