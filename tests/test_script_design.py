@@ -169,3 +169,65 @@ def test_an_emboss_svg_is_found_beside_the_design_file(tmp_path, monkeypatch):
     (folder / "logo.svg").unlink()
     with pytest.raises(DesignError, match=r"svg = 'logo.svg' is not allowed: .*relative paths start in the design's folder"):
         Design.from_toml(folder / "d.toml")
+
+
+def test_a_boxs_corners_and_size_compute_as_build123d_vectors():
+    """``bounding_box()``'s ``min``, ``max``, ``size`` and ``center()`` read as build123d's ``Vector`` and now compute
+    as it does: a tuple's ``+`` had joined two of them into a 6-tuple, its ``*`` repeated them, ``max - min`` was a
+    TypeError.  They stay tuples otherwise (unpacking, equality)."""
+    import tabletcad
+
+    bb = tabletcad.make("flat_face_round", diameter=10.0, thickness=4.0).bounding_box()
+    size = bb.max - bb.min
+    assert size == bb.size and tuple(size) == pytest.approx((10.0, 10.0, 4.0), rel=1e-9)
+    assert tuple(bb.size * 2) == tuple(2 * bb.size) == pytest.approx((20.0, 20.0, 8.0), rel=1e-9)
+    assert tuple(bb.size / 2) == pytest.approx((5.0, 5.0, 2.0), rel=1e-9)
+    assert tuple(bb.center() + (1, 0, 0)) == pytest.approx((1.0, 0.0, 2.0), abs=1e-9)
+    assert tuple((0, 0, 1) - bb.center()) == pytest.approx((0.0, 0.0, -1.0), abs=1e-9)
+    assert tuple(-bb.max) == tuple(-x for x in bb.max)
+    assert size.length == pytest.approx(bb.diagonal, rel=1e-15) == pytest.approx(math.sqrt(216.0), rel=1e-9)
+    x, y, z = bb.size
+    assert (x, y, z) == bb.size and bb.size[2] == bb.size.Z
+    with pytest.raises(TypeError):
+        bb.size + (1.0, 2.0)  # (not a 3-vector)
+    with pytest.raises(TypeError):
+        bb.size * bb.size  # (build123d's * of two vectors is a dot product; here neither is guessed)
+
+
+@pytest.mark.parametrize("name", ["x.png", "x.svg", "x.pdf", "x.PNG"])
+def test_a_picture_is_written_in_the_format_its_name_asks_for(tmp_path, name):
+    """``plot_tablet(m, "x.pdf")`` had written PNG bytes under any name; PNG, SVG and PDF are written as named."""
+    import tabletcad
+    from tabletcad.pipeline.plot import plot_tablet, plot_tablets
+
+    m = tabletcad.make("flat_face_round", diameter=10.0, thickness=4.0)
+    magic = {".png": b"\x89PNG", ".svg": b"<?xml", ".pdf": b"%PDF"}[Path(name).suffix.lower()]
+    assert plot_tablet(m.tablet, tmp_path / name).read_bytes().startswith(magic)
+    assert plot_tablets([m, m], tmp_path / f"two{Path(name).suffix}").read_bytes().startswith(magic)
+
+
+def test_a_picture_under_another_suffix_is_refused_and_nothing_is_written(tmp_path):
+    import tabletcad
+    from tabletcad.pipeline.plot import plot_tablet
+
+    with pytest.raises(DesignError, match=r"^path = '.*x\.jpg' is not allowed: must end in \.png, \.svg or \.pdf$"):
+        plot_tablet(tabletcad.make("flat_face_round", diameter=10.0, thickness=4.0).tablet, tmp_path / "x.jpg")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_outline_point_with_a_third_coordinate_is_refused():
+    """The outline lies in the plan: a segment's point [x, y, z] had been read as [x, y], its z dropped in silence
+    (the same 229.25 mm³ as the plan's)."""
+    import tabletcad
+
+    half = math.pi
+    segs = [["line", [-2.5, -3.5, 7.0], [2.5, -3.5]], ["arc", [2.5, 0.0], 3.5, -half / 2, half],
+            ["line", [2.5, 3.5], [-2.5, 3.5]], ["arc", [-2.5, 0.0], 3.5, half / 2, half]]
+    with pytest.raises(DesignError, match=r"^tablet\.segments\[0\]\[1\] = \[-2.5, -3.5, 7.0\] is not allowed: must be a point "):
+        tabletcad.make("custom_outline", segments=segs, band=2.0, cup_depth=0.5)
+    segs[0][1] = [-2.5, -3.5]
+    segs[2][2] = [-2.5, 3.5, 0.0, 1.0]
+    with pytest.raises(DesignError, match=r"segments\[2\]\[2\] = \[-2.5, 3.5, 0.0, 1.0\] is not allowed"):
+        tabletcad.make("custom_outline", segments=segs, band=2.0, cup_depth=0.5)
+    segs[2][2] = [-2.5, 3.5]
+    assert tabletcad.make("custom_outline", segments=segs, band=2.0, cup_depth=0.5).tablet.volume() > 0.0

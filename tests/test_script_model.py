@@ -249,6 +249,8 @@ def test_tooling_parts_have_the_same_vocabulary(model):
         tools.parts["die"] = None
     assert isinstance(tools.die, tabletcad.pipeline.model.PartModel)
     assert tools.report["keys"]["clearance_mm"] == 0.03
+    tools.report["keys"]["clearance_mm"] = 1.0  # a copy: the tool set's own report stays (it had been handed out)
+    assert tools.report["keys"]["clearance_mm"] == 0.03 and tools.toolset.report["keys"]["clearance_mm"] == 0.03
     up = tools.upper_punch
     assert isinstance(up.to_build123d(), bd.Solid)
     # build123d's volume is OCC's default integration (no eps: 1.4e-9 off on the punch's B-spline cup with
@@ -504,3 +506,26 @@ def test_sum_of_models_is_what_sum_of_build123d_shapes_is(model):
     fused = sum([model.to_build123d(), shifted], bd.Part())
     assert fused.volume == pytest.approx((model + shifted).volume, rel=1e-9)
     assert model.volume < fused.volume < 2 * model.volume  # (overlapping copies: less than both)
+
+
+@pytest.mark.parametrize("trim", [dict(u=[0.0, 0.5]), dict(w=[0.5, 1.0])])
+def test_a_view_without_a_solid_shows_its_picture_not_a_traceback(trim):
+    """A cut-away in u and a hollow view have no solid to mesh: the notebook's HTML view had raised GeometryError
+    (IPython printed the traceback, then fell back to the PNG); it is None now, and the PNG is the picture."""
+    m = tabletcad.make("concave_round", diameter=D, band=BAND, cup_depth=CUP, trim=trim)
+    assert m._repr_html_() is None
+    assert m._repr_png_()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_an_exports_options_are_refused_in_one_line(model, tmp_path):
+    """``schema=None`` had raised an AttributeError, ``schema="X"`` a plain ValueError, ``relative="no"`` had been
+    read as true: each is the one-line DesignError, and nothing is written."""
+    for kw, line in ((dict(schema=None), "schema = None is not allowed: must be one of AP203, AP214, AP242"),
+                     (dict(schema=214), "schema = 214 is not allowed: must be one of AP203, AP214, AP242"),
+                     (dict(schema="X"), "schema = 'X' is not allowed: must be one of AP203, AP214, AP242")):
+        with pytest.raises(DesignError) as e:
+            model.export(tmp_path / "x.step", **kw)
+        assert str(e.value) == line
+    with pytest.raises(DesignError, match=r"^relative = 'no' is not allowed: must be true or false$"):
+        model.export(tmp_path / "x.stl", relative="no")
+    assert list(tmp_path.iterdir()) == []

@@ -63,8 +63,8 @@ def step_document(schema: str = "AP242", *, assembly: bool = False):
     Sets OCCT's (process-global) STEP writer options every time, so one export
     cannot leak its schema or assembly mode into the next.
     """
-    if schema.upper() not in _SCHEMAS:
-        raise ValueError(f"schema = {schema!r} is not allowed: must be one of {sorted(_SCHEMAS)}")
+    if not isinstance(schema, str) or schema.upper() not in _SCHEMAS:  # (None had raised an AttributeError)
+        raise DesignError("schema", schema, f"must be one of {', '.join(sorted(_SCHEMAS))}")
     STEPControl_Controller.Init_s()
     Interface_Static.SetCVal_s("write.step.schema", _SCHEMAS[schema.upper()])
     Interface_Static.SetCVal_s("write.step.unit", "MM")
@@ -136,6 +136,8 @@ def _mesh_of(obj: Any, mesh: MeshResult | None, **kw: Any) -> MeshResult:
         raise TypeError(f"export got an unexpected keyword argument {unknown[0]!r} (mesh options: linear_deflection "
                         "mm, angular_deflection rad, relative)")
     opts = {**MESH_DEFAULTS, "relative": False, **kw}
+    if not isinstance(opts["relative"], (bool, np.bool_)):  # ("no" had been read as true)
+        raise DesignError("relative", opts["relative"], "must be true or false")
     if hasattr(obj, "surfaces") and hasattr(obj, "shape") and not opts["relative"]:
         # a TabletSolid: meshed from its faces' data, as the CAD stage does
         m = tessellate_solid(obj, opts["linear_deflection"], opts["angular_deflection"])

@@ -976,6 +976,11 @@ def outline_from_items(items, name: str = "outline", parameter: str = "outline")
         kind = it[0]
         for k, part in enumerate(it[1:], start=1):  # no text where a number goes ("3" is not a radius)
             check_numbers(f"{parameter}[{i}][{k}]", part)
+        # a point is (x, y): a third coordinate had been dropped in silence (the outline lies in the plan)
+        for k in ((1, 2) if kind == "line" else (1,) if kind == "arc" else ()):
+            if k < len(it) and isinstance(it[k], (list, tuple, np.ndarray)) and len(it[k]) != 2:
+                raise DesignError(f"{parameter}[{i}][{k}]", list(np.asarray(it[k]).tolist()),
+                                  "must be a point [x, y] in mm (the outline lies in the plan)")
         try:
             if kind == "line" and len(it) == 3:
                 segs.append(_line(it[1], it[2]))

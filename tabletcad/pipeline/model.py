@@ -20,6 +20,7 @@ methods that need it, so ``import tabletcad.pipeline.model`` stays numpy-only.
 from __future__ import annotations
 
 import html
+import math
 import io
 import uuid
 import json
@@ -30,7 +31,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from tabletcad.errors import DesignError
+from tabletcad.errors import DesignError, GeometryError
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.design import Design
 from tabletcad.tolerance import DEFAULT
@@ -42,11 +43,54 @@ VIEW_DEFLECTION = (0.02, 0.35)
 
 
 class Vec3(NamedTuple):
-    """A point or extent (mm) that reads as build123d's ``Vector`` does (``.X``, ``.Y``, ``.Z``) and is a tuple."""
+    """A point or extent (mm) that reads as build123d's ``Vector`` does (``.X``, ``.Y``, ``.Z``, ``length``) and
+    computes as it does: ``+`` and ``-`` with another vector or a 3-tuple, ``*`` and ``/`` by a number, unary
+    ``-`` (a tuple's ``+`` had joined two boxes' corners into a 6-tuple, its ``*`` repeated them); it is a tuple
+    otherwise (unpacking, indexing, equality)."""
 
     X: float
     Y: float
     Z: float
+
+    @property
+    def length(self) -> float:
+        """Euclidean length (mm)."""
+        return math.sqrt(self.X * self.X + self.Y * self.Y + self.Z * self.Z)
+
+    def _other(self, other: Any) -> tuple[float, float, float]:
+        o = tuple(other)
+        if len(o) != 3:
+            raise TypeError(f"a vector takes a vector or 3 numbers, not {len(o)}")
+        return float(o[0]), float(o[1]), float(o[2])
+
+    def __add__(self, other: Any) -> "Vec3":  # type: ignore[override]
+        x, y, z = self._other(other)
+        return Vec3(self.X + x, self.Y + y, self.Z + z)
+
+    __radd__ = __add__
+
+    def __sub__(self, other: Any) -> "Vec3":
+        x, y, z = self._other(other)
+        return Vec3(self.X - x, self.Y - y, self.Z - z)
+
+    def __rsub__(self, other: Any) -> "Vec3":
+        x, y, z = self._other(other)
+        return Vec3(x - self.X, y - self.Y, z - self.Z)
+
+    def __mul__(self, k: Any) -> "Vec3":  # type: ignore[override]
+        if isinstance(k, bool) or not isinstance(k, (int, float, np.integer, np.floating)):
+            return NotImplemented
+        return Vec3(self.X * k, self.Y * k, self.Z * k)
+
+    __rmul__ = __mul__
+
+    def __truediv__(self, k: Any) -> "Vec3":
+        if isinstance(k, bool) or not isinstance(k, (int, float, np.integer, np.floating)):
+            return NotImplemented
+        return Vec3(self.X / k, self.Y / k, self.Z / k)
+
+    def __neg__(self) -> "Vec3":
+        return Vec3(-self.X, -self.Y, -self.Z)
 
 
 @dataclass(frozen=True)
@@ -161,8 +205,14 @@ class _Shaped:
         m = self.mesh(*VIEW_DEFLECTION)
         return [(self.name, m.vertices, m.triangles)]
 
-    def _repr_html_(self) -> str:
-        return mesh_html(self._view_meshes(), title=self.name)
+    def _repr_html_(self) -> str | None:
+        """The notebook's 3-D view; None (the notebook then shows the PNG) for a view with no solid to mesh:
+        a cut-away in ``u`` or a hollow tablet (a :class:`GeometryError` had printed its traceback first)."""
+        try:
+            meshes = self._view_meshes()
+        except GeometryError:
+            return None
+        return mesh_html(meshes, title=self.name)
 
     def _repr_png_(self) -> bytes:
         return mesh_png(self._view_meshes(), title=self.name)
@@ -215,7 +265,10 @@ class ToolingModel:
 
     @property
     def report(self) -> dict[str, Any]:
-        return self.toolset.report
+        """The ``tooling`` section of ``report.json``: a copy (changing it leaves the tool set's as it is)."""
+        import copy
+
+        return copy.deepcopy(self.toolset.report)
 
     def placed(self) -> dict[str, PartModel]:
         """Parts at the press position of the spec's ``gap_mm``."""

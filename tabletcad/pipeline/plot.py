@@ -21,6 +21,7 @@ from typing import Sequence
 
 import numpy as np
 
+from tabletcad.errors import DesignError
 from tabletcad.io.atomic import atomic_path
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.geometry.vectors import cross
@@ -640,18 +641,35 @@ def tablet_png(tablet: Tablet, *, dpi: int = 110, **kw) -> bytes:
 _PNG = {"compress_level": 1}
 
 
-def _save(fig, path: str | Path, dpi: int) -> Path:
+#: the picture formats a path may ask for, by its suffix (matplotlib writes each)
+PICTURE_SUFFIXES = (".png", ".svg", ".pdf")
+
+
+def _picture_path(path: str | Path) -> Path:
+    """``path`` as a :class:`Path` when its suffix names a picture format (:data:`PICTURE_SUFFIXES`), else a
+    :class:`DesignError` (PNG bytes had been written under any name: ``x.pdf`` held a PNG)."""
     path = Path(path)
+    if path.suffix.lower() not in PICTURE_SUFFIXES:
+        raise DesignError("path", str(path), f"must end in {', '.join(PICTURE_SUFFIXES[:-1])} or {PICTURE_SUFFIXES[-1]}")
+    return path
+
+
+def _save(fig, path: Path, dpi: int) -> Path:
+    fmt = path.suffix.lower()[1:]
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=dpi, format="png", pil_kwargs=_PNG)
+        fig.savefig(tmp, dpi=dpi, format=fmt, **({"pil_kwargs": _PNG} if fmt == "png" else {}))
     return path
 
 
 def plot_tablet(tablet: Tablet, path: str | Path, *, dpi: int = 110, **kw) -> Path:
-    """Write the picture of :func:`tablet_figure` to ``path`` (PNG, written atomically)."""
+    """Write the picture of :func:`tablet_figure` to ``path`` (written atomically), in the format its suffix
+    names: ``.png``, ``.svg`` or ``.pdf``."""
+    path = _picture_path(path)
     return _save(tablet_figure(tablet, **kw), path, dpi)
 
 
 def plot_tablets(tablets: Sequence, path: str | Path, *, dpi: int = 110, **kw) -> Path:
-    """Write :func:`tablets_figure` (several tablets, or models, at one scale) to ``path`` (PNG)."""
+    """Write :func:`tablets_figure` (several tablets, or models, at one scale) to ``path``: ``.png``, ``.svg`` or
+    ``.pdf`` by its suffix."""
+    path = _picture_path(path)
     return _save(tablets_figure(tablets, **kw), path, dpi)
