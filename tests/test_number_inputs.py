@@ -89,3 +89,14 @@ def test_a_design_that_contains_itself_is_refused():
     data["tablet"]["again"] = data
     with pytest.raises(DesignError, match=r"^design = 'dict' is not allowed: must not contain itself$"):
         Design.from_dict(data)
+
+
+def test_a_decimal_or_a_fraction_is_kept_as_the_float_toml_would_give():
+    """``make(diameter=Decimal("10.1"), band=Fraction(5, 2))`` built, then ``design.to_toml()`` refused the design
+    ("must hold numbers, text, ..."): the design holds the floats TOML would, and round-trips through its text."""
+    import tomllib
+
+    d = Design.from_dict({"tablet": {"family": "concave_round", "diameter": decimal.Decimal("10.1"),
+                                     "band": fractions.Fraction(5, 2), "cup_depth": 1}})
+    assert d.tablet["diameter"] == 10.1 and d.tablet["band"] == 2.5 and type(d.tablet["cup_depth"]) is int
+    assert tomllib.loads(d.to_toml())["tablet"] == dict(d.tablet)

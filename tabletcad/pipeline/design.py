@@ -35,6 +35,7 @@ one factor per patch, ``radius`` = one factor) — the thesis's section 4.4.
 from __future__ import annotations
 
 import copy
+import decimal
 import json
 import math
 import numbers
@@ -484,7 +485,8 @@ _CUSTOM_KEYS = {"outline", "segments", "band", "cup_depth", "land", "cup_width",
 
 def _as_toml(value: Any, _open: frozenset = frozenset()) -> Any:
     """A copy of a design's data as TOML would give it: numpy arrays as (nested) lists, numpy scalars
-    as Python ones and tuples as lists (a Python caller's outline may be an (n, 2) array or pairs)."""
+    as Python ones, Decimals and Fractions as floats and tuples as lists (a Python caller's outline may be an
+    (n, 2) array or pairs)."""
     if isinstance(value, (dict, list, tuple)):
         if id(value) in _open:  # TOML has no cycles
             raise DesignError("design", type(value).__name__, "must not contain itself")
@@ -498,6 +500,9 @@ def _as_toml(value: Any, _open: frozenset = frozenset()) -> Any:
             return _as_toml(plain, _open)
         # no Python type holds it (np.longdouble): the float it rounds to, else as given
         return float(plain) if isinstance(plain, numbers.Real) else copy.deepcopy(plain)
+    if (isinstance(value, numbers.Rational) and not isinstance(value, int)) or \
+            (isinstance(value, decimal.Decimal) and value.is_finite()):  # (an infinite one is refused as given)
+        return float(value)  # a Decimal or a Fraction: TOML's float (the design had kept it and to_toml refused it)
     return copy.deepcopy(value)
 
 
