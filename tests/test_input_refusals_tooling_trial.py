@@ -243,6 +243,12 @@ _LAND = '[tablet]\nfamily = "concave_round"\ndiameter = 10.0\nband = 2.8\ncup_de
      "error: tooling.lower_tip_length_mm = 8 mm is not allowed: must be > 22.22 mm, the die's height: at ejection the "
      "lower tip edge rises to the die's top face and the barrel must stay below the die (not given, it is "
      "tip_length_mm: give lower_tip_length_mm)"),
+    # a tip relief that leaves no tip outline (report had passed it; build refused it after the solid)
+    (ROUND.replace("[tooling]\nclearance_mm = 0.02\n", "")
+     + TSM_B.replace("tip_relief_mm = 0.1", "tip_relief_mm = 10.0").replace(
+         "tip_length_mm = 8.0\n", "tip_length_mm = 8.0\nlower_tip_length_mm = 25.4\n") + "head_top_angle_deg = 10.0\n",
+     "error: tooling.punch.tip_relief_mm = 10 mm is not allowed: must leave a relieved tip: the outline offset inwards "
+     "by the clearance and the relief (10.02 mm) leaves no single outline (tablet width 10 mm)"),
     # a rounded square 24 mm on the axes is 33.1 mm across its corners: larger than a D die takes (it had been
     # read as 24 mm, and an 18 mm one, 24.6 mm across, given a B die, which takes shaped tablets up to 19 mm)
     ('[tablet]\nfamily = "rounded_square"\nside = 24.0\ncorner_radius = 1.0\nband = 3.0\ncup_depth = 0.5\n'

@@ -285,6 +285,26 @@ def check_punch_lengths(spec: ToolingSpec, band_z: tuple[float, float], height: 
                              " (not given, it is tip_length_mm: give lower_tip_length_mm)"), "mm")
 
 
+def relief_refused(spec: ToolingSpec, width: float) -> DesignError:
+    """The refusal of a complete punch's ``tip_relief_mm`` that leaves no relieved tip outline (the tablet's
+    ``width``, mm, quoted)."""
+    d = spec.clearance_mm + spec.body.tip_relief_mm
+    return DesignError("[tooling.punch] tip_relief_mm", spec.body.tip_relief_mm,
+                       f"must leave a relieved tip: the outline offset inwards by the clearance and the relief "
+                       f"({d:.4g} mm) leaves no single outline (tablet width {width:.4g} mm)", "mm")
+
+
+def check_relief_reach(spec: ToolingSpec, narrow: float, width: float) -> None:
+    """On the PDE tablet, before any geometry: a relief that, with the clearance, reaches half the tablet's
+    ``narrow``\ est extent (mm) or more leaves no tip outline (no plan outline is thicker than its narrowest
+    extent); :func:`relief_refused` then.  The tooling build checks the exact offset of the outline too."""
+    b = spec.body
+    if b is None or b.tip_relief_mm <= 0 or max(spec.tip_length_mm, spec.lower_tip) <= b.tip_straight_mm:
+        return  # no relief is cut
+    if spec.clearance_mm + b.tip_relief_mm >= 0.5 * narrow:
+        raise relief_refused(spec, width)
+
+
 #: TSM die blanks: (outer diameter, height, type), mm; the largest tablet each takes, round and shaped,
 #: is the standard's (``max_round_tablet_mm``, ``max_shaped_tablet_mm`` in tabletcad/data/tooling_standards.toml)
 TSM_DIES = ((30.16, 22.22, "B"), (38.10, 23.81, "D"))

@@ -52,7 +52,7 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
     if t.u != (0.0, 1.0) or not t.full_v or t.w[0] > 0:
         raise DesignError("[tooling]", tablet.name, "tooling needs a whole solid tablet (no [trim], no ring)")
     from tabletcad.pipeline.designreport import plan_diameter
-    from tabletcad.tooling.spec import check_punch_lengths, die_height_for, standard_die_size
+    from tabletcad.tooling.spec import check_punch_lengths, check_relief_reach, die_height_for, standard_die_size
 
     band_heights(tablet)  # (a sphere has no band for the die to form)
     od = spec.die_outer_diameter_mm
@@ -72,8 +72,11 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
                               f"must be >= {2 * (reach + MIN_DIE_WALL_MM):.4g} mm (the tablet reaches {reach:.4g} mm "
                               f"from the axis, the die's walls need {MIN_DIE_WALL_MM} mm)", "mm")
     check_on_tablet(tablet, spec)
-    if spec.body is not None:  # complete punches: their tips against the die (the build checks them on its frame too)
+    if spec.body is not None:  # complete punches: their tips against the die, their relief against the tablet's
+        # width (the build checks both on its frame too, the relief by the outline's exact offset)
         check_punch_lengths(spec, band_heights(tablet), die_height_for(spec, size, shaped))
+        lo, hi = tablet.bounds()
+        check_relief_reach(spec, min(float(hi[0] - lo[0]), float(hi[1] - lo[1])), float(hi[1] - lo[1]))
 
 
 def write_tooling(ts, out: Path, *, drawing: bool = True) -> list[Path]:

@@ -16,7 +16,7 @@ from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.designreport import ReportOptions
 from tabletcad.tooling.booleans import TIMER, to_manifold, volume
 from tabletcad.tolerance import DEFAULT
-from tabletcad.tooling.spec import ToolingSpec, check_numbers, check_punch_lengths, die_height_for
+from tabletcad.tooling.spec import ToolingSpec, check_numbers, check_punch_lengths, die_height_for, relief_refused
 
 __all__ = ["ToolSet", "make_tooling", "check_closed_position", "finished_solid", "DEFLECTION_MM"]
 
@@ -171,9 +171,7 @@ def _check_relief(frame, spec: ToolingSpec) -> None:
     except GeometryError:
         relieved = 0.0
     if not relieved > 0.0:
-        raise DesignError("[tooling.punch] tip_relief_mm", b.tip_relief_mm,
-                          f"must leave a relieved tip: the outline offset inwards by the clearance and the relief "
-                          f"({d:.4g} mm) leaves no single outline (tablet width {frame.width:.4g} mm)", "mm")
+        raise relief_refused(spec, frame.width)
 
 
 def finished_solid(tablet: Tablet, spec: ToolingSpec, *, shape=None, deflection: float = DEFLECTION_MM):
