@@ -520,3 +520,19 @@ def test_simulate_compressions_omega_z0_range_from_python():
         simulate_compression(P, omega_z0=-5.9)
     with pytest.raises(DesignError, match=r"^omega_z0 = "):
         simulate_compression(P, omega_z0=hi + 1e-6)
+
+
+def test_heckel_refuses_punch_travel_taken_as_the_gap(capsys, tmp_path):
+    """A new user's trial: 'Punch Travel (mm)' rising with the force, metadata without displacement_sign, gave
+    K = -0.0003289 1/MPa and Py = -3040 MPa with exit 0.  One line now, exit 2, nothing written."""
+    F = np.linspace(0.05, 15.0, 40)
+    travel = 8.0 - 300.0 / (1.3 * np.pi * 25.0 * (1.0 - np.exp(-(10.0 * F / (np.pi * 25.0) + 0.9))))
+    data = tmp_path / "travel.csv"
+    data.write_text("Upper Punch Force (kN),Punch Travel (mm)\n" + "".join(f"{f:.5f},{x:.5f}\n" for f, x in zip(F, travel)))
+    (tmp_path / "travel.toml").write_text("mass_mg = 300.0\ntrue_density = 1.3\ndiameter = 10.0\n")
+    rc, out, err = run(capsys, "heckel", data, "--json-file", tmp_path / "h.json")
+    assert rc == 2 and out == "" and not (tmp_path / "h.json").exists()
+    assert len(err.splitlines()) == 1 and "Traceback" not in err
+    assert err.startswith("error: displacement_sign = 'auto' is not allowed: makes the punch gap 0 + "
+                          "'Punch Travel (mm)' grow from")
+    assert "displacement_zero" in err

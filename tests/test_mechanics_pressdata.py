@@ -540,3 +540,45 @@ def test_a_compliance_table_short_of_the_records_forces_is_warned_of():
     with warnings.catch_warnings():
         warnings.simplefilter("error", DataWarning)
         read_press_data(SAMPLE, whole)
+
+
+# ----------------------------------------------------------------------------- the gap must close under load
+def _travel_record(tmp_path: Path, meta: str) -> Path:
+    """A new user's record: punch travel (mm) rising as the force rises, 8 mm of gap at zero travel."""
+    F = np.concatenate([np.linspace(0.05, 15.0, 40), np.linspace(14.0, 0.5, 10)])  # kN
+    gap = 300.0 / (1.3 * np.pi * 25.0 * (1.0 - np.exp(-(0.01 * F * 1000 / (np.pi * 25.0) + 0.9))))
+    gap[40:] = gap[39] * (1.0 + 0.02 * (1.0 - F[40:] / 15.0))
+    rows = "\n".join(f"{0.5 * i:g}\t{f:.5f}\t{8.0 - g:.5f}" for i, (f, g) in enumerate(zip(F, gap)))
+    p = _write(tmp_path, "Time (ms)\tUpper Punch Force (kN)\tPunch Travel (mm)\n" + rows + "\n", "travel.csv")
+    (tmp_path / "travel.toml").write_text("mass_mg = 300.0\ntrue_density = 1.3\ndiameter = 10.0\n" + meta)
+    return p
+
+
+def test_auto_sign_refuses_punch_travel_read_as_the_gap(tmp_path):
+    """A new user's trial: travel rising with the force was read by 'auto' as the gap itself (the gap grew
+    under load) and gave K = -0.000329 1/MPa, Py = -3040 MPa, exit 0 with a warning.  Refused now, naming
+    displacement_sign and displacement_zero; given, the same record reads as its made-up K = 0.01 1/MPa."""
+    from tabletcad.mechanics.heckel import fit_heckel
+
+    p = _travel_record(tmp_path, "")
+    with pytest.raises(DesignError) as e:
+        read_press_data(p)
+    msg = str(e.value)
+    assert msg.startswith("displacement_sign = 'auto' is not allowed: makes the punch gap 0 + 'Punch Travel (mm)' "
+                          "grow from ")
+    assert "(file lines 2-41)" in msg and "'auto' read the readings as the gap itself" in msg
+    assert "displacement_sign = -1 and displacement_zero = the gap at zero travel (mm)" in msg
+    d = read_press_data(_travel_record(tmp_path, "displacement_sign = -1\ndisplacement_zero = 8.0\n"))
+    assert fit_heckel(compaction_curves(d), window=(20.0, 150.0)).K_per_MPa == pytest.approx(0.01, rel=1e-3)
+
+
+def test_a_sign_given_the_wrong_way_round_is_refused(tmp_path):
+    """The check is of the physics, not of 'auto': a sign given as +1 for travel is refused as well,
+    and so is 'auto' reading negative travel (every reading <= 0) as minus the gap."""
+    with pytest.raises(DesignError, match=r"^displacement_sign = 1 is not allowed: makes the punch gap 8 \+ .*"
+                                          r"\+1 as given"):
+        read_press_data(_travel_record(tmp_path, "displacement_sign = 1\ndisplacement_zero = 8.0\n"))
+    F = np.linspace(10.0, 5000.0, 30)
+    with pytest.raises(DesignError, match=r"^displacement_sign = 'auto' .* read the readings as minus the gap"):
+        PressData.from_arrays(F, displacement=-np.linspace(0.0, 3.0, 30) - 0.1,
+                              metadata=PressMetadata(mass_mg=300, true_density=1.3, diameter=10))

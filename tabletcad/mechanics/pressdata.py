@@ -45,7 +45,11 @@ With ``displacement_sign = "auto"`` the sign is -1 when every reading is <= 0
 (readings are the negative distance between the punch faces, as in the
 thesis's Appendix B) and +1 otherwise (readings are the gap itself).  Data
 recorded as punch *travel* need an explicit ``displacement_zero`` (the gap at
-zero travel) and ``displacement_sign = -1``.
+zero travel) and ``displacement_sign = -1``.  Whatever the sign, the gap must
+close while the force rises through the loading branch; one that grows there
+(punch travel read as the gap by "auto", or a sign given the wrong way round)
+is refused, naming ``displacement_sign`` and ``displacement_zero``: neither is
+ever guessed.
 
 Corrected thickness (mm): ``thickness = gap + compliance.deflection(F)``.
 """
@@ -331,7 +335,59 @@ class PressData:
         return _assemble(F, pos, thickness is not None, t, metadata, {}, np.arange(1, F.size + 1), 0, "<arrays>")
 
 
-def _assemble(F, pos, is_thickness, t, meta, extra, lines, dropped, source) -> PressData:
+def _check_gap_closes(F: np.ndarray, gap: np.ndarray, sign: int, meta: PressMetadata, lines: np.ndarray,
+                      column: str) -> None:
+    """Refuse a punch gap, read from displacements with ``sign``, that does not close while the force rises.
+
+    Through the loading branch (:func:`tabletcad.mechanics.compaction.split_branches`) the punches
+    close on the powder: the gap (mm) at the peak force is smaller than at the branch's first row.
+    A gap that grows there is a column read the wrong way round, e.g. punch travel taken as the gap
+    itself by ``displacement_sign = "auto"`` (a new user's record gave K = -0.000329 1/MPa and
+    Py = -3040 MPa with only a warning).  A record without a loading branch is left to the
+    curves' own refusal.
+
+    Parameters
+    ----------
+    F : ndarray
+        Force per row, N.
+    gap : ndarray
+        Punch gap per row, mm, ``displacement_zero + sign * displacement``.
+    sign : int
+        The sign used, +1 or -1 (``meta.displacement_sign`` resolved).
+    meta : PressMetadata
+        The record's metadata (``displacement_sign`` as given, ``displacement_zero``).
+    lines : ndarray of int
+        The rows' 1-based line numbers in the file.
+    column : str
+        The displacement column's header, for the message.
+
+    Raises
+    ------
+    DesignError
+        ``displacement_sign``, naming ``displacement_zero`` too, when the gap does not close.
+    """
+    from tabletcad.mechanics.compaction import split_branches  # (compaction imports this module)
+
+    try:
+        first, end = split_branches(F).loading
+    except DesignError:
+        return
+    peak = end - 1
+    if gap[peak] < gap[first]:
+        return
+    how = ("'auto' read the readings as the gap itself (some are > 0; it takes -1 only when every reading "
+           "is <= 0, as the thesis's Appendix B)" if sign == 1 else "'auto' read the readings as minus the gap "
+           "(every one is <= 0)") if meta.displacement_sign == "auto" else f"{sign:+d} as given"
+    raise DesignError(
+        "displacement_sign", meta.displacement_sign,
+        f"makes the punch gap {meta.displacement_zero:g} {'+' if sign > 0 else '-'} {column!r} grow from "
+        f"{gap[first]:.4g} mm to {gap[peak]:.4g} mm while the force rises to its peak {F[peak]:.4g} N "
+        f"(file lines {int(lines[first])}-{int(lines[peak])}), where the punches close on the powder: {how}. "
+        "A column of punch travel needs displacement_sign = -1 and displacement_zero = the gap at zero travel "
+        "(mm) in the metadata file; tabletcad does not guess them")
+
+
+def _assemble(F, pos, is_thickness, t, meta, extra, lines, dropped, source, column="displacement") -> PressData:
     if F.size == 0:
         raise DesignError("data", source, "has no complete rows")
     if is_thickness:
@@ -343,6 +399,7 @@ def _assemble(F, pos, is_thickness, t, meta, extra, lines, dropped, source) -> P
         if sign == "auto":
             sign = -1 if np.all(disp <= 0.0) else 1
         gap = meta.displacement_zero + sign * disp
+        _check_gap_closes(F, gap, sign, meta, lines, column)
     comp = meta.compliance
     if comp is not None and comp.is_table and np.any(np.isfinite(F)):
         f_hi, f_lo = float(np.nanmax(F)), float(np.nanmin(F))
@@ -725,7 +782,7 @@ def read_press_data(
     metadata = _resolve_metadata(path, meta, overrides)
     return _assemble(
         values[:, roles["force"]].copy(), values[:, roles[pos_role]].copy(), pos_role == "thickness",
-        t, metadata, extra, lines, dropped, path.name,
+        t, metadata, extra, lines, dropped, path.name, header[roles[pos_role]],
     )
 
 
