@@ -475,6 +475,37 @@ def test_love_names_its_options(capsys, tmp_path, args, line):
     _refused_writing_nothing(capsys, tmp_path, ["love", *args], line)
 
 
+MODEL_WHY = ("(where the model runs with the other options: the bed stays thicker than 0, at least 3 of the 41 "
+             "simulated points keep a relative density below 1 for the Heckel fit and the densest reaches 0.05)")
+
+
+@pytest.mark.parametrize("args, line", [
+    # had been "relative_density = 'at most 0.0298' ... check the mass (mg, not g), the true density (mg/mm³), the
+    # die diameter (mm) and the displacement's unit": options love does not have, and --h0 not named
+    (["--h0", "100"], "error: --h0 = 100 mm is not allowed: must be >= 4.292 and <= 60.1443 mm " + MODEL_WHY),
+    # over the 1000 mm length limit: had been refused as a relative density too
+    (["--h0", "6000"], "error: --h0 = 6000 mm is not allowed: must be > 0 and <= 1000 mm"),
+    # GPa typed as MPa had been "--window = 11 MPa is not allowed: compresses the model bed to zero thickness"
+    (["--E", "2.64"], "error: --E = 2.64 MPa is not allowed: must be >= 483.527 and <= 1e+07 MPa " + MODEL_WHY
+                      + "; Young's modulus in MPa: 2.64 GPa is 2640 MPa"),
+    # a bed below the default --z had been "--z = 2.9635 mm is not allowed", an option not given
+    (["--h0", "2"], "error: --h0 = 2 mm is not allowed: must be >= 2.9635 mm, the default --z (the height where "
+                    "ω_z is taken lies within the bed; or give a lower --z)"),
+])
+def test_love_names_the_option_given_not_the_models_quantity(capsys, tmp_path, args, line):
+    _refused_writing_nothing(capsys, tmp_path, ["love", *args], line)
+
+
+@pytest.mark.parametrize("option, value, lo, hi", [("--h0", 100.0, "4.292", "60.1443"), ("--E", 2.64, "483.527", "1e+07")])
+def test_loves_model_range_ends_run(capsys, option, value, lo, hi):
+    """The ends of the stated range compute (exit 0); a step outside the lower end is refused again."""
+    for end in (lo, hi):
+        rc, out, err = run(capsys, "love", option, end, "--json")
+        assert rc == 0 and math.isfinite(json.loads(out)["K_per_MPa"]), err
+    rc, _, err = run(capsys, "love", option, float(lo) * (1 - 1e-5))
+    assert rc == 2 and err.startswith(f"error: {option} = ") and f"must be >= {lo} and <= {hi}" in err
+
+
 @pytest.mark.parametrize("options", [[], ["--h0", "10", "--z", "5"], ["--h0", "60"], ["--window", "10", "500"],
                                      ["--E", "900", "--nu", "0.4"]])
 def test_loves_omega_z0_range_is_what_it_computes(capsys, tmp_path, options):

@@ -24,7 +24,7 @@ from tabletcad.cli.outputs import check_output as _check_output
 from tabletcad.io.jsontext import json_text
 from tabletcad.cli.outputs import staged as _staged
 from tabletcad.errors import MISSING, DesignError, check_finite, check_positive, check_range, format_bound
-from tabletcad.tolerance import MAX_MODULUS_MPA, MAX_PRESSURE_MPA
+from tabletcad.tolerance import DEFAULT, MAX_MODULUS_MPA, MAX_PRESSURE_MPA
 
 __all__ = ["COMMANDS"]
 
@@ -533,6 +533,52 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
 
 
 # --------------------------------------------------------------------------- love
+#: love's model options: their units, and what a value in the wrong unit looks like
+_LOVE_UNITS = {"E": ("MPa", "; Young's modulus in MPa: 2.64 GPa is 2640 MPa"), "nu": ("", ""),
+               "h0": ("mm", ""), "z": ("mm", ""), "r": ("mm", "")}
+
+
+def _given_options(names: tuple[str, ...]) -> list[str]:
+    """The parameters among ``names`` that the command line gave (not left at their defaults)."""
+    from click.core import ParameterSource
+
+    ctx = click.get_current_context()
+    return [n for n in names if ctx.get_parameter_source(n) not in (ParameterSource.DEFAULT, None)]
+
+
+def _refuse_love_option(pressures: np.ndarray, model: dict[str, Any], given: list[str]) -> None:
+    """Refuse the first option given on the command line (``--E``, ``--nu``, ``--h0``, ``--z``, ``--r``)
+    whose value lies outside the range where the love model runs with the others, naming it and that range.
+
+    The model's own refusal names what failed in it (``relative_density`` with a hint at a mass the
+    command has no option for, ``pressure`` = a point of the default --window): ``--h0 100`` and
+    ``--E 2.64`` (GPa typed as MPa) had been refused that way.  Returns when no given option is at
+    fault (the caller re-raises the model's refusal).
+
+    Parameters
+    ----------
+    pressures : ndarray
+        The simulated pressures, MPa.
+    model : dict
+        :func:`tabletcad.mechanics.love.simulate_compression`'s keyword arguments.
+    given : list of str
+        The model options the command line gave, in the order to blame them.
+
+    Raises
+    ------
+    DesignError
+        ``--<option>`` with its range (:func:`tabletcad.mechanics.love.model_range`).
+    """
+    from tabletcad.mechanics.love import model_allowed, model_range
+
+    for name in given:
+        lo, hi = model_range(name, pressures, **model)
+        value = model[name]
+        if math.isnan(lo) or not lo <= value <= hi:
+            unit, hint = _LOVE_UNITS[name]
+            raise DesignError(f"--{name}", value, model_allowed(lo, hi, pressures.size, unit) + hint, unit) from None
+
+
 @click.command("love")
 @click.option("--E", "E", type=float, default=2640.0, show_default=True, help="Young's modulus, MPa.")
 @click.option("--nu", type=float, default=0.21, show_default=True, help="Poisson's ratio.")
@@ -558,7 +604,12 @@ def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json, json_file) -> None:
     # every option is checked here, by its own name, before the model runs
     check_range("--E", E, 0.0, MAX_MODULUS_MPA, "MPa", lo_open=True)
     check_range("--nu", nu, 0.0, 0.5, hi_open=True)
-    check_positive("--h0", h0, "mm")
+    check_range("--h0", h0, 0.0, DEFAULT.max_length, "mm", lo_open=True)  # a length, as every other (6000 had
+    # been refused as a relative density)
+    given = _given_options(("E", "nu", "h0", "z", "r"))
+    if "z" not in given and z > h0:  # the default z names the bed's height, which the user chose
+        raise DesignError("--h0", h0, f"must be >= {z:g} mm, the default --z (the height where ω_z is taken lies "
+                          "within the bed; or give a lower --z)", "mm")
     check_range("--z", z, 0.0, h0, "mm")  # a height within the bed (above it, eq 5.18 gave K = -0.015 1/MPa)
     if r is not None:  # a radius within the die (the model's own check named it r)
         check_range("--r", r, 0.0, THESIS_DIAMETER / 2.0, "mm", lo_open=True)
@@ -576,8 +627,13 @@ def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json, json_file) -> None:
         if not (w_lo < w0 or w0 == w_lo == -h0) or not w0 <= w_hi:  # (nan: nothing works)
             raise DesignError("--omega-z0", omega_z0, omega_z0_allowed(w_lo, w_hi, 41, cap=h0), "mm")
     # the model's refusal of a bed pressed to nothing names its keyword; here the option
+    model = {"E": E, "nu": nu, "h0": h0, "z": z, "r": r, "omega_z0": omega_z0}
     with _collect() as msgs, option_names({"omega_z0": "--omega-z0", "pressure": "--window"}):
-        sim = simulate_compression(np.linspace(lo, hi, 41), E=E, nu=nu, h0=h0, z=z, r=r, omega_z0=omega_z0)
+        try:
+            sim = simulate_compression(np.linspace(lo, hi, 41), **model)
+        except DesignError:
+            _refuse_love_option(np.linspace(lo, hi, 41), model, given)
+            raise
     f = sim.heckel
     payload = {"K_per_MPa": f.K_per_MPa, "A": f.A, "Py_MPa": f.Py_MPa, "r2": f.r2, "window_MPa": list(f.window_MPa),
                "n_points": f.n_points, "omega_z0_mm": sim.omega_z0, "assumptions": sim.assumptions, "warnings": msgs}

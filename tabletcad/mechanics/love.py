@@ -49,6 +49,7 @@ answer for a frictionless rigid die (uniaxial strain).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -56,6 +57,7 @@ import numpy as np
 from tabletcad.errors import DesignError, check_positive, check_range, format_bound
 from tabletcad.mechanics.compaction import MIN_PEAK_RELATIVE_DENSITY, relative_density
 from tabletcad.mechanics.heckel import HeckelFit, fit_heckel_arrays
+from tabletcad.tolerance import DEFAULT, MAX_MODULUS_MPA
 
 __all__ = [
     "THESIS_DIAMETER",
@@ -68,6 +70,8 @@ __all__ = [
     "axial_displacement",
     "confined_compression",
     "love_fields",
+    "model_allowed",
+    "model_range",
     "omega_z0_allowed",
     "omega_z0_range",
     "simulate_compression",
@@ -293,6 +297,107 @@ def omega_z0_allowed(lo: float, hi: float, n: int, cap: float | None = None) -> 
         return f"no value works with these options ({why})"
     low = ">=" if cap is not None and lo == -cap else ">"
     return f"must be {low} {format_bound(lo, upper=False)} and <= {format_bound(hi, upper=True)} mm ({why})"
+
+
+#: Points of :func:`model_range`'s scan of a parameter's limits, and its bisection steps at each end.
+_SCAN_POINTS = 400
+_BISECTIONS = 48
+
+
+def _model_limits(name: str, model: dict) -> tuple[float, float, bool]:
+    """The scan of :func:`model_range` for ``name``: ``(low, high, log scale)``, within the model's own
+    checks (E > 0 MPa up to 1e7, 0 <= nu < 0.5, z <= h0 <= 1000 mm, 0 <= z <= h0, 0 < r <= c)."""
+    c = model.get("diameter", THESIS_DIAMETER) / 2.0
+    h0 = model.get("h0", THESIS_H0)
+    z = model.get("z", THESIS_Z)
+    limits = {"E": (MAX_MODULUS_MPA * 1e-12, MAX_MODULUS_MPA, True),
+              "nu": (0.0, math.nextafter(0.5, 0.0), False),
+              "h0": (max(z, 1e-3), DEFAULT.max_length, True),
+              "z": (0.0, h0, False),
+              "r": (c * 1e-6, c, False)}
+    if name not in limits:
+        raise DesignError("name", name, f"must be one of {', '.join(limits)}")
+    return limits[name]
+
+
+def _model_runs(pressures: np.ndarray, model: dict) -> bool:
+    """Whether :func:`simulate_compression` runs (no refusal) with the keyword arguments ``model``."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            simulate_compression(pressures, **model)
+    except DesignError:
+        return False
+    return True
+
+
+def model_range(name: str, pressures, **model) -> tuple[float, float]:
+    """The values of one parameter of :func:`simulate_compression` with which it runs, the others fixed.
+
+    The bed must stay thicker than 0 mm, at least 3 simulated points must keep a relative density
+    below 1 for the Heckel fit and the densest must reach
+    :data:`~tabletcad.mechanics.compaction.MIN_PEAK_RELATIVE_DENSITY` (with ``omega_z0`` matched to the
+    experiment, a bed of ``h0 = 100`` mm reached 0.03 and ``E = 2.64`` MPa, a modulus typed in GPa,
+    pressed the bed to nothing).  The parameter's limits are scanned at 400 points (logarithmically for
+    ``E`` and ``h0``) and the ends of the run of working values nearest ``model[name]`` refined by
+    bisection, so both ends returned run.
+
+    Parameters
+    ----------
+    name : {"E", "nu", "h0", "z", "r"}
+        The parameter: MPa, dimensionless or mm.
+    pressures : array_like
+        Simulated pressures, MPa.
+    **model
+        Keyword arguments of :func:`simulate_compression` (``name`` among them: the value whose
+        neighbourhood is searched).
+
+    Returns
+    -------
+    (float, float)
+        ``(lo, hi)``, both inclusive, in the parameter's unit; ``(nan, nan)`` when no value runs.
+    """
+    P = np.asarray(pressures, dtype=float).ravel()
+    lo, hi, log = _model_limits(name, model)
+    grid = np.geomspace(lo, hi, _SCAN_POINTS) if log else np.linspace(lo, hi, _SCAN_POINTS)
+    ok = np.array([_model_runs(P, model | {name: float(x)}) for x in grid])
+    if not ok.any():
+        return (math.nan, math.nan)
+    here = int(np.argmin(np.abs(grid - float(model.get(name, grid[0])))))
+    good = np.flatnonzero(ok)
+    k = int(good[np.argmin(np.abs(good - here))])
+    a = k
+    while a > 0 and ok[a - 1]:
+        a -= 1
+    b = k
+    while b < grid.size - 1 and ok[b + 1]:
+        b += 1
+    ends = []
+    for inside, outside in ((a, a - 1), (b, b + 1)):
+        x_in = float(grid[inside])
+        if 0 <= outside < grid.size:
+            x_out = float(grid[outside])
+            for _ in range(_BISECTIONS):
+                mid = 0.5 * (x_in + x_out)
+                if mid in (x_in, x_out):
+                    break
+                if _model_runs(P, model | {name: mid}):
+                    x_in = mid
+                else:
+                    x_out = mid
+        ends.append(x_in)
+    return (ends[0], ends[1])
+
+
+def model_allowed(lo: float, hi: float, n: int, unit: str) -> str:
+    """The refusal's range of a parameter for :func:`model_range`'s ``(lo, hi)`` over ``n`` pressures."""
+    why = (f"where the model runs with the other options: the bed stays thicker than 0, at least "
+           f"{_MIN_FIT_POINTS} of the {n} simulated points keep a relative density below 1 for the Heckel fit "
+           f"and the densest reaches {MIN_PEAK_RELATIVE_DENSITY:g}")
+    if math.isnan(lo):
+        return f"no value works with the other options ({why})"
+    unit = f" {unit}" if unit else ""
+    return f"must be >= {format_bound(lo, upper=False)} and <= {format_bound(hi, upper=True)}{unit} ({why})"
 
 
 def _refuse_collapse(pressure: float, omega_z0: float, h0: float, given: bool) -> None:
