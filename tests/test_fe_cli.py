@@ -154,10 +154,23 @@ def test_punch_bad_input(capsys, tmp_path, extra, match):
     assert not out.exists()
 
 
-def test_strength_needs_its_inputs(capsys, thin):
+def test_strength_needs_its_inputs(capsys, tmp_path, thin):
+    """A new user's trial: the refusal named only the [report] keys (``report.tensile_strength_MPa = (not given)
+    ... reference_breaking_force_N, ...``), not the options this command line takes.  It names the options
+    now, the keys as the alternative (this test had pinned the keys-only line)."""
     rc, so, err = run(capsys, "fe", "strength", thin)
-    assert rc == 2 and err.count("\n") == 1
-    assert err.startswith("error: report.tensile_strength_MPa = (not given) is not allowed: give it, or all of"), err
+    assert rc == 2 and so == "" and err.splitlines() == [
+        "error: --tensile-strength = (not given) is not allowed: give it (MPa), or all of --reference-force (N), "
+        "--reference-diameter and --reference-thickness (mm) of a flat-faced round reference compact; or in "
+        "DESIGN's [report] table tensile_strength_MPa, or all of reference_breaking_force_N, reference_diameter_mm "
+        "and reference_thickness_mm"]
+    begun = tmp_path / "begun.toml"  # a reference test begun in the file: its key named, and its option
+    begun.write_text(THIN + "[report]\nreference_breaking_force_N = 80.0\n")
+    rc, so, err = run(capsys, "fe", "strength", begun)
+    assert rc == 2 and err.splitlines() == [
+        "error: report.reference_diameter_mm = (not given) is not allowed: the reference test needs "
+        "reference_breaking_force_N, reference_diameter_mm, reference_thickness_mm (or give tensile_strength_MPa "
+        "instead); or give it as --reference-diameter"]
 
 
 def test_diametral_refuses_a_ring_fast(capsys):

@@ -167,6 +167,49 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
     ] + [f"-> {f}" for f in files], json_file=json_file)
 
 
+#: ``fe strength``'s inputs: the design file's ``[report]`` key (as a refusal names it) and the option for it
+_STRENGTH_OPTIONS = {"report.tensile_strength_MPa": "--tensile-strength",
+                     "report.reference_breaking_force_N": "--reference-force",
+                     "report.reference_diameter_mm": "--reference-diameter",
+                     "report.reference_thickness_mm": "--reference-thickness"}
+_REFERENCE_OPTIONS = "--reference-force (N), --reference-diameter and --reference-thickness (mm)"
+
+
+def _refuse_missing_strength(exc: DesignError, given: dict[str, str]) -> None:
+    """Refuse a strength input that is missing by the name the command line gives it.
+
+    :class:`~tabletcad.fe.prediction.StrengthInputs` names the design file's ``[report]`` keys
+    (``report.tensile_strength_MPa = (not given) ... reference_breaking_force_N``); ``fe strength``
+    takes them as options too, which a new user's trial had not been told of.  With no input at all,
+    ``--tensile-strength`` is named with the reference options and, as the alternative, the keys; a
+    reference test begun with options names the option it lacks; one begun in the file names the key
+    and its option.  Returns (the caller re-raises) for any other refusal.
+
+    Parameters
+    ----------
+    exc : DesignError
+        The refusal of :meth:`StrengthInputs.from_table`.
+    given : dict of str to str
+        The ``[report]`` keys the command line gave, to their options.
+
+    Raises
+    ------
+    DesignError
+        The missing input, named as above.
+    """
+    if exc.value != MISSING or exc.parameter not in _STRENGTH_OPTIONS:
+        return
+    option = _STRENGTH_OPTIONS[exc.parameter]
+    if option == "--tensile-strength":
+        raise DesignError(option, MISSING, f"give it (MPa), or all of {_REFERENCE_OPTIONS} of a flat-faced round "
+                          "reference compact; or in DESIGN's [report] table tensile_strength_MPa, or all of "
+                          "reference_breaking_force_N, reference_diameter_mm and reference_thickness_mm") from None
+    if given:  # a reference test begun on the command line
+        raise DesignError(option, MISSING, f"the reference test needs all of {_REFERENCE_OPTIONS} (or give "
+                          "--tensile-strength instead)") from None
+    raise DesignError(exc.parameter, MISSING, f"{exc.allowed}; or give it as {option}") from None
+
+
 @fe_group.command("strength")
 @click.argument("design", type=click.Path(dir_okay=False, path_type=Path))
 @click.option("--tensile-strength", type=float, default=None, help="Tensile strength of the material, MPa.")
@@ -201,25 +244,21 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
     from tabletcad.fe.prediction import StrengthInputs, predict_breaking_force
 
     tablet, spec = load_family_design(design)
-    solid, meshed = _finished(spec, tablet)
     given = {f"report.{k}": o for k, o, v in (
         ("tensile_strength_MPa", "--tensile-strength", tensile_strength),
         ("reference_breaking_force_N", "--reference-force", reference_force),
         ("reference_diameter_mm", "--reference-diameter", reference_diameter),
         ("reference_thickness_mm", "--reference-thickness", reference_thickness)) if v is not None}
-    options = {"report.reference_breaking_force_N": "--reference-force",
-               "report.reference_diameter_mm": "--reference-diameter",
-               "report.reference_thickness_mm": "--reference-thickness"}
     with option_names(given):  # an option given overrides the design's [report] key: named as given
-        try:
+        try:  # before the finished tablet is built: a missing input is refused at once
             inputs = StrengthInputs.from_table(spec.report, tensile_strength_MPa=tensile_strength,
                                                reference_breaking_force_N=reference_force,
                                                reference_diameter_mm=reference_diameter,
                                                reference_thickness_mm=reference_thickness)
-        except DesignError as exc:  # the input a reference test from the options lacks: named as its option
-            if exc.value == MISSING and exc.parameter in options and any(o in given for o in options):
-                raise exc.renamed(options[exc.parameter]) from None
+        except DesignError as exc:
+            _refuse_missing_strength(exc, given)
             raise
+        solid, meshed = _finished(spec, tablet)
         pred = (coarse_prediction(tablet, inputs, direction, solid=solid) if coarse
                 else predict_breaking_force(tablet, inputs, direction, solid=solid, mesh_size=mesh_size,
                                             error_estimate=False))
