@@ -258,3 +258,22 @@ def test_a_bracket_saying_no_unit_is_no_unit(capsys, tmp_path, bracket):
     rc, out, err = run(capsys, "profiles", data, "--json", "--solid-fraction-column", name)
     assert rc == 0, err
     assert json.loads(out)["ryshkewitch_duckworth"]["k"] == pytest.approx(K, rel=1e-9)
+
+
+@pytest.mark.parametrize("rows, line", [
+    # a new user's trial: a solid fraction of 70 had been "error: solid.fraction = 70 is not allowed", no file or row
+    ("50.0,70,1.32\n100.0,0.78,2.14\n150.0,0.83,2.88\n",
+     "error: \"prof6.csv\".line[2].solid_fraction = 70 is not allowed: must be > 0 and < 1 (a solid fraction; a "
+     "percentage needs '%' in its header, as 'Solid fraction (%)')"),
+    ("50.0,0.7,1.32\n100.0,0.78,-2.14\n150.0,0.83,2.88\n",
+     "error: \"prof6.csv\".line[3].tensile_strength_MPa = -2.14 MPa is not allowed: must be > 0 (a tablet's tensile "
+     "strength)"),
+    ("50.0,0.7,1.32\n-100.0,0.78,2.14\n150.0,0.83,2.88\n",
+     "error: \"prof6.csv\".line[3].pressure_MPa = -100 MPa is not allowed: must be >= 0 (a compaction pressure)"),
+])
+def test_profiles_name_the_row_and_column_of_a_bad_value(capsys, tmp_path, rows, line):
+    data = tmp_path / "prof6.csv"
+    data.write_text("pressure_MPa,solid_fraction,tensile_strength_MPa\n" + rows, encoding="utf-8")
+    rc, out, err = run(capsys, "profiles", data, "--json-file", tmp_path / "p.json")
+    assert rc == 2 and out == "" and err.splitlines() == [line]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["prof6.csv"]

@@ -285,6 +285,38 @@ walker_cmd = _compression_command(
     "Walker fit 100 V/V0 = -W log10 P + c (V/V0 = h/h0) of a table of pressure (MPa) and thickness (mm).")
 
 
+def _refuse_row(data: Path, table: dict[str, np.ndarray], key: str, column: str, bad: np.ndarray, allowed: str,
+               unit: str = "") -> None:
+    """Refuse the first row of ``table[key]`` marked ``bad``, named by the file, its line and the column
+    (``"prof6.csv".line[3].solid_fraction``, as the kawakita and press-record readers name a cell).
+
+    Parameters
+    ----------
+    data : Path
+        The table's file.
+    table : dict of str to ndarray
+        Columns as :func:`tabletcad.mechanics.pressdata.read_columns` returns them (``_lines`` among them).
+    key : str
+        The column's key in ``table``.
+    column : str
+        The column as the command line names it (its header).
+    bad : ndarray of bool
+        Rows to refuse.
+    allowed, unit : str
+        The refusal's range and the value's unit.
+
+    Raises
+    ------
+    DesignError
+        For the first bad row.
+    """
+    rows = np.flatnonzero(bad)
+    if rows.size:
+        k = int(rows[0])
+        raise DesignError(f"{data.name!r} line {int(table['_lines'][k])} {column!r}", float(table[key][k]), allowed,
+                          unit)
+
+
 @click.command("profiles")
 @click.argument("data", type=click.Path(path_type=Path))
 @click.option("--pressure-column", default="pressure_MPa", show_default=True, help="Compaction pressure, MPa.")
@@ -309,6 +341,11 @@ def profiles_cmd(data: Path, pressure_column: str, solid_fraction_column: str, s
         raise DesignError("--plot", str(plot_file), "must differ from --json-file")
     t = _read_table(data, {"P": (pressure_column, "pressure"), "sf": (solid_fraction_column, "fraction"),
                            "s": (strength_column, "pressure")})
+    _refuse_row(data, t, "P", pressure_column, t["P"] < 0.0, "must be >= 0 (a compaction pressure)", "MPa")
+    _refuse_row(data, t, "sf", solid_fraction_column, ~((t["sf"] > 0.0) & (t["sf"] < 1.0)),
+                "must be > 0 and < 1 (a solid fraction; a percentage needs '%' in its header, as "
+                "'Solid fraction (%)')")
+    _refuse_row(data, t, "s", strength_column, ~(t["s"] > 0.0), "must be > 0 (a tablet's tensile strength)", "MPa")
     porosity = not as_solid_fraction
     with _collect() as msgs:
         profs = [tabletability(t["P"], t["s"]), compressibility(t["P"], t["sf"], as_porosity=porosity),
