@@ -151,6 +151,11 @@ MIN_FORCE_N = 1e-6
 #: The largest yield stress (MPa) a punch rating takes: no tool steel reaches 4 GPa, and a yield stress
 #: typed in pascals (1.45e9) had rated a punch at 2508 kN.
 MAX_YIELD_MPA = 10000.0
+#: The smallest yield stress (MPa) a punch rating takes: punches are tool steels (the S7 tempers of
+#: tabletcad/data/tool_steels.toml yield at 1380-1585 MPa, D2 and M2 higher) and even annealed mild
+#: steel yields near 200 MPa, so 100 MPa is below any steel a punch is made of.  A yield stress typed in
+#: GPa (1.45 for S7's 1450 MPa) had been accepted, rating the punch a thousand times too weak.
+MIN_YIELD_MPA = 100.0
 #: The largest effective-length factor ``K`` of the punch's buckling check (a column fixed at one end and
 #: free at the other has 2; 1e9 had rated a punch at 1e-14 kN).
 MAX_EFFECTIVE_LENGTH_FACTOR = 10.0

@@ -138,8 +138,12 @@ def test_punch_json_and_files(capsys, tmp_path):
         # 1e-200 kN left no stress to divide by (ZeroDivisionError, exit 1)
         (["--force", "1e-200", "--yield-stress", "1000"], "--force = 1e-200 kN is not allowed: must be >= 1e-09"),
         # a yield stress in pascals had rated the punch at 2508 kN; K = 1e9 at 1e-14 kN
-        (["--force", "12", "--yield-stress", "1.45e9"], "--yield-stress = 1.45e+09 MPa is not allowed: must be > 0 and "
+        (["--force", "12", "--yield-stress", "1.45e9"], "--yield-stress = 1.45e+09 MPa is not allowed: must be >= 100 and "
                                                         "<= 10000 MPa"),
+        # a new user's trial: S7's 1.45 GPa typed as 1.45 had been taken, a tool steel of 1.45 MPa (the lower bound
+        # had been 0; the case above pinned "> 0")
+        (["--force", "20", "--yield-stress", "1.45"], "--yield-stress = 1.45 MPa is not allowed: must be >= 100 and "
+                                                      "<= 10000 MPa"),
         (["--force", "12", "--yield-stress", "1000", "--effective-length-factor", "1e9"],
          "--effective-length-factor = 1e+09 is not allowed: must be > 0 and <= 10"),
         (["--force", "5", "--yield-stress", "1000", "--steel", "S7_tempered_205C"], "not both"),

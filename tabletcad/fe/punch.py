@@ -40,7 +40,7 @@ import numpy as np
 
 from tabletcad.errors import MISSING, DesignError, GeometryError, check_positive, check_range
 from tabletcad.fe.elasticity import Material, PressureLoad, _skfem_mesh, boundary_facets, solve_elasticity, von_mises
-from tabletcad.tolerance import MAX_YIELD_MPA, MIN_FORCE_N
+from tabletcad.tolerance import MAX_YIELD_MPA, MIN_FORCE_N, MIN_YIELD_MPA
 from tabletcad.fe.mesh import Refinement, check_mesh_size, mesh_solid
 
 if sys.version_info >= (3, 11):
@@ -201,7 +201,8 @@ def punch_stress(
     force_kN : float
         Compaction force, kN.
     yield_MPa : float, optional
-        Steel yield stress, MPa (no rating without it).
+        Steel yield stress, MPa (no rating without it): 100-10000 MPa
+        (:data:`~tabletcad.tolerance.MIN_YIELD_MPA`: below any punch steel, so a value in GPa is refused).
     safety_factor : float
         Divides the yield stress and the buckling force.
     E, nu
@@ -217,7 +218,7 @@ def punch_stress(
     F = check_range("--force", force_kN, MIN_FORCE_N / 1000.0, 1e6, "kN") * 1000.0
     S = check_range("--safety-factor", safety_factor, 1.0, 100.0)
     if yield_MPa is not None:
-        check_range("--yield-stress", yield_MPa, 0.0, MAX_YIELD_MPA, "MPa", lo_open=True)
+        check_range("--yield-stress", yield_MPa, MIN_YIELD_MPA, MAX_YIELD_MPA, "MPa")  # a steel's, in MPa
     axis = np.array([0.0, 0.0, 1.0 if which == "upper" else -1.0])
     A_plan = float(tip["tip_plan_area_mm2"])
     width = 2.0 * math.sqrt(A_plan / math.pi)
