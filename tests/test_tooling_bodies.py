@@ -124,10 +124,36 @@ def test_bad_complete_tooling_is_one_design_error(table, parameter):
 
 
 def test_tip_longer_than_the_punch_names_the_room_left():
-    b = resolve_body("TSM", "B", dict(EU_B["punch"], head_top_angle_deg=10.0), 8.0, 19.0)
+    # (the EU set's punch table less its dome radius, which a TSM angled head now refuses)
+    tsm = {k: v for k, v in EU_B["punch"].items() if k != "dome_radius_mm"}
+    b = resolve_body("TSM", "B", dict(tsm, head_top_angle_deg=10.0), 8.0, 19.0)
     room = b.overall_length_mm - b.neck_length_mm - b.head_height_mm
     with pytest.raises(DesignError, match=f"must be < {room:.4g} mm"):
-        resolve_body("TSM", "B", dict(EU_B["punch"], head_top_angle_deg=10.0), room + 0.01, 19.0)
+        resolve_body("TSM", "B", dict(tsm, head_top_angle_deg=10.0), room + 0.01, 19.0)
+
+
+@pytest.mark.parametrize("standard, extra, key, value", [
+    ("TSM", {"head_top_angle_deg": 10.0}, "dome_radius_mm", "40 mm"),   # EU_B's dome radius, set to 40 here
+    ("EU", {"head_top_angle_deg": 10.0}, "head_top_angle_deg", "10 deg"),
+    ("custom", {"head": "angled", "head_top_angle_deg": 10.0, "overall_length_mm": 133.35, "barrel_diameter_mm": 19.0,
+                "inside_head_angle_deg": 37.0}, "dome_radius_mm", "40 mm"),
+])
+def test_a_head_value_the_head_style_does_not_use_is_refused(standard, extra, key, value):
+    """A trial: dome_radius_mm = 40 on a TSM (angled) head and head_top_angle_deg on an EU (domed) one were
+    ignored in silence; now the one-line error names the key and the head style."""
+    head = "domed" if standard == "EU" else "angled"
+    other = "angled" if head == "domed" else "domed"
+    table = dict(EU_B, standard=standard, punch=dict(EU_B["punch"], dome_radius_mm=40.0, **extra))
+    if standard == "custom":
+        table.pop("type")
+        table["die_outer_diameter_mm"] = 30.16
+    with pytest.raises(DesignError) as e:
+        parse_tooling(table)
+    takes = "head_top_angle_deg" if head == "angled" else "dome_radius_mm"
+    assert str(e.value) == (f"tooling.punch.{key} = {value} is not allowed: not used by the {standard} punches' "
+                            f"{head} head, which takes {takes}: remove it, or set head = '{other}'")
+    # the same table without the other style's key is taken
+    parse_tooling(dict(table, punch={k: v for k, v in table["punch"].items() if k != key}))
 
 
 # ----------------------------------------------------------------------------- solids (OCC)

@@ -136,6 +136,20 @@ def _num(where: str, t: dict, key: str, entry: dict, sources: dict, lo: float | 
     return check_range(f"{where} {key}", v, 0.0 if lo is None else lo, hi, unit, lo_open=not zero_ok, hi_open=True)
 
 
+#: the head top's dimension of each head style, which the other style has no use for
+_HEAD_TOP_KEYS = {"angled": "head_top_angle_deg", "domed": "dome_radius_mm"}
+
+
+def _refuse_other_head(where: str, table: dict, head: str, standard: str) -> None:
+    """A :class:`DesignError` naming a head-top key of the other head style (a trial: ``dome_radius_mm = 40``
+    on a TSM angled head, ``head_top_angle_deg`` on an EU domed one, were ignored in silence)."""
+    for style, key in _HEAD_TOP_KEYS.items():
+        if style != head and key in table:
+            raise DesignError(f"{where} {key}", table[key], f"not used by the {standard} punches' {head} head, which "
+                              f"takes {_HEAD_TOP_KEYS[head]}: remove it, or set head = '{style}'",
+                              "deg" if key.endswith("_deg") else "mm")
+
+
 def resolve_body(standard: str, kind: str | None, table: Any, tip_length: float, lower_tip_length: float) -> PunchBody:
     """Check ``[tooling.punch]`` against the standard and return the :class:`PunchBody` (raises DesignError).
 
@@ -154,6 +168,7 @@ def resolve_body(standard: str, kind: str | None, table: Any, tip_length: float,
     if head not in ("angled", "domed"):
         raise DesignError(f"{w} head", head if head is not None else MISSING,
                           "must be 'angled' (TSM) or 'domed' (EU); required with standard = 'custom'")
+    _refuse_other_head(w, t, head, standard)
     L = _num(w, t, "overall_length_mm", entry, src)
     Db = _num(w, t, "barrel_diameter_mm", entry, src)
     Dh = _num(w, t, "head_diameter_mm", entry, src)
