@@ -541,3 +541,58 @@ def test_an_elliptic_outline_is_one_ellipse_entity_on_the_outline(rx, ry):
     assert at["ratio"] == pytest.approx(min(rx, ry) / max(rx, ry), rel=1e-15)
     ((kind, at),) = _exact_entities(ellipse_wire(3.0, 3.0), (0.0, 0.0))
     assert kind == "CIRCLE" and at["radius"] == pytest.approx(3.0, rel=1e-15)
+
+
+# ----------------------------------------------------------------------------- a new user's trial (session 50)
+def _outline_crossing(outline, direction_deg: float) -> float:
+    """How far from the axis the plan outline crosses the ray across ``direction_deg`` on the section's
+    positive side (section_view's ``n = (-sin, cos)``): the outline's edges sampled 0.0005 mm apart, the
+    sign change of the cross product interpolated."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.GCPnts import GCPnts_UniformAbscissa
+
+    from tabletcad.cad._occ import explore
+
+    th = math.radians(direction_deg)
+    n = np.array([-math.sin(th), math.cos(th)])
+    best = []
+    for e in explore(outline, "Edge"):
+        c = BRepAdaptor_Curve(e)
+        u = GCPnts_UniformAbscissa(c, 0.0005)
+        pts = np.array([[c.Value(u.Parameter(i)).X(), c.Value(u.Parameter(i)).Y()] for i in range(1, u.NbPoints() + 1)])
+        side = pts @ np.array([-n[1], n[0]])
+        along = pts @ n
+        for i in np.nonzero(np.sign(side[:-1]) != np.sign(side[1:]))[0]:
+            t = side[i] / (side[i] - side[i + 1])
+            best.append(along[i] + t * (along[i + 1] - along[i]))
+    return max(best)
+
+
+@pytest.mark.parametrize("direction", [90.0, 0.0])
+def test_detail_b_looks_where_the_section_meets_the_band(direction):
+    """A rounded triangle (a trial: tri_eud.toml): section A-A at y = 0 ends 4.667 mm out, where half the
+    outline's 10.34 mm length had put detail B on a bare band line, its "land 0.080" hanging off the
+    geometry, and the score's dimension line 0.5 mm off the section.  Now the detail is centred where the
+    section meets the band (the outline's own crossing), showing the land and the band; the score
+    dimension stands off that edge."""
+    d = Design.from_dict({"tablet": dict(family="rounded_triangle", side=14.0, corner_radius=2.5, band=2.5, cup_depth=0.8,
+                                         land=0.08),
+                          "tooling": dict(clearance_mm=0.03, tip_length_mm=6.0,
+                                          score=[dict(kind="bisect", depth_mm=0.3, direction_deg=direction)])})
+    ts = make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False)
+    fr = ts.frame
+    edge = _outline_crossing(fr.outline, direction)
+    if direction == 90.0:
+        assert edge == pytest.approx(4.6667, abs=1e-3) and fr.length / 2 > edge + 0.4  # the trial's numbers
+    dr = drawing_model(ts)
+    (land,) = [x for x in dr.dims if x.text.startswith("land")]
+    ox, oy = dr.origins["detail B 10:1"]
+    assert land.p2 == (ox, oy) and land.p1[0] == pytest.approx(ox - 0.8)
+    # the detail shows the band's top corner at its centre: the land runs in from it, the band down from it
+    pts = np.vstack(dr.views["detail B 10:1"]["visible"])
+    near = lambda x, y: np.min(np.hypot(pts[:, 0] - x, pts[:, 1] - y))  # noqa: E731
+    assert near(0.0, 0.0) < 0.05 and near(-0.8, 0.0) < 0.05 and near(0.0, -3.0) < 0.05
+    sec = dr.views["section A-A"]["visible"]
+    assert max(float(p[:, 0].max()) for p in sec) == pytest.approx(edge, abs=2e-3)
+    (score,) = [x for x in dr.dims if x.text.startswith("score")]
+    assert score.offset == pytest.approx(2.0 + edge, abs=2e-3)

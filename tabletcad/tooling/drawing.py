@@ -127,6 +127,17 @@ def _section_view(shape, direction_deg: float) -> dict:
     return {"visible": out, "hidden": []}
 
 
+def section_band_edge(sec: dict, band_z: tuple[float, float]) -> float:
+    """The across coordinate (mm) where the section :func:`section_view` meets the band on its positive
+    side: the farthest point of its polylines between the band's heights.  Detail B looks there (a rounded
+    triangle's section through the axis ends 4.667 mm out on that side, where half its 10.34 mm length had
+    put the detail on a bare band line)."""
+    b0, b1 = min(band_z), max(band_z)
+    pts = np.vstack([p for p in sec["visible"] if len(p)]) if sec["visible"] else np.zeros((1, 2))
+    on_band = pts[(pts[:, 1] >= b0 - 1e-6) & (pts[:, 1] <= b1 + 1e-6)]
+    return float((on_band if len(on_band) else pts)[:, 0].max())
+
+
 def detail_view(view: dict, centre: tuple[float, float], half: float, k: float) -> dict:
     """The part of ``view`` within ``half`` mm of ``centre``, enlarged ``k`` times about it."""
     c = np.asarray(centre, float)
@@ -305,7 +316,7 @@ def drawing_model(ts) -> Drawing:
     sec = section_view(shape, th)
     k = 10.0
     half = max(0.6, 1.2 * (fr.land or 0.0) + 0.2 * fr.cup_depth_top + 0.3)
-    half_w = 0.5 * (W if abs(math.sin(math.radians(th))) < 0.5 else L)  # the section's half width
+    half_w = section_band_edge(sec, fr.band_z)  # where the section meets the band on its +across side
     det = detail_view(sec, (half_w, fr.band_z[1]), half, k)
     ox = L / 2 + gap + W / 2
     sx_, sy_ = ox, py - zc
