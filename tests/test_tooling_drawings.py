@@ -544,6 +544,31 @@ def test_an_elliptic_outline_is_one_ellipse_entity_on_the_outline(rx, ry):
 
 
 # ----------------------------------------------------------------------------- a new user's trial (session 50)
+def test_an_overload_reads_true_and_a_rating_is_never_rounded_up():
+    """A trial: a 14.967 kN rating read "tip force rating 15 kN" and "OVERLOADED: compaction force 15 kN is
+    1 x the rated 15 kN".  The rating is rounded down, and the overload has the digits to read true."""
+    from tabletcad.tooling.drawing import rating_notes
+
+    rated = 14.967
+    r = dict(rated_force_kN=rated, allowed_pressure_MPa=300.0, tip_projected_area_mm2=rated / 0.3,
+             allowed_pressure_source="x", compaction_force_kN=15.0, utilisation=15.0 / rated, overloaded=True)
+    first, over = rating_notes(r)
+    assert first.startswith("tip force rating 14.96 kN = 300 MPa x")
+    assert over == "OVERLOADED: compaction force 15 kN is 1.002 x the rated 14.96 kN"
+    # a force that rounds onto the rating: more digits, until the force reads above it
+    r.update(rated_force_kN=14.96012, compaction_force_kN=14.9604, utilisation=14.9604 / 14.96012)
+    first, over = rating_notes(r)
+    assert over == "OVERLOADED: compaction force 14.9604 kN is 1.00002 x the rated 14.9601 kN"
+    assert first.startswith("tip force rating 14.9601 kN")
+    r.update(overloaded=False, compaction_force_kN=14.0, utilisation=14.0 / 14.96012)
+    assert rating_notes(r)[0].startswith("tip force rating 14.96 kN")  # (.4g had read 14.96 here too)
+    r.update(rated_force_kN=9.99996)
+    assert rating_notes(r)[0].startswith("tip force rating 9.999 kN")  # (.4g: "10")
+    fe = {"allowed_force_kN": 20.998, "tips": {"upper": {"allowed_force_kN": 20.998}}, "yield_MPa": 1450.0,
+          "safety_factor": 1.5, "yield_source": "y"}
+    assert rating_notes({"fe": fe})[0].startswith("tip force rating 20.99 kN (FE punch analysis: upper 20.99 kN;")
+
+
 def _outline_crossing(outline, direction_deg: float) -> float:
     """How far from the axis the plan outline crosses the ray across ``direction_deg`` on the section's
     positive side (section_view's ``n = (-sin, cos)``): the outline's edges sampled 0.0005 mm apart, the

@@ -68,12 +68,14 @@ def test_drawing_states_the_fe_rating_of_tabletcad_fe_punch(built, design, capsy
     assert fe["tips"]["upper"]["max_von_mises_MPa"] == pytest.approx(cli["max_von_mises_MPa"], rel=1e-9)
     assert fe["force_kN"] == 12.0 and fe["utilisation"] == pytest.approx(12.0 / cli["allowed_force_kN"])
     svg = (out / "drawing.svg").read_text(encoding="utf-8")
-    assert f"{cli['allowed_force_kN']:.4g} kN" in svg
+    from tabletcad.tooling.rating import rating_text
+
+    assert f"{rating_text(cli['allowed_force_kN'])} kN" in svg  # (rounded down: a rating is never drawn above itself)
     assert "FE punch analysis" in svg
     from tabletcad.tooling.drawing import rating_notes
 
     first, second = rating_notes(rep["tooling"]["tip_rating"])
-    assert first.startswith(f"tip force rating {cli['allowed_force_kN']:.4g} kN (FE punch analysis")
+    assert first.startswith(f"tip force rating {rating_text(cli['allowed_force_kN'])} kN (FE punch analysis")
     assert second.startswith("pressure-rule rating")
 
 

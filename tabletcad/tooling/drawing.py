@@ -35,6 +35,7 @@ from OCP.HLRBRep import HLRBRep_Algo, HLRBRep_HLRToShape
 
 from tabletcad.cad._occ import explore
 from tabletcad.io import atomic_path
+from tabletcad.tooling.rating import overload_texts, rating_text
 from tabletcad.tooling.shape_cache import ShapeCache, frozen
 from tabletcad.tolerance import DEFAULT as DEFAULT_TOLERANCES
 
@@ -307,7 +308,7 @@ def drawing_model(ts) -> Drawing:
     notes += rating_notes(r)
     for k, b in ((r.get("buckling") or {}).get("tips") or {}).items():
         if b["buckling_load_kN"] is not None:
-            notes.append(f"{k} tip Euler buckling load {b['buckling_load_kN']:.3g} kN (K = 2, free length "
+            notes.append(f"{k} tip Euler buckling load {rating_text(b['buckling_load_kN'], 3)} kN (K = 2, free length "
                          f"{_fmt(b['free_length_mm'])} mm)")
     notes.append("all dimensions in mm; third-angle projection; generated from the B-rep (OCC HLR)")
     # section across the (first) score, or across x, and a detail of the land and band edge
@@ -368,20 +369,25 @@ def _cup_edge_radius(fr) -> float:
 
 def rating_notes(r: dict) -> list[str]:
     """The tip-force rating lines of the drawing from ``tooling.tip_rating``: the FE punch analysis's
-    (``fe``, when it was computed) first, then the projected-area pressure rule's."""
+    (``fe``, when it was computed) first, then the projected-area pressure rule's.  Ratings are rounded down
+    (:func:`~tabletcad.tooling.rating.rating_text`), and an overload is stated with as many digits as it takes
+    for the force to read above the rating and the utilisation above 1 (14.967 kN had read "15 kN", and a
+    15 kN force "1 x the rated 15 kN")."""
     notes = []
     fe = r.get("fe") or {}
     if fe.get("allowed_force_kN") is not None:
-        tips = ", ".join(f"{k} {t['allowed_force_kN']:.4g} kN" for k, t in fe["tips"].items())
-        notes.append(f"tip force rating {fe['allowed_force_kN']:.4g} kN (FE punch analysis: {tips}; allowed stress "
-                     f"{fe['yield_MPa']:g} MPa yield / safety factor {fe['safety_factor']:g}, from {fe['yield_source']})")
+        tips = ", ".join(f"{k} {rating_text(t['allowed_force_kN'])} kN" for k, t in fe["tips"].items())
+        notes.append(f"tip force rating {rating_text(fe['allowed_force_kN'])} kN (FE punch analysis: {tips}; allowed "
+                     f"stress {fe['yield_MPa']:g} MPa yield / safety factor {fe['safety_factor']:g}, from {fe['yield_source']})")
     if r.get("rated_force_kN") is not None:
         lead = "pressure-rule rating" if notes else "tip force rating"
-        notes.append(f"{lead} {r['rated_force_kN']:.3g} kN = {r['allowed_pressure_MPa']:g} MPa x "
+        rated = r["rated_force_kN"]
+        force, shown, u = (overload_texts(r["compaction_force_kN"], rated) if r.get("overloaded")
+                           else (None, rating_text(rated), None))
+        notes.append(f"{lead} {shown} kN = {r['allowed_pressure_MPa']:g} MPa x "
                      f"{r['tip_projected_area_mm2']:.4g} mm2 tip area (allowed pressure: {r['allowed_pressure_source']})")
         if r.get("overloaded"):
-            notes.append(f"OVERLOADED: compaction force {r['compaction_force_kN']:.4g} kN is {r['utilisation']:.3g} x "
-                         f"the rated {r['rated_force_kN']:.3g} kN")
+            notes.append(f"OVERLOADED: compaction force {force} kN is {u} x the rated {shown} kN")
     return notes
 
 

@@ -27,10 +27,36 @@ from OCP.GProp import GProp_GProps
 from tabletcad.pipeline.designreport import ReportOptions
 from tabletcad.tooling.outline import TabletFrame, offset_wire, plan_face
 
-__all__ = ["section_properties", "tip_rating", "EULER_K"]
+__all__ = ["section_properties", "tip_rating", "rating_text", "overload_texts", "EULER_K"]
 
 #: effective-length factor of a column fixed at one end and free at the other
 EULER_K = 2.0
+
+
+def rating_text(force_kN: float, digits: int = 4) -> str:
+    """A rated force (kN) to ``digits`` significant digits, rounded down: a rating is never printed above
+    what it is (14.967 kN is "14.96", where ``.3g`` had printed "15")."""
+    from decimal import ROUND_FLOOR, Decimal
+
+    d = Decimal(repr(float(force_kN)))
+    if not d.is_finite() or d.is_zero():
+        return f"{force_kN:g}"
+    q = d.quantize(Decimal(1).scaleb(d.adjusted() - (digits - 1)), rounding=ROUND_FLOOR)
+    return format(q.normalize(), "f")
+
+
+def overload_texts(force_kN: float, rated_kN: float) -> tuple[str, str, str]:
+    """``(force, rating, utilisation)`` texts of an overload (force > rating), with as many digits as it takes
+    for the force to read above the rating (rounded down, :func:`rating_text`) and the utilisation above 1:
+    a 15 kN force on a 14.967 kN rating had read "1 x the rated 15 kN"."""
+    digits = 4
+    while digits < 15 and not float(f"{force_kN:.{digits}g}") > float(rating_text(rated_kN, digits)):
+        digits += 1
+    u = force_kN / rated_kN
+    places = 3
+    while places < 15 and not float(f"{u:.{places}g}") > 1.0:
+        places += 1
+    return f"{force_kN:.{digits}g}", rating_text(rated_kN, digits), f"{u:.{places}g}"
 
 
 def section_properties(wire) -> tuple[float, float]:
@@ -65,8 +91,9 @@ def tip_rating(frame: TabletFrame, spec, options: ReportOptions | None = None) -
     if out["overloaded"]:
         import warnings
 
-        warnings.warn(f"the compaction force {force:.4g} kN exceeds the tips' rated force {out['rated_force_kN']:.4g} kN "
-                      f"({p:g} MPa x {area:.4g} mm2 tip area; utilisation {out['utilisation']:.3g}): the tips would be "
+        f_text, r_text, u_text = overload_texts(force, out["rated_force_kN"])
+        warnings.warn(f"the compaction force {f_text} kN exceeds the tips' rated force {r_text} kN "
+                      f"({p:g} MPa x {area:.4g} mm2 tip area; utilisation {u_text}): the tips would be "
                       "overloaded; lower [report] compaction_force_kN or enlarge the tablet", stacklevel=2)
     if p is None:
         out["note"] = "no allowed pressure given ([tooling] allowed_tip_pressure_MPa with its source): no rating"
