@@ -63,7 +63,10 @@ def test_sheets_carry_toleranced_dimensions_and_the_title_block(drawn):
     # sheet is test_drawing_sheet_keeps_every_text_on_the_sheet's)
     notes = " ".join(tooling_model(ts).notes)
     for text in ("working length (head flat to cup bottom): upper 132.45, lower 132.45 ±0.076",
-                 "bore Ø10.000 ±0.076 (the tablet's", "tips Ø9.960 ±0.076 (the bore less the clearance 0.020 per side)"):
+                 # the fit one-sided by default (a ±0.076 bore and tips had let a 10.036 tip meet a 9.924 bore)
+                 "bore Ø10.000 +0.020/+0.000 (the tablet's",
+                 "tips Ø9.960 +0.000/-0.020 (the bore less the clearance 0.020 per side; 0.020 to 0.040 a side at the "
+                 "tolerances' limits)"):
         assert text in notes, text
     # the head that runs on the press's cams (a toolmaker's trial: only its diameters were on the sheet): the
     # TSM head's height is its rim, the underside cone over (25.4 - 12.7) / 2 at 37 deg and the top over
@@ -139,7 +142,9 @@ def test_no_text_leaves_the_sheet_or_lies_on_the_views(drawn, capsule, which):
         dr, paper = tips_model(capsule), "A4"
         fit = capsule.frame.tip_inset(capsule.spec.clearance_mm)
         assert [d.text for d in dr.dims] == ["tip 8.00 ±0.076", "tip 8.00 ±0.076", "Ø30.16 ±0.076", "H 22.22 ±0.076"]
-        assert f"tips {14.0 - 2 * fit:.3f} x {6.0 - 2 * fit:.3f} ±0.076 (" in dr.notes[1]
+        # (the fit one-sided, inside the 0.02 mm clearance: ±0.076 had let the tips jam in the bore)
+        assert f"tips {14.0 - 2 * fit:.3f} x {6.0 - 2 * fit:.3f} +0.000/-0.020 (" in dr.notes[1]
+        assert "0.020 to 0.040 a side at the tolerances' limits" in dr.notes[1]
     elif which == "tablet":
         dr, paper = drawing_model(ts), "A4"
     else:
@@ -544,6 +549,34 @@ def test_an_elliptic_outline_is_one_ellipse_entity_on_the_outline(rx, ry):
 
 
 # ----------------------------------------------------------------------------- a new user's trial (session 50)
+def test_the_fit_is_toleranced_so_that_the_clearance_survives():
+    """A toolmaker's fit: with the general ±0.076 on the bore and the tips, a 9.960 tip at its largest
+    (10.036) jammed in a 10.000 bore at its smallest (9.924).  By default the bore is +t/0 and the tips 0/-t,
+    t the general tolerance but at most the clearance; given tolerances that can close the clearance are
+    warned of (stderr and the sheets)."""
+    from tabletcad.tooling.spec import fit_warnings, parse_tooling
+
+    d = parse_tooling({"clearance_mm": 0.02}).drawing
+    assert (d.tolerance_text("bore_diameter"), d.tolerance_text("tip_diameter")) == ("+0.020/+0.000", "+0.000/-0.020")
+    assert d.fit_clearance() == pytest.approx((0.02, 0.04), abs=1e-12)
+    assert d.tolerance_text("die_diameter") == "±0.076"  # (not a fit: the general tolerance)
+    wide = parse_tooling({"clearance_mm": 0.2}).drawing  # the general 0.076 is below the clearance
+    assert (wide.tolerance_text("bore_diameter"), wide.fit_clearance()[0]) == ("+0.076/+0.000", pytest.approx(0.2))
+    fine = parse_tooling({"clearance_mm": 0.0125}).drawing  # to 0.1 µm where that is the size
+    assert fine.tolerance_text("tip_diameter") == "+0.000/-0.0125"
+    assert not [m for m in fit_warnings(parse_tooling({"clearance_mm": 0.02})) if "close" in m]
+    # given: a ±0.076 bore with the default tips leaves 0.02 - 0.076 / 2 = -0.018 mm a side
+    given = parse_tooling({"clearance_mm": 0.02, "drawing": {"tolerances": {"bore_diameter": 0.076}}})
+    (msg,) = fit_warnings(given)
+    assert msg.startswith("the fit's tolerances can close the 0.02 mm clearance: a tip at its largest in a bore at its "
+                          "smallest leaves -0.018 mm a side (bore ±0.076, tips +0.000/-0.020)")
+    # line to line at the limits closes it too; one-sided limits inside twice the clearance do not
+    touching = {"bore_diameter": [0.02, -0.02], "tip_diameter": [0.02, -0.02]}
+    assert len(fit_warnings(parse_tooling({"clearance_mm": 0.02, "drawing": {"tolerances": touching}}))) == 1
+    ok = {"bore_diameter": [0.02, -0.01], "tip_diameter": [0.01, -0.02]}
+    assert fit_warnings(parse_tooling({"clearance_mm": 0.02, "drawing": {"tolerances": ok}})) == []
+
+
 def test_an_overload_reads_true_and_a_rating_is_never_rounded_up():
     """A trial: a 14.967 kN rating read "tip force rating 15 kN" and "OVERLOADED: compaction force 15 kN is
     1 x the rated 15 kN".  The rating is rounded down, and the overload has the digits to read true."""

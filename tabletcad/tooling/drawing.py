@@ -391,6 +391,20 @@ def rating_notes(r: dict) -> list[str]:
     return notes
 
 
+def _fit_range(spec) -> str:
+    """``; 0.020 to 0.040 a side at the tolerances' limits``: the clearance (mm) the bore's and the tips'
+    tolerances allow (:meth:`~tabletcad.tooling.spec.DrawingSpec.fit_clearance`)."""
+    least, most = spec.drawing.fit_clearance()
+    return f"; {_micrometres(least)} to {_micrometres(most)} a side at the tolerances' limits"
+
+
+def _micrometres(x: float) -> str:
+    """``x`` (mm) to the micrometre, or to 0.1 µm where that is its size (0.0125)."""
+    x = round(x, 9) + 0.0  # (no -0.000)
+    text = f"{x:.3f}"
+    return text if abs(float(text) - x) < 1e-9 else f"{x:.4f}"
+
+
 _DIM_KEYS = {"Ø": "diameter", "L": "length", "W": "width", "band": "band", "cup": "cup_depth", "T": "thickness",
              "score": "score_depth", "R": "cup_radius", "land": "land"}
 
@@ -773,8 +787,8 @@ def tips_model(ts) -> Drawing:
     notes = [f"{ts.tablet.name}: punch tips and die (no punch bodies: the tips fit the toolmaker's punches)"
              + (f", die TSM {die['tsm_size']}" if die.get("tsm_size") not in (None, "custom") else ""),
              f"tips {_plan_size(fr, fr.tip_inset(ts.spec.clearance_mm))} {tol('tip_diameter')} ({up['tip_outline']}; the "
-             f"bore less the clearance {_fmt(ts.spec.clearance_mm)} per side); upper tip {_fmt(up['tip_length_mm'])}, "
-             f"lower tip {_fmt(lo['tip_length_mm'])} from the tip edge",
+             f"bore less the clearance {_fmt(ts.spec.clearance_mm)} per side{_fit_range(ts.spec)}); upper tip "
+             f"{_fmt(up['tip_length_mm'])}, lower tip {_fmt(lo['tip_length_mm'])} from the tip edge",
              f"cups on the tips: upper {_fmt(up['cup_depth_on_tip_mm'])}, lower {_fmt(lo['cup_depth_on_tip_mm'])} deep "
              "from the tip edge (the tablet's face, as on the tablet's sheet)",
              f"{_die_note(die, fr, tol)}, upper punch entry {_fmt(die['punch_entry_mm'])} at the closed position"]
@@ -828,7 +842,7 @@ def tooling_model(ts) -> Drawing:
              f"working length (head flat to cup bottom): upper {_fmt(up['working_length_mm'])}, lower "
              f"{_fmt(lo['working_length_mm'])} {tol('working_length')}",
              f"{_die_note(die, fr, tol)}; tips {_plan_size(fr, fr.tip_inset(ts.spec.clearance_mm))} {tol('tip_diameter')} (the bore less the "
-             f"clearance {_fmt(ts.spec.clearance_mm)} per side)",
+             f"clearance {_fmt(ts.spec.clearance_mm)} per side{_fit_range(ts.spec)})",
              ("standard dimensions: tabletcad/data/tooling_standards.toml (sources per value in report.json)"
               + (", but for the modified ones above (from [tooling.punch])" if mod else ""))
              if up["standard"] != "custom" else "user-defined set: every dimension from [tooling.punch]"]

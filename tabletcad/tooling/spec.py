@@ -31,7 +31,9 @@
     tolerances = { cup_depth = 0.05 }   # per dimension: diameter, length, width, band, cup_depth, thickness,
                                    # land, score_depth, cup_radius, bevel_width, bevel_angle (deg);
                                    # overall_length, tip_length,
-                                   # barrel_diameter, head_diameter, die_diameter, die_height
+                                   # barrel_diameter, head_diameter, die_diameter, die_height; the fit's
+                                   # working_length, tip_diameter, bore_diameter (bore and tips default
+                                   # one-sided, +t/0 and 0/-t with t <= the clearance: DrawingSpec.deviations)
 
     [tooling.punch]                # body dimensions the standard file does not hold (see standards.py)
     head_diameter_mm = 25.4        # ... every key of tabletcad.tooling.standards.BODY_KEYS
@@ -453,9 +455,17 @@ TITLE_KEYS = ("name", "number", "revision", "material", "date", "author")
 TITLE_MAX_CHARS = {"name": 60, "number": 30, "revision": 30, "material": 60, "date": 30, "author": 30}
 
 
+#: the fit's dimensions: toleranced one-sided by default so that the running clearance survives at the limits
+FIT_KEYS = ("bore_diameter", "tip_diameter")
+
+
 @dataclass(frozen=True)
 class DrawingSpec:
-    """Title block texts and tolerances (mm) of the drawings (``[tooling.drawing]``)."""
+    """Title block texts and tolerances (mm) of the drawings (``[tooling.drawing]``).
+
+    ``clearance_mm``: the fit's radial clearance (mm a side), set by :class:`ToolingSpec`: the die bore and
+    the punch tips not given a tolerance of their own take one-sided limits from it (:meth:`deviations`).
+    """
 
     name: str | None = None
     number: str | None = None
@@ -466,19 +476,56 @@ class DrawingSpec:
     tolerance_mm: float = DEFAULT_TOLERANCE_MM
     tolerance_given: bool = False
     tolerances: tuple = ()
+    clearance_mm: float | None = None
+
+    def deviations(self, key: str) -> float | tuple[float, float]:
+        """Dimension ``key``'s tolerance (mm): a ``±`` number, or ``(upper, lower)`` limit deviations.
+
+        As given in ``tolerances``, else the general ``tolerance_mm``, but for the fit's bore and tips
+        (:data:`FIT_KEYS`) with a known clearance: the bore ``(+t, 0)`` and the tips ``(0, -t)``, ``t`` the
+        general tolerance but at most the clearance (the whole general one at a clearance of 0), so that
+        the bore's smallest size less the tips' largest leaves at least the nominal clearance a side and
+        the largest at most ``t`` more (a ``±`` tolerance on both had let a tip at its largest jam in a
+        bore at its smallest).
+        """
+        given = dict(self.tolerances)
+        if key in given or key not in FIT_KEYS or self.clearance_mm is None:
+            return given.get(key, self.tolerance_mm)
+        t = min(self.tolerance_mm, self.clearance_mm) if self.clearance_mm > 0.0 else self.tolerance_mm
+        return (t, 0.0) if key == "bore_diameter" else (0.0, -t)
+
+    def limits(self, key: str) -> tuple[float, float]:
+        """``(upper, lower)`` deviations (mm) of dimension ``key`` (a ``±t`` tolerance is ``(t, -t)``)."""
+        t = self.deviations(key)
+        return t if isinstance(t, tuple) else (t, -t)
 
     def tolerance(self, key: str) -> float:
         """The largest deviation (mm) dimension ``key`` may have: its ``±`` tolerance, or the larger of its
         limit deviations' sizes."""
-        t = dict(self.tolerances).get(key, self.tolerance_mm)
-        return max(abs(t[0]), abs(t[1])) if isinstance(t, tuple) else t
+        up, lo = self.limits(key)
+        return max(abs(up), abs(lo))
 
     def tolerance_text(self, key: str) -> str:
         """The tolerance of dimension ``key`` as drawn: ``±0.076``, or limit deviations ``+0.000/-0.013``."""
-        t = dict(self.tolerances).get(key, self.tolerance_mm)
+        t = self.deviations(key)
         if isinstance(t, tuple):
-            return f"{t[0]:+.3f}/{t[1]:+.3f}"
+            return f"{_deviation_text(t[0])}/{_deviation_text(t[1])}"
         return f"±{t:.2f}" if t >= 0.1 else f"±{t:.3f}"  # (as the sheets print sizes)
+
+    def fit_clearance(self) -> tuple[float, float] | None:
+        """``(least, most)`` punch-to-die clearance (mm a side) the bore's and tips' tolerances allow: the
+        nominal clearance plus half of (bore lower - tip upper) and of (bore upper - tip lower); None without
+        a clearance."""
+        if self.clearance_mm is None:
+            return None
+        (b_up, b_lo), (t_up, t_lo) = self.limits("bore_diameter"), self.limits("tip_diameter")
+        return self.clearance_mm + 0.5 * (b_lo - t_up), self.clearance_mm + 0.5 * (b_up - t_lo)
+
+
+def _deviation_text(x: float) -> str:
+    """A limit deviation (mm) with its sign, to the micrometre, or to 0.1 µm where that is its size."""
+    text = f"{x:+.3f}"
+    return text if abs(float(text) - x) < 1e-9 else f"{x:+.4f}"
 
 
 def _tolerance(name: str, value: Any, unit: str) -> float | tuple[float, float]:
@@ -599,6 +646,10 @@ class ToolingSpec:
                                       f"must name the source of {key} (a non-empty string)")
             elif src is not None:
                 raise DesignError(f"[tooling] {skey}", src, f"give it together with {key}")
+        if not isinstance(self.drawing, DrawingSpec):
+            raise DesignError("[tooling.drawing]", self.drawing, "must be a DrawingSpec (parse_tooling makes it from the table)")
+        if self.drawing.clearance_mm != self.clearance_mm:  # the fit's default tolerances follow the clearance
+            object.__setattr__(self, "drawing", replace(self.drawing, clearance_mm=self.clearance_mm))
         for key, kind, name in (("scores", ScoreSpec, "[[tooling.score]]"), ("emboss", EmbossSpec, "[[tooling.emboss]]")):
             items = getattr(self, key)
             if not isinstance(items, (tuple, list)) or not all(isinstance(x, kind) for x in items):
@@ -619,6 +670,34 @@ class ToolingSpec:
             table, base = self.source
             return parse_tooling({k: v for k, v in {**table, **kw}.items() if v is not None}, base=base)
         return replace(self, **kw, source=None)
+
+
+#: a punch-to-die clearance (mm a side) above which a build warns
+WIDE_CLEARANCE_MM = 0.1
+
+
+def fit_warnings(spec: ToolingSpec) -> list[str]:
+    """What a build warns of in the punch-to-die fit, one line each, for stderr and the drawings' notes: a
+    clearance of 0 (line to line) or wider than :data:`WIDE_CLEARANCE_MM` a side, and bore and tip
+    tolerances (``[tooling.drawing] tolerances``) that let a tip at its largest meet a bore at its smallest
+    (:meth:`DrawingSpec.fit_clearance`)."""
+    out = []
+    c = spec.clearance_mm
+    if c == 0.0:  # allowed (a model of the nominal fit), but no punch runs in its die so
+        out.append("clearance_mm = 0: the punch tips fit the die bore line to line, with no running clearance "
+                   "(presses use about 0.01-0.05 mm a side); the parts model the nominal fit")
+    elif c > WIDE_CLEARANCE_MM:  # (1 mm a side had been built without a word)
+        out.append(f"clearance_mm = {c:g}: wider than {WIDE_CLEARANCE_MM:g} mm a side (presses use about "
+                   "0.01-0.05 mm): powder flashes into the gap and the tablet's band edge gets a burr")
+    d = spec.drawing
+    least, _ = d.fit_clearance()
+    if least < -1e-9 or (c > 1e-9 and least < 1e-9):  # (a ±0.076 bore and tips: a 9.960 tip could be 10.036)
+        bound = f"above {-2.0 * c:g} mm (twice the clearance)" if c > 0.0 else "at least 0"
+        out.append(f"the fit's tolerances can close the {c:g} mm clearance: a tip at its largest in a bore at its "
+                   f"smallest leaves {least:.4g} mm a side (bore {d.tolerance_text('bore_diameter')}, tips "
+                   f"{d.tolerance_text('tip_diameter')}); [tooling.drawing] tolerances.bore_diameter's lower deviation "
+                   f"less tolerances.tip_diameter's upper one must be {bound}, such as [0.01, 0.0] and [0.0, -0.01]")
+    return out
 
 
 #: the [tooling] table's numbers and their ranges, for the table (parse_tooling) and every ToolingSpec alike;

@@ -16,7 +16,8 @@ from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.designreport import ReportOptions
 from tabletcad.tooling.booleans import TIMER, to_manifold, volume
 from tabletcad.tolerance import DEFAULT
-from tabletcad.tooling.spec import ToolingSpec, check_numbers, check_punch_lengths, die_height_for, relief_refused
+from tabletcad.tooling.spec import (WIDE_CLEARANCE_MM, ToolingSpec, check_numbers, check_punch_lengths,  # noqa: F401
+                                   die_height_for, fit_warnings, relief_refused)
 
 __all__ = ["ToolSet", "make_tooling", "check_closed_position", "finished_solid", "DEFLECTION_MM"]
 
@@ -50,10 +51,6 @@ class ToolSet:
         return out
 
 
-#: a punch-to-die clearance (mm a side) above which a build warns
-WIDE_CLEARANCE_MM = 0.1
-
-
 def die_height(frame, spec: ToolingSpec) -> float:
     """The die height (mm) a build uses (:func:`~tabletcad.tooling.spec.die_height_for` of the tablet's plan
     diameter): the given one, else 22.22 mm beside a given outer diameter, else the TSM die table's."""
@@ -77,17 +74,10 @@ def check_on_frame(frame, spec: ToolingSpec) -> list:
     emb_checked = [check_emboss(frame, e, spec.clearance_mm, i) for i, e in enumerate(spec.emboss)]
     _warn_crossings(frame, spec, emb_checked)
     _warn_sharp_edge(frame, spec.clearance_mm)
-    if spec.clearance_mm == 0.0:  # allowed (a model of the nominal fit), but no punch runs in its die so
-        import warnings
+    import warnings
 
-        warnings.warn("clearance_mm = 0: the punch tips fit the die bore line to line, with no running clearance "
-                      "(presses use about 0.01-0.05 mm a side); the parts model the nominal fit", stacklevel=3)
-    elif spec.clearance_mm > WIDE_CLEARANCE_MM:  # (1 mm a side had been built without a word)
-        import warnings
-
-        warnings.warn(f"clearance_mm = {spec.clearance_mm:g}: wider than {WIDE_CLEARANCE_MM:g} mm a side (presses use "
-                      "about 0.01-0.05 mm): powder flashes into the gap and the tablet's band edge gets a burr",
-                      stacklevel=3)
+    for message in fit_warnings(spec):  # (and on the drawings' notes: tabletcad.tooling.drawing)
+        warnings.warn(message, stacklevel=3)
     if spec.body is not None:
         _check_complete_punches(frame, spec)
     return emb_checked
