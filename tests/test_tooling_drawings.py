@@ -577,6 +577,38 @@ def test_the_fit_is_toleranced_so_that_the_clearance_survives():
     assert fit_warnings(parse_tooling({"clearance_mm": 0.02, "drawing": {"tolerances": ok}})) == []
 
 
+def test_fit_and_clearance_warnings_are_on_the_sheets(drawn, tmp_path):
+    """The README: a clearance of 0 or wider than 0.1 mm a side "is warned of and drawn"; 0.2 mm reached
+    stderr but no sheet.  Now on both sheets' notes (SVG, PDF, DXF) as the overload is, and so is a fit
+    whose tolerances can close the clearance."""
+    import warnings
+    from dataclasses import replace
+
+    from tabletcad.tooling.outline import tablet_frame  # noqa: F401  (OCC present: the fixture built)
+    from tabletcad.tooling.spec import parse_tooling
+    from tabletcad.tooling.toolset import check_on_frame
+
+    ts, _, _ = drawn
+    wide = replace(ts, spec=replace(ts.spec, clearance_mm=0.2))
+    want = ("WARNING: clearance_mm = 0.2: wider than 0.1 mm a side (presses use about 0.01-0.05 mm): powder flashes "
+            "into the gap and the tablet's band edge gets a burr")
+    assert want in tooling_model(wide).notes and want in drawing_model(wide).notes
+    with warnings.catch_warnings(record=True) as got:  # stderr has the same line
+        warnings.simplefilter("always")
+        check_on_frame(ts.frame, wide.spec)
+    assert want[len("WARNING: "):] in [str(w.message) for w in got]
+    files = write_drawing(wide, tmp_path)
+    for f in files:
+        if f.suffix in (".svg", ".dxf"):
+            text = " ".join(re.sub(r"<[^>]+>", " ", f.read_text(encoding="utf-8", errors="replace")).split())
+            assert "WARNING: clearance_mm = 0.2: wider than 0.1 mm a side" in text.replace("\\P", " "), f.name
+    closing = replace(ts, spec=replace(ts.spec, drawing=parse_tooling(
+        {"drawing": {"tolerances": {"tip_diameter": 0.076}}}).drawing))
+    assert any(n.startswith("WARNING: the fit's tolerances can close the 0.02 mm clearance") for n in
+               tooling_model(closing).notes)
+    assert not any(n.startswith("WARNING") for n in tooling_model(ts).notes)  # the sample's fit is sound
+
+
 def test_an_overload_reads_true_and_a_rating_is_never_rounded_up():
     """A trial: a 14.967 kN rating read "tip force rating 15 kN" and "OVERLOADED: compaction force 15 kN is
     1 x the rated 15 kN".  The rating is rounded down, and the overload has the digits to read true."""

@@ -305,7 +305,7 @@ def drawing_model(ts) -> Drawing:
                      f"on the {e.face} face, stroke angle {e.draft_deg:g} deg, centred at "
                      f"({_fmt(e.position_mm[0])}, {_fmt(e.position_mm[1])}) mm, turned {e.rotation_deg:g} deg")
     r = ts.report.get("tip_rating") or {}
-    notes += rating_notes(r)
+    notes += rating_notes(r) + fit_notes(ts.spec)
     for k, b in ((r.get("buckling") or {}).get("tips") or {}).items():
         if b["buckling_load_kN"] is not None:
             notes.append(f"{k} tip Euler buckling load {rating_text(b['buckling_load_kN'], 3)} kN (K = 2, free length "
@@ -389,6 +389,14 @@ def rating_notes(r: dict) -> list[str]:
         if r.get("overloaded"):
             notes.append(f"OVERLOADED: compaction force {force} kN is {u} x the rated {shown} kN")
     return notes
+
+
+def fit_notes(spec) -> list[str]:
+    """The fit's warnings (:func:`~tabletcad.tooling.spec.fit_warnings`: a clearance of 0 or wider than 0.1 mm a
+    side, bore and tip tolerances that can close it) as the drawings' notes, as stderr has them."""
+    from tabletcad.tooling.spec import fit_warnings
+
+    return [f"WARNING: {m}" for m in fit_warnings(spec)]
 
 
 def _fit_range(spec) -> str:
@@ -792,7 +800,7 @@ def tips_model(ts) -> Drawing:
              f"cups on the tips: upper {_fmt(up['cup_depth_on_tip_mm'])}, lower {_fmt(lo['cup_depth_on_tip_mm'])} deep "
              "from the tip edge (the tablet's face, as on the tablet's sheet)",
              f"{_die_note(die, fr, tol)}, upper punch entry {_fmt(die['punch_entry_mm'])} at the closed position"]
-    notes += rating_notes(rep.get("tip_rating") or {})
+    notes += rating_notes(rep.get("tip_rating") or {}) + fit_notes(ts.spec)
     return Drawing(views, origins, dims, notes, title=f"{_title(ts)} — punch tips and die",
                    title_block=title_block(ts, "punch tips and die"))
 
@@ -846,7 +854,8 @@ def tooling_model(ts) -> Drawing:
              ("standard dimensions: tabletcad/data/tooling_standards.toml (sources per value in report.json)"
               + (", but for the modified ones above (from [tooling.punch])" if mod else ""))
              if up["standard"] != "custom" else "user-defined set: every dimension from [tooling.punch]"]
-    notes += rating_notes(ts.report.get("tip_rating") or {})  # (a toolmaker's trial: on the tablet's sheet only)
+    notes += rating_notes(ts.report.get("tip_rating") or {}) + fit_notes(ts.spec)  # (a toolmaker's trial: on the
+    # tablet's sheet only; a 0.2 mm clearance's warning reached stderr, not the sheets)
     body = ts.spec.body
     if body is not None and body.key:  # (a toolmaker's trial: the keyway could not be made from the drawing)
         notes.append(f"key {_fmt(body.key_width_mm)} wide x {_fmt(body.key_length_mm)} long x {_fmt(body.key_height_mm)} "
