@@ -232,3 +232,21 @@ def test_every_layer_names_modules_that_exist(layer):
     for key in LAYERS[layer]:
         assert key in MODULES, key
 
+
+
+def test_every_module_compiles_without_a_warning():
+    """No invalid escape sequence or other compile-time warning in the package, the workbench, the tests or the
+    benchmarks: FreeCAD 1.0's Python 3.13 printed ``SyntaxWarning: invalid escape sequence '\\ '`` on importing
+    tabletcad.tooling.spec (a docstring's ``\\ ``), and a later Python makes it an error."""
+    import warnings
+
+    files = sorted(p for d in ("tabletcad", "freecad_workbench", "tests", "benchmarks") for p in (ROOT / d).rglob("*.py"))
+    assert len(files) > 200
+    found = []
+    for f in files:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            compile(f.read_text(encoding="utf-8"), str(f), "exec")
+        found += [f"{f.relative_to(ROOT)}:{w.lineno}: {w.message}" for w in caught
+                  if issubclass(w.category, (SyntaxWarning, DeprecationWarning))]
+    assert found == []

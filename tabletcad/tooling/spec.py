@@ -298,7 +298,7 @@ def relief_refused(spec: ToolingSpec, width: float) -> DesignError:
 
 def check_relief_reach(spec: ToolingSpec, narrow: float, width: float) -> None:
     """On the PDE tablet, before any geometry: a relief that, with the clearance, reaches half the tablet's
-    ``narrow``\ est extent (mm) or more leaves no tip outline (no plan outline is thicker than its narrowest
+    narrowest extent ``narrow`` (mm) or more leaves no tip outline (no plan outline is thicker than its narrowest
     extent); :func:`relief_refused` then.  The tooling build checks the exact offset of the outline too."""
     b = spec.body
     if b is None or b.tip_relief_mm <= 0 or max(spec.tip_length_mm, spec.lower_tip) <= b.tip_straight_mm:
