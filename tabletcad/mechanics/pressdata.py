@@ -366,7 +366,7 @@ def _check_gap_closes(F: np.ndarray, gap: np.ndarray, sign: int, meta: PressMeta
     DesignError
         ``displacement_sign``, naming ``displacement_zero`` too, when the gap does not close.
     """
-    from tabletcad.mechanics.compaction import split_branches  # (compaction imports this module)
+    from tabletcad.mechanics.branches import split_branches
 
     try:
         first, end = split_branches(F).loading
