@@ -265,8 +265,12 @@ def test_tooling_valid_and_linked(headless, family):
     # punches sit on the tablet's band edges and carry its outline; the die surrounds it
     up, low, die = step["upper"], step["lower"], step["die"]
     assert up["bbox"][2] <= tab["bbox"][5] + 1e-6 and low["bbox"][5] >= tab["bbox"][2] - 1e-6
-    assert up["bbox"][5] == pytest.approx(step["rim_z"][0] + 10.0, abs=1e-6)  # 10 mm tips from the band edges
-    assert low["bbox"][2] == pytest.approx(step["rim_z"][1] - 10.0, abs=1e-6)
+    # 10 mm tips from their edges (OCC's optimal box, as build measures them): the band's edges where a land is
+    # wider than the tip's inset, else up the cup (this concave round and capsule have none; they had been run
+    # from the band's edges, shorter than build's)
+    up_t, low_t = up["tight_bbox"], low["tight_bbox"]
+    assert up_t[5] - up_t[2] == pytest.approx(10.0, abs=1e-6) and up_t[2] >= step["rim_z"][0] - 1e-6
+    assert low_t[5] - low_t[2] == pytest.approx(10.0, abs=1e-6) and low_t[5] <= step["rim_z"][1] + 1e-6
     from tabletcad.tooling.spec import standard_die_size
 
     box = tab["tight_bbox"]
@@ -338,8 +342,9 @@ def test_make_tooling_reads_the_design_files_tooling_table(headless):
     assert die["bbox"][5] - die["bbox"][2] == pytest.approx(20.0, abs=1e-6)
     assert die["volume"] == pytest.approx(math.pi * (16.0**2 - 5.0**2) * 20.0, rel=1e-9)
     assert up["bbox"][3] - up["bbox"][0] == pytest.approx(10.0 - 0.1, abs=1e-6)
-    assert up["bbox"][5] == pytest.approx(st["rim_z"][0] + 8.0, abs=1e-6)  # from the band edges
-    assert low["bbox"][2] == pytest.approx(st["rim_z"][1] - 12.0, abs=1e-6)
+    up_t, low_t = up["tight_bbox"], low["tight_bbox"]  # from the tips' edges (no land here: up the cup)
+    assert up_t[5] - up_t[2] == pytest.approx(8.0, abs=1e-6) and up_t[2] > st["rim_z"][0] + 1e-4
+    assert low_t[5] - low_t[2] == pytest.approx(12.0, abs=1e-6) and low_t[5] < st["rim_z"][1] - 1e-4
     assert all(part["valid"] and part["n_solids"] == 1 for part in (die, up, low))
     shown = headless["_stdout"] + headless["_stderr"]
     assert "[[tooling.score]] of tooled.toml are built by `tabletcad build` only" in shown
@@ -524,6 +529,9 @@ def test_a_nan_or_negative_gap_is_refused_and_a_scripts_tracebacks_stay_whole(he
     for s in steps:
         assert "Invalid" in s["state"] and s["placement_finite"], s
         assert s["tracebacklimit"] is None
+    # a refused recompute of the punch alone (obj.recompute(): no document recompute follows) restores it too
+    (one,) = _steps(headless, "bad_gap_object")
+    assert "Invalid" in one["state"] and one["tracebacklimit"] is None
 
 
 def test_a_density_in_the_wrong_unit_is_refused(headless):
@@ -604,6 +612,41 @@ def test_step_export_beside_a_tablet_without_a_band(headless):
     assert [label for label, _ in s["objects"]] == ["thesis.spherical", "concave_round", "concave_round upper punch",
                                                    "concave_round lower punch", "concave_round die"]
     assert all(valid for _, valid in s["objects"])
+
+
+def test_tablets_whose_labels_make_one_file_name_each_get_their_own_step(headless):
+    """Labels "CR 9mm" and "CR_9mm" both made the file CR_9mm.step: the second tablet's had overwritten the
+    first's, both labels pointing at the 11 mm tablet.  Each file now reads back as its own tablet."""
+    (s,) = _steps(headless, "export_names")
+    files = {label: name for label, (name, _) in s["written"].items()}
+    assert files == {"CR 9mm": "CR_9mm.step", "CR_9mm": "CR_9mm_2.step"}
+    for label, (_, volume) in s["written"].items():
+        assert volume == pytest.approx(s["volumes"][label], rel=1e-9)
+    assert s["volumes"]["CR 9mm"] < 0.8 * s["volumes"]["CR_9mm"]
+    assert sorted(s["files"])[:2] == ["CR_9mm.step", "CR_9mm_2.step"] and len(s["files"]) == 3
+    assert s["files"][2].endswith("_all.step")
+
+
+def test_punch_tips_without_a_land_run_from_their_edge_as_builds(headless, tmp_path):
+    """A round without a land wider than the tip's inset: the tip's wall meets the cup above the band's edge.
+    The workbench had run the tip's length from the band's edge (10.4 µm short, 0.65 mm³ less than build's on
+    this 9 mm round); it runs from the tip's edge now, as tabletcad build's, to the same volume."""
+    pytest.importorskip("OCP")
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.toolset import make_tooling
+
+    (s,) = _steps(headless, "no_land_tooling")
+    design = Design.from_toml(s["design"])
+    ts = make_tooling(design.build(), design.tooling_spec, check=False, interference_check=False)
+    for which, i, face in (("upper", 0, "upper_punch"), ("lower", 1, "lower_punch")):
+        info, rep = s[which], ts.report[face]
+        assert info["valid"] and info["n_solids"] == 1
+        box = info["tight_bbox"]
+        edge = box[2] if which == "upper" else box[5]
+        assert abs(edge - s["rim_z"][i]) > 1e-3  # (the edge stands on the cup, off the band's edge)
+        assert edge == pytest.approx(rep["tip_edge_z_mm"], abs=1e-6)
+        assert box[5] - box[2] == pytest.approx(10.0, abs=1e-6)
+        assert info["volume"] == pytest.approx(rep["volume_mm3"], rel=1e-7)
 
 
 def test_a_standard_die_follows_the_tablets_size(headless):

@@ -140,7 +140,7 @@ try:
             family=fam,
             wall_s=time.perf_counter() - t0,
             upper=shape_info(up, tight=True),
-            lower=shape_info(low),
+            lower=shape_info(low, tight=True),
             die=shape_info(die),
             links=[o.Tablet.Name for o in (up, low, die)],
             # the tools' overlap with the tablet (mm³): none (a die bore on the rim cut a thesis band's
@@ -163,7 +163,19 @@ try:
                  '[tooling]\nclearance_mm = 0.05\ntip_length_mm = 8.0\n')
     given = make_tooling(doc, make_tablet(doc, design2), length=5.0)
     step("design_tooling_length", lengths=[float(o.Length.Value) for o in given[:2]])
-    step("design_tooling", tablet=tablet_info(tooled), upper=shape_info(tparts[0]), lower=shape_info(tparts[1]),
+    # a round without a land wider than the tip's inset: the tips' edges stand on the cup, above the band's
+    # edges, and their lengths run from there (tests/test_freecad_workbench.py compares them with build's)
+    design3 = os.path.abspath("no_land.toml")
+    with open(design3, "w") as fh:
+        fh.write('[tablet]\nfamily = "concave_round"\ndiameter = 9.0\nband = 2.0\ncup_depth = 0.9\n'
+                 '[tooling]\nclearance_mm = 0.025\ntip_length_mm = 10.0\n')
+    no_land = make_tablet(doc, design3)
+    nl_parts = make_tooling(doc, no_land)
+    step("no_land_tooling", design=design3, upper=shape_info(nl_parts[0], tight=True),
+         lower=shape_info(nl_parts[1], tight=True),
+         rim_z=[wb_geometry._select(wb_geometry.rims_from_json(no_land.RimData), w)[1] for w in ("upper", "lower")])
+    step("design_tooling", tablet=tablet_info(tooled), upper=shape_info(tparts[0], tight=True),
+         lower=shape_info(tparts[1], tight=True),
          rim_z=[wb_geometry._select(wb_geometry.rims_from_json(tooled.RimData), w)[1] for w in ("upper", "lower")],
          die=shape_info(tparts[2]), clearance=[float(o.Clearance.Value) for o in tparts[:2]],
          lengths=[float(o.Length.Value) for o in tparts[:2]])
@@ -247,6 +259,10 @@ try:
         step("bad_gap", value=repr(bad), state=list(up.State), zmin=up.Shape.BoundBox.ZMin,
              placement_finite=all(math.isfinite(x) for x in up.Placement.Base),
              tracebacklimit=getattr(sys, "tracebacklimit", None))
+    # (the punch alone recomputed: no document recompute follows to restore the limit)
+    up.Gap = float("nan")
+    up.recompute()
+    step("bad_gap_object", state=list(up.State), tracebacklimit=getattr(sys, "tracebacklimit", None))
     up.Gap = 0.0
     doc.recompute()
     fit0 = float(t.FitTolerance.Value)
@@ -398,6 +414,16 @@ try:
     step("export_with_sphere", written=sorted(written), files=sorted(p.name for p in exp_dir.iterdir()),
          objects=[(o.Label, bool(o.isValid())) for o in exp_doc.Objects])
     FreeCAD.closeDocument(exp_doc.Name)
+    # two labels that make one file name: each tablet its own file (the second had overwritten the first's)
+    names_doc = FreeCAD.newDocument("export_names")
+    make_tablet(names_doc, "concave_round", name="CR 9mm", diameter=9.0)
+    make_tablet(names_doc, "concave_round", name="CR_9mm", diameter=11.0)
+    names_dir = Path(os.environ["TABLETCAD_FC_WORK"]) / "step_names"
+    names = tasks.export_step(names_doc, str(names_dir), with_tooling=False)
+    step("export_names", written={k: [Path(v).name, Part.read(v).Volume] for k, v in names.items() if k != "all"},
+         volumes={o.Label: o.Shape.Volume for o in names_doc.Objects},
+         files=sorted(p.name for p in names_dir.iterdir()))
+    FreeCAD.closeDocument(names_doc.Name)
     FreeCAD.setActiveDocument(doc.Name)  # (TechDraw's commands below work on the active document)
 
     # ---- family switch: Dimensions group follows the family

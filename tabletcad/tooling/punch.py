@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tabletcad.errors import GeometryError
+from tabletcad.tooling.spec import EDGE_SNAP_MM
 from tabletcad.tooling.booleans import CACHE, boolean, checked_boolean, reference_point, split_cells, volume
 from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, prism, wire_length
 
@@ -158,9 +159,6 @@ def tip_trimmed(tip, wire, z: float, up: bool):
     return split_cells(tip, [end], keep, what="punch tip end")
 
 
-#: how near (mm) a tip's measured edge must lie to the band's edge to be taken as the band's edge (OCC's
-#: optimal box is good to ~1e-7 mm: a land's edge is the band's)
-EDGE_SNAP_MM = 1e-6
 
 
 def tight_z_range(shape, *, low: bool = True, high: bool = True) -> tuple[float | None, float | None]:

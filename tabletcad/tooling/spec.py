@@ -116,6 +116,10 @@ MIN_TIP_BACKING_MM = 1.0
 #: a cup shallower than this (mm) is a flat face (a flat face's cup depth is the round-off of its heights)
 FLAT_FACE_MM = 1e-9
 
+#: how near (mm) a tip's measured edge must lie to the band's edge to be taken as the band's edge (OCC's
+#: optimal box is good to ~1e-7 mm: a land's edge is the band's)
+EDGE_SNAP_MM = 1e-6
+
 #: how far (mm) a standard score's groove stays shallower than its cup: it runs out on the face
 RUN_OUT_MARGIN_MM = 0.005
 

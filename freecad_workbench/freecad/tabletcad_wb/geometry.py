@@ -259,6 +259,8 @@ def build_tablet(tablet, tol=None):
     rims = (_revolved_rims if profiles is not None else _rims)([f.surface for f in fits], hollow=hollow)
     outline = outline_segments(tablet)
     band = tablet.band()
+    from tabletcad.pipeline.designreport import plan_diameter
+
     lo, hi = tablet.bounds()
     for r in rims:
         if not r["inner"]:
@@ -272,7 +274,8 @@ def build_tablet(tablet, tol=None):
             r["shaped"] = tablet.revolution is None
             # the core's largest plan extent (its polished bounds, as tabletcad build sizes its die): the
             # solid's box is looser (0.20 has no tight box: an 18.9 mm capsule's read 19.02 mm, a D die)
-            r["plan_size"] = float(max(hi[0] - lo[0], hi[1] - lo[1]))
+            # in any direction (a rounded square's diagonal: tabletcad.pipeline.designreport.plan_diameter)
+            r["plan_size"] = float(plan_diameter(tablet))
             # the tablet's lowest and highest z (mm, the core's polished bounds): a face flat at its rim
             # gives the punch its whole prism (punch_shape)
             r["tablet_z"] = [float(lo[2]), float(hi[2])]
@@ -498,7 +501,7 @@ def punch_shape(tablet_shape, rims, which="upper", length=10.0, clearance=0.025)
 
     from tabletcad.errors import DesignError, GeometryError
     from tabletcad.tolerance import DEFAULT
-    from tabletcad.tooling.spec import MAX_CLEARANCE_MM, MIN_TIP_BACKING_MM
+    from tabletcad.tooling.spec import EDGE_SNAP_MM, MAX_CLEARANCE_MM, MIN_TIP_BACKING_MM
 
     if not 0.0 < length <= DEFAULT.max_length:
         raise DesignError("punch Length", length, f"must be > 0 and <= {DEFAULT.max_length:g}", "mm")
@@ -530,15 +533,42 @@ def punch_shape(tablet_shape, rims, which="upper", length=10.0, clearance=0.025)
         result = prism
     else:
         result = prism.cut(tablet_shape)
-    solids = result.Solids
+    punch = _valid_solid(result.Solids, which)
+    if result is not prism:
+        # the tip's edge, where its wall meets the tablet's face, stands above the band's edge where the cup runs
+        # into the wall (no land wider than the tip's inset): the length runs from that edge, as tabletcad
+        # build's tips (tabletcad.tooling.punch.punch_tip: the same optimal box); the tips had been that rise
+        # shorter (10.4 µm on a 9 mm round with a land below the clearance)
+        edge = _tight_z(punch, low=which == "upper")
+        rise_edge = sign * (edge - z)
+        if rise_edge > EDGE_SNAP_MM:
+            prism = face.extrude(FreeCAD.Vector(0, 0, sign * (float(length) + rise_edge)))
+            punch = _valid_solid(prism.cut(tablet_shape).Solids, which)
+    return punch
+
+
+def _valid_solid(solids, which):
+    """The one solid of a punch's Boolean, fixed if OCC's check finds it invalid; GeometryError else."""
+    from tabletcad.errors import GeometryError
+
     if len(solids) != 1:
-        raise GeometryError(f"{which} punch: Boolean gave {len(solids)} solids, expected 1", result)
+        raise GeometryError(f"{which} punch: Boolean gave {len(solids)} solids, expected 1", solids)
     punch = solids[0]
     if not punch.isValid():
         punch.fix(1e-7, 1e-7, 1e-7)
     if not punch.isValid():
         raise GeometryError(f"{which} punch: Boolean result is not valid", punch)
     return punch
+
+
+def _tight_z(shape, low: bool) -> float:
+    """The lowest (``low``) or highest z (mm) of ``shape``'s geometry: OCC's optimal box without triangulation
+    or tolerances, as tabletcad build measures a tip's edge (an older FreeCAD without it: the box)."""
+    try:
+        box = shape.optimalBoundingBox(False)  # (useTriangulation; FreeCAD 0.20 takes no second argument)
+    except Exception:
+        box = shape.BoundBox
+    return float(box.ZMin if low else box.ZMax)
 
 
 def _bore_offset(rims) -> float:

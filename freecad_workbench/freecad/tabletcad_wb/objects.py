@@ -82,8 +82,8 @@ def _fail(obj, exc):
 
 
 class _RestoreAfterRecompute:
-    """A document observer that restores ``sys.tracebacklimit`` when a recompute ends (headless, where no
-    event loop runs a timer), then removes itself."""
+    """A document observer that restores ``sys.tracebacklimit`` when a recompute ends, of the document or of one
+    object (headless, where no event loop runs a timer), then removes itself."""
 
     _armed = None
 
@@ -92,6 +92,9 @@ class _RestoreAfterRecompute:
         if cls._armed is None:
             cls._armed = cls()
             FreeCAD.addDocumentObserver(cls._armed)
+
+    def slotRecomputedObject(self, obj):  # (``obj.recompute()`` alone: no document recompute follows)
+        self.slotRecomputedDocument(obj.Document)
 
     def slotRecomputedDocument(self, doc):
         _restore_traceback()

@@ -112,11 +112,20 @@ def export_step(doc=None, directory=None, with_tooling=True):
     if bad:
         raise RuntimeError(f"not exported, recompute failed: {', '.join(bad)}")
     out = {}
+    all_name = _safe(doc.Label) + "_all"
+    taken = {all_name.casefold()}
     for o in wanted:
-        p = directory / (_safe(o.Label) + ".step")
+        # two labels may make one file name ("CR 9mm" and "CR_9mm"): the second had overwritten the first's file
+        stem = base = _safe(o.Label)
+        k = 1
+        while stem.casefold() in taken:  # (casefold: a file system that ignores case too)
+            k += 1
+            stem = f"{base}_{k}"
+        taken.add(stem.casefold())
+        p = directory / (stem + ".step")
         o.Shape.exportStep(str(p))
         out[o.Label] = str(p)
-    allp = directory / (_safe(doc.Label) + "_all.step")
+    allp = directory / (all_name + ".step")
     Import.export(wanted, str(allp))
     out["all"] = str(allp)
     for label, why in skipped.items():
