@@ -432,6 +432,46 @@ def test_a_plot_of_no_column_is_refused_before_any_design_is_built(tmp_path, cap
         assert "design.name" not in allowed and "status" not in allowed and "tablet.band" not in allowed
 
 
+def test_a_varied_key_or_a_status_plot_is_refused_even_when_the_first_design_fails(tmp_path):
+    """Whether the first design builds or not, a varied key or a status column is no report column: a sweep whose
+    first design is refused (a band of 0) had built every design, written results.csv, and then refused them."""
+    from tabletcad.sweep.run import _check_plot_columns
+
+    sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
+    data = __import__("tomllib").loads(sweep.read_text())
+    data["sweep"]["vary"]["tablet.band"] = [0.0, 3.2]
+    spec = parse_sweep(data, name="g")
+    design = spec.designs()[0]
+    assert design["tablet"]["band"] == 0.0
+    for bad, why in (("tablet.band", "not a varied key"), ("status", "not a status column")):
+        with pytest.raises(DesignError) as e:
+            _check_plot_columns((bad,), design, spec)
+        assert e.value.parameter == "--plot" and why in e.value.allowed
+    _check_plot_columns(("volume_mm3",), design, spec)  # (a column: left to the end, the design failing here)
+
+
+def test_a_resumed_sweep_keeps_a_users_file_under_a_plots_name(tmp_path):
+    """``--resume --plot volume_mm3`` had written its plot over the user's own plot_volume_mm3.png, a file no earlier
+    run of the sweep wrote (a first run into such a folder is refused): refused in one line, the file kept; the
+    sweep's own plot (its PNG marked by the sweep) is replaced on the next resume."""
+    from tabletcad.sweep.results import is_sweep_plot
+
+    sweep = ROOT / "samples" / "sweep" / "concave_round_grid.toml"
+    out = tmp_path / "sw"
+    run_sweep(sweep, out, workers=0, progress=False)
+    mine = out / "plot_volume_mm3.png"
+    mine.write_text("my own figure")
+    with pytest.raises(DesignError) as e:
+        run_sweep(sweep, out, workers=0, progress=False, resume=True, plot=("volume_mm3",))
+    assert str(e.value) == (f"--out = {str(out)!r} is not allowed: must not hold files this sweep writes that no "
+                            "earlier run of it wrote (plot_volume_mm3.png): move them or write into another folder")
+    assert mine.read_text() == "my own figure" and not is_sweep_plot(mine)
+    mine.unlink()
+    for _ in range(2):  # its own plot, then replaced by the next resume
+        run_sweep(sweep, out, workers=0, progress=False, resume=True, plot=("volume_mm3",))
+        assert is_sweep_plot(mine)
+
+
 # The tests below use the module's local cluster (local_client), which lives until the module ends:
 # the tests above, which do not, run before it starts (it had idled through them, ~40 s, 1 CPU-s)
 @pytest.fixture(scope="module")

@@ -200,6 +200,22 @@ def plot_results(df, keys: Sequence[str], outputs: Sequence[str], out_dir: str |
             ax.grid(alpha=0.3)
         fig.suptitle(f"{o}: {len(ok)} designs")
         path = Path(out_dir) / plot_names([o])[0]
-        fig.savefig(path, dpi=110)
+        fig.savefig(path, dpi=110, metadata={"Software": PLOT_SOFTWARE})  # (how a resumed run knows it for its own)
         paths.append(path)
     return paths
+
+
+#: the PNG ``Software`` text a sweep's plots carry: a resumed run replaces a plot file only when it is one
+PLOT_SOFTWARE = "tabletcad sweep"
+
+
+def is_sweep_plot(path: str | Path) -> bool:
+    """Whether ``path`` is a plot a sweep wrote (a PNG whose ``Software`` text is :data:`PLOT_SOFTWARE`), not a file
+    of the user's under that name (``--resume --plot`` had replaced the user's own ``plot_volume_mm3.png``)."""
+    from PIL import Image
+
+    try:
+        with Image.open(path) as im:
+            return im.format == "PNG" and getattr(im, "text", {}).get("Software") == PLOT_SOFTWARE
+    except Exception:  # noqa: BLE001 - not an image, unreadable: not the sweep's
+        return False

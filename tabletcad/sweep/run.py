@@ -10,7 +10,7 @@ from typing import Any
 
 from tabletcad.errors import DesignError
 from tabletcad.sweep.engine import CONNECT_TIMEOUT_S, failed_design, map_tasks, open_client, sweep_task
-from tabletcad.sweep.results import (JOURNAL, RESULTS_CSV, TAIL_COLUMNS, append_journal, plot_column_error,
+from tabletcad.sweep.results import (JOURNAL, RESULTS_CSV, TAIL_COLUMNS, append_journal, is_sweep_plot, plot_column_error,
                                      plot_names, plot_results, read_done, results_frame, write_results)
 from tabletcad.sweep.spec import SweepSpec, design_hash, load_sweep, parse_sweep
 
@@ -100,6 +100,10 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
                               f"holds {len(foreign)} designs that are not in this sweep file; use another --out folder")
         if files_wanted:  # outputs asked for now that an earlier run did not write: those designs run again
             done = {h: r for h, r in done.items() if r.get("status") != "ok" or _has_files(out, store, h, spec.outputs)}
+        theirs = [n for n in plot_names(plot) if (out / n).exists() and not is_sweep_plot(out / n)]
+        if theirs:  # (a resumed run replaces its own plots only: it had written over the user's file of that name)
+            raise DesignError("--out", str(out), f"must not hold files this sweep writes that no earlier run of it "
+                              f"wrote ({', '.join(theirs)}): move them or write into another folder")
     elif out is not None and out.is_dir():  # a first run into a used folder: it owns only what it writes
         theirs = [n for n in plot_names(plot) if (out / n).exists()]
         if files_wanted and (out / "designs").exists():
@@ -233,6 +237,10 @@ def _check_plot_columns(plot: tuple[str, ...], design: dict[str, Any], spec) -> 
             d = Design.from_dict(design, default_name=spec.name)
             cols = flatten_report(geometry_report(d.build(), d.report_options))
     except Exception:  # noqa: BLE001 - a design that fails is the sweep's row, not a reason to stop here
+        for o in plot:  # (no design needed to know these: they had been refused only after the whole sweep)
+            if o in spec.keys or o in TAIL_COLUMNS:
+                raise DesignError("--plot", o, "must be a report column of results.csv, not " + (
+                    "a varied key (each plot is drawn against the varied keys)" if o in spec.keys else "a status column"))
         return
     files = any(o != "report" for o in spec.outputs)
     sections = {c.split(".")[0] for c in cols}
