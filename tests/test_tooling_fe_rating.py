@@ -114,6 +114,8 @@ def test_without_fe_rating_the_drawing_keeps_the_pressure_rule():
     ({"yield_stress_MPa": -1.0, "yield_stress_source": "x"}, "yield_stress_MPa"),
     # a yield stress in pascals (1.45e9) had been taken: the punch rated at 2508 kN
     ({"yield_stress_MPa": 1.45e9, "yield_stress_source": "x"}, "yield_stress_MPa"),
+    # and one in GPa (1.45 for S7's 1450 MPa): below any punch steel (tabletcad.tolerance.MIN_YIELD_MPA, as fe punch's)
+    ({"yield_stress_MPa": 1.45, "yield_stress_source": "x"}, "yield_stress_MPa"),
     ({"steel": STEEL, "punch": "middle"}, "punch"),
     ({"steel": STEEL, "safety_factor": 0.0}, "safety_factor"),
     ({"steel": STEEL, "bogus": 1}, "bogus"),

@@ -75,7 +75,7 @@ from typing import Any
 
 from tabletcad.errors import MISSING, DesignError, check_finite, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
-from tabletcad.tolerance import MAX_YIELD_MPA
+from tabletcad.tolerance import MAX_YIELD_MPA, MIN_YIELD_MPA
 from tabletcad.tooling.polygon import polygon_problem
 from tabletcad.tooling.standards import PunchBody, resolve_body
 
@@ -428,7 +428,9 @@ def _fe_rating(t: Any) -> FeRatingSpec | None:
         if src is not None:
             raise DesignError(f"{w} yield_stress_source", src, "give it with yield_stress_MPa (a steel has its own)")
     else:
-        y = check_range(f"{w} yield_stress_MPa", y, 0.0, MAX_YIELD_MPA, "MPa", lo_open=True)
+        # (tabletcad.tolerance.MIN_YIELD_MPA: below any punch steel, as fe punch's --yield-stress; 1.45, a value in
+        # GPa, had rated the tips a thousand times too weak)
+        y = check_range(f"{w} yield_stress_MPa", y, MIN_YIELD_MPA, MAX_YIELD_MPA, "MPa")
         if not (isinstance(src, str) and src.strip()):
             raise DesignError(f"{w} yield_stress_source", src if src is not None else MISSING,
                               "must name the source of yield_stress_MPa (a non-empty string)")
