@@ -491,6 +491,10 @@ MODEL_WHY = ("(where the model runs with the other options: the bed stays thicke
     # a bed below the default --z had been "--z = 2.9635 mm is not allowed", an option not given
     (["--h0", "2"], "error: --h0 = 2 mm is not allowed: must be >= 2.9635 mm, the default --z (the height where "
                     "ω_z is taken lies within the bed; or give a lower --z)"),
+    # an option with no working value while another is out of its range: the other is named (an ordinary
+    # --nu 0.3, tried first, had been blamed: "no value works with the other options")
+    (["--z", "0.5", "--h0", "0.6", "--nu", "0.3"], "error: --h0 = 0.6 mm is not allowed: must be >= 4.23377 and "
+                                                   "<= 60.0612 mm " + MODEL_WHY),
 ])
 def test_love_names_the_option_given_not_the_models_quantity(capsys, tmp_path, args, line):
     _refused_writing_nothing(capsys, tmp_path, ["love", *args], line)

@@ -100,3 +100,12 @@ def test_a_decimal_or_a_fraction_is_kept_as_the_float_toml_would_give():
                                      "band": fractions.Fraction(5, 2), "cup_depth": 1}})
     assert d.tablet["diameter"] == 10.1 and d.tablet["band"] == 2.5 and type(d.tablet["cup_depth"]) is int
     assert tomllib.loads(d.to_toml())["tablet"] == dict(d.tablet)
+
+
+@pytest.mark.parametrize("value, shown", [(decimal.Decimal("1e400"), "1E+400"), (decimal.Decimal("-1e400"), "-1E+400"),
+                                          (fractions.Fraction(10**400), "1000000")])
+def test_a_decimal_or_a_fraction_no_float_holds_is_refused_as_given(value, shown):
+    """``Fraction(10**400)`` had raised a bare OverflowError, ``Decimal("1e400")`` been quoted as ``inf``."""
+    with pytest.raises(DesignError) as e:
+        _design(value).build()
+    assert str(e.value).startswith(f"tablet.diameter = {shown}") and str(e.value).endswith("must be a finite number")

@@ -463,8 +463,10 @@ def test_a_resumed_sweep_keeps_a_users_file_under_a_plots_name(tmp_path):
     mine.write_text("my own figure")
     with pytest.raises(DesignError) as e:
         run_sweep(sweep, out, workers=0, progress=False, resume=True, plot=("volume_mm3",))
-    assert str(e.value) == (f"--out = {str(out)!r} is not allowed: must not hold files this sweep writes that no "
-                            "earlier run of it wrote (plot_volume_mm3.png): move them or write into another folder")
+    assert str(e.value) == (f"--out = {str(out)!r} is not allowed: must not hold files under the names of this "
+                            "sweep's plots that no sweep wrote (plot_volume_mm3.png; a sweep's plot carries 'Software: "
+                            "tabletcad sweep' in its PNG, which tabletcad before 2026-12-07 did not write): move them "
+                            "or write into another folder")
     assert mine.read_text() == "my own figure" and not is_sweep_plot(mine)
     mine.unlink()
     for _ in range(2):  # its own plot, then replaced by the next resume

@@ -632,6 +632,12 @@ def test_an_overload_reads_true_and_a_rating_is_never_rounded_up():
     fe = {"allowed_force_kN": 20.998, "tips": {"upper": {"allowed_force_kN": 20.998}}, "yield_MPa": 1450.0,
           "safety_factor": 1.5, "yield_source": "y"}
     assert rating_notes({"fe": fe})[0].startswith("tip force rating 20.99 kN (FE punch analysis: upper 20.99 kN;")
+    # one float step: a force 1 ulp above its rating reads above it (15 digits had read "30 kN is 1 x the rated
+    # 30 kN"), and a rating a product's last bit under a round value is that value ("14.99" had been printed)
+    from tabletcad.tooling.rating import overload_texts, rating_text
+
+    assert overload_texts(30.000000000000004, 30.0) == ("30.000000000000004", "30", "1.0000000000000002")
+    assert (rating_text(14.999999999999998), rating_text(99.99999999999999), rating_text(14.967)) == ("15", "100", "14.96")
 
 
 def _outline_crossing(outline, direction_deg: float) -> float:

@@ -608,8 +608,12 @@ def _refuse_love_option(pressures: np.ndarray, model: dict[str, Any], given: lis
     """
     from tabletcad.mechanics.love import model_allowed, model_range
 
-    for name in given:
-        lo, hi = model_range(name, pressures, **model)
+    ranges = {name: model_range(name, pressures, **model) for name in given}
+    # an option whose range exists but leaves its value out is at fault; one with no range at all (no value works
+    # with the others as given) is blamed only when no other option is out of its own range (--z 0.5 --h0 0.6 had
+    # blamed --nu = 0.3, the first option tried, where --h0 >= 4.23 mm makes it run)
+    for name in sorted(given, key=lambda n: math.isnan(ranges[n][0])):
+        lo, hi = ranges[name]
         value = model[name]
         if math.isnan(lo) or not lo <= value <= hi:
             unit, hint = _LOVE_UNITS[name]

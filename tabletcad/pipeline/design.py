@@ -501,8 +501,14 @@ def _as_toml(value: Any, _open: frozenset = frozenset()) -> Any:
         # no Python type holds it (np.longdouble): the float it rounds to, else as given
         return float(plain) if isinstance(plain, numbers.Real) else copy.deepcopy(plain)
     if (isinstance(value, numbers.Rational) and not isinstance(value, int)) or \
-            (isinstance(value, decimal.Decimal) and value.is_finite()):  # (an infinite one is refused as given)
-        return float(value)  # a Decimal or a Fraction: TOML's float (the design had kept it and to_toml refused it)
+            (isinstance(value, decimal.Decimal) and value.is_finite()):
+        # a Decimal or a Fraction: TOML's float (the design had kept it and to_toml refused it); one no float
+        # holds (Decimal("1e400"), Fraction(10**400)) is kept as given, for its refusal to quote it
+        try:
+            x = float(value)
+        except OverflowError:
+            return copy.deepcopy(value)
+        return x if math.isfinite(x) else copy.deepcopy(value)
     return copy.deepcopy(value)
 
 

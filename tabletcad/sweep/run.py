@@ -102,8 +102,10 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
             done = {h: r for h, r in done.items() if r.get("status") != "ok" or _has_files(out, store, h, spec.outputs)}
         theirs = [n for n in plot_names(plot) if (out / n).exists() and not is_sweep_plot(out / n)]
         if theirs:  # (a resumed run replaces its own plots only: it had written over the user's file of that name)
-            raise DesignError("--out", str(out), f"must not hold files this sweep writes that no earlier run of it "
-                              f"wrote ({', '.join(theirs)}): move them or write into another folder")
+            raise DesignError("--out", str(out), f"must not hold files under the names of this sweep's plots that no "
+                              f"sweep wrote ({', '.join(theirs)}; a sweep's plot carries 'Software: tabletcad sweep' in "
+                              "its PNG, which tabletcad before 2026-12-07 did not write): move them or write into "
+                              "another folder")
     elif out is not None and out.is_dir():  # a first run into a used folder: it owns only what it writes
         theirs = [n for n in plot_names(plot) if (out / n).exists()]
         if files_wanted and (out / "designs").exists():

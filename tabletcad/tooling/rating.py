@@ -35,10 +35,12 @@ EULER_K = 2.0
 
 def rating_text(force_kN: float, digits: int = 4) -> str:
     """A rated force (kN) to ``digits`` significant digits, rounded down: a rating is never printed above
-    what it is (14.967 kN is "14.96", where ``.3g`` had printed "15")."""
+    what it is (14.967 kN is "14.96", where ``.3g`` had printed "15").  The float is read to 15 significant
+    digits first, so that its round-off is not taken for a fall below a round value (14.999999999999998 kN, a
+    product's last bit, is "15", not "14.99")."""
     from decimal import ROUND_FLOOR, Decimal
 
-    d = Decimal(repr(float(force_kN)))
+    d = Decimal(f"{float(force_kN):.15g}")
     if not d.is_finite() or d.is_zero():
         return f"{force_kN:g}"
     q = d.quantize(Decimal(1).scaleb(d.adjusted() - (digits - 1)), rounding=ROUND_FLOOR)
@@ -49,14 +51,14 @@ def overload_texts(force_kN: float, rated_kN: float) -> tuple[str, str, str]:
     """``(force, rating, utilisation)`` texts of an overload (force > rating), with as many digits as it takes
     for the force to read above the rating (rounded down, :func:`rating_text`) and the utilisation above 1:
     a 15 kN force on a 14.967 kN rating had read "1 x the rated 15 kN"."""
-    digits = 4
-    while digits < 15 and not float(f"{force_kN:.{digits}g}") > float(rating_text(rated_kN, digits)):
+    digits = 4  # (up to 17: a force one float step above the rating needs them all)
+    while digits < 17 and not float(f"{force_kN:.{digits}g}") > float(rating_text(rated_kN, min(digits, 15))):
         digits += 1
     u = force_kN / rated_kN
     places = 3
-    while places < 15 and not float(f"{u:.{places}g}") > 1.0:
+    while places < 17 and not float(f"{u:.{places}g}") > 1.0:
         places += 1
-    return f"{force_kN:.{digits}g}", rating_text(rated_kN, digits), f"{u:.{places}g}"
+    return f"{force_kN:.{digits}g}", rating_text(rated_kN, min(digits, 15)), f"{u:.{places}g}"
 
 
 def section_properties(wire) -> tuple[float, float]:
