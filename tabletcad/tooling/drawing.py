@@ -402,15 +402,10 @@ def fit_notes(spec) -> list[str]:
 def _fit_range(spec) -> str:
     """``; 0.020 to 0.040 a side at the tolerances' limits``: the clearance (mm) the bore's and the tips'
     tolerances allow (:meth:`~tabletcad.tooling.spec.DrawingSpec.fit_clearance`)."""
+    from tabletcad.tooling.spec import micrometre_text
+
     least, most = spec.drawing.fit_clearance()
-    return f"; {_micrometres(least)} to {_micrometres(most)} a side at the tolerances' limits"
-
-
-def _micrometres(x: float) -> str:
-    """``x`` (mm) to the micrometre, or to 0.1 µm where that is its size (0.0125)."""
-    x = round(x, 9) + 0.0  # (no -0.000)
-    text = f"{x:.3f}"
-    return text if abs(float(text) - x) < 1e-9 else f"{x:.4f}"
+    return f"; {micrometre_text(least)} to {micrometre_text(most)} a side at the tolerances' limits"
 
 
 _DIM_KEYS = {"Ø": "diameter", "L": "length", "W": "width", "band": "band", "cup": "cup_depth", "T": "thickness",

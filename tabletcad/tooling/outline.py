@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -111,14 +112,15 @@ class TabletFrame:
     def thickness(self) -> float:
         return self.z_max - self.z_min
 
-    @property
+    @cached_property
     def plan_diameter(self) -> float:
         """The tablet's largest extent in plan, in any direction (mm; a rounded square's diagonal): the size
         the standards' die types and punch bodies are rated by
-        (:func:`~tabletcad.pipeline.designreport.plan_diameter`)."""
+        (:func:`~tabletcad.pipeline.designreport.plan_diameter`, never below :attr:`length` and :attr:`width`,
+        the same bounds; computed once)."""
         from tabletcad.pipeline.designreport import plan_diameter
 
-        return max(self.length, self.width, plan_diameter(self.tablet))
+        return plan_diameter(self.tablet)
 
     @property
     def plan_area(self) -> float:

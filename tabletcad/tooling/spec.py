@@ -515,7 +515,7 @@ class DrawingSpec:
         """The tolerance of dimension ``key`` as drawn: ``±0.076``, or limit deviations ``+0.000/-0.013``."""
         t = self.deviations(key)
         if isinstance(t, tuple):
-            return f"{_deviation_text(t[0])}/{_deviation_text(t[1])}"
+            return f"{micrometre_text(t[0], signed=True)}/{micrometre_text(t[1], signed=True)}"
         return f"±{t:.2f}" if t >= 0.1 else f"±{t:.3f}"  # (as the sheets print sizes)
 
     def fit_clearance(self) -> tuple[float, float] | None:
@@ -528,10 +528,13 @@ class DrawingSpec:
         return self.clearance_mm + 0.5 * (b_lo - t_up), self.clearance_mm + 0.5 * (b_up - t_lo)
 
 
-def _deviation_text(x: float) -> str:
-    """A limit deviation (mm) with its sign, to the micrometre, or to 0.1 µm where that is its size."""
-    text = f"{x:+.3f}"
-    return text if abs(float(text) - x) < 1e-9 else f"{x:+.4f}"
+def micrometre_text(x: float, signed: bool = False) -> str:
+    """``x`` (mm) to the micrometre, or to 0.1 µm where that is its size (a 0.0125 mm clearance); with its sign
+    (``+0.000``) when ``signed``, as a limit deviation is drawn."""
+    x = round(x, 9) + 0.0  # (no -0.000)
+    sign = "+" if signed else ""
+    text = f"{x:{sign}.3f}"
+    return text if abs(float(text) - x) < 1e-9 else f"{x:{sign}.4f}"
 
 
 def _tolerance(name: str, value: Any, unit: str) -> float | tuple[float, float]:

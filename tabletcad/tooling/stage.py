@@ -54,7 +54,7 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
     from tabletcad.pipeline.designreport import plan_diameter
     from tabletcad.tooling.spec import check_punch_lengths, check_relief_reach, die_height_for, standard_die_size
 
-    band_heights(tablet)  # (a sphere has no band for the die to form)
+    band_z = band_heights(tablet)  # (a sphere has no band for the die to form)
     od = spec.die_outer_diameter_mm
     size, shaped = plan_diameter(tablet), tablet.revolution is None  # (its largest extent in plan: a square's diagonal)
     if od is None:  # the TSM die the build will take: one larger than a 'D' takes is refused here, not after the CAD
@@ -74,7 +74,7 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
     check_on_tablet(tablet, spec)
     if spec.body is not None:  # complete punches: their tips against the die, their relief against the tablet's
         # width (the build checks both on its frame too, the relief by the outline's exact offset)
-        check_punch_lengths(spec, band_heights(tablet), die_height_for(spec, size, shaped))
+        check_punch_lengths(spec, band_z, die_height_for(spec, size, shaped))
         lo, hi = tablet.bounds()
         check_relief_reach(spec, min(float(hi[0] - lo[0]), float(hi[1] - lo[1])), float(hi[1] - lo[1]))
 

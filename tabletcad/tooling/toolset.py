@@ -16,8 +16,8 @@ from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.designreport import ReportOptions
 from tabletcad.tooling.booleans import TIMER, to_manifold, volume
 from tabletcad.tolerance import DEFAULT
-from tabletcad.tooling.spec import (WIDE_CLEARANCE_MM, ToolingSpec, check_numbers, check_punch_lengths,  # noqa: F401
-                                   die_height_for, fit_warnings, relief_refused)
+from tabletcad.tooling.spec import (ToolingSpec, check_numbers, check_punch_lengths, die_height_for, fit_warnings,
+                                   relief_refused)
 
 __all__ = ["ToolSet", "make_tooling", "check_closed_position", "finished_solid", "DEFLECTION_MM"]
 

@@ -561,13 +561,20 @@ def _valid_solid(solids, which):
     return punch
 
 
-def _tight_z(shape, low: bool) -> float:
-    """The lowest (``low``) or highest z (mm) of ``shape``'s geometry: OCC's optimal box without triangulation
-    or tolerances, as tabletcad build measures a tip's edge (an older FreeCAD without it: the box)."""
+def _tight_box(shape):
+    """``shape``'s box from its geometry: OCC's optimal box without triangulation or tolerances, as tabletcad
+    build measures (FreeCAD 0.20 takes no second argument: ``(False, False)`` had always fallen back); the
+    loose box in a FreeCAD without it."""
     try:
-        box = shape.optimalBoundingBox(False)  # (useTriangulation; FreeCAD 0.20 takes no second argument)
+        return shape.optimalBoundingBox(False)
     except Exception:
-        box = shape.BoundBox
+        return shape.BoundBox
+
+
+def _tight_z(shape, low: bool) -> float:
+    """The lowest (``low``) or highest z (mm) of ``shape``'s geometry (:func:`_tight_box`), as tabletcad build
+    measures a tip's edge."""
+    box = _tight_box(shape)
     return float(box.ZMin if low else box.ZMax)
 
 
@@ -582,10 +589,7 @@ def _bore_offset(rims) -> float:
 def plan_size(shape) -> float:
     """The tablet's largest plan extent (mm) from its solid's tight box (the surfaces' extrema, as the
     core's dimensions: the loose box of B-spline poles could cross a TSM die's size limit)."""
-    try:
-        box = shape.optimalBoundingBox(False, False)
-    except Exception:  # (an older FreeCAD without it)
-        box = shape.BoundBox
+    box = _tight_box(shape)
     return max(box.XLength, box.YLength)
 
 
