@@ -434,7 +434,8 @@ def test_build_exits_2_and_writes_nothing_when_the_fit_fails(tmp_path, monkeypat
     from tabletcad.cli import main
 
     original = ts.tablet_solid
-    monkeypatch.setattr(ts, "tablet_solid", functools.partial(original, tol=1e-13, max_nv=40, max_iterations=2))
+    monkeypatch.setattr(ts, "tablet_solid",
+                        lambda tablet, tol=None, **kw: original(tablet, tol=1e-13, max_nv=40, max_iterations=2))
     out = tmp_path / "out"
     rc = main(["build", str(ROOT / "samples" / "spherical.toml"), "--out", str(out), "--quiet"])
     assert rc == 2
@@ -442,6 +443,29 @@ def test_build_exits_2_and_writes_nothing_when_the_fit_fails(tmp_path, monkeypat
     assert "error:" in err and "misses tolerance" in err
     assert not out.exists() or not any(out.iterdir())
     assert not any(p.name.startswith(".out.") for p in tmp_path.iterdir())  # no staging folder left
+
+
+def test_a_fit_within_tolerance_that_moves_the_volume_is_fitted_again(monkeypatch):
+    """The thesis sphere at ``a = 5``: its first fit, 3.8e-5 mm from the PDE surface (within the 1e-4 mm
+    tolerance), moves the volume by 1.6e-6 relative, more than the stage's agreement; the stage fits the
+    faces again at a tenth of the tolerance and they agree (1.5e-7)."""
+    import tabletcad.cad.stage as stage
+
+    t = design_from_dict({"tablet": {"family": "thesis.spherical", "diameter": 5.0, "a": 5.0}}, "sphere_a5")
+    first = tablet_solid(t)
+    assert abs(abs(first.data_volume_area[0]) - t.volume()) > AGREE * t.volume()  # the case: a first fit that misses
+    assert max(f.max_deviation for f in first.fits) <= t.tol.fit
+    solid, _mesh, sections = stage.check_tablet_solid(t)
+    b = sections["brep"]
+    assert b["fit_tolerance_mm"] == pytest.approx(t.tol.fit / 10, rel=1e-12)
+    assert b["fit_max_deviation_mm"] <= b["fit_tolerance_mm"]
+    assert b["volume_mm3"] == pytest.approx(t.volume(), rel=AGREE)
+    assert b["surface_area_mm2"] == pytest.approx(t.surface_area(), rel=AGREE)
+    assert b["volume_mm3"] == abs(solid.data_volume_area[0])  # the solid handed on is the one that agrees
+    # without the second fit the stage refuses it, saying at which fit tolerance
+    monkeypatch.setattr(stage, "REFITS", 0)
+    with pytest.raises(GeometryError, match=r"sphere_a5: B-rep volume/area differ .* at a fit tolerance of 1e-04 mm"):
+        stage.check_tablet_solid(t)
 
 
 # --------------------------------------------------------------------------- end to end
