@@ -156,6 +156,14 @@ MAX_YIELD_MPA = 10000.0
 #: steel yields near 200 MPa, so 100 MPa is below any steel a punch is made of.  A yield stress typed in
 #: GPa (1.45 for S7's 1450 MPa) had been accepted, rating the punch a thousand times too weak.
 MIN_YIELD_MPA = 100.0
+#: The range (MPa) of an allowed punch-tip pressure (a tip-force rating ``F = p x tip area``): below the
+#: yield of the steels punches are made of, and from 10 MPa, so that one typed in GPa (0.3 for 300 MPa)
+#: is refused rather than rating the tips a thousand times too weak (it had been taken, as had 1e9 MPa).
+MIN_TIP_PRESSURE_MPA = 10.0
+#: The smallest Young's modulus (MPa) of a punch's buckling check: punches are tool steels (190-215 GPa)
+#: or carbide (about 600 GPa), and aluminium's 70 GPa is already no punch's; one typed in GPa (210)
+#: had been taken, rating the tips' buckling a thousand times too low.
+MIN_PUNCH_MODULUS_MPA = 5.0e4
 #: The largest effective-length factor ``K`` of the punch's buckling check (a column fixed at one end and
 #: free at the other has 2; 1e9 had rated a punch at 1e-14 kN).
 MAX_EFFECTIVE_LENGTH_FACTOR = 10.0

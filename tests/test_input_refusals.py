@@ -300,6 +300,9 @@ ROUND = '[tablet]\nfamily = "concave_round"\ndiameter = 12.0\nband = 3.0\ncup_de
     # a strength in pascals: the report had printed an FE breaking force of 1.3e8 N
     ("tensile_strength_MPa = 2e6", "error: report.tensile_strength_MPa = 2e+06 MPa is not allowed: must be > 0 and <= 1000 MPa"),
     ("reference_diameter_mm = -1", "error: report.reference_diameter_mm = -1 mm is not allowed: must be >= 0.001"),
+    # a tip pressure in GPa (0.3 for 300 MPa) had been taken, rating the punch tips a thousand times too weak
+    ("max_punch_pressure_MPa = 0.3", "error: report.max_punch_pressure_MPa = 0.3 MPa is not allowed: must be >= 10 and <= 10000 MPa"),
+    ("max_punch_pressure_MPa = 1e9", "error: report.max_punch_pressure_MPa = 1e+09 MPa is not allowed: must be >= 10 and <= 10000 MPa"),
     ("reference_thickness_mm = 0", "error: report.reference_thickness_mm = 0 mm is not allowed: must be >= 0.001"),
 ])
 @pytest.mark.parametrize("command", ["report", "build"])

@@ -74,6 +74,28 @@ def test_unsourced_or_bad_limits_are_design_errors(table, parameter):
     assert parameter in e.value.parameter
 
 
+@pytest.mark.parametrize("key, value, line", [
+    # figures typed in GPa had been taken: tips rated (and buckling loads computed) a thousand times too low
+    ("allowed_tip_pressure_MPa", 0.3,
+     "error: tooling.allowed_tip_pressure_MPa = 0.3 MPa is not allowed: must be >= 10 and <= 10000 MPa"),
+    ("allowed_tip_pressure_MPa", 3e5,
+     "error: tooling.allowed_tip_pressure_MPa = 300000 MPa is not allowed: must be >= 10 and <= 10000 MPa"),
+    ("punch_youngs_modulus_MPa", 210.0,
+     "error: tooling.punch_youngs_modulus_MPa = 210 MPa is not allowed: must be >= 50000 and <= 1e+07 MPa"),
+])
+def test_sourced_figures_in_the_wrong_unit_are_refused_however_the_spec_is_made(key, value, line):
+    from dataclasses import replace
+
+    table = {key: value, key.replace("_MPa", "_source"): SRC}
+    for make in (lambda: parse_tooling(table), lambda: replace(parse_tooling({}), **table)):
+        with pytest.raises(DesignError) as e:
+            make()
+        assert f"error: {e.value}" == line
+    # the range's ends are taken
+    lo, hi = (10.0, 10000.0) if key.startswith("allowed") else (5e4, 1e7)
+    assert [getattr(parse_tooling({**table, key: x}), key) for x in (lo, hi)] == [lo, hi]
+
+
 def test_a_compaction_force_above_the_rating_is_warned_of_and_drawn(frame):
     """A force above the tips' rating is an overload: a warning, ``overloaded`` in the report and a line on
     the drawing (a 1 kN force on a 2 mm tip rated 0.924 kN had passed in silence)."""

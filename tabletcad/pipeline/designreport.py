@@ -32,7 +32,8 @@ from tabletcad.families.sweep import SweepNominal, certify, sweep_properties
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.geometry.vectors import clip, cross, norm3
 from tabletcad.mechanics.strength import MAX_FORCE_N
-from tabletcad.tolerance import DEFAULT, MAX_TENSILE_STRENGTH_MPA, MAX_TRUE_DENSITY_MG_MM3, MIN_TRUE_DENSITY_MG_MM3
+from tabletcad.tolerance import (DEFAULT, MAX_TENSILE_STRENGTH_MPA, MAX_TRUE_DENSITY_MG_MM3, MAX_YIELD_MPA, MIN_TIP_PRESSURE_MPA,
+                                 MIN_TRUE_DENSITY_MG_MM3)
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -66,14 +67,15 @@ REPORT_KEYS = {
 
 #: The largest value of each number of ``[report]`` (all must be > 0): a true density in mg/mm³ (not
 #: kg/m³), forces as a breaking test's (:data:`tabletcad.mechanics.strength.MAX_FORCE_N`, 1e9 N; in kN,
-#: 1e6), a punch-tip pressure up to 1e9 MPa, a tensile strength as the FE prediction's (1000 MPa: not
+#: 1e6), a punch-tip pressure as the tooling's allowed tip pressure (10 MPa to a steel's
+#: 10 GPa: neither in GPa nor in Pa), a tensile strength as the FE prediction's (1000 MPa: not
 #: pascals); the reference tablet's lengths as a design's.
 _REPORT_LIMITS = {
     "true_density_mg_mm3": MAX_TRUE_DENSITY_MG_MM3,
     "breaking_force_N": MAX_FORCE_N,
     "compaction_force_kN": 1e6,
     "max_punch_force_kN": 1e6,
-    "max_punch_pressure_MPa": 1e9,
+    "max_punch_pressure_MPa": MAX_YIELD_MPA,
     "tensile_strength_MPa": MAX_TENSILE_STRENGTH_MPA,
     "reference_breaking_force_N": MAX_FORCE_N,
     "reference_diameter_mm": None,
@@ -126,6 +128,8 @@ class ReportOptions:
                     check_range(f"[report] {k}", v, DEFAULT.min_length, DEFAULT.max_length, "mm")
                 elif k == "true_density_mg_mm3":  # neither kg/m³ nor g/mm³
                     check_range(f"[report] {k}", v, MIN_TRUE_DENSITY_MG_MM3, hi, REPORT_KEYS[k])
+                elif k == "max_punch_pressure_MPa":  # as [tooling] allowed_tip_pressure_MPa
+                    check_range(f"[report] {k}", v, MIN_TIP_PRESSURE_MPA, hi, REPORT_KEYS[k])
                 else:
                     check_range(f"[report] {k}", v, 0.0, hi, REPORT_KEYS[k], lo_open=True)
 

@@ -75,7 +75,8 @@ from typing import Any
 
 from tabletcad.errors import MISSING, DesignError, check_finite, check_positive, check_range
 from tabletcad.tolerance import DEFAULT
-from tabletcad.tolerance import MAX_YIELD_MPA, MIN_YIELD_MPA
+from tabletcad.tolerance import (MAX_MODULUS_MPA, MAX_YIELD_MPA, MIN_PUNCH_MODULUS_MPA, MIN_TIP_PRESSURE_MPA,
+                                 MIN_YIELD_MPA)
 from tabletcad.tooling.polygon import polygon_problem
 from tabletcad.tooling.standards import PunchBody, resolve_body
 
@@ -411,6 +412,17 @@ def steel_names() -> list[str]:
     return list(tomllib.loads(text).get("steel", {}))
 
 
+#: the range (MPa) of each figure the [tooling] table takes with its source: a tip pressure below any
+#: punch steel's yield and from 10 MPa, a punch's Young's modulus of steel or carbide (neither in GPa)
+_SOURCED_RANGES = {"allowed_tip_pressure_MPa": (MIN_TIP_PRESSURE_MPA, MAX_YIELD_MPA),
+                   "punch_youngs_modulus_MPa": (MIN_PUNCH_MODULUS_MPA, MAX_MODULUS_MPA)}
+
+
+def _sourced_figure(key: str, value: Any) -> float:
+    """``[tooling] allowed_tip_pressure_MPa`` or ``punch_youngs_modulus_MPa`` as a float in its range (MPa)."""
+    return check_range(f"[tooling] {key}", value, *_SOURCED_RANGES[key], "MPa")
+
+
 def _fe_rating(t: Any) -> FeRatingSpec | None:
     w = "[tooling.fe_rating]"
     if t is None:
@@ -649,7 +661,7 @@ class ToolingSpec:
             skey = key.replace("_MPa", "_source")
             src = getattr(self, skey)
             if getattr(self, key) is not None:
-                object.__setattr__(self, key, check_positive(f"[tooling] {key}", getattr(self, key), "MPa"))
+                object.__setattr__(self, key, _sourced_figure(key, getattr(self, key)))
                 if not (isinstance(src, str) and src.strip()):  # no figure without its source (as in the table)
                     raise DesignError(f"[tooling] {skey}", src if src is not None else MISSING,
                                       f"must name the source of {key} (a non-empty string)")
@@ -914,10 +926,10 @@ def parse_tooling(table: Any, base: Path | None = None) -> ToolingSpec:
             body = replace(body, modified={**body.modified, "die_outer_diameter_mm": {
                 "given": float(od), "standard": float(body.die_outer_diameter_mm)}})
     sourced = {}
-    for key, unit in (("allowed_tip_pressure_MPa", "MPa"), ("punch_youngs_modulus_MPa", "MPa")):
+    for key in ("allowed_tip_pressure_MPa", "punch_youngs_modulus_MPa"):
         skey = key.replace("_MPa", "_source")
         if key in t:
-            sourced[key] = check_positive(f"[tooling] {key}", t[key], unit)
+            sourced[key] = _sourced_figure(key, t[key])
             src = t.get(skey)
             if not (isinstance(src, str) and src.strip()):
                 raise DesignError(f"[tooling] {skey}", src if src is not None else MISSING,
