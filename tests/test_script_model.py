@@ -221,6 +221,24 @@ def test_make_takes_every_table_of_a_design():
         tabletcad.make("thesis.flat_faced_round", diameter=10.0, thickness=3.0, reshape=dict(radius=1e-5))
 
 
+def test_make_takes_a_free_form_tablet_s_patches():
+    """``patches=`` carries a free-form design's ``[[patch]]`` tables (a trial: ``make("free_form", ...)`` had no
+    way to take them); the tablet is the design file's, and its tables are checked as the file's are."""
+    import tomllib
+
+    path = ROOT / "samples" / "free_form_stadium.toml"
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    made = tabletcad.make("free_form", patches=data["patch"], a="auto", name="free_form_stadium")
+    loaded = tabletcad.load(path)
+    assert made.volume == loaded.volume and made.area == loaded.area
+    assert [p.name for p in made.tablet.patches] == [p.name for p in loaded.tablet.patches]
+    with pytest.raises(DesignError) as exc:
+        tabletcad.make("free_form", patches=[{"curves": data["patch"][0]["curves"][:2]}])
+    assert exc.value.parameter == "patch[0].curves"
+    with pytest.raises(DesignError, match="only read for family free_form"):
+        tabletcad.make("concave_round", diameter=10.0, band=3.0, cup_depth=1.0, patches=data["patch"])
+
+
 def test_make_takes_numpy_scalars():
     import numpy as np
 

@@ -27,7 +27,7 @@ import json
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, Sequence
 
 import numpy as np
 
@@ -505,7 +505,7 @@ class TabletModel(_Shaped):
 
 
 def make(family: str, *, report: dict | None = None, tooling: dict | None = None, trim: dict | None = None,
-         reshape: dict | None = None, **dims: Any) -> TabletModel:
+         reshape: dict | None = None, patches: Sequence[dict] | None = None, **dims: Any) -> TabletModel:
     """A tablet of a named family (``tabletcad shapes`` lists them) with dimensions in mm.
 
     Checked as a design file's ``[tablet]`` table is (:class:`~tabletcad.pipeline.design.Design`):
@@ -514,14 +514,17 @@ def make(family: str, *, report: dict | None = None, tooling: dict | None = None
     ``report``, ``tooling``, ``trim`` and ``reshape``: the design's ``[report]``, ``[tooling]``, ``[trim]``
     and ``[reshape]`` tables as dicts (``report=dict(solid_fraction=0.85, true_density_mg_mm3=1.5)`` gives
     :meth:`TabletModel.report` its weight, ``trim=dict(v=[0.0, 3.14159])`` a cut-away), checked as a
-    design file's are.
+    design file's are. ``patches``: a ``free_form`` tablet's ``[[patch]]`` tables, each a dict
+    ``{"curves": [...]}`` of four curve tables (``"previous"`` repeats the previous patch's last curve), as
+    in ``samples/free_form_stadium.toml``.
     """
     import numpy as np
 
     # numpy's scalars (np.arange(...)[i], np.float32) are the numbers they hold; arrays are not numbers
     dims = {k: v.item() if isinstance(v, np.generic) else v for k, v in dims.items()}
     data: dict[str, Any] = {"tablet": {"family": family, **dims}}
-    for table, value in (("report", report), ("tooling", tooling), ("trim", trim), ("reshape", reshape)):
+    for table, value in (("report", report), ("tooling", tooling), ("trim", trim), ("reshape", reshape),
+                         ("patch", None if patches is None else list(patches))):
         if value is not None:
             data[table] = value
     design = Design.from_dict(data, default_name=str(family).split(".")[-1])
