@@ -931,6 +931,11 @@ def test_gui_smoke_and_screenshot(fc, fc_home, assembly_step, tmp_path):
     assert r["report_found"]
     assert not [ln for ln in r["report_view"] if "Traceback" in ln or "File " in ln], r["report_view"]
     assert 1 <= len(r["report_view"]) <= 2 and "DesignError" in r["report_view"][0], r["report_view"]
+    # "Tablet from design" with a missing file adds nothing and says so in one line (an invalid tablet had been added)
+    added, missing, lines = r["design_refused"]
+    lines = [re.sub(r"^\d\d:\d\d:\d\d\s+", "", ln) for ln in lines]  # (the Report view's time stamps, when shown)
+    assert added == 0 and lines == [f"tabletcad: design_file = '{missing}' is not allowed: must be an existing TOML "
+                                    "file"], r["design_refused"]
     # ImportGui.insert reads the tooling assembly STEP: four named, valid parts in their colours
     from tabletcad.tooling.assembly import PART_COLOURS
 
