@@ -379,7 +379,10 @@ def test_invalid_values_keep_previous_shape(headless):
     assert deep["upper"]["valid_obj"] and deep["upper"]["valid"]
     (neg,) = _steps(headless, "negative_diameter")
     assert neg["diameter"] == 0.0  # App::PropertyLength clamps negative lengths to 0
-    assert not neg["tablet"]["valid_obj"] and "diameter" in neg["tablet"]["status"]
+    # the -3 set is not known to the workbench: the refusal of the 0 stored says so plainly
+    assert not neg["tablet"]["valid_obj"] and neg["tablet"]["status"] == (
+        "tablet.diameter = 0 mm is not allowed: must be > 0; FreeCAD's length properties hold no negative value: "
+        "one set below 0 mm is stored as 0 mm")
     assert neg["tablet"]["volume"] == neg["before"]["volume"]
     (ok,) = _steps(headless, "repaired")
     assert ok["tablet"]["valid_obj"] and ok["state"] == ["Up-to-date"]
@@ -563,7 +566,9 @@ def test_make_tablet_refuses_its_arguments_before_making_an_object(headless):
     assert s["refusals"][0] == "family 'concave_round' has no parameter 'cup_depht'"
     assert s["refusals"][1].startswith("diameter = 'abc' is not allowed: must be a length (mm, cm, in, ...)")
     assert s["refusals"][2] == "diameter = '10 kg' is not allowed: must be a length (mm, cm, in, ...)"
-    assert "is not a density" in s["refusals"][3]
+    # (the project's one line, a DesignError: it had been "density '1.2 kg' is not a density (...)")
+    assert s["refusals"][3] == ("density = '1.2 kg' is not allowed: must be a density: mg/mm³ as a number, or with "
+                                "units such as '1.2 g/cm^3'")
     assert s["left_by_refusals"] == 0
     # the tools' constructors too, each argument named
     assert [r.split(" = ")[0] for r in s["tool_refusals"]] == ["length", "die_height", "die_outer_diameter",
@@ -571,6 +576,36 @@ def test_make_tablet_refuses_its_arguments_before_making_an_object(headless):
     assert all("is not allowed: must be a length" in r for r in s["tool_refusals"])
     assert s["tools_left"] == 0
     assert s["inch_diameter"] == pytest.approx(10.16, abs=1e-12)
+
+
+def test_make_tablet_refuses_what_the_core_or_the_object_would_as_given_and_adds_nothing(headless):
+    """A trial (session 51): ``diameter=-5`` had been refused as "diameter = 0" (its PropertyLength stores 0) on an
+    invalid tablet added to the document, as a missing design file and ``density=2000`` (kg/m³ for mg/mm³) had
+    been; ``fit_tolerance=-1`` had become 0, the default.  Each is the project's one line quoting the argument
+    as given, and nothing is added; the core tablet built for the check is the one the recompute takes."""
+    (s,) = _steps(headless, "argument_refusals")
+    r = s["refusals"]
+    assert r["diameter"] == "DesignError: tablet.diameter = -5 mm is not allowed: must be > 0"
+    assert r["cup_depth"] == ("DesignError: tablet.cup_depth = -0.5 mm is not allowed: must be > 0 and <= 5 mm "
+                              "(a hemisphere over the 10 mm wide cup)")
+    assert r["bevel_angle"] == "DesignError: tablet.bevel_angle = 400 deg is not allowed: must be > 0 and < 90 deg"
+    missing = str(Path(s["work"]) / "no_such_design.toml")
+    assert r["missing"] == f"DesignError: design_file = '{missing}' is not allowed: must be an existing TOML file"
+    relative = Path(s["work"]).resolve() / "no_such_folder" / "x.toml"
+    assert r["missing_relative"] == ("DesignError: design_file = 'no_such_folder/x.toml' is not allowed: must be an "
+                                     f"existing TOML file (read as {relative})")
+    kg = "must be >= 0.01 and <= 25 mg/mm³ (= g/cm³); 2000 kg/m³ would be 2 mg/mm³"
+    assert r["density"] == f"DesignError: density = 2000 mg/mm³ is not allowed: {kg}"
+    assert r["density_text"] == f"DesignError: density = '2 g/mm^3' is not allowed: {kg}"
+    assert r["fit_tolerance"] == ("DesignError: fit_tolerance = -1 mm is not allowed: must be 0 (the default, "
+                                  "0.0001 mm) or within [1e-07, 0.01]")
+    assert r["design_file"] == ("DesignError: design_or_family = 'design_file' is not allowed: give the path of a "
+                                "design file (TOML) or a family name")
+    assert s["left"] == 0
+    assert s["core_builds"] == 1 and s["checked_valid"]
+    # an angle set on the property: FreeCAD stores 360° for 400°, and the refusal says so
+    assert s["angle_status"] == ("tablet.bevel_angle = 360 deg is not allowed: must be > 0 and < 90 deg; FreeCAD's "
+                                 "angle properties hold -360° to 360°: one set beyond is stored as ±360°")
 
 
 def test_tooling_a_die_cannot_take_is_refused_before_any_part(headless):
@@ -896,6 +931,11 @@ def test_gui_smoke_and_screenshot(fc, fc_home, assembly_step, tmp_path):
     assert r["report_found"]
     assert not [ln for ln in r["report_view"] if "Traceback" in ln or "File " in ln], r["report_view"]
     assert 1 <= len(r["report_view"]) <= 2 and "DesignError" in r["report_view"][0], r["report_view"]
+    # "Tablet from design" with a missing file adds nothing and says so in one line (an invalid tablet had been added)
+    added, missing, lines = r["design_refused"]
+    lines = [re.sub(r"^\d\d:\d\d:\d\d\s+", "", ln) for ln in lines]  # (the Report view's time stamps, when shown)
+    assert added == 0 and lines == [f"tabletcad: design_file = '{missing}' is not allowed: must be an existing TOML "
+                                    "file"], r["design_refused"]
     # ImportGui.insert reads the tooling assembly STEP: four named, valid parts in their colours
     from tabletcad.tooling.assembly import PART_COLOURS
 

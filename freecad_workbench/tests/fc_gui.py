@@ -112,6 +112,21 @@ try:
     tab.CupDepth = 1.0
     doc.recompute()
     mark("report")
+    # "Tablet from design" with a file the core refuses: its one line in the Report view, nothing added (an
+    # invalid tablet had been)
+    missing = os.path.join(os.environ["TABLETCAD_FC_WORK"], "no_such_design.toml")
+    n_objects = len(doc.Objects)
+    _open = QtGui.QFileDialog.getOpenFileName
+    QtGui.QFileDialog.getOpenFileName = staticmethod(lambda *a, **k: (missing, ""))
+    try:
+        FreeCADGui.runCommand("Tabletcad_TabletFromDesign")
+    finally:
+        QtGui.QFileDialog.getOpenFileName = _open
+    QtGui.QApplication.processEvents()
+    text = reports[0].toPlainText() if reports else ""
+    result["design_refused"] = [len(doc.Objects) - n_objects, missing,
+                                [ln for ln in text.splitlines() if "no_such_design" in ln or "Traceback" in ln]]
+    mark("design_refused")
     FreeCADGui.Selection.clearSelection()
     FreeCADGui.Selection.addSelection(tab)
     result["active"] = {

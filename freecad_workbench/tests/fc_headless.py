@@ -404,6 +404,44 @@ try:
         doc.removeObject(o.Name)
     doc.UndoMode = 0
     doc.recompute()
+
+    # ---- make_tablet's arguments checked before any object, refused as given (session 51): -5 mm had been
+    # refused as the 0 mm its PropertyLength stored, a missing design file or a density in kg/m^3 had added an
+    # invalid tablet, a fit tolerance of -1 mm had become 0 (the default)
+    n_objects = len(doc.Objects)
+    arg_refusals = {}
+    for key, args, kw in (("diameter", ("concave_round",), dict(diameter=-5)),
+                          ("cup_depth", ("concave_round",), dict(cup_depth="-0.5 mm")),
+                          ("bevel_angle", ("ffbe",), dict(bevel_angle=400)),
+                          ("missing", (os.path.join(work, "no_such_design.toml"),), {}),
+                          ("missing_relative", (os.path.join("no_such_folder", "x.toml"),), {}),
+                          ("density", ("concave_round",), dict(density=2000)),
+                          ("density_text", ("concave_round",), dict(density="2 g/mm^3")),
+                          ("fit_tolerance", ("concave_round",), dict(fit_tolerance=-1)),
+                          ("design_file", ("design_file",), {})):
+        try:
+            make_tablet(doc, *args, **kw)
+            arg_refusals[key] = None
+        except Exception as exc:
+            arg_refusals[key] = f"{type(exc).__name__}: {exc}"
+    args_left = len(doc.Objects) - n_objects
+    # the core tablet built for the check is the one the first recompute takes (not built twice)
+    core_calls = []
+    _spec = wb_geometry.tablet_from_spec
+    wb_geometry.tablet_from_spec = lambda *a, **k: core_calls.append(a) or _spec(*a, **k)
+    try:
+        checked = make_tablet(doc, "concave_round", diameter=9)
+    finally:
+        wb_geometry.tablet_from_spec = _spec
+    # set on the property (the editor or a script): the value set is not known, the refusal says what FreeCAD stores
+    bev = make_tablet(doc, "ffbe")
+    bev.BevelAngle = 400
+    doc.recompute()
+    step("argument_refusals", refusals=arg_refusals, left=args_left, core_builds=len(core_calls),
+         checked_valid=bool(checked.isValid()), angle_status=bev.getStatusString(), work=work)
+    for o in (bev, checked):
+        doc.removeObject(o.Name)
+    doc.recompute()
     from freecad.tabletcad_wb import tasks
 
     exp_doc = FreeCAD.newDocument("export_sphere")

@@ -94,10 +94,17 @@ class TabletFromDesignCommand(_Command):
         path, _ = QtGui.QFileDialog.getOpenFileName(
             None, "tabletcad design", start, "tabletcad design (*.toml)"
         )
-        if path:
-            doc = _doc()
+        if not path:
+            return
+        from tabletcad.errors import TabletcadError
+
+        doc = _doc()
+        try:  # a design the core refuses adds nothing: its one line in the Report view (not a traceback)
             _transaction(doc, "Tablet from design", lambda: make_tablet(doc, path))
-            _fit()
+        except TabletcadError as exc:
+            FreeCAD.Console.PrintError(f"tabletcad: {exc}\n")
+            return
+        _fit()
 
 
 class _ToolCommand(_Command):

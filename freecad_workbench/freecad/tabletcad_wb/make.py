@@ -19,7 +19,7 @@ from pathlib import Path
 
 import FreeCAD
 
-from . import objects
+from . import geometry, objects
 
 __all__ = ["design_tooling", "make_die", "make_lower_punch", "make_tablet", "make_tooling", "make_upper_punch"]
 
@@ -40,6 +40,77 @@ def _value(v, unit="mm", name=None):
     if q.Unit != FreeCAD.Units.Unit(unit):
         raise ValueError(f"{name or 'value'} = {v!r} is not allowed: must be {kind}")
     return q
+
+
+def _density(density) -> tuple[float, str | None]:
+    """``make_tablet``'s ``density`` in mg/mm³, and the text it was given as (None for a number).
+
+    Parameters
+    ----------
+    density : float, str or FreeCAD.Units.Quantity
+        mg/mm³ (= g/cm³) as a number, or a density with units (``"1.2 g/cm^3"``, a Quantity).
+
+    Returns
+    -------
+    tuple of (float, str or None)
+        The density (mg/mm³) and what to quote when it is refused.
+
+    Raises
+    ------
+    tabletcad.errors.DesignError
+        Text that is no quantity, or a quantity that is no density, naming ``density``.
+    """
+    from tabletcad.errors import DesignError
+
+    if not (isinstance(density, str) or (hasattr(density, "Unit") and hasattr(density, "Value"))):
+        return float(density), None
+    # a string with units or a FreeCAD Quantity (float() of one is its value in kg/mm^3: 1.2 g/cm^3 had been
+    # stored as 1.2e-6 mg/mm^3)
+    given = density if isinstance(density, str) else density.UserString
+    kind = "a density: mg/mm³ as a number, or with units such as '1.2 g/cm^3'"
+    try:
+        q = FreeCAD.Units.Quantity(density)
+    except Exception as exc:  # FreeCAD's parser: ValueError "syntax error", ArithmeticError ...
+        raise DesignError("density", given, f"must be {kind} ({exc})") from None
+    if q.Unit != FreeCAD.Units.Unit("kg/mm^3"):
+        raise DesignError("density", given, f"must be {kind}")
+    return float(q.Value) * 1e6, given  # kg/mm^3 -> mg/mm^3
+
+
+def _checked_core(spec: dict, given: str):
+    """The core tablet of ``make_tablet``'s arguments, built before the object is made: what the core refuses
+    is refused with the value as given, and no object is added.
+
+    A value set into a property first could be another: a ``PropertyLength`` stores -5 mm as 0 mm and an
+    angle 400° as 360°, and the refusal had quoted those, after an invalid object had been added (as it had
+    for a missing design file).
+
+    Parameters
+    ----------
+    spec : dict
+        ``{family, params, design}`` as :meth:`objects.TabletProxy.spec` gives it (mm, deg; ``design``
+        the resolved path of a design file, or None).
+    given : str
+        ``make_tablet``'s first argument as given (a design file's refusal quotes it).
+
+    Returns
+    -------
+    tabletcad.geometry.tablet.Tablet
+        The core's tablet (handed to the object: its first recompute does not build it again).
+
+    Raises
+    ------
+    tabletcad.errors.DesignError
+        The core's refusal (a missing or unreadable design file names ``design_file`` as given).
+    """
+    from tabletcad.errors import DesignError
+
+    try:
+        return geometry.tablet_from_spec(spec["family"], spec["params"], spec["design"])
+    except DesignError as exc:
+        if exc.parameter == "design_file" and exc.value == spec["design"] and given != spec["design"]:
+            raise DesignError("design_file", given, f"{exc.allowed} (read as {spec['design']})") from None
+        raise
 
 
 @contextmanager
@@ -68,6 +139,7 @@ def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, reco
     ``fit_tolerance`` (mm).
     """
     density = params.pop("density", None)
+    user_density = density is not None
     fit_tol = params.pop("fit_tolerance", None)
     design = None
     label = name
@@ -97,21 +169,25 @@ def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, reco
         if fam is None or k not in fam.params:
             raise ValueError(f"family {family!r} has no parameter {k!r}")
         values[objects.prop_name(k)] = _value(v, "deg" if fam.params[k] == "deg" else "mm", k)
-    if density is not None:  # mg/mm^3, or a string with units ("1.2 g/cm^3")
-        if isinstance(density, str) or (hasattr(density, "Unit") and hasattr(density, "Value")):
-            # a string with units or a FreeCAD Quantity (float() of one is its value in kg/mm^3: 1.2 g/cm^3 had
-            # been stored as 1.2e-6 mg/mm^3)
-            try:
-                q = FreeCAD.Units.Quantity(density)
-            except Exception as exc:
-                raise ValueError(f"density = {density!r} is not a quantity ({exc})") from None
-            if q.Unit != FreeCAD.Units.Unit("kg/mm^3"):
-                raise ValueError(f"density {density!r} is not a density (give mg/mm^3, or units such as g/cm^3)")
-            density = float(q.Value) * 1e6  # kg/mm^3 -> mg/mm^3
-        else:
-            density = float(density)
+    if user_density:  # mg/mm^3, or a string with units ("1.2 g/cm^3"); in range before any object
+        density, given = _density(density)
+        objects.check_density("density", density, given)
     if fit_tol is not None:
         fit_tol = _value(fit_tol, "mm", "fit_tolerance")
+        objects.check_fit_tolerance("fit_tolerance", float(fit_tol.Value))  # (-1 mm had become 0, the default)
+    if fam is None and design is None:  # ("design_file" given as a family: a tablet of no file had been added)
+        from tabletcad.errors import DesignError
+
+        raise DesignError("design_or_family", family, "give the path of a design file (TOML) or a family name")
+    if fam is None:
+        spec = {"family": None, "params": {}, "design": str(design)}
+    else:  # the values as the object's properties will hold them: given (mm, deg) or the family's defaults
+        given_values = {k: float(values[objects.prop_name(k)].getValueAs("deg" if u == "deg" else "mm"))
+                        for k, u in fam.params.items() if objects.prop_name(k) in values}
+        spec = {"family": fam.name, "params": {k: given_values.get(k, float(fam.defaults[k])) for k in fam.params},
+                "design": None}
+    digest = objects._file_digest(spec["design"])
+    core = _checked_core(spec, str(design_or_family))
     with _new(doc, "Tablet") as obj:
         objects.TabletProxy(obj, family)
         if design is not None:
@@ -123,6 +199,7 @@ def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, reco
         if fit_tol is not None:
             obj.FitTolerance = fit_tol
         obj.Label = label or family
+        obj.Proxy.adopt_core(obj, core, spec, digest)
         objects.attach_view_provider(obj)
     if recompute:
         doc.recompute()

@@ -125,6 +125,90 @@ def _default_fit() -> float:
     return DEFAULT.fit
 
 
+def check_density(parameter: str, value: float, given=None) -> None:
+    """Refuse an apparent density outside :data:`DENSITY_LIMITS` (or NaN) naming ``parameter``.
+
+    Parameters
+    ----------
+    parameter : str
+        The name refused: the property (``Density``) or ``make_tablet``'s argument (``density``).
+    value : float
+        The density, mg/mm³ (= g/cm³).
+    given : str, optional
+        What the user gave, when it was text or a quantity (``"2 g/mm^3"``): quoted instead of ``value``.
+
+    Raises
+    ------
+    tabletcad.errors.DesignError
+        Out of range; a value that is in range in kg/m³ says what it is in mg/mm³ (the usual slip).
+    """
+    from tabletcad.errors import DesignError
+
+    lo, hi = DENSITY_LIMITS
+    if lo <= value <= hi:  # (also refuses NaN)
+        return
+    allowed = f"must be >= {lo:g} and <= {hi:g} mg/mm³ (= g/cm³)"
+    if 1000.0 * lo <= value <= 1000.0 * hi:
+        allowed += f"; {value:g} kg/m³ would be {value / 1000.0:g} mg/mm³"
+    raise DesignError(parameter, value if given is None else given, allowed, "mg/mm³")
+
+
+def check_fit_tolerance(parameter: str, value: float) -> None:
+    """Refuse a B-spline fit tolerance (mm) that is not 0 (the core's default) or within
+    [:data:`MIN_FIT_TOLERANCE_MM`, :data:`MAX_FIT_TOLERANCE_MM`] (NaN included), naming ``parameter``.
+
+    Raises
+    ------
+    tabletcad.errors.DesignError
+        Out of range.
+    """
+    from tabletcad.errors import DesignError
+
+    if not (value == 0.0 or MIN_FIT_TOLERANCE_MM <= value <= MAX_FIT_TOLERANCE_MM):  # (NaN had reached the core)
+        raise DesignError(parameter, value, f"must be 0 (the default, {_default_fit():g} mm) or within "
+                          f"[{MIN_FIT_TOLERANCE_MM:g}, {MAX_FIT_TOLERANCE_MM:g}]", "mm")
+
+
+#: what FreeCAD's quantity properties do to a value beyond their range, by the value they keep instead:
+#: a length set below 0 is stored as 0, an angle beyond ±360° as ±360° (so the core never sees the value set)
+_STORED_FOR = {
+    "App::PropertyLength": (lambda v: v == 0.0, "FreeCAD's length properties hold no negative value: one set "
+                                                "below 0 mm is stored as 0 mm"),
+    "App::PropertyAngle": (lambda v: abs(v) == 360.0, "FreeCAD's angle properties hold -360° to 360°: one set "
+                                                      "beyond is stored as ±360°"),
+}
+
+
+def _as_stored(obj, exc):
+    """The core's refusal ``exc`` of a dimension, saying plainly that FreeCAD may have changed the value set
+    when the property holds the value it stores for one out of its range (the value set is not known here:
+    the property editor or a script set -5 mm and the core was asked about 0 mm).
+
+    Parameters
+    ----------
+    obj : App.FeaturePython
+        The tablet.
+    exc : tabletcad.errors.DesignError
+        The core's refusal of its dimensions.
+
+    Returns
+    -------
+    tabletcad.errors.DesignError
+        ``exc`` itself, or the same refusal with the note.
+    """
+    from tabletcad.errors import DesignError
+
+    fam = _family(obj.Family)
+    for k in fam.params if fam is not None else ():
+        p = prop_name(k)
+        if exc.parameter != f"tablet.{k}" or p not in obj.PropertiesList:
+            continue
+        stored, note = _STORED_FOR.get(obj.getTypeIdOfProperty(p), (None, ""))
+        if stored is not None and stored(float(getattr(obj, p).Value)):
+            return DesignError(exc.parameter, exc.value, f"{exc.allowed}; {note}", exc.unit)
+    return exc
+
+
 #: the largest punch lift off the tablet (mm) of an exploded view
 MAX_GAP_MM = 1000.0
 
@@ -435,6 +519,25 @@ class TabletProxy(_Proxy):
         s = self.spec(obj)
         return repr((s, fit, _file_digest(s["design"])))
 
+    def adopt_core(self, obj, tablet, spec: dict, digest: str | None) -> None:
+        """Keep the core tablet ``make_tablet`` built from ``spec`` (:meth:`spec`) to check its arguments, for
+        the object's first recompute, when the object's inputs are still those (the design file's bytes had
+        the digest ``digest`` before it was read): it is not built twice.
+
+        Parameters
+        ----------
+        obj : App.FeaturePython
+            The tablet.
+        tablet : tabletcad.geometry.tablet.Tablet
+            The core's tablet of ``spec``.
+        spec : dict
+            ``{family, params, design}`` it was built from (mm, deg).
+        digest : str or None
+            The design file's digest read before it was built (None without one).
+        """
+        if self.spec(obj) == spec and _file_digest(spec["design"]) == digest:
+            self._core = (self._geometry_key(obj, float(obj.FitTolerance.Value)), tablet)
+
     def current_core_tablet(self, obj):
         """The core tablet of the object's inputs as they are now: the one its last recompute built when they
         have not changed since (``make_die`` sizes its standard die from it: it had built the same tablet again,
@@ -459,17 +562,17 @@ class TabletProxy(_Proxy):
 
         t0 = time.perf_counter()
         density = float(obj.Density)
-        if not (DENSITY_LIMITS[0] <= density <= DENSITY_LIMITS[1]):  # (also refuses NaN)
-            raise DesignError("Density", density, f"must be >= {DENSITY_LIMITS[0]:g} and <= {DENSITY_LIMITS[1]:g} mg/mm³ "
-                              "(= g/cm³)", "mg/mm³")
+        check_density("Density", density)
         fit = float(obj.FitTolerance.Value)
-        if not (fit == 0.0 or MIN_FIT_TOLERANCE_MM <= fit <= MAX_FIT_TOLERANCE_MM):  # (NaN had reached the core as "tol")
-            raise DesignError("FitTolerance", fit, f"must be 0 (the default, {_default_fit():g} mm) or within "
-                              f"[{MIN_FIT_TOLERANCE_MM:g}, {MAX_FIT_TOLERANCE_MM:g}]", "mm")
+        check_fit_tolerance("FitTolerance", fit)
         key = self._geometry_key(obj, fit)
         if key != getattr(self, "_built", None) or obj.Shape.isNull() or not obj.RimData:
             # rebuild only when the geometry's inputs changed (not for Density, Label, Placement)
-            tablet = self.core_tablet(obj)
+            core = getattr(self, "_core", None)  # (make_tablet's check of its arguments built it)
+            try:
+                tablet = core[1] if core is not None and core[0] == key else self.core_tablet(obj)
+            except DesignError as exc:
+                raise _as_stored(obj, exc) from None
             geo = geometry.build_tablet(tablet, tol=fit or None)
             pl = obj.Placement
             obj.Shape = geo.solid
