@@ -250,6 +250,24 @@ def check_on_tablet(tablet: Any, spec: ToolingSpec) -> None:
                   width=float(hi[1] - lo[1]), bore_offset_mm=bore_offset(overhang))
 
 
+#: why a tablet whose plan is a spline through points gets no tooling (OCC 7.9's planar offset, which makes the
+#: tips and the bore, fails on the one periodic B-spline edge that such a band's section is: a 24-point
+#: circle, 8- and 64-point ovals were all refused)
+SPLINE_OUTLINE_REFUSAL = ("tooling needs an outline OpenCascade can offset for the tips and the bore: lines and arcs "
+                          "(custom_outline segments), a circle or an ellipse; the section of this tablet's band cannot "
+                          "be offset")
+
+
+def spline_outline_refusal(tablet: Any) -> DesignError | None:
+    """The refusal of tooling for a tablet whose nominal plan outline is a spline through points (a
+    :class:`~tabletcad.families.outline.SplineOutline`: it has no lines and arcs), else ``None``: decided
+    from the design alone, so that ``report`` and ``build`` refuse it alike and before any geometry."""
+    outline = getattr(tablet.nominal, "outline", None)
+    if outline is not None and not getattr(outline, "segs", None):
+        return DesignError("tablet.outline", "points (a spline through them)", SPLINE_OUTLINE_REFUSAL)
+    return None
+
+
 #: the die height (mm) beside a given outer diameter when no height is given (a TSM B die's)
 DEFAULT_DIE_HEIGHT_MM = 22.22
 
