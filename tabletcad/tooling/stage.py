@@ -41,8 +41,8 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
     """Refuse a tablet that cannot have tooling (a cut-away or a ring, one without a band, one whose outline is a
     spline through points: :func:`~tabletcad.tooling.spec.spline_outline_refusal`, one too large for its
     die or for every TSM die when no die is given) and a ``[tooling]`` table its numbers refuse (a score or a
-    figure deeper than its face allows, a groove wider than half the tablet, a clearance, gap or tip length:
-    :func:`~tabletcad.tooling.spec.check_on_tablet`; complete punches' tips too short for the die they run in:
+    figure deeper than its face allows, a groove wider than half the tablet, a clearance, gap or tip length, a
+    figure that does not fit its face: :func:`~tabletcad.tooling.spec.check_on_tablet`; complete punches' tips too short for the die they run in:
     :func:`~tabletcad.tooling.spec.check_punch_lengths`), before any geometry is built: ``report`` and ``build``
     refuse alike, in a second where the tooling stage had refused after the solid was built.
 
