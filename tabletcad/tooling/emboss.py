@@ -158,7 +158,7 @@ def legibility(frame: TabletFrame, e: EmbossSpec, figure: TopoDS_Shape, clearanc
         a, b = c.FirstParameter(), c.LastParameter()
         from OCP.GCPnts import GCPnts_AbscissaPoint
 
-        perimeter += GCPnts_AbscissaPoint.Length_s(c)
+        perimeter += GCPnts_AbscissaPoint.Length_s(c, 1e-12)  # (its default tolerance left ~2e-7 relative)
         props = BRepLProp_CLProps(c, 2, 1e-9)
         for k in range(9):
             props.SetParameter(a + (b - a) * k / 8.0)
@@ -218,8 +218,8 @@ def check_fit(frame: TabletFrame, e: EmbossSpec, figure: TopoDS_Shape, clearance
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
 
-    box = Bnd_Box()
-    BRepBndLib.Add_s(figure, box)
+    box = Bnd_Box()  # the exact box (the poles' box that BRepBndLib.Add gives had grown with the figure's turn)
+    BRepBndLib.AddOptimal_s(figure, box, False, False)
     lo, hi = box.CornerMin(), box.CornerMax()
     size = (hi.X() - lo.X(), hi.Y() - lo.Y())
     if outside > 1e-6 * max(area, 1e-9):

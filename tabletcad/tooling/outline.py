@@ -41,7 +41,7 @@ from tabletcad.errors import DesignError, GeometryError
 from tabletcad.families.thesis import NO_LAND
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tooling.booleans import translated
-from tabletcad.tooling.spec import band_heights
+from tabletcad.tooling.spec import SPLINE_OUTLINE_REFUSAL, band_heights, spline_outline_refusal
 
 __all__ = ["TabletFrame", "tablet_frame", "offset_wire", "prism", "plan_face", "wire_length", "face_area"]
 
@@ -387,6 +387,9 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
     nom = tablet.nominal
     outline_nom = getattr(nom, "outline", None)
     band_z = band_heights(tablet)  # (a DesignError without a band)
+    refusal = spline_outline_refusal(tablet)  # (decided from the design: check_tooling refuses it alike)
+    if refusal is not None:
+        raise refusal
     found = tablet.band()
     if shape is None:
         from tabletcad.cad.tablet_solid import tablet_solid
@@ -431,12 +434,7 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
             try:  # the tips and the bore are offsets of it: refused here, named, when OCC cannot offset it
                 offset_wire(wire, -0.01)
             except GeometryError:
-                spline = outline_nom is not None and not getattr(outline_nom, "segs", None)
-                raise DesignError("tablet.outline" if spline else "tablet.family",
-                                  "points (a spline through them)" if spline else tablet.family,
-                                  "tooling needs an outline OpenCascade can offset for the tips and the bore: lines "
-                                  "and arcs (custom_outline segments), a circle or an ellipse; the section of this "
-                                  "tablet's band cannot be offset") from None
+                raise DesignError("tablet.family", tablet.family, SPLINE_OUTLINE_REFUSAL) from None
     land = info.get("land_mm")
     if land is None and tablet.family in NO_LAND:  # the thesis's shapes say so in the catalogue
         land = 0.0

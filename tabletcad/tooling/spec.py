@@ -243,12 +243,143 @@ def check_numbers(spec: ToolingSpec, *, band_z: tuple[float, float], z_range: tu
 def check_on_tablet(tablet: Any, spec: ToolingSpec) -> None:
     """:func:`check_numbers` on the PDE ``tablet`` (a :class:`~tabletcad.geometry.tablet.Tablet`): its band
     (:func:`band_heights`: a tablet without one is refused), its extents and plan overhang, which are the
-    tooling frame's (:func:`tabletcad.tooling.outline.tablet_frame`).  No solid is built."""
+    tooling frame's (:func:`tabletcad.tooling.outline.tablet_frame`); then whether each figure fits its face
+    (:func:`check_figures_on_tablet`).  No solid is built."""
     band_z = band_heights(tablet)
     lo, hi = tablet.bounds()
     overhang = tablet.plan_overhang() if tablet.band() is not None else 0.0
-    check_numbers(spec, band_z=band_z, z_range=(float(lo[2]), float(hi[2])), length=float(hi[0] - lo[0]),
+    z_range = (float(lo[2]), float(hi[2]))
+    check_numbers(spec, band_z=band_z, z_range=z_range, length=float(hi[0] - lo[0]),
                   width=float(hi[1] - lo[1]), bore_offset_mm=bore_offset(overhang))
+    check_figures_on_tablet(tablet, spec, {"top": z_range[1] - band_z[1], "bottom": band_z[0] - z_range[0]})
+
+
+#: why a tablet whose plan is a spline through points gets no tooling (OCC 7.9's planar offset, which makes the
+#: tips and the bore, fails on the one periodic B-spline edge that such a band's section is: a 24-point
+#: circle, 8- and 64-point ovals were all refused)
+SPLINE_OUTLINE_REFUSAL = ("tooling needs an outline OpenCascade can offset for the tips and the bore: lines and arcs "
+                          "(custom_outline segments), a circle or an ellipse; the section of this tablet's band cannot "
+                          "be offset")
+
+
+def spline_outline_refusal(tablet: Any) -> DesignError | None:
+    """The refusal of tooling for a tablet whose nominal plan outline is a spline through points (a
+    :class:`~tabletcad.families.outline.SplineOutline`: it has no lines and arcs), else ``None``: decided
+    from the design alone, so that ``report`` and ``build`` refuse it alike and before any geometry."""
+    outline = getattr(tablet.nominal, "outline", None)
+    if outline is not None and not getattr(outline, "segs", None):
+        return DesignError("tablet.outline", "points (a spline through them)", SPLINE_OUTLINE_REFUSAL)
+    return None
+
+
+def tooling_plan_outline(tablet: Any) -> Any:
+    """The plan outline (a :class:`~tabletcad.families.outline.PlanOutline` of lines and arcs) that the tooling
+    frame (:func:`tabletcad.tooling.outline.tablet_frame`) makes its wire of: the family's nominal outline, or
+    the band's circle or line-and-arc outline; ``None`` where it takes an ellipse or the band's section."""
+    from tabletcad.families.outline import PlanOutline, circle_outline
+    from tabletcad.geometry.curves import Circle, Outline, Transformed
+
+    outline = getattr(tablet.nominal, "outline", None)
+    if outline is not None and getattr(outline, "segs", None):
+        return outline
+    found = tablet.band()
+    if outline is not None or found is None:
+        return None
+    curve, shift = tablet.patches[found.patch].data[0], [0.0, 0.0]
+    while isinstance(curve, Transformed) and all(curve.matrix[i][j] == (i == j) for i in range(2) for j in range(2)) \
+            and not any(curve.matrix[i][2] for i in range(2)):  # moved along the axis only: the same plan
+        shift, curve = [shift[0] + curve.offset[0], shift[1] + curve.offset[1]], curve.base
+    if isinstance(curve, Circle):
+        segs = circle_outline(float(curve.radius)).segs
+        shift = [shift[0] + curve.center[0], shift[1] + curve.center[1]]
+    elif isinstance(curve, Outline):
+        segs = curve.segs
+    else:
+        return None
+    return PlanOutline([q.translated(float(shift[0]), float(shift[1])) for q in segs])
+
+
+def figure_contours(e: EmbossSpec, i: int = 0) -> list | None:
+    """The placed plan contours (mm) of figure ``i`` as :func:`tabletcad.tooling.emboss.figure_faces` places its
+    faces (:mod:`tabletcad.geometry.lettering`), ``None`` for an SVG logo (read by build123d only); a
+    :class:`DesignError` for text that gives no glyphs, as the tooling's."""
+    from tabletcad.geometry import lettering
+
+    if e.svg is not None:
+        return None
+    if e.text is not None:
+        contours = lettering.text_contours(e.text, e.height_mm, font_path(e.font, f"[[tooling.emboss]] {i} font"))
+    else:
+        contours = lettering.polyline_contours(e.outline)
+    if not contours:
+        raise DesignError(f"[[tooling.emboss]] {i} text", e.text, "gives no glyphs in this font")
+    return lettering.placed(contours, e.rotation_deg, e.position_mm, e.face == "bottom")
+
+
+def figure_fit_refusal(e: EmbossSpec, i: int, contours: list, outline: Any, inset: float) -> DesignError | None:
+    """The refusal of figure ``i`` (its placed ``contours``) that does not lie inside ``outline`` offset inwards
+    by ``inset`` mm (the punch tip less the land and margin), in the words of
+    :func:`tabletcad.tooling.emboss.check_fit`, else ``None`` (the figure's size is its exact box, as there)."""
+    from tabletcad.geometry import lettering
+
+    what = "text" if e.text is not None else "outline"
+    value = e.text if e.text is not None else f"{len(e.outline)} points"
+    if not inset < outline.inscribed_radius():
+        return DesignError(f"[[tooling.emboss]] {i} {what}", value, f"does not fit: the face inset by {inset:.3g} mm is empty")
+    area, outside = lettering.outside_area(contours, outline, inset)
+    if outside > 1e-6 * max(area, 1e-9):
+        w, h = lettering.figure_box(contours)
+        return DesignError(f"[[tooling.emboss]] {i} {what}", value,
+                           f"does not fit the {e.face} face: {w:.3g} x {h:.3g} mm with {outside:.3g} mm^2 "
+                           f"outside the punch tip inset by {inset:.3g} mm (clearance + land + margin); "
+                           "use a smaller height_mm or move it")
+    return None
+
+
+def check_figures_on_tablet(tablet: Any, spec: ToolingSpec, cups: dict[str, float]) -> None:
+    """Refuse, as the tooling stage would after building the solid (:func:`tabletcad.tooling.emboss.check_emboss`),
+    a figure of ``spec`` that does not fit its face: text or a polyline outside the tablet's outline offset
+    inwards by the clearance, the face's land and the figure's margin, one whose text gives no glyphs, or one
+    whose stroke angle closes its strokes before its depth (:func:`stroke_angle_refusal`).
+    Decided on the same curves without OCC (:mod:`tabletcad.geometry.lettering`); ``cups`` (face -> mm) tell
+    a flat face (no land).  Not decided here (the build still checks them): an SVG logo, an outline the
+    tooling takes as an ellipse or its band's section, and an inset at or beyond a convex arc's radius of the
+    outline (its offset there is no longer the arc's)."""
+    from tabletcad.families.thesis import NO_LAND
+
+    if not spec.emboss:
+        return
+    outline = tooling_plan_outline(tablet)
+    info = dict(getattr(tablet.nominal, "info", {}) or {})
+    land = info.get("land_mm")
+    if land is None and tablet.family in NO_LAND:
+        land = 0.0
+    for i, e in enumerate(spec.emboss):
+        contours = figure_contours(e, i)
+        if contours is None or outline is None:
+            continue
+        inset = spec.clearance_mm + (0.0 if cups[e.face] < 1e-9 else (land or 0.0)) + e.margin_mm
+        if inset >= outline.min_convex_radius and inset < outline.inscribed_radius():
+            continue
+        refusal = figure_fit_refusal(e, i, contours, outline, inset) or stroke_angle_refusal(e, i, contours)
+        if refusal is not None:
+            raise refusal
+
+
+def stroke_angle_refusal(e: EmbossSpec, i: int, contours: list) -> DesignError | None:
+    """The refusal of figure ``i`` whose stroke angle closes its strokes before its depth, in the words of
+    :func:`tabletcad.tooling.emboss.check_emboss` (the mean stroke width ``2 A / P`` of its placed ``contours``),
+    else ``None``."""
+    from tabletcad.geometry import lettering
+
+    if not e.draft_deg > 0:
+        return None
+    width = 2.0 * abs(lettering.figure_area(contours)) / lettering.figure_length(contours)
+    if e.depth_mm * math.tan(math.radians(e.draft_deg)) >= 0.5 * width:
+        return DesignError(f"[[tooling.emboss]] {i} stroke_angle_deg", e.draft_deg,
+                           f"must be < {math.degrees(math.atan(0.5 * width / e.depth_mm)):.3g} deg: the "
+                           f"walls of {width:.3g} mm strokes would meet before the depth {e.depth_mm:.3g} mm", "deg")
+    return None
 
 
 #: the die height (mm) beside a given outer diameter when no height is given (a TSM B die's)

@@ -1,0 +1,306 @@
+"""``tabletcad report`` refuses what ``tabletcad build`` refuses for a design's ``[tooling]``, with the same
+line, before any geometry: lettering that does not fit its face and a spline outline, which a trial found
+``report`` accepting (exit 0) while ``build`` refused them after ~2 s of CAD.
+
+The fit is decided without OCC (:mod:`tabletcad.geometry.lettering`); the tests marked ``cad`` hold it
+against OpenCascade's own figure and Boolean (:func:`tabletcad.tooling.emboss.check_fit`)."""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tabletcad.cli import main
+from tabletcad.errors import DesignError
+
+ROOT = Path(__file__).resolve().parents[1]
+ONE_LINE = re.compile(r"^error: (\S+) = (.+) is not allowed: (.+)$")
+
+#: the concave round sample's tablet (10 mm, 0.08 mm land) with one debossed text on its bottom face
+ROUND = """[tablet]
+family = "concave_round"
+diameter = 10.0
+band = 2.8
+cup_depth = 0.9
+land = 0.08
+
+[tooling]
+clearance_mm = 0.02
+tip_length_mm = 8.0
+
+[[tooling.emboss]]
+text = "ABCDEFGH"
+mode = "deboss"
+face = "bottom"
+height_mm = {height}
+depth_mm = 0.12
+"""
+
+#: the tallest "ABCDEFGH" that fits (DejaVu Sans Bold; the face inset by 0.02 + 0.08 + 0.2 mm is a circle
+#: of 4.7 mm): 1.52836089096 mm by bisection of the exact area outside, where OCC's Boolean agrees to 1e-9 mm
+TALLEST = 1.5283608900960957
+
+#: "AB" (2.5 mm, DejaVu Sans Bold: strokes 0.41356 mm wide by 2A/P) debossed 0.5 mm: its walls meet at 22.468 deg
+STROKE = ROUND.replace('"ABCDEFGH"', '"AB"').replace("depth_mm = 0.12", "depth_mm = 0.5\nstroke_angle_deg = {angle}")
+
+SPLINE = """[tablet]
+family = "custom_outline"
+outline = [[4, 0], [3, 3], [0, 4], [-3, 3], [-4, 0], [-3, -3], [0, -4], [3, -3]]
+band = 2.5
+cup_depth = 0.5
+
+[tooling]
+clearance_mm = 0.02
+tip_length_mm = 8.0
+"""
+
+#: an outline of lines and arcs (the custom-outline sample's "D"), which tooling takes
+SEGMENTS = """[tablet]
+family = "custom_outline"
+segments = [
+  ["line", [-2.5, -3.5], [2.5, -3.5]],
+  ["arc",  [2.5, 0.0], 3.5, -1.5707963267948966, 3.141592653589793],
+  ["line", [2.5, 3.5], [-2.5, 3.5]],
+  ["arc",  [-2.5, 2.0], 1.5, 1.5707963267948966, 1.5707963267948966],
+  ["line", [-4.0, 2.0], [-4.0, -2.0]],
+  ["arc",  [-2.5, -2.0], 1.5, 3.141592653589793, 1.5707963267948966],
+]
+band = 2.8
+cup_depth = 0.5
+
+[tooling]
+clearance_mm = 0.02
+tip_length_mm = 8.0
+"""
+
+
+def _refusal(capsys, tmp_path: Path, design: str, command: str) -> str:
+    """The one line of ``tabletcad report`` or ``build`` refusing ``design``: exit 2, nothing written."""
+    src = tmp_path / "d.toml"
+    src.write_text(design, encoding="utf-8")
+    args = ["report", str(src), "--json-file", str(tmp_path / "r.json")] if command == "report" else \
+        ["build", str(src), "--out", str(tmp_path / "out"), "--quiet"]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and ONE_LINE.match(err[0]), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.toml"]
+    return err[0]
+
+
+def _design(tmp_path: Path, text: str):
+    from tabletcad.pipeline.design import Design
+
+    src = tmp_path / "d.toml"
+    src.write_text(text, encoding="utf-8")
+    return Design.from_toml(src)
+
+
+# ----------------------------------------------------------------------------- lettering (no CAD)
+
+def test_report_refuses_text_that_does_not_fit_its_face(capsys, tmp_path):
+    """The text 9.2 x 1.9 mm on a face whose punch tip, less land and margin, is 9.4 mm across: report had
+    printed its table (exit 0), build refused it after the solid."""
+    line = _refusal(capsys, tmp_path, ROUND.format(height=2.5), "report")
+    assert line == ("error: tooling.emboss[0].text = 'ABCDEFGH' is not allowed: does not fit the bottom face: "
+                    "15.1 x 1.89 mm with 5.79 mm^2 outside the punch tip inset by 0.3 mm (clearance + land + "
+                    "margin); use a smaller height_mm or move it")
+
+
+@pytest.mark.parametrize("height, refused", [(1.528, False), (1.529, True)])
+def test_the_fit_is_decided_at_the_tallest_text_that_fits(capsys, tmp_path, height, refused):
+    """A micrometre below the tallest fitting height the report passes, one above it refuses (1.87e-5 mm^2
+    outside, above the 1e-6 of the figure's area that the tooling allows)."""
+    src = tmp_path / "d.toml"
+    src.write_text(ROUND.format(height=height), encoding="utf-8")
+    assert main(["report", str(src)]) == (2 if refused else 0)
+    err = capsys.readouterr().err
+    assert ("1.87e-05 mm^2 outside" in err) if refused else err == ""
+
+
+def test_the_area_outside_is_exact_for_a_rectangle_across_a_circle():
+    """A polyline figure across the inset circle: the area outside by Green's theorem equals the closed form
+    (the rectangle's area less its part in the disc: a rectangle to the corner's x, then the circular segment
+    beyond it, ∫ 2 sqrt(r^2 - x^2) dx = [x sqrt(r^2 - x^2) + r^2 asin(x / r)]) to 1e-12 mm^2."""
+    from tabletcad.families.outline import circle_outline
+    from tabletcad.geometry.lettering import outside_area, polyline_contours
+
+    R, inset, (x0, x1, h) = 5.0, 0.3, (2.0, 6.0, 1.2)
+    r = R - inset
+    xk = math.sqrt(r * r - h * h)  # where the rectangle's long sides cross the circle
+    F = lambda x: x * math.sqrt(max(r * r - x * x, 0.0)) + r * r * math.asin(x / r)  # noqa: E731
+    inside = 2 * h * (xk - x0) + F(r) - F(xk)
+    area, outside = outside_area(polyline_contours([[x0, -h], [x1, -h], [x1, h], [x0, h]]), circle_outline(R), inset)
+    assert area == pytest.approx((x1 - x0) * 2 * h, abs=1e-12)
+    assert outside == pytest.approx(area - inside, abs=1e-12)
+
+
+def test_text_is_laid_out_as_occ_lays_it_out():
+    """"AB" at 2.5 mm in DejaVu Sans Bold: the area and box OCC's text builder gives (3.868877018491427 mm^2,
+    3.65234375 x 1.822509765625 mm, measured), and "LT" 47 font units wider than its advances (OCC pairs the
+    last symbol with itself for kerning: 'T','T' is +47 in the font's kern table)."""
+    from tabletcad.geometry.lettering import figure_area, figure_box, text_contours
+    from tabletcad.tooling.spec import font_path
+
+    ab = text_contours("AB", 2.5, font_path("DejaVuSans-Bold"))
+    assert abs(figure_area(ab)) == pytest.approx(3.868877018491427, abs=1e-13)
+    assert figure_box(ab) == pytest.approx((3.65234375, 1.822509765625), abs=1e-13)
+    lt = text_contours("LT", 2048.0, font_path("DejaVuSans-Bold"))  # one font unit a millimetre
+    assert min(float(np.min(c[:, 0])) for contour in lt for c in contour) == pytest.approx(-1017.0, abs=1e-9)
+
+
+def test_report_refuses_a_stroke_angle_that_closes_the_strokes(capsys, tmp_path):
+    """The build's other refusal of a figure after the solid: walls at 25 deg meet before 0.5 mm in strokes
+    0.414 mm wide (report had printed its table); at 22 deg the report passes."""
+    line = _refusal(capsys, tmp_path, STROKE.format(height=2.5, angle=25.0), "report")
+    assert line == ("error: tooling.emboss[0].stroke_angle_deg = 25 deg is not allowed: must be < 22.5 deg: the walls "
+                    "of 0.414 mm strokes would meet before the depth 0.5 mm")
+    src = tmp_path / "d.toml"
+    src.write_text(STROKE.format(height=2.5, angle=22.0), encoding="utf-8")
+    assert main(["report", str(src)]) == 0
+
+
+# ----------------------------------------------------------------------------- spline outline (no CAD)
+
+def test_report_refuses_tooling_of_a_spline_outline(capsys, tmp_path):
+    """A custom outline through points with [tooling]: report had printed its table (exit 0); build refused it
+    after the solid, OCC failing to offset the band's section for the tips and the bore."""
+    line = _refusal(capsys, tmp_path, SPLINE, "report")
+    assert line.startswith("error: tablet.outline = 'points (a spline through them)' is not allowed: tooling needs "
+                           "an outline OpenCascade can offset")
+
+
+def test_the_same_outline_of_lines_and_arcs_is_reported(tmp_path):
+    src = tmp_path / "d.toml"
+    src.write_text(SEGMENTS, encoding="utf-8")
+    assert main(["report", str(src)]) == 0
+
+
+# ----------------------------------------------------------------------------- against OpenCascade
+
+@pytest.mark.cad
+@pytest.mark.parametrize("design, needle", [(ROUND.format(height=2.5), "does not fit the bottom face"),
+                                            (STROKE.format(height=2.5, angle=25.0), "strokes would meet"),
+                                            (SPLINE, "tablet.outline")])
+def test_report_and_build_refuse_with_the_same_line(capsys, tmp_path, design, needle):
+    report = _refusal(capsys, tmp_path, design, "report")
+    build = _refusal(capsys, tmp_path, design, "build")
+    assert report == build and needle in report
+
+
+@pytest.mark.cad
+def test_text_just_inside_the_limit_builds(tmp_path):
+    src = tmp_path / "d.toml"
+    src.write_text(ROUND.format(height=1.528), encoding="utf-8")
+    assert main(["report", str(src)]) == 0
+    assert main(["build", str(src), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    assert (tmp_path / "out" / "upper_punch.step").is_file()
+
+
+@pytest.mark.cad
+def test_the_spline_refusal_is_occs():
+    """The refusal is decided from the outline's kind: OCC's planar offset fails on the band section of every
+    spline outline tried (a circle through 24 points, ovals through 8 and 64)."""
+    from tabletcad.cad.tablet_solid import tablet_solid
+    from tabletcad.errors import GeometryError
+    from tabletcad.families.shaped import outline_tablet
+    from tabletcad.tooling.outline import _section_wire, offset_wire
+    from tabletcad.tooling.spec import band_heights
+
+    for n, a, b in ((24, 5.0, 5.0), (8, 4.0, 4.0), (64, 6.0, 4.0)):
+        t = outline_tablet([[a * math.cos(math.tau * k / n), b * math.sin(math.tau * k / n)] for k in range(n)],
+                           band=2.5, cup_depth=0.5)
+        z = band_heights(t)
+        with pytest.raises(GeometryError):
+            offset_wire(_section_wire(tablet_solid(t).shape, 0.5 * (z[0] + z[1])), -0.01)
+
+
+@pytest.mark.cad
+def test_glyphs_are_occs_vertex_for_vertex():
+    """Random strings in five DejaVu fonts at random sizes: every vertex of OCC's glyph faces is a contour end
+    of the core's and back, to 1e-12 mm (kerning, the last symbol's self-kerning, composite glyphs)."""
+    import random
+
+    from OCP.BRep import BRep_Tool
+    from scipy.spatial import cKDTree
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.geometry.lettering import text_contours
+    from tabletcad.tooling.emboss import text_faces
+    from tabletcad.tooling.spec import font_path
+
+    rnd = random.Random(1)
+    chars = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789 .,-/%&ÅÉüß"
+    fonts = ["DejaVuSans-Bold", "DejaVuSans", "DejaVuSerif", "DejaVuSansMono-Bold", "DejaVuSansCondensed"]
+    for text in ["LT", "AV To", "ÅÉ8"] + ["".join(rnd.choice(chars) for _ in range(rnd.randint(2, 7))) for _ in range(20)]:
+        if not text.strip():
+            continue
+        path, size = font_path(rnd.choice(fonts)), rnd.uniform(0.5, 4.0)
+        occ = np.array([(BRep_Tool.Pnt_s(v).X(), BRep_Tool.Pnt_s(v).Y())
+                        for v in explore(text_faces(text, size, path), "Vertex")])
+        ends = np.array([c[0] for contour in text_contours(text, size, path) for c in contour])
+        assert max(cKDTree(ends).query(occ)[0].max(), cKDTree(occ).query(ends)[0].max()) < 1e-12, text
+
+
+@pytest.mark.cad
+def test_the_fit_is_occs_boolean(tmp_path):
+    """Figures placed at random on five tablets (round, oval, capsule, rounded triangle, a custom outline of
+    lines and arcs; turned, on either face): the core refuses exactly those the tooling's OCC Boolean refuses,
+    with the tooling's own line (the area outside to its three figures, the size the exact box of both; the
+    areas agreed to 1.6e-13 mm^2 on 40 such figures when this was written)."""
+    import random
+
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.emboss import check_fit, figure_faces
+    from tabletcad.tooling.outline import tablet_frame
+    from tabletcad.tooling.spec import figure_contours, figure_fit_refusal, parse_tooling, tooling_plan_outline
+
+    rnd = random.Random(3)
+    files = ["families/concave_round", "families/oval", "families/capsule", "families/rounded_triangle",
+             "families/custom_outline"]
+    refused = 0
+    for name in files:
+        t = Design.from_toml(ROOT / "samples" / f"{name}.toml").build()
+        frame, outline = tablet_frame(t), tooling_plan_outline(t)
+        for _ in range(4):
+            e = parse_tooling({"clearance_mm": 0.02, "emboss": [{
+                "text": rnd.choice(["AB", "10", "X8", "WWW", "Ag%"]), "height_mm": rnd.uniform(1.5, 4.0),
+                "face": rnd.choice(["top", "bottom"]), "position_mm": [rnd.uniform(-3, 3), rnd.uniform(-2, 2)],
+                "rotation_deg": rnd.uniform(0, 360), "font": rnd.choice(["DejaVuSans-Bold", "DejaVuSerif"]),
+                "depth_mm": 0.05}]}).emboss[0]
+            inset = 0.02 + frame.edge_land(e.face) + e.margin_mm
+            mine = figure_fit_refusal(e, 0, figure_contours(e), outline, inset)
+            try:
+                check_fit(frame, e, figure_faces(e), 0.02)
+                theirs = None
+            except DesignError as exc:
+                theirs = exc
+            assert (mine is None) == (theirs is None), (name, e)
+            if mine is not None:
+                refused += 1
+                assert str(mine) == str(theirs)
+    assert refused >= 5
+
+
+@pytest.mark.cad
+@pytest.mark.parametrize("angle", [22.0, 22.468, 22.469, 25.0])
+def test_the_stroke_angle_refusal_is_the_tooling_s(tmp_path, angle):
+    """The core's stroke width (exact Bézier lengths) and the tooling's (OCC's lengths, asked to 1e-12) agree to
+    round-off, so both refuse the same angles with the same line, even 0.001 deg either side of the limit."""
+    from tabletcad.tooling.emboss import check_emboss
+    from tabletcad.tooling.outline import tablet_frame
+    from tabletcad.tooling.spec import figure_contours, stroke_angle_refusal
+
+    d = _design(tmp_path, STROKE.format(height=2.5, angle=angle))
+    e = d.tooling_spec.emboss[0]
+    mine = stroke_angle_refusal(e, 0, figure_contours(e))
+    try:
+        check_emboss(tablet_frame(d.build()), e, 0.02, 0)
+        theirs = None
+    except DesignError as exc:
+        theirs = str(exc)
+    assert (None if mine is None else str(mine)) == theirs
+    assert (mine is None) == (angle < 22.468013302665)  # atan(0.5 x 0.41356 / 0.5)
