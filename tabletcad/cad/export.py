@@ -10,6 +10,10 @@ suffix     format
            are scaled by 1e-3 unless ``glb_scale`` says otherwise
 .brep      OCCT native BREP
 =========  ======================================================================
+
+A STEP header and a 3MF's entries are dated by :func:`tabletcad.io.timestamp.stamp_time`
+(``SOURCE_DATE_EPOCH`` when set, else the time of writing), and nothing else in a file depends on
+the run: the same shape and environment give the same bytes.
 """
 
 from __future__ import annotations
@@ -21,12 +25,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from OCP.APIHeaderSection import APIHeaderSection_MakeHeader
 from OCP.BRepTools import BRepTools
 from OCP.IFSelect import IFSelect_ReturnStatus
 from OCP.Interface import Interface_Static
 from OCP.STEPCAFControl import STEPCAFControl_Writer
 from OCP.STEPControl import STEPControl_Controller, STEPControl_StepModelType
-from OCP.TCollection import TCollection_ExtendedString
+from OCP.TCollection import TCollection_ExtendedString, TCollection_HAsciiString
 from OCP.TDataStd import TDataStd_Name
 from OCP.TDocStd import TDocStd_Document
 from OCP.TopoDS import TopoDS_Shape
@@ -36,6 +41,7 @@ from tabletcad.cad._occ import quiet
 from tabletcad.cad.mesh import MeshResult, tessellate, tessellate_solid
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.io import atomic_path
+from tabletcad.io.timestamp import stamp_time, zip_date_time
 from tabletcad.tolerance import DEFAULT
 
 __all__ = ["export", "export_step", "export_stl", "export_3mf", "export_glb", "export_brep", "SUFFIXES"]
@@ -86,15 +92,32 @@ def write_step_document(doc, path: str | os.PathLike[str], *, what: str, obj: An
 
 
 def _write_step(writer: STEPCAFControl_Writer, path: str | os.PathLike[str], obj: Any) -> Path:
-    """Write a transferred STEP model atomically to ``path``, its names in Part 21's basic alphabet."""
+    """Write a transferred STEP model atomically to ``path``: its header stamped with
+    :func:`~tabletcad.io.timestamp.stamp_time`, its names in Part 21's basic alphabet, its styles in an
+    order of their content (:func:`canonical_style_order`)."""
+    _stamp_header(writer)
     with atomic_path(path) as tmp:
         status = writer.Write(str(tmp))
         if status != IFSelect_ReturnStatus.IFSelect_RetDone:
             raise GeometryError(f"writing STEP {path} failed: {status}", obj)
         raw = Path(tmp).read_bytes()
+        text = None
         if not raw.isascii():  # OCC writes names as raw UTF-8
-            Path(tmp).write_bytes(part21_text(raw.decode("utf-8")).encode("ascii"))
+            text = part21_text(raw.decode("utf-8"))
+        if raw.count(_STYLE_ROOT.encode("ascii")) > 1:  # two parts coloured or more
+            text = canonical_style_order(text if text is not None else raw.decode("ascii"))
+        if text is not None:
+            Path(tmp).write_bytes(text.encode("ascii"))
     return Path(path)
+
+
+def _stamp_header(writer: STEPCAFControl_Writer) -> None:
+    """Set the header's FILE_NAME time stamp (OCC puts the local time of the transfer there) to
+    :func:`~tabletcad.io.timestamp.stamp_time` in ISO 8601 with its UTC offset (``SOURCE_DATE_EPOCH``
+    when set)."""
+    header = APIHeaderSection_MakeHeader(writer.ChangeWriter().Model())
+    if header.IsDone():
+        header.SetTimeStamp(TCollection_HAsciiString(stamp_time().isoformat()))
 
 
 _NON_ASCII = re.compile(r"[^\x00-\x7f]+")
@@ -117,6 +140,92 @@ def part21_text(text: str) -> str:
         return "\\X4\\" + "".join(f"{ord(c):08X}" for c in run) + "\\X0\\"
 
     return _NON_ASCII.sub(directive, text)
+
+
+_STYLE_ROOT = "MECHANICAL_DESIGN_GEOMETRIC_PRESENTATION_REPRESENTATION"
+_STRING = r"'(?:[^']|'')*'"  # a Part 21 string ('' is a quote inside it)
+_ENTITY = re.compile(r"#(\d+)\s*=\s*((?:" + _STRING + r"|[^;'])*);")
+_REF_OR_STRING = re.compile(_STRING + r"|#(\d+)")
+
+
+def _refs(body: str) -> list[int]:
+    """The entity numbers ``body`` refers to, in field order (none inside strings)."""
+    return [int(m.group(1)) for m in _REF_OR_STRING.finditer(body) if m.group(1)]
+
+
+def canonical_style_order(text: str) -> str:
+    """A STEP file's presentation styles numbered in an order of their content, not of memory addresses.
+
+    OCC's XCAF writer adds each coloured part's MECHANICAL_DESIGN_GEOMETRIC_PRESENTATION_REPRESENTATION,
+    with the styles and colours it refers to, at the end of the data section, in the order of a map
+    hashed on the parts' addresses in memory: the same assembly came out with its colours in another
+    order from one run to the next.  That tail is renumbered here: its representations sorted by the
+    entities before the tail that they refer to (the parts' contexts and the styled solids, numbered
+    in transfer order), each followed by what it refers to, depth first, as OCC lays it out.  A file
+    whose tail is anything else (an entity before it refers into it, or text that is not entities)
+    is returned as it is.
+    """
+    data = text.find("\nDATA;")
+    first = text.find("= " + _STYLE_ROOT, data)
+    end = text.rfind("ENDSEC;")
+    if data < 0 or first < 0 or end < first:
+        return text
+    start = text.rfind("\n#", data, first) + 1
+    tail = text[start:end]
+    bodies = {int(m.group(1)): m.group(2) for m in _ENTITY.finditer(tail)}
+    if _ENTITY.sub("", tail).strip() or not bodies:
+        return text
+    low = min(bodies)
+    if any(r >= low for r in _refs(text[data:start])):
+        return text
+    order = _style_order(bodies, low)
+    new = {old: low + k for k, old in enumerate(order)}
+
+    def renumber(m: re.Match) -> str:
+        return f"#{new.get(int(m.group(1)), int(m.group(1)))}" if m.group(1) else m.group(0)
+
+    lines = [f"#{new[old]} = {_REF_OR_STRING.sub(renumber, bodies[old])};\n" for old in order]
+    return text[:start] + "".join(lines) + text[end:]
+
+
+def _style_order(bodies: dict[int, str], low: int) -> list[int]:
+    """The tail's entity numbers in their new order: roots by the earlier entities they reach, each
+    root's closure depth first (a shared colour where it is first reached), then any left over."""
+
+    def outside(root: int) -> tuple[int, ...]:
+        seen, stack, found = set(), [root], []
+        while stack:
+            n = stack.pop()
+            if n in seen:
+                continue
+            seen.add(n)
+            refs = _refs(bodies[n])
+            found += [r for r in refs if r < low]
+            stack += [r for r in reversed(refs) if r in bodies]
+        return tuple(found)
+
+    def skeleton(body: str) -> str:  # the text without its references: a tie-break that no numbering changes
+        return _REF_OR_STRING.sub(lambda m: "#" if m.group(1) else m.group(0), body)
+
+    roots = sorted((n for n, b in bodies.items() if b.lstrip().startswith(_STYLE_ROOT)),
+                   key=lambda n: (outside(n), skeleton(bodies[n])))
+    order: list[int] = []
+    placed: set[int] = set()
+
+    def visit(n: int) -> None:  # iteratively: pre-order, children in field order
+        stack = [n]
+        while stack:
+            k = stack.pop()
+            if k in placed or k not in bodies:
+                continue
+            placed.add(k)
+            order.append(k)
+            stack += [r for r in reversed(_refs(bodies[k])) if r in bodies and r not in placed]
+
+    for r in roots:
+        visit(r)
+    order += [n for n in sorted(bodies) if n not in placed]
+    return order
 
 
 def export_step(obj: Any, path: str | os.PathLike[str], *, name: str = "tablet", schema: str = "AP242") -> Path:
@@ -201,11 +310,15 @@ def export_3mf(obj: Any, path, *, name: str = "tablet", mesh: MeshResult | None 
         f"<vertices>{verts}</vertices><triangles>{tris}</triangles></mesh></object></resources>\n"
         '<build><item objectid="1"/></build>\n</model>\n'
     )
+    when = zip_date_time(stamp_time())  # (zipfile dates a named entry with the local time of writing)
     with atomic_path(path) as tmp:
         with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as zf:
-            zf.writestr("[Content_Types].xml", _3MF_TYPES)
-            zf.writestr("_rels/.rels", _3MF_RELS)
-            zf.writestr("3D/3dmodel.model", model)
+            for member, text in (("[Content_Types].xml", _3MF_TYPES), ("_rels/.rels", _3MF_RELS),
+                                 ("3D/3dmodel.model", model)):
+                info = zipfile.ZipInfo(member, date_time=when)
+                info.compress_type = zipfile.ZIP_DEFLATED
+                info.external_attr = 0o600 << 16  # -rw-------, as writestr gives a named entry
+                zf.writestr(info, text)
     return Path(path)
 
 

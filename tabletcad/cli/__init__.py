@@ -56,6 +56,9 @@ def _group():
         @click.version_option(package_name="tabletcad")
         def group() -> None:
             """Design pharmaceutical tablets and tooling; all lengths in mm, forces in N, stresses in MPa."""
+            from tabletcad.io.timestamp import check_stamp
+
+            check_stamp()  # a malformed SOURCE_DATE_EPOCH is refused before any command writes a file
 
         for name in _COMMAND_MODULES:
             for cmd in getattr(importlib.import_module(name), "COMMANDS", []):

@@ -35,6 +35,7 @@ from OCP.HLRBRep import HLRBRep_Algo, HLRBRep_HLRToShape
 
 from tabletcad.cad._occ import explore
 from tabletcad.io import atomic_path
+from tabletcad.io.timestamp import content_uuid, stamp_time
 from tabletcad.tooling.rating import overload_texts, rating_text
 from tabletcad.tooling.shape_cache import ShapeCache, frozen
 from tabletcad.tolerance import DEFAULT as DEFAULT_TOLERANCES
@@ -630,16 +631,22 @@ def _write_matplotlib(dr: Drawing, svg: Path, pdf: Path) -> None:
 
     # TrueType (Type 42) fonts in the PDF: its text is text a reader can search and copy, and
     # PDF/A and print workflows accept it (Type 3 fonts are glyph drawings)
-    with matplotlib.rc_context({"svg.fonttype": "none", "pdf.fonttype": 42}):
+    # the SVG's element ids hashed from their content with a fixed salt (matplotlib salts them with a
+    # random UUID), both files dated by stamp_time(): one drawing, one set of bytes with SOURCE_DATE_EPOCH
+    when = stamp_time()
+    with matplotlib.rc_context({"svg.fonttype": "none", "pdf.fonttype": 42, "svg.hashsalt": _SVG_SALT}):
         for paper in PAPER:  # the smallest sheet that shows the views at 1:1 or larger (else the largest)
             fig = _views_figure(dr, paper)
             if dr.scale >= 1.0 or paper == "A2":
                 break
         _add_title_block(fig, dr, paper)  # (on the sheet kept only)
         with atomic_path(svg) as tmp:
-            fig.savefig(tmp, format="svg")
+            fig.savefig(tmp, format="svg", metadata={"Date": when.isoformat()})
         with atomic_path(pdf) as tmp:
-            fig.savefig(tmp, format="pdf")
+            fig.savefig(tmp, format="pdf", metadata={"CreationDate": when})
+
+
+_SVG_SALT = "tabletcad drawing"
 
 
 def _exact_entities(wire, origin: tuple[float, float]) -> list[tuple[str, dict]]:
@@ -727,8 +734,58 @@ def _write_dxf(dr: Drawing, path: Path) -> None:
     xs = [float(q[0]) for _, p in _sheet_lines(dr) for q in p]
     ys = [float(q[1]) for _, p in _sheet_lines(dr) for q in p]
     msp.add_mtext("\\P".join([dr.title, *dr.title_block, *dr.notes]), dxfattribs={"layer": "NOTES", "char_height": 0.8}).set_location((max(xs) + 8, max(ys)))
+    _save_dxf(doc, path)
+
+
+# stand-ins written where the header's GUIDs go, then replaced by GUIDs of the file's content
+_FINGERPRINT_MARK = "{00000000-0000-0000-0000-0000000000F1}"
+_VERSION_MARK = "{00000000-0000-0000-0000-0000000000F2}"
+
+
+def _save_dxf(doc, path: Path) -> None:
+    """Write the ezdxf document ``doc`` atomically to ``path``, as ``doc.saveas`` does, but reproducibly.
+
+    ezdxf stamps the local time of writing into the header ($TDCREATE, $TDUPDATE) and its own
+    marker, and a random $FINGERPRINTGUID and $VERSIONGUID: here every date is
+    :func:`~tabletcad.io.timestamp.stamp_time` (UTC; ``SOURCE_DATE_EPOCH`` when set) and both GUIDs
+    are derived from the rest of the file, so the same drawing gives the same bytes and a changed one
+    new GUIDs; its CLASS section is in an order of names.  (ezdxf sets these in
+    ``Drawing._update_metadata`` on every write; its public ``options.write_fixed_meta_data_for_testing``
+    dates every file 2000-01-01 instead.)
+    """
+    import io
+
+    import ezdxf
+    from ezdxf.tools.juliandate import juliandate
+
+    when = stamp_time()
+    update = doc._update_metadata
+
+    def stamped() -> None:
+        update()
+        day = juliandate(when.replace(tzinfo=None))
+        for var in ("$TDCREATE", "$TDUCREATE", "$TDUPDATE", "$TDUUPDATE"):
+            doc.header[var] = day
+        doc.header["$FINGERPRINTGUID"], doc.header["$VERSIONGUID"] = _FINGERPRINT_MARK, _VERSION_MARK
+        meta = doc.ezdxf_metadata()
+        for key in ("CREATED_BY_EZDXF", "WRITTEN_BY_EZDXF"):
+            meta[key] = f"{ezdxf.__version__} @ {when.isoformat()}"
+
+    doc._update_metadata = stamped
+    # ezdxf declares a CLASS for each entity type in use in the order of a set of strings, which
+    # Python's per-process hash salt shuffles (LAYOUT and ACDBPLACEHOLDER swapped from one build to
+    # the next): declared here first, by name; ezdxf then finds them declared
+    doc.commit_pending_changes()
+    for dxftype in sorted(doc.entitydb.dxf_types_in_use()):
+        doc.classes.add_class(dxftype)
+    stream = io.StringIO()
+    doc.write(stream)
+    text = stream.getvalue()
+    for mark, role in ((_FINGERPRINT_MARK, "fingerprint"), (_VERSION_MARK, "version")):
+        text = text.replace(mark, "{" + str(content_uuid("tabletcad DXF " + role, text)).upper() + "}", 1)
     with atomic_path(path) as tmp:
-        doc.saveas(tmp)
+        with open(tmp, "w", encoding=doc.output_encoding, errors="dxfreplace") as fh:
+            fh.write(text)
 
 
 def write_drawing(ts, out_dir) -> list[Path]:
