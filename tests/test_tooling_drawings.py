@@ -692,3 +692,46 @@ def test_detail_b_looks_where_the_section_meets_the_band(direction):
     assert max(float(p[:, 0].max()) for p in sec) == pytest.approx(edge, abs=2e-3)
     (score,) = [x for x in dr.dims if x.text.startswith("score")]
     assert score.offset == pytest.approx(2.0 + edge, abs=2e-3)
+
+
+def _die_bore_lines(view: dict, origin: tuple[float, float] = (0.0, 0.0)) -> dict:
+    """The vertical hidden lines of a die's front view: ``{x (mm, 3 decimals): (lowest, highest z)}``."""
+    out: dict = {}
+    for p in view["hidden"]:
+        p = np.asarray(p) + np.asarray(origin)
+        if np.ptp(p[:, 0]) < 1e-6 and np.ptp(p[:, 1]) > 1e-3:
+            x = round(float(p[0, 0]), 3)
+            lo, hi = out.get(x, (np.inf, -np.inf))
+            out[x] = (min(lo, float(p[:, 1].min())), max(hi, float(p[:, 1].max())))
+    return out
+
+
+@pytest.mark.parametrize("which", ["tsm_b_round", "capsule tips"])
+def test_the_die_elevation_shows_the_bore_through_it_dashed(drawn, capsule, which, tmp_path):
+    """The die's front elevation does not cut the bore: both of its walls are hidden lines the die's full
+    height (the bore's cylinder and an oval's end arcs are outlines, not edges: a trial's die showed only
+    the round bore's seam on one side, and an oval's bore not at all), and the DXF has them on HIDDEN."""
+    import ezdxf
+
+    from tabletcad.tooling.drawing import tips_model
+
+    ts = drawn[0] if which == "tsm_b_round" else capsule
+    dr = tooling_model(ts) if which == "tsm_b_round" else tips_model(ts)
+    die = ts.report["die"]
+    half = 5.0 if which == "tsm_b_round" else 7.0  # Ø10 bore; the 14 x 6 capsule's ends
+    bores = _die_bore_lines(dr.views["die"])
+    assert sorted(bores) == [-half, half], bores
+    for lo, hi in bores.values():
+        assert lo == pytest.approx(die["bottom_z_mm"], abs=1e-6) and hi == pytest.approx(die["top_z_mm"], abs=1e-6)
+    # no hidden line lies on a visible one (the bore's ends at the die's faces are drawn once, solid)
+    for p in dr.views["die"]["hidden"]:
+        assert not (np.ptp(np.asarray(p)[:, 1]) < 1e-6 and abs(p[0, 1] - die["top_z_mm"]) < 1e-6)
+    out = tmp_path / "tooling.dxf"
+    from tabletcad.tooling.drawing import _write_dxf
+
+    _write_dxf(dr, out)
+    ox, oy = dr.origins["die"]
+    hidden = [np.array([v[:2] for v in e.get_points()]) for e in ezdxf.readfile(out).modelspace().query("LWPOLYLINE")
+              if e.dxf.layer == "HIDDEN"]
+    assert sorted(_die_bore_lines({"hidden": hidden}, (-ox, -oy))) == [-half, half]
+

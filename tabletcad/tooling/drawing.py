@@ -2,7 +2,8 @@
 
 Views are projections of the B-rep by OCC's hidden-line removal
 (``HLRBRep_Algo`` / ``HLRBRep_HLRToShape``): visible sharp edges and
-silhouettes drawn solid, hidden sharp edges dashed.  Third-angle layout: the
+silhouettes drawn solid, hidden sharp edges and silhouettes dashed (a die's bore in elevation) unless a
+visible line covers them.  Third-angle layout: the
 front elevation (looking along +y), the plan above it (looking down -z) and
 the side elevation (looking along -x) to its right.  Dimensions state the
 design's numbers: diameter (or length and width), band, cup depth, overall
@@ -95,8 +96,31 @@ def _project_view(shape, view: str) -> dict:
     algo.Hide()
     h = HLRBRep_HLRToShape(algo)
     vis = _polylines(h.VCompound()) + _polylines(h.OutLineVCompound())
-    hid = _polylines(h.HCompound())
-    return {"visible": vis, "hidden": hid}
+    # hidden sharp edges and hidden outlines: a die's bore in elevation is its cylinder's (or its ends' arcs')
+    # outline, not an edge (a trial's die showed the bore's seam alone, dashed, on one side)
+    hid = _polylines(h.HCompound()) + _polylines(h.OutLineHCompound())
+    return {"visible": vis, "hidden": [p for p in hid if not _on_lines(p, vis)]}
+
+
+def _on_lines(p: np.ndarray, lines: list[np.ndarray], tol: float = 1e-4) -> bool:
+    """Whether every point of the polyline ``p`` (and every point between them) lies within ``tol`` mm of
+    ``lines``' segments: a hidden line a visible one covers, which a drawing does not show twice."""
+    if not lines:
+        return False
+    t = np.linspace(0.0, 1.0, 5)[:, None]
+    q = (p[:-1, None, :] * (1.0 - t) + p[1:, None, :] * t).reshape(-1, 2)
+    lo, hi = q.min(axis=0) - tol, q.max(axis=0) + tol
+    a = np.concatenate([v[:-1] for v in lines])
+    b = np.concatenate([v[1:] for v in lines])
+    near = np.all((np.minimum(a, b) <= hi) & (np.maximum(a, b) >= lo), axis=1)  # segments by the polyline
+    a, b = a[near], b[near]
+    if not len(a):
+        return False
+    ab = b - a
+    u = np.clip(np.einsum("qsk,sk->qs", q[:, None, :] - a[None], ab) / np.maximum(np.einsum("sk,sk->s", ab, ab), 1e-300),
+                0.0, 1.0)
+    d = np.linalg.norm(q[:, None, :] - (a[None] + u[..., None] * ab[None]), axis=2)
+    return bool(np.all(d.min(axis=1) <= tol))
 
 
 def section_view(shape, direction_deg: float) -> dict:
@@ -546,8 +570,9 @@ def _views_figure(dr: Drawing, paper: str):
     lines = {"visible": [], "hidden": []}
     for kind, p in _sheet_lines(dr):
         lines[kind].append(p)
-    ax.add_collection(LineCollection(lines["visible"], colors="k", linewidths=0.7))
+    # hidden lines under the visible ones (where a hidden line crosses a visible one, the visible is drawn)
     ax.add_collection(LineCollection(lines["hidden"], colors="0.4", linewidths=0.4, linestyles=[(0, (3, 2))]))
+    ax.add_collection(LineCollection(lines["visible"], colors="k", linewidths=0.7))
     ax.add_collection(LineCollection([np.array(e) for d in dr.dims for e in _dim_geometry(d)[2]], colors="0.3",
                                      linewidths=0.3))
     for d in dr.dims:
