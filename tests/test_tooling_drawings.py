@@ -692,3 +692,125 @@ def test_detail_b_looks_where_the_section_meets_the_band(direction):
     assert max(float(p[:, 0].max()) for p in sec) == pytest.approx(edge, abs=2e-3)
     (score,) = [x for x in dr.dims if x.text.startswith("score")]
     assert score.offset == pytest.approx(2.0 + edge, abs=2e-3)
+
+
+def _die_bore_lines(view: dict, origin: tuple[float, float] = (0.0, 0.0)) -> dict:
+    """The vertical hidden lines of a die's front view: ``{x (mm, 3 decimals): (lowest, highest z)}``."""
+    out: dict = {}
+    for p in view["hidden"]:
+        p = np.asarray(p) + np.asarray(origin)
+        if np.ptp(p[:, 0]) < 1e-6 and np.ptp(p[:, 1]) > 1e-3:
+            x = round(float(p[0, 0]), 3)
+            lo, hi = out.get(x, (np.inf, -np.inf))
+            out[x] = (min(lo, float(p[:, 1].min())), max(hi, float(p[:, 1].max())))
+    return out
+
+
+@pytest.mark.parametrize("which", ["tsm_b_round", "capsule tips"])
+def test_the_die_elevation_shows_the_bore_through_it_dashed(drawn, capsule, which, tmp_path):
+    """The die's front elevation does not cut the bore: both of its walls are hidden lines the die's full
+    height (the bore's cylinder and an oval's end arcs are outlines, not edges: a trial's die showed only
+    the round bore's seam on one side, and an oval's bore not at all), and the DXF has them on HIDDEN."""
+    import ezdxf
+
+    from tabletcad.tooling.drawing import tips_model
+
+    ts = drawn[0] if which == "tsm_b_round" else capsule
+    dr = tooling_model(ts) if which == "tsm_b_round" else tips_model(ts)
+    die = ts.report["die"]
+    half = 5.0 if which == "tsm_b_round" else 7.0  # Ø10 bore; the 14 x 6 capsule's ends
+    bores = _die_bore_lines(dr.views["die"])
+    assert sorted(bores) == [-half, half], bores
+    for lo, hi in bores.values():
+        assert lo == pytest.approx(die["bottom_z_mm"], abs=1e-6) and hi == pytest.approx(die["top_z_mm"], abs=1e-6)
+    # no hidden line lies on a visible one (the bore's ends at the die's faces are drawn once, solid)
+    for p in dr.views["die"]["hidden"]:
+        assert not (np.ptp(np.asarray(p)[:, 1]) < 1e-6 and abs(p[0, 1] - die["top_z_mm"]) < 1e-6)
+    out = tmp_path / "tooling.dxf"
+    from tabletcad.tooling.drawing import _write_dxf
+
+    _write_dxf(dr, out)
+    ox, oy = dr.origins["die"]
+    hidden = [np.array([v[:2] for v in e.get_points()]) for e in ezdxf.readfile(out).modelspace().query("LWPOLYLINE")
+              if e.dxf.layer == "HIDDEN"]
+    assert sorted(_die_bore_lines({"hidden": hidden}, (-ox, -oy))) == [-half, half]
+
+
+def _segment_meets_box(p, q, box) -> bool:
+    """Whether the segment ``p``-``q`` meets (or touches) the box ``(x0, y0, x1, y1)``: Liang-Barsky."""
+    t0, t1 = 0.0, 1.0
+    d = (q[0] - p[0], q[1] - p[1])
+    for k, lo, hi in ((0, box[0], box[2]), (1, box[1], box[3])):
+        for a, b in ((-d[k], p[k] - lo), (d[k], hi - p[k])):
+            if a == 0.0:
+                if b < 0.0:
+                    return False
+            elif a < 0.0:
+                t0 = max(t0, b / a)
+            else:
+                t1 = min(t1, b / a)
+    return t0 <= t1
+
+
+@pytest.fixture(scope="module", params=["tsm_b_round", "eu_d_oval", "capsule", "concave_round_bisect",
+                                        "shallow_convex_round"])
+def sample_sheets(request):
+    """Each tooling sample's two sheets, as its build draws them: the tablet's and the tooling's."""
+    from tabletcad.tooling.drawing import tips_model
+
+    p = SAMPLE.parent / f"{request.param}.toml"
+    with __import__("warnings").catch_warnings():
+        __import__("warnings").simplefilter("ignore")  # (the samples' fit and land warnings)
+        ts = make_tooling(load_design(p), Design.from_toml(p).tooling_spec, check=False, interference_check=False)
+        return request.param, [drawing_model(ts), tooling_model(ts) if ts.spec.body is not None else tips_model(ts)]
+
+
+def test_no_dimension_text_meets_a_dimension_line_or_another_text(sample_sheets):
+    """On every sample's sheets, every dimension's text box (the renderer's extent of the text, in sheet mm)
+    meets no dimension line with its arrows (the arrows' own outlines), no extension line or leader and no other
+    text (a trial: a band's text over the cup dimension's extension lines, a T's over its own, a tip's over
+    its arrows)."""
+    import matplotlib.pyplot as plt
+
+    from tabletcad.tooling.drawing import _dim_geometry
+
+    name, drawings = sample_sheets
+    for dr in drawings:
+        for paper in ("A4", "A3", "A2"):  # the sheet the build writes: the smallest at 1:1 or larger
+            fig = sheet_figure(dr, paper)
+            if dr.scale >= 1.0 or paper == "A2":
+                break
+            plt.close(fig)
+        try:
+            fig.canvas.draw()
+            renderer = fig.canvas.get_renderer()
+            ax = fig.axes[0]
+            to_data = ax.transData.inverted()
+
+            def box(t):
+                bb = t.get_window_extent(renderer)
+                (x0, y0), (x1, y1) = to_data.transform([(bb.x0, bb.y0), (bb.x1, bb.y1)])
+                return min(x0, x1), min(y0, y1), max(x0, x1), max(y0, y1)
+
+            dim_texts = {d.text for d in dr.dims}
+            texts = [(t.get_text(), box(t)) for t in list(ax.texts) + list(fig.texts) if t.get_text()]
+            lines = [np.array(e, float) for d in dr.dims for e in _dim_geometry(d)[2]]  # extension lines
+            lines += [np.asarray(s, float) for c in ax.collections if c.get_gid() == "dimension lines"
+                      for s in c.get_segments()]  # (and the leaders to texts beyond an arrow)
+            arrows = [t.arrow_patch for t in ax.texts if getattr(t, "arrow_patch", None) is not None]
+            assert len(arrows) == len(dr.dims)
+            lines += [to_data.transform(poly) for a in arrows  # (the arrows' outlines: drawn in display units)
+                      for poly in a.get_transform().transform_path(a.get_path()).to_polygons(closed_only=False)]
+            assert sorted(t for t, _ in texts if t in dim_texts) == sorted(d.text for d in dr.dims)
+            for k, (text, b) in enumerate(texts):
+                if text not in dim_texts:
+                    continue
+                for p in lines:
+                    for q0, q1 in zip(p[:-1], p[1:]):
+                        assert not _segment_meets_box(q0, q1, b), (name, dr.title, text, q0, q1)
+                for j, (other, c) in enumerate(texts):
+                    if j != k:
+                        assert not (b[0] <= c[2] and c[0] <= b[2] and b[1] <= c[3] and c[1] <= b[3]), \
+                            (name, dr.title, text, other)
+        finally:
+            plt.close(fig)

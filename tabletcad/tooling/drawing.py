@@ -2,7 +2,8 @@
 
 Views are projections of the B-rep by OCC's hidden-line removal
 (``HLRBRep_Algo`` / ``HLRBRep_HLRToShape``): visible sharp edges and
-silhouettes drawn solid, hidden sharp edges dashed.  Third-angle layout: the
+silhouettes drawn solid, hidden sharp edges and silhouettes dashed (a die's bore in elevation) unless a
+visible line covers them.  Third-angle layout: the
 front elevation (looking along +y), the plan above it (looking down -z) and
 the side elevation (looking along -x) to its right.  Dimensions state the
 design's numbers: diameter (or length and width), band, cup depth, overall
@@ -96,8 +97,31 @@ def _project_view(shape, view: str) -> dict:
     algo.Hide()
     h = HLRBRep_HLRToShape(algo)
     vis = _polylines(h.VCompound()) + _polylines(h.OutLineVCompound())
-    hid = _polylines(h.HCompound())
-    return {"visible": vis, "hidden": hid}
+    # hidden sharp edges and hidden outlines: a die's bore in elevation is its cylinder's (or its ends' arcs')
+    # outline, not an edge (a trial's die showed the bore's seam alone, dashed, on one side)
+    hid = _polylines(h.HCompound()) + _polylines(h.OutLineHCompound())
+    return {"visible": vis, "hidden": [p for p in hid if not _on_lines(p, vis)]}
+
+
+def _on_lines(p: np.ndarray, lines: list[np.ndarray], tol: float = 1e-4) -> bool:
+    """Whether every point of the polyline ``p`` (and every point between them) lies within ``tol`` mm of
+    ``lines``' segments: a hidden line a visible one covers, which a drawing does not show twice."""
+    if not lines:
+        return False
+    t = np.linspace(0.0, 1.0, 5)[:, None]
+    q = (p[:-1, None, :] * (1.0 - t) + p[1:, None, :] * t).reshape(-1, 2)
+    lo, hi = q.min(axis=0) - tol, q.max(axis=0) + tol
+    a = np.concatenate([v[:-1] for v in lines])
+    b = np.concatenate([v[1:] for v in lines])
+    near = np.all((np.minimum(a, b) <= hi) & (np.maximum(a, b) >= lo), axis=1)  # segments by the polyline
+    a, b = a[near], b[near]
+    if not len(a):
+        return False
+    ab = b - a
+    u = np.clip(np.einsum("qsk,sk->qs", q[:, None, :] - a[None], ab) / np.maximum(np.einsum("sk,sk->s", ab, ab), 1e-300),
+                0.0, 1.0)
+    d = np.linalg.norm(q[:, None, :] - (a[None] + u[..., None] * ab[None]), axis=2)
+    return bool(np.all(d.min(axis=1) <= tol))
 
 
 def section_view(shape, direction_deg: float) -> dict:
@@ -531,9 +555,18 @@ def sheet_figure(dr: Drawing, paper: str = "A4"):
     return fig
 
 
+def _smallest_views_figure(dr: Drawing):
+    """:func:`_views_figure` on the smallest sheet that shows the views at 1:1 or larger (else the largest)."""
+    for paper in PAPER:
+        fig = _views_figure(dr, paper)
+        if dr.scale >= 1.0 or paper == "A2":
+            return fig
+
+
 def _views_figure(dr: Drawing, paper: str):
     """The figure of ``dr``'s views and dimensions on ``paper`` (no title block yet); sets ``dr.paper``
-    and ``dr.scale`` (paper mm per model mm, the views' limits fixed as a draw fixes them)."""
+    and ``dr.scale`` (paper mm per model mm, the views' limits fixed as a draw fixes them).  The
+    dimension texts are placed once the scale is known (:func:`_place_dimension_texts`)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.collections import LineCollection
     from matplotlib.figure import Figure
@@ -547,22 +580,17 @@ def _views_figure(dr: Drawing, paper: str):
     lines = {"visible": [], "hidden": []}
     for kind, p in _sheet_lines(dr):
         lines[kind].append(p)
-    ax.add_collection(LineCollection(lines["visible"], colors="k", linewidths=0.7))
+    # hidden lines under the visible ones (where a hidden line crosses a visible one, the visible is drawn)
     ax.add_collection(LineCollection(lines["hidden"], colors="0.4", linewidths=0.4, linestyles=[(0, (3, 2))]))
-    ax.add_collection(LineCollection([np.array(e) for d in dr.dims for e in _dim_geometry(d)[2]], colors="0.3",
-                                     linewidths=0.3))
+    ax.add_collection(LineCollection(lines["visible"], colors="k", linewidths=0.7))
+    ext = [np.array(e, float) for d in dr.dims for e in _dim_geometry(d)[2]]
+    ext_lines = ax.add_collection(LineCollection(ext, colors="0.3", linewidths=0.3, gid="dimension lines"))
     for d in dr.dims:
         a, b, _ = _dim_geometry(d)
         ax.annotate("", xy=a, xytext=b, arrowprops=dict(arrowstyle="-|>" if d.radius else "<|-|>", lw=0.4,
-                                                        color="0.2", shrinkA=0, shrinkB=0))
-        if d.radius:  # the text beyond the leader's end, on its side
-            ax.text(b[0], b[1], d.text, fontsize=7, ha="left" if b[0] >= a[0] else "right",
-                    va="bottom" if b[1] >= a[1] else "top")
-            continue
-        mx, my = 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])
-        ax.text(mx + (0.4 if d.vertical else 0), my + (0 if d.vertical else 0.4), d.text, fontsize=7,
-                rotation=90 if d.vertical else 0, ha="center" if not d.vertical else "left",
-                va="bottom" if not d.vertical else "center")
+                                                        color="0.2", shrinkA=0, shrinkB=0,
+                                                        mutation_scale=_ARROW_PT), gid="dimension line")
+    labels = []
     for name, (ox, oy) in dr.origins.items():
         pts = np.concatenate([q for q in dr.views[name]["visible"]] or [np.zeros((1, 2))]) + np.array([ox, oy])
         ys = [pts[:, 1].min()]
@@ -572,7 +600,7 @@ def _views_figure(dr: Drawing, paper: str):
             if not d.vertical and all(np.all((lo <= q) & (q <= hi)) for q in (np.asarray(d.p1), np.asarray(d.p2))):
                 ys.append(a[1] - 0.5)
         y = float(min(ys)) - 0.04 * float(np.ptp(pts[:, 1])) - 1.5  # under the view
-        ax.text(ox, y, name.upper(), fontsize=8, ha="center", va="top")
+        labels.append(ax.text(ox, y, name.upper(), fontsize=8, ha="center", va="top", gid="view label"))
         ax.update_datalim([(ox, y - 1.5)])  # keep the label inside the views' area
     ax.autoscale_view()
     ax.set_aspect("equal", adjustable="datalim")
@@ -581,9 +609,149 @@ def _views_figure(dr: Drawing, paper: str):
     # fix the limits as drawing would (equal aspect: the data limits grow to the axes' shape), without
     # rendering the views: the scale is paper mm per model mm
     ax.apply_aspect()
+    ax.set_autoscale_on(False)  # (the texts and leaders added below do not move the views)
     x0, x1 = ax.get_xlim()
     dr.scale = ax.get_window_extent().width / fig.dpi * 25.4 / (x1 - x0)
+    leaders = _place_dimension_texts(ax, dr, lines["visible"] + lines["hidden"], ext, labels)
+    ext_lines.set_segments(ext + leaders)  # and the leaders to texts set beyond an arrow
     return fig
+
+
+#: the dimension arrows' size (points): heads 0.4 of it long and 0.2 of it to either side of the line
+_ARROW_PT = 10.0
+#: the gap (points) between a dimension's text and its line, and the room kept around every text
+_TEXT_GAP_PT, _TEXT_ROOM_PT = 3.0, 1.0
+
+
+def _place_dimension_texts(ax, dr: Drawing, view_lines: list, ext: list, labels: list) -> list[np.ndarray]:
+    """Add every dimension's text to ``ax`` (limits fixed) where it meets no line of the views, no dimension
+    line or arrow, no extension line and no other text, and return the leaders the placement needs.
+
+    ISO 129 style: a linear dimension's text runs along its line, centred above it (right of a vertical
+    one), else below (left of) it; a text longer than its line less its arrows goes beyond an arrow on the line's
+    continuation (the leader returned), past either end, on either side.  A radius's text sits beyond its
+    leader's end.  The first candidate that meets nothing is taken (else the one that meets the fewest
+    lines and texts).  Earlier dimensions' texts and leaders are in the way of later ones.
+
+    ``view_lines``: the views' polylines (sheet mm); ``ext``: the extension lines; ``labels``: the views'
+    label texts.
+    """
+    renderer = ax.figure.canvas.get_renderer()
+    to_data = ax.transData.inverted()
+    mm_pt = 25.4 / 72.0 / dr.scale  # sheet (model) mm per point of paper
+    gap, head_length = _TEXT_GAP_PT * mm_pt, 0.4 * _ARROW_PT * mm_pt
+    lines = dict(views=_segments(view_lines), ext=_segments(ext),
+                 arrows=_segments([np.array(_dim_geometry(d)[:2], float) for d in dr.dims]))
+    boxes = [_data_box(t, renderer, to_data) for t in labels]
+    leaders: list[np.ndarray] = []
+    for d in dr.dims:
+        t = ax.text(0.0, 0.0, d.text, fontsize=7, rotation=90 if d.vertical and not d.radius else 0, ha="center",
+                    va="center", gid="dimension text")
+        x0, y0, x1, y1 = _data_box(t, renderer, to_data)
+        size = (x1 - x0, y1 - y0)
+        best = None
+        for centre, leader in _text_candidates(d, size, gap, head_length):
+            box = (centre[0] - size[0] / 2, centre[1] - size[1] / 2, centre[0] + size[0] / 2, centre[1] + size[1] / 2)
+            hits = _text_hits(box, leader, lines, boxes, leaders, mm_pt, (ax.get_xlim(), ax.get_ylim()))
+            if best is None or hits < best[0]:
+                best = (hits, centre, box, leader)
+            if hits == 0:
+                break
+        _, centre, box, leader = best
+        t.set_position(centre)
+        boxes.append(box)
+        if leader is not None:
+            leaders.append(leader)
+    return leaders
+
+
+def _text_hits(box, leader, lines: dict, boxes: list, leaders: list, mm_pt: float, limits) -> int:
+    """How many things a text at ``box`` (sheet mm) with its ``leader`` (or None) meets: the views' lines,
+    extension lines, dimension lines with their arrows (``lines``: segments), the texts (``boxes``) and the
+    leaders placed so far; 1000 more off the views' area ``limits`` (onto the title block or off the sheet)."""
+    grown = _grow(box, _TEXT_ROOM_PT * mm_pt)
+    head_width = 0.2 * _ARROW_PT * mm_pt  # to either side of the line: 2/3 of the gap
+    hits = sum(int(np.count_nonzero(_meets_box(segs, grown))) for segs in (lines["views"], lines["ext"],
+                                                                           _segments(leaders)))
+    hits += int(np.count_nonzero(_meets_box(lines["arrows"], _grow(box, head_width))))
+    hits += sum(_boxes_meet(grown, b) for b in boxes)
+    if leader is not None:  # the leader must pass every text placed so far
+        hits += sum(bool(_meets_box(_segments([leader]), _grow(b, _TEXT_ROOM_PT * mm_pt)).any()) for b in boxes)
+    (x0, x1), (y0, y1) = limits
+    return hits + (0 if x0 <= box[0] and box[2] <= x1 and y0 <= box[1] and box[3] <= y1 else 1000)
+
+
+def _text_candidates(d: Dim, size: tuple[float, float], gap: float, head: float):
+    """``(centre, leader or None)`` of the places for ``d``'s text of ``size`` (sheet mm, x and y), best first
+    (see :func:`_place_dimension_texts`); ``gap`` from the line, ``head`` the arrows' length (sheet mm): a
+    text centred on its line runs between the arrows."""
+    a, b, _ = _dim_geometry(d)
+    if d.radius:  # beyond the leader's end, on the side it points to
+        sx = 1.0 if b[0] >= a[0] else -1.0
+        sy = 1.0 if b[1] >= a[1] else -1.0
+        yield (b[0] + sx * (gap + size[0] / 2), b[1] + sy * (gap + size[1] / 2)), None
+        return
+    k = 1 if d.vertical else 0  # the axis the dimension line runs along
+    lo, hi = sorted((a[k], b[k]))
+    at = a[1 - k]  # the line's place across
+    along, across = size[k], size[1 - k]
+
+    def place(s: float, side: float):
+        c = [0.0, 0.0]
+        c[k], c[1 - k] = s, at + side * (gap + across / 2)
+        return tuple(c)
+
+    def leader(s0: float, s1: float):
+        p = np.zeros((2, 2))
+        p[:, k], p[:, 1 - k] = (s0, s1), at
+        return p
+
+    if along + 2.0 * head <= hi - lo:  # the text fits between the arrows: centred, above (right) or below (left)
+        for side in (1.0, -1.0):
+            yield place(0.5 * (lo + hi), side), None
+    for side in (1.0, -1.0):  # beyond an arrow, on the line's continuation
+        yield place(hi + gap + along / 2, side), leader(hi, hi + gap + along)
+        yield place(lo - gap - along / 2, side), leader(lo, lo - gap - along)
+
+
+def _data_box(t, renderer, to_data) -> tuple[float, float, float, float]:
+    """The box ``(x0, y0, x1, y1)`` (sheet mm) text ``t`` covers."""
+    bb = t.get_window_extent(renderer)
+    (x0, y0), (x1, y1) = to_data.transform([(bb.x0, bb.y0), (bb.x1, bb.y1)])
+    return min(x0, x1), min(y0, y1), max(x0, x1), max(y0, y1)
+
+
+def _grow(box, by: float) -> tuple[float, float, float, float]:
+    return box[0] - by, box[1] - by, box[2] + by, box[3] + by
+
+
+def _boxes_meet(a, b) -> bool:
+    return a[0] <= b[2] and b[0] <= a[2] and a[1] <= b[3] and b[1] <= a[3]
+
+
+def _segments(polylines: list) -> np.ndarray:
+    """The segments ``(n, 2, 2)`` of ``polylines``."""
+    segs = [np.stack([p[:-1], p[1:]], axis=1) for p in map(np.asarray, polylines) if len(p) >= 2]
+    return np.concatenate(segs) if segs else np.zeros((0, 2, 2))
+
+
+def _meets_box(segs: np.ndarray, box) -> np.ndarray:
+    """Which of the segments ``segs`` ``(n, 2, 2)`` meet the box ``(x0, y0, x1, y1)`` (touching counts):
+    Liang-Barsky clipping of each against the box."""
+    segs = np.asarray(segs, float).reshape(-1, 2, 2)
+    p, d = segs[:, 0], segs[:, 1] - segs[:, 0]
+    t0, t1 = np.zeros(len(segs)), np.ones(len(segs))
+    ok = np.ones(len(segs), bool)
+    for k, lo, hi in ((0, box[0], box[2]), (1, box[1], box[3])):
+        for q, r in ((-d[:, k], p[:, k] - lo), (d[:, k], hi - p[:, k])):
+            par = q == 0.0
+            ok &= ~(par & (r < 0.0))
+            with np.errstate(divide="ignore", invalid="ignore"):
+                u = np.where(par, 0.0, r / np.where(par, 1.0, q))
+            t0 = np.where(~par & (q < 0.0), np.maximum(t0, u), t0)
+            t1 = np.where(~par & (q > 0.0), np.minimum(t1, u), t1)
+    return ok & (t0 <= t1)
+
 
 
 def _add_title_block(fig, dr: Drawing, paper: str) -> None:
@@ -635,11 +803,8 @@ def _write_matplotlib(dr: Drawing, svg: Path, pdf: Path) -> None:
     # random UUID), both files dated by stamp_time(): one drawing, one set of bytes with SOURCE_DATE_EPOCH
     when = stamp_time()
     with matplotlib.rc_context({"svg.fonttype": "none", "pdf.fonttype": 42, "svg.hashsalt": _SVG_SALT}):
-        for paper in PAPER:  # the smallest sheet that shows the views at 1:1 or larger (else the largest)
-            fig = _views_figure(dr, paper)
-            if dr.scale >= 1.0 or paper == "A2":
-                break
-        _add_title_block(fig, dr, paper)  # (on the sheet kept only)
+        fig = _smallest_views_figure(dr)
+        _add_title_block(fig, dr, dr.paper)  # (on the sheet kept only)
         with atomic_path(svg) as tmp:
             fig.savefig(tmp, format="svg", metadata={"Date": when.isoformat()})
         with atomic_path(pdf) as tmp:
