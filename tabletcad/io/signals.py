@@ -1,4 +1,5 @@
-"""Ctrl-C and SIGTERM held back over a step that must not be cut in two."""
+"""Ctrl-C and SIGTERM held back over a step that must not be cut in two; SIGTERM made an exception
+that clean-up code sees."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import signal
 import threading
 from collections.abc import Iterator
 
-__all__ = ["signals_deferred"]
+__all__ = ["signals_deferred", "sigterm_raises"]
 
 
 @contextlib.contextmanager
@@ -41,3 +42,36 @@ def signals_deferred() -> Iterator[None]:
                 handler(s, None)  # Python's default_int_handler raises KeyboardInterrupt
             elif handler == signal.SIG_DFL or handler is None:
                 os.kill(os.getpid(), s)
+
+
+@contextlib.contextmanager
+def sigterm_raises() -> Iterator[None]:
+    """While inside (main thread), SIGTERM raises :class:`SystemExit` (status 143) so that clean-up runs.
+
+    Python's default for SIGTERM ends the process at once: no ``finally`` block, no ``atexit`` handler
+    (a build's staging folder, a sweep's empty ``--out`` folder and its cluster's semaphores were left).
+    From the signal to the block's end the log records are turned off (as the command line does for a
+    Ctrl-C): what the clean-up logs tells only of the termination itself (a sweep's in-process Dask
+    scheduler logged "Couldn't gather keys" for the result the terminated client no longer fetched).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    import logging
+
+    disabled: list[int] = []  # the level of logging.disable before the signal, once it came
+
+    def handler(signum, frame):  # noqa: ARG001
+        if not disabled:
+            disabled.append(logging.root.manager.disable)
+        logging.disable(logging.CRITICAL)
+        raise SystemExit(128 + signum)
+
+    old = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old if old is not None else signal.SIG_DFL)
+        if disabled:  # (only what the handler turned off: a Ctrl-C's own turning off stays)
+            logging.disable(disabled[0])
+
