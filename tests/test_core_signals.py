@@ -1,14 +1,20 @@
-"""``tabletcad.io.signals``: SIGTERM as an exception clean-up code sees."""
+"""``tabletcad.io.signals``: SIGTERM as an exception clean-up code sees, and SIGINT kept from the
+processes a thread starts (the sweep's local workers)."""
 
 from __future__ import annotations
 
 import logging
 import os
 import signal
+import subprocess
+import sys
+import threading
 
 import pytest
 
-from tabletcad.io.signals import sigterm_raises
+from tabletcad.io.signals import sigint_blocked, sigterm_raises
+
+posix = pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="POSIX signal masks")
 
 
 def test_a_sigterm_inside_raises_systemexit_143_with_the_logs_off_until_the_block_ends():
@@ -37,3 +43,21 @@ def test_without_a_sigterm_the_logs_stay_as_they_were():
     finally:
         logging.disable(logging.NOTSET)
 
+
+@posix
+def test_a_process_started_from_a_thread_begun_with_sigint_blocked_is_born_deaf_to_it():
+    """The mask goes to a thread started inside and, across exec, to the processes it starts; the
+    calling thread's own mask is restored."""
+    seen: list[str] = []
+
+    def start() -> None:
+        out = subprocess.run([sys.executable, "-c", "import signal; print(int(signal.SIGINT in "
+                              "signal.pthread_sigmask(signal.SIG_BLOCK, set())))"], capture_output=True, text=True)
+        seen.append(out.stdout.strip())
+
+    with sigint_blocked():
+        thread = threading.Thread(target=start)
+        thread.start()
+    thread.join()
+    assert seen == ["1"]
+    assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, set())

@@ -115,3 +115,14 @@ def test_a_sigterm_between_designs_keeps_the_rows_written(tmp_path):
     assert [q.name for q in out.iterdir()] == [JOURNAL]
     assert 1 <= len(read_done(out)) < 400
 
+
+def test_a_ctrl_c_while_the_workers_start_prints_one_line(tmp_path):
+    """A terminal's Ctrl-C reaches the workers too.  Sent while they start, it had killed them in their
+    imports (their tracebacks after ``interrupted``) and cut the cluster's start in two: the half-started
+    cluster was never closed, and Python's resource tracker printed "There appear to be 12 leaked
+    semaphore objects to clean up at shutdown" (the nannies' multiprocessing queues, 6 semaphores a
+    worker).  The workers are now born with SIGINT blocked, and the start ends before the Ctrl-C acts."""
+    out = tmp_path / "out"
+    rc, err = _stop_sweep(tmp_path, out, lambda p: _workers_starting(p.pid), signal.SIGINT, workers=2)
+    assert (rc, err) == (130, "interrupted\n")
+    assert not out.exists()

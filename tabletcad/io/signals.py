@@ -1,5 +1,5 @@
 """Ctrl-C and SIGTERM held back over a step that must not be cut in two; SIGTERM made an exception
-that clean-up code sees."""
+that clean-up code sees; Ctrl-C kept from the processes a thread starts."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import signal
 import threading
 from collections.abc import Iterator
 
-__all__ = ["signals_deferred", "sigterm_raises"]
+__all__ = ["signals_deferred", "sigterm_raises", "sigint_blocked"]
 
 
 @contextlib.contextmanager
@@ -75,3 +75,21 @@ def sigterm_raises() -> Iterator[None]:
         if disabled:  # (only what the handler turned off: a Ctrl-C's own turning off stays)
             logging.disable(disabled[0])
 
+
+@contextlib.contextmanager
+def sigint_blocked() -> Iterator[None]:
+    """While inside, SIGINT is blocked in the calling thread's signal mask (POSIX; elsewhere nothing).
+
+    A thread started inside keeps the mask, and so does every process it starts, across ``exec``:
+    such a process is born deaf to a terminal's Ctrl-C, which a SIGINT handler installed after its
+    start-up imports (a Dask worker's preload, :mod:`tabletcad.worker_setup`) came too late for.
+    A SIGINT that arrives meanwhile for this process waits and is delivered when the block ends.
+    """
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
