@@ -53,25 +53,47 @@ def sigterm_raises() -> Iterator[None]:
     From the signal to the block's end the log records are turned off (as the command line does for a
     Ctrl-C): what the clean-up logs tells only of the termination itself (a sweep's in-process Dask
     scheduler logged "Couldn't gather keys" for the result the terminated client no longer fetched).
+
+    Python runs the handler between any two bytecodes of the main thread, also in a garbage-collector
+    callback or a ``__del__``, where an exception cannot be raised: it is printed as "Exception ignored
+    in ..." and lost (distributed's ``GCDiagnosis`` callback: a sweep then ran to its end, status 0).
+    Such a lost SystemExit is sent again as a SIGTERM to this process 50 ms later (from a timer thread:
+    sent at once, it would be raised inside the callback again).
     """
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     import logging
+    import sys
 
     disabled: list[int] = []  # the level of logging.disable before the signal, once it came
+    raised: list[SystemExit] = []
 
     def handler(signum, frame):  # noqa: ARG001
         if not disabled:
             disabled.append(logging.root.manager.disable)
         logging.disable(logging.CRITICAL)
-        raise SystemExit(128 + signum)
+        raised.append(SystemExit(128 + signum))
+        raise raised[-1]
+
+    previous_hook = sys.unraisablehook
+
+    def hook(unraisable) -> None:
+        if any(unraisable.exc_value is exc for exc in raised):
+            again = threading.Timer(0.05, os.kill, (os.getpid(), signal.SIGTERM))
+            again.daemon = True
+            again.start()
+            return
+        previous_hook(unraisable)
 
     old = signal.signal(signal.SIGTERM, handler)
+    sys.unraisablehook = hook
     try:
         yield
     finally:
         signal.signal(signal.SIGTERM, old if old is not None else signal.SIG_DFL)
+        if sys.unraisablehook is hook:
+            sys.unraisablehook = previous_hook
         if disabled:  # (only what the handler turned off: a Ctrl-C's own turning off stays)
             logging.disable(disabled[0])
 
