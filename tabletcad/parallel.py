@@ -20,6 +20,7 @@ from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
 from tabletcad.errors import DesignError
+from tabletcad.io.signals import sigint_blocked, signals_deferred
 
 __all__ = ["map_tasks", "open_client", "CONNECT_TIMEOUT_S", "IN_FLIGHT_PER_WORKER"]
 
@@ -129,24 +130,63 @@ def open_client(workers: int | None = None, scheduler: str | None = None,
            if k != "MALLOC_TRIM_THRESHOLD_"}
     # An earlier nanny in this process may have left its 65536 in os.environ, which workers inherit.
     inherited = os.environ.pop("MALLOC_TRIM_THRESHOLD_") if os.environ.get("MALLOC_TRIM_THRESHOLD_") == "65536" else None
-    try:
-        with dask.config.set({"distributed.nanny.pre-spawn-environ": env, "distributed.worker.profile.enabled": False,
-                              "distributed.admin.tick.interval": "1s"}):
-            # no dashboard; the scheduler's own HTTP server (health, metrics) on a free local port, not
-            # 8787 (taken by another sweep or notebook: "Port 8787 is already in use" on every run)
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                                   scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
-                                   silence_logs=logging.ERROR,
-                                   preload=["tabletcad.worker_setup"])  # workers ignore the terminal's Ctrl-C
-    finally:
-        if inherited is not None:
-            os.environ["MALLOC_TRIM_THRESHOLD_"] = inherited
-    with cluster, Client(cluster, set_as_default=False) as client:
+    with contextlib.ExitStack() as stack:
+        # the start is not cut in two by a Ctrl-C or SIGTERM (held until the cluster is up, then closing
+        # it): one during the start had left the half-started cluster unclosed, its workers running on and
+        # its nannies' multiprocessing queues never released (Python's resource tracker then printed
+        # "There appear to be 12 leaked semaphore objects to clean up at shutdown" after ``interrupted``)
+        with signals_deferred():
+            loop = stack.enter_context(_loop_deaf_to_ctrl_c())
+            try:
+                with dask.config.set({"distributed.nanny.pre-spawn-environ": env,
+                                      "distributed.worker.profile.enabled": False,
+                                      "distributed.admin.tick.interval": "1s"}):
+                    # no dashboard; the scheduler's own HTTP server (health, metrics) on a free local port, not
+                    # 8787 (taken by another sweep or notebook: "Port 8787 is already in use" on every run)
+                    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                           scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
+                                           silence_logs=logging.ERROR, loop=loop,
+                                           preload=["tabletcad.worker_setup"])  # workers ignore the terminal's Ctrl-C
+            finally:
+                if inherited is not None:
+                    os.environ["MALLOC_TRIM_THRESHOLD_"] = inherited
+            stack.enter_context(cluster)
+            client = stack.enter_context(Client(cluster, set_as_default=False))
         try:
             yield client
         except BaseException:  # a Ctrl-C, or an error: the workers' tasks are not waited for
             _stop_workers(cluster)
             raise
+
+
+@contextlib.contextmanager
+def _loop_deaf_to_ctrl_c() -> Iterator[Any]:
+    """A running Tornado IO loop of its own thread, started with SIGINT blocked in that thread.
+
+    A local cluster's nannies start the worker processes from that thread (and threads it starts), and a
+    process keeps its starter's signal mask across ``exec``: the workers are born deaf to the terminal's
+    Ctrl-C, which reaches the whole process group.  Their own handler (:mod:`tabletcad.worker_setup`, which
+    then ignores SIGINT) runs only once Dask is imported, and a Ctrl-C in their first 1.5 s had printed
+    their import tracebacks after ``interrupted`` and killed them while their nannies waited for them.
+    This process's main thread keeps its Ctrl-C.
+
+    Python's multiprocessing resource tracker is started first, here: started by the nannies' first queue,
+    in the loop's thread, it unblocks SIGINT in the thread that starts it (``resource_tracker.ensure_running``
+    unblocks the signals it had blocked rather than restoring the mask; CPython 3.11), and the workers
+    were born with SIGINT unblocked again."""
+    from multiprocessing import resource_tracker
+
+    from distributed.utils import LoopRunner
+
+    if hasattr(resource_tracker, "ensure_running"):  # (POSIX only)
+        resource_tracker.ensure_running()
+    runner = LoopRunner()
+    try:
+        with sigint_blocked():
+            runner.start()
+        yield runner.loop
+    finally:
+        runner.stop()  # (nothing when it had not started)
 
 
 WORKER_STOP_GRACE_S = 0.5

@@ -29,17 +29,15 @@ import hashlib
 import json
 import os
 import shutil
-import signal
 import socket
 import tempfile
-import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
 
 from tabletcad.errors import DesignError
 from tabletcad.io.atomic import atomic_write_text
-from tabletcad.io.signals import signals_deferred
+from tabletcad.io.signals import sigterm_raises, signals_deferred
 
 __all__ = ["MANIFEST", "OPTIMISE_MANIFEST", "STAGING_MARKER", "STALE_AFTER_S", "staging_folder", "publish", "read_manifest",
            "clean_stale_staging", "file_sha256", "check_replaceable"]
@@ -128,23 +126,6 @@ def clean_stale_staging(out_dir: str | os.PathLike[str]) -> list[Path]:
 
 
 @contextlib.contextmanager
-def _sigterm_raises() -> Iterator[None]:
-    """While inside, SIGTERM raises :class:`SystemExit` (status 143) so that clean-up runs."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def handler(signum, frame):  # noqa: ARG001
-        raise SystemExit(128 + signum)
-
-    old = signal.signal(signal.SIGTERM, handler)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, old)
-
-
-@contextlib.contextmanager
 def staging_folder(out_dir: str | os.PathLike[str]) -> Iterator[Path]:
     """A fresh staging folder on ``out_dir``'s file system, removed on exit whatever happens: inside
     ``out_dir`` when it is an existing folder (or a link to one), else beside it.
@@ -154,7 +135,7 @@ def staging_folder(out_dir: str | os.PathLike[str]) -> Iterator[Path]:
     """
     out_dir = Path(out_dir)
     inside = out_dir.is_dir()
-    with _sigterm_raises():
+    with sigterm_raises():
         try:
             if not inside:
                 out_dir.parent.mkdir(parents=True, exist_ok=True)

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from tabletcad.errors import DesignError
+from tabletcad.io.signals import sigterm_raises
 from tabletcad.sweep.engine import CONNECT_TIMEOUT_S, failed_design, map_tasks, open_client, sweep_task
 from tabletcad.sweep.results import (JOURNAL, RESULTS_CSV, TAIL_COLUMNS, append_journal, is_sweep_plot, plot_column_error,
                                      plot_names, plot_results, read_done, results_frame, write_results)
@@ -57,7 +58,10 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
 
     Every check of the sweep file, the options and the scheduler connection
     happens before any design is built; a failure raises
-    :class:`~tabletcad.errors.DesignError` and writes nothing.
+    :class:`~tabletcad.errors.DesignError` and writes nothing.  A run ended by an
+    exception, a Ctrl-C or a SIGTERM (in the main thread: :class:`SystemExit` 143) keeps
+    the rows written so far (the journal) and removes the ``out_dir`` folders it made
+    while they are empty.
     """
     spec = _spec(sweep)
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 0):
@@ -150,9 +154,10 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
     kw = dict(outputs=spec.outputs, name=spec.name, store=store)
     common = dict(kwargs=kw, progress=progress, desc=spec.name, failed=lambda r: r["status"] != "ok",
                   on_result=on_result, on_error=failed_design)
-    created = out is not None and not out.exists()
+    created = _missing_folders(out) if out is not None else []
     try:
         with contextlib.ExitStack() as stack:
+            stack.enter_context(sigterm_raises())  # a SIGTERM cleans up as a Ctrl-C does (it had ended the process)
             if files_wanted and scheduler is None and client is None:
                 # the builds' temporary folders in one of this run's own, removed below once the workers are
                 # gone however the run ends (a trial: a Ctrl-C left the killed workers' folders in /tmp)
@@ -168,8 +173,7 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
                     raise DesignError("--out", str(out), f"cannot be written: {(exc.strerror or str(exc)).lower()}") from None
             map_tasks(sweep_task, items, client=client, workers=0 if client is None else None, **common)
     except BaseException:
-        if created and out.is_dir() and not any(out.iterdir()):  # stopped before any design: no empty folder left
-            out.rmdir()
+        _remove_empty(created)  # stopped before any design: no empty folder left (a folder given stays)
         raise
 
     rows = [results.get(h) or _restored(done[h], spec.keys, values[h]) for h in hashes]
@@ -186,6 +190,28 @@ def run_sweep(sweep: Any, out_dir: str | Path | None = None, *, workers: int | N
                     if "of results.csv:" in exc.allowed else f"{exc.allowed}; {where}"
                 raise DesignError(exc.parameter, exc.value, allowed) from None
     return df
+
+
+def _missing_folders(out: Path) -> list[Path]:
+    """The folders that making ``out`` would create: ``out`` and its missing parents, innermost first."""
+    missing = []
+    p = out.absolute()
+    while not p.exists() and p != p.parent:
+        missing.append(p)
+        p = p.parent
+    return missing
+
+
+def _remove_empty(folders: list[Path]) -> None:
+    """Remove each of ``folders`` (innermost first) that is an empty folder, stopping at the first that is not:
+    a run stopped before it wrote anything leaves none of the folders it made."""
+    for folder in folders:
+        try:
+            folder.rmdir()  # (only an empty folder: never what another process put there meanwhile)
+        except FileNotFoundError:
+            continue
+        except OSError:
+            return
 
 
 def _held_files(store: str, keys: list[str], outputs) -> str:
