@@ -466,6 +466,33 @@ def test_a_fit_within_tolerance_that_moves_the_volume_is_fitted_again(monkeypatc
     monkeypatch.setattr(stage, "REFITS", 0)
     with pytest.raises(GeometryError, match=r"sphere_a5: B-rep volume/area differ .* at a fit tolerance of 1e-04 mm"):
         stage.check_tablet_solid(t)
+    # a finer fit that cannot be made (too many poles, say) ends the refits: the miss is what is reported
+    import tabletcad.cad.tablet_solid as ts
+
+    monkeypatch.setattr(stage, "REFITS", 2)
+    original = ts.tablet_solid
+
+    def coarse_only(tablet, tol=None, **kw):
+        if tol is not None and tol < t.tol.fit:
+            raise GeometryError("B-spline fit of patch 0 misses tolerance", tablet)
+        return original(tablet, tol, **kw)
+
+    monkeypatch.setattr(ts, "tablet_solid", coarse_only)
+    with pytest.raises(GeometryError, match=r"sphere_a5: B-rep volume/area differ .* at a fit tolerance of 1e-04 mm"):
+        stage.check_tablet_solid(t)
+
+
+def test_a_cut_away_whose_volume_misses_is_fitted_again():
+    """The same sphere at ``a = 5`` cut in half (the whole solid in common with a wedge): fitted again as the
+    whole tablet is (it had been refused, -1.56e-6 relative), its volume the quadrature's over the half."""
+    import tabletcad.cad.stage as stage
+
+    t = design_from_dict({"tablet": {"family": "thesis.spherical", "diameter": 5.0, "a": 5.0},
+                          "trim": {"v": [0.0, math.pi]}}, "sphere_a5_half")
+    made = stage.cutaway_shape(t, {"volume_mm3": t.volume()})
+    assert made.fit_tolerance_mm == pytest.approx(t.tol.fit / 10, rel=1e-12)
+    assert made.volume_mm3 == pytest.approx(t.volume(), rel=AGREE)
+    assert abs(made.volume_rel_diff_vs_quadrature) <= AGREE
 
 
 # --------------------------------------------------------------------------- end to end

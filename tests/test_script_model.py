@@ -235,6 +235,10 @@ def test_make_takes_a_free_form_tablet_s_patches():
     with pytest.raises(DesignError) as exc:
         tabletcad.make("free_form", patches=[{"curves": data["patch"][0]["curves"][:2]}])
     assert exc.value.parameter == "patch[0].curves"
+    for bad in ("abc", 5, [["circle"]]):  # ("abc" had been read as three patches, 5 raised a bare TypeError)
+        with pytest.raises(DesignError) as exc:
+            tabletcad.make("free_form", patches=bad)
+        assert exc.value.parameter == "patches"
     with pytest.raises(DesignError, match="only read for family free_form"):
         tabletcad.make("concave_round", diameter=10.0, band=3.0, cup_depth=1.0, patches=data["patch"])
 

@@ -38,6 +38,32 @@ AGREEMENT_REL = DEFAULT.brep_agreement
 REFITS = 2
 
 
+def refitted(tol: float, measured, refused):
+    """The first of the fits at ``tol``, ``tol / 10``, ... (``REFITS`` after the first) whose solid agrees with
+    the core's quadrature: ``(solid, tol, differences)``.
+
+    A fit within its distance tolerance may still move the volume or area by more than the agreement asked
+    for (a tolerance of 1e-4 mm over a 5 mm sphere's 79 mm² allows 1e-4 of its volume): the faces are then
+    fitted again, a tenth as far from the PDE surface.  ``measured(tol)`` makes the solid and returns
+    ``(solid, *relative differences)``; ``refused(solid, tol, *differences)`` the error raised for the last
+    fit made when it still misses (a finer fit that cannot be made ends the refits).
+    """
+    last = None
+    for _ in range(REFITS + 1):
+        try:
+            solid, *diffs = measured(tol)
+        except GeometryError:
+            if last is None:
+                raise
+            break  # a finer fit that cannot be made (too many poles, sewing): the last one made is reported
+        if all(abs(d) <= AGREEMENT_REL for d in diffs):  # (a NaN difference is no agreement)
+            return solid, tol, diffs
+        last = (solid, tol, diffs)
+        tol /= 10.0
+    solid, tol, diffs = last
+    raise refused(solid, tol, *diffs)
+
+
 def check_tablet_solid(tablet: Tablet, report: dict[str, Any] | None = None):
     """Build the solid and its mesh and cross-check them; return ``(solid, mesh, sections)``.
 
@@ -48,28 +74,25 @@ def check_tablet_solid(tablet: Tablet, report: dict[str, Any] | None = None):
     t0 = time.perf_counter()
     v_q = report["volume_mm3"] if report else tablet.volume()
     a_q = report["surface_area_mm2"] if report else tablet.surface_area()
-    # a fit within its distance tolerance may still move the volume or area by more than the agreement
-    # asked for (a tolerance of 1e-4 mm over a 5 mm sphere's 79 mm2 allows 1e-4 of its volume): the faces
-    # are then fitted again, a tenth as far from the surface, until they agree (REFITS more at most)
-    tol = tablet.tol.fit
-    for refit in range(REFITS + 1):
+
+    def measured(tol: float):
         solid = tablet_solid(tablet, tol)
         # the B-rep's own surfaces (poles, knots) integrated by Gauss-Legendre: exact for the volume,
         # within ~1e-9 for the area, and 5-25x cheaper than OCC's adaptive integration of the faces
         volume, area = solid.data_volume_area
-        volume = abs(volume)
-        dv = (volume - v_q) / v_q
-        da = (area - a_q) / a_q
+        return solid, (abs(volume) - v_q) / v_q, (area - a_q) / a_q
+
+    def refused(solid, tol: float, dv: float, da: float) -> GeometryError:
         dev = max(f.max_deviation for f in solid.fits)
-        if abs(dv) <= AGREEMENT_REL and abs(da) <= AGREEMENT_REL:
-            break
-        if refit == REFITS:
-            raise GeometryError(
-                f"{tablet.name}: B-rep volume/area differ from the quadrature by {dv:.2e}/{da:.2e} relative "
-                f"(allowed {AGREEMENT_REL:g}; largest fit deviation {dev:.2e} mm at a fit tolerance of {tol:.0e} mm)",
-                solid,
-            )
-        tol /= 10.0
+        return GeometryError(
+            f"{tablet.name}: B-rep volume/area differ from the quadrature by {dv:.2e}/{da:.2e} relative "
+            f"(allowed {AGREEMENT_REL:g}; largest fit deviation {dev:.2e} mm at a fit tolerance of {tol:.0e} mm)",
+            solid,
+        )
+
+    solid, tol, (dv, da) = refitted(tablet.tol.fit, measured, refused)
+    volume, area = abs(solid.data_volume_area[0]), solid.data_volume_area[1]
+    dev = max(f.max_deviation for f in solid.fits)
     t1 = time.perf_counter()
     mesh = tessellate_solid(solid, MESH_LINEAR_MM, MESH_ANGULAR_RAD)
     t2 = time.perf_counter()
@@ -165,6 +188,7 @@ class CutawayShape(NamedTuple):
     volume_rel_diff_vs_quadrature: float
     how: str  #: how the solid was made (``brep.cutaway``)
     seconds: float
+    fit_tolerance_mm: float  #: the fit tolerance of the faces kept (:func:`refitted`)
 
 
 def cutaway_solid(tablet: Tablet, report: dict[str, Any]):
@@ -205,8 +229,8 @@ def cutaway_shape(tablet: Tablet, report: dict[str, Any], *, _stacklevel: int = 
 
     phi0, phi1 = _cut_plane_angle(tablet, v0), _cut_plane_angle(tablet, v1)
     t0 = time.perf_counter()
-    chain = None
-    if phi0 is None or phi1 is None:
+    sewn = phi0 is None or phi1 is None
+    if sewn:
         if t.w != (0.0, 1.0):
             return "hollow ([trim] w) with cut faces that are not planes through the axis"
         from tabletcad.cad.solid import build_solid
@@ -214,9 +238,6 @@ def cutaway_shape(tablet: Tablet, report: dict[str, Any], *, _stacklevel: int = 
 
         funcs, breaks = cutaway_surface_functions(tablet)
         names = [f"{p.name or f'patch {j}'} cut-away" for j, p in enumerate(tablet.patches)]
-        chain = build_solid(funcs, tablet.tol.fit, name=f"{tablet.name} cut-away", names=names,
-                            **fit_options(tablet, v_breaks=breaks))
-        shape = chain.shape
         how = ("fitted and sewn as one chain: the outer surface between the cuts and the ruled cut faces "
                f"A0(u) + w (X(u, v) - A0(u)) at v = {v0:.6g} and {v1:.6g}")
         import warnings
@@ -231,26 +252,39 @@ def cutaway_shape(tablet: Tablet, report: dict[str, Any], *, _stacklevel: int = 
     else:
         # angles grow with v (counter-clockwise sections); the kept sector runs from phi0 to phi1
         span = (phi1 - phi0) % (2.0 * np.pi) or 2.0 * np.pi
-        whole = tablet_solid(replace(tablet, trim=Trim(w=t.w)))
         size = 10.0 * max(tablet.dimensions().values())
-        common = BRepAlgoAPI_Common(whole.shape, _wedge(phi0, phi0 + span, size, -size, size))
-        if not common.IsDone():
-            raise GeometryError(f"{tablet.name}: cutting the cut-away solid failed", tablet)
-        solids = explore(common.Shape(), "Solid")
-        if len(solids) != 1:
-            raise GeometryError(f"{tablet.name}: the cut-away gave {len(solids)} solids, not one", tablet)
-        shape = solids[0]
         how = (f"whole solid in common with the wedge between the half-planes at {phi0:.6g} and "
                f"{phi0 + span:.6g} rad (BRepAlgoAPI_Common)")
-    check_solid(shape, f"{tablet.name} cut-away")
-    mass = mass_properties(shape)
     v_q = report["volume_mm3"]
-    dv = (mass.volume - v_q) / v_q
+
+    def measured(tol: float):
+        """The cut-away's shape and fitted chain (None for the wedge's) at fit tolerance ``tol``, checked, its
+        mass properties and their volume's difference from the quadrature."""
+        chain = None
+        if sewn:
+            chain = build_solid(funcs, tol, name=f"{tablet.name} cut-away", names=names,
+                                **fit_options(tablet, v_breaks=breaks))
+            shape = chain.shape
+        else:
+            whole = tablet_solid(replace(tablet, trim=Trim(w=t.w)), tol)
+            common = BRepAlgoAPI_Common(whole.shape, _wedge(phi0, phi0 + span, size, -size, size))
+            if not common.IsDone():
+                raise GeometryError(f"{tablet.name}: cutting the cut-away solid failed", tablet)
+            solids = explore(common.Shape(), "Solid")
+            if len(solids) != 1:
+                raise GeometryError(f"{tablet.name}: the cut-away gave {len(solids)} solids, not one", tablet)
+            shape = solids[0]
+        check_solid(shape, f"{tablet.name} cut-away")
+        mass = mass_properties(shape)
+        return (shape, chain, mass), (mass.volume - v_q) / v_q
+
+    def refused(made, tol: float, dv: float) -> GeometryError:
+        return GeometryError(f"{tablet.name}: cut-away B-rep volume differs from the quadrature by {dv:.2e} relative "
+                             f"(allowed {AGREEMENT_REL:g} at a fit tolerance of {tol:.0e} mm)", made[0])
+
+    (shape, chain, mass), tol, (dv,) = refitted(tablet.tol.fit, measured, refused)
     t1 = time.perf_counter()
-    if abs(dv) > AGREEMENT_REL:
-        raise GeometryError(f"{tablet.name}: cut-away B-rep volume differs from the quadrature by {dv:.2e} relative "
-                            f"(allowed {AGREEMENT_REL:g})", shape)
-    return CutawayShape(tablet.name, shape, chain, mass.volume, mass.area, dv, how, t1 - t0)
+    return CutawayShape(tablet.name, shape, chain, mass.volume, mass.area, dv, how, t1 - t0, tol)
 
 
 def cutaway_mesh(made: CutawayShape):
@@ -269,7 +303,7 @@ def cutaway_mesh(made: CutawayShape):
     brep = dict(valid=True, volume_mm3=made.volume_mm3, surface_area_mm2=made.surface_area_mm2,
                 faces=len(explore(shape, "Face")),
                 volume_rel_diff_vs_quadrature=made.volume_rel_diff_vs_quadrature, cutaway=made.how,
-                seconds=made.seconds)
+                fit_tolerance_mm=made.fit_tolerance_mm, seconds=made.seconds)
     if not mesh.ok or mesh.manifold_genus != genus_expected:
         failed = (f"manifold3d {mesh.manifold_status}, genus {mesh.manifold_genus}, watertight {mesh.watertight}, "
                   f"winding {mesh.winding_consistent}")

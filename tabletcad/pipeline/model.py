@@ -523,6 +523,8 @@ def make(family: str, *, report: dict | None = None, tooling: dict | None = None
     # numpy's scalars (np.arange(...)[i], np.float32) are the numbers they hold; arrays are not numbers
     dims = {k: v.item() if isinstance(v, np.generic) else v for k, v in dims.items()}
     data: dict[str, Any] = {"tablet": {"family": family, **dims}}
+    if patches is not None and not (isinstance(patches, (list, tuple)) and all(isinstance(p, dict) for p in patches)):
+        raise DesignError("patches", patches, 'must be a list of [[patch]] tables, each a dict {"curves": [...]}')
     for table, value in (("report", report), ("tooling", tooling), ("trim", trim), ("reshape", reshape),
                          ("patch", None if patches is None else list(patches))):
         if value is not None:
