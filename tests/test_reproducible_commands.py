@@ -256,3 +256,12 @@ def test_redate_zip_keeps_the_entries_and_dates_them(monkeypatch):
     monkeypatch.setenv("SOURCE_DATE_EPOCH", str(EPOCH))
     with zipfile.ZipFile(io.BytesIO(redate_zip(src.getvalue()))) as zf:
         assert {i.date_time for i in zf.infolist()} == {(2023, 11, 14, 22, 13, 20)}
+
+
+def test_every_picture_is_saved_through_save_figure():
+    # one place fixes the SVG salt and the dates: a savefig or print_figure anywhere else would bypass it
+    package = ROOT / "tabletcad"
+    found = [f"{p.relative_to(ROOT)}:{n}" for p in sorted(package.rglob("*.py")) if p != package / "io" / "figures.py"
+             for n, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+             if re.search(r"\.(savefig|print_figure|print_svg|print_pdf|print_png)\(", line)]
+    assert found == []
