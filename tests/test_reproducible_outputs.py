@@ -173,3 +173,26 @@ def test_style_tail_is_renumbered_by_what_it_styles():
     # a file whose earlier entities refer into the tail is left as it is
     odd = TAIL.format(tail=blue_first).replace("(#2),#3)", "(#2,#7),#3)")
     assert canonical_style_order(odd) == odd
+
+
+def test_an_assembly_written_twice_in_one_process_is_the_same_file(tmp_path):
+    # OCC numbers the assembly links (NEXT_ASSEMBLY_USAGE_OCCURRENCE ids) from a counter of the process:
+    # the second file had ids 3 and 4 (the second size of a tooling batch: 5 to 8)
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+
+    from tabletcad.tooling.assembly import write_assembly
+
+    parts = {"tablet": BRepPrimAPI_MakeBox(1.0, 2.0, 3.0).Shape(), "die": BRepPrimAPI_MakeBox(4.0, 4.0, 1.0).Shape()}
+    a = write_assembly(parts, tmp_path / "a.step")
+    b = write_assembly(parts, tmp_path / "b.step")
+    text = a.read_text(encoding="ascii")
+    assert re.findall(r"NEXT_ASSEMBLY_USAGE_OCCURRENCE\('(\d+)','(\w+)'", text) == [("1", "tablet"), ("2", "die")]
+    assert a.read_bytes() == b.read_bytes()
+
+
+def test_nauo_ids_are_numbered_in_file_order():
+    from tabletcad.cad.export import canonical_nauo_ids
+
+    text = ("#7 = NEXT_ASSEMBLY_USAGE_OCCURRENCE('13','a','',#5,#6,$);\n#9 = PRODUCT('NEXT_ASSEMBLY_USAGE_OCCURRENCE"
+            "(''2''','','',(#1));\n#12 =  NEXT_ASSEMBLY_USAGE_OCCURRENCE( '14','b','',#5,#8,$);\n")
+    assert canonical_nauo_ids(text) == text.replace("'13'", "'1'").replace("'14'", "'2'")

@@ -18,6 +18,7 @@ the run: the same shape and environment give the same bytes.
 
 from __future__ import annotations
 
+import itertools
 import os
 import re
 import struct
@@ -94,7 +95,8 @@ def write_step_document(doc, path: str | os.PathLike[str], *, what: str, obj: An
 def _write_step(writer: STEPCAFControl_Writer, path: str | os.PathLike[str], obj: Any) -> Path:
     """Write a transferred STEP model atomically to ``path``: its header stamped with
     :func:`~tabletcad.io.timestamp.stamp_time`, its names in Part 21's basic alphabet, its styles in an
-    order of their content (:func:`canonical_style_order`)."""
+    order of their content (:func:`canonical_style_order`), its assembly links numbered from 1
+    (:func:`canonical_nauo_ids`)."""
     _stamp_header(writer)
     with atomic_path(path) as tmp:
         status = writer.Write(str(tmp))
@@ -106,6 +108,8 @@ def _write_step(writer: STEPCAFControl_Writer, path: str | os.PathLike[str], obj
             text = part21_text(raw.decode("utf-8"))
         if raw.count(_STYLE_ROOT.encode("ascii")) > 1:  # two parts coloured or more
             text = canonical_style_order(text if text is not None else raw.decode("ascii"))
+        if _NAUO.encode("ascii") in raw:  # an assembly
+            text = canonical_nauo_ids(text if text is not None else raw.decode("ascii"))
         if text is not None:
             Path(tmp).write_bytes(text.encode("ascii"))
     return Path(path)
@@ -140,6 +144,23 @@ def part21_text(text: str) -> str:
         return "\\X4\\" + "".join(f"{ord(c):08X}" for c in run) + "\\X0\\"
 
     return _NON_ASCII.sub(directive, text)
+
+
+_NAUO = "NEXT_ASSEMBLY_USAGE_OCCURRENCE"
+_NAUO_ID = re.compile(r"(=\s*" + _NAUO + r"\(\s*)'\d+'")
+
+
+def canonical_nauo_ids(text: str) -> str:
+    """A STEP file's NEXT_ASSEMBLY_USAGE_OCCURRENCEs (an assembly's links to its parts) with the ids
+    ``'1'``, ``'2'``, ... in the order of the file.
+
+    OCC's writer (``STEPConstruct_Assembly::MakeRelationship``) takes each id from a counter that lives
+    as long as the process: the same assembly written again in one process (the second size of a tooling
+    batch, a notebook's second build) had ids 5 to 8 where a fresh process writes 1 to 4.  The ids only
+    need to be unique within the file; entities refer to each other by their ``#`` numbers.
+    """
+    counter = itertools.count(1)
+    return _NAUO_ID.sub(lambda m: f"{m.group(1)}'{next(counter)}'", text)
 
 
 _STYLE_ROOT = "MECHANICAL_DESIGN_GEOMETRIC_PRESENTATION_REPRESENTATION"

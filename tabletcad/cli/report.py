@@ -258,7 +258,26 @@ def _write_tables(payloads: list[dict[str, Any]], csv_out: Path | None, xlsx_out
         for row in rows:
             ws.append([row.get(k) for k in columns])
         ws.freeze_panes = "C2"
-        wb.save(staged["xlsx"])
+        _save_workbook(wb, staged["xlsx"])
+
+
+def _save_workbook(wb, path: Path) -> None:
+    """Write the openpyxl workbook ``wb`` to ``path`` dated by :func:`~tabletcad.io.timestamp.stamp_time`:
+    its ``created`` and ``modified`` properties and its zip entries (``Workbook.save`` gives the properties
+    the time of writing, UTC, and the entries the local time), so that with ``SOURCE_DATE_EPOCH`` two runs
+    write the same bytes."""
+    import io
+    import zipfile
+
+    from openpyxl.writer.excel import ExcelWriter
+
+    from tabletcad.io.timestamp import redate_zip, stamp_time
+
+    when = stamp_time()
+    wb.properties.created = wb.properties.modified = when.replace(tzinfo=None)  # (openpyxl's: naive, UTC)
+    buf = io.BytesIO()
+    ExcelWriter(wb, zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED, allowZip64=True)).save()  # (closes it)
+    path.write_bytes(redate_zip(buf.getvalue(), when))
 
 
 def _write_plot(tablets: list, path: Path) -> None:

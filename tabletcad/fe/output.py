@@ -11,6 +11,7 @@ import numpy as np
 
 from tabletcad.fe.elasticity import ElasticSolution, principal_stresses, von_mises
 from tabletcad.io.atomic import atomic_path
+from tabletcad.io.figures import save_figure
 
 __all__ = ["write_vtu", "section", "plot_section"]
 
@@ -101,7 +102,4 @@ def plot_section(sol: ElasticSolution, path: str | Path, *, axis: int, level: fl
     ax.set_ylabel(f"{names[other[1]]} (mm)")
     ax.set_aspect("equal")
     ax.set_title(title, fontsize=9)
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=120, format=path.suffix.lstrip(".").lower())
-    return path
+    return save_figure(fig, Path(path), dpi=120)

@@ -12,11 +12,13 @@ content, whatever the environment.
 from __future__ import annotations
 
 import hashlib
+import io
 import os
 import uuid
+import zipfile
 from datetime import datetime, timezone
 
-__all__ = ["ENV", "stamp_time", "check_stamp", "content_uuid", "zip_date_time"]
+__all__ = ["ENV", "stamp_time", "check_stamp", "content_uuid", "zip_date_time", "redate_zip"]
 
 #: the environment variable of the reproducible-builds specification
 ENV = "SOURCE_DATE_EPOCH"
@@ -75,3 +77,28 @@ def zip_date_time(when: datetime) -> tuple[int, int, int, int, int, int]:
     low, high = datetime(1980, 1, 1, tzinfo=timezone.utc), datetime(2107, 12, 31, 23, 59, 58, tzinfo=timezone.utc)
     t = min(max(when.astimezone(timezone.utc), low), high)
     return (t.year, t.month, t.day, t.hour, t.minute, t.second)
+
+
+def redate_zip(data: bytes, when: datetime | None = None) -> bytes:
+    """The zip archive ``data`` with every entry dated ``when`` (default :func:`stamp_time`), else unchanged.
+
+    A library that writes a zip by name (``ZipFile.writestr(name, ...)``, as openpyxl does for a workbook)
+    dates each entry with the local time of writing; this gives its entries one date, in the same order,
+    with the same contents, compression and permissions.
+
+    Parameters
+    ----------
+    data : bytes
+        A zip archive.
+    when : datetime, optional
+        The date (clamped to the zip format's 1980-2107, :func:`zip_date_time`).
+    """
+    stamp = zip_date_time(when if when is not None else stamp_time())
+    out = io.BytesIO()
+    with zipfile.ZipFile(io.BytesIO(data)) as src, zipfile.ZipFile(out, "w") as dst:
+        for old in src.infolist():
+            info = zipfile.ZipInfo(old.filename, date_time=stamp)
+            info.compress_type, info.external_attr, info.comment = old.compress_type, old.external_attr, old.comment
+            info.create_system = old.create_system
+            dst.writestr(info, src.read(old))
+    return out.getvalue()

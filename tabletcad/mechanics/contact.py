@@ -384,13 +384,10 @@ def _figure():
 
 
 def _save(fig, path) -> Path:
-    from tabletcad.io import atomic_path
+    from tabletcad.io.figures import save_figure
 
-    path = Path(path)
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=path.suffix.lstrip(".").lower() or "png")
-    return path
+    return save_figure(fig, Path(path))
 
 
 def plot_force_displacement(curves: list[ForceDisplacementCurve], path) -> Path:

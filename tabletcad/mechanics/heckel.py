@@ -414,7 +414,7 @@ def plot_heckel(fit: HeckelFit, path: str | Path, *, title: str = "", others: di
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from tabletcad.io import atomic_path
+    from tabletcad.io.figures import save_figure
 
     fig = Figure(figsize=(6.4, 4.4), dpi=120)
     FigureCanvasAgg(fig)  # its own canvas: the global backend is left alone
@@ -438,8 +438,4 @@ def plot_heckel(fit: HeckelFit, path: str | Path, *, title: str = "", others: di
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="lower right")
     fig.tight_layout()
-    path = Path(path)
-    fmt = path.suffix.lstrip(".").lower() or "png"
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=fmt)
-    return path
+    return save_figure(fig, Path(path))

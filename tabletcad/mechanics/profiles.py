@@ -142,7 +142,7 @@ def plot_profiles(profiles: list[Profile], path: str | Path) -> Path:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from tabletcad.io import atomic_path
+    from tabletcad.io.figures import save_figure
 
     n = max(len(profiles), 1)
     fig = Figure(figsize=(4.0 * n, 3.6), dpi=120)
@@ -155,7 +155,4 @@ def plot_profiles(profiles: list[Profile], path: str | Path) -> Path:
         ax.set_title(p.name)
         ax.grid(True, alpha=0.3)
     fig.tight_layout()
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=path.suffix.lstrip(".").lower() or "png")
-    return path
+    return save_figure(fig, Path(path))

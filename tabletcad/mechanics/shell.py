@@ -355,7 +355,7 @@ def plot_shell(sol: ShellSolution, path, n_theta: int = 361) -> Path:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from tabletcad.io import atomic_path
+    from tabletcad.io.figures import save_figure
 
     th = np.linspace(0.0, math.pi, n_theta)
     fig = Figure(figsize=(6.4, 4.2), dpi=120)
@@ -368,7 +368,4 @@ def plot_shell(sol: ShellSolution, path, n_theta: int = 361) -> Path:
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=path.suffix.lstrip(".").lower() or "png")
-    return path
+    return save_figure(fig, Path(path))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tabletcad.io.atomic import atomic_path
+from tabletcad.io.figures import save_figure
 from tabletcad.optimise.problem import Result
 
 __all__ = ["plot_convergence"]
@@ -29,8 +29,9 @@ def plot_convergence(result: Result, path: str | Path, *, dpi: int = 120) -> Pat
     ax1.plot(it, obj, "o-", color="tab:blue", ms=3)
     ax1.set_ylabel(f"{result.objective_name}{unit}")
     ax1.grid(True, alpha=0.3)
+    # (no wall time: it is report.json's wall_time_s; the picture is the same for the same run)
     ax1.set_title(f"{result.problem}: {result.method}, {result.status} "
-                  f"({result.iterations} it., {result.nfev} builds, {result.wall_time_s:.2f} s)", fontsize=9)
+                  f"({result.iterations} it., {result.nfev} builds)", fontsize=9)
     ax2.semilogy(it, viol, "s-", color="tab:red", ms=3)
     ax2.axhline(1e-6, color="0.5", ls="--", lw=0.8, label="tolerance 1e-6")
     ax2.set_ylabel("max constraint violation (scaled, -)")
@@ -38,6 +39,4 @@ def plot_convergence(result: Result, path: str | Path, *, dpi: int = 120) -> Pat
     ax2.grid(True, alpha=0.3)
     ax2.legend(fontsize=8)
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=dpi, format="png")
-    return Path(path)
+    return save_figure(fig, Path(path), fmt="png", dpi=dpi)

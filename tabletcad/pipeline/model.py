@@ -651,6 +651,8 @@ def mesh_png(meshes: list[tuple[str, np.ndarray, np.ndarray]], *, title: str = "
     ax.set_box_aspect((1, 1, 1))
     ax.set_axis_off()
     ax.set_title(f"{title} ({2 * r:.3g} mm across)" if title else f"{2 * r:.3g} mm across", fontsize=9)
+    from tabletcad.io.figures import save_figure
+
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=80)
+    save_figure(fig, buf, fmt="png", dpi=80)
     return buf.getvalue()

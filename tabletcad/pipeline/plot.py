@@ -22,7 +22,7 @@ from typing import Sequence
 import numpy as np
 
 from tabletcad.errors import DesignError
-from tabletcad.io.atomic import atomic_path
+from tabletcad.io.figures import save_figure
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.geometry.vectors import cross
 
@@ -632,7 +632,7 @@ def tablets_figure(tablets: Sequence[Tablet], *, labels: Sequence[str] | None = 
 def tablet_png(tablet: Tablet, *, dpi: int = 110, **kw) -> bytes:
     """The picture of :func:`tablet_figure` as PNG bytes (for notebooks' ``_repr_png_``)."""
     buf = io.BytesIO()
-    tablet_figure(tablet, **kw).savefig(buf, dpi=dpi, format="png", pil_kwargs=_PNG)
+    save_figure(tablet_figure(tablet, **kw), buf, fmt="png", dpi=dpi, pil_kwargs=_PNG)
     return buf.getvalue()
 
 
@@ -656,9 +656,7 @@ def _picture_path(path: str | Path) -> Path:
 
 def _save(fig, path: Path, dpi: int) -> Path:
     fmt = path.suffix.lower()[1:]
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=dpi, format=fmt, **({"pil_kwargs": _PNG} if fmt == "png" else {}))
-    return path
+    return save_figure(fig, path, fmt=fmt, dpi=dpi, **({"pil_kwargs": _PNG} if fmt == "png" else {}))
 
 
 def plot_tablet(tablet: Tablet, path: str | Path, *, dpi: int = 110, **kw) -> Path:

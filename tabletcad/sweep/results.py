@@ -170,7 +170,7 @@ def plot_results(df, keys: Sequence[str], outputs: Sequence[str], out_dir: str |
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from tabletcad.io.atomic import atomic_path
+    from tabletcad.io.figures import save_figure
 
     ok = df[df["status"] == "ok"]
     numeric = [c for c in df.columns if c not in keys and c not in TAIL_COLUMNS
@@ -202,9 +202,9 @@ def plot_results(df, keys: Sequence[str], outputs: Sequence[str], out_dir: str |
             ax.grid(alpha=0.3)
         fig.suptitle(f"{o}: {len(ok)} designs")
         path = Path(out_dir) / plot_names([o])[0]
-        with atomic_path(path) as tmp:  # (whole or not at all: a plot cut short is no plot of the sweep's)
-            # the mark by which a resumed run knows the plot for its own
-            fig.savefig(tmp, dpi=110, format="png", metadata={"Software": PLOT_SOFTWARE})
+        # written atomically (whole or not at all: a plot cut short is no plot of the sweep's), with the mark
+        # by which a resumed run knows the plot for its own
+        save_figure(fig, path, fmt="png", dpi=110, metadata={"Software": PLOT_SOFTWARE})
         paths.append(path)
     return paths
 

@@ -36,6 +36,7 @@ from OCP.HLRBRep import HLRBRep_Algo, HLRBRep_HLRToShape
 
 from tabletcad.cad._occ import explore
 from tabletcad.io import atomic_path
+from tabletcad.io.figures import save_figure
 from tabletcad.io.timestamp import content_uuid, stamp_time
 from tabletcad.tooling.rating import overload_texts, rating_text
 from tabletcad.tooling.shape_cache import ShapeCache, frozen
@@ -799,19 +800,12 @@ def _write_matplotlib(dr: Drawing, svg: Path, pdf: Path) -> None:
 
     # TrueType (Type 42) fonts in the PDF: its text is text a reader can search and copy, and
     # PDF/A and print workflows accept it (Type 3 fonts are glyph drawings)
-    # the SVG's element ids hashed from their content with a fixed salt (matplotlib salts them with a
-    # random UUID), both files dated by stamp_time(): one drawing, one set of bytes with SOURCE_DATE_EPOCH
-    when = stamp_time()
-    with matplotlib.rc_context({"svg.fonttype": "none", "pdf.fonttype": 42, "svg.hashsalt": _SVG_SALT}):
+    # (save_figure: the SVG's element ids hashed with a fixed salt, both files dated by stamp_time())
+    with matplotlib.rc_context({"svg.fonttype": "none", "pdf.fonttype": 42}):
         fig = _smallest_views_figure(dr)
         _add_title_block(fig, dr, dr.paper)  # (on the sheet kept only)
-        with atomic_path(svg) as tmp:
-            fig.savefig(tmp, format="svg", metadata={"Date": when.isoformat()})
-        with atomic_path(pdf) as tmp:
-            fig.savefig(tmp, format="pdf", metadata={"CreationDate": when})
-
-
-_SVG_SALT = "tabletcad drawing"
+        save_figure(fig, svg, fmt="svg")
+        save_figure(fig, pdf, fmt="pdf")
 
 
 def _exact_entities(wire, origin: tuple[float, float]) -> list[tuple[str, dict]]:
