@@ -199,6 +199,36 @@ def test_text_is_laid_out_as_occ_lays_it_out():
     assert min(float(np.min(c[:, 0])) for contour in lt for c in contour) == pytest.approx(-1017.0, abs=1e-9)
 
 
+def test_the_numerical_core_imports_only_declared_dependencies():
+    """Every library imported by tabletcad.geometry (the lettering: fontTools, which had arrived only through
+    matplotlib), tabletcad.families and tabletcad.mechanics is the distribution of one of [project]'s
+    dependencies, so a plain install runs ``report``."""
+    import ast
+    import sys
+    from importlib.metadata import packages_distributions
+
+    try:
+        import tomllib
+    except ImportError:  # Python 3.10
+        import tomli as tomllib
+
+    deps = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["dependencies"]
+    declared = {re.split(r"[<>=!~;\[ ]", r, maxsplit=1)[0].lower().replace("_", "-") for r in deps}
+    imported = set()
+    for package in ("geometry", "families", "mechanics"):
+        for f in (ROOT / "tabletcad" / package).rglob("*.py"):
+            for node in ast.walk(ast.parse(f.read_text(encoding="utf-8"))):
+                if isinstance(node, ast.Import):
+                    imported |= {a.name.split(".")[0] for a in node.names}
+                elif isinstance(node, ast.ImportFrom) and node.level == 0:
+                    imported.add(node.module.split(".")[0])
+    third = sorted(n for n in imported if n not in sys.stdlib_module_names and n != "tabletcad")
+    assert "fontTools" in third
+    dists = packages_distributions()
+    missing = [n for n in third if not {d.lower().replace("_", "-") for d in dists.get(n, [n])} & declared]
+    assert missing == []
+
+
 def test_report_refuses_a_stroke_angle_that_closes_the_strokes(capsys, tmp_path):
     """The build's other refusal of a figure after the solid: walls at 25 deg meet before 0.5 mm in strokes
     0.414 mm wide (report had printed its table); at 22 deg the report passes."""
