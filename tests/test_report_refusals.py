@@ -229,6 +229,28 @@ def test_the_numerical_core_imports_only_declared_dependencies():
     assert missing == []
 
 
+def _mpl_font(name: str) -> Path:
+    """A font file that matplotlib bundles (STIX: 1000 units per em; the Computer Modern cmr10: 2048)."""
+    import matplotlib
+
+    return Path(matplotlib.get_data_path()) / "fonts" / "ttf" / f"{name}.ttf"
+
+
+def test_a_font_of_1000_units_per_em_is_rounded_as_freetype_rounds_it():
+    """STIX General Bold (1000 units per em) "D1" at 3 mm: the area of OCC's faces (3.0368605419794705 mm^2,
+    measured) to 1e-12; scaled by size / unitsPerEm in double precision it had been 3.036840 (FreeType's 26.6
+    points at 4800 ppem, 0.2 of a step a unit off the grid, and OCC's single-precision layout)."""
+    from tabletcad.geometry.lettering import _font, figure_area, text_contours
+
+    assert abs(figure_area(text_contours("D1", 3.0, _mpl_font("STIXGeneralBol")))) == \
+        pytest.approx(3.0368605419794705, abs=1e-12)
+    from tabletcad.geometry.glyphs import div_fix, face_scale, mul_fix
+
+    assert face_scale(_font(str(_mpl_font("STIXGeneralBol")))) == div_fix(307200, 1000) == 20132659
+    assert div_fix(307200, 2048) == 150 << 16
+    assert [mul_fix(v, 0x8000) for v in (3, -3, 1, -1)] == [2, -2, 1, -1]  # halves away from zero
+
+
 def test_report_refuses_a_stroke_angle_that_closes_the_strokes(capsys, tmp_path):
     """The build's other refusal of a figure after the solid: walls at 25 deg meet before 0.5 mm in strokes
     0.414 mm wide (report had printed its table); at 22 deg the report passes."""
@@ -383,6 +405,36 @@ def test_glyphs_are_occs_vertex_for_vertex():
                         for v in explore(text_faces(text, size, path), "Vertex")])
         ends = np.array([c[0] for contour in text_contours(text, size, path) for c in contour])
         assert max(cKDTree(ends).query(occ)[0].max(), cKDTree(occ).query(ends)[0].max()) < 1e-12, text
+
+
+@pytest.mark.cad
+@pytest.mark.parametrize("name", ["STIXGeneral", "STIXGeneralBol", "STIXGeneralItalic", "STIXGeneralBolIta", "cmr10",
+                                  "cmss10", "DejaVuSansMono-Bold"])
+def test_glyphs_are_occs_vertex_for_vertex_at_any_units_per_em(name):
+    """The bundled fonts of 1000 units per em (STIX), the TeX ones (2048, their own encoding) and a composite
+    with a 2x2 matrix (DejaVu Sans Mono Bold's 'ď'): every vertex OCC's to 1e-12 mm, random strings of the
+    characters each font has (the plain scaling had left STIX up to 1.5e-5 mm off)."""
+    import random
+
+    from fontTools.ttLib import TTFont
+    from OCP.BRep import BRep_Tool
+    from scipy.spatial import cKDTree
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.geometry.lettering import text_contours
+    from tabletcad.tooling.emboss import text_faces
+
+    path = _mpl_font(name)
+    chars = [chr(u) for u in sorted(TTFont(path, lazy=True).getBestCmap()) if 33 <= u < 0x250 and chr(u).isprintable()]
+    rnd = random.Random(name)
+    texts = ["D1", "ď" if "ď" in chars else "AV"] + ["".join(rnd.choice(chars) for _ in range(rnd.randint(2, 6)))
+                                                     for _ in range(8)]
+    for text in texts:
+        size = rnd.uniform(0.5, 4.0)
+        occ = np.array([(BRep_Tool.Pnt_s(v).X(), BRep_Tool.Pnt_s(v).Y())
+                        for v in explore(text_faces(text, size, path), "Vertex")])
+        ends = np.array([c[0] for contour in text_contours(text, size, path) for c in contour])
+        assert max(cKDTree(ends).query(occ)[0].max(), cKDTree(occ).query(ends)[0].max()) < 1e-12, (text, size)
 
 
 @pytest.mark.cad

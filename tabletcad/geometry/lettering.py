@@ -5,18 +5,19 @@ with the punch tip's face (the outline offset inwards by the clearance, land and
 figure that does not fit.  ``tabletcad report`` builds no solid, so the same decision is taken here
 on the same curves:
 
-* **Text** (:func:`text_contours`): the glyph contours read from the font file with fontTools (the
-  TrueType ``glyf`` quadratic or the CFF cubic Béziers, composites decomposed), scaled by
-  ``size / unitsPerEm`` (mm), laid out as OCC's ``StdPrs_BRepTextBuilder`` lays them out with
-  ``Graphic3d_HTA_CENTER`` and ``Graphic3d_VTA_CENTER``: each glyph at the pen, the pen advanced by the
-  glyph's advance width plus the legacy ``kern`` table's pair value (FreeType's ``FT_Get_Kerning``,
-  which OCC calls, reads no GPOS; OCC 7.9's formatter pairs the last of several symbols with itself,
-  so "LT" in DejaVu Sans Bold is 47 units wider than its advances), the line centred on that total
-  advance, and the baseline at ``-ascender + line spacing / 2`` of the ``hhea`` table.  OCC reads the outlines through FreeType at
-  4800 pixels per em in 26.6 fixed point (1/307200 em): a font of 2048 units per em (every DejaVu
-  font) maps onto that grid exactly (150 steps a unit), so the curves are OCC's to round-off
-  (``tests/test_report_refusals.py`` compares them vertex by vertex); a font of other units per em
-  may differ by FreeType's rounding, at most 1/614400 em.
+* **Text** (:func:`text_contours`): the glyph contours read from the font file with fontTools, laid out
+  as OCC's ``StdPrs_BRepTextBuilder`` lays them out with ``Graphic3d_HTA_CENTER`` and
+  ``Graphic3d_VTA_CENTER``: each glyph at the pen, the pen advanced by the glyph's advance width plus
+  the legacy ``kern`` table's pair value (FreeType's ``FT_Get_Kerning``, which OCC calls, reads no
+  GPOS; OCC 7.9's formatter pairs the last of several symbols with itself, so "LT" in DejaVu Sans Bold
+  is 47 units wider than its advances), the line centred on that total advance, and the baseline at
+  ``-ascender + line spacing / 2``.  OCC reads the outlines through FreeType at 4800 pixels per em in
+  26.6 fixed point: a TrueType font's points, advances and kerning are rounded to that grid as
+  FreeType rounds them and laid out in OCC's single precision (:mod:`tabletcad.geometry.glyphs`), so
+  the curves are OCC's to round-off for any units per em (2048: DejaVu, cmr10; 1000: STIX; 1024;
+  ``tests/test_report_refusals.py`` compares them vertex by vertex: the plain scaling had left STIX
+  5e-6 mm off, 7e-6 relative in area).  A CFF font's cubics are scaled in double precision (FreeType's
+  CFF scaling is not reproduced).
 * **A polyline** (``outline = [[x, y], ...]``): its segments.
 * Placed as :func:`tabletcad.tooling.emboss.figure_faces` places it: turned by ``rotation_deg``, moved
   to ``position_mm`` and, on the bottom face, mirrored ``x -> -x``.
@@ -111,21 +112,48 @@ def text_contours(text: str, size: float, path: str | Path) -> list[list[np.ndar
     """The contours (mm) of ``text`` at ``size`` mm per em in the font file ``path``, laid out and centred as
     OCC's text builder centres them (see the module docstring); each contour a list of Bézier control arrays."""
     font = _font(str(path))
-    upm = float(font["head"].unitsPerEm)
     cmap = font.getBestCmap() or {}
+    names = [cmap.get(ord(c), ".notdef") for c in text]
+    # OCC's formatter pairs the last of several symbols with itself (its iterator's next symbol)
+    following = [names[i + 1] if i + 1 < len(names) else name if len(names) > 1 else None
+                 for i, name in enumerate(names)]
+    if "glyf" in font:
+        return _truetype_contours(font, names, following, size)
+    return _pen_contours(font, names, following, size)
+
+
+def _truetype_contours(font, names: list[str], following: list, size: float) -> list[list[np.ndarray]]:
+    """A TrueType font's glyphs as FreeType gives them to OCC (:mod:`tabletcad.geometry.glyphs`), laid out."""
+    from tabletcad.geometry import glyphs
+
+    scale = glyphs.face_scale(font)
+    scale_mm = size / 72.0 * 72.0 / glyphs.PPEM  # (StdPrs_BRepFont's getScale, in its order)
+    loaded, advances = [], []
+    for name, nxt in zip(names, following):
+        pts, on, ends, advance = glyphs.glyph_outline(font, name, scale)
+        kern = glyphs.mul_fix(int(_kerning(font, name, nxt)), scale) if nxt is not None else 0
+        loaded.append(glyphs.glyph_contours(pts, on, ends, scale_mm))
+        advances.append(advance + kern)
+    xs, y = glyphs.layout(advances, font, scale_mm)
+    return [[c + (x, y) for c in contour] for x, contours in zip(xs, loaded) for contour in contours]
+
+
+def _pen_contours(font, names: list[str], following: list, size: float) -> list[list[np.ndarray]]:
+    """A CFF font's glyphs scaled by ``size / unitsPerEm`` in double precision (FreeType's CFF scaling is
+    not reproduced: these may differ from OCC's by its 26.6 rounding), laid out as OCC lays them out."""
+    from tabletcad.geometry.glyphs import face_metrics
+
+    upm = float(font["head"].unitsPerEm)
     glyphs = font.getGlyphSet()
     hmtx = font["hmtx"]
-    names = [cmap.get(ord(c), ".notdef") for c in text]
     pens, x = [], 0.0
-    for i, name in enumerate(names):
+    for name, nxt in zip(names, following):
         rec = _Recorder(glyphs)
         glyphs[name].draw(rec.pen)
         pens.append((x, rec.pen.contours))
-        # OCC's formatter pairs the last of several symbols with itself (its iterator's next symbol)
-        following = names[i + 1] if i + 1 < len(names) else name if len(names) > 1 else None
-        x += hmtx[name][0] + (_kerning(font, name, following) if following is not None else 0.0)
-    hhea = font["hhea"]  # the first baseline at -ascender, moved up by half the line spacing
-    dx, dy = -0.5 * x, -hhea.ascent + 0.5 * (hhea.ascent - hhea.descent + hhea.lineGap)
+        x += hmtx[name][0] + (_kerning(font, name, nxt) if nxt is not None else 0.0)
+    ascender, height = face_metrics(font)  # the first baseline at -ascender, up by half the line spacing
+    dx, dy = -0.5 * x, -ascender + 0.5 * height
     k = size / upm
     return [[(c + (x0 + dx, dy)) * k for c in contour] for x0, contours in pens for contour in contours]
 
