@@ -296,8 +296,11 @@ def offset_bounds_inset(outline, inset: float, tol: float = 1e-9) -> bool:
     h = clearance(v)
     if float(h.min()) < -tol:
         return False
-    spacing = outline.perimeter / len(v)  # a minimum between samples lies below its samples by ~spacing^2 / radius
-    low = (h <= np.roll(h, 1)) & (h <= np.roll(h, -1)) & (h < 4.0 * spacing)
+    # the offset point moves (1 + inset / r) times as fast as the outline's, so the clearance changes by at most
+    # that a millimetre: a minimum between two samples lies within it times their spacing of both
+    speed = 1.0 + inset * max([1.0 / sg.radius for sg in segs if sg.kind != "line"] or [0.0])
+    reach = 2.0 * speed * outline.perimeter / len(v)
+    low = (h <= np.roll(h, 1)) & (h <= np.roll(h, -1)) & (h < reach)
     ext = np.concatenate([[v[-1] - math.tau], v, [v[0] + math.tau]])  # neighbours across 0 = 2 pi
     for i in _lowest_of_runs(low, h):
         r = minimize_scalar(lambda x: float(clearance(np.array([x]))[0]), bounds=(ext[i], ext[i + 2]),
