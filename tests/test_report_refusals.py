@@ -47,6 +47,53 @@ TALLEST = 1.5283608900960957
 #: "AB" (2.5 mm, DejaVu Sans Bold: strokes 0.41356 mm wide by 2A/P) debossed 0.5 mm: its walls meet at 22.468 deg
 STROKE = ROUND.replace('"ABCDEFGH"', '"AB"').replace("depth_mm = 0.12", "depth_mm = 0.5\nstroke_angle_deg = {angle}")
 
+#: a thesis oval (its tooling outline an ellipse: the core does not decide the fit) with "A" (2 mm, DejaVu Sans
+#: Bold: strokes 0.323 mm wide) debossed 0.25 mm at 55 deg: its walls meet at 32.8 deg
+OVAL_STROKE = """[tablet]
+family = "thesis.shallow_convex_oval"
+width = 6.0
+length = 12.0
+thickness = 3.0
+band = 2.0
+
+[tooling]
+clearance_mm = 0.02
+tip_length_mm = 8.0
+
+[[tooling.emboss]]
+text = "A"
+mode = "deboss"
+face = "top"
+height_mm = 2.0
+depth_mm = 0.25
+stroke_angle_deg = 55.0
+"""
+
+#: a peanut of four arcs (lobes of 2 mm, a neck 1.374868 mm across between concave arcs of 0.5 mm: its inward
+#: offsets are clean up to half that) with a bar across the neck, inset by 0.02 + {margin} mm
+PEANUT = """[tablet]
+family = "custom_outline"
+segments = [
+  ["arc", [2.2, 0], 2.0, -2.646658527248898, 5.293317054497796],
+  ["arc", [0, 1.1874342087037915], 0.5, -0.4949341263408954, -2.1517244009080025],
+  ["arc", [-2.2, 0], 2.0, 0.4949341263408953, 5.293317054497796],
+  ["arc", [0, -1.1874342087037915], 0.5, 2.646658527248898, -2.1517244009080025],
+]
+band = 2.5
+cup_depth = 0.05
+
+[tooling]
+clearance_mm = 0.02
+tip_length_mm = 8.0
+
+[[tooling.emboss]]
+outline = [[-0.3, -0.25], [2.5, -0.25], [2.5, 0.25], [-0.3, 0.25]]
+mode = "deboss"
+face = "top"
+depth_mm = 0.1
+margin_mm = {margin}
+"""
+
 SPLINE = """[tablet]
 family = "custom_outline"
 outline = [[4, 0], [3, 3], [0, 4], [-3, 3], [-4, 0], [-3, -3], [0, -4], [3, -3]]
@@ -152,6 +199,58 @@ def test_text_is_laid_out_as_occ_lays_it_out():
     assert min(float(np.min(c[:, 0])) for contour in lt for c in contour) == pytest.approx(-1017.0, abs=1e-9)
 
 
+def test_the_numerical_core_imports_only_declared_dependencies():
+    """Every library imported by tabletcad.geometry (the lettering: fontTools, which had arrived only through
+    matplotlib), tabletcad.families and tabletcad.mechanics is the distribution of one of [project]'s
+    dependencies, so a plain install runs ``report``."""
+    import ast
+    import sys
+    from importlib.metadata import packages_distributions
+
+    try:
+        import tomllib
+    except ImportError:  # Python 3.10
+        import tomli as tomllib
+
+    deps = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["dependencies"]
+    declared = {re.split(r"[<>=!~;\[ ]", r, maxsplit=1)[0].lower().replace("_", "-") for r in deps}
+    imported = set()
+    for package in ("geometry", "families", "mechanics"):
+        for f in (ROOT / "tabletcad" / package).rglob("*.py"):
+            for node in ast.walk(ast.parse(f.read_text(encoding="utf-8"))):
+                if isinstance(node, ast.Import):
+                    imported |= {a.name.split(".")[0] for a in node.names}
+                elif isinstance(node, ast.ImportFrom) and node.level == 0:
+                    imported.add(node.module.split(".")[0])
+    third = sorted(n for n in imported if n not in sys.stdlib_module_names and n != "tabletcad")
+    assert "fontTools" in third
+    dists = packages_distributions()
+    missing = [n for n in third if not {d.lower().replace("_", "-") for d in dists.get(n, [n])} & declared]
+    assert missing == []
+
+
+def _mpl_font(name: str) -> Path:
+    """A font file that matplotlib bundles (STIX: 1000 units per em; the Computer Modern cmr10: 2048)."""
+    import matplotlib
+
+    return Path(matplotlib.get_data_path()) / "fonts" / "ttf" / f"{name}.ttf"
+
+
+def test_a_font_of_1000_units_per_em_is_rounded_as_freetype_rounds_it():
+    """STIX General Bold (1000 units per em) "D1" at 3 mm: the area of OCC's faces (3.0368605419794705 mm^2,
+    measured) to 1e-12; scaled by size / unitsPerEm in double precision it had been 3.036840 (FreeType's 26.6
+    points at 4800 ppem, 0.2 of a step a unit off the grid, and OCC's single-precision layout)."""
+    from tabletcad.geometry.lettering import _font, figure_area, text_contours
+
+    assert abs(figure_area(text_contours("D1", 3.0, _mpl_font("STIXGeneralBol")))) == \
+        pytest.approx(3.0368605419794705, abs=1e-12)
+    from tabletcad.geometry.glyphs import div_fix, face_scale, mul_fix
+
+    assert face_scale(_font(str(_mpl_font("STIXGeneralBol")))) == div_fix(307200, 1000) == 20132659
+    assert div_fix(307200, 2048) == 150 << 16
+    assert [mul_fix(v, 0x8000) for v in (3, -3, 1, -1)] == [2, -2, 1, -1]  # halves away from zero
+
+
 def test_report_refuses_a_stroke_angle_that_closes_the_strokes(capsys, tmp_path):
     """The build's other refusal of a figure after the solid: walls at 25 deg meet before 0.5 mm in strokes
     0.414 mm wide (report had printed its table); at 22 deg the report passes."""
@@ -161,6 +260,39 @@ def test_report_refuses_a_stroke_angle_that_closes_the_strokes(capsys, tmp_path)
     src = tmp_path / "d.toml"
     src.write_text(STROKE.format(height=2.5, angle=22.0), encoding="utf-8")
     assert main(["report", str(src)]) == 0
+
+
+def test_report_refuses_a_stroke_angle_on_a_tablet_whose_fit_it_leaves_to_the_build(capsys, tmp_path):
+    """The stroke angle needs no outline: on a thesis oval (tooling outline an ellipse) report had skipped it with
+    the fit (exit 0) while build refused it before the solid."""
+    line = _refusal(capsys, tmp_path, OVAL_STROKE, "report")
+    assert line == ("error: tooling.emboss[0].stroke_angle_deg = 55 deg is not allowed: must be < 32.8 deg: the walls "
+                    "of 0.323 mm strokes would meet before the depth 0.25 mm")
+
+
+def test_the_fit_beyond_the_offset_limit_is_left_to_the_build(capsys, tmp_path):
+    """Inset by 0.72 mm the peanut's neck (0.6875 mm half width) parts its offset: the closing integral ran along
+    the crossing offset and report refused the bar with 0.464 mm^2 outside (a grid gives 0.440); now the core
+    leaves it to the build's OCC check.  Below the offset limit the area outside is the grid's."""
+    src = tmp_path / "d.toml"
+    src.write_text(PEANUT.format(margin=0.7), encoding="utf-8")
+    assert main(["report", str(src), "--json-file", str(tmp_path / "r.json")]) == 0
+    assert capsys.readouterr().err == ""
+
+    from tabletcad.geometry.lettering import outside_area, polyline_contours
+    from tabletcad.tooling.spec import fit_is_decided, tooling_plan_outline
+
+    outline = tooling_plan_outline(_design(tmp_path, PEANUT.format(margin=0.7)).build())
+    neck = 1.1874342087037915 - 0.5  # the half width of the neck: the offset parts there
+    assert [fit_is_decided(outline, d) for d in (0.68, neck - 1e-8, neck + 1e-8, 0.72, 2.0)] == \
+        [True, True, False, False, True]  # (2 mm: the inscribed radius, nothing left: refused as the tooling)
+    bar = polyline_contours([[-0.3, -0.25], [2.5, -0.25], [2.5, 0.25], [-0.3, 0.25]])
+    xs, ys = (np.arange(2000) + 0.5) * 2.8 / 2000 - 0.3, (np.arange(500) + 0.5) * 0.5 / 500 - 0.25
+    grid = np.stack(np.meshgrid(xs, ys), -1).reshape(-1, 2)
+    depth = np.concatenate([outline.signed_distance(grid[k:k + 1000]) for k in range(0, len(grid), 1000)])
+    for inset in (0.5, 0.68):
+        area, outside = outside_area(bar, outline, inset)
+        assert outside == pytest.approx(float(np.mean(depth < inset)) * area, abs=1e-4)
 
 
 # ----------------------------------------------------------------------------- spline outline (no CAD)
@@ -184,6 +316,7 @@ def test_the_same_outline_of_lines_and_arcs_is_reported(tmp_path):
 @pytest.mark.cad
 @pytest.mark.parametrize("design, needle", [(ROUND.format(height=2.5), "does not fit the bottom face"),
                                             (STROKE.format(height=2.5, angle=25.0), "strokes would meet"),
+                                            (OVAL_STROKE, "strokes would meet"),
                                             (SPLINE, "tablet.outline")])
 def test_report_and_build_refuse_with_the_same_line(capsys, tmp_path, design, needle):
     report = _refusal(capsys, tmp_path, design, "report")
@@ -198,6 +331,35 @@ def test_text_just_inside_the_limit_builds(tmp_path):
     assert main(["report", str(src)]) == 0
     assert main(["build", str(src), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     assert (tmp_path / "out" / "upper_punch.step").is_file()
+
+
+@pytest.mark.cad
+def test_the_fit_on_a_concave_outline_is_occs_boolean_below_its_offset_limit(tmp_path):
+    """The peanut's bar inset by 0.62 and 0.68 mm (below its neck's half width 0.687434): the core's area outside is the
+    OCC Boolean's and both refuse with the same line; at 0.72 mm (beyond it) the core says nothing and the build
+    refuses after the solid, OCC's offset of the outline giving two wires (the README's list), writing nothing."""
+    from tabletcad.cad._occ import explore
+    from tabletcad.geometry.lettering import outside_area
+    from tabletcad.tooling.emboss import check_fit, figure_faces
+    from tabletcad.tooling.outline import face_area, offset_wire, plan_face, tablet_frame
+    from tabletcad.tooling.spec import figure_contours, figure_fit_refusal, tooling_plan_outline
+
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+
+    for margin in (0.6, 0.66):
+        d = _design(tmp_path, PEANUT.format(margin=margin))
+        t, e = d.build(), d.tooling_spec.emboss[0]
+        frame, outline, inset = tablet_frame(t), tooling_plan_outline(t), 0.02 + margin
+        cut = BRepAlgoAPI_Cut(figure_faces(e), plan_face(offset_wire(frame.outline, -inset))).Shape()
+        occ = sum(face_area(f) for f in explore(cut, "Face"))
+        assert outside_area(figure_contours(e), outline, inset)[1] == pytest.approx(occ, abs=1e-9)
+        mine = figure_fit_refusal(e, 0, figure_contours(e), outline, inset)
+        with pytest.raises(DesignError) as theirs:
+            check_fit(frame, e, figure_faces(e), 0.02)
+        assert str(mine) == str(theirs.value)
+    (tmp_path / "d.toml").write_text(PEANUT.format(margin=0.7), encoding="utf-8")
+    assert main(["build", str(tmp_path / "d.toml"), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    assert not (tmp_path / "out").exists()
 
 
 @pytest.mark.cad
@@ -243,6 +405,36 @@ def test_glyphs_are_occs_vertex_for_vertex():
                         for v in explore(text_faces(text, size, path), "Vertex")])
         ends = np.array([c[0] for contour in text_contours(text, size, path) for c in contour])
         assert max(cKDTree(ends).query(occ)[0].max(), cKDTree(occ).query(ends)[0].max()) < 1e-12, text
+
+
+@pytest.mark.cad
+@pytest.mark.parametrize("name", ["STIXGeneral", "STIXGeneralBol", "STIXGeneralItalic", "STIXGeneralBolIta", "cmr10",
+                                  "cmss10", "DejaVuSansMono-Bold"])
+def test_glyphs_are_occs_vertex_for_vertex_at_any_units_per_em(name):
+    """The bundled fonts of 1000 units per em (STIX), the TeX ones (2048, their own encoding) and a composite
+    with a 2x2 matrix (DejaVu Sans Mono Bold's 'ď'): every vertex OCC's to 1e-12 mm, random strings of the
+    characters each font has (the plain scaling had left STIX up to 1.5e-5 mm off)."""
+    import random
+
+    from fontTools.ttLib import TTFont
+    from OCP.BRep import BRep_Tool
+    from scipy.spatial import cKDTree
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.geometry.lettering import text_contours
+    from tabletcad.tooling.emboss import text_faces
+
+    path = _mpl_font(name)
+    chars = [chr(u) for u in sorted(TTFont(path, lazy=True).getBestCmap()) if 33 <= u < 0x250 and chr(u).isprintable()]
+    rnd = random.Random(name)
+    texts = ["D1", "ď" if "ď" in chars else "AV"] + ["".join(rnd.choice(chars) for _ in range(rnd.randint(2, 6)))
+                                                     for _ in range(8)]
+    for text in texts:
+        size = rnd.uniform(0.5, 4.0)
+        occ = np.array([(BRep_Tool.Pnt_s(v).X(), BRep_Tool.Pnt_s(v).Y())
+                        for v in explore(text_faces(text, size, path), "Vertex")])
+        ends = np.array([c[0] for contour in text_contours(text, size, path) for c in contour])
+        assert max(cKDTree(ends).query(occ)[0].max(), cKDTree(occ).query(ends)[0].max()) < 1e-12, (text, size)
 
 
 @pytest.mark.cad

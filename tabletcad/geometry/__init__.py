@@ -5,5 +5,6 @@ closed boundary curves a design is made of (:mod:`.curves`), the Bloor-Wilson PD
 patches they bound (:mod:`.patch`), and the tablet, a chain of patches with its
 trims, checks and solid map (:mod:`.tablet`).  :mod:`.nominal` holds the exact
 nominal shapes of the thesis's tablets as signed distance functions; :mod:`.lettering` an engraved
-figure's plan curves (a font's glyphs, as OCC lays them out) and how much of it lies outside a face.
+figure's plan curves (a font's glyphs, as OCC lays them out) and how much of it lies outside a face,
+:mod:`.glyphs` a TrueType glyph's points as FreeType rounds them for OCC.
 """

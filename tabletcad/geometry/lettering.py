@@ -5,18 +5,19 @@ with the punch tip's face (the outline offset inwards by the clearance, land and
 figure that does not fit.  ``tabletcad report`` builds no solid, so the same decision is taken here
 on the same curves:
 
-* **Text** (:func:`text_contours`): the glyph contours read from the font file with fontTools (the
-  TrueType ``glyf`` quadratic or the CFF cubic Béziers, composites decomposed), scaled by
-  ``size / unitsPerEm`` (mm), laid out as OCC's ``StdPrs_BRepTextBuilder`` lays them out with
-  ``Graphic3d_HTA_CENTER`` and ``Graphic3d_VTA_CENTER``: each glyph at the pen, the pen advanced by the
-  glyph's advance width plus the legacy ``kern`` table's pair value (FreeType's ``FT_Get_Kerning``,
-  which OCC calls, reads no GPOS; OCC 7.9's formatter pairs the last of several symbols with itself,
-  so "LT" in DejaVu Sans Bold is 47 units wider than its advances), the line centred on that total
-  advance, and the baseline at ``-ascender + line spacing / 2`` of the ``hhea`` table.  OCC reads the outlines through FreeType at
-  4800 pixels per em in 26.6 fixed point (1/307200 em): a font of 2048 units per em (every DejaVu
-  font) maps onto that grid exactly (150 steps a unit), so the curves are OCC's to round-off
-  (``tests/test_report_refusals.py`` compares them vertex by vertex); a font of other units per em
-  may differ by FreeType's rounding, at most 1/614400 em.
+* **Text** (:func:`text_contours`): the glyph contours read from the font file with fontTools, laid out
+  as OCC's ``StdPrs_BRepTextBuilder`` lays them out with ``Graphic3d_HTA_CENTER`` and
+  ``Graphic3d_VTA_CENTER``: each glyph at the pen, the pen advanced by the glyph's advance width plus
+  the legacy ``kern`` table's pair value (FreeType's ``FT_Get_Kerning``, which OCC calls, reads no
+  GPOS; OCC 7.9's formatter pairs the last of several symbols with itself, so "LT" in DejaVu Sans Bold
+  is 47 units wider than its advances), the line centred on that total advance, and the baseline at
+  ``-ascender + line spacing / 2``.  OCC reads the outlines through FreeType at 4800 pixels per em in
+  26.6 fixed point: a TrueType font's points, advances and kerning are rounded to that grid as
+  FreeType rounds them and laid out in OCC's single precision (:mod:`tabletcad.geometry.glyphs`), so
+  the curves are OCC's to round-off for any units per em (2048: DejaVu, cmr10; 1000: STIX; 1024;
+  ``tests/test_report_refusals.py`` compares them vertex by vertex: the plain scaling had left STIX
+  5e-6 mm off, 7e-6 relative in area).  A CFF font's cubics are scaled in double precision (FreeType's
+  CFF scaling is not reproduced).
 * **A polyline** (``outline = [[x, y], ...]``): its segments.
 * Placed as :func:`tabletcad.tooling.emboss.figure_faces` places it: turned by ``rotation_deg``, moved
   to ``position_mm`` and, on the bottom face, mirrored ``x -> -x``.
@@ -25,8 +26,10 @@ on the same curves:
 (the outline's inward offset by ``inset``) by Green's theorem, exactly: ``∮ x dy`` over the figure's
 curves where they lie outside (Gauss–Legendre, exact on polynomials), their crossings of the offset
 found by Brent's method on the outline's exact signed distance, and closed along the offset curve
-(its lines and arcs) between the crossings.  It needs the offset to be regular where the figure
-crosses it (every convex arc of radius above ``inset``: :attr:`PlanOutline.min_convex_radius`); a
+(its lines and arcs) between the crossings.  It needs that offset curve to be the inset region's
+boundary (:func:`offset_bounds_inset`: ``inset`` below every convex arc's radius, and no neck where
+the offset would cross itself or part in two: there the closing integral would run along the
+crossing offset, 0.464 mm² instead of 0.440 on a peanut's neck; the caller leaves those to OCC); a
 crossing point is found between 64 samples of each Bézier, so a tangential touch thinner than their
 spacing (area < 1e-9 mm² on tablet lettering) is missed, far below the refusal threshold.
 """
@@ -40,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["text_contours", "polyline_contours", "placed", "figure_area", "figure_box", "figure_length",
-           "outside_area"]
+           "outside_area", "offset_bounds_inset"]
 
 #: Gauss-Legendre nodes and weights on [0, 1] (exact for polynomials of degree 15)
 _GX, _GW = np.polynomial.legendre.leggauss(8)
@@ -109,21 +112,48 @@ def text_contours(text: str, size: float, path: str | Path) -> list[list[np.ndar
     """The contours (mm) of ``text`` at ``size`` mm per em in the font file ``path``, laid out and centred as
     OCC's text builder centres them (see the module docstring); each contour a list of Bézier control arrays."""
     font = _font(str(path))
-    upm = float(font["head"].unitsPerEm)
     cmap = font.getBestCmap() or {}
+    names = [cmap.get(ord(c), ".notdef") for c in text]
+    # OCC's formatter pairs the last of several symbols with itself (its iterator's next symbol)
+    following = [names[i + 1] if i + 1 < len(names) else name if len(names) > 1 else None
+                 for i, name in enumerate(names)]
+    if "glyf" in font:
+        return _truetype_contours(font, names, following, size)
+    return _pen_contours(font, names, following, size)
+
+
+def _truetype_contours(font, names: list[str], following: list, size: float) -> list[list[np.ndarray]]:
+    """A TrueType font's glyphs as FreeType gives them to OCC (:mod:`tabletcad.geometry.glyphs`), laid out."""
+    from tabletcad.geometry import glyphs
+
+    scale = glyphs.face_scale(font)
+    scale_mm = size / 72.0 * 72.0 / glyphs.PPEM  # (StdPrs_BRepFont's getScale, in its order)
+    loaded, advances = [], []
+    for name, nxt in zip(names, following):
+        pts, on, ends, advance = glyphs.glyph_outline(font, name, scale)
+        kern = glyphs.mul_fix(int(_kerning(font, name, nxt)), scale) if nxt is not None else 0
+        loaded.append(glyphs.glyph_contours(pts, on, ends, scale_mm))
+        advances.append(advance + kern)
+    xs, y = glyphs.layout(advances, font, scale_mm)
+    return [[c + (x, y) for c in contour] for x, contours in zip(xs, loaded) for contour in contours]
+
+
+def _pen_contours(font, names: list[str], following: list, size: float) -> list[list[np.ndarray]]:
+    """A CFF font's glyphs scaled by ``size / unitsPerEm`` in double precision (FreeType's CFF scaling is
+    not reproduced: these may differ from OCC's by its 26.6 rounding), laid out as OCC lays them out."""
+    from tabletcad.geometry.glyphs import face_metrics
+
+    upm = float(font["head"].unitsPerEm)
     glyphs = font.getGlyphSet()
     hmtx = font["hmtx"]
-    names = [cmap.get(ord(c), ".notdef") for c in text]
     pens, x = [], 0.0
-    for i, name in enumerate(names):
+    for name, nxt in zip(names, following):
         rec = _Recorder(glyphs)
         glyphs[name].draw(rec.pen)
         pens.append((x, rec.pen.contours))
-        # OCC's formatter pairs the last of several symbols with itself (its iterator's next symbol)
-        following = names[i + 1] if i + 1 < len(names) else name if len(names) > 1 else None
-        x += hmtx[name][0] + (_kerning(font, name, following) if following is not None else 0.0)
-    hhea = font["hhea"]  # the first baseline at -ascender, moved up by half the line spacing
-    dx, dy = -0.5 * x, -hhea.ascent + 0.5 * (hhea.ascent - hhea.descent + hhea.lineGap)
+        x += hmtx[name][0] + (_kerning(font, name, nxt) if nxt is not None else 0.0)
+    ascender, height = face_metrics(font)  # the first baseline at -ascender, up by half the line spacing
+    dx, dy = -0.5 * x, -ascender + 0.5 * height
     k = size / upm
     return [[(c + (x0 + dx, dy)) * k for c in contour] for x0, contours in pens for contour in contours]
 
@@ -236,10 +266,72 @@ def _offset_x_dy(outline, inset: float, v0: float, v1: float) -> float:
     return total
 
 
+def offset_bounds_inset(outline, inset: float, tol: float = 1e-9) -> bool:
+    """Whether the lines-and-arcs ``outline``'s inward offset by ``inset`` mm is the boundary of its inset region
+    ``{p : distance inside >= inset}``, the curve :func:`outside_area` closes along: ``inset`` below every convex
+    arc's radius and no point of the offset nearer than ``inset - tol`` to another segment of the outline than
+    its own (else the offset crosses itself or parts in two at a neck).
+
+    That clearance ``min_{j != own} d_j(O + inset N) - inset`` is smooth where the signed distance is flat (0 on
+    a clean offset), so it is sampled (4,096 and the joins) and every low local minimum polished by bounded
+    Brent: a neck is found to round-off, where
+    :meth:`~tabletcad.families.outline.PlanOutline.offset_limit` (2,048 samples of the signed distance, to
+    1e-7) takes a peanut's neck of half width 0.687434 mm for 0.687451."""
+    from scipy.optimize import minimize_scalar
+
+    from tabletcad.families.outline import _signed_to_segment
+
+    if not inset < outline.min_convex_radius:
+        return False
+    segs, breaks = outline.segs, outline.breaks
+
+    def clearance(vs: np.ndarray) -> np.ndarray:
+        own = np.clip(np.searchsorted(breaks, np.mod(vs, math.tau), side="right") - 1, 0, len(segs) - 1)
+        q = outline.offset(vs, 0, 1.0, inset)
+        dist = np.stack([_signed_to_segment(sg, q)[0] for sg in segs])
+        dist[own, np.arange(len(vs))] = np.inf
+        return dist.min(axis=0) - inset
+
+    v = np.unique(np.concatenate([np.linspace(0.0, math.tau, 4096, endpoint=False), breaks[:-1]]))
+    h = clearance(v)
+    if float(h.min()) < -tol:
+        return False
+    # the offset point moves (1 + inset / r) times as fast as the outline's, so the clearance changes by at most
+    # that a millimetre: a minimum between two samples lies within it times their spacing of both
+    speed = 1.0 + inset * max([1.0 / sg.radius for sg in segs if sg.kind != "line"] or [0.0])
+    reach = 2.0 * speed * outline.perimeter / len(v)
+    low = (h <= np.roll(h, 1)) & (h <= np.roll(h, -1)) & (h < reach)
+    ext = np.concatenate([[v[-1] - math.tau], v, [v[0] + math.tau]])  # neighbours across 0 = 2 pi
+    for i in _lowest_of_runs(low, h):
+        r = minimize_scalar(lambda x: float(clearance(np.array([x]))[0]), bounds=(ext[i], ext[i + 2]),
+                            method="bounded", options=dict(xatol=1e-13))
+        if float(r.fun) < -tol:
+            return False
+    return True
+
+
+def _lowest_of_runs(mask: np.ndarray, h: np.ndarray) -> list[int]:
+    """The index of the least ``h`` in each run of adjacent ``True`` of the cyclic ``mask`` (a flat stretch of
+    local minima, as a capsule's parallel sides give, polished once)."""
+    if mask.all():
+        return [int(np.argmin(h))]
+    start = int(np.flatnonzero(~mask)[0])  # runs read from a False, so none wraps
+    order = np.roll(np.arange(mask.size), -start)
+    out, run = [], []
+    for k in list(order) + [start]:
+        if mask[k]:
+            run.append(k)
+        elif run:
+            out.append(min(run, key=lambda j: h[j]))
+            run = []
+    return [int(k) for k in out]
+
+
 def outside_area(contours, outline, inset: float) -> tuple[float, float]:
     """``(area, outside)`` (mm²): the figure's area and the part of it farther out than the lines-and-arcs
     ``outline`` (a :class:`~tabletcad.families.outline.PlanOutline`) offset inwards by ``inset`` mm (see the
-    module docstring).  ``inset`` must be below the outline's :attr:`min_convex_radius` and its inscribed radius."""
+    module docstring).  The offset must bound the inset region (:func:`offset_bounds_inset`), else the result is not
+    the area outside."""
     sign = 1.0 if figure_area(contours) >= 0 else -1.0  # the fill's orientation made counter-clockwise
     area = sign * figure_area(contours)
 

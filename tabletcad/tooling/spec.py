@@ -342,9 +342,10 @@ def check_figures_on_tablet(tablet: Any, spec: ToolingSpec, cups: dict[str, floa
     inwards by the clearance, the face's land and the figure's margin, one whose text gives no glyphs, or one
     whose stroke angle closes its strokes before its depth (:func:`stroke_angle_refusal`).
     Decided on the same curves without OCC (:mod:`tabletcad.geometry.lettering`); ``cups`` (face -> mm) tell
-    a flat face (no land).  Not decided here (the build still checks them): an SVG logo, an outline the
-    tooling takes as an ellipse or its band's section, and an inset at or beyond a convex arc's radius of the
-    outline (its offset there is no longer the arc's)."""
+    a flat face (no land).  The stroke angle is decided for every text or polyline figure (it needs no
+    outline).  The fit is not decided here (the build still checks it after the solid) for an SVG logo, an
+    outline the tooling takes as an ellipse or its band's section, and an inset whose offset of the outline
+    crosses itself or parts in two (:func:`fit_is_decided`)."""
     from tabletcad.families.thesis import NO_LAND
 
     if not spec.emboss:
@@ -356,14 +357,27 @@ def check_figures_on_tablet(tablet: Any, spec: ToolingSpec, cups: dict[str, floa
         land = 0.0
     for i, e in enumerate(spec.emboss):
         contours = figure_contours(e, i)
-        if contours is None or outline is None:
+        if contours is None:
             continue
         inset = spec.clearance_mm + (0.0 if cups[e.face] < 1e-9 else (land or 0.0)) + e.margin_mm
-        if inset >= outline.min_convex_radius and inset < outline.inscribed_radius():
-            continue
-        refusal = figure_fit_refusal(e, i, contours, outline, inset) or stroke_angle_refusal(e, i, contours)
+        decided = outline is not None and fit_is_decided(outline, inset)
+        # the fit first, as the tooling's check_emboss; the stroke angle, which needs no outline, in any case
+        refusal = (figure_fit_refusal(e, i, contours, outline, inset) if decided else None) \
+            or stroke_angle_refusal(e, i, contours)
         if refusal is not None:
             raise refusal
+
+
+def fit_is_decided(outline: Any, inset: float) -> bool:
+    """Whether :func:`figure_fit_refusal` decides a figure's fit inside ``outline`` (a
+    :class:`~tabletcad.families.outline.PlanOutline`) offset inwards by ``inset`` mm as the tooling's OCC
+    Boolean does: where that offset bounds the inset region
+    (:func:`tabletcad.geometry.lettering.offset_bounds_inset`: the curve the area outside is closed along) or
+    at and beyond the outline's inscribed radius (no face left).  Between the two (a convex arc turned inside
+    out, a narrow neck whose offset crosses itself or parts in two) the build decides it after the solid."""
+    from tabletcad.geometry.lettering import offset_bounds_inset
+
+    return not inset < outline.inscribed_radius() or offset_bounds_inset(outline, inset)
 
 
 def stroke_angle_refusal(e: EmbossSpec, i: int, contours: list) -> DesignError | None:
