@@ -1,6 +1,7 @@
 """``tabletcad report`` refuses what ``tabletcad build`` refuses for a design's ``[tooling]``, with the same
-line, before any geometry: lettering that does not fit its face and a spline outline, which a trial found
-``report`` accepting (exit 0) while ``build`` refused them after ~2 s of CAD.
+line, before any geometry: lettering that does not fit its face, which a trial found ``report`` accepting
+(exit 0) while ``build`` refused it after ~2 s of CAD, and a clearance beyond a spline outline's regular
+offsets (a custom outline through points; its tooling is tested in tests/test_tooling_spline_outline.py).
 
 The fit is decided without OCC (:mod:`tabletcad.geometry.lettering`); the tests marked ``cad`` hold it
 against OpenCascade's own figure and Boolean (:func:`tabletcad.tooling.emboss.check_fit`)."""
@@ -55,6 +56,22 @@ cup_depth = 0.5
 
 [tooling]
 clearance_mm = 0.02
+tip_length_mm = 8.0
+"""
+
+#: a rounded square through points whose corners' smallest radius of curvature is 0.276 mm: its tips, inset by a
+#: 0.3 mm clearance, would pass it (the largest regular inset is 0.273248 mm, 1 % short of that radius)
+SPLINE_CORNER = """[tablet]
+family = "custom_outline"
+outline = [[4.0, -1.8], [4.0, 0.0], [4.0, 1.8], [3.9864, 3.7035], [3.8828, 3.8828], [3.7035, 3.9864], [1.8, 4.0],
+           [0.0, 4.0], [-1.8, 4.0], [-3.7035, 3.9864], [-3.8828, 3.8828], [-3.9864, 3.7035], [-4.0, 1.8], [-4.0, 0.0],
+           [-4.0, -1.8], [-3.9864, -3.7035], [-3.8828, -3.8828], [-3.7035, -3.9864], [-1.8, -4.0], [0.0, -4.0],
+           [1.8, -4.0], [3.7035, -3.9864], [3.8828, -3.8828], [3.9864, -3.7035]]
+band = 2.5
+cup_depth = 0.2
+
+[tooling]
+clearance_mm = {clearance}
 tip_length_mm = 8.0
 """
 
@@ -165,12 +182,27 @@ def test_report_refuses_a_stroke_angle_that_closes_the_strokes(capsys, tmp_path)
 
 # ----------------------------------------------------------------------------- spline outline (no CAD)
 
-def test_report_refuses_tooling_of_a_spline_outline(capsys, tmp_path):
-    """A custom outline through points with [tooling]: report had printed its table (exit 0); build refused it
-    after the solid, OCC failing to offset the band's section for the tips and the bore."""
-    line = _refusal(capsys, tmp_path, SPLINE, "report")
-    assert line.startswith("error: tablet.outline = 'points (a spline through them)' is not allowed: tooling needs "
-                           "an outline OpenCascade can offset")
+def test_report_passes_tooling_of_a_spline_outline(tmp_path):
+    """A custom outline through points with [tooling]: refused by report and build alike (OCC could not offset
+    it), it is reported now (the tips and the bore are the B-splines of its exact offsets)."""
+    src = tmp_path / "d.toml"
+    src.write_text(SPLINE, encoding="utf-8")
+    assert main(["report", str(src)]) == 0
+
+
+def test_report_refuses_a_clearance_beyond_a_spline_corner(capsys, tmp_path):
+    """The tips inset by the clearance past the spline's smallest convex radius of curvature (less 1 %,
+    Tolerances.offset_regularity) would loop there: refused, with the largest clearance that is allowed."""
+    line = _refusal(capsys, tmp_path, SPLINE_CORNER.format(clearance=0.3), "report")
+    assert line == ("error: tooling.clearance_mm = 0.3 mm is not allowed: must be <= 0.273249 mm: the tooling offsets "
+                    "the spline outline 0.3 mm inward for it, at most 0.273248 mm (its smallest convex radius of "
+                    "curvature is 0.276 mm, and the offset must stay regular and clear of the narrowest place)")
+
+
+def test_the_largest_clearance_stated_is_reported(tmp_path):
+    src = tmp_path / "d.toml"
+    src.write_text(SPLINE_CORNER.format(clearance=0.273249), encoding="utf-8")
+    assert main(["report", str(src)]) == 0
 
 
 def test_the_same_outline_of_lines_and_arcs_is_reported(tmp_path):
@@ -184,7 +216,7 @@ def test_the_same_outline_of_lines_and_arcs_is_reported(tmp_path):
 @pytest.mark.cad
 @pytest.mark.parametrize("design, needle", [(ROUND.format(height=2.5), "does not fit the bottom face"),
                                             (STROKE.format(height=2.5, angle=25.0), "strokes would meet"),
-                                            (SPLINE, "tablet.outline")])
+                                            (SPLINE_CORNER.format(clearance=0.3), "tooling.clearance_mm")])
 def test_report_and_build_refuse_with_the_same_line(capsys, tmp_path, design, needle):
     report = _refusal(capsys, tmp_path, design, "report")
     build = _refusal(capsys, tmp_path, design, "build")
@@ -198,24 +230,6 @@ def test_text_just_inside_the_limit_builds(tmp_path):
     assert main(["report", str(src)]) == 0
     assert main(["build", str(src), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     assert (tmp_path / "out" / "upper_punch.step").is_file()
-
-
-@pytest.mark.cad
-def test_the_spline_refusal_is_occs():
-    """The refusal is decided from the outline's kind: OCC's planar offset fails on the band section of every
-    spline outline tried (a circle through 24 points, ovals through 8 and 64)."""
-    from tabletcad.cad.tablet_solid import tablet_solid
-    from tabletcad.errors import GeometryError
-    from tabletcad.families.shaped import outline_tablet
-    from tabletcad.tooling.outline import _section_wire, offset_wire
-    from tabletcad.tooling.spec import band_heights
-
-    for n, a, b in ((24, 5.0, 5.0), (8, 4.0, 4.0), (64, 6.0, 4.0)):
-        t = outline_tablet([[a * math.cos(math.tau * k / n), b * math.sin(math.tau * k / n)] for k in range(n)],
-                           band=2.5, cup_depth=0.5)
-        z = band_heights(t)
-        with pytest.raises(GeometryError):
-            offset_wire(_section_wire(tablet_solid(t).shape, 0.5 * (z[0] + z[1])), -0.01)
 
 
 @pytest.mark.cad

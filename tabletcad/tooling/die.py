@@ -22,7 +22,7 @@ from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
 from tabletcad.cad._occ import cast, explore
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.tooling.booleans import boolean, translated, volume
-from tabletcad.tooling.outline import TabletFrame, offset_wire, plan_face, prism
+from tabletcad.tooling.outline import TabletFrame, plan_face, prism, spline_offset_deviation
 from tabletcad.tooling.spec import MIN_DIE_WALL_MM, die_faces_z, standard_die_size
 
 __all__ = ["die", "default_die_size", "tapered_prism", "bore_wire", "MIN_WALL_MM"]
@@ -82,7 +82,7 @@ def bore_wire(frame: TabletFrame):
         (mm) where the band bulges; the outline itself where the band is a prism.
     """
     bulge = frame.bore_offset
-    return offset_wire(frame.outline, bulge) if bulge > 0 else frame.outline
+    return frame.offset(bulge) if bulge > 0 else frame.outline
 
 
 def default_die_size(frame: TabletFrame) -> tuple[float, float, str]:
@@ -140,4 +140,6 @@ def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, 
         bore_max_radius_mm=r_bore, taper_deg=taper_deg, taper_start_z_mm=z_taper if taper_deg > 0 else None,
         bore_growth_at_top_mm=grow, volume_mm3=volume(shape),
     )
+    if frame.spline is not None:  # the bore's B-spline against the spline outline's exact offset, measured densely
+        info.update(spline_offset_deviation(frame, bulge, "bore"))
     return shape, info
