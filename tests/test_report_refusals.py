@@ -205,6 +205,36 @@ def test_the_largest_clearance_stated_is_reported(tmp_path):
     assert main(["report", str(src)]) == 0
 
 
+#: a circle of 4 mm through 24 points, dented at -x: its spline's dent has a concave radius of curvature 0.6389 mm,
+#: which an outward offset (the die bore drafted by taper_deg over the 3 mm entry and 1 mm above) may not pass
+DENTED = """[tablet]
+family = "custom_outline"
+outline = [[4.0, 0.0], [3.8637, 1.0353], [3.4641, 2.0], [2.8284, 2.8284], [2.0, 3.4641], [1.0353, 3.8637], [0.0, 4.0],
+           [-1.0353, 3.8637], [-1.9999, 3.464], [-2.8238, 2.8238], [-3.3717, 1.9467], [-3.3117, 0.8874], [-3.0, 0.0],
+           [-3.3117, -0.8874], [-3.3717, -1.9467], [-2.8238, -2.8238], [-1.9999, -3.464], [-1.0353, -3.8637],
+           [0.0, -4.0], [1.0353, -3.8637], [2.0, -3.4641], [2.8284, -2.8284], [3.4641, -2.0], [3.8637, -1.0353]]
+band = 2.5
+cup_depth = 0.3
+
+[tooling]
+clearance_mm = 0.02
+tip_length_mm = 8.0
+taper_deg = {taper}
+"""
+
+
+def test_report_refuses_a_taper_whose_bore_passes_a_spline_dent(capsys, tmp_path):
+    """An outward offset past the spline's smallest concave radius of curvature (less 1 %) loops: the drafted
+    bore, 4 mm x tan(9.5 deg) = 0.6694 mm outward at its top, is refused with the largest taper allowed."""
+    line = _refusal(capsys, tmp_path, DENTED.format(taper=9.5), "report")
+    assert line == ("error: tooling.taper_deg = 9.5 deg is not allowed: must be <= 8.98497 deg: the die bore drafted "
+                    "over 4 mm grows 0.6694 mm outward, at most 0.632463 mm (its smallest concave radius of curvature "
+                    "is 0.6389 mm, and the offset must stay regular and keep its notches open)")
+    src = tmp_path / "d.toml"
+    src.write_text(DENTED.format(taper=8.98497), encoding="utf-8")
+    assert main(["report", str(src)]) == 0
+
+
 def test_the_same_outline_of_lines_and_arcs_is_reported(tmp_path):
     src = tmp_path / "d.toml"
     src.write_text(SEGMENTS, encoding="utf-8")

@@ -178,3 +178,24 @@ def test_build_writes_the_tooling(tmp_path, capsys):
     assert r["upper_punch"]["tip_outline"] == "spline"
     assert r["upper_punch"]["tip_outline_deviation_mm"] <= SPLINE_OFFSET_TOL_MM
     assert r["interference_mm3"] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_tapered_bore_is_the_exact_offset_at_every_height(square):
+    """LocOpe_DPrism's draft of the spline bore failed BRepCheck_Analyzer (``build`` exit 1 with taper_deg);
+    the ruled solid between the bore and its exact offset at the top is valid, and the die's volume is the
+    blank less the straight bore and the drafted one: the integral of Steiner's area of the outline grown by
+    ``e(z) = bulge + z tan(taper)``."""
+    from tabletcad.tooling.die import die
+
+    frame, outline = square.frame, square.tablet.nominal.outline
+    shape, info = die(frame, None, None, taper_deg=1.0)
+    check_solid(shape, "die")
+    t, h = math.tan(math.radians(1.0)), info["top_z_mm"] - info["taper_start_z_mm"]
+    e = info["bore_enlarged_by_band_bulge_mm"]
+    A, P = outline.area, outline.perimeter
+    straight = (A + P * e + math.pi * e * e) * (info["taper_start_z_mm"] - info["bottom_z_mm"])
+    drafted = A * h + P * (e * h + t * h * h / 2) + math.pi * (e * e * h + e * t * h * h + t * t * h ** 3 / 3)
+    blank = math.pi * (0.5 * info["outer_diameter_mm"]) ** 2 * info["height_mm"]
+    assert info["bore_growth_at_top_mm"] == pytest.approx(info["punch_entry_mm"] * t, rel=1e-12)
+    assert info["volume_mm3"] == pytest.approx(blank - straight - drafted,
+                                               abs=P * SPLINE_OFFSET_TOL_MM * info["height_mm"])

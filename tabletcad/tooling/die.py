@@ -67,6 +67,26 @@ def tapered_prism(wire, z0: float, z1: float, taper_deg: float):
     return shape
 
 
+def spline_tapered_prism(frame: TabletFrame, bulge: float, z0: float, z1: float, taper_deg: float):
+    """:func:`tapered_prism` of a spline outline's bore (the outline grown by ``bulge`` mm at ``z0``), which
+    ``LocOpe_DPrism`` made invalid (``BRepCheck_Analyzer``): the ruled solid between the bore and the outline's
+    exact offset by ``bulge + (z1 - z0) tan(taper)`` at ``z1`` (:meth:`TabletFrame.offset`), both B-splines in
+    the outline's parameter, so that each ruling joins the points of one normal and each section is the
+    exact offset's B-spline at its height (the offset is linear in its distance)."""
+    from OCP.BRepCheck import BRepCheck_Analyzer
+    from OCP.BRepOffsetAPI import BRepOffsetAPI_ThruSections
+
+    top = bulge + (z1 - z0) * math.tan(math.radians(taper_deg))
+    mk = BRepOffsetAPI_ThruSections(True, True, 1e-6)  # (a solid, ruled)
+    mk.CheckCompatibility(False)  # (the sections' own parameters pair them: no rotation to match)
+    mk.AddWire(cast(translated(bore_wire(frame), dz=z0), "Wire"))
+    mk.AddWire(cast(translated(frame.offset(top), dz=z1), "Wire"))
+    mk.Build()
+    if not mk.IsDone() or not BRepCheck_Analyzer(mk.Shape()).IsValid():
+        raise GeometryError(f"drafting the die bore by {taper_deg} deg failed", frame.outline)
+    return mk.Shape()
+
+
 def bore_wire(frame: TabletFrame):
     """The die bore's plan wire at ``z = 0``: its narrowest section, which the taper only widens.
 
@@ -132,7 +152,8 @@ def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, 
     grow = 0.0
     if taper_deg > 0:
         grow = (z_top - z_taper) * math.tan(math.radians(taper_deg))
-        cone = tapered_prism(bore, z_taper, z_top + 1.0, taper_deg)
+        cone = (tapered_prism(bore, z_taper, z_top + 1.0, taper_deg) if frame.spline is None
+                else spline_tapered_prism(frame, bulge, z_taper, z_top + 1.0, taper_deg))
         shape = boolean("cut", shape, cone, what="die taper")
     info = dict(
         outer_diameter_mm=od, height_mm=H, tsm_size=kind, top_z_mm=z_top, bottom_z_mm=z_bot,

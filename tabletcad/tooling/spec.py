@@ -281,7 +281,7 @@ def check_spline_offsets(tablet: Any, spec: ToolingSpec) -> None:
     (:meth:`~tabletcad.families.outline.SplineOutline.offset_bound`: inward within its smallest convex
     radius of curvature and its inscribed radius, outward within its smallest concave one), each refusal
     naming what asks for it: ``clearance_mm`` (the tips), ``tip_relief_mm`` (a complete punch's relieved
-    tip), a figure's ``margin_mm`` (the face it must fit in), a short score's ``length_mm`` (the face inset by
+    tip), ``taper_deg`` (the bore drafted from the band's top to 1 mm above the die), a figure's ``margin_mm`` (the face it must fit in), a short score's ``length_mm`` (the face inset by
     its land + 0.05 mm), the outline itself (the die bore grown by the band's bulge, the relief ring).
     Nothing for another outline.  The tooling frame builds the same offsets
     (:meth:`tabletcad.tooling.outline.TabletFrame.offset`) and refuses them alike."""
@@ -308,6 +308,17 @@ def check_spline_offsets(tablet: Any, spec: ToolingSpec) -> None:
         asks += [("[tooling.punch] tip_relief_mm", b.tip_relief_mm, -(spec.clearance_mm + b.tip_relief_mm)),
                  ("tablet.outline", "points (a spline through them)", RELIEF_RING_OVERLAP_MM - inset)]
     asks.append(("tablet.outline", "points (a spline through them)", bore))
+    if spec.taper_deg > 0:  # the bore drafted from the band's top to 1 mm above the die (die_faces_z: the entry)
+        from tabletcad.pipeline.designreport import plan_diameter
+
+        rise = die_faces_z(band_z, die_height_for(spec, plan_diameter(tablet), True))[0] + 1.0
+        top = bore + rise * math.tan(math.radians(spec.taper_deg))
+        bound = outline.offset_bound(top)
+        if bound is not None:
+            most = math.degrees(math.atan((bound[0] - bore) / rise))
+            raise DesignError("[tooling] taper_deg", spec.taper_deg, f"must be <= {format_bound(most, upper=True)} deg: "
+                              f"the die bore drafted over {rise:.4g} mm grows {top:.4g} mm outward, at most "
+                              f"{format_bound(bound[0], upper=True)} mm ({bound[1]})", "deg")
     asks += [(f"[[tooling.emboss]] {i} margin_mm", e.margin_mm, -(spec.clearance_mm + edge_land(e.face) + e.margin_mm))
              for i, e in enumerate(spec.emboss)]
     asks += [(f"[[tooling.score]] {i} length_mm", s.length_mm,
