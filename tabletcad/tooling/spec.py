@@ -408,7 +408,7 @@ def check_figures_on_tablet(tablet: Any, spec: ToolingSpec, cups: dict[str, floa
     whose stroke angle closes its strokes before its depth (:func:`stroke_angle_refusal`).
     Decided on the same curves without OCC (:mod:`tabletcad.geometry.lettering`); ``cups`` (face -> mm) tell
     a flat face (no land).  Not decided here (the build still checks them): an SVG logo, an outline the
-    tooling takes as an ellipse or its band's section, and an inset at or beyond a convex arc's radius of the
+    tooling takes as an ellipse, a spline through points or its band's section, and an inset at or beyond a convex arc's radius of the
     outline (its offset there is no longer the arc's)."""
     from tabletcad.families.thesis import NO_LAND
 
