@@ -62,3 +62,43 @@ def test_a_patchs_data_evaluated_together_equal_each_on_its_own(kind):
             assert np.array_equal(together, np.stack([c.evaluate(v, der) for c in p.data]))
             seen += 1
     assert seen >= 3 * (len(t.patches) - 2)
+
+
+# ----------------------------------------------------------------------------- offsets for tooling
+
+def _peanut(n: int = 24) -> SplineOutline:
+    """A 13 x 8 mm peanut through ``n`` points: convex ends, a concave waist (curvature radius ~5.6 mm)."""
+    t = 2.0 * np.pi * np.arange(n) / n
+    r = 4.0 + 1.2 * np.cos(2.0 * t)
+    return SplineOutline(np.column_stack([1.3 * r * np.cos(t), r * np.sin(t)]))
+
+
+def test_the_concave_curvature_peak_is_found_exactly():
+    ol = _peanut()
+    v = np.linspace(0.0, 2.0 * np.pi, 200_001)
+    k_dense = float(np.max(-ol.frame(v)[3]))
+    assert k_dense > 0.0 and ol.max_concave_curvature >= k_dense * (1.0 - 1e-12)
+    assert ol.min_concave_radius == pytest.approx((1.0 - DEFAULT.offset_regularity) / ol.max_concave_curvature,
+                                                  rel=1e-15)
+    assert SplineOutline(ellipse_points()).min_concave_radius == np.inf  # convex: every outward offset is regular
+
+
+def test_offsets_beyond_the_regular_ones_are_bounded_both_ways():
+    """Tooling offsets a spline outline inward (punch tips) and outward (a die bore, a relief ring): an offset
+    past the smallest convex (inward) or concave (outward) radius of curvature loops; its bound is that radius
+    less Tolerances.offset_regularity, or less where the offset would cross the outline's narrowest place."""
+    ol = _peanut()
+    assert ol.offset_bound(-0.02) is None and ol.offset_bound(0.03) is None and ol.offset_bound(0.0) is None
+    inward, why = ol.offset_bound(-50.0)
+    assert inward == pytest.approx(ol.offset_limit(), rel=0, abs=0) and "convex radius of curvature" in why
+    assert inward <= ol.min_convex_radius
+    outward, why = ol.offset_bound(50.0)
+    assert outward == ol.outward_offset_limit() and "concave radius of curvature" in why
+    assert 0.0 < outward <= ol.min_concave_radius
+    # at the bound the offset is regular and stays that far outside the outline everywhere: the exact offset's
+    # speed |O'| (1 + e κ) does not vanish and its points' distance to the outline is the offset
+    v = np.linspace(0.0, 2.0 * np.pi, 20_001)
+    speed = np.linalg.norm(ol.point(v, 1) - outward * ol.normal(v, 1), axis=1) / np.linalg.norm(ol.point(v, 1), axis=1)
+    assert np.min(speed) >= DEFAULT.offset_regularity * (1.0 - 1e-6)
+    assert ol.signed_distance(ol.offset(v, 0, 1.0, -outward)) == pytest.approx(-outward, abs=1e-7)
+    assert ol.offset_bound(outward) is None and ol.offset_bound(outward * (1.0 + 1e-6)) is not None

@@ -1,6 +1,7 @@
 """``tabletcad report`` refuses what ``tabletcad build`` refuses for a design's ``[tooling]``, with the same
-line, before any geometry: lettering that does not fit its face and a spline outline, which a trial found
-``report`` accepting (exit 0) while ``build`` refused them after ~2 s of CAD.
+line, before any geometry: lettering that does not fit its face, which a trial found ``report`` accepting
+(exit 0) while ``build`` refused it after ~2 s of CAD, and a clearance beyond a spline outline's regular
+offsets (a custom outline through points; its tooling is tested in tests/test_tooling_spline_outline.py).
 
 The fit is decided without OCC (:mod:`tabletcad.geometry.lettering`); the tests marked ``cad`` hold it
 against OpenCascade's own figure and Boolean (:func:`tabletcad.tooling.emboss.check_fit`)."""
@@ -102,6 +103,22 @@ cup_depth = 0.5
 
 [tooling]
 clearance_mm = 0.02
+tip_length_mm = 8.0
+"""
+
+#: a rounded square through points whose corners' smallest radius of curvature is 0.276 mm: its tips, inset by a
+#: 0.3 mm clearance, would pass it (the largest regular inset is 0.273248 mm, 1 % short of that radius)
+SPLINE_CORNER = """[tablet]
+family = "custom_outline"
+outline = [[4.0, -1.8], [4.0, 0.0], [4.0, 1.8], [3.9864, 3.7035], [3.8828, 3.8828], [3.7035, 3.9864], [1.8, 4.0],
+           [0.0, 4.0], [-1.8, 4.0], [-3.7035, 3.9864], [-3.8828, 3.8828], [-3.9864, 3.7035], [-4.0, 1.8], [-4.0, 0.0],
+           [-4.0, -1.8], [-3.9864, -3.7035], [-3.8828, -3.8828], [-3.7035, -3.9864], [-1.8, -4.0], [0.0, -4.0],
+           [1.8, -4.0], [3.7035, -3.9864], [3.8828, -3.8828], [3.9864, -3.7035]]
+band = 2.5
+cup_depth = 0.2
+
+[tooling]
+clearance_mm = {clearance}
 tip_length_mm = 8.0
 """
 
@@ -297,12 +314,57 @@ def test_the_fit_beyond_the_offset_limit_is_left_to_the_build(capsys, tmp_path):
 
 # ----------------------------------------------------------------------------- spline outline (no CAD)
 
-def test_report_refuses_tooling_of_a_spline_outline(capsys, tmp_path):
-    """A custom outline through points with [tooling]: report had printed its table (exit 0); build refused it
-    after the solid, OCC failing to offset the band's section for the tips and the bore."""
-    line = _refusal(capsys, tmp_path, SPLINE, "report")
-    assert line.startswith("error: tablet.outline = 'points (a spline through them)' is not allowed: tooling needs "
-                           "an outline OpenCascade can offset")
+def test_report_passes_tooling_of_a_spline_outline(tmp_path):
+    """A custom outline through points with [tooling]: refused by report and build alike (OCC could not offset
+    it), it is reported now (the tips and the bore are the B-splines of its exact offsets)."""
+    src = tmp_path / "d.toml"
+    src.write_text(SPLINE, encoding="utf-8")
+    assert main(["report", str(src)]) == 0
+
+
+def test_report_refuses_a_clearance_beyond_a_spline_corner(capsys, tmp_path):
+    """The tips inset by the clearance past the spline's smallest convex radius of curvature (less 1 %,
+    Tolerances.offset_regularity) would loop there: refused, with the largest clearance that is allowed."""
+    line = _refusal(capsys, tmp_path, SPLINE_CORNER.format(clearance=0.3), "report")
+    assert line == ("error: tooling.clearance_mm = 0.3 mm is not allowed: must be <= 0.273249 mm: the tooling offsets "
+                    "the spline outline 0.3 mm inward for it, at most 0.273248 mm (its smallest convex radius of "
+                    "curvature is 0.276 mm, and the offset must stay regular and clear of the narrowest place)")
+
+
+def test_the_largest_clearance_stated_is_reported(tmp_path):
+    src = tmp_path / "d.toml"
+    src.write_text(SPLINE_CORNER.format(clearance=0.273249), encoding="utf-8")
+    assert main(["report", str(src)]) == 0
+
+
+#: a circle of 4 mm through 24 points, dented at -x: its spline's dent has a concave radius of curvature 0.6389 mm,
+#: which an outward offset (the die bore drafted by taper_deg over the 3 mm entry and 1 mm above) may not pass
+DENTED = """[tablet]
+family = "custom_outline"
+outline = [[4.0, 0.0], [3.8637, 1.0353], [3.4641, 2.0], [2.8284, 2.8284], [2.0, 3.4641], [1.0353, 3.8637], [0.0, 4.0],
+           [-1.0353, 3.8637], [-1.9999, 3.464], [-2.8238, 2.8238], [-3.3717, 1.9467], [-3.3117, 0.8874], [-3.0, 0.0],
+           [-3.3117, -0.8874], [-3.3717, -1.9467], [-2.8238, -2.8238], [-1.9999, -3.464], [-1.0353, -3.8637],
+           [0.0, -4.0], [1.0353, -3.8637], [2.0, -3.4641], [2.8284, -2.8284], [3.4641, -2.0], [3.8637, -1.0353]]
+band = 2.5
+cup_depth = 0.3
+
+[tooling]
+clearance_mm = 0.02
+tip_length_mm = 8.0
+taper_deg = {taper}
+"""
+
+
+def test_report_refuses_a_taper_whose_bore_passes_a_spline_dent(capsys, tmp_path):
+    """An outward offset past the spline's smallest concave radius of curvature (less 1 %) loops: the drafted
+    bore, 4 mm x tan(9.5 deg) = 0.6694 mm outward at its top, is refused with the largest taper allowed."""
+    line = _refusal(capsys, tmp_path, DENTED.format(taper=9.5), "report")
+    assert line == ("error: tooling.taper_deg = 9.5 deg is not allowed: must be <= 8.98497 deg: the die bore drafted "
+                    "over 4 mm grows 0.6694 mm outward, at most 0.632463 mm (its smallest concave radius of curvature "
+                    "is 0.6389 mm, and the offset must stay regular and keep its notches open)")
+    src = tmp_path / "d.toml"
+    src.write_text(DENTED.format(taper=8.98497), encoding="utf-8")
+    assert main(["report", str(src)]) == 0
 
 
 def test_the_same_outline_of_lines_and_arcs_is_reported(tmp_path):
@@ -317,7 +379,7 @@ def test_the_same_outline_of_lines_and_arcs_is_reported(tmp_path):
 @pytest.mark.parametrize("design, needle", [(ROUND.format(height=2.5), "does not fit the bottom face"),
                                             (STROKE.format(height=2.5, angle=25.0), "strokes would meet"),
                                             (OVAL_STROKE, "strokes would meet"),
-                                            (SPLINE, "tablet.outline")])
+                                            (SPLINE_CORNER.format(clearance=0.3), "tooling.clearance_mm")])
 def test_report_and_build_refuse_with_the_same_line(capsys, tmp_path, design, needle):
     report = _refusal(capsys, tmp_path, design, "report")
     build = _refusal(capsys, tmp_path, design, "build")
@@ -360,24 +422,6 @@ def test_the_fit_on_a_concave_outline_is_occs_boolean_below_its_offset_limit(tmp
     (tmp_path / "d.toml").write_text(PEANUT.format(margin=0.7), encoding="utf-8")
     assert main(["build", str(tmp_path / "d.toml"), "--out", str(tmp_path / "out"), "--quiet"]) == 2
     assert not (tmp_path / "out").exists()
-
-
-@pytest.mark.cad
-def test_the_spline_refusal_is_occs():
-    """The refusal is decided from the outline's kind: OCC's planar offset fails on the band section of every
-    spline outline tried (a circle through 24 points, ovals through 8 and 64)."""
-    from tabletcad.cad.tablet_solid import tablet_solid
-    from tabletcad.errors import GeometryError
-    from tabletcad.families.shaped import outline_tablet
-    from tabletcad.tooling.outline import _section_wire, offset_wire
-    from tabletcad.tooling.spec import band_heights
-
-    for n, a, b in ((24, 5.0, 5.0), (8, 4.0, 4.0), (64, 6.0, 4.0)):
-        t = outline_tablet([[a * math.cos(math.tau * k / n), b * math.sin(math.tau * k / n)] for k in range(n)],
-                           band=2.5, cup_depth=0.5)
-        z = band_heights(t)
-        with pytest.raises(GeometryError):
-            offset_wire(_section_wire(tablet_solid(t).shape, 0.5 * (z[0] + z[1])), -0.01)
 
 
 @pytest.mark.cad

@@ -683,18 +683,84 @@ class SplineOutline(PlanOutline):
         are evaluated exactly.
         """
         if self._kmax is None:
-            from scipy.optimize import minimize_scalar
-
-            k = self.frame(self._vs)[3]
-            h = float(self._vs[1] - self._vs[0])
-            peaks = np.flatnonzero((k >= np.roll(k, 1)) & (k >= np.roll(k, -1)))
-            best = max(float(np.max(k)), float(np.max(self.frame(self.smooth_breaks)[3])))
-            for i in peaks[np.argsort(k[peaks])[::-1][:8]]:
-                r = minimize_scalar(lambda v: -float(self.frame(v)[3][0]), bounds=(self._vs[i] - h, self._vs[i] + h),
-                                    method="bounded", options=dict(xatol=1e-13))
-                best = max(best, -float(r.fun))
-            self._kmax = best
+            self._kmax = self._curvature_peak(1.0)
         return self._kmax
+
+    @property
+    def max_concave_curvature(self) -> float:
+        """Largest curvature (1/mm) of the spline's concave parts (> 0 where it has any, else <= 0: the
+        negated least signed curvature), refined as :attr:`max_curvature`."""
+        if "_kneg" not in self.__dict__:
+            self.__dict__["_kneg"] = self._curvature_peak(-1.0)
+        return self.__dict__["_kneg"]
+
+    def _curvature_peak(self, sign: float) -> float:
+        """The largest of ``sign * κ`` (1/mm) over the spline: the largest sampled peaks polished by
+        bounded Brent, the knots (corners of a cubic spline's curvature) evaluated exactly."""
+        from scipy.optimize import minimize_scalar
+
+        k = sign * self.frame(self._vs)[3]
+        h = float(self._vs[1] - self._vs[0])
+        peaks = np.flatnonzero((k >= np.roll(k, 1)) & (k >= np.roll(k, -1)))
+        best = max(float(np.max(k)), float(np.max(sign * self.frame(self.smooth_breaks)[3])))
+        for i in peaks[np.argsort(k[peaks])[::-1][:8]]:
+            r = minimize_scalar(lambda v: -sign * float(self.frame(v)[3][0]), bounds=(self._vs[i] - h, self._vs[i] + h),
+                                method="bounded", options=dict(xatol=1e-13))
+            best = max(best, -float(r.fun))
+        return best
+
+    @property
+    def min_concave_radius(self) -> float:
+        """The largest outward offset whose curve is regular (mm): the smallest radius of curvature of
+        the concave parts less the relative margin ``Tolerances.offset_regularity`` (as
+        :attr:`min_convex_radius` inward); ``inf`` for a convex outline."""
+        kneg = self.max_concave_curvature
+        return (1.0 - DEFAULT.offset_regularity) / kneg if kneg > 0 else math.inf
+
+    def _outward_offset_is_clean(self, e: float) -> bool:
+        """Whether the outward offset by ``e`` (mm) stays ``e`` outside the outline at 2,048 samples and the
+        knots (no two parts of the outline, across a notch, bring their offsets together)."""
+        e = float(e)
+
+        def clean() -> bool:
+            v = np.concatenate([linspace(0.0, math.tau, 2048, endpoint=False), self.smooth_breaks])
+            O, T, N, k = self.frame(v)
+            return bool(np.max(self.signed_distance(O - e * N)) <= -e + 1e-7 * max(1.0, e))
+
+        return self._remembered(("outward clean", e), clean)
+
+    def outward_offset_limit(self) -> float:
+        """Largest outward offset (mm) that is a regular, clean offset of the outline: at most
+        :attr:`min_concave_radius` (``inf`` for a convex outline, whose outward offsets are all clean),
+        and no offset point nearer than the offset to the outline (bisection to ~1e-9 mm)."""
+        hi = self.min_concave_radius
+        if math.isinf(hi) or self._outward_offset_is_clean(hi):
+            return hi
+        lo = 0.0
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if self._outward_offset_is_clean(mid) else (lo, mid)
+        return lo
+
+    def offset_bound(self, distance: float) -> tuple[float, str] | None:
+        """For an offset of the outline by ``distance`` mm (> 0 outward, < 0 inward: a die bore, a punch
+        tip) that is no regular offset of it, ``(limit, why)``: the largest regular offset that way (mm) and
+        what sets it; ``None`` for a regular one.  Inward the limit is :meth:`offset_limit` (the smallest
+        convex radius of curvature less ``Tolerances.offset_regularity``, or the inscribed radius where it is
+        narrowest), outward :meth:`outward_offset_limit` (the smallest concave radius of curvature less that
+        margin, or where a notch between two parts of the outline closes)."""
+        d = float(distance)
+        if d < 0.0 and not (-d <= self.min_convex_radius and self._offset_is_clean(-d)):
+            lim = self.offset_limit()
+            if -d > lim:
+                return lim, (f"its smallest convex radius of curvature is {1.0 / self.max_curvature:.4g} mm, and the "
+                             "offset must stay regular and clear of the narrowest place")
+        elif d > 0.0 and not (d <= self.min_concave_radius and self._outward_offset_is_clean(d)):
+            lim = self.outward_offset_limit()
+            if d > lim:
+                return lim, (f"its smallest concave radius of curvature is {1.0 / self.max_concave_curvature:.4g} mm, "
+                             "and the offset must stay regular and keep its notches open")
+        return None
 
     @property
     def min_convex_radius(self) -> float:

@@ -22,7 +22,7 @@ from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
 from tabletcad.cad._occ import cast, explore
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.tooling.booleans import boolean, translated, volume
-from tabletcad.tooling.outline import TabletFrame, offset_wire, plan_face, prism
+from tabletcad.tooling.outline import TabletFrame, plan_face, prism, spline_offset_deviation
 from tabletcad.tooling.spec import MIN_DIE_WALL_MM, die_faces_z, standard_die_size
 
 __all__ = ["die", "default_die_size", "tapered_prism", "bore_wire", "MIN_WALL_MM"]
@@ -67,6 +67,26 @@ def tapered_prism(wire, z0: float, z1: float, taper_deg: float):
     return shape
 
 
+def spline_tapered_prism(frame: TabletFrame, bulge: float, z0: float, z1: float, taper_deg: float):
+    """:func:`tapered_prism` of a spline outline's bore (the outline grown by ``bulge`` mm at ``z0``), which
+    ``LocOpe_DPrism`` made invalid (``BRepCheck_Analyzer``): the ruled solid between the bore and the outline's
+    exact offset by ``bulge + (z1 - z0) tan(taper)`` at ``z1`` (:meth:`TabletFrame.offset`), both B-splines in
+    the outline's parameter, so that each ruling joins the points of one normal and each section is the
+    exact offset's B-spline at its height (the offset is linear in its distance)."""
+    from OCP.BRepCheck import BRepCheck_Analyzer
+    from OCP.BRepOffsetAPI import BRepOffsetAPI_ThruSections
+
+    top = bulge + (z1 - z0) * math.tan(math.radians(taper_deg))
+    mk = BRepOffsetAPI_ThruSections(True, True, 1e-6)  # (a solid, ruled)
+    mk.CheckCompatibility(False)  # (the sections' own parameters pair them: no rotation to match)
+    mk.AddWire(cast(translated(bore_wire(frame), dz=z0), "Wire"))
+    mk.AddWire(cast(translated(frame.offset(top), dz=z1), "Wire"))
+    mk.Build()
+    if not mk.IsDone() or not BRepCheck_Analyzer(mk.Shape()).IsValid():
+        raise GeometryError(f"drafting the die bore by {taper_deg} deg failed", frame.outline)
+    return mk.Shape()
+
+
 def bore_wire(frame: TabletFrame):
     """The die bore's plan wire at ``z = 0``: its narrowest section, which the taper only widens.
 
@@ -82,7 +102,7 @@ def bore_wire(frame: TabletFrame):
         (mm) where the band bulges; the outline itself where the band is a prism.
     """
     bulge = frame.bore_offset
-    return offset_wire(frame.outline, bulge) if bulge > 0 else frame.outline
+    return frame.offset(bulge) if bulge > 0 else frame.outline
 
 
 def default_die_size(frame: TabletFrame) -> tuple[float, float, str]:
@@ -132,7 +152,8 @@ def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, 
     grow = 0.0
     if taper_deg > 0:
         grow = (z_top - z_taper) * math.tan(math.radians(taper_deg))
-        cone = tapered_prism(bore, z_taper, z_top + 1.0, taper_deg)
+        cone = (tapered_prism(bore, z_taper, z_top + 1.0, taper_deg) if frame.spline is None
+                else spline_tapered_prism(frame, bulge, z_taper, z_top + 1.0, taper_deg))
         shape = boolean("cut", shape, cone, what="die taper")
     info = dict(
         outer_diameter_mm=od, height_mm=H, tsm_size=kind, top_z_mm=z_top, bottom_z_mm=z_bot,
@@ -140,4 +161,6 @@ def die(frame: TabletFrame, outer_diameter: float | None, height: float | None, 
         bore_max_radius_mm=r_bore, taper_deg=taper_deg, taper_start_z_mm=z_taper if taper_deg > 0 else None,
         bore_growth_at_top_mm=grow, volume_mm3=volume(shape),
     )
+    if frame.spline is not None:  # the bore's B-spline against the spline outline's exact offset, measured densely
+        info.update(spline_offset_deviation(frame, bulge, "bore"))
     return shape, info

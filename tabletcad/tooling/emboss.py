@@ -65,7 +65,7 @@ from tabletcad.cad._occ import explore
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.tooling.booleans import checked_boolean, translated
 from tabletcad.tooling.booleans import compound as _compound
-from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, polyline_wire, wire_length
+from tabletcad.tooling.outline import TabletFrame, face_area, plan_face, polyline_wire, wire_length
 from tabletcad.tooling.spec import EmbossSpec, check_emboss_depth, font_path
 
 __all__ = ["figure_faces", "figure_prism", "apply_emboss", "check_fit", "check_emboss", "face_heights", "offset_solid",
@@ -183,7 +183,7 @@ def legibility(frame: TabletFrame, e: EmbossSpec, figure: TopoDS_Shape, clearanc
             t_end, t_start = tans[k][1], tans[(k + 1) % len(tans)][0]
             if t_end.Magnitude() > 1e-12 and t_start.Magnitude() > 1e-12 and t_end.Angle(t_start) > math.radians(5.0):
                 sharp += 1
-    tip_edge = offset_wire(frame.outline, -frame.tip_inset(clearance))
+    tip_edge = frame.offset(-frame.tip_inset(clearance))
     dss = BRepExtrema_DistShapeShape(figure, tip_edge)
     land = float(dss.Value()) if dss.IsDone() else None
     width = 2.0 * area / perimeter if perimeter > 0 else 0.0
@@ -209,7 +209,7 @@ def check_fit(frame: TabletFrame, e: EmbossSpec, figure: TopoDS_Shape, clearance
     what = "text" if e.text is not None else "svg" if e.svg is not None else "outline"
     value = e.text if e.text is not None else e.svg if e.svg is not None else f"{len(e.outline)} points"
     try:
-        region = plan_face(offset_wire(frame.outline, -inset))
+        region = plan_face(frame.offset(-inset))
     except GeometryError:
         raise DesignError(f"[[tooling.emboss]] {i} {what}", value, f"does not fit: the face inset by {inset:.3g} mm is empty") from None
     cut = BRepAlgoAPI_Cut(figure, region)

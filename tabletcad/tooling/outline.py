@@ -14,6 +14,13 @@ outward (> 0) or inward (< 0), :func:`prism` extrudes it.  An offset that OCC
 keeps as a ``Geom_OffsetCurve`` (an ellipse's: the thesis's ovals and caplet)
 becomes a B-spline within :data:`OFFSET_CURVE_TOL_MM` of it, whose p-curves on
 the tips' planes agree with it (:func:`bspline_offset_curves`).
+
+A custom outline through points (a :class:`~tabletcad.families.outline.SplineOutline`) is not offset
+by OCC (its planar offset failed on every such outline tried): its wire and each offset the tooling
+asks for (:meth:`TabletFrame.offset`) are B-splines built from the outline's exact offset
+``O + d N`` (:func:`spline_offset_wire`), within :data:`SPLINE_OFFSET_TOL_MM` of it, measured
+densely; an offset that is no regular offset of the outline is refused
+(:meth:`~tabletcad.families.outline.SplineOutline.offset_bound`).
 """
 
 from __future__ import annotations
@@ -38,12 +45,20 @@ from OCP.TopoDS import TopoDS_Shape
 
 from tabletcad.cad._occ import cast, explore
 from tabletcad.errors import DesignError, GeometryError
+from tabletcad.families.outline import SplineOutline
 from tabletcad.families.thesis import NO_LAND
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.tooling.booleans import translated
-from tabletcad.tooling.spec import SPLINE_OUTLINE_REFUSAL, band_heights, spline_outline_refusal
+from tabletcad.tooling.spec import band_heights, spline_offset_error
 
-__all__ = ["TabletFrame", "tablet_frame", "offset_wire", "prism", "plan_face", "wire_length", "face_area"]
+__all__ = ["TabletFrame", "tablet_frame", "offset_wire", "spline_offset_wire", "prism", "plan_face", "wire_length",
+           "face_area"]
+
+#: why a tablet whose band's section OCC cannot offset gets no tooling (a free-form band that is none of the
+#: outlines the frame takes exactly)
+SECTION_OFFSET_REFUSAL = ("tooling needs an outline it can offset for the tips and the bore: lines and arcs, a circle, "
+                          "an ellipse or a spline through points (custom_outline); the section of this tablet's band "
+                          "cannot be offset")
 
 
 
@@ -56,7 +71,9 @@ class TabletFrame:
     the band (``z_max - band_z[1]``; the bottom one is ``band_z[0] - z_min``),
     ``outline`` a closed OCC wire at ``z = 0``, ``shape`` the tablet solid;
     ``band_bulge`` how far the band's PDE surface leaves the outline (mm); ``revolved`` the solid with
-    faces of revolution whose rational B-spline form ``shape`` is (None when it had none).
+    faces of revolution whose rational B-spline form ``shape`` is (None when it had none); ``spline`` the
+    tablet's :class:`~tabletcad.families.outline.SplineOutline` when its plan is a spline through points
+    (``outline`` is then its B-spline, and :meth:`offset` builds each offset from its exact offset).
     """
 
     tablet: Tablet
@@ -73,6 +90,8 @@ class TabletFrame:
     width: float
     info: dict = field(default_factory=dict)
     revolved: TopoDS_Shape | None = None
+    spline: Any = None
+    _offsets: dict = field(default_factory=dict, repr=False)
 
     @property
     def band(self) -> float:
@@ -93,6 +112,27 @@ class TabletFrame:
         from tabletcad.tooling.spec import tip_inset
 
         return tip_inset(clearance, self.bore_offset)
+
+    def offset(self, distance: float) -> Any:
+        """The outline offset by ``distance`` mm (> 0 outward: a die bore; < 0 inward: a punch tip), a closed
+        wire at ``z = 0``: OCC's planar offset (:func:`offset_wire`), or for a spline outline the B-spline of
+        its exact offset (:func:`spline_offset_wire`, remembered per distance; a :class:`DesignError` for an
+        offset that is no regular offset of it)."""
+        if self.spline is None:
+            return offset_wire(self.outline, distance)
+        return self._spline_offset(distance)[0]
+
+    def offset_deviation(self, distance: float) -> float | None:
+        """How far (mm) the wire :meth:`offset` gives for ``distance`` leaves the outline's exact offset, as
+        measured densely (:func:`spline_offset_wire`); ``None`` where OCC offsets the outline."""
+        return None if self.spline is None else self._spline_offset(distance)[1]
+
+    def _spline_offset(self, distance: float) -> tuple[Any, float]:
+        key = float(distance)
+        hit = self._offsets.get(key)
+        if hit is None:
+            hit = self._offsets[key] = spline_offset_wire(self.spline, key)
+        return hit
 
     @property
     def cup_depth_top(self) -> float:
@@ -191,8 +231,15 @@ def plan_face(wire) -> Any:
 
 
 def face_area(face) -> float:
+    """The plan face's area (mm²): OCC's Gauss integration, adaptive to 1e-10 on a face bounded by a spline
+    outline's periodic B-spline (its fixed rule had given a tip 64.0303 mm² for 64.0461)."""
+    from tabletcad.tooling.booleans import has_periodic_bspline_curve
+
     p = GProp_GProps()
-    BRepGProp.SurfaceProperties_s(face, p)
+    if has_periodic_bspline_curve(face):
+        BRepGProp.SurfaceProperties_s(face, p, 1e-10)
+    else:
+        BRepGProp.SurfaceProperties_s(face, p)
     return abs(p.Mass())
 
 
@@ -317,6 +364,100 @@ def _bspline_edge(edge) -> Any:
     return cast(mk.Edge().Oriented(edge.Orientation()), "Edge")
 
 
+#: how far (mm) the B-spline standing for a spline outline's exact offset may leave it (:func:`spline_offset_wire`)
+SPLINE_OFFSET_TOL_MM = 1e-6
+
+#: the points per span at which :func:`spline_offset_wire` measures its B-spline against the exact offset
+SPLINE_OFFSET_SAMPLES = 16
+
+
+def spline_offset_wire(outline: Any, distance: float, tol: float = SPLINE_OFFSET_TOL_MM) -> tuple[Any, float]:
+    """The spline ``outline`` offset by ``distance`` mm (> 0 outward, < 0 inward) as one closed B-spline edge,
+    and its deviation (mm) from the exact offset.
+
+    The exact offset is ``O(v) - distance N(v)`` (``N`` the inward unit normal,
+    :meth:`~tabletcad.families.outline.SplineOutline.offset`).  Its B-spline is the cubic Hermite
+    interpolant of it in ``v``: on each span the exact point and derivative at both ends, one knot of
+    multiplicity 2 at each span's end (C1 there, as the offset of a cubic spline is at its knots).  The
+    spans are the spline's own (on which a zero offset is the spline itself), halved where the B-spline
+    leaves the exact offset by more than ``tol`` at :data:`SPLINE_OFFSET_SAMPLES` points per span; the
+    deviation returned is the largest distance so measured between points of the same ``v``.
+
+    Raises
+    ------
+    DesignError
+        An offset beyond the outline's regular offsets
+        (:meth:`~tabletcad.families.outline.SplineOutline.offset_bound`).
+    GeometryError
+        No B-spline within ``tol`` of the offset (after 15 halvings).
+    """
+    err = spline_offset_error(outline, distance)
+    if err is not None:
+        raise err
+    knots, poles, deviation = _hermite_offset(outline, float(distance), tol)
+    return _wire([_periodic_bspline_edge(knots, poles)]), deviation
+
+
+def spline_offset_deviation(frame: TabletFrame, distance: float, name: str) -> dict:
+    """The report's entries for the B-spline of a spline outline's offset by ``distance`` mm
+    (:meth:`TabletFrame.offset`): ``<name>_deviation_mm``, its largest distance from the exact offset as
+    measured, ``<name>_tolerance_mm`` (:data:`SPLINE_OFFSET_TOL_MM`) and how it was measured."""
+    return {f"{name}_deviation_mm": frame.offset_deviation(distance), f"{name}_tolerance_mm": SPLINE_OFFSET_TOL_MM,
+            f"{name}_deviation_method": "the outline's exact offset O + d N (tabletcad.families.outline.SplineOutline) "
+                                        "as a C1 cubic Hermite B-spline in its parameter, spans halved until within "
+                                        f"the tolerance at {SPLINE_OFFSET_SAMPLES} points a span"}
+
+
+def _hermite_offset(outline: Any, distance: float, tol: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """Knots (n + 1, from 0 to 2 pi), poles (2 n, 2: each span's two inner Bezier poles) and measured
+    deviation (mm) of the C1 cubic B-spline within ``tol`` of the exact offset (:func:`spline_offset_wire`)."""
+    breaks = np.asarray(outline.smooth_breaks, dtype=float)
+    ends = np.append(breaks, math.tau)
+    split = np.ones(len(breaks), dtype=int)
+    f = (np.arange(SPLINE_OFFSET_SAMPLES) + 0.5) / SPLINE_OFFSET_SAMPLES
+    for _ in range(16):
+        v = np.concatenate([np.linspace(a, b, m, endpoint=False) for a, b, m in zip(ends[:-1], ends[1:], split)] +
+                           [[math.tau]])
+        p, dp = outline.offset(v, 0, 1.0, -distance), outline.offset(v, 1, 1.0, -distance)
+        h = np.diff(v)[:, None]
+        inner = np.stack([p[:-1] + h / 3.0 * dp[:-1], p[1:] - h / 3.0 * dp[1:]], axis=1)  # (spans, 2, 2)
+        u = f[None, :, None]
+        bez = ((1 - u) ** 3 * p[:-1, None] + 3 * u * (1 - u) ** 2 * inner[:, :1] + 3 * u * u * (1 - u) * inner[:, 1:]
+               + u ** 3 * p[1:, None])
+        exact = outline.offset((v[:-1, None] + f[None, :] * h).reshape(-1), 0, 1.0, -distance)
+        gap = np.linalg.norm(bez.reshape(-1, 2) - exact, axis=1).reshape(len(h), -1).max(axis=1)
+        owner = np.repeat(np.arange(len(split)), split)
+        worst = np.zeros(len(split))
+        np.maximum.at(worst, owner, gap)
+        if np.all(worst <= tol):
+            return v, inner.reshape(-1, 2), float(gap.max())
+        split = np.where(worst > tol, 2 * split, split)
+    raise GeometryError(f"the spline outline's offset by {distance} mm did not become a B-spline within {tol} mm "
+                        f"(deviation {float(worst.max()):.3g} mm)", None)
+
+
+def _periodic_bspline_edge(knots: np.ndarray, poles: np.ndarray) -> Any:
+    """The closed edge at ``z = 0`` on the periodic cubic B-spline of ``knots`` (each of multiplicity 2,
+    the last the first's period) and plan ``poles`` (two a span)."""
+    from OCP.Geom import Geom_BSplineCurve
+    from OCP.TColgp import TColgp_Array1OfPnt
+    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+
+    n = len(knots)
+    kn, mu = TColStd_Array1OfReal(1, n), TColStd_Array1OfInteger(1, n)
+    for i, k in enumerate(knots, start=1):
+        kn.SetValue(i, float(k))
+        mu.SetValue(i, 2)
+    pts = TColgp_Array1OfPnt(1, len(poles))
+    # a periodic curve's span from its first knot starts at its last pole pair's second pole
+    for i, (x, y) in enumerate(np.roll(poles, 1, axis=0), start=1):
+        pts.SetValue(i, gp_Pnt(float(x), float(y), 0.0))
+    mk = BRepBuilderAPI_MakeEdge(Geom_BSplineCurve(pts, kn, mu, 3, True))
+    if not mk.IsDone():
+        raise GeometryError("the spline outline's B-spline gave no edge", None)
+    return mk.Edge()
+
+
 def prism(wire, z0: float, z1: float) -> TopoDS_Shape:
     """Solid extrusion of the plan ``wire`` (at z = 0) from ``z0`` to ``z1``."""
     face = plan_face(wire)
@@ -387,9 +528,6 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
     nom = tablet.nominal
     outline_nom = getattr(nom, "outline", None)
     band_z = band_heights(tablet)  # (a DesignError without a band)
-    refusal = spline_outline_refusal(tablet)  # (decided from the design: check_tooling refuses it alike)
-    if refusal is not None:
-        raise refusal
     found = tablet.band()
     if shape is None:
         from tabletcad.cad.tablet_solid import tablet_solid
@@ -403,8 +541,10 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
         revolved, shape = shape, _rational_bspline_solid(shape)
     lo, hi = tablet.bounds()
     info = dict(getattr(nom, "info", {}) or {})
-    round_radius = None
-    if outline_nom is not None and getattr(outline_nom, "segs", None):  # (a spline outline has none)
+    round_radius, spline = None, None
+    if isinstance(outline_nom, SplineOutline):  # its exact outline, as a B-spline; offsets from its exact offsets
+        spline, wire, kind = outline_nom, spline_offset_wire(outline_nom, 0.0)[0], "spline"
+    elif outline_nom is not None and getattr(outline_nom, "segs", None):  # (a spline outline has none)
         segs = outline_nom.segs
         if len(segs) == 1 or all(s.kind == "arc" and abs(s.radius - segs[0].radius) < 1e-12 and
                                   np.allclose(s.center, segs[0].center) for s in segs):
@@ -434,7 +574,7 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
             try:  # the tips and the bore are offsets of it: refused here, named, when OCC cannot offset it
                 offset_wire(wire, -0.01)
             except GeometryError:
-                raise DesignError("tablet.family", tablet.family, SPLINE_OUTLINE_REFUSAL) from None
+                raise DesignError("tablet.family", tablet.family, SECTION_OFFSET_REFUSAL) from None
     land = info.get("land_mm")
     if land is None and tablet.family in NO_LAND:  # the thesis's shapes say so in the catalogue
         land = 0.0
@@ -442,4 +582,4 @@ def tablet_frame(tablet: Tablet, shape: TopoDS_Shape | None = None) -> TabletFra
     bulge = tablet.plan_overhang() if found is not None else 0.0
     return TabletFrame(tablet, shape, (float(band_z[0]), float(band_z[1])), bulge, float(lo[2]), float(hi[2]), wire, kind,
                        round_radius, None if land is None else float(land), float(hi[0] - lo[0]), float(hi[1] - lo[1]), info,
-                       revolved)
+                       revolved, spline)

@@ -23,7 +23,7 @@ import numpy as np
 from tabletcad.errors import GeometryError
 from tabletcad.tooling.spec import EDGE_SNAP_MM
 from tabletcad.tooling.booleans import CACHE, boolean, checked_boolean, reference_point, split_cells, volume
-from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, prism, wire_length
+from tabletcad.tooling.outline import TabletFrame, face_area, plan_face, prism, spline_offset_deviation, wire_length
 
 __all__ = ["PunchTip", "punch_tip", "cup_volume_within", "elliptic_tip_quadrature", "punch_volume_quadrature"]
 
@@ -47,7 +47,7 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
     2.5 mm-deep oval cup at 0.025 mm clearance).  ``tip_length`` runs from that edge, so the punch's
     overall length, measured from its tip edge, is the one its body gives."""
     inset = frame.tip_inset(clearance)  # the tip follows the die bore, the clearance inside it
-    tip_wire = offset_wire(frame.outline, -inset)
+    tip_wire = frame.offset(-inset)
     z_mid = 0.5 * (frame.band_z[0] + frame.band_z[1])
     up = which == "upper"
     edge = frame.band_z[1] if up else frame.band_z[0]
@@ -133,6 +133,8 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
         volume_quadrature_mm3=quad,
         volume_rel_diff_vs_quadrature=None if quad is None else (vol - quad) / quad,
     )
+    if frame.spline is not None:  # the tip's B-spline against the spline outline's exact offset, measured densely
+        info.update(spline_offset_deviation(frame, -inset, "tip_outline"))
     return PunchTip(f"{which}_punch", shape, vol, info), chk
 
 

@@ -21,7 +21,8 @@ from OCP.gp import gp_Ax1, gp_Ax2, gp_Dir, gp_Pnt, gp_Trsf, gp_Vec
 
 from tabletcad.errors import DesignError
 from tabletcad.tooling.booleans import boolean, volume
-from tabletcad.tooling.outline import TabletFrame, face_area, offset_wire, plan_face, prism
+from tabletcad.tooling.outline import TabletFrame, face_area, plan_face, prism
+from tabletcad.tooling.spec import RELIEF_RING_OVERLAP_MM
 from tabletcad.tooling.standards import PunchBody
 
 __all__ = ["body_profile", "body_solid", "body_volume", "key_volume", "relief_volume", "complete_punch",
@@ -115,8 +116,8 @@ def relief_volume(frame: TabletFrame, b: PunchBody, clearance: float, tip_length
     if b.tip_relief_mm <= 0 or tip_length <= b.tip_straight_mm:
         return 0.0
     inset = frame.tip_inset(clearance)
-    a = face_area(plan_face(offset_wire(frame.outline, -inset)))
-    r = face_area(plan_face(offset_wire(frame.outline, -inset - b.tip_relief_mm)))
+    a = face_area(plan_face(frame.offset(-inset)))
+    r = face_area(plan_face(frame.offset(-inset - b.tip_relief_mm)))
     return (a - r) * (tip_length - b.tip_straight_mm)
 
 
@@ -150,8 +151,8 @@ def complete_punch(frame: TabletFrame, tip_shape, which: str, b: PunchBody, clea
     if b.tip_relief_mm > 0 and tip_length > b.tip_straight_mm:
         a, c = sorted((edge + sign * b.tip_straight_mm, edge + sign * (tip_length + 1.0)))
         inset = frame.tip_inset(clearance)
-        ring = boolean("cut", prism(offset_wire(frame.outline, -inset + 0.05), a, c),
-                       prism(offset_wire(frame.outline, -inset - b.tip_relief_mm), a - 1.0, c + 1.0),
+        ring = boolean("cut", prism(frame.offset(-inset + RELIEF_RING_OVERLAP_MM), a, c),
+                       prism(frame.offset(-inset - b.tip_relief_mm), a - 1.0, c + 1.0),
                        what=f"{which} tip relief ring")
         shape = boolean("cut", shape, ring, what=f"{which} tip relief")
     lb = b.barrel_length_mm(tip_length)

@@ -25,7 +25,7 @@ from OCP.BRepGProp import BRepGProp
 from OCP.GProp import GProp_GProps
 
 from tabletcad.pipeline.designreport import ReportOptions
-from tabletcad.tooling.outline import TabletFrame, offset_wire, plan_face
+from tabletcad.tooling.outline import TabletFrame, plan_face
 
 __all__ = ["section_properties", "tip_rating", "rating_text", "overload_texts", "EULER_K"]
 
@@ -79,7 +79,7 @@ def tip_rating(frame: TabletFrame, spec, options: ReportOptions | None = None) -
     """
     options = ReportOptions() if options is None else options
     inset = frame.tip_inset(spec.clearance_mm)  # the tips' outline (the die bore less the clearance)
-    area, _ = section_properties(offset_wire(frame.outline, -inset))
+    area, _ = section_properties(frame.offset(-inset))
     out: dict = dict(tip_projected_area_mm2=area, rule="F = p_allowed x tip projected area")
     p, src = spec.allowed_tip_pressure_MPa, spec.allowed_tip_pressure_source
     if p is None and options.max_punch_pressure_MPa is not None:
@@ -102,7 +102,7 @@ def tip_rating(frame: TabletFrame, spec, options: ReportOptions | None = None) -
     E = spec.punch_youngs_modulus_MPa
     body = spec.body
     relief = 0.0 if body is None else body.tip_relief_mm
-    _, i_min = section_properties(offset_wire(frame.outline, -inset - relief))
+    _, i_min = section_properties(frame.offset(-inset - relief))
     tips = {}
     for name, L in (("upper", spec.tip_length_mm), ("lower", spec.lower_tip)):
         p_cr = None if E is None else math.pi ** 2 * E * i_min / (EULER_K * L) ** 2 / 1000.0

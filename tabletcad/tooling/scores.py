@@ -82,7 +82,8 @@ def _check_short(frame: TabletFrame, s: ScoreSpec, i: int) -> None:
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
 
     from tabletcad.cad._occ import explore
-    from tabletcad.tooling.outline import face_area, offset_wire, plan_face
+    from tabletcad.tooling.outline import face_area, plan_face
+    from tabletcad.tooling.spec import SHORT_SCORE_MARGIN_MM
 
     th = math.radians(s.direction_deg)
     d, n = (math.cos(th), math.sin(th)), (-math.sin(th), math.cos(th))
@@ -92,8 +93,8 @@ def _check_short(frame: TabletFrame, s: ScoreSpec, i: int) -> None:
         poly.Add(gp_Pnt(u * d[0] + v * n[0], u * d[1] + v * n[1], 0.0))
     poly.Close()
     foot = BRepBuilderAPI_MakeFace(poly.Wire(), True).Face()
-    inset = max(frame.edge_land(f) for f in s.face_list) + 0.05
-    outside = sum(face_area(f) for f in explore(BRepAlgoAPI_Cut(foot, plan_face(offset_wire(frame.outline, -inset))).Shape(),
+    inset = max(frame.edge_land(f) for f in s.face_list) + SHORT_SCORE_MARGIN_MM
+    outside = sum(face_area(f) for f in explore(BRepAlgoAPI_Cut(foot, plan_face(frame.offset(-inset))).Shape(),
                                                   "Face"))
     if outside > 1e-9:
         raise DesignError(f"[[tooling.score]] {i} length_mm", s.length_mm,

@@ -73,7 +73,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-from tabletcad.errors import MISSING, DesignError, check_finite, check_positive, check_range
+from tabletcad.errors import MISSING, DesignError, check_finite, check_positive, check_range, format_bound
 from tabletcad.tolerance import DEFAULT
 from tabletcad.tolerance import (MAX_MODULUS_MPA, MAX_YIELD_MPA, MIN_PUNCH_MODULUS_MPA, MIN_TIP_PRESSURE_MPA,
                                  MIN_YIELD_MPA)
@@ -254,22 +254,87 @@ def check_on_tablet(tablet: Any, spec: ToolingSpec) -> None:
     check_figures_on_tablet(tablet, spec, {"top": z_range[1] - band_z[1], "bottom": band_z[0] - z_range[0]})
 
 
-#: why a tablet whose plan is a spline through points gets no tooling (OCC 7.9's planar offset, which makes the
-#: tips and the bore, fails on the one periodic B-spline edge that such a band's section is: a 24-point
-#: circle, 8- and 64-point ovals were all refused)
-SPLINE_OUTLINE_REFUSAL = ("tooling needs an outline OpenCascade can offset for the tips and the bore: lines and arcs "
-                          "(custom_outline segments), a circle or an ellipse; the section of this tablet's band cannot "
-                          "be offset")
+def spline_offset_error(outline: Any, distance: float) -> DesignError | None:
+    """The refusal of an offset by ``distance`` mm (> 0 outward, < 0 inward) of a spline plan ``outline`` (a
+    :class:`~tabletcad.families.outline.SplineOutline`) that is no regular offset of it
+    (:meth:`~tabletcad.families.outline.SplineOutline.offset_bound`), naming the outline, else ``None``."""
+    bound = outline.offset_bound(distance)
+    if bound is None:
+        return None
+    lim, why = bound
+    way = "outward" if distance > 0 else "inward"
+    return DesignError("tablet.outline", "points (a spline through them)",
+                       f"the tooling offsets it {abs(distance):.4g} mm {way}, beyond its regular offsets that way: at "
+                       f"most {format_bound(lim, upper=True)} mm ({why})")
 
 
-def spline_outline_refusal(tablet: Any) -> DesignError | None:
-    """The refusal of tooling for a tablet whose nominal plan outline is a spline through points (a
-    :class:`~tabletcad.families.outline.SplineOutline`: it has no lines and arcs), else ``None``: decided
-    from the design alone, so that ``report`` and ``build`` refuse it alike and before any geometry."""
+#: how far (mm) a complete punch's relief ring reaches outside its tip (:func:`tabletcad.tooling.punch_body.complete_punch`)
+RELIEF_RING_OVERLAP_MM = 0.05
+
+#: how far (mm) inside the face's land a short score's footprint must end (:func:`tabletcad.tooling.scores.check_score`)
+SHORT_SCORE_MARGIN_MM = 0.05
+
+
+def check_spline_offsets(tablet: Any, spec: ToolingSpec) -> None:
+    """On the design, before any geometry: every offset of a spline plan outline (a custom outline through
+    points) that the tooling will build is a regular offset of it
+    (:meth:`~tabletcad.families.outline.SplineOutline.offset_bound`: inward within its smallest convex
+    radius of curvature and its inscribed radius, outward within its smallest concave one), each refusal
+    naming what asks for it: ``clearance_mm`` (the tips), ``tip_relief_mm`` (a complete punch's relieved
+    tip), ``taper_deg`` (the bore drafted from the band's top to 1 mm above the die), a figure's ``margin_mm`` (the face it must fit in), a short score's ``length_mm`` (the face inset by
+    its land + 0.05 mm), the outline itself (the die bore grown by the band's bulge, the relief ring).
+    Nothing for another outline.  The tooling frame builds the same offsets
+    (:meth:`tabletcad.tooling.outline.TabletFrame.offset`) and refuses them alike."""
+    from tabletcad.families.outline import SplineOutline
+    from tabletcad.families.thesis import NO_LAND
+
     outline = getattr(tablet.nominal, "outline", None)
-    if outline is not None and not getattr(outline, "segs", None):
-        return DesignError("tablet.outline", "points (a spline through them)", SPLINE_OUTLINE_REFUSAL)
-    return None
+    if not isinstance(outline, SplineOutline):
+        return
+    band_z = band_heights(tablet)
+    lo, hi = tablet.bounds()
+    bore = bore_offset(tablet.plan_overhang() if tablet.band() is not None else 0.0)
+    inset = tip_inset(spec.clearance_mm, bore)
+    cups = {"top": float(hi[2]) - band_z[1], "bottom": band_z[0] - float(lo[2])}
+    land = dict(getattr(tablet.nominal, "info", {}) or {}).get("land_mm")
+    land = 0.0 if land is None and tablet.family in NO_LAND else (land or 0.0)
+
+    def edge_land(face: str) -> float:
+        return 0.0 if cups[face] < 1e-9 else float(land)
+
+    asks: list[tuple[str, Any, float]] = [("[tooling] clearance_mm", spec.clearance_mm, -inset)]
+    b = spec.body
+    if b is not None and b.tip_relief_mm > 0 and max(spec.tip_length_mm, spec.lower_tip) > b.tip_straight_mm:
+        asks += [("[tooling.punch] tip_relief_mm", b.tip_relief_mm, -(spec.clearance_mm + b.tip_relief_mm)),
+                 ("tablet.outline", "points (a spline through them)", RELIEF_RING_OVERLAP_MM - inset)]
+    asks.append(("tablet.outline", "points (a spline through them)", bore))
+    if spec.taper_deg > 0:  # the bore drafted from the band's top to 1 mm above the die (die_faces_z: the entry)
+        from tabletcad.pipeline.designreport import plan_diameter
+
+        rise = die_faces_z(band_z, die_height_for(spec, plan_diameter(tablet), True))[0] + 1.0
+        top = bore + rise * math.tan(math.radians(spec.taper_deg))
+        bound = outline.offset_bound(top)
+        if bound is not None:
+            most = math.degrees(math.atan((bound[0] - bore) / rise))
+            raise DesignError("[tooling] taper_deg", spec.taper_deg, f"must be <= {format_bound(most, upper=True)} deg: "
+                              f"the die bore drafted over {rise:.4g} mm grows {top:.4g} mm outward, at most "
+                              f"{format_bound(bound[0], upper=True)} mm ({bound[1]})", "deg")
+    asks += [(f"[[tooling.emboss]] {i} margin_mm", e.margin_mm, -(spec.clearance_mm + edge_land(e.face) + e.margin_mm))
+             for i, e in enumerate(spec.emboss)]
+    asks += [(f"[[tooling.score]] {i} length_mm", s.length_mm,
+              -(max(edge_land(f) for f in s.face_list) + SHORT_SCORE_MARGIN_MM))
+             for i, s in enumerate(spec.scores) if s.length_mm is not None]
+    for parameter, value, distance in asks:
+        bound = outline.offset_bound(distance)
+        if bound is None:
+            continue
+        if parameter == "tablet.outline":  # (the bore grown by the band's bulge, the relief ring: as the frame says)
+            raise spline_offset_error(outline, distance)
+        lim, why = bound
+        most = value - (abs(distance) - lim)  # (each of them moves the offset by as much as it changes)
+        raise DesignError(parameter, value, f"must be <= {format_bound(most, upper=True)} mm: the tooling offsets the "
+                          f"spline outline {abs(distance):.4g} mm inward for it, at most {format_bound(lim, upper=True)} "
+                          f"mm ({why})", "mm")
 
 
 def tooling_plan_outline(tablet: Any) -> Any:
@@ -344,8 +409,8 @@ def check_figures_on_tablet(tablet: Any, spec: ToolingSpec, cups: dict[str, floa
     Decided on the same curves without OCC (:mod:`tabletcad.geometry.lettering`); ``cups`` (face -> mm) tell
     a flat face (no land).  The stroke angle is decided for every text or polyline figure (it needs no
     outline).  The fit is not decided here (the build still checks it after the solid) for an SVG logo, an
-    outline the tooling takes as an ellipse or its band's section, and an inset whose offset of the outline
-    crosses itself or parts in two (:func:`fit_is_decided`)."""
+    outline the tooling takes as an ellipse, a spline through points or its band's section, and an inset
+    whose offset of the outline crosses itself or parts in two (:func:`fit_is_decided`)."""
     from tabletcad.families.thesis import NO_LAND
 
     if not spec.emboss:

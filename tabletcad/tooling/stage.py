@@ -21,7 +21,7 @@ from typing import Any, Callable
 from tabletcad.errors import DesignError, GeometryError
 from tabletcad.geometry.tablet import Tablet
 from tabletcad.pipeline.designreport import ReportOptions
-from tabletcad.tooling.spec import ToolingSpec, band_heights, check_on_tablet, spline_outline_refusal
+from tabletcad.tooling.spec import ToolingSpec, band_heights, check_on_tablet, check_spline_offsets
 
 __all__ = ["check_tooling", "tooling_outputs", "tooling_stage", "write_tooling", "write_finished_tablet"]
 
@@ -38,12 +38,12 @@ def tooling_outputs(spec: ToolingSpec) -> list[str]:
 
 
 def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
-    """Refuse a tablet that cannot have tooling (a cut-away or a ring, one without a band, one whose outline is a
-    spline through points: :func:`~tabletcad.tooling.spec.spline_outline_refusal`, one too large for its
+    """Refuse a tablet that cannot have tooling (a cut-away or a ring, one without a band, one too large for its
     die or for every TSM die when no die is given) and a ``[tooling]`` table its numbers refuse (a score or a
     figure deeper than its face allows, a groove wider than half the tablet, a clearance, gap or tip length, a
     figure that does not fit its face: :func:`~tabletcad.tooling.spec.check_on_tablet`; complete punches' tips too short for the die they run in:
-    :func:`~tabletcad.tooling.spec.check_punch_lengths`), before any geometry is built: ``report`` and ``build``
+    :func:`~tabletcad.tooling.spec.check_punch_lengths`; for a custom outline through points, an offset of it beyond
+    its regular offsets: :func:`~tabletcad.tooling.spec.check_spline_offsets`), before any geometry is built: ``report`` and ``build``
     refuse alike, in a second where the tooling stage had refused after the solid was built.
 
     ``spec`` is the design's checked ``[tooling]`` table
@@ -56,9 +56,6 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
     from tabletcad.tooling.spec import check_punch_lengths, check_relief_reach, die_height_for, standard_die_size
 
     band_z = band_heights(tablet)  # (a sphere has no band for the die to form)
-    refusal = spline_outline_refusal(tablet)  # (the tooling frame's own refusal, before any geometry)
-    if refusal is not None:
-        raise refusal
     od = spec.die_outer_diameter_mm
     size, shaped = plan_diameter(tablet), tablet.revolution is None  # (its largest extent in plan: a square's diagonal)
     if od is None:  # the TSM die the build will take: one larger than a 'D' takes is refused here, not after the CAD
@@ -81,6 +78,7 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
         check_punch_lengths(spec, band_z, die_height_for(spec, size, shaped))
         lo, hi = tablet.bounds()
         check_relief_reach(spec, min(float(hi[0] - lo[0]), float(hi[1] - lo[1])), float(hi[1] - lo[1]))
+    check_spline_offsets(tablet, spec)  # (a custom outline through points: its offsets, as the frame builds them)
 
 
 def write_tooling(ts, out: Path, *, drawing: bool = True) -> list[Path]:

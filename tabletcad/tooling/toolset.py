@@ -150,14 +150,14 @@ def _check_relief(frame, spec: ToolingSpec) -> None:
     """A tip relief that leaves no relieved outline (the tip's outline offset inwards by the clearance
     and the relief is empty or falls apart) as a DesignError naming ``tip_relief_mm``."""
     from tabletcad.errors import GeometryError
-    from tabletcad.tooling.outline import face_area, offset_wire, plan_face
+    from tabletcad.tooling.outline import face_area, plan_face
 
     b = spec.body
     if b.tip_relief_mm <= 0 or max(spec.tip_length_mm, spec.lower_tip) <= b.tip_straight_mm:
         return  # no relief is cut
     d = spec.clearance_mm + b.tip_relief_mm
     try:
-        relieved = face_area(plan_face(offset_wire(frame.outline, -d)))
+        relieved = face_area(plan_face(frame.offset(-d)))
     except GeometryError:
         relieved = 0.0
     if not relieved > 0.0:
