@@ -27,7 +27,7 @@ on the same curves:
 curves where they lie outside (Gauss–Legendre, exact on polynomials), their crossings of the offset
 found by Brent's method on the outline's exact signed distance, and closed along the offset curve
 (its lines and arcs) between the crossings.  It needs that offset curve to be the inset region's
-boundary (:func:`offset_bounds_inset`: ``inset`` below every convex arc's radius, and no neck where
+boundary (:func:`tabletcad.families.outline.offset_bounds_inset`: ``inset`` below every convex arc's radius, and no neck where
 the offset would cross itself or part in two: there the closing integral would run along the
 crossing offset, 0.464 mm² instead of 0.440 on a peanut's neck; the caller leaves those to OCC); a
 crossing point is found between 64 samples of each Bézier, so a tangential touch thinner than their
@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["text_contours", "polyline_contours", "placed", "figure_area", "figure_box", "figure_length",
-           "outside_area", "offset_bounds_inset"]
+           "outside_area"]
 
 #: Gauss-Legendre nodes and weights on [0, 1] (exact for polynomials of degree 15)
 _GX, _GW = np.polynomial.legendre.leggauss(8)
@@ -266,71 +266,10 @@ def _offset_x_dy(outline, inset: float, v0: float, v1: float) -> float:
     return total
 
 
-def offset_bounds_inset(outline, inset: float, tol: float = 1e-9) -> bool:
-    """Whether the lines-and-arcs ``outline``'s inward offset by ``inset`` mm is the boundary of its inset region
-    ``{p : distance inside >= inset}``, the curve :func:`outside_area` closes along: ``inset`` below every convex
-    arc's radius and no point of the offset nearer than ``inset - tol`` to another segment of the outline than
-    its own (else the offset crosses itself or parts in two at a neck).
-
-    That clearance ``min_{j != own} d_j(O + inset N) - inset`` is smooth where the signed distance is flat (0 on
-    a clean offset), so it is sampled (4,096 and the joins) and every low local minimum polished by bounded
-    Brent: a neck is found to round-off, where
-    :meth:`~tabletcad.families.outline.PlanOutline.offset_limit` (2,048 samples of the signed distance, to
-    1e-7) takes a peanut's neck of half width 0.687434 mm for 0.687451."""
-    from scipy.optimize import minimize_scalar
-
-    from tabletcad.families.outline import _signed_to_segment
-
-    if not inset < outline.min_convex_radius:
-        return False
-    segs, breaks = outline.segs, outline.breaks
-
-    def clearance(vs: np.ndarray) -> np.ndarray:
-        own = np.clip(np.searchsorted(breaks, np.mod(vs, math.tau), side="right") - 1, 0, len(segs) - 1)
-        q = outline.offset(vs, 0, 1.0, inset)
-        dist = np.stack([_signed_to_segment(sg, q)[0] for sg in segs])
-        dist[own, np.arange(len(vs))] = np.inf
-        return dist.min(axis=0) - inset
-
-    v = np.unique(np.concatenate([np.linspace(0.0, math.tau, 4096, endpoint=False), breaks[:-1]]))
-    h = clearance(v)
-    if float(h.min()) < -tol:
-        return False
-    # the offset point moves (1 + inset / r) times as fast as the outline's, so the clearance changes by at most
-    # that a millimetre: a minimum between two samples lies within it times their spacing of both
-    speed = 1.0 + inset * max([1.0 / sg.radius for sg in segs if sg.kind != "line"] or [0.0])
-    reach = 2.0 * speed * outline.perimeter / len(v)
-    low = (h <= np.roll(h, 1)) & (h <= np.roll(h, -1)) & (h < reach)
-    ext = np.concatenate([[v[-1] - math.tau], v, [v[0] + math.tau]])  # neighbours across 0 = 2 pi
-    for i in _lowest_of_runs(low, h):
-        r = minimize_scalar(lambda x: float(clearance(np.array([x]))[0]), bounds=(ext[i], ext[i + 2]),
-                            method="bounded", options=dict(xatol=1e-13))
-        if float(r.fun) < -tol:
-            return False
-    return True
-
-
-def _lowest_of_runs(mask: np.ndarray, h: np.ndarray) -> list[int]:
-    """The index of the least ``h`` in each run of adjacent ``True`` of the cyclic ``mask`` (a flat stretch of
-    local minima, as a capsule's parallel sides give, polished once)."""
-    if mask.all():
-        return [int(np.argmin(h))]
-    start = int(np.flatnonzero(~mask)[0])  # runs read from a False, so none wraps
-    order = np.roll(np.arange(mask.size), -start)
-    out, run = [], []
-    for k in list(order) + [start]:
-        if mask[k]:
-            run.append(k)
-        elif run:
-            out.append(min(run, key=lambda j: h[j]))
-            run = []
-    return [int(k) for k in out]
-
-
 def outside_area(contours, outline, inset: float) -> tuple[float, float]:
     """``(area, outside)`` (mm²): the figure's area and the part of it farther out than the lines-and-arcs
     ``outline`` (a :class:`~tabletcad.families.outline.PlanOutline`) offset inwards by ``inset`` mm (see the
-    module docstring).  The offset must bound the inset region (:func:`offset_bounds_inset`), else the result is not
+    module docstring).  The offset must bound the inset region (:func:`tabletcad.families.outline.offset_bounds_inset`), else the result is not
     the area outside."""
     sign = 1.0 if figure_area(contours) >= 0 else -1.0  # the fill's orientation made counter-clockwise
     area = sign * figure_area(contours)

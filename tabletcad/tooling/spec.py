@@ -275,7 +275,7 @@ RELIEF_RING_OVERLAP_MM = 0.05
 SHORT_SCORE_MARGIN_MM = 0.05
 
 
-def check_spline_offsets(tablet: Any, spec: ToolingSpec) -> None:
+def check_spline_offsets(tablet: Any, spec: ToolingSpec, size: float) -> None:
     """On the design, before any geometry: every offset of a spline plan outline (a custom outline through
     points) that the tooling will build is a regular offset of it
     (:meth:`~tabletcad.families.outline.SplineOutline.offset_bound`: inward within its smallest convex
@@ -283,8 +283,9 @@ def check_spline_offsets(tablet: Any, spec: ToolingSpec) -> None:
     naming what asks for it: ``clearance_mm`` (the tips), ``tip_relief_mm`` (a complete punch's relieved
     tip), ``taper_deg`` (the bore drafted from the band's top to 1 mm above the die), a figure's ``margin_mm`` (the face it must fit in), a short score's ``length_mm`` (the face inset by
     its land + 0.05 mm), the outline itself (the die bore grown by the band's bulge, the relief ring).
-    Nothing for another outline.  The tooling frame builds the same offsets
-    (:meth:`tabletcad.tooling.outline.TabletFrame.offset`) and refuses them alike."""
+    Nothing for another outline.  ``size``: the tablet's plan diameter (mm,
+    :func:`tabletcad.pipeline.designreport.plan_diameter`: the die's height goes by it).  The tooling frame
+    builds the same offsets (:meth:`tabletcad.tooling.outline.TabletFrame.offset`) and refuses them alike."""
     from tabletcad.families.outline import SplineOutline
     from tabletcad.families.thesis import NO_LAND
 
@@ -309,9 +310,7 @@ def check_spline_offsets(tablet: Any, spec: ToolingSpec) -> None:
                  ("tablet.outline", "points (a spline through them)", RELIEF_RING_OVERLAP_MM - inset)]
     asks.append(("tablet.outline", "points (a spline through them)", bore))
     if spec.taper_deg > 0:  # the bore drafted from the band's top to 1 mm above the die (die_faces_z: the entry)
-        from tabletcad.pipeline.designreport import plan_diameter
-
-        rise = die_faces_z(band_z, die_height_for(spec, plan_diameter(tablet), True))[0] + 1.0
+        rise = die_faces_z(band_z, die_height_for(spec, size, True))[0] + 1.0
         top = bore + rise * math.tan(math.radians(spec.taper_deg))
         bound = outline.offset_bound(top)
         if bound is not None:
@@ -437,10 +436,10 @@ def fit_is_decided(outline: Any, inset: float) -> bool:
     """Whether :func:`figure_fit_refusal` decides a figure's fit inside ``outline`` (a
     :class:`~tabletcad.families.outline.PlanOutline`) offset inwards by ``inset`` mm as the tooling's OCC
     Boolean does: where that offset bounds the inset region
-    (:func:`tabletcad.geometry.lettering.offset_bounds_inset`: the curve the area outside is closed along) or
+    (:func:`tabletcad.families.outline.offset_bounds_inset`: the curve the area outside is closed along) or
     at and beyond the outline's inscribed radius (no face left).  Between the two (a convex arc turned inside
     out, a narrow neck whose offset crosses itself or parts in two) the build decides it after the solid."""
-    from tabletcad.geometry.lettering import offset_bounds_inset
+    from tabletcad.families.outline import offset_bounds_inset
 
     return not inset < outline.inscribed_radius() or offset_bounds_inset(outline, inset)
 

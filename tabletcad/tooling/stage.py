@@ -78,7 +78,7 @@ def check_tooling(tablet: Tablet, spec: ToolingSpec) -> None:
         check_punch_lengths(spec, band_z, die_height_for(spec, size, shaped))
         lo, hi = tablet.bounds()
         check_relief_reach(spec, min(float(hi[0] - lo[0]), float(hi[1] - lo[1])), float(hi[1] - lo[1]))
-    check_spline_offsets(tablet, spec)  # (a custom outline through points: its offsets, as the frame builds them)
+    check_spline_offsets(tablet, spec, size)  # (a custom outline through points: its offsets, as the frame builds them)
 
 
 def write_tooling(ts, out: Path, *, drawing: bool = True) -> list[Path]:
