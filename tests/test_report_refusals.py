@@ -388,11 +388,22 @@ def test_report_and_build_refuse_with_the_same_line(capsys, tmp_path, design, ne
 
 @pytest.mark.cad
 def test_text_just_inside_the_limit_builds(tmp_path):
+    """1.528 mm, below the tallest that fits (1.5283608901): reported, and the tooling is made with it, the
+    figure cut (the Booleans' manifold3d checks and the closed-position check, which the text does not
+    touch, left to the tooling tests: the build's fit check is the one made here)."""
+    import tomllib
+
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.toolset import make_tooling
+
     src = tmp_path / "d.toml"
     src.write_text(ROUND.format(height=1.528), encoding="utf-8")
     assert main(["report", str(src)]) == 0
-    assert main(["build", str(src), "--out", str(tmp_path / "out"), "--quiet"]) == 0
-    assert (tmp_path / "out" / "upper_punch.step").is_file()
+    d = Design.from_dict(tomllib.loads(src.read_text(encoding="utf-8")))
+    ts = make_tooling(d.build(), d.tooling_spec, check=False, interference_check=False)
+    (figure,) = ts.report["emboss"]
+    assert figure["text"] == "ABCDEFGH" and figure["height_mm"] == 1.528 and figure["figure_area_mm2"] > 5.0
+    assert ts.report["lower_punch"]["volume_mm3"] > 0
 
 
 @pytest.mark.cad

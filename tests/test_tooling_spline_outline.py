@@ -10,7 +10,6 @@ tests/test_families_spline_outline.py).
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
@@ -22,7 +21,6 @@ pytest.importorskip("manifold3d")
 pytest.importorskip("ezdxf")
 
 from tabletcad.cad.solid import check_solid  # noqa: E402
-from tabletcad.cli import main  # noqa: E402
 from tabletcad.families.shaped import outline_tablet  # noqa: E402
 from tabletcad.tooling import ToolingSpec, make_tooling  # noqa: E402
 from tabletcad.tooling.outline import SPLINE_OFFSET_TOL_MM  # noqa: E402
@@ -37,18 +35,6 @@ SQUARE = [[4.0, -1.8], [4.0, 0.0], [4.0, 1.8], [3.9864, 3.7035], [3.8828, 3.8828
           [0.0, 4.0], [-1.8, 4.0], [-3.7035, 3.9864], [-3.8828, 3.8828], [-3.9864, 3.7035], [-4.0, 1.8], [-4.0, 0.0],
           [-4.0, -1.8], [-3.9864, -3.7035], [-3.8828, -3.8828], [-3.7035, -3.9864], [-1.8, -4.0], [0.0, -4.0],
           [1.8, -4.0], [3.7035, -3.9864], [3.8828, -3.8828], [3.9864, -3.7035]]
-
-#: the design of tests/test_report_refusals.py: an 8 x 8 mm outline through 8 points
-DESIGN = """[tablet]
-family = "custom_outline"
-outline = [[4, 0], [3, 3], [0, 4], [-3, 3], [-4, 0], [-3, -3], [0, -4], [3, -3]]
-band = 2.5
-cup_depth = 0.5
-
-[tooling]
-clearance_mm = 0.02
-tip_length_mm = 8.0
-"""
 
 
 @pytest.fixture(scope="module")
@@ -164,17 +150,16 @@ def test_volumes(square):
     assert volume(square.parts["tablet"]) == pytest.approx(square.tablet.properties()["volume_mm3"], rel=1e-7)
 
 
-@pytest.mark.slow
-def test_build_writes_the_tooling(tmp_path, capsys):
-    """``tabletcad build`` of the design report and build had refused: the parts, assembly and drawings,
-    the report's deviations within the tolerance."""
-    src = tmp_path / "d.toml"
-    src.write_text(DESIGN, encoding="utf-8")
-    assert main(["build", str(src), "--out", str(tmp_path / "out"), "--quiet"]) == 0, capsys.readouterr().err
-    out = tmp_path / "out"
+def test_the_tooling_is_written(square, tmp_path):
+    """The files ``tabletcad build`` writes of such tooling (the stage's writer on the fixture's tool set: the
+    command's own path, check and all, is the one ``report`` and ``build`` take alike in
+    tests/test_report_refusals.py): the parts, assembly and drawings, the deviations within the tolerance."""
+    from tabletcad.tooling.stage import write_tooling
+
+    written = {p.name for p in write_tooling(square, tmp_path)}
     for name in ("assembly.step", "upper_punch.step", "lower_punch.step", "die.step", "tooling.dxf"):
-        assert (out / name).is_file(), name
-    r = json.loads((out / "report.json").read_text())["tooling"]
+        assert name in written and (tmp_path / name).stat().st_size > 0, name
+    r = square.report
     assert r["upper_punch"]["tip_outline"] == "spline"
     assert r["upper_punch"]["tip_outline_deviation_mm"] <= SPLINE_OFFSET_TOL_MM
     assert r["interference_mm3"] == pytest.approx(0.0, abs=1e-9)
