@@ -10,7 +10,8 @@ dropped here.
 A worker still busy when its run is stopped (an OpenCascade call holds the interpreter) is killed by its
 nanny after a short grace (:func:`tabletcad.parallel._stop_workers`): a named semaphore it had made is then
 never unlinked, and Python's resource tracker, which the workers share with the command line's process,
-reported it after ``interrupted``.  The workers therefore make none (:func:`_tqdm_lock_unnamed`).
+reported it after ``interrupted``.  The one a build made, tqdm's lock, has no name now
+(:func:`_tqdm_lock_unnamed`); a build that made others (a multiprocessing queue or lock) would leave them.
 """
 
 from __future__ import annotations
