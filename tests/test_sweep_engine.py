@@ -182,11 +182,14 @@ def test_the_workers_drop_only_the_heartbeats_report_of_a_closed_scheduler(caplo
     import logging
     import signal
 
+    from tqdm import tqdm
+
     from tabletcad.worker_setup import dask_setup
 
     before = signal.getsignal(signal.SIGINT)
     logger = logging.getLogger("distributed.worker")
     kept = list(logger.filters)
+    lock = tqdm.get_lock()  # (the workers' set-up gives tqdm another: this process keeps its own)
     try:
         dask_setup(None)
         dask_setup(None)  # (once per worker: the filter is not added twice)
@@ -198,6 +201,7 @@ def test_the_workers_drop_only_the_heartbeats_report_of_a_closed_scheduler(caplo
     finally:
         signal.signal(signal.SIGINT, before)
         logger.filters[:] = kept
+        tqdm.set_lock(lock)
 
 
 @pytest.mark.parametrize("guarded", [False, True])

@@ -407,12 +407,31 @@ def _exit_now(status: int) -> None:
     (CPython 3.11; seen in tests/test_cli_contract.py)."""
     import os
 
+    _release_semaphores()
     for stream in (sys.stdout, sys.stderr):
         try:
             stream.flush()
         except (OSError, ValueError, AttributeError):
             pass
     os._exit(status)
+
+
+def _release_semaphores() -> None:
+    """Unlink the named semaphores this process made, as its normal exit would: multiprocessing's exit-time
+    finalizers (those of priority 0 and up; its ``atexit`` handler runs the same), when it was imported.
+
+    ``os._exit`` skips them, and Python's resource tracker then reported every semaphore still registered:
+    tqdm's write lock (made at a sweep's progress bar) is one wherever the start method is not ``fork``
+    (macOS; Linux from Python 3.14): "resource_tracker: There appear to be 1 leaked semaphore objects to
+    clean up at shutdown" after each Ctrl-C's ``interrupted``.
+    """
+    util = sys.modules.get("multiprocessing.util")
+    if util is None:
+        return
+    try:
+        util._run_finalizers(0)
+    except BaseException:  # noqa: BLE001 - the process ends now whatever a finalizer does (a second Ctrl-C)
+        pass
 
 
 if __name__ == "__main__":  # pragma: no cover
