@@ -181,10 +181,12 @@ def test_a_shaped_sheet_gives_the_outline_radius_and_the_plateau():
 
 
 @pytest.mark.cad
-def test_tooling_of_an_outline_through_points_is_refused_naming_the_outline(capsys, tmp_path):
+def test_tooling_of_an_outline_through_points_is_made_from_its_exact_offsets(capsys, tmp_path):
     """A custom outline given as points is a spline through them, whose band section OpenCascade could not
     offset for the tips and the bore: an internal IndexError had ended the build (a reviewer's trial), then a
-    bare geometry error; now the one-line refusal names the outline."""
+    one-line refusal; the tips and the bore are now B-splines of the outline's exact offsets (the tooling
+    itself: tests/test_tooling_spline_outline.py), so the design is reported with its tooling, and the frame's
+    tip outline lies within 1e-6 mm of the exact offset by the clearance."""
     design = """[tablet]
 family = "custom_outline"
 outline = [[5.4, 0.0], [5.102834, 0.905867], [4.330127, 1.75], [3.335534, 2.474874], [2.3, 3.031089], [1.22089, 3.38074], [0.0, 3.5], [-1.3673, 3.38074], [-2.7, 3.031089], [-3.735534, 2.474874], [-4.330127, 1.75], [-4.556424, 0.905867], [-4.6, 0.0], [-4.556424, -0.905867], [-4.330127, -1.75], [-3.735534, -2.474874], [-2.7, -3.031089], [-1.3673, -3.38074], [-0.0, -3.5], [1.22089, -3.38074], [2.3, -3.031089], [3.335534, -2.474874], [4.330127, -1.75], [5.102834, -0.905867]]
@@ -196,5 +198,20 @@ land = 0.05
 clearance_mm = 0.02
 tip_length_mm = 8.0
 """
-    param, value, allowed = _refused(capsys, tmp_path, design)
-    assert param == "tablet.outline" and "spline" in value and "lines and arcs" in allowed
+    import math
+    import tomllib
+
+    from tabletcad.cli import main
+    from tabletcad.pipeline.design import Design
+    from tabletcad.tooling.outline import SPLINE_OFFSET_TOL_MM, face_area, plan_face, tablet_frame
+
+    src = tmp_path / "d.toml"
+    src.write_text(design, encoding="utf-8")
+    assert main(["report", str(src)]) == 0
+    assert capsys.readouterr().err == ""
+    t = Design.from_dict(tomllib.loads(design)).build()
+    frame, outline = tablet_frame(t), t.nominal.outline
+    assert frame.offset_deviation(-0.02) <= SPLINE_OFFSET_TOL_MM
+    # the tips' plan area is Steiner's for the convex outline shrunk by the clearance
+    area = outline.area - outline.perimeter * 0.02 + math.pi * 0.02 ** 2
+    assert face_area(plan_face(frame.offset(-0.02))) == pytest.approx(area, rel=1e-6)
