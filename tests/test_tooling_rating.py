@@ -63,6 +63,28 @@ def test_without_a_sourced_pressure_there_is_no_rating(frame):
     assert r["rated_force_kN"] == pytest.approx(0.25 * r["tip_projected_area_mm2"]) and "user-given" in r["allowed_pressure_source"]
 
 
+def test_buckling_takes_each_tip_s_own_smallest_section(frame):
+    """A complete punch's tip is relieved only beyond its straight part: the upper tip (8 mm, straight 8 mm) keeps
+    its full section, the lower (25.4 mm) is relieved by 0.5 mm; the figures are the discs' (the relieved
+    section had been taken for both, and its offset asked for where no relief is cut)."""
+    spec = parse_tooling(dict(standard="EU", type="B", die_height_mm=22.0, tip_length_mm=8.0,
+                              lower_tip_length_mm=25.4, clearance_mm=0.02, punch_youngs_modulus_MPa=210000.0,
+                              punch_youngs_modulus_source=SRC,
+                              punch=dict(head_diameter_mm=25.0, head_flat_diameter_mm=12.0, head_rim_mm=3.0,
+                                         dome_radius_mm=30.0, neck_diameter_mm=13.0, neck_length_mm=10.0,
+                                         tip_straight_mm=8.0, tip_relief_mm=0.5)))
+    r = tip_rating(frame, spec, ReportOptions(compaction_force_kN=15.0))["buckling"]
+    rt = 5.0 - (0.02 - frame.bore_offset)
+    for name, radius, relief in (("upper", rt, 0.0), ("lower", rt - 0.5, 0.5)):
+        tip = r["tips"][name]
+        assert tip["relieved_by_mm"] == relief
+        assert tip["section_min_second_moment_mm4"] == pytest.approx(math.pi * radius ** 4 / 4.0, rel=1e-9)
+        L = tip["free_length_mm"]
+        assert tip["buckling_load_kN"] == pytest.approx(
+            math.pi ** 2 * 210000.0 * (math.pi * radius ** 4 / 4.0) / (2.0 * L) ** 2 / 1000.0, rel=1e-9)
+    assert r["section_min_second_moment_mm4"] == pytest.approx(math.pi * (rt - 0.5) ** 4 / 4.0, rel=1e-9)
+
+
 @pytest.mark.parametrize("table, parameter", [
     ({"allowed_tip_pressure_MPa": 300.0}, "allowed_tip_pressure_source"),
     ({"allowed_tip_pressure_MPa": -3.0, "allowed_tip_pressure_source": SRC}, "allowed_tip_pressure_MPa"),

@@ -165,6 +165,29 @@ def test_the_tooling_is_written(square, tmp_path):
     assert r["interference_mm3"] == pytest.approx(0.0, abs=1e-9)
 
 
+def test_the_tip_rating_s_section_is_the_exact_offset_s(square):
+    """The tips' projected area and least second moment (the pressure rating's and the buckling check's figures)
+    are those of the outline's exact offset by the tips' inset (a 200,000-gon of it, by the shoelace sums):
+    OCC's fixed integration rule had given them 0.21 % and 2.4 % off on the spline's offsets."""
+    from tabletcad.tooling.rating import section_properties
+
+    frame, outline = square.frame, square.tablet.nominal.outline
+    inset = frame.tip_inset(CLEARANCE)
+    v = np.linspace(0.0, 2 * math.pi, 200_000, endpoint=False)
+    x, y = outline.offset(v, 0, 1.0, inset).T
+    x1, y1 = np.roll(x, -1), np.roll(y, -1)
+    c = x * y1 - x1 * y
+    a = 0.5 * c.sum()
+    cx, cy = ((x + x1) * c).sum() / (6 * a), ((y + y1) * c).sum() / (6 * a)
+    ixx = ((y * y + y * y1 + y1 * y1) * c).sum() / 12 - a * cy * cy
+    iyy = ((x * x + x * x1 + x1 * x1) * c).sum() / 12 - a * cx * cx
+    ixy = ((x * y1 + 2 * x * y + 2 * x1 * y1 + x1 * y) * c).sum() / 24 - a * cx * cy
+    i_min = 0.5 * (ixx + iyy) - math.sqrt(0.25 * (ixx - iyy) ** 2 + ixy * ixy)
+    area, i_occ = section_properties(frame.offset(-inset))
+    assert area == pytest.approx(a, rel=1e-7) and i_occ == pytest.approx(i_min, rel=1e-7)
+    assert square.report["tip_rating"]["tip_projected_area_mm2"] == pytest.approx(a, rel=1e-7)
+
+
 def test_a_tapered_bore_is_the_exact_offset_at_every_height(square):
     """LocOpe_DPrism's draft of the spline bore failed BRepCheck_Analyzer (``build`` exit 1 with taper_deg);
     the ruled solid between the bore and its exact offset at the top is valid, and the die's volume is the

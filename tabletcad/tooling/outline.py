@@ -230,9 +230,10 @@ def plan_face(wire) -> Any:
     return mk.Face()
 
 
-def face_area(face) -> float:
-    """The plan face's area (mm²): OCC's Gauss integration, adaptive to 1e-10 on a face bounded by a spline
-    outline's periodic B-spline (its fixed rule had given a tip 64.0303 mm² for 64.0461)."""
+def plan_face_properties(face) -> GProp_GProps:
+    """The plan face's area properties (area, centroid, inertia): OCC's Gauss integration, adaptive to 1e-10 on
+    a face bounded by a spline outline's periodic B-spline (its fixed rule had given a tip 64.0303 mm² for
+    64.0461, and the tip's least second moment 2.4 % high)."""
     from tabletcad.tooling.booleans import has_periodic_bspline_curve
 
     p = GProp_GProps()
@@ -240,7 +241,12 @@ def face_area(face) -> float:
         BRepGProp.SurfaceProperties_s(face, p, 1e-10)
     else:
         BRepGProp.SurfaceProperties_s(face, p)
-    return abs(p.Mass())
+    return p
+
+
+def face_area(face) -> float:
+    """The plan face's area (mm², :func:`plan_face_properties`)."""
+    return abs(plan_face_properties(face).Mass())
 
 
 def wire_length(wire) -> float:

@@ -21,11 +21,8 @@ from __future__ import annotations
 
 import math
 
-from OCP.BRepGProp import BRepGProp
-from OCP.GProp import GProp_GProps
-
 from tabletcad.pipeline.designreport import ReportOptions
-from tabletcad.tooling.outline import TabletFrame, plan_face
+from tabletcad.tooling.outline import TabletFrame, plan_face, plan_face_properties
 
 __all__ = ["section_properties", "tip_rating", "rating_text", "overload_texts", "EULER_K"]
 
@@ -63,8 +60,7 @@ def overload_texts(force_kN: float, rated_kN: float) -> tuple[str, str, str]:
 
 def section_properties(wire) -> tuple[float, float]:
     """``(area mm², smallest principal second moment of area mm⁴)`` of the plan region bounded by ``wire``."""
-    props = GProp_GProps()
-    BRepGProp.SurfaceProperties_s(plan_face(wire), props)
+    props = plan_face_properties(plan_face(wire))  # (adaptive on a spline outline's periodic B-spline)
     m = props.MatrixOfInertia()  # about the centroid; for a plane region in z = 0: [[Iyy, -Ixy], [-Ixy, Ixx]] block
     a, b, c = m.Value(1, 1), m.Value(1, 2), m.Value(2, 2)
     i_min = 0.5 * (a + c) - math.sqrt(0.25 * (a - c) ** 2 + b * b)
@@ -101,16 +97,20 @@ def tip_rating(frame: TabletFrame, spec, options: ReportOptions | None = None) -
         out["note"] = "no allowed pressure given ([tooling] allowed_tip_pressure_MPa with its source): no rating"
     E = spec.punch_youngs_modulus_MPa
     body = spec.body
-    relief = 0.0 if body is None else body.tip_relief_mm
-    _, i_min = section_properties(frame.offset(-inset - relief))
-    tips = {}
+    tips, sections = {}, {}
     for name, L in (("upper", spec.tip_length_mm), ("lower", spec.lower_tip)):
+        # the smallest section of the tip: its relieved part, where one is cut (a tip no longer than its
+        # straight part has none: punch_body; its offset had been asked for anyway, and refused on a spline)
+        relief = body.tip_relief_mm if body is not None and body.tip_relief_mm > 0 and L > body.tip_straight_mm else 0.0
+        if relief not in sections:
+            sections[relief] = section_properties(frame.offset(-inset - relief))[1]
+        i_min = sections[relief]
         p_cr = None if E is None else math.pi ** 2 * E * i_min / (EULER_K * L) ** 2 / 1000.0
         load = force if force is not None else out["rated_force_kN"]
-        tips[name] = dict(free_length_mm=L, buckling_load_kN=p_cr,
-                          safety_factor=None if p_cr is None or not load else p_cr / load)
+        tips[name] = dict(free_length_mm=L, buckling_load_kN=p_cr, section_min_second_moment_mm4=i_min,
+                          relieved_by_mm=relief, safety_factor=None if p_cr is None or not load else p_cr / load)
     out["buckling"] = dict(model="Euler column fixed at the barrel, free at the face (K = 2)", K=EULER_K,
-                           section_min_second_moment_mm4=i_min, youngs_modulus_MPa=E,
+                           section_min_second_moment_mm4=min(sections.values()), youngs_modulus_MPa=E,
                            youngs_modulus_source=spec.punch_youngs_modulus_source, tips=tips,
                            note=None if E is not None else "no punch_youngs_modulus_MPa given: not computed")
     return out
