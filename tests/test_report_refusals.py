@@ -253,6 +253,19 @@ def _mpl_font(name: str) -> Path:
     return Path(matplotlib.get_data_path()) / "fonts" / "ttf" / f"{name}.ttf"
 
 
+def test_text_the_font_has_no_glyph_for_is_refused_for_what_would_be_cut(capsys, tmp_path):
+    """Computer Modern cmr10 has no 'Å': the refusal had said OCC would cut it "as an empty box", but OCC's
+    text shape takes a fallback system font's glyph for it (another 'Å', 26 vertices, where 'A' has 25; an
+    empty box only where no font has the character, as DejaVu's missing '日'): what is refused is cutting
+    something that is not the letter asked for."""
+    font = _mpl_font("cmr10")
+    design = ROUND.format(height=2.0).replace('"ABCDEFGH"', '"AÅ"') + f'font = "{font}"\n'
+    line = _refusal(capsys, tmp_path, design, "report")
+    assert line == (f"error: tooling.emboss[0].text = 'AÅ' is not allowed: has characters the font '{font}' has no "
+                    "glyph for: 'Å' (the figure cut would not be them: OpenCascade puts another font's glyph or an "
+                    "empty box in their place); give a font that has them")
+
+
 def test_a_font_of_1000_units_per_em_is_rounded_as_freetype_rounds_it():
     """STIX General Bold (1000 units per em) "D1" at 3 mm: the area of OCC's faces (3.0368605419794705 mm^2,
     measured) to 1e-12; scaled by size / unitsPerEm in double precision it had been 3.036840 (FreeType's 26.6

@@ -792,9 +792,11 @@ def _charmap(path: str) -> frozenset[int]:
 
 
 def missing_glyphs(text: str, path: str | Path, where: str = "[[tooling.emboss]] font") -> str:
-    """The characters of ``text`` (each once, in order) that the font file ``path`` has no glyph for: OCC
-    and matplotlib draw them as empty boxes (the .notdef glyph).  The plain space needs none.  A file that
-    is no font is a :class:`DesignError` of ``where``."""
+    """The characters of ``text`` (each once, in order) that the font file ``path`` has no glyph for: not
+    those letters would be drawn (matplotlib draws the .notdef glyph, an empty box; OCC's text shape takes a
+    fallback system font's glyph where one has the character, cmr10's missing 'Å' came out as another glyph,
+    else an empty box).  The plain space needs none.  A file that is no font is a :class:`DesignError` of
+    ``where``."""
     try:
         cmap = _charmap(str(path))
     except (RuntimeError, OSError, ValueError):
@@ -1069,7 +1071,8 @@ def _emboss(i: int, t: Any, base: Path | None = None) -> EmbossSpec:
         missing = missing_glyphs(text, font_path(font, f"{w} font"), f"{w} font")
         if missing:
             raise DesignError(f"{w} text", text, f"has characters the font {font!r} has no glyph for: {missing!r} "
-                              "(they would be cut as empty boxes); give a font that has them")
+                              "(the figure cut would not be them: OpenCascade puts another font's glyph or an empty "
+                              "box in their place); give a font that has them")
     if svg is not None:
         _check_svg(f"{w} svg", svg)
     return EmbossSpec(
