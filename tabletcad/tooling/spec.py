@@ -275,6 +275,39 @@ RELIEF_RING_OVERLAP_MM = 0.05
 SHORT_SCORE_MARGIN_MM = 0.05
 
 
+def allowed_upper_bound(most: float, accepted: Any) -> str:
+    """``most`` as a refusal's upper end (:func:`~tabletcad.errors.format_bound`, rounded down), stepped down
+    a unit of its last printed digit while ``accepted`` (a float -> bool) refuses the value printed: the
+    value quoted as allowed is then allowed though ``most`` came of a difference in floating point (a
+    clearance's bound of a spline outline's offset limit plus the die bore's offset)."""
+    text = format_bound(most, upper=True)
+    for _ in range(4):
+        if accepted(float(text)):
+            break
+        text = format_bound(math.nextafter(float(text), -math.inf), upper=True)
+    return text
+
+
+def _spline_inward_refusal(outline: Any, parameter: str, value: Any, distance: float, how: str) -> DesignError:
+    """The refusal of ``parameter`` (``value`` mm) for which the tooling offsets the spline ``outline``
+    ``-distance`` mm inward (``how``: of what), beyond its largest regular inward offset: the largest value
+    allowed, said once and accepted (each of these parameters moves the offset by as much as it changes;
+    a short score's length does not move it, nor does a margin below 0)."""
+    lim, why = outline.offset_bound(distance)
+    beyond = f"beyond its largest regular inward offset ({why})"
+    if parameter.endswith("length_mm"):  # (a short score: the face inset by its land + the margin, whatever its length)
+        return DesignError(parameter, value, f"a short score needs the face inset by {how} = {-distance:.4g} mm, "
+                           f"beyond the spline outline's largest regular inward offset ({why}); leave length_mm out "
+                           "for a score across the face", "mm")
+    most = value - (-distance - lim)
+    if most < 0.0:  # (a margin: the clearance and the land alone reach past it)
+        return DesignError(parameter, value, f"no margin fits: the clearance and the face's land alone offset the "
+                           f"spline outline {-distance - value:.4g} mm inward, {beyond}", "mm")
+    bound = allowed_upper_bound(most, lambda q: outline.offset_bound(distance - (q - value)) is None)
+    return DesignError(parameter, value, f"must be <= {bound} mm: the tooling offsets the spline outline "
+                       f"{-distance:.4g} mm inward for it ({how}), {beyond}", "mm")
+
+
 def check_spline_offsets(tablet: Any, spec: ToolingSpec, size: float) -> None:
     """On the design, before any geometry: every offset of a spline plan outline (a custom outline through
     points) that the tooling will build is a regular offset of it
@@ -303,37 +336,35 @@ def check_spline_offsets(tablet: Any, spec: ToolingSpec, size: float) -> None:
     def edge_land(face: str) -> float:
         return 0.0 if cups[face] < 1e-9 else float(land)
 
-    asks: list[tuple[str, Any, float]] = [("[tooling] clearance_mm", spec.clearance_mm, -inset)]
+    clear = "the clearance" + (f" less the die bore's {bore:g} mm outside the outline" if bore > 0 else "")
+    asks: list[tuple[str, Any, float, str]] = [("[tooling] clearance_mm", spec.clearance_mm, -inset, clear)]
     b = spec.body
     if b is not None and b.tip_relief_mm > 0 and max(spec.tip_length_mm, spec.lower_tip) > b.tip_straight_mm:
-        asks += [("[tooling.punch] tip_relief_mm", b.tip_relief_mm, -(spec.clearance_mm + b.tip_relief_mm)),
-                 ("tablet.outline", "points (a spline through them)", RELIEF_RING_OVERLAP_MM - inset)]
-    asks.append(("tablet.outline", "points (a spline through them)", bore))
+        asks += [("[tooling.punch] tip_relief_mm", b.tip_relief_mm, -(spec.clearance_mm + b.tip_relief_mm),
+                  "clearance + tip relief"),
+                 ("tablet.outline", "points (a spline through them)", RELIEF_RING_OVERLAP_MM - inset, "")]
+    asks.append(("tablet.outline", "points (a spline through them)", bore, ""))
     if spec.taper_deg > 0:  # the bore drafted from the band's top to 1 mm above the die (die_faces_z: the entry)
         rise = die_faces_z(band_z, die_height_for(spec, size, True))[0] + 1.0
         top = bore + rise * math.tan(math.radians(spec.taper_deg))
         bound = outline.offset_bound(top)
         if bound is not None:
-            most = math.degrees(math.atan((bound[0] - bore) / rise))
-            raise DesignError("[tooling] taper_deg", spec.taper_deg, f"must be <= {format_bound(most, upper=True)} deg: "
+            most = allowed_upper_bound(math.degrees(math.atan((bound[0] - bore) / rise)), lambda q: outline.offset_bound(
+                bore + rise * math.tan(math.radians(q))) is None)
+            raise DesignError("[tooling] taper_deg", spec.taper_deg, f"must be <= {most} deg: "
                               f"the die bore drafted over {rise:.4g} mm grows {top:.4g} mm outward, at most "
                               f"{format_bound(bound[0], upper=True)} mm ({bound[1]})", "deg")
-    asks += [(f"[[tooling.emboss]] {i} margin_mm", e.margin_mm, -(spec.clearance_mm + edge_land(e.face) + e.margin_mm))
-             for i, e in enumerate(spec.emboss)]
+    asks += [(f"[[tooling.emboss]] {i} margin_mm", e.margin_mm, -(spec.clearance_mm + edge_land(e.face) + e.margin_mm),
+              "clearance + land + margin") for i, e in enumerate(spec.emboss)]
     asks += [(f"[[tooling.score]] {i} length_mm", s.length_mm,
-              -(max(edge_land(f) for f in s.face_list) + SHORT_SCORE_MARGIN_MM))
+              -(max(edge_land(f) for f in s.face_list) + SHORT_SCORE_MARGIN_MM), f"its land + {SHORT_SCORE_MARGIN_MM:g} mm")
              for i, s in enumerate(spec.scores) if s.length_mm is not None]
-    for parameter, value, distance in asks:
-        bound = outline.offset_bound(distance)
-        if bound is None:
+    for parameter, value, distance, how in asks:
+        if outline.offset_bound(distance) is None:
             continue
         if parameter == "tablet.outline":  # (the bore grown by the band's bulge, the relief ring: as the frame says)
             raise spline_offset_error(outline, distance)
-        lim, why = bound
-        most = value - (abs(distance) - lim)  # (each of them moves the offset by as much as it changes)
-        raise DesignError(parameter, value, f"must be <= {format_bound(most, upper=True)} mm: the tooling offsets the "
-                          f"spline outline {abs(distance):.4g} mm inward for it, at most {format_bound(lim, upper=True)} "
-                          f"mm ({why})", "mm")
+        raise _spline_inward_refusal(outline, parameter, value, distance, how)
 
 
 def tooling_plan_outline(tablet: Any) -> Any:
