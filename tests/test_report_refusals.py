@@ -494,7 +494,7 @@ def test_text_just_inside_the_limit_builds(tmp_path):
 
 
 @pytest.mark.cad
-def test_the_fit_on_a_concave_outline_is_occs_boolean_below_its_offset_limit(tmp_path):
+def test_the_fit_on_a_concave_outline_is_occs_boolean_below_its_offset_limit(capsys, tmp_path):
     """The peanut's bar inset by 0.62 and 0.68 mm (below its neck's half width 0.687434): the core's area outside is the
     OCC Boolean's and both refuse with the same line; at 0.72 mm (beyond it) the core says nothing and the build
     refuses after the solid, OCC's offset of the outline giving two wires (the README's list), writing nothing."""
@@ -520,6 +520,55 @@ def test_the_fit_on_a_concave_outline_is_occs_boolean_below_its_offset_limit(tmp
     (tmp_path / "d.toml").write_text(PEANUT.format(margin=0.7), encoding="utf-8")
     assert main(["build", str(tmp_path / "d.toml"), "--out", str(tmp_path / "out"), "--quiet"]) == 2
     assert not (tmp_path / "out").exists()
+    assert capsys.readouterr().err.strip() == PEANUT_PARTS  # (it had said the face "is empty")
+
+
+#: the build's refusal of the peanut's bar inset by 0.02 + 0.7 mm, past the neck's half width 0.6874342087 mm
+PEANUT_PARTS = ("error: tooling.emboss[0].outline = '4 points' is not allowed: does not fit: the face inset by 0.72 mm "
+                "(clearance + land + margin) parts in two at a neck 1.37487 mm wide; a margin_mm < 0.667434 mm would "
+                "keep it one region")
+
+
+def test_the_face_parted_at_a_neck_is_refused_as_parted_without_occ(tmp_path):
+    """The line the build gives when OCC's offset of the peanut parts in two, made of the core's numbers: the neck's
+    half width by bisection of offset_bounds_inset (to 1e-9 mm), the margin that keeps the face one region."""
+    from tabletcad.families.outline import whole_inset_limit
+    from tabletcad.tooling.spec import inset_face_refusal, tooling_plan_outline
+
+    d = _design(tmp_path, PEANUT.format(margin=0.7))
+    outline = tooling_plan_outline(d.build())
+    assert whole_inset_limit(outline, 0.72) == pytest.approx(1.1874342087037915 - 0.5, abs=2e-9)
+    assert whole_inset_limit(outline, 0.6) == 0.6  # (whole there)
+    assert "error: " + str(inset_face_refusal(d.tooling_spec.emboss[0], 0, outline, 0.72)) == PEANUT_PARTS
+
+
+def test_a_face_inset_past_the_inscribed_radius_is_refused_as_empty_with_the_margin_that_leaves_one(tmp_path):
+    """The core's refusal of a figure whose face is inset past the outline's inscribed radius (the 10 mm round:
+    5 mm) says so, and the margin below which a face is left (it had said only that the face is empty)."""
+    from tabletcad.tooling.spec import figure_contours, figure_fit_refusal, tooling_plan_outline
+
+    d = _design(tmp_path, ROUND.format(height=1.0) + "margin_mm = 5.0\n")
+    e = d.tooling_spec.emboss[0]
+    refusal = figure_fit_refusal(e, 0, figure_contours(e), tooling_plan_outline(d.build()), 5.1)
+    assert str(refusal) == ("tooling.emboss[0].text = 'ABCDEFGH' is not allowed: does not fit: the face inset by 5.1 mm "
+                            "(clearance + land + margin) is empty: the outline's inscribed radius is 5 mm; a margin_mm "
+                            "< 4.9 mm would leave a face")
+
+
+@pytest.mark.cad
+@pytest.mark.parametrize("margin, parted", [(0.667434, False), (0.667435, True)])
+def test_the_margin_quoted_keeps_occs_face_one_region(tmp_path, margin, parted):
+    """OCC's offset of the peanut agrees at the printed digits: at the margin quoted the face is one region (the
+    bar is refused for lying outside it, across the neck), a unit of its last digit more parts it."""
+    from tabletcad.tooling.emboss import check_fit, figure_faces
+    from tabletcad.tooling.outline import tablet_frame
+
+    d = _design(tmp_path, PEANUT.format(margin=margin))
+    e = d.tooling_spec.emboss[0]
+    with pytest.raises(DesignError) as refused:
+        check_fit(tablet_frame(d.build()), e, figure_faces(e), 0.02)
+    assert ("parts in two at a neck 1.37487 mm wide; a margin_mm < 0.667434 mm" in str(refused.value)) == parted
+    assert ("mm^2 outside the punch tip inset by 0.687 mm" in str(refused.value)) == (not parted)
 
 
 @pytest.mark.cad

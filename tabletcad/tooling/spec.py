@@ -411,6 +411,39 @@ def figure_contours(e: EmbossSpec, i: int = 0) -> list | None:
     return lettering.placed(contours, e.rotation_deg, e.position_mm, e.face == "bottom")
 
 
+def inset_face_refusal(e: EmbossSpec, i: int, outline: Any, inset: float, half_width: float | None = None) -> DesignError:
+    """The refusal of figure ``i`` whose face, the punch tip inset by ``inset`` mm (clearance + land +
+    margin), is no single region: empty (``inset`` at least the ``outline``'s inscribed radius) or parted in
+    two at a neck (its inward offsets stay whole up to the neck's half width,
+    :func:`~tabletcad.families.outline.whole_inset_limit`), with the margin below which it is one region.
+    ``outline``: the :class:`~tabletcad.families.outline.PlanOutline`, or ``None`` where the tooling offsets
+    another curve (an ellipse, a band's section): then ``half_width`` (mm, half the tablet's smaller
+    extent, at least its inscribed radius) tells an empty face, and a face that is not is called not one
+    region."""
+    from tabletcad.families.outline import whole_inset_limit
+
+    what = "text" if e.text is not None else "svg" if e.svg is not None else "outline"
+    value = e.text if e.text is not None else e.svg if e.svg is not None else f"{len(e.outline)} points"
+    head = f"does not fit: the face inset by {inset:.4g} mm (clearance + land + margin)"
+    if outline is None:
+        empty = half_width is not None and not inset < half_width
+        return DesignError(f"[[tooling.emboss]] {i} {what}", value, f"{head} is empty: the tablet is "
+                           f"{2.0 * half_width:.4g} mm wide" if empty else f"{head} is not one region (the offset "
+                           "of the tablet's outline is not one wire)")
+    deep = outline.inscribed_radius()
+    if not inset < deep:
+        whole, why, keep = deep, f"{head} is empty: the outline's inscribed radius is {deep:.4g} mm", "leave a face"
+    else:
+        whole = whole_inset_limit(outline, inset)  # (a neck's half width, unless a convex arc's radius stops it first)
+        where = f"at a neck {2.0 * whole:.6g} mm wide" if whole < outline.min_convex_radius - 1e-7 else \
+            f"where the outline is less than {2.0 * inset:.4g} mm across"
+        why, keep = f"{head} parts in two {where}", "keep it one region"
+    fixed = inset - e.margin_mm  # (the clearance and the land)
+    tail = (f"; a margin_mm < {format_bound(whole - fixed, upper=True)} mm would {keep}" if whole > fixed
+            else f"; the clearance and land alone inset it {fixed:.4g} mm: no margin would {keep}")
+    return DesignError(f"[[tooling.emboss]] {i} {what}", value, why + tail)
+
+
 def figure_fit_refusal(e: EmbossSpec, i: int, contours: list, outline: Any, inset: float) -> DesignError | None:
     """The refusal of figure ``i`` (its placed ``contours``) that does not lie inside ``outline`` offset inwards
     by ``inset`` mm (the punch tip less the land and margin), in the words of
@@ -420,7 +453,7 @@ def figure_fit_refusal(e: EmbossSpec, i: int, contours: list, outline: Any, inse
     what = "text" if e.text is not None else "outline"
     value = e.text if e.text is not None else f"{len(e.outline)} points"
     if not inset < outline.inscribed_radius():
-        return DesignError(f"[[tooling.emboss]] {i} {what}", value, f"does not fit: the face inset by {inset:.3g} mm is empty")
+        return inset_face_refusal(e, i, outline, inset)
     area, outside = lettering.outside_area(contours, outline, inset)
     if outside > 1e-6 * max(area, 1e-9):
         w, h = lettering.figure_box(contours)
