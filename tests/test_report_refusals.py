@@ -253,6 +253,19 @@ def _mpl_font(name: str) -> Path:
     return Path(matplotlib.get_data_path()) / "fonts" / "ttf" / f"{name}.ttf"
 
 
+def test_text_the_font_has_no_glyph_for_is_refused_for_what_would_be_cut(capsys, tmp_path):
+    """Computer Modern cmr10 has no 'Å': the refusal had said OCC would cut it "as an empty box", but OCC's
+    text shape takes a fallback system font's glyph for it (another 'Å', 26 vertices, where 'A' has 25; an
+    empty box only where no font has the character, as DejaVu's missing '日'): what is refused is cutting
+    something that is not the letter asked for."""
+    font = _mpl_font("cmr10")
+    design = ROUND.format(height=2.0).replace('"ABCDEFGH"', '"AÅ"') + f'font = "{font}"\n'
+    line = _refusal(capsys, tmp_path, design, "report")
+    assert line == (f"error: tooling.emboss[0].text = 'AÅ' is not allowed: has characters the font '{font}' has no "
+                    "glyph for: 'Å' (the figure cut would not be them: OpenCascade puts another font's glyph or an "
+                    "empty box in their place); give a font that has them")
+
+
 def test_a_font_of_1000_units_per_em_is_rounded_as_freetype_rounds_it():
     """STIX General Bold (1000 units per em) "D1" at 3 mm: the area of OCC's faces (3.0368605419794705 mm^2,
     measured) to 1e-12; scaled by size / unitsPerEm in double precision it had been 3.036840 (FreeType's 26.6
@@ -324,17 +337,89 @@ def test_report_passes_tooling_of_a_spline_outline(tmp_path):
 
 def test_report_refuses_a_clearance_beyond_a_spline_corner(capsys, tmp_path):
     """The tips inset by the clearance past the spline's smallest convex radius of curvature (less 1 %,
-    Tolerances.offset_regularity) would loop there: refused, with the largest clearance that is allowed."""
+    Tolerances.offset_regularity) would loop there: refused, with the largest clearance that is allowed, said
+    once.  The line had quoted two bounds for the one limit, "<= 0.273249 mm" and "at most 0.273248 mm" (the
+    offset's limit, 0.273248630 mm, less the die bore's 1e-06 mm: the tips stand the clearance less it inside
+    the outline); this test had pinned them."""
     line = _refusal(capsys, tmp_path, SPLINE_CORNER.format(clearance=0.3), "report")
     assert line == ("error: tooling.clearance_mm = 0.3 mm is not allowed: must be <= 0.273249 mm: the tooling offsets "
-                    "the spline outline 0.3 mm inward for it, at most 0.273248 mm (its smallest convex radius of "
-                    "curvature is 0.276 mm, and the offset must stay regular and clear of the narrowest place)")
+                    "the spline outline 0.3 mm inward for it (the clearance less the die bore's 1e-06 mm outside the "
+                    "outline), beyond its largest regular inward offset (its smallest convex radius of curvature is "
+                    "0.276 mm, and the offset must stay regular and clear of the narrowest place)")
 
 
 def test_the_largest_clearance_stated_is_reported(tmp_path):
     src = tmp_path / "d.toml"
     src.write_text(SPLINE_CORNER.format(clearance=0.273249), encoding="utf-8")
     assert main(["report", str(src)]) == 0
+
+
+#: SPLINE_CORNER's clearance 0.02 mm with a complete TSM B punch relieved {relief} mm behind its 4 mm straight tip
+SPLINE_RELIEF = SPLINE_CORNER.format(clearance=0.02).replace(
+    "tip_length_mm = 8.0\n", 'tip_length_mm = 8.0\nstandard = "TSM"\ntype = "B"\ndie_height_mm = 22.22\n'
+    "lower_tip_length_mm = 25.4\n\n[tooling.punch]\nhead_diameter_mm = 25.4\nhead_flat_diameter_mm = 12.0\n"
+    "head_rim_mm = 2.5\nhead_top_angle_deg = 10.0\nneck_diameter_mm = 12.7\nneck_length_mm = 12.0\n"
+    "tip_straight_mm = 4.0\ntip_relief_mm = {relief}\n")
+
+#: SPLINE_CORNER's clearance 0.02 mm with a figure {margin} mm inside the tip edge
+SPLINE_MARGIN = SPLINE_CORNER.format(clearance=0.02) + (
+    '\n[[tooling.emboss]]\ntext = "A"\nheight_mm = 1.0\ndepth_mm = 0.05\nmargin_mm = {margin}\n')
+
+_CORNER = ("beyond its largest regular inward offset (its smallest convex radius of curvature is 0.276 mm, and the "
+           "offset must stay regular and clear of the narrowest place)")
+
+
+@pytest.mark.parametrize("design, key, over, line", [
+    (SPLINE_CORNER.replace("{clearance}", "{}"), "clearance_mm", 0.27325,
+     "error: tooling.clearance_mm = 0.27325 mm is not allowed: must be <= 0.273249 mm: the tooling offsets the spline "
+     f"outline 0.2732 mm inward for it (the clearance less the die bore's 1e-06 mm outside the outline), {_CORNER}"),
+    (SPLINE_RELIEF.replace("{relief}", "{}"), "punch.tip_relief_mm", 0.253249,
+     "error: tooling.punch.tip_relief_mm = 0.253249 mm is not allowed: must be <= 0.253248 mm: the tooling offsets "
+     f"the spline outline 0.2732 mm inward for it (clearance + tip relief), {_CORNER}"),
+    (SPLINE_MARGIN.replace("{margin}", "{}"), "emboss[0].margin_mm", 0.253249,
+     "error: tooling.emboss[0].margin_mm = 0.253249 mm is not allowed: must be <= 0.253248 mm: the tooling offsets "
+     f"the spline outline 0.2732 mm inward for it (clearance + land + margin), {_CORNER}"),
+])
+def test_each_spline_offset_bound_quoted_is_allowed_and_one_step_above_it_refused(capsys, tmp_path, design, key,
+                                                                                  over, line):
+    """Every bound check_spline_offsets quotes for a parameter (the clearance, a complete punch's tip relief,
+    a figure's margin; the taper below) is said once, and in its printed digits it is the edge: the value
+    quoted is reported, one unit of its last digit more is refused with the same bound."""
+    assert _refusal(capsys, tmp_path, design.format(over), "report") == line
+    bound = re.search(r"must be <= (\S+) mm", line).group(1)
+    assert float(bound) == pytest.approx(over - 1e-6, abs=1e-12)
+    src = tmp_path / "d.toml"
+    src.write_text(design.format(bound), encoding="utf-8")
+    assert main(["report", str(src), "--json-file", str(tmp_path / "r.json")]) == 0, key
+
+
+def test_a_short_score_beyond_the_spline_corner_is_refused_for_what_moves_the_offset(capsys, tmp_path):
+    """A short score's footprint must end 0.05 mm inside the land, whatever its length: the line had asked for a
+    length_mm "<= 1.97324 mm" (2 mm less the offset's excess), which is refused as well."""
+    design = SPLINE_CORNER.format(clearance=0.02).replace("cup_depth = 0.2", "cup_depth = 0.005\nland = 0.25")
+    line = _refusal(capsys, tmp_path, design + "\n[[tooling.score]]\nlength_mm = 2.0\n", "report")
+    assert line == ("error: tooling.score[0].length_mm = 2 mm is not allowed: a short score needs the face inset by its "
+                    "land + 0.05 mm = 0.3 mm, beyond the spline outline's largest regular inward offset (its smallest "
+                    "convex radius of curvature is 0.276 mm, and the offset must stay regular and clear of the "
+                    "narrowest place); leave length_mm out for a score across the face")
+
+
+def test_a_margin_no_value_of_which_fits_a_spline_corner_is_not_given_a_negative_bound(capsys, tmp_path):
+    """Clearance and land inset the face 0.285 mm, past the 0.273249 mm limit: the line had asked for a margin
+    "<= -0.0117514 mm"."""
+    design = SPLINE_MARGIN.format(margin=0.1).replace("cup_depth = 0.2", "cup_depth = 0.001\nland = 0.265")
+    assert _refusal(capsys, tmp_path, design.replace("depth_mm = 0.05", "depth_mm = 0.001"), "report") == (
+        "error: tooling.emboss[0].margin_mm = 0.1 mm is not allowed: no margin fits: the clearance and the face's "
+        f"land alone offset the spline outline 0.285 mm inward, {_CORNER}")
+
+
+def test_an_upper_bound_is_stepped_down_until_it_is_allowed():
+    """allowed_upper_bound: a bound whose six digits are refused (0.273249 where 0.2732489999 is the edge) is
+    quoted a unit lower; one that is accepted as printed is kept."""
+    from tabletcad.tooling.spec import allowed_upper_bound
+
+    assert allowed_upper_bound(0.273249, lambda q: q <= 0.2732489999) == "0.273248"
+    assert allowed_upper_bound(0.27324963044442513, lambda q: q <= 0.27324963044442513) == "0.273249"
 
 
 #: a circle of 4 mm through 24 points, dented at -x: its spline's dent has a concave radius of curvature 0.6389 mm,
@@ -365,6 +450,8 @@ def test_report_refuses_a_taper_whose_bore_passes_a_spline_dent(capsys, tmp_path
     src = tmp_path / "d.toml"
     src.write_text(DENTED.format(taper=8.98497), encoding="utf-8")
     assert main(["report", str(src)]) == 0
+    line = _refusal(capsys, tmp_path, DENTED.format(taper=8.98498), "report")  # one step above: the same bound
+    assert line.startswith("error: tooling.taper_deg = 8.98498 deg is not allowed: must be <= 8.98497 deg: ")
 
 
 def test_the_same_outline_of_lines_and_arcs_is_reported(tmp_path):
@@ -407,7 +494,7 @@ def test_text_just_inside_the_limit_builds(tmp_path):
 
 
 @pytest.mark.cad
-def test_the_fit_on_a_concave_outline_is_occs_boolean_below_its_offset_limit(tmp_path):
+def test_the_fit_on_a_concave_outline_is_occs_boolean_below_its_offset_limit(capsys, tmp_path):
     """The peanut's bar inset by 0.62 and 0.68 mm (below its neck's half width 0.687434): the core's area outside is the
     OCC Boolean's and both refuse with the same line; at 0.72 mm (beyond it) the core says nothing and the build
     refuses after the solid, OCC's offset of the outline giving two wires (the README's list), writing nothing."""
@@ -433,6 +520,55 @@ def test_the_fit_on_a_concave_outline_is_occs_boolean_below_its_offset_limit(tmp
     (tmp_path / "d.toml").write_text(PEANUT.format(margin=0.7), encoding="utf-8")
     assert main(["build", str(tmp_path / "d.toml"), "--out", str(tmp_path / "out"), "--quiet"]) == 2
     assert not (tmp_path / "out").exists()
+    assert capsys.readouterr().err.strip() == PEANUT_PARTS  # (it had said the face "is empty")
+
+
+#: the build's refusal of the peanut's bar inset by 0.02 + 0.7 mm, past the neck's half width 0.6874342087 mm
+PEANUT_PARTS = ("error: tooling.emboss[0].outline = '4 points' is not allowed: does not fit: the face inset by 0.72 mm "
+                "(clearance + land + margin) parts in two at a neck 1.37487 mm wide; a margin_mm < 0.667434 mm would "
+                "keep it one region")
+
+
+def test_the_face_parted_at_a_neck_is_refused_as_parted_without_occ(tmp_path):
+    """The line the build gives when OCC's offset of the peanut parts in two, made of the core's numbers: the neck's
+    half width by bisection of offset_bounds_inset (to 1e-9 mm), the margin that keeps the face one region."""
+    from tabletcad.families.outline import whole_inset_limit
+    from tabletcad.tooling.spec import inset_face_refusal, tooling_plan_outline
+
+    d = _design(tmp_path, PEANUT.format(margin=0.7))
+    outline = tooling_plan_outline(d.build())
+    assert whole_inset_limit(outline, 0.72) == pytest.approx(1.1874342087037915 - 0.5, abs=2e-9)
+    assert whole_inset_limit(outline, 0.6) == 0.6  # (whole there)
+    assert "error: " + str(inset_face_refusal(d.tooling_spec.emboss[0], 0, outline, 0.72)) == PEANUT_PARTS
+
+
+def test_a_face_inset_past_the_inscribed_radius_is_refused_as_empty_with_the_margin_that_leaves_one(tmp_path):
+    """The core's refusal of a figure whose face is inset past the outline's inscribed radius (the 10 mm round:
+    5 mm) says so, and the margin below which a face is left (it had said only that the face is empty)."""
+    from tabletcad.tooling.spec import figure_contours, figure_fit_refusal, tooling_plan_outline
+
+    d = _design(tmp_path, ROUND.format(height=1.0) + "margin_mm = 5.0\n")
+    e = d.tooling_spec.emboss[0]
+    refusal = figure_fit_refusal(e, 0, figure_contours(e), tooling_plan_outline(d.build()), 5.1)
+    assert str(refusal) == ("tooling.emboss[0].text = 'ABCDEFGH' is not allowed: does not fit: the face inset by 5.1 mm "
+                            "(clearance + land + margin) is empty: the outline's inscribed radius is 5 mm; a margin_mm "
+                            "< 4.9 mm would leave a face")
+
+
+@pytest.mark.cad
+@pytest.mark.parametrize("margin, parted", [(0.667434, False), (0.667435, True)])
+def test_the_margin_quoted_keeps_occs_face_one_region(tmp_path, margin, parted):
+    """OCC's offset of the peanut agrees at the printed digits: at the margin quoted the face is one region (the
+    bar is refused for lying outside it, across the neck), a unit of its last digit more parts it."""
+    from tabletcad.tooling.emboss import check_fit, figure_faces
+    from tabletcad.tooling.outline import tablet_frame
+
+    d = _design(tmp_path, PEANUT.format(margin=margin))
+    e = d.tooling_spec.emboss[0]
+    with pytest.raises(DesignError) as refused:
+        check_fit(tablet_frame(d.build()), e, figure_faces(e), 0.02)
+    assert ("parts in two at a neck 1.37487 mm wide; a margin_mm < 0.667434 mm" in str(refused.value)) == parted
+    assert ("mm^2 outside the punch tip inset by 0.687 mm" in str(refused.value)) == (not parted)
 
 
 @pytest.mark.cad

@@ -938,6 +938,21 @@ def offset_bounds_inset(outline, inset: float, tol: float = 1e-9) -> bool:
     return True
 
 
+def whole_inset_limit(outline, below: float, tol: float = 1e-9) -> float:
+    """The largest inset (mm) below ``below`` whose inward offset of the lines-and-arcs ``outline`` is still
+    the boundary of its inset region (:func:`offset_bounds_inset`), by bisection to about ``tol``: where an
+    inset by ``below`` parts in two at a neck, the neck's half width (the peanut of
+    tests/test_report_refusals.py: 0.6874342092 mm for 0.6874342087); ``0.0`` when even the least inset
+    is no clean offset."""
+    lo, hi = 0.0, float(below)
+    if offset_bounds_inset(outline, hi, tol):
+        return hi
+    while hi - lo > tol:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if offset_bounds_inset(outline, mid, tol) else (lo, mid)
+    return lo
+
+
 def _lowest_of_runs(mask: np.ndarray, h: np.ndarray) -> list[int]:
     """The index of the least ``h`` in each run of adjacent ``True`` of the cyclic ``mask`` (a flat stretch of
     local minima, as a capsule's parallel sides give, polished once)."""

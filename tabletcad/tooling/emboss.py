@@ -210,8 +210,11 @@ def check_fit(frame: TabletFrame, e: EmbossSpec, figure: TopoDS_Shape, clearance
     value = e.text if e.text is not None else e.svg if e.svg is not None else f"{len(e.outline)} points"
     try:
         region = plan_face(frame.offset(-inset))
-    except GeometryError:
-        raise DesignError(f"[[tooling.emboss]] {i} {what}", value, f"does not fit: the face inset by {inset:.3g} mm is empty") from None
+    except GeometryError:  # (no wire, or more than one: empty, or parted at a neck; said as the core says it)
+        from tabletcad.tooling.spec import inset_face_refusal, tooling_plan_outline
+
+        raise inset_face_refusal(e, i, tooling_plan_outline(frame.tablet), inset,
+                                 0.5 * min(frame.length, frame.width)) from None
     cut = BRepAlgoAPI_Cut(figure, region)
     outside = sum(face_area(f) for f in explore(cut.Shape(), "Face"))
     area = sum(face_area(f) for f in explore(figure, "Face"))

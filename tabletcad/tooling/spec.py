@@ -275,6 +275,39 @@ RELIEF_RING_OVERLAP_MM = 0.05
 SHORT_SCORE_MARGIN_MM = 0.05
 
 
+def allowed_upper_bound(most: float, accepted: Any) -> str:
+    """``most`` as a refusal's upper end (:func:`~tabletcad.errors.format_bound`, rounded down), stepped down
+    a unit of its last printed digit while ``accepted`` (a float -> bool) refuses the value printed: the
+    value quoted as allowed is then allowed though ``most`` came of a difference in floating point (a
+    clearance's bound of a spline outline's offset limit plus the die bore's offset)."""
+    text = format_bound(most, upper=True)
+    for _ in range(4):
+        if accepted(float(text)):
+            break
+        text = format_bound(math.nextafter(float(text), -math.inf), upper=True)
+    return text
+
+
+def _spline_inward_refusal(outline: Any, parameter: str, value: Any, distance: float, how: str) -> DesignError:
+    """The refusal of ``parameter`` (``value`` mm) for which the tooling offsets the spline ``outline``
+    ``-distance`` mm inward (``how``: of what), beyond its largest regular inward offset: the largest value
+    allowed, said once and accepted (each of these parameters moves the offset by as much as it changes;
+    a short score's length does not move it, nor does a margin below 0)."""
+    lim, why = outline.offset_bound(distance)
+    beyond = f"beyond its largest regular inward offset ({why})"
+    if parameter.endswith("length_mm"):  # (a short score: the face inset by its land + the margin, whatever its length)
+        return DesignError(parameter, value, f"a short score needs the face inset by {how} = {-distance:.4g} mm, "
+                           f"beyond the spline outline's largest regular inward offset ({why}); leave length_mm out "
+                           "for a score across the face", "mm")
+    most = value - (-distance - lim)
+    if most < 0.0:  # (a margin: the clearance and the land alone reach past it)
+        return DesignError(parameter, value, f"no margin fits: the clearance and the face's land alone offset the "
+                           f"spline outline {-distance - value:.4g} mm inward, {beyond}", "mm")
+    bound = allowed_upper_bound(most, lambda q: outline.offset_bound(distance - (q - value)) is None)
+    return DesignError(parameter, value, f"must be <= {bound} mm: the tooling offsets the spline outline "
+                       f"{-distance:.4g} mm inward for it ({how}), {beyond}", "mm")
+
+
 def check_spline_offsets(tablet: Any, spec: ToolingSpec, size: float) -> None:
     """On the design, before any geometry: every offset of a spline plan outline (a custom outline through
     points) that the tooling will build is a regular offset of it
@@ -303,37 +336,35 @@ def check_spline_offsets(tablet: Any, spec: ToolingSpec, size: float) -> None:
     def edge_land(face: str) -> float:
         return 0.0 if cups[face] < 1e-9 else float(land)
 
-    asks: list[tuple[str, Any, float]] = [("[tooling] clearance_mm", spec.clearance_mm, -inset)]
+    clear = "the clearance" + (f" less the die bore's {bore:g} mm outside the outline" if bore > 0 else "")
+    asks: list[tuple[str, Any, float, str]] = [("[tooling] clearance_mm", spec.clearance_mm, -inset, clear)]
     b = spec.body
     if b is not None and b.tip_relief_mm > 0 and max(spec.tip_length_mm, spec.lower_tip) > b.tip_straight_mm:
-        asks += [("[tooling.punch] tip_relief_mm", b.tip_relief_mm, -(spec.clearance_mm + b.tip_relief_mm)),
-                 ("tablet.outline", "points (a spline through them)", RELIEF_RING_OVERLAP_MM - inset)]
-    asks.append(("tablet.outline", "points (a spline through them)", bore))
+        asks += [("[tooling.punch] tip_relief_mm", b.tip_relief_mm, -(spec.clearance_mm + b.tip_relief_mm),
+                  "clearance + tip relief"),
+                 ("tablet.outline", "points (a spline through them)", RELIEF_RING_OVERLAP_MM - inset, "")]
+    asks.append(("tablet.outline", "points (a spline through them)", bore, ""))
     if spec.taper_deg > 0:  # the bore drafted from the band's top to 1 mm above the die (die_faces_z: the entry)
         rise = die_faces_z(band_z, die_height_for(spec, size, True))[0] + 1.0
         top = bore + rise * math.tan(math.radians(spec.taper_deg))
         bound = outline.offset_bound(top)
         if bound is not None:
-            most = math.degrees(math.atan((bound[0] - bore) / rise))
-            raise DesignError("[tooling] taper_deg", spec.taper_deg, f"must be <= {format_bound(most, upper=True)} deg: "
+            most = allowed_upper_bound(math.degrees(math.atan((bound[0] - bore) / rise)), lambda q: outline.offset_bound(
+                bore + rise * math.tan(math.radians(q))) is None)
+            raise DesignError("[tooling] taper_deg", spec.taper_deg, f"must be <= {most} deg: "
                               f"the die bore drafted over {rise:.4g} mm grows {top:.4g} mm outward, at most "
                               f"{format_bound(bound[0], upper=True)} mm ({bound[1]})", "deg")
-    asks += [(f"[[tooling.emboss]] {i} margin_mm", e.margin_mm, -(spec.clearance_mm + edge_land(e.face) + e.margin_mm))
-             for i, e in enumerate(spec.emboss)]
+    asks += [(f"[[tooling.emboss]] {i} margin_mm", e.margin_mm, -(spec.clearance_mm + edge_land(e.face) + e.margin_mm),
+              "clearance + land + margin") for i, e in enumerate(spec.emboss)]
     asks += [(f"[[tooling.score]] {i} length_mm", s.length_mm,
-              -(max(edge_land(f) for f in s.face_list) + SHORT_SCORE_MARGIN_MM))
+              -(max(edge_land(f) for f in s.face_list) + SHORT_SCORE_MARGIN_MM), f"its land + {SHORT_SCORE_MARGIN_MM:g} mm")
              for i, s in enumerate(spec.scores) if s.length_mm is not None]
-    for parameter, value, distance in asks:
-        bound = outline.offset_bound(distance)
-        if bound is None:
+    for parameter, value, distance, how in asks:
+        if outline.offset_bound(distance) is None:
             continue
         if parameter == "tablet.outline":  # (the bore grown by the band's bulge, the relief ring: as the frame says)
             raise spline_offset_error(outline, distance)
-        lim, why = bound
-        most = value - (abs(distance) - lim)  # (each of them moves the offset by as much as it changes)
-        raise DesignError(parameter, value, f"must be <= {format_bound(most, upper=True)} mm: the tooling offsets the "
-                          f"spline outline {abs(distance):.4g} mm inward for it, at most {format_bound(lim, upper=True)} "
-                          f"mm ({why})", "mm")
+        raise _spline_inward_refusal(outline, parameter, value, distance, how)
 
 
 def tooling_plan_outline(tablet: Any) -> Any:
@@ -380,6 +411,39 @@ def figure_contours(e: EmbossSpec, i: int = 0) -> list | None:
     return lettering.placed(contours, e.rotation_deg, e.position_mm, e.face == "bottom")
 
 
+def inset_face_refusal(e: EmbossSpec, i: int, outline: Any, inset: float, half_width: float | None = None) -> DesignError:
+    """The refusal of figure ``i`` whose face, the punch tip inset by ``inset`` mm (clearance + land +
+    margin), is no single region: empty (``inset`` at least the ``outline``'s inscribed radius) or parted in
+    two at a neck (its inward offsets stay whole up to the neck's half width,
+    :func:`~tabletcad.families.outline.whole_inset_limit`), with the margin below which it is one region.
+    ``outline``: the :class:`~tabletcad.families.outline.PlanOutline`, or ``None`` where the tooling offsets
+    another curve (an ellipse, a band's section): then ``half_width`` (mm, half the tablet's smaller
+    extent, at least its inscribed radius) tells an empty face, and a face that is not is called not one
+    region."""
+    from tabletcad.families.outline import whole_inset_limit
+
+    what = "text" if e.text is not None else "svg" if e.svg is not None else "outline"
+    value = e.text if e.text is not None else e.svg if e.svg is not None else f"{len(e.outline)} points"
+    head = f"does not fit: the face inset by {inset:.4g} mm (clearance + land + margin)"
+    if outline is None:
+        empty = half_width is not None and not inset < half_width
+        return DesignError(f"[[tooling.emboss]] {i} {what}", value, f"{head} is empty: the tablet is "
+                           f"{2.0 * half_width:.4g} mm wide" if empty else f"{head} is not one region (the offset "
+                           "of the tablet's outline is not one wire)")
+    deep = outline.inscribed_radius()
+    if not inset < deep:
+        whole, why, keep = deep, f"{head} is empty: the outline's inscribed radius is {deep:.4g} mm", "leave a face"
+    else:
+        whole = whole_inset_limit(outline, inset)  # (a neck's half width, unless a convex arc's radius stops it first)
+        where = f"at a neck {2.0 * whole:.6g} mm wide" if whole < outline.min_convex_radius - 1e-7 else \
+            f"where the outline is less than {2.0 * inset:.4g} mm across"
+        why, keep = f"{head} parts in two {where}", "keep it one region"
+    fixed = inset - e.margin_mm  # (the clearance and the land)
+    tail = (f"; a margin_mm < {format_bound(whole - fixed, upper=True)} mm would {keep}" if whole > fixed
+            else f"; the clearance and land alone inset it {fixed:.4g} mm: no margin would {keep}")
+    return DesignError(f"[[tooling.emboss]] {i} {what}", value, why + tail)
+
+
 def figure_fit_refusal(e: EmbossSpec, i: int, contours: list, outline: Any, inset: float) -> DesignError | None:
     """The refusal of figure ``i`` (its placed ``contours``) that does not lie inside ``outline`` offset inwards
     by ``inset`` mm (the punch tip less the land and margin), in the words of
@@ -389,7 +453,7 @@ def figure_fit_refusal(e: EmbossSpec, i: int, contours: list, outline: Any, inse
     what = "text" if e.text is not None else "outline"
     value = e.text if e.text is not None else f"{len(e.outline)} points"
     if not inset < outline.inscribed_radius():
-        return DesignError(f"[[tooling.emboss]] {i} {what}", value, f"does not fit: the face inset by {inset:.3g} mm is empty")
+        return inset_face_refusal(e, i, outline, inset)
     area, outside = lettering.outside_area(contours, outline, inset)
     if outside > 1e-6 * max(area, 1e-9):
         w, h = lettering.figure_box(contours)
@@ -792,9 +856,11 @@ def _charmap(path: str) -> frozenset[int]:
 
 
 def missing_glyphs(text: str, path: str | Path, where: str = "[[tooling.emboss]] font") -> str:
-    """The characters of ``text`` (each once, in order) that the font file ``path`` has no glyph for: OCC
-    and matplotlib draw them as empty boxes (the .notdef glyph).  The plain space needs none.  A file that
-    is no font is a :class:`DesignError` of ``where``."""
+    """The characters of ``text`` (each once, in order) that the font file ``path`` has no glyph for: not
+    those letters would be drawn (matplotlib draws the .notdef glyph, an empty box; OCC's text shape takes a
+    fallback system font's glyph where one has the character, cmr10's missing 'Å' came out as another glyph,
+    else an empty box).  The plain space needs none.  A file that is no font is a :class:`DesignError` of
+    ``where``."""
     try:
         cmap = _charmap(str(path))
     except (RuntimeError, OSError, ValueError):
@@ -1069,7 +1135,8 @@ def _emboss(i: int, t: Any, base: Path | None = None) -> EmbossSpec:
         missing = missing_glyphs(text, font_path(font, f"{w} font"), f"{w} font")
         if missing:
             raise DesignError(f"{w} text", text, f"has characters the font {font!r} has no glyph for: {missing!r} "
-                              "(they would be cut as empty boxes); give a font that has them")
+                              "(the figure cut would not be them: OpenCascade puts another font's glyph or an empty "
+                              "box in their place); give a font that has them")
     if svg is not None:
         _check_svg(f"{w} svg", svg)
     return EmbossSpec(
