@@ -526,8 +526,29 @@ try:
     edit.density = 1.5
     edit.apply(made)
     doc.recompute()
+    # the panel checks with the recompute's own function: a ffbe whose bevel leaves a band of 0.0005 mm (the
+    # design's rule, which the family's constructor alone lets pass) had been "valid", and OK refused it
+    leaves = {}
+    for how, width in (("plain", "1.5"), ("cm", "0.15 cm")):
+        band = TabletForm("ffbe")
+        band_read = [band.read("bevel_angle", "45"), band.read("bevel_width", width),
+                     band.read("thickness", "3.0005 mm")]
+        n0 = len(doc.Objects)
+        try:
+            band.create(doc)
+            on_ok = None
+        except Exception as exc:
+            on_ok = f"{type(exc).__name__}: {exc}"
+        leaves[how] = dict(read=band_read, panel=list(band.validate()), on_ok=on_ok, left=len(doc.Objects) - n0)
+    band_obj = make_tablet(doc, "ffbe")
+    band_obj.BevelAngle, band_obj.BevelWidth, band_obj.Thickness = 45.0, 1.5, 3.0005
+    doc.recompute()
+    leaves["recompute"] = [list(band_obj.State), band_obj.getStatusString()]
+    doc.removeObject(band_obj.Name)
+    doc.recompute()
     step(
         "form",
+        leaves=leaves,
         fields=fields,
         bad=list(bad),
         good=list(good),

@@ -323,6 +323,34 @@ class _Proxy:
             obj.setEditorMode(name, _EDITOR_MODES[mode])
 
 
+def core_tablet_of(spec: dict):
+    """The core tablet of a Tablet's inputs: what its recompute builds, and what the task panel checks its
+    fields with (the panel had called the family's constructor alone, which skips the design's own checks:
+    a ffbe whose bevel leaves a band of 0.0005 mm was "valid" in the panel and refused on OK).
+
+    Parameters
+    ----------
+    spec : dict
+        ``{family, params, design}`` as :meth:`TabletProxy.spec` gives it (mm, deg; ``design`` the design
+        file's path, or None for a family's tablet).
+
+    Returns
+    -------
+    tabletcad.geometry.tablet.Tablet
+        The core's tablet (dimensions in mm).
+
+    Raises
+    ------
+    tabletcad.errors.DesignError
+        What ``tabletcad build`` refuses (:func:`geometry.tablet_from_spec`), or no design file given.
+    """
+    if spec["design"] is not None and not spec["design"]:
+        from tabletcad.errors import DesignError
+
+        raise DesignError("DesignFile", "", "set a tabletcad design file (TOML) when Family is design_file")
+    return geometry.tablet_from_spec(spec["family"], spec["params"], spec["design"])
+
+
 # ============================================================================ Tablet
 class TabletProxy(_Proxy):
     """A tablet of a tabletcad family (dimensions as properties) or from a design file."""
@@ -493,14 +521,7 @@ class TabletProxy(_Proxy):
         return {"family": obj.Family, "params": params, "design": None}
 
     def core_tablet(self, obj):
-        s = self.spec(obj)
-        if s["design"] is not None and not s["design"]:
-            from tabletcad.errors import DesignError
-
-            raise DesignError(
-                "DesignFile", "", "set a tabletcad design file (TOML) when Family is design_file"
-            )
-        return geometry.tablet_from_spec(s["family"], s["params"], s["design"])
+        return core_tablet_of(self.spec(obj))
 
     def _geometry_key(self, obj, fit: float) -> str:
         """What the solid is made of: the spec, the fit tolerance ``fit`` (mm) and the design file's digest.
