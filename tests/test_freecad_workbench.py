@@ -721,6 +721,24 @@ def test_a_nan_fit_tolerance_is_refused_naming_it(headless):
     assert "Invalid" in s["state"] and "FitTolerance = nan" in s["tablet"]["status"], s
 
 
+def test_a_fit_tolerance_stored_as_0_is_refused_saying_so_and_the_default_is_held_explicitly(headless):
+    """A helper's trial (session 51): ``FitTolerance = -1 mm`` is stored as 0 mm by its PropertyLength, and 0 was
+    the core's default: the tablet rebuilt at 0.0001 mm with no message, as for a 0 set on purpose.  The property
+    now holds the tolerance used: a 0 (set or stored) is refused saying what FreeCAD does to a negative length,
+    the last shape stays; ``make_tablet(..., fit_tolerance=0)`` still asks for the default, which the property
+    then shows, as a new tablet's does."""
+    (s,) = _steps(headless, "stored_fit_tolerance")
+    refusal = ("FitTolerance = 0 mm is not allowed: must be within [1e-07, 0.01] mm (the default: 0.0001 mm); "
+               "FreeCAD's length properties hold no negative value: one set below 0 mm is stored as 0 mm")
+    for bad in ("-1.0", "0.0"):
+        stored, state, status = s["stored"][bad]
+        assert stored == 0.0 and "Invalid" in state and status == refusal, (bad, s["stored"][bad])
+    assert "Invalid" not in s["restored"][0] and s["restored"][1] is True  # (0.20 says Up-to-date, 1.0 nothing)
+    fit, valid, deviation = s["default_fit"]
+    assert fit == pytest.approx(1e-4, rel=1e-12) and valid and 0.0 < deviation <= 1e-4
+    assert s["new_fit"] == pytest.approx(1e-4, rel=1e-12)
+
+
 def test_an_edited_design_file_is_read_again(headless):
     """The rebuild key held the file's name only: an edited file kept the old solid until the document
     was reopened."""
