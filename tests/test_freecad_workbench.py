@@ -468,6 +468,26 @@ def test_density_change_rescales_weight_without_rebuilding(headless):
     assert st["tips"] == 2 and st["cuts"][1] == st["cuts"][0] and min(st["cuts"][0]) >= 1, st["cuts"]
 
 
+#: the design's refusal of a ffbe (bevel 45°, 1.5 mm wide, 3.0005 mm thick) whose bevels leave a band of 0.0005 mm
+LEAVES_BAND = ("leaves a band of 0.0005 mm: a part the dimensions leave must be at least 0.001 mm "
+               "(Tolerances.min_length, the least length a design takes) or, where the family allows it, none")
+
+
+def test_the_panel_checks_with_the_recomputes_function_quoting_the_field_as_typed(headless):
+    """A helper's trial (session 51): the panel checked its fields with the family's constructor alone, which lets
+    a bevel leave a band of 0.0005 mm pass (a design's rule): it showed "valid", and OK (or a recompute) refused
+    it.  The panel now asks :func:`objects.core_tablet_of`, the recompute's function: its verdict is the
+    recompute's message and OK's, word for word, quoting the field as typed (``0.15 cm``, read as 1.5 mm)."""
+    (st,) = _steps(headless, "form")
+    refusal = f"tablet.bevel_width = 1.5 mm is not allowed: {LEAVES_BAND}"
+    plain, cm, recompute = st["leaves"]["plain"], st["leaves"]["cm"], st["leaves"]["recompute"]
+    assert plain["read"] == cm["read"] == [True, True, True]
+    assert plain["panel"] == [False, refusal, {}]
+    assert cm["panel"] == [False, f"tablet.bevel_width = '0.15 cm' is not allowed: {LEAVES_BAND} (read as 1.5 mm)", {}]
+    assert plain["on_ok"] == cm["on_ok"] == f"DesignError: {refusal}" and plain["left"] == cm["left"] == 0
+    assert "Invalid" in recompute[0] and recompute[1] == refusal
+
+
 def test_task_panel_form(headless):
     """The panel's form: the family's fields with units and ranges, the core's verdict as you
     type (its one-line message when refused), key figures that match the core, a tablet with
@@ -699,6 +719,24 @@ def test_a_nan_fit_tolerance_is_refused_naming_it(headless):
     """A NaN FitTolerance had reached the core as "tol = nan" (a ValueError and its traceback)."""
     (s,) = _steps(headless, "bad_fit_tolerance")
     assert "Invalid" in s["state"] and "FitTolerance = nan" in s["tablet"]["status"], s
+
+
+def test_a_fit_tolerance_stored_as_0_is_refused_saying_so_and_the_default_is_held_explicitly(headless):
+    """A helper's trial (session 51): ``FitTolerance = -1 mm`` is stored as 0 mm by its PropertyLength, and 0 was
+    the core's default: the tablet rebuilt at 0.0001 mm with no message, as for a 0 set on purpose.  The property
+    now holds the tolerance used: a 0 (set or stored) is refused saying what FreeCAD does to a negative length,
+    the last shape stays; ``make_tablet(..., fit_tolerance=0)`` still asks for the default, which the property
+    then shows, as a new tablet's does."""
+    (s,) = _steps(headless, "stored_fit_tolerance")
+    refusal = ("FitTolerance = 0 mm is not allowed: must be within [1e-07, 0.01] mm (the default: 0.0001 mm); "
+               "FreeCAD's length properties hold no negative value: one set below 0 mm is stored as 0 mm")
+    for bad in ("-1.0", "0.0"):
+        stored, state, status = s["stored"][bad]
+        assert stored == 0.0 and "Invalid" in state and status == refusal, (bad, s["stored"][bad])
+    assert "Invalid" not in s["restored"][0] and s["restored"][1] is True  # (0.20 says Up-to-date, 1.0 nothing)
+    fit, valid, deviation = s["default_fit"]
+    assert fit == pytest.approx(1e-4, rel=1e-12) and valid and 0.0 < deviation <= 1e-4
+    assert s["new_fit"] == pytest.approx(1e-4, rel=1e-12)
 
 
 def test_an_edited_design_file_is_read_again(headless):
@@ -949,6 +987,8 @@ def test_gui_smoke_and_screenshot(fc, fc_home, assembly_step, tmp_path):
     assert r["panel_shown"] and r["panel_fields"] == sorted(families.FAMILIES["concave_round"].params)
     assert r["panel_suffix"].endswith(" mm")
     assert r["panel_invalid"][0] is False and "cup_depth" in r["panel_invalid"][1] and "hemisphere" in r["panel_invalid"][1]
+    # the design's own rule, as the recompute checks it, quoting the field as typed (the panel had said valid)
+    assert r["panel_band"] == [False, f"✘ tablet.bevel_width = '0.15 cm' is not allowed: {LEAVES_BAND} (read as 1.5 mm)"]
     # a FreeCAD user's trial: units as typed, a mass refused naming the field
     assert r["panel_kg"][0] is False and "Diameter = '10 kg' is not allowed: must be a length" in r["panel_kg"][1]
     assert r["panel_inch"] == pytest.approx(10.16, abs=1e-12)

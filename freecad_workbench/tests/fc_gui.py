@@ -41,6 +41,12 @@ try:
     panel = taskpanel.current
     mark("panel")
     result["panel_shown"] = FreeCADGui.Control.activeDialog()
+    # a bevel that leaves a band of 0.0005 mm: the design's rule, checked by the recompute's function as you
+    # type (the panel had said "valid" and OK refused it), quoting the field as typed
+    panel.family.setCurrentIndex(panel.model.families.index("ffbe"))
+    for key, text in (("bevel_angle", "45"), ("bevel_width", "0.15 cm"), ("thickness", "3.0005")):
+        panel.type_text(key, text)
+    result["panel_band"] = [panel.ok, panel.status.text()]
     panel.family.setCurrentIndex(panel.model.families.index("concave_round"))
     result["panel_fields"] = sorted(panel.spins)
     result["panel_suffix"] = panel.spins["diameter"].text()

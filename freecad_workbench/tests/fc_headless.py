@@ -269,7 +269,22 @@ try:
     t.FitTolerance = float("nan")
     doc.recompute()
     step("bad_fit_tolerance", tablet=tablet_info(t), state=list(t.State))
+    # a negative tolerance is stored as 0 mm by its PropertyLength: refused saying so (it had been taken as the
+    # default with no message), as a 0 set is (the property holds the tolerance used)
+    stored_fit = {}
+    for bad in (-1.0, 0.0):
+        t.FitTolerance = bad
+        doc.recompute()
+        stored_fit[repr(bad)] = [float(t.FitTolerance.Value), list(t.State), t.getStatusString()]
     t.FitTolerance = fit0
+    doc.recompute()
+    # make_tablet's fit_tolerance=0 asks for the default: the property holds it, the value used
+    zero_fit, new_fit = make_tablet(doc, "concave_round", fit_tolerance=0), make_tablet(doc, "concave_round")
+    step("stored_fit_tolerance", stored=stored_fit, restored=[list(t.State), bool(t.isValid())],
+         default_fit=[float(zero_fit.FitTolerance.Value), bool(zero_fit.isValid()), float(zero_fit.FitDeviation)],
+         new_fit=float(new_fit.FitTolerance.Value))
+    for o in (zero_fit, new_fit):
+        doc.removeObject(o.Name)
     doc.recompute()
     dens0 = float(t.Density)
     for bad in (1200.0, 0.0015):  # kg/m³ and g/mm³ where mg/mm³ belong
@@ -526,8 +541,29 @@ try:
     edit.density = 1.5
     edit.apply(made)
     doc.recompute()
+    # the panel checks with the recompute's own function: a ffbe whose bevel leaves a band of 0.0005 mm (the
+    # design's rule, which the family's constructor alone lets pass) had been "valid", and OK refused it
+    leaves = {}
+    for how, width in (("plain", "1.5"), ("cm", "0.15 cm")):
+        band = TabletForm("ffbe")
+        band_read = [band.read("bevel_angle", "45"), band.read("bevel_width", width),
+                     band.read("thickness", "3.0005 mm")]
+        n0 = len(doc.Objects)
+        try:
+            band.create(doc)
+            on_ok = None
+        except Exception as exc:
+            on_ok = f"{type(exc).__name__}: {exc}"
+        leaves[how] = dict(read=band_read, panel=list(band.validate()), on_ok=on_ok, left=len(doc.Objects) - n0)
+    band_obj = make_tablet(doc, "ffbe")
+    band_obj.BevelAngle, band_obj.BevelWidth, band_obj.Thickness = 45.0, 1.5, 3.0005
+    doc.recompute()
+    leaves["recompute"] = [list(band_obj.State), band_obj.getStatusString()]
+    doc.removeObject(band_obj.Name)
+    doc.recompute()
     step(
         "form",
+        leaves=leaves,
         fields=fields,
         bad=list(bad),
         good=list(good),

@@ -136,7 +136,8 @@ def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, reco
     ``Family = design_file`` with ``DesignFile`` set.
     ``params``: dimensions by core name (``diameter=9.0``, ``cup_depth="0.8 mm"``),
     plus ``density`` (mg/mm³, or a string with units such as ``"1.2 g/cm^3"``) and
-    ``fit_tolerance`` (mm).
+    ``fit_tolerance`` (mm, 1e-7 to 0.01; 0 for the core's default, 0.0001 mm, which ``FitTolerance``
+    then holds).
     """
     density = params.pop("density", None)
     user_density = density is not None
@@ -175,6 +176,8 @@ def make_tablet(doc, design_or_family="thesis.flat_faced_round", name=None, reco
     if fit_tol is not None:
         fit_tol = _value(fit_tol, "mm", "fit_tolerance")
         objects.check_fit_tolerance("fit_tolerance", float(fit_tol.Value))  # (-1 mm had become 0, the default)
+        if float(fit_tol.Value) == 0.0:  # the default, held by the property as the value used (it refuses 0)
+            fit_tol = FreeCAD.Units.Quantity(objects._default_fit(), FreeCAD.Units.Unit("mm"))
     if fam is None and design is None:  # ("design_file" given as a family: a tablet of no file had been added)
         from tabletcad.errors import DesignError
 

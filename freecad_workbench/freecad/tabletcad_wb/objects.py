@@ -110,7 +110,7 @@ def _restore_traceback():
         del sys.tracebacklimit
 
 
-#: the B-spline fit tolerances (mm) a tablet takes (0: the core's default): below 1e-7 mm the fit runs
+#: the B-spline fit tolerances (mm) a tablet takes (``make_tablet``'s 0: the core's default): below 1e-7 mm the fit runs
 #: into the surfaces' own rounding, above 0.01 mm a face would be visibly off its PDE surface
 MIN_FIT_TOLERANCE_MM, MAX_FIT_TOLERANCE_MM = 1e-7, 0.01
 #: the apparent density a tablet takes, mg/mm³ (= g/cm³): from a very porous compact's to the largest true
@@ -153,9 +153,21 @@ def check_density(parameter: str, value: float, given=None) -> None:
     raise DesignError(parameter, value if given is None else given, allowed, "mg/mm³")
 
 
-def check_fit_tolerance(parameter: str, value: float) -> None:
-    """Refuse a B-spline fit tolerance (mm) that is not 0 (the core's default) or within
-    [:data:`MIN_FIT_TOLERANCE_MM`, :data:`MAX_FIT_TOLERANCE_MM`] (NaN included), naming ``parameter``.
+def check_fit_tolerance(parameter: str, value: float, zero_is_default: bool = True) -> None:
+    """Refuse a B-spline fit tolerance (mm) outside [:data:`MIN_FIT_TOLERANCE_MM`, :data:`MAX_FIT_TOLERANCE_MM`]
+    (NaN included), naming ``parameter``.
+
+    Parameters
+    ----------
+    parameter : str
+        The name refused: ``make_tablet``'s argument (``fit_tolerance``) or the property (``FitTolerance``).
+    value : float
+        The tolerance, mm.
+    zero_is_default : bool
+        True for ``make_tablet``'s argument, where 0 asks for the core's default (which the property then
+        holds); False for the property, which holds the tolerance used: a ``PropertyLength`` stores a value
+        set below 0 mm as 0 mm, so a 0 there may have been set as -1 mm and is refused, saying so (it had
+        been taken as the default, with no message).
 
     Raises
     ------
@@ -164,9 +176,18 @@ def check_fit_tolerance(parameter: str, value: float) -> None:
     """
     from tabletcad.errors import DesignError
 
-    if not (value == 0.0 or MIN_FIT_TOLERANCE_MM <= value <= MAX_FIT_TOLERANCE_MM):  # (NaN had reached the core)
-        raise DesignError(parameter, value, f"must be 0 (the default, {_default_fit():g} mm) or within "
-                          f"[{MIN_FIT_TOLERANCE_MM:g}, {MAX_FIT_TOLERANCE_MM:g}]", "mm")
+    if zero_is_default and value == 0.0:
+        return
+    if MIN_FIT_TOLERANCE_MM <= value <= MAX_FIT_TOLERANCE_MM:  # (NaN had reached the core)
+        return
+    within = f"[{MIN_FIT_TOLERANCE_MM:g}, {MAX_FIT_TOLERANCE_MM:g}]"
+    if zero_is_default:
+        allowed = f"must be 0 (the default, {_default_fit():g} mm) or within {within}"
+    else:
+        allowed = f"must be within {within} mm (the default: {_default_fit():g} mm)"
+        if value == 0.0:
+            allowed += f"; {_STORED_FOR['App::PropertyLength'][1]}"
+    raise DesignError(parameter, value, allowed, "mm")
 
 
 #: what FreeCAD's quantity properties do to a value beyond their range, by the value they keep instead:
@@ -323,6 +344,34 @@ class _Proxy:
             obj.setEditorMode(name, _EDITOR_MODES[mode])
 
 
+def core_tablet_of(spec: dict):
+    """The core tablet of a Tablet's inputs: what its recompute builds, and what the task panel checks its
+    fields with (the panel had called the family's constructor alone, which skips the design's own checks:
+    a ffbe whose bevel leaves a band of 0.0005 mm was "valid" in the panel and refused on OK).
+
+    Parameters
+    ----------
+    spec : dict
+        ``{family, params, design}`` as :meth:`TabletProxy.spec` gives it (mm, deg; ``design`` the design
+        file's path, or None for a family's tablet).
+
+    Returns
+    -------
+    tabletcad.geometry.tablet.Tablet
+        The core's tablet (dimensions in mm).
+
+    Raises
+    ------
+    tabletcad.errors.DesignError
+        What ``tabletcad build`` refuses (:func:`geometry.tablet_from_spec`), or no design file given.
+    """
+    if spec["design"] is not None and not spec["design"]:
+        from tabletcad.errors import DesignError
+
+        raise DesignError("DesignFile", "", "set a tabletcad design file (TOML) when Family is design_file")
+    return geometry.tablet_from_spec(spec["family"], spec["params"], spec["design"])
+
+
 # ============================================================================ Tablet
 class TabletProxy(_Proxy):
     """A tablet of a tabletcad family (dimensions as properties) or from a design file."""
@@ -366,8 +415,8 @@ class TabletProxy(_Proxy):
             "App::PropertyLength",
             "FitTolerance",
             "Tablet",
-            "largest distance between the B-spline faces and the PDE surfaces",
-            _qty(1e-4, "mm"),
+            "largest distance between the B-spline faces and the PDE surfaces (mm; 1e-07 to 0.01, default 0.0001)",
+            _qty(_default_fit(), "mm"),
         )
         if "Density" in obj.PropertiesList and obj.getTypeIdOfProperty("Density") == "App::PropertyQuantity":
             # documents of the first workbench version: a Quantity in kg/m^3 (internally kg/mm^3)
@@ -493,14 +542,7 @@ class TabletProxy(_Proxy):
         return {"family": obj.Family, "params": params, "design": None}
 
     def core_tablet(self, obj):
-        s = self.spec(obj)
-        if s["design"] is not None and not s["design"]:
-            from tabletcad.errors import DesignError
-
-            raise DesignError(
-                "DesignFile", "", "set a tabletcad design file (TOML) when Family is design_file"
-            )
-        return geometry.tablet_from_spec(s["family"], s["params"], s["design"])
+        return core_tablet_of(self.spec(obj))
 
     def _geometry_key(self, obj, fit: float) -> str:
         """What the solid is made of: the spec, the fit tolerance ``fit`` (mm) and the design file's digest.
@@ -510,7 +552,7 @@ class TabletProxy(_Proxy):
         obj : App.FeaturePython
             The tablet.
         fit : float
-            Its ``FitTolerance`` (mm; 0: the core's default).
+            Its ``FitTolerance`` (mm).
 
         Returns
         -------
@@ -564,7 +606,7 @@ class TabletProxy(_Proxy):
         density = float(obj.Density)
         check_density("Density", density)
         fit = float(obj.FitTolerance.Value)
-        check_fit_tolerance("FitTolerance", fit)
+        check_fit_tolerance("FitTolerance", fit, zero_is_default=False)
         key = self._geometry_key(obj, fit)
         if key != getattr(self, "_built", None) or obj.Shape.isNull() or not obj.RimData:
             # rebuild only when the geometry's inputs changed (not for Density, Label, Placement)
@@ -573,7 +615,7 @@ class TabletProxy(_Proxy):
                 tablet = core[1] if core is not None and core[0] == key else self.core_tablet(obj)
             except DesignError as exc:
                 raise _as_stored(obj, exc) from None
-            geo = geometry.build_tablet(tablet, tol=fit or None)
+            geo = geometry.build_tablet(tablet, tol=fit)
             pl = obj.Placement
             obj.Shape = geo.solid
             obj.Placement = pl

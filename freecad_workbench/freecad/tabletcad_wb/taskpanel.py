@@ -34,6 +34,7 @@ class TabletForm:
         self.families = objects.family_names()
         self.density = float(density)
         self.errors: dict[str, str] = {}  # a field whose text is no value of its kind: the refusal
+        self.typed: dict[str, str] = {}  # a field's text as typed (a refusal of its value quotes it)
         self.set_family(family)
         if values:
             self.values.update({k: float(v) for k, v in values.items() if k in self.values})
@@ -57,6 +58,7 @@ class TabletForm:
             return False
         self.errors.pop(key, None)
         self.values[key] = value
+        self.typed[key] = text
         return True
 
     @classmethod
@@ -72,6 +74,7 @@ class TabletForm:
         self.units = dict(fam.params)
         self.values = {k: float(v) for k, v in fam.defaults.items() if v is not None}
         self.errors = {}
+        self.typed = {}
 
     def fields(self) -> list[tuple[str, str, str, float, float, float]]:
         """``(parameter, label, unit, minimum, maximum, value)`` per dimension."""
@@ -81,21 +84,26 @@ class TabletForm:
             out.append((k, objects.prop_name(k), unit, lo, hi, self.values.get(k, lo)))
         return out
 
+    def spec(self) -> dict:
+        """What the form asks the core for, as :meth:`objects.TabletProxy.spec` gives an object's:
+        ``{family, params, design}`` (mm, deg)."""
+        return {"family": self.family, "params": dict(self.values), "design": None}
+
     def validate(self) -> tuple[bool, str, dict]:
-        """``(ok, message, figures)``: the core builds the tablet (or says why not);
+        """``(ok, message, figures)``: the core builds the tablet (or says why not) with the function a
+        Tablet's recompute uses (:func:`objects.core_tablet_of`), so what the panel shows is what OK does;
         figures: volume (mm³), surface area (mm²), weight (mg), height (mm)."""
         from tabletcad.errors import TabletcadError
 
         if self.errors:
             return False, next(iter(self.errors.values())), {}
-        if not (DENSITY_LIMITS[0] <= self.density <= DENSITY_LIMITS[1]):
-            return False, f"Density = {self.density:g} mg/mm³ is not allowed: {DENSITY_LIMITS[0]} to {DENSITY_LIMITS[1]}", {}
         try:
-            tablet = objects._family(self.family).build(**self.values)
+            objects.check_density("Density", self.density)  # (the object's check of its Density)
+            tablet = objects.core_tablet_of(self.spec())
             props = tablet.properties()
             dims = tablet.dimensions()
         except TabletcadError as exc:
-            return False, str(exc), {}
+            return False, str(self.as_typed(exc)), {}
         v = float(props["volume_mm3"])
         figs = dict(
             volume_mm3=v,
@@ -105,6 +113,37 @@ class TabletForm:
         )
         figs = {k: x for k, x in figs.items() if math.isfinite(x)}
         return True, "valid", figs
+
+    def as_typed(self, exc):
+        """The core's refusal ``exc`` quoting the refused field's text as typed (``'0.059 in'``, read as
+        1.4986 mm), when it names a field whose text was more than a plain number in the field's unit.
+
+        Parameters
+        ----------
+        exc : tabletcad.errors.TabletcadError
+            The refusal (a :class:`~tabletcad.errors.DesignError` names ``tablet.<parameter>``).
+
+        Returns
+        -------
+        tabletcad.errors.TabletcadError
+            ``exc`` itself, or the same refusal quoting the text.
+        """
+        from tabletcad.errors import DesignError
+
+        key = getattr(exc, "parameter", "").removeprefix("tablet.")
+        text = self.typed.get(key) if isinstance(exc, DesignError) else None
+        if text is None or exc.value != self.values.get(key):
+            return exc
+        try:
+            float(text)
+            return exc  # a plain number: the refusal's value in the field's unit is what was typed
+        except ValueError:
+            pass
+        unit = "deg" if self.units[key] == "deg" else "mm"
+        value = f"{self.values[key]:.12g} {unit}"
+        same = text.replace(" ", "") in (value.replace(" ", ""), f"{self.values[key]:.12g}°")
+        allowed = exc.allowed if same else f"{exc.allowed} (read as {value})"
+        return DesignError(exc.parameter, text, allowed, exc.unit)
 
     def apply(self, obj) -> None:
         """Write what the form changed into a Tablet object: its family (which resets the dimensions) and then
