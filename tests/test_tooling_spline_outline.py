@@ -298,3 +298,34 @@ def test_part_of_a_periodic_bspline_becomes_a_clamped_spline(square):
     pts = _spline_points(spline, v)
     occ = np.array([[curve.Value(float(x)).X(), curve.Value(float(x)).Y()] for x in v])
     assert float(np.abs(pts - occ).max()) <= 1e-12
+
+
+@pytest.mark.parametrize("degree, mults", [(3, [1] * 9), (2, [1, 2, 1, 1, 2, 1]), (4, [1] * 8), (3, [3, 1, 2, 1, 1])])
+def test_a_periodic_bspline_is_written_as_the_same_closed_spline(degree, mults):
+    """Any periodic B-spline (degree, knots' multiplicities, random knots and poles) as a closed SPLINE: its
+    data's de Boor is OCC's curve to round-off over the whole period (OCC's first pole is the coefficient
+    of the basis function that starts ``degree`` flat knots before the last copy of its first knot)."""
+    from OCP.Geom import Geom_BSplineCurve
+    from OCP.gp import gp_Pnt
+    from OCP.TColgp import TColgp_Array1OfPnt
+    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+
+    from tabletcad.tooling.drawing import _spline_entity
+
+    rng = np.random.default_rng(sum(mults) * degree)
+    m, n = len(mults) + 1, sum(mults)
+    knots = np.cumsum(np.r_[0.0, rng.uniform(0.5, 1.5, m - 1)])
+    kn, mu = TColStd_Array1OfReal(1, m), TColStd_Array1OfInteger(1, m)
+    for i in range(m):
+        kn.SetValue(i + 1, float(knots[i]))
+        mu.SetValue(i + 1, mults[i % len(mults)])
+    poles = TColgp_Array1OfPnt(1, n)
+    for i, (x, y) in enumerate(rng.normal(size=(n, 2)), start=1):
+        poles.SetValue(i, gp_Pnt(float(x), float(y), 0.0))
+    curve = Geom_BSplineCurve(poles, kn, mu, degree, True)
+    at = _spline_entity(curve, curve.FirstParameter(), curve.LastParameter(), (0.0, 0.0))
+    assert at["closed"] and len(at["knots"]) == len(at["control_points"]) + degree + 1 == n + 2 * degree + 1
+    v = np.linspace(curve.FirstParameter(), curve.LastParameter(), 1001)
+    ours = _de_boor(np.asarray(at["knots"]), np.asarray(at["control_points"]), degree, v)
+    occ = np.array([[curve.Value(float(x)).X(), curve.Value(float(x)).Y()] for x in v])
+    assert float(np.abs(ours - occ).max()) <= 1e-14

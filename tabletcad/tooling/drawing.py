@@ -861,7 +861,7 @@ def _spline_entity(curve, t0: float, t1: float, origin: tuple[float, float]) -> 
     A periodic curve over its whole period is written as AutoCAD and ezdxf write a closed spline (flags
     CLOSED and PERIODIC): its poles followed by its first ``degree`` poles again, its knots the periodic
     extension of its flat knots, the curve the standard B-spline over ``[knots[degree],
-    knots[-degree-1]]`` = ``[t0, t0 + period]``.  Any other B-spline (or part of one) is written clamped:
+    knots[-degree-1]]`` = its first knot and a period on (the whole closed curve, whichever its start).  Any other B-spline (or part of one) is written clamped:
     OCC's own non-periodic form of the part, its ends at its first and last control points.
     """
     p = curve.Degree()
