@@ -207,3 +207,148 @@ def test_a_tapered_bore_is_the_exact_offset_at_every_height(square):
     assert info["bore_growth_at_top_mm"] == pytest.approx(info["punch_entry_mm"] * t, rel=1e-12)
     assert info["volume_mm3"] == pytest.approx(blank - straight - drafted,
                                                abs=P * SPLINE_OFFSET_TOL_MM * info["height_mm"])
+
+
+def _dxf_splines(entities: list) -> list:
+    """The SPLINE entities of ``entities`` (:func:`tabletcad.tooling.drawing._exact_entities`' data) as a DXF
+    written and read back by ezdxf."""
+    import io
+
+    import ezdxf
+
+    from tabletcad.tooling.drawing import _add_spline
+
+    doc = ezdxf.new("R2010")
+    for kind, at in entities:
+        assert kind == "SPLINE"
+        _add_spline(doc.modelspace(), at, {"layer": "OUTLINE"})
+    stream = io.StringIO()
+    doc.write(stream)
+    return list(ezdxf.read(io.StringIO(stream.getvalue())).modelspace().query('SPLINE[layer=="OUTLINE"]'))
+
+
+def _de_boor(knots: np.ndarray, cp: np.ndarray, p: int, v: np.ndarray) -> np.ndarray:
+    """The standard (non-rational) B-spline of degree ``p``, ``knots`` and control points ``cp`` at ``v`` (de
+    Boor's algorithm; ``v`` within ``[knots[p], knots[len(cp)]]``)."""
+    end = knots[len(cp)]  # (the domain's end: in the last span of nonzero length before it)
+    k = np.where(v < end, np.searchsorted(knots, v, side="right"), np.searchsorted(knots, end, side="left")) - 1
+    d = np.stack([cp[k - p + j] for j in range(p + 1)], axis=1)  # (len(v), p + 1, 2)
+    for r in range(1, p + 1):
+        for j in range(p, r - 1, -1):
+            lo, hi = knots[j + k - p], knots[j + 1 + k - r]
+            a = ((v - lo) / (hi - lo))[:, None]
+            d[:, j] = (1.0 - a) * d[:, j - 1] + a * d[:, j]
+    return d[:, p]
+
+
+def _spline_points(spline, v: np.ndarray) -> np.ndarray:
+    """The plan points of the DXF ``spline`` at its knots' parameters ``v``: de Boor's on its data as read,
+    which ezdxf's own B-spline of it (its knots scaled to run from 0 to 1 and rounded to its
+    ``knot_tolerance``, 1e-10) agrees with within 1e-8 mm."""
+    kn, cp = np.asarray(spline.knots), np.asarray(spline.control_points)[:, :2]
+    pts = _de_boor(kn, cp, spline.dxf.degree, v)
+    u = (v - kn[0]) / (kn[-1] - kn[0])
+    ez = np.asarray(list(spline.construction_tool().points(u)))[:, :2]
+    assert float(np.abs(ez - pts).max()) <= 1e-8
+    return pts
+
+
+def _check_closed_spline(spline, exact, origin=(0.0, 0.0), tol=1e-12) -> None:
+    """A closed periodic cubic SPLINE as AutoCAD and ezdxf write one (flags CLOSED | PERIODIC, knots = control
+    points + degree + 1, control points wrapped by the degree), whose B-spline over its domain
+    ``[knots[3], knots[-4]] = [0, 2 pi]`` is ``exact(v)`` (the core's points, moved by ``origin``) within ``tol``
+    mm at 20,001 parameters."""
+    from ezdxf.entities import Spline
+
+    assert spline.dxf.degree == 3 and spline.closed
+    assert spline.dxf.flags & Spline.PERIODIC and not spline.dxf.flags & Spline.RATIONAL
+    cp, kn = np.asarray(spline.control_points)[:, :2], np.asarray(spline.knots)
+    assert len(kn) == len(cp) + 3 + 1 and spline.fit_point_count() == 0
+    assert np.array_equal(cp[:3], cp[-3:])  # wrapped: the curve closes C1 (the spline's own continuity)
+    assert (kn[3], kn[-4]) == pytest.approx((0.0, math.tau), abs=1e-15)
+    v = np.linspace(0.0, math.tau, 20_001)
+    gap = np.linalg.norm(_spline_points(spline, v) - (exact(v) + np.asarray(origin)), axis=1)
+    assert float(gap.max()) <= tol
+
+
+def test_the_drawing_dxf_holds_the_outline_as_a_spline(square, tmp_path):
+    """The tablet sheet's DXF has the nominal outline on its OUTLINE layer as one exact SPLINE (it had nothing
+    there for a spline outline): read back by ezdxf, its B-spline is the core's outline at the same parameter
+    to round-off, placed at the plan's origin; the sheet's note says so."""
+    import ezdxf
+
+    from tabletcad.tooling.drawing import _write_dxf, drawing_model
+
+    dr = drawing_model(square)
+    _write_dxf(dr, tmp_path / "drawing.dxf")
+    msp = ezdxf.readfile(tmp_path / "drawing.dxf").modelspace()
+    assert len(msp.query('*[layer=="OUTLINE"]')) == 1
+    (spline,) = msp.query('SPLINE[layer=="OUTLINE"]')
+    outline = square.tablet.nominal.outline
+    _check_closed_spline(spline, lambda v: outline.offset(v, 0, 1.0, 0.0), dr.origins["plan"], tol=1e-12)
+    assert any("layer OUTLINE" in n and "SPLINE" in n for n in dr.notes)
+
+
+@pytest.mark.parametrize("distance", [-CLEARANCE, 0.5])
+def test_an_offset_outline_becomes_its_exact_spline(square, distance):
+    """A tip's and a bore's B-spline as SPLINE entities: the exact offset within the offset's tolerance."""
+    from tabletcad.tooling.drawing import _exact_entities
+
+    outline = square.tablet.nominal.outline
+    (spline,) = _dxf_splines(_exact_entities(square.frame.offset(distance), (1.5, -2.0)))
+    _check_closed_spline(spline, lambda v: outline.offset(v, 0, 1.0, -distance), (1.5, -2.0),
+                         tol=SPLINE_OFFSET_TOL_MM)
+
+
+def test_part_of_a_periodic_bspline_becomes_a_clamped_spline(square):
+    """An edge on part of a periodic B-spline is written open and clamped (OCC's own non-periodic form of the
+    part): knots = control points + degree + 1, its ends its end points, its points OCC's."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
+
+    from tabletcad.cad._occ import explore
+    from tabletcad.tooling.drawing import _exact_entities
+
+    curve = BRepAdaptor_Curve(explore(square.frame.outline, "Edge")[0]).BSpline()
+    a, b = 5.9, 7.1  # across the period's end
+    wire = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(curve, a, b).Edge()).Wire()
+    (spline,) = _dxf_splines(_exact_entities(wire, (0.0, 0.0)))
+    assert spline.dxf.degree == 3 and not spline.closed and spline.dxf.flags == 0
+    kn = np.asarray(spline.knots)
+    assert len(kn) == spline.control_point_count() + 4
+    assert (kn[0], kn[-1]) == pytest.approx((a, b), abs=1e-12)
+    v = np.linspace(a, b, 2001)
+    pts = _spline_points(spline, v)
+    occ = np.array([[curve.Value(float(x)).X(), curve.Value(float(x)).Y()] for x in v])
+    assert float(np.abs(pts - occ).max()) <= 1e-12
+
+
+@pytest.mark.parametrize("degree, mults", [(3, [1] * 9), (2, [1, 2, 1, 1, 2, 1]), (4, [1] * 8), (3, [3, 1, 2, 1, 1])])
+def test_a_periodic_bspline_is_written_as_the_same_closed_spline(degree, mults):
+    """Any periodic B-spline (degree, knots' multiplicities, random knots and poles) as a closed SPLINE: its
+    data's de Boor is OCC's curve to round-off over the whole period (OCC's first pole is the coefficient
+    of the basis function that starts ``degree`` flat knots before the last copy of its first knot)."""
+    from OCP.Geom import Geom_BSplineCurve
+    from OCP.gp import gp_Pnt
+    from OCP.TColgp import TColgp_Array1OfPnt
+    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+
+    from tabletcad.tooling.drawing import _spline_entity
+
+    rng = np.random.default_rng(sum(mults) * degree)
+    m, n = len(mults) + 1, sum(mults)
+    knots = np.cumsum(np.r_[0.0, rng.uniform(0.5, 1.5, m - 1)])
+    kn, mu = TColStd_Array1OfReal(1, m), TColStd_Array1OfInteger(1, m)
+    for i in range(m):
+        kn.SetValue(i + 1, float(knots[i]))
+        mu.SetValue(i + 1, mults[i % len(mults)])
+    poles = TColgp_Array1OfPnt(1, n)
+    for i, (x, y) in enumerate(rng.normal(size=(n, 2)), start=1):
+        poles.SetValue(i, gp_Pnt(float(x), float(y), 0.0))
+    curve = Geom_BSplineCurve(poles, kn, mu, degree, True)
+    at = _spline_entity(curve, curve.FirstParameter(), curve.LastParameter(), (0.0, 0.0))
+    assert at["closed"] and len(at["knots"]) == len(at["control_points"]) + degree + 1 == n + 2 * degree + 1
+    v = np.linspace(curve.FirstParameter(), curve.LastParameter(), 1001)
+    ours = _de_boor(np.asarray(at["knots"]), np.asarray(at["control_points"]), degree, v)
+    occ = np.array([[curve.Value(float(x)).X(), curve.Value(float(x)).Y()] for x in v])
+    assert float(np.abs(ours - occ).max()) <= 1e-14

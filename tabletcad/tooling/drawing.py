@@ -216,8 +216,8 @@ class Drawing:
     title_block: list = field(default_factory=list)
     scale: float | None = None
     paper: str = "A4"
-    #: ``(wire, (x, y))``: plan wires (z = 0, mm) the DXF carries as exact LINE, ARC, CIRCLE and ELLIPSE
-    #: entities on its OUTLINE layer, placed at a view's origin (the tablet's nominal outline in the plan)
+    #: ``(wire, (x, y))``: plan wires (z = 0, mm) the DXF carries as exact LINE, ARC, CIRCLE, ELLIPSE and
+    #: SPLINE entities on its OUTLINE layer, placed at a view's origin (the tablet's nominal outline in the plan)
     exact: list = field(default_factory=list)
 
     def __post_init__(self) -> None:
@@ -369,10 +369,12 @@ def drawing_model(ts) -> Drawing:
         dims.append(Dim((dx - k * fr.land, dy), (dx, dy), 0.25 * k * half, f"land {_fmt(fr.land)}", scale=k))
     notes.append(f"section A-A through the axis across {th:g} deg{' (the score)' if scores else ''}; "
                  f"detail B: band edge and land, {k:g}:1")
-    exact = fr.outline_kind in ("circle", "ellipse", "lines and arcs")  # (not a section of a free-form band)
+    # (not a section of a free-form band)
+    exact = fr.outline_kind in ("circle", "ellipse", "lines and arcs", "spline")
     if exact:
         notes.append("drawing.dxf: layer OUTLINE holds the nominal outline in the plan as exact "
-                     + {"circle": "a circle", "ellipse": "an ellipse"}.get(fr.outline_kind, "lines and arcs"))
+                     + {"circle": "a circle", "ellipse": "an ellipse",
+                        "spline": "a closed cubic B-spline (SPLINE)"}.get(fr.outline_kind, "lines and arcs"))
     return Drawing(views, origins, _toleranced(dims, ts), notes, title=_title(ts), title_block=title_block(ts),
                    exact=[(fr.outline, origins["plan"])] if exact else [])
 
@@ -811,7 +813,8 @@ def _write_matplotlib(dr: Drawing, svg: Path, pdf: Path) -> None:
 def _exact_entities(wire, origin: tuple[float, float]) -> list[tuple[str, dict]]:
     """``(kind, attributes)`` of DXF entities for the edges of a plan wire moved by ``origin``: a line's
     LINE, a circle's CIRCLE (whole) or ARC (counter-clockwise from ``start_angle`` to ``end_angle``, degrees),
-    an ellipse's ELLIPSE, anything else (a spline outline) a polyline through points 0.002 mm from it."""
+    an ellipse's ELLIPSE, a B-spline's SPLINE (:func:`_spline_entity`: its own degree, knots and poles),
+    anything else a polyline through points 0.002 mm from it."""
     from OCP.GeomAbs import GeomAbs_CurveType
 
     ox, oy = origin
@@ -840,11 +843,60 @@ def _exact_entities(wire, origin: tuple[float, float]) -> list[tuple[str, dict]]
             R = el.MajorRadius()
             out.append(("ELLIPSE", dict(center=(ctr.X() + ox, ctr.Y() + oy), major_axis=(R * major.X(), R * major.Y()),
                                         ratio=el.MinorRadius() / R)))
+        elif kind == GeomAbs_CurveType.GeomAbs_BSplineCurve:
+            out.append(("SPLINE", _spline_entity(c.BSpline(), t0, t1, origin)))
         else:
             d = GCPnts_TangentialDeflection(c, 0.05, 0.002)
             out.append(("POLYLINE", dict(points=[(d.Value(i).X() + ox, d.Value(i).Y() + oy)
                                                  for i in range(1, d.NbPoints() + 1)])))
     return out
+
+
+def _spline_entity(curve, t0: float, t1: float, origin: tuple[float, float]) -> dict:
+    """A DXF SPLINE's data of the OCC B-spline ``curve`` (``Geom_BSplineCurve``, plan, mm) between its
+    parameters ``t0`` and ``t1``, moved by ``origin``: ``degree``, ``control_points`` (x, y), ``knots``
+    (count = control points + degree + 1, the curve's own parameter), ``weights`` (empty unless rational)
+    and ``closed``.
+
+    A periodic curve over its whole period is written as AutoCAD and ezdxf write a closed spline (flags
+    CLOSED and PERIODIC): its poles followed by its first ``degree`` poles again, its knots the periodic
+    extension of its flat knots, the curve the standard B-spline over ``[knots[degree],
+    knots[-degree-1]]`` = its first knot and a period on (the whole closed curve, whichever its start).  Any other B-spline (or part of one) is written clamped:
+    OCC's own non-periodic form of the part, its ends at its first and last control points.
+    """
+    p = curve.Degree()
+    whole = curve.IsPeriodic() and abs(t1 - t0 - curve.Period()) < 1e-12 * max(1.0, curve.Period())
+    if whole:
+        knots = _periodic_flat_knots(curve)
+        poles = list(range(1, curve.NbPoles() + 1))
+        poles += poles[:p]
+    else:
+        curve = curve.Copy()
+        if curve.IsPeriodic() or t0 > curve.FirstParameter() or t1 < curve.LastParameter():
+            curve.Segment(t0, t1)  # (on a periodic curve, across its period's end too)
+        if curve.IsPeriodic():
+            curve.SetNotPeriodic()
+        seq = curve.KnotSequence()
+        knots = [seq.Value(i) for i in range(seq.Lower(), seq.Upper() + 1)]
+        poles = list(range(1, curve.NbPoles() + 1))
+    ox, oy = origin
+    pts = [curve.Pole(i) for i in poles]
+    return dict(degree=p, control_points=[(q.X() + ox, q.Y() + oy) for q in pts], knots=knots,
+                weights=[curve.Weight(i) for i in poles] if curve.IsRational() else [], closed=whole)
+
+
+def _periodic_flat_knots(curve) -> list[float]:
+    """The ``NbPoles + 2 Degree + 1`` flat knots of the periodic ``curve`` (``Geom_BSplineCurve``) as an
+    unperiodic B-spline over its poles followed by its first ``Degree`` poles: the periodic extension
+    of its knots (each repeated by its multiplicity) from ``Degree`` before the last copy of its first knot.
+
+    (OCC's first pole is the coefficient of the basis function starting there: on a periodic curve's first
+    span the poles 1 to ``Degree + 1`` act, as for ``tabletcad.tooling.outline._periodic_bspline_edge``.)
+    """
+    p, n, L = curve.Degree(), curve.NbPoles(), curve.Period()
+    one = [curve.Knot(i) for i in range(1, curve.NbKnots()) for _ in range(curve.Multiplicity(i))]  # n of them
+    start = curve.Multiplicity(1) - 1 - p
+    return [one[j % n] + L * (j // n) for j in range(start, start + n + 2 * p + 1)]
 
 
 def _write_dxf(dr: Drawing, path: Path) -> None:
@@ -872,6 +924,8 @@ def _write_dxf(dr: Drawing, path: Path) -> None:
                 msp.add_arc(at["center"], at["radius"], at["start_angle"], at["end_angle"], dxfattribs=attribs)
             elif kind == "ELLIPSE":
                 msp.add_ellipse(at["center"], at["major_axis"], at["ratio"], dxfattribs=attribs)
+            elif kind == "SPLINE":
+                _add_spline(msp, at, attribs)
             else:
                 msp.add_lwpolyline(at["points"], dxfattribs=attribs)
     for kind, p in _sheet_lines(dr):
@@ -894,6 +948,20 @@ def _write_dxf(dr: Drawing, path: Path) -> None:
     ys = [float(q[1]) for _, p in _sheet_lines(dr) for q in p]
     msp.add_mtext("\\P".join([dr.title, *dr.title_block, *dr.notes]), dxfattribs={"layer": "NOTES", "char_height": 0.8}).set_location((max(xs) + 8, max(ys)))
     _save_dxf(doc, path)
+
+
+def _add_spline(msp, at: dict, attribs: dict) -> None:
+    """A SPLINE entity of :func:`_spline_entity`'s data ``at`` in the modelspace ``msp``: control points,
+    knots and weights as given (no fit points), flags CLOSED and PERIODIC for a closed one (as ezdxf's
+    ``Spline.set_closed`` and AutoCAD write a closed spline), RATIONAL with weights."""
+    from ezdxf.entities import Spline
+
+    s = msp.add_spline(degree=at["degree"], dxfattribs=attribs)
+    s.control_points = at["control_points"]
+    s.knots = at["knots"]
+    if at["weights"]:
+        s.weights = at["weights"]
+    s.dxf.flags = ((Spline.CLOSED | Spline.PERIODIC) if at["closed"] else 0) | (Spline.RATIONAL if at["weights"] else 0)
 
 
 # stand-ins written where the header's GUIDs go, then replaced by GUIDs of the file's content
