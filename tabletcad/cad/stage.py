@@ -79,20 +79,18 @@ def check_tablet_solid(tablet: Tablet, report: dict[str, Any] | None = None):
         solid = tablet_solid(tablet, tol)
         # the B-rep's own surfaces (poles, knots) integrated by Gauss-Legendre: exact for the volume,
         # within ~1e-9 for the area, and 5-25x cheaper than OCC's adaptive integration of the faces
-        volume, area = solid.data_volume_area
-        return solid, (abs(volume) - v_q) / v_q, (area - a_q) / a_q
-
-    def refused(solid, tol: float, dv: float, da: float) -> GeometryError:
+        volume, area = abs(solid.data_volume_area[0]), solid.data_volume_area[1]
         dev = max(f.max_deviation for f in solid.fits)
+        return (solid, volume, area, dev), (volume - v_q) / v_q, (area - a_q) / a_q
+
+    def refused(made, tol: float, dv: float, da: float) -> GeometryError:
         return GeometryError(
             f"{tablet.name}: B-rep volume/area differ from the quadrature by {dv:.2e}/{da:.2e} relative "
-            f"(allowed {AGREEMENT_REL:g}; largest fit deviation {dev:.2e} mm at a fit tolerance of {tol:.0e} mm)",
-            solid,
+            f"(allowed {AGREEMENT_REL:g}; largest fit deviation {made[3]:.2e} mm at a fit tolerance of {tol:.0e} mm)",
+            made[0],
         )
 
-    solid, tol, (dv, da) = refitted(tablet.tol.fit, measured, refused)
-    volume, area = abs(solid.data_volume_area[0]), solid.data_volume_area[1]
-    dev = max(f.max_deviation for f in solid.fits)
+    (solid, volume, area, dev), tol, (dv, da) = refitted(tablet.tol.fit, measured, refused)
     t1 = time.perf_counter()
     mesh = tessellate_solid(solid, MESH_LINEAR_MM, MESH_ANGULAR_RAD)
     t2 = time.perf_counter()

@@ -271,8 +271,9 @@ def outside_area(contours, outline, inset: float) -> tuple[float, float]:
     ``outline`` (a :class:`~tabletcad.families.outline.PlanOutline`) offset inwards by ``inset`` mm (see the
     module docstring).  The offset must bound the inset region (:func:`tabletcad.families.outline.offset_bounds_inset`), else the result is not
     the area outside."""
-    sign = 1.0 if figure_area(contours) >= 0 else -1.0  # the fill's orientation made counter-clockwise
-    area = sign * figure_area(contours)
+    signed = figure_area(contours)
+    sign = 1.0 if signed >= 0 else -1.0  # the fill's orientation made counter-clockwise
+    area = sign * signed
 
     def g(points):  # > 0 outside the inset region
         return inset - outline.signed_distance(np.atleast_2d(points))
