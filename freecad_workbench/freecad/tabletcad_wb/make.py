@@ -19,7 +19,7 @@ from pathlib import Path
 
 import FreeCAD
 
-from . import geometry, objects
+from . import objects
 
 __all__ = ["design_tooling", "make_die", "make_lower_punch", "make_tablet", "make_tooling", "make_upper_punch"]
 
@@ -106,7 +106,7 @@ def _checked_core(spec: dict, given: str):
     from tabletcad.errors import DesignError
 
     try:
-        return geometry.tablet_from_spec(spec["family"], spec["params"], spec["design"])
+        return objects.core_tablet_of(spec)  # (the recompute's and the task panel's one way in)
     except DesignError as exc:
         if exc.parameter == "design_file" and exc.value == spec["design"] and given != spec["design"]:
             raise DesignError("design_file", given, f"{exc.allowed} (read as {spec['design']})") from None
