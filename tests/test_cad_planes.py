@@ -22,6 +22,7 @@ pytestmark = pytest.mark.cad
 ROOT = Path(__file__).resolve().parents[1]
 CRASHED = ("oval", "almond", "rounded_triangle", "rounded_square", "rounded_rectangle", "modified_capsule")
 FLAT_ROUNDS = ("flat_face_round", "ffbe", "ffre")  # a flat disc each side: a B-spline disc with a seam, now a plane
+LANDS = ("rounded_triangle", "rounded_rectangle", "modified_capsule")  # a flat land round the cup, each side
 
 SCRIPT = r"""
 import math, sys
@@ -118,19 +119,20 @@ def forked_runs(tmp_path_factory):
 
 @pytest.mark.parametrize("family", FAMILIES)
 def test_booleans_and_clean_on_flat_centred_families_run_and_are_exact(family, forked_runs):
-    """The pin through the flat centre removes pi r^2 T exactly; clean() merges the flat pieces
-    and keeps the volume.  On the code before tabletcad.cad.planes each ended in SIGSEGV (-11)."""
+    """The pin through the flat centre removes pi r^2 T exactly; clean() keeps the volume, and has no flat
+    pieces left to merge: each flat region (the flat centre, a land) is one plane face.  On the code before
+    tabletcad.cad.planes each ended in SIGSEGV (-11); before the regions were merged, clean() merged the
+    shaped families' pieces (the rounded rectangle's 48 plane faces)."""
     returncode, stdout, stderr = forked_runs[family]
     assert returncode == 0, (returncode, stderr[-2000:])
     n, V, T, cut, cut_ok, qv, q_ok, cv, c_ok, c_faces, b_faces = stdout.split()[-11:]
     V, T, cut, qv, cv = map(float, (V, T, cut, qv, cv))
-    assert int(n) >= 2  # the top's and the bottom's flat pieces at least
+    assert int(n) == (4 if family in LANDS else 2)  # top and bottom: the flat centre, and the land if any
     pin = math.pi * 0.2**2 * T
     assert V - cut == pytest.approx(pin, rel=1e-7) and cut_ok == "True"
     assert qv == pytest.approx(cut, rel=1e-9) and q_ok == "True"
     assert cv == pytest.approx(V, rel=1e-9) and c_ok == "True"
-    # the shaped families' flat pieces merge; a round's disc is one face already
-    assert int(c_faces) < int(b_faces) if family in CRASHED else int(c_faces) == int(b_faces)
+    assert int(c_faces) == int(b_faces)
 
 
 def test_plane_of_reads_coplanar_poles_with_the_surface_normal():
@@ -185,9 +187,9 @@ def test_every_flat_face_of_a_shaped_solid_is_judged_on_its_own_numpy_poles(monk
     calls = []
     real = planes.flat_faces_as_planes
 
-    def spy(solid, check=True, made=None):
+    def spy(solid, check=True, made=None, merge=True):
         calls.append((solid, made))
-        return real(solid, check=check, made=made)
+        return real(solid, check=check, made=made, merge=merge)
 
     monkeypatch.setattr(solid_module, "flat_faces_as_planes", spy)
     solid = tablet_solid(Design.from_toml(ROOT / "samples" / "families" / "rounded_rectangle.toml").build())
@@ -202,7 +204,9 @@ def test_every_flat_face_of_a_shaped_solid_is_judged_on_its_own_numpy_poles(monk
         assert (g is None) == (r is None) == (planes.plane_of(None, P) is None)
         if g is not None:
             assert np.allclose(g[0], r[0], rtol=0, atol=1e-12) and np.array_equal(g[1], r[1])
-    assert sum(g is not None for g in got) == solid.planes == 48
+    # 48 flat pieces (plateau, plateau ring and land, each side, 8 pieces each): one plane face per flat region
+    assert sum(g is not None for g in got) == 48
+    assert solid.planes == 4 and len(explore(solid.shape, "Face")) == 72 - 48 + 4 == len(solid.faces)
 
 
 OFF_CENTRE = r"""
@@ -256,9 +260,9 @@ def test_plane_faces_store_their_edges_projections_and_enclose_the_same_volume(f
     before = []
     real = planes.flat_faces_as_planes
 
-    def spy(solid, check=True, made=None):
+    def spy(solid, check=True, made=None, merge=True):
         before.append(solid)
-        return real(solid, check=check, made=made)
+        return real(solid, check=check, made=made, merge=merge)
 
     monkeypatch.setattr(solid_module, "flat_faces_as_planes", spy)
     solid = tablet_solid(Design.from_toml(ROOT / "samples" / "families" / f"{family}.toml").build())

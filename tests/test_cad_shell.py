@@ -207,14 +207,15 @@ def test_a_snapped_corner_is_covered_by_its_cut_edges_tolerance():
 @pytest.mark.freecad
 @pytest.mark.parametrize("fc", freecads.params())
 def test_freecad_reads_an_assembled_shell_with_collapsed_corners(fc, tmp_path):
-    """The rounded square's assembled shell (56 faces, degenerated edges between the runs of the
-    collapsed corners' rows) as STEP, read by FreeCAD 0.20 and 1.0 (their own OCCT): one valid
+    """The rounded square's assembled shell (56 faces made, 26 once each flat centre's 16 pieces are one
+    plane face; degenerated edges between the runs of the collapsed corners' rows) as STEP, read by FreeCAD 0.20 and 1.0 (their own OCCT): one valid
     closed solid, named, whose volume by OCC's default rule is ours to 1e-9."""
     from support.readback import freecad_read_step
     from tabletcad.cad.export import export
 
     s = tablet_solid(Design.from_toml(ROOT / "samples/families/rounded_square.toml").build())
-    assert not s.sewn and len(s.faces) == 56
+    degenerated = [e for e in explore(s.shape, "Edge") if BRep_Tool.Degenerated_s(e)]
+    assert not s.sewn and len(s.faces) == 26 and s.planes == 2 and len(degenerated) == 8
     r = freecad_read_step(export(s, tmp_path / "rounded_square.step"), freecadcmd=fc.cmd)
     assert r["n_solids"] == 1 and r["valid"] and r["solids_valid"] == [True] and r["solids_closed"] == [True]
     assert r["labels"] == [s.name]

@@ -374,20 +374,30 @@ def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequenc
     revolved = [isinstance(sd, RevolvedSurfaceData) for sd in surfaces]
     enclosed = -va[0] if all(revolved) else va[0] if not any(revolved) else math.nan
     solid = _make_solid(shell, name, enclosed, check=False)
-    # flat B-spline pieces as exact planes: OCCT's face merging, which build123d and CadQuery run after
-    # every Boolean, crashed the process on them (tabletcad.cad.planes); one check of the solid with them,
-    # and of the solid as made only if that fails
-    planar, n_planes, reshape = flat_faces_as_planes(solid, check=False, made=made)
-    try:
-        check_solid(planar, name)
-        solid = planar
-    except GeometryError:
-        if not n_planes:
-            raise
+    # flat B-spline pieces as exact planes, one per flat region: OCCT's face merging, which build123d and
+    # CadQuery run after every Boolean, crashed the process on the pieces (tabletcad.cad.planes); one check of
+    # the solid with them, of the solid with a plane per piece only if that fails, of the solid as made last
+    for merge in (True, False):
+        planar, n_planes, reshape = flat_faces_as_planes(solid, check=False, made=made, merge=merge)
+        try:
+            check_solid(planar, name)
+            solid = planar
+            break
+        except GeometryError:
+            if not n_planes:
+                raise
+    else:
         check_solid(solid, name)
         n_planes, reshape = 0, None
-    if reshape is not None:  # the faces as the solid has them
-        faces = tuple(cast(reshape.Value(f), "Face") for f in faces)
+    if sewn:  # the faces as sewing made them
+        faces = tuple(explore(shell, "Face"))
+    if reshape is not None:  # and with their planes (a flat region's pieces: its one face, once)
+        kept: list = []
+        for f in faces:
+            g = reshape.Value(f)
+            if not g.IsNull() and not any(g.IsSame(k) for k in kept):
+                kept.append(cast(g, "Face"))
+        faces = tuple(kept)
     t2 = time.perf_counter()
     out = TabletSolid(
         name=name,
