@@ -26,7 +26,7 @@ caller sews.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from OCP.BRep import BRep_Builder
@@ -51,7 +51,8 @@ def _spread(points: np.ndarray) -> float:
 
 
 def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Sequence[Sequence[Geom_BSplineSurface]],
-                   tol_degen: float = 1e-7):
+                   tol_degen: float = 1e-7,
+                   whole: Callable[[int], Geom_BSplineSurface | None] | None = None):
     """The closed shell of a chain of faces, or None when it is not a chain this can assemble.
 
     Parameters
@@ -63,11 +64,16 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
     tol_degen : float
         A boundary row whose poles stay within this distance (mm) of one point over a piece
         is a degenerated edge.
+    whole : optional; ``whole(j)`` is patch ``j``'s surface before it was cut (periodic in ``v``;
+        :func:`tabletcad.cad.faces.make_geom_surface`), or None.  A patch cut only because its
+        neighbours are (no piece of it has a degenerated edge, its pieces run once round the period
+        in order) is then one face on that surface, bounded by its pieces' row edges and one seam
+        (:func:`_whole_face`): a shaped tablet's band is one face, not eight.
 
     Returns
     -------
     ``(shell, faces)`` - the shell (its faces all ``FORWARD``: the surfaces' own normals) and
-    its faces in the order of ``pieces`` - or None.
+    its faces in the order of ``pieces`` (a patch made whole: its one face) - or None.
     """
     n_patch = len(pieces)
     n_piece = len(pieces[0]) if n_patch else 0
@@ -202,6 +208,13 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
     B.MakeShell(shell)
     faces = []
     for j in range(n_patch):
+        if whole is not None and not periodic:
+            made = _whole_face(B, whole, j, pieces[j], v_ranges, row_edges[j], row_edges[(j + 1) % n_row],
+                               col_edges[j][0], col_tol[j])
+            if made is not None:
+                B.Add(shell, made)
+                faces.append(made)
+                continue
         for k in range(n_piece):
             d, s = pieces[j][k], surfaces[j][k]
             u0, u1 = float(d.u_knots[0]), float(d.u_knots[-1])
@@ -245,3 +258,46 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
             B.SameParameter(e, True)
     shell.Closed(True)
     return shell, faces
+
+
+def _whole_face(B: BRep_Builder, whole: Callable[[int], Geom_BSplineSurface | None], j: int,
+                pieces: Sequence[BSplineSurfaceData], v_ranges: Sequence[tuple[float, float]],
+                low: Sequence[TopoDS_Edge | None], high: Sequence[TopoDS_Edge | None], seam: TopoDS_Edge,
+                tols: Sequence[float]) -> TopoDS_Face | None:
+    """Patch ``j`` as one face on its uncut surface ``whole(j)``, or None when it cannot be: a piece's row
+    is a pole (a degenerated edge: the row stands still there, as one face a reader would tear it open),
+    a cut was moved to meet a snapped neighbour (``tols``), or the pieces do not run once round the
+    period from its start in order (a first piece across the seam).
+
+    The wire is the periodic parameter rectangle's, counter-clockwise: the seam (the cut at the period's
+    start, with p-curves at both ends of the period), the ``high`` row's edges, the seam back, the
+    ``low`` row's edges back; each row edge gets the p-curve its piece gave it, at the same ``v``."""
+    if any(e is None for e in (*low, *high)) or any(t != EDGE_TOL for t in tols):
+        return None
+    if any(b0 != a1 for (_, b0), (a1, _) in zip(v_ranges, v_ranges[1:])):
+        return None
+    d0 = pieces[0]
+    a, b = v_ranges[0][0], v_ranges[-1][1]
+    surf = whole(j)
+    if surf is None or not surf.IsVPeriodic() or surf.VPeriod() != b - a \
+            or surf.VKnot(1) != a or surf.IsUPeriodic():
+        return None
+    u0, u1 = float(d0.u_knots[0]), float(d0.u_knots[-1])
+    f = TopoDS_Face()
+    B.MakeFace(f, surf, EDGE_TOL)
+    for d, (va, vb), e_low, e_high in zip(pieces, v_ranges, low, high):
+        breaks = v_breaks(d.v_knots, d.v_mults, d.v_degree)
+        B.UpdateEdge(e_low, iso_u_pcurve(u0, va, vb, breaks), f, EDGE_TOL)
+        B.UpdateEdge(e_high, iso_u_pcurve(u1, va, vb, breaks), f, EDGE_TOL)
+    B.UpdateEdge(seam, Geom2d_Line(gp_Pnt2d(0.0, a), gp_Dir2d(1.0, 0.0)),
+                 Geom2d_Line(gp_Pnt2d(0.0, b), gp_Dir2d(1.0, 0.0)), f, tols[0])
+    w = TopoDS_Wire()
+    B.MakeWire(w)
+    B.Add(w, seam.Oriented(_FORWARD))
+    for e in high:
+        B.Add(w, e.Oriented(_FORWARD))
+    B.Add(w, seam.Oriented(_REVERSED))
+    for e in reversed(low):
+        B.Add(w, e.Oriented(_REVERSED))
+    B.Add(f, w)
+    return f

@@ -50,7 +50,7 @@ from tabletcad.brep.surface import BSplineSurfaceData, volume_and_area
 from tabletcad.cad._occ import cast, explore, shape_type
 from tabletcad.cad.content import ContentMemo, content_key, has_all_surfaces
 from tabletcad.cad.faces import face_of, knot_boundary_pcurves, make_geom_surface
-from tabletcad.cad.planes import flat_faces_as_planes, made_poles
+from tabletcad.cad.planes import flat_faces_as_planes, made_poles, planes_of
 from tabletcad.cad.shell import assemble_shell
 from tabletcad.errors import GeometryError
 from tabletcad.brep.slit import chain_face_surfaces
@@ -328,9 +328,20 @@ def solid_from_surfaces(
     made = made_poles((g, p.poles) for gs, ps in zip(geoms, pieces) for g, p in zip(gs, ps))  # for the planes
     va = volume_and_area(surfaces)  # the faces' own volume and area (orientation, the stage's check)
     # the chain's topology is known: its shell is assembled edge by edge (tabletcad.cad.shell);
-    # a chain that cannot be (the capsule's slit), or whose assembled solid fails its check, is sewn
+    # a chain that cannot be (the capsule's slit), or whose assembled solid fails its check, is sewn.
+    # A curved patch cut only because its neighbours are is one face on its uncut surface (a flat one is
+    # one plane face per flat region anyway: tabletcad.cad.planes)
+    flat = planes_of([np.asarray(sd.poles) for sd in surfaces]) if any(len(ps) > 1 for ps in pieces) else None
+
+    def whole(j: int):
+        if flat is None or flat[j] is not None or not surfaces[j].v_periodic:
+            return None
+        g = make_geom_surface(surfaces[j])
+        made.update(made_poles([(g, surfaces[j].poles)]))
+        return g
+
     try:
-        assembled = assemble_shell(pieces, geoms, tol_degen)
+        assembled = assemble_shell(pieces, geoms, tol_degen, whole=whole)
     except Standard_Failure:  # an OCC exception while building it: sewing decides
         assembled = None
     if assembled is not None:
