@@ -14,7 +14,7 @@ pytest.importorskip("OCP")
 pytest.importorskip("manifold3d")
 
 import freecads  # noqa: E402
-from support.readback import freecad_read_step  # noqa: E402
+from support.readback import freecad_read_steps  # noqa: E402
 from tabletcad.families.thesis import shallow_convex_round  # noqa: E402
 from tabletcad.tooling import ToolingSpec, make_tooling, write_tooling  # noqa: E402
 
@@ -112,10 +112,29 @@ def test_freecad020_import_insert_crash_is_freecads_own(fc, files, tmp_path):
         assert r is not None and set(r["named_solids"]) == {"BoxA", "BoxB"}
 
 
-@pytest.mark.parametrize("name", ["upper_punch", "lower_punch", "die"])
-def test_freecad_reads_each_part(fc, files, name):
+PARTS = ["upper_punch", "lower_punch", "die"]
+
+
+@pytest.fixture(scope="module")
+def parts_read(files):
+    """``read(fc)``: ``{part: freecad_read_step's result}`` of that FreeCAD, the three part files read in one
+    ``freecadcmd`` process per FreeCAD (three had each started FreeCAD for one file)."""
+    out, _ = files
+    cache: dict = {}
+
+    def read(fc: freecads.FreeCADInstall) -> dict:
+        if fc.version not in cache:
+            cache[fc.version] = dict(zip(PARTS, freecad_read_steps([out / f"{n}.step" for n in PARTS],
+                                                                   freecadcmd=fc.cmd)))
+        return cache[fc.version]
+
+    return read
+
+
+@pytest.mark.parametrize("name", PARTS)
+def test_freecad_reads_each_part(fc, files, parts_read, name):
     out, ts = files
-    r = freecad_read_step(out / f"{name}.step", freecadcmd=fc.cmd)
+    r = parts_read(fc)[name]
     assert r["n_solids"] == 1 and r["valid"]
     from tabletcad.cad.solid import mass_properties
 

@@ -3,9 +3,10 @@
 Inputs come from environment variables (freecadcmd treats extra arguments as
 documents to open):
 
-``TABLETCAD_FC_MODE``   ``read_step``, ``read_steps`` or ``bspline``
-``TABLETCAD_FC_INPUT``  the STEP file, a JSON file of a list of STEP files (``read_steps``), or a JSON file
-                        ``{"surfaces": [BSplineSurfaceData.as_dict()...], "u": [...], "v": [...]}``
+``TABLETCAD_FC_MODE``   ``read_step``, ``read_steps``, ``bspline`` or ``batch``
+``TABLETCAD_FC_INPUT``  the STEP file, a JSON file of a list of STEP files (``read_steps``), a JSON file
+                        ``{"surfaces": [BSplineSurfaceData.as_dict()...], "u": [...], "v": [...]}``, or (``batch``)
+                        a JSON file ``{"read_step": [STEP files...], "bspline": [JSON files as bspline's...]}``
 ``TABLETCAD_FC_OUTPUT`` where the JSON result is written (also printed after ``TABLETCAD_JSON:``)
 
 ``read_step``: reads the file with ``Part.read`` (FreeCAD's OCCT STEP reader) and
@@ -18,6 +19,10 @@ process: ``{"results": [{"ok": ..., <read_step's result or "error">}, ...]}`` in
 ``Part.BSplineSurface().buildFromPolesMultsKnots(...)`` from the kernel-neutral
 data, evaluates it at the given ``(u, v)`` pairs, reads poles/knots back, then
 sews the faces, makes a solid and reports validity, volume and area.
+
+``batch``: ``read_step`` of each STEP file and ``bspline`` of each surfaces file, in one FreeCAD process
+(one start-up and one ``Import`` load for all of them): ``{"read_step": [...], "bspline": [...]}`` in the
+lists' order, each ``{"ok": ..., <the mode's result or "error">}``.
 """
 
 import json
@@ -121,12 +126,26 @@ def _bspline(path):
     return out
 
 
+def _batch(path):
+    with open(path) as fh:
+        jobs = json.load(fh)
+    out = {}
+    for mode, run in (("read_step", _read_step), ("bspline", _bspline)):
+        results = out[mode] = []
+        for p in jobs.get(mode, []):
+            try:
+                results.append({"ok": True, "path": p, **run(p)})
+            except Exception as exc:
+                results.append({"ok": False, "path": p, "error": repr(exc), "traceback": traceback.format_exc()})
+    return out
+
+
 def main():
     mode = os.environ.get("TABLETCAD_FC_MODE", "read_step")
     inp = os.environ["TABLETCAD_FC_INPUT"]
     out_path = os.environ.get("TABLETCAD_FC_OUTPUT")
     try:
-        result = {"ok": True, **{"read_step": _read_step, "read_steps": _read_steps}.get(mode, _bspline)(inp)}
+        result = {"ok": True, **{"read_step": _read_step, "read_steps": _read_steps, "batch": _batch}.get(mode, _bspline)(inp)}
     except Exception as exc:
         result = {"ok": False, "error": repr(exc), "traceback": traceback.format_exc()}
     text = json.dumps(result)

@@ -11,6 +11,7 @@
   a 500,000-triangle STL).
 * :func:`freecad_build_bspline` rebuilds kernel-neutral surfaces with FreeCAD's
   ``Part.BSplineSurface().buildFromPolesMultsKnots``.
+* :func:`freecad_batch` does both for several files and surface sets in *one* ``freecadcmd``.
 
 FreeCAD's ``Shape.Volume`` uses OCCT's default (non-adaptive) integration,
 measured up to ~1e-3 relative off on dense B-spline tablets: compare it with
@@ -37,6 +38,7 @@ __all__ = [
     "freecad_read_step",
     "freecad_read_steps",
     "freecad_build_bspline",
+    "freecad_batch",
     "ocp_read_step",
     "ocp_read_steps",
     "mesh_volume",
@@ -138,6 +140,51 @@ def freecad_build_bspline(
         p = Path(d) / "surfaces.json"
         p.write_text(json.dumps(payload))
         return _run_freecad("bspline", p, timeout, freecadcmd)
+
+
+def freecad_batch(
+    steps: Sequence[str | os.PathLike[str]] = (),
+    bsplines: Sequence[tuple[Sequence[Any], Sequence[float], Sequence[float]]] = (),
+    timeout: float = 300.0,
+    freecadcmd: Sequence[str] | None = None,
+) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """:func:`freecad_read_step` of each of ``steps`` and :func:`freecad_build_bspline` of each
+    ``(surfaces, u, v)`` of ``bsplines``, in *one* ``freecadcmd`` process.
+
+    Parameters
+    ----------
+    steps : sequence of path-like
+        STEP files to read.
+    bsplines : sequence of (surfaces, u, v)
+        :class:`~tabletcad.brep.surface.BSplineSurfaceData` sets and the parameters to evaluate them at.
+    timeout : float
+        Seconds the process may take.
+    freecadcmd : sequence of str, optional
+        The command that runs FreeCAD's ``freecadcmd`` (default: the one on PATH).
+
+    Returns
+    -------
+    tuple of (list of dict, list of dict)
+        The results of :func:`freecad_read_step` and of :func:`freecad_build_bspline`, in the given orders.
+    """
+    steps = [str(Path(p).resolve()) for p in steps]
+    with tempfile.TemporaryDirectory(prefix="tabletcad-fcin-") as d:
+        payloads = []
+        for k, (surfaces, u, v) in enumerate(bsplines):
+            p = Path(d) / f"surfaces{k}.json"
+            p.write_text(json.dumps({"surfaces": [s.as_dict() for s in surfaces], "u": [float(x) for x in u],
+                                     "v": [float(x) for x in v]}))
+            payloads.append(str(p))
+        jobs = Path(d) / "jobs.json"
+        jobs.write_text(json.dumps({"read_step": steps, "bspline": payloads}))
+        result = _run_freecad("batch", jobs, timeout, freecadcmd)
+    read, built = result["read_step"], result["bspline"]
+    if [r.get("path") for r in read] != steps or [r.get("path") for r in built] != payloads:
+        raise ReadbackError(f"FreeCAD gave {len(read)} + {len(built)} results for {len(steps)} + {len(payloads)} jobs")
+    for r in read + built:
+        if not r.get("ok"):
+            raise ReadbackError(f"FreeCAD check failed on {r.get('path')}: {r.get('error')}\n{r.get('traceback', '')}")
+    return read, built
 
 
 _OCP_READER = r"""
