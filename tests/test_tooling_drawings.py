@@ -755,13 +755,16 @@ def _segment_meets_box(p, q, box) -> bool:
 @pytest.fixture(scope="module", params=["tsm_b_round", "eu_d_oval", "capsule", "concave_round_bisect",
                                         "shallow_convex_round"])
 def sample_sheets(request):
-    """Each tooling sample's two sheets, as its build draws them: the tablet's and the tooling's."""
+    """Each tooling sample's two sheets, as its build draws them: the tablet's and the tooling's (the TSM B
+    round's and the capsule's tool sets are the ``drawn`` and ``capsule`` fixtures', built alike)."""
     from tabletcad.tooling.drawing import tips_model
 
     p = SAMPLE.parent / f"{request.param}.toml"
+    shared = {SAMPLE.stem: lambda: request.getfixturevalue("drawn")[0], "capsule": lambda: request.getfixturevalue("capsule")}
     with __import__("warnings").catch_warnings():
         __import__("warnings").simplefilter("ignore")  # (the samples' fit and land warnings)
-        ts = make_tooling(load_design(p), Design.from_toml(p).tooling_spec, check=False, interference_check=False)
+        ts = shared[request.param]() if request.param in shared else make_tooling(
+            load_design(p), Design.from_toml(p).tooling_spec, check=False, interference_check=False)
         return request.param, [drawing_model(ts), tooling_model(ts) if ts.spec.body is not None else tips_model(ts)]
 
 
