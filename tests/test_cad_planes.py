@@ -173,12 +173,16 @@ def test_plane_of_reads_coplanar_poles_with_the_surface_normal():
     assert plane_of(bumped, poles(bumped)) is None
 
 
-def test_every_flat_face_of_a_shaped_solid_is_judged_on_its_own_numpy_poles(monkeypatch):
+@pytest.mark.parametrize("regions", [True, False], ids=["flat regions assembled", "assembled in pieces"])
+def test_every_flat_face_of_a_shaped_solid_is_judged_on_its_own_numpy_poles(regions, monkeypatch):
     """The solid builder hands flat_faces_as_planes the poles it made each face from; each face's
-    verdict and plane are those of its poles read back from OCC."""
+    verdict and plane are those of its poles read back from OCC.  Assembled with its flat regions
+    (tabletcad.cad.shell), the rounded rectangle's shell has its four planes already and no flat B-spline
+    face left; assembled in its 72 pieces, the 48 flat ones become the same four planes here."""
     import tabletcad.cad.planes as planes
     import tabletcad.cad.solid as solid_module
     from OCP.BRep import BRep_Tool
+    from OCP.Geom import Geom_BSplineSurface, Geom_Plane
 
     from tabletcad.cad._occ import explore
     from tabletcad.cad.tablet_solid import tablet_solid
@@ -192,11 +196,17 @@ def test_every_flat_face_of_a_shaped_solid_is_judged_on_its_own_numpy_poles(monk
         return real(solid, check=check, made=made, merge=merge)
 
     monkeypatch.setattr(solid_module, "flat_faces_as_planes", spy)
+    if not regions:
+        assemble = solid_module.assemble_shell
+        monkeypatch.setattr(solid_module, "assemble_shell", lambda *a, whole=None, flat=None, **k: assemble(*a, **k))
     solid = tablet_solid(Design.from_toml(ROOT / "samples" / "families" / "rounded_rectangle.toml").build())
     (before, made), = calls
-    surfaces = [BRep_Tool.Surface_s(f) for f in explore(before, "Face")]
-    # 72 pieces, the band's 8 one face on its uncut surface (tabletcad.cad.shell): every face, its own poles
-    assert len(surfaces) == 72 - 7 and all(made[id(s)][0] is s for s in surfaces)
+    faces = explore(before, "Face")
+    surfaces = [BRep_Tool.Surface_s(f) for f in faces if isinstance(BRep_Tool.Surface_s(f), Geom_BSplineSurface)]
+    made_planes = sum(isinstance(BRep_Tool.Surface_s(f), Geom_Plane) for f in faces)
+    # 72 pieces; or 4 flat regions' planes, 16 cup pieces and the band one face on its uncut surface
+    assert (len(faces), len(surfaces), made_planes) == ((4 + 16 + 1, 16 + 1, 4) if regions else (72, 72, 0))
+    assert all(made[id(s)][0] is s for s in surfaces)  # every B-spline face: its own poles
     nets = [made[id(s)][1] for s in surfaces]
     read = [planes._poles(s) for s in surfaces]  # read back from OCC, one by one
     assert all(np.array_equal(a, b) for a, b in zip(nets, read))
@@ -206,8 +216,8 @@ def test_every_flat_face_of_a_shaped_solid_is_judged_on_its_own_numpy_poles(monk
         if g is not None:
             assert np.allclose(g[0], r[0], rtol=0, atol=1e-12) and np.array_equal(g[1], r[1])
     # 48 flat pieces (plateau, plateau ring and land, each side, 8 pieces each): one plane face per flat region
-    assert sum(g is not None for g in got) == 48
-    assert solid.planes == 4 and len(explore(solid.shape, "Face")) == 65 - 48 + 4 == len(solid.faces)
+    assert sum(g is not None for g in got) == (0 if regions else 48)
+    assert solid.planes == 4 and len(explore(solid.shape, "Face")) == len(solid.faces) == (21 if regions else 28)
 
 
 OFF_CENTRE = r"""
@@ -290,14 +300,16 @@ def test_plane_faces_store_their_edges_projections_and_enclose_the_same_volume(f
 
 def test_flat_faces_whose_edges_do_not_chain_are_made_as_before():
     """Edges left that do not chain vertex to vertex go to MakeWire and MakeFace, as before: a concave
-    round's flat land (two circles once its seam is left out) stays a face of revolution, and the almond
-    cut-away, where a degenerated edge joins two vertices at one point (MakeWire bridges the gap with new
-    edges, and the solid with them fails its check), keeps its B-spline faces; its STEP reads back with
-    its volume (tests/test_build_outputs_cad.py)."""
+    round's flat land (two circles once its seam is left out) stays a face of revolution.  The almond
+    cut-away's flat pieces, where a degenerated edge joins two vertices at one point (MakeWire bridged the
+    gap with new edges, the solid with them failed its check, and its B-spline faces were kept), are now
+    assembled as flat regions before any such face is made: two planes; its STEP reads back with its
+    volume (tests/test_build_outputs_cad.py)."""
     from dataclasses import replace
 
     import tabletcad.cad.planes as planes
     from OCP.BRep import BRep_Tool
+    from OCP.BRepCheck import BRepCheck_Analyzer
     from OCP.Geom import Geom_Plane, Geom_SurfaceOfRevolution
 
     from tabletcad.cad._occ import explore
@@ -316,4 +328,7 @@ def test_flat_faces_whose_edges_do_not_chain_are_made_as_before():
         assert planes._plane_face(f, *planes._revolved_plane_of(BRep_Tool.Surface_s(f))) is None
     t = replace(load_design(ROOT / "samples" / "families" / "almond.toml"), trim=Trim(v=(0.0, 3.0)))
     shape = cutaway_shape(t, {"volume_mm3": t.volume(), "surface_area_mm2": t.surface_area()}).shape  # (no mesh)
-    assert not any(isinstance(BRep_Tool.Surface_s(f), Geom_Plane) for f in explore(shape, "Face"))
+    # its flat centres' pieces are assembled as one flat region each (tabletcad.cad.shell), no degenerated edge
+    # left in them to bridge: two planes, a valid solid (its volume the quadrature's: cutaway_shape checks it)
+    assert sum(isinstance(BRep_Tool.Surface_s(f), Geom_Plane) for f in explore(shape, "Face")) == 2
+    assert BRepCheck_Analyzer(shape).IsValid()

@@ -48,7 +48,7 @@ from OCP.TopoDS import TopoDS_Edge, TopoDS_Face, TopoDS_Iterator, TopoDS_Shape, 
 
 from tabletcad.cad._occ import cast, explore
 
-__all__ = ["flat_faces_as_planes", "made_poles", "plane_of", "planes_of"]
+__all__ = ["coplanar", "flat_faces_as_planes", "made_poles", "plane_axes", "plane_of", "planes_of"]
 
 Plane = tuple[np.ndarray, np.ndarray]  # (point (3,) mm, unit normal (3,))
 
@@ -249,7 +249,7 @@ def _plane_face(face: TopoDS_Face, point: np.ndarray, normal: np.ndarray,
         B.Add(wire, e)
     wire.Closed(True)
     new = TopoDS_Face()
-    B.MakeFace(new, Geom_Plane(_axes(point, normal)), 1e-7)
+    B.MakeFace(new, Geom_Plane(plane_axes(point, normal)), 1e-7)
     B.Add(new, wire if face.Orientation() == TopAbs_Orientation.TopAbs_FORWARD else wire.Reversed())
     for e in edges:  # stored, not recomputed by every reader of the face
         BRepLib.BuildPCurveForEdgeOnPlane_s(e, new)
@@ -257,7 +257,7 @@ def _plane_face(face: TopoDS_Face, point: np.ndarray, normal: np.ndarray,
     return new
 
 
-def _axes(point: np.ndarray, normal: np.ndarray) -> gp_Ax3:
+def plane_axes(point: np.ndarray, normal: np.ndarray) -> gp_Ax3:
     """The plane's axes: origin ``point`` (mm), main direction ``normal``, OCC's x direction for it."""
     return gp_Ax3(gp_Pnt(*map(float, point)), gp_Dir(*map(float, normal)))
 
@@ -275,7 +275,7 @@ def _made_face(edges: Sequence[TopoDS_Edge], point: np.ndarray, normal: np.ndarr
         mw.Add(e)
     if not mw.IsDone() or not BRep_Tool.IsClosed_s(mw.Wire()):
         return None
-    mf = BRepBuilderAPI_MakeFace(gp_Pln(_axes(point, normal)), mw.Wire(), True)
+    mf = BRepBuilderAPI_MakeFace(gp_Pln(plane_axes(point, normal)), mw.Wire(), True)
     if not mf.IsDone():
         return None
     new = mf.Face()
@@ -283,7 +283,7 @@ def _made_face(edges: Sequence[TopoDS_Edge], point: np.ndarray, normal: np.ndarr
     return new
 
 
-def _coplanar(a: Plane, b: Plane) -> bool:
+def coplanar(a: Plane, b: Plane) -> bool:
     """True when planes ``a`` and ``b`` are one plane with one normal sense (to :data:`EDGE_PLANE_TOL_MM`
     over 1 mm)."""
     return float(a[1] @ b[1]) >= 1.0 - 1e-12 and abs(float((b[0] - a[0]) @ a[1])) <= EDGE_PLANE_TOL_MM
@@ -306,7 +306,7 @@ def _flat_regions(flat: Sequence[tuple[TopoDS_Face, Plane, list[TopoDS_Edge]]]) 
         for e in edges:
             for other, j in owner.setdefault(hash(e), []):
                 fj, pj, _ = flat[j]
-                if j != k and other.IsSame(e) and fj.Orientation() == face.Orientation() and _coplanar(pj, plane):
+                if j != k and other.IsSame(e) and fj.Orientation() == face.Orientation() and coplanar(pj, plane):
                     parent[root(k)] = root(j)
             owner[hash(e)].append((e, k))
     groups: dict[int, list[int]] = {}
@@ -369,7 +369,7 @@ def _region_face(faces: Sequence[TopoDS_Face], point: np.ndarray, normal: np.nda
     forward = faces[0].Orientation() == TopAbs_Orientation.TopAbs_FORWARD
     B = BRep_Builder()
     new = TopoDS_Face()
-    B.MakeFace(new, Geom_Plane(_axes(point, normal)), 1e-7)
+    B.MakeFace(new, Geom_Plane(plane_axes(point, normal)), 1e-7)
     for loop in loops:
         wire = TopoDS_Wire()
         B.MakeWire(wire)

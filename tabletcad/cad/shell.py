@@ -30,7 +30,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 from OCP.BRep import BRep_Builder
-from OCP.Geom import Geom_BSplineSurface
+from OCP.BRepLib import BRepLib
+from OCP.Geom import Geom_BSplineSurface, Geom_Plane
 from OCP.Geom2d import Geom2d_Line
 from OCP.gp import gp_Dir2d, gp_Pnt, gp_Pnt2d
 from OCP.TopAbs import TopAbs_Orientation
@@ -38,6 +39,7 @@ from OCP.TopoDS import TopoDS_Edge, TopoDS_Face, TopoDS_Shell, TopoDS_Vertex, To
 
 from tabletcad.brep.surface import BSplineSurfaceData
 from tabletcad.cad.faces import iso_u_pcurve, v_breaks
+from tabletcad.cad.planes import coplanar, plane_axes
 
 __all__ = ["assemble_shell"]
 
@@ -50,9 +52,11 @@ def _spread(points: np.ndarray) -> float:
     return float(np.max(np.linalg.norm(points - points[0], axis=-1)))
 
 
-def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Sequence[Sequence[Geom_BSplineSurface]],
+def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
+                   surfaces: Sequence[Sequence[Geom_BSplineSurface]] | Callable[[int, int], Geom_BSplineSurface],
                    tol_degen: float = 1e-7,
-                   whole: Callable[[int], Geom_BSplineSurface | None] | None = None):
+                   whole: Callable[[int], Geom_BSplineSurface | None] | None = None,
+                   flat: Sequence[tuple[np.ndarray, np.ndarray] | None] | None = None):
     """The closed shell of a chain of faces, or None when it is not a chain this can assemble.
 
     Parameters
@@ -60,7 +64,8 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
     pieces : per patch, its pieces' data (:func:`tabletcad.brep.slit.chain_face_surfaces`):
         every patch has the same number of pieces over the same ``v`` ranges; one piece is
         the whole patch, periodic in ``v``.
-    surfaces : the OCCT surfaces of the same pieces (:func:`tabletcad.cad.faces.make_geom_surface`).
+    surfaces : the OCCT surfaces of the same pieces (:func:`tabletcad.cad.faces.make_geom_surface`), or
+        ``surfaces(j, k)`` making patch ``j``'s piece ``k`` when asked (a flat region's pieces are not).
     tol_degen : float
         A boundary row whose poles stay within this distance (mm) of one point over a piece
         is a degenerated edge.
@@ -69,12 +74,19 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
         neighbours are (no piece of it has a degenerated edge, its pieces run once round the period
         in order) is then one face on that surface, bounded by its pieces' row edges and one seam
         (:func:`_whole_face`): a shaped tablet's band is one face, not eight.
+    flat : optional; per patch, ``(point, unit normal)`` of the plane holding its poles in its
+        ``S_u x S_v`` sense (:func:`tabletcad.cad.planes.planes_of`), or None.  Neighbouring patches
+        in one plane (a shaped tablet's flat centre and its ring; a land) cut into pieces are one
+        flat region, made one plane face bounded by the row edges round it (:func:`_region_plane`):
+        its pieces, their surfaces and the edges between them are not made.
 
     Returns
     -------
-    ``(shell, faces)`` - the shell (its faces all ``FORWARD``: the surfaces' own normals) and
-    its faces in the order of ``pieces`` (a patch made whole: its one face) - or None.
+    ``(shell, faces, planes)`` - the shell (its faces all ``FORWARD``: the surfaces' own normals),
+    its faces in the order of ``pieces`` (a patch made whole: its one face; a flat region: its plane
+    face, once) and how many of them are flat regions' planes - or None.
     """
+    surface = surfaces if callable(surfaces) else (lambda j, k: surfaces[j][k])
     n_patch = len(pieces)
     n_piece = len(pieces[0]) if n_patch else 0
     if n_patch == 0 or any(len(p) != n_piece for p in pieces):
@@ -99,12 +111,21 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
     if closed and n_patch == 1:  # one patch closed on itself: its one row would bound it twice
         return None
     n_row = n_patch if closed else n_patch + 1
+    # flat regions: runs of neighbouring patches in one plane (not across the closed chain's start)
+    region = [-1] * n_patch
+    if flat is not None and not periodic:
+        for j in range(n_patch):
+            if flat[j] is not None:
+                region[j] = region[j - 1] if j > 0 and region[j - 1] >= 0 and coplanar(flat[j - 1], flat[j]) else j
+    inner = [0 < r < n_patch and region[r] >= 0 and region[r] == region[r - 1] for r in range(n_row)]
 
     def row_data(r: int, k: int) -> tuple[BSplineSurfaceData, Geom_BSplineSurface, int]:
-        """The piece whose boundary gives row ``r``, piece ``k``, and which of its rows (0 or -1)."""
-        if r < n_patch:
-            return pieces[r][k], surfaces[r][k], 0
-        return pieces[n_patch - 1][k], surfaces[n_patch - 1][k], -1
+        """The piece whose boundary gives row ``r``, piece ``k``, and which of its rows (0 or -1): the
+        patch's above the row, or below it where the one above is flat (its pieces are not made)."""
+        below = r - 1 if r > 0 else (n_patch - 1 if closed else -1)
+        if r < n_patch and (region[r] < 0 or below < 0 or region[below] >= 0):
+            return pieces[r][k], surface(r, k), 0
+        return pieces[below][k], surface(below, k), -1
 
     def ends(r: int, k: int) -> tuple[np.ndarray, np.ndarray]:
         """The points where row ``r``'s piece ``k`` starts and ends, mm: its end poles (clamped
@@ -150,6 +171,9 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
     ranged: list[tuple[TopoDS_Edge, float, float]] = []  # every row edge, with its v range
     for r in range(n_row):
         out: list[TopoDS_Edge | None] = []
+        if inner[r]:  # inside a flat region: bounds no face
+            row_edges.append(out)
+            continue
         for k in range(n_piece):
             d, s, i = row_data(r, k)
             v0, v1 = vertices[r][k], vertices[r][(k + 1) % n_piece]
@@ -184,8 +208,12 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
     col_tol: list[list[float]] = []
     for j in range(n_patch):
         out, tols = [], []
+        if region[j] >= 0:  # a flat region's cuts bound no face
+            col_edges.append(out)
+            col_tol.append(tols)
+            continue
         for k in range(n_piece):
-            d, s = pieces[j][k], surfaces[j][k]
+            d, s = pieces[j][k], surface(j, k)
             if _spread(np.asarray(d.poles)[:, 0]) <= tol_degen:
                 return None
             tol = EDGE_TOL
@@ -207,7 +235,18 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
     shell = TopoDS_Shell()
     B.MakeShell(shell)
     faces = []
+    planes: list[tuple[TopoDS_Face, list[TopoDS_Edge]]] = []
     for j in range(n_patch):
+        if region[j] >= 0:
+            if j + 1 < n_patch and region[j + 1] == region[j]:
+                continue  # the region's face comes with its last patch
+            made_plane = _region_plane(B, flat[j], row_edges[region[j]], row_edges[(j + 1) % n_row])
+            if made_plane is None:
+                return None
+            B.Add(shell, made_plane[0])
+            faces.append(made_plane[0])
+            planes.append(made_plane)
+            continue
         if whole is not None and not periodic:
             made = _whole_face(B, whole, j, pieces[j], v_ranges, row_edges[j], row_edges[(j + 1) % n_row],
                                col_edges[j][0], col_tol[j])
@@ -216,7 +255,7 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
                 faces.append(made)
                 continue
         for k in range(n_piece):
-            d, s = pieces[j][k], surfaces[j][k]
+            d, s = pieces[j][k], surface(j, k)
             u0, u1 = float(d.u_knots[0]), float(d.u_knots[-1])
             a, b = v_ranges[k]
             f = TopoDS_Face()
@@ -256,8 +295,40 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]], surfaces: Seq
             B.Range(e, float(d.u_knots[0]), float(d.u_knots[-1]))
             B.SameRange(e, True)
             B.SameParameter(e, True)
+    for f, edges in planes:  # stored, not recomputed by every reader of the face (tabletcad.cad.planes)
+        for e in edges:
+            BRepLib.BuildPCurveForEdgeOnPlane_s(e, f)
     shell.Closed(True)
-    return shell, faces
+    return shell, faces, len(planes)
+
+
+def _region_plane(B: BRep_Builder, plane: tuple[np.ndarray, np.ndarray], low: Sequence[TopoDS_Edge | None],
+                  high: Sequence[TopoDS_Edge | None]) -> tuple[TopoDS_Face, list[TopoDS_Edge]] | None:
+    """A flat region's plane face (``plane``: point and unit normal, the patches' ``S_u x S_v`` sense),
+    bounded by its first patch's ``low`` row and its last patch's ``high`` row, each a loop of its pieces'
+    edges (a degenerated piece, None, leaves its vertex: the loop goes on from it), run as the patches'
+    faces ran them: ``high`` forward, ``low`` back.  A row that is one point (a pole, all None) or bounds
+    no face (``[]``) gives no loop; None when neither gives one.  Returns the face and its edges, whose
+    p-curves on the plane the caller stores once every edge has its range."""
+    loops, bounding = [], []
+    for row, forward in ((high, True), (low, False)):
+        edges = [e for e in row if e is not None]
+        bounding += edges
+        if edges:
+            loops.append([e.Oriented(_FORWARD) for e in edges] if forward
+                         else [e.Oriented(_REVERSED) for e in reversed(edges)])
+    if not loops:
+        return None
+    f = TopoDS_Face()
+    B.MakeFace(f, Geom_Plane(plane_axes(*plane)), EDGE_TOL)
+    for loop in loops:
+        w = TopoDS_Wire()
+        B.MakeWire(w)
+        for e in loop:
+            B.Add(w, e)
+        w.Closed(True)
+        B.Add(f, w)
+    return f, bounding
 
 
 def _whole_face(B: BRep_Builder, whole: Callable[[int], Geom_BSplineSurface | None], j: int,

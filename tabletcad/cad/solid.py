@@ -324,39 +324,51 @@ def solid_from_surfaces(
     face_names: list[str] = []
     for ps, n in zip(pieces, names):
         face_names.extend([n] if len(ps) == 1 else [f"{n} (piece {k + 1})" for k in range(len(ps))])
-    geoms = [[make_geom_surface(p) for p in ps] for ps in pieces]
-    made = made_poles((g, p.poles) for gs, ps in zip(geoms, pieces) for g, p in zip(gs, ps))  # for the planes
+    geoms: list[list] = [[None] * len(ps) for ps in pieces]  # each piece's OCC surface, made when asked for
+    wholes: list = []
+
+    def geom(j: int, k: int):
+        if geoms[j][k] is None:
+            geoms[j][k] = make_geom_surface(pieces[j][k])
+        return geoms[j][k]
+
     va = volume_and_area(surfaces)  # the faces' own volume and area (orientation, the stage's check)
     # the chain's topology is known: its shell is assembled edge by edge (tabletcad.cad.shell);
     # a chain that cannot be (the capsule's slit), or whose assembled solid fails its check, is sewn.
-    # A curved patch cut only because its neighbours are is one face on its uncut surface (a flat one is
-    # one plane face per flat region anyway: tabletcad.cad.planes)
+    # A cut chain's flat regions are made plane faces there, and a curved patch cut only because its
+    # neighbours are one face on its uncut surface; if that fails, the chain is assembled in its pieces
     flat = planes_of([np.asarray(sd.poles) for sd in surfaces]) if any(len(ps) > 1 for ps in pieces) else None
 
     def whole(j: int):
         if flat is None or flat[j] is not None or not surfaces[j].v_periodic:
             return None
         g = make_geom_surface(surfaces[j])
-        made.update(made_poles([(g, surfaces[j].poles)]))
+        wholes.append((g, surfaces[j].poles))
         return g
 
-    try:
-        assembled = assemble_shell(pieces, geoms, tol_degen, whole=whole)
-    except Standard_Failure:  # an OCC exception while building it: sewing decides
-        assembled = None
-    if assembled is not None:
-        shell, faces_a = assembled
+    def made():  # for the planes: the surfaces made so far, with their poles
+        return made_poles([*((g, p.poles) for gs, ps in zip(geoms, pieces) for g, p in zip(gs, ps) if g is not None),
+                           *wholes])
+
+    for kw in ([dict(whole=whole, flat=flat)] if flat is not None else []) + [{}]:
         try:
-            return _solid_from_faces(tuple(faces_a), face_names, surfaces, names, fits, sew_tolerance, eps, name, t0,
-                                     shell=shell, va=va, made=made)
-        except GeometryError:
-            pass
+            assembled = assemble_shell(pieces, geom, tol_degen, **kw)
+        except Standard_Failure:  # an OCC exception while building it: the next way decides
+            assembled = None
+        if assembled is not None:
+            shell, faces_a, n_flat = assembled
+            try:
+                return _solid_from_faces(tuple(faces_a), face_names, surfaces, names, fits, sew_tolerance, eps, name,
+                                         t0, shell=shell, va=va, made=made(), planes=n_flat)
+            except GeometryError:
+                pass
+    geoms = [[geom(j, k) for k in range(len(ps))] for j, ps in enumerate(pieces)]
     # each face is checked as part of the solid (BRepCheck_Analyzer of the solid checks its
     # faces); only when that fails are they checked one by one, to name the bad one
     faces_l = [face_of(g, tol_degen=tol_degen, name=n) for gs, n in zip(geoms, names) for g in gs]
     try:
         return _solid_from_faces(tuple(faces_l), face_names, surfaces, names, fits, sew_tolerance, eps, name, t0,
-                                 va=va, made=made)
+                                 va=va, made=made())
     except GeometryError as exc:
         for face, n in zip(faces_l, face_names):
             if not BRepCheck_Analyzer(face).IsValid():
@@ -366,11 +378,12 @@ def solid_from_surfaces(
 
 def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequence, names: Sequence[str],
                       fits: Sequence, sew_tolerance: float, eps: float, name: str, t0: float,
-                      shell=None, va: tuple[float, float] | None = None, made=None) -> TabletSolid:
+                      shell=None, va: tuple[float, float] | None = None, made=None, planes: int = 0) -> TabletSolid:
     """Sew ``faces`` into one closed shell (unless the ``shell`` they make is given), make the
     outward solid and check it (its mass properties are integrated when first asked for:
     :attr:`TabletSolid.mass`).  ``va``: the surfaces' :func:`volume_and_area`, if known; ``made``: the
-    faces' surfaces and their poles (:func:`~tabletcad.cad.planes.made_poles`), if known."""
+    faces' surfaces and their poles (:func:`~tabletcad.cad.planes.made_poles`), if known; ``planes``: how
+    many of the faces are planes already (a flat region's, made by :func:`~tabletcad.cad.shell.assemble_shell`)."""
     t1 = time.perf_counter()
     sewn = shell is None
     if sewn:
@@ -421,7 +434,7 @@ def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequenc
         eps=eps,
         timings={"faces": t1 - t0, "sew_and_check" if sewn else "shell_and_check": t2 - t1},
         sewn=sewn,
-        planes=n_planes,
+        planes=n_planes + planes,
     )
     object.__setattr__(out, "_data_volume_area", va)
     return out
