@@ -55,7 +55,6 @@ def _spread(points: np.ndarray) -> float:
 def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
                    surfaces: Sequence[Sequence[Geom_BSplineSurface]] | Callable[[int, int], Geom_BSplineSurface],
                    tol_degen: float = 1e-7,
-                   whole: Callable[[int], Geom_BSplineSurface | None] | None = None,
                    flat: Sequence[tuple[np.ndarray, np.ndarray] | None] | None = None):
     """The closed shell of a chain of faces, or None when it is not a chain this can assemble.
 
@@ -69,11 +68,6 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
     tol_degen : float
         A boundary row whose poles stay within this distance (mm) of one point over a piece
         is a degenerated edge.
-    whole : optional; ``whole(j)`` is patch ``j``'s surface before it was cut (periodic in ``v``;
-        :func:`tabletcad.cad.faces.make_geom_surface`), or None.  A patch cut only because its
-        neighbours are (no piece of it has a degenerated edge, its pieces run once round the period
-        in order) is then one face on that surface, bounded by its pieces' row edges and one seam
-        (:func:`_whole_face`): a shaped tablet's band is one face, not eight.
     flat : optional; per patch, ``(point, unit normal)`` of the plane holding its poles in its
         ``S_u x S_v`` sense (:func:`tabletcad.cad.planes.planes_of`), or None.  Neighbouring patches
         in one plane (a shaped tablet's flat centre and its ring; a land) cut into pieces are one
@@ -83,8 +77,7 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
     Returns
     -------
     ``(shell, faces, planes)`` - the shell (its faces all ``FORWARD``: the surfaces' own normals),
-    its faces in the order of ``pieces`` (a patch made whole: its one face; a flat region: its plane
-    face, once) and how many of them are flat regions' planes - or None.
+    its faces in the order of ``pieces`` (a flat region: its plane face, once) and how many of them are flat regions' planes - or None.
     """
     surface = surfaces if callable(surfaces) else (lambda j, k: surfaces[j][k])
     n_patch = len(pieces)
@@ -247,13 +240,6 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
             faces.append(made_plane[0])
             planes.append(made_plane)
             continue
-        if whole is not None and not periodic:
-            made = _whole_face(B, whole, j, pieces[j], v_ranges, row_edges[j], row_edges[(j + 1) % n_row],
-                               col_edges[j][0], col_tol[j])
-            if made is not None:
-                B.Add(shell, made)
-                faces.append(made)
-                continue
         for k in range(n_piece):
             d, s = pieces[j][k], surface(j, k)
             u0, u1 = float(d.u_knots[0]), float(d.u_knots[-1])
@@ -331,44 +317,30 @@ def _region_plane(B: BRep_Builder, plane: tuple[np.ndarray, np.ndarray], low: Se
     return f, bounding
 
 
-def _whole_face(B: BRep_Builder, whole: Callable[[int], Geom_BSplineSurface | None], j: int,
-                pieces: Sequence[BSplineSurfaceData], v_ranges: Sequence[tuple[float, float]],
-                low: Sequence[TopoDS_Edge | None], high: Sequence[TopoDS_Edge | None], seam: TopoDS_Edge,
-                tols: Sequence[float]) -> TopoDS_Face | None:
-    """Patch ``j`` as one face on its uncut surface ``whole(j)``, or None when it cannot be: a piece's row
-    is a pole (a degenerated edge: the row stands still there, as one face a reader would tear it open),
-    a cut was moved to meet a snapped neighbour (``tols``), or the pieces do not run once round the
-    period from its start in order (a first piece across the seam).
-
-    The wire is the periodic parameter rectangle's, counter-clockwise: the seam (the cut at the period's
-    start, with p-curves at both ends of the period), the ``high`` row's edges, the seam back, the
-    ``low`` row's edges back; each row edge gets the p-curve its piece gave it, at the same ``v``."""
-    if any(e is None for e in (*low, *high)) or any(t != EDGE_TOL for t in tols):
+def _region_plane(B: BRep_Builder, plane: tuple[np.ndarray, np.ndarray], low: Sequence[TopoDS_Edge | None],
+                  high: Sequence[TopoDS_Edge | None]) -> tuple[TopoDS_Face, list[TopoDS_Edge]] | None:
+    """A flat region's plane face (``plane``: point and unit normal, the patches' ``S_u x S_v`` sense),
+    bounded by its first patch's ``low`` row and its last patch's ``high`` row, each a loop of its pieces'
+    edges (a degenerated piece, None, leaves its vertex: the loop goes on from it), run as the patches'
+    faces ran them: ``high`` forward, ``low`` back.  A row that is one point (a pole, all None) or bounds
+    no face (``[]``) gives no loop; None when neither gives one.  Returns the face and its edges, whose
+    p-curves on the plane the caller stores once every edge has its range."""
+    loops, bounding = [], []
+    for row, forward in ((high, True), (low, False)):
+        edges = [e for e in row if e is not None]
+        bounding += edges
+        if edges:
+            loops.append([e.Oriented(_FORWARD) for e in edges] if forward
+                         else [e.Oriented(_REVERSED) for e in reversed(edges)])
+    if not loops:
         return None
-    if any(b0 != a1 for (_, b0), (a1, _) in zip(v_ranges, v_ranges[1:])):
-        return None
-    d0 = pieces[0]
-    a, b = v_ranges[0][0], v_ranges[-1][1]
-    surf = whole(j)
-    if surf is None or not surf.IsVPeriodic() or surf.VPeriod() != b - a \
-            or surf.VKnot(1) != a or surf.IsUPeriodic():
-        return None
-    u0, u1 = float(d0.u_knots[0]), float(d0.u_knots[-1])
     f = TopoDS_Face()
-    B.MakeFace(f, surf, EDGE_TOL)
-    for d, (va, vb), e_low, e_high in zip(pieces, v_ranges, low, high):
-        breaks = v_breaks(d.v_knots, d.v_mults, d.v_degree)
-        B.UpdateEdge(e_low, iso_u_pcurve(u0, va, vb, breaks), f, EDGE_TOL)
-        B.UpdateEdge(e_high, iso_u_pcurve(u1, va, vb, breaks), f, EDGE_TOL)
-    B.UpdateEdge(seam, Geom2d_Line(gp_Pnt2d(0.0, a), gp_Dir2d(1.0, 0.0)),
-                 Geom2d_Line(gp_Pnt2d(0.0, b), gp_Dir2d(1.0, 0.0)), f, tols[0])
-    w = TopoDS_Wire()
-    B.MakeWire(w)
-    B.Add(w, seam.Oriented(_FORWARD))
-    for e in high:
-        B.Add(w, e.Oriented(_FORWARD))
-    B.Add(w, seam.Oriented(_REVERSED))
-    for e in reversed(low):
-        B.Add(w, e.Oriented(_REVERSED))
-    B.Add(f, w)
-    return f
+    B.MakeFace(f, Geom_Plane(plane_axes(*plane)), EDGE_TOL)
+    for loop in loops:
+        w = TopoDS_Wire()
+        B.MakeWire(w)
+        for e in loop:
+            B.Add(w, e)
+        w.Closed(True)
+        B.Add(f, w)
+    return f, bounding

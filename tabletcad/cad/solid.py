@@ -325,7 +325,6 @@ def solid_from_surfaces(
     for ps, n in zip(pieces, names):
         face_names.extend([n] if len(ps) == 1 else [f"{n} (piece {k + 1})" for k in range(len(ps))])
     geoms: list[list] = [[None] * len(ps) for ps in pieces]  # each piece's OCC surface, made when asked for
-    wholes: list = []
 
     def geom(j: int, k: int):
         if geoms[j][k] is None:
@@ -335,22 +334,16 @@ def solid_from_surfaces(
     va = volume_and_area(surfaces)  # the faces' own volume and area (orientation, the stage's check)
     # the chain's topology is known: its shell is assembled edge by edge (tabletcad.cad.shell);
     # a chain that cannot be (the capsule's slit), or whose assembled solid fails its check, is sewn.
-    # A cut chain's flat regions are made plane faces there, and a curved patch cut only because its
-    # neighbours are one face on its uncut surface; if that fails, the chain is assembled in its pieces
+    # A cut chain's flat regions are made plane faces there; if that fails, the chain is assembled in its pieces
+    # (a curved patch cut only because its neighbours are, such as a band, stays in pieces: as one face on its
+    # uncut surface, C0 where the pieces meet, the rounded rectangle's band made OCC's Common of the tablet with
+    # the outside of the die bore's column non-empty, so the tooling's exact proof that they do not overlap failed)
     flat = planes_of([np.asarray(sd.poles) for sd in surfaces]) if any(len(ps) > 1 for ps in pieces) else None
 
-    def whole(j: int):
-        if flat is None or flat[j] is not None or not surfaces[j].v_periodic:
-            return None
-        g = make_geom_surface(surfaces[j])
-        wholes.append((g, surfaces[j].poles))
-        return g
-
     def made():  # for the planes: the surfaces made so far, with their poles
-        return made_poles([*((g, p.poles) for gs, ps in zip(geoms, pieces) for g, p in zip(gs, ps) if g is not None),
-                           *wholes])
+        return made_poles((g, p.poles) for gs, ps in zip(geoms, pieces) for g, p in zip(gs, ps) if g is not None)
 
-    for kw in ([dict(whole=whole, flat=flat)] if flat is not None else []) + [{}]:
+    for kw in ([dict(flat=flat)] if flat is not None else []) + [{}]:
         try:
             assembled = assemble_shell(pieces, geom, tol_degen, **kw)
         except Standard_Failure:  # an OCC exception while building it: the next way decides
