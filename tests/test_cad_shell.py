@@ -49,6 +49,7 @@ def _sewn(monkeypatch, make):
 
 
 @pytest.mark.parametrize("sample", ["families/rounded_rectangle", "families/oval", "families/modified_capsule",
+                                    "families/capsule",
                                     "caplet", "ring", "free_form_stadium"])
 def test_assembled_shell_is_the_sewn_one(sample, monkeypatch):
     """Cut chains (collapsed corners: degenerated edges between runs), periodic chains (seams)
@@ -87,15 +88,28 @@ def test_standins_are_assembled_to_their_closed_forms(standin):
     assert abs(s.volume - standin.volume) <= s.max_fit_deviation * standin.area
 
 
-def test_a_slit_or_mismatched_chain_is_left_to_sewing():
+def test_a_slit_is_assembled_and_a_mismatched_chain_is_left_to_sewing():
     """The capsule's innermost cup ends on a segment run there and back (an open end that is not a
-    pole): not assembled, and the build sews it.  A chain whose neighbours' rows differ by one
-    pole is not assembled either."""
+    pole): the two runs share one edge, each face's p-curve on it at its own ``v`` (the way back's
+    ``v = c - t``), and the solid is assembled, not sewn.  A way back that is not the way there
+    reversed (one pole moved 1e-6 mm) is not assembled; nor is a chain whose neighbours' rows differ
+    by one pole."""
+    from dataclasses import replace
+
     capsule = Design.from_toml(ROOT / "samples/families/capsule.toml").build()
     s = tablet_solid(capsule)
-    assert s.sewn and BRepCheck_Analyzer(s.shape).IsValid()
-    pieces = chain_face_surfaces(s.surfaces)
-    assert assemble_shell(pieces, [[make_geom_surface(p) for p in ps] for ps in pieces]) is None
+    assert not s.sewn and BRepCheck_Analyzer(s.shape).IsValid()
+    segment = [n for deg, n in _edge_faces(s.shape) if not deg]
+    assert segment and all(n == 2 for n in segment)
+    pieces = [list(ps) for ps in chain_face_surfaces(s.surfaces)]
+    assert [len(ps) for ps in pieces] == [4] * 9
+    geoms = [[make_geom_surface(p) for p in ps] for ps in pieces]
+    assert assemble_shell(pieces, geoms) is not None
+    d = pieces[0][3]  # the way back along the top's segment
+    poles = np.array(d.poles)
+    poles[0, 5] += [0.0, 1e-6, 0.0]
+    pieces[0][3] = replace(d, poles=poles)
+    assert assemble_shell(pieces, geoms) is None
 
     oval = tablet_solid(Design.from_toml(ROOT / "samples/families/oval.toml").build())
     pieces = [list(ps) for ps in chain_face_surfaces(oval.surfaces)]
@@ -104,8 +118,6 @@ def test_a_slit_or_mismatched_chain_is_left_to_sewing():
     d = pieces[3][1]
     poles = np.array(d.poles)
     poles[0, 2] += 1e-9
-    from dataclasses import replace
-
     pieces[3][1] = replace(d, poles=poles)
     assert assemble_shell(pieces, geoms) is None
 

@@ -165,16 +165,22 @@ def _v_breaks(surf: Geom_BSplineSurface) -> list[float]:
                     surf.VDegree())
 
 
-def iso_u_pcurve(u0: float, a: float, b: float, breaks) -> Geom2d_BSplineCurve | Geom2d_Line:
+def iso_u_pcurve(u0: float, a: float, b: float, breaks, mirror: float | None = None) -> Geom2d_BSplineCurve | Geom2d_Line:
     """The p-curve ``t -> (u0, t)`` on ``[a, b]``: a ``Geom2d_Line``, or where ``breaks`` fall
     inside the range a degree-1 ``Geom2d_BSplineCurve`` with knots there (the same line, which
-    ``BRepGProp`` splits its integration at: see the module docstring)."""
-    ks = [a] + [k for k in breaks if a + 1e-9 < k < b - 1e-9] + [b]
+    ``BRepGProp`` splits its integration at: see the module docstring).  With ``mirror`` = ``c``, the
+    p-curve ``t -> (u0, c - t)`` of a row run back along an edge whose parameter is ``t`` (``breaks``:
+    the face's own ``v`` values, taken at ``t = c - v``)."""
+    if mirror is not None:
+        breaks = [mirror - k for k in breaks]
+    ks = [a] + sorted(k for k in breaks if a + 1e-9 < k < b - 1e-9) + [b]
     if len(ks) == 2:
+        if mirror is not None:
+            return Geom2d_Line(gp_Pnt2d(u0, mirror), gp_Dir2d(0.0, -1.0))
         return Geom2d_Line(gp_Pnt2d(u0, 0.0), gp_Dir2d(0.0, 1.0))
     poles = Array1OfPnt2d(1, len(ks))
     for i, k in enumerate(ks, start=1):
-        poles.SetValue(i, gp_Pnt2d(u0, k))
+        poles.SetValue(i, gp_Pnt2d(u0, k if mirror is None else mirror - k))
     return Geom2d_BSplineCurve(poles, _real_array(ks), _int_array([2] + [1] * (len(ks) - 2) + [2]), 1)
 
 

@@ -162,11 +162,14 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
     # piece's row is one pole (each face gets its own degenerated edge there, as sewing leaves it)
     row_edges: list[list[TopoDS_Edge | None]] = []
     ranged: list[tuple[TopoDS_Edge, float, float]] = []  # every row edge, with its v range
+    mirrored: dict[tuple[int, int], int] = {}  # (row, piece): the piece whose edge it runs back along
     for r in range(n_row):
         out: list[TopoDS_Edge | None] = []
         if inner[r]:  # inside a flat region: bounds no face
             row_edges.append(out)
             continue
+        open_end = not closed and r in (0, n_row - 1)  # an end of the chain that is not one pole
+        partner = _runs_back(r, [row_data(r, k) for k in range(n_piece)], tol_degen) if open_end else {}
         for k in range(n_piece):
             d, s, i = row_data(r, k)
             v0, v1 = vertices[r][k], vertices[r][(k + 1) % n_piece]
@@ -175,8 +178,16 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
                     return None
                 out.append(None)
                 continue
-            if not closed and r in (0, n_row - 1):  # an open end that does not close in a pole
-                return None  # (the capsule's slit, the same run there and back: for sewing)
+            if open_end:  # the capsule's slit: the same segment run there and back by two pieces
+                m = partner.get(k)
+                if m is None:
+                    return None
+                if m < k:  # the way back: the way there's edge, which ends where this piece starts
+                    if not (v0.IsSame(vertices[r][(m + 1) % n_piece]) and v1.IsSame(vertices[r][m])):
+                        return None
+                    out.append(out[m])
+                    mirrored[(r, k)] = m
+                    continue
             e = TopoDS_Edge()
             B.MakeEdge(e, s.UIso(float(d.u_knots[i])), EDGE_TOL)
             B.Add(e, v0.Oriented(_FORWARD))
@@ -250,8 +261,15 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
             low = row_edges[j][k] or degenerated(j, k)
             high = row_edges[(j + 1) % n_row][k] or degenerated((j + 1) % n_row, k)
             start, start_tol = col_edges[j][k], col_tol[j][k]
-            for e, u in ((low, u0), (high, u1)):
-                B.UpdateEdge(e, iso_u_pcurve(u, a, b, breaks), f, EDGE_TOL)
+            back = {}  # row edges run back along their partner's: t in the partner's range -> v = c - t
+            for e, u, r in ((low, u0, j), (high, u1, (j + 1) % n_row)):
+                m = mirrored.get((r, k))
+                if m is None:
+                    B.UpdateEdge(e, iso_u_pcurve(u, a, b, breaks), f, EDGE_TOL)
+                else:
+                    back[r] = True
+                    B.UpdateEdge(e, iso_u_pcurve(u, v_ranges[m][0], v_ranges[m][1], breaks, mirror=a + v_ranges[m][1]),
+                                 f, EDGE_TOL)
             if periodic:
                 B.UpdateEdge(start, Geom2d_Line(gp_Pnt2d(0.0, a), gp_Dir2d(1.0, 0.0)),
                              Geom2d_Line(gp_Pnt2d(0.0, b), gp_Dir2d(1.0, 0.0)), f, start_tol)
@@ -263,9 +281,9 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
             w = TopoDS_Wire()
             B.MakeWire(w)
             B.Add(w, start.Oriented(_FORWARD))
-            B.Add(w, high.Oriented(_FORWARD))
+            B.Add(w, high.Oriented(_REVERSED if (j + 1) % n_row in back else _FORWARD))
             B.Add(w, end.Oriented(_REVERSED))
-            B.Add(w, low.Oriented(_REVERSED))
+            B.Add(w, low.Oriented(_FORWARD if j in back else _REVERSED))
             B.Add(f, w)
             B.Add(shell, f)
             faces.append(f)
@@ -344,3 +362,32 @@ def _region_plane(B: BRep_Builder, plane: tuple[np.ndarray, np.ndarray], low: Se
         w.Closed(True)
         B.Add(f, w)
     return f, bounding
+
+
+def _runs_back(r: int, rows: Sequence[tuple[BSplineSurfaceData, Geom_BSplineSurface, int]],
+               tol_degen: float) -> dict[int, int]:
+    """At an open end of the chain (row ``r``; ``rows``: each piece's data and which row of it), the
+    pieces whose row runs back along another's: ``{k: m}`` both ways, for each piece whose row moves
+    (``_spread`` > ``tol_degen``) and has exactly one partner whose row poles are its own reversed (to
+    ``tol_degen``) over a knot sequence that is its own mirrored (to 1e-12), so that ``v_m = c - v_k``
+    along the shared segment.  A moving row without one such partner is left out (the caller gives up)."""
+    runs = [k for k, (d, _, i) in enumerate(rows) if _spread(np.asarray(d.poles[i])) > tol_degen]
+    out: dict[int, int] = {}
+    for k in runs:
+        dk, _, ik = rows[k]
+        Pk = np.asarray(dk.poles[ik])
+        found = []
+        for m in runs:
+            dm, _, im = rows[m]
+            Pm = np.asarray(dm.poles[im])
+            if m == k or Pm.shape != Pk.shape or len(dm.v_knots) != len(dk.v_knots):
+                continue
+            if float(np.max(np.linalg.norm(Pk - Pm[::-1], axis=-1))) > tol_degen:
+                continue
+            if not (np.allclose(np.diff(dk.v_knots), np.diff(dm.v_knots)[::-1], rtol=0.0, atol=1e-12)
+                    and np.array_equal(dk.v_mults, dm.v_mults[::-1])):
+                continue
+            found.append(m)
+        if len(found) == 1:
+            out[k] = found[0]
+    return out
