@@ -48,7 +48,7 @@ from OCP.TopoDS import TopoDS_Edge, TopoDS_Face, TopoDS_Iterator, TopoDS_Shape, 
 
 from tabletcad.cad._occ import cast, explore
 
-__all__ = ["coplanar", "flat_faces_as_planes", "made_poles", "plane_axes", "plane_of", "planes_of"]
+__all__ = ["coplanar", "flat_faces_as_planes", "made_poles", "plane_axes", "plane_face_of_loops", "plane_of", "planes_of"]
 
 Plane = tuple[np.ndarray, np.ndarray]  # (point (3,) mm, unit normal (3,))
 
@@ -257,6 +257,24 @@ def _plane_face(face: TopoDS_Face, point: np.ndarray, normal: np.ndarray,
     return new
 
 
+def plane_face_of_loops(plane: Plane, loops: Sequence[Sequence[TopoDS_Shape]], tol: float,
+                        reversed_wires: bool = False) -> TopoDS_Face:
+    """A face on ``plane`` (point and unit normal, mm) bounded by ``loops``, each a closed chain of edges held
+    with the orientation the wire runs them (``reversed_wires``: each wire held reversed, as a reversed face
+    holds its loop), built with ``BRep_Builder`` (no classification); ``tol``: the face's tolerance (mm)."""
+    B = BRep_Builder()
+    f = TopoDS_Face()
+    B.MakeFace(f, Geom_Plane(plane_axes(*plane)), tol)
+    for loop in loops:
+        w = TopoDS_Wire()
+        B.MakeWire(w)
+        for e in loop:
+            B.Add(w, e)
+        w.Closed(True)
+        B.Add(f, w.Reversed() if reversed_wires else w)
+    return f
+
+
 def plane_axes(point: np.ndarray, normal: np.ndarray) -> gp_Ax3:
     """The plane's axes: origin ``point`` (mm), main direction ``normal``, OCC's x direction for it."""
     return gp_Ax3(gp_Pnt(*map(float, point)), gp_Dir(*map(float, normal)))
@@ -367,16 +385,7 @@ def _region_face(faces: Sequence[TopoDS_Face], point: np.ndarray, normal: np.nda
     if loops is None or not _edges_in_plane([e for lp in loops for e in lp], point, normal, cache=cache):
         return None
     forward = faces[0].Orientation() == TopAbs_Orientation.TopAbs_FORWARD
-    B = BRep_Builder()
-    new = TopoDS_Face()
-    B.MakeFace(new, Geom_Plane(plane_axes(point, normal)), 1e-7)
-    for loop in loops:
-        wire = TopoDS_Wire()
-        B.MakeWire(wire)
-        for e in loop:
-            B.Add(wire, e)
-        wire.Closed(True)
-        B.Add(new, wire if forward else wire.Reversed())
+    new = plane_face_of_loops((point, normal), loops, 1e-7, reversed_wires=not forward)
     for loop in loops:
         for e in loop:
             BRepLib.BuildPCurveForEdgeOnPlane_s(e, new)

@@ -31,7 +31,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 from OCP.BRep import BRep_Builder
 from OCP.BRepLib import BRepLib
-from OCP.Geom import Geom_BSplineSurface, Geom_Plane
+from OCP.Geom import Geom_BSplineSurface
 from OCP.Geom2d import Geom2d_Line
 from OCP.gp import gp_Dir2d, gp_Pnt, gp_Pnt2d
 from OCP.TopAbs import TopAbs_Orientation
@@ -39,7 +39,7 @@ from OCP.TopoDS import TopoDS_Edge, TopoDS_Face, TopoDS_Shell, TopoDS_Vertex, To
 
 from tabletcad.brep.surface import BSplineSurfaceData
 from tabletcad.cad.faces import iso_u_pcurve, v_breaks
-from tabletcad.cad.planes import coplanar, plane_axes
+from tabletcad.cad.planes import coplanar, plane_face_of_loops
 
 __all__ = ["assemble_shell"]
 
@@ -323,45 +323,7 @@ def _region_plane(B: BRep_Builder, plane: tuple[np.ndarray, np.ndarray], low: Se
                          else [e.Oriented(_REVERSED) for e in reversed(edges)])
     if not loops:
         return None
-    f = TopoDS_Face()
-    B.MakeFace(f, Geom_Plane(plane_axes(*plane)), EDGE_TOL)
-    for loop in loops:
-        w = TopoDS_Wire()
-        B.MakeWire(w)
-        for e in loop:
-            B.Add(w, e)
-        w.Closed(True)
-        B.Add(f, w)
-    return f, bounding
-
-
-def _region_plane(B: BRep_Builder, plane: tuple[np.ndarray, np.ndarray], low: Sequence[TopoDS_Edge | None],
-                  high: Sequence[TopoDS_Edge | None]) -> tuple[TopoDS_Face, list[TopoDS_Edge]] | None:
-    """A flat region's plane face (``plane``: point and unit normal, the patches' ``S_u x S_v`` sense),
-    bounded by its first patch's ``low`` row and its last patch's ``high`` row, each a loop of its pieces'
-    edges (a degenerated piece, None, leaves its vertex: the loop goes on from it), run as the patches'
-    faces ran them: ``high`` forward, ``low`` back.  A row that is one point (a pole, all None) or bounds
-    no face (``[]``) gives no loop; None when neither gives one.  Returns the face and its edges, whose
-    p-curves on the plane the caller stores once every edge has its range."""
-    loops, bounding = [], []
-    for row, forward in ((high, True), (low, False)):
-        edges = [e for e in row if e is not None]
-        bounding += edges
-        if edges:
-            loops.append([e.Oriented(_FORWARD) for e in edges] if forward
-                         else [e.Oriented(_REVERSED) for e in reversed(edges)])
-    if not loops:
-        return None
-    f = TopoDS_Face()
-    B.MakeFace(f, Geom_Plane(plane_axes(*plane)), EDGE_TOL)
-    for loop in loops:
-        w = TopoDS_Wire()
-        B.MakeWire(w)
-        for e in loop:
-            B.Add(w, e)
-        w.Closed(True)
-        B.Add(f, w)
-    return f, bounding
+    return plane_face_of_loops(plane, loops, EDGE_TOL), bounding
 
 
 def _runs_back(r: int, rows: Sequence[tuple[BSplineSurfaceData, Geom_BSplineSurface, int]],
