@@ -79,6 +79,26 @@ def test_assembled_shell_is_the_sewn_one(sample, monkeypatch):
     assert abs(m.area - data_area) <= 1e-9 * m.area
 
 
+def test_a_flat_region_round_a_slit_is_one_plane_face(monkeypatch, tmp_path):
+    """A capsule without cups (cup depth 0): its flat top ends on the centre segment, run there and back
+    inside the flat region; the region is one plane face bounded by the land's row alone, assembled at the
+    first attempt (no fallback to the pieces or to sewing): six faces, two planes, valid, OCC's volume the
+    faces' own."""
+    text = (ROOT / "samples/families/capsule.toml").read_text()
+    assert "cup_depth = 1.3" in text
+    path = tmp_path / "capsule_flat.toml"
+    path.write_text(text.replace("cup_depth = 1.3", "cup_depth = 0.0"))
+    calls = []
+    real = solid_module._solid_from_faces
+    monkeypatch.setattr(solid_module, "_solid_from_faces",
+                        lambda *a, **k: calls.append(k.get("planes")) or real(*a, **k))
+    s = tablet_solid(Design.from_toml(path).build())
+    assert calls == [2] and not s.sewn and s.planes == 2 and len(s.faces) == 6
+    assert BRepCheck_Analyzer(s.shape).IsValid()
+    v = mass_properties(s.shape).volume
+    assert abs(v - abs(s.data_volume_area[0])) <= 1e-9 * v
+
+
 @pytest.mark.parametrize("standin", [sphere(2.5), cylinder(2.5, 3.0), ring(1.5, 3.0, 2.0)], ids=lambda s: s.name)
 def test_standins_are_assembled_to_their_closed_forms(standin):
     """The sphere (two poles), cylinder (flat ends) and ring (a chain closed on itself): assembled,

@@ -112,22 +112,23 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
                 region[j] = region[j - 1] if j > 0 and region[j - 1] >= 0 and coplanar(flat[j - 1], flat[j]) else j
     inner = [0 < r < n_patch and region[r] >= 0 and region[r] == region[r - 1] for r in range(n_row)]
 
-    def row_data(r: int, k: int) -> tuple[BSplineSurfaceData, Geom_BSplineSurface, int]:
-        """The piece whose boundary gives row ``r``, piece ``k``, and which of its rows (0 or -1): the
-        patch's above the row, or below it where the one above is flat (its pieces are not made)."""
+    def row_data(r: int, k: int) -> tuple[BSplineSurfaceData, int, int]:
+        """The piece whose boundary gives row ``r``, piece ``k``: its data, its patch and which of its rows
+        (0 or -1): the patch's above the row, or below it where the one above is flat (a flat region's
+        pieces' surfaces are made only where nothing else gives the row)."""
         below = r - 1 if r > 0 else (n_patch - 1 if closed else -1)
         if r < n_patch and (region[r] < 0 or below < 0 or region[below] >= 0):
-            return pieces[r][k], surface(r, k), 0
-        return pieces[below][k], surface(below, k), -1
+            return pieces[r][k], r, 0
+        return pieces[below][k], below, -1
 
     def ends(r: int, k: int) -> tuple[np.ndarray, np.ndarray]:
         """The points where row ``r``'s piece ``k`` starts and ends, mm: its end poles (clamped
         in ``v``), or the periodic row's point at the period's start, twice."""
-        d, s, i = row_data(r, k)
+        d, j, i = row_data(r, k)
         if not periodic:
             row = d.poles[i]
             return row[0], row[-1]
-        q = s.Value(float(d.u_knots[i]), v_ranges[k][0])
+        q = surface(j, k).Value(float(d.u_knots[i]), v_ranges[k][0])
         p = np.array([q.X(), q.Y(), q.Z()])
         return p, p
 
@@ -171,7 +172,7 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
         open_end = not closed and r in (0, n_row - 1)  # an end of the chain that is not one pole
         partner = _runs_back(r, [row_data(r, k) for k in range(n_piece)], tol_degen) if open_end else {}
         for k in range(n_piece):
-            d, s, i = row_data(r, k)
+            d, j, i = row_data(r, k)
             v0, v1 = vertices[r][k], vertices[r][(k + 1) % n_piece]
             if _spread(np.asarray(d.poles[i])) <= tol_degen:
                 if not v0.IsSame(v1):
@@ -189,7 +190,7 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
                     mirrored[(r, k)] = m
                     continue
             e = TopoDS_Edge()
-            B.MakeEdge(e, s.UIso(float(d.u_knots[i])), EDGE_TOL)
+            B.MakeEdge(e, surface(j, k).UIso(float(d.u_knots[i])), EDGE_TOL)
             B.Add(e, v0.Oriented(_FORWARD))
             B.Add(e, v1.Oriented(_REVERSED))
             out.append(e)
@@ -310,13 +311,15 @@ def _region_plane(B: BRep_Builder, plane: tuple[np.ndarray, np.ndarray], low: Se
                   high: Sequence[TopoDS_Edge | None]) -> tuple[TopoDS_Face, list[TopoDS_Edge]] | None:
     """A flat region's plane face (``plane``: point and unit normal, the patches' ``S_u x S_v`` sense),
     bounded by its first patch's ``low`` row and its last patch's ``high`` row, each a loop of its pieces'
-    edges (a degenerated piece, None, leaves its vertex: the loop goes on from it), run as the patches'
-    faces ran them: ``high`` forward, ``low`` back.  A row that is one point (a pole, all None) or bounds
+    edges (a degenerated piece, None, leaves its vertex: the loop goes on from it; an edge run there and
+    back, a slit, lies inside the region), run as the patches' faces ran them: ``high`` forward, ``low`` back.  A row that is one point (a pole, all None) or bounds
     no face (``[]``) gives no loop; None when neither gives one.  Returns the face and its edges, whose
     p-curves on the plane the caller stores once every edge has its range."""
     loops, bounding = [], []
     for row, forward in ((high, True), (low, False)):
         edges = [e for e in row if e is not None]
+        # a segment run there and back (the capsule's slit: one edge twice) lies inside the region
+        edges = [e for e in edges if sum(e.IsSame(o) for o in edges) == 1]
         bounding += edges
         if edges:
             loops.append([e.Oriented(_FORWARD) for e in edges] if forward
@@ -326,9 +329,9 @@ def _region_plane(B: BRep_Builder, plane: tuple[np.ndarray, np.ndarray], low: Se
     return plane_face_of_loops(plane, loops, EDGE_TOL), bounding
 
 
-def _runs_back(r: int, rows: Sequence[tuple[BSplineSurfaceData, Geom_BSplineSurface, int]],
+def _runs_back(r: int, rows: Sequence[tuple[BSplineSurfaceData, int, int]],
                tol_degen: float) -> dict[int, int]:
-    """At an open end of the chain (row ``r``; ``rows``: each piece's data and which row of it), the
+    """At an open end of the chain (row ``r``; ``rows``: each piece's data, patch and which row of it), the
     pieces whose row runs back along another's: ``{k: m}`` both ways, for each piece whose row moves
     (``_spread`` > ``tol_degen``) and has exactly one partner whose row poles are its own reversed (to
     ``tol_degen``) over a knot sequence that is its own mirrored (to 1e-12), so that ``v_m = c - v_k``

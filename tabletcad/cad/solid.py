@@ -314,8 +314,14 @@ def solid_from_surfaces(
     eps: float = DEFAULT_EPS,
     fits: Sequence[SurfaceFit] = (),
     tol_degen: float = 1e-7,
+    flat_regions: bool = True,
 ) -> TabletSolid:
-    """Faces -> sewn closed shell -> outward solid, validated; adaptive mass properties."""
+    """Faces -> sewn closed shell -> outward solid, validated; adaptive mass properties.
+
+    ``flat_regions``: neighbouring flat faces in one plane become one plane face (:mod:`tabletcad.cad.planes`,
+    :func:`~tabletcad.cad.shell.assemble_shell`), else one plane each.  A shaped cut-away's chain is built
+    without: the ruled cut faces of a flat patch lie in that patch's plane, over its pieces, and one face for
+    the region would not count their area as the surface data does (1-2 % less on the rounded square's)."""
     t0 = time.perf_counter()
     names = list(names) if names is not None else [f"patch {j}" for j in range(len(surfaces))]
     # one face per surface; the whole chain cut alike where a boundary row stands still over
@@ -338,7 +344,8 @@ def solid_from_surfaces(
     # (a curved patch cut only because its neighbours are, such as a band, stays in pieces: as one face on its
     # uncut surface, C0 where the pieces meet, the rounded rectangle's band made OCC's Common of the tablet with
     # the outside of the die bore's column non-empty, so the tooling's exact proof that they do not overlap failed)
-    flat = planes_of([np.asarray(sd.poles) for sd in surfaces]) if any(len(ps) > 1 for ps in pieces) else None
+    flat = planes_of([np.asarray(sd.poles) for sd in surfaces]) \
+        if flat_regions and any(len(ps) > 1 for ps in pieces) else None
 
     def made():  # for the planes: the surfaces made so far, with their poles
         return made_poles((g, p.poles) for gs, ps in zip(geoms, pieces) for g, p in zip(gs, ps) if g is not None)
@@ -352,7 +359,7 @@ def solid_from_surfaces(
             shell, faces_a, n_flat = assembled
             try:
                 return _solid_from_faces(tuple(faces_a), face_names, surfaces, names, fits, sew_tolerance, eps, name,
-                                         t0, shell=shell, va=va, made=made(), planes=n_flat)
+                                         t0, shell=shell, va=va, made=made(), planes=n_flat, merge=flat_regions)
             except GeometryError:
                 pass
     geoms = [[geom(j, k) for k in range(len(ps))] for j, ps in enumerate(pieces)]
@@ -361,7 +368,7 @@ def solid_from_surfaces(
     faces_l = [face_of(g, tol_degen=tol_degen, name=n) for gs, n in zip(geoms, names) for g in gs]
     try:
         return _solid_from_faces(tuple(faces_l), face_names, surfaces, names, fits, sew_tolerance, eps, name, t0,
-                                 va=va, made=made())
+                                 va=va, made=made(), merge=flat_regions)
     except GeometryError as exc:
         for face, n in zip(faces_l, face_names):
             if not BRepCheck_Analyzer(face).IsValid():
@@ -371,12 +378,15 @@ def solid_from_surfaces(
 
 def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequence, names: Sequence[str],
                       fits: Sequence, sew_tolerance: float, eps: float, name: str, t0: float,
-                      shell=None, va: tuple[float, float] | None = None, made=None, planes: int = 0) -> TabletSolid:
+                      shell=None, va: tuple[float, float] | None = None, made=None, planes: int = 0,
+                      merge: bool = True) -> TabletSolid:
     """Sew ``faces`` into one closed shell (unless the ``shell`` they make is given), make the
     outward solid and check it (its mass properties are integrated when first asked for:
     :attr:`TabletSolid.mass`).  ``va``: the surfaces' :func:`volume_and_area`, if known; ``made``: the
     faces' surfaces and their poles (:func:`~tabletcad.cad.planes.made_poles`), if known; ``planes``: how
-    many of the faces are planes already (a flat region's, made by :func:`~tabletcad.cad.shell.assemble_shell`)."""
+    many of the faces are planes already (a flat region's, made by :func:`~tabletcad.cad.shell.assemble_shell`);
+    ``merge``: whether coplanar flat faces that share an edge become one plane face
+    (:func:`~tabletcad.cad.planes.flat_faces_as_planes`), else a plane each."""
     t1 = time.perf_counter()
     sewn = shell is None
     if sewn:
@@ -394,8 +404,8 @@ def _solid_from_faces(faces: tuple, face_names: Sequence[str], surfaces: Sequenc
     # flat B-spline pieces as exact planes, one per flat region: OCCT's face merging, which build123d and
     # CadQuery run after every Boolean, crashed the process on the pieces (tabletcad.cad.planes); one check of
     # the solid with them, of the solid with a plane per piece only if that fails, of the solid as made last
-    for merge in (True, False):
-        planar, n_planes, reshape = flat_faces_as_planes(solid, check=False, made=made, merge=merge)
+    for merged in ((True, False) if merge else (False,)):
+        planar, n_planes, reshape = flat_faces_as_planes(solid, check=False, made=made, merge=merged)
         try:
             check_solid(planar, name)
             solid = planar
@@ -441,13 +451,15 @@ def build_solid(
     names: Sequence[str] | None = None,
     sew_tolerance: float | None = None,
     eps: float = DEFAULT_EPS,
+    flat_regions: bool = True,
     **fit_kwargs: Any,
 ) -> TabletSolid:
     """Fit every patch (callable ``f(u, v)`` or object with ``.evaluate``) within ``tol`` mm and build the solid.
 
     Patches form a chain: patch ``j``'s ``u=1`` curve is patch ``j+1``'s ``u=0``
     curve (the chain may close on itself, e.g. a ring).  ``sew_tolerance``
-    defaults to ``max(2 tol, 1e-6)`` mm.  Extra keyword arguments go to
+    defaults to ``max(2 tol, 1e-6)`` mm; ``flat_regions``: see :func:`solid_from_surfaces`.  Extra keyword
+    arguments go to
     :func:`tabletcad.brep.fit.fit_surface` (``nu``, ``nv``, ``max_nu``, ``v_breaks``...);
     ``v_breaks`` defaults to the union of the patches' ``breakpoints()`` (if they have any).
     """
@@ -466,7 +478,8 @@ def build_solid(
     t1 = time.perf_counter()
     sew_tol = float(sew_tolerance) if sew_tolerance is not None else max(2.0 * tol, 1e-6)
     result = solid_from_surfaces(
-        [f.surface for f in fits], name=name, names=names, sew_tolerance=sew_tol, eps=eps, fits=fits
+        [f.surface for f in fits], name=name, names=names, sew_tolerance=sew_tol, eps=eps, fits=fits,
+        flat_regions=flat_regions,
     )
     timings = {"fit": t1 - t0, **result.timings}
     timings["total"] = time.perf_counter() - t0

@@ -260,7 +260,7 @@ def cutaway_shape(tablet: Tablet, report: dict[str, Any], *, _stacklevel: int = 
         mass properties and their volume's difference from the quadrature."""
         chain = None
         if sewn:
-            chain = build_solid(funcs, tol, name=f"{tablet.name} cut-away", names=names,
+            chain = build_solid(funcs, tol, name=f"{tablet.name} cut-away", names=names, flat_regions=False,
                                 **fit_options(tablet, v_breaks=breaks))
             shape = chain.shape
         else:
