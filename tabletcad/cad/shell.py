@@ -10,18 +10,21 @@ made, and :func:`assemble_shell` builds it directly with ``BRep_Builder``:
   faces on both sides), or, where the piece's row is one pole, a degenerated edge of each face;
 * one edge per cut of each patch (its exact ``v`` iso-curve, shared by the pieces on both
   sides), or a seam edge, used twice by its face, where a patch is one periodic piece;
+* at an open end of the chain, one edge for a segment run there and back by two pieces (the
+  capsule's slit: the way back's row is the way there's reversed, its p-curve ``v = c - t``);
 * every p-curve a straight line of the face's parameter rectangle; along the rows it is a
   degree-1 B-spline with knots at the surface's C0/C1 ``v`` knots, which OCCT's mass
-  properties need to integrate across them (see :mod:`tabletcad.cad.faces`).
+  properties need to integrate across them (see :mod:`tabletcad.cad.faces`);
+* with ``flat``, one plane face per flat region (neighbouring patches in one plane), bounded by
+  the rows round it; its pieces and the edges between them are not made.
 
 Each 3-D curve is an iso-curve of one of the faces it bounds, with the same parameter as its
 p-curves, so the edges are same-parameter by construction, and BRepCheck_Analyzer of the solid
 checks it.  ``BRepBuilderAPI_Sewing`` found the same topology by searching for it and took most
 of the solid's time on the shaped families (31 of 116 ms on a rounded rectangle of 72 faces).
 
-A chain this cannot assemble - a row that runs along the same segment twice (the capsule's
-slit), a cut whose iso-curve is a point, rows that do not match - gives ``None``, and the
-caller sews.
+A chain this cannot assemble - a segment whose way back is not its way there reversed, a cut
+whose iso-curve is a point, rows that do not match - gives ``None``, and the caller sews.
 """
 
 from __future__ import annotations

@@ -10,13 +10,13 @@ free edge) that failed.
    the whole chain cut alike into pieces where a boundary row stands still over part
    of its length (:func:`tabletcad.brep.slit.chain_face_surfaces`);
 3. one closed shell: assembled edge by edge from the chain's known topology
-   (:func:`tabletcad.cad.shell.assemble_shell`), or, for a chain it cannot assemble (the
-   capsule's slit) or whose assembled solid fails its check, ``BRepBuilderAPI_Sewing`` with
+   (:func:`tabletcad.cad.shell.assemble_shell`; a flat region one plane face), or, for a chain it
+   cannot assemble or whose assembled solid fails its check, ``BRepBuilderAPI_Sewing`` with
    tolerance ``max(2 tol, 1e-6)`` mm - no free or multiple edges allowed;
 4. ``BRepBuilderAPI_MakeSolid`` + ``BRepLib::OrientClosedSolid`` (matter
    inside, positive volume; faces of revolution: reversed if their volume is
-   negative) + ``BRepCheck_Analyzer``; flat B-spline faces become exact planes
-   (:mod:`tabletcad.cad.planes`);
+   negative) + ``BRepCheck_Analyzer``; flat B-spline faces become exact planes, one per flat
+   region (:mod:`tabletcad.cad.planes`);
 5. volume/area/centroid by *adaptive* Gauss integration
    (``BRepGProp::VolumeProperties(shape, props, eps)``, ``eps`` = 1e-9): the
    default integration was measured up to ~1e-3 relative off on dense B-spline faces;
@@ -339,7 +339,8 @@ def solid_from_surfaces(
 
     va = volume_and_area(surfaces)  # the faces' own volume and area (orientation, the stage's check)
     # the chain's topology is known: its shell is assembled edge by edge (tabletcad.cad.shell);
-    # a chain that cannot be (the capsule's slit), or whose assembled solid fails its check, is sewn.
+    # a chain that cannot be (a segment whose way back is not its way there reversed), or whose assembled solid
+    # fails its check, is sewn.
     # A cut chain's flat regions are made plane faces there; if that fails, the chain is assembled in its pieces
     # (a curved patch cut only because its neighbours are, such as a band, stays in pieces: as one face on its
     # uncut surface, C0 where the pieces meet, the rounded rectangle's band made OCC's Common of the tablet with
