@@ -165,7 +165,8 @@ def _v_breaks(surf: Geom_BSplineSurface) -> list[float]:
                     surf.VDegree())
 
 
-def iso_u_pcurve(u0: float, a: float, b: float, breaks, mirror: float | None = None) -> Geom2d_BSplineCurve | Geom2d_Line:
+def iso_u_pcurve(u0: float, a: float, b: float, breaks,
+                 mirror: float | None = None) -> Geom2d_BSplineCurve | Geom2d_Line:
     """The p-curve ``t -> (u0, t)`` on ``[a, b]``: a ``Geom2d_Line``, or where ``breaks`` fall
     inside the range a degree-1 ``Geom2d_BSplineCurve`` with knots there (the same line, which
     ``BRepGProp`` splits its integration at: see the module docstring).  With ``mirror`` = ``c``, the

@@ -48,7 +48,8 @@ from OCP.TopoDS import TopoDS_Edge, TopoDS_Face, TopoDS_Iterator, TopoDS_Shape, 
 
 from tabletcad.cad._occ import cast, explore
 
-__all__ = ["coplanar", "flat_faces_as_planes", "made_poles", "plane_axes", "plane_face_of_loops", "plane_of", "planes_of"]
+__all__ = ["coplanar", "flat_faces_as_planes", "made_poles", "plane_axes", "plane_face_of_loops", "plane_of",
+           "planes_of"]
 
 Plane = tuple[np.ndarray, np.ndarray]  # (point (3,) mm, unit normal (3,))
 
@@ -307,8 +308,8 @@ def coplanar(a: Plane, b: Plane) -> bool:
     return float(a[1] @ b[1]) >= 1.0 - 1e-12 and abs(float((b[0] - a[0]) @ a[1])) <= EDGE_PLANE_TOL_MM
 
 
-def _flat_regions(flat: Sequence[tuple[TopoDS_Face, Plane, list[TopoDS_Edge]]]) -> list[list[int]]:
-    """The indices of ``flat`` (faces with their plane and boundary edges, :func:`_boundary`) in groups:
+def _flat_regions(flat: Sequence[tuple[TopoDS_Face, Plane, tuple[list[TopoDS_Edge], bool]]]) -> list[list[int]]:
+    """The indices of ``flat`` (faces with their plane and :func:`_boundary`) in groups:
     faces that share an edge, lie in one plane and are oriented alike in the solid are one flat region;
     each group in the order of ``flat``, the groups in the order of their first face."""
     parent = list(range(len(flat)))
@@ -320,7 +321,7 @@ def _flat_regions(flat: Sequence[tuple[TopoDS_Face, Plane, list[TopoDS_Edge]]]) 
         return k
 
     owner: dict[int, list[tuple[TopoDS_Edge, int]]] = {}
-    for k, (face, plane, edges) in enumerate(flat):
+    for k, (face, plane, (edges, _)) in enumerate(flat):
         for e in edges:
             for other, j in owner.setdefault(hash(e), []):
                 fj, pj, _ = flat[j]
@@ -432,27 +433,24 @@ def flat_faces_as_planes(solid: TopoDS_Shape, check: bool = True,
         for k, plane in zip(at, planes_of(nets)):
             planes[k] = plane
         cache: EdgeSamples = {}
-        flat, bounds = [], []  # (face, plane, boundary edges) of the flat faces with a plain boundary
+        flat = []  # (face, plane, its boundary: edges and whether they chain) of the flat faces with a plain one
         for f, plane in zip(faces, planes):
-            if plane is not None:
-                found = _boundary(f)
-                if found is not None:
-                    flat.append((f, plane, found[0]))
-                    bounds.append(found)
+            found = None if plane is None else _boundary(f)
+            if found is not None:
+                flat.append((f, plane, found))
         for group in _flat_regions(flat) if merge else [[k] for k in range(len(flat))]:
             members = [flat[k] for k in group]
             new = None
             if len(members) > 1:
-                new = _region_face([m[0] for m in members], *members[0][1], [m[2] for m in members], cache)
+                new = _region_face([m[0] for m in members], *members[0][1], [m[2][0] for m in members], cache)
             if new is not None:
                 rs.Replace(members[0][0], new)
                 for m in members[1:]:
                     rs.Remove(m[0])
                 n += 1
                 continue
-            for k in group:
-                f, plane, _ = flat[k]
-                one = _plane_face(f, *plane, cache, bounds[k])
+            for f, plane, found in members:
+                one = _plane_face(f, *plane, cache, found)
                 if one is not None:
                     rs.Replace(f, one)
                     n += 1

@@ -80,7 +80,8 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
     Returns
     -------
     ``(shell, faces, planes)`` - the shell (its faces all ``FORWARD``: the surfaces' own normals),
-    its faces in the order of ``pieces`` (a flat region: its plane face, once) and how many of them are flat regions' planes - or None.
+    its faces in the order of ``pieces`` (a flat region: its plane face, once) and how many of them
+    are flat regions' planes - or None.
     """
     surface = surfaces if callable(surfaces) else (lambda j, k: surfaces[j][k])
     n_patch = len(pieces)
@@ -173,7 +174,7 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
             row_edges.append(out)
             continue
         open_end = not closed and r in (0, n_row - 1)  # an end of the chain that is not one pole
-        partner = _runs_back(r, [row_data(r, k) for k in range(n_piece)], tol_degen) if open_end else {}
+        partner = _runs_back([row_data(r, k) for k in range(n_piece)], tol_degen) if open_end else {}
         for k in range(n_piece):
             d, j, i = row_data(r, k)
             v0, v1 = vertices[r][k], vertices[r][(k + 1) % n_piece]
@@ -265,13 +266,13 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
             low = row_edges[j][k] or degenerated(j, k)
             high = row_edges[(j + 1) % n_row][k] or degenerated((j + 1) % n_row, k)
             start, start_tol = col_edges[j][k], col_tol[j][k]
-            back = {}  # row edges run back along their partner's: t in the partner's range -> v = c - t
+            back = set()  # rows whose edge runs back along the partner's: t in its range -> v = c - t
             for e, u, r in ((low, u0, j), (high, u1, (j + 1) % n_row)):
                 m = mirrored.get((r, k))
                 if m is None:
                     B.UpdateEdge(e, iso_u_pcurve(u, a, b, breaks), f, EDGE_TOL)
                 else:
-                    back[r] = True
+                    back.add(r)
                     B.UpdateEdge(e, iso_u_pcurve(u, v_ranges[m][0], v_ranges[m][1], breaks, mirror=a + v_ranges[m][1]),
                                  f, EDGE_TOL)
             if periodic:
@@ -315,8 +316,9 @@ def _region_plane(B: BRep_Builder, plane: tuple[np.ndarray, np.ndarray], low: Se
     """A flat region's plane face (``plane``: point and unit normal, the patches' ``S_u x S_v`` sense),
     bounded by its first patch's ``low`` row and its last patch's ``high`` row, each a loop of its pieces'
     edges (a degenerated piece, None, leaves its vertex: the loop goes on from it; an edge run there and
-    back, a slit, lies inside the region), run as the patches' faces ran them: ``high`` forward, ``low`` back.  A row that is one point (a pole, all None) or bounds
-    no face (``[]``) gives no loop; None when neither gives one.  Returns the face and its edges, whose
+    back, a slit, lies inside the region), run as the patches' faces ran them: ``high`` forward, ``low``
+    back.  A row that is one point (a pole, all None) or bounds no face (``[]``) gives no loop; None when
+    neither gives one.  Returns the face and its edges, whose
     p-curves on the plane the caller stores once every edge has its range."""
     loops, bounding = [], []
     for row, forward in ((high, True), (low, False)):
@@ -332,9 +334,8 @@ def _region_plane(B: BRep_Builder, plane: tuple[np.ndarray, np.ndarray], low: Se
     return plane_face_of_loops(plane, loops, EDGE_TOL), bounding
 
 
-def _runs_back(r: int, rows: Sequence[tuple[BSplineSurfaceData, int, int]],
-               tol_degen: float) -> dict[int, int]:
-    """At an open end of the chain (row ``r``; ``rows``: each piece's data, patch and which row of it), the
+def _runs_back(rows: Sequence[tuple[BSplineSurfaceData, int, int]], tol_degen: float) -> dict[int, int]:
+    """At an open end of the chain (``rows``: each piece's data, patch and which of its rows gives the end), the
     pieces whose row runs back along another's: ``{k: m}`` both ways, for each piece whose row moves
     (``_spread`` > ``tol_degen``) and has exactly one partner whose row poles are its own reversed (to
     ``tol_degen``) over a knot sequence that is its own mirrored (to 1e-12), so that ``v_m = c - v_k``
