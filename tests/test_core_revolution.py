@@ -261,28 +261,40 @@ def test_the_thesis_ovals_plan_is_their_widest_ellipse():
        z=st.lists(st.floats(0.0, 3.0), min_size=4, max_size=4), angle=st.floats(0.0, math.pi),
        aspect=st.floats(0.3, 3.0), a=st.floats(0.2, 2.0), form=st.sampled_from(["curves", "hermite"]))
 @example(rho=[1.0] * 4, z=[0.0] * 4, angle=0.0, aspect=2.0, a=1.0, form="curves")  # level: folds in its plane
+# a fold on a principal meridian alone (v = -0.871, near u = 0.26): none of the 32 sampled meridians shows it
+@example(rho=[0.8984375, 3.6875, 0.8984375, 0.8984375], z=[0.8984375, 0.0, 0.8984375, 0.5], angle=0.0,
+         aspect=2.21875, a=0.3125, form="curves")
 def test_fold_checks_of_a_section_decide_as_the_sampled_ones(rho, z, angle, aspect, a, form):
     """The radius and fold-back checks from the profile refuse exactly the patches the sampled grid
-    refuses, with the same reason, and never a smaller negative radius (they add the ellipse's
-    principal meridians)."""
+    refuses on the same meridians (the given ones and the ellipse's four principal ones, which the
+    profile's checks add), with the same reason, and never a smaller negative radius; so they refuse
+    every patch the given meridians alone refuse."""
     from tabletcad.errors import DesignError
 
     p, q = _plan_vectors(angle, aspect)
     patch = PDEPatch(tuple(_Section(r, pp, p, zz) for r, zz, pp in zip(rho, z, [q] * 4)), a=a, form=form, check=False)
     assert patch.section is not None
-    outcome, saved = [], patch.section
-    for section in (saved, None):
+    saved = patch.section
+    u, v = np.linspace(0.0, 1.0, 201), np.linspace(0.0, math.tau, 32, endpoint=False)
+
+    def outcome(section, meridians):
         object.__setattr__(patch, "_section", section)
-        u, v = np.linspace(0.0, 1.0, 201), np.linspace(0.0, math.tau, 32, endpoint=False)
         try:
-            (patch._check_fold_section if section is not None else patch._check_fold_sampled)(u, v)
-            outcome.append(("ok", 0.0))
+            (patch._check_fold_section if section is not None else patch._check_fold_sampled)(u, meridians)
+            return ("ok", 0.0)
         except DesignError as exc:
             what = str(exc).split("'")[1]
-            outcome.append((what.split()[0], float(what.split()[1]) if what.startswith("radius") else 0.0))
-    object.__setattr__(patch, "_section", saved)
-    assert outcome[0][0] == outcome[1][0]
-    assert outcome[0][1] <= outcome[1][1] + 1e-12
+            return (what.split()[0], float(what.split()[1]) if what.startswith("radius") else 0.0)
+        finally:
+            object.__setattr__(patch, "_section", saved)
+
+    profile = outcome(saved, v)
+    same = outcome(None, np.concatenate([v, patch._principal_v()]))
+    given = outcome(None, v)
+    assert profile[0] == same[0]
+    assert profile[1] <= same[1] + 1e-12
+    assert given[0] == "ok" or profile[0] != "ok"
+    assert profile[1] <= given[1] + 1e-12
     # the figures the checks read, against the patch's own surface: the radius about the spine and
     # X_u × X_v (in-plane length and z part)
     u, v = np.linspace(0.0, 1.0, 23), np.linspace(0.0, math.tau, 19)
