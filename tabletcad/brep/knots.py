@@ -125,7 +125,7 @@ def _derivative_from_lower(t: np.ndarray, degree: int, n_basis: int, span: np.nd
     degree ``degree - 1`` ones ``span-degree+1 ... span``: each ``lower[k]`` enters derivative ``k+1``
     with ``+a`` and derivative ``k`` with ``-a``, the same product ``a_{span-p+1+k} lower[k]``, so one
     table of products serves both (the same values as a loop over ``k``, in 3 array passes instead of
-    ~20 small ones: 0.2 of a 0.3 ms evaluation of 513 profile points)."""
+    ~20 small ones: a profile's derivative at 513 points took 0.27 ms, 0.17 now)."""
     d = t[degree : degree + n_basis + 1] - t[: n_basis + 1]  # support length of each degree p-1 B-spline
     a = np.zeros(d.shape)
     np.divide(degree, d, out=a, where=d != 0)

@@ -521,8 +521,8 @@ def revolved_solid(
     fits = fit_profiles(profiles, tol, names=names, degree=degree)
     t1 = time.perf_counter()
     surfaces = [f.surface for f in fits]
-    # each face is checked as part of the solid (BRepCheck_Analyzer of the solid checks its faces: 0.8 ms
-    # of the compound cup's 7 faces, checked twice before); only when that fails one by one, to name it
+    # each face is checked as part of the solid (BRepCheck_Analyzer of the solid checks its faces; checking
+    # each alone too took 0.8 ms of the compound cup's build); only when that fails one by one, to name it
     faces = tuple(make_revolved_face(sd, name=n, check=False) for sd, n in zip(surfaces, names))
     sew_tol = float(sew_tolerance) if sew_tolerance is not None else max(2.0 * tol, 1e-6)
     try:
