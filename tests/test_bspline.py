@@ -182,6 +182,36 @@ def test_basis_on_whole_columns_is_the_textbook_recursion_bit_for_bit(seed, degr
     assert np.max(np.abs(N.sum(axis=1) - 1.0)) < 1e-14
 
 
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), degree=st.integers(1, 6), repeat=st.booleans())
+def test_basis_derivatives_are_the_textbook_formula_bit_for_bit(seed, degree, repeat):
+    """First derivatives of the B-splines equal, to the last bit, the textbook formula term by term
+    (``N'_{i,p} = p/(t_{i+p}-t_i) N_{i,p-1} - p/(t_{i+p+1}-t_{i+1}) N_{i+1,p-1}``, a zero support's term
+    dropped), with repeated interior knots too, and sum to 0."""
+    from tabletcad.brep.knots import _find_span, basis_derivatives
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(degree + 1, 30))
+    interior = np.sort(rng.uniform(0.0, 1.0, n - degree - 1))
+    if repeat and interior.size > 2:
+        interior[1] = interior[2]
+    t = np.concatenate([np.zeros(degree + 1), interior, np.ones(degree + 1)])
+    x = np.concatenate([rng.uniform(0.0, 1.0, 50), [0.0, 1.0], interior])
+    span, dN = basis_derivatives(t, degree, n, x, 1)
+    np.testing.assert_array_equal(span, _find_span(t, degree, n, x))
+    lower = _cox_de_boor_guarded(t, degree - 1, x, span) if degree > 1 else np.ones((x.size, 1))
+    expected = np.zeros((x.size, degree + 1))
+    for m, i0 in enumerate(span - degree):
+        for k in range(degree + 1):
+            i = i0 + k
+            if k >= 1 and t[i + degree] != t[i]:
+                expected[m, k] += degree / (t[i + degree] - t[i]) * lower[m, k - 1]
+            if k <= degree - 1 and t[i + degree + 1] != t[i + 1]:
+                expected[m, k] -= degree / (t[i + degree + 1] - t[i + 1]) * lower[m, k]
+    np.testing.assert_array_equal(dN, expected)
+    assert np.max(np.abs(dN.sum(axis=1))) <= 1e-12 * np.max(np.abs(dN))
+
+
 def test_collocation_is_shared_between_surfaces_with_the_same_knots():
     """The faces of a chain share their knots: their collocation matrices are one read-only table
     (:data:`tabletcad.geometry.tables.COLLOCATION`), what each would compute alone, and a surface

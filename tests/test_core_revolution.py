@@ -107,6 +107,45 @@ def test_revolved_volume_of_a_polyline_profile_is_exact():
     assert abs(revolved_volume(frustum)) == pytest.approx(math.pi * h / 3 * (R1 * R1 + R1 * R2 + R2 * R2), rel=1e-14)
 
 
+def test_shared_profile_tables_are_what_each_profile_computes_alone():
+    """Profiles with the same knots share their B-spline values on a common grid (a read-only table of
+    :data:`tabletcad.geometry.tables.COLLOCATION`): each gets, bit for bit, what it computes alone,
+    at any shape of samples; other knots or other samples get their own."""
+    from tabletcad.geometry.tables import COLLOCATION
+
+    fits = fit_profiles([_arc(5.0, 0.0, math.pi / 2), _arc(5.0, math.pi / 2, math.pi)], 1e-6)
+    a, b = fits[0].surface, fits[1].surface
+    assert np.array_equal(a.knots, b.knots) and np.array_equal(a.mults, b.mults)
+    COLLOCATION.clear()
+    for u in (np.linspace(0.0, 1.0, 77), np.linspace(0.0, 1.0, 60).reshape(5, 12)):
+        for du in (0, 1):
+            for s in (a, b):
+                np.testing.assert_array_equal(s.profile(u, du, shared=True), s.profile(u, du))
+            assert a._basis(u, du, True) is b._basis(u, du, True)
+    assert a._basis(np.linspace(0.0, 1.0, 77), 0, True) is not a._basis(np.linspace(0.0, 1.0, 78), 0, True)
+    other = fit_profile(_arc(5.0, 0.0, math.pi), 1e-9).surface
+    assert other.knots.size != a.knots.size
+    u = np.linspace(0.0, 1.0, 77)
+    np.testing.assert_array_equal(other.profile(u, 1, shared=True), other.profile(u, 1))
+
+
+def test_mesh_deviation_of_a_chain_is_the_largest_of_its_bands_measured_alone(monkeypatch):
+    """The deflection measured with one B-spline evaluation for all faces with the same knots (and one
+    for each other knot vector) is, bit for bit, the largest of every band measured on its own."""
+    import tabletcad.brep.revolved as rv
+
+    seen, real = [], rv._mesh_deviation
+    monkeypatch.setattr(rv, "_mesh_deviation", lambda *a: seen.append(a) or real(*a))
+    arc = [_arc(5.0, k * math.pi / 6, (k + 1) * math.pi / 6) for k in range(5)]
+    fits = fit_profiles(arc, 1e-7)
+    fits.append(fit_profile(_arc(5.0, 5 * math.pi / 6, math.pi), 1e-10, start=fits[-1].surface.poles[-1]))
+    surfaces = [f.surface for f in fits]
+    assert len({s.knots.size for s in surfaces}) == 2  # two knot vectors: two groups
+    measured = revolved_mesh(surfaces, 0.005, 0.2)[2]
+    surfaces, P, bands, dth = seen[-1]
+    assert measured == max(real(surfaces, P, [band], dth) for band in bands) and 0.0 < measured <= 0.005
+
+
 def _edges_twice(T):
     e = np.sort(np.concatenate([T[:, [0, 1]], T[:, [1, 2]], T[:, [2, 0]]]), axis=1)
     _, counts = np.unique(e, axis=0, return_counts=True)

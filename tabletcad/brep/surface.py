@@ -364,7 +364,8 @@ def volume_and_area(surfaces: Sequence) -> tuple[float, float]:
     for s in surfaces:
         if isinstance(s, RevolvedSurfaceData):
             u, wu = _span_rule(s.knots, max(int(math.ceil(3 * s.degree / 2)) + 1, s.degree + 4))
-            (R, Z), (dR, dZ) = s.profile(u).T, s.profile(u, 1).T
+            # (the faces of a chain fitted with as many poles share these nodes: RevolvedSurfaceData.profile)
+            (R, Z), (dR, dZ) = s.profile(u, shared=True).T, s.profile(u, 1, shared=True).T
             volume += (math.tau / 3.0) * float(np.sum(wu * (Z * R * dR - R * R * dZ)))
             area += math.tau * float(np.sum(wu * np.abs(R) * np.hypot(dR, dZ)))
             continue

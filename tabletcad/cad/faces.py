@@ -132,10 +132,13 @@ def face_of(surf: Geom_BSplineSurface, *, tol_degen: float = 1e-7, name: str = "
     return face
 
 
-def make_revolved_face(data: RevolvedSurfaceData, *, tol_degen: float = 1e-7, name: str = "surface") -> TopoDS_Face:
+def make_revolved_face(data: RevolvedSurfaceData, *, tol_degen: float = 1e-7, name: str = "surface",
+                       check: bool = True) -> TopoDS_Face:
     """The full turn about the z axis of the profile ``data`` (a ``Geom_BSplineCurve`` in the
     plane ``y = 0``, ``x = R``) as a ``Geom_SurfaceOfRevolution`` face; checked with
-    ``BRepCheck_Analyzer``.  A profile end on the axis becomes a degenerated edge (a pole)."""
+    ``BRepCheck_Analyzer`` unless ``check`` is False (a solid's own check covers its faces:
+    :func:`~tabletcad.cad.solid.revolved_solid`).  A profile end on the axis becomes a degenerated
+    edge (a pole)."""
     n = data.poles.shape[0]
     poles = Array1OfPnt(1, n)
     for i, (r, z) in enumerate(data.poles, start=1):
@@ -149,7 +152,7 @@ def make_revolved_face(data: RevolvedSurfaceData, *, tol_degen: float = 1e-7, na
     if not maker.IsDone():
         raise GeometryError(f"BRepBuilderAPI_MakeFace failed for {name} (error {maker.Error()})", data)
     face = maker.Face()
-    if not BRepCheck_Analyzer(face).IsValid():
+    if check and not BRepCheck_Analyzer(face).IsValid():
         raise GeometryError(f"face of {name} is not valid (BRepCheck_Analyzer)", data)
     return face
 

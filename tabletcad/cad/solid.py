@@ -521,9 +521,17 @@ def revolved_solid(
     fits = fit_profiles(profiles, tol, names=names, degree=degree)
     t1 = time.perf_counter()
     surfaces = [f.surface for f in fits]
-    faces = tuple(make_revolved_face(sd, name=n) for sd, n in zip(surfaces, names))
+    # each face is checked as part of the solid (BRepCheck_Analyzer of the solid checks its faces; checking
+    # each alone too took 0.8 ms of the compound cup's build); only when that fails one by one, to name it
+    faces = tuple(make_revolved_face(sd, name=n, check=False) for sd, n in zip(surfaces, names))
     sew_tol = float(sew_tolerance) if sew_tolerance is not None else max(2.0 * tol, 1e-6)
-    result = _solid_from_faces(faces, names, surfaces, names, fits, sew_tol, eps, name, t1)
+    try:
+        result = _solid_from_faces(faces, names, surfaces, names, fits, sew_tol, eps, name, t1)
+    except GeometryError as exc:
+        for face, sd, n in zip(faces, surfaces, names):
+            if not BRepCheck_Analyzer(face).IsValid():
+                raise GeometryError(f"face of {n} is not valid (BRepCheck_Analyzer)", sd) from exc
+        raise
     timings = {"fit": t1 - t0, **result.timings}
     timings["total"] = time.perf_counter() - t0
     object.__setattr__(result, "timings", timings)
