@@ -82,6 +82,21 @@ def _eval_f(f: SurfaceFunction, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.array(X)
 
 
+def _eval_f_components(f: SurfaceFunction, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``f`` on the tensor grid ``u x v``, components first: ``(3, len(u), len(v))`` mm.  A function
+    with ``grid_components`` (a PDE patch: :class:`PatchFunction`) gives that layout straight from its
+    matrix products, with no transposed copy; any other is evaluated by :func:`_eval_f` and viewed so."""
+    grid = getattr(f, "grid_components", None)
+    if grid is None:
+        return np.moveaxis(_eval_f(f, u, v), -1, 0)
+    X = np.asarray(grid(np.asarray(u, dtype=float), np.asarray(v, dtype=float)), dtype=float)
+    if X.shape != (3, np.size(u), np.size(v)):
+        raise GeometryError(f"grid_components returned shape {X.shape}", f)
+    if not np.all(np.isfinite(X)):
+        raise GeometryError("surface function returned non-finite values", f)
+    return X
+
+
 def _solve_poles(
     D: np.ndarray, u: np.ndarray, v: np.ndarray, u_degree: int, v_degree: int, v_knots, v_mults, u_periodic: bool
 ):
@@ -167,9 +182,12 @@ def _deviation(f: SurfaceFunction, data: BSplineSurfaceData, u: np.ndarray, v: n
     # ``factor`` points per gap between consecutive (periodic) samples; column ``factor * j`` is sample j
     vs = np.concatenate([v, [v[0] + math.tau]])
     vc = (vs[:-1, None] + (np.arange(factor) / factor)[None, :] * np.diff(vs)[:, None]).ravel()
-    F = _eval_f(f, uc, vc)
-    D = data.evaluate_grid(uc, vc) - F
-    E = np.sqrt(np.einsum("...k,...k->...", D, D))
+    # components first (3, len(uc), len(vc)), as the products make them: no transposed copies, and
+    # |D| from three contiguous planes (the squares summed x, z, y: the einsum over the last axis this
+    # replaced added them in that order, so the figures stay the same to the bit)
+    D = data.evaluate_grid(uc, vc, components=True)
+    D -= _eval_f_components(f, uc, vc)
+    E = np.sqrt(D[0] * D[0] + D[2] * D[2] + D[1] * D[1])
     # split: points on sample v-lines (pure u-interpolation error) and on sample u-lines
     err_u = float(E[:, ::factor].max())
     err_v = float(E[::factor, :].max())
@@ -390,9 +408,13 @@ class PatchFunction:
     matrix products), which :func:`fit_surface` uses when present."""
 
     def __init__(self, patch) -> None:
+        from tabletcad.geometry.patch import PDEPatch  # (here: brep.fit alone does not load the patches)
+
         self.patch = patch
         if hasattr(patch, "evaluate_grid"):
             self.evaluate_grid = lambda u, v: np.asarray(patch.evaluate_grid(u, v))
+        if isinstance(patch, PDEPatch):  # the same grid, components first (no transposed copy)
+            self.grid_components = lambda u, v: patch.evaluate_grid(u, v, components=True)
 
     def __call__(self, u, v) -> np.ndarray:
         return np.asarray(self.patch.evaluate(u, v))
