@@ -20,6 +20,7 @@ import numpy as np
 from tabletcad.brep.knots import clamped_interp_knots, normalise_breaks, periodic_knots
 from tabletcad.brep.surface import BSplineSurfaceData
 from tabletcad.errors import GeometryError
+from tabletcad.geometry.vectors import norm3
 
 __all__ = ["PatchFunction", "SurfaceFit", "SurfaceFunction", "chain_breakpoints", "fit_patches", "fit_surface"]
 
@@ -131,7 +132,7 @@ def _solve_poles(
 
 def _pole_point(row: np.ndarray, pole_tol: float) -> np.ndarray | None:
     centre = row.mean(axis=0)
-    if np.max(np.linalg.norm(row - centre, axis=-1)) <= pole_tol:
+    if np.max(norm3(row - centre)) <= pole_tol:
         return centre
     return None
 
@@ -331,10 +332,10 @@ def fit_patches(
     rows_start = [_eval_f(fj, zeros, v)[0] for fj in functions]
     shared: list[list[np.ndarray | None]] = [[None, None] for _ in range(n)]
     pairs = [(j, j + 1) for j in range(n - 1)]
-    if n > 1 and np.max(np.linalg.norm(rows_end[-1] - rows_start[0], axis=-1)) <= share_tol:
+    if n > 1 and np.max(norm3(rows_end[-1] - rows_start[0])) <= share_tol:
         pairs.append((n - 1, 0))
     for a, b in pairs:
-        gap = float(np.max(np.linalg.norm(rows_end[a] - rows_start[b], axis=-1)))
+        gap = float(np.max(norm3(rows_end[a] - rows_start[b])))
         if gap > share_tol:
             raise GeometryError(
                 f"{names[a]} (u=1) and {names[b]} (u=0) do not share their boundary curve: gap {gap:.3g} mm",
@@ -395,7 +396,7 @@ def _with_rows(fit: SurfaceFit, rows, v: np.ndarray, u_degree: int, v_degree: in
                                   tuple(rows), s.v_knots, s.v_mults)
     if data.shape != s.shape:
         return None
-    moved = float(np.max(np.linalg.norm(data.poles - s.poles, axis=-1)))
+    moved = float(np.max(norm3(data.poles - s.poles)))
     bound = fit.max_deviation + moved
     if bound > fit.tol:
         return None
