@@ -20,6 +20,7 @@ import numpy as np
 from tabletcad.brep.knots import clamped_interp_knots, normalise_breaks, periodic_knots
 from tabletcad.brep.surface import BSplineSurfaceData
 from tabletcad.errors import GeometryError
+from tabletcad.geometry.vectors import norm3
 
 __all__ = ["PatchFunction", "SurfaceFit", "SurfaceFunction", "chain_breakpoints", "fit_patches", "fit_surface"]
 
@@ -82,6 +83,21 @@ def _eval_f(f: SurfaceFunction, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.array(X)
 
 
+def _eval_f_components(f: SurfaceFunction, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``f`` on the tensor grid ``u x v``, components first: ``(3, len(u), len(v))`` mm.  A function
+    with ``grid_components`` (a PDE patch: :class:`PatchFunction`) gives that layout straight from its
+    matrix products, with no transposed copy; any other is evaluated by :func:`_eval_f` and viewed so."""
+    grid = getattr(f, "grid_components", None)
+    if grid is None:
+        return np.moveaxis(_eval_f(f, u, v), -1, 0)
+    X = np.asarray(grid(np.asarray(u, dtype=float), np.asarray(v, dtype=float)), dtype=float)
+    if X.shape != (3, np.size(u), np.size(v)):
+        raise GeometryError(f"grid_components returned shape {X.shape}", f)
+    if not np.all(np.isfinite(X)):
+        raise GeometryError("surface function returned non-finite values", f)
+    return X
+
+
 def _solve_poles(
     D: np.ndarray, u: np.ndarray, v: np.ndarray, u_degree: int, v_degree: int, v_knots, v_mults, u_periodic: bool
 ):
@@ -116,7 +132,7 @@ def _solve_poles(
 
 def _pole_point(row: np.ndarray, pole_tol: float) -> np.ndarray | None:
     centre = row.mean(axis=0)
-    if np.max(np.linalg.norm(row - centre, axis=-1)) <= pole_tol:
+    if np.max(norm3(row - centre)) <= pole_tol:
         return centre
     return None
 
@@ -167,9 +183,12 @@ def _deviation(f: SurfaceFunction, data: BSplineSurfaceData, u: np.ndarray, v: n
     # ``factor`` points per gap between consecutive (periodic) samples; column ``factor * j`` is sample j
     vs = np.concatenate([v, [v[0] + math.tau]])
     vc = (vs[:-1, None] + (np.arange(factor) / factor)[None, :] * np.diff(vs)[:, None]).ravel()
-    F = _eval_f(f, uc, vc)
-    D = data.evaluate_grid(uc, vc) - F
-    E = np.sqrt(np.einsum("...k,...k->...", D, D))
+    # components first (3, len(uc), len(vc)), as the products make them: no transposed copies, and
+    # |D| from three contiguous planes (the squares summed x, z, y: the einsum over the last axis this
+    # replaced added them in that order, so the figures stay the same to the bit)
+    D = data.evaluate_grid(uc, vc, components=True)
+    D -= _eval_f_components(f, uc, vc)
+    E = np.sqrt(D[0] * D[0] + D[2] * D[2] + D[1] * D[1])
     # split: points on sample v-lines (pure u-interpolation error) and on sample u-lines
     err_u = float(E[:, ::factor].max())
     err_v = float(E[::factor, :].max())
@@ -313,10 +332,10 @@ def fit_patches(
     rows_start = [_eval_f(fj, zeros, v)[0] for fj in functions]
     shared: list[list[np.ndarray | None]] = [[None, None] for _ in range(n)]
     pairs = [(j, j + 1) for j in range(n - 1)]
-    if n > 1 and np.max(np.linalg.norm(rows_end[-1] - rows_start[0], axis=-1)) <= share_tol:
+    if n > 1 and np.max(norm3(rows_end[-1] - rows_start[0])) <= share_tol:
         pairs.append((n - 1, 0))
     for a, b in pairs:
-        gap = float(np.max(np.linalg.norm(rows_end[a] - rows_start[b], axis=-1)))
+        gap = float(np.max(norm3(rows_end[a] - rows_start[b])))
         if gap > share_tol:
             raise GeometryError(
                 f"{names[a]} (u=1) and {names[b]} (u=0) do not share their boundary curve: gap {gap:.3g} mm",
@@ -377,7 +396,7 @@ def _with_rows(fit: SurfaceFit, rows, v: np.ndarray, u_degree: int, v_degree: in
                                   tuple(rows), s.v_knots, s.v_mults)
     if data.shape != s.shape:
         return None
-    moved = float(np.max(np.linalg.norm(data.poles - s.poles, axis=-1)))
+    moved = float(np.max(norm3(data.poles - s.poles)))
     bound = fit.max_deviation + moved
     if bound > fit.tol:
         return None
@@ -390,9 +409,13 @@ class PatchFunction:
     matrix products), which :func:`fit_surface` uses when present."""
 
     def __init__(self, patch) -> None:
+        from tabletcad.geometry.patch import PDEPatch  # (here: brep.fit alone does not load the patches)
+
         self.patch = patch
         if hasattr(patch, "evaluate_grid"):
             self.evaluate_grid = lambda u, v: np.asarray(patch.evaluate_grid(u, v))
+        if isinstance(patch, PDEPatch):  # the same grid, components first (no transposed copy)
+            self.grid_components = lambda u, v: patch.evaluate_grid(u, v, components=True)
 
     def __call__(self, u, v) -> np.ndarray:
         return np.asarray(self.patch.evaluate(u, v))

@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from functools import lru_cache
 
 import numpy as np
 
@@ -300,6 +301,17 @@ def _lattice_cells(n_cells: int, n: int) -> tuple[np.ndarray, np.ndarray]:
     return cell, k - n * cell
 
 
+@lru_cache(maxsize=4)
+def _lattice_table(n: int) -> tuple[np.ndarray, ...]:
+    """:func:`_lattice_weights` of every step ``(a, b)`` of an ``n``-step lattice in a cell, for both
+    diagonals: four read-only ``(2, n + 1, n + 1)`` arrays (the same for every surface and round: made once)."""
+    steps = np.arange(n + 1) / n
+    table = _lattice_weights(steps[None, :, None], steps[None, None, :], np.array([False, True])[:, None, None])
+    for w in table:
+        w.setflags(write=False)
+    return table
+
+
 def _cell_deviation(s: BSplineSurfaceData, u: np.ndarray, v: np.ndarray, V: np.ndarray, corners, diag,
                     curvature: float, col: _Collocation) -> np.ndarray:
     """Distance (mm) from the triangles to the surface, estimated at every point of the lattice of
@@ -322,8 +334,7 @@ def _cell_deviation(s: BSplineSurfaceData, u: np.ndarray, v: np.ndarray, V: np.n
 
     # the weights depend only on a point's steps (a, b) in its cell and the cell's diagonal: a table of
     # the 2 (n + 1)² values (_lattice_weights' own arithmetic on the same numbers), taken at each point
-    steps = np.arange(n + 1) / n
-    table = _lattice_weights(steps[None, :, None], steps[None, None, :], np.array([False, True])[:, None, None])
+    table = _lattice_table(n)
     code = spread(diag.astype(np.intp)) * (n + 1) ** 2 + (a[:, None] * (n + 1) + b[None, :])
     M = None  # (3, n nu1 + 1, n m + 1): the weighted corners, summed in place (the same sums, fewer arrays)
     for w, idx in zip(table, corners):

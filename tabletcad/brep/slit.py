@@ -31,6 +31,7 @@ import numpy as np
 
 from tabletcad.brep.surface import BSplineSurfaceData, segments_v
 from tabletcad.errors import GeometryError
+from tabletcad.geometry.vectors import norm3
 
 __all__ = ["chain_face_surfaces", "row_pieces"]
 
@@ -63,7 +64,7 @@ def row_pieces(data: BSplineSurfaceData, row: int, tol: float = 1e-7):
     for k, (a, b) in enumerate(spans):
         p = rows[k * t.size:(k + 1) * t.size]
         pts.append(p)
-        pieces.append((a, b, "point" if float(np.max(np.linalg.norm(p - p[0], axis=-1))) <= tol else "run"))
+        pieces.append((a, b, "point" if float(np.max(norm3(p - p[0]))) <= tol else "run"))
     return pieces, pts, u_row
 
 
@@ -102,7 +103,7 @@ def _standing_rows(data: BSplineSurfaceData, tol: float, made: dict | None = Non
                 pieces = segments_v(data, spans)
                 if made is not None:
                     made[id(data)] = (cuts, pieces)
-            spread = [float(np.max(np.linalg.norm(q.poles[k] - q.poles[k][0], axis=-1))) for q in pieces]
+            spread = [float(np.max(norm3(q.poles[k] - q.poles[k][0]))) for q in pieces]
             if all(x <= tol or x > 100.0 * tol for x in spread):  # clear either way: the poles say it
                 kinds = ["point" if x <= tol else "run" for x in spread]
         if kinds is None:  # not clamped, across the seam, or poles just beyond tol: the row's samples
@@ -129,7 +130,7 @@ def _pieces(data: BSplineSurfaceData, cuts: list[float], tol: float,
         poles = None
         for k in (0, -1):
             r = piece.poles[k]
-            spread = float(np.max(np.linalg.norm(r - r[0], axis=-1)))
+            spread = float(np.max(norm3(r - r[0])))
             if 0.0 < spread <= 10.0 * tol:  # a collapsed row: one pole, so every kernel makes it degenerate
                 poles = np.array(piece.poles) if poles is None else poles
                 poles[k] = r.mean(axis=0)
@@ -160,7 +161,7 @@ def chain_face_surfaces(surfaces, tol: float = 1e-7, names=None) -> list[tuple[B
     for data, name in zip(surfaces, names):
         for k, pieces in _standing_rows(data, tol, made).items():
             other = np.asarray(data.poles[-1 if k == 0 else 0])
-            if float(np.max(np.linalg.norm(other - other[0], axis=-1))) <= tol:
+            if float(np.max(norm3(other - other[0]))) <= tol:
                 raise GeometryError(f"{name}: a row that stands still in part opposite a pole is not supported", data)
             cuts.update(x for a, b, _ in pieces for x in (a, b))
     if not cuts:

@@ -43,6 +43,7 @@ from OCP.TopoDS import TopoDS_Edge, TopoDS_Face, TopoDS_Shell, TopoDS_Vertex, To
 from tabletcad.brep.surface import BSplineSurfaceData
 from tabletcad.cad.faces import iso_u_pcurve, v_breaks
 from tabletcad.cad.planes import coplanar, plane_face_of_loops
+from tabletcad.geometry.vectors import norm3
 
 __all__ = ["assemble_shell"]
 
@@ -52,7 +53,7 @@ EDGE_TOL = 1e-7  # mm: Precision::Confusion, the tolerance MakeFace gives its ed
 
 
 def _spread(points: np.ndarray) -> float:
-    return float(np.max(np.linalg.norm(points - points[0], axis=-1)))
+    return float(np.max(norm3(points - points[0])))
 
 
 def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
@@ -230,7 +231,7 @@ def assemble_shell(pieces: Sequence[Sequence[BSplineSurfaceData]],
                 prev = pieces[j][(k - 1) % n_piece].poles[:, -1]
                 if prev.shape != d.poles[:, 0].shape:
                     return None
-                tol += 1.01 * float(np.max(np.linalg.norm(prev - d.poles[:, 0], axis=-1)))
+                tol += 1.01 * float(np.max(norm3(prev - d.poles[:, 0])))
             e = TopoDS_Edge()
             B.MakeEdge(e, s.VIso(v_ranges[k][0]), tol)
             B.Add(e, vertices[j][k].Oriented(_FORWARD))
@@ -351,7 +352,7 @@ def _runs_back(rows: Sequence[tuple[BSplineSurfaceData, int, int]], tol_degen: f
             Pm = np.asarray(dm.poles[im])
             if m == k or Pm.shape != Pk.shape or len(dm.v_knots) != len(dk.v_knots):
                 continue
-            if float(np.max(np.linalg.norm(Pk - Pm[::-1], axis=-1))) > tol_degen:
+            if float(np.max(norm3(Pk - Pm[::-1]))) > tol_degen:
                 continue
             if not (np.allclose(np.diff(dk.v_knots), np.diff(dm.v_knots)[::-1], rtol=0.0, atol=1e-12)
                     and np.array_equal(dk.v_mults, dm.v_mults[::-1])):
