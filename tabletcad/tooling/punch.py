@@ -345,8 +345,8 @@ def tip_cell(body, tablet_shape, z_mid: float, z0: float, z1: float, which: str,
     when the split does not give one such cell.
 
     ``memo``: ``(frame, inset)`` when ``body`` is the prism of ``frame``'s outline inset by ``inset`` (mm)
-    from ``z0`` to ``z1``: a split of the same faces (``IsEqual``, in :func:`_faces_in_order`) by the prism of the
-    same frame's outline (its tablet the same object, its plain solid the same shape, so the same
+    from ``z0`` to ``z1``: a split of the same faces (``IsEqual``, in :func:`_faces_in_order`) by the prism
+    of the same frame's outline (its tablet the same object, its plain solid the same shape, so the same
     outline: :func:`~tabletcad.tooling.outline.tablet_frame` is a function of them) is the cell found
     before, kept in :data:`~tabletcad.tooling.booleans.CACHE` (the plain and the scored tooling of one
     tablet cut the same lower tip from the same faces; 0.1-0.6 s a split)."""
