@@ -345,15 +345,16 @@ def tip_cell(body, tablet_shape, z_mid: float, z0: float, z1: float, which: str,
     when the split does not give one such cell.
 
     ``memo``: ``(frame, inset)`` when ``body`` is the prism of ``frame``'s outline inset by ``inset`` (mm)
-    from ``z0`` to ``z1``: a split of the same faces (``IsEqual``, in the same order) by the prism of the
-    same frame's outline (its tablet the same object, its plain solid the same shape, so the same
+    from ``z0`` to ``z1``: a split of the same faces (``IsEqual``, in :func:`_faces_in_order`) by the prism
+    of the same frame's outline (its tablet the same object, its plain solid the same shape, so the same
     outline: :func:`~tabletcad.tooling.outline.tablet_frame` is a function of them) is the cell found
     before, kept in :data:`~tabletcad.tooling.booleans.CACHE` (the plain and the scored tooling of one
     tablet cut the same lower tip from the same faces; 0.1-0.6 s a split)."""
     from tabletcad.cad._occ import explore
 
     up = which == "upper"
-    faces = [f for f in explore(tablet_shape, "Face") if (_z_range(f)[0] > z_mid if up else _z_range(f)[1] < z_mid)]
+    faces = _faces_in_order([f for f in explore(tablet_shape, "Face")
+                             if (_z_range(f)[0] > z_mid if up else _z_range(f)[1] < z_mid)])
     far, near = (z1, z0) if up else (z0, z1)
     tol = 1e-6
 
@@ -373,6 +374,25 @@ def tip_cell(body, tablet_shape, z_mid: float, z0: float, z1: float, which: str,
         return _memo_cell(frame, (which, float(inset), float(z_mid), float(z0), float(z1)), faces, split)
     except GeometryError:
         return boolean("cut", body, tablet_shape, what=f"{which} punch tip", sliver=1e-4)
+
+
+def _faces_in_order(faces: list) -> list:
+    """``faces`` sorted by their boxes' corners (``BRepBndLib.Add``, mm: x, y, z low then high; ties in
+    the order given), an order set by the faces alone.
+
+    The splitter's cell depends on the order of its faces, and a Boolean that leaves a face as it was
+    may list it elsewhere: a scored tablet's unscored bottom faces are the plain tablet's, reordered by
+    the score's cut (the oval's and the capsule's), so :func:`_memo_cell`, which needs them in the same
+    order, missed the lower tip a scored build after a plain one shares with it, and cut it again."""
+    def corners(face) -> tuple[float, ...]:
+        from OCP.Bnd import Bnd_Box
+        from OCP.BRepBndLib import BRepBndLib
+
+        box = Bnd_Box()
+        BRepBndLib.Add_s(face, box, False)
+        return (*box.CornerMin().Coord(), *box.CornerMax().Coord())
+
+    return [f for _, _, f in sorted(((corners(f), k, f) for k, f in enumerate(faces)), key=lambda e: e[:2])]
 
 
 def _memo_cell(frame: TabletFrame, numbers: tuple, faces: list, compute):
