@@ -161,6 +161,18 @@ def _cox_de_boor_guarded(t, degree, x, span):
     return out
 
 
+def _random_clamped_knots(seed: int, degree: int, repeat: bool) -> tuple[int, np.ndarray, np.ndarray]:
+    """``(n, t, x)``: a random clamped knot vector ``t`` on [0, 1] of ``n`` B-splines of ``degree`` (its
+    second interior knot repeated when ``repeat``) and parameters ``x`` on it, the ends and knots included."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(degree + 1, 30))
+    interior = np.sort(rng.uniform(0.0, 1.0, n - degree - 1))
+    if repeat and interior.size > 2:
+        interior[1] = interior[2]
+    t = np.concatenate([np.zeros(degree + 1), interior, np.ones(degree + 1)])
+    return n, t, np.concatenate([rng.uniform(0.0, 1.0, 50), [0.0, 1.0], interior])
+
+
 @settings(max_examples=60, deadline=None)
 @given(seed=st.integers(0, 2**31 - 1), degree=st.integers(1, 6), repeat=st.booleans())
 def test_basis_on_whole_columns_is_the_textbook_recursion_bit_for_bit(seed, degree, repeat):
@@ -169,13 +181,7 @@ def test_basis_on_whole_columns_is_the_textbook_recursion_bit_for_bit(seed, degr
     last bit, with repeated interior knots too; and they sum to 1 (partition of unity)."""
     from tabletcad.brep.knots import _find_span, basis_functions
 
-    rng = np.random.default_rng(seed)
-    n = int(rng.integers(degree + 1, 30))
-    interior = np.sort(rng.uniform(0.0, 1.0, n - degree - 1))
-    if repeat and interior.size > 2:
-        interior[1] = interior[2]
-    t = np.concatenate([np.zeros(degree + 1), interior, np.ones(degree + 1)])
-    x = np.concatenate([rng.uniform(0.0, 1.0, 50), [0.0, 1.0], interior])
+    n, t, x = _random_clamped_knots(seed, degree, repeat)
     span, N = basis_functions(t, degree, n, x)
     np.testing.assert_array_equal(span, _find_span(t, degree, n, x))
     np.testing.assert_array_equal(N, _cox_de_boor_guarded(t, degree, x, span))
@@ -190,13 +196,7 @@ def test_basis_derivatives_are_the_textbook_formula_bit_for_bit(seed, degree, re
     dropped), with repeated interior knots too, and sum to 0."""
     from tabletcad.brep.knots import _find_span, basis_derivatives
 
-    rng = np.random.default_rng(seed)
-    n = int(rng.integers(degree + 1, 30))
-    interior = np.sort(rng.uniform(0.0, 1.0, n - degree - 1))
-    if repeat and interior.size > 2:
-        interior[1] = interior[2]
-    t = np.concatenate([np.zeros(degree + 1), interior, np.ones(degree + 1)])
-    x = np.concatenate([rng.uniform(0.0, 1.0, 50), [0.0, 1.0], interior])
+    n, t, x = _random_clamped_knots(seed, degree, repeat)
     span, dN = basis_derivatives(t, degree, n, x, 1)
     np.testing.assert_array_equal(span, _find_span(t, degree, n, x))
     lower = _cox_de_boor_guarded(t, degree - 1, x, span) if degree > 1 else np.ones((x.size, 1))
