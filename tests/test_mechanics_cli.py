@@ -383,6 +383,32 @@ def _refused_writing_nothing(capsys, tmp_path, args, line):
     assert sorted(p.name for p in tmp_path.iterdir()) == before
 
 
+@pytest.mark.parametrize("args, line", [
+    # had been exit 1: OverflowError in eq 2.1's cubic
+    (["contact", "--force", "100", "--radius", "1e300"],
+     "error: --radius = 1e+300 mm is not allowed: must be > 0 and <= 1000 mm"),
+    # had been exit 1: ZeroDivisionError (the contact radius at yield underflowed to 0)
+    (["strength", "sphere", "--force", "100", "--E", "1e300", "--nu", "0.3", "--radius", "5", "--s-y", "10"],
+     "error: --E = 1e+300 MPa is not allowed: must be > 0 and <= 1e+07 MPa"),
+    # had been exit 0 with "tensile strength = 0 MPa"
+    (["strength", "sphere", "--force", "100", "--E", "1000", "--nu", "0.3", "--radius", "1e300", "--s-y", "10"],
+     "error: --radius = 1e+300 mm is not allowed: must be > 0 and <= 1000 mm"),
+    (["strength", "sphere", "--force", "100", "--E", "1000", "--nu", "0.3", "--radius", "5", "--s-y", "1e300"],
+     "error: --s-y = 1e+300 MPa is not allowed: must be > 0 and <= 10000 MPa"),
+])
+def test_sphere_inputs_out_of_range_are_refused_by_their_options(capsys, tmp_path, args, line):
+    _refused_writing_nothing(capsys, tmp_path, args, line)
+
+
+def test_sphere_at_the_length_limit_still_runs(capsys):
+    """A 1000 mm sphere (the size limit itself) is taken by contact and strength alike."""
+    rc, out, err = run(capsys, "contact", "--force", 100, "--radius", 1000)
+    assert rc == 0 and err == "" and "r_s = 1000 mm" in out
+    rc, out, err = run(capsys, "strength", "sphere", "--force", 100, "--E", 1e7, "--nu", 0.3, "--radius", 1000,
+                       "--s-y", 10000)
+    assert rc == 0 and err == "" and "tensile strength" in out
+
+
 @pytest.mark.parametrize("table, line", [
     # an empty table had been taken as no compliance: exit 0, K = 0.00988 instead of 0.008557 1/MPa, no word
     ("force = []\ndeflection = []\n",

@@ -472,8 +472,8 @@ def contact_cmd(material: str, forces: tuple[float, ...], radius: float | None, 
     _check_json_file(json_file, plot=plot_file)
     for f in forces:
         check_finite("--force", f, "N")
-    if radius is not None:
-        check_positive("--radius", radius, "mm")
+    if radius is not None:  # a length, as a design's (1e300 mm had overflowed eq 2.1's cubic: exit 1)
+        check_range("--radius", radius, 0.0, DEFAULT.max_length, "mm", lo_open=True)
     with _collect() as msgs, option_names({"material": "--material", "radius": "--radius", "force": "--force"}):
         m = get_material(material)
         results = [ct.compress_sphere(f, m, radius) for f in forces]

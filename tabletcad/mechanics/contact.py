@@ -39,6 +39,7 @@ import numpy as np
 
 from tabletcad.errors import DesignError, check_positive, check_range, format_bound
 from tabletcad.mechanics.materials import Material, get_material
+from tabletcad.tolerance import DEFAULT, MAX_MODULUS_MPA, MAX_YIELD_MPA
 
 __all__ = [
     "CompressedSphere",
@@ -189,9 +190,22 @@ def contact_radius(omega, r_s: float) -> np.ndarray:
 
 
 def contact_radius_at_yield(E: float, nu: float, r_s: float, s_y: float) -> float:
-    """Contact radius (mm) of eq 2.11, ``π s_y r_s (1-ν²) / (2E)`` (= eq 5.23 at ω = ω')."""
-    return math.pi * check_positive("s_y", s_y, "MPa") * check_positive("r_s", r_s, "mm") * (
-        1.0 - _nu(nu) ** 2) / (2.0 * check_positive("E", E, "MPa"))
+    """Contact radius (mm) of eq 2.11, ``π s_y r_s (1-ν²) / (2E)`` (= eq 5.23 at ω = ω').
+
+    ``E`` (MPa) at most ``MAX_MODULUS_MPA``, ``r_s`` (mm) at most ``Tolerances.max_length`` and ``s_y``
+    (MPa) at most ``MAX_YIELD_MPA``: E = 1e300 had underflowed the radius to 0 (a division by zero, exit
+    1 in ``tabletcad strength sphere``), and r_s or s_y = 1e300 had read a tensile strength of 0 MPa.
+    """
+    s_y = check_range("s_y", s_y, 0.0, MAX_YIELD_MPA, "MPa", lo_open=True)
+    r_s = _radius("r_s", r_s)
+    E = check_range("E", E, 0.0, MAX_MODULUS_MPA, "MPa", lo_open=True)
+    return math.pi * s_y * r_s * (1.0 - _nu(nu) ** 2) / (2.0 * E)
+
+
+def _radius(name: str, r: float) -> float:
+    """A sphere's radius (mm): > 0 and at most ``Tolerances.max_length``, as a design's lengths (a radius of
+    1e300 mm had overflowed eq 2.1's cubic: exit 1 in ``tabletcad contact``)."""
+    return check_range(name, r, 0.0, DEFAULT.max_length, "mm", lo_open=True)
 
 
 def _props(material: Material | str, radius: float | None):
@@ -199,7 +213,7 @@ def _props(material: Material | str, radius: float | None):
     r = radius if radius is not None else m.radius
     if r is None or m.s_y is None:
         raise DesignError("material", m.key, "needs a radius and a micro-yield strength s_y for contact laws")
-    r = check_positive("radius", r, "mm")
+    r = _radius("radius", r)
     return m, r, yield_displacement(m.E, m.nu, r, m.s_y)
 
 
