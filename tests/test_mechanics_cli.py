@@ -400,6 +400,18 @@ def test_sphere_inputs_out_of_range_are_refused_by_their_options(capsys, tmp_pat
     _refused_writing_nothing(capsys, tmp_path, args, line)
 
 
+@pytest.mark.parametrize("option", ["--outer", "--inner"])
+def test_shell_radii_keep_the_size_limit(capsys, tmp_path, option):
+    """--outer 1e300 had run: u_r(a) = -4e+297 mm, exit 0; the radii are lengths, at most 1000 mm."""
+    radii = {"--outer": "5", "--inner": "3", option: "1e300"}
+    args = ["shell", "--outer", radii["--outer"], "--inner", radii["--inner"], "--E", "1000", "--nu", "0.3",
+            "--p-ext", "10"]
+    _refused_writing_nothing(capsys, tmp_path, args,
+                             f"error: {option} = 1e+300 mm is not allowed: must be > 0 and <= 1000 mm")
+    rc, out, err = run(capsys, "shell", "--outer", 1000, "--inner", 999, "--E", 1000, "--nu", 0.3, "--p-ext", 10)
+    assert rc == 0 and "a = 1000 mm" in out
+
+
 def test_sphere_at_the_length_limit_still_runs(capsys):
     """A 1000 mm sphere (the size limit itself) is taken by contact and strength alike."""
     rc, out, err = run(capsys, "contact", "--force", 100, "--radius", 1000)

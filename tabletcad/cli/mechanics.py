@@ -517,8 +517,8 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
         raise DesignError("--plot", str(plot_file), "must differ from --csv")
     _check_json_file(json_file, csv=csv_file, plot=plot_file)
     check_range("--terms", terms, 2, 20000)
-    for name, v in (("--outer", a), ("--inner", b)):
-        check_positive(name, v, "mm")
+    for name, v in (("--outer", a), ("--inner", b)):  # lengths within the size limit (1e300 had run: exit 0)
+        check_range(name, v, 0.0, DEFAULT.max_length, "mm", lo_open=True)
     check_range("--E", E, 0.0, MAX_MODULUS_MPA, "MPa", lo_open=True)
     if b >= a:
         raise DesignError("--inner", b, f"must be < --outer = {format_bound(a, upper=True)} mm (inner radius below outer)", "mm")

@@ -50,6 +50,7 @@ from pathlib import Path
 import numpy as np
 
 from tabletcad.errors import DesignError, check_positive, check_range, format_bound
+from tabletcad.tolerance import DEFAULT
 
 __all__ = [
     "ShellSolution",
@@ -276,8 +277,10 @@ def solve_shell(
     -------
     ShellSolution
     """
-    a = check_positive("a", a, "mm")
-    b = check_positive("b", b, "mm")
+    # radii are lengths, as a design's: at most Tolerances.max_length (a = 1e300 mm had given u_r = -4e297 mm,
+    # exit 0)
+    a = check_range("a", a, 0.0, DEFAULT.max_length, "mm", lo_open=True)
+    b = check_range("b", b, 0.0, DEFAULT.max_length, "mm", lo_open=True)
     if not b < a:
         raise DesignError("b", b, f"must be < a = {format_bound(a, upper=True)} (inner radius below outer)", "mm")
     E = check_positive("E", E, "MPa")
