@@ -500,7 +500,9 @@ OMEGA_WHY = ("(so that the bed stays thicker than 0, at least 3 of the 41 "
 
 
 @pytest.mark.parametrize("args, line", [
-    (["--r", "100"], "error: --r = 100 mm is not allowed: must be > 0 and <= 5 mm"),  # had been "r = 100 mm"
+    (["--r", "100"], "error: --r = 100 mm is not allowed: must be >= 0.001 and <= 5 mm"),  # had been "r = 100 mm"
+    # had been exit 1: ZeroDivisionError (r * r underflowed to 0)
+    (["--r", "1e-300"], "error: --r = 1e-300 mm is not allowed: must be >= 0.001 and <= 5 mm"),
     # had been refused as "relative_density = 'at most 2.94e-300'"
     (["--omega-z0", "1e300"], "error: --omega-z0 = 1e+300 mm is not allowed: must be > -2.80315 and <= 6 mm " + OMEGA_WHY),
     # had been "pressure = 10 MPa", then "the model then compresses the 6 mm bed to zero thickness at 10 MPa"

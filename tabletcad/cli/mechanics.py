@@ -653,7 +653,7 @@ def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json, json_file) -> None:
                           "within the bed; or give a lower --z)", "mm")
     check_range("--z", z, 0.0, h0, "mm")  # a height within the bed (above it, eq 5.18 gave K = -0.015 1/MPa)
     if r is not None:  # a radius within the die (the model's own check named it r)
-        check_range("--r", r, 0.0, THESIS_DIAMETER / 2.0, "mm", lo_open=True)
+        check_range("--r", r, DEFAULT.min_length, THESIS_DIAMETER / 2.0, "mm")  # (1e-300 had divided by 0)
     if omega_z0 is not None:  # a shift of the punch face by more than the bed's height: 1e300 mm had been
         # refused as a relative density; within it, where the model runs (-5.9 mm in a 6 mm bed had been
         # offered by "must be >= -6 and <= 6 mm", then refused as a bed pressed to nothing)

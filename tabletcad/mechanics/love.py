@@ -152,7 +152,7 @@ def axial_displacement(
     h0 : float
         Initial bed height, mm.
     z, r : float
-        Point at which the displacement is evaluated, mm (``0 < r <= c``).
+        Point at which the displacement is evaluated, mm (``Tolerances.min_length <= r <= c``).
     omega_z0 : float
         Adjustment of eq 5.18, mm.
     scale : {"thesis", "derived"}
@@ -164,7 +164,9 @@ def axial_displacement(
     nu = check_range("nu", nu, 0.0, 0.5, hi_open=True)
     c = check_positive("c", c, "mm")
     h0 = check_positive("h0", h0, "mm")
-    r = check_range("r", r, 0.0, c, "mm", lo_open=True)
+    # a radius is a length: 0 or at least Tolerances.min_length, and 0 divides (r = 1e-300 mm had squared to
+    # 0: ZeroDivisionError, exit 1 in `tabletcad love --r 1e-300`)
+    r = check_range("r", r, DEFAULT.min_length, c, "mm")
     z = check_range("z", z, 0.0, None, "mm")
     if scale not in ("thesis", "derived"):
         raise DesignError("scale", scale, "must be 'thesis' or 'derived'")
@@ -306,7 +308,7 @@ _BISECTIONS = 48
 
 def _model_limits(name: str, model: dict) -> tuple[float, float, bool]:
     """The scan of :func:`model_range` for ``name``: ``(low, high, log scale)``, within the model's own
-    checks (E > 0 MPa up to 1e7, 0 <= nu < 0.5, z <= h0 <= 1000 mm, 0 <= z <= h0, 0 < r <= c)."""
+    checks (E > 0 MPa up to 1e7, 0 <= nu < 0.5, z <= h0 <= 1000 mm, 0 <= z <= h0, 0.001 mm <= r <= c)."""
     c = model.get("diameter", THESIS_DIAMETER) / 2.0
     h0 = model.get("h0", THESIS_H0)
     z = model.get("z", THESIS_Z)
@@ -314,7 +316,7 @@ def _model_limits(name: str, model: dict) -> tuple[float, float, bool]:
               "nu": (0.0, math.nextafter(0.5, 0.0), False),
               "h0": (max(z, 1e-3), DEFAULT.max_length, True),
               "z": (0.0, h0, False),
-              "r": (c * 1e-6, c, False)}
+              "r": (DEFAULT.min_length, c, False)}
     if name not in limits:
         raise DesignError("name", name, f"must be one of {', '.join(limits)}")
     return limits[name]
