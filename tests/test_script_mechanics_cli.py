@@ -89,6 +89,27 @@ def test_bad_input_is_one_line_and_writes_nothing(capsys, tmp_path, monkeypatch,
     assert sorted(tmp_path.iterdir()) == before
 
 
+@pytest.mark.parametrize("command", ["kawakita", "walker"])
+@pytest.mark.parametrize("rows, extra, line", [
+    # --h0 = 1e300 mm had fitted Walker's W = 1.5e-298 % per decade, exit 0
+    ("0,6\n10,5\n20,4.5\n40,4\n", ["--h0", "1e300"], "error: --h0 = 1e+300 mm is not allowed: must be > 0 and <= 1000 mm"),
+    # thicknesses of 1e300 mm had been fitted as a compact's, exit 0
+    ("0,1e300\n10,5e299\n20,4e299\n40,3e299\n", [],
+     "error: \"k.csv\".line[2].thickness_mm = 1e+300 mm is not allowed: must be > 0 and <= 1000 mm (the compact's "
+     "thickness)"),
+    # a pressure of 1e300 MPa had given Kawakita's a = inf, R² = nan, exit 0
+    ("0,6\n1e300,5\n2e300,4\n4e300,3\n", [],
+     "error: \"k.csv\".line[3].pressure_MPa = 1e+300 MPa is not allowed: must be >= 0 and <= 100000 MPa (a "
+     "compaction pressure)"),
+])
+def test_compression_tables_keep_a_compacts_sizes(capsys, tmp_path, command, rows, extra, line):
+    data = tmp_path / "k.csv"
+    data.write_text("pressure_MPa,thickness_mm\n" + rows, encoding="utf-8")
+    rc, out, err = run(capsys, command, data, *extra, "--json-file", tmp_path / "k.json")
+    assert rc == 2 and out == "" and err.splitlines() == [line]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["k.csv"]
+
+
 def test_non_numeric_cell(capsys, tmp_path):
     data = tmp_path / "bad.csv"
     data.write_text("pressure_MPa,thickness_mm\n10,9.5\nx,9\n", encoding="utf-8")
@@ -270,6 +291,13 @@ def test_a_bracket_saying_no_unit_is_no_unit(capsys, tmp_path, bracket):
      "strength)"),
     ("50.0,0.7,1.32\n-100.0,0.78,2.14\n150.0,0.83,2.88\n",
      "error: \"prof6.csv\".line[3].pressure_MPa = -100 MPa is not allowed: must be >= 0 (a compaction pressure)"),
+    # 1e300 MPa of a pressure or a strength had been fitted and plotted, exit 0
+    ("50.0,0.7,1.32\n1e300,0.78,2.14\n150.0,0.83,2.88\n",
+     "error: \"prof6.csv\".line[3].pressure_MPa = 1e+300 MPa is not allowed: must be >= 0 and <= 100000 MPa (a "
+     "compaction pressure)"),
+    ("50.0,0.7,1.32\n100.0,0.78,1e300\n150.0,0.83,2.88\n",
+     "error: \"prof6.csv\".line[3].tensile_strength_MPa = 1e+300 MPa is not allowed: must be > 0 and <= 1000 MPa "
+     "(a tablet's tensile strength)"),
 ])
 def test_profiles_name_the_row_and_column_of_a_bad_value(capsys, tmp_path, rows, line):
     data = tmp_path / "prof6.csv"

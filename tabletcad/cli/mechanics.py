@@ -24,7 +24,7 @@ from tabletcad.cli.outputs import check_output as _check_output
 from tabletcad.io.jsontext import json_text
 from tabletcad.cli.outputs import staged as _staged
 from tabletcad.errors import MISSING, DesignError, check_finite, check_positive, check_range, format_bound
-from tabletcad.tolerance import DEFAULT, MAX_MODULUS_MPA, MAX_PRESSURE_MPA
+from tabletcad.tolerance import DEFAULT, MAX_MODULUS_MPA, MAX_PRESSURE_MPA, MAX_TENSILE_STRENGTH_MPA
 
 __all__ = ["COMMANDS"]
 
@@ -209,8 +209,8 @@ def _compression_table(data: Path, pressure_column: str, thickness_column: str, 
     _check_input("DATA", data)
     _check_output("--json-file", json_file, (".json",))
     _check_window(window)
-    if h0 is not None:
-        check_positive("--h0", h0, "mm")
+    if h0 is not None:  # a length within the size limit (1e300 had fitted W = 1.5e-298 % per decade, exit 0)
+        check_range("--h0", h0, 0.0, DEFAULT.max_length, "mm", lo_open=True)
     table = _read_table(data, {"P": (pressure_column, "pressure"), "h": (thickness_column, "length")})
     bad = np.flatnonzero(~(table["h"] > 0.0))
     if bad.size:  # a thickness is a length: 0 or less is a misread column or a displacement
@@ -220,7 +220,30 @@ def _compression_table(data: Path, pressure_column: str, thickness_column: str, 
     if bad.size:  # a compact is pressed, never pulled: a negative pressure is a misread column
         raise DesignError(f"{data.name!r} line {int(table['_lines'][bad[0]])} {pressure_column!r}",
                           float(table["P"][bad[0]]), "must be >= 0 (a compaction pressure)", "MPa")
+    _refuse_too_large(data, table, pressure_column, thickness_column)
     return table
+
+
+def _refuse_too_large(data: Path, table: dict[str, np.ndarray], pressure_column: str, thickness_column: str) -> None:
+    """Refuse a pressure above ``MAX_PRESSURE_MPA`` or a thickness above ``Tolerances.max_length`` in a
+    compression table, named by its file, line and column.
+
+    A pressure of 1e300 MPa had fitted Kawakita's a = inf with R² = nan, and thicknesses of 1e300 mm
+    had been fitted as a tablet's, exit 0: no compact has them.
+
+    Parameters
+    ----------
+    data : Path
+        The table's file.
+    table : dict of str to ndarray
+        Its columns ``P`` (MPa), ``h`` (mm) and ``_lines``.
+    pressure_column, thickness_column : str
+        The columns' headers as the command line names them.
+    """
+    _refuse_row(data, table, "P", pressure_column, table["P"] > MAX_PRESSURE_MPA,
+                f"must be >= 0 and <= {MAX_PRESSURE_MPA:g} MPa (a compaction pressure)", "MPa")
+    _refuse_row(data, table, "h", thickness_column, table["h"] > DEFAULT.max_length,
+                f"must be > 0 and <= {DEFAULT.max_length:g} mm (the compact's thickness)", "mm")
 
 
 def _compression_options(f):
@@ -346,6 +369,11 @@ def profiles_cmd(data: Path, pressure_column: str, solid_fraction_column: str, s
                 "must be > 0 and < 1 (a solid fraction; a percentage needs '%' in its header, as "
                 "'Solid fraction (%)')")
     _refuse_row(data, t, "s", strength_column, ~(t["s"] > 0.0), "must be > 0 (a tablet's tensile strength)", "MPa")
+    # no compact has these (1e300 MPa of either had been plotted and fitted, exit 0)
+    _refuse_row(data, t, "P", pressure_column, t["P"] > MAX_PRESSURE_MPA,
+                f"must be >= 0 and <= {MAX_PRESSURE_MPA:g} MPa (a compaction pressure)", "MPa")
+    _refuse_row(data, t, "s", strength_column, t["s"] > MAX_TENSILE_STRENGTH_MPA,
+                f"must be > 0 and <= {MAX_TENSILE_STRENGTH_MPA:g} MPa (a tablet's tensile strength)", "MPa")
     porosity = not as_solid_fraction
     with _collect() as msgs:
         profs = [tabletability(t["P"], t["s"]), compressibility(t["P"], t["sf"], as_porosity=porosity),
