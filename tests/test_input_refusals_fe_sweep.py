@@ -54,6 +54,20 @@ def test_fe_strength_names_the_reference_options(tmp_path, capsys, args, line):
     assert rc == 2 and capsys.readouterr().err.strip().splitlines() == [line]
 
 
+@pytest.mark.parametrize("E", ["210", "1e300"])
+def test_fe_punch_takes_a_punch_steels_modulus(tmp_path, capsys, E):
+    """``--E 210`` (210 GPa typed as MPa) had been taken, rating the tip's buckling a thousand times too low,
+    and 1e300 too: the range is [tooling] punch_youngs_modulus_MPa's, refused before the design is read."""
+    from pathlib import Path
+
+    sample = Path(__file__).resolve().parents[1] / "samples" / "tooling" / "tsm_b_round.toml"
+    rc = main(["fe", "punch", str(sample), "--force", "10", "--steel", "S7_tempered_205C", "--E", E,
+               "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and err == [f"error: --E = {float(E):g} MPa is not allowed: must be >= 50000 and <= 1e+07 MPa"]
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_fe_on_a_cut_away_is_bad_input_not_a_geometry_failure(tmp_path, capsys):
     from pathlib import Path
 

@@ -17,7 +17,8 @@ from tabletcad.cli.options import option_names
 from tabletcad.cli.outputs import out_folder
 from tabletcad.io.jsontext import json_text
 from tabletcad.errors import MISSING, DesignError, check_range
-from tabletcad.tolerance import MAX_EFFECTIVE_LENGTH_FACTOR, MAX_YIELD_MPA, MIN_FORCE_N, MIN_YIELD_MPA
+from tabletcad.tolerance import (MAX_EFFECTIVE_LENGTH_FACTOR, MAX_MODULUS_MPA, MAX_YIELD_MPA, MIN_FORCE_N,
+                                 MIN_PUNCH_MODULUS_MPA, MIN_YIELD_MPA)
 
 __all__ = ["COMMANDS"]
 
@@ -280,7 +281,7 @@ def strength_cmd(design: Path, tensile_strength: float | None, reference_force: 
 @click.option("--punch", "which", type=click.Choice(["upper", "lower"]), default="upper", show_default=True)
 @click.option("--steel", default=None, help="Tool steel from tabletcad/data/tool_steels.toml (yield stress and E).")
 @click.option("--yield-stress", type=float, default=None, help="Steel yield stress, MPa, 100-10000 (instead of --steel).")
-@click.option("--E", "E", type=float, default=None, help="Steel Young's modulus, MPa [default: the steel's, else 206000].")
+@click.option("--E", "E", type=float, default=None, help="Steel Young's modulus, MPa, 5e4-1e7 [default: the steel's, else 206000].")
 @click.option("--safety-factor", type=float, default=1.5, show_default=True)
 @click.option("--effective-length-factor", type=float, default=2.0, show_default=True,
               help="Buckling: K of the tip column (2 = fixed at the barrel, free at the tip).")
@@ -301,6 +302,9 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
     check_range("--effective-length-factor", effective_length_factor, 0.0, MAX_EFFECTIVE_LENGTH_FACTOR, lo_open=True)
     if yield_stress is not None:
         check_range("--yield-stress", yield_stress, MIN_YIELD_MPA, MAX_YIELD_MPA, "MPa")  # a steel's, in MPa
+    if E is not None:  # a punch steel's, in MPa, as [tooling] punch_youngs_modulus_MPa (210 for 210 GPa had rated
+        # the tip's buckling a thousand times too low, and 1e300 had been taken)
+        check_range("--E", E, MIN_PUNCH_MODULUS_MPA, MAX_MODULUS_MPA, "MPa")
     _check_json_file(json_file)
     _check_out(out)
     from tabletcad.fe.punch import tool_steels
