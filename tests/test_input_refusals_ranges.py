@@ -209,3 +209,20 @@ def test_a_refusal_of_a_default_says_so(tmp_path, capsys):
         "error: tablet.edge_radius = 0 mm is not allowed: must be > 0 for a compound cup (give both radii, or neither) "
         "(edge_radius is not given: the value it takes by default)"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["d.toml"]
+
+
+def test_a_curve_without_its_height_is_refused_not_placed_at_zero(tmp_path, capsys):
+    """The stadium sample with its first curve's ``z = 0.0`` left out had built (the curve put at z = 0 by
+    default, exit 0): a height guessed.  A curve needs ``z`` or ``center``, or ``[x, y, z]`` points."""
+    from pathlib import Path
+
+    sample = (Path(__file__).resolve().parents[1] / "samples" / "free_form_stadium.toml").read_text(encoding="utf-8")
+    text = sample.replace('{ type = "circle", radius = 0.0, z = 0.0 }', '{ type = "circle", radius = 0.0 }', 1)
+    assert text != sample
+    design = tmp_path / "d.toml"
+    design.write_text(text, encoding="utf-8")
+    assert main(["build", str(design), "--out", str(tmp_path / "out")]) == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        "error: patch[0].curves[0].z = (not given) is not allowed: a circle curve needs its height z (mm) or its "
+        "center [x, y, z] (mm)"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.toml"]

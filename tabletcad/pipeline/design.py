@@ -126,6 +126,14 @@ def _check_keys(where: str, table: dict, allowed: set[str]) -> None:
                               f"allowed keys{' of ' + where if where else ''} are {', '.join(sorted(allowed))}")
 
 
+def _points_in_space(kind: str, spec: dict) -> bool:
+    """Whether a curve table places itself without ``z`` or ``center``: a ``points`` curve whose every point
+    is ``[x, y, z]`` (mm)."""
+    pts = spec.get("points")
+    return kind == "points" and isinstance(pts, list) and bool(pts) and all(
+        isinstance(q, list) and len(q) == 3 for q in pts)
+
+
 def _curve(spec: Any, where: str, previous: Curve | None) -> Curve:
     if spec == "previous":
         if previous is None:
@@ -142,6 +150,10 @@ def _curve(spec: Any, where: str, previous: Curve | None) -> Curve:
             raise DesignError(f"{where}.{k}", MISSING, f"a {kind} curve needs {', '.join(sorted(_CURVE_KEYS[kind]))}")
     if "center" in spec and "z" in spec:
         raise DesignError(f"{where}.z", spec["z"], "give either z or center, not both")
+    if "center" not in spec and "z" not in spec and not _points_in_space(kind, spec):  # not guessed (a curve
+        # without either had been placed at z = 0, wherever its neighbours lie)
+        raise DesignError(f"{where}.z", MISSING, f"a {kind} curve needs its height z (mm) or its center [x, y, z] (mm)"
+                          + (" (or [x, y, z] points)" if kind == "points" else ""))
     if "center" in spec:
         center = spec["center"]
         if not (isinstance(center, (list, tuple)) and len(center) == 3):
