@@ -3,6 +3,7 @@ TOML reader and writer (round trips through tomllib, a second reader)."""
 
 from __future__ import annotations
 
+import datetime
 import math
 import sys
 from pathlib import Path
@@ -117,7 +118,9 @@ def test_family_design_text_is_the_one_writer():
 _keys = st.text(st.characters(blacklist_categories=("Cs",)), min_size=1, max_size=8)
 _scalars = st.one_of(
     st.booleans(), st.integers(-(2**63), 2**63 - 1), st.floats(allow_nan=False),
-    st.text(st.characters(blacklist_categories=("Cs",)), max_size=12))
+    st.text(st.characters(blacklist_categories=("Cs",)), max_size=12),
+    # TOML's dates and times (a drawing's unquoted date = 2026-12-01), local and at an offset
+    st.dates(), st.times(), st.datetimes(), st.datetimes(timezones=st.just(datetime.timezone.utc)))
 _values = st.recursive(_scalars, lambda inner: st.one_of(st.lists(inner, max_size=4),
                                                          st.dictionaries(_keys, inner, max_size=3)), max_leaves=12)
 _tables = st.dictionaries(_keys, _values, max_size=4)

@@ -307,6 +307,22 @@ def test_title_block_texts_that_do_not_fit_are_refused_when_read(key, value, fra
     assert e.value.parameter == f"tooling.drawing.{key}" and fragment in str(e.value)
 
 
+def test_an_unquoted_toml_date_is_the_drawings_date():
+    """``date = 2026-12-01`` unquoted is a TOML date: the title block's date is its ISO text, as quoted (it had
+    been refused as "must be a non-empty string"); a design holding it is written back as the same date."""
+    import datetime
+    import tomllib
+
+    from tabletcad.pipeline.design import toml_text
+    from tabletcad.tooling.spec import parse_tooling
+
+    data = tomllib.loads('[tooling.drawing]\ndate = 2026-12-01\n')
+    assert parse_tooling(data["tooling"]).drawing.date == "2026-12-01"
+    assert parse_tooling({"drawing": {"date": "2026-12-01"}}).drawing.date == "2026-12-01"
+    assert parse_tooling({"drawing": {"date": datetime.datetime(2026, 12, 1, 9, 30)}}).drawing.date == "2026-12-01T09:30:00"
+    assert tomllib.loads(toml_text(data)) == data
+
+
 def test_a_tablet_name_of_200_characters_is_cut_to_the_room_beside_the_title_block(drawn):
     """Without ``[tooling.drawing] name`` the title is the tablet's name, up to 200 characters: it
     overlapped the title block (and ran off the sheet in a wide letter); now cut with an ellipsis."""

@@ -35,6 +35,7 @@ one factor per patch, ``radius`` = one factor) — the thesis's section 4.4.
 from __future__ import annotations
 
 import copy
+import datetime
 import decimal
 import json
 import math
@@ -710,7 +711,10 @@ def _toml_value(value: Any) -> str:
         return "{ " + ", ".join(f"{_toml_key(k)} = {_toml_value(v)}" for k, v in value.items()) + " }" if value else "{}"
     if isinstance(value, np.generic):
         return _toml_value(value.item())
-    raise DesignError("design", repr(value), "must hold numbers, text, booleans, lists and tables only")
+    if isinstance(value, datetime.date) or (isinstance(value, datetime.time) and value.tzinfo is None):
+        # TOML's own dates and times, as read (a drawing's unquoted date = 2026-12-01), written back alike
+        return value.isoformat()
+    raise DesignError("design", repr(value), "must hold numbers, text, booleans, lists, tables and dates only")
 
 
 def _toml_table(lines: list[str], path: str, table: dict) -> None:

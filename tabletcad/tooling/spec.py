@@ -67,6 +67,7 @@
 from __future__ import annotations
 
 import copy
+import datetime
 import math
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
@@ -882,6 +883,8 @@ def _drawing(t: Any) -> DrawingSpec:
     for k in TITLE_KEYS:
         if k in t:
             v = t[k]
+            if k == "date" and isinstance(v, datetime.date):  # a TOML date, unquoted (date = 2026-12-01): its
+                v = v.isoformat()  # ISO text, as quoted (it had been refused as "must be a non-empty string")
             if not isinstance(v, (str, int, float)) or isinstance(v, bool) or not str(v).strip():
                 raise DesignError(f"{w} {k}", v, "must be a non-empty string")
             if not printable_line(str(v)):  # a line break or a NUL would leave its line in the title block
