@@ -85,14 +85,16 @@ def _eval_f(f: SurfaceFunction, u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 def _eval_f_components(f: SurfaceFunction, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """``f`` on the tensor grid ``u x v``, components first: ``(3, len(u), len(v))`` mm.  A function
-    with ``grid_components`` (a PDE patch: :class:`PatchFunction`) gives that layout straight from its
-    matrix products, with no transposed copy; any other is evaluated by :func:`_eval_f` and viewed so."""
-    grid = getattr(f, "grid_components", None)
+    with ``evaluate_grid_components`` (a PDE patch: :class:`PatchFunction`) gives that layout straight
+    from its matrix products, with no transposed copy; any other is evaluated by :func:`_eval_f` and
+    viewed so."""
+    # (not ``grid_components``: BSplineSurfaceData's method of that name gives points and derivatives)
+    grid = getattr(f, "evaluate_grid_components", None)
     if grid is None:
         return np.moveaxis(_eval_f(f, u, v), -1, 0)
     X = np.asarray(grid(np.asarray(u, dtype=float), np.asarray(v, dtype=float)), dtype=float)
     if X.shape != (3, np.size(u), np.size(v)):
-        raise GeometryError(f"grid_components returned shape {X.shape}", f)
+        raise GeometryError(f"evaluate_grid_components returned shape {X.shape}", f)
     if not np.all(np.isfinite(X)):
         raise GeometryError("surface function returned non-finite values", f)
     return X
@@ -415,7 +417,7 @@ class PatchFunction:
         if hasattr(patch, "evaluate_grid"):
             self.evaluate_grid = lambda u, v: np.asarray(patch.evaluate_grid(u, v))
         if isinstance(patch, PDEPatch):  # the same grid, components first (no transposed copy)
-            self.grid_components = lambda u, v: patch.evaluate_grid(u, v, components=True)
+            self.evaluate_grid_components = lambda u, v: patch.evaluate_grid(u, v, components=True)
 
     def __call__(self, u, v) -> np.ndarray:
         return np.asarray(self.patch.evaluate(u, v))
