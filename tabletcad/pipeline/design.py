@@ -370,9 +370,11 @@ class Design:
                                   "(the shape is in the [[patch]] tables)")
             tablet = _free_form(self.patch, name, 1.0 if a is None else a)
             _check_plan(tablet, "patch")
+            _check_height(tablet, {}, "patch")
         elif family == "custom_outline":
             tablet = _custom_outline(tab, name)
             _check_plan(tablet, "tablet.outline" if "outline" in tab else "tablet.segments")
+            _check_height(tablet, tab)
         else:
             fam = lookup_family(family)  # a Design made directly may hold an old or unknown name
             family = fam.name
@@ -405,6 +407,7 @@ class Design:
                 raise
             _check_left_lengths(built, family, kw)
             tablet = replace(built, name=name)
+            _check_height(tablet, kw)  # (its bounds kept for the report: on the tablet returned)
         if self.reshape is not None:
             tablet = _reshape(tablet, self.reshape)
             _check_size(tablet, what=self.reshape)
@@ -474,6 +477,28 @@ def _check_size(tablet: Tablet, tol: Tolerances = DEFAULT, *, what: dict | None 
         raise DesignError("reshape", what if what is not None else "factors",
                           f"must leave the tablet's length, width and height at least {tol.min_length:g} mm "
                           f"(Tolerances.min_length, the least length a design takes; the smallest is {small:.6g} mm)")
+
+
+#: a family's parameters that add to its height, the largest given named where the height is too large
+_HEIGHT_BY = ("thickness", "height", "band", "cup_depth", "dome")
+
+
+def _check_height(tablet: Tablet, given: dict, where: str = "tablet", tol: Tolerances = DEFAULT) -> None:
+    """Refuse a tablet taller than ``tol.max_length``, the size limit a family's diameter or length keeps:
+    each of its lengths lies within the limit, but not what they add up to (a concave round's 999 mm band
+    with 400 mm cups had made a tablet 1799 mm thick).  Named by the largest of :data:`_HEIGHT_BY` the
+    design gives (``given``: the ``[tablet]`` table's numbers), else ``where`` with the height."""
+    lo, hi = tablet.bounds()
+    height = float(hi[2] - lo[2])
+    if height <= tol.max_length * (1.0 + 1e-9):  # (the bounds' rounding aside, as _check_size)
+        return
+    allowed = (f"must keep the tablet's height at most {tol.max_length:g} mm (size limit, Tolerances.max_length, "
+               "as a diameter or length")
+    names = [k for k in _HEIGHT_BY if k in given]
+    if names:
+        k = max(names, key=lambda n: abs(float(given[n])))
+        raise DesignError(f"tablet.{k}", given[k], f"{allowed}; the tablet is {height:.6g} mm tall)", "mm")
+    raise DesignError(where, f"a tablet {height:.9g} mm tall", allowed + ")")
 
 
 def _check_plan(tablet: Tablet, where: str, tol: Tolerances = DEFAULT) -> None:
