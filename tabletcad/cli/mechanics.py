@@ -127,11 +127,7 @@ def heckel_cmd(data: Path, meta: Path | None, mass: float | None, true_density: 
         raise DesignError("--face-area", face_area, "give --diameter or --face-area, not both", "mm²")
     _check_output("--plot", plot_file)
     _check_json_file(json_file, plot=plot_file)
-    if window is not None:
-        check_range("--window", window[0], 0.0, None, "MPa")  # pressures: a compact is never pulled
-        check_positive("--window", window[1], "MPa")
-        if not window[0] < window[1]:
-            raise DesignError("--window", window, "must be two increasing pressures", "MPa")
+    _check_window(window)
     given = {k: o for k, o, v in (("mass_mg", "--mass", mass), ("true_density", "--true-density", true_density),
                                   ("diameter", "--diameter", diameter), ("face_area", "--face-area", face_area),
                                   ("compliance slope", "--compliance", compliance),
