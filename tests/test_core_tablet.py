@@ -314,3 +314,18 @@ def test_a_trim_exactly_the_least_width_as_typed_is_taken(lo, hi, ok):
         for kw in (dict(v=(lo, hi)), dict(u=w), dict(w=w)):
             with pytest.raises(DesignError, match="at least 0.001"):
                 Trim(**kw)
+
+
+def test_band_bulge_and_inward_bow_are_the_profiles_extremes():
+    """The thesis's shallow convex round: its PDE band leaves the edge circle outward by 2.525 µm and
+    inward by 1.407 µm (a profile sampled at 20,001 points); Band keeps both from its 65 x 96 samples, the
+    outward within 1.4e-4 relative (its 65 samples across the band miss the peak by that), the inward to 1e-9."""
+    from tabletcad.families.thesis import shallow_convex_round
+
+    t = shallow_convex_round()
+    band = t.band()
+    u = np.linspace(0.0, 1.0, 20001)
+    x = t.patches[band.patch].evaluate(u, np.zeros_like(u))
+    r = np.hypot(x[:, 0], x[:, 1]) - np.hypot(x[0, 0], x[0, 1])  # from the edge circle (mm)
+    assert band.bulge == pytest.approx(r.max(), rel=4e-4) and band.bulge <= r.max()
+    assert band.inward == pytest.approx(-r.min(), rel=1e-9) and 1e-3 < band.inward < band.bulge

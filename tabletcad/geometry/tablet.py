@@ -345,12 +345,17 @@ class Band:
         Largest outward plan distance (mm) of the patch from its end curve (0 when it bows
         inward, or leaves it by rounding only, under 1e-12 of its size): the PDE surface between the two edges may bulge a little (the thesis's
         10 mm shallow convex round: 1.4 µm), which a die bore has to clear.
+    inward : float
+        Largest inward plan distance (mm) of the patch from its end curve, rounding aside as for
+        ``bulge`` (an almond's band: 9e-8 mm): how much farther than its edges the band may stand from a
+        die bore.
     """
 
     patch: int
     z0: float
     z1: float
     bulge: float
+    inward: float = 0.0
 
     @property
     def height(self) -> float:
@@ -686,11 +691,12 @@ class Tablet:
                 continue
             out = x0[:, :2] - x0[:, :2].mean(axis=0)  # outward (star-shaped outlines about their centroid)
             out /= np.maximum(np.linalg.norm(out, axis=1, keepdims=True), 1e-300)
-            bulge = float(np.einsum("uvc,vc->uv", dev, out).max())
+            along = np.einsum("uvc,vc->uv", dev, out)
+            bulge, inward = float(along.max()), float(-along.min())
             # rounding is no bulge: a straight band's 1e-16 mm on one machine's BLAS had the die bore
             # offset by MIN_BORE_OFFSET_MM there and not on another
-            bulge = bulge if bulge > 1e-12 * max(1.0, float(np.abs(x0).max())) else 0.0
-            return Band(i, min(z0, z1), max(z0, z1), bulge)
+            least = 1e-12 * max(1.0, float(np.abs(x0).max()))
+            return Band(i, min(z0, z1), max(z0, z1), bulge if bulge > least else 0.0, inward if inward > least else 0.0)
         return None
 
     def plan_area(self, nu: int = 33, nv: int = 2048) -> float | None:

@@ -966,14 +966,19 @@ def _not_inside(b, a) -> bool:
 
 
 def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0.005, refine: int = 40,
-                 tablet_model=None, forked: bool = False, bore=None) -> dict:
+                 tablet_model=None, forked: bool = False, bore=None, band_gap: float = 0.0) -> dict:
     """Overlaps (mm^3) between all pairs of ``{"tablet": shape, **parts}`` and the tablet's largest gap (mm).
 
     ``tablet_model``: the :class:`~tabletcad.geometry.tablet.Tablet`, whose patches add surface samples.
     ``forked``: the gap is measured by a forked process (:class:`tabletcad.io.forked.Forked`) while this
     one checks the overlaps; the same result (the gap uses neither manifold3d nor OCC's thread pool).
     ``bore``: the die bore's plan wire at ``z = 0`` (:func:`~tabletcad.tooling.die.bore_wire`), with which
-    the tablet is first proved apart from ``parts["die"]`` without its taper (:func:`inside_bore`)."""
+    the tablet is first proved apart from ``parts["die"]`` without its taper (:func:`inside_bore`).
+    ``band_gap``: how far (mm) the tablet's band may stand inside that bore (the bore's offset from the
+    outline, :attr:`~tabletcad.tooling.outline.TabletFrame.bore_offset`, plus the band's inward bow,
+    :attr:`~tabletcad.geometry.tablet.Band.inward`); the largest gap allowed is the larger of it and
+    ``clearance`` (a PDE band's bulge puts the bore at least 1e-6 mm out, for which a line-to-line fit,
+    clearance 0, had been refused: a rounded rectangle's largest gap 9.9e-7 mm, a capsule's 1.09e-6)."""
     t0 = time.perf_counter()
     gap_args = (tablet, parts, clearance, deflection, refine, tablet_model)
     if forked:
@@ -1006,7 +1011,8 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
         punch_die_clearance_tolerance_mm=max(_largest_tolerance(s) for n, s in parts.items()
                                              if n == "die" or n.endswith("punch")),
         clearance_mm=clearance,
-        gap_within_clearance=bool(gap["max_gap_mm"] <= clearance * (1 + 1e-6) + 1e-7),
+        gap_allowed_mm=max(clearance, band_gap),
+        gap_within_clearance=bool(gap["max_gap_mm"] <= max(clearance, band_gap) * (1 + 1e-6) + 1e-7),
         pairs=pairs,
         deflection_mm=deflection,
         seconds=dict(overlap=t1 - t0, gap=gap_s),

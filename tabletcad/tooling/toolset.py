@@ -284,6 +284,13 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
     return ts
 
 
+def _band_gap(ts: ToolSet) -> float:
+    """How far (mm) the tablet's band may stand inside the die bore: the bore's offset from the outline plus
+    the band's inward bow (0 for a band that is a prism)."""
+    band = ts.tablet.band() if ts.frame.bore_offset > 0.0 else None
+    return ts.frame.bore_offset + (band.inward if band is not None else 0.0)
+
+
 def check_closed_position(ts: ToolSet, *, deflection: float = DEFLECTION_MM, forked: bool = False) -> dict[str, Any]:
     """The closed-position check of a tool set made with ``interference_check=False``: overlaps of
     every pair of parts and the tablet's largest gap (:func:`tabletcad.tooling.interference.interference`).
@@ -300,7 +307,8 @@ def check_closed_position(ts: ToolSet, *, deflection: float = DEFLECTION_MM, for
     b0 = dict(TIMER)
     parts = ts.parts
     res = interference(parts["tablet"], {k: v for k, v in parts.items() if k != "tablet"}, ts.spec.clearance_mm,
-                       deflection=deflection, tablet_model=ts.tablet, forked=forked, bore=bore_wire(ts.frame))
+                       deflection=deflection, tablet_model=ts.tablet, forked=forked, bore=bore_wire(ts.frame),
+                       band_gap=_band_gap(ts))
     report = ts.report
     seconds = report.pop("seconds")  # kept last, as the sum of the steps
     report.update(interference_mm3=res["interference_mm3"], max_gap_mm=res["max_gap_mm"], interference=res)
