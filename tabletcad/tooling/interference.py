@@ -34,7 +34,8 @@ from tabletcad.geometry.tablet import coordinate_range
 from tabletcad.io.forked import OCC_PARALLEL
 from tabletcad.tooling.booleans import (bound_area, box_solid, mesh_arrays, mesh_face_ids, manifold_op, manifold_volume,
                                         raw_boolean, to_manifold, volume)
-from tabletcad.tooling.outline import prism
+from tabletcad.tolerance import DEFAULT
+from tabletcad.tooling.outline import face_area, prism
 from tabletcad.tooling.spec import MIN_BORE_OFFSET_MM
 
 __all__ = ["interference", "inside_bore", "MeshDistance", "mesh_distance", "largest_inside", "ExactDistance"]
@@ -974,11 +975,12 @@ def interference(tablet, parts: dict, clearance: float, *, deflection: float = 0
     one checks the overlaps; the same result (the gap uses neither manifold3d nor OCC's thread pool).
     ``bore``: the die bore's plan wire at ``z = 0`` (:func:`~tabletcad.tooling.die.bore_wire`), with which
     the tablet is first proved apart from ``parts["die"]`` without its taper (:func:`inside_bore`).
-    ``band_gap``: how far (mm) the tablet's band may stand inside that bore (the bore's offset from the
-    outline, :attr:`~tabletcad.tooling.outline.TabletFrame.bore_offset`, plus the band's inward bow,
-    :attr:`~tabletcad.geometry.tablet.Band.inward`); the largest gap allowed is the larger of it and
-    ``clearance`` (a PDE band's bulge puts the bore at least 1e-6 mm out, for which a line-to-line fit,
-    clearance 0, had been refused: a rounded rectangle's largest gap 9.9e-7 mm, a capsule's 1.09e-6)."""
+    ``band_gap``: how far (mm) the tablet's B-rep band may stand inside that bore (the bore's offset from
+    the outline, :attr:`~tabletcad.tooling.outline.TabletFrame.bore_offset`, plus the PDE band's inward
+    bow, :attr:`~tabletcad.geometry.tablet.Band.inward`, plus the B-rep's fit to the PDE surface,
+    ``Tolerances.fit``); the largest gap allowed is the larger of it and ``clearance`` (a PDE band's bulge
+    puts the bore at least 1e-6 mm out, for which a line-to-line fit, clearance 0, had been refused: a
+    rounded rectangle's largest gap 9.9e-7 mm, a capsule's 1.09e-6, another rounded rectangle's 3.1e-6)."""
     t0 = time.perf_counter()
     gap_args = (tablet, parts, clearance, deflection, refine, tablet_model)
     if forked:
@@ -1159,9 +1161,32 @@ def _occ_overlap(a: str, b: str, shapes: dict, entry: dict) -> tuple[float, str]
     # Common of such near-coincident faces returns slivers of ~1e-6 mm^3 that are not there (a
     # 1 deg taper on the almond: 8.9e-6 mm^3); the fuzzy Boolean treats closer faces as touching
     fuzzy = MIN_BORE_OFFSET_MM if (a == "tablet" and b == "die") else 0.0
-    occ = volume(raw_boolean("common", shapes[a], shapes[b], glue=glue, fuzzy=fuzzy))
-    return occ, "BRepAlgoAPI_Common" + (" (BOPAlgo_GlueFull: shared faces)" if glue else "") + (
+    common = raw_boolean("common", shapes[a], shapes[b], glue=glue, fuzzy=fuzzy)
+    how = "BRepAlgoAPI_Common" + (" (BOPAlgo_GlueFull: shared faces)" if glue else "") + (
         f" (fuzzy {fuzzy:g} mm: the band touches the bore)" if fuzzy else "")
+    if not fuzzy:
+        return volume(common), how
+    # pieces thinner than the B-rep's fit are the B-rep's: an almond with 1.235 mm end arcs has its band's
+    # B-spline faces (4.3e-5 mm from the PDE surface) 7.5e-6 mm through a bore 1e-6 mm out at its ends,
+    # four slivers of 1.2e-5 mm^3 the build had been refused for
+    solids = explore(common, "Solid")
+    thick = [s for s in solids if _thickness(s) > FIT_MM]
+    if len(thick) == len(solids):
+        return volume(common), how
+    entry["occ_thinner_than_the_fit_mm3"] = sum(volume(s) for s in solids if not any(s is t for t in thick))
+    how += f"; {len(solids) - len(thick)} solids thinner than the B-rep's fit ({FIT_MM:g} mm) left out"
+    return float(sum(volume(s) for s in thick)), how
+
+
+#: how thin (mm) a piece of a tablet's Common with its die may be and be taken as the B-rep's, not the design's:
+#: the tablet's faces stand within ``Tolerances.fit`` of its PDE surface, which the bore clears
+FIT_MM = DEFAULT.fit
+
+
+def _thickness(solid) -> float:
+    """A solid's mean thickness (mm): twice its volume over its boundary's area (a slab's thickness)."""
+    area = sum(face_area(f) for f in explore(solid, "Face"))
+    return 2.0 * volume(solid) / area if area > 0.0 else 0.0
 
 
 def _largest_gap(tablet, parts: dict, clearance: float, deflection: float, refine: int, tablet_model) -> dict:

@@ -285,10 +285,13 @@ def make_tooling(tablet: Tablet, spec: ToolingSpec | None = None, *, shape=None,
 
 
 def _band_gap(ts: ToolSet) -> float:
-    """How far (mm) the tablet's band may stand inside the die bore: the bore's offset from the outline plus
-    the band's inward bow (0 for a band that is a prism)."""
-    band = ts.tablet.band() if ts.frame.bore_offset > 0.0 else None
-    return ts.frame.bore_offset + (band.inward if band is not None else 0.0)
+    """How far (mm) the tablet's B-rep band may stand inside the die bore: the bore's offset from the
+    outline, the PDE band's inward bow and the B-rep's fit to the PDE surface (``Tolerances.fit``); 0 for
+    a band that is a prism (its B-rep is exact)."""
+    if ts.frame.bore_offset == 0.0:
+        return 0.0
+    band = ts.tablet.band()
+    return ts.frame.bore_offset + (band.inward if band is not None else 0.0) + ts.tablet.tol.fit
 
 
 def check_closed_position(ts: ToolSet, *, deflection: float = DEFLECTION_MM, forked: bool = False) -> dict[str, Any]:
