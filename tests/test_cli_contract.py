@@ -272,6 +272,26 @@ def test_standard_output_on_a_full_disk_is_the_machines_state_not_a_bug(tmp_path
     assert not (tmp_path / "cache").exists()
 
 
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
+@pytest.mark.parametrize("args", [["love", "--json"], ["report", "OLD"]])
+def test_a_full_disk_after_a_warning_is_still_one_line(tmp_path, args):
+    """A trial: ``love --json > /dev/full`` printed its fit's warning and then the error, two lines for one
+    refusal, and so did a report of a design under an old family name.  A command's warnings are printed
+    once it has its result; a refusal is its one line.  Written in full, both print their warnings."""
+    old = tmp_path / "old.toml"
+    old.write_text('[tablet]\nfamily = "flat_faced_round"\ndiameter = 10.0\nthickness = 3.0\n', encoding="utf-8")
+    args = [str(old) if a == "OLD" else a for a in args]
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], stdout=full, stderr=subprocess.PIPE,
+                              text=True, env=env, timeout=120)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.splitlines() == ["error: output = '(being written)' is not allowed: no space left on device"]
+    proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], capture_output=True, text=True, env=env,
+                          timeout=120)
+    assert proc.returncode == 0 and proc.stdout and proc.stderr.startswith("warning: "), proc.stderr
+
+
 def test_a_full_disk_while_writing_a_file_names_the_file(capsys, tmp_path, monkeypatch):
     """A write into the temporary file that stands for an output, refused for want of space, carries no file
     name: the output it stands for is named (a review: "output = '(being written)'" on a full tmpfs), and

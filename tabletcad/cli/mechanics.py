@@ -31,7 +31,9 @@ __all__ = ["COMMANDS"]
 
 @contextlib.contextmanager
 def _collect() -> Iterator[list[str]]:
-    """Collect mechanics warnings (their text) and echo them on stderr at the end."""
+    """Collect mechanics warnings (their text) into the list yielded; :func:`_emit` echoes them on stderr
+    once the command's outputs are written (a write refused after them, ``--json > /dev/full``, had left
+    the warnings and the error line: two lines for one refusal)."""
     from tabletcad.mechanics.validity import MechanicsWarning
 
     msgs: list[str] = []
@@ -41,16 +43,20 @@ def _collect() -> Iterator[list[str]]:
     for w in rec:
         if issubclass(w.category, MechanicsWarning):
             msgs.append(str(w.message))
-    for m in msgs:
-        click.echo(f"warning: {m}", err=True)
 
 
 def _emit(payload: dict[str, Any], as_json: bool, lines: list[str]) -> None:
+    """Print the result (its lines, or ``payload`` as JSON), then the payload's ``warnings`` on stderr.
+
+    The warnings come last: a refused write of standard output (a full disk) is then the command's one
+    ``error:`` line, as every refusal is."""
     if as_json:
         click.echo(json_text(payload))
     else:
         for ln in lines:
             click.echo(ln)
+    for m in payload.get("warnings", ()):
+        click.echo(f"warning: {m}", err=True)
 
 
 #: the metadata's keys (as a metadata file writes them) with their units, for the JSON documents
