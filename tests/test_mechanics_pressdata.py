@@ -455,6 +455,52 @@ def test_a_metadata_file_that_would_be_misread_is_refused(tmp_path, edit, parame
     assert exc.value.parameter == parameter and fragment in str(exc.value), str(exc.value)
 
 
+@pytest.mark.parametrize("edit, parameter, value, fragment", [
+    # a compensation line's entries, as the file gives them (they had been named compliance.slope and
+    # compliance.offset, keys the file did not have, the intercept with its sign flipped)
+    ("[1.0, -0.0267]", "compliance.compensation_line[0]", 1.0, "must be >= 0 and <= 0.001 mm/N"),
+    ("[0.00002, 1e300]", "compliance.compensation_line[1]", 1e300, "must be >= -1000 and <= 1000 mm"),
+    ('[0.00002, "x"]', "compliance.compensation_line[1]", "x", "not text"),
+])
+def test_a_compensation_lines_refusal_names_its_entry(tmp_path, edit, parameter, value, fragment):
+    from tabletcad.mechanics.pressdata import read_metadata
+
+    p = tmp_path / "m.toml"
+    p.write_text(_META.read_text(encoding="utf-8").replace("[0.00002, -0.0267]", edit), encoding="utf-8")
+    with pytest.raises(DesignError) as exc:
+        read_metadata(p)
+    assert (exc.value.parameter, exc.value.value) == (parameter, value) and fragment in str(exc.value), str(exc.value)
+    p.write_text("mass_mg = 300.0\ntrue_density = 1.3\ndiameter = 10.0\n[compliance]\nforce = [0.0, \"a\"]\n"
+                 "deflection = [0.0, 0.02]\n", encoding="utf-8")
+    with pytest.raises(DesignError, match=r"^compliance\.force\[1\] = 'a' is not allowed"):
+        read_metadata(p)
+
+
+@pytest.mark.parametrize("row, column, value, line", [
+    # a force no press makes: 1e300 N had been refused as the fit's window, a negative one as a thickness;
+    # in a row after the loading branch it had moved the branch: K = 0.046 1/MPa, a warning only, exit 0
+    (15, 0, "1e300", "force_N = 1e+300 N is not allowed: must be within ±7.854e+06 N (100000 MPa on the 78.54 mm² "
+                     "punch face)"),
+    (15, 0, "-1e300", "force_N = -1e+300 N is not allowed: must be within ±7.854e+06 N"),
+    (15, 0, "1e7", "force_N = 1e+07 N is not allowed"),
+    (215, 0, "1e300", "force_N = 1e+300 N is not allowed"),
+    # a displacement of -1e300 mm had been read as a bed 1e300 mm thick (the fit unchanged, exit 0)
+    (15, 1, "-1e300", "thickness = 1e+300 mm is not allowed: must be <= 1000 mm (size limit"),
+])
+def test_a_reading_no_press_makes_is_refused_by_its_line_and_column(tmp_path, row, column, value, line):
+    header, rows = _printed_rows()
+    rows[row][column] = value
+    p = tmp_path / "edited.csv"
+    p.write_text("\n".join(",".join(r) for r in [header, *rows]) + "\n", encoding="utf-8")
+    with pytest.raises(DesignError) as exc:
+        compaction_curves(read_press_data(p, meta=_META))
+    assert str(exc.value).startswith(f"line[{row + 2}].{line}"), str(exc.value)  # (the header is line 1)
+    if column == 0:  # a load cell's small negative reading is read as it was
+        rows[row][column] = "-5"
+        p.write_text("\n".join(",".join(r) for r in [header, *rows]) + "\n", encoding="utf-8")
+        assert read_press_data(p, meta=_META).force[row] == -5.0
+
+
 def test_metadata_overrides_binary_files_and_a_byte_order_mark(tmp_path):
     from tabletcad.errors import DesignError
     from tabletcad.mechanics.pressdata import read_metadata
