@@ -7,6 +7,7 @@ import math
 import shutil
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -595,6 +596,32 @@ def test_simulate_compressions_omega_z0_range_from_python():
         simulate_compression(P, omega_z0=-5.9)
     with pytest.raises(DesignError, match=r"^omega_z0 = "):
         simulate_compression(P, omega_z0=hi + 1e-6)
+
+
+@pytest.mark.parametrize("model", [{}, {"h0": 4.3}, {"E": 483.6}, {"nu": 1e-9}, {"h0": 60.0}, {"z": 6.0}])
+def test_omega_z0_ranges_ends_are_exact_in_floating_point(capsys, model):
+    """The closed-form ends round differently from the model's sums: the value next to the lower end had
+    been let through and then refused by the model, as the fit's window from Python and as ``--h0 = 4.3 mm
+    ... must be >= 4.30001`` (an option given in range) on the command line.  Now the next value above
+    ``lo`` runs, ``lo`` does not, ``hi`` runs and the next above it does not."""
+    from tabletcad.errors import DesignError
+    from tabletcad.mechanics.love import omega_z0_range, simulate_compression
+
+    P = np.linspace(10.0, 50.0, 41)
+    lo, hi = omega_z0_range(P, **model)
+    for w0 in (math.nextafter(lo, math.inf), hi):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            assert simulate_compression(P, omega_z0=w0, **model).heckel.n_points >= 3
+    for w0 in (lo, math.nextafter(hi, math.inf)):
+        with pytest.raises(DesignError, match=r"^omega_z0 = "):
+            simulate_compression(P, omega_z0=w0, **model)
+    if model in ({"h0": 4.3}, {"E": 483.6}):  # the command line: the option at fault is --omega-z0
+        options = [a for k, v in model.items() for a in (f"--{k}", repr(v))]
+        rc, _, err = run(capsys, "love", *options, "--omega-z0", repr(lo))
+        assert rc == 2 and err.startswith("error: --omega-z0 = ") and err.count("\n") == 1, err
+        rc, out, err = run(capsys, "love", *options, "--omega-z0", repr(math.nextafter(lo, math.inf)), "--json")
+        assert rc == 0 and json.loads(out)["omega_z0_mm"] == math.nextafter(lo, math.inf), err
 
 
 def test_heckel_refuses_punch_travel_taken_as_the_gap(capsys, tmp_path):
