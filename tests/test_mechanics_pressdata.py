@@ -501,6 +501,30 @@ def test_a_reading_no_press_makes_is_refused_by_its_line_and_column(tmp_path, ro
         assert read_press_data(p, meta=_META).force[row] == -5.0
 
 
+@pytest.mark.parametrize("cell", ["inf", "-inf", "1e400"])
+def test_an_infinite_reading_is_refused_not_dropped_as_missing(tmp_path, cell):
+    """A trial: ``inf`` and ``1e400`` (a float's overflow) had been dropped with the warning "missing force or
+    position value"; an empty or ``nan`` cell still is."""
+    p = _write(tmp_path, f"force_N,displacement_mm\n1,-5\n{cell},-4.95\n2,-4.9\n3,-4.8\n")
+    with pytest.raises(DesignError, match=r"^line\[3\]\.force_N = -?inf N is not allowed: must be a finite number"):
+        read_press_data(p, **META)
+    p = _write(tmp_path, f"force_N,displacement_mm\n1,-5\n2,{cell}\n3,-4.8\n4,-4.7\n")
+    with pytest.raises(DesignError, match=r"^line\[3\]\.displacement_mm = -?inf mm is not allowed"):
+        read_press_data(p, **META)
+    p = _write(tmp_path, "force_N,displacement_mm\n1,-5\nnan,-4.95\n,-4.93\n2,-4.9\n3,-4.8\n")
+    with pytest.warns(DataWarning, match="dropped 2 row"):
+        assert len(read_press_data(p, **META)) == 3
+
+
+def test_a_column_header_naming_two_columns_is_refused_not_taken_first(tmp_path):
+    """A trial: ``--force-column force_N`` with two columns of that name had taken the first without a word."""
+    p = _write(tmp_path, "force_N,force_N,displacement_mm\n1,10,-5\n2,20,-4.9\n3,30,-4.8\n")
+    with pytest.raises(DesignError, match=r"^--force-column = 'force_N' is not allowed: names 2 columns \(numbers 1, "
+                                          r"2\): give the column's number$"):
+        read_press_data(p, **META, columns={"force": "force_N"})
+    assert np.array_equal(read_press_data(p, **META, columns={"force": "2"}).force, [10.0, 20.0, 30.0])
+
+
 def test_metadata_overrides_binary_files_and_a_byte_order_mark(tmp_path):
     from tabletcad.errors import DesignError
     from tabletcad.mechanics.pressdata import read_metadata

@@ -649,6 +649,10 @@ def _pick(role: str, header: list[str], found: list[int], chosen: str | None) ->
     if chosen is not None:
         names = [h.lower() for h in header]
         key = str(chosen).strip().lower()
+        if names.count(key) > 1:  # (the first of them had been taken)
+            numbers = ", ".join(str(j + 1) for j, n in enumerate(names) if n == key)
+            raise DesignError(option, str(chosen), f"names {names.count(key)} columns (numbers {numbers}): give "
+                              "the column's number")
         if key in names:
             return names.index(key)
         if key.isdigit() and 1 <= int(key) <= len(header):
@@ -796,6 +800,14 @@ def read_press_data(
         if exponent is None:
             values[:, j] *= factor
     need = [roles["force"], roles[pos_role]]
+    for j in need:  # an infinite reading (inf, 1e400) is no missing value: it had been dropped as one
+        inf = np.flatnonzero(np.isinf(values[:, j]))
+        if inf.size:
+            k = int(inf[0])
+            unit = "N" if j == roles["force"] else "mm"
+            raise DesignError(f"line {line_numbers[k]} {header[j]!r}", float(values[k, j]),
+                              f"must be a finite number (infinite as read, in {unit}); leave a missing value's "
+                              "cell empty", unit)
     keep = np.all(np.isfinite(values[:, need]), axis=1)
     dropped = int((~keep).sum())
     if dropped:
