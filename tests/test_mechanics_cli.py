@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import shutil
 import subprocess
 import sys
@@ -596,6 +597,28 @@ def test_simulate_compressions_omega_z0_range_from_python():
         simulate_compression(P, omega_z0=-5.9)
     with pytest.raises(DesignError, match=r"^omega_z0 = "):
         simulate_compression(P, omega_z0=hi + 1e-6)
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
+@pytest.mark.parametrize("args", [
+    ["heckel", str(SAMPLE), "--plot", "h.png", "--json-file", "h.json"],
+    ["shell", "--outer", "5", "--inner", "4", "--E", "100", "--nu", "0.3", "--p-ext", "1", "--psi", "10",
+     "--csv", "u.csv", "--plot", "u.png", "--json-file", "u.json"],
+])
+def test_a_refused_standard_output_leaves_no_file(tmp_path, args):
+    """A trial: ``heckel ... --plot h.png > /dev/full`` exited 2 with one line and left h.png; the files
+    are moved into place only once the result is printed."""
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache"), "PYTHONPATH": str(ROOT)}
+    work = tmp_path / "work"
+    work.mkdir()
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], stdout=full, stderr=subprocess.PIPE,
+                              text=True, env=env, cwd=work, timeout=120)
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
+    assert sorted(work.iterdir()) == []
+    proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], capture_output=True, text=True, env=env,
+                          cwd=work, timeout=120)
+    assert proc.returncode == 0 and len(list(work.iterdir())) == 2 + ("--csv" in args), proc.stderr
 
 
 @pytest.mark.parametrize("model", [{}, {"h0": 4.3}, {"E": 483.6}, {"nu": 1e-9}, {"h0": 60.0}, {"z": 6.0}])

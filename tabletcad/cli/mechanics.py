@@ -199,15 +199,16 @@ def _check_json_file(json_file: Path | None, **others: Path | None) -> None:
 
 def _finish(payload: dict[str, Any], as_json: bool, json_file: Path | None, lines: list[str],
             plot: tuple[Path | None, Any] = (None, None)) -> None:
-    """Write ``--json-file`` (and a plot) all-or-nothing, then print the lines or the JSON."""
+    """Write ``--json-file`` (and a plot) all-or-nothing with the lines or the JSON printed: the files are
+    moved into place once the printing succeeded (``--plot h.png > /dev/full`` had left h.png, exit 2)."""
     plot_file, draw = plot
     with _staged(json=json_file, plot=plot_file) as out:
         if json_file is not None:
             out["json"].write_text(json_text(payload) + "\n", encoding="utf-8")
         if plot_file is not None:
             draw(out["plot"])
-    _emit(payload, as_json, lines + ([f"json -> {json_file}"] if json_file and not as_json else [])
-          + ([f"plot -> {plot_file}"] if plot_file and not as_json else []))
+        _emit(payload, as_json, lines + ([f"json -> {json_file}"] if json_file and not as_json else [])
+              + ([f"plot -> {plot_file}"] if plot_file and not as_json else []))
 
 
 def _compression_table(data: Path, pressure_column: str, thickness_column: str, h0: float | None,
@@ -594,13 +595,13 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
             out["csv"].write_text("\n".join(rows) + "\n", encoding="utf-8")
         if plot_file is not None:
             plot_shell(sol, out["plot"])
-    _emit(payload, as_json, [
-        (f"shell a = {a:g} mm, b = {b:g} mm, E = {E:g} MPa, ν = {nu:g}; p_ext = {p_ext:g} MPa over "
-         f"{region} ψ = {psi:g}°, p_int = {p_int:g} MPa; {terms} orders"),
-        f"u_r(a): θ=0° {ua[0]:.4g} mm, θ=90° {eq:.4g} mm; u_r(b): θ=0° {ub[0]:.4g} mm, θ=90° {ub[90]:.4g} mm",
-        f"series change at θ=90° from {terms // 2} to {terms} orders: {eq - half:.3g} mm",
-    ] + [f"{option} -> {path}" for option, path in (("json", json_file), ("csv", csv_file), ("plot", plot_file))
-         if path is not None and not as_json])
+        _emit(payload, as_json, [  # (before the files are moved into place, as in _finish)
+            (f"shell a = {a:g} mm, b = {b:g} mm, E = {E:g} MPa, ν = {nu:g}; p_ext = {p_ext:g} MPa over "
+             f"{region} ψ = {psi:g}°, p_int = {p_int:g} MPa; {terms} orders"),
+            f"u_r(a): θ=0° {ua[0]:.4g} mm, θ=90° {eq:.4g} mm; u_r(b): θ=0° {ub[0]:.4g} mm, θ=90° {ub[90]:.4g} mm",
+            f"series change at θ=90° from {terms // 2} to {terms} orders: {eq - half:.3g} mm",
+        ] + [f"{option} -> {path}" for option, path in (("json", json_file), ("csv", csv_file), ("plot", plot_file))
+             if path is not None and not as_json])
 
 
 # --------------------------------------------------------------------------- love
