@@ -480,7 +480,7 @@ def test_a_compensation_lines_refusal_names_its_entry(tmp_path, edit, parameter,
     # a force no press makes: 1e300 N had been refused as the fit's window, a negative one as a thickness;
     # in a row after the loading branch it had moved the branch: K = 0.046 1/MPa, a warning only, exit 0
     (15, 0, "1e300", "force_N = 1e+300 N is not allowed: must be within ±7.854e+06 N (100000 MPa on the 78.54 mm² "
-                     "punch face)"),
+                     "punch face: check the column's unit and the die diameter or face area)"),
     (15, 0, "-1e300", "force_N = -1e+300 N is not allowed: must be within ±7.854e+06 N"),
     (15, 0, "1e7", "force_N = 1e+07 N is not allowed"),
     (215, 0, "1e300", "force_N = 1e+300 N is not allowed"),

@@ -411,8 +411,8 @@ def _check_forces(F: np.ndarray, area: float, lines: np.ndarray, force_column: s
     if bad.size:
         i = int(bad[0])
         raise DesignError(f"line {int(lines[i])} {force_column!r}", float(F[i]),
-                          f"must be within ±{f_max:.4g} N ({MAX_PRESSURE_MPA:g} MPa on the {area:.4g} mm² punch face)",
-                          "N")
+                          f"must be within ±{f_max:.4g} N ({MAX_PRESSURE_MPA:g} MPa on the {area:.4g} mm² punch face: "
+                          "check the column's unit and the die diameter or face area)", "N")
 
 
 def _assemble(F, pos, is_thickness, t, meta, extra, lines, dropped, source, column="displacement",
