@@ -329,6 +329,23 @@ def test_a_refused_standard_output_leaves_no_output(tmp_path, args, made):
     assert sorted(p.name for p in work.iterdir()) == sorted(made)
 
 
+def test_a_forked_helpers_warning_is_printed_at_once(capsys, monkeypatch):
+    """The command's own warnings wait for its outcome; a forked helper's (tabletcad.io.forked: the picture, a
+    tooling build's files) would be lost with its copy of the held list, so it prints them as it did."""
+    import warnings
+
+    monkeypatch.setattr(cli_mod, "_PENDING_WARNINGS", [])
+    monkeypatch.setattr(cli_mod, "_MAIN_PID", [os.getpid()])
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        warnings.showwarning = cli_mod._show_warning
+        warnings.warn("held", UserWarning)
+        assert capsys.readouterr().err == "" and cli_mod._PENDING_WARNINGS == ["warning: held"]
+        monkeypatch.setattr(cli_mod, "_MAIN_PID", [os.getpid() + 1])  # this process stands for a helper
+        warnings.warn("from a helper", UserWarning)
+    assert capsys.readouterr().err == "warning: from a helper\n" and cli_mod._PENDING_WARNINGS == ["warning: held"]
+
+
 def test_a_full_disk_while_writing_a_file_names_the_file(capsys, tmp_path, monkeypatch):
     """A write into the temporary file that stands for an output, refused for want of space, carries no file
     name: the output it stands for is named (a review: "output = '(being written)'" on a full tmpfs), and

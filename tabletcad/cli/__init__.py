@@ -258,12 +258,21 @@ def _run(argv: list[str] | None) -> int:
 #: refusal is its one ``error:`` line (a design's warning had come before the error of a write to a
 #: full disk, two lines for one refusal)
 _PENDING_WARNINGS: list[str] = []
+#: the process that runs :func:`main` (a forked helper, ``tabletcad.io.forked``, prints its warnings at once:
+#: its copy of the held list ends with it)
+_MAIN_PID = [0]
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """A warning on the command line: one line, ``warning: <message>``, no source line; held until the
     command has its outcome (:data:`_PENDING_WARNINGS`)."""
-    _PENDING_WARNINGS.append("warning: " + " ".join(str(message).split()))
+    import os
+
+    text = "warning: " + " ".join(str(message).split())
+    if os.getpid() == _MAIN_PID[0]:
+        _PENDING_WARNINGS.append(text)
+    else:
+        _say(text)
 
 
 def _say_warnings(status: int) -> None:
@@ -294,6 +303,7 @@ def main(argv: list[str] | None = None) -> int:
         signal.signal(signal.SIGINT, _on_sigint)
         sys.unraisablehook = _unraisable_interrupt(sys.unraisablehook)
     _PENDING_WARNINGS.clear()
+    _MAIN_PID[0] = os.getpid()
     try:
         try:
             with warnings.catch_warnings():
