@@ -704,7 +704,7 @@ def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json, json_file) -> None:
             raise DesignError("--omega-z0", omega_z0, omega_z0_allowed(w_lo, w_hi, 41, cap=h0), "mm")
     # the model's refusal of a bed pressed to nothing names its keyword; here the option
     model = {"E": E, "nu": nu, "h0": h0, "z": z, "r": r, "omega_z0": omega_z0}
-    with _collect() as msgs, option_names({"omega_z0": "--omega-z0", "pressure": "--window"}):
+    with _collect() as msgs, option_names({"omega_z0": "--omega-z0", "pressure": "--window", "window": "--window"}):
         try:
             sim = simulate_compression(np.linspace(lo, hi, 41), **model)
         except DesignError:
