@@ -272,6 +272,80 @@ def test_standard_output_on_a_full_disk_is_the_machines_state_not_a_bug(tmp_path
     assert not (tmp_path / "cache").exists()
 
 
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
+@pytest.mark.parametrize("args", [["love", "--json"], ["report", "OLD"]])
+def test_a_full_disk_after_a_warning_is_still_one_line(tmp_path, args):
+    """A trial: ``love --json > /dev/full`` printed its fit's warning and then the error, two lines for one
+    refusal, and so did a report of a design under an old family name.  A command's warnings are printed
+    once it has its result; a refusal is its one line.  Written in full, both print their warnings."""
+    old = tmp_path / "old.toml"
+    old.write_text('[tablet]\nfamily = "flat_faced_round"\ndiameter = 10.0\nthickness = 3.0\n', encoding="utf-8")
+    args = [str(old) if a == "OLD" else a for a in args]
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], stdout=full, stderr=subprocess.PIPE,
+                              text=True, env=env, timeout=120)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.splitlines() == ["error: output = '(being written)' is not allowed: no space left on device"]
+    proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], capture_output=True, text=True, env=env,
+                          timeout=120)
+    assert proc.returncode == 0 and proc.stdout and proc.stderr.startswith("warning: "), proc.stderr
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
+@pytest.mark.parametrize("args, made", [
+    (["build", "{root}/samples/flat_faced_round.toml", "--out", "b"], ["b"]),
+    (["mesh", "{root}/samples/spherical.toml", "--nodes", "5", "9", "3", "--out", "m.vtu"], ["m.vtu"]),
+    (["report", "{root}/samples/families/concave_round.toml", "--csv", "c.csv", "--plot", "c.png", "--json-file",
+      "c.json"], ["c.csv", "c.json", "c.png"]),
+    (["optimise", "{root}/samples/optimise/cylinder_min_area.toml", "--out", "o"], ["o"]),
+    pytest.param(["fe", "diametral", "{root}/samples/families/concave_round.toml", "--force", "100",
+                  "--no-error-estimate", "--out", "f", "--json-file", "f.json"], ["f", "f.json"],
+                 marks=pytest.mark.fe),
+])
+def test_a_refused_standard_output_leaves_no_output(tmp_path, args, made):
+    """A trial: ``build ... > /dev/full`` exited 2 with its one line and left the whole build in its folder
+    (mesh its file, report its --csv, --plot and --json-file, optimise and fe their folders, fe its --json-file).  The summary is printed before the
+    files are put in place; written in full, the same command makes them (exit 0)."""
+    if "fe" in args:
+        pytest.importorskip("skfem")
+        pytest.importorskip("gmsh")
+    if args[0] in ("build", "optimise", "fe"):
+        pytest.importorskip("OCP")
+    args = [a.format(root=ROOT) for a in args]
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    work = tmp_path / "work"
+    work.mkdir()
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], stdout=full, stderr=subprocess.PIPE,
+                              text=True, env={**env, "PYTHONPATH": str(ROOT)}, cwd=work, timeout=300)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.splitlines()[-1:] == ["error: output = '(being written)' is not allowed: no space left on device"]
+    assert not any(line.startswith(("error", "warning")) for line in proc.stderr.splitlines()[:-1]), proc.stderr
+    assert sorted(p.name for p in work.iterdir()) == []
+    proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], capture_output=True, text=True,
+                          env={**env, "PYTHONPATH": str(ROOT)}, cwd=work, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert sorted(p.name for p in work.iterdir()) == sorted(made)
+
+
+def test_a_forked_helpers_warning_is_printed_at_once(capsys, monkeypatch):
+    """The command's own warnings wait for its outcome; a forked helper's (tabletcad.io.forked: the picture, a
+    tooling build's files) would be lost with its copy of the held list, so it prints them as it did."""
+    import warnings
+
+    monkeypatch.setattr(cli_mod, "_PENDING_WARNINGS", [])
+    monkeypatch.setattr(cli_mod, "_MAIN_PID", [os.getpid()])
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        warnings.showwarning = cli_mod._show_warning
+        warnings.warn("held", UserWarning)
+        assert capsys.readouterr().err == "" and cli_mod._PENDING_WARNINGS == ["warning: held"]
+        monkeypatch.setattr(cli_mod, "_MAIN_PID", [os.getpid() + 1])  # this process stands for a helper
+        warnings.warn("from a helper", UserWarning)
+    assert capsys.readouterr().err == "warning: from a helper\n" and cli_mod._PENDING_WARNINGS == ["warning: held"]
+
+
 def test_a_full_disk_while_writing_a_file_names_the_file(capsys, tmp_path, monkeypatch):
     """A write into the temporary file that stands for an output, refused for want of space, carries no file
     name: the output it stands for is named (a review: "output = '(being written)'" on a full tmpfs), and

@@ -117,16 +117,19 @@ FRAGMENTS = ["[tablet]", "[[patch]]", "family = ", '"thesis.flat_faced_round"', 
 raw_text = st.lists(st.one_of(st.sampled_from(FRAGMENTS), texts(8)), max_size=25).map("".join)
 
 
-def _fake_build_design(design, out_dir, *, progress=True, parallel=False):
+def _fake_build_design(design, out_dir, *, progress=True, parallel=False, announce=None):
     """Everything ``build`` does before its CAD stages: read and validate the design, build the PDE tablet;
-    the report keys the command prints."""
+    the report keys the command prints (given to ``announce`` before the folder is made, as the build does)."""
     from tabletcad.pipeline.design import load_design
 
     t = load_design(design)
-    Path(out_dir).mkdir(parents=True, exist_ok=True)
     dims = t.dimensions()
-    return dict(design=dict(name=t.name, family=t.family, params=dict(t.params)), volume_mm3=t.volume(),
-                surface_area_mm2=t.surface_area(), outputs=[], **dims)
+    rep = dict(design=dict(name=t.name, family=t.family, params=dict(t.params)), volume_mm3=t.volume(),
+               surface_area_mm2=t.surface_area(), outputs=[], **dims)
+    if announce is not None:
+        announce(rep)
+    Path(out_dir).mkdir(parents=True, exist_ok=True)
+    return rep
 
 
 VALID = '[tablet]\nfamily = "concave_round"\ndiameter = 8.0\nband = 2.0\ncup_depth = 0.8\n'

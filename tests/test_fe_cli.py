@@ -95,6 +95,20 @@ def test_diametral_bad_input_one_line_exit_2_nothing_written(capsys, tmp_path, t
     assert not out.exists()
 
 
+def test_a_mesh_size_gmsh_cannot_mesh_is_refused_by_its_name(capsys, tmp_path):
+    """A trial: ``--mesh-size 10`` (within its stated range, up to the tablet's 10 mm) on the concave round
+    sample printed "error: mesh: gmsh produced no tetrahedra" (the error estimate's 15 mm mesh); without the
+    estimate the 10 mm mesh itself is made."""
+    sample = Path(__file__).resolve().parents[1] / "samples" / "families" / "concave_round.toml"
+    out = tmp_path / "never"
+    rc, _, err = run(capsys, "fe", "diametral", sample, "--force", "100", "--mesh-size", "10", "--out", out)
+    assert rc == 2 and err == ("error: --mesh-size = 10 mm is not allowed: gmsh makes no tetrahedra of this solid at "
+                               "15 mm (the error estimate's mesh, 1.5 times coarser): give a finer size\n"), err
+    assert not out.exists()
+    rc, _, err = run(capsys, "fe", "diametral", sample, "--force", "100", "--mesh-size", "10", "--no-error-estimate")
+    assert rc == 0, err
+
+
 def test_punch_needs_tooling(capsys, tmp_path, thin):
     out = tmp_path / "never"
     rc, so, err = run(capsys, "fe", "punch", thin, "--force", 10, "--yield-stress", 1450)

@@ -28,7 +28,7 @@ from pathlib import Path
 import pytest
 
 from tabletcad.cli import main
-from tabletcad.errors import DesignError
+from tabletcad.errors import DesignError, format_bound
 from tabletcad.families.inverse import VARY, reachable, solvable, solve_for
 from tabletcad.families.sweep import SweepNominal, nominal_volume
 from tabletcad.pipeline.design import Design
@@ -109,11 +109,20 @@ def test_targets_outside_the_range_are_refused_with_the_range(path, vary):
         with pytest.raises(DesignError) as ei:
             solve_for(family, target_volume_mm3=target, vary=vary, **dims)
         assert ei.value.parameter == "target_volume_mm3"
-        assert f"must be within {reach.volume_lo_mm3:.6g} to {reach.volume_hi_mm3:.6g} mm3 for {vary} in" in str(ei.value)
+        # (the ends rounded into the range, so that each is accepted)
+        assert f"must be within {format_bound(reach.volume_lo_mm3, upper=False)} to " \
+               f"{format_bound(reach.volume_hi_mm3, upper=True)} mm3 for {vary} in" in str(ei.value)
     with pytest.raises(DesignError, match=r"must be within .* mg for") as ei:
         solve_for(family, target_weight_mg=reach.volume_hi_mm3 * 2.0, vary=vary, solid_fraction=0.5,
                   true_density_mg_mm3=2.0, **dims)  # 1 mg per mm3: the weight range is the volume range
-    assert ei.value.parameter == "target_weight_mg" and f"{reach.volume_hi_mm3:.6g} mg" in str(ei.value)
+    assert ei.value.parameter == "target_weight_mg" and f"{format_bound(reach.volume_hi_mm3, upper=True)} mg" \
+        in str(ei.value)
+    # the stated ends are reached (a lower end at a flat face, 0 mm, is reached only there: the volumes just
+    # above it need a length below Tolerances.min_length)
+    ends = [format_bound(reach.volume_hi_mm3, upper=True)] + (
+        [format_bound(reach.volume_lo_mm3, upper=False)] if reach.lo_mm > 0 else [])
+    for end in ends:
+        solve_for(family, target_volume_mm3=float(end), vary=vary, **dims)
 
 
 def test_the_oblong_dome_lowers_the_volume_and_is_still_solved():
@@ -175,7 +184,7 @@ def test_reviewer_commands_succeed(tmp_path, capsys, monkeypatch, sample, vary, 
     (["families/capsule.toml", "--solve-for", "cup_depth", "--target-volume", "5000"], "--target-volume",
      r"must be within \S+ to \S+ mm3 for cup_depth in \["),
     (["families/concave_round.toml", "--solve-for", "band", "--target-weight", "1", "--solid-fraction", "0.8",
-      "--true-density", "1.4"], "--target-weight", r"must be within \S+ to \S+ mg for band in \[0.001, 1000\] mm"),
+      "--true-density", "1.4"], "--target-weight", r"must be within \S+ to \S+ mg for band in \[0.001, 998\.2\] mm"),
     (["families/concave_round.toml", "--solve-for", "thickness", "--target-volume", "300"], "--solve-for",
      r"concave_round can solve for band, cup_depth$"),
     (["spherical.toml", "--solve-for", "band", "--target-volume", "300"], "--solve-for",
@@ -205,7 +214,33 @@ def test_a_weight_range_is_the_volume_range_times_the_density(capsys):
     err = capsys.readouterr().err
     lo, hi = (float(x) for x in re.search(r"within (\S+) to (\S+) mg", err).groups())
     assert lo == pytest.approx(reach.volume_lo_mm3 * 1.12, rel=1e-5) and hi == pytest.approx(reach.volume_hi_mm3 * 1.12, rel=1e-5)
-    assert reach.lo_mm == 1e-3 and reach.hi_mm == 1000.0  # band >= Tolerances.min_length, as a design file allows
+    # band >= Tolerances.min_length, and the tablet (band and two 0.9 mm cups) at most 1000 mm tall, as a design
+    # file allows (the band had reached 1000 mm: a tablet 1001.8 mm tall)
+    assert reach.lo_mm == 1e-3 and reach.hi_mm == pytest.approx(1000.0 - 2 * 0.9, abs=1e-5)
+
+
+def test_a_solved_tablet_keeps_the_size_limit_and_the_stated_ends_are_reached(capsys):
+    """A trial: ``--solve-for band --target-weight 100200`` on the 10 mm concave round gave a band of 999.7 mm, a
+    tablet 1001.5 mm tall that a design file refuses (exit 0), and the refusal's range "88.337 to 100227 mg"
+    refused both its printed ends.  The band now stops where the tablet is 1000 mm tall, and each printed end
+    is solved."""
+    from tabletcad.pipeline.design import Design
+
+    sample = str(ROOT / "samples" / "families" / "concave_round.toml")
+    assert main(["report", sample, "--solve-for", "band", "--target-weight", "100200"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: --target-weight = 100200 mg is not allowed: must be within ") and \
+        "for band in [0.001, 998.2] mm" in err, err
+    lo, hi = re.search(r"within (\S+) to (\S+) mg", err).groups()
+    for end in (lo, hi):
+        assert main(["report", sample, "--solve-for", "band", "--target-weight", end, "--json"]) == 0
+        d = json.loads(capsys.readouterr().out)
+        band = d["inverse"]["value_mm"]
+        data = Design.from_toml(sample).to_dict()
+        data["tablet"]["band"] = band
+        t = Design.from_dict(data).build()  # a design file takes it: within the size limit
+        b_lo, b_hi = t.bounds()
+        assert b_hi[2] - b_lo[2] <= 1000.0 * (1 + 1e-9)
 
 
 def test_a_solved_length_is_one_a_design_file_accepts(tmp_path):
@@ -219,7 +254,7 @@ def test_a_solved_length_is_one_a_design_file_accepts(tmp_path):
 
     dims = dict(diameter=10.0, cup_depth=0.9, land=0.08)
     reach = reachable("concave_round", "band", **dims)
-    with pytest.raises(DesignError, match=r"\[0.001, 1000\] mm"):
+    with pytest.raises(DesignError, match=r"\[0.001, 998\.2\] mm"):
         solve_for("concave_round", vary="band", target_volume_mm3=69.2055, **dims)
     band = solve_for("concave_round", vary="band", target_volume_mm3=reach.volume_lo_mm3 * (1 + 1e-6), **dims).value
     assert 1e-3 <= band < 2e-3

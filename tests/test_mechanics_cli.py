@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import shutil
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -257,6 +259,8 @@ def test_outputs_are_written_only_when_all_succeed(capsys, tmp_path, monkeypatch
         (["love", "--z", "inf"], ["--z = inf"]),
         (["love", "--h0", "-1"], ["--h0 = -1"]),
         (["love", "--window", "10", "inf"], ["--window"]),
+        # a trial: a window too narrow for the model's densities to change had been named "window"
+        (["love", "--window", "1e-300", "1e-299"], ["error: --window = "]),
         (["shell", "--outer", "nan", "--inner", "2", "--E", "100", "--nu", "0.3", "--p-ext", "3"], ["--outer = nan"]),
         (["shell", "--outer", "2.5", "--inner", "2", "--E", "100", "--nu", "0.3", "--p-ext", "nan"], ["--p-ext = nan"]),
         (["contact", "--force", "nan"], ["--force = nan"]),
@@ -597,6 +601,54 @@ def test_simulate_compressions_omega_z0_range_from_python():
         simulate_compression(P, omega_z0=-5.9)
     with pytest.raises(DesignError, match=r"^omega_z0 = "):
         simulate_compression(P, omega_z0=hi + 1e-6)
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
+@pytest.mark.parametrize("args", [
+    ["heckel", str(SAMPLE), "--plot", "h.png", "--json-file", "h.json"],
+    ["shell", "--outer", "5", "--inner", "4", "--E", "100", "--nu", "0.3", "--p-ext", "1", "--psi", "10",
+     "--csv", "u.csv", "--plot", "u.png", "--json-file", "u.json"],
+])
+def test_a_refused_standard_output_leaves_no_file(tmp_path, args):
+    """A trial: ``heckel ... --plot h.png > /dev/full`` exited 2 with one line and left h.png; the files
+    are moved into place only once the result is printed."""
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache"), "PYTHONPATH": str(ROOT)}
+    work = tmp_path / "work"
+    work.mkdir()
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], stdout=full, stderr=subprocess.PIPE,
+                              text=True, env=env, cwd=work, timeout=120)
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
+    assert sorted(work.iterdir()) == []
+    proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], capture_output=True, text=True, env=env,
+                          cwd=work, timeout=120)
+    assert proc.returncode == 0 and len(list(work.iterdir())) == 2 + ("--csv" in args), proc.stderr
+
+
+@pytest.mark.parametrize("model", [{}, {"h0": 4.3}, {"E": 483.6}, {"nu": 1e-9}, {"h0": 60.0}, {"z": 6.0}])
+def test_omega_z0_ranges_ends_are_exact_in_floating_point(capsys, model):
+    """The closed-form ends round differently from the model's sums: the value next to the lower end had
+    been let through and then refused by the model, as the fit's window from Python and as ``--h0 = 4.3 mm
+    ... must be >= 4.30001`` (an option given in range) on the command line.  Now the next value above
+    ``lo`` runs, ``lo`` does not, ``hi`` runs and the next above it does not."""
+    from tabletcad.errors import DesignError
+    from tabletcad.mechanics.love import omega_z0_range, simulate_compression
+
+    P = np.linspace(10.0, 50.0, 41)
+    lo, hi = omega_z0_range(P, **model)
+    for w0 in (math.nextafter(lo, math.inf), hi):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            assert simulate_compression(P, omega_z0=w0, **model).heckel.n_points >= 3
+    for w0 in (lo, math.nextafter(hi, math.inf)):
+        with pytest.raises(DesignError, match=r"^omega_z0 = "):
+            simulate_compression(P, omega_z0=w0, **model)
+    if model in ({"h0": 4.3}, {"E": 483.6}):  # the command line: the option at fault is --omega-z0
+        options = [a for k, v in model.items() for a in (f"--{k}", repr(v))]
+        rc, _, err = run(capsys, "love", *options, "--omega-z0", repr(lo))
+        assert rc == 2 and err.startswith("error: --omega-z0 = ") and err.count("\n") == 1, err
+        rc, out, err = run(capsys, "love", *options, "--omega-z0", repr(math.nextafter(lo, math.inf)), "--json")
+        assert rc == 0 and json.loads(out)["omega_z0_mm"] == math.nextafter(lo, math.inf), err
 
 
 def test_heckel_refuses_punch_travel_taken_as_the_gap(capsys, tmp_path):

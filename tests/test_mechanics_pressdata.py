@@ -455,6 +455,76 @@ def test_a_metadata_file_that_would_be_misread_is_refused(tmp_path, edit, parame
     assert exc.value.parameter == parameter and fragment in str(exc.value), str(exc.value)
 
 
+@pytest.mark.parametrize("edit, parameter, value, fragment", [
+    # a compensation line's entries, as the file gives them (they had been named compliance.slope and
+    # compliance.offset, keys the file did not have, the intercept with its sign flipped)
+    ("[1.0, -0.0267]", "compliance.compensation_line[0]", 1.0, "must be >= 0 and <= 0.001 mm/N"),
+    ("[0.00002, 1e300]", "compliance.compensation_line[1]", 1e300, "must be >= -1000 and <= 1000 mm"),
+    ('[0.00002, "x"]', "compliance.compensation_line[1]", "x", "not text"),
+])
+def test_a_compensation_lines_refusal_names_its_entry(tmp_path, edit, parameter, value, fragment):
+    from tabletcad.mechanics.pressdata import read_metadata
+
+    p = tmp_path / "m.toml"
+    p.write_text(_META.read_text(encoding="utf-8").replace("[0.00002, -0.0267]", edit), encoding="utf-8")
+    with pytest.raises(DesignError) as exc:
+        read_metadata(p)
+    assert (exc.value.parameter, exc.value.value) == (parameter, value) and fragment in str(exc.value), str(exc.value)
+    p.write_text("mass_mg = 300.0\ntrue_density = 1.3\ndiameter = 10.0\n[compliance]\nforce = [0.0, \"a\"]\n"
+                 "deflection = [0.0, 0.02]\n", encoding="utf-8")
+    with pytest.raises(DesignError, match=r"^compliance\.force\[1\] = 'a' is not allowed"):
+        read_metadata(p)
+
+
+@pytest.mark.parametrize("row, column, value, line", [
+    # a force no press makes: 1e300 N had been refused as the fit's window, a negative one as a thickness;
+    # in a row after the loading branch it had moved the branch: K = 0.046 1/MPa, a warning only, exit 0
+    (15, 0, "1e300", "force_N = 1e+300 N is not allowed: must be within ±7.854e+06 N (100000 MPa on the 78.54 mm² "
+                     "punch face: check the column's unit and the die diameter or face area)"),
+    (15, 0, "-1e300", "force_N = -1e+300 N is not allowed: must be within ±7.854e+06 N"),
+    (15, 0, "1e7", "force_N = 1e+07 N is not allowed"),
+    (215, 0, "1e300", "force_N = 1e+300 N is not allowed"),
+    # a displacement of -1e300 mm had been read as a bed 1e300 mm thick (the fit unchanged, exit 0)
+    (15, 1, "-1e300", "thickness = 1e+300 mm is not allowed: must be <= 1000 mm (size limit"),
+])
+def test_a_reading_no_press_makes_is_refused_by_its_line_and_column(tmp_path, row, column, value, line):
+    header, rows = _printed_rows()
+    rows[row][column] = value
+    p = tmp_path / "edited.csv"
+    p.write_text("\n".join(",".join(r) for r in [header, *rows]) + "\n", encoding="utf-8")
+    with pytest.raises(DesignError) as exc:
+        compaction_curves(read_press_data(p, meta=_META))
+    assert str(exc.value).startswith(f"line[{row + 2}].{line}"), str(exc.value)  # (the header is line 1)
+    if column == 0:  # a load cell's small negative reading is read as it was
+        rows[row][column] = "-5"
+        p.write_text("\n".join(",".join(r) for r in [header, *rows]) + "\n", encoding="utf-8")
+        assert read_press_data(p, meta=_META).force[row] == -5.0
+
+
+@pytest.mark.parametrize("cell", ["inf", "-inf", "1e400"])
+def test_an_infinite_reading_is_refused_not_dropped_as_missing(tmp_path, cell):
+    """A trial: ``inf`` and ``1e400`` (a float's overflow) had been dropped with the warning "missing force or
+    position value"; an empty or ``nan`` cell still is."""
+    p = _write(tmp_path, f"force_N,displacement_mm\n1,-5\n{cell},-4.95\n2,-4.9\n3,-4.8\n")
+    with pytest.raises(DesignError, match=r"^line\[3\]\.force_N = -?inf N is not allowed: must be a finite number"):
+        read_press_data(p, **META)
+    p = _write(tmp_path, f"force_N,displacement_mm\n1,-5\n2,{cell}\n3,-4.8\n4,-4.7\n")
+    with pytest.raises(DesignError, match=r"^line\[3\]\.displacement_mm = -?inf mm is not allowed"):
+        read_press_data(p, **META)
+    p = _write(tmp_path, "force_N,displacement_mm\n1,-5\nnan,-4.95\n,-4.93\n2,-4.9\n3,-4.8\n")
+    with pytest.warns(DataWarning, match="dropped 2 row"):
+        assert len(read_press_data(p, **META)) == 3
+
+
+def test_a_column_header_naming_two_columns_is_refused_not_taken_first(tmp_path):
+    """A trial: ``--force-column force_N`` with two columns of that name had taken the first without a word."""
+    p = _write(tmp_path, "force_N,force_N,displacement_mm\n1,10,-5\n2,20,-4.9\n3,30,-4.8\n")
+    with pytest.raises(DesignError, match=r"^--force-column = 'force_N' is not allowed: names 2 columns \(numbers 1, "
+                                          r"2\): give the column's number$"):
+        read_press_data(p, **META, columns={"force": "force_N"})
+    assert np.array_equal(read_press_data(p, **META, columns={"force": "2"}).force, [10.0, 20.0, 30.0])
+
+
 def test_metadata_overrides_binary_files_and_a_byte_order_mark(tmp_path):
     from tabletcad.errors import DesignError
     from tabletcad.mechanics.pressdata import read_metadata

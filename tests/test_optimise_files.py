@@ -120,6 +120,9 @@ BAD = [
      "problem.objective"),
     ("weight_on_thesis_kind", SPHERE.replace('kind = "spherical_tablet"', 'kind = "spherical_tablet"\nweight_mg = 3.0'),
      "problem.weight_mg"),
+    # a trial: reversed bounds had been named constraint[1].bounds, a key the file does not have
+    ("constraint_bounds_reversed", FAMILY + '\n[[constraint]]\nquantity = "height_mm"\nlower = 5.0\nupper = 4.0\n',
+     "constraint[1].upper"),
 ]
 
 

@@ -18,6 +18,7 @@ pytest.importorskip("distributed")
 pytest.importorskip("pandas")
 
 from tabletcad.cli import main  # noqa: E402
+from tabletcad.errors import DesignError  # noqa: E402
 from tabletcad.sweep import design_hash, parse_sweep  # noqa: E402
 from tabletcad.sweep.engine import flatten_report  # noqa: E402
 
@@ -236,6 +237,28 @@ def _refused_up_front(tmp_path, capsys, body: str, line: str) -> None:
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith(line), err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("vary, line", [
+    ("{ min = 0.6, max = 1e300, num = 2 }", 'error: sweep.vary."tablet.cup_depth".max = 1e+300 mm is not allowed: '
+                                           "must be within ±1000 mm (size limit"),
+    ("{ min = -2000.0, max = 1.0, num = 3 }", 'error: sweep.vary."tablet.cup_depth".min = -2000 mm is not allowed: '
+                                             "must be within ±1000 mm"),
+    ("[0.6, 1e300]", 'error: sweep.vary."tablet.cup_depth" = 1e+300 mm is not allowed: must be within ±1000 mm'),
+])
+def test_a_varied_length_beyond_the_size_limit_is_refused_before_the_sweep(tmp_path, capsys, vary, line):
+    """A new user's range ``max = 1e300`` (a trial): its design failed as a row, exit 0; a length beyond
+    ±1000 mm is refused by every design reader, so up front here (one line, exit 2, no folder), named as
+    the file has it."""
+    p = _write(tmp_path, f'[sweep.vary]\n"tablet.cup_depth" = {vary}\n')
+    out = tmp_path / "out"
+    assert main(["sweep", str(p), "--out", str(out), "--workers", "1", "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(line), err
+    assert not out.exists()
+    lhs = {"tablet.cup_depth": {"min": 0.5, "max": 1e300}}
+    with pytest.raises(DesignError, match="must be within ±1000 mm"):
+        parse_sweep({"design": BASE, "sweep": {"method": "lhs", "samples": 4, "seed": 1, "vary": lhs}})
 
 
 def test_a_dimension_wrong_only_with_the_varied_values_or_varied_itself_is_left_to_the_rows():

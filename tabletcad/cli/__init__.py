@@ -254,9 +254,35 @@ def _run(argv: list[str] | None) -> int:
     return 0
 
 
+#: ``warning:`` lines of the running command, printed when it ends with a result (status 0 or 3): a
+#: refusal is its one ``error:`` line (a design's warning had come before the error of a write to a
+#: full disk, two lines for one refusal)
+_PENDING_WARNINGS: list[str] = []
+#: the process that runs :func:`main` (a forked helper, ``tabletcad.io.forked``, prints its warnings at once:
+#: its copy of the held list ends with it)
+_MAIN_PID = [0]
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """A warning on the command line: one line, ``warning: <message>``, no source line."""
-    _say("warning: " + " ".join(str(message).split()))
+    """A warning on the command line: one line, ``warning: <message>``, no source line; held until the
+    command has its outcome (:data:`_PENDING_WARNINGS`)."""
+    import os
+
+    text = "warning: " + " ".join(str(message).split())
+    if os.getpid() == _MAIN_PID[0]:
+        _PENDING_WARNINGS.append(text)
+    else:
+        _say(text)
+
+
+def _say_warnings(status: int) -> None:
+    """Print the held warnings after a result (status 0, or 3: ``optimise`` found no feasible optimum),
+    drop them after a refusal, an internal error or an interruption (their one line is the outcome)."""
+    lines = list(_PENDING_WARNINGS)
+    _PENDING_WARNINGS.clear()
+    if status in (0, 3):
+        for line in lines:
+            _say(line)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -276,6 +302,8 @@ def main(argv: list[str] | None = None) -> int:
         _SIGINT_SEEN[0] = False
         signal.signal(signal.SIGINT, _on_sigint)
         sys.unraisablehook = _unraisable_interrupt(sys.unraisablehook)
+    _PENDING_WARNINGS.clear()
+    _MAIN_PID[0] = os.getpid()
     try:
         try:
             with warnings.catch_warnings():
@@ -285,6 +313,7 @@ def main(argv: list[str] | None = None) -> int:
                 warnings.simplefilter("ignore", DeprecationWarning)
                 warnings.simplefilter("ignore", PendingDeprecationWarning)
                 status = _run(argv)
+            _say_warnings(status)
             if argv is None:  # the program's outcome is decided: a Ctrl-C now would only break its exit
                 import signal
 

@@ -8,6 +8,8 @@ extra (scikit-fem, gmsh) and the ``cad`` extra.
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -31,18 +33,26 @@ def _require_fe() -> None:
         raise DesignError("tabletcad fe", exc.name, "needs the fe extra: pip install 'tabletcad[fe]'") from None
 
 
-def _echo(payload: dict[str, Any], as_json: bool, lines: list[str], json_file: Path | None = None) -> None:
-    """Write ``--json-file`` (all-or-nothing), then print the JSON or the lines."""
-    if json_file is not None:
-        from tabletcad.cli.outputs import staged
+def _echo(payload: dict[str, Any], as_json: bool, lines: list[str], json_file: Path | None = None,
+          outputs: tuple[Path, Any, dict] | None = None) -> None:
+    """Write ``--json-file`` and, with ``outputs`` (``--out``, the solution, the section's arguments),
+    ``stress.vtu`` and ``section.png`` (:func:`_write_outputs`), print the JSON or the lines, and only then
+    move the files into place: a refused standard output (a full disk) leaves none of them (it had left the
+    folder's and the JSON file, exit 2)."""
+    import contextlib
 
-        with staged(json=json_file) as out:
+    from tabletcad.cli.outputs import staged
+
+    with staged(json=json_file) as out, contextlib.ExitStack() as publishing:
+        if json_file is not None:
             out["json"].write_text(json_text(payload) + "\n", encoding="utf-8")
-    if as_json:
-        click.echo(json_text(payload))
-    else:
-        for ln in lines + ([f"json -> {json_file}"] if json_file is not None else []):
-            click.echo(ln)
+        if outputs is not None:
+            publishing.enter_context(_write_outputs(*outputs))
+        if as_json:
+            click.echo(json_text(payload))
+        else:
+            for ln in lines + ([f"json -> {json_file}"] if json_file is not None else []):
+                click.echo(ln)
 
 
 #: what ``--out`` of ``tabletcad fe diametral/punch`` holds
@@ -58,17 +68,23 @@ def _check_out(out: Path | None) -> None:
         check_replaceable(out, FE_FILES, manifest=FE_MANIFEST)
 
 
-def _write_outputs(out: Path, solution, section: dict) -> list[str]:
-    """``stress.vtu`` and ``section.png`` written to a staging folder and moved into ``out`` together,
-    recorded in its FE manifest; their paths."""
+def _out_files(out: Path) -> list[str]:
+    """The paths of :data:`FE_FILES` in ``out``."""
+    return [str(out / n) for n in FE_FILES]
+
+
+@contextlib.contextmanager
+def _write_outputs(out: Path, solution, section: dict) -> Iterator[None]:
+    """``stress.vtu`` and ``section.png`` written to a staging folder and, when the block succeeds, moved
+    into ``out`` together, recorded in its FE manifest."""
     from tabletcad.fe.output import plot_section, write_vtu
     from tabletcad.io.outputs import FE_MANIFEST, publish, staging_folder
 
     with staging_folder(out) as staging:
         write_vtu(solution, staging / "stress.vtu")
         plot_section(solution, staging / "section.png", **section)
+        yield
         publish(staging, out, FE_MANIFEST)
-    return [str(out / n) for n in FE_FILES]
 
 
 def _check_json_file(json_file: Path | None) -> None:
@@ -145,15 +161,16 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
                     error_estimate=not no_error_estimate, solid=solid)
     payload = {"design": str(design), "tablet_meshed": meshed, **res.to_dict()}
     files: list[str] = []
+    outputs = None
     if out is not None:
         ax = "xy".index(res.axis)
         px = 1 - ax
         s = res.centre_tensile_stress_MPa
-        files = _write_outputs(out, res.solution, dict(
+        outputs = (out, res.solution, dict(
             axis=2, level=res.centre_mm[2], component=(px, px),
             title=f"{tablet.name}: σ_{'xy'[px]}{'xy'[px]} at mid-thickness, {force:g} N along {res.axis}",
             label=f"σ_{'xy'[px]}{'xy'[px]} (MPa)", limits=(-3.0 * abs(s), 3.0 * abs(s))))
-        payload["files"] = files
+        files = payload["files"] = _out_files(out)
     err = res.discretisation_error_MPa
     _echo(payload, as_json, [
         f"{tablet.name}: {force:g} N along {res.axis} ({direction}), strip {res.strip_width_mm:.4g} mm, "
@@ -165,7 +182,7 @@ def diametral_cmd(design: Path, force: float, direction: str, strip_width: float
         f"2P/(πDt) = {res.line_load_MPa:.4g} MPa, shape factor {res.shape_factor:.4f}",
         f"largest tensile stress {res.max_tensile_stress_MPa:.4g} MPa at "
         + "(" + ", ".join(f"{v:.3g}" for v in res.max_tensile_location_mm) + ") mm",
-    ] + [f"-> {f}" for f in files], json_file=json_file)
+    ] + [f"-> {f}" for f in files], json_file=json_file, outputs=outputs)
 
 
 #: ``fe strength``'s inputs: the design file's ``[report]`` key (as a refusal names it) and the option for it
@@ -341,11 +358,12 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
                    f"({res.allowed_force_kN:.4g} kN): the tip would yield or buckle (--force is in kN)", err=True)
     payload = {"design": str(design), "steel": steel, **res.to_dict()}
     files: list[str] = []
+    outputs = None
     if out is not None:
-        files = _write_outputs(out, res.solution, dict(
+        outputs = (out, res.solution, dict(
             axis=1, level=float(res.solution.mesh.p[1].mean()), component="von_mises",
             title=f"{tablet.name}: {which} punch tip, von Mises stress at {force:g} kN", label="von Mises stress (MPa)"))
-        payload["files"] = files
+        files = payload["files"] = _out_files(out)
     b = res.buckling
     _echo(payload, as_json, [
         f"{tablet.name}: {which} punch tip, {force:g} kN over the cup face ({res.loaded_area_mm2:.4g} mm2)",
@@ -355,7 +373,7 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
         f"allowed force {res.allowed_force_kN:.4g} kN (yield {yield_stress:g} MPa / {safety_factor:g}"
         + (f"; {b['method']} buckling {b['critical_force_kN']:.4g} kN at slenderness {b['slenderness']:.3g}" if b else "")
         + ")",
-    ] + [f"-> {f}" for f in files], json_file=json_file)
+    ] + [f"-> {f}" for f in files], json_file=json_file, outputs=outputs)
 
 
 COMMANDS = [fe_group]

@@ -94,18 +94,21 @@ def build_cmd(design: Path, out_dir: Path, quiet: bool) -> None:
     from tabletcad.cli.report import nominal_note
     from tabletcad.collector import fewer_full_collections
 
+    def announce(rep: dict) -> None:  # printed before the files are put in place: a refused standard output
+        # (a full disk) leaves the folder as it was (it had left the whole build, exit 2)
+        written = rep["outputs"]  # this build's files only (the folder may hold files tabletcad did not write)
+        d = rep["design"]
+        size = f"{rep['length_mm']:.4g} x {rep['width_mm']:.4g} x {rep['height_mm']:.4g} mm"
+        click.echo(
+            f"{d['name']}: volume {rep['volume_mm3']:.4g} mm3, area {rep['surface_area_mm2']:.4g} mm2, {size}"
+            f"{nominal_note(d['family'], d['params'], rep['length_mm'], rep['width_mm'], rep['height_mm'])}"
+            f"{_finished_note(rep)} -> {out_dir}/ ({', '.join(written)})"
+        )
+
     with fewer_full_collections():  # the build's imports and its work (see tabletcad.collector)
         from tabletcad.pipeline.build import build_design
 
-        rep = build_design(design, out_dir, progress=not quiet, parallel=True)
-    written = rep["outputs"]  # this build's files only (the folder may hold files tabletcad did not write)
-    d = rep["design"]
-    size = f"{rep['length_mm']:.4g} x {rep['width_mm']:.4g} x {rep['height_mm']:.4g} mm"
-    click.echo(
-        f"{d['name']}: volume {rep['volume_mm3']:.4g} mm3, area {rep['surface_area_mm2']:.4g} mm2, {size}"
-        f"{nominal_note(d['family'], d['params'], rep['length_mm'], rep['width_mm'], rep['height_mm'])}"
-        f"{_finished_note(rep)} -> {out_dir}/ ({', '.join(written)})"
-    )
+        build_design(design, out_dir, progress=not quiet, parallel=True, announce=announce)
 
 
 def _finished_note(rep: dict) -> str:
@@ -135,7 +138,7 @@ def mesh_cmd(design: Path, nodes: tuple[int, int, int], out_file: Path) -> None:
     faces, so a coarse mesh holds less volume than the tablet.
     """
     from tabletcad.pipeline.design import load_design
-    from tabletcad.volume_mesh import degenerate_cells, hex_mesh, mesh_volume, write_mesh
+    from tabletcad.volume_mesh import degenerate_cells, hex_mesh, mesh_volume
 
     for n in nodes:
         if n < 2 or n > 2000:
@@ -149,15 +152,14 @@ def mesh_cmd(design: Path, nodes: tuple[int, int, int], out_file: Path) -> None:
 
     with option_names({"nodes": "--nodes"}):
         mesh = hex_mesh(tablet, nodes=nodes)
-    write_mesh(mesh, out_file)
     counts = ", ".join(f"{len(c)} {k}" for k, c in mesh.cells.items() if len(c))
     v_mesh, v_exact = mesh_volume(mesh), tablet.solid_volume()
     if not (math.isfinite(v_exact) and v_exact > 0.0):  # pragma: no cover - valid designs have a volume
-        click.echo(f"{out_file}: {len(mesh.points)} nodes, {counts}; mesh volume {v_mesh:.6g} mm3")
+        _write_then_place(mesh, out_file, f"{out_file}: {len(mesh.points)} nodes, {counts}; mesh volume {v_mesh:.6g} mm3")
         return
     rel = v_mesh / v_exact - 1.0
-    click.echo(f"{out_file}: {len(mesh.points)} nodes, {counts}; mesh volume {v_mesh:.6g} mm3 "
-               f"({rel * 100:+.3g} % of the exact {v_exact:.6g} mm3)")
+    _write_then_place(mesh, out_file, f"{out_file}: {len(mesh.points)} nodes, {counts}; mesh volume {v_mesh:.6g} mm3 "
+                                      f"({rel * 100:+.3g} % of the exact {v_exact:.6g} mm3)")
     bad = {k: n for k, n in degenerate_cells(mesh).items() if n}
     if bad:
         which = ", ".join(f"{n} {k}" for k, n in bad.items())
@@ -176,6 +178,28 @@ def mesh_cmd(design: Path, nodes: tuple[int, int, int], out_file: Path) -> None:
         hint = f"{math.ceil((nodes[0] - 1) * s) + 1} {math.ceil((nodes[1] - 1) * s) + 1} {nodes[2]}"
         click.echo(f"warning: the mesh volume is {abs(rel) * 100:.3g} % {'below' if rel < 0 else 'above'} the exact "
                    f"volume (more than {tablet.tol.mesh_volume * 100:g} %): use more nodes, e.g. --nodes {hint}", err=True)
+
+
+class _Unprinted(Exception):
+    """A refused write of standard output, carried out of :func:`tabletcad.io.atomic_path`'s block as it
+    is (that block names its file for an ``OSError``; standard output is ``output``)."""
+
+
+def _write_then_place(mesh, out_file: Path, line: str) -> None:
+    """Write ``mesh`` to a temporary file beside ``out_file``, print ``line``, then rename the file onto
+    ``out_file``: a refused standard output (a full disk) leaves no mesh file (it had, exit 2)."""
+    from tabletcad.io import atomic_path
+    from tabletcad.volume_mesh import write_mesh
+
+    try:
+        with atomic_path(out_file) as tmp:
+            write_mesh(mesh, tmp)
+            try:
+                click.echo(line)
+            except OSError as exc:
+                raise _Unprinted(exc) from None
+    except _Unprinted as held:
+        raise held.args[0] from None
 
 
 def available_memory() -> int | None:

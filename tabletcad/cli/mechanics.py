@@ -31,7 +31,9 @@ __all__ = ["COMMANDS"]
 
 @contextlib.contextmanager
 def _collect() -> Iterator[list[str]]:
-    """Collect mechanics warnings (their text) and echo them on stderr at the end."""
+    """Collect mechanics warnings (their text) into the list yielded; :func:`_emit` echoes them on stderr
+    once the command's outputs are written (a write refused after them, ``--json > /dev/full``, had left
+    the warnings and the error line: two lines for one refusal)."""
     from tabletcad.mechanics.validity import MechanicsWarning
 
     msgs: list[str] = []
@@ -41,16 +43,20 @@ def _collect() -> Iterator[list[str]]:
     for w in rec:
         if issubclass(w.category, MechanicsWarning):
             msgs.append(str(w.message))
-    for m in msgs:
-        click.echo(f"warning: {m}", err=True)
 
 
 def _emit(payload: dict[str, Any], as_json: bool, lines: list[str]) -> None:
+    """Print the result (its lines, or ``payload`` as JSON), then the payload's ``warnings`` on stderr.
+
+    The warnings come last: a refused write of standard output (a full disk) is then the command's one
+    ``error:`` line, as every refusal is."""
     if as_json:
         click.echo(json_text(payload))
     else:
         for ln in lines:
             click.echo(ln)
+    for m in payload.get("warnings", ()):
+        click.echo(f"warning: {m}", err=True)
 
 
 #: the metadata's keys (as a metadata file writes them) with their units, for the JSON documents
@@ -189,15 +195,16 @@ def _check_json_file(json_file: Path | None, **others: Path | None) -> None:
 
 def _finish(payload: dict[str, Any], as_json: bool, json_file: Path | None, lines: list[str],
             plot: tuple[Path | None, Any] = (None, None)) -> None:
-    """Write ``--json-file`` (and a plot) all-or-nothing, then print the lines or the JSON."""
+    """Write ``--json-file`` (and a plot) all-or-nothing with the lines or the JSON printed: the files are
+    moved into place once the printing succeeded (``--plot h.png > /dev/full`` had left h.png, exit 2)."""
     plot_file, draw = plot
     with _staged(json=json_file, plot=plot_file) as out:
         if json_file is not None:
             out["json"].write_text(json_text(payload) + "\n", encoding="utf-8")
         if plot_file is not None:
             draw(out["plot"])
-    _emit(payload, as_json, lines + ([f"json -> {json_file}"] if json_file and not as_json else [])
-          + ([f"plot -> {plot_file}"] if plot_file and not as_json else []))
+        _emit(payload, as_json, lines + ([f"json -> {json_file}"] if json_file and not as_json else [])
+              + ([f"plot -> {plot_file}"] if plot_file and not as_json else []))
 
 
 def _compression_table(data: Path, pressure_column: str, thickness_column: str, h0: float | None,
@@ -584,13 +591,13 @@ def shell_cmd(a, b, E, nu, p_ext, p_int, psi, region, terms, csv_file, plot_file
             out["csv"].write_text("\n".join(rows) + "\n", encoding="utf-8")
         if plot_file is not None:
             plot_shell(sol, out["plot"])
-    _emit(payload, as_json, [
-        (f"shell a = {a:g} mm, b = {b:g} mm, E = {E:g} MPa, ν = {nu:g}; p_ext = {p_ext:g} MPa over "
-         f"{region} ψ = {psi:g}°, p_int = {p_int:g} MPa; {terms} orders"),
-        f"u_r(a): θ=0° {ua[0]:.4g} mm, θ=90° {eq:.4g} mm; u_r(b): θ=0° {ub[0]:.4g} mm, θ=90° {ub[90]:.4g} mm",
-        f"series change at θ=90° from {terms // 2} to {terms} orders: {eq - half:.3g} mm",
-    ] + [f"{option} -> {path}" for option, path in (("json", json_file), ("csv", csv_file), ("plot", plot_file))
-         if path is not None and not as_json])
+        _emit(payload, as_json, [  # (before the files are moved into place, as in _finish)
+            (f"shell a = {a:g} mm, b = {b:g} mm, E = {E:g} MPa, ν = {nu:g}; p_ext = {p_ext:g} MPa over "
+             f"{region} ψ = {psi:g}°, p_int = {p_int:g} MPa; {terms} orders"),
+            f"u_r(a): θ=0° {ua[0]:.4g} mm, θ=90° {eq:.4g} mm; u_r(b): θ=0° {ub[0]:.4g} mm, θ=90° {ub[90]:.4g} mm",
+            f"series change at θ=90° from {terms // 2} to {terms} orders: {eq - half:.3g} mm",
+        ] + [f"{option} -> {path}" for option, path in (("json", json_file), ("csv", csv_file), ("plot", plot_file))
+             if path is not None and not as_json])
 
 
 # --------------------------------------------------------------------------- love
@@ -693,7 +700,7 @@ def love_cmd(E, nu, h0, z, r, omega_z0, window, as_json, json_file) -> None:
             raise DesignError("--omega-z0", omega_z0, omega_z0_allowed(w_lo, w_hi, 41, cap=h0), "mm")
     # the model's refusal of a bed pressed to nothing names its keyword; here the option
     model = {"E": E, "nu": nu, "h0": h0, "z": z, "r": r, "omega_z0": omega_z0}
-    with _collect() as msgs, option_names({"omega_z0": "--omega-z0", "pressure": "--window"}):
+    with _collect() as msgs, option_names({"omega_z0": "--omega-z0", "pressure": "--window", "window": "--window"}):
         try:
             sim = simulate_compression(np.linspace(lo, hi, 41), **model)
         except DesignError:

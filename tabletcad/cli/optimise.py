@@ -109,9 +109,10 @@ def optimise_cmd(problem_file: Path, out_dir: Path, method: str | None, starts: 
         written.append("convergence.png")
         atomic_write_text(staging / "report.json", to_json(report))
         written.append("report.json")
+        # printed before the files are moved into place: a refused standard output (a full disk) leaves none
+        click.echo(summary(result))
+        click.echo(f"-> {out_dir}/ ({', '.join(written)})")
         publish(staging, out_dir, OPTIMISE_MANIFEST)  # replaces only its earlier run's unchanged files
-    click.echo(summary(result))
-    click.echo(f"-> {out_dir}/ ({', '.join(written)})")
     if not result.success:  # the reason is the summary's last line
         raise OptimisationFailed(f"optimisation {result.status}: no certified optimum (see above; report.json "
                                  "holds every constraint's value)")

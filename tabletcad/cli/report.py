@@ -409,6 +409,18 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
             _write_tables(payloads, csv_out, xlsx_out, st)
         if plot_out is not None:
             _write_plot(tablets, st["plot"])
+        # printed before the files are moved into place: a refused standard output (a full disk) leaves none
+        # of them (it had left --csv, --plot and --json-file, exit 2)
+        _print_report(document, payloads, shown, as_json,
+                      (("json", json_file), ("csv", csv_out), ("xlsx", xlsx_out), ("plot", plot_out)))
+
+
+def _print_report(document: dict | list, payloads: list[dict[str, Any]], shown: list, as_json: bool,
+                  files: tuple[tuple[str, Path | None], ...]) -> None:
+    """Print the reports: the JSON document, or each solved dimension, the table (one design) or the
+    comparison (several), and the files written (option, path)."""
+    from tabletcad.pipeline.report import to_json
+
     if as_json:
         click.echo(to_json(document).rstrip("\n") if isinstance(document, dict)
                    else "[\n" + ",\n".join(to_json(p).rstrip("\n") for p in payloads) + "\n]")
@@ -421,7 +433,7 @@ def report_cmd(designs: tuple[Path, ...], solid_fraction, true_density, breaking
             click.echo(f"{p['design']['name']}: {inv['solved_for']} = {inv['value_mm']:.4g} mm gives {target}"
                        + (f" (was {inv['given_mm']:.4g} mm)" if inv["given_mm"] is not None else ""))
     click.echo(_table(*shown[0]) if len(shown) == 1 else _comparison(shown))
-    for option, path in (("json", json_file), ("csv", csv_out), ("xlsx", xlsx_out), ("plot", plot_out)):
+    for option, path in files:
         if path is not None:
             click.echo(f"{option} -> {path}")
 

@@ -13,9 +13,10 @@ Method
    nominal while searching (its PDE patches are made once, for the answer).  The thesis's
    shapes have no such nominal: their own :meth:`Tablet.volume() <tabletcad.geometry.tablet.Tablet.volume>`.
 2. The feasible interval of the solved dimension: the families' constructors raise
-   :class:`~tabletcad.errors.DesignError` on dimensions they cannot build, and with the
-   other dimensions fixed the buildable values form one interval inside
-   ``[0, tol.max_length]`` mm.  From a buildable start (the given value, else the family
+   :class:`~tabletcad.errors.DesignError` on dimensions they cannot build, a tablet taller than
+   ``tol.max_length`` is refused as a design file refuses it (a 10 mm concave round had been
+   solved to a 999.7 mm band, 1001.5 mm tall), and with the other dimensions fixed the buildable
+   values form one interval inside ``[0, tol.max_length]`` mm.  From a buildable start (the given value, else the family
    default, else the first buildable value of a logarithmic scan) its ends are found by
    doubling and then bisection on buildability, to ``1e-9`` relative (industry families,
    cheap) or ``1e-7`` relative (the thesis's shapes, whose every build makes patches).
@@ -54,7 +55,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from tabletcad.errors import MISSING, DesignError, GeometryError, check_finite, check_positive, check_range
+from tabletcad.errors import (MISSING, DesignError, GeometryError, check_finite, check_positive, check_range,
+                              format_bound)
 from tabletcad.families.family import lengths_unchecked
 from tabletcad.families.sweep import NominalBuilt, SweepNominal, nominal_only, nominal_volume
 from tabletcad.geometry.tablet import Tablet
@@ -187,6 +189,8 @@ class _Probe:
         # a length between 0 and min_length is refused by a design file (tabletcad.pipeline.design):
         # an approached lower end is raised to it, and a root between them is refused (solve_for)
         self.min_length = float(getattr(dims.get("tol", DEFAULT), "min_length", DEFAULT.min_length))
+        # and one taller than the size limit (tabletcad.pipeline.design._check_height): not buildable here either
+        self.max_height = float(getattr(dims.get("tol", DEFAULT), "max_length", DEFAULT.max_length)) * (1.0 + 1e-9)
         self.builds = 0
         self._cache: dict[float, tuple[bool, Any]] = {}
         self.exact_nominal: bool | None = None
@@ -198,11 +202,11 @@ class _Probe:
                 with nominal_only(), lengths_unchecked():  # (a lower end approached is put on min_length below)
                     t = self.func(**self.dims, **{self.vary: x})
             except NominalBuilt as ready:
-                self._cache[x] = (True, ready.nominal)
+                self._cache[x] = (_height(ready.nominal) <= self.max_height, ready.nominal)
             except (DesignError, GeometryError):
                 self._cache[x] = (False, None)
             else:
-                self._cache[x] = (True, t)
+                self._cache[x] = (_height(t) <= self.max_height, t)
         return self._cache[x]
 
     def ok(self, x: float) -> bool:
@@ -220,6 +224,15 @@ class _Probe:
             return nominal_volume(obj.nominal)
         self.exact_nominal = False
         return float(obj.volume())
+
+
+def _height(built: SweepNominal | Tablet) -> float:
+    """The height (mm) of a nominal-only build (its nominal thickness) or of a tablet (its extent in z)."""
+    nominal = built if isinstance(built, SweepNominal) else getattr(built, "nominal", None)
+    if isinstance(nominal, SweepNominal):
+        return float(nominal.thickness)
+    lo, hi = built.bounds()
+    return float(hi[2] - lo[2])
 
 
 def _start(probe: _Probe, x0: float, x_max: float) -> float:
@@ -292,8 +305,9 @@ def _reach(probe: _Probe, name: str, x0: float, x_max: float, rel: float):
 # ---------------------------------------------------------------------------- API
 
 def _interval(reach: Reach) -> str:
-    """``[lo, hi]`` (a lower end > 0 is at least ``Tolerances.min_length``, a design file's least length)."""
-    return f"[{reach.lo_mm:.6g}, {reach.hi_mm:.6g}]"
+    """``[lo, hi]`` (a lower end > 0 is at least ``Tolerances.min_length``, a design file's least length),
+    rounded into the interval."""
+    return f"[{format_bound(reach.lo_mm, upper=False)}, {format_bound(reach.hi_mm, upper=True)}]"
 
 
 def _prepare(family, vary, dims):
@@ -477,8 +491,11 @@ def solve_for(
         param, given, unit, scale = "target_weight_mg", target_weight_mg, "mg", mg_per_mm3
     if not reach.volume_lo_mm3 <= target <= reach.volume_hi_mm3:
         basis = "" if reach.monotone else " (sampled: the volume is not monotone in it)"
-        raise DesignError(param, given, f"must be within {reach.volume_lo_mm3 * scale:.6g} to "
-                          f"{reach.volume_hi_mm3 * scale:.6g} {unit} for {vary} in {_interval(reach)} mm{basis} ({name}, the other dimensions fixed)", unit)
+        # the ends rounded into the range: each is accepted (rounded to 6 digits, 88.337 mg had been refused as
+        # outside "88.337 to 100227 mg")
+        raise DesignError(param, given, f"must be within {format_bound(reach.volume_lo_mm3 * scale, upper=False)} to "
+                          f"{format_bound(reach.volume_hi_mm3 * scale, upper=True)} {unit} for {vary} in "
+                          f"{_interval(reach)} mm{basis} ({name}, the other dimensions fixed)", unit)
     # a bracket: consecutive samples around the target (the one nearest the start if several)
     f = vs - target
     exact = np.flatnonzero(f == 0.0)

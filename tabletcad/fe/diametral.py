@@ -96,7 +96,9 @@ which tends to the line-load value ``2P/(πDt)`` (thesis eq 2.4) as ``b → 0``.
 
 from __future__ import annotations
 
+import contextlib
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -327,6 +329,21 @@ def default_averaging_radius(strip_width: float, thickness: float) -> float:
 def contact_depth(D: float, b: float) -> float:
     """Depth (mm) of a flat platen into a circle of diameter ``D`` whose contact chord is ``b`` (mm)."""
     return 0.5 * D - math.sqrt(max(0.25 * D * D - 0.25 * b * b, 0.0))
+
+
+@contextlib.contextmanager
+def _meshable(mesh_size: float | None, size: float, which: str = "") -> Iterator[None]:
+    """A given ``mesh_size`` (mm) at which gmsh makes no tetrahedra of the solid, refused by its name: a size within
+    its stated range (at most the tablet's largest extent) can be too coarse for the solid's faces, at ``size`` mm
+    (``which`` mesh); ``--mesh-size 10`` on the 10 mm concave round had printed "mesh: gmsh produced no tetrahedra".
+    A default size's failure stays what it is."""
+    try:
+        yield
+    except GeometryError as exc:
+        if mesh_size is None or "no tetrahedra" not in str(exc):
+            raise
+        raise DesignError("mesh_size", mesh_size, f"gmsh makes no tetrahedra of this solid at {size:.4g} mm{which}: "
+                          "give a finer size", "mm") from None
 
 
 def _solve_once(solid: Any, lo: np.ndarray, hi: np.ndarray, ax: int, P: float, b: float, h: float,
@@ -599,14 +616,17 @@ def diametral(
         return (h / 1.5, D / 8.0) if hc is None else (min(h, hc), max(D / 8.0, RECOVERY_RADIUS * h))
 
     hc = None if centre_mesh_size is None else check_positive("centre_mesh_size", centre_mesh_size, "mm")
-    sol, s_c, m, bf = _solve_once(solid, lo, hi, ax, P, b, h, hs, material, R, hp, *centre_ball(h, hc), symmetric)
+    with _meshable(mesh_size, h):
+        sol, s_c, m, bf = _solve_once(solid, lo, hi, ax, P, b, h, hs, material, R, hp, *centre_ball(h, hc), symmetric)
     s_max, loc, _ = largest_tensile(sol, bf, lo, hi, ax, b, R, symmetric)
     s_t, s_l = float(s_c[px, px]), float(s_c[ax, ax])
     w, vec = np.linalg.eigh(s_c)
     err = coarse = None
     if error_estimate:
-        _, s_cc, *_ = _solve_once(solid, lo, hi, ax, P, b, COARSENING * h, COARSENING * hs, material, R,
-                                  COARSENING * hp, *centre_ball(COARSENING * h, None if hc is None else COARSENING * hc), symmetric)
+        with _meshable(mesh_size, COARSENING * h, f" (the error estimate's mesh, {COARSENING:g} times coarser)"):
+            _, s_cc, *_ = _solve_once(solid, lo, hi, ax, P, b, COARSENING * h, COARSENING * hs, material, R,
+                                      COARSENING * hp, *centre_ball(COARSENING * h, None if hc is None else COARSENING * hc),
+                                      symmetric)
         coarse = float(s_cc[px, px])
         err = (s_t - coarse) / (COARSENING**2 - 1.0)
     c = 0.5 * (lo + hi)

@@ -124,6 +124,21 @@ class CompactionCurves:
         return s
 
 
+def _check_thickness(h: np.ndarray, lines: np.ndarray | None) -> None:
+    """Refuse a compact thickness (mm, after the compliance correction) beyond the size limit
+    (``Tolerances.max_length``), named by its line: a displacement of -1e300 mm had been taken as a bed
+    1e300 mm thick (exit 0, the row's relative density 3e-301)."""
+    from tabletcad.tolerance import DEFAULT
+
+    bad = np.flatnonzero(h > DEFAULT.max_length)
+    if bad.size:
+        i = int(bad[0])
+        row = f"line {int(lines[i])}" if lines is not None else f"row {i + 1}"
+        raise DesignError(f"{row} thickness", float(h[i]), f"must be <= {DEFAULT.max_length:g} mm (size limit, "
+                          "Tolerances.max_length): check the position column's unit, displacement_sign and "
+                          "displacement_zero", "mm")
+
+
 def compaction_curves(
     data: PressData, *, drop: float = 0.02, recovery_force_fraction: float = 0.1
 ) -> CompactionCurves:
@@ -141,6 +156,7 @@ def compaction_curves(
     meta = data.metadata
     P = data.force / meta.area
     h = np.asarray(data.thickness, dtype=float)
+    _check_thickness(h, data.line_numbers)
     D = relative_density(h, meta.mass_mg, meta.true_density, meta.area)
     branches = split_branches(data.force, drop=drop)
     check_peak_relative_density(D[slice(*branches.loading)])

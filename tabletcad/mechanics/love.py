@@ -286,7 +286,53 @@ def omega_z0_range(pressures, *, E: float = 2640.0, nu: float = 0.21, diameter: 
     h_dense = float(relative_density(1.0, mass_mg, true_density, math.pi * c * c))  # h at D = 1
     lo = max(-h0 - float(w[-1]), h_dense - h0 - float(w[_MIN_FIT_POINTS - 1]))
     hi = h_dense / MIN_PEAK_RELATIVE_DENSITY - h0 - float(w[-1])
+    if not lo < hi:
+        return (math.nan, math.nan)
+
+    def runs(omega_z0: float) -> bool:  # the three rules in the model's own arithmetic
+        h = h0 + axial_displacement(P, E, nu, c, h0, z, r, omega_z0=omega_z0, scale=scale)
+        if np.any(h <= 0.0):
+            return False
+        D = relative_density(h, mass_mg, true_density, math.pi * c * c)
+        return int(np.sum(D < 1.0)) >= _MIN_FIT_POINTS and float(np.max(D)) >= MIN_PEAK_RELATIVE_DENSITY
+
+    # the closed forms round differently from the model's sums: the value next to lo had been let through
+    # and refused by the model as the fit's window (h0 = 4.3 mm) or a bed pressed to nothing (E = 483.6 MPa)
+    scale_mm = max(abs(lo), abs(hi), h0, float(np.max(np.abs(w))))
+    lo = _exact_edge(runs, lo, math.inf, scale_mm)
+    hi = _exact_edge(runs, hi, -math.inf, scale_mm, closed=True)
     return (lo, hi) if lo < hi else (math.nan, math.nan)
+
+
+def _exact_edge(runs, edge: float, inward: float, scale: float, closed: bool = False) -> float:
+    """``edge`` of a range of ``omega_z0`` (mm) moved inward to where ``runs`` holds in floating point.
+
+    ``runs`` is monotonic in ``omega_z0`` (each rule is a bound on ``h0 + omega_z0 + w``).  An open edge
+    (``closed`` False) must be followed, towards ``inward`` (``±inf``), by a value that runs; a closed one
+    must run itself.  Where not, the edge is moved by doubling steps from an ulp of ``scale`` (mm) and
+    bisection to the last value that does not run (open) or the first that does (closed)."""
+    first = edge if closed else math.nextafter(edge, inward)
+    if runs(first):
+        return edge
+    step = math.ulp(scale)
+    sign = 1.0 if inward > 0 else -1.0
+    bad, good = edge, edge + sign * step
+    for _ in range(64):  # (a few ulps in practice)
+        if runs(good):
+            break
+        bad, step = good, 2.0 * step
+        good = edge + sign * step
+    else:
+        return math.nan
+    while True:
+        mid = bad + (good - bad) / 2.0
+        if mid in (bad, good):
+            break
+        if runs(mid):
+            good = mid
+        else:
+            bad = mid
+    return good if closed else bad
 
 
 def omega_z0_allowed(lo: float, hi: float, n: int, cap: float | None = None) -> str:

@@ -69,7 +69,8 @@ import numpy as np
 from tabletcad.errors import MISSING, DesignError, check_finite, check_range
 from tabletcad.tolerance import DEFAULT
 from tabletcad.mechanics.units import DIMENSIONS, header_unit, strip_unit, unit_factor
-from tabletcad.tolerance import MAX_COMPLIANCE_MM_PER_N, MAX_TRUE_DENSITY_MG_MM3, MIN_TRUE_DENSITY_MG_MM3
+from tabletcad.tolerance import (MAX_COMPLIANCE_MM_PER_N, MAX_PRESSURE_MPA, MAX_TRUE_DENSITY_MG_MM3,
+                                 MIN_TRUE_DENSITY_MG_MM3)
 from tabletcad.mechanics.validity import DataWarning, warn
 
 __all__ = [
@@ -387,9 +388,38 @@ def _check_gap_closes(F: np.ndarray, gap: np.ndarray, sign: int, meta: PressMeta
         "(mm) in the metadata file; tabletcad does not guess them")
 
 
-def _assemble(F, pos, is_thickness, t, meta, extra, lines, dropped, source, column="displacement") -> PressData:
+def _check_forces(F: np.ndarray, area: float, lines: np.ndarray, force_column: str) -> None:
+    """Refuse a force no press makes, beyond ``MAX_PRESSURE_MPA`` on the punch face either way, named by
+    its line and column (a load cell's small negative readings are read).
+
+    A force of 1e300 N had been refused as the fit's window or as a thickness, or, in a row after the
+    loading branch, had moved the branch and given K = 0.046 1/MPa with a warning only, exit 0.
+
+    Parameters
+    ----------
+    F : ndarray
+        Force per row, N (converted from the file's unit).
+    area : float
+        Punch face area, mm².
+    lines : ndarray of int
+        The rows' 1-based line numbers in the file.
+    force_column : str
+        The force column's header.
+    """
+    f_max = MAX_PRESSURE_MPA * area
+    bad = np.flatnonzero(np.abs(F) > f_max)
+    if bad.size:
+        i = int(bad[0])
+        raise DesignError(f"line {int(lines[i])} {force_column!r}", float(F[i]),
+                          f"must be within ±{f_max:.4g} N ({MAX_PRESSURE_MPA:g} MPa on the {area:.4g} mm² punch face: "
+                          "check the column's unit and the die diameter or face area)", "N")
+
+
+def _assemble(F, pos, is_thickness, t, meta, extra, lines, dropped, source, column="displacement",
+              force_column="force") -> PressData:
     if F.size == 0:
         raise DesignError("data", source, "has no complete rows")
+    _check_forces(F, meta.area, lines, force_column)
     if is_thickness:
         gap = pos.copy()
         disp = None
@@ -619,6 +649,10 @@ def _pick(role: str, header: list[str], found: list[int], chosen: str | None) ->
     if chosen is not None:
         names = [h.lower() for h in header]
         key = str(chosen).strip().lower()
+        if names.count(key) > 1:  # (the first of them had been taken)
+            numbers = ", ".join(str(j + 1) for j, n in enumerate(names) if n == key)
+            raise DesignError(option, str(chosen), f"names {names.count(key)} columns (numbers {numbers}): give "
+                              "the column's number")
         if key in names:
             return names.index(key)
         if key.isdigit() and 1 <= int(key) <= len(header):
@@ -766,6 +800,14 @@ def read_press_data(
         if exponent is None:
             values[:, j] *= factor
     need = [roles["force"], roles[pos_role]]
+    for j in need:  # an infinite reading (inf, 1e400) is no missing value: it had been dropped as one
+        inf = np.flatnonzero(np.isinf(values[:, j]))
+        if inf.size:
+            k = int(inf[0])
+            unit = "N" if j == roles["force"] else "mm"
+            raise DesignError(f"line {line_numbers[k]} {header[j]!r}", float(values[k, j]),
+                              f"must be a finite number (infinite as read, in {unit}); leave a missing value's "
+                              "cell empty", unit)
     keep = np.all(np.isfinite(values[:, need]), axis=1)
     dropped = int((~keep).sum())
     if dropped:
@@ -782,7 +824,7 @@ def read_press_data(
     metadata = _resolve_metadata(path, meta, overrides)
     return _assemble(
         values[:, roles["force"]].copy(), values[:, roles[pos_role]].copy(), pos_role == "thickness",
-        t, metadata, extra, lines, dropped, path.name, header[roles[pos_role]],
+        t, metadata, extra, lines, dropped, path.name, header[roles[pos_role]], header[roles["force"]],
     )
 
 
@@ -852,7 +894,20 @@ def _numbers(name: str, values: Any, unit: str, n: int | None = None) -> tuple[f
     """A list of finite numbers (of length ``n`` if given), else :class:`DesignError`."""
     if not isinstance(values, (list, tuple)) or (n is not None and len(values) != n):
         raise DesignError(name, values, f"must be a list of {n or 'several'} numbers", unit)
-    return tuple(check_finite(name, x, unit) for x in values)
+    return tuple(check_finite(f"{name} {i}", x, unit) for i, x in enumerate(values))  # named by its index
+
+
+def _named_line(slope: float, offset: float, names: tuple[str, str], shown: tuple[float, float]) -> MachineCompliance:
+    """The compliance line ``slope`` (mm/N), ``offset`` (mm), its refusal named as the file gives it: the
+    entries ``names`` with their values ``shown`` (a compensation line's intercept is minus the offset;
+    ``compensation_line = [1, 0]`` had been refused as ``compliance.slope``, a key the file did not have)."""
+    try:
+        return MachineCompliance(slope=slope, offset=offset)
+    except DesignError as exc:
+        i = {"compliance.slope": 0, "compliance.offset": 1}.get(exc.parameter)
+        if i is None:
+            raise
+        raise DesignError(names[i], shown[i], exc.allowed, exc.unit) from None
 
 
 def _compliance(comp: Any) -> MachineCompliance | None:
@@ -872,7 +927,8 @@ def _compliance(comp: Any) -> MachineCompliance | None:
                           f"must hold exactly one form of keys: {allowed}")
     if form == ("compensation_line",):
         s, b = _numbers("compliance compensation_line", comp["compensation_line"], "", 2)
-        return MachineCompliance.from_compensation_line(s, b)
+        # MachineCompliance.from_compensation_line's convention (offset = -intercept), named as the file's entries
+        return _named_line(s, -b, ("compliance compensation_line 0", "compliance compensation_line 1"), (s, b))
     if form == ("force", "deflection"):
         force = _numbers("compliance force", comp["force"], "N")
         deflection = _numbers("compliance deflection", comp["deflection"], "mm")

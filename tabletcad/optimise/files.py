@@ -562,6 +562,10 @@ def family_problem(prob: dict, variables: Any, fixed: dict, constraints: Any, fe
               for kk in ("target", "lower", "upper") if kk in c}
         kw.update({kk: number(f"[[constraint]] {k} {kk}", c[kk], "" if kk == "tol" else unit, lo=0.0, lo_open=True,
                               hi=LIMITS["" if kk == "tol" else unit]) for kk in ("tol", "scale") if kk in c})
+        if "lower" in kw and "upper" in kw and kw["upper"] < kw["lower"]:  # named by the file's key, as a variable's
+            # (the Constraint would say "constraint[1].bounds = (5.0, 4.0)", a key the file does not have)
+            raise DesignError(f"[[constraint]] {k} upper", kw["upper"],
+                              f"must be >= lower = {format_bound(kw['lower'], upper=False)}", unit)
         relative = boolean(f"[[constraint]] {k} relative", c["relative"]) if "relative" in c else False
         cname = c.get("name", q)
         if not isinstance(cname, str) or not cname.strip() or "\n" in cname:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import importlib.util
 import os
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -87,7 +88,8 @@ def fe_breaking_force_section(tablet: Any, options: Any, tooling: Any, cad: bool
 
 def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | None = None,
                  options: ReportOptions | None = None, cad: bool | None = None, progress: bool = True,
-                 parallel: bool = False, picture: bool = True) -> dict[str, Any]:
+                 parallel: bool = False, picture: bool = True,
+                 announce: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
     """Write ``report.json``, ``tablet.png``, the CAD files and the tooling of ``tablet`` into ``out_dir``.
 
     The steps, in order: the geometry report (:func:`~tabletcad.pipeline.report.geometry_report`,
@@ -107,6 +109,10 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
     (:func:`import_shared`), once for both.  ``picture=False`` leaves ``tablet.png`` out (a sweep that
     keeps only other files: the picture, 0.08 CPU-s, was most of a report-and-CAD-files design's
     0.1 CPU-s and the only reason its worker imported Matplotlib); nothing else changes.
+
+    ``announce``, if given, is called with the report once every file is made, before they are put in
+    place: the command line prints its summary there, so that a refused standard output (a full disk)
+    leaves ``out_dir`` as it was.
 
     Returns the report; ``report["outputs"]`` names the files this build wrote.
     Nothing in ``out_dir`` changes if any step fails.  The folder is owned by
@@ -166,6 +172,8 @@ def build_tablet(tablet: Tablet, out_dir: str | Path, *, tooling: ToolingSpec | 
         names = sorted(p.name for p in staging.iterdir() if p.name != STAGING_MARKER) + ["report.json"]
         report["outputs"] = sorted(names)
         (staging / "report.json").write_text(to_json(report), encoding="utf-8")
+        if announce is not None:
+            announce(report)
         publish(staging, out_dir)
         return report
 
@@ -184,10 +192,11 @@ def fe_tip_rating(ts: Any, options: ReportOptions | None) -> dict[str, Any]:
 
 
 def build_design(design: str | Path | Design, out_dir: str | Path, *, cad: bool | None = None,
-                 progress: bool = True, parallel: bool = False) -> dict[str, Any]:
+                 progress: bool = True, parallel: bool = False,
+                 announce: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
     """:func:`build_tablet` of a design (a :class:`~tabletcad.pipeline.design.Design` or a design file):
     its tablet, its ``[tooling]`` specification and its ``[report]`` options."""
     if not isinstance(design, Design):
         design = Design.from_toml(design)
     return build_tablet(design.build(), out_dir, tooling=design.tooling_spec, options=design.report_options,
-                        cad=cad, progress=progress, parallel=parallel)
+                        cad=cad, progress=progress, parallel=parallel, announce=announce)

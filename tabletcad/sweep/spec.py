@@ -235,6 +235,34 @@ def _check_fixed_dimensions(design: dict, varied: set[str]) -> None:
                                   "vary it, so every design would be refused)", "mm")
 
 
+def _check_varied_length(design: dict, key: str, spec: Any) -> None:
+    """Refuse a list entry or a range's end of a varied length of the family (``tablet.<param>`` in mm)
+    beyond the size limit (``Tolerances.max_length``), where every design reader refuses a length, named
+    as the file has it: a range's ``max = 1e300`` had failed its rows one by one, exit 0.  A value that
+    only the family refuses (a negative land) is left to the rows, as is every value within the limit.
+
+    Parameters
+    ----------
+    design : dict
+        The sweep's ``[design]`` table.
+    key : str
+        The varied dotted key.
+    spec : list or dict
+        Its ``[sweep.vary]`` entry: a list of values or a ``{ min, max, num }`` range (already checked to be
+        numbers where the key is a dimension).
+    """
+    from tabletcad.pipeline.design import _number as _design_number
+
+    fam = _family_of(design)
+    name = key.split(".", 1)[1] if key.startswith("tablet.") else None
+    if fam is None or fam.params.get(name) != "mm":
+        return
+    where = f"[sweep.vary] {key!r}"
+    given = [(where, v) for v in spec] if isinstance(spec, list) else [(f"{where} {k}", spec[k]) for k in ("min", "max")]
+    for at, v in given:  # (a range's inner values lie between its ends)
+        _design_number(at, v, "mm", least=False)
+
+
 def _family_range(fam, key: str, value: float) -> str:
     """The lower bound ``fam`` sets to a length ``key``, from its own refusal of the negative ``value`` (``must be
     > 0``: a diameter of 0 is refused too), its constructor called with that value and its defaults (it checks
@@ -414,6 +442,7 @@ def parse_sweep(data: dict[str, Any], name: str = "sweep") -> SweepSpec:
         axis = _axis(key, spec, method)
         for v in axis.values if key in dims else ():  # a dimension is a number in every design ("a" failed every row)
             _number(f"[sweep.vary] {key!r}", v)
+        _check_varied_length(design, key, spec)
         axes.append(axis)
     if method == "grid" and math.prod(len(a.values) for a in axes) > MAX_DESIGNS:
         raise DesignError("[sweep.vary]", " x ".join(str(len(a.values)) for a in axes),
