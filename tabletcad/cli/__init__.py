@@ -264,11 +264,17 @@ _MAIN_PID = [0]
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """A warning on the command line: one line, ``warning: <message>``, no source line; held until the
-    command has its outcome (:data:`_PENDING_WARNINGS`)."""
+    """A warning on the command line: one line, ``warning: <message>``, no source line (:func:`say_warning`)."""
+    say_warning(str(message))
+
+
+def say_warning(message: str) -> None:
+    """``warning: <message>`` on one line, held until the command has its outcome (:data:`_PENDING_WARNINGS`),
+    in the order the command's warnings arose, Python's and its own (``mesh`` had printed its volume's
+    warning before the design's, raised first)."""
     import os
 
-    text = "warning: " + " ".join(str(message).split())
+    text = "warning: " + " ".join(message.split())
     if os.getpid() == _MAIN_PID[0]:
         _PENDING_WARNINGS.append(text)
     else:

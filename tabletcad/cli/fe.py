@@ -354,8 +354,10 @@ def punch_cmd(design: Path, force: float, which: str, steel: str | None, yield_s
     for w in said:
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     if force > res.allowed_force_kN:  # e.g. a force in N given as kN
-        click.echo(f"warning: --force {force:g} kN is {force / res.allowed_force_kN:.3g} times the allowed force "
-                   f"({res.allowed_force_kN:.4g} kN): the tip would yield or buckle (--force is in kN)", err=True)
+        from tabletcad.cli import say_warning
+
+        say_warning(f"--force {force:g} kN is {force / res.allowed_force_kN:.3g} times the allowed force "
+                    f"({res.allowed_force_kN:.4g} kN): the tip would yield or buckle (--force is in kN)")
     payload = {"design": str(design), "steel": steel, **res.to_dict()}
     files: list[str] = []
     outputs = None

@@ -160,24 +160,26 @@ def mesh_cmd(design: Path, nodes: tuple[int, int, int], out_file: Path) -> None:
     rel = v_mesh / v_exact - 1.0
     _write_then_place(mesh, out_file, f"{out_file}: {len(mesh.points)} nodes, {counts}; mesh volume {v_mesh:.6g} mm3 "
                                       f"({rel * 100:+.3g} % of the exact {v_exact:.6g} mm3)")
+    from tabletcad.cli import say_warning
+
     bad = {k: n for k, n in degenerate_cells(mesh).items() if n}
     if bad:
         which = ", ".join(f"{n} {k}" for k, n in bad.items())
-        click.echo(f"warning: {sum(bad.values())} of {mesh.n_cells} cells ({which}) have a zero Jacobian at a corner: "
-                   "the cup folds onto its centre line or corners next to the spine, where the solid map of eq 4.12 "
-                   "collapses; their volumes are positive, but a solver that checks corner Jacobians refuses them "
-                   "(tabletcad fe meshes the B-rep with tetrahedra)", err=True)
+        say_warning(f"{sum(bad.values())} of {mesh.n_cells} cells ({which}) have a zero Jacobian at a corner: "
+                    "the cup folds onto its centre line or corners next to the spine, where the solid map of eq 4.12 "
+                    "collapses; their volumes are positive, but a solver that checks corner Jacobians refuses them "
+                    "(tabletcad fe meshes the B-rep with tetrahedra)")
     if mesh.nonconforming:
-        click.echo(f"warning: the mesh is not conforming across {', '.join(mesh.nonconforming)}: a flat patch has no "
-                   "volume, and the solids on either side of it meet there without sharing their nodes (separate "
-                   "blocks to a solver); tabletcad fe meshes the B-rep with conforming tetrahedra", err=True)
+        say_warning(f"the mesh is not conforming across {', '.join(mesh.nonconforming)}: a flat patch has no "
+                    "volume, and the solids on either side of it meet there without sharing their nodes (separate "
+                    "blocks to a solver); tabletcad fe meshes the B-rep with conforming tetrahedra")
     if abs(rel) > tablet.tol.mesh_volume:
         # the error falls as the square of the cell size in u and v (the solid map is linear in w):
         # scale those node spacings to land at half the bound
         s = math.sqrt(abs(rel) / (0.5 * tablet.tol.mesh_volume))
         hint = f"{math.ceil((nodes[0] - 1) * s) + 1} {math.ceil((nodes[1] - 1) * s) + 1} {nodes[2]}"
-        click.echo(f"warning: the mesh volume is {abs(rel) * 100:.3g} % {'below' if rel < 0 else 'above'} the exact "
-                   f"volume (more than {tablet.tol.mesh_volume * 100:g} %): use more nodes, e.g. --nodes {hint}", err=True)
+        say_warning(f"the mesh volume is {abs(rel) * 100:.3g} % {'below' if rel < 0 else 'above'} the exact "
+                    f"volume (more than {tablet.tol.mesh_volume * 100:g} %): use more nodes, e.g. --nodes {hint}")
 
 
 class _Unprinted(Exception):

@@ -55,8 +55,10 @@ def _emit(payload: dict[str, Any], as_json: bool, lines: list[str]) -> None:
     else:
         for ln in lines:
             click.echo(ln)
+    from tabletcad.cli import say_warning
+
     for m in payload.get("warnings", ()):
-        click.echo(f"warning: {m}", err=True)
+        say_warning(m)
 
 
 #: the metadata's keys (as a metadata file writes them) with their units, for the JSON documents
