@@ -71,7 +71,7 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
 
     def cut(edge_z: float, length: float):
         z0, z1, body = tip_prism(edge_z, length)
-        if on_outline:  # (tip_cell's split needs the prism's inner end inside the tablet; fuzzy: see _ON_OUTLINE_MM)
+        if on_outline:  # (tip_cell's split needs the prism's inner end inside the tablet; fuzzy: _ON_OUTLINE_MM)
             return body, boolean("cut", body, tablet_shape, what=f"{which} punch tip", sliver=1e-4, fuzzy=1e-5)
         return body, tip_cell(body, tablet_shape, z_mid, z0, z1, which, memo=(frame, inset))
 
@@ -150,7 +150,9 @@ def punch_tip(frame: TabletFrame, tablet_shape, which: str, clearance: float, ti
 #: tablet.  From the band's middle, an almond's tips at no clearance held the skin between their walls and a
 #: band bowing inward by a fraction of a micrometre: their edges were measured in the band's middle (2.1 mm,
 #: the band running from 0.6 to 3.6 mm), the tips cut 1.5 mm short, and OCC's Common of a tip with the die
-#: gave the whole tip, so the closed-position check refused the build.
+#: gave the whole tip, so the closed-position check refused the build.  The cut from the band's edge is
+#: fuzzy (1e-5 mm): exact, it left strips of the prism's end face 1e-7 mm wide (6e-7 mm^2) where the band
+#: bows inward, faces BRepMesh cannot mesh.
 _ON_OUTLINE_MM = 1e-3
 
 
@@ -395,10 +397,11 @@ def tip_cell(body, tablet_shape, z_mid: float, z0: float, z1: float, which: str,
 def _full_cut(body, tablet_shape, which: str):
     """``body - tablet_shape`` by OCC's Boolean, for a tip prism the split of :func:`tip_cell` failed on.
 
-    Where the prism's wall runs along an edge of the tablet's face (a shaped tablet's tip inset exactly by
-    its land: the land's inner edge lies on the wall) the splitter gave no cell and the Boolean left the
-    prism whole, nothing removed (a capsule's tip: 377.351 of 377.351 mm^3 kept; manifold3d removed 240 mm^3,
-    so the check refused the build).  A tip always removes the tablet's part inside the prism (from the
+    Where the prism's wall runs within a micrometre of an edge of the tablet's face (a shaped tablet's tip
+    at a clearance equal to its land: the tips follow the die bore, which stands the band's 1 µm bulge
+    outside the outline, so the wall cuts the land 1 µm outside its inner edge) the splitter gave no cell and
+    the Boolean left the prism whole, nothing removed (a capsule's tip: 377.351 of 377.351 mm^3 kept;
+    manifold3d removed 240 mm^3, so the check refused the build).  A tip always removes the tablet's part inside the prism (from the
     band's middle up): the cut is taken again with OCC's fuzzy tolerance 1e-5 mm, which joins the two
     edges (the parts then pass every check, the closed-position one too)."""
     what = f"{which} punch tip"
