@@ -294,11 +294,12 @@ def test_a_full_disk_after_a_warning_is_still_one_line(tmp_path, args):
 
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
 @pytest.mark.parametrize("args, made", [
-    (["build", "{root}/samples/flat_faced_round.toml", "--out", "b"], ["b"]),
+    pytest.param(["build", "{root}/samples/flat_faced_round.toml", "--out", "b"], ["b"], marks=pytest.mark.cad),
     (["mesh", "{root}/samples/spherical.toml", "--nodes", "5", "9", "3", "--out", "m.vtu"], ["m.vtu"]),
     (["report", "{root}/samples/families/concave_round.toml", "--csv", "c.csv", "--plot", "c.png", "--json-file",
       "c.json"], ["c.csv", "c.json", "c.png"]),
-    (["optimise", "{root}/samples/optimise/cylinder_min_area.toml", "--out", "o"], ["o"]),
+    pytest.param(["optimise", "{root}/samples/optimise/cylinder_min_area.toml", "--out", "o"], ["o"],
+                 marks=pytest.mark.cad),
     pytest.param(["fe", "diametral", "{root}/samples/families/concave_round.toml", "--force", "100",
                   "--no-error-estimate", "--out", "f", "--json-file", "f.json"], ["f", "f.json"],
                  marks=pytest.mark.fe),
