@@ -258,17 +258,27 @@ def test_shapes_marks_required_and_optional_and_prints_whole_descriptions(capsys
         assert sorted(entry["required"] + entry["optional"]) == sorted(entry["params"]) == sorted(entry["defaults"])
 
 
+#: the one line of a command whose standard output is refused (a full disk)
+FULL_DISK_LINE = "error: output = '(being written)' is not allowed: no space left on device"
+
+
+def _on_a_full_disk(args: list[str], **kw) -> subprocess.CompletedProcess:
+    """``tabletcad <args>`` in a subprocess with its standard output on /dev/full (every write: no space left on
+    device), its standard error captured."""
+    with open("/dev/full", "w") as full:
+        return subprocess.run([sys.executable, "-m", "tabletcad", *args], stdout=full, stderr=subprocess.PIPE,
+                              text=True, **kw)
+
+
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
 @pytest.mark.parametrize("args", [["shapes", "--json"], ["report", str(ROOT / "samples" / "families" / "concave_round.toml")]])
 def test_standard_output_on_a_full_disk_is_the_machines_state_not_a_bug(tmp_path, args):
     """``> /dev/full`` (every write: no space left on device) had been reported as an internal error with a
     traceback log, exit 1: it is one line naming the output, exit 2, and no log."""
     env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
-    with open("/dev/full", "w") as full:
-        proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], stdout=full, stderr=subprocess.PIPE,
-                              text=True, env=env, timeout=120)
+    proc = _on_a_full_disk(args, env=env, timeout=120)
     assert proc.returncode == 2, proc.stderr
-    assert proc.stderr.splitlines() == ["error: output = '(being written)' is not allowed: no space left on device"]
+    assert proc.stderr.splitlines() == [FULL_DISK_LINE]
     assert not (tmp_path / "cache").exists()
 
 
@@ -282,11 +292,9 @@ def test_a_full_disk_after_a_warning_is_still_one_line(tmp_path, args):
     old.write_text('[tablet]\nfamily = "flat_faced_round"\ndiameter = 10.0\nthickness = 3.0\n', encoding="utf-8")
     args = [str(old) if a == "OLD" else a for a in args]
     env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
-    with open("/dev/full", "w") as full:
-        proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], stdout=full, stderr=subprocess.PIPE,
-                              text=True, env=env, timeout=120)
+    proc = _on_a_full_disk(args, env=env, timeout=120)
     assert proc.returncode == 2, proc.stderr
-    assert proc.stderr.splitlines() == ["error: output = '(being written)' is not allowed: no space left on device"]
+    assert proc.stderr.splitlines() == [FULL_DISK_LINE]
     proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], capture_output=True, text=True, env=env,
                           timeout=120)
     assert proc.returncode == 0 and proc.stdout and proc.stderr.startswith("warning: "), proc.stderr
@@ -317,11 +325,9 @@ def test_a_refused_standard_output_leaves_no_output(tmp_path, args, made):
     env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
     work = tmp_path / "work"
     work.mkdir()
-    with open("/dev/full", "w") as full:
-        proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], stdout=full, stderr=subprocess.PIPE,
-                              text=True, env={**env, "PYTHONPATH": str(ROOT)}, cwd=work, timeout=300)
+    proc = _on_a_full_disk(args, env={**env, "PYTHONPATH": str(ROOT)}, cwd=work, timeout=300)
     assert proc.returncode == 2, proc.stderr
-    assert proc.stderr.splitlines()[-1:] == ["error: output = '(being written)' is not allowed: no space left on device"]
+    assert proc.stderr.splitlines()[-1:] == [FULL_DISK_LINE]
     assert not any(line.startswith(("error", "warning")) for line in proc.stderr.splitlines()[:-1]), proc.stderr
     assert sorted(p.name for p in work.iterdir()) == []
     proc = subprocess.run([sys.executable, "-m", "tabletcad", *args], capture_output=True, text=True,
