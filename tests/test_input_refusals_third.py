@@ -155,7 +155,7 @@ def test_heckel_window_of_a_negative_pressure_is_refused(tmp_path, capsys):
     p.write_text("force_N,thickness_mm\n100,5\n", encoding="utf-8")
     rc, err = _run(capsys, tmp_path, "heckel", p, "--window", "-5", "10", "--mass", "300", "--true-density", "1.5",
                    "--diameter", "10")
-    assert rc == 2 and err == ["error: --window = -5 MPa is not allowed: must be >= 0 MPa"]
+    assert rc == 2 and err == ["error: --window = -5 MPa is not allowed: must be >= 0 and <= 100000 MPa"]
 
 
 @pytest.mark.parametrize("args, line", [

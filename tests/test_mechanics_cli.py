@@ -61,6 +61,7 @@ def test_heckel_options_replace_metadata_file(capsys, tmp_path):
         (["--window", "10", "10.5"], "need >= 3"),
         (["--window", "50", "10"], "--window = (50.0, 10.0) is not allowed: must be two increasing pressures"),
         (["--window", "-1", "10"], "--window = -1 MPa is not allowed: must be >= 0"),
+        (["--window", "10", "1e300"], "--window = 1e+300 MPa is not allowed: must be > 0 and <= 100000 MPa"),
         # a new user's trial: each of these had been exit 0 (K = -2.6e-303; Py = inf; D 0.0008, Py 3.6e5 MPa)
         (["--compliance", "1e300", "0"], "--compliance = 1e+300 mm/N is not allowed: must be >= 0 and <= 0.001 mm/N"),
         (["--compliance", "0", "1e300"], "--compliance = 1e+300 mm is not allowed: must be >= -1000 and <= 1000 mm"),

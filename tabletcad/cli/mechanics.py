@@ -180,9 +180,11 @@ def _read_table(path: Path, columns: dict[str, tuple[str, str]]) -> dict[str, np
 
 
 def _check_window(window: tuple[float, float] | None) -> None:
+    """Refuse a ``--window`` that is not two increasing compaction pressures up to ``MAX_PRESSURE_MPA`` (a
+    window to 1e300 MPa had been taken, as love, which simulates its window, refused it)."""
     if window is not None:
-        check_range("--window", window[0], 0.0, None, "MPa")  # pressures: a compact is never pulled
-        check_positive("--window", window[1], "MPa")
+        check_range("--window", window[0], 0.0, MAX_PRESSURE_MPA, "MPa")  # pressures: a compact is never pulled
+        check_range("--window", window[1], 0.0, MAX_PRESSURE_MPA, "MPa", lo_open=True)
         if not window[0] < window[1]:
             raise DesignError("--window", window, "must be two increasing pressures", "MPa")
 
