@@ -1170,12 +1170,12 @@ def _occ_overlap(a: str, b: str, shapes: dict, entry: dict) -> tuple[float, str]
     # B-spline faces (4.3e-5 mm from the PDE surface) 7.5e-6 mm through a bore 1e-6 mm out at its ends,
     # four slivers of 1.2e-5 mm^3 the build had been refused for
     solids = explore(common, "Solid")
-    thick = [s for s in solids if _thickness(s) > FIT_MM]
-    if len(thick) == len(solids):
+    thin = [_thickness(s) <= FIT_MM for s in solids]
+    if not any(thin):
         return volume(common), how
-    entry["occ_thinner_than_the_fit_mm3"] = sum(volume(s) for s in solids if not any(s is t for t in thick))
-    how += f"; {len(solids) - len(thick)} solids thinner than the B-rep's fit ({FIT_MM:g} mm) left out"
-    return float(sum(volume(s) for s in thick)), how
+    entry["occ_thinner_than_the_fit_mm3"] = sum(volume(s) for s, t in zip(solids, thin) if t)
+    how += f"; {sum(thin)} solids thinner than the B-rep's fit ({FIT_MM:g} mm) left out"
+    return float(sum(volume(s) for s, t in zip(solids, thin) if not t)), how
 
 
 #: how thin (mm) a piece of a tablet's Common with its die may be and be taken as the B-rep's, not the design's:
