@@ -347,7 +347,7 @@ class Band:
         10 mm shallow convex round: 1.4 µm), which a die bore has to clear.
     inward : float
         Largest inward plan distance (mm) of the patch from its end curve, rounding aside as for
-        ``bulge`` (an almond's band: 9e-8 mm): how much farther than its edges the band may stand from a
+        ``bulge`` (a 15 mm almond's band: 7e-8 mm): how much farther than its edges the band may stand from a
         die bore.
     """
 
